@@ -1,0 +1,13 @@
+//! tensegrity-testbed: checks published closed-form models of tensegrity mechanisms against
+//! rigid-body dynamics.
+//!
+//! Data flows one way: [`scenario`] file -> [`mechanisms`] model -> [`structure`] ->
+//! [`sim`]ulation -> [`observers`] -> [`report`].
+
+pub mod mechanisms;
+pub mod observers;
+pub mod report;
+pub mod run;
+pub mod scenario;
+pub mod sim;
+pub mod structure;

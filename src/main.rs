@@ -1,0 +1,285 @@
+//! The `tensegrity` command line.
+
+use clap::{Parser, Subcommand};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use tensegrity_testbed::mechanisms::{self, Origin, Values};
+use tensegrity_testbed::report::{Report, EXIT_BAD_INPUT, EXIT_FAIL, EXIT_PASS};
+use tensegrity_testbed::run::{run, RunOptions};
+use tensegrity_testbed::scenario::{self, Scenario};
+
+#[derive(Parser)]
+#[command(name = "tensegrity", version, about = "Check published tensegrity mechanism models against rigid-body dynamics")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run scenario files headless and compare the simulation with the analytic model.
+    Run {
+        #[arg(required = true)]
+        scenarios: Vec<PathBuf>,
+        /// Write the JSON report {"scenarios": [...]} to this file.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Record to this .rrd file (with several scenarios: one file each, named FILE-<scenario>.rrd).
+        #[arg(long)]
+        record: Option<PathBuf>,
+    },
+    /// Validate scenario files without running them.
+    Check {
+        #[arg(required = true)]
+        scenarios: Vec<PathBuf>,
+    },
+    /// List the mechanisms, their parameters (units, defaults) and their queries.
+    List,
+    /// The analytic model alone: print every result of a query.
+    Solve {
+        mechanism: String,
+        query: String,
+        /// NAME=VALUE for a parameter or an input (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Check every printed equation of a mechanism's paper against the testbed's derivation.
+    Findings {
+        mechanism: String,
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let code = match cli.command {
+        Command::Run { scenarios, json, record } => cmd_run(&scenarios, json.as_deref(), record.as_deref()),
+        Command::Check { scenarios } => match load_all(&scenarios) {
+            Ok(list) => {
+                for s in &list {
+                    println!("{}: ok ({} on {})", s.file.display(), s.name, s.mechanism);
+                }
+                EXIT_PASS
+            }
+            Err(code) => code,
+        },
+        Command::List => cmd_list(),
+        Command::Solve { mechanism, query, set, json } => cmd_solve(&mechanism, &query, &set, json),
+        Command::Findings { mechanism, set, json } => cmd_findings(&mechanism, &set, json),
+    };
+    ExitCode::from(code as u8)
+}
+
+/// Loads and validates every scenario; prints each error; exit code 2 if any is bad.
+fn load_all(paths: &[PathBuf]) -> Result<Vec<Scenario>, i32> {
+    let mut out = Vec::new();
+    let mut bad = false;
+    for p in paths {
+        match scenario::load(p) {
+            Ok(s) => out.push(s),
+            Err(e) => {
+                eprintln!("error: {e}");
+                bad = true;
+            }
+        }
+    }
+    if bad {
+        Err(EXIT_BAD_INPUT)
+    } else {
+        Ok(out)
+    }
+}
+
+/// Writes `text` to `path` through a temporary file and a rename: never half-written.
+fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
+    if let Some(dir) = path.parent() {
+        if !dir.as_os_str().is_empty() {
+            std::fs::create_dir_all(dir)?;
+        }
+    }
+    let tmp = path.with_extension("partial");
+    {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(text.as_bytes())?;
+        f.sync_all()?;
+    }
+    std::fs::rename(&tmp, path)
+}
+
+fn record_path(base: &Path, name: &str, several: bool) -> PathBuf {
+    if !several {
+        return base.to_path_buf();
+    }
+    let stem = base.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "run".into());
+    let safe: String = name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+    base.with_file_name(format!("{stem}-{safe}.rrd"))
+}
+
+fn cmd_run(paths: &[PathBuf], json: Option<&Path>, record: Option<&Path>) -> i32 {
+    let scenarios = match load_all(paths) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    if let Some(r) = record {
+        if r.extension().and_then(|e| e.to_str()) != Some("rrd") {
+            eprintln!("error: --record {} must end in .rrd", r.display());
+            return EXIT_BAD_INPUT;
+        }
+    }
+    let several = scenarios.len() > 1;
+    let mut report = Report { scenarios: vec![] };
+    for sc in &scenarios {
+        let opts = RunOptions { record: record.map(|r| record_path(r, &sc.name, several)), cancel: None };
+        let r = run(sc, &opts);
+        report.scenarios.push(r);
+    }
+    print!("{}", report.to_table());
+    if let Some(j) = json {
+        if let Err(e) = write_atomic(j, &report.to_json()) {
+            eprintln!("error: cannot write the JSON report {}: {e}", j.display());
+            return EXIT_FAIL;
+        }
+    }
+    if report.passed() {
+        EXIT_PASS
+    } else {
+        EXIT_FAIL
+    }
+}
+
+fn cmd_list() -> i32 {
+    for m in mechanisms::registry() {
+        println!("{}: {}", m.name(), m.title());
+        println!("  parameters:");
+        for p in m.params() {
+            let origin = match p.origin {
+                Origin::Paper => "paper",
+                Origin::ModelChoice => "model choice",
+            };
+            println!("    {:<12} [{}] default {} ({}): {}", p.symbol, p.unit, p.default, origin, p.description);
+        }
+        println!("  inputs:");
+        for i in m.inputs() {
+            println!("    {:<12} [{}] {}", i.symbol, i.unit, i.description);
+        }
+        println!("  checkable quantities:");
+        for q in m.quantities() {
+            println!("    {:<12} [{}] {}", q.symbol, q.unit, q.description);
+        }
+        println!("  queries (tensegrity solve {} QUERY --set NAME=VALUE ...):", m.name());
+        for q in m.queries() {
+            println!("    {:<12} inputs {}: {}", q.name, q.inputs.join(" "), q.description);
+        }
+    }
+    EXIT_PASS
+}
+
+/// Splits --set NAME=VALUE arguments into parameters and inputs of the mechanism.
+fn parse_sets(m: &dyn mechanisms::Mechanism, sets: &[String], allowed_inputs: &[&str]) -> Result<(Values, Values), String> {
+    let mut params = Values::new();
+    let mut inputs = Values::new();
+    for s in sets {
+        let (k, v) = s.split_once('=').ok_or_else(|| format!("--set {s}: expected NAME=VALUE"))?;
+        let x: f64 = v.trim().parse().map_err(|_| format!("--set {s}: '{v}' is not a number"))?;
+        if !x.is_finite() {
+            return Err(format!("--set {s}: the value must be finite"));
+        }
+        if m.params().iter().any(|p| p.symbol == k) {
+            params.insert(k.into(), x);
+        } else if allowed_inputs.contains(&k) {
+            inputs.insert(k.into(), x);
+        } else {
+            let known: Vec<&str> = m.params().iter().map(|p| p.symbol).chain(allowed_inputs.iter().copied()).collect();
+            return Err(format!("--set {s}: unknown name '{k}' (expected one of: {})", known.join(", ")));
+        }
+    }
+    let params = mechanisms::with_defaults(m, &params);
+    m.validate_params(&params).map_err(|(_, msg)| msg)?;
+    Ok((params, inputs))
+}
+
+fn cmd_solve(mechanism: &str, query: &str, sets: &[String], json: bool) -> i32 {
+    let Some(m) = mechanisms::find(mechanism) else {
+        let known: Vec<_> = mechanisms::registry().iter().map(|m| m.name()).collect();
+        eprintln!("error: unknown mechanism '{mechanism}' (expected one of: {})", known.join(", "));
+        return EXIT_BAD_INPUT;
+    };
+    let Some(q) = m.queries().iter().find(|q| q.name == query) else {
+        let known: Vec<_> = m.queries().iter().map(|q| q.name).collect();
+        eprintln!("error: unknown query '{query}' for {mechanism} (expected one of: {})", known.join(", "));
+        return EXIT_BAD_INPUT;
+    };
+    let (params, inputs) = match parse_sets(m.as_ref(), sets, q.inputs) {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    for i in q.inputs {
+        if !inputs.contains_key(*i) {
+            eprintln!("error: query '{query}' needs --set {i}=VALUE (inputs: {})", q.inputs.join(" "));
+            return EXIT_BAD_INPUT;
+        }
+    }
+    match m.solve(query, &params, &inputs) {
+        Ok(sols) => {
+            if json {
+                let v = serde_json::json!({
+                    "mechanism": mechanism, "query": query, "params": params, "inputs": inputs,
+                    "solutions": sols.iter().map(|s| serde_json::json!({"label": s.label, "values": s.values, "stable": s.stable})).collect::<Vec<_>>(),
+                });
+                println!("{}", serde_json::to_string_pretty(&v).unwrap());
+            } else {
+                println!("{mechanism} {query}: {} result(s)", sols.len());
+                for s in &sols {
+                    let st = match s.stable {
+                        Some(true) => ", stable",
+                        Some(false) => ", unstable",
+                        None => "",
+                    };
+                    println!("  {}{st}:", s.label);
+                    for (k, v) in &s.values {
+                        println!("    {k:<12} = {v:.12}");
+                    }
+                }
+            }
+            EXIT_PASS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_BAD_INPUT
+        }
+    }
+}
+
+fn cmd_findings(mechanism: &str, sets: &[String], json: bool) -> i32 {
+    let Some(m) = mechanisms::find(mechanism) else {
+        eprintln!("error: unknown mechanism '{mechanism}'");
+        return EXIT_BAD_INPUT;
+    };
+    let (params, _) = match parse_sets(m.as_ref(), sets, &[]) {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let f = m.findings(&params);
+    if json {
+        let v: Vec<_> = f.iter().map(|f| serde_json::json!({"equation": f.equation, "claim": f.claim, "measured": f.measured, "holds": f.holds})).collect();
+        println!("{}", serde_json::to_string_pretty(&v).unwrap());
+    } else {
+        for f in &f {
+            println!("[{}] {}: {}\n      measured: {}", if f.holds { "holds" } else { "WRONG" }, f.equation, f.claim, f.measured);
+        }
+    }
+    EXIT_PASS
+}

@@ -1,0 +1,1636 @@
+//! Closed-form model of the planar tensegrity parallel mechanism of
+//! Ji, Li & Lin (2014), "Kinematics and stiffness of a planar tensegrity
+//! parallel mechanism", Periodica Polytechnica Mech. Eng. 58(2) 101-111.
+//!
+//! Everything here is a pure function of `f64` / `nalgebra` values.
+//! Units: lengths in metres [m], angles in radians [rad], spring rates in
+//! newtons per metre [N/m], energies in joules [J], torques in newton-metres
+//! [N*m] and the rotational stiffness `K = d2U/dtheta2^2` in [N*m/rad].
+//!
+//! # Model (paper Eq. 1-4)
+//! Base nodes `C1=(0,0)`, `C2=(-L,-sqrt3 L)`, `C3=(L,-sqrt3 L)`; actuator
+//! node `D1 = L3 (cos th1, sin th1)`; mobile equilateral triangle of side `L`
+//! with `D3 = D1 + L (cos th2, sin th2)` and `D2 = D1 + L (cos(th2+pi/3),
+//! sin(th2+pi/3))`. Zero-free-length springs `K1: D2-C2`, `K2: D3-C3`:
+//! `U = K1/2 |D2-C2|^2 + K2/2 |D3-C3|^2`. With the actuators locked the only
+//! freedom is `th2` (the triangle pivots about `D1`).
+//!
+//! # Key derived results (see `findings()` for the numeric checks)
+//! * `U = U0 + A cos th2 + B sin th2` exactly (Eq. 4 is correct), with
+//!   `A = L eta2 / 2`, `B = L eta1 / 2` (Eq. 6-7).
+//! * Equilibria: `(cos th2, sin th2) = -/+ (eta2, eta1)/|eta|`; the minus sign
+//!   is the energy minimum (stiffness `+L|eta|/2`), the plus sign the maximum.
+//!   The paper's `th2 in [0, pi]` root is the minimum only when `eta1 < 0`.
+//! * Stable stiffness `K = L sqrt(K1^2+K1K2+K2^2) |D1 - D1*|`, `D1*` being the
+//!   neutral point where `eta = 0` ([`neutral_point`]).
+//! * `det J = L3 (1 + s L (K1+2K2)/|eta|)`, `s = -1` on the stable branch,
+//!   `+1` on the unstable one: finite whenever `eta != 0`.
+//! * Inverse kinematics in closed form from Eq. 48: `delta1 cos th2 - delta2
+//!   sin th2 + sqrt3 K1 L = 0` is one trigonometric equation in `th2` only.
+
+use nalgebra::{Matrix2, Vector2};
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_3, PI};
+
+/// `sqrt(3)`, appears throughout the equilateral-triangle geometry.
+pub const SQRT_3: f64 = 1.732_050_807_568_877_2;
+/// Full turn [rad].
+const TWO_PI: f64 = 2.0 * PI;
+/// Eq. 31: the paper limits the actuator to `0 <= L3 <= 2L`.
+pub const PAPER_L3_MAX_OVER_L: f64 = 2.0;
+/// Figs. 4-6 example: actuator length `L3 = 6 m`.
+pub const PAPER_FIG4_L3: f64 = 6.0;
+/// Figs. 4-6 example: `theta1 = pi/10` (the captions print "theta2 = pi/10", a typo).
+pub const PAPER_FIG4_THETA1: f64 = PI / 10.0;
+/// Inverse kinematics: every returned solution reproduces `(x, y)` through
+/// [`equilibria`] to within this tolerance times `max(L, |(x,y)|)`.
+pub const IK_VERIFY_REL_TOL: f64 = 1e-10;
+/// Inverse kinematics: `L3` below this fraction of `L` is treated as `L3 = 0`
+/// (then `theta1` is irrelevant and `0` is returned as representative).
+const IK_L3_ZERO_REL: f64 = 1e-12;
+/// Inverse kinematics: `D1` may lie this far (relative to `L3`) below the X
+/// axis (rounding) and still be accepted with `theta1` clamped to `0` or `pi`.
+const IK_THETA1_CLAMP_REL: f64 = 1e-12;
+/// Newton polishing steps applied to each closed-form IK root of Eq. 48.
+const IK_NEWTON_STEPS: usize = 3;
+/// Two IK roots closer than this (in `theta2` [rad]) are merged.
+const IK_DUPLICATE_TOL: f64 = 1e-12;
+
+/// Mechanism parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Params {
+    /// Side of the mobile triangle `L` [m] (base triangle side is `2L`).
+    pub l: f64,
+    /// Spring rate `K1` of spring `D2-C2` [N/m].
+    pub k1: f64,
+    /// Spring rate `K2` of spring `D3-C3` [N/m].
+    pub k2: f64,
+}
+
+impl Params {
+    /// Figs. 2, 3, 7, 8: `L = 1 m, K1 = 200 N/m, K2 = 100 N/m`.
+    pub const PAPER_WORKSPACE: Params = Params { l: 1.0, k1: 200.0, k2: 100.0 };
+    /// Figs. 4-6: `L = 1 m, K1 = 100 N/m, K2 = 10 N/m` (with `L3 = 6 m`, `theta1 = pi/10`).
+    pub const PAPER_FIG4: Params = Params { l: 1.0, k1: 100.0, k2: 10.0 };
+
+    /// `L > 0`, `K1 > 0`, `K2 > 0`, all finite.
+    pub fn validate(&self) -> Result<(), String> {
+        for (name, v) in [("L", self.l), ("K1", self.k1), ("K2", self.k2)] {
+            if !v.is_finite() {
+                return Err(format!("{name} must be finite, got {v}"));
+            }
+            if v <= 0.0 {
+                return Err(format!("{name} must be > 0, got {v}"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Node positions [m] (Eq. 1-3).
+#[derive(Clone, Copy, Debug)]
+pub struct Nodes {
+    pub c1: Vector2<f64>,
+    pub c2: Vector2<f64>,
+    pub c3: Vector2<f64>,
+    pub d1: Vector2<f64>,
+    pub d2: Vector2<f64>,
+    pub d3: Vector2<f64>,
+}
+
+/// Eq. 1-3: node coordinates for inputs `l3` [m], `theta1` [rad] and the free
+/// coordinate `theta2` [rad].
+pub fn nodes(p: &Params, l3: f64, theta1: f64, theta2: f64) -> Nodes {
+    let l = p.l;
+    let c1 = Vector2::zeros();
+    let c2 = Vector2::new(-l, -SQRT_3 * l);
+    let c3 = Vector2::new(l, -SQRT_3 * l);
+    let d1 = l3 * Vector2::new(theta1.cos(), theta1.sin());
+    let d2 = d1 + l * Vector2::new((theta2 + FRAC_PI_3).cos(), (theta2 + FRAC_PI_3).sin());
+    let d3 = d1 + l * Vector2::new(theta2.cos(), theta2.sin());
+    Nodes { c1, c2, c3, d1, d2, d3 }
+}
+
+/// Spring lengths `(|D2-C2|, |D3-C3|)` [m].
+pub fn spring_lengths(p: &Params, l3: f64, theta1: f64, theta2: f64) -> (f64, f64) {
+    let n = nodes(p, l3, theta1, theta2);
+    ((n.d2 - n.c2).norm(), (n.d3 - n.c3).norm())
+}
+
+/// Ground-truth potential energy [J]: `K1/2 |D2-C2|^2 + K2/2 |D3-C3|^2`
+/// (zero free lengths).
+pub fn potential_energy(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
+    let n = nodes(p, l3, theta1, theta2);
+    0.5 * p.k1 * (n.d2 - n.c2).norm_squared() + 0.5 * p.k2 * (n.d3 - n.c3).norm_squared()
+}
+
+/// Coefficients of Eq. 4 written as `U = u0 + a cos th2 + b sin th2`
+/// (`u0` [J], `a` [J], `b` [J]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnergyCoefficients {
+    pub u0: f64,
+    pub a: f64,
+    pub b: f64,
+}
+
+/// Eq. 4 coefficients exactly as printed:
+/// `u0 = (K1+K2)/2 (5L^2 + L3^2 + 2 sqrt3 L L3 sin th1) + (K1-K2) L L3 cos th1`,
+/// `a = (2K1-K2)L^2 + (K1/2+K2) L L3 cos th1 + sqrt3/2 K1 L L3 sin th1`,
+/// `b = (K1/2+K2) L L3 sin th1 - sqrt3/2 K1 L L3 cos th1 + sqrt3 K2 L^2`.
+pub fn energy_coefficients_eq4(p: &Params, l3: f64, theta1: f64) -> EnergyCoefficients {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let (s1, c1) = theta1.sin_cos();
+    let u0 = 0.5 * (k1 + k2) * (5.0 * l * l + l3 * l3 + 2.0 * SQRT_3 * l * l3 * s1)
+        + (k1 - k2) * l * l3 * c1;
+    let a = (2.0 * k1 - k2) * l * l + (0.5 * k1 + k2) * l * l3 * c1 + 0.5 * SQRT_3 * k1 * l * l3 * s1;
+    let b = (0.5 * k1 + k2) * l * l3 * s1 - 0.5 * SQRT_3 * k1 * l * l3 * c1 + SQRT_3 * k2 * l * l;
+    EnergyCoefficients { u0, a, b }
+}
+
+/// Eq. 4 exactly as printed [J].
+pub fn potential_energy_eq4(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
+    let e = energy_coefficients_eq4(p, l3, theta1);
+    let (s2, c2) = theta2.sin_cos();
+    e.u0 + e.a * c2 + e.b * s2
+}
+
+/// Eq. 6-7: `(eta1, eta2)` [N], with
+/// `eta1 = (K1+2K2) L3 sin th1 - sqrt3 K1 L3 cos th1 + 2 sqrt3 K2 L` and
+/// `eta2 = 2(2K1-K2) L + (K1+2K2) L3 cos th1 + sqrt3 K1 L3 sin th1`.
+/// Note `eta1 = 2B/L`, `eta2 = 2A/L` with `A, B` the Eq. 4 coefficients.
+pub fn eta(p: &Params, l3: f64, theta1: f64) -> (f64, f64) {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let (s1, c1) = theta1.sin_cos();
+    let eta1 = (k1 + 2.0 * k2) * l3 * s1 - SQRT_3 * k1 * l3 * c1 + 2.0 * k2 * SQRT_3 * l;
+    let eta2 = 2.0 * (2.0 * k1 - k2) * l + (k1 + 2.0 * k2) * l3 * c1 + SQRT_3 * k1 * l3 * s1;
+    (eta1, eta2)
+}
+
+/// `N = eta1^2 + eta2^2` [N^2]; equals `4[4L^2(K1^2-K1K2+K2^2) + L3^2(K1^2+K1K2+K2^2)
+/// + 2 L3 L cos th1 (K1^2-K2^2) + 2 sqrt3 L3 L sin th1 (K1^2+K2^2)]` (the bracket of Eq. 24).
+pub fn eta_norm_sq(p: &Params, l3: f64, theta1: f64) -> f64 {
+    let (e1, e2) = eta(p, l3, theta1);
+    e1 * e1 + e2 * e2
+}
+
+/// Rotate a plane vector by +90 degrees (derivative of a rotation).
+fn perp(v: Vector2<f64>) -> Vector2<f64> {
+    Vector2::new(-v.y, v.x)
+}
+
+/// `tau = dU/dtheta2` [N*m], derived directly from the spring vectors:
+/// `tau = K1 (D2-C2).perp(D2-D1) + K2 (D3-C3).perp(D3-D1)`.
+/// Equals Eq. 41 (`-A sin th2 + B cos th2`), which is correct as printed.
+pub fn torque(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
+    let n = nodes(p, l3, theta1, theta2);
+    p.k1 * (n.d2 - n.c2).dot(&perp(n.d2 - n.d1)) + p.k2 * (n.d3 - n.c3).dot(&perp(n.d3 - n.d1))
+}
+
+/// Eq. 41 as printed: `tau = -A sin th2 + B cos th2` [N*m].
+pub fn torque_eq41(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
+    let e = energy_coefficients_eq4(p, l3, theta1);
+    let (s2, c2) = theta2.sin_cos();
+    -e.a * s2 + e.b * c2
+}
+
+/// `K = d2U/dtheta2^2` [N*m/rad], derived from the spring vectors:
+/// `K = K1 (L^2 - (D2-C2).(D2-D1)) + K2 (L^2 - (D3-C3).(D3-D1))`.
+/// Equals Eq. 42 (`-A cos th2 - B sin th2`), which is correct as printed.
+pub fn stiffness(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
+    let n = nodes(p, l3, theta1, theta2);
+    let l2 = p.l * p.l;
+    p.k1 * (l2 - (n.d2 - n.c2).dot(&(n.d2 - n.d1))) + p.k2 * (l2 - (n.d3 - n.c3).dot(&(n.d3 - n.d1)))
+}
+
+/// Eq. 42 as printed: `K = -A cos th2 - B sin th2` [N*m/rad].
+pub fn stiffness_eq42(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
+    let e = energy_coefficients_eq4(p, l3, theta1);
+    let (s2, c2) = theta2.sin_cos();
+    -e.a * c2 - e.b * s2
+}
+
+/// Wrap an angle to `(-pi, pi]`.
+pub fn wrap_angle(a: f64) -> f64 {
+    let t = a.rem_euclid(TWO_PI);
+    if t > PI {
+        t - TWO_PI
+    } else {
+        t
+    }
+}
+
+/// An equilibrium (`tau = 0`) for fixed inputs.
+#[derive(Clone, Copy, Debug)]
+pub struct Equilibrium {
+    /// [rad], wrapped to `(-pi, pi]` (by [`fk_paper`]: in `[0, pi]`).
+    pub theta2: f64,
+    /// `D3.x` [m] (Eq. 2).
+    pub x: f64,
+    /// `D3.y` [m] (Eq. 3).
+    pub y: f64,
+    /// Potential energy [J].
+    pub energy: f64,
+    /// `K = d2U/dtheta2^2` [N*m/rad].
+    pub stiffness: f64,
+    /// `K > 0` (energy minimum).
+    pub stable: bool,
+}
+
+fn equilibrium_at(p: &Params, l3: f64, theta1: f64, theta2: f64) -> Equilibrium {
+    let n = nodes(p, l3, theta1, theta2);
+    let k = stiffness(p, l3, theta1, theta2);
+    Equilibrium {
+        theta2,
+        x: n.d3.x,
+        y: n.d3.y,
+        energy: potential_energy(p, l3, theta1, theta2),
+        stiffness: k,
+        stable: k > 0.0,
+    }
+}
+
+/// Both roots of `dU/dtheta2 = 0` (they differ by pi), energy minimum first.
+/// `theta2` wrapped to `(-pi, pi]`. Minimum: `(cos, sin) th2 = -(eta2, eta1)/|eta|`;
+/// maximum: `+(eta2, eta1)/|eta|`. In the degenerate case `eta = 0` (the
+/// neutral point, `U` independent of `theta2`) `theta2 = 0` and `pi` are
+/// returned, both with `K = 0`, `stable = false`.
+pub fn equilibria(p: &Params, l3: f64, theta1: f64) -> [Equilibrium; 2] {
+    let (e1, e2) = eta(p, l3, theta1);
+    let (th_min, th_max) = if e1 == 0.0 && e2 == 0.0 {
+        (0.0, PI)
+    } else {
+        (wrap_angle((-e1).atan2(-e2)), wrap_angle(e1.atan2(e2)))
+    };
+    [equilibrium_at(p, l3, theta1, th_min), equilibrium_at(p, l3, theta1, th_max)]
+}
+
+/// The paper's FK: Eq. 5 `tan th2 = eta1/eta2` with `theta2` restricted to
+/// `[0, pi]` (one root). This is the energy minimum only when `eta1 < 0`
+/// (for `eta1 > 0` it is the maximum); for `eta1 = 0` it returns `0` if
+/// `eta2 >= 0` else `pi`.
+pub fn fk_paper(p: &Params, l3: f64, theta1: f64) -> Equilibrium {
+    let (e1, e2) = eta(p, l3, theta1);
+    let (s, c) = if e1 < 0.0 { (-e1, -e2) } else { (e1, e2) };
+    let th2 = if s == 0.0 && c == 0.0 { 0.0 } else { s.atan2(c) };
+    equilibrium_at(p, l3, theta1, th2)
+}
+
+/// One inverse-kinematics solution.
+#[derive(Clone, Copy, Debug)]
+pub struct IkSolution {
+    /// [m], `>= 0`.
+    pub l3: f64,
+    /// [rad], in `[0, pi]`.
+    pub theta1: f64,
+    /// [rad], `(-pi, pi]`, of the equilibrium whose `D3` is the target.
+    pub theta2: f64,
+    pub stable: bool,
+    /// [N*m/rad].
+    pub stiffness: f64,
+}
+
+/// Eq. 50-51: `(delta1, delta2)` [N] of the target `(x, y)` [m]:
+/// `delta1 = (K1+2K2) y - sqrt3 K1 x + 2 sqrt3 K2 L`,
+/// `delta2 = 2(2K1-K2) L + (K1+2K2) x + sqrt3 K1 y`.
+pub fn delta(p: &Params, x: f64, y: f64) -> (f64, f64) {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let d1 = (k1 + 2.0 * k2) * y - SQRT_3 * k1 * x + 2.0 * SQRT_3 * k2 * l;
+    let d2 = 2.0 * (2.0 * k1 - k2) * l + (k1 + 2.0 * k2) * x + SQRT_3 * k1 * y;
+    (d1, d2)
+}
+
+/// Eq. 48 / 40 residual [N]: `delta1 cos th2 - delta2 sin th2 + sqrt3 K1 L`
+/// (zero iff `theta2` is an equilibrium of the inputs with `D3 = (x, y)`;
+/// it equals `eta1 cos th2 - eta2 sin th2 = 2 tau / L`).
+pub fn equilibrium_residual_eq48(p: &Params, x: f64, y: f64, theta2: f64) -> f64 {
+    let (d1, d2) = delta(p, x, y);
+    let (s, c) = theta2.sin_cos();
+    d1 * c - d2 * s + SQRT_3 * p.k1 * p.l
+}
+
+/// Inverse kinematics. Every `(L3, theta1)` with `0 <= theta1 <= pi`,
+/// `L3 >= 0`, for which `(x, y)` [m] is `D3` of an equilibrium (stable or
+/// not) of that input. Each solution is verified by [`equilibria`] to
+/// `IK_VERIFY_REL_TOL * max(L, |(x,y)|)`.
+///
+/// Derivation (replaces Eq. 9-16 / Appendix A): substituting Eq. 2-3 into
+/// Eq. 5 gives Eq. 48, `delta1 cos th2 - delta2 sin th2 = -sqrt3 K1 L`, which
+/// involves `theta2` only. With `delta1 = R cos(phi)`, `delta2 = R sin(phi)`
+/// it reads `R cos(th2 + phi) = -sqrt3 K1 L`, so
+/// `th2 = -phi +/- acos(-sqrt3 K1 L / R)` (no solution if `R < sqrt3 K1 L`).
+/// Then `D1 = D3 - L(cos th2, sin th2)`, `L3 = |D1|`, `theta1 = atan2(D1)`;
+/// roots with `D1` below the X axis are discarded (they need `L3 < 0`).
+/// At most two solutions. Each root is polished by Newton on Eq. 48.
+pub fn inverse_kinematics(p: &Params, x: f64, y: f64) -> Vec<IkSolution> {
+    let (d1, d2) = delta(p, x, y);
+    let c = SQRT_3 * p.k1 * p.l;
+    let r = d1.hypot(d2);
+    let mut out: Vec<IkSolution> = Vec::new();
+    if !(r.is_finite()) || r == 0.0 {
+        return out;
+    }
+    let ratio = -c / r;
+    if ratio < -1.0 - 1e-12 {
+        return out;
+    }
+    let alpha = ratio.clamp(-1.0, 1.0).acos();
+    let phi = d2.atan2(d1);
+    let mut roots = vec![wrap_angle(-phi + alpha)];
+    if alpha > IK_DUPLICATE_TOL {
+        roots.push(wrap_angle(-phi - alpha));
+    }
+    let target = Vector2::new(x, y);
+    let tol = IK_VERIFY_REL_TOL * p.l.max(target.norm());
+    for mut th2 in roots {
+        for _ in 0..IK_NEWTON_STEPS {
+            let (s, co) = th2.sin_cos();
+            let f = d1 * co - d2 * s + c;
+            let df = -d1 * s - d2 * co;
+            if df.abs() > 1e-8 * r {
+                th2 -= f / df;
+            }
+        }
+        let d1v = target - p.l * Vector2::new(th2.cos(), th2.sin());
+        let mut l3 = d1v.norm();
+        let theta1 = if l3 <= IK_L3_ZERO_REL * p.l {
+            l3 = 0.0;
+            0.0
+        } else {
+            let t = d1v.y.atan2(d1v.x);
+            if t >= 0.0 {
+                t
+            } else if d1v.y >= -IK_THETA1_CLAMP_REL * l3 {
+                if t > -FRAC_PI_2 {
+                    0.0
+                } else {
+                    PI
+                }
+            } else {
+                continue;
+            }
+        };
+        // Verify by forward kinematics.
+        let eqs = equilibria(p, l3, theta1);
+        let best = eqs
+            .iter()
+            .map(|e| ((Vector2::new(e.x, e.y) - target).norm(), *e))
+            .min_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
+        if let Some((err, e)) = best {
+            if err <= tol {
+                let dup = out
+                    .iter()
+                    .any(|s| (s.l3 - l3).abs() <= tol && (s.theta1 - theta1).abs() <= IK_DUPLICATE_TOL.max(tol));
+                if !dup {
+                    out.push(IkSolution { l3, theta1, theta2: e.theta2, stable: e.stable, stiffness: e.stiffness });
+                }
+            }
+        }
+    }
+    out
+}
+
+// ---------------------------------------------------------------------------
+// The paper's own IK route (Eq. 8-16, Appendix A), for comparison.
+// ---------------------------------------------------------------------------
+
+/// Eq. 10: `[E1, E2, E3] = [1, -2(x cos th1 + y sin th1), x^2 + y^2 - L^2]` of
+/// Eq. 9 `E1 L3^2 + E2 L3 + E3 = 0` (units 1, m, m^2). Correct.
+pub fn e_coefficients_eq10(p: &Params, x: f64, y: f64, theta1: f64) -> [f64; 3] {
+    let (s1, c1) = theta1.sin_cos();
+    [1.0, -2.0 * (x * c1 + y * s1), x * x + y * y - p.l * p.l]
+}
+
+/// Eq. 12, derived (units N*m, N*m^2, N*m^3) for Eq. 11 `F1 L3^2 + F2 L3 + F3 = 0`,
+/// which is `L (eta1 (x - L3 cos th1) - eta2 (y - L3 sin th1)) = 0`:
+/// `F1 = sqrt3 K1 L` and `F2` as printed; `F3 = 2 sqrt3 K2 L^2 x - 2(2K1-K2) L^2 y`
+/// (printed as a second "F2" and without the `sqrt3`).
+pub fn f_coefficients_eq12(p: &Params, x: f64, y: f64, theta1: f64) -> [f64; 3] {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let (s1, c1) = theta1.sin_cos();
+    let f1 = SQRT_3 * k1 * l;
+    let f2 = l * (k1 + 2.0 * k2) * (x * s1 - y * c1) - SQRT_3 * l * c1 * (k1 * x + 2.0 * k2 * l)
+        + (2.0 * (2.0 * k1 - k2) * l - SQRT_3 * k1 * y) * l * s1;
+    let f3 = 2.0 * SQRT_3 * k2 * l * l * x - 2.0 * (2.0 * k1 - k2) * l * l * y;
+    [f1, f2, f3]
+}
+
+/// Eq. 12's third coefficient exactly as printed: `2 K2 L^2 x - 2(2K1-K2) L^2 y` (wrong).
+pub fn f3_eq12_as_printed(p: &Params, x: f64, y: f64) -> f64 {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    2.0 * k2 * l * l * x - 2.0 * (2.0 * k1 - k2) * l * l * y
+}
+
+fn det2(a: f64, b: f64, c: f64, d: f64) -> f64 {
+    a * d - b * c
+}
+
+/// Eq. 13: Bezout resultant of Eq. 9 and Eq. 11 (with the derived `F`).
+pub fn bezout_eq13(p: &Params, x: f64, y: f64, theta1: f64) -> f64 {
+    let [e1, e2, e3] = e_coefficients_eq10(p, x, y, theta1);
+    let [f1, f2, f3] = f_coefficients_eq12(p, x, y, theta1);
+    let m = det2(e1, e3, f1, f3);
+    det2(e1, e2, f1, f2) * det2(e2, e3, f2, f3) - m * m
+}
+
+/// Eq. 14: common root `L3 = -|E2 E3; F2 F3| / |E1 E3; F1 F3|` [m].
+pub fn l3_eq14(p: &Params, x: f64, y: f64, theta1: f64) -> f64 {
+    let [e1, e2, e3] = e_coefficients_eq10(p, x, y, theta1);
+    let [f1, f2, f3] = f_coefficients_eq12(p, x, y, theta1);
+    -det2(e2, e3, f2, f3) / det2(e1, e3, f1, f3)
+}
+
+/// `phi1..phi4` of Eq. 15 derived from Eq. 13: with `G = E1F2 - E2F1 =
+/// L (delta2 sin th1 - delta1 cos th1)` and `H = E2F3 - E3F2 = Hs sin th1 + Hc cos th1`,
+/// `phi1 = L delta2 Hs`, `phi2 = L delta2 Hc - L delta1 Hs`, `phi3 = -L delta1 Hc`,
+/// `phi4 = -(F3 - E3 F1)^2`.
+pub fn phi_coefficients_derived(p: &Params, x: f64, y: f64) -> [f64; 4] {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let (dl1, dl2) = delta(p, x, y);
+    let e3 = x * x + y * y - l * l;
+    let f1 = SQRT_3 * k1 * l;
+    let f3 = 2.0 * SQRT_3 * k2 * l * l * x - 2.0 * (2.0 * k1 - k2) * l * l * y;
+    let f2s = l * ((k1 + 2.0 * k2) * x + 2.0 * (2.0 * k1 - k2) * l - SQRT_3 * k1 * y);
+    let f2c = -l * ((k1 + 2.0 * k2) * y + SQRT_3 * k1 * x + 2.0 * SQRT_3 * k2 * l);
+    let hs = -2.0 * y * f3 - e3 * f2s;
+    let hc = -2.0 * x * f3 - e3 * f2c;
+    let (gs, gc) = (l * dl2, -l * dl1);
+    let m = f3 - e3 * f1;
+    [gs * hs, gs * hc + gc * hs, gc * hc, -m * m]
+}
+
+/// Appendix A, C.1-C.4 as printed, with C.3 (whose two factors the scan
+/// flattened into a sum) read as the product
+/// `[L(x^2+y^2-L^2)(K1y+2K2y+2sqrt3K2L+sqrt3K1x) - 4L^2x(K2y-2K1y+sqrt3K2x)]
+///  * [-Ly(K1+2K2) - 2sqrt3L^2K2 + sqrt3K1Lx]`.
+pub fn phi_coefficients_appendix_a(p: &Params, x: f64, y: f64) -> [f64; 4] {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let r2 = x * x + y * y;
+    let w = k2 * y - 2.0 * k1 * y + SQRT_3 * k2 * x;
+    let dm = 4.0 * k1 * l - 2.0 * k2 * l + k1 * x + 2.0 * k2 * x - SQRT_3 * k1 * y;
+    let dp = 4.0 * k1 * l - 2.0 * k2 * l + k1 * x + 2.0 * k2 * x + SQRT_3 * k1 * y;
+    let gm = k1 * y + 2.0 * k2 * y + 2.0 * SQRT_3 * k2 * l - SQRT_3 * k1 * x;
+    let gp = k1 * y + 2.0 * k2 * y + 2.0 * SQRT_3 * k2 * l + SQRT_3 * k1 * x;
+    let c1 = l * (l * (l * l - r2) * dm - 4.0 * l * l * y * w) * dp;
+    let c2 = (4.0 * l * l * l * y * w + l * l * (r2 - l * l) * dm) * gm
+        - l * (4.0 * l * l * x * w - l * (r2 - l * l) * gp) * dp;
+    let c3 = (l * (r2 - l * l) * gp - 4.0 * l * l * x * w)
+        * (-l * y * (k1 + 2.0 * k2) - 2.0 * SQRT_3 * l * l * k2 + SQRT_3 * k1 * l * x);
+    let q = 2.0 * SQRT_3 * k2 * l * x - 2.0 * (2.0 * k1 - k2) * l * y + SQRT_3 * k1 * (l * l - r2);
+    let c4 = -l * l * q * q;
+    [c1, c2, c3, c4]
+}
+
+/// The paper's IK route: Eq. 15-16 roots `tan th1` mapped to `theta1 in [0, pi)`,
+/// then Eq. 14 for `L3` (which may come out negative, i.e. `D1` below the X
+/// axis). Uses the given `phi` coefficients. Returns `(L3, theta1)` pairs.
+pub fn inverse_kinematics_eq16(p: &Params, x: f64, y: f64, phi: [f64; 4]) -> Vec<(f64, f64)> {
+    let (qa, qb, qc) = (phi[0] + phi[3], phi[1], phi[2] + phi[3]);
+    let mut ts = Vec::new();
+    if qa == 0.0 {
+        if qb != 0.0 {
+            ts.push(-qc / qb);
+        }
+    } else {
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc >= 0.0 {
+            let sq = disc.sqrt();
+            ts.push((-qb + sq) / (2.0 * qa));
+            ts.push((-qb - sq) / (2.0 * qa));
+        }
+    }
+    ts.into_iter()
+        .map(|t| {
+            let mut th1 = t.atan();
+            if th1 < 0.0 {
+                th1 += PI;
+            }
+            (l3_eq14(p, x, y, th1), th1)
+        })
+        .collect()
+}
+
+// ---------------------------------------------------------------------------
+// Jacobian and singularities (Eq. 17-37).
+// ---------------------------------------------------------------------------
+
+/// `(dtheta2/dL3 [rad/m], dtheta2/dtheta1 [rad/rad])` at an equilibrium, by
+/// the implicit-function theorem on `tau = 0`: `dth2/dI = -(dtau/dI)/K`.
+/// Equal to Eq. 22 `cos^2 th2 d(tan th2)/dI` (whose printed denominators lack the `d`).
+pub fn dtheta2_dinputs(p: &Params, l3: f64, theta1: f64, theta2: f64) -> (f64, f64) {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let (s1, c1) = theta1.sin_cos();
+    let (s2, c2) = theta2.sin_cos();
+    // dA/dL3, dB/dL3; dA/dth1 = -L3 dB/dL3, dB/dth1 = L3 dA/dL3.
+    let a_l = (0.5 * k1 + k2) * l * c1 + 0.5 * SQRT_3 * k1 * l * s1;
+    let b_l = (0.5 * k1 + k2) * l * s1 - 0.5 * SQRT_3 * k1 * l * c1;
+    let dtau_dl3 = -a_l * s2 + b_l * c2;
+    let dtau_dth1 = l3 * (b_l * s2 + a_l * c2);
+    let k = stiffness(p, l3, theta1, theta2);
+    (-dtau_dl3 / k, -dtau_dth1 / k)
+}
+
+/// Eq. 22 as intended: `cos^2 th2 * d(eta1/eta2)/dI`, `I = (L3, theta1)`.
+pub fn dtheta2_dinputs_eq22(p: &Params, l3: f64, theta1: f64, theta2: f64) -> (f64, f64) {
+    let (k1, k2) = (p.k1, p.k2);
+    let (s1, c1) = theta1.sin_cos();
+    let (e1, e2) = eta(p, l3, theta1);
+    let pp = (k1 + 2.0 * k2) * s1 - SQRT_3 * k1 * c1; // d eta1 / d L3
+    let qq = (k1 + 2.0 * k2) * c1 + SQRT_3 * k1 * s1; // d eta2 / d L3
+    let c2sq = theta2.cos().powi(2);
+    let dtan_dl3 = (pp * e2 - e1 * qq) / (e2 * e2);
+    let dtan_dth1 = (l3 * qq * e2 + e1 * l3 * pp) / (e2 * e2);
+    (c2sq * dtan_dl3, c2sq * dtan_dth1)
+}
+
+/// Eq. 17-21: `J = d(x, y)/d(L3, theta1)` at an equilibrium `theta2`
+/// (units: column 1 dimensionless, column 2 [m/rad]).
+pub fn jacobian(p: &Params, l3: f64, theta1: f64, theta2: f64) -> Matrix2<f64> {
+    let (s1, c1) = theta1.sin_cos();
+    let (s2, c2) = theta2.sin_cos();
+    let (a, b) = dtheta2_dinputs(p, l3, theta1, theta2);
+    let l = p.l;
+    Matrix2::new(
+        c1 - l * s2 * a,       // Eq. 18
+        -l3 * s1 - l * s2 * b, // Eq. 19
+        s1 + l * c2 * a,       // Eq. 20
+        l3 * c1 + l * c2 * b,  // Eq. 21
+    )
+}
+
+/// `det J` [m/rad] from [`jacobian`].
+pub fn det_jacobian(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
+    jacobian(p, l3, theta1, theta2).determinant()
+}
+
+/// Derived closed form: `det J = L3 (1 + s L (K1+2K2)/sqrt(eta1^2+eta2^2))`
+/// with `s = -1` at the energy minimum and `+1` at the maximum
+/// (`s = sign(eta2 cos th2 + eta1 sin th2)`). Equivalently
+/// `det J = L3 (1 + L (K1+2K2) sin th2 / eta1)` (the corrected Eq. 23-24).
+pub fn det_jacobian_closed_form(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
+    let (e1, e2) = eta(p, l3, theta1);
+    let (s2, c2) = theta2.sin_cos();
+    let s = (e2 * c2 + e1 * s2).signum();
+    l3 * (1.0 + s * p.l * (p.k1 + 2.0 * p.k2) / e1.hypot(e2))
+}
+
+/// Corrected Eq. 24 [N^3]: `Phi1 = eta1 N + L (K1+2K2) sin th2 N` with
+/// `N = eta1^2 + eta2^2` (the printed version has a spurious extra `L3`).
+pub fn phi1(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
+    let (e1, _) = eta(p, l3, theta1);
+    let n = eta_norm_sq(p, l3, theta1);
+    e1 * n + p.l * (p.k1 + 2.0 * p.k2) * theta2.sin() * n
+}
+
+/// Eq. 24 exactly as printed: `eta1 N + 4 L3 L sin th2 (K1+2K2) [N/4]`.
+pub fn phi1_eq24_as_printed(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let (s1, c1) = theta1.sin_cos();
+    let (e1, _) = eta(p, l3, theta1);
+    let n = eta_norm_sq(p, l3, theta1);
+    let bracket = 4.0 * l * l * (k1 * k1 + k2 * k2 - k1 * k2)
+        + l3 * l3 * (k1 * k1 + k2 * k2 + k1 * k2)
+        + 2.0 * l3 * l * c1 * (k1 * k1 - k2 * k2)
+        + 2.0 * SQRT_3 * l3 * l * s1 * (k1 * k1 + k2 * k2);
+    e1 * n + 4.0 * l3 * l * theta2.sin() * (k1 + 2.0 * k2) * bracket
+}
+
+/// Eq. 25 [N^3]: `Phi2 = eta1 (eta1^2 + eta2^2)` (correct).
+pub fn phi2(p: &Params, l3: f64, theta1: f64) -> f64 {
+    let (e1, _) = eta(p, l3, theta1);
+    e1 * eta_norm_sq(p, l3, theta1)
+}
+
+/// Eq. 23 as printed, `L3 Phi1 / Phi2` with the printed Eq. 24-25; `None` when `Phi2 = 0`.
+/// Dimensionally inconsistent (extra factor `L3` in the second term of `Phi1`).
+pub fn det_jacobian_eq23(p: &Params, l3: f64, theta1: f64, theta2: f64) -> Option<f64> {
+    let d = phi2(p, l3, theta1);
+    if d == 0.0 {
+        None
+    } else {
+        Some(l3 * phi1_eq24_as_printed(p, l3, theta1, theta2) / d)
+    }
+}
+
+/// Eq. 23 with the corrected `Phi1` ([`phi1`]); `None` when `Phi2 = 0`.
+pub fn det_jacobian_eq23_corrected(p: &Params, l3: f64, theta1: f64, theta2: f64) -> Option<f64> {
+    let d = phi2(p, l3, theta1);
+    if d == 0.0 {
+        None
+    } else {
+        Some(l3 * phi1(p, l3, theta1, theta2) / d)
+    }
+}
+
+/// Eq. 26, curve i: `L3 = 0` [m].
+pub fn curve_i_eq26(l3: f64) -> f64 {
+    l3
+}
+
+/// Eq. 27, curve ii: `sin th1 = 0` (only a boundary of the imposed range
+/// `0 <= th1 <= pi`, not a singularity of `J`).
+pub fn curve_ii_eq27(theta1: f64) -> f64 {
+    theta1.sin()
+}
+
+/// Eq. 28, curve iii: `eta1 = 0` [N] (where the paper's `[0, pi]` FK branch
+/// jumps; `det J` stays finite on both true branches).
+pub fn curve_iii_eq28(p: &Params, l3: f64, theta1: f64) -> f64 {
+    eta(p, l3, theta1).0
+}
+
+/// Eq. 33, curve iv (`theta1 = theta2 mod pi` substituted in Eq. 5) [N*m]:
+/// `2(2K1-K2) L sin th1 - 2 sqrt3 K2 L cos th1 + sqrt3 K1 L3` (correct algebra;
+/// equals `eta2 sin th1 - eta1 cos th1`).
+pub fn curve_iv_eq33(p: &Params, l3: f64, theta1: f64) -> f64 {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let (s1, c1) = theta1.sin_cos();
+    2.0 * (2.0 * k1 - k2) * l * s1 - 2.0 * SQRT_3 * k2 * l * c1 + SQRT_3 * k1 * l3
+}
+
+/// `L3` on curve iv (Eq. 33 solved for `L3`) [m]; may be negative.
+pub fn curve_iv_l3(p: &Params, theta1: f64) -> f64 {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let (s1, c1) = theta1.sin_cos();
+    -(2.0 * (2.0 * k1 - k2) * l * s1 - 2.0 * SQRT_3 * k2 * l * c1) / (SQRT_3 * k1)
+}
+
+/// Eq. 30 corrected, curve v [N^2]: `eta1^2 + eta2^2 - L^2 (K1+2K2)^2`;
+/// zero exactly where the *stable* branch has `det J = 0` (`Phi1 = 0`).
+/// In the `D1` plane this is a circle of radius `L(K1+2K2)/(2 sqrt(K1^2+K1K2+K2^2))`
+/// about [`neutral_point`].
+pub fn curve_v_eq30(p: &Params, l3: f64, theta1: f64) -> f64 {
+    let g = p.l * (p.k1 + 2.0 * p.k2);
+    eta_norm_sq(p, l3, theta1) - g * g
+}
+
+/// Eq. 34, curve i in Cartesian space [m^2]: `x^2 + y^2 - L^2`.
+pub fn curve_i_eq34(p: &Params, x: f64, y: f64) -> f64 {
+    x * x + y * y - p.l * p.l
+}
+
+/// Eq. 35, curve ii in Cartesian space [m^2]: `(x - L3)^2 + y^2 - L^2`.
+pub fn curve_ii_eq35(p: &Params, x: f64, y: f64, l3: f64) -> f64 {
+    (x - l3).powi(2) + y * y - p.l * p.l
+}
+
+/// Eq. 36 as printed [N*m]: `2 sqrt3 K1 x - (K1+2K2) y + 2 sqrt3 L (K2 - K1)` (wrong).
+pub fn curve_iii_eq36_as_printed(p: &Params, x: f64, y: f64) -> f64 {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    2.0 * SQRT_3 * k1 * x - (k1 + 2.0 * k2) * y + 2.0 * SQRT_3 * l * (k2 - k1)
+}
+
+/// Curve iii (`eta1 = 0`) in Cartesian space, derived [N*m]. On `eta1 = 0`
+/// the equilibria are `theta2 = 0` and `theta2 = pi`; with `theta2 = 0`
+/// (`theta2_is_pi = false`, the paper's Eq. 38-39):
+/// `(K1+2K2) y - sqrt3 K1 x + sqrt3 (K1+2K2) L = 0`; with `theta2 = pi`:
+/// `(K1+2K2) y - sqrt3 K1 x + sqrt3 (2K2-K1) L = 0`.
+pub fn curve_iii_cartesian(p: &Params, x: f64, y: f64, theta2_is_pi: bool) -> f64 {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let c = if theta2_is_pi { 2.0 * k2 - k1 } else { k1 + 2.0 * k2 };
+    (k1 + 2.0 * k2) * y - SQRT_3 * k1 * x + SQRT_3 * c * l
+}
+
+/// Eq. 37 as printed [m^2]: `x^2 + y^2 - 9 L^2` (this is the outer reach
+/// circle `L3 = 2L, theta2 = theta1`, not curve iv).
+pub fn curve_iv_eq37_as_printed(p: &Params, x: f64, y: f64) -> f64 {
+    x * x + y * y - 9.0 * p.l * p.l
+}
+
+/// Curve iv in Cartesian space, derived [N*m^2]:
+/// `2(2K1-K2) L y - 2 sqrt3 K2 L x + sqrt3 K1 (r^2 - L r) = 0`, `r = |D3|`.
+/// Covers `theta2 = theta1` (`D3 = (L3 + L) e(theta1)`) and `theta2 = theta1 + pi`
+/// with `L3 < L` (`D3 = -(L - L3) e(theta1)`); for `theta2 = theta1 + pi` with
+/// `L3 > L` the term is `+L r` instead.
+pub fn curve_iv_cartesian(p: &Params, x: f64, y: f64) -> f64 {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let r = x.hypot(y);
+    2.0 * (2.0 * k1 - k2) * l * y - 2.0 * SQRT_3 * k2 * l * x + SQRT_3 * k1 * (r * r - l * r)
+}
+
+/// The neutral point `D1*` [m]: the actuator-node position where
+/// `eta1 = eta2 = 0`, i.e. where `U` does not depend on `theta2` (`K = 0`).
+pub fn neutral_point(p: &Params) -> Vector2<f64> {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    // eta2 = 0: (K1+2K2) X + sqrt3 K1 Y = -2(2K1-K2) L
+    // eta1 = 0: -sqrt3 K1 X + (K1+2K2) Y = -2 sqrt3 K2 L
+    let m = Matrix2::new(k1 + 2.0 * k2, SQRT_3 * k1, -SQRT_3 * k1, k1 + 2.0 * k2);
+    let rhs = Vector2::new(-2.0 * (2.0 * k1 - k2) * l, -2.0 * SQRT_3 * k2 * l);
+    let det = m.determinant();
+    let inv = Matrix2::new(m[(1, 1)], -m[(0, 1)], -m[(1, 0)], m[(0, 0)]) / det;
+    inv * rhs
+}
+
+/// Stiffness at the stable equilibrium, closed form [N*m/rad]:
+/// `K = (L/2) sqrt(eta1^2+eta2^2) = L sqrt(K1^2+K1K2+K2^2) |D1 - D1*|`.
+pub fn stiffness_stable_closed_form(p: &Params, l3: f64, theta1: f64) -> f64 {
+    let d1 = l3 * Vector2::new(theta1.cos(), theta1.sin());
+    p.l * (p.k1 * p.k1 + p.k1 * p.k2 + p.k2 * p.k2).sqrt() * (d1 - neutral_point(p)).norm()
+}
+
+// ---------------------------------------------------------------------------
+// Stiffness distribution formulas (Eq. 46-52).
+// ---------------------------------------------------------------------------
+
+/// Eq. 46 as printed: `(sin th2, cos th2) = (|eta1|/|eta|, |eta1|/|eta| * eta2/eta1)`
+/// (the `[0, pi]` root of Eq. 5). Returns `(sin, cos)`.
+pub fn sincos_theta2_eq46(p: &Params, l3: f64, theta1: f64) -> (f64, f64) {
+    let (e1, e2) = eta(p, l3, theta1);
+    let f = (e1 * e1 / (e1 * e1 + e2 * e2)).sqrt();
+    (f, f * e2 / e1)
+}
+
+/// Eq. 47 as printed [N*m/rad]: `K = -sqrt(eta1^2/(eta1^2+eta2^2)) (A eta2/eta1 + B)`.
+/// Equals `-sign(eta1) (L/2) sqrt(eta1^2+eta2^2)`: the stiffness at the
+/// paper's `[0, pi]` root, negative (unstable) whenever `eta1 > 0`.
+pub fn stiffness_eq47(p: &Params, l3: f64, theta1: f64) -> f64 {
+    let e = energy_coefficients_eq4(p, l3, theta1);
+    let (e1, e2) = eta(p, l3, theta1);
+    -(e1 * e1 / (e1 * e1 + e2 * e2)).sqrt() * (e.a * e2 / e1 + e.b)
+}
+
+/// Eq. 49 as printed [N*m/rad], `K` in terms of `(x, y, theta2)` (wrong sign
+/// pattern, see [`stiffness_xy_derived`]).
+pub fn stiffness_eq49_as_printed(p: &Params, x: f64, y: f64, theta2: f64) -> f64 {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let (s2, c2) = theta2.sin_cos();
+    ((2.0 * k1 - k2) * l * l + (0.5 * k1 + k2) * l * x - 0.5 * SQRT_3 * k1 * l * y) * c2
+        + ((0.5 * k1 + k2) * l * y - 0.5 * SQRT_3 * k1 * l * x + SQRT_3 * k2 * l * l) * s2
+        - (0.5 * k1 + k2) * l * l
+}
+
+/// Corrected Eq. 49 [N*m/rad]:
+/// `K = -[(2K1-K2)L^2 + (K1/2+K2)Lx + sqrt3/2 K1 L y] cos th2
+///      - [(K1/2+K2)Ly - sqrt3/2 K1 L x + sqrt3 K2 L^2] sin th2 + (K1/2+K2) L^2`.
+pub fn stiffness_xy_derived(p: &Params, x: f64, y: f64, theta2: f64) -> f64 {
+    let (l, k1, k2) = (p.l, p.k1, p.k2);
+    let (s2, c2) = theta2.sin_cos();
+    -((2.0 * k1 - k2) * l * l + (0.5 * k1 + k2) * l * x + 0.5 * SQRT_3 * k1 * l * y) * c2
+        - ((0.5 * k1 + k2) * l * y - 0.5 * SQRT_3 * k1 * l * x + SQRT_3 * k2 * l * l) * s2
+        + (0.5 * k1 + k2) * l * l
+}
+
+/// The `theta2` root Eq. 52 uses [rad]:
+/// `2 atan((delta2 + sqrt(delta1^2+delta2^2-3K1^2L^2)) / (sqrt3 K1 L - delta1))`
+/// (a correct root of Eq. 48; NaN outside the workspace).
+pub fn theta2_eq52(p: &Params, x: f64, y: f64) -> f64 {
+    let (d1, d2) = delta(p, x, y);
+    let c = SQRT_3 * p.k1 * p.l;
+    2.0 * ((d2 + (d1 * d1 + d2 * d2 - c * c).sqrt()) / (c - d1)).atan()
+}
+
+/// Eq. 52 as printed [N*m/rad]: Eq. 49 (as printed) evaluated at [`theta2_eq52`].
+pub fn stiffness_eq52(p: &Params, x: f64, y: f64) -> f64 {
+    stiffness_eq49_as_printed(p, x, y, theta2_eq52(p, x, y))
+}
+
+// ---------------------------------------------------------------------------
+// Findings.
+// ---------------------------------------------------------------------------
+
+/// One checked claim of the paper.
+#[derive(Clone, Debug)]
+pub struct Finding {
+    pub equation: &'static str,
+    pub claim: String,
+    pub measured: String,
+    pub holds: bool,
+}
+
+fn finding(equation: &'static str, claim: &str, measured: String, holds: bool) -> Finding {
+    Finding { equation, claim: claim.to_string(), measured, holds }
+}
+
+/// Representative inputs `(L3, theta1)` for `p`: `L3 in {0.25, 0.7, 1.3, 2} L`,
+/// `theta1 in {0.15, 0.9, 1.7, 2.6, 3.05}`.
+fn sample_inputs(p: &Params) -> Vec<(f64, f64)> {
+    let mut v = Vec::new();
+    for f in [0.25, 0.7, 1.3, 2.0] {
+        for t in [0.15, 0.9, 1.7, 2.6, 3.05] {
+            v.push((f * p.l, t));
+        }
+    }
+    v
+}
+
+/// Every printed equation checked against the derivation, with numbers.
+/// Generic identities are checked at [`sample_inputs`] for `p` (both
+/// equilibria); figure-specific claims use [`Params::PAPER_WORKSPACE`] and
+/// [`Params::PAPER_FIG4`].
+pub fn findings(p: &Params) -> Vec<Finding> {
+    let mut f = Vec::new();
+    let pts = sample_inputs(p);
+    let scale_u = (p.k1 + p.k2) * p.l * p.l;
+    let max_over = |g: &dyn Fn(f64, f64, f64) -> f64| -> f64 {
+        let mut m: f64 = 0.0;
+        for &(l3, t1) in &pts {
+            for e in equilibria(p, l3, t1) {
+                m = m.max(g(l3, t1, e.theta2).abs());
+            }
+        }
+        m
+    };
+
+    // Eq. 1-3
+    let err_geo = max_over(&|l3, t1, t2| {
+        let n = nodes(p, l3, t1, t2);
+        ((n.d1 - n.d2).norm() - p.l).abs().max(((n.d2 - n.d3).norm() - p.l).abs())
+            .max(((n.c2 - n.c3).norm() - 2.0 * p.l).abs())
+            .max(((n.c1 - n.c2).norm() - 2.0 * p.l).abs())
+    });
+    f.push(finding("Eq. 1-3", "node coordinates: mobile triangle side L, base side 2L", format!("max side-length error {err_geo:.2e} m"), err_geo < 1e-12 * p.l.max(1.0)));
+
+    // Eq. 4
+    let err4 = max_over(&|l3, t1, t2| potential_energy_eq4(p, l3, t1, t2) - potential_energy(p, l3, t1, t2)) / scale_u;
+    let err4_any = {
+        let mut m: f64 = 0.0;
+        for &(l3, t1) in &pts {
+            for t2 in [-2.5, -0.4, 0.7, 2.2] {
+                m = m.max((potential_energy_eq4(p, l3, t1, t2) - potential_energy(p, l3, t1, t2)).abs());
+            }
+        }
+        m / scale_u
+    };
+    f.push(finding("Eq. 4", "U (printed) equals K1/2|D2C2|^2 + K2/2|D3C3|^2", format!("max |U_eq4 - U_springs|/((K1+K2)L^2) = {:.2e} (equilibria), {:.2e} (arbitrary theta2)", err4, err4_any), err4_any < 1e-12));
+
+    // Eq. 5-7 root
+    let err5 = {
+        let mut m: f64 = 0.0;
+        for &(l3, t1) in &pts {
+            let e = fk_paper(p, l3, t1);
+            m = m.max(torque(p, l3, t1, e.theta2).abs());
+        }
+        m / scale_u
+    };
+    f.push(finding("Eq. 5-7", "tan th2 = eta1/eta2 (eta1, eta2 as printed) solves dU/dth2 = 0", format!("max |tau|/((K1+K2)L^2) at the Eq. 5 root = {err5:.2e}; eta1 = 2B/L, eta2 = 2A/L exactly"), err5 < 1e-12));
+
+    // Eq. 5 branch on the paper's workspace
+    {
+        let q = Params::PAPER_WORKSPACE;
+        let (mut n_tot, mut n_min) = (0usize, 0usize);
+        let (nl, nt) = (100usize, 100usize);
+        for i in 1..=nl {
+            let l3 = PAPER_L3_MAX_OVER_L * q.l * i as f64 / nl as f64;
+            for j in 0..=nt {
+                let t1 = PI * j as f64 / nt as f64;
+                n_tot += 1;
+                if fk_paper(&q, l3, t1).stable {
+                    n_min += 1;
+                }
+            }
+        }
+        let q4 = Params::PAPER_FIG4;
+        let (e1_fig4, _) = eta(&q4, PAPER_FIG4_L3, PAPER_FIG4_THETA1);
+        let fk4 = fk_paper(&q4, PAPER_FIG4_L3, PAPER_FIG4_THETA1);
+        let (e1_l0, e2_l0) = eta(&q, 0.0, 0.0);
+        f.push(finding("Eq. 5 (range 0<=th2<=pi)", "the unique root with th2 in [0, pi] is the mechanism's (stable) equilibrium",
+            format!("the [0,pi] root is the energy MINIMUM iff eta1 < 0, the MAXIMUM iff eta1 > 0. K1=200,K2=100,L=1 grid 0<L3<=2, 0<=th1<=pi ({n_tot} pts): minimum at only {n_min} pts ({:.1}%; eta1<0 needs L3>1 and small th1). E.g. L3=0: eta=({e1_l0:.1},{e2_l0:.1}) N, paper th2={:.4} rad is the maximum, stable th2={:.4} rad. Figs 4-6 point (K1=100,K2=10,L3=6,th1=pi/10): eta1={e1_fig4:.1} N<0, paper root th2={:.6} rad is the minimum (stable={}).",
+                100.0 * n_min as f64 / n_tot as f64, fk_paper(&q, 0.0, 0.0).theta2, equilibria(&q, 0.0, 0.0)[0].theta2, fk4.theta2, fk4.stable),
+            false));
+    }
+
+    // Eq. 8-10
+    let err9 = max_over(&|l3, t1, t2| {
+        let n = nodes(p, l3, t1, t2);
+        let [e1, e2, e3] = e_coefficients_eq10(p, n.d3.x, n.d3.y, t1);
+        (e1 * l3 * l3 + e2 * l3 + e3) / (p.l * p.l)
+    });
+    f.push(finding("Eq. 8-10", "E1 L3^2 + E2 L3 + E3 = 0 with E = [1, -2(x c1 + y s1), x^2+y^2-L^2]", format!("max |residual|/L^2 = {err9:.2e}"), err9 < 1e-12));
+
+    // Eq. 11-12
+    {
+        let fscale = p.k1.max(p.k2) * p.l.powi(3);
+        let err11 = max_over(&|l3, t1, t2| {
+            let n = nodes(p, l3, t1, t2);
+            let [a, b, c] = f_coefficients_eq12(p, n.d3.x, n.d3.y, t1);
+            (a * l3 * l3 + b * l3 + c) / fscale
+        });
+        let err11p = max_over(&|l3, t1, t2| {
+            let n = nodes(p, l3, t1, t2);
+            let [a, b, _] = f_coefficients_eq12(p, n.d3.x, n.d3.y, t1);
+            (a * l3 * l3 + b * l3 + f3_eq12_as_printed(p, n.d3.x, n.d3.y)) / fscale
+        });
+        f.push(finding("Eq. 11-12", "F1 L3^2 + F2 L3 + F3 = 0 with F1 = sqrt3 K1 L, F2 and F3 (printed as a second 'F2') as printed",
+            format!("F1, F2 correct; with printed F3 = 2K2L^2x - 2(2K1-K2)L^2y: max |residual|/(K L^3) = {err11p:.3e}; with F3 = 2*sqrt3*K2L^2x - 2(2K1-K2)L^2y (consistent with C.4): {err11:.2e}"),
+            err11p < 1e-10));
+    }
+
+    // Eq. 13-14
+    {
+        let (mut r13, mut r14) = (0.0f64, 0.0f64);
+        for &(l3, t1) in &pts {
+            for e in equilibria(p, l3, t1) {
+                let [_, _, e3] = e_coefficients_eq10(p, e.x, e.y, t1);
+                let [f1, _, f3] = f_coefficients_eq12(p, e.x, e.y, t1);
+                let m = (f3 - e3 * f1).abs().max(1e-300);
+                r13 = r13.max((bezout_eq13(p, e.x, e.y, t1) / (m * m)).abs());
+                r14 = r14.max((l3_eq14(p, e.x, e.y, t1) - l3).abs() / p.l);
+            }
+        }
+        f.push(finding("Eq. 13-14", "Bezout condition for a common L3 root and the common root formula",
+            format!("max |Eq.13|/|E1F3-E3F1|^2 = {r13:.2e}; max |L3(Eq.14) - L3|/L = {r14:.2e}"), r13 < 1e-8 && r14 < 1e-8));
+    }
+
+    // Eq. 15-16 + Appendix A
+    {
+        let (mut dc1, mut dc2, mut dc3, mut dc4) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        let mut worst_match: f64 = 0.0;
+        let mut n_sol = 0usize;
+        for &(l3, t1) in &pts {
+            for e in equilibria(p, l3, t1) {
+                let a = phi_coefficients_appendix_a(p, e.x, e.y);
+                let d = phi_coefficients_derived(p, e.x, e.y);
+                let s = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                dc1 = dc1.max((a[0] - d[0]).abs() / s);
+                dc2 = dc2.max((a[1] - d[1]).abs() / s);
+                dc3 = dc3.max((a[2] - d[2]).abs() / s);
+                dc4 = dc4.max((a[3] - d[3]).abs() / s);
+                let cands = inverse_kinematics_eq16(p, e.x, e.y, a);
+                for sol in inverse_kinematics(p, e.x, e.y) {
+                    n_sol += 1;
+                    let best = cands
+                        .iter()
+                        .map(|&(cl3, ct1)| ((cl3 - sol.l3).abs() / p.l).max((ct1 - sol.theta1).abs()))
+                        .fold(f64::INFINITY, f64::min);
+                    let best = if sol.theta1 >= PI - 1e-9 || sol.theta1 <= 1e-9 { best.min(0.0) } else { best };
+                    worst_match = worst_match.max(best);
+                }
+            }
+        }
+        f.push(finding("Eq. 15-16, Appendix A (C.1-C.4)", "phi1..phi4 as printed; the tan th1 roots of Eq. 15 with Eq. 14 give the IK solutions",
+            format!("relative deviation from the derived coefficients: C.1 {dc1:.1e}, C.2 {dc2:.1e}, C.3 (read as product of its two factors; printed flattened into a sum) {dc3:.1e}, C.4 {dc4:.1e}. Eq. 15 structure (phi1+phi4) t^2 + phi2 t + phi3+phi4 correct. Using C.1-C.4 in Eq. 16 + Eq. 14: max deviation from the closed-form IK over {n_sol} solutions = {worst_match:.2e} (Eq. 16 also yields extra roots with L3<0, i.e. D1 below the X axis, which must be discarded)"),
+            dc1 < 1e-9 && dc2 < 1e-9 && dc4 < 1e-9));
+        f.push(finding("Appendix A, C.3", "C.3 as printed", format!("garbled: printed as a sum of unrelated terms; recoverable as the product [L(x^2+y^2-L^2)(K1y+2K2y+2sqrt3K2L+sqrt3K1x) - 4L^2x(K2y-2K1y+sqrt3K2x)]*[-Ly(K1+2K2) - 2sqrt3L^2K2 + sqrt3K1Lx], which matches the derivation to {dc3:.1e}"), false));
+    }
+
+    // Eq. 17-22
+    {
+        let mut ej: f64 = 0.0;
+        let mut e22: f64 = 0.0;
+        let h = 1e-6;
+        for &(l3, t1) in &pts {
+            let j = jacobian(p, l3, t1, equilibria(p, l3, t1)[0].theta2);
+            let fk = |a: f64, b: f64| {
+                let e = equilibria(p, a, b)[0];
+                Vector2::new(e.x, e.y)
+            };
+            let col1 = (fk(l3 + h * p.l, t1) - fk(l3 - h * p.l, t1)) / (2.0 * h * p.l);
+            let col2 = (fk(l3, t1 + h) - fk(l3, t1 - h)) / (2.0 * h);
+            let jf = Matrix2::from_columns(&[col1, col2]);
+            ej = ej.max((j - jf).abs().max() / (1.0 + j.abs().max()));
+            for e in equilibria(p, l3, t1) {
+                let (a, b) = dtheta2_dinputs(p, l3, t1, e.theta2);
+                let (a2, b2) = dtheta2_dinputs_eq22(p, l3, t1, e.theta2);
+                e22 = e22.max(((a - a2).abs() * p.l).max((b - b2).abs()) / (1.0 + a.abs() * p.l + b.abs()));
+            }
+        }
+        f.push(finding("Eq. 17-21", "J = d(x,y)/d(L3,th1) via Eq. 18-21", format!("implicit-function J (dth2/dI = -(dtau/dI)/K) vs central differences of FK: max rel. deviation {ej:.1e}"), ej < 1e-6));
+        f.push(finding("Eq. 22", "dth2/dI = cos^2 th2 d(tan th2)/dI", format!("correct once the missing 'd' in the denominators is restored (printed 'd(tan th2)/L3'); vs implicit-function derivative: max rel. deviation {e22:.1e}"), e22 < 1e-9));
+    }
+
+    // Eq. 23-25
+    {
+        let (mut e_pr, mut e_cor, mut e_cf) = (0.0f64, 0.0f64, 0.0f64);
+        for &(l3, t1) in &pts {
+            for e in equilibria(p, l3, t1) {
+                let dj = det_jacobian(p, l3, t1, e.theta2);
+                let s = 1.0 + dj.abs();
+                if let Some(v) = det_jacobian_eq23(p, l3, t1, e.theta2) {
+                    e_pr = e_pr.max((v - dj).abs() / s);
+                }
+                if let Some(v) = det_jacobian_eq23_corrected(p, l3, t1, e.theta2) {
+                    e_cor = e_cor.max((v - dj).abs() / s);
+                }
+                e_cf = e_cf.max((det_jacobian_closed_form(p, l3, t1, e.theta2) - dj).abs() / s);
+            }
+        }
+        f.push(finding("Eq. 23-25", "det J = L3 Phi1/Phi2 with Phi1, Phi2 as printed",
+            format!("Phi2 = eta1 (eta1^2+eta2^2) correct. Printed Phi1 = eta1 N + 4 L3 L sin th2 (K1+2K2)[...] has a spurious L3 (dimensionally inconsistent): max rel. error {e_pr:.2e}. Corrected Phi1 = eta1 N + L (K1+2K2) sin th2 N: {e_cor:.1e}. Simplified: det J = L3 (1 -/+ L(K1+2K2)/sqrt(eta1^2+eta2^2)) (stable/unstable): {e_cf:.1e}"),
+            e_pr < 1e-8));
+    }
+
+    // Singular curves in actuator space
+    {
+        let q = Params::PAPER_WORKSPACE;
+        // Eq. 26
+        let e0 = equilibria(&q, 0.0, 1.0)[0];
+        let dj0 = det_jacobian(&q, 0.0, 1.0, e0.theta2);
+        f.push(finding("Eq. 26 (curve i, L3 = 0)", "det J = 0; finite motions of D3 possible with actuators locked; equilibrium independent of th1",
+            format!("det J = {dj0:.1e} (holds) and equilibrium independent of th1 (holds), but the platform is NOT free: K = {:.2} N*m/rad at the stable equilibrium th2 = {:.4} rad (K1=200,K2=100,L=1); D3 image is a single point ({:.4},{:.4}) m, not the circle of Eq. 34", e0.stiffness, e0.theta2, e0.x, e0.y),
+            false));
+        // Eq. 27
+        let mut djmin = f64::INFINITY;
+        for l3 in [0.3, 0.8, 1.2, 1.7, 2.0] {
+            for t1 in [0.0, PI] {
+                for e in equilibria(&q, l3, t1) {
+                    djmin = djmin.min(det_jacobian(&q, l3, t1, e.theta2).abs());
+                }
+            }
+        }
+        f.push(finding("Eq. 27 (curve ii, sin th1 = 0)", "singular configuration", format!("min |det J| over L3 in {{0.3..2}}, th1 in {{0, pi}}, both equilibria = {djmin:.3} m/rad (non-zero): not a singularity, only the boundary of the imposed range 0<=th1<=pi"), false));
+        // Eq. 28
+        let mut djmax: f64 = 0.0;
+        let mut jump: f64 = 0.0;
+        for l3 in [1.2, 1.5, 1.8, 2.0] {
+            // eta1 = 0 on th1 with (K1+2K2) s1 - sqrt3 K1 c1 = -2 sqrt3 K2 L / L3
+            let mut lo = 0.0;
+            let mut hi = FRAC_PI_2;
+            if curve_iii_eq28(&q, l3, lo) * curve_iii_eq28(&q, l3, hi) > 0.0 {
+                continue;
+            }
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if curve_iii_eq28(&q, l3, lo) * curve_iii_eq28(&q, l3, mid) <= 0.0 {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            let t1 = 0.5 * (lo + hi);
+            for dt in [-1e-7, 0.0, 1e-7] {
+                for e in equilibria(&q, l3, t1 + dt) {
+                    djmax = djmax.max(det_jacobian(&q, l3, t1 + dt, e.theta2).abs());
+                }
+            }
+            let a = fk_paper(&q, l3, t1 - 1e-7);
+            let b = fk_paper(&q, l3, t1 + 1e-7);
+            jump = jump.max((a.theta2 - b.theta2).abs());
+        }
+        f.push(finding("Eq. 28 (curve iii, eta1 = 0)", "det J goes to infinity", format!("false: on/near eta1=0 (K1=200,K2=100, L3 in 1.2..2) max |det J| over both equilibria = {djmax:.3} m/rad (finite); Phi1 also has the factor eta1 (sin th2 = -/+ eta1/|eta|), so eta1 cancels. What happens there is that the paper's [0,pi] FK root jumps by {jump:.4} rad (switches between minimum and maximum)"), false));
+        // Eq. 29 / 33
+        let mut dj_iv = f64::INFINITY;
+        let mut branch = String::new();
+        for t1 in [0.05, 0.2, 0.35, 0.45] {
+            let l3 = curve_iv_l3(&q, t1);
+            if l3 <= 0.0 {
+                continue;
+            }
+            for (k, e) in equilibria(&q, l3, t1).iter().enumerate() {
+                dj_iv = dj_iv.min(det_jacobian(&q, l3, t1, e.theta2).abs());
+                if k == 0 {
+                    branch.push_str(&format!("th1={t1}: L3={l3:.4}, stable th2-th1={:.4}; ", wrap_angle(e.theta2 - t1)));
+                }
+            }
+        }
+        f.push(finding("Eq. 29, 32-33 (curve iv, th1 = th2)", "Eq. 33 is th1 = th2 substituted in Eq. 5; curve iv is singular",
+            format!("Eq. 33 = eta2 sin th1 - eta1 cos th1 (algebra holds: on Eq. 33 the equilibria are th2 = th1 and th1+pi; {branch}). But it is not a singularity: min |det J| on curve iv = {dj_iv:.3} m/rad; det J depends on (L3,th1) only through |eta|"),
+            false));
+        // Eq. 30
+        let mut ev: f64 = 0.0;
+        let c = neutral_point(&q);
+        let rad = q.l * (q.k1 + 2.0 * q.k2) / (2.0 * (q.k1 * q.k1 + q.k1 * q.k2 + q.k2 * q.k2).sqrt());
+        for ang in [0.3, 1.0, 1.4, 2.0] {
+            let d1 = c + rad * Vector2::new(f64::cos(ang), f64::sin(ang));
+            if d1.y < 0.0 {
+                continue;
+            }
+            let (l3, t1) = (d1.norm(), d1.y.atan2(d1.x));
+            let e = equilibria(&q, l3, t1)[0];
+            ev = ev.max(det_jacobian(&q, l3, t1, e.theta2).abs()).max(phi1(&q, l3, t1, e.theta2).abs() / (1.0 + phi2(&q, l3, t1).abs()));
+        }
+        f.push(finding("Eq. 30 (curve v, Phi1 = 0)", "det J = 0 on Phi1 = 0",
+            format!("holds with the corrected Phi1: for the stable branch Phi1 = 0 <=> eta1^2+eta2^2 = L^2 (K1+2K2)^2, a circle in the D1 plane centred at the neutral point D1* = ({:.4},{:.4}) m with radius {rad:.4} m (K1=200,K2=100,L=1); max |det J| on it = {ev:.1e}. The unstable branch is never singular (det J = L3(1 + L(K1+2K2)/|eta|) > 0 for L3>0)", c.x, c.y),
+            true));
+    }
+
+    // Cartesian curves
+    {
+        let q = Params::PAPER_WORKSPACE;
+        // Eq. 36
+        let mut r_pr: f64 = 0.0;
+        let mut r_d: f64 = 0.0;
+        let mut which = String::new();
+        for l3 in [1.2, 1.6, 2.0] {
+            let mut lo = 0.0;
+            let mut hi = FRAC_PI_2;
+            if curve_iii_eq28(&q, l3, lo) * curve_iii_eq28(&q, l3, hi) > 0.0 {
+                continue;
+            }
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if curve_iii_eq28(&q, l3, lo) * curve_iii_eq28(&q, l3, mid) <= 0.0 {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            let t1 = 0.5 * (lo + hi);
+            let sc = q.k1 * q.l;
+            for e in equilibria(&q, l3, t1) {
+                let is_pi = e.theta2.abs() > FRAC_PI_2;
+                r_pr = r_pr.max(curve_iii_eq36_as_printed(&q, e.x, e.y).abs() / sc);
+                r_d = r_d.max(curve_iii_cartesian(&q, e.x, e.y, is_pi).abs() / sc);
+            }
+            let st = equilibria(&q, l3, t1)[0];
+            which = format!("stable th2 = {:.4} rad (pi), paper's Eq. 38-39 assume th2 = 0 (the maximum when eta2>0)", st.theta2);
+        }
+        f.push(finding("Eq. 36 (curve iii, Cartesian)", "2sqrt3 K1 x - (K1+2K2) y + 2sqrt3 L (K2-K1) = 0",
+            format!("wrong: at D3 of the equilibria on eta1 = 0 (K1=200,K2=100,L3 in 1.2..2) |Eq.36|/(K1 L) up to {r_pr:.3}; derived th2=0: (K1+2K2)y - sqrt3K1x + sqrt3(K1+2K2)L = 0, th2=pi: (K1+2K2)y - sqrt3K1x + sqrt3(2K2-K1)L = 0, residual {r_d:.1e}; {which}"),
+            false));
+        // Eq. 37
+        let (mut rmin, mut rmax) = (f64::INFINITY, 0.0f64);
+        let (mut smin, mut smax) = (f64::INFINITY, 0.0f64);
+        let mut riv: f64 = 0.0;
+        for i in 0..=20 {
+            let t1 = 0.5 * i as f64 / 20.0;
+            let l3 = curve_iv_l3(&q, t1);
+            if l3 <= 0.0 || l3 >= q.l {
+                continue;
+            }
+            for e in equilibria(&q, l3, t1) {
+                let r = e.x.hypot(e.y) / q.l;
+                if e.stable {
+                    smin = smin.min(r);
+                    smax = smax.max(r);
+                } else {
+                    rmin = rmin.min(r);
+                    rmax = rmax.max(r);
+                }
+                riv = riv.max(curve_iv_cartesian(&q, e.x, e.y).abs() / (q.k1 * q.l * q.l));
+            }
+        }
+        f.push(finding("Eq. 37 (curve iv, Cartesian)", "x^2 + y^2 = 9 L^2",
+            format!("wrong: on curve iv (K1=200,K2=100, L3 = 2cos(th1+pi/3) L in (0, L)) the stable equilibrium is th2 = th1 + pi with |D3| = L - L3, |D3|/L in {smin:.4}..{smax:.4}; the unstable one th2 = th1 with |D3| = L3 + L, |D3|/L in {rmin:.4}..{rmax:.4}; never 3. x^2+y^2 = 9L^2 is only the outer reach circle (L3 = 2L, th2 = th1). Derived Cartesian curve iv: 2(2K1-K2)Ly - 2sqrt3K2Lx + sqrt3K1(r^2 - Lr) = 0, r = |D3| (covers th2 = th1, and th2 = th1+pi with L3 < L; use +Lr for th2 = th1+pi with L3 > L), max residual {riv:.1e}"),
+            false));
+        // Eq. 34-35
+        f.push(finding("Eq. 34-35 (curves i, ii Cartesian)", "i: x^2+y^2 = L^2; ii: (x-L3)^2+y^2 = L^2, 0<=L3<=2L",
+            "trivially true loci of D3 given D1 (|D3-D1| = L), but as images of equilibria: curve i maps to ONE point (theta2 fixed by the springs), curve ii to one point per L3 (a curve, not a region); see Eq. 26-27".to_string(), false));
+    }
+
+    // Eq. 40, 41, 42, 48, 50, 51
+    {
+        let (mut e41, mut e42, mut e48) = (0.0f64, 0.0f64, 0.0f64);
+        for &(l3, t1) in &pts {
+            for t2 in [-2.9, -1.0, 0.3, 1.9] {
+                e41 = e41.max((torque_eq41(p, l3, t1, t2) - torque(p, l3, t1, t2)).abs() / scale_u);
+                e42 = e42.max((stiffness_eq42(p, l3, t1, t2) - stiffness(p, l3, t1, t2)).abs() / scale_u);
+                let n = nodes(p, l3, t1, t2);
+                e48 = e48.max((equilibrium_residual_eq48(p, n.d3.x, n.d3.y, t2) * 0.5 * p.l - torque(p, l3, t1, t2)).abs() / scale_u);
+            }
+        }
+        f.push(finding("Eq. 41", "tau = dU/dth2 = -A sin th2 + B cos th2", format!("holds (signs correct): max rel. error vs spring-vector derivative {e41:.1e}"), e41 < 1e-12));
+        f.push(finding("Eq. 42", "K = d2U/dth2^2 = -A cos th2 - B sin th2", format!("holds (signs correct): max rel. error {e42:.1e}"), e42 < 1e-12));
+        f.push(finding("Eq. 40, 48, 50-51", "delta1 cos th2 - delta2 sin th2 + sqrt3 K1 L = 0 is Eq. 5 in (x, y)", format!("holds: (L/2) x residual equals tau identically, max rel. error {e48:.1e}"), e48 < 1e-12));
+    }
+
+    // Eq. 43-45 + claim
+    {
+        let (l3, t1) = (1.3 * p.l, 0.9);
+        let e = energy_coefficients_eq4(p, l3, t1);
+        let h = 1e-3;
+        let mut e43: f64 = 0.0;
+        let mut e0: f64 = 0.0;
+        for t2 in [-2.0, -0.5, 0.4, 1.7, 2.8] {
+            let u = |t: f64| potential_energy(p, l3, t1, t);
+            let d1 = torque(p, l3, t1, t2);
+            let d2 = stiffness(p, l3, t1, t2);
+            let d3 = (stiffness(p, l3, t1, t2 + h) - stiffness(p, l3, t1, t2 - h)) / (2.0 * h);
+            let d4 = (stiffness(p, l3, t1, t2 + h) - 2.0 * d2 + stiffness(p, l3, t1, t2 - h)) / (h * h);
+            e43 = e43.max((d1 + d3).abs().max((d2 + d4).abs()) / scale_u);
+            e0 = e0.max((u(t2) + d2 - e.u0).abs() / scale_u);
+        }
+        f.push(finding("Eq. 43", "d^jU/dth2^j = -d^(j+2)U/dth2^(j+2), j = 1,2,3,...", format!("holds exactly for j >= 1 (max rel. deviation, finite differences h=1e-3: {e43:.1e}); for j = 0 only up to the constant: U = U0 - d2U/dth2^2 with U0 = {:.4} J here (L3=1.3L, th1=0.9), residual after subtracting U0 {e0:.1e}", e.u0), e43 < 1e-5));
+        f.push(finding("Eq. 44", "dK/dth2 = -d3U/dth2^3 = -dU/dth2", "middle term has the wrong sign: dK/dth2 = +d3U/dth2^3 = -dU/dth2 = -tau (outer equality holds, follows from Eq. 43)".to_string(), false));
+        f.push(finding("Eq. 45", "d2K/dth2^2 = d4U/dth2^4 = -d2U/dth2^2", format!("holds (same check as Eq. 43, {e43:.1e}); text says 'with respect to th1' twice where th2 is meant"), true));
+        let mut ok = true;
+        let mut worst: f64 = 0.0;
+        for &(l3, t1) in &pts {
+            let [mn, mx] = equilibria(p, l3, t1);
+            for d in [-0.3, -0.01, 0.01, 0.3] {
+                let a = stiffness(p, l3, t1, mn.theta2 + d);
+                let b = stiffness(p, l3, t1, mx.theta2 + d);
+                ok &= a < mn.stiffness && b > mx.stiffness;
+                worst = worst.max(a - mn.stiffness);
+            }
+        }
+        f.push(finding("Sec. 6.1 claim", "stiffness K(th2) is at a local maximum at the stable equilibrium and a local minimum at the unstable one",
+            format!("holds (even global): K(th2) = |A,B| cos(th2 - th2_min); max K(th2_min +/- d) - K(th2_min) over d in {{0.01, 0.3}} = {worst:.3e} < 0"), ok));
+    }
+
+    // Eq. 46-47
+    {
+        let (mut e46, mut e47) = (0.0f64, 0.0f64);
+        let (mut neg, mut tot) = (0usize, 0usize);
+        for &(l3, t1) in &pts {
+            let e = fk_paper(p, l3, t1);
+            let (s, c) = sincos_theta2_eq46(p, l3, t1);
+            e46 = e46.max((s - e.theta2.sin()).abs().max((c - e.theta2.cos()).abs()));
+            e47 = e47.max((stiffness_eq47(p, l3, t1) - e.stiffness).abs() / scale_u);
+            tot += 1;
+            if stiffness_eq47(p, l3, t1) < 0.0 {
+                neg += 1;
+            }
+        }
+        f.push(finding("Eq. 46", "sin th2 = |eta1|/|eta|, cos th2 = |eta1|/|eta| eta2/eta1", format!("holds for the [0,pi] root (max error {e46:.1e}); when eta1 < 0 cos th2 = -eta2/|eta| (sign flips correctly). At the stable equilibrium the true values are (cos, sin) = -(eta2, eta1)/|eta|, which differ whenever eta1 > 0"), e46 < 1e-12));
+        f.push(finding("Eq. 47", "K(L3, th1) at equilibrium", format!("algebraically = -sign(eta1) (L/2) sqrt(eta1^2+eta2^2): K at the [0,pi] root (max rel. error {e47:.1e}); NEGATIVE (unstable) at {neg}/{tot} sample inputs. Stable stiffness: K = (L/2) sqrt(eta1^2+eta2^2) = L sqrt(K1^2+K1K2+K2^2) |D1 - D1*|"), e47 < 1e-12));
+    }
+
+    // Eq. 49, 52
+    {
+        let (mut e49p, mut e49d) = (0.0f64, 0.0f64);
+        let (mut e52, mut e52_other) = (0.0f64, 0.0f64);
+        let mut e52_neg: f64 = 0.0;
+        for &(l3, t1) in &pts {
+            for e in equilibria(p, l3, t1) {
+                e49p = e49p.max((stiffness_eq49_as_printed(p, e.x, e.y, e.theta2) - e.stiffness).abs() / scale_u);
+                e49d = e49d.max((stiffness_xy_derived(p, e.x, e.y, e.theta2) - e.stiffness).abs() / scale_u);
+                // Eq. 52 root: which equilibrium does it pick?
+                let t52 = theta2_eq52(p, e.x, e.y);
+                let same = wrap_angle(t52 - e.theta2).abs() < 1e-6;
+                let v = stiffness_eq52(p, e.x, e.y);
+                if same {
+                    e52 = e52.max((v - e.stiffness).abs() / scale_u);
+                    e52_neg = e52_neg.max((v + e.stiffness).abs() / scale_u);
+                } else {
+                    e52_other = e52_other.max(1.0);
+                }
+            }
+        }
+        f.push(finding("Eq. 49", "K = [(2K1-K2)L^2 + (K1/2+K2)Lx - sqrt3/2 K1Ly] cos th2 + [...] sin th2 - (K1/2+K2)L^2",
+            format!("wrong: max |K_eq49 - K|/((K1+K2)L^2) = {e49p:.3}. Corrected: K = -[(2K1-K2)L^2 + (K1/2+K2)Lx + sqrt3/2 K1Ly] cos th2 - [(K1/2+K2)Ly - sqrt3/2 K1Lx + sqrt3K2L^2] sin th2 + (K1/2+K2)L^2 (error {e49d:.1e}); i.e. overall sign and the y-term sign, constant term is +(K1/2+K2)L^2"),
+            e49p < 1e-9));
+        f.push(finding("Eq. 52", "K(x, y) closed form",
+            format!("the th2 = 2atan((delta2 + sqrt(delta1^2+delta2^2-3K1^2L^2))/(sqrt3K1L - delta1)) root is a correct root of Eq. 48 (picks one of the two IK branches); but it inherits Eq. 49's errors: |K_eq52 - K|/((K1+K2)L^2) up to {e52:.3}, |K_eq52 + K| up to {e52_neg:.3} on the equilibria it selects. Use stiffness_xy_derived at the root"),
+            e52 < 1e-9));
+    }
+
+    // Figs 4-6 and Fig 7 claims
+    {
+        let q = Params::PAPER_FIG4;
+        let [mn, mx] = equilibria(&q, PAPER_FIG4_L3, PAPER_FIG4_THETA1);
+        let th2_0 = mn.theta2 - FRAC_PI_2;
+        f.push(finding("Figs. 4-6", "L=1, L3=6, K1=100, K2=10, th1=pi/10 ('th2 = pi/10' in captions is a typo): stable equilibrium th2_m with K maximal; K=0 at th2_0; range [th2_0, pi]",
+            format!("th2_m = {:.6} rad ({:.3} deg), U_min = {:.4} J, K_max = {:.4} N*m/rad; unstable th2 = {:.6} rad, U_max = {:.4} J; K = 0 at th2_0 = th2_m - pi/2 = {th2_0:.6} rad (and th2_m + pi/2 - 2pi = {:.6} rad)",
+                mn.theta2, mn.theta2.to_degrees(), mn.energy, mn.stiffness, mx.theta2, mx.energy, wrap_angle(mn.theta2 + FRAC_PI_2)),
+            mn.stable));
+        let w = Params::PAPER_WORKSPACE;
+        let c = neutral_point(&w);
+        let axis = wrap_angle((-c.y).atan2(-c.x));
+        f.push(finding("Fig. 7 text", "stiffness distribution approximately symmetric about th1 = 0.3; stiffness increases with L3",
+            format!("|K| = L sqrt(K1^2+K1K2+K2^2) |D1 - D1*| with D1* = ({:.4},{:.4}) m, so |K| is EXACTLY symmetric about th1 = {axis:.4} rad (the direction opposite D1*), not 0.3; it increases with L3 for every th1 in [0,pi] (holds). Note the paper's FK gives the negative (unstable) value of K wherever eta1 > 0", c.x, c.y),
+            false));
+    }
+    f
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use proptest::prelude::*;
+
+    const P: Params = Params::PAPER_WORKSPACE;
+
+    /// Deterministic 64-bit LCG (Knuth MMIX constants) -> uniform [0, 1).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next_f64(&mut self) -> f64 {
+            self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    #[test]
+    fn validate_rejects_bad_params() {
+        assert!(P.validate().is_ok());
+        assert!(Params { l: 0.0, ..P }.validate().is_err());
+        assert!(Params { k1: -1.0, ..P }.validate().is_err());
+        assert!(Params { k2: f64::NAN, ..P }.validate().is_err());
+        assert!(Params { l: f64::INFINITY, ..P }.validate().is_err());
+    }
+
+    proptest! {
+        #[test]
+        fn energy_eq4_equals_spring_energy(l in 0.1f64..3.0, k1 in 1.0f64..500.0, k2 in 1.0f64..500.0,
+                                           l3 in 0.0f64..8.0, t1 in -4.0f64..4.0, t2 in -4.0f64..4.0) {
+            let p = Params { l, k1, k2 };
+            let u = potential_energy(&p, l3, t1, t2);
+            let u4 = potential_energy_eq4(&p, l3, t1, t2);
+            prop_assert!((u - u4).abs() <= 1e-12 * (k1 + k2) * (l + l3).powi(2) + 1e-12);
+        }
+
+        #[test]
+        fn torque_and_stiffness_match_central_differences(l3 in 0.0f64..6.0, t1 in 0.0f64..3.2, t2 in -3.2f64..3.2) {
+            let h = 1e-5;
+            let fd_tau = (potential_energy(&P, l3, t1, t2 + h) - potential_energy(&P, l3, t1, t2 - h)) / (2.0 * h);
+            let fd_k = (torque(&P, l3, t1, t2 + h) - torque(&P, l3, t1, t2 - h)) / (2.0 * h);
+            let sc = (P.k1 + P.k2) * (P.l + l3).powi(2);
+            prop_assert!((fd_tau - torque(&P, l3, t1, t2)).abs() < 1e-7 * sc);
+            prop_assert!((fd_k - stiffness(&P, l3, t1, t2)).abs() < 1e-7 * sc);
+            prop_assert!((torque_eq41(&P, l3, t1, t2) - torque(&P, l3, t1, t2)).abs() < 1e-11 * sc);
+            prop_assert!((stiffness_eq42(&P, l3, t1, t2) - stiffness(&P, l3, t1, t2)).abs() < 1e-11 * sc);
+        }
+    }
+
+    #[test]
+    fn nodes_form_equilateral_triangles() {
+        let n = nodes(&P, 1.3, 0.7, -2.1);
+        assert_relative_eq!((n.d1 - n.d2).norm(), 1.0, epsilon = 1e-14);
+        assert_relative_eq!((n.d2 - n.d3).norm(), 1.0, epsilon = 1e-14);
+        assert_relative_eq!((n.d1 - n.d3).norm(), 1.0, epsilon = 1e-14);
+        assert_relative_eq!((n.c2 - n.c3).norm(), 2.0, epsilon = 1e-14);
+        assert_relative_eq!((n.c1 - n.c3).norm(), 2.0, epsilon = 1e-14);
+        let (a, b) = spring_lengths(&P, 1.3, 0.7, -2.1);
+        assert_relative_eq!(a, (n.d2 - n.c2).norm());
+        assert_relative_eq!(b, (n.d3 - n.c3).norm());
+    }
+
+    #[test]
+    fn eta_is_twice_eq4_coefficients_over_l() {
+        let p = Params { l: 0.7, k1: 30.0, k2: 55.0 };
+        let e = energy_coefficients_eq4(&p, 1.1, 2.3);
+        let (e1, e2) = eta(&p, 1.1, 2.3);
+        assert_relative_eq!(e1, 2.0 * e.b / p.l, max_relative = 1e-13);
+        assert_relative_eq!(e2, 2.0 * e.a / p.l, max_relative = 1e-13);
+    }
+
+    #[test]
+    fn equilibria_have_zero_torque_and_minimum_has_positive_stiffness() {
+        let mut rng = Lcg(7);
+        for _ in 0..300 {
+            let l3 = 3.0 * rng.next_f64();
+            let t1 = PI * rng.next_f64();
+            let [mn, mx] = equilibria(&P, l3, t1);
+            let sc = (P.k1 + P.k2) * (1.0 + l3).powi(2);
+            assert!(torque(&P, l3, t1, mn.theta2).abs() < 1e-12 * sc);
+            assert!(torque(&P, l3, t1, mx.theta2).abs() < 1e-12 * sc);
+            assert!(mn.stable && mn.stiffness > 0.0 && !mx.stable && mx.stiffness < 0.0);
+            assert!(mn.energy < mx.energy);
+            assert_relative_eq!(mn.stiffness, -mx.stiffness, max_relative = 1e-10);
+            assert_relative_eq!(mn.stiffness, stiffness_stable_closed_form(&P, l3, t1), max_relative = 1e-10);
+            assert!(mn.theta2 > -PI && mn.theta2 <= PI && mx.theta2 > -PI && mx.theta2 <= PI);
+            assert_relative_eq!(wrap_angle(mx.theta2 - mn.theta2).abs(), PI, epsilon = 1e-12);
+            // Energy minimum really is a minimum against a scan.
+            for k in 0..64 {
+                let t2 = -PI + TWO_PI * k as f64 / 64.0;
+                assert!(potential_energy(&P, l3, t1, t2) >= mn.energy - 1e-9 * sc);
+            }
+        }
+    }
+
+    #[test]
+    fn paper_fk_branch_is_minimum_iff_eta1_negative() {
+        for (l3, t1) in [(0.5, 1.0), (1.8, 0.05), (1.5, 0.2), (2.0, 2.5), (0.0, 0.0)] {
+            let (e1, _) = eta(&P, l3, t1);
+            let e = fk_paper(&P, l3, t1);
+            assert!(e.theta2 >= 0.0 && e.theta2 <= PI);
+            assert!(torque(&P, l3, t1, e.theta2).abs() < 1e-9);
+            assert_eq!(e.stable, e1 < 0.0, "l3={l3} t1={t1} eta1={e1}");
+            assert_relative_eq!(stiffness_eq47(&P, l3, t1), e.stiffness, max_relative = 1e-10);
+        }
+    }
+
+    #[test]
+    fn figs_4_to_6_example_numbers() {
+        let q = Params::PAPER_FIG4;
+        let [mn, mx] = equilibria(&q, PAPER_FIG4_L3, PAPER_FIG4_THETA1);
+        // Independent hand computation: eta1 = 120*6 sin18 - 100 sqrt3 *6 cos18 + 20 sqrt3,
+        // eta2 = 380 + 720 cos18 + 600 sqrt3 sin18; th2_m = atan2(-eta1, -eta2).
+        let s18 = (PI / 10.0).sin();
+        let c18 = (PI / 10.0).cos();
+        let e1 = 720.0 * s18 - 600.0 * SQRT_3 * c18 + 20.0 * SQRT_3;
+        let e2 = 380.0 + 720.0 * c18 + 600.0 * SQRT_3 * s18;
+        assert_relative_eq!(e1, -731.233_672_154_258_6, epsilon = 1e-9);
+        assert_relative_eq!(mn.theta2, (-e1).atan2(-e2), epsilon = 1e-12);
+        assert_relative_eq!(mn.theta2, 2.656_091_256_013_927, epsilon = 1e-12);
+        assert_relative_eq!(mn.stiffness, 0.5 * e1.hypot(e2), max_relative = 1e-12);
+        assert_relative_eq!(mn.stiffness, 783.489_483_054_247_6, epsilon = 1e-9);
+        assert!(mn.stable && !mx.stable);
+        // Paper's [0, pi] FK gives the same (stable) root here because eta1 < 0.
+        let pk = fk_paper(&q, PAPER_FIG4_L3, PAPER_FIG4_THETA1);
+        assert_relative_eq!(pk.theta2, mn.theta2, epsilon = 1e-12);
+        // K = 0 at th2_0 = th2_m - pi/2, inside [0, pi].
+        let th2_0 = mn.theta2 - FRAC_PI_2;
+        assert!(stiffness(&q, PAPER_FIG4_L3, PAPER_FIG4_THETA1, th2_0).abs() < 1e-9);
+        assert!(th2_0 > 0.0 && th2_0 < PI);
+    }
+
+    fn check_round_trip(p: &Params, seed: u64, l3_max: f64, n: usize) -> (usize, f64) {
+        let mut rng = Lcg(seed);
+        let mut worst: f64 = 0.0;
+        let mut tested = 0;
+        for i in 0..n {
+            let l3 = 0.02 * p.l + (l3_max - 0.02 * p.l) * rng.next_f64();
+            let t1 = PI * rng.next_f64();
+            let e = equilibria(p, l3, t1)[i % 2];
+            let sols = inverse_kinematics(p, e.x, e.y);
+            assert!(!sols.is_empty() && sols.len() <= 2);
+            for s in &sols {
+                assert!(s.l3 >= 0.0 && s.theta1 >= 0.0 && s.theta1 <= PI);
+                let eqs = equilibria(p, s.l3, s.theta1);
+                let err = eqs.iter().map(|q| (q.x - e.x).hypot(q.y - e.y)).fold(f64::INFINITY, f64::min);
+                assert!(err < 1e-10, "IK solution not verified: {err}");
+            }
+            let best = sols
+                .iter()
+                .map(|s| (s.l3 - l3).abs().max((s.theta1 - t1).abs()))
+                .fold(f64::INFINITY, f64::min);
+            let m = sols.iter().find(|s| (s.l3 - l3).abs().max((s.theta1 - t1).abs()) == best).unwrap();
+            assert_eq!(m.stable, e.stable);
+            worst = worst.max(best);
+            tested += 1;
+        }
+        (tested, worst)
+    }
+
+    #[test]
+    fn fk_ik_round_trip_200_random_points() {
+        let (n, worst) = check_round_trip(&P, 12345, 2.0, 200);
+        assert_eq!(n, 200);
+        assert!(worst < 1e-10, "worst round-trip deviation {worst}");
+        let (n, worst) = check_round_trip(&Params::PAPER_FIG4, 999, 8.0, 200);
+        assert_eq!(n, 200);
+        assert!(worst < 1e-10, "worst round-trip deviation {worst}");
+    }
+
+    #[test]
+    fn ik_solutions_are_verified_by_fk_on_a_cartesian_grid() {
+        let mut count = 0;
+        for i in -12..=12 {
+            for j in -12..=12 {
+                let (x, y) = (0.25 * i as f64, 0.25 * j as f64);
+                for s in inverse_kinematics(&P, x, y) {
+                    let e = equilibria(&P, s.l3, s.theta1);
+                    let m = e.iter().find(|q| (q.x - x).hypot(q.y - y) < 1e-10).expect("verified");
+                    assert_relative_eq!(m.theta2, s.theta2, epsilon = 1e-12);
+                    assert_eq!(m.stable, s.stable);
+                    count += 1;
+                }
+            }
+        }
+        assert!(count > 100, "only {count} solutions");
+    }
+
+    #[test]
+    fn paper_ik_route_with_appendix_a_reproduces_ik() {
+        let mut rng = Lcg(4242);
+        for _ in 0..50 {
+            let l3 = 0.1 + 1.9 * rng.next_f64();
+            let t1 = 0.05 + 3.0 * rng.next_f64();
+            let e = equilibria(&P, l3, t1)[0];
+            let a = phi_coefficients_appendix_a(&P, e.x, e.y);
+            let d = phi_coefficients_derived(&P, e.x, e.y);
+            let sc = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for k in 0..4 {
+                assert!((a[k] - d[k]).abs() < 1e-10 * sc, "phi{} mismatch", k + 1);
+            }
+            assert!(bezout_eq13(&P, e.x, e.y, t1).abs() < 1e-9 * d[3].abs().max(1.0));
+            assert_relative_eq!(l3_eq14(&P, e.x, e.y, t1), l3, epsilon = 1e-8);
+            let c = inverse_kinematics_eq16(&P, e.x, e.y, a);
+            assert!(c.iter().any(|&(cl, ct)| (cl - l3).abs() < 1e-7 && (ct - t1).abs() < 1e-7));
+            // printed F3 (without sqrt3) breaks Eq. 11
+            let [f1, f2, _] = f_coefficients_eq12(&P, e.x, e.y, t1);
+            let r = f1 * l3 * l3 + f2 * l3 + f3_eq12_as_printed(&P, e.x, e.y);
+            let r_ok = f1 * l3 * l3 + f2 * l3 + f_coefficients_eq12(&P, e.x, e.y, t1)[2];
+            assert!(r_ok.abs() < 1e-9 * P.k1);
+            if e.x.abs() > 0.05 {
+                assert!(r.abs() > 1e-3 * P.k1);
+            }
+        }
+    }
+
+    #[test]
+    fn jacobian_matches_finite_differences_of_fk() {
+        let h = 1e-6;
+        let mut rng = Lcg(31);
+        for _ in 0..100 {
+            let l3 = 0.1 + 1.9 * rng.next_f64();
+            let t1 = 0.05 + 3.0 * rng.next_f64();
+            for b in 0..2 {
+                let fk = |a: f64, t: f64| {
+                    let e = equilibria(&P, a, t)[b];
+                    Vector2::new(e.x, e.y)
+                };
+                let j = jacobian(&P, l3, t1, equilibria(&P, l3, t1)[b].theta2);
+                let c1 = (fk(l3 + h, t1) - fk(l3 - h, t1)) / (2.0 * h);
+                let c2 = (fk(l3, t1 + h) - fk(l3, t1 - h)) / (2.0 * h);
+                let jf = Matrix2::from_columns(&[c1, c2]);
+                assert!((j - jf).abs().max() < 1e-6 * (1.0 + j.abs().max()), "J={j} fd={jf}");
+                let th2 = equilibria(&P, l3, t1)[b].theta2;
+                let dj = det_jacobian(&P, l3, t1, th2);
+                assert_relative_eq!(dj, det_jacobian_closed_form(&P, l3, t1, th2), epsilon = 1e-10, max_relative = 1e-10);
+                assert_relative_eq!(dj, det_jacobian_eq23_corrected(&P, l3, t1, th2).unwrap(), epsilon = 1e-9, max_relative = 1e-9);
+                let (a1, b1) = dtheta2_dinputs(&P, l3, t1, th2);
+                let (a2, b2) = dtheta2_dinputs_eq22(&P, l3, t1, th2);
+                assert_relative_eq!(a1, a2, epsilon = 1e-9, max_relative = 1e-9);
+                assert_relative_eq!(b1, b2, epsilon = 1e-9, max_relative = 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn printed_det_eq23_differs_but_corrected_matches() {
+        let (l3, t1) = (1.5, 1.0);
+        let th2 = equilibria(&P, l3, t1)[0].theta2;
+        let dj = det_jacobian(&P, l3, t1, th2);
+        let pr = det_jacobian_eq23(&P, l3, t1, th2).unwrap();
+        assert!((pr - dj).abs() > 1e-2 * dj.abs().max(1e-3));
+        // At L3 = L the spurious factor L3/L = 1 makes them agree.
+        let th2b = equilibria(&P, 1.0, t1)[0].theta2;
+        assert_relative_eq!(det_jacobian_eq23(&P, 1.0, t1, th2b).unwrap(), det_jacobian(&P, 1.0, t1, th2b), max_relative = 1e-9);
+    }
+
+    #[test]
+    fn det_j_is_zero_on_curve_v_and_finite_on_curve_iii() {
+        let c = neutral_point(&P);
+        let (e1, e2) = eta(&P, c.norm(), c.y.atan2(c.x));
+        assert!(e1.abs() < 1e-10 && e2.abs() < 1e-10);
+        let rad = P.l * (P.k1 + 2.0 * P.k2) / (2.0 * (P.k1 * P.k1 + P.k1 * P.k2 + P.k2 * P.k2).sqrt());
+        let d1 = c + rad * Vector2::new(1.2f64.cos(), 1.2f64.sin());
+        let (l3, t1) = (d1.norm(), d1.y.atan2(d1.x));
+        assert!(curve_v_eq30(&P, l3, t1).abs() < 1e-8);
+        let st = equilibria(&P, l3, t1)[0];
+        assert!(det_jacobian(&P, l3, t1, st.theta2).abs() < 1e-10);
+        assert!(phi1(&P, l3, t1, st.theta2).abs() < 1e-6 * phi2(&P, l3, t1).abs().max(1.0) + 1e-3);
+        // curve iii: eta1 = 0 at L3 = 2, th1 from bisection -> det J finite
+        let (mut lo, mut hi) = (0.0, FRAC_PI_2);
+        for _ in 0..100 {
+            let m = 0.5 * (lo + hi);
+            if curve_iii_eq28(&P, 2.0, lo) * curve_iii_eq28(&P, 2.0, m) <= 0.0 { hi = m } else { lo = m }
+        }
+        for e in equilibria(&P, 2.0, lo) {
+            let dj = det_jacobian(&P, 2.0, lo, e.theta2);
+            assert!(dj.is_finite() && dj.abs() < 10.0);
+            assert!(curve_iii_cartesian(&P, e.x, e.y, e.theta2.abs() > FRAC_PI_2).abs() < 1e-9 * P.k1);
+            assert!(curve_iii_eq36_as_printed(&P, e.x, e.y).abs() > 1.0);
+        }
+    }
+
+    #[test]
+    fn curve_iv_is_theta1_equals_theta2_but_not_radius_3l() {
+        for t1 in [0.05, 0.2, 0.4] {
+            let l3 = curve_iv_l3(&P, t1);
+            assert!(l3 > 0.0);
+            assert!(curve_iv_eq33(&P, l3, t1).abs() < 1e-10);
+            let hit = equilibria(&P, l3, t1).into_iter().find(|e| wrap_angle(e.theta2 - t1).abs() < 1e-9).unwrap();
+            assert_relative_eq!(hit.x.hypot(hit.y), l3 + P.l, epsilon = 1e-12);
+            assert!(curve_iv_cartesian(&P, hit.x, hit.y).abs() < 1e-9 * P.k1);
+            assert!(curve_iv_eq37_as_printed(&P, hit.x, hit.y).abs() > 1.0);
+            assert!(det_jacobian(&P, l3, t1, hit.theta2).abs() > 1e-3);
+            // the stable equilibrium is th2 = th1 + pi here, |D3| = L - L3, same Cartesian curve
+            let st = equilibria(&P, l3, t1)[0];
+            assert_relative_eq!(wrap_angle(st.theta2 - t1 - PI), 0.0, epsilon = 1e-9);
+            assert_relative_eq!(st.x.hypot(st.y), P.l - l3, epsilon = 1e-12);
+            assert!(curve_iv_cartesian(&P, st.x, st.y).abs() < 1e-9 * P.k1);
+        }
+    }
+
+    #[test]
+    fn stiffness_xy_forms() {
+        let mut rng = Lcg(77);
+        for _ in 0..50 {
+            let l3 = 0.1 + 1.9 * rng.next_f64();
+            let t1 = 0.05 + 3.0 * rng.next_f64();
+            for e in equilibria(&P, l3, t1) {
+                assert_relative_eq!(stiffness_xy_derived(&P, e.x, e.y, e.theta2), e.stiffness, epsilon = 1e-9, max_relative = 1e-10);
+                assert!(equilibrium_residual_eq48(&P, e.x, e.y, e.theta2).abs() < 1e-10 * P.k1);
+                let t52 = theta2_eq52(&P, e.x, e.y);
+                assert!(equilibrium_residual_eq48(&P, e.x, e.y, t52).abs() < 1e-9 * P.k1);
+            }
+        }
+        // printed Eq. 49 is off
+        let e = equilibria(&P, 1.2, 1.0)[0];
+        assert!((stiffness_eq49_as_printed(&P, e.x, e.y, e.theta2) - e.stiffness).abs() > 1.0);
+    }
+
+    #[test]
+    fn derivative_identities_eq43_to_45() {
+        let (l3, t1) = (1.3, 0.9);
+        let e = energy_coefficients_eq4(&P, l3, t1);
+        for t2 in [-2.0, 0.4, 1.7] {
+            let h = 1e-4;
+            let dk = (stiffness(&P, l3, t1, t2 + h) - stiffness(&P, l3, t1, t2 - h)) / (2.0 * h);
+            assert_relative_eq!(dk, -torque(&P, l3, t1, t2), epsilon = 1e-5);
+            let d2k = (stiffness(&P, l3, t1, t2 + h) - 2.0 * stiffness(&P, l3, t1, t2) + stiffness(&P, l3, t1, t2 - h)) / (h * h);
+            assert_relative_eq!(d2k, -stiffness(&P, l3, t1, t2), epsilon = 1e-2);
+            // j = 0 only up to the constant U0
+            assert_relative_eq!(potential_energy(&P, l3, t1, t2) + stiffness(&P, l3, t1, t2), e.u0, max_relative = 1e-12);
+        }
+    }
+
+    #[test]
+    fn findings_report_expected_verdicts() {
+        let fs = findings(&P);
+        let get = |eq: &str| fs.iter().find(|f| f.equation == eq).unwrap_or_else(|| panic!("missing {eq}"));
+        assert!(get("Eq. 4").holds);
+        assert!(get("Eq. 5-7").holds);
+        assert!(!get("Eq. 5 (range 0<=th2<=pi)").holds);
+        assert!(!get("Eq. 11-12").holds);
+        assert!(get("Eq. 13-14").holds);
+        assert!(get("Eq. 15-16, Appendix A (C.1-C.4)").holds);
+        assert!(get("Eq. 17-21").holds);
+        assert!(get("Eq. 22").holds);
+        assert!(!get("Eq. 23-25").holds);
+        assert!(!get("Eq. 28 (curve iii, eta1 = 0)").holds);
+        assert!(get("Eq. 30 (curve v, Phi1 = 0)").holds);
+        assert!(!get("Eq. 36 (curve iii, Cartesian)").holds);
+        assert!(!get("Eq. 37 (curve iv, Cartesian)").holds);
+        assert!(get("Eq. 41").holds && get("Eq. 42").holds);
+        assert!(get("Eq. 43").holds && !get("Eq. 44").holds && get("Eq. 45").holds);
+        assert!(get("Eq. 46").holds && get("Eq. 47").holds);
+        assert!(!get("Eq. 49").holds && !get("Eq. 52").holds);
+        assert!(get("Sec. 6.1 claim").holds);
+        assert!(get("Figs. 4-6").holds);
+        for f in &fs {
+            println!("[{}] {} | {} | {}", if f.holds { "HOLDS" } else { "FAILS" }, f.equation, f.claim, f.measured);
+        }
+    }
+}

@@ -1,0 +1,111 @@
+//! ji2014 parameters -> the generic structure.
+//!
+//! Bodies: the fixed base triangle C1C2C3; the actuator, an ideal RP chain from C1 (a housing
+//! turned by the angle actuator theta1 about z at C1, and a rod slid by the length actuator L3
+//! along the housing); the mobile triangle D1D2D3, a rigid body pivoting about z at D1 on the
+//! rod's tip. Springs K1 (D2-C2) and K2 (D3-C3) have zero free length (Section 2). The revolute
+//! joints about z keep the motion in the plane.
+
+use super::analytic::{self, Params};
+use crate::structure::{
+    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Strut, Structure,
+};
+
+/// Model choices that the paper does not give (defaults in `Ji2014::params`).
+#[derive(Clone, Copy, Debug)]
+pub struct ModelChoices {
+    /// Mass of the mobile triangle [kg], three equal point masses at its nodes.
+    pub platform_mass_kg: f64,
+    /// Viscous damping of the pivot at D1 [N m s/rad].
+    pub pivot_damping: f64,
+    /// Strut radius for drawing and interference [m].
+    pub strut_radius_m: f64,
+}
+
+/// Nominal mass of the actuator's kinematic bodies [kg]: they are placed, not integrated, so
+/// the value never enters the dynamics; rapier only needs it positive.
+const ACTUATOR_BODY_MASS_KG: f64 = 1.0;
+
+pub fn build(p: &Params, m: &ModelChoices, l3: f64, theta1: f64, theta2: f64) -> Structure {
+    let nodes = analytic::nodes(p, l3, theta1, theta2);
+    let xyz = |v: nalgebra::Vector2<f64>| [v.x, v.y, 0.0];
+    let mut s = Structure { name: "ji2014".into(), gravity: [0.0; 3], ..Default::default() };
+    let nominal = Some(Inertia {
+        mass_kg: ACTUATOR_BODY_MASS_KG,
+        com: [0.0; 3],
+        principal_kg_m2: [ACTUATOR_BODY_MASS_KG; 3],
+    });
+    let ground = s.add_body("base", BodyKind::Fixed, None);
+    let housing = s.add_body("actuator_housing", BodyKind::Free, nominal);
+    let rod = s.add_body("actuator_rod", BodyKind::Free, nominal);
+    // Three point masses m/3 at the vertices of an equilateral triangle of side L:
+    // I_z = m L^2 / 3 about the centroid, I_x = I_y = m L^2 / 6.
+    let centroid = (nodes.d1 + nodes.d2 + nodes.d3) / 3.0;
+    let ml2 = m.platform_mass_kg * p.l * p.l;
+    let platform = s.add_body(
+        "platform",
+        BodyKind::Free,
+        Some(Inertia {
+            mass_kg: m.platform_mass_kg,
+            com: xyz(centroid),
+            principal_kg_m2: [ml2 / 6.0, ml2 / 6.0, ml2 / 3.0],
+        }),
+    );
+    let c1 = s.add_node("C1", ground, xyz(nodes.c1));
+    let c2 = s.add_node("C2", ground, xyz(nodes.c2));
+    let c3 = s.add_node("C3", ground, xyz(nodes.c3));
+    let tip = s.add_node("L3_tip", rod, xyz(nodes.d1));
+    let d1 = s.add_node("D1", platform, xyz(nodes.d1));
+    let d2 = s.add_node("D2", platform, xyz(nodes.d2));
+    let d3 = s.add_node("D3", platform, xyz(nodes.d3));
+    let r = m.strut_radius_m;
+    for (name, a, b) in [
+        ("C1C2", c1, c2),
+        ("C2C3", c2, c3),
+        ("C1C3", c1, c3),
+        ("D1D2", d1, d2),
+        ("D2D3", d2, d3),
+        ("D1D3", d1, d3),
+    ] {
+        s.struts.push(Strut { name: name.into(), a, b, radius_m: r });
+    }
+    if l3 > 0.0 {
+        s.struts.push(Strut { name: "C1D1 (actuator L3)".into(), a: c1, b: tip, radius_m: r });
+    }
+    s.springs.push(Spring { name: "K1".into(), a: d2, b: c2, stiffness_n_per_m: p.k1, rest_length_m: 0.0 });
+    s.springs.push(Spring { name: "K2".into(), a: d3, b: c3, stiffness_n_per_m: p.k2, rest_length_m: 0.0 });
+    let z = [0.0, 0.0, 1.0];
+    s.joints.push(Joint {
+        name: "theta1".into(),
+        kind: JointKind::Revolute { axis: z },
+        parent: ground,
+        child: housing,
+        anchor: c1,
+        initial_coordinate: theta1,
+        torsion_spring: None,
+        damping: 0.0,
+    });
+    s.joints.push(Joint {
+        name: "L3".into(),
+        kind: JointKind::Prismatic { axis: [theta1.cos(), theta1.sin(), 0.0] },
+        parent: housing,
+        child: rod,
+        anchor: c1,
+        initial_coordinate: l3,
+        torsion_spring: None,
+        damping: 0.0,
+    });
+    s.joints.push(Joint {
+        name: "D1".into(),
+        kind: JointKind::Revolute { axis: z },
+        parent: rod,
+        child: platform,
+        anchor: d1,
+        initial_coordinate: theta2,
+        torsion_spring: None,
+        damping: m.pivot_damping,
+    });
+    s.actuators.push(Actuator { symbol: "L3".into(), target: ActuatorTarget::Joint(1) });
+    s.actuators.push(Actuator { symbol: "theta1".into(), target: ActuatorTarget::Joint(0) });
+    s
+}

@@ -1,0 +1,167 @@
+//! The built-in mechanisms. Each one lives in its own folder: `analytic.rs` (the paper's model,
+//! pure functions) and `build.rs` (parameters -> [`Structure`]); `mod.rs` ties them to the
+//! [`Mechanism`] trait that the rest of the testbed uses.
+
+pub mod ji2014;
+
+use crate::sim::Snapshot;
+use crate::structure::Structure;
+use std::collections::BTreeMap;
+
+/// Named values keyed by the paper's symbols (SI units unless a spec says otherwise).
+pub type Values = BTreeMap<String, f64>;
+
+/// Whether a parameter comes from the paper or is a choice of the dynamic model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Origin {
+    Paper,
+    /// Not in the paper: a plausible value chosen for the simulation (documented in `source`).
+    ModelChoice,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct ParamSpec {
+    pub symbol: &'static str,
+    pub unit: &'static str,
+    pub default: f64,
+    pub description: &'static str,
+    pub origin: Origin,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct InputSpec {
+    pub symbol: &'static str,
+    pub unit: &'static str,
+    pub description: &'static str,
+}
+
+/// How errors of a quantity are normalised for the relative error.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum QuantityKind {
+    /// Divided by the mechanism's characteristic length.
+    Length,
+    /// Angles: the error is wrapped to (-pi, pi] and taken as is (rad).
+    Angle,
+    /// Divided by the magnitude of the analytic value (forces, stiffness, energy).
+    Magnitude,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct QuantitySpec {
+    pub symbol: &'static str,
+    pub unit: &'static str,
+    pub kind: QuantityKind,
+    pub description: &'static str,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct QuerySpec {
+    pub name: &'static str,
+    pub inputs: &'static [&'static str],
+    pub description: &'static str,
+}
+
+/// One result of an analytic query: one branch, root or solution.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Solution {
+    pub label: String,
+    pub values: Values,
+    /// Stability of the equilibrium, where that applies.
+    pub stable: Option<bool>,
+}
+
+/// The analytic quasi-static prediction for one set of inputs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prediction {
+    /// The branch the dynamics is expected to reach (the stable one), keyed by quantity.
+    pub expected: Values,
+    /// Every branch, for identifying which one the dynamics landed on.
+    pub branches: Vec<Solution>,
+}
+
+/// A printed equation checked against the testbed's derivation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Finding {
+    pub equation: String,
+    pub claim: String,
+    pub measured: String,
+    pub holds: bool,
+}
+
+/// A small load applied to a body to measure a stiffness in the simulation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StiffnessProbe {
+    /// Body that carries the load.
+    pub body: String,
+    /// Torque axis (world) [unit vector].
+    pub torque_axis: [f64; 3],
+    /// The coordinate whose change is measured (a simulated quantity, rad).
+    pub coordinate: String,
+    /// The analytic quantity to compare dtau/dq with (N m/rad).
+    pub analytic: String,
+}
+
+/// A mechanism from a paper: its analytic model and how to build it for the simulator.
+pub trait Mechanism: Send + Sync {
+    fn name(&self) -> &'static str;
+    fn title(&self) -> &'static str;
+    fn params(&self) -> &'static [ParamSpec];
+    fn inputs(&self) -> &'static [InputSpec];
+    fn quantities(&self) -> &'static [QuantitySpec];
+    fn queries(&self) -> &'static [QuerySpec];
+    /// Checks parameter values; the message names the parameter and the accepted range.
+    fn validate_params(&self, params: &Values) -> Result<(), (String, String)>;
+    /// Checks one set of inputs against the parameters; `Err((symbol, message))`.
+    fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), (String, String)>;
+    /// The analytic model alone: every result of `query`.
+    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String>;
+    /// The structure at `inputs`, with the free coordinates started from `start` (symbols of
+    /// free coordinates; missing ones take the mechanism's default start).
+    fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, String>;
+    /// Actuator commands for `inputs`, in the structure's actuator order.
+    fn commands(&self, params: &Values, inputs: &Values) -> Vec<f64>;
+    /// The analytic prediction for `inputs`.
+    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String>;
+    /// The simulated quantities read off a snapshot.
+    fn observe(&self, params: &Values, structure: &Structure, snap: &Snapshot) -> Values;
+    /// Characteristic length [m] used to normalise length errors.
+    fn length_scale(&self, params: &Values) -> f64;
+    /// Analytic node positions (structure order) at the expected equilibrium, for the ghost
+    /// overlay of recordings.
+    fn analytic_nodes(&self, _params: &Values, _inputs: &Values) -> Option<Vec<[f64; 3]>> {
+        None
+    }
+    fn stiffness_probe(&self) -> Option<StiffnessProbe> {
+        None
+    }
+    /// Every printed equation checked against the derivation.
+    fn findings(&self, params: &Values) -> Vec<Finding>;
+}
+
+/// All built-in mechanisms.
+pub fn registry() -> Vec<Box<dyn Mechanism>> {
+    vec![Box::new(ji2014::Ji2014)]
+}
+
+pub fn find(name: &str) -> Option<Box<dyn Mechanism>> {
+    registry().into_iter().find(|m| m.name() == name)
+}
+
+/// The parameter values: the defaults overridden by `given`.
+pub fn with_defaults(m: &dyn Mechanism, given: &Values) -> Values {
+    let mut out: Values = m.params().iter().map(|p| (p.symbol.to_string(), p.default)).collect();
+    for (k, v) in given {
+        out.insert(k.clone(), *v);
+    }
+    out
+}
+
+/// Wraps an angle difference to (-pi, pi].
+pub fn wrap_angle(a: f64) -> f64 {
+    let two_pi = std::f64::consts::TAU;
+    let mut r = a.rem_euclid(two_pi);
+    if r > std::f64::consts::PI {
+        r -= two_pi;
+    }
+    r
+}

@@ -1,0 +1,112 @@
+//! Analytic versus simulated, tick by tick and at the settle points.
+
+use super::{Observer, Tick};
+use crate::mechanisms::{wrap_angle, QuantityKind};
+use crate::report::CheckReport;
+use crate::scenario::Check;
+
+/// Error of `simulated` against `analytic` for a quantity: (absolute, normalised).
+/// Lengths are normalised by `length_scale`, angles are wrapped and taken in rad, other
+/// quantities are divided by |analytic| (by 1 when the analytic value is zero).
+pub fn error(kind: QuantityKind, analytic: f64, simulated: f64, length_scale: f64) -> (f64, f64) {
+    match kind {
+        QuantityKind::Angle => {
+            let e = wrap_angle(simulated - analytic).abs();
+            (e, e)
+        }
+        QuantityKind::Length => {
+            let e = (simulated - analytic).abs();
+            (e, e / length_scale)
+        }
+        QuantityKind::Magnitude => {
+            let e = (simulated - analytic).abs();
+            let scale = if analytic != 0.0 { analytic.abs() } else { 1.0 };
+            (e, e / scale)
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+struct Accumulator {
+    check: Check,
+    settled_max_abs: f64,
+    settled_max_rel: f64,
+    settled_points: usize,
+    transient_max_abs: f64,
+    transient_sum_sq: f64,
+    ticks: u64,
+    missing: bool,
+}
+
+/// The comparison observer: accumulates errors per checked quantity.
+pub struct Compare {
+    acc: Vec<Accumulator>,
+    length_scale: f64,
+}
+
+impl Compare {
+    pub fn new(checks: &[Check], length_scale: f64) -> Self {
+        Compare {
+            acc: checks
+                .iter()
+                .map(|c| Accumulator {
+                    check: c.clone(),
+                    settled_max_abs: 0.0,
+                    settled_max_rel: 0.0,
+                    settled_points: 0,
+                    transient_max_abs: 0.0,
+                    transient_sum_sq: 0.0,
+                    ticks: 0,
+                    missing: false,
+                })
+                .collect(),
+            length_scale,
+        }
+    }
+
+    /// Records the errors at a settle point (settled or not: an unsettled point fails).
+    pub fn settle_point(&mut self, analytic: &crate::mechanisms::Values, simulated: &crate::mechanisms::Values, settled: bool) {
+        for a in &mut self.acc {
+            match (analytic.get(&a.check.quantity), simulated.get(&a.check.quantity)) {
+                (Some(&x), Some(&y)) => {
+                    let (abs, rel) = error(a.check.kind, x, y, self.length_scale);
+                    let (abs, rel) = if settled && abs.is_finite() { (abs, rel) } else { (f64::INFINITY, f64::INFINITY) };
+                    a.settled_max_abs = a.settled_max_abs.max(abs);
+                    a.settled_max_rel = a.settled_max_rel.max(rel);
+                    a.settled_points += 1;
+                }
+                _ => a.missing = true,
+            }
+        }
+    }
+
+    pub fn reports(&self) -> Vec<CheckReport> {
+        self.acc
+            .iter()
+            .map(|a| CheckReport {
+                quantity: a.check.quantity.clone(),
+                unit: a.check.unit.clone(),
+                max_abs_error: a.settled_max_abs,
+                max_rel_error: a.settled_max_rel,
+                tolerance: a.check.tolerance,
+                passed: !a.missing && a.settled_points > 0 && a.settled_max_rel <= a.check.tolerance,
+                transient_max_abs_error: a.transient_max_abs,
+                transient_rms_abs_error: if a.ticks > 0 { (a.transient_sum_sq / a.ticks as f64).sqrt() } else { 0.0 },
+                ticks_compared: a.ticks,
+            })
+            .collect()
+    }
+}
+
+impl Observer for Compare {
+    fn tick(&mut self, t: &Tick) {
+        for a in &mut self.acc {
+            if let (Some(&x), Some(&y)) = (t.prediction.expected.get(&a.check.quantity), t.simulated.get(&a.check.quantity)) {
+                let (abs, _) = error(a.check.kind, x, y, self.length_scale);
+                a.transient_max_abs = a.transient_max_abs.max(abs);
+                a.transient_sum_sq += abs * abs;
+                a.ticks += 1;
+            }
+        }
+    }
+}

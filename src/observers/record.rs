@@ -1,0 +1,150 @@
+//! Recording a run to a rerun `.rrd` file, headless.
+//!
+//! Entities: `structure/{nodes,struts,springs,cables}` (springs and cables coloured by force),
+//! `analytic/nodes` (the analytic prediction as a ghost overlay), `errors/<quantity>`,
+//! `forces/<member>`, `inputs/<symbol>`, `speed`, and `events` (text log). The scenario file
+//! and the report summary are stored as documents. Timelines: `tick` and `sim_time`.
+//! The file is written to `<path>.partial` and renamed when the run ends, so a reader never
+//! sees a half-written recording under the final name.
+
+use super::{Observer, Tick};
+use crate::mechanisms::wrap_angle;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    #[error("cannot record to {path}: {message}")]
+    Io { path: String, message: String },
+}
+
+pub struct Recorder {
+    rec: rerun::RecordingStream,
+    partial: PathBuf,
+    target: PathBuf,
+    every: u64,
+}
+
+fn f32x3(p: [f64; 3]) -> [f32; 3] {
+    [p[0] as f32, p[1] as f32, p[2] as f32]
+}
+
+/// Colour of a member by its force: blue in compression, red in tension, grey when slack.
+fn force_colour(force: f64, max_abs: f64) -> [u8; 4] {
+    if force == 0.0 {
+        return [150, 150, 150, 255];
+    }
+    let s = (force.abs() / max_abs.max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+    let c = (80.0 + 175.0 * s) as u8;
+    if force > 0.0 {
+        [c, 60, 60, 255]
+    } else {
+        [60, 60, c, 255]
+    }
+}
+
+impl Recorder {
+    /// Starts a recording that will be renamed to `path` by [`Recorder::finish`].
+    pub fn create(path: &Path, app: &'static str, every: u64) -> Result<Self, RecordError> {
+        let io = |e: String| RecordError::Io { path: path.display().to_string(), message: e };
+        if let Some(dir) = path.parent() {
+            if !dir.as_os_str().is_empty() {
+                std::fs::create_dir_all(dir).map_err(|e| io(e.to_string()))?;
+            }
+        }
+        let partial = path.with_extension("rrd.partial");
+        let rec = rerun::RecordingStreamBuilder::new(app)
+            .save(&partial)
+            .map_err(|e| io(e.to_string()))?;
+        Ok(Recorder { rec, partial, target: path.to_path_buf(), every: every.max(1) })
+    }
+
+    /// Stores a text document (static: it belongs to the whole run).
+    pub fn document(&mut self, entity: &str, text: &str) {
+        let _ = self.rec.log_static(entity, &rerun::TextDocument::new(text));
+    }
+
+    /// Flushes and moves the recording to its final name.
+    pub fn finish(self) -> Result<PathBuf, RecordError> {
+        self.rec.flush_blocking().map_err(|e| RecordError::Io {
+            path: self.target.display().to_string(),
+            message: e.to_string(),
+        })?;
+        drop(self.rec);
+        std::fs::rename(&self.partial, &self.target).map_err(|e| RecordError::Io {
+            path: self.target.display().to_string(),
+            message: e.to_string(),
+        })?;
+        Ok(self.target)
+    }
+}
+
+impl Observer for Recorder {
+    fn tick(&mut self, t: &Tick) {
+        let snap = t.snapshot;
+        if snap.tick % self.every != 0 {
+            return;
+        }
+        let s = t.structure;
+        let rec = &self.rec;
+        rec.set_time_sequence("tick", snap.tick as i64);
+        rec.set_duration_secs("sim_time", snap.time_s);
+        let pts: Vec<[f32; 3]> = snap.nodes.iter().map(|p| f32x3(*p)).collect();
+        let labels: Vec<String> = s.nodes.iter().map(|n| n.name.clone()).collect();
+        let _ = rec.log("structure/nodes", &rerun::Points3D::new(pts.clone()).with_labels(labels.clone()).with_radii([0.02f32]));
+        let strips = |pairs: Vec<(usize, usize)>| -> Vec<Vec<[f32; 3]>> { pairs.into_iter().map(|(a, b)| vec![pts[a], pts[b]]).collect() };
+        let _ = rec.log(
+            "structure/struts",
+            &rerun::LineStrips3D::new(strips(s.struts.iter().map(|m| (m.a, m.b)).collect()))
+                .with_radii(s.struts.iter().map(|m| m.radius_m as f32).collect::<Vec<_>>())
+                .with_colors([[200u8, 200, 200, 255]])
+                .with_labels(s.struts.iter().map(|m| m.name.clone()).collect::<Vec<_>>()),
+        );
+        let f = &snap.forces;
+        let max_f = f.spring_force_n.iter().chain(&f.cable_tension_n).fold(0.0f64, |m, x| m.max(x.abs()));
+        if !s.springs.is_empty() {
+            let _ = rec.log(
+                "structure/springs",
+                &rerun::LineStrips3D::new(strips(s.springs.iter().map(|m| (m.a, m.b)).collect()))
+                    .with_colors(f.spring_force_n.iter().map(|x| force_colour(*x, max_f)).collect::<Vec<_>>())
+                    .with_labels(s.springs.iter().map(|m| m.name.clone()).collect::<Vec<_>>()),
+            );
+        }
+        if !s.cables.is_empty() {
+            let _ = rec.log(
+                "structure/cables",
+                &rerun::LineStrips3D::new(strips(s.cables.iter().map(|m| (m.a, m.b)).collect()))
+                    .with_colors(f.cable_tension_n.iter().map(|x| force_colour(*x, max_f)).collect::<Vec<_>>())
+                    .with_labels(s.cables.iter().map(|m| m.name.clone()).collect::<Vec<_>>()),
+            );
+        }
+        if let Some(ghost) = t.ghost_nodes {
+            let g: Vec<[f32; 3]> = ghost.iter().map(|p| f32x3(*p)).collect();
+            let _ = rec.log("analytic/nodes", &rerun::Points3D::new(g.clone()).with_labels(labels).with_colors([[80u8, 220, 120, 160]]).with_radii([0.015f32]));
+            let ghost_struts: Vec<Vec<[f32; 3]>> = s.struts.iter().map(|m| vec![g[m.a], g[m.b]]).collect();
+            let _ = rec.log("analytic/struts", &rerun::LineStrips3D::new(ghost_struts).with_colors([[80u8, 220, 120, 120]]));
+        }
+        for (q, a) in &t.prediction.expected {
+            if let Some(sv) = t.simulated.get(q) {
+                let e = if q.starts_with("theta") { wrap_angle(sv - a) } else { sv - a };
+                let _ = rec.log(format!("errors/{q}"), &rerun::Scalars::single(e));
+            }
+        }
+        for (i, m) in s.springs.iter().enumerate() {
+            let _ = rec.log(format!("forces/spring/{}", m.name), &rerun::Scalars::single(f.spring_force_n[i]));
+        }
+        for (i, m) in s.cables.iter().enumerate() {
+            let _ = rec.log(format!("forces/cable/{}", m.name), &rerun::Scalars::single(f.cable_tension_n[i]));
+        }
+        for (i, a) in s.actuators.iter().enumerate() {
+            let _ = rec.log(format!("inputs/{}", a.symbol), &rerun::Scalars::single(snap.actuator_values[i]));
+            let _ = rec.log(format!("forces/actuator/{}", a.symbol), &rerun::Scalars::single(f.actuator_force[i]));
+        }
+        let _ = rec.log("residual/force_n", &rerun::Scalars::single(f.residual.max_force_n));
+        let _ = rec.log("residual/torque_nm", &rerun::Scalars::single(f.residual.max_torque_nm));
+    }
+
+    fn event(&mut self, tick: u64, text: &str) {
+        self.rec.set_time_sequence("tick", tick as i64);
+        let _ = self.rec.log("events", &rerun::TextLog::new(text));
+    }
+}

@@ -1,0 +1,392 @@
+//! Running one scenario: scenario -> model -> simulation -> observers -> report.
+
+use crate::mechanisms::{self, Mechanism, Prediction, Values};
+use crate::observers::compare::{self, Compare};
+use crate::observers::record::Recorder;
+use crate::observers::{Observer, Tick};
+use crate::report::{PointReport, ProbeReport, ScenarioReport, SettleSummary};
+use crate::scenario::{Actuation, Scenario};
+use crate::sim::settle::SettleDetector;
+use crate::sim::{SimError, Simulation, Snapshot};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// How a run is observed beyond the comparison.
+#[derive(Default)]
+pub struct RunOptions<'a> {
+    /// Record to this `.rrd` file (overrides the scenario's `[record]`).
+    pub record: Option<PathBuf>,
+    /// Set from a signal handler: the run stops at the next tick and reports what it has.
+    pub cancel: Option<&'a AtomicBool>,
+}
+
+#[derive(Debug, thiserror::Error)]
+enum Stop {
+    #[error("{0}")]
+    Sim(#[from] SimError),
+    #[error("interrupted at tick {0}")]
+    Interrupted(u64),
+    #[error("{0}")]
+    Model(String),
+}
+
+struct Runner<'a> {
+    mech: Box<dyn Mechanism>,
+    sc: &'a Scenario,
+    sim: Simulation,
+    compare: Compare,
+    recorder: Option<Recorder>,
+    cancel: Option<&'a AtomicBool>,
+    steps: u64,
+}
+
+/// Result of one settle.
+struct Settled {
+    settled: bool,
+    steps: u64,
+    final_speed: f64,
+    snapshot: Snapshot,
+    simulated: Values,
+}
+
+impl Runner<'_> {
+    fn observe(&self, snap: &Snapshot) -> Values {
+        self.mech.observe(&self.sc.params, &self.sim.structure, snap)
+    }
+
+    fn emit(&mut self, text: &str) {
+        let tick = self.sim.tick();
+        if let Some(r) = self.recorder.as_mut() {
+            r.event(tick, text);
+        }
+    }
+
+    /// One step followed by every observer.
+    fn step(&mut self, inputs: &Values, prediction: &Prediction) -> Result<(Snapshot, Values), Stop> {
+        if self.cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
+            return Err(Stop::Interrupted(self.sim.tick()));
+        }
+        self.sim.step()?;
+        self.steps += 1;
+        let snap = self.sim.snapshot();
+        let simulated = self.observe(&snap);
+        let ghost = self.mech.analytic_nodes(&self.sc.params, inputs);
+        let tick = Tick {
+            structure: &self.sim.structure,
+            snapshot: &snap,
+            inputs,
+            prediction,
+            simulated: &simulated,
+            ghost_nodes: ghost.as_deref(),
+        };
+        self.compare.tick(&tick);
+        if let Some(r) = self.recorder.as_mut() {
+            r.tick(&tick);
+        }
+        Ok((snap, simulated))
+    }
+
+    /// Steps until the speed stays below the threshold for the window and the residual passes,
+    /// or until the settle time runs out (a failure, never a pass).
+    fn settle(&mut self, inputs: &Values, prediction: &Prediction) -> Result<Settled, Stop> {
+        let criteria = self.sc.settle.clone();
+        let dt = self.sc.sim.dt_s;
+        let max_steps = (criteria.max_time_s / dt).ceil() as u64;
+        let mut detector = SettleDetector::new();
+        let mut last = None;
+        for k in 1..=max_steps {
+            let (snap, simulated) = self.step(inputs, prediction)?;
+            let quiet = detector.update(&snap, dt, &criteria);
+            if quiet && SettleDetector::residual_ok(&snap, &criteria) {
+                return Ok(Settled { settled: true, steps: k, final_speed: detector.last_speed, snapshot: snap, simulated });
+            }
+            last = Some((snap, simulated));
+        }
+        let (snapshot, simulated) = match last {
+            Some(x) => x,
+            None => {
+                let s = self.sim.snapshot();
+                let v = self.observe(&s);
+                (s, v)
+            }
+        };
+        Ok(Settled { settled: false, steps: max_steps, final_speed: detector.last_speed, snapshot, simulated })
+    }
+
+    /// Perturbs every free coordinate and settles again: stable if it comes back.
+    fn classify(&mut self, inputs: &Values, prediction: &Prediction, before: &Snapshot, delta: f64) -> Result<bool, Stop> {
+        self.sim.perturb_free_coordinates(delta);
+        self.emit(&format!("perturbed every free coordinate by {delta}"));
+        let after = self.settle(inputs, prediction)?;
+        let moved = before
+            .nodes
+            .iter()
+            .zip(&after.snapshot.nodes)
+            .map(|(a, b)| crate::structure::distance(*a, *b))
+            .fold(0.0, f64::max);
+        // Back within a small fraction of the perturbation: the same equilibrium.
+        Ok(after.settled && moved < RETURN_FRACTION * delta * self.sim.length_scale_m)
+    }
+
+    /// Stiffness by the probe: +tau and -tau on the probe body, K = 2 tau / (q+ - q-).
+    fn probe(&mut self, inputs: &Values, prediction: &Prediction, torque: f64) -> Result<Option<f64>, Stop> {
+        let Some(spec) = self.mech.stiffness_probe() else { return Ok(None) };
+        let body = self.sim.structure.body_id(&spec.body).ok_or_else(|| Stop::Model(format!("probe body '{}' not found", spec.body)))?;
+        let axis = spec.torque_axis;
+        let mut q = [0.0; 2];
+        for (i, sign) in [1.0, -1.0].iter().enumerate() {
+            let t = [axis[0] * torque * sign, axis[1] * torque * sign, axis[2] * torque * sign];
+            self.sim.set_probe_load(body, [0.0; 3], t);
+            self.emit(&format!("stiffness probe: torque {:+e} N m", torque * sign));
+            let s = self.settle(inputs, prediction)?;
+            if !s.settled {
+                self.sim.set_probe_load(body, [0.0; 3], [0.0; 3]);
+                return Ok(None);
+            }
+            q[i] = s.simulated[&spec.coordinate];
+        }
+        self.sim.set_probe_load(body, [0.0; 3], [0.0; 3]);
+        self.settle(inputs, prediction)?;
+        Ok(Some(2.0 * torque / mechanisms::wrap_angle(q[0] - q[1])))
+    }
+}
+
+/// A perturbed equilibrium counts as returned when every node is back within this fraction of
+/// the perturbation (times the structure's length).
+const RETURN_FRACTION: f64 = 1e-2;
+
+/// Which analytic branch a simulated state matches (nearest in the checked quantities).
+fn branch_of(mech: &dyn Mechanism, sc: &Scenario, prediction: &Prediction, simulated: &Values) -> (String, Option<bool>) {
+    let scale = mech.length_scale(&sc.params);
+    let mut best: Option<(f64, &mechanisms::Solution)> = None;
+    for b in &prediction.branches {
+        let mut d: f64 = 0.0;
+        for q in mech.quantities() {
+            if let (Some(a), Some(s)) = (b.values.get(q.symbol), simulated.get(q.symbol)) {
+                if q.kind != mechanisms::QuantityKind::Magnitude {
+                    d = d.max(compare::error(q.kind, *a, *s, scale).1);
+                }
+            }
+        }
+        if best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, b));
+        }
+    }
+    match best {
+        Some((_, b)) => (b.label.clone(), b.stable),
+        None => ("unknown".into(), None),
+    }
+}
+
+/// Runs a validated scenario. Bad model input found late (for example a structure the
+/// simulator cannot build) is reported in `error` with `passed = false`.
+pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
+    let wall = Instant::now();
+    let mech = mechanisms::find(&sc.mechanism).expect("validated mechanism");
+    let mut report = ScenarioReport {
+        name: sc.name.clone(),
+        file: sc.file.display().to_string(),
+        mechanism: sc.mechanism.clone(),
+        passed: false,
+        params: sc.params.clone(),
+        settle: SettleSummary::default(),
+        checks: vec![],
+        points: vec![],
+        stiffness_probe: None,
+        findings: mech.findings(&sc.params).into_iter().map(Into::into).collect(),
+        error: None,
+    };
+    let first_inputs = match &sc.actuation {
+        Actuation::Points { points, .. } => points[0].clone(),
+        Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
+    };
+    let sim = match mech.build(&sc.params, &first_inputs, &sc.start).and_then(|s| Simulation::new(&s, &sc.sim).map_err(|e| e.to_string())) {
+        Ok(s) => s,
+        Err(e) => {
+            report.error = Some(e);
+            return report;
+        }
+    };
+    let record_path = opts.record.clone().or_else(|| sc.record.clone());
+    let recorder = match record_path.as_ref().map(|p| Recorder::create(p, "tensegrity-testbed", 1)) {
+        None => None,
+        Some(Ok(r)) => Some(r),
+        Some(Err(e)) => {
+            report.error = Some(e.to_string());
+            return report;
+        }
+    };
+    let length_scale = mech.length_scale(&sc.params);
+    let mut runner = Runner {
+        compare: Compare::new(&sc.checks, length_scale),
+        mech,
+        sc,
+        sim,
+        recorder,
+        cancel: opts.cancel,
+        steps: 0,
+    };
+    if let Some(r) = runner.recorder.as_mut() {
+        r.document("scenario", &sc.source);
+    }
+    let mut probe_errors: Vec<f64> = Vec::new();
+    let outcome = run_actuation(&mut runner, sc, &mut report, &mut probe_errors);
+    if let Err(e) = outcome {
+        report.error = Some(e.to_string());
+        runner.emit(&format!("run stopped: {e}"));
+    }
+
+    report.checks = runner.compare.reports();
+    report.settle = SettleSummary {
+        settled: !report.points.is_empty() && report.points.iter().all(|p| p.settled),
+        steps: runner.steps,
+        sim_time_s: runner.sim.time_s(),
+        wall_s: wall.elapsed().as_secs_f64(),
+    };
+    if let Some(p) = &sc.probe {
+        let max = probe_errors.iter().copied().fold(0.0, f64::max);
+        let complete = !probe_errors.is_empty() && probe_errors.len() == report.points.len();
+        report.stiffness_probe = Some(ProbeReport {
+            torque_nm: p.torque_nm,
+            tolerance: p.tolerance,
+            max_rel_error: if complete { max } else { f64::INFINITY },
+            passed: complete && max <= p.tolerance,
+        });
+    }
+    let stability_agrees = report
+        .points
+        .iter()
+        .all(|p| p.stable.is_none() || p.analytic_stable.is_none() || p.stable == p.analytic_stable);
+    report.passed = report.error.is_none()
+        && report.settle.settled
+        && report.checks.iter().all(|c| c.passed)
+        && report.stiffness_probe.as_ref().is_none_or(|p| p.passed)
+        && stability_agrees;
+    if let Some(r) = runner.recorder.take() {
+        let mut r = r;
+        r.document("report", &serde_json::to_string_pretty(&report).unwrap_or_default());
+        r.event(runner.sim.tick(), if report.passed { "run passed" } else { "run FAILED" });
+        if let Err(e) = r.finish() {
+            report.passed = false;
+            report.error.get_or_insert(e.to_string());
+        }
+    }
+    report
+}
+
+fn run_actuation(runner: &mut Runner, sc: &Scenario, report: &mut ScenarioReport, probe_errors: &mut Vec<f64>) -> Result<(), Stop> {
+    match &sc.actuation {
+        Actuation::Points { points, continuation } => {
+            for (i, inputs) in points.iter().enumerate() {
+                if i > 0 {
+                    if *continuation {
+                        let cmds = runner.mech.commands(&sc.params, inputs);
+                        runner.sim.set_commands(&cmds);
+                    } else {
+                        let s = runner.mech.build(&sc.params, inputs, &sc.start).map_err(Stop::Model)?;
+                        let tick = runner.sim.tick();
+                        runner.sim = Simulation::new(&s, &sc.sim)?;
+                        runner.sim.set_tick(tick);
+                    }
+                    runner.emit(&format!("point {i}: inputs {inputs:?}"));
+                }
+                settle_point(runner, sc, i, inputs, report, probe_errors)?;
+            }
+        }
+        Actuation::Schedule { waypoints } => {
+            let end = waypoints.last().unwrap().0;
+            let dt = sc.sim.dt_s;
+            loop {
+                let t = runner.sim.time_s() + dt;
+                if t > end + 0.5 * dt {
+                    break;
+                }
+                let inputs = interpolate(waypoints, t);
+                let cmds = runner.mech.commands(&sc.params, &inputs);
+                runner.sim.set_commands(&cmds);
+                let prediction = runner.mech.predict(&sc.params, &inputs).map_err(Stop::Model)?;
+                runner.step(&inputs, &prediction)?;
+            }
+            let inputs = waypoints.last().unwrap().1.clone();
+            runner.emit("schedule done: settling at the last waypoint");
+            settle_point(runner, sc, 0, &inputs, report, probe_errors)?;
+        }
+    }
+    Ok(())
+}
+
+/// Linear interpolation of the waypoints at time `t`, held at the last.
+pub fn interpolate(waypoints: &[(f64, Values)], t: f64) -> Values {
+    if t <= waypoints[0].0 {
+        return waypoints[0].1.clone();
+    }
+    for w in waypoints.windows(2) {
+        let ((t0, a), (t1, b)) = (&w[0], &w[1]);
+        if t <= *t1 {
+            let s = (t - t0) / (t1 - t0);
+            return a.iter().map(|(k, x)| (k.clone(), x + (b[k] - x) * s)).collect();
+        }
+    }
+    waypoints.last().unwrap().1.clone()
+}
+
+fn settle_point(runner: &mut Runner, sc: &Scenario, index: usize, inputs: &Values, report: &mut ScenarioReport, probe_errors: &mut Vec<f64>) -> Result<(), Stop> {
+    let prediction = runner.mech.predict(&sc.params, inputs).map_err(Stop::Model)?;
+    let s = runner.settle(inputs, &prediction)?;
+    runner.emit(&if s.settled {
+        format!("point {index} settled after {} steps", s.steps)
+    } else {
+        format!("point {index} did NOT settle in {} s (speed {:.3e} m/s, residual {:.3e} N, {:.3e} N m)", sc.settle.max_time_s, s.final_speed, s.snapshot.forces.residual.max_force_n, s.snapshot.forces.residual.max_torque_nm)
+    });
+    let mut simulated = s.simulated.clone();
+    let (branch, analytic_stable) = branch_of(runner.mech.as_ref(), sc, &prediction, &simulated);
+    // The settled state is compared with the branch it landed on; landing on an analytically
+    // unstable branch is a failure unless the scenario deliberately starts there.
+    let landed = prediction.branches.iter().find(|b| b.label == branch).map(|b| b.values.clone()).unwrap_or_else(|| prediction.expected.clone());
+    let wanted_unstable = sc.start.get("at_unstable_root").is_some_and(|f| *f != 0.0);
+    if analytic_stable == Some(false) && !wanted_unstable {
+        runner.emit(&format!("point {index}: landed on the analytically unstable branch '{branch}'"));
+        report.error.get_or_insert(format!("point {index} settled on the analytically unstable branch '{branch}'"));
+    }
+    let stable = match sc.stability_perturbation {
+        Some(d) if s.settled => Some(runner.classify(inputs, &prediction, &s.snapshot, d)?),
+        _ => None,
+    };
+    if let Some(st) = stable {
+        runner.emit(&format!("point {index}: equilibrium is {}", if st { "stable" } else { "unstable" }));
+    }
+    if let (Some(p), true) = (&sc.probe, s.settled) {
+        if let Some(k) = runner.probe(inputs, &prediction, p.torque_nm)? {
+            simulated.insert("K".into(), k);
+            if let Some(ka) = landed.get("K") {
+                probe_errors.push(((k - ka) / ka).abs());
+            }
+        }
+    }
+    runner.compare.settle_point(&landed, &simulated, s.settled);
+    report.points.push(PointReport {
+        index,
+        inputs: inputs.clone(),
+        analytic: landed,
+        simulated,
+        settled: s.settled,
+        steps: s.steps,
+        residual_force_n: s.snapshot.forces.residual.max_force_n,
+        residual_torque_nm: s.snapshot.forces.residual.max_torque_nm,
+        final_speed_m_per_s: s.final_speed,
+        branch,
+        stable,
+        analytic_stable,
+        slack_cables: runner
+            .sim
+            .structure
+            .cables
+            .iter()
+            .zip(&s.snapshot.forces.cable_slack)
+            .filter(|(_, sl)| **sl)
+            .map(|(c, _)| c.name.clone())
+            .collect(),
+    });
+    Ok(())
+}

@@ -1,0 +1,236 @@
+//! Structure -> rapier sets.
+
+use super::{LinkRef, SimError, SimSettings, Simulation};
+use crate::structure::{ActuatorTarget, BodyKind, CableLaw, Joint, JointKind, Structure, Vec3};
+use rapier3d_f64::prelude::*;
+
+fn v(a: Vec3) -> Vector {
+    Vector::new(a[0], a[1], a[2])
+}
+
+pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation, SimError> {
+    if !(settings.dt_s > 0.0 && settings.dt_s.is_finite()) {
+        return Err(SimError::Build(format!("time step must be > 0 s, got {}", settings.dt_s)));
+    }
+    if settings.substeps == 0 || settings.pgs_iterations == 0 {
+        return Err(SimError::Build("substeps and PGS iterations must be at least 1".into()));
+    }
+    let n = s.bodies.len();
+    // Driven bodies: children of actuated joints.
+    let mut driven = vec![false; n];
+    let mut driving_joint = vec![None; n];
+    for a in &s.actuators {
+        if let ActuatorTarget::Joint(j) = a.target {
+            let joint = &s.joints[j];
+            if driven[joint.child] {
+                return Err(SimError::Build(format!(
+                    "body '{}' is driven by two actuated joints",
+                    s.bodies[joint.child].name
+                )));
+            }
+            driven[joint.child] = true;
+            driving_joint[joint.child] = Some(j);
+        }
+    }
+    // Every driven body must hang from the ground through driven bodies only.
+    for b in 0..n {
+        let mut cur = b;
+        let mut hops = 0;
+        while driven[cur] {
+            let j = driving_joint[cur].expect("driven implies a driving joint");
+            cur = s.joints[j].parent;
+            hops += 1;
+            if hops > n {
+                return Err(SimError::Build("actuated joints form a loop".into()));
+            }
+        }
+        if driven[b] && s.bodies[cur].kind != BodyKind::Fixed {
+            return Err(SimError::Build(format!(
+                "actuated joint '{}' must hang from a fixed or driven body, not from free body '{}'",
+                s.joints[driving_joint[b].unwrap()].name,
+                s.bodies[cur].name
+            )));
+        }
+    }
+
+    let mut bodies = RigidBodySet::new();
+    let mut handles = Vec::with_capacity(n);
+    for (i, b) in s.bodies.iter().enumerate() {
+        let builder = if b.kind == BodyKind::Fixed {
+            RigidBodyBuilder::fixed()
+        } else if driven[i] {
+            RigidBodyBuilder::kinematic_position_based()
+        } else {
+            let inertia = b.inertia.expect("validated: free bodies have inertia");
+            RigidBodyBuilder::dynamic()
+                .can_sleep(false)
+                .additional_mass_properties(MassProperties::new(
+                    v(inertia.com),
+                    inertia.mass_kg,
+                    v(inertia.principal_kg_m2),
+                ))
+                .linear_damping(settings_body_damping(settings))
+                .angular_damping(settings_body_damping(settings))
+        };
+        handles.push(bodies.insert(builder.build()));
+    }
+
+    let mut impulse_joints = ImpulseJointSet::new();
+    let mut multibody_joints = MultibodyJointSet::new();
+    let mut joint_links = vec![None; s.joints.len()];
+    let mut joint_impulse = vec![None; s.joints.len()];
+    for (j, joint) in s.joints.iter().enumerate() {
+        if driving_joint.contains(&Some(j)) {
+            continue; // ideal actuator: the child is placed kinematically
+        }
+        let data = generic_joint(s, joint);
+        let (h1, h2) = (handles[joint.parent], handles[joint.child]);
+        let child_is_free = s.bodies[joint.child].kind == BodyKind::Free && !driven[joint.child];
+        let as_link = if child_is_free { multibody_joints.insert(h1, h2, data, true) } else { None };
+        match as_link {
+            Some(h) => {
+                if let Some((mb, link_id)) = multibody_joints.get_mut(h) {
+                    let (start, ndofs) = {
+                        let l = mb.link(link_id).expect("link just inserted");
+                        (l.assembly_id(), l.joint().ndofs())
+                    };
+                    for k in start..start + ndofs {
+                        mb.damping_mut()[k] = joint.damping;
+                    }
+                }
+                joint_links[j] = Some(LinkRef { multibody_joint: h });
+            }
+            None => {
+                joint_impulse[j] = Some(impulse_joints.insert(h1, h2, data, true));
+            }
+        }
+    }
+
+    let mut cable_ropes = vec![None; s.cables.len()];
+    for (c, cable) in s.cables.iter().enumerate() {
+        if cable.law == CableLaw::Inextensible {
+            let (na, nb) = (&s.nodes[cable.a], &s.nodes[cable.b]);
+            if na.body == nb.body {
+                return Err(SimError::Build(format!(
+                    "cable '{}' joins two nodes of the same body",
+                    cable.name
+                )));
+            }
+            let rope = RopeJointBuilder::new(cable.length_m)
+                .local_anchor1(v(na.position))
+                .local_anchor2(v(nb.position))
+                .build();
+            cable_ropes[c] =
+                Some(impulse_joints.insert(handles[na.body], handles[nb.body], rope, true));
+        }
+    }
+
+    let mut params = IntegrationParameters::default();
+    params.dt = settings.dt_s;
+    params.num_solver_iterations = settings.substeps;
+    params.num_internal_pgs_iterations = settings.pgs_iterations;
+
+    let length_scale_m = characteristic_length(s);
+    let commands: Vec<f64> = s
+        .actuators
+        .iter()
+        .map(|a| match a.target {
+            ActuatorTarget::Joint(j) => s.joints[j].initial_coordinate,
+            ActuatorTarget::CableLength(c) => s.cables[c].length_m,
+        })
+        .collect();
+    let mut sim = Simulation {
+        structure: s.clone(),
+        settings: settings.clone(),
+        pipeline: PhysicsPipeline::new(),
+        params,
+        islands: IslandManager::new(),
+        broad_phase: BroadPhaseBvh::new(),
+        narrow_phase: NarrowPhase::new(),
+        bodies,
+        colliders: ColliderSet::new(),
+        impulse_joints,
+        multibody_joints,
+        soft_bodies: SoftBodySet::new(),
+        ccd: CCDSolver::new(),
+        handles,
+        driven,
+        driving_joint,
+        joint_links,
+        joint_impulse,
+        cable_ropes,
+        cable_lengths: s.cables.iter().map(|c| c.length_m).collect(),
+        commands: commands.clone(),
+        probe_loads: vec![([0.0; 3], [0.0; 3]); n],
+        tick: 0,
+        length_scale_m,
+    };
+    sim.set_commands(&commands);
+    Ok(sim)
+}
+
+/// Linear and angular damping of free bodies [1/s]; zero: joint damping does the work.
+fn settings_body_damping(settings: &SimSettings) -> f64 {
+    settings.body_damping_per_s
+}
+
+/// The rapier joint for a structure joint, with both local frames equal to the world frame of
+/// the initial configuration (every body starts at the identity pose).
+fn generic_joint(s: &Structure, joint: &Joint) -> GenericJoint {
+    let anchor = v(s.nodes[joint.anchor].position);
+    match &joint.kind {
+        JointKind::Revolute { axis } => {
+            let mut b = RevoluteJointBuilder::new(v(*axis).normalize())
+                .local_anchor1(anchor)
+                .local_anchor2(anchor);
+            if let Some(t) = &joint.torsion_spring {
+                b = b
+                    .motor_model(MotorModel::ForceBased)
+                    .motor_position(t.rest_angle_rad - joint.initial_coordinate, t.stiffness_nm_per_rad, 0.0);
+            }
+            b.build().into()
+        }
+        JointKind::Prismatic { axis } => PrismaticJointBuilder::new(v(*axis).normalize())
+            .local_anchor1(anchor)
+            .local_anchor2(anchor)
+            .build()
+            .into(),
+        JointKind::Spherical => SphericalJointBuilder::new()
+            .local_anchor1(anchor)
+            .local_anchor2(anchor)
+            .build()
+            .into(),
+        JointKind::Universal { axis1, axis2 } => {
+            // Frame: x along axis1, y along axis2 (made orthogonal), z = x cross y is locked.
+            let x = v(*axis1).normalize();
+            let y = (v(*axis2) - x * x.dot(v(*axis2))).normalize();
+            let z = x.cross(y);
+            let rot = Rotation::from_mat3(&glam_mat3(x, y, z));
+            let frame = Pose::from_parts(anchor, rot);
+            GenericJointBuilder::new(JointAxesMask::LIN_AXES | JointAxesMask::ANG_Z)
+                .local_frame1(frame)
+                .local_frame2(frame)
+                .build()
+        }
+        JointKind::Fixed => FixedJointBuilder::new()
+            .local_anchor1(anchor)
+            .local_anchor2(anchor)
+            .build()
+            .into(),
+    }
+}
+
+fn glam_mat3(x: Vector, y: Vector, z: Vector) -> rapier3d_f64::glamx::DMat3 {
+    rapier3d_f64::glamx::DMat3::from_cols(x, y, z)
+}
+
+/// Largest distance between two nodes of the structure [m] (at least 1e-3 m).
+fn characteristic_length(s: &Structure) -> f64 {
+    let mut l: f64 = 1e-3;
+    for a in &s.nodes {
+        for b in &s.nodes {
+            l = l.max(crate::structure::distance(a.position, b.position));
+        }
+    }
+    l
+}

@@ -1,0 +1,342 @@
+//! The simulator: turns a [`Structure`] into rapier sets, drives its actuators, steps it and
+//! reads member forces and equilibrium residuals.
+//!
+//! Modelling choices (see `../shared/notes/rapier-parry-rerun-0.36.md` for the measurements
+//! behind them):
+//! - Free bodies hung from the ground or from an actuator by a tree of joints are rapier
+//!   *multibody* links (reduced coordinates): the joint constraints hold exactly, with no
+//!   solver offset. A joint that would close a loop becomes an impulse joint.
+//! - Position-controlled joint actuators are ideal: the bodies they move are kinematic and are
+//!   placed exactly at the commanded coordinate before every step. Their force is read from
+//!   the balance of everything they carry.
+//! - Springs and elastic cables are explicit forces computed from the current geometry, so
+//!   their force law is exact at rest: F = k (l - l0), tension-only for cables.
+//! - Inextensible cables are rapier rope joints; their tension is read from the limit impulse.
+//! - Torsion springs are force-based joint motors; joint damping is multibody DOF damping
+//!   (implicit, and zero at rest, so it does not move the equilibrium).
+
+mod build;
+mod forces;
+pub mod settle;
+
+use crate::structure::{ActuatorTarget, BodyKind, JointKind, Structure};
+use rapier3d_f64::prelude::*;
+
+pub use forces::{MemberForces, Residual};
+
+/// Numerical settings of the integrator, all from the scenario file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimSettings {
+    /// Time step [s].
+    pub dt_s: f64,
+    /// rapier substeps per step (`num_solver_iterations`).
+    pub substeps: usize,
+    /// rapier PGS iterations per substep (`num_internal_pgs_iterations`).
+    pub pgs_iterations: usize,
+    /// Half-size of the box that every node must stay inside, else the run diverged [m].
+    pub bounding_box_m: f64,
+    /// Linear and angular damping of free bodies [1/s] (applied after each step; it slows
+    /// motion but does not move the equilibrium).
+    pub body_damping_per_s: f64,
+}
+
+impl Default for SimSettings {
+    fn default() -> Self {
+        SimSettings { dt_s: 0.01, substeps: 1, pgs_iterations: 8, bounding_box_m: 1e3, body_damping_per_s: 0.0 }
+    }
+}
+
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum SimError {
+    #[error("the structure cannot be simulated: {0}")]
+    Build(String),
+    #[error("simulation diverged at tick {tick} (t = {time_s:.6} s): {what}")]
+    Diverged { tick: u64, time_s: f64, what: String },
+}
+
+/// Where a free body sits in a multibody, so its joint coordinates can be read and perturbed.
+#[derive(Clone, Copy, Debug)]
+struct LinkRef {
+    multibody_joint: MultibodyJointHandle,
+}
+
+/// The mutable state that steps: rapier sets and the current commands.
+pub struct Simulation {
+    pub structure: Structure,
+    pub settings: SimSettings,
+    pipeline: PhysicsPipeline,
+    params: IntegrationParameters,
+    islands: IslandManager,
+    broad_phase: BroadPhaseBvh,
+    narrow_phase: NarrowPhase,
+    bodies: RigidBodySet,
+    colliders: ColliderSet,
+    impulse_joints: ImpulseJointSet,
+    multibody_joints: MultibodyJointSet,
+    soft_bodies: SoftBodySet,
+    ccd: CCDSolver,
+    /// rapier handle of each structure body.
+    handles: Vec<RigidBodyHandle>,
+    /// Body moved by a position-controlled actuator (kinematic in rapier).
+    driven: Vec<bool>,
+    /// For each driven body: the joint that drives it.
+    driving_joint: Vec<Option<usize>>,
+    /// For each joint: the multibody link it made, if any.
+    joint_links: Vec<Option<LinkRef>>,
+    /// For each joint: the impulse joint it made, if any (loop closures).
+    joint_impulse: Vec<Option<ImpulseJointHandle>>,
+    /// For each inextensible cable: its rope joint.
+    cable_ropes: Vec<Option<ImpulseJointHandle>>,
+    /// Current unstretched cable lengths [m].
+    cable_lengths: Vec<f64>,
+    /// Current actuator commands, in actuator order.
+    commands: Vec<f64>,
+    /// External loads [N] and [N m] applied to bodies (probes), world frame, about the body's
+    /// centre of mass.
+    probe_loads: Vec<([f64; 3], [f64; 3])>,
+    tick: u64,
+    /// Characteristic length of the structure [m], for speeds and tolerances.
+    pub length_scale_m: f64,
+}
+
+/// Pose of a body as translation and rotation (unit quaternion `[x, y, z, w]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyPose {
+    pub translation: [f64; 3],
+    pub rotation_xyzw: [f64; 4],
+}
+
+/// One tick's state, handed to every observer.
+#[derive(Clone, Debug)]
+pub struct Snapshot {
+    pub tick: u64,
+    pub time_s: f64,
+    /// World position of every node, in structure order [m].
+    pub nodes: Vec<[f64; 3]>,
+    pub body_poses: Vec<BodyPose>,
+    pub forces: MemberForces,
+    /// Actuator commands, in structure order (m or rad).
+    pub actuator_values: Vec<f64>,
+}
+
+impl Simulation {
+    /// Builds rapier sets for `structure`. The structure must have passed `validate`.
+    pub fn new(structure: &Structure, settings: &SimSettings) -> Result<Self, SimError> {
+        structure.validate().map_err(|e| SimError::Build(e.to_string()))?;
+        build::build(structure, settings)
+    }
+
+    pub fn tick(&self) -> u64 {
+        self.tick
+    }
+
+    /// Continues the tick count of a previous simulation (after a rebuild between points).
+    pub fn set_tick(&mut self, tick: u64) {
+        self.tick = tick;
+    }
+
+    pub fn time_s(&self) -> f64 {
+        self.tick as f64 * self.settings.dt_s
+    }
+
+    pub fn commands(&self) -> &[f64] {
+        &self.commands
+    }
+
+    /// Sets every actuator's command (in structure order: m for lengths, rad for angles) and
+    /// moves the driven bodies there at once.
+    pub fn set_commands(&mut self, values: &[f64]) {
+        assert_eq!(values.len(), self.structure.actuators.len(), "one command per actuator");
+        self.commands.copy_from_slice(values);
+        for (i, a) in self.structure.actuators.iter().enumerate() {
+            if let ActuatorTarget::CableLength(c) = a.target {
+                self.cable_lengths[c] = values[i];
+                if let Some(h) = self.cable_ropes[c] {
+                    if let Some(j) = self.impulse_joints.get_mut(h, true) {
+                        j.data.set_limits(JointAxis::LinX, [0.0, values[i]]);
+                    }
+                }
+            }
+        }
+        self.place_driven_bodies();
+    }
+
+    /// Applies a constant external wrench (world frame, about the centre of mass) to a body
+    /// from now on; zeros remove it.
+    pub fn set_probe_load(&mut self, body: usize, force_n: [f64; 3], torque_nm: [f64; 3]) {
+        self.probe_loads[body] = (force_n, torque_nm);
+    }
+
+    /// Advances one time step. Fails if the state is no longer finite or leaves the box.
+    pub fn step(&mut self) -> Result<(), SimError> {
+        self.place_driven_bodies();
+        self.apply_member_forces();
+        let gravity = Vector::new(
+            self.structure.gravity[0],
+            self.structure.gravity[1],
+            self.structure.gravity[2],
+        );
+        self.pipeline.step(
+            gravity,
+            &self.params,
+            &mut self.islands,
+            &mut self.broad_phase,
+            &mut self.narrow_phase,
+            &mut self.bodies,
+            &mut self.colliders,
+            &mut self.impulse_joints,
+            &mut self.multibody_joints,
+            &mut self.soft_bodies,
+            &mut self.ccd,
+            &(),
+            &(),
+        );
+        self.tick += 1;
+        self.check_divergence()
+    }
+
+    fn check_divergence(&self) -> Result<(), SimError> {
+        let limit = self.settings.bounding_box_m;
+        for (i, n) in self.structure.nodes.iter().enumerate() {
+            let p = self.node_position(i);
+            if p.iter().any(|c| !c.is_finite()) {
+                return Err(self.diverged(format!("node '{}' position is not finite", n.name)));
+            }
+            if p.iter().any(|c| c.abs() > limit) {
+                return Err(self.diverged(format!(
+                    "node '{}' left the bounding box of half-size {limit} m (at [{:.3e}, {:.3e}, {:.3e}])",
+                    n.name, p[0], p[1], p[2]
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    fn diverged(&self, what: String) -> SimError {
+        SimError::Diverged { tick: self.tick, time_s: self.time_s(), what }
+    }
+
+    /// World position of a node [m].
+    pub fn node_position(&self, node: usize) -> [f64; 3] {
+        let n = &self.structure.nodes[node];
+        let pose = self.bodies[self.handles[n.body]].position();
+        let p = pose.transform_point(Vector::new(n.position[0], n.position[1], n.position[2]));
+        [p.x, p.y, p.z]
+    }
+
+    pub fn body_pose(&self, body: usize) -> BodyPose {
+        let pose = self.bodies[self.handles[body]].position();
+        let q = pose.rotation;
+        BodyPose {
+            translation: [pose.translation.x, pose.translation.y, pose.translation.z],
+            rotation_xyzw: [q.x, q.y, q.z, q.w],
+        }
+    }
+
+    /// Bodies that move under forces (neither fixed nor driven).
+    pub fn is_free(&self, body: usize) -> bool {
+        self.structure.bodies[body].kind == BodyKind::Free && !self.driven[body]
+    }
+
+    pub fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            tick: self.tick,
+            time_s: self.time_s(),
+            nodes: (0..self.structure.nodes.len()).map(|i| self.node_position(i)).collect(),
+            body_poses: (0..self.structure.bodies.len()).map(|b| self.body_pose(b)).collect(),
+            forces: self.member_forces(),
+            actuator_values: self.commands.clone(),
+        }
+    }
+
+    /// Displaces every free joint coordinate of every multibody by `delta` (rad or m) and zeroes
+    /// the velocities: the perturbation used to classify an equilibrium.
+    pub fn perturb_free_coordinates(&mut self, delta: f64) {
+        let mut touched = Vec::new();
+        for link in self.joint_links.iter().flatten() {
+            if let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) {
+                let assembly = mb.link(link_id).map(|l| (l.assembly_id(), l.joint().ndofs()));
+                if let Some((start, n)) = assembly {
+                    let mut disp = vec![0.0; mb.ndofs()];
+                    for d in disp.iter_mut().skip(start).take(n) {
+                        *d = delta;
+                    }
+                    mb.apply_displacements(&disp);
+                    touched.push(link.multibody_joint);
+                }
+            }
+        }
+        for h in touched {
+            if let Some((mb, _)) = self.multibody_joints.get_mut(h) {
+                mb.forward_kinematics(&self.bodies, true);
+                mb.update_rigid_bodies(&mut self.bodies, true);
+                mb.generalized_velocity_mut().fill(0.0);
+            }
+        }
+        for (b, &h) in self.handles.iter().enumerate() {
+            if self.is_free(b) {
+                let rb = &mut self.bodies[h];
+                rb.set_linvel(Vector::ZERO, true);
+                rb.set_angvel(Vector::ZERO, true);
+            }
+        }
+    }
+
+    /// Places every driven body at the pose its actuators command: the product of the joint
+    /// displacements from the ground up (ideal position control).
+    fn place_driven_bodies(&mut self) {
+        // Process in structure order repeatedly so parents come before children.
+        let n = self.structure.bodies.len();
+        let mut placed = vec![false; n];
+        for (b, d) in self.driven.iter().enumerate() {
+            if !d {
+                placed[b] = true;
+            }
+        }
+        for _ in 0..n {
+            let mut progress = false;
+            for b in 0..n {
+                if placed[b] {
+                    continue;
+                }
+                let j = self.driving_joint[b].expect("a driven body has a driving joint");
+                let joint = &self.structure.joints[j];
+                if !placed[joint.parent] {
+                    continue;
+                }
+                let q = self.joint_command(j);
+                let parent_pose = *self.bodies[self.handles[joint.parent]].position();
+                let anchor = self.structure.nodes[joint.anchor].position;
+                let anchor = Vector::new(anchor[0], anchor[1], anchor[2]);
+                let rel = match &joint.kind {
+                    JointKind::Revolute { axis } => {
+                        let axis = Vector::new(axis[0], axis[1], axis[2]).normalize();
+                        let rot = Rotation::from_axis_angle(axis, q - joint.initial_coordinate);
+                        Pose::from_parts(anchor - rot * anchor, rot)
+                    }
+                    JointKind::Prismatic { axis } => {
+                        let axis = Vector::new(axis[0], axis[1], axis[2]).normalize();
+                        Pose::from_translation(axis * (q - joint.initial_coordinate))
+                    }
+                    _ => unreachable!("validated: only revolute and prismatic joints are actuated"),
+                };
+                let pose = parent_pose * rel;
+                self.bodies[self.handles[b]].set_position(pose, true);
+                placed[b] = true;
+                progress = true;
+            }
+            if !progress {
+                break;
+            }
+        }
+    }
+
+    fn joint_command(&self, joint: usize) -> f64 {
+        self.structure
+            .actuators
+            .iter()
+            .position(|a| a.target == ActuatorTarget::Joint(joint))
+            .map(|i| self.commands[i])
+            .unwrap_or(self.structure.joints[joint].initial_coordinate)
+    }
+}

@@ -1,0 +1,368 @@
+//! The generic structure description: bodies, nodes, struts, springs, cables, joints and
+//! actuators. A mechanism module turns its parameters into one of these; the simulator turns
+//! one of these into rapier sets. Nothing in here knows about a particular paper.
+//!
+//! Conventions: SI units (m, kg, N, N/m, N m/rad, rad); node coordinates are *world*
+//! coordinates in the initial configuration; a body's frame is its initial world pose.
+
+use std::collections::BTreeMap;
+
+/// A 3-vector in metres (or a unit axis).
+pub type Vec3 = [f64; 3];
+
+/// Index of a body in [`Structure::bodies`].
+pub type BodyId = usize;
+/// Index of a node in [`Structure::nodes`].
+pub type NodeId = usize;
+/// Index of a joint in [`Structure::joints`].
+pub type JointId = usize;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodyKind {
+    /// Welded to the world.
+    Fixed,
+    /// Moves under the forces of the members and joints.
+    Free,
+}
+
+/// Mass properties of a free body, expressed at its initial pose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inertia {
+    /// Mass [kg].
+    pub mass_kg: f64,
+    /// Centre of mass, world coordinates in the initial configuration [m].
+    pub com: Vec3,
+    /// Principal moments of inertia about the centre of mass, along the world axes [kg m^2].
+    pub principal_kg_m2: Vec3,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    pub name: String,
+    pub kind: BodyKind,
+    /// Needed for free bodies; ignored for fixed ones.
+    pub inertia: Option<Inertia>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Node {
+    pub name: String,
+    pub body: BodyId,
+    /// World position in the initial configuration [m].
+    pub position: Vec3,
+}
+
+/// A compression member drawn between two nodes of the same body (or of two bodies joined at
+/// its ends). It carries no force law of its own: it is rigid through its body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Strut {
+    pub name: String,
+    pub a: NodeId,
+    pub b: NodeId,
+    /// Radius of the capsule used for interference checks and drawing [m].
+    pub radius_m: f64,
+}
+
+/// A linear spring that pushes as well as pulls: force = stiffness (l - rest_length).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spring {
+    pub name: String,
+    pub a: NodeId,
+    pub b: NodeId,
+    pub stiffness_n_per_m: f64,
+    /// Free length [m]; zero is allowed (a zero-free-length spring).
+    pub rest_length_m: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum CableLaw {
+    /// Inextensible: never longer than `length_m`, slack (no force) when shorter.
+    Inextensible,
+    /// Elastic, tension only: force = max(0, stiffness (l - length_m)).
+    Elastic { stiffness_n_per_m: f64 },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cable {
+    pub name: String,
+    pub a: NodeId,
+    pub b: NodeId,
+    pub law: CableLaw,
+    /// Unstretched length in the initial configuration [m] (an actuator may change it).
+    pub length_m: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum JointKind {
+    /// One rotation about `axis` (world, initial configuration).
+    Revolute { axis: Vec3 },
+    /// One translation along `axis` (world, initial configuration).
+    Prismatic { axis: Vec3 },
+    /// Three rotations about the anchor.
+    Spherical,
+    /// Two rotations, about `axis1` (fixed in the parent) and `axis2` (fixed in the child).
+    Universal { axis1: Vec3, axis2: Vec3 },
+    /// No relative motion.
+    Fixed,
+}
+
+impl JointKind {
+    pub fn label(&self) -> &'static str {
+        match self {
+            JointKind::Revolute { .. } => "revolute",
+            JointKind::Prismatic { .. } => "prismatic",
+            JointKind::Spherical => "spherical",
+            JointKind::Universal { .. } => "universal",
+            JointKind::Fixed => "fixed",
+        }
+    }
+}
+
+/// A linear torsion spring on a revolute joint: torque = -stiffness (q - rest_angle), with q the
+/// joint angle measured from the initial configuration plus `Joint::initial_coordinate`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TorsionSpring {
+    pub stiffness_nm_per_rad: f64,
+    pub rest_angle_rad: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
+    pub name: String,
+    pub kind: JointKind,
+    pub parent: BodyId,
+    pub child: BodyId,
+    /// The joint's centre, a node of the child or the parent (world, initial configuration).
+    pub anchor: NodeId,
+    /// Joint coordinate (rad or m) in the initial configuration, so that actuator targets and
+    /// torsion-spring rest angles are absolute, in the paper's convention.
+    pub initial_coordinate: f64,
+    pub torsion_spring: Option<TorsionSpring>,
+    /// Viscous damping on the joint's free coordinates [N m s/rad or N s/m]; zero at rest.
+    pub damping: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ActuatorTarget {
+    /// Position-controlled revolute or prismatic joint: its coordinate follows the command.
+    Joint(JointId),
+    /// Winch: the cable's unstretched length follows the command.
+    CableLength(usize),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Actuator {
+    /// The paper's symbol for the input (for example `L3`, `theta1`).
+    pub symbol: String,
+    pub target: ActuatorTarget,
+}
+
+/// A whole mechanism, ready to be simulated.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Structure {
+    pub name: String,
+    /// Gravity [m/s^2].
+    pub gravity: Vec3,
+    pub bodies: Vec<Body>,
+    pub nodes: Vec<Node>,
+    pub struts: Vec<Strut>,
+    pub springs: Vec<Spring>,
+    pub cables: Vec<Cable>,
+    pub joints: Vec<Joint>,
+    pub actuators: Vec<Actuator>,
+}
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum StructureError {
+    #[error("{what} '{name}' refers to {kind} index {index}, which does not exist")]
+    DanglingReference { what: &'static str, name: String, kind: &'static str, index: usize },
+    #[error("{what} '{name}' has zero length: its two nodes coincide")]
+    ZeroLength { what: &'static str, name: String },
+    #[error("free body '{0}' needs a positive mass and positive moments of inertia")]
+    NoMass(String),
+    #[error("{what} '{name}': {message}")]
+    Invalid { what: &'static str, name: String, message: String },
+    #[error("duplicate name '{0}'")]
+    Duplicate(String),
+}
+
+impl Structure {
+    pub fn add_body(&mut self, name: &str, kind: BodyKind, inertia: Option<Inertia>) -> BodyId {
+        self.bodies.push(Body { name: name.into(), kind, inertia });
+        self.bodies.len() - 1
+    }
+
+    pub fn add_node(&mut self, name: &str, body: BodyId, position: Vec3) -> NodeId {
+        self.nodes.push(Node { name: name.into(), body, position });
+        self.nodes.len() - 1
+    }
+
+    pub fn node_id(&self, name: &str) -> Option<NodeId> {
+        self.nodes.iter().position(|n| n.name == name)
+    }
+
+    pub fn body_id(&self, name: &str) -> Option<BodyId> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// Initial world positions of all nodes, by name.
+    pub fn initial_positions(&self) -> BTreeMap<String, Vec3> {
+        self.nodes.iter().map(|n| (n.name.clone(), n.position)).collect()
+    }
+
+    /// Checks references, lengths and masses. Every built-in mechanism and every file-described
+    /// structure goes through this before it reaches the simulator.
+    pub fn validate(&self) -> Result<(), StructureError> {
+        let mut seen = std::collections::BTreeSet::new();
+        for b in &self.bodies {
+            if !seen.insert(&b.name) {
+                return Err(StructureError::Duplicate(b.name.clone()));
+            }
+            if b.kind == BodyKind::Free {
+                let ok = b.inertia.is_some_and(|i| {
+                    i.mass_kg > 0.0
+                        && i.mass_kg.is_finite()
+                        && i.principal_kg_m2.iter().all(|m| *m > 0.0 && m.is_finite())
+                });
+                if !ok {
+                    return Err(StructureError::NoMass(b.name.clone()));
+                }
+            }
+        }
+        let mut seen = std::collections::BTreeSet::new();
+        for n in &self.nodes {
+            if !seen.insert(&n.name) {
+                return Err(StructureError::Duplicate(n.name.clone()));
+            }
+            self.check_body("node", &n.name, n.body)?;
+            if n.position.iter().any(|c| !c.is_finite()) {
+                return Err(invalid("node", &n.name, "coordinates must be finite numbers"));
+            }
+        }
+        for s in &self.struts {
+            self.check_member("strut", &s.name, s.a, s.b)?;
+            if !(s.radius_m >= 0.0 && s.radius_m.is_finite()) {
+                return Err(invalid("strut", &s.name, "radius must be a finite number >= 0 m"));
+            }
+        }
+        for s in &self.springs {
+            self.check_member("spring", &s.name, s.a, s.b)?;
+            if !(s.stiffness_n_per_m > 0.0 && s.stiffness_n_per_m.is_finite()) {
+                return Err(invalid("spring", &s.name, "stiffness must be a finite number > 0 N/m"));
+            }
+            if !(s.rest_length_m >= 0.0 && s.rest_length_m.is_finite()) {
+                return Err(invalid("spring", &s.name, "rest length must be a finite number >= 0 m"));
+            }
+        }
+        for c in &self.cables {
+            self.check_member("cable", &c.name, c.a, c.b)?;
+            if !(c.length_m > 0.0 && c.length_m.is_finite()) {
+                return Err(invalid("cable", &c.name, "length must be a finite number > 0 m"));
+            }
+            if let CableLaw::Elastic { stiffness_n_per_m } = c.law {
+                if !(stiffness_n_per_m > 0.0 && stiffness_n_per_m.is_finite()) {
+                    return Err(invalid("cable", &c.name, "stiffness must be a finite number > 0 N/m"));
+                }
+            }
+        }
+        for j in &self.joints {
+            self.check_body("joint", &j.name, j.parent)?;
+            self.check_body("joint", &j.name, j.child)?;
+            self.check_node("joint", &j.name, j.anchor)?;
+            if j.parent == j.child {
+                return Err(invalid("joint", &j.name, "parent and child must be different bodies"));
+            }
+            if self.bodies[j.child].kind == BodyKind::Fixed {
+                return Err(invalid("joint", &j.name, "the child body must not be fixed"));
+            }
+            let axes: Vec<Vec3> = match &j.kind {
+                JointKind::Revolute { axis } | JointKind::Prismatic { axis } => vec![*axis],
+                JointKind::Universal { axis1, axis2 } => vec![*axis1, *axis2],
+                _ => vec![],
+            };
+            for a in axes {
+                let n = norm(a);
+                if !(n > 1e-12 && n.is_finite()) {
+                    return Err(invalid("joint", &j.name, "axis must be a finite non-zero vector"));
+                }
+            }
+            if j.torsion_spring.is_some() && !matches!(j.kind, JointKind::Revolute { .. }) {
+                return Err(invalid("joint", &j.name, "a torsion spring needs a revolute joint"));
+            }
+            if !(j.damping >= 0.0 && j.damping.is_finite()) {
+                return Err(invalid("joint", &j.name, "damping must be a finite number >= 0"));
+            }
+        }
+        for a in &self.actuators {
+            match a.target {
+                ActuatorTarget::Joint(j) => {
+                    let joint = self.joints.get(j).ok_or_else(|| StructureError::DanglingReference {
+                        what: "actuator",
+                        name: a.symbol.clone(),
+                        kind: "joint",
+                        index: j,
+                    })?;
+                    if !matches!(joint.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. }) {
+                        return Err(invalid("actuator", &a.symbol, "only revolute and prismatic joints can be actuated"));
+                    }
+                    if joint.torsion_spring.is_some() {
+                        return Err(invalid("actuator", &a.symbol, "an actuated joint cannot also carry a torsion spring"));
+                    }
+                }
+                ActuatorTarget::CableLength(c) => {
+                    if c >= self.cables.len() {
+                        return Err(StructureError::DanglingReference {
+                            what: "actuator",
+                            name: a.symbol.clone(),
+                            kind: "cable",
+                            index: c,
+                        });
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn check_body(&self, what: &'static str, name: &str, b: BodyId) -> Result<(), StructureError> {
+        if b >= self.bodies.len() {
+            return Err(StructureError::DanglingReference { what, name: name.into(), kind: "body", index: b });
+        }
+        Ok(())
+    }
+
+    fn check_node(&self, what: &'static str, name: &str, n: NodeId) -> Result<(), StructureError> {
+        if n >= self.nodes.len() {
+            return Err(StructureError::DanglingReference { what, name: name.into(), kind: "node", index: n });
+        }
+        Ok(())
+    }
+
+    fn check_member(&self, what: &'static str, name: &str, a: NodeId, b: NodeId) -> Result<(), StructureError> {
+        self.check_node(what, name, a)?;
+        self.check_node(what, name, b)?;
+        if what != "spring" && distance(self.nodes[a].position, self.nodes[b].position) < MIN_MEMBER_LENGTH_M {
+            return Err(StructureError::ZeroLength { what, name: name.into() });
+        }
+        if a == b {
+            return Err(StructureError::ZeroLength { what, name: name.into() });
+        }
+        Ok(())
+    }
+}
+
+/// Shortest strut or cable the description accepts [m]. (A spring may start at zero length:
+/// a zero-free-length spring whose ends coincide carries no force and is legal.)
+pub const MIN_MEMBER_LENGTH_M: f64 = 1e-9;
+
+fn invalid(what: &'static str, name: &str, message: &str) -> StructureError {
+    StructureError::Invalid { what, name: name.into(), message: message.into() }
+}
+
+pub fn norm(v: Vec3) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+pub fn distance(a: Vec3, b: Vec3) -> f64 {
+    norm([a[0] - b[0], a[1] - b[1], a[2] - b[2]])
+}
