@@ -75,9 +75,15 @@ impl Simulation {
                 }
             }
         }
+        // Force at the centre of mass plus its moment, with the centre of mass taken from the
+        // current pose: rapier's cached world centre of mass is stale before the first step,
+        // which gave a spurious kick of |c x F| there.
         for (body, f, p) in loads {
             if self.is_free(body) {
-                self.bodies[self.handles[body]].add_force_at_point(f, p, false);
+                let com = self.world_com(body);
+                let rb = &mut self.bodies[self.handles[body]];
+                rb.add_force(f, false);
+                rb.add_torque((p - com).cross(f), false);
             }
         }
         for b in 0..n {
@@ -88,6 +94,12 @@ impl Simulation {
                 rb.add_torque(v(t), false);
             }
         }
+    }
+
+    /// World position of a free body's centre of mass, from its current pose [m].
+    fn world_com(&self, body: usize) -> Vector {
+        let local = self.structure.bodies[body].inertia.map_or([0.0; 3], |i| i.com);
+        self.bodies[self.handles[body]].position().transform_point(v(local))
     }
 
     /// Reads every member force and computes the equilibrium residual.
@@ -146,7 +158,7 @@ impl Simulation {
                     wrench[b].1 += com.cross(f);
                 }
                 let (pf, pt) = self.probe_loads[b];
-                let com = self.bodies[self.handles[b]].center_of_mass();
+                let com = self.world_com(b);
                 wrench[b].0 += v(pf);
                 wrench[b].1 += com.cross(v(pf)) + v(pt);
             }
@@ -246,7 +258,7 @@ impl Simulation {
                     residual.unchecked_coordinates += 6;
                     continue;
                 }
-                let com = self.bodies[self.handles[b]].center_of_mass();
+                let com = self.world_com(b);
                 residual.max_force_n = residual.max_force_n.max(w.0.length());
                 residual.max_torque_nm = residual.max_torque_nm.max(about(w, com).length());
             }
