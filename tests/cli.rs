@@ -1,0 +1,168 @@
+//! The command line: exit codes 0 / 1 / 2, file:line:col errors, solve, list, record.
+
+use std::process::Command;
+
+fn tensegrity(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_tensegrity")).args(args).output().expect("binary runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn temp_file(name: &str, text: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("tensegrity-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const VALID: &str = r#"name = "t"
+mechanism = "ji2014"
+[params]
+L = 1.0
+[actuation]
+points = [ { L3 = 1.0, theta1 = 0.5 } ]
+[[checks]]
+quantity = "theta2"
+tolerance = 1e-9
+"#;
+
+#[test]
+fn run_passes_with_exit_0_and_writes_the_json_report() {
+    let json = std::env::temp_dir().join(format!("tensegrity-report-{}.json", std::process::id()));
+    let (code, out, err) = tensegrity(&["run", "scenarios/ji2014/quick.toml", "--json", json.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("PASS"));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let s = &v["scenarios"][0];
+    assert_eq!(s["mechanism"], "ji2014");
+    assert_eq!(s["passed"], true);
+    assert_eq!(s["settle"]["settled"], true);
+    assert!(s["points"][0]["inputs"]["L3"].is_number());
+    assert!(s["points"][0]["simulated"]["theta2"].is_number());
+    assert!(s["points"][0]["stable"].is_boolean());
+    assert!(s["checks"][0]["max_rel_error"].as_f64().unwrap() <= 1e-9);
+}
+
+#[test]
+fn a_check_that_fails_gives_exit_1() {
+    // A tolerance below what f64 can resolve cannot pass.
+    let p = temp_file("tight.toml", &VALID.replace("tolerance = 1e-9", "tolerance = 1e-300"));
+    let (code, out, _) = tensegrity(&["run", p.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("FAIL"));
+}
+
+/// Each malformed scenario gives exit 2 from check and run, with file:line:col in the message.
+#[test]
+fn bad_scenarios_give_exit_2_with_file_line_and_column() {
+    let cases: &[(&str, String, &str)] = &[
+        ("syntax", VALID.replace("L = 1.0", "L = = 1.0"), ":4:"),
+        ("unknown key", VALID.replace("[params]", "colour = 3\n[params]"), ":3:1"),
+        ("wrong type", VALID.replace("L = 1.0", "L = \"one\""), ":4:"),
+        ("negative length", VALID.replace("L = 1.0", "L = -1.0"), ":4:5"),
+        ("unknown param", VALID.replace("L = 1.0", "Q = 1.0"), ":4:1"),
+        ("theta1 out of range", VALID.replace("theta1 = 0.5", "theta1 = 4.0"), ":6:"),
+        ("missing input", VALID.replace(", theta1 = 0.5", ""), ":6:"),
+        ("unknown mechanism", VALID.replace("\"ji2014\"", "\"ji2015\""), ":2:13"),
+        ("zero dt", VALID.replace("[actuation]", "[sim]\ndt = 0.0\n[actuation]"), ":6:6"),
+        ("nan", VALID.replace("L = 1.0", "L = nan"), ":4:5"),
+        ("unknown quantity", VALID.replace("quantity = \"theta2\"", "quantity = \"zeta\""), ":8:12"),
+        ("empty points", VALID.replace("points = [ { L3 = 1.0, theta1 = 0.5 } ]", "points = []"), ":5:1"),
+        (
+            "unsorted waypoints",
+            VALID.replace(
+                "points = [ { L3 = 1.0, theta1 = 0.5 } ]",
+                "waypoints = [ { t = 1.0, L3 = 1.0, theta1 = 0.5 }, { t = 0.5, L3 = 1.0, theta1 = 0.5 } ]",
+            ),
+            ":6:",
+        ),
+    ];
+    for (what, text, loc) in cases {
+        let p = temp_file(&format!("{}.toml", what.replace(' ', "_")), text);
+        for cmd in ["check", "run"] {
+            let (code, out, err) = tensegrity(&[cmd, p.to_str().unwrap()]);
+            assert_eq!(code, 2, "{what} ({cmd}): exit {code}\n{out}{err}");
+            let file = p.to_str().unwrap();
+            assert!(err.contains(&format!("{file}{loc}")), "{what} ({cmd}): expected '{file}{loc}' in: {err}");
+            assert!(!err.contains("panicked"), "{what}: {err}");
+        }
+    }
+}
+
+#[test]
+fn a_missing_file_gives_exit_2() {
+    let (code, _, err) = tensegrity(&["check", "no/such/file.toml"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("no/such/file.toml:1:1"), "{err}");
+}
+
+#[test]
+fn every_shipped_scenario_is_valid() {
+    for entry in std::fs::read_dir("scenarios/ji2014").unwrap() {
+        let p = entry.unwrap().path();
+        if p.extension().is_some_and(|e| e == "toml") {
+            let (code, out, err) = tensegrity(&["check", p.to_str().unwrap()]);
+            assert_eq!(code, 0, "{}: {out}{err}", p.display());
+        }
+    }
+}
+
+#[test]
+fn solve_fk_prints_both_equilibria_with_their_stability() {
+    let (code, out, err) = tensegrity(&["solve", "ji2014", "fk", "--set", "L3=6", "--set", "theta1=0.3141592653589793", "--set", "K1=100", "--set", "K2=10", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let sols = v["solutions"].as_array().unwrap();
+    assert_eq!(sols.len(), 2);
+    assert_eq!(sols[0]["stable"], true);
+    assert!((sols[0]["values"]["theta2"].as_f64().unwrap() - 2.656091).abs() < 1e-6);
+    assert_eq!(sols[1]["stable"], false);
+}
+
+#[test]
+fn solve_ik_solutions_reproduce_the_target_through_fk() {
+    let (code, out, err) = tensegrity(&["solve", "ji2014", "ik", "--set", "x=-0.5", "--set", "y=0.8", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let sols = v["solutions"].as_array().unwrap();
+    assert!(!sols.is_empty());
+    for s in sols {
+        let (l3, th1, th2) = (s["values"]["L3"].as_f64().unwrap(), s["values"]["theta1"].as_f64().unwrap(), s["values"]["theta2"].as_f64().unwrap());
+        let x = l3 * th1.cos() + th2.cos();
+        let y = l3 * th1.sin() + th2.sin();
+        assert!((x + 0.5).abs() < 1e-10 && (y - 0.8).abs() < 1e-10, "({x}, {y})");
+    }
+}
+
+#[test]
+fn solve_rejects_unknown_names_and_unreachable_targets_with_exit_2() {
+    assert_eq!(tensegrity(&["solve", "ji2014", "fk", "--set", "L3=1"]).0, 2);
+    assert_eq!(tensegrity(&["solve", "ji2014", "fk", "--set", "L3=1", "--set", "theta1=0.5", "--set", "Z=1"]).0, 2);
+    assert_eq!(tensegrity(&["solve", "ji2014", "ik", "--set", "x=0", "--set", "y=-5"]).0, 2);
+    assert_eq!(tensegrity(&["solve", "nope", "fk"]).0, 2);
+    assert_eq!(tensegrity(&["solve", "ji2014", "fk", "--set", "L3=1", "--set", "theta1=0.5", "--set", "K1=-3"]).0, 2);
+}
+
+#[test]
+fn list_names_parameters_with_units_and_queries() {
+    let (code, out, _) = tensegrity(&["list"]);
+    assert_eq!(code, 0);
+    for s in ["ji2014", "K1", "[N/m]", "L3", "theta1", "fk", "ik"] {
+        assert!(out.contains(s), "missing {s} in list output");
+    }
+}
+
+#[test]
+fn record_writes_an_rrd_file_and_no_partial_file() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-rec-{}", std::process::id()));
+    let path = dir.join("quick.rrd");
+    let (code, out, err) = tensegrity(&["run", "scenarios/ji2014/quick.toml", "--record", path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    let len = std::fs::metadata(&path).expect("recording exists").len();
+    assert!(len > 10_000, "recording is only {len} bytes");
+    assert!(!dir.join("quick.rrd.partial").exists());
+}
