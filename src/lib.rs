@@ -4,6 +4,7 @@
 //! Data flows one way: [`scenario`] file -> [`mechanisms`] model -> [`structure`] ->
 //! [`sim`]ulation -> [`observers`] -> [`report`].
 
+pub mod bench;
 pub mod mechanisms;
 pub mod observers;
 pub mod report;

@@ -47,6 +47,15 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Measure settling speed and accuracy on the built-in case sets (medians over rounds).
+    Bench {
+        /// Rounds per case set.
+        #[arg(long, default_value_t = 5)]
+        rounds: usize,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Check every printed equation of a mechanism's paper against the testbed's derivation.
     Findings {
         mechanism: String,
@@ -73,6 +82,7 @@ fn main() -> ExitCode {
         Command::List => cmd_list(),
         Command::Solve { mechanism, query, set, json } => cmd_solve(&mechanism, &query, &set, json),
         Command::Findings { mechanism, set, json } => cmd_findings(&mechanism, &set, json),
+        Command::Bench { rounds, json } => cmd_bench(rounds, json),
     };
     ExitCode::from(code as u8)
 }
@@ -282,4 +292,33 @@ fn cmd_findings(mechanism: &str, sets: &[String], json: bool) -> i32 {
         }
     }
     EXIT_PASS
+}
+
+fn cmd_bench(rounds: usize, json: bool) -> i32 {
+    let mut results = Vec::new();
+    for (m, file) in tensegrity_testbed::bench::CASE_SETS {
+        match tensegrity_testbed::bench::bench_case_set(m, Path::new(file), rounds) {
+            Ok(r) => results.push(r),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return EXIT_BAD_INPUT;
+            }
+        }
+    }
+    if json {
+        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "results": results })).unwrap());
+    } else {
+        println!("{:<10} {:>6} {:>7} {:>12} {:>12} {:>10} {:>12} {:>12}", "mechanism", "cases", "rounds", "cases/s", "steps/case", "us/step", "median err", "max err");
+        for r in &results {
+            println!(
+                "{:<10} {:>6} {:>7} {:>12.1} {:>12.1} {:>10.2} {:>12.2e} {:>12.2e}",
+                r.mechanism, r.cases, r.rounds, r.median_cases_per_s, r.median_steps_per_case, r.median_us_per_step, r.median_error, r.max_error
+            );
+        }
+    }
+    if results.iter().all(|r| r.all_settled) {
+        EXIT_PASS
+    } else {
+        EXIT_FAIL
+    }
 }

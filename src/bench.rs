@@ -1,0 +1,92 @@
+//! `tensegrity bench`: how fast and how accurately the testbed settles a fixed case set.
+//!
+//! The case set of a mechanism is a scenario's settle points, each settled from a fresh build
+//! (no continuation, no stability test): the same work a peer simulator would do per case.
+//! Several rounds are run and medians reported, so that one noisy round does not decide.
+
+use crate::run::{run, RunOptions};
+use crate::scenario::{self, Actuation};
+use serde::Serialize;
+use std::path::Path;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchResult {
+    pub mechanism: String,
+    pub scenario: String,
+    pub cases: usize,
+    pub rounds: usize,
+    /// Median over rounds of cases settled per wall-clock second.
+    pub median_cases_per_s: f64,
+    /// Median over cases of the steps needed to settle.
+    pub median_steps_per_case: f64,
+    /// Median over rounds of the wall time per step [us].
+    pub median_us_per_step: f64,
+    /// Median and largest normalised error over cases and checked quantities.
+    pub median_error: f64,
+    pub max_error: f64,
+    pub all_settled: bool,
+}
+
+/// The built-in case sets: (mechanism, scenario file).
+pub const CASE_SETS: &[(&str, &str)] = &[("ji2014", "scenarios/ji2014/grid.toml")];
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Runs one case set `rounds` times.
+pub fn bench_case_set(mechanism: &str, file: &Path, rounds: usize) -> Result<BenchResult, String> {
+    let mut sc = scenario::load(file).map_err(|e| e.to_string())?;
+    sc.stability_perturbation = None;
+    sc.probe = None;
+    sc.record = None;
+    if let Actuation::Points { continuation, .. } = &mut sc.actuation {
+        *continuation = false;
+    }
+    let mut rates = Vec::new();
+    let mut us_per_step = Vec::new();
+    let mut steps = Vec::new();
+    let mut errors = Vec::new();
+    let mut all_settled = true;
+    let mut cases = 0;
+    for round in 0..rounds.max(1) {
+        let r = run(&sc, &RunOptions::default());
+        cases = r.points.len();
+        rates.push(cases as f64 / r.settle.wall_s);
+        us_per_step.push(r.settle.wall_s * 1e6 / r.settle.steps.max(1) as f64);
+        all_settled &= r.settle.settled;
+        if round == 0 {
+            let scale = r.params.get("L").copied().unwrap_or(1.0);
+            for p in &r.points {
+                steps.push(p.steps as f64);
+                for c in &sc.checks {
+                    if let (Some(a), Some(s)) = (p.analytic.get(&c.quantity), p.simulated.get(&c.quantity)) {
+                        errors.push(crate::observers::compare::error(c.kind, *a, *s, scale).1);
+                    }
+                }
+            }
+        }
+    }
+    let max_error = errors.iter().copied().fold(0.0, f64::max);
+    Ok(BenchResult {
+        mechanism: mechanism.into(),
+        scenario: file.display().to_string(),
+        cases,
+        rounds: rounds.max(1),
+        median_cases_per_s: median(&mut rates),
+        median_steps_per_case: median(&mut steps),
+        median_us_per_step: median(&mut us_per_step),
+        median_error: median(&mut errors),
+        max_error,
+        all_settled,
+    })
+}
