@@ -366,3 +366,57 @@ pub fn norm(v: Vec3) -> f64 {
 pub fn distance(a: Vec3, b: Vec3) -> f64 {
     norm([a[0] - b[0], a[1] - b[1], a[2] - b[2]])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two_bodies() -> Structure {
+        let mut s = Structure::default();
+        let g = s.add_body("ground", BodyKind::Fixed, None);
+        let b = s.add_body(
+            "b",
+            BodyKind::Free,
+            Some(Inertia { mass_kg: 1.0, com: [1.0, 0.0, 0.0], principal_kg_m2: [0.1; 3] }),
+        );
+        s.add_node("A", g, [0.0; 3]);
+        s.add_node("B", b, [1.0, 0.0, 0.0]);
+        s
+    }
+
+    #[test]
+    fn a_valid_structure_passes_validation() {
+        let mut s = two_bodies();
+        s.springs.push(Spring { name: "k".into(), a: 0, b: 1, stiffness_n_per_m: 10.0, rest_length_m: 0.0 });
+        assert_eq!(s.validate(), Ok(()));
+    }
+
+    #[test]
+    fn a_member_naming_an_unknown_node_is_rejected() {
+        let mut s = two_bodies();
+        s.cables.push(Cable { name: "c".into(), a: 0, b: 7, law: CableLaw::Inextensible, length_m: 1.0 });
+        assert!(matches!(s.validate(), Err(StructureError::DanglingReference { index: 7, .. })));
+    }
+
+    #[test]
+    fn a_zero_length_strut_is_rejected() {
+        let mut s = two_bodies();
+        s.add_node("A2", 0, [0.0; 3]);
+        s.struts.push(Strut { name: "s".into(), a: 0, b: 2, radius_m: 0.01 });
+        assert_eq!(s.validate(), Err(StructureError::ZeroLength { what: "strut", name: "s".into() }));
+    }
+
+    #[test]
+    fn a_free_body_without_mass_is_rejected() {
+        let mut s = two_bodies();
+        s.bodies[1].inertia = Some(Inertia { mass_kg: 0.0, com: [0.0; 3], principal_kg_m2: [0.1; 3] });
+        assert_eq!(s.validate(), Err(StructureError::NoMass("b".into())));
+    }
+
+    #[test]
+    fn a_negative_spring_stiffness_is_rejected() {
+        let mut s = two_bodies();
+        s.springs.push(Spring { name: "k".into(), a: 0, b: 1, stiffness_n_per_m: -1.0, rest_length_m: 0.0 });
+        assert!(matches!(s.validate(), Err(StructureError::Invalid { what: "spring", .. })));
+    }
+}

@@ -166,3 +166,33 @@ fn record_writes_an_rrd_file_and_no_partial_file() {
     assert!(len > 10_000, "recording is only {len} bytes");
     assert!(!dir.join("quick.rrd.partial").exists());
 }
+
+/// A settle that runs out of time is a failure (exit 1), never a pass.
+#[test]
+fn a_settle_that_never_comes_fails_with_exit_1() {
+    let text = VALID.replace("[actuation]", "[settle]\nmax_time = 0.05\n[actuation]");
+    let p = temp_file("timeout.toml", &text);
+    let json = p.with_extension("json");
+    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap(), "--json", json.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("NOT SETTLED"), "{out}");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["scenarios"][0]["settle"]["settled"], false);
+    assert_eq!(v["scenarios"][0]["passed"], false);
+}
+
+/// A time step far too large for stiff springs never passes: rapier clamps velocities, so
+/// the state stays finite, but the run fails (it ends on the wrong branch or does not settle).
+#[test]
+fn an_absurd_time_step_never_passes() {
+    let text = VALID
+        .replace("L = 1.0", "L = 1.0\nK1 = 1e9\nK2 = 1e9\nc_D1 = 0.0")
+        .replace("[actuation]", "[sim]\ndt = 0.5\n[settle]\nmax_time = 50.0\n[actuation]");
+    let p = temp_file("diverge.toml", &text);
+    let json = p.with_extension("json");
+    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap(), "--json", json.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["scenarios"][0]["passed"], false);
+    assert!(!err.contains("panicked"));
+}

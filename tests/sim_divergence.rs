@@ -1,0 +1,52 @@
+//! Divergence is detected and reported with what diverged and when.
+
+use tensegrity_testbed::sim::{SimError, SimSettings, Simulation};
+use tensegrity_testbed::structure::{BodyKind, Inertia, Structure};
+
+/// An unsupported body under gravity leaves a 10 m box after about sqrt(2 * 10 / 9.81) = 1.43 s;
+/// the simulator stops with a divergence naming the node, within one step of that time.
+#[test]
+fn a_body_leaving_the_bounding_box_is_reported_as_divergence() {
+    let mut s = Structure { gravity: [0.0, 0.0, -9.81], ..Default::default() };
+    let b = s.add_body("falling", BodyKind::Free, Some(Inertia { mass_kg: 1.0, com: [0.0; 3], principal_kg_m2: [0.1; 3] }));
+    s.add_node("P", b, [0.0; 3]);
+    let settings = SimSettings { dt_s: 0.01, bounding_box_m: 10.0, ..Default::default() };
+    let mut sim = Simulation::new(&s, &settings).unwrap();
+    let err = loop {
+        if let Err(e) = sim.step() {
+            break e;
+        }
+        assert!(sim.tick() < 1000, "never diverged");
+    };
+    match err {
+        SimError::Diverged { tick, time_s, what } => {
+            assert!(what.contains("node 'P' left the bounding box"), "{what}");
+            let expected = (2.0 * 10.0 / 9.81f64).sqrt();
+            assert!((time_s - expected).abs() <= 0.02, "diverged at {time_s} s (tick {tick}), expected {expected:.3} s");
+        }
+        other => panic!("expected divergence, got {other:?}"),
+    }
+}
+
+/// A spring of zero free length between the ground and a free body pulls it to the anchor:
+/// the explicit force law is exact at rest, so the settled position error is at round-off.
+#[test]
+fn a_free_body_on_a_zero_length_spring_settles_on_the_anchor() {
+    use tensegrity_testbed::structure::Spring;
+    let mut s = Structure::default();
+    let g = s.add_body("ground", BodyKind::Fixed, None);
+    let b = s.add_body("mass", BodyKind::Free, Some(Inertia { mass_kg: 1.0, com: [0.3, 0.2, 0.0], principal_kg_m2: [0.1; 3] }));
+    let a = s.add_node("anchor", g, [0.0; 3]);
+    let p = s.add_node("P", b, [0.3, 0.2, 0.0]);
+    s.springs.push(Spring { name: "k".into(), a, b: p, stiffness_n_per_m: 100.0, rest_length_m: 0.0 });
+    let settings = SimSettings { dt_s: 0.01, body_damping_per_s: 10.0, ..Default::default() };
+    let mut sim = Simulation::new(&s, &settings).unwrap();
+    for _ in 0..5000 {
+        sim.step().unwrap();
+    }
+    let pos = sim.node_position(p);
+    let err = (pos[0].powi(2) + pos[1].powi(2) + pos[2].powi(2)).sqrt();
+    assert!(err < 1e-12, "settled {err:e} m from the anchor");
+    let f = sim.member_forces();
+    assert!(f.residual.max_force_n < 1e-9, "residual {:e} N", f.residual.max_force_n);
+}
