@@ -206,7 +206,13 @@ fn fmt_values(v: &Values) -> String {
 fn fmt_errors(analytic: &Values, simulated: &Values) -> String {
     simulated
         .iter()
-        .filter_map(|(k, s)| analytic.get(k).map(|a| format!("{k}={s:.9} (err {:.1e})", (s - a).abs())))
+        .filter_map(|(k, s)| {
+            analytic.get(k).map(|a| {
+                // Angles (the papers' theta symbols) are compared modulo 2 pi.
+                let e = if k.starts_with("theta") { crate::mechanisms::wrap_angle(s - a) } else { s - a };
+                format!("{k}={s:.9} (err {:.1e})", e.abs())
+            })
+        })
         .collect::<Vec<_>>()
         .join(" ")
 }

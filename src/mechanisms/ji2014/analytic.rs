@@ -637,6 +637,25 @@ pub fn curve_iii_eq28(p: &Params, l3: f64, theta1: f64) -> f64 {
     eta(p, l3, theta1).0
 }
 
+/// The theta1 in [0, pi/2] on curve iii (eta1 = 0, Eq. 28) for a given L3, by bisection;
+/// None when the curve does not cross that range.
+pub fn curve_iii_theta1(p: &Params, l3: f64) -> Option<f64> {
+    let (mut lo, mut hi) = (0.0, FRAC_PI_2);
+    if curve_iii_eq28(p, l3, lo) * curve_iii_eq28(p, l3, hi) > 0.0 {
+        return None;
+    }
+    const BISECTION_STEPS: usize = 200;
+    for _ in 0..BISECTION_STEPS {
+        let mid = 0.5 * (lo + hi);
+        if curve_iii_eq28(p, l3, lo) * curve_iii_eq28(p, l3, mid) <= 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
 /// Eq. 33, curve iv (`theta1 = theta2 mod pi` substituted in Eq. 5) [N*m]:
 /// `2(2K1-K2) L sin th1 - 2 sqrt3 K2 L cos th1 + sqrt3 K1 L3` (correct algebra;
 /// equals `eta2 sin th1 - eta1 cos th1`).
@@ -1031,20 +1050,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let mut jump: f64 = 0.0;
         for l3 in [1.2, 1.5, 1.8, 2.0] {
             // eta1 = 0 on th1 with (K1+2K2) s1 - sqrt3 K1 c1 = -2 sqrt3 K2 L / L3
-            let mut lo = 0.0;
-            let mut hi = FRAC_PI_2;
-            if curve_iii_eq28(&q, l3, lo) * curve_iii_eq28(&q, l3, hi) > 0.0 {
-                continue;
-            }
-            for _ in 0..200 {
-                let mid = 0.5 * (lo + hi);
-                if curve_iii_eq28(&q, l3, lo) * curve_iii_eq28(&q, l3, mid) <= 0.0 {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            let t1 = 0.5 * (lo + hi);
+            let Some(t1) = curve_iii_theta1(&q, l3) else { continue };
             for dt in [-1e-7, 0.0, 1e-7] {
                 for e in equilibria(&q, l3, t1 + dt) {
                     djmax = djmax.max(det_jacobian(&q, l3, t1 + dt, e.theta2).abs());
@@ -1099,20 +1105,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let mut r_d: f64 = 0.0;
         let mut which = String::new();
         for l3 in [1.2, 1.6, 2.0] {
-            let mut lo = 0.0;
-            let mut hi = FRAC_PI_2;
-            if curve_iii_eq28(&q, l3, lo) * curve_iii_eq28(&q, l3, hi) > 0.0 {
-                continue;
-            }
-            for _ in 0..200 {
-                let mid = 0.5 * (lo + hi);
-                if curve_iii_eq28(&q, l3, lo) * curve_iii_eq28(&q, l3, mid) <= 0.0 {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            let t1 = 0.5 * (lo + hi);
+            let Some(t1) = curve_iii_theta1(&q, l3) else { continue };
             let sc = q.k1 * q.l;
             for e in equilibria(&q, l3, t1) {
                 let is_pi = e.theta2.abs() > FRAC_PI_2;
