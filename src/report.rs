@@ -166,6 +166,13 @@ impl Report {
                     "   stability: {tested} point(s) perturbed, {unstable} unstable, {disagree} disagree with the analytic sign of K\n"
                 ));
             }
+            let mut branches: std::collections::BTreeMap<&str, usize> = std::collections::BTreeMap::new();
+            for p in &s.points {
+                *branches.entry(p.branch.as_str()).or_default() += 1;
+            }
+            for (b, n) in &branches {
+                out.push_str(&format!("   landed on: {b}: {n} point(s)\n"));
+            }
             let shown = s.points.len().min(MAX_POINTS_IN_TABLE);
             for p in &s.points[..shown] {
                 out.push_str(&format!(

@@ -26,12 +26,16 @@ fn grid_settles_on_the_energy_minimum_within_1e_9_of_l() {
         }
         let e = tensegrity_testbed::mechanisms::wrap_angle(p.simulated["theta2"] - p.analytic["theta2"]).abs();
         assert!(e <= 1e-9, "point {} theta2: error {e:e} rad", p.index);
-        assert_eq!(p.branch, "energy minimum");
+        assert!(p.branch.starts_with("energy minimum"), "{}", p.branch);
         assert_eq!(p.stable, Some(true), "point {}: perturbation test", p.index);
         assert_eq!(p.analytic_stable, Some(p.analytic["K"] > 0.0));
         assert_eq!(p.stable, p.analytic_stable);
     }
     assert!(r.passed);
+    // The paper's Eq. 5 root (theta2 in [0, pi]) is the one the dynamics reaches only where
+    // eta1 < 0: a minority of this workspace (FINDINGS.md, Eq. 5).
+    let on_paper_root = r.points.iter().filter(|p| p.branch.contains("Eq. 5")).count();
+    assert!(on_paper_root * 4 < r.points.len(), "{on_paper_root} of {} points on the paper's root", r.points.len());
 }
 
 /// Started on the energy maximum (the other root of Eq. 5), the dynamics holds it, and the
@@ -41,7 +45,7 @@ fn energy_maximum_is_found_unstable_in_agreement_with_negative_stiffness() {
     let r = run_file("scenarios/ji2014/unstable.toml");
     assert!(r.passed, "{:?}", r.error);
     for p in &r.points {
-        assert_eq!(p.branch, "energy maximum");
+        assert!(p.branch.starts_with("energy maximum"), "{}", p.branch);
         assert_eq!(p.stable, Some(false));
         assert!(p.analytic["K"] < 0.0);
         assert!((p.simulated["theta2"] - p.analytic["theta2"]).abs() <= 1e-9);

@@ -88,6 +88,29 @@ fn equilibrium_values(p: &Params, l3: f64, theta1: f64, e: &analytic::Equilibriu
     ])
 }
 
+/// Both roots of dU/dtheta2 = 0, energy minimum first, each labelled with whether it is the
+/// root the paper's Eq. 5 picks (theta2 restricted to [0, pi]).
+fn branches(p: &Params, l3: f64, th1: f64) -> Vec<Solution> {
+    let paper = analytic::fk_paper(p, l3, th1);
+    analytic::equilibria(p, l3, th1)
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let mut label = if i == 0 { "energy minimum".to_string() } else { "energy maximum".to_string() };
+            if wrap_angle(e.theta2 - paper.theta2).abs() < SAME_ROOT_RAD {
+                label.push_str(PAPER_ROOT_MARK);
+            }
+            Solution { label, values: equilibrium_values(p, l3, th1, e), stable: Some(e.stable) }
+        })
+        .collect()
+}
+
+/// Appended to the label of the root that Eq. 5 picks with theta2 in [0, pi].
+pub const PAPER_ROOT_MARK: &str = " (the root of Eq. 5 with theta2 in [0, pi])";
+
+/// Two roots closer than this are the same root [rad] (the two roots are pi apart).
+const SAME_ROOT_RAD: f64 = 1e-9;
+
 impl Mechanism for Ji2014 {
     fn name(&self) -> &'static str {
         "ji2014"
@@ -152,19 +175,7 @@ impl Mechanism for Ji2014 {
         match query {
             "fk" => {
                 let (l3, th1) = (input(inputs, "L3")?, input(inputs, "theta1")?);
-                let paper = analytic::fk_paper(&p, l3, th1);
-                Ok(analytic::equilibria(&p, l3, th1)
-                    .iter()
-                    .enumerate()
-                    .map(|(i, e)| {
-                        let is_paper = wrap_angle(e.theta2 - paper.theta2).abs() < 1e-9;
-                        let mut label = if i == 0 { "energy minimum".to_string() } else { "energy maximum".to_string() };
-                        if is_paper {
-                            label.push_str(" (the root of Eq. 5 with theta2 in [0, pi])");
-                        }
-                        Solution { label, values: equilibrium_values(&p, l3, th1, e), stable: Some(e.stable) }
-                    })
-                    .collect())
+                Ok(branches(&p, l3, th1))
             }
             "ik" => {
                 let (x, y) = (input(inputs, "x")?, input(inputs, "y")?);
@@ -230,18 +241,7 @@ impl Mechanism for Ji2014 {
         let p = params_of(params);
         let (l3, th1) = (input(inputs, "L3")?, input(inputs, "theta1")?);
         let eqs = analytic::equilibria(&p, l3, th1);
-        Ok(Prediction {
-            expected: equilibrium_values(&p, l3, th1, &eqs[0]),
-            branches: eqs
-                .iter()
-                .enumerate()
-                .map(|(i, e)| Solution {
-                    label: if i == 0 { "energy minimum".into() } else { "energy maximum".into() },
-                    values: equilibrium_values(&p, l3, th1, e),
-                    stable: Some(e.stable),
-                })
-                .collect(),
-        })
+        Ok(Prediction { expected: equilibrium_values(&p, l3, th1, &eqs[0]), branches: branches(&p, l3, th1) })
     }
 
     fn observe(&self, _params: &Values, s: &Structure, snap: &Snapshot) -> Values {
