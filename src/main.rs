@@ -179,6 +179,10 @@ fn cmd_list() -> i32 {
         for i in m.inputs() {
             println!("    {:<12} [{}] {}", i.symbol, i.unit, i.description);
         }
+        println!("  start keys ([start] table):");
+        for (k, what) in m.start_keys() {
+            println!("    {k:<16} {what}");
+        }
         println!("  checkable quantities:");
         for q in m.quantities() {
             println!("    {:<12} [{}] {}", q.symbol, q.unit, q.description);

@@ -297,6 +297,12 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         residual_torque_tol_nm: positive(ctx, &raw.settle.residual_torque_tol, "settle.residual_torque_tol (N m)", d.residual_torque_tol_nm)?,
         max_time_s: positive(ctx, &raw.settle.max_time, "settle.max_time (s)", d.max_time_s)?,
     };
+    for (k, _) in &raw.start {
+        if !m.start_keys().iter().any(|(key, _)| key == k.get_ref()) {
+            let known: Vec<_> = m.start_keys().iter().map(|(key, _)| *key).collect();
+            return Err(ctx.err(k, format!("unknown start key '{}' for {} (expected one of: {})", k.get_ref(), m.name(), known.join(", "))));
+        }
+    }
     let start = values(ctx, &raw.start)?;
 
     let input_syms: Vec<&str> = m.inputs().iter().map(|i| i.symbol).collect();

@@ -69,6 +69,7 @@ fn bad_scenarios_give_exit_2_with_file_line_and_column() {
         ("missing input", VALID.replace(", theta1 = 0.5", ""), ":6:"),
         ("unknown mechanism", VALID.replace("\"ji2014\"", "\"ji2015\""), ":2:13"),
         ("zero dt", VALID.replace("[actuation]", "[sim]\ndt = 0.0\n[actuation]"), ":6:6"),
+        ("unknown start key", VALID.replace("[actuation]", "[start]\ntheta9 = 1.0\n[actuation]"), ":6:1"),
         ("nan", VALID.replace("L = 1.0", "L = nan"), ":4:5"),
         ("unknown quantity", VALID.replace("quantity = \"theta2\"", "quantity = \"zeta\""), ":8:12"),
         ("empty points", VALID.replace("points = [ { L3 = 1.0, theta1 = 0.5 } ]", "points = []"), ":5:1"),

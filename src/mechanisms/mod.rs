@@ -109,6 +109,10 @@ pub trait Mechanism: Send + Sync {
     fn inputs(&self) -> &'static [InputSpec];
     fn quantities(&self) -> &'static [QuantitySpec];
     fn queries(&self) -> &'static [QuerySpec];
+    /// Keys accepted in a scenario's `[start]` table: (key, meaning).
+    fn start_keys(&self) -> &'static [(&'static str, &'static str)] {
+        &[]
+    }
     /// Checks parameter values; the message names the parameter and the accepted range.
     fn validate_params(&self, params: &Values) -> Result<(), (String, String)>;
     /// Checks one set of inputs against the parameters; `Err((symbol, message))`.

@@ -131,6 +131,14 @@ impl Mechanism for Ji2014 {
         QUERIES
     }
 
+    fn start_keys(&self) -> &'static [(&'static str, &'static str)] {
+        &[
+            ("theta2", "start angle of strut D1D3 [rad]"),
+            ("theta2_offset", "start this far from the stable root [rad] (default 0.5)"),
+            ("at_unstable_root", "1: start exactly on the energy maximum"),
+        ]
+    }
+
     fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
         for (sym, what) in [("L", "m"), ("K1", "N/m"), ("K2", "N/m"), ("m_platform", "kg")] {
             let x = v[sym];
