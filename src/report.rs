@@ -24,6 +24,10 @@ pub struct ScenarioReport {
     pub checks: Vec<CheckReport>,
     pub points: Vec<PointReport>,
     pub stiffness_probe: Option<ProbeReport>,
+    /// Every interval of ticks in which a cable was slack.
+    pub slack_intervals: Vec<SlackInterval>,
+    /// Present when the scenario has an `[interference]` section.
+    pub interference: Option<InterferenceReport>,
     pub findings: Vec<FindingReport>,
     /// Why the run stopped early (divergence, interruption), if it did.
     pub error: Option<String>,
@@ -74,6 +78,52 @@ pub struct PointReport {
     /// Stability from the analytic model (sign of the stiffness) for the branch landed on.
     pub analytic_stable: Option<bool>,
     pub slack_cables: Vec<String>,
+    /// Cables the analytic statics says are slack (mechanisms with cables only).
+    pub expected_slack: Option<Vec<String>>,
+    /// Whether the simulated slack set equals the analytic one.
+    pub slack_agrees: Option<bool>,
+    /// Outside the analytic model's validity (some cable slack): the distance of the settled
+    /// state from the analytic point, over the length quantities [m].
+    pub distance_from_analytic_m: Option<f64>,
+}
+
+/// Strut interference over the run (parry capsule distances).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct InterferenceReport {
+    /// Smallest clearance seen over the run [m] (None: no pair ever came within the margin).
+    pub min_clearance_m: Option<f64>,
+    pub closest_pair: Option<[String; 2]>,
+    pub closest_points: Option<[[f64; 3]; 2]>,
+    pub tick_of_min: Option<u64>,
+    /// Strut pairs checked every tick (all pairs minus those meeting at a joint or excluded).
+    pub pairs_checked: usize,
+    pub ticks_checked: u64,
+    pub threshold_m: f64,
+    pub margin_m: f64,
+    /// Violations are reported without failing the run.
+    pub informative: bool,
+    pub passed: bool,
+    pub violations: Vec<InterferenceViolation>,
+}
+
+/// One interval of ticks in which a pair's clearance stayed below the threshold.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct InterferenceViolation {
+    pub pair: [String; 2],
+    pub first_tick: u64,
+    pub last_tick: u64,
+    pub min_clearance_m: f64,
+    pub tick_of_min: u64,
+    /// Closest points on the two strut axes at the minimum [m].
+    pub closest_points: [[f64; 3]; 2],
+}
+
+/// Ticks during which one cable was slack.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct SlackInterval {
+    pub cable: String,
+    pub first_tick: u64,
+    pub last_tick: u64,
 }
 
 #[derive(Clone, Debug, Serialize, PartialEq)]
@@ -153,6 +203,53 @@ impl Report {
                     p.tolerance,
                     if p.passed { "pass" } else { "FAIL" }
                 ));
+            }
+            let slack_checked: Vec<_> = s.points.iter().filter(|p| p.slack_agrees.is_some()).collect();
+            if !slack_checked.is_empty() {
+                let agree = slack_checked.iter().filter(|p| p.slack_agrees == Some(true)).count();
+                out.push_str(&format!(
+                    "   slack cables: simulated set equals the analytic one at {agree} of {} point(s)\n",
+                    slack_checked.len()
+                ));
+                for p in slack_checked.iter().filter(|p| p.expected_slack.as_ref().is_some_and(|e| !e.is_empty()) || p.slack_agrees == Some(false)) {
+                    out.push_str(&format!(
+                        "     point {:>4}: analytic slack [{}], simulated slack [{}]{}{}\n",
+                        p.index,
+                        p.expected_slack.as_deref().unwrap_or(&[]).join(", "),
+                        p.slack_cables.join(", "),
+                        p.distance_from_analytic_m.map(|d| format!(", {d:.3e} m from the analytic point")).unwrap_or_default(),
+                        if p.slack_agrees == Some(false) { "  DISAGREE" } else { "" }
+                    ));
+                }
+            }
+            if !s.slack_intervals.is_empty() {
+                out.push_str(&format!("   slack intervals ({}):", s.slack_intervals.len()));
+                for iv in s.slack_intervals.iter().take(MAX_POINTS_IN_TABLE) {
+                    out.push_str(&format!(" {} ticks {}-{};", iv.cable, iv.first_tick, iv.last_tick));
+                }
+                out.push('\n');
+            }
+            if let Some(i) = &s.interference {
+                out.push_str(&format!(
+                    "   interference: {} pair(s) checked over {} tick(s); min clearance {}; {} violation(s) below {:.3e} m{}\n",
+                    i.pairs_checked,
+                    i.ticks_checked,
+                    match (&i.min_clearance_m, &i.closest_pair) {
+                        (Some(c), Some([a, b])) => format!("{c:.6e} m ({a} / {b}, tick {})", i.tick_of_min.unwrap_or(0)),
+                        _ => format!("> {:.3e} m (no pair within the margin)", i.margin_m),
+                    },
+                    i.violations.len(),
+                    i.threshold_m,
+                    if i.informative { " (informative)" } else if i.passed { "" } else { "  FAIL" }
+                ));
+                for v in i.violations.iter().take(MAX_POINTS_IN_TABLE) {
+                    let [p, q] = v.closest_points;
+                    out.push_str(&format!(
+                        "     {} / {}: ticks {}-{}, min clearance {:.6e} m at tick {}, closest points ({:.6}, {:.6}, {:.6}) ({:.6}, {:.6}, {:.6})\n",
+                        v.pair[0], v.pair[1], v.first_tick, v.last_tick, v.min_clearance_m, v.tick_of_min,
+                        p[0], p[1], p[2], q[0], q[1], q[2]
+                    ));
+                }
             }
             let unstable = s.points.iter().filter(|p| p.stable == Some(false)).count();
             let tested = s.points.iter().filter(|p| p.stable.is_some()).count();

@@ -3,6 +3,8 @@
 use crate::mechanisms::{self, Mechanism, Prediction, Values};
 use crate::observers::compare::{self, Compare};
 use crate::observers::record::Recorder;
+use crate::observers::interference::Interference;
+use crate::observers::slack::SlackTracker;
 use crate::observers::{Observer, Tick};
 use crate::report::{PointReport, ProbeReport, ScenarioReport, SettleSummary};
 use crate::scenario::{Actuation, Scenario};
@@ -36,6 +38,8 @@ struct Runner<'a> {
     sc: &'a Scenario,
     sim: Simulation,
     compare: Compare,
+    slack: SlackTracker,
+    interference: Option<Interference>,
     recorder: Option<Recorder>,
     cancel: Option<&'a AtomicBool>,
     steps: u64,
@@ -71,7 +75,8 @@ impl Runner<'_> {
         self.steps += 1;
         let snap = self.sim.snapshot();
         let simulated = self.observe(&snap);
-        let ghost = self.mech.analytic_nodes(&self.sc.params, inputs);
+        // The ghost overlay is only drawn in recordings.
+        let ghost = if self.recorder.is_some() { self.mech.analytic_nodes(&self.sc.params, inputs) } else { None };
         let tick = Tick {
             structure: &self.sim.structure,
             snapshot: &snap,
@@ -81,8 +86,23 @@ impl Runner<'_> {
             ghost_nodes: ghost.as_deref(),
         };
         self.compare.tick(&tick);
+        self.slack.tick(&tick);
+        if let Some(i) = self.interference.as_mut() {
+            i.tick(&tick);
+        }
         if let Some(r) = self.recorder.as_mut() {
             r.tick(&tick);
+            if let Some(i) = &self.interference {
+                if let Some(c) = i.last_min_clearance_m {
+                    r.scalar(snap.tick, "interference/min_clearance_m", c);
+                }
+                for (a, b, c) in &i.new_violations {
+                    r.event(snap.tick, &format!("interference: {a} / {b} clearance {c:.3e} m"));
+                }
+            }
+            for (cable, slack) in &self.slack.changes {
+                r.event(snap.tick, &format!("cable {cable} went {}", if *slack { "slack" } else { "taut" }));
+            }
         }
         Ok((snap, simulated))
     }
@@ -193,6 +213,8 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         checks: vec![],
         points: vec![],
         stiffness_probe: None,
+        slack_intervals: vec![],
+        interference: None,
         findings: mech.findings(&sc.params).into_iter().map(Into::into).collect(),
         error: None,
     };
@@ -209,6 +231,14 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
             return report;
         }
     };
+    let interference = match sc.interference.as_ref().map(|i| Interference::new(&sim.structure, i)) {
+        None => None,
+        Some(Ok(i)) => Some(i),
+        Some(Err(e)) => {
+            report.error = Some(e);
+            return report;
+        }
+    };
     let record_path = opts.record.clone().or_else(|| sc.record.clone());
     let recorder = match record_path.as_ref().map(|p| Recorder::create(p, "tensegrity-testbed", 1)) {
         None => None,
@@ -221,6 +251,8 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
     let length_scale = mech.length_scale(&sc.params);
     let mut runner = Runner {
         compare: Compare::new(&sc.checks, length_scale),
+        slack: SlackTracker::new(),
+        interference,
         mech,
         sc,
         sim,
@@ -239,6 +271,8 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
     }
 
     report.checks = runner.compare.reports();
+    report.slack_intervals = runner.slack.intervals();
+    report.interference = runner.interference.as_ref().map(Interference::report);
     report.settle = SettleSummary {
         settled: !report.points.is_empty() && report.points.iter().all(|p| p.settled),
         steps: runner.steps,
@@ -263,7 +297,9 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         && report.settle.settled
         && report.checks.iter().all(|c| c.passed)
         && report.stiffness_probe.as_ref().is_none_or(|p| p.passed)
-        && stability_agrees;
+        && stability_agrees
+        && report.points.iter().all(|p| p.slack_agrees != Some(false))
+        && report.interference.as_ref().is_none_or(|i| i.passed);
     if let Some(r) = runner.recorder.take() {
         let mut r = r;
         r.document("report", &serde_json::to_string_pretty(&report).unwrap_or_default());
@@ -365,7 +401,42 @@ fn settle_point(runner: &mut Runner, sc: &Scenario, index: usize, inputs: &Value
             }
         }
     }
-    runner.compare.settle_point(&landed, &simulated, s.settled);
+    let slack_cables: Vec<String> = runner
+        .sim
+        .structure
+        .cables
+        .iter()
+        .zip(&s.snapshot.forces.cable_slack)
+        .filter(|(_, sl)| **sl)
+        .map(|(c, _)| c.name.clone())
+        .collect();
+    let slack_agrees = prediction.expected_slack.as_ref().map(|e| {
+        let mut e = e.clone();
+        e.sort();
+        let mut got = slack_cables.clone();
+        got.sort();
+        e == got
+    });
+    let outside = prediction.expected_slack.as_ref().is_some_and(|e| !e.is_empty());
+    // Outside the analytic model's validity the analytic point is no equilibrium: report the
+    // distance from it instead of checking against it.
+    let distance_from_analytic_m = outside.then(|| {
+        runner
+            .mech
+            .quantities()
+            .iter()
+            .filter(|q| q.kind == mechanisms::QuantityKind::Length)
+            .filter_map(|q| Some(simulated.get(q.symbol)? - landed.get(q.symbol)?))
+            .map(|d| d * d)
+            .sum::<f64>()
+            .sqrt()
+    });
+    if slack_agrees == Some(false) {
+        runner.emit(&format!("point {index}: slack cables {slack_cables:?} differ from the analytic {:?}", prediction.expected_slack));
+    }
+    if !outside {
+        runner.compare.settle_point(&landed, &simulated, s.settled);
+    }
     report.points.push(PointReport {
         index,
         inputs: inputs.clone(),
@@ -379,15 +450,10 @@ fn settle_point(runner: &mut Runner, sc: &Scenario, index: usize, inputs: &Value
         branch,
         stable,
         analytic_stable,
-        slack_cables: runner
-            .sim
-            .structure
-            .cables
-            .iter()
-            .zip(&s.snapshot.forces.cable_slack)
-            .filter(|(_, sl)| **sl)
-            .map(|(c, _)| c.name.clone())
-            .collect(),
+        slack_cables,
+        expected_slack: prediction.expected_slack.clone(),
+        slack_agrees,
+        distance_from_analytic_m,
     });
     Ok(())
 }

@@ -47,6 +47,22 @@ pub struct RawScenario {
     pub probe: Option<RawProbe>,
     #[serde(default)]
     pub record: Option<RawRecord>,
+    #[serde(default)]
+    pub interference: Option<Spanned<RawInterference>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawInterference {
+    /// Clearance below which a pair violates [m] (default 0: actual overlap only).
+    pub threshold: Option<Spanned<f64>>,
+    /// Pairs farther apart are not measured [m] (default: the mechanism's length scale).
+    pub margin: Option<Spanned<f64>>,
+    /// Report violations without failing the run (default false).
+    pub informative: Option<bool>,
+    /// Further strut pairs to exclude, by name.
+    #[serde(default)]
+    pub exclude: Vec<Spanned<(String, String)>>,
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -137,6 +153,7 @@ pub struct Scenario {
     pub stability_perturbation: Option<f64>,
     pub probe: Option<Probe>,
     pub record: Option<PathBuf>,
+    pub interference: Option<crate::observers::interference::InterferenceSettings>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -305,19 +322,39 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     }
     let start = values(ctx, &raw.start)?;
 
-    let input_syms: Vec<&str> = m.inputs().iter().map(|i| i.symbol).collect();
+    let native: Vec<&str> = m.inputs().iter().map(|i| i.symbol).collect();
+    // The accepted sets of input symbols: the mechanism's inputs, or one of its alternatives.
+    let mut input_sets: Vec<Vec<&str>> = vec![native.clone()];
+    input_sets.extend(m.alternative_inputs().iter().map(|s| s.to_vec()));
+    let expected_sets = input_sets.iter().map(|s| s.join(", ")).collect::<Vec<_>>().join("; or ");
+    // The set a table of keys belongs to: the first that contains its first key.
+    let set_of = |keys: &[&str]| -> Vec<&str> {
+        input_sets.iter().find(|s| keys.iter().any(|k| s.contains(k))).cloned().unwrap_or_else(|| native.clone())
+    };
     let check_inputs = |map: &SpannedMap, whole: &Spanned<SpannedMap>, allow_t: bool| -> Result<Values, ScenarioError> {
+        let keys: Vec<&str> = map.iter().map(|(k, _)| k.get_ref().as_str()).filter(|k| *k != "t").collect();
+        let input_syms = set_of(&keys);
         for (k, _) in map {
             if !(input_syms.contains(&k.get_ref().as_str()) || (allow_t && k.get_ref() == "t")) {
-                return Err(ctx.err(k, format!("unknown input '{}' (expected {}{})", k.get_ref(), input_syms.join(", "), if allow_t { " and t" } else { "" })));
+                return Err(ctx.err(k, format!("unknown input '{}' (expected {}{})", k.get_ref(), expected_sets, if allow_t { ", and t" } else { "" })));
             }
         }
         for s in &input_syms {
             if !map.iter().any(|(k, _)| k.get_ref() == s) {
-                return Err(ctx.err(whole, format!("missing input '{s}'")));
+                return Err(ctx.err(whole, format!("missing input '{s}' (expected {expected_sets})")));
             }
         }
-        let vals = values(ctx, map)?;
+        let mut vals = values(ctx, map)?;
+        let t = vals.remove("t");
+        if input_syms != native {
+            vals = m.convert_inputs(&params, &vals).map_err(|(sym, msg)| {
+                let at = map.iter().find(|(k, _)| k.get_ref() == &sym).map(|(_, v)| v.span().start).unwrap_or(whole.span().start);
+                ctx.err_at(at, msg)
+            })?;
+        }
+        if let Some(t) = t {
+            vals.insert("t".into(), t);
+        }
         if let Err((sym, msg)) = m.validate_inputs(&params, &vals) {
             let at = map.iter().find(|(k, _)| k.get_ref() == &sym).map(|(_, v)| v.span().start).unwrap_or(whole.span().start);
             return Err(ctx.err_at(at, msg));
@@ -331,9 +368,11 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         return Err(ctx.err(&raw.actuation, "actuation needs exactly one of: grid, points, waypoints"));
     }
     let actuation = if let Some(grid) = &act.grid {
+        let keys: Vec<&str> = grid.iter().map(|(k, _)| k.get_ref().as_str()).collect();
+        let input_syms = set_of(&keys);
         for (k, _) in grid {
             if !input_syms.contains(&k.get_ref().as_str()) {
-                return Err(ctx.err(k, format!("unknown input '{}' in actuation.grid (expected {})", k.get_ref(), input_syms.join(", "))));
+                return Err(ctx.err(k, format!("unknown input '{}' in actuation.grid (expected {expected_sets})", k.get_ref())));
             }
         }
         let mut axes: Vec<(String, Vec<f64>)> = Vec::new();
@@ -365,6 +404,14 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
                     q
                 }))
                 .collect();
+        }
+        if input_syms != native {
+            for p in points.iter_mut() {
+                *p = m.convert_inputs(&params, p).map_err(|(sym, msg)| {
+                    let at = grid.iter().find(|(k, _)| k.get_ref() == &sym).map(|(_, v)| v.span().start).unwrap_or(0);
+                    ctx.err_at(at, format!("grid point {:?}: {msg}", p))
+                })?;
+            }
         }
         for p in &points {
             if let Err((sym, msg)) = m.validate_inputs(&params, p) {
@@ -459,6 +506,45 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
             Some(PathBuf::from(p))
         }
     };
+    let interference = match &raw.interference {
+        None => None,
+        Some(i) => {
+            let threshold = match &i.get_ref().threshold {
+                None => 0.0,
+                Some(t) => finite(ctx, t, "interference.threshold")?,
+            };
+            let margin = match &i.get_ref().margin {
+                None => m.length_scale(&params),
+                Some(t) => {
+                    let x = finite(ctx, t, "interference.margin")?;
+                    if x <= 0.0 {
+                        return Err(ctx.err(t, format!("interference.margin must be > 0 m, got {x}")));
+                    }
+                    x
+                }
+            };
+            if threshold >= margin {
+                return Err(ctx.err(i, format!("interference.threshold ({threshold} m) must be below interference.margin ({margin} m)")));
+            }
+            let exclude = i.get_ref().exclude.iter().map(|e| e.get_ref().clone()).collect();
+            // Strut names are checked against the built structure.
+            let settings = crate::observers::interference::InterferenceSettings {
+                threshold_m: threshold,
+                margin_m: margin,
+                informative: i.get_ref().informative.unwrap_or(false),
+                exclude,
+            };
+            let first = match &actuation {
+                Actuation::Points { points, .. } => points[0].clone(),
+                Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
+            };
+            let structure = m.build(&params, &first, &start).map_err(|e| ctx.err(&raw.actuation, e))?;
+            if let Err(e) = crate::observers::interference::Interference::new(&structure, &settings) {
+                return Err(ctx.err(i, e));
+            }
+            Some(settings)
+        }
+    };
     Ok(Scenario {
         file: path.to_path_buf(),
         source: ctx.source.to_string(),
@@ -474,5 +560,6 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         stability_perturbation,
         probe,
         record,
+        interference,
     })
 }

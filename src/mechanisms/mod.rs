@@ -3,6 +3,7 @@
 //! [`Mechanism`] trait that the rest of the testbed uses.
 
 pub mod ji2014;
+pub mod mohr2011;
 
 use crate::sim::Snapshot;
 use crate::structure::Structure;
@@ -77,6 +78,10 @@ pub struct Prediction {
     pub expected: Values,
     /// Every branch, for identifying which one the dynamics landed on.
     pub branches: Vec<Solution>,
+    /// For mechanisms with cables: the cables (by structure name) that the analytic statics
+    /// says are slack here. A non-empty set means the analytic point is not an equilibrium:
+    /// the settled state is not checked against it; the slack set is.
+    pub expected_slack: Option<Vec<String>>,
 }
 
 /// A printed equation checked against the testbed's derivation.
@@ -115,6 +120,17 @@ pub trait Mechanism: Send + Sync {
     }
     /// Checks parameter values; the message names the parameter and the accepted range.
     fn validate_params(&self, params: &Values) -> Result<(), (String, String)>;
+    /// Other sets of symbols a scenario may give instead of the inputs (for example the
+    /// end-effector position of a cable-driven mechanism); [`Mechanism::convert_inputs`] turns
+    /// them into inputs through the analytic inverse model.
+    fn alternative_inputs(&self) -> &'static [&'static [&'static str]] {
+        &[]
+    }
+    /// Converts one of the [`Mechanism::alternative_inputs`] sets into inputs;
+    /// `Err((symbol, message))` when it has no solution.
+    fn convert_inputs(&self, _params: &Values, given: &Values) -> Result<Values, (String, String)> {
+        Ok(given.clone())
+    }
     /// Checks one set of inputs against the parameters; `Err((symbol, message))`.
     fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), (String, String)>;
     /// The analytic model alone: every result of `query`.
@@ -144,7 +160,7 @@ pub trait Mechanism: Send + Sync {
 
 /// All built-in mechanisms.
 pub fn registry() -> Vec<Box<dyn Mechanism>> {
-    vec![Box::new(ji2014::Ji2014)]
+    vec![Box::new(ji2014::Ji2014), Box::new(mohr2011::Mohr2011)]
 }
 
 pub fn find(name: &str) -> Option<Box<dyn Mechanism>> {

@@ -1,8 +1,11 @@
-//! Observers, each fed one snapshot per tick: `compare` (analytic versus simulated) and
-//! `record` (rerun).
+//! Observers, each fed one snapshot per tick: `compare` (analytic versus simulated), `slack`
+//! (cable slackness intervals), `interference` (parry distances between struts) and `record`
+//! (rerun).
 
 pub mod compare;
+pub mod interference;
 pub mod record;
+pub mod slack;
 
 use crate::mechanisms::{Prediction, Values};
 use crate::sim::Snapshot;

@@ -63,6 +63,12 @@ impl Recorder {
         let _ = self.rec.log_static(entity, &rerun::TextDocument::new(text));
     }
 
+    /// Logs one scalar time series value at `tick`.
+    pub fn scalar(&mut self, tick: u64, entity: &str, value: f64) {
+        self.rec.set_time_sequence("tick", tick as i64);
+        let _ = self.rec.log(entity, &rerun::Scalars::single(value));
+    }
+
     /// Flushes and moves the recording to its final name.
     pub fn finish(self) -> Result<PathBuf, RecordError> {
         self.rec.flush_blocking().map_err(|e| RecordError::Io {

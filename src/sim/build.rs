@@ -79,31 +79,70 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
     let mut multibody_joints = MultibodyJointSet::new();
     let mut joint_links = vec![None; s.joints.len()];
     let mut joint_impulse = vec![None; s.joints.len()];
+    let mut hidden_links = Vec::new();
+    let mut fixed_roots: std::collections::BTreeMap<usize, RigidBodyHandle> = std::collections::BTreeMap::new();
+    // Bodies held by inextensible cables stay plain rigid bodies: rapier's rope joints (coupled
+    // linear axes) did not hold on multibody links (measured: the cables stretched from 3.2 m
+    // to 6 m with zero tension), while they hold to 1e-13 on plain bodies.
+    let mut roped = vec![false; n];
+    for c in &s.cables {
+        if c.law == CableLaw::Inextensible {
+            roped[s.nodes[c.a].body] = true;
+            roped[s.nodes[c.b].body] = true;
+        }
+    }
     for (j, joint) in s.joints.iter().enumerate() {
         if driving_joint.contains(&Some(j)) {
             continue; // ideal actuator: the child is placed kinematically
         }
-        let data = generic_joint(s, joint);
-        let (h1, h2) = (handles[joint.parent], handles[joint.child]);
-        let child_is_free = s.bodies[joint.child].kind == BodyKind::Free && !driven[joint.child];
-        let as_link = if child_is_free { multibody_joints.insert(h1, h2, data, true) } else { None };
-        match as_link {
-            Some(h) => {
-                if let Some((mb, link_id)) = multibody_joints.get_mut(h) {
-                    let (start, ndofs) = {
-                        let l = mb.link(link_id).expect("link just inserted");
-                        (l.assembly_id(), l.joint().ndofs())
-                    };
-                    for k in start..start + ndofs {
-                        mb.damping_mut()[k] = joint.damping;
-                    }
-                }
-                joint_links[j] = Some(LinkRef { multibody_joint: h });
-            }
-            None => {
-                joint_impulse[j] = Some(impulse_joints.insert(h1, h2, data, true));
-            }
+        let (mut h1, h2) = (handles[joint.parent], handles[joint.child]);
+        let child_is_free = s.bodies[joint.child].kind == BodyKind::Free && !driven[joint.child] && !roped[joint.child];
+        let can_link = child_is_free && multibody_link_possible(&multibody_joints, h1, h2);
+        if !can_link {
+            joint_impulse[j] = Some(impulse_joints.insert(h1, h2, generic_joint(s, joint), true));
+            continue;
         }
+        // A multibody hung from a fixed body gets its own fixed root: impulse joints (cables)
+        // attached to a fixed body that is also a multibody root had no effect in rapier 0.36
+        // (measured: six rope joints from the base let the end-effector fly away).
+        if s.bodies[joint.parent].kind == BodyKind::Fixed {
+            let root = *fixed_roots.entry(joint.parent).or_insert_with(|| bodies.insert(RigidBodyBuilder::fixed().build()));
+            h1 = root;
+        }
+        let link = match &joint.kind {
+            // rapier's 2-DoF multibody joints are `todo!()`: a universal joint becomes two
+            // revolute links through a hidden body that sits at the anchor.
+            JointKind::Universal { axis1, axis2 } => {
+                let anchor = v(s.nodes[joint.anchor].position);
+                let child = s.bodies[joint.child].inertia.expect("validated: free bodies have inertia");
+                let hidden = bodies.insert(
+                    RigidBodyBuilder::dynamic()
+                        .can_sleep(false)
+                        .gravity_scale(0.0)
+                        .additional_mass_properties(MassProperties::new(
+                            anchor,
+                            child.mass_kg * HIDDEN_LINK_MASS_FRACTION,
+                            v(child.principal_kg_m2) * HIDDEN_LINK_MASS_FRACTION,
+                        ))
+                        .build(),
+                );
+                let first = RevoluteJointBuilder::new(v(*axis1).normalize())
+                    .local_anchor1(anchor)
+                    .local_anchor2(anchor)
+                    .build();
+                let second = RevoluteJointBuilder::new(v(*axis2).normalize())
+                    .local_anchor1(anchor)
+                    .local_anchor2(anchor)
+                    .build();
+                let h_first = multibody_joints.insert(h1, hidden, first, true).expect("checked: no loop");
+                set_link_damping(&mut multibody_joints, h_first, joint.damping);
+                hidden_links.push(LinkRef { multibody_joint: h_first });
+                multibody_joints.insert(hidden, h2, second, true).expect("checked: no loop")
+            }
+            _ => multibody_joints.insert(h1, h2, generic_joint(s, joint), true).expect("checked: no loop"),
+        };
+        set_link_damping(&mut multibody_joints, link, joint.damping);
+        joint_links[j] = Some(LinkRef { multibody_joint: link });
     }
 
     let mut cable_ropes = vec![None; s.cables.len()];
@@ -130,7 +169,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
     params.num_solver_iterations = settings.substeps;
     params.num_internal_pgs_iterations = settings.pgs_iterations;
 
-    let length_scale_m = characteristic_length(s);
+    let length_scale_m = structure_size(s);
     let commands: Vec<f64> = s
         .actuators
         .iter()
@@ -157,6 +196,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         driven,
         driving_joint,
         joint_links,
+        hidden_links,
         joint_impulse,
         cable_ropes,
         cable_lengths: s.cables.iter().map(|c| c.length_m).collect(),
@@ -167,6 +207,33 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
     };
     sim.set_commands(&commands);
     Ok(sim)
+}
+
+/// Mass of the hidden body of a split universal joint, as a fraction of the child's: small, so
+/// the dynamics are the child's; it sits at the anchor, so it adds no moment at rest.
+const HIDDEN_LINK_MASS_FRACTION: f64 = 1e-3;
+
+/// Whether `parent -> child` can be a multibody link: the child must not hang from anything
+/// yet and must not be in the parent's multibody already (that would close a loop).
+fn multibody_link_possible(set: &MultibodyJointSet, parent: RigidBodyHandle, child: RigidBodyHandle) -> bool {
+    match (set.rigid_body_link(parent), set.rigid_body_link(child)) {
+        (_, Some(c)) if c.id != 0 => false,
+        (Some(p), Some(c)) => p.multibody != c.multibody,
+        _ => true,
+    }
+}
+
+/// Sets the damping of every degree of freedom of a multibody link [N s/m or N m s/rad].
+fn set_link_damping(set: &mut MultibodyJointSet, link: MultibodyJointHandle, damping: f64) {
+    if let Some((mb, link_id)) = set.get_mut(link) {
+        let (start, ndofs) = {
+            let l = mb.link(link_id).expect("link just inserted");
+            (l.assembly_id(), l.joint().ndofs())
+        };
+        for k in start..start + ndofs {
+            mb.damping_mut()[k] = damping;
+        }
+    }
 }
 
 /// Linear and angular damping of free bodies [1/s]; zero: joint damping does the work.
@@ -225,7 +292,7 @@ fn glam_mat3(x: Vector, y: Vector, z: Vector) -> rapier3d_f64::glamx::DMat3 {
 }
 
 /// Largest distance between two nodes of the structure [m] (at least 1e-3 m).
-fn characteristic_length(s: &Structure) -> f64 {
+pub fn structure_size(s: &Structure) -> f64 {
     let mut l: f64 = 1e-3;
     for a in &s.nodes {
         for b in &s.nodes {

@@ -25,15 +25,14 @@ pub struct MemberForces {
 
 /// Equilibrium residual: the generalized forces of member forces, gravity and probe loads on
 /// every free coordinate (a joint's free axes, summed over the subtree it carries). Zero at an
-/// exact equilibrium. Computed from the force laws, not from the solver.
+/// exact equilibrium. Computed from the force laws, not from the solver; the reactions of
+/// loop-closing joints, which no force law gives, are fitted by least squares.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Residual {
     /// Largest residual force on a translational coordinate [N].
     pub max_force_n: f64,
     /// Largest residual torque on a rotational coordinate [N m].
     pub max_torque_nm: f64,
-    /// Free coordinates that could not be checked (subtrees closed by loop joints).
-    pub unchecked_coordinates: usize,
 }
 
 type Wrench = (Vector, Vector); // (force, moment about the world origin)
@@ -107,6 +106,7 @@ impl Simulation {
         let s = &self.structure;
         let nb = s.bodies.len();
         let mut wrench: Vec<Wrench> = vec![(Vector::ZERO, Vector::ZERO); nb];
+        #[allow(clippy::type_complexity)]
         let push = |w: &mut Vec<Wrench>, body: usize, f: Vector, p: Vector| {
             w[body].0 += f;
             w[body].1 += p.cross(f);
@@ -171,99 +171,49 @@ impl Simulation {
                 parent_joint[joint.child] = Some(j);
             }
         }
-        // Bodies touched by a loop-closing impulse joint: their reactions are unknown.
-        let mut in_loop = vec![false; nb];
-        for (j, joint) in s.joints.iter().enumerate() {
-            if self.joint_impulse[j].is_some() {
-                in_loop[joint.parent] = true;
-                in_loop[joint.child] = true;
-            }
-        }
-        let descends_from = |mut b: usize, ancestor: usize| -> bool {
-            for _ in 0..=nb {
-                if b == ancestor {
-                    return true;
-                }
-                match parent_joint[b] {
-                    Some(j) => b = s.joints[j].parent,
-                    None => return false,
-                }
-            }
-            false
-        };
-        let subtree_wrench = |root: usize| -> (Wrench, bool) {
-            let mut w = (Vector::ZERO, Vector::ZERO);
-            let mut loop_free = true;
-            for b in 0..nb {
-                if descends_from(b, root) {
-                    w.0 += wrench[b].0;
-                    w.1 += wrench[b].1;
-                    loop_free &= !in_loop[b];
-                }
-            }
-            (w, loop_free)
-        };
-        let about = |w: Wrench, p: Vector| -> Vector { w.1 - p.cross(w.0) };
+        let tree = Tree { parent_joint };
 
-        let mut residual = Residual::default();
-        for (j, joint) in s.joints.iter().enumerate() {
-            if self.joint_links[j].is_none() {
-                continue;
+        // Loop-closing joints carry reactions that no force law gives. They are the unknowns of
+        // a least-squares fit: the reactions that best balance every free coordinate. At an
+        // equilibrium the fit is exact and the residual is zero; the fitted reactions are
+        // added to the bodies' loads.
+        let scale = self.length_scale_m;
+        let base = self.coordinate_forces(&tree, &wrench, true);
+        let closure_loads = self.closure_unit_loads();
+        if !closure_loads.is_empty() && !base.is_empty() {
+            let rows = base.len();
+            let cols = closure_loads.len();
+            let scaled = |c: &CoordinateForce| if c.is_torque { c.value / scale } else { c.value };
+            let mut g = nalgebra::DMatrix::<f64>::zeros(rows, cols);
+            for (k, load) in closure_loads.iter().enumerate() {
+                let col = self.coordinate_forces(&tree, load, false);
+                for (r, c) in col.iter().enumerate() {
+                    g[(r, k)] = scaled(c);
+                }
             }
-            let (w, ok) = subtree_wrench(joint.child);
-            let ndofs = match joint.kind {
-                JointKind::Fixed => 0,
-                JointKind::Revolute { .. } | JointKind::Prismatic { .. } => 1,
-                JointKind::Universal { .. } => 2,
-                JointKind::Spherical => 3,
-            };
-            if !ok {
-                residual.unchecked_coordinates += ndofs;
-                continue;
-            }
-            let anchor = v(self.node_position(joint.anchor));
-            let parent_rot = self.bodies[self.handles[joint.parent]].position().rotation;
-            let child_rot = self.bodies[self.handles[joint.child]].position().rotation;
-            let m = about(w, anchor);
-            match &joint.kind {
-                JointKind::Revolute { axis } => {
-                    let a = (parent_rot * v(*axis)).normalize();
-                    // A torsion spring on this joint is a generalized force on its coordinate.
-                    let spring = joint.torsion_spring.as_ref().map_or(0.0, |t| {
-                        let q = joint.initial_coordinate + relative_angle(parent_rot, child_rot, v(*axis));
-                        -t.stiffness_nm_per_rad * (q - t.rest_angle_rad)
-                    });
-                    residual.max_torque_nm = residual.max_torque_nm.max((m.dot(a) + spring).abs());
+            let r0 = nalgebra::DVector::<f64>::from_iterator(rows, base.iter().map(scaled));
+            let svd = g.clone().svd(true, true);
+            let tol = CLOSURE_SVD_RELATIVE_TOLERANCE * svd.singular_values.max();
+            if let Ok(lambda) = svd.solve(&(-r0), tol) {
+                for (k, load) in closure_loads.iter().enumerate() {
+                    for b in 0..nb {
+                        wrench[b].0 += load[b].0 * lambda[k];
+                        wrench[b].1 += load[b].1 * lambda[k];
+                    }
                 }
-                JointKind::Prismatic { axis } => {
-                    let a = (parent_rot * v(*axis)).normalize();
-                    residual.max_force_n = residual.max_force_n.max(w.0.dot(a).abs());
-                }
-                JointKind::Universal { axis1, axis2 } => {
-                    let a1 = (parent_rot * v(*axis1)).normalize();
-                    let a2 = (child_rot * v(*axis2)).normalize();
-                    residual.max_torque_nm = residual.max_torque_nm.max(m.dot(a1).abs()).max(m.dot(a2).abs());
-                }
-                JointKind::Spherical => {
-                    residual.max_torque_nm = residual.max_torque_nm.max(m.length());
-                }
-                JointKind::Fixed => {}
             }
         }
-        // Free bodies with no parent joint: all six coordinates.
-        for b in 0..nb {
-            if self.is_free(b) && parent_joint[b].is_none() {
-                let (w, ok) = subtree_wrench(b);
-                if !ok {
-                    residual.unchecked_coordinates += 6;
-                    continue;
-                }
-                let com = self.world_com(b);
-                residual.max_force_n = residual.max_force_n.max(w.0.length());
-                residual.max_torque_nm = residual.max_torque_nm.max(about(w, com).length());
+        let mut residual = Residual::default();
+        for c in self.coordinate_forces(&tree, &wrench, true) {
+            if c.is_torque {
+                residual.max_torque_nm = residual.max_torque_nm.max(c.value.abs());
+            } else {
+                residual.max_force_n = residual.max_force_n.max(c.value.abs());
             }
         }
         out.residual = residual;
+        let subtree_wrench = |root: usize| -> Wrench { tree.subtree_wrench(s, &wrench, root) };
+        let about = |w: Wrench, p: Vector| -> Vector { w.1 - p.cross(w.0) };
 
         // Actuator forces: minus the load of everything the actuated joint carries.
         for a in &s.actuators {
@@ -271,7 +221,7 @@ impl Simulation {
                 ActuatorTarget::CableLength(c) => out.cable_tension_n[c],
                 ActuatorTarget::Joint(j) => {
                     let joint = &s.joints[j];
-                    let (w, _) = subtree_wrench(joint.child);
+                    let w = subtree_wrench(joint.child);
                     let anchor = v(self.node_position(joint.anchor));
                     let parent_rot = self.bodies[self.handles[joint.parent]].position().rotation;
                     match &joint.kind {
@@ -294,4 +244,159 @@ pub(crate) fn relative_angle(parent: Rotation, child: Rotation, axis: Vector) ->
     let axis = axis.normalize();
     let s = Vector::new(rel.x, rel.y, rel.z).dot(axis);
     2.0 * s.atan2(rel.w)
+}
+
+/// Singular values below this fraction of the largest are treated as zero when fitting the
+/// reactions of loop-closing joints (redundant closures).
+const CLOSURE_SVD_RELATIVE_TOLERANCE: f64 = 1e-12;
+
+/// One free coordinate's generalized force: a force [N] or a torque [N m].
+#[derive(Clone, Copy, Debug)]
+struct CoordinateForce {
+    value: f64,
+    is_torque: bool,
+}
+
+/// The tree of joints that carry bodies (multibody links and actuator drives).
+struct Tree {
+    /// The joint each body hangs from, if any.
+    parent_joint: Vec<Option<usize>>,
+}
+
+impl Tree {
+    fn descends_from(&self, s: &crate::structure::Structure, mut b: usize, ancestor: usize) -> bool {
+        for _ in 0..=self.parent_joint.len() {
+            if b == ancestor {
+                return true;
+            }
+            match self.parent_joint[b] {
+                Some(j) => b = s.joints[j].parent,
+                None => return false,
+            }
+        }
+        false
+    }
+
+    /// Sum of the wrenches of `root` and every body hanging from it.
+    fn subtree_wrench(&self, s: &crate::structure::Structure, wrench: &[Wrench], root: usize) -> Wrench {
+        let mut w = (Vector::ZERO, Vector::ZERO);
+        for (b, wb) in wrench.iter().enumerate() {
+            if self.descends_from(s, b, root) {
+                w.0 += wb.0;
+                w.1 += wb.1;
+            }
+        }
+        w
+    }
+}
+
+impl Simulation {
+    /// Generalized force on every free coordinate for the body loads `wrench` (force, moment
+    /// about the world origin), torsion springs included when `with_springs`.
+    fn coordinate_forces(&self, tree: &Tree, wrench: &[Wrench], with_springs: bool) -> Vec<CoordinateForce> {
+        let s = &self.structure;
+        let about = |w: Wrench, p: Vector| -> Vector { w.1 - p.cross(w.0) };
+        let force = |value: f64| CoordinateForce { value, is_torque: false };
+        let torque = |value: f64| CoordinateForce { value, is_torque: true };
+        let mut out = Vec::new();
+        for (j, joint) in s.joints.iter().enumerate() {
+            if self.joint_links[j].is_none() {
+                continue;
+            }
+            let w = tree.subtree_wrench(s, wrench, joint.child);
+            let anchor = v(self.node_position(joint.anchor));
+            let parent_rot = self.bodies[self.handles[joint.parent]].position().rotation;
+            let child_rot = self.bodies[self.handles[joint.child]].position().rotation;
+            let m = about(w, anchor);
+            match &joint.kind {
+                JointKind::Revolute { axis } => {
+                    let a = (parent_rot * v(*axis)).normalize();
+                    // A torsion spring on this joint is a generalized force on its coordinate.
+                    let spring = match (&joint.torsion_spring, with_springs) {
+                        (Some(t), true) => {
+                            let q = joint.initial_coordinate + relative_angle(parent_rot, child_rot, v(*axis));
+                            -t.stiffness_nm_per_rad * (q - t.rest_angle_rad)
+                        }
+                        _ => 0.0,
+                    };
+                    out.push(torque(m.dot(a) + spring));
+                }
+                JointKind::Prismatic { axis } => {
+                    out.push(force(w.0.dot((parent_rot * v(*axis)).normalize())));
+                }
+                JointKind::Universal { axis1, axis2 } => {
+                    out.push(torque(m.dot((parent_rot * v(*axis1)).normalize())));
+                    out.push(torque(m.dot((child_rot * v(*axis2)).normalize())));
+                }
+                JointKind::Spherical => {
+                    out.extend([torque(m.x), torque(m.y), torque(m.z)]);
+                }
+                JointKind::Fixed => {}
+            }
+        }
+        // Free bodies with no parent joint: all six coordinates.
+        for b in 0..s.bodies.len() {
+            if self.is_free(b) && tree.parent_joint[b].is_none() {
+                let w = tree.subtree_wrench(s, wrench, b);
+                let m = about(w, self.world_com(b));
+                out.extend([force(w.0.x), force(w.0.y), force(w.0.z), torque(m.x), torque(m.y), torque(m.z)]);
+            }
+        }
+        out
+    }
+
+    /// For every reaction component of every loop-closing joint: the body loads of a unit
+    /// reaction (child +, parent -), world frame.
+    fn closure_unit_loads(&self) -> Vec<Vec<Wrench>> {
+        let s = &self.structure;
+        let nb = s.bodies.len();
+        let axes = [Vector::X, Vector::Y, Vector::Z];
+        let mut out = Vec::new();
+        for (j, joint) in s.joints.iter().enumerate() {
+            if self.joint_impulse[j].is_none() {
+                continue;
+            }
+            let anchor = v(self.node_position(joint.anchor));
+            let parent_rot = self.bodies[self.handles[joint.parent]].position().rotation;
+            let child_rot = self.bodies[self.handles[joint.child]].position().rotation;
+            // Directions the joint transmits: forces, then moments.
+            let (forces, moments): (Vec<Vector>, Vec<Vector>) = match &joint.kind {
+                JointKind::Spherical => (axes.to_vec(), vec![]),
+                JointKind::Revolute { axis } => {
+                    let a = (parent_rot * v(*axis)).normalize();
+                    (axes.to_vec(), orthogonal_pair(a).to_vec())
+                }
+                JointKind::Prismatic { axis } => {
+                    let a = (parent_rot * v(*axis)).normalize();
+                    (orthogonal_pair(a).to_vec(), axes.to_vec())
+                }
+                JointKind::Universal { axis1, axis2 } => {
+                    let a1 = (parent_rot * v(*axis1)).normalize();
+                    let a2 = (child_rot * v(*axis2)).normalize();
+                    (axes.to_vec(), vec![a1.cross(a2).normalize()])
+                }
+                JointKind::Fixed => (axes.to_vec(), axes.to_vec()),
+            };
+            for f in forces {
+                let mut w = vec![(Vector::ZERO, Vector::ZERO); nb];
+                w[joint.child] = (f, anchor.cross(f));
+                w[joint.parent] = (-f, -anchor.cross(f));
+                out.push(w);
+            }
+            for m in moments {
+                let mut w = vec![(Vector::ZERO, Vector::ZERO); nb];
+                w[joint.child] = (Vector::ZERO, m);
+                w[joint.parent] = (Vector::ZERO, -m);
+                out.push(w);
+            }
+        }
+        out
+    }
+}
+
+/// Two unit vectors orthogonal to `a` and to each other.
+fn orthogonal_pair(a: Vector) -> [Vector; 2] {
+    let helper = if a.x.abs() < 0.9 { Vector::X } else { Vector::Y };
+    let u = a.cross(helper).normalize();
+    [u, a.cross(u)]
 }

@@ -22,6 +22,7 @@ pub mod settle;
 use crate::structure::{ActuatorTarget, BodyKind, JointKind, Structure};
 use rapier3d_f64::prelude::*;
 
+pub use build::structure_size;
 pub use forces::{MemberForces, Residual};
 
 /// Numerical settings of the integrator, all from the scenario file.
@@ -83,6 +84,8 @@ pub struct Simulation {
     driving_joint: Vec<Option<usize>>,
     /// For each joint: the multibody link it made, if any.
     joint_links: Vec<Option<LinkRef>>,
+    /// First halves of universal joints split into two multibody revolutes.
+    hidden_links: Vec<LinkRef>,
     /// For each joint: the impulse joint it made, if any (loop closures).
     joint_impulse: Vec<Option<ImpulseJointHandle>>,
     /// For each inextensible cable: its rope joint.
@@ -253,7 +256,7 @@ impl Simulation {
     /// the velocities: the perturbation used to classify an equilibrium.
     pub fn perturb_free_coordinates(&mut self, delta: f64) {
         let mut touched = Vec::new();
-        for link in self.joint_links.iter().flatten() {
+        for link in self.joint_links.iter().flatten().chain(self.hidden_links.iter()) {
             if let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) {
                 let assembly = mb.link(link_id).map(|l| (l.assembly_id(), l.joint().ndofs()));
                 if let Some((start, n)) = assembly {

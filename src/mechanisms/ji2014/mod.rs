@@ -249,7 +249,7 @@ impl Mechanism for Ji2014 {
         let p = params_of(params);
         let (l3, th1) = (input(inputs, "L3")?, input(inputs, "theta1")?);
         let eqs = analytic::equilibria(&p, l3, th1);
-        Ok(Prediction { expected: equilibrium_values(&p, l3, th1, &eqs[0]), branches: branches(&p, l3, th1) })
+        Ok(Prediction { expected: equilibrium_values(&p, l3, th1, &eqs[0]), branches: branches(&p, l3, th1), expected_slack: None })
     }
 
     fn observe(&self, _params: &Values, s: &Structure, snap: &Snapshot) -> Values {

@@ -1,0 +1,306 @@
+//! mohr2011: the translational 3-DOF tensegrity mechanism of Mohr and Arsenault (2011).
+
+pub mod analytic;
+pub mod build;
+
+use super::{Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec, Solution, Values};
+use crate::sim::Snapshot;
+use crate::structure::Structure;
+use analytic::Params;
+use nalgebra::Vector3;
+
+pub struct Mohr2011;
+
+/// Default start: the end-effector this fraction of its height below the analytic point, so
+/// every cable starts slack and every settle is a real dynamic approach.
+pub const DEFAULT_START_DROP_FRACTION: f64 = 0.1;
+
+const PARAMS: &[ParamSpec] = &[
+    ParamSpec { symbol: "lb", unit: "m", default: 2.0, description: "side of the base and end-effector triangles l_b (Fig. 4-6: 2)", origin: Origin::Paper },
+    ParamSpec { symbol: "lo", unit: "m", default: 6.0, description: "outer length of a virtual compression spring l_o, two links of l_o/2 (Fig. 4-6: 3 l_b)", origin: Origin::Paper },
+    ParamSpec { symbol: "kappa", unit: "N m/rad", default: 10.0, description: "torsion spring constant (Eq. 4); the paper gives no value and the static workspace does not depend on it (Section 4.2)", origin: Origin::ModelChoice },
+    ParamSpec { symbol: "m_platform", unit: "kg", default: 1.0, description: "end-effector mass (not in the paper: quasi-static results without gravity do not depend on it)", origin: Origin::ModelChoice },
+    ParamSpec { symbol: "m_link", unit: "kg", default: 0.1, description: "mass of each link of a virtual spring (not in the paper)", origin: Origin::ModelChoice },
+    ParamSpec { symbol: "c_joint", unit: "N m s/rad", default: 2.0, description: "viscous damping of the leg joints (not in the paper: zero at rest, it only speeds settling)", origin: Origin::ModelChoice },
+    ParamSpec { symbol: "k_cable", unit: "N/m", default: 0.0, description: "cable stiffness; 0 = inextensible, the paper's assumption (Section 3)", origin: Origin::ModelChoice },
+    ParamSpec { symbol: "g", unit: "m/s^2", default: 0.0, description: "gravity along -Z; 0 = the paper's assumption (Section 4); the end-effector mass carries it", origin: Origin::ModelChoice },
+    ParamSpec { symbol: "r_strut", unit: "m", default: 0.02, description: "link radius for drawing and interference (not in the paper)", origin: Origin::ModelChoice },
+];
+
+const INPUTS: &[InputSpec] = &[
+    InputSpec { symbol: "rho1", unit: "m", description: "length of cables A2B3 and A3B2 (Eq. 6)" },
+    InputSpec { symbol: "rho2", unit: "m", description: "length of cables A1B3 and A3B1 (Eq. 6)" },
+    InputSpec { symbol: "rho3", unit: "m", description: "length of cables A1B2 and A2B1 (Eq. 6)" },
+];
+
+const QUANTITIES: &[QuantitySpec] = &[
+    QuantitySpec { symbol: "x", unit: "m", kind: QuantityKind::Length, description: "end-effector centroid x (Eq. 12)" },
+    QuantitySpec { symbol: "y", unit: "m", kind: QuantityKind::Length, description: "end-effector centroid y (Eq. 13)" },
+    QuantitySpec { symbol: "z", unit: "m", kind: QuantityKind::Length, description: "end-effector centroid z > 0 (Eq. 14)" },
+    QuantitySpec { symbol: "rotation", unit: "rad", kind: QuantityKind::Angle, description: "rotation angle of the end-effector from the base's orientation (0: pure translation, Section 2)" },
+    QuantitySpec { symbol: "l1", unit: "m", kind: QuantityKind::Length, description: "effective length of virtual spring 1, |A1B1| (Eq. 16)" },
+    QuantitySpec { symbol: "l2", unit: "m", kind: QuantityKind::Length, description: "effective length of virtual spring 2, |A2B2| (Eq. 16)" },
+    QuantitySpec { symbol: "l3", unit: "m", kind: QuantityKind::Length, description: "effective length of virtual spring 3, |A3B3| (Eq. 16)" },
+    QuantitySpec { symbol: "t1", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A2B3 (Eq. 26)" },
+    QuantitySpec { symbol: "t2", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A1B3 (Eq. 27)" },
+    QuantitySpec { symbol: "t3", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A1B2 (Eq. 28)" },
+    QuantitySpec { symbol: "t4", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A3B2 (Eq. 26)" },
+    QuantitySpec { symbol: "t5", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A3B1 (Eq. 27)" },
+    QuantitySpec { symbol: "t6", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A2B1 (Eq. 28)" },
+];
+
+const QUERIES: &[QuerySpec] = &[
+    QuerySpec { name: "ikp", inputs: &["x", "y", "z"], description: "inverse kinematics (Eq. 15): the cable lengths rho1..rho3 for a centroid" },
+    QuerySpec { name: "dkp", inputs: &["rho1", "rho2", "rho3"], description: "direct kinematics (Eq. 12-14): the centroid, z > 0 branch (and the mirror z < 0)" },
+    QuerySpec { name: "statics", inputs: &["x", "y", "z"], description: "spring forces (Eq. 5), cable tensions by the wrench balance (Eq. 24) and the closed form (Eq. 26-28), det W_t (Eq. 25), workspace membership" },
+];
+
+/// Structure name of cable j (0-based, the paper's order t1..t6 of Eq. 21), e.g. `A2B3`.
+pub fn cable_name(j: usize) -> String {
+    let c = analytic::CABLES[j];
+    format!("A{}B{}", c.base + 1, c.platform + 1)
+}
+
+/// The input symbol (rho1..rho3) that drives cable j (Eq. 6).
+fn cable_symbol(j: usize) -> String {
+    format!("rho{}", analytic::CABLES[j].rho + 1)
+}
+
+pub fn params_of(v: &Values) -> Params {
+    Params { lb: v["lb"], lo: v["lo"], kappa: v["kappa"], l_min: 0.0 }
+}
+
+fn model_of(v: &Values) -> build::ModelChoices {
+    build::ModelChoices {
+        platform_mass_kg: v["m_platform"],
+        link_mass_kg: v["m_link"],
+        joint_damping: v["c_joint"],
+        cable_stiffness_n_per_m: (v["k_cable"] > 0.0).then_some(v["k_cable"]),
+        strut_radius_m: v["r_strut"],
+        gravity_m_per_s2: v["g"],
+    }
+}
+
+fn input(inputs: &Values, key: &str) -> Result<f64, String> {
+    inputs.get(key).copied().ok_or_else(|| format!("missing input '{key}'"))
+}
+
+fn rho_of(inputs: &Values) -> Result<[f64; 3], String> {
+    Ok([input(inputs, "rho1")?, input(inputs, "rho2")?, input(inputs, "rho3")?])
+}
+
+/// Analytic values at centroid `p`: position, spring lengths, tensions (closed form).
+fn values_at(pa: &Params, p: Vector3<f64>) -> Values {
+    let st = analytic::statics(pa, &p);
+    let mut v = Values::from([("x".into(), p.x), ("y".into(), p.y), ("z".into(), p.z), ("rotation".into(), 0.0)]);
+    for i in 0..3 {
+        v.insert(format!("l{}", i + 1), st.spring_lengths[i]);
+        v.insert(format!("f{}", i + 1), st.spring_forces[i]);
+    }
+    for j in 0..6 {
+        v.insert(format!("t{}", j + 1), st.tensions_closed_form[j]);
+    }
+    v
+}
+
+impl Mechanism for Mohr2011 {
+    fn name(&self) -> &'static str {
+        "mohr2011"
+    }
+    fn title(&self) -> &'static str {
+        "Mohr, Arsenault (2011): translational 3-DOF tensegrity mechanism, six cables in pairs, three virtual compression springs"
+    }
+    fn params(&self) -> &'static [ParamSpec] {
+        PARAMS
+    }
+    fn inputs(&self) -> &'static [InputSpec] {
+        INPUTS
+    }
+    fn quantities(&self) -> &'static [QuantitySpec] {
+        QUANTITIES
+    }
+    fn queries(&self) -> &'static [QuerySpec] {
+        QUERIES
+    }
+    fn start_keys(&self) -> &'static [(&'static str, &'static str)] {
+        &[("drop", "start the end-effector this fraction of its height below the analytic point (default 0.1)")]
+    }
+    fn alternative_inputs(&self) -> &'static [&'static [&'static str]] {
+        &[&["x", "y", "z"]]
+    }
+    fn convert_inputs(&self, params: &Values, given: &Values) -> Result<Values, (String, String)> {
+        let get = |k: &str| given.get(k).copied().ok_or((k.to_string(), format!("missing input '{k}'")));
+        let p = Vector3::new(get("x")?, get("y")?, get("z")?);
+        if !(p.z > 0.0 && p.iter().all(|c| c.is_finite())) {
+            return Err(("z".into(), format!("the end-effector must be above the base: z > 0 m (Section 4.1), got {}", p.z)));
+        }
+        let rho = analytic::ikp(&params_of(params), &p);
+        Ok(Values::from([("rho1".into(), rho[0]), ("rho2".into(), rho[1]), ("rho3".into(), rho[2])]))
+    }
+
+    fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
+        for (sym, what) in [("lb", "m"), ("lo", "m"), ("kappa", "N m/rad"), ("m_platform", "kg"), ("m_link", "kg")] {
+            let x = v[sym];
+            if !(x > 0.0 && x.is_finite()) {
+                return Err((sym.into(), format!("{sym} must be a finite number > 0 {what}, got {x}")));
+            }
+        }
+        for (sym, what) in [("c_joint", "N m s/rad"), ("k_cable", "N/m"), ("g", "m/s^2"), ("r_strut", "m")] {
+            let x = v[sym];
+            if !(x >= 0.0 && x.is_finite()) {
+                return Err((sym.into(), format!("{sym} must be a finite number >= 0 {what}, got {x}")));
+            }
+        }
+        params_of(v).validate().map_err(|m| ("lo".to_string(), m))
+    }
+
+    fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), (String, String)> {
+        let pa = params_of(params);
+        let mut rho = [0.0; 3];
+        for (i, s) in ["rho1", "rho2", "rho3"].iter().enumerate() {
+            let x = inputs.get(*s).copied().ok_or((s.to_string(), format!("missing input {s} [m]")))?;
+            if !(x > 0.0 && x.is_finite()) {
+                return Err((s.to_string(), format!("{s} must be a finite number > 0 m, got {x}")));
+            }
+            rho[i] = x;
+        }
+        let p = analytic::dkp(&pa, &rho).ok_or_else(|| {
+            ("rho1".to_string(), format!("cable lengths {rho:?} m are unreachable: Eq. 14 has no real z > 0 (the radicand is negative)"))
+        })?;
+        // Kinematic workspace (Eq. 17-18): every virtual spring strictly between 0 and l_o.
+        let st = analytic::statics(&pa, &p);
+        for (i, l) in st.spring_lengths.iter().enumerate() {
+            if !(*l > 0.0 && *l < pa.lo) {
+                return Err(("rho1".to_string(), format!(
+                    "cable lengths {rho:?} m put the end-effector at ({:.6}, {:.6}, {:.6}) m, where virtual spring {} would be {l:.6} m long: outside 0 < l_i < l_o = {} m (Eq. 17-18)",
+                    p.x, p.y, p.z, i + 1, pa.lo
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String> {
+        let pa = params_of(params);
+        let centroid = || -> Result<Vector3<f64>, String> { Ok(Vector3::new(input(inputs, "x")?, input(inputs, "y")?, input(inputs, "z")?)) };
+        match query {
+            "ikp" => {
+                let p = centroid()?;
+                let rho = analytic::ikp(&pa, &p);
+                Ok(vec![Solution {
+                    label: "Eq. 15".into(),
+                    values: Values::from([("rho1".into(), rho[0]), ("rho2".into(), rho[1]), ("rho3".into(), rho[2])]),
+                    stable: None,
+                }])
+            }
+            "dkp" => {
+                let rho = rho_of(inputs)?;
+                let p = analytic::dkp(&pa, &rho).ok_or_else(|| format!("cable lengths {rho:?} m are unreachable: Eq. 14 has no real z"))?;
+                let st = analytic::statics(&pa, &p);
+                Ok(vec![
+                    Solution {
+                        label: "z > 0 (Eq. 12-14, the mechanism's branch)".into(),
+                        values: Values::from([("x".into(), p.x), ("y".into(), p.y), ("z".into(), p.z)]),
+                        stable: Some(st.in_static_workspace),
+                    },
+                    Solution {
+                        label: "z < 0 (mirror, through the base: ignored by the paper)".into(),
+                        values: Values::from([("x".into(), p.x), ("y".into(), p.y), ("z".into(), -p.z)]),
+                        stable: None,
+                    },
+                ])
+            }
+            "statics" => {
+                let p = centroid()?;
+                let st = analytic::statics(&pa, &p);
+                let mut v = values_at(&pa, p);
+                for j in 0..6 {
+                    v.insert(format!("t{}_full", j + 1), st.tensions_full[j]);
+                }
+                v.insert("det_Wt".into(), st.det_wt);
+                v.insert("det_Wt_eq25".into(), analytic::det_wt_eq25(&pa, &p));
+                v.insert("in_kinematic_workspace".into(), f64::from(u8::from(st.in_kinematic_workspace)));
+                v.insert("in_static_workspace".into(), f64::from(u8::from(st.in_static_workspace)));
+                Ok(vec![Solution { label: "statics at the centroid".into(), values: v, stable: Some(st.in_static_workspace) }])
+            }
+            other => Err(format!("unknown query '{other}' for mohr2011 (expected one of: ikp, dkp, statics)")),
+        }
+    }
+
+    fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, String> {
+        let pa = params_of(params);
+        let rho = rho_of(inputs)?;
+        let p = analytic::dkp(&pa, &rho).ok_or_else(|| format!("cable lengths {rho:?} m are unreachable"))?;
+        let drop = start.get("drop").copied().unwrap_or(DEFAULT_START_DROP_FRACTION);
+        let p0 = Vector3::new(p.x, p.y, p.z * (1.0 - drop));
+        let leg = |i: usize| {
+            analytic::spring_chain(&pa, &p0, i)
+                .ok_or_else(|| format!("virtual spring {} cannot be assembled at the start ({:?})", i + 1, p0.as_slice()))
+        };
+        let g = build::Geometry {
+            lo: pa.lo,
+            kappa: pa.kappa,
+            legs: [leg(0)?, leg(1)?, leg(2)?],
+            cables: (0..6).map(|j| {
+                let c = analytic::CABLES[j];
+                (cable_name(j), c.base, c.platform, cable_symbol(j))
+            }).collect(),
+            cable_lengths: (0..6).map(|j| inputs[&cable_symbol(j)]).collect(),
+        };
+        Ok(build::build(&g, &model_of(params)))
+    }
+
+    fn commands(&self, _params: &Values, inputs: &Values) -> Vec<f64> {
+        (0..6).map(|j| inputs[&cable_symbol(j)]).collect()
+    }
+
+    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
+        let pa = params_of(params);
+        let rho = rho_of(inputs)?;
+        let p = analytic::dkp(&pa, &rho).ok_or_else(|| format!("cable lengths {rho:?} m are unreachable"))?;
+        let expected = values_at(&pa, p);
+        let st = analytic::statics(&pa, &p);
+        let slack = (0..6).filter(|j| st.slack[*j]).map(cable_name).collect();
+        Ok(Prediction {
+            branches: vec![Solution { label: "z > 0 (Eq. 12-14)".into(), values: expected.clone(), stable: None }],
+            expected,
+            expected_slack: Some(slack),
+        })
+    }
+
+    fn observe(&self, _params: &Values, s: &Structure, snap: &Snapshot) -> Values {
+        let node = |name: &str| Vector3::from(snap.nodes[s.node_id(name).expect("mohr2011 node")]);
+        let b = [node("B1"), node("B2"), node("B3")];
+        let a = [node("A1"), node("A2"), node("A3")];
+        let c = (b[0] + b[1] + b[2]) / 3.0;
+        let mut v = Values::from([("x".into(), c.x), ("y".into(), c.y), ("z".into(), c.z)]);
+        if let Some(platform) = s.body_id("end_effector") {
+            let q = snap.body_poses[platform].rotation_xyzw;
+            let sin_half = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+            v.insert("rotation".into(), 2.0 * sin_half.atan2(q[3].abs()));
+        }
+        for i in 0..3 {
+            v.insert(format!("l{}", i + 1), (b[i] - a[i]).norm());
+        }
+        for (j, t) in snap.forces.cable_tension_n.iter().enumerate().take(6) {
+            v.insert(format!("t{}", j + 1), *t);
+        }
+        v
+    }
+
+    fn length_scale(&self, params: &Values) -> f64 {
+        params["lb"]
+    }
+
+    fn analytic_nodes(&self, params: &Values, inputs: &Values) -> Option<Vec<[f64; 3]>> {
+        let s = self.build(params, inputs, &Values::from([("drop".into(), 0.0)])).ok()?;
+        Some(s.nodes.iter().map(|n| n.position).collect())
+    }
+
+    fn findings(&self, params: &Values) -> Vec<Finding> {
+        analytic::findings(&params_of(params))
+            .into_iter()
+            .map(|f| Finding { equation: f.equation.to_string(), claim: f.claim, measured: f.measured, holds: f.holds })
+            .collect()
+    }
+}

@@ -1,0 +1,60 @@
+//! Cable slackness, tick by tick: the intervals of ticks in which each cable carried no
+//! tension.
+
+use super::{Observer, Tick};
+use crate::report::SlackInterval;
+
+#[derive(Default)]
+pub struct SlackTracker {
+    /// Per cable: the open interval (first, last tick) while slack.
+    open: Vec<Option<(u64, u64)>>,
+    names: Vec<String>,
+    closed: Vec<SlackInterval>,
+    /// Cables whose state changed at the last tick: (name, now slack).
+    pub changes: Vec<(String, bool)>,
+}
+
+impl SlackTracker {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Every interval so far, the open ones closed at their last tick.
+    pub fn intervals(&self) -> Vec<SlackInterval> {
+        let mut out = self.closed.clone();
+        for (c, iv) in self.open.iter().enumerate() {
+            if let Some((first, last)) = iv {
+                out.push(SlackInterval { cable: self.names[c].clone(), first_tick: *first, last_tick: *last });
+            }
+        }
+        out.sort_by(|a, b| (a.first_tick, &a.cable).cmp(&(b.first_tick, &b.cable)));
+        out
+    }
+}
+
+impl Observer for SlackTracker {
+    fn tick(&mut self, t: &Tick) {
+        let slack = &t.snapshot.forces.cable_slack;
+        if self.open.len() != slack.len() {
+            self.open = vec![None; slack.len()];
+            self.names = t.structure.cables.iter().map(|c| c.name.clone()).collect();
+        }
+        self.changes.clear();
+        let tick = t.snapshot.tick;
+        for (c, &is_slack) in slack.iter().enumerate() {
+            match (&mut self.open[c], is_slack) {
+                (Some(iv), true) => iv.1 = tick,
+                (None, true) => {
+                    self.open[c] = Some((tick, tick));
+                    self.changes.push((self.names[c].clone(), true));
+                }
+                (Some((first, last)), false) => {
+                    self.closed.push(SlackInterval { cable: self.names[c].clone(), first_tick: *first, last_tick: *last });
+                    self.open[c] = None;
+                    self.changes.push((self.names[c].clone(), false));
+                }
+                (None, false) => {}
+            }
+        }
+    }
+}
