@@ -10,7 +10,11 @@ use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario::{self, Scenario};
 
 #[derive(Parser)]
-#[command(name = "tensegrity", version, about = "Check published tensegrity mechanism models against rigid-body dynamics")]
+#[command(
+    name = "tensegrity",
+    version,
+    about = "Check published tensegrity mechanism models against rigid-body dynamics"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -128,7 +132,8 @@ fn record_path(base: &Path, name: &str, several: bool) -> PathBuf {
         return base.to_path_buf();
     }
     let stem = base.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "run".into());
-    let safe: String = name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+    let safe: String =
+        name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
     base.with_file_name(format!("{stem}-{safe}.rrd"))
 }
 
@@ -196,7 +201,11 @@ fn cmd_list() -> i32 {
 }
 
 /// Splits --set NAME=VALUE arguments into parameters and inputs of the mechanism.
-fn parse_sets(m: &dyn mechanisms::Mechanism, sets: &[String], allowed_inputs: &[&str]) -> Result<(Values, Values), String> {
+fn parse_sets(
+    m: &dyn mechanisms::Mechanism,
+    sets: &[String],
+    allowed_inputs: &[&str],
+) -> Result<(Values, Values), String> {
     let mut params = Values::new();
     let mut inputs = Values::new();
     for s in sets {
@@ -292,7 +301,13 @@ fn cmd_findings(mechanism: &str, sets: &[String], json: bool) -> i32 {
         println!("{}", serde_json::to_string_pretty(&v).unwrap());
     } else {
         for f in &f {
-            println!("[{}] {}: {}\n      measured: {}", if f.holds { "holds" } else { "WRONG" }, f.equation, f.claim, f.measured);
+            println!(
+                "[{}] {}: {}\n      measured: {}",
+                if f.holds { "holds" } else { "WRONG" },
+                f.equation,
+                f.claim,
+                f.measured
+            );
         }
     }
     EXIT_PASS
@@ -312,11 +327,21 @@ fn cmd_bench(rounds: usize, json: bool) -> i32 {
     if json {
         println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "results": results })).unwrap());
     } else {
-        println!("{:<10} {:>6} {:>7} {:>12} {:>12} {:>10} {:>12} {:>12}", "mechanism", "cases", "rounds", "cases/s", "steps/case", "us/step", "median err", "max err");
+        println!(
+            "{:<10} {:>6} {:>7} {:>12} {:>12} {:>10} {:>12} {:>12}",
+            "mechanism", "cases", "rounds", "cases/s", "steps/case", "us/step", "median err", "max err"
+        );
         for r in &results {
             println!(
                 "{:<10} {:>6} {:>7} {:>12.1} {:>12.1} {:>10.2} {:>12.2e} {:>12.2e}",
-                r.mechanism, r.cases, r.rounds, r.median_cases_per_s, r.median_steps_per_case, r.median_us_per_step, r.median_error, r.max_error
+                r.mechanism,
+                r.cases,
+                r.rounds,
+                r.median_cases_per_s,
+                r.median_steps_per_case,
+                r.median_us_per_step,
+                r.median_error,
+                r.max_error
             );
         }
     }

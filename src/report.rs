@@ -26,6 +26,10 @@ pub struct ScenarioReport {
     pub stiffness_probe: Option<ProbeReport>,
     /// Every interval of ticks in which a cable was slack.
     pub slack_intervals: Vec<SlackInterval>,
+    /// Analytic against dynamic workspace classification (mechanisms with cables).
+    pub workspace: Option<WorkspaceAgreement>,
+    /// Grid points dropped as outside the mechanism's domain (`actuation.skip_outside`).
+    pub skipped_points: usize,
     /// Present when the scenario has an `[interference]` section.
     pub interference: Option<InterferenceReport>,
     pub findings: Vec<FindingReport>,
@@ -57,6 +61,8 @@ pub struct CheckReport {
     pub transient_max_abs_error: f64,
     pub transient_rms_abs_error: f64,
     pub ticks_compared: u64,
+    /// Settle points compared (points outside the analytic model's validity are not).
+    pub points_compared: usize,
 }
 
 #[derive(Clone, Debug, Serialize, PartialEq)]
@@ -85,6 +91,48 @@ pub struct PointReport {
     /// Outside the analytic model's validity (some cable slack): the distance of the settled
     /// state from the analytic point, over the length quantities [m].
     pub distance_from_analytic_m: Option<f64>,
+    /// Settled, and every check within its tolerance at this point.
+    pub within_tolerance: bool,
+}
+
+/// Workspace classification, analytic against dynamic, over the points of a run whose
+/// mechanism predicts slack cables: a point is in the static workspace analytically when no
+/// cable is predicted slack, and by the dynamics when it settled with every cable taut and
+/// every check within tolerance.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct WorkspaceAgreement {
+    pub points: usize,
+    pub analytic_inside: usize,
+    pub simulated_inside: usize,
+    pub agree: usize,
+    pub agreement_percent: f64,
+    /// Indices of the points where the two classifications differ.
+    pub disagreements: Vec<usize>,
+    /// The scenario's pass threshold, if it is a workspace sweep.
+    pub min_agreement_percent: Option<f64>,
+}
+
+impl WorkspaceAgreement {
+    pub fn from_points(points: &[PointReport]) -> Option<Self> {
+        let classified: Vec<&PointReport> = points.iter().filter(|p| p.expected_slack.is_some()).collect();
+        if classified.is_empty() {
+            return None;
+        }
+        let analytic = |p: &PointReport| p.expected_slack.as_ref().is_some_and(|e| e.is_empty());
+        let simulated = |p: &PointReport| p.settled && p.slack_cables.is_empty() && p.within_tolerance;
+        let disagreements: Vec<usize> =
+            classified.iter().filter(|p| analytic(p) != simulated(p)).map(|p| p.index).collect();
+        let n = classified.len();
+        Some(WorkspaceAgreement {
+            points: n,
+            analytic_inside: classified.iter().filter(|p| analytic(p)).count(),
+            simulated_inside: classified.iter().filter(|p| simulated(p)).count(),
+            agree: n - disagreements.len(),
+            agreement_percent: 100.0 * (n - disagreements.len()) as f64 / n as f64,
+            disagreements,
+            min_agreement_percent: None,
+        })
+    }
 }
 
 /// Strut interference over the run (parry capsule distances).
@@ -211,16 +259,36 @@ impl Report {
                     "   slack cables: simulated set equals the analytic one at {agree} of {} point(s)\n",
                     slack_checked.len()
                 ));
-                for p in slack_checked.iter().filter(|p| p.expected_slack.as_ref().is_some_and(|e| !e.is_empty()) || p.slack_agrees == Some(false)) {
+                for p in slack_checked.iter().filter(|p| {
+                    p.expected_slack.as_ref().is_some_and(|e| !e.is_empty()) || p.slack_agrees == Some(false)
+                }) {
                     out.push_str(&format!(
                         "     point {:>4}: analytic slack [{}], simulated slack [{}]{}{}\n",
                         p.index,
                         p.expected_slack.as_deref().unwrap_or(&[]).join(", "),
                         p.slack_cables.join(", "),
-                        p.distance_from_analytic_m.map(|d| format!(", {d:.3e} m from the analytic point")).unwrap_or_default(),
+                        p.distance_from_analytic_m
+                            .map(|d| format!(", {d:.3e} m from the analytic point"))
+                            .unwrap_or_default(),
                         if p.slack_agrees == Some(false) { "  DISAGREE" } else { "" }
                     ));
                 }
+            }
+            if let Some(w) = &s.workspace {
+                out.push_str(&format!(
+                    "   workspace: {} point(s), {} inside analytically, {} inside by the dynamics; agreement {:.2} %{}\n",
+                    w.points,
+                    w.analytic_inside,
+                    w.simulated_inside,
+                    w.agreement_percent,
+                    if w.disagreements.is_empty() { String::new() } else { format!(" (disagree at points {:?})", w.disagreements) }
+                ));
+            }
+            if s.skipped_points > 0 {
+                out.push_str(&format!(
+                    "   skipped: {} grid point(s) outside the mechanism's domain\n",
+                    s.skipped_points
+                ));
             }
             if !s.slack_intervals.is_empty() {
                 out.push_str(&format!("   slack intervals ({}):", s.slack_intervals.len()));

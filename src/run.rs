@@ -2,8 +2,8 @@
 
 use crate::mechanisms::{self, Mechanism, Prediction, Values};
 use crate::observers::compare::{self, Compare};
-use crate::observers::record::Recorder;
 use crate::observers::interference::Interference;
+use crate::observers::record::Recorder;
 use crate::observers::slack::SlackTracker;
 use crate::observers::{Observer, Tick};
 use crate::report::{PointReport, ProbeReport, ScenarioReport, SettleSummary};
@@ -119,7 +119,13 @@ impl Runner<'_> {
             let (snap, simulated) = self.step(inputs, prediction)?;
             let quiet = detector.update(&snap, dt, &criteria);
             if quiet && SettleDetector::residual_ok(&snap, &criteria) {
-                return Ok(Settled { settled: true, steps: k, final_speed: detector.last_speed, snapshot: snap, simulated });
+                return Ok(Settled {
+                    settled: true,
+                    steps: k,
+                    final_speed: detector.last_speed,
+                    snapshot: snap,
+                    simulated,
+                });
             }
             last = Some((snap, simulated));
         }
@@ -135,7 +141,13 @@ impl Runner<'_> {
     }
 
     /// Perturbs every free coordinate and settles again: stable if it comes back.
-    fn classify(&mut self, inputs: &Values, prediction: &Prediction, before: &Snapshot, delta: f64) -> Result<bool, Stop> {
+    fn classify(
+        &mut self,
+        inputs: &Values,
+        prediction: &Prediction,
+        before: &Snapshot,
+        delta: f64,
+    ) -> Result<bool, Stop> {
         self.sim.perturb_free_coordinates(delta);
         self.emit(&format!("perturbed every free coordinate by {delta}"));
         let after = self.settle(inputs, prediction)?;
@@ -151,8 +163,14 @@ impl Runner<'_> {
 
     /// Stiffness by the probe: +tau and -tau on the probe body, K = 2 tau / (q+ - q-).
     fn probe(&mut self, inputs: &Values, prediction: &Prediction, torque: f64) -> Result<Option<f64>, Stop> {
-        let Some(spec) = self.mech.stiffness_probe() else { return Ok(None) };
-        let body = self.sim.structure.body_id(&spec.body).ok_or_else(|| Stop::Model(format!("probe body '{}' not found", spec.body)))?;
+        let Some(spec) = self.mech.stiffness_probe() else {
+            return Ok(None);
+        };
+        let body = self
+            .sim
+            .structure
+            .body_id(&spec.body)
+            .ok_or_else(|| Stop::Model(format!("probe body '{}' not found", spec.body)))?;
         let axis = spec.torque_axis;
         let mut q = [0.0; 2];
         for (i, sign) in [1.0, -1.0].iter().enumerate() {
@@ -177,7 +195,12 @@ impl Runner<'_> {
 const RETURN_FRACTION: f64 = 1e-2;
 
 /// Which analytic branch a simulated state matches (nearest in the checked quantities).
-fn branch_of(mech: &dyn Mechanism, sc: &Scenario, prediction: &Prediction, simulated: &Values) -> (String, Option<bool>) {
+fn branch_of(
+    mech: &dyn Mechanism,
+    sc: &Scenario,
+    prediction: &Prediction,
+    simulated: &Values,
+) -> (String, Option<bool>) {
     let scale = mech.length_scale(&sc.params);
     let mut best: Option<(f64, &mechanisms::Solution)> = None;
     for b in &prediction.branches {
@@ -214,6 +237,8 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         points: vec![],
         stiffness_probe: None,
         slack_intervals: vec![],
+        workspace: None,
+        skipped_points: sc.skipped_points.len(),
         interference: None,
         findings: mech.findings(&sc.params).into_iter().map(Into::into).collect(),
         error: None,
@@ -224,7 +249,10 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         Actuation::Points { points, .. } => points[0].clone(),
         Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
     };
-    let sim = match mech.build(&sc.params, &first_inputs, &sc.start).and_then(|s| Simulation::new(&s, &sc.sim).map_err(|e| e.to_string())) {
+    let sim = match mech
+        .build(&sc.params, &first_inputs, &sc.start)
+        .and_then(|s| Simulation::new(&s, &sc.sim).map_err(|e| e.to_string()))
+    {
         Ok(s) => s,
         Err(e) => {
             report.error = Some(e);
@@ -272,6 +300,10 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
 
     report.checks = runner.compare.reports();
     report.slack_intervals = runner.slack.intervals();
+    report.workspace = crate::report::WorkspaceAgreement::from_points(&report.points).map(|mut w| {
+        w.min_agreement_percent = sc.min_agreement_percent;
+        w
+    });
     report.interference = runner.interference.as_ref().map(Interference::report);
     report.settle = SettleSummary {
         settled: !report.points.is_empty() && report.points.iter().all(|p| p.settled),
@@ -293,13 +325,21 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         .points
         .iter()
         .all(|p| p.stable.is_none() || p.analytic_stable.is_none() || p.stable == p.analytic_stable);
-    report.passed = report.error.is_none()
-        && report.settle.settled
-        && report.checks.iter().all(|c| c.passed)
-        && report.stiffness_probe.as_ref().is_none_or(|p| p.passed)
-        && stability_agrees
-        && report.points.iter().all(|p| p.slack_agrees != Some(false))
-        && report.interference.as_ref().is_none_or(|i| i.passed);
+    if let (Some(min), Some(w)) = (sc.min_agreement_percent, &report.workspace) {
+        // A workspace sweep passes on the agreement of the two classifications; per-point
+        // settling and checks are what the classification is made of.
+        report.passed = report.error.is_none()
+            && w.agreement_percent >= min
+            && report.interference.as_ref().is_none_or(|i| i.passed);
+    } else {
+        report.passed = report.error.is_none()
+            && report.settle.settled
+            && report.checks.iter().all(|c| c.passed)
+            && report.stiffness_probe.as_ref().is_none_or(|p| p.passed)
+            && stability_agrees
+            && report.points.iter().all(|p| p.slack_agrees != Some(false))
+            && report.interference.as_ref().is_none_or(|i| i.passed);
+    }
     if let Some(r) = runner.recorder.take() {
         let mut r = r;
         r.document("report", &serde_json::to_string_pretty(&report).unwrap_or_default());
@@ -312,7 +352,12 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
     report
 }
 
-fn run_actuation(runner: &mut Runner, sc: &Scenario, report: &mut ScenarioReport, probe_errors: &mut Vec<f64>) -> Result<(), Stop> {
+fn run_actuation(
+    runner: &mut Runner,
+    sc: &Scenario,
+    report: &mut ScenarioReport,
+    probe_errors: &mut Vec<f64>,
+) -> Result<(), Stop> {
     match &sc.actuation {
         Actuation::Points { points, continuation } => {
             for (i, inputs) in points.iter().enumerate() {
@@ -368,19 +413,37 @@ pub fn interpolate(waypoints: &[(f64, Values)], t: f64) -> Values {
     waypoints.last().unwrap().1.clone()
 }
 
-fn settle_point(runner: &mut Runner, sc: &Scenario, index: usize, inputs: &Values, report: &mut ScenarioReport, probe_errors: &mut Vec<f64>) -> Result<(), Stop> {
+fn settle_point(
+    runner: &mut Runner,
+    sc: &Scenario,
+    index: usize,
+    inputs: &Values,
+    report: &mut ScenarioReport,
+    probe_errors: &mut Vec<f64>,
+) -> Result<(), Stop> {
     let prediction = runner.mech.predict(&sc.params, inputs).map_err(Stop::Model)?;
     let s = runner.settle(inputs, &prediction)?;
     runner.emit(&if s.settled {
         format!("point {index} settled after {} steps", s.steps)
     } else {
-        format!("point {index} did NOT settle in {} s (speed {:.3e} m/s, residual {:.3e} N, {:.3e} N m)", sc.settle.max_time_s, s.final_speed, s.snapshot.forces.residual.max_force_n, s.snapshot.forces.residual.max_torque_nm)
+        format!(
+            "point {index} did NOT settle in {} s (speed {:.3e} m/s, residual {:.3e} N, {:.3e} N m)",
+            sc.settle.max_time_s,
+            s.final_speed,
+            s.snapshot.forces.residual.max_force_n,
+            s.snapshot.forces.residual.max_torque_nm
+        )
     });
     let mut simulated = s.simulated.clone();
     let (branch, analytic_stable) = branch_of(runner.mech.as_ref(), sc, &prediction, &simulated);
     // The settled state is compared with the branch it landed on; landing on an analytically
     // unstable branch is a failure unless the scenario deliberately starts there.
-    let landed = prediction.branches.iter().find(|b| b.label == branch).map(|b| b.values.clone()).unwrap_or_else(|| prediction.expected.clone());
+    let landed = prediction
+        .branches
+        .iter()
+        .find(|b| b.label == branch)
+        .map(|b| b.values.clone())
+        .unwrap_or_else(|| prediction.expected.clone());
     let wanted_unstable = sc.start.get("at_unstable_root").is_some_and(|f| *f != 0.0);
     if analytic_stable == Some(false) && !wanted_unstable {
         runner.emit(&format!("point {index}: landed on the analytically unstable branch '{branch}'"));
@@ -432,11 +495,22 @@ fn settle_point(runner: &mut Runner, sc: &Scenario, index: usize, inputs: &Value
             .sqrt()
     });
     if slack_agrees == Some(false) {
-        runner.emit(&format!("point {index}: slack cables {slack_cables:?} differ from the analytic {:?}", prediction.expected_slack));
+        runner.emit(&format!(
+            "point {index}: slack cables {slack_cables:?} differ from the analytic {:?}",
+            prediction.expected_slack
+        ));
     }
-    if !outside {
+    if outside {
+        runner.compare.outside_point();
+    } else {
         runner.compare.settle_point(&landed, &simulated, s.settled);
     }
+    let within_tolerance = s.settled
+        && !outside
+        && sc.checks.iter().all(|c| match (landed.get(&c.quantity), simulated.get(&c.quantity)) {
+            (Some(a), Some(b)) => compare::error(c.kind, *a, *b, runner.mech.length_scale(&sc.params)).1 <= c.tolerance,
+            _ => false,
+        });
     report.points.push(PointReport {
         index,
         inputs: inputs.clone(),
@@ -454,6 +528,7 @@ fn settle_point(runner: &mut Runner, sc: &Scenario, index: usize, inputs: &Value
         expected_slack: prediction.expected_slack.clone(),
         slack_agrees,
         distance_from_analytic_m,
+        within_tolerance,
     });
     Ok(())
 }

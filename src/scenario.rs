@@ -49,6 +49,16 @@ pub struct RawScenario {
     pub record: Option<RawRecord>,
     #[serde(default)]
     pub interference: Option<Spanned<RawInterference>>,
+    #[serde(default)]
+    pub workspace: Option<RawWorkspace>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawWorkspace {
+    /// The run passes when the analytic and dynamic workspace classifications agree at least
+    /// at this percentage of the points; checks and settling are then reported per point.
+    pub min_agreement_percent: Spanned<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -105,6 +115,9 @@ pub struct RawActuation {
     pub waypoints: Option<Vec<Spanned<SpannedMap>>>,
     /// Grid and points: start each point from the previous equilibrium (default true).
     pub continuation: Option<bool>,
+    /// Grid only: drop grid points outside the mechanism's domain (for example outside the
+    /// kinematic workspace) instead of rejecting the file; they are counted in the report.
+    pub skip_outside: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -154,6 +167,10 @@ pub struct Scenario {
     pub probe: Option<Probe>,
     pub record: Option<PathBuf>,
     pub interference: Option<crate::observers::interference::InterferenceSettings>,
+    /// Workspace sweep: pass on this agreement percentage instead of on every check.
+    pub min_agreement_percent: Option<f64>,
+    /// Grid points dropped by `skip_outside`, with the reason.
+    pub skipped_points: Vec<(Values, String)>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -254,9 +271,7 @@ fn count(ctx: &Ctx, v: &Option<Spanned<i64>>, what: &str, default: usize, max: i
 }
 
 fn values(ctx: &Ctx, m: &SpannedMap) -> Result<Values, ScenarioError> {
-    m.iter()
-        .map(|(k, v)| Ok((k.get_ref().clone(), finite(ctx, v, k.get_ref())?)))
-        .collect()
+    m.iter().map(|(k, v)| Ok((k.get_ref().clone(), finite(ctx, v, k.get_ref())?))).collect()
 }
 
 /// Largest number of settle points a scenario may ask for.
@@ -268,7 +283,10 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     }
     let mech: Box<dyn Mechanism> = mechanisms::find(raw.mechanism.get_ref()).ok_or_else(|| {
         let known: Vec<_> = mechanisms::registry().iter().map(|m| m.name()).collect();
-        ctx.err(&raw.mechanism, format!("unknown mechanism '{}' (expected one of: {})", raw.mechanism.get_ref(), known.join(", ")))
+        ctx.err(
+            &raw.mechanism,
+            format!("unknown mechanism '{}' (expected one of: {})", raw.mechanism.get_ref(), known.join(", ")),
+        )
     })?;
     let m = mech.as_ref();
 
@@ -276,7 +294,10 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     for (k, _) in &raw.params {
         if !m.params().iter().any(|p| p.symbol == k.get_ref()) {
             let known: Vec<_> = m.params().iter().map(|p| p.symbol).collect();
-            return Err(ctx.err(k, format!("unknown parameter '{}' for {} (expected one of: {})", k.get_ref(), m.name(), known.join(", "))));
+            return Err(ctx.err(
+                k,
+                format!("unknown parameter '{}' for {} (expected one of: {})", k.get_ref(), m.name(), known.join(", ")),
+            ));
         }
     }
     let given = values(ctx, &raw.params)?;
@@ -309,15 +330,29 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let d = SettleCriteria::default();
     let settle = SettleCriteria {
         speed_tol_m_per_s: positive(ctx, &raw.settle.speed_tol, "settle.speed_tol (m/s)", d.speed_tol_m_per_s)?,
-        window_steps: count(ctx, &raw.settle.window, "settle.window (steps)", d.window_steps as usize, 1_000_000)? as u64,
-        residual_force_tol_n: positive(ctx, &raw.settle.residual_force_tol, "settle.residual_force_tol (N)", d.residual_force_tol_n)?,
-        residual_torque_tol_nm: positive(ctx, &raw.settle.residual_torque_tol, "settle.residual_torque_tol (N m)", d.residual_torque_tol_nm)?,
+        window_steps: count(ctx, &raw.settle.window, "settle.window (steps)", d.window_steps as usize, 1_000_000)?
+            as u64,
+        residual_force_tol_n: positive(
+            ctx,
+            &raw.settle.residual_force_tol,
+            "settle.residual_force_tol (N)",
+            d.residual_force_tol_n,
+        )?,
+        residual_torque_tol_nm: positive(
+            ctx,
+            &raw.settle.residual_torque_tol,
+            "settle.residual_torque_tol (N m)",
+            d.residual_torque_tol_nm,
+        )?,
         max_time_s: positive(ctx, &raw.settle.max_time, "settle.max_time (s)", d.max_time_s)?,
     };
     for (k, _) in &raw.start {
         if !m.start_keys().iter().any(|(key, _)| key == k.get_ref()) {
             let known: Vec<_> = m.start_keys().iter().map(|(key, _)| *key).collect();
-            return Err(ctx.err(k, format!("unknown start key '{}' for {} (expected one of: {})", k.get_ref(), m.name(), known.join(", "))));
+            return Err(ctx.err(
+                k,
+                format!("unknown start key '{}' for {} (expected one of: {})", k.get_ref(), m.name(), known.join(", ")),
+            ));
         }
     }
     let start = values(ctx, &raw.start)?;
@@ -331,53 +366,79 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let set_of = |keys: &[&str]| -> Vec<&str> {
         input_sets.iter().find(|s| keys.iter().any(|k| s.contains(k))).cloned().unwrap_or_else(|| native.clone())
     };
-    let check_inputs = |map: &SpannedMap, whole: &Spanned<SpannedMap>, allow_t: bool| -> Result<Values, ScenarioError> {
-        let keys: Vec<&str> = map.iter().map(|(k, _)| k.get_ref().as_str()).filter(|k| *k != "t").collect();
-        let input_syms = set_of(&keys);
-        for (k, _) in map {
-            if !(input_syms.contains(&k.get_ref().as_str()) || (allow_t && k.get_ref() == "t")) {
-                return Err(ctx.err(k, format!("unknown input '{}' (expected {}{})", k.get_ref(), expected_sets, if allow_t { ", and t" } else { "" })));
+    let check_inputs =
+        |map: &SpannedMap, whole: &Spanned<SpannedMap>, allow_t: bool| -> Result<Values, ScenarioError> {
+            let keys: Vec<&str> = map.iter().map(|(k, _)| k.get_ref().as_str()).filter(|k| *k != "t").collect();
+            let input_syms = set_of(&keys);
+            for (k, _) in map {
+                if !(input_syms.contains(&k.get_ref().as_str()) || (allow_t && k.get_ref() == "t")) {
+                    return Err(ctx.err(
+                        k,
+                        format!(
+                            "unknown input '{}' (expected {}{})",
+                            k.get_ref(),
+                            expected_sets,
+                            if allow_t { ", and t" } else { "" }
+                        ),
+                    ));
+                }
             }
-        }
-        for s in &input_syms {
-            if !map.iter().any(|(k, _)| k.get_ref() == s) {
-                return Err(ctx.err(whole, format!("missing input '{s}' (expected {expected_sets})")));
+            for s in &input_syms {
+                if !map.iter().any(|(k, _)| k.get_ref() == s) {
+                    return Err(ctx.err(whole, format!("missing input '{s}' (expected {expected_sets})")));
+                }
             }
-        }
-        let mut vals = values(ctx, map)?;
-        let t = vals.remove("t");
-        if input_syms != native {
-            vals = m.convert_inputs(&params, &vals).map_err(|(sym, msg)| {
-                let at = map.iter().find(|(k, _)| k.get_ref() == &sym).map(|(_, v)| v.span().start).unwrap_or(whole.span().start);
-                ctx.err_at(at, msg)
-            })?;
-        }
-        if let Some(t) = t {
-            vals.insert("t".into(), t);
-        }
-        if let Err((sym, msg)) = m.validate_inputs(&params, &vals) {
-            let at = map.iter().find(|(k, _)| k.get_ref() == &sym).map(|(_, v)| v.span().start).unwrap_or(whole.span().start);
-            return Err(ctx.err_at(at, msg));
-        }
-        Ok(vals)
-    };
+            let mut vals = values(ctx, map)?;
+            let t = vals.remove("t");
+            if input_syms != native {
+                vals = m.convert_inputs(&params, &vals).map_err(|(sym, msg)| {
+                    let at = map
+                        .iter()
+                        .find(|(k, _)| k.get_ref() == &sym)
+                        .map(|(_, v)| v.span().start)
+                        .unwrap_or(whole.span().start);
+                    ctx.err_at(at, msg)
+                })?;
+            }
+            if let Some(t) = t {
+                vals.insert("t".into(), t);
+            }
+            if let Err((sym, msg)) = m.validate_inputs(&params, &vals) {
+                let at = map
+                    .iter()
+                    .find(|(k, _)| k.get_ref() == &sym)
+                    .map(|(_, v)| v.span().start)
+                    .unwrap_or(whole.span().start);
+                return Err(ctx.err_at(at, msg));
+            }
+            Ok(vals)
+        };
 
     let act = raw.actuation.get_ref();
     let given = [act.grid.is_some(), act.points.is_some(), act.waypoints.is_some()].iter().filter(|b| **b).count();
     if given != 1 {
         return Err(ctx.err(&raw.actuation, "actuation needs exactly one of: grid, points, waypoints"));
     }
+    let mut skipped_points = Vec::new();
+    if act.skip_outside.is_some() && act.grid.is_none() {
+        return Err(ctx.err(&raw.actuation, "skip_outside applies to a grid only"));
+    }
     let actuation = if let Some(grid) = &act.grid {
         let keys: Vec<&str> = grid.iter().map(|(k, _)| k.get_ref().as_str()).collect();
         let input_syms = set_of(&keys);
         for (k, _) in grid {
             if !input_syms.contains(&k.get_ref().as_str()) {
-                return Err(ctx.err(k, format!("unknown input '{}' in actuation.grid (expected {expected_sets})", k.get_ref())));
+                return Err(
+                    ctx.err(k, format!("unknown input '{}' in actuation.grid (expected {expected_sets})", k.get_ref()))
+                );
             }
         }
         let mut axes: Vec<(String, Vec<f64>)> = Vec::new();
         for s in &input_syms {
-            let (_, r) = grid.iter().find(|(k, _)| k.get_ref() == s).ok_or_else(|| ctx.err(&raw.actuation, format!("actuation.grid is missing input '{s}'")))?;
+            let (_, r) = grid
+                .iter()
+                .find(|(k, _)| k.get_ref() == s)
+                .ok_or_else(|| ctx.err(&raw.actuation, format!("actuation.grid is missing input '{s}'")))?;
             let r2 = r.get_ref();
             let (a, b) = (finite(ctx, &r2.from, "from")?, finite(ctx, &r2.to, "to")?);
             let n = *r2.count.get_ref();
@@ -398,27 +459,52 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         for (sym, vals) in &axes {
             points = points
                 .into_iter()
-                .flat_map(|p| vals.iter().map(move |v| {
-                    let mut q = p.clone();
-                    q.insert(sym.clone(), *v);
-                    q
-                }))
+                .flat_map(|p| {
+                    vals.iter().map(move |v| {
+                        let mut q = p.clone();
+                        q.insert(sym.clone(), *v);
+                        q
+                    })
+                })
                 .collect();
         }
         if input_syms != native {
-            for p in points.iter_mut() {
-                *p = m.convert_inputs(&params, p).map_err(|(sym, msg)| {
+            let mut converted = Vec::new();
+            for p in points {
+                match m.convert_inputs(&params, &p) {
+                    Ok(c) => converted.push(c),
+                    Err((_, msg)) if act.skip_outside.unwrap_or(false) => skipped_points.push((p, msg)),
+                    Err((sym, msg)) => {
+                        let at =
+                            grid.iter().find(|(k, _)| k.get_ref() == &sym).map(|(_, v)| v.span().start).unwrap_or(0);
+                        return Err(ctx.err_at(at, format!("grid point {:?}: {msg}", p)));
+                    }
+                }
+            }
+            points = converted;
+        }
+        let skip = act.skip_outside.unwrap_or(false);
+        let mut kept = Vec::new();
+        for p in points {
+            match m.validate_inputs(&params, &p) {
+                Ok(()) => kept.push(p),
+                Err((_, msg)) if skip => skipped_points.push((p, msg)),
+                Err((sym, msg)) => {
                     let at = grid.iter().find(|(k, _)| k.get_ref() == &sym).map(|(_, v)| v.span().start).unwrap_or(0);
-                    ctx.err_at(at, format!("grid point {:?}: {msg}", p))
-                })?;
+                    return Err(ctx.err_at(
+                        at,
+                        format!("grid point {:?}: {msg} (or set actuation.skip_outside = true to drop such points)", p),
+                    ));
+                }
             }
         }
-        for p in &points {
-            if let Err((sym, msg)) = m.validate_inputs(&params, p) {
-                let at = grid.iter().find(|(k, _)| k.get_ref() == &sym).map(|(_, v)| v.span().start).unwrap_or(0);
-                return Err(ctx.err_at(at, format!("grid point {:?}: {msg}", p)));
-            }
+        if kept.is_empty() {
+            return Err(ctx.err(
+                &raw.actuation,
+                format!("every grid point is outside the mechanism's domain ({} skipped)", skipped_points.len()),
+            ));
         }
+        let points = kept;
         Actuation::Points { points, continuation: act.continuation.unwrap_or(true) }
     } else if let Some(list) = &act.points {
         if list.is_empty() {
@@ -434,13 +520,19 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         let mut waypoints = Vec::new();
         let mut last_t = f64::NEG_INFINITY;
         for w in list {
-            let (tk, tv) = w.get_ref().iter().find(|(k, _)| k.get_ref() == "t").ok_or_else(|| ctx.err(w, "waypoint needs a time t (s)"))?;
+            let (tk, tv) = w
+                .get_ref()
+                .iter()
+                .find(|(k, _)| k.get_ref() == "t")
+                .ok_or_else(|| ctx.err(w, "waypoint needs a time t (s)"))?;
             let t = finite(ctx, tv, "t")?;
             if t < 0.0 {
                 return Err(ctx.err(tk, format!("waypoint time must be >= 0 s, got {t}")));
             }
             if t <= last_t {
-                return Err(ctx.err(tv, format!("waypoints must be sorted by strictly increasing t: {t} s follows {last_t} s")));
+                return Err(
+                    ctx.err(tv, format!("waypoints must be sorted by strictly increasing t: {t} s follows {last_t} s"))
+                );
             }
             last_t = t;
             let mut vals = check_inputs(w.get_ref(), w, true)?;
@@ -457,7 +549,10 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     for c in &raw.checks {
         let q = m.quantities().iter().find(|q| q.symbol == c.quantity.get_ref()).ok_or_else(|| {
             let known: Vec<_> = m.quantities().iter().map(|q| q.symbol).collect();
-            ctx.err(&c.quantity, format!("unknown quantity '{}' (expected one of: {})", c.quantity.get_ref(), known.join(", ")))
+            ctx.err(
+                &c.quantity,
+                format!("unknown quantity '{}' (expected one of: {})", c.quantity.get_ref(), known.join(", ")),
+            )
         })?;
         let tol = finite(ctx, &c.tolerance, "tolerance")?;
         if tol <= 0.0 {
@@ -466,7 +561,8 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         checks.push(Check { quantity: q.symbol.into(), kind: q.kind, unit: q.unit.into(), tolerance: tol });
     }
     if checks.is_empty() && raw.probe.is_none() {
-        return Err(ctx.err_at(0, "the scenario checks nothing: add at least one [[checks]] entry (quantity, tolerance)".into()));
+        return Err(ctx
+            .err_at(0, "the scenario checks nothing: add at least one [[checks]] entry (quantity, tolerance)".into()));
     }
 
     let stability_perturbation = match &raw.stability {
@@ -474,7 +570,9 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         Some(s) => {
             let x = finite(ctx, &s.perturbation, "stability.perturbation")?;
             if !(x > 0.0 && x < 1.0) {
-                return Err(ctx.err(&s.perturbation, format!("stability.perturbation must be in (0, 1) (rad or m), got {x}")));
+                return Err(
+                    ctx.err(&s.perturbation, format!("stability.perturbation must be in (0, 1) (rad or m), got {x}"))
+                );
             }
             Some(x)
         }
@@ -506,6 +604,19 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
             Some(PathBuf::from(p))
         }
     };
+    let min_agreement_percent = match &raw.workspace {
+        None => None,
+        Some(w) => {
+            let x = finite(ctx, &w.min_agreement_percent, "workspace.min_agreement_percent")?;
+            if !(0.0..=100.0).contains(&x) {
+                return Err(ctx.err(
+                    &w.min_agreement_percent,
+                    format!("workspace.min_agreement_percent must lie in [0, 100], got {x}"),
+                ));
+            }
+            Some(x)
+        }
+    };
     let interference = match &raw.interference {
         None => None,
         Some(i) => {
@@ -524,7 +635,10 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
                 }
             };
             if threshold >= margin {
-                return Err(ctx.err(i, format!("interference.threshold ({threshold} m) must be below interference.margin ({margin} m)")));
+                return Err(ctx.err(
+                    i,
+                    format!("interference.threshold ({threshold} m) must be below interference.margin ({margin} m)"),
+                ));
             }
             let exclude = i.get_ref().exclude.iter().map(|e| e.get_ref().clone()).collect();
             // Strut names are checked against the built structure.
@@ -561,5 +675,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         probe,
         record,
         interference,
+        min_agreement_percent,
+        skipped_points,
     })
 }

@@ -157,6 +157,14 @@ pub struct Actuator {
     pub target: ActuatorTarget,
 }
 
+/// A constant external force on a body, applied at its centre of mass (a payload's weight,
+/// for example) [N], world frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExternalLoad {
+    pub body: BodyId,
+    pub force_n: Vec3,
+}
+
 /// A whole mechanism, ready to be simulated.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Structure {
@@ -170,6 +178,7 @@ pub struct Structure {
     pub cables: Vec<Cable>,
     pub joints: Vec<Joint>,
     pub actuators: Vec<Actuator>,
+    pub loads: Vec<ExternalLoad>,
 }
 
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -303,10 +312,18 @@ impl Structure {
                         index: j,
                     })?;
                     if !matches!(joint.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. }) {
-                        return Err(invalid("actuator", &a.symbol, "only revolute and prismatic joints can be actuated"));
+                        return Err(invalid(
+                            "actuator",
+                            &a.symbol,
+                            "only revolute and prismatic joints can be actuated",
+                        ));
                     }
                     if joint.torsion_spring.is_some() {
-                        return Err(invalid("actuator", &a.symbol, "an actuated joint cannot also carry a torsion spring"));
+                        return Err(invalid(
+                            "actuator",
+                            &a.symbol,
+                            "an actuated joint cannot also carry a torsion spring",
+                        ));
                     }
                 }
                 ActuatorTarget::CableLength(c) => {
@@ -319,6 +336,12 @@ impl Structure {
                         });
                     }
                 }
+            }
+        }
+        for (i, load) in self.loads.iter().enumerate() {
+            self.check_body("load", &format!("#{i}"), load.body)?;
+            if load.force_n.iter().any(|f| !f.is_finite()) {
+                return Err(invalid("load", &format!("#{i}"), "force must be finite"));
             }
         }
         Ok(())

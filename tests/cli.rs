@@ -114,7 +114,20 @@ fn every_shipped_scenario_is_valid() {
 
 #[test]
 fn solve_fk_prints_both_equilibria_with_their_stability() {
-    let (code, out, err) = tensegrity(&["solve", "ji2014", "fk", "--set", "L3=6", "--set", "theta1=0.3141592653589793", "--set", "K1=100", "--set", "K2=10", "--json"]);
+    let (code, out, err) = tensegrity(&[
+        "solve",
+        "ji2014",
+        "fk",
+        "--set",
+        "L3=6",
+        "--set",
+        "theta1=0.3141592653589793",
+        "--set",
+        "K1=100",
+        "--set",
+        "K2=10",
+        "--json",
+    ]);
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let sols = v["solutions"].as_array().unwrap();
@@ -132,7 +145,11 @@ fn solve_ik_solutions_reproduce_the_target_through_fk() {
     let sols = v["solutions"].as_array().unwrap();
     assert!(!sols.is_empty());
     for s in sols {
-        let (l3, th1, th2) = (s["values"]["L3"].as_f64().unwrap(), s["values"]["theta1"].as_f64().unwrap(), s["values"]["theta2"].as_f64().unwrap());
+        let (l3, th1, th2) = (
+            s["values"]["L3"].as_f64().unwrap(),
+            s["values"]["theta1"].as_f64().unwrap(),
+            s["values"]["theta2"].as_f64().unwrap(),
+        );
         let x = l3 * th1.cos() + th2.cos();
         let y = l3 * th1.sin() + th2.sin();
         assert!((x + 0.5).abs() < 1e-10 && (y - 0.8).abs() < 1e-10, "({x}, {y})");

@@ -8,7 +8,8 @@ use tensegrity_testbed::structure::{BodyKind, Inertia, Structure};
 #[test]
 fn a_body_leaving_the_bounding_box_is_reported_as_divergence() {
     let mut s = Structure { gravity: [0.0, 0.0, -9.81], ..Default::default() };
-    let b = s.add_body("falling", BodyKind::Free, Some(Inertia { mass_kg: 1.0, com: [0.0; 3], principal_kg_m2: [0.1; 3] }));
+    let b =
+        s.add_body("falling", BodyKind::Free, Some(Inertia { mass_kg: 1.0, com: [0.0; 3], principal_kg_m2: [0.1; 3] }));
     s.add_node("P", b, [0.0; 3]);
     let settings = SimSettings { dt_s: 0.01, bounding_box_m: 10.0, ..Default::default() };
     let mut sim = Simulation::new(&s, &settings).unwrap();
@@ -22,7 +23,10 @@ fn a_body_leaving_the_bounding_box_is_reported_as_divergence() {
         SimError::Diverged { tick, time_s, what } => {
             assert!(what.contains("node 'P' left the bounding box"), "{what}");
             let expected = (2.0 * 10.0 / 9.81f64).sqrt();
-            assert!((time_s - expected).abs() <= 0.02, "diverged at {time_s} s (tick {tick}), expected {expected:.3} s");
+            assert!(
+                (time_s - expected).abs() <= 0.02,
+                "diverged at {time_s} s (tick {tick}), expected {expected:.3} s"
+            );
         }
         other => panic!("expected divergence, got {other:?}"),
     }
@@ -35,7 +39,11 @@ fn a_free_body_on_a_zero_length_spring_settles_on_the_anchor() {
     use tensegrity_testbed::structure::Spring;
     let mut s = Structure::default();
     let g = s.add_body("ground", BodyKind::Fixed, None);
-    let b = s.add_body("mass", BodyKind::Free, Some(Inertia { mass_kg: 1.0, com: [0.3, 0.2, 0.0], principal_kg_m2: [0.1; 3] }));
+    let b = s.add_body(
+        "mass",
+        BodyKind::Free,
+        Some(Inertia { mass_kg: 1.0, com: [0.3, 0.2, 0.0], principal_kg_m2: [0.1; 3] }),
+    );
     let a = s.add_node("anchor", g, [0.0; 3]);
     let p = s.add_node("P", b, [0.3, 0.2, 0.0]);
     s.springs.push(Spring { name: "k".into(), a, b: p, stiffness_n_per_m: 100.0, rest_length_m: 0.0 });

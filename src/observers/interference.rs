@@ -125,7 +125,9 @@ impl Interference {
             for j in i + 1..n {
                 let meet = ends(i).iter().any(|&p| {
                     ends(j).iter().any(|&q| {
-                        p == q || crate::structure::distance(s.nodes[p].position, s.nodes[q].position) <= COINCIDENT_FRACTION * size
+                        p == q
+                            || crate::structure::distance(s.nodes[p].position, s.nodes[q].position)
+                                <= COINCIDENT_FRACTION * size
                     })
                 });
                 excluded[i][j] = meet;
@@ -197,7 +199,13 @@ impl Interference {
         }
     }
 
-    fn violation(&self, (i, j): (usize, usize), first: u64, last: u64, min: (f64, u64, [[f64; 3]; 2])) -> InterferenceViolation {
+    fn violation(
+        &self,
+        (i, j): (usize, usize),
+        first: u64,
+        last: u64,
+        min: (f64, u64, [[f64; 3]; 2]),
+    ) -> InterferenceViolation {
         InterferenceViolation {
             pair: [self.names[i].clone(), self.names[j].clone()],
             first_tick: first,

@@ -52,9 +52,7 @@ impl Recorder {
             }
         }
         let partial = path.with_extension("rrd.partial");
-        let rec = rerun::RecordingStreamBuilder::new(app)
-            .save(&partial)
-            .map_err(|e| io(e.to_string()))?;
+        let rec = rerun::RecordingStreamBuilder::new(app).save(&partial).map_err(|e| io(e.to_string()))?;
         Ok(Recorder { rec, partial, target: path.to_path_buf(), every: every.max(1) })
     }
 
@@ -71,15 +69,12 @@ impl Recorder {
 
     /// Flushes and moves the recording to its final name.
     pub fn finish(self) -> Result<PathBuf, RecordError> {
-        self.rec.flush_blocking().map_err(|e| RecordError::Io {
-            path: self.target.display().to_string(),
-            message: e.to_string(),
-        })?;
+        self.rec
+            .flush_blocking()
+            .map_err(|e| RecordError::Io { path: self.target.display().to_string(), message: e.to_string() })?;
         drop(self.rec);
-        std::fs::rename(&self.partial, &self.target).map_err(|e| RecordError::Io {
-            path: self.target.display().to_string(),
-            message: e.to_string(),
-        })?;
+        std::fs::rename(&self.partial, &self.target)
+            .map_err(|e| RecordError::Io { path: self.target.display().to_string(), message: e.to_string() })?;
         Ok(self.target)
     }
 }
@@ -96,8 +91,13 @@ impl Observer for Recorder {
         rec.set_duration_secs("sim_time", snap.time_s);
         let pts: Vec<[f32; 3]> = snap.nodes.iter().map(|p| f32x3(*p)).collect();
         let labels: Vec<String> = s.nodes.iter().map(|n| n.name.clone()).collect();
-        let _ = rec.log("structure/nodes", &rerun::Points3D::new(pts.clone()).with_labels(labels.clone()).with_radii([0.02f32]));
-        let strips = |pairs: Vec<(usize, usize)>| -> Vec<Vec<[f32; 3]>> { pairs.into_iter().map(|(a, b)| vec![pts[a], pts[b]]).collect() };
+        let _ = rec.log(
+            "structure/nodes",
+            &rerun::Points3D::new(pts.clone()).with_labels(labels.clone()).with_radii([0.02f32]),
+        );
+        let strips = |pairs: Vec<(usize, usize)>| -> Vec<Vec<[f32; 3]>> {
+            pairs.into_iter().map(|(a, b)| vec![pts[a], pts[b]]).collect()
+        };
         let _ = rec.log(
             "structure/struts",
             &rerun::LineStrips3D::new(strips(s.struts.iter().map(|m| (m.a, m.b)).collect()))
@@ -125,9 +125,16 @@ impl Observer for Recorder {
         }
         if let Some(ghost) = t.ghost_nodes {
             let g: Vec<[f32; 3]> = ghost.iter().map(|p| f32x3(*p)).collect();
-            let _ = rec.log("analytic/nodes", &rerun::Points3D::new(g.clone()).with_labels(labels).with_colors([[80u8, 220, 120, 160]]).with_radii([0.015f32]));
+            let _ = rec.log(
+                "analytic/nodes",
+                &rerun::Points3D::new(g.clone())
+                    .with_labels(labels)
+                    .with_colors([[80u8, 220, 120, 160]])
+                    .with_radii([0.015f32]),
+            );
             let ghost_struts: Vec<Vec<[f32; 3]>> = s.struts.iter().map(|m| vec![g[m.a], g[m.b]]).collect();
-            let _ = rec.log("analytic/struts", &rerun::LineStrips3D::new(ghost_struts).with_colors([[80u8, 220, 120, 120]]));
+            let _ = rec
+                .log("analytic/struts", &rerun::LineStrips3D::new(ghost_struts).with_colors([[80u8, 220, 120, 120]]));
         }
         for (q, a) in &t.prediction.expected {
             if let Some(sv) = t.simulated.get(q) {

@@ -49,7 +49,11 @@ impl Observer for SlackTracker {
                     self.changes.push((self.names[c].clone(), true));
                 }
                 (Some((first, last)), false) => {
-                    self.closed.push(SlackInterval { cable: self.names[c].clone(), first_tick: *first, last_tick: *last });
+                    self.closed.push(SlackInterval {
+                        cable: self.names[c].clone(),
+                        first_tick: *first,
+                        last_tick: *last,
+                    });
                     self.open[c] = None;
                     self.changes.push((self.names[c].clone(), false));
                 }

@@ -106,7 +106,8 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         // attached to a fixed body that is also a multibody root had no effect in rapier 0.36
         // (measured: six rope joints from the base let the end-effector fly away).
         if s.bodies[joint.parent].kind == BodyKind::Fixed {
-            let root = *fixed_roots.entry(joint.parent).or_insert_with(|| bodies.insert(RigidBodyBuilder::fixed().build()));
+            let root =
+                *fixed_roots.entry(joint.parent).or_insert_with(|| bodies.insert(RigidBodyBuilder::fixed().build()));
             h1 = root;
         }
         let link = match &joint.kind {
@@ -150,17 +151,13 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         if cable.law == CableLaw::Inextensible {
             let (na, nb) = (&s.nodes[cable.a], &s.nodes[cable.b]);
             if na.body == nb.body {
-                return Err(SimError::Build(format!(
-                    "cable '{}' joins two nodes of the same body",
-                    cable.name
-                )));
+                return Err(SimError::Build(format!("cable '{}' joins two nodes of the same body", cable.name)));
             }
             let rope = RopeJointBuilder::new(cable.length_m)
                 .local_anchor1(v(na.position))
                 .local_anchor2(v(nb.position))
                 .build();
-            cable_ropes[c] =
-                Some(impulse_joints.insert(handles[na.body], handles[nb.body], rope, true));
+            cable_ropes[c] = Some(impulse_joints.insert(handles[na.body], handles[nb.body], rope, true));
         }
     }
 
@@ -202,6 +199,15 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         cable_lengths: s.cables.iter().map(|c| c.length_m).collect(),
         commands: commands.clone(),
         probe_loads: vec![([0.0; 3], [0.0; 3]); n],
+        external_loads: {
+            let mut l = vec![[0.0; 3]; n];
+            for load in &s.loads {
+                for k in 0..3 {
+                    l[load.body][k] += load.force_n[k];
+                }
+            }
+            l
+        },
         tick: 0,
         length_scale_m,
     };
@@ -247,26 +253,20 @@ fn generic_joint(s: &Structure, joint: &Joint) -> GenericJoint {
     let anchor = v(s.nodes[joint.anchor].position);
     match &joint.kind {
         JointKind::Revolute { axis } => {
-            let mut b = RevoluteJointBuilder::new(v(*axis).normalize())
-                .local_anchor1(anchor)
-                .local_anchor2(anchor);
+            let mut b = RevoluteJointBuilder::new(v(*axis).normalize()).local_anchor1(anchor).local_anchor2(anchor);
             if let Some(t) = &joint.torsion_spring {
-                b = b
-                    .motor_model(MotorModel::ForceBased)
-                    .motor_position(t.rest_angle_rad - joint.initial_coordinate, t.stiffness_nm_per_rad, 0.0);
+                b = b.motor_model(MotorModel::ForceBased).motor_position(
+                    t.rest_angle_rad - joint.initial_coordinate,
+                    t.stiffness_nm_per_rad,
+                    0.0,
+                );
             }
             b.build().into()
         }
-        JointKind::Prismatic { axis } => PrismaticJointBuilder::new(v(*axis).normalize())
-            .local_anchor1(anchor)
-            .local_anchor2(anchor)
-            .build()
-            .into(),
-        JointKind::Spherical => SphericalJointBuilder::new()
-            .local_anchor1(anchor)
-            .local_anchor2(anchor)
-            .build()
-            .into(),
+        JointKind::Prismatic { axis } => {
+            PrismaticJointBuilder::new(v(*axis).normalize()).local_anchor1(anchor).local_anchor2(anchor).build().into()
+        }
+        JointKind::Spherical => SphericalJointBuilder::new().local_anchor1(anchor).local_anchor2(anchor).build().into(),
         JointKind::Universal { axis1, axis2 } => {
             // Frame: x along axis1, y along axis2 (made orthogonal), z = x cross y is locked.
             let x = v(*axis1).normalize();
@@ -279,11 +279,7 @@ fn generic_joint(s: &Structure, joint: &Joint) -> GenericJoint {
                 .local_frame2(frame)
                 .build()
         }
-        JointKind::Fixed => FixedJointBuilder::new()
-            .local_anchor1(anchor)
-            .local_anchor2(anchor)
-            .build()
-            .into(),
+        JointKind::Fixed => FixedJointBuilder::new().local_anchor1(anchor).local_anchor2(anchor).build().into(),
     }
 }
 

@@ -86,7 +86,10 @@ impl Simulation {
             }
         }
         for b in 0..n {
-            let (f, t) = self.probe_loads[b];
+            let (mut f, t) = self.probe_loads[b];
+            for k in 0..3 {
+                f[k] += self.external_loads[b][k];
+            }
             if self.is_free(b) && (f != [0.0; 3] || t != [0.0; 3]) {
                 let rb = &mut self.bodies[self.handles[b]];
                 rb.add_force(v(f), false);
@@ -157,7 +160,10 @@ impl Simulation {
                     wrench[b].0 += f;
                     wrench[b].1 += com.cross(f);
                 }
-                let (pf, pt) = self.probe_loads[b];
+                let (mut pf, pt) = self.probe_loads[b];
+                for k in 0..3 {
+                    pf[k] += self.external_loads[b][k];
+                }
                 let com = self.world_com(b);
                 wrench[b].0 += v(pf);
                 wrench[b].1 += com.cross(v(pf)) + v(pt);
@@ -183,7 +189,13 @@ impl Simulation {
         if !closure_loads.is_empty() && !base.is_empty() {
             let rows = base.len();
             let cols = closure_loads.len();
-            let scaled = |c: &CoordinateForce| if c.is_torque { c.value / scale } else { c.value };
+            let scaled = |c: &CoordinateForce| {
+                if c.is_torque {
+                    c.value / scale
+                } else {
+                    c.value
+                }
+            };
             let mut g = nalgebra::DMatrix::<f64>::zeros(rows, cols);
             for (k, load) in closure_loads.iter().enumerate() {
                 let col = self.coordinate_forces(&tree, load, false);

@@ -97,6 +97,8 @@ pub struct Simulation {
     /// External loads [N] and [N m] applied to bodies (probes), world frame, about the body's
     /// centre of mass.
     probe_loads: Vec<([f64; 3], [f64; 3])>,
+    /// The structure's constant external forces, summed per body [N].
+    external_loads: Vec<[f64; 3]>,
     tick: u64,
     /// Characteristic length of the structure [m], for speeds and tolerances.
     pub length_scale_m: f64,
@@ -174,11 +176,7 @@ impl Simulation {
     pub fn step(&mut self) -> Result<(), SimError> {
         self.place_driven_bodies();
         self.apply_member_forces();
-        let gravity = Vector::new(
-            self.structure.gravity[0],
-            self.structure.gravity[1],
-            self.structure.gravity[2],
-        );
+        let gravity = Vector::new(self.structure.gravity[0], self.structure.gravity[1], self.structure.gravity[2]);
         self.pipeline.step(
             gravity,
             &self.params,

@@ -48,11 +48,9 @@ impl SettleDetector {
     /// Feeds one tick; returns true when the speed has been below the threshold for the window.
     pub fn update(&mut self, snap: &Snapshot, dt_s: f64, criteria: &SettleCriteria) -> bool {
         let speed = match &self.previous {
-            Some(prev) => prev
-                .iter()
-                .zip(&snap.nodes)
-                .map(|(a, b)| crate::structure::distance(*a, *b) / dt_s)
-                .fold(0.0, f64::max),
+            Some(prev) => {
+                prev.iter().zip(&snap.nodes).map(|(a, b)| crate::structure::distance(*a, *b) / dt_s).fold(0.0, f64::max)
+            }
             None => f64::INFINITY,
         };
         self.previous = Some(snap.nodes.clone());

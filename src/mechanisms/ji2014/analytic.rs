@@ -139,8 +139,7 @@ pub struct EnergyCoefficients {
 pub fn energy_coefficients_eq4(p: &Params, l3: f64, theta1: f64) -> EnergyCoefficients {
     let (l, k1, k2) = (p.l, p.k1, p.k2);
     let (s1, c1) = theta1.sin_cos();
-    let u0 = 0.5 * (k1 + k2) * (5.0 * l * l + l3 * l3 + 2.0 * SQRT_3 * l * l3 * s1)
-        + (k1 - k2) * l * l3 * c1;
+    let u0 = 0.5 * (k1 + k2) * (5.0 * l * l + l3 * l3 + 2.0 * SQRT_3 * l * l3 * s1) + (k1 - k2) * l * l3 * c1;
     let a = (2.0 * k1 - k2) * l * l + (0.5 * k1 + k2) * l * l3 * c1 + 0.5 * SQRT_3 * k1 * l * l3 * s1;
     let b = (0.5 * k1 + k2) * l * l3 * s1 - 0.5 * SQRT_3 * k1 * l * l3 * c1 + SQRT_3 * k2 * l * l;
     EnergyCoefficients { u0, a, b }
@@ -255,11 +254,8 @@ fn equilibrium_at(p: &Params, l3: f64, theta1: f64, theta2: f64) -> Equilibrium 
 /// returned, both with `K = 0`, `stable = false`.
 pub fn equilibria(p: &Params, l3: f64, theta1: f64) -> [Equilibrium; 2] {
     let (e1, e2) = eta(p, l3, theta1);
-    let (th_min, th_max) = if e1 == 0.0 && e2 == 0.0 {
-        (0.0, PI)
-    } else {
-        (wrap_angle((-e1).atan2(-e2)), wrap_angle(e1.atan2(e2)))
-    };
+    let (th_min, th_max) =
+        if e1 == 0.0 && e2 == 0.0 { (0.0, PI) } else { (wrap_angle((-e1).atan2(-e2)), wrap_angle(e1.atan2(e2))) };
     [equilibrium_at(p, l3, theta1, th_min), equilibrium_at(p, l3, theta1, th_max)]
 }
 
@@ -851,11 +847,18 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     // Eq. 1-3
     let err_geo = max_over(&|l3, t1, t2| {
         let n = nodes(p, l3, t1, t2);
-        ((n.d1 - n.d2).norm() - p.l).abs().max(((n.d2 - n.d3).norm() - p.l).abs())
+        ((n.d1 - n.d2).norm() - p.l)
+            .abs()
+            .max(((n.d2 - n.d3).norm() - p.l).abs())
             .max(((n.c2 - n.c3).norm() - 2.0 * p.l).abs())
             .max(((n.c1 - n.c2).norm() - 2.0 * p.l).abs())
     });
-    f.push(finding("Eq. 1-3", "node coordinates: mobile triangle side L, base side 2L", format!("max side-length error {err_geo:.2e} m"), err_geo < 1e-12 * p.l.max(1.0)));
+    f.push(finding(
+        "Eq. 1-3",
+        "node coordinates: mobile triangle side L, base side 2L",
+        format!("max side-length error {err_geo:.2e} m"),
+        err_geo < 1e-12 * p.l.max(1.0),
+    ));
 
     // Eq. 4
     let err4 = max_over(&|l3, t1, t2| potential_energy_eq4(p, l3, t1, t2) - potential_energy(p, l3, t1, t2)) / scale_u;
@@ -868,7 +871,15 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         }
         m / scale_u
     };
-    f.push(finding("Eq. 4", "U (printed) equals K1/2|D2C2|^2 + K2/2|D3C3|^2", format!("max |U_eq4 - U_springs|/((K1+K2)L^2) = {:.2e} (equilibria), {:.2e} (arbitrary theta2)", err4, err4_any), err4_any < 1e-12));
+    f.push(finding(
+        "Eq. 4",
+        "U (printed) equals K1/2|D2C2|^2 + K2/2|D3C3|^2",
+        format!(
+            "max |U_eq4 - U_springs|/((K1+K2)L^2) = {:.2e} (equilibria), {:.2e} (arbitrary theta2)",
+            err4, err4_any
+        ),
+        err4_any < 1e-12,
+    ));
 
     // Eq. 5-7 root
     let err5 = {
@@ -879,7 +890,12 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         }
         m / scale_u
     };
-    f.push(finding("Eq. 5-7", "tan th2 = eta1/eta2 (eta1, eta2 as printed) solves dU/dth2 = 0", format!("max |tau|/((K1+K2)L^2) at the Eq. 5 root = {err5:.2e}; eta1 = 2B/L, eta2 = 2A/L exactly"), err5 < 1e-12));
+    f.push(finding(
+        "Eq. 5-7",
+        "tan th2 = eta1/eta2 (eta1, eta2 as printed) solves dU/dth2 = 0",
+        format!("max |tau|/((K1+K2)L^2) at the Eq. 5 root = {err5:.2e}; eta1 = 2B/L, eta2 = 2A/L exactly"),
+        err5 < 1e-12,
+    ));
 
     // Eq. 5 branch on the paper's workspace
     {
@@ -912,7 +928,12 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let [e1, e2, e3] = e_coefficients_eq10(p, n.d3.x, n.d3.y, t1);
         (e1 * l3 * l3 + e2 * l3 + e3) / (p.l * p.l)
     });
-    f.push(finding("Eq. 8-10", "E1 L3^2 + E2 L3 + E3 = 0 with E = [1, -2(x c1 + y s1), x^2+y^2-L^2]", format!("max |residual|/L^2 = {err9:.2e}"), err9 < 1e-12));
+    f.push(finding(
+        "Eq. 8-10",
+        "E1 L3^2 + E2 L3 + E3 = 0 with E = [1, -2(x c1 + y s1), x^2+y^2-L^2]",
+        format!("max |residual|/L^2 = {err9:.2e}"),
+        err9 < 1e-12,
+    ));
 
     // Eq. 11-12
     {
@@ -944,8 +965,12 @@ pub fn findings(p: &Params) -> Vec<Finding> {
                 r14 = r14.max((l3_eq14(p, e.x, e.y, t1) - l3).abs() / p.l);
             }
         }
-        f.push(finding("Eq. 13-14", "Bezout condition for a common L3 root and the common root formula",
-            format!("max |Eq.13|/|E1F3-E3F1|^2 = {r13:.2e}; max |L3(Eq.14) - L3|/L = {r14:.2e}"), r13 < 1e-8 && r14 < 1e-8));
+        f.push(finding(
+            "Eq. 13-14",
+            "Bezout condition for a common L3 root and the common root formula",
+            format!("max |Eq.13|/|E1F3-E3F1|^2 = {r13:.2e}; max |L3(Eq.14) - L3|/L = {r14:.2e}"),
+            r13 < 1e-8 && r14 < 1e-8,
+        ));
     }
 
     // Eq. 15-16 + Appendix A
@@ -1050,7 +1075,9 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let mut jump: f64 = 0.0;
         for l3 in [1.2, 1.5, 1.8, 2.0] {
             // eta1 = 0 on th1 with (K1+2K2) s1 - sqrt3 K1 c1 = -2 sqrt3 K2 L / L3
-            let Some(t1) = curve_iii_theta1(&q, l3) else { continue };
+            let Some(t1) = curve_iii_theta1(&q, l3) else {
+                continue;
+            };
             for dt in [-1e-7, 0.0, 1e-7] {
                 for e in equilibria(&q, l3, t1 + dt) {
                     djmax = djmax.max(det_jacobian(&q, l3, t1 + dt, e.theta2).abs());
@@ -1072,7 +1099,8 @@ pub fn findings(p: &Params) -> Vec<Finding> {
             for (k, e) in equilibria(&q, l3, t1).iter().enumerate() {
                 dj_iv = dj_iv.min(det_jacobian(&q, l3, t1, e.theta2).abs());
                 if k == 0 {
-                    branch.push_str(&format!("th1={t1}: L3={l3:.4}, stable th2-th1={:.4}; ", wrap_angle(e.theta2 - t1)));
+                    branch
+                        .push_str(&format!("th1={t1}: L3={l3:.4}, stable th2-th1={:.4}; ", wrap_angle(e.theta2 - t1)));
                 }
             }
         }
@@ -1090,7 +1118,9 @@ pub fn findings(p: &Params) -> Vec<Finding> {
             }
             let (l3, t1) = (d1.norm(), d1.y.atan2(d1.x));
             let e = equilibria(&q, l3, t1)[0];
-            ev = ev.max(det_jacobian(&q, l3, t1, e.theta2).abs()).max(phi1(&q, l3, t1, e.theta2).abs() / (1.0 + phi2(&q, l3, t1).abs()));
+            ev = ev
+                .max(det_jacobian(&q, l3, t1, e.theta2).abs())
+                .max(phi1(&q, l3, t1, e.theta2).abs() / (1.0 + phi2(&q, l3, t1).abs()));
         }
         f.push(finding("Eq. 30 (curve v, Phi1 = 0)", "det J = 0 on Phi1 = 0",
             format!("holds with the corrected Phi1: for the stable branch Phi1 = 0 <=> eta1^2+eta2^2 = L^2 (K1+2K2)^2, a circle in the D1 plane centred at the neutral point D1* = ({:.4},{:.4}) m with radius {rad:.4} m (K1=200,K2=100,L=1); max |det J| on it = {ev:.1e}. The unstable branch is never singular (det J = L3(1 + L(K1+2K2)/|eta|) > 0 for L3>0)", c.x, c.y),
@@ -1105,7 +1135,9 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let mut r_d: f64 = 0.0;
         let mut which = String::new();
         for l3 in [1.2, 1.6, 2.0] {
-            let Some(t1) = curve_iii_theta1(&q, l3) else { continue };
+            let Some(t1) = curve_iii_theta1(&q, l3) else {
+                continue;
+            };
             let sc = q.k1 * q.l;
             for e in equilibria(&q, l3, t1) {
                 let is_pi = e.theta2.abs() > FRAC_PI_2;
@@ -1113,7 +1145,10 @@ pub fn findings(p: &Params) -> Vec<Finding> {
                 r_d = r_d.max(curve_iii_cartesian(&q, e.x, e.y, is_pi).abs() / sc);
             }
             let st = equilibria(&q, l3, t1)[0];
-            which = format!("stable th2 = {:.4} rad (pi), paper's Eq. 38-39 assume th2 = 0 (the maximum when eta2>0)", st.theta2);
+            which = format!(
+                "stable th2 = {:.4} rad (pi), paper's Eq. 38-39 assume th2 = 0 (the maximum when eta2>0)",
+                st.theta2
+            );
         }
         f.push(finding("Eq. 36 (curve iii, Cartesian)", "2sqrt3 K1 x - (K1+2K2) y + 2sqrt3 L (K2-K1) = 0",
             format!("wrong: at D3 of the equilibria on eta1 = 0 (K1=200,K2=100,L3 in 1.2..2) |Eq.36|/(K1 L) up to {r_pr:.3}; derived th2=0: (K1+2K2)y - sqrt3K1x + sqrt3(K1+2K2)L = 0, th2=pi: (K1+2K2)y - sqrt3K1x + sqrt3(2K2-K1)L = 0, residual {r_d:.1e}; {which}"),
@@ -1156,12 +1191,30 @@ pub fn findings(p: &Params) -> Vec<Finding> {
                 e41 = e41.max((torque_eq41(p, l3, t1, t2) - torque(p, l3, t1, t2)).abs() / scale_u);
                 e42 = e42.max((stiffness_eq42(p, l3, t1, t2) - stiffness(p, l3, t1, t2)).abs() / scale_u);
                 let n = nodes(p, l3, t1, t2);
-                e48 = e48.max((equilibrium_residual_eq48(p, n.d3.x, n.d3.y, t2) * 0.5 * p.l - torque(p, l3, t1, t2)).abs() / scale_u);
+                e48 = e48.max(
+                    (equilibrium_residual_eq48(p, n.d3.x, n.d3.y, t2) * 0.5 * p.l - torque(p, l3, t1, t2)).abs()
+                        / scale_u,
+                );
             }
         }
-        f.push(finding("Eq. 41", "tau = dU/dth2 = -A sin th2 + B cos th2", format!("holds (signs correct): max rel. error vs spring-vector derivative {e41:.1e}"), e41 < 1e-12));
-        f.push(finding("Eq. 42", "K = d2U/dth2^2 = -A cos th2 - B sin th2", format!("holds (signs correct): max rel. error {e42:.1e}"), e42 < 1e-12));
-        f.push(finding("Eq. 40, 48, 50-51", "delta1 cos th2 - delta2 sin th2 + sqrt3 K1 L = 0 is Eq. 5 in (x, y)", format!("holds: (L/2) x residual equals tau identically, max rel. error {e48:.1e}"), e48 < 1e-12));
+        f.push(finding(
+            "Eq. 41",
+            "tau = dU/dth2 = -A sin th2 + B cos th2",
+            format!("holds (signs correct): max rel. error vs spring-vector derivative {e41:.1e}"),
+            e41 < 1e-12,
+        ));
+        f.push(finding(
+            "Eq. 42",
+            "K = d2U/dth2^2 = -A cos th2 - B sin th2",
+            format!("holds (signs correct): max rel. error {e42:.1e}"),
+            e42 < 1e-12,
+        ));
+        f.push(finding(
+            "Eq. 40, 48, 50-51",
+            "delta1 cos th2 - delta2 sin th2 + sqrt3 K1 L = 0 is Eq. 5 in (x, y)",
+            format!("holds: (L/2) x residual equals tau identically, max rel. error {e48:.1e}"),
+            e48 < 1e-12,
+        ));
     }
 
     // Eq. 43-45 + claim
@@ -1182,7 +1235,14 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         }
         f.push(finding("Eq. 43", "d^jU/dth2^j = -d^(j+2)U/dth2^(j+2), j = 1,2,3,...", format!("holds exactly for j >= 1 (max rel. deviation, finite differences h=1e-3: {e43:.1e}); for j = 0 only up to the constant: U = U0 - d2U/dth2^2 with U0 = {:.4} J here (L3=1.3L, th1=0.9), residual after subtracting U0 {e0:.1e}", e.u0), e43 < 1e-5));
         f.push(finding("Eq. 44", "dK/dth2 = -d3U/dth2^3 = -dU/dth2", "middle term has the wrong sign: dK/dth2 = +d3U/dth2^3 = -dU/dth2 = -tau (outer equality holds, follows from Eq. 43)".to_string(), false));
-        f.push(finding("Eq. 45", "d2K/dth2^2 = d4U/dth2^4 = -d2U/dth2^2", format!("holds (same check as Eq. 43, {e43:.1e}); text says 'with respect to th1' twice where th2 is meant"), true));
+        f.push(finding(
+            "Eq. 45",
+            "d2K/dth2^2 = d4U/dth2^4 = -d2U/dth2^2",
+            format!(
+                "holds (same check as Eq. 43, {e43:.1e}); text says 'with respect to th1' twice where th2 is meant"
+            ),
+            true,
+        ));
         let mut ok = true;
         let mut worst: f64 = 0.0;
         for &(l3, t1) in &pts {
@@ -1412,10 +1472,7 @@ mod tests {
                 let err = eqs.iter().map(|q| (q.x - e.x).hypot(q.y - e.y)).fold(f64::INFINITY, f64::min);
                 assert!(err < 1e-10, "IK solution not verified: {err}");
             }
-            let best = sols
-                .iter()
-                .map(|s| (s.l3 - l3).abs().max((s.theta1 - t1).abs()))
-                .fold(f64::INFINITY, f64::min);
+            let best = sols.iter().map(|s| (s.l3 - l3).abs().max((s.theta1 - t1).abs())).fold(f64::INFINITY, f64::min);
             let m = sols.iter().find(|s| (s.l3 - l3).abs().max((s.theta1 - t1).abs()) == best).unwrap();
             assert_eq!(m.stable, e.stable);
             worst = worst.max(best);
@@ -1499,8 +1556,18 @@ mod tests {
                 assert!((j - jf).abs().max() < 1e-6 * (1.0 + j.abs().max()), "J={j} fd={jf}");
                 let th2 = equilibria(&P, l3, t1)[b].theta2;
                 let dj = det_jacobian(&P, l3, t1, th2);
-                assert_relative_eq!(dj, det_jacobian_closed_form(&P, l3, t1, th2), epsilon = 1e-10, max_relative = 1e-10);
-                assert_relative_eq!(dj, det_jacobian_eq23_corrected(&P, l3, t1, th2).unwrap(), epsilon = 1e-9, max_relative = 1e-9);
+                assert_relative_eq!(
+                    dj,
+                    det_jacobian_closed_form(&P, l3, t1, th2),
+                    epsilon = 1e-10,
+                    max_relative = 1e-10
+                );
+                assert_relative_eq!(
+                    dj,
+                    det_jacobian_eq23_corrected(&P, l3, t1, th2).unwrap(),
+                    epsilon = 1e-9,
+                    max_relative = 1e-9
+                );
                 let (a1, b1) = dtheta2_dinputs(&P, l3, t1, th2);
                 let (a2, b2) = dtheta2_dinputs_eq22(&P, l3, t1, th2);
                 assert_relative_eq!(a1, a2, epsilon = 1e-9, max_relative = 1e-9);
@@ -1518,7 +1585,11 @@ mod tests {
         assert!((pr - dj).abs() > 1e-2 * dj.abs().max(1e-3));
         // At L3 = L the spurious factor L3/L = 1 makes them agree.
         let th2b = equilibria(&P, 1.0, t1)[0].theta2;
-        assert_relative_eq!(det_jacobian_eq23(&P, 1.0, t1, th2b).unwrap(), det_jacobian(&P, 1.0, t1, th2b), max_relative = 1e-9);
+        assert_relative_eq!(
+            det_jacobian_eq23(&P, 1.0, t1, th2b).unwrap(),
+            det_jacobian(&P, 1.0, t1, th2b),
+            max_relative = 1e-9
+        );
     }
 
     #[test]
@@ -1537,7 +1608,11 @@ mod tests {
         let (mut lo, mut hi) = (0.0, FRAC_PI_2);
         for _ in 0..100 {
             let m = 0.5 * (lo + hi);
-            if curve_iii_eq28(&P, 2.0, lo) * curve_iii_eq28(&P, 2.0, m) <= 0.0 { hi = m } else { lo = m }
+            if curve_iii_eq28(&P, 2.0, lo) * curve_iii_eq28(&P, 2.0, m) <= 0.0 {
+                hi = m
+            } else {
+                lo = m
+            }
         }
         for e in equilibria(&P, 2.0, lo) {
             let dj = det_jacobian(&P, 2.0, lo, e.theta2);
@@ -1573,7 +1648,12 @@ mod tests {
             let l3 = 0.1 + 1.9 * rng.next_f64();
             let t1 = 0.05 + 3.0 * rng.next_f64();
             for e in equilibria(&P, l3, t1) {
-                assert_relative_eq!(stiffness_xy_derived(&P, e.x, e.y, e.theta2), e.stiffness, epsilon = 1e-9, max_relative = 1e-10);
+                assert_relative_eq!(
+                    stiffness_xy_derived(&P, e.x, e.y, e.theta2),
+                    e.stiffness,
+                    epsilon = 1e-9,
+                    max_relative = 1e-10
+                );
                 assert!(equilibrium_residual_eq48(&P, e.x, e.y, e.theta2).abs() < 1e-10 * P.k1);
                 let t52 = theta2_eq52(&P, e.x, e.y);
                 assert!(equilibrium_residual_eq48(&P, e.x, e.y, t52).abs() < 1e-9 * P.k1);
@@ -1592,10 +1672,15 @@ mod tests {
             let h = 1e-4;
             let dk = (stiffness(&P, l3, t1, t2 + h) - stiffness(&P, l3, t1, t2 - h)) / (2.0 * h);
             assert_relative_eq!(dk, -torque(&P, l3, t1, t2), epsilon = 1e-5);
-            let d2k = (stiffness(&P, l3, t1, t2 + h) - 2.0 * stiffness(&P, l3, t1, t2) + stiffness(&P, l3, t1, t2 - h)) / (h * h);
+            let d2k = (stiffness(&P, l3, t1, t2 + h) - 2.0 * stiffness(&P, l3, t1, t2) + stiffness(&P, l3, t1, t2 - h))
+                / (h * h);
             assert_relative_eq!(d2k, -stiffness(&P, l3, t1, t2), epsilon = 1e-2);
             // j = 0 only up to the constant U0
-            assert_relative_eq!(potential_energy(&P, l3, t1, t2) + stiffness(&P, l3, t1, t2), e.u0, max_relative = 1e-12);
+            assert_relative_eq!(
+                potential_energy(&P, l3, t1, t2) + stiffness(&P, l3, t1, t2),
+                e.u0,
+                max_relative = 1e-12
+            );
         }
     }
 

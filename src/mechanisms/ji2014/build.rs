@@ -7,9 +7,7 @@
 //! joints about z keep the motion in the plane.
 
 use super::analytic::{self, Params};
-use crate::structure::{
-    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Strut, Structure,
-};
+use crate::structure::{Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut};
 
 /// Model choices that the paper does not give (defaults in `Ji2014::params`).
 #[derive(Clone, Copy, Debug)]
@@ -30,11 +28,8 @@ pub fn build(p: &Params, m: &ModelChoices, l3: f64, theta1: f64, theta2: f64) ->
     let nodes = analytic::nodes(p, l3, theta1, theta2);
     let xyz = |v: nalgebra::Vector2<f64>| [v.x, v.y, 0.0];
     let mut s = Structure { name: "ji2014".into(), gravity: [0.0; 3], ..Default::default() };
-    let nominal = Some(Inertia {
-        mass_kg: ACTUATOR_BODY_MASS_KG,
-        com: [0.0; 3],
-        principal_kg_m2: [ACTUATOR_BODY_MASS_KG; 3],
-    });
+    let nominal =
+        Some(Inertia { mass_kg: ACTUATOR_BODY_MASS_KG, com: [0.0; 3], principal_kg_m2: [ACTUATOR_BODY_MASS_KG; 3] });
     let ground = s.add_body("base", BodyKind::Fixed, None);
     let housing = s.add_body("actuator_housing", BodyKind::Free, nominal);
     let rod = s.add_body("actuator_rod", BodyKind::Free, nominal);
@@ -59,14 +54,9 @@ pub fn build(p: &Params, m: &ModelChoices, l3: f64, theta1: f64, theta2: f64) ->
     let d2 = s.add_node("D2", platform, xyz(nodes.d2));
     let d3 = s.add_node("D3", platform, xyz(nodes.d3));
     let r = m.strut_radius_m;
-    for (name, a, b) in [
-        ("C1C2", c1, c2),
-        ("C2C3", c2, c3),
-        ("C1C3", c1, c3),
-        ("D1D2", d1, d2),
-        ("D2D3", d2, d3),
-        ("D1D3", d1, d3),
-    ] {
+    for (name, a, b) in
+        [("C1C2", c1, c2), ("C2C3", c2, c3), ("C1C3", c1, c3), ("D1D2", d1, d2), ("D2D3", d2, d3), ("D1D3", d1, d3)]
+    {
         s.struts.push(Strut { name: name.into(), a, b, radius_m: r });
     }
     if l3 > 0.0 {

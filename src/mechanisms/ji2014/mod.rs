@@ -4,8 +4,8 @@ pub mod analytic;
 pub mod build;
 
 use super::{
-    wrap_angle, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind,
-    QuantitySpec, QuerySpec, Solution, StiffnessProbe, Values,
+    wrap_angle, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec,
+    Solution, StiffnessProbe, Values,
 };
 use crate::sim::Snapshot;
 use crate::structure::Structure;
@@ -18,33 +18,110 @@ pub struct Ji2014;
 pub const DEFAULT_START_OFFSET_RAD: f64 = 0.5;
 
 const PARAMS: &[ParamSpec] = &[
-    ParamSpec { symbol: "L", unit: "m", default: 1.0, description: "side of the mobile triangle (base side is 2L)", origin: Origin::Paper },
-    ParamSpec { symbol: "K1", unit: "N/m", default: 200.0, description: "stiffness of spring K1 (D2-C2), zero free length", origin: Origin::Paper },
-    ParamSpec { symbol: "K2", unit: "N/m", default: 100.0, description: "stiffness of spring K2 (D3-C3), zero free length", origin: Origin::Paper },
-    ParamSpec { symbol: "m_platform", unit: "kg", default: 1.0, description: "mass of the mobile triangle (not in the paper: quasi-static results do not depend on it)", origin: Origin::ModelChoice },
-    ParamSpec { symbol: "c_D1", unit: "N m s/rad", default: 20.0, description: "viscous damping of the pivot at D1 (not in the paper: zero at rest, it only speeds settling)", origin: Origin::ModelChoice },
-    ParamSpec { symbol: "r_strut", unit: "m", default: 0.01, description: "strut radius for drawing and interference (not in the paper)", origin: Origin::ModelChoice },
+    ParamSpec {
+        symbol: "L",
+        unit: "m",
+        default: 1.0,
+        description: "side of the mobile triangle (base side is 2L)",
+        origin: Origin::Paper,
+    },
+    ParamSpec {
+        symbol: "K1",
+        unit: "N/m",
+        default: 200.0,
+        description: "stiffness of spring K1 (D2-C2), zero free length",
+        origin: Origin::Paper,
+    },
+    ParamSpec {
+        symbol: "K2",
+        unit: "N/m",
+        default: 100.0,
+        description: "stiffness of spring K2 (D3-C3), zero free length",
+        origin: Origin::Paper,
+    },
+    ParamSpec {
+        symbol: "m_platform",
+        unit: "kg",
+        default: 1.0,
+        description: "mass of the mobile triangle (not in the paper: quasi-static results do not depend on it)",
+        origin: Origin::ModelChoice,
+    },
+    ParamSpec {
+        symbol: "c_D1",
+        unit: "N m s/rad",
+        default: 20.0,
+        description: "viscous damping of the pivot at D1 (not in the paper: zero at rest, it only speeds settling)",
+        origin: Origin::ModelChoice,
+    },
+    ParamSpec {
+        symbol: "r_strut",
+        unit: "m",
+        default: 0.01,
+        description: "strut radius for drawing and interference (not in the paper)",
+        origin: Origin::ModelChoice,
+    },
 ];
 
 const INPUTS: &[InputSpec] = &[
     InputSpec { symbol: "L3", unit: "m", description: "length of the prismatic actuator C1D1" },
-    InputSpec { symbol: "theta1", unit: "rad", description: "angle of the actuator from the X axis, 0 <= theta1 <= pi" },
+    InputSpec {
+        symbol: "theta1",
+        unit: "rad",
+        description: "angle of the actuator from the X axis, 0 <= theta1 <= pi",
+    },
 ];
 
 const QUANTITIES: &[QuantitySpec] = &[
-    QuantitySpec { symbol: "theta2", unit: "rad", kind: QuantityKind::Angle, description: "angle of strut D1D3 from the X axis (Eq. 5)" },
+    QuantitySpec {
+        symbol: "theta2",
+        unit: "rad",
+        kind: QuantityKind::Angle,
+        description: "angle of strut D1D3 from the X axis (Eq. 5)",
+    },
     QuantitySpec { symbol: "x", unit: "m", kind: QuantityKind::Length, description: "x of node D3 (Eq. 2)" },
     QuantitySpec { symbol: "y", unit: "m", kind: QuantityKind::Length, description: "y of node D3 (Eq. 3)" },
-    QuantitySpec { symbol: "F_K1", unit: "N", kind: QuantityKind::Magnitude, description: "force in spring K1 = K1 |D2C2|" },
-    QuantitySpec { symbol: "F_K2", unit: "N", kind: QuantityKind::Magnitude, description: "force in spring K2 = K2 |D3C3|" },
-    QuantitySpec { symbol: "F_L3", unit: "N", kind: QuantityKind::Magnitude, description: "axial force of the actuator on D1 along C1->D1" },
-    QuantitySpec { symbol: "K", unit: "N m/rad", kind: QuantityKind::Magnitude, description: "stiffness d tau / d theta2 with the actuators locked (Eq. 42); simulated by the stiffness probe" },
+    QuantitySpec {
+        symbol: "F_K1",
+        unit: "N",
+        kind: QuantityKind::Magnitude,
+        description: "force in spring K1 = K1 |D2C2|",
+    },
+    QuantitySpec {
+        symbol: "F_K2",
+        unit: "N",
+        kind: QuantityKind::Magnitude,
+        description: "force in spring K2 = K2 |D3C3|",
+    },
+    QuantitySpec {
+        symbol: "F_L3",
+        unit: "N",
+        kind: QuantityKind::Magnitude,
+        description: "axial force of the actuator on D1 along C1->D1",
+    },
+    QuantitySpec {
+        symbol: "K",
+        unit: "N m/rad",
+        kind: QuantityKind::Magnitude,
+        description: "stiffness d tau / d theta2 with the actuators locked (Eq. 42); simulated by the stiffness probe",
+    },
 ];
 
 const QUERIES: &[QuerySpec] = &[
-    QuerySpec { name: "fk", inputs: &["L3", "theta1"], description: "forward kinematics: both equilibria of Eq. 5 (energy minimum and maximum), with K and stability" },
-    QuerySpec { name: "ik", inputs: &["x", "y"], description: "inverse kinematics: every (L3, theta1) placing D3 at (x, y) in equilibrium" },
-    QuerySpec { name: "jacobian", inputs: &["L3", "theta1"], description: "Jacobian of Eq. 17 and det J at the stable equilibrium" },
+    QuerySpec {
+        name: "fk",
+        inputs: &["L3", "theta1"],
+        description: "forward kinematics: both equilibria of Eq. 5 (energy minimum and maximum), with K and stability",
+    },
+    QuerySpec {
+        name: "ik",
+        inputs: &["x", "y"],
+        description: "inverse kinematics: every (L3, theta1) placing D3 at (x, y) in equilibrium",
+    },
+    QuerySpec {
+        name: "jacobian",
+        inputs: &["L3", "theta1"],
+        description: "Jacobian of Eq. 17 and det J at the stable equilibrium",
+    },
 ];
 
 pub fn params_of(v: &Values) -> Params {
@@ -52,11 +129,7 @@ pub fn params_of(v: &Values) -> Params {
 }
 
 fn model_of(v: &Values) -> build::ModelChoices {
-    build::ModelChoices {
-        platform_mass_kg: v["m_platform"],
-        pivot_damping: v["c_D1"],
-        strut_radius_m: v["r_strut"],
-    }
+    build::ModelChoices { platform_mass_kg: v["m_platform"], pivot_damping: v["c_D1"], strut_radius_m: v["r_strut"] }
 }
 
 fn input(inputs: &Values, key: &str) -> Result<f64, String> {
@@ -158,7 +231,8 @@ impl Mechanism for Ji2014 {
     fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), (String, String)> {
         let l = params["L"];
         let l3 = inputs.get("L3").copied().ok_or(("L3".to_string(), "missing input L3 [m]".to_string()))?;
-        let th = inputs.get("theta1").copied().ok_or(("theta1".to_string(), "missing input theta1 [rad]".to_string()))?;
+        let th =
+            inputs.get("theta1").copied().ok_or(("theta1".to_string(), "missing input theta1 [rad]".to_string()))?;
         if !(l3 > 0.0 && l3.is_finite()) {
             return Err(("L3".into(), format!(
                 "L3 must be a finite number > 0 m (L3 = 0 is singularity i: the equilibrium does not depend on theta1), got {l3}"
@@ -168,12 +242,18 @@ impl Mechanism for Ji2014 {
             return Err(("L3".into(), format!("L3 = {l3} m is more than 1000 L: outside any plausible workspace")));
         }
         if !(0.0..=std::f64::consts::PI).contains(&th) {
-            return Err(("theta1".into(), format!("theta1 must lie in [0, pi] rad (Section 2: D1 above the X axis), got {th}")));
+            return Err((
+                "theta1".into(),
+                format!("theta1 must lie in [0, pi] rad (Section 2: D1 above the X axis), got {th}"),
+            ));
         }
         // Singularity iii (Eq. 28): eta1 = eta2 = 0 leaves theta2 undetermined.
         let (e1, e2) = analytic::eta(&params_of(params), l3, th);
         if e1.hypot(e2) < 1e-12 * params["K1"].max(params["K2"]) * l {
-            return Err(("L3".into(), "inputs on a singularity where eta1 = eta2 = 0: every theta2 is an equilibrium".into()));
+            return Err((
+                "L3".into(),
+                "inputs on a singularity where eta1 = eta2 = 0: every theta2 is an equilibrium".into(),
+            ));
         }
         Ok(())
     }
@@ -189,7 +269,9 @@ impl Mechanism for Ji2014 {
                 let (x, y) = (input(inputs, "x")?, input(inputs, "y")?);
                 let sols = analytic::inverse_kinematics(&p, x, y);
                 if sols.is_empty() {
-                    return Err(format!("({x}, {y}) is not reachable: no equilibrium places D3 there with 0 <= theta1 <= pi"));
+                    return Err(format!(
+                        "({x}, {y}) is not reachable: no equilibrium places D3 there with 0 <= theta1 <= pi"
+                    ));
                 }
                 Ok(sols
                     .iter()
@@ -249,7 +331,11 @@ impl Mechanism for Ji2014 {
         let p = params_of(params);
         let (l3, th1) = (input(inputs, "L3")?, input(inputs, "theta1")?);
         let eqs = analytic::equilibria(&p, l3, th1);
-        Ok(Prediction { expected: equilibrium_values(&p, l3, th1, &eqs[0]), branches: branches(&p, l3, th1), expected_slack: None })
+        Ok(Prediction {
+            expected: equilibrium_values(&p, l3, th1, &eqs[0]),
+            branches: branches(&p, l3, th1),
+            expected_slack: None,
+        })
     }
 
     fn observe(&self, _params: &Values, s: &Structure, snap: &Snapshot) -> Values {

@@ -98,12 +98,8 @@ pub struct Params {
 impl Params {
     /// Figs. 4-6: `lb = 2 m`, `lo = 3 lb = 6 m`, `l_min = 0`; `kappa` = [`DEFAULT_KAPPA`]
     /// (not in the paper).
-    pub const PAPER: Params = Params {
-        lb: PAPER_LB,
-        lo: PAPER_LO_OVER_LB * PAPER_LB,
-        kappa: DEFAULT_KAPPA,
-        l_min: 0.0,
-    };
+    pub const PAPER: Params =
+        Params { lb: PAPER_LB, lo: PAPER_LO_OVER_LB * PAPER_LB, kappa: DEFAULT_KAPPA, l_min: 0.0 };
 
     /// `lb > 0`, `lo > 0`, `kappa > 0`, `0 <= l_min < lo`, all finite.
     pub fn validate(&self) -> Result<(), String> {
@@ -486,11 +482,8 @@ pub fn det_wt_derived(p: &Params, centroid: &Vector3<f64>) -> f64 {
     let a = base_nodes(p);
     let q = a.map(|ai| centroid + ai);
     let qm = Matrix3::from_columns(&q);
-    let r = Matrix3::from_columns(&[
-        (a[2] - a[1]).cross(&q[0]),
-        (a[2] - a[0]).cross(&q[1]),
-        (a[1] - a[0]).cross(&q[2]),
-    ]);
+    let r =
+        Matrix3::from_columns(&[(a[2] - a[1]).cross(&q[0]), (a[2] - a[0]).cross(&q[1]), (a[1] - a[0]).cross(&q[2])]);
     let rho2: f64 = q.iter().map(|v| v.norm_squared()).product();
     qm.determinant() * r.determinant() / rho2
 }
@@ -567,11 +560,7 @@ pub fn statics(p: &Params, centroid: &Vector3<f64>) -> Statics {
 pub fn tension_agreement(p: &Params, centroid: &Vector3<f64>) -> f64 {
     let s = statics(p, centroid);
     let scale = s.tensions_closed_form.iter().fold(0.0f64, |m, t| m.max(t.abs()));
-    s.tensions_full
-        .iter()
-        .zip(s.tensions_closed_form.iter())
-        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
-        / scale
+    s.tensions_full.iter().zip(s.tensions_closed_form.iter()).fold(0.0f64, |m, (a, b)| m.max((a - b).abs())) / scale
 }
 
 // ---------------------------------------------------------------------------
@@ -789,7 +778,10 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     out.push(Finding {
         equation: "Eq. 6-10, 15",
         claim: "paired cables equal and rho_j = |p + a_j|".into(),
-        measured: format!("{} points: max rel pair mismatch {worst_pair:.1e}, max rel |len - rho| {worst_rho:.1e}", pts.len()),
+        measured: format!(
+            "{} points: max rel pair mismatch {worst_pair:.1e}, max rel |len - rho| {worst_rho:.1e}",
+            pts.len()
+        ),
         holds: worst_pair < tol && worst_rho < tol,
     });
 
@@ -814,7 +806,8 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let d = dkp(p, &rho).expect("assembles");
         worst_dkp = worst_dkp.max((d - c).norm() / p.lb);
         let rad = dkp_radicand_eq14(p, &rho);
-        worst_rad = worst_rad.max((rad - 3.0 * p.lb * p.lb * c.z * c.z).abs() / (p.lb.powi(2) * rho.iter().map(|r| r * r).sum::<f64>()));
+        worst_rad = worst_rad
+            .max((rad - 3.0 * p.lb * p.lb * c.z * c.z).abs() / (p.lb.powi(2) * rho.iter().map(|r| r * r).sum::<f64>()));
     }
     out.push(Finding {
         equation: "Eq. 12-14",
@@ -835,7 +828,10 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     out.push(Finding {
         equation: "Eq. 16-18",
         claim: "l_i = |p + b_i - a_i| = |p - 2 a_i|: spheres about 2 a_i of radius l_min, l_max".into(),
-        measured: format!("|B_i - A_i| vs |p - 2a_i|: max rel diff {worst_l:.1e}; z_max on the axis sqrt(lo^2 - 4 lb^2/3) = {:.6}", z_max_on_axis(p)),
+        measured: format!(
+            "|B_i - A_i| vs |p - 2a_i|: max rel diff {worst_l:.1e}; z_max on the axis sqrt(lo^2 - 4 lb^2/3) = {:.6}",
+            z_max_on_axis(p)
+        ),
         holds: worst_l < tol,
     });
 
@@ -850,7 +846,8 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let h = 1e-6 * p.lo;
         let de = (spring_energy(p, l + h) - spring_energy(p, l - h)) / (2.0 * h);
         worst_de = worst_de.max((de - spring_force(p, l)).abs() / spring_force(p, l).abs());
-        worst_eq5 = worst_eq5.max((spring_force_eq5_as_printed(p, l) - spring_force(p, l)).abs() / spring_force(p, l).abs());
+        worst_eq5 =
+            worst_eq5.max((spring_force_eq5_as_printed(p, l) - spring_force(p, l)).abs() / spring_force(p, l).abs());
     }
     out.push(Finding {
         equation: "Eq. 3",
@@ -901,7 +898,9 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     out.push(Finding {
         equation: "Eq. 24, 26-28",
         claim: "t1=t4, t2=t5, t3=t6 = rho_j/2 (fh_j - fh_k - fh_l)".into(),
-        measured: format!("closed form vs 6x6 LU: max rel diff {worst_t:.1e}; wrench residual of closed form {worst_w:.1e} (rel)"),
+        measured: format!(
+            "closed form vs 6x6 LU: max rel diff {worst_t:.1e}; wrench residual of closed form {worst_w:.1e} (rel)"
+        ),
         holds: worst_t < 1e-8 && worst_w < 1e-12,
     });
 
@@ -949,7 +948,10 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     out.push(Finding {
         equation: "Sec. 4.2, 5 (kappa)",
         claim: "static-workspace boundaries independent of the spring stiffness".into(),
-        measured: format!("classification with kappa and 1000 kappa differs at {diff} of {} points (f is linear in kappa)", pts.len()),
+        measured: format!(
+            "classification with kappa and 1000 kappa differs at {diff} of {} points (f is linear in kappa)",
+            pts.len()
+        ),
         holds: diff == 0,
     });
 
@@ -1006,12 +1008,7 @@ pub struct OuterSurvey {
 /// spherical angles about `2 a_1`.
 pub fn outer_boundary_survey(p: &Params, n: usize) -> OuterSurvey {
     let a = base_nodes(p);
-    let mut s = OuterSurvey {
-        points: 0,
-        static_with_eq5: 0,
-        static_if_zero_force: 0,
-        slack_pair_counts: [0; 3],
-    };
+    let mut s = OuterSurvey { points: 0, static_with_eq5: 0, static_if_zero_force: 0, slack_pair_counts: [0; 3] };
     for i in 0..n {
         let polar = FRAC_PI_2 * (i as f64 + 0.5) / n as f64; // from +Z
         for k in 0..4 * n {
@@ -1267,7 +1264,11 @@ mod tests {
         }
         let c = Vector3::new(0.0, 0.0, 3.0);
         // -3 sqrt3/4 * 27 * 64 / (31/3)^3
-        assert_relative_eq!(det_wt(&P, &c), -3.0 * SQRT_3 / 4.0 * 27.0 * 64.0 / (31.0f64 / 3.0).powi(3), max_relative = 1e-10);
+        assert_relative_eq!(
+            det_wt(&P, &c),
+            -3.0 * SQRT_3 / 4.0 * 27.0 * 64.0 / (31.0f64 / 3.0).powi(3),
+            max_relative = 1e-10
+        );
         assert!(det_wt(&P, &Vector3::new(0.3, 0.1, 0.0)).abs() < 1e-12);
     }
 
@@ -1413,7 +1414,20 @@ mod tests {
     fn findings_report_expected_verdicts() {
         let fs = findings(&P);
         let get = |eq: &str| fs.iter().find(|f| f.equation == eq).unwrap_or_else(|| panic!("missing {eq}"));
-        for eq in ["Eq. 1-2", "Eq. 6-10, 15", "Eq. 12-14", "Eq. 16-18", "Eq. 3", "Eq. 4-5", "Eq. 20-21", "Eq. 24, 26-28", "Eq. 25", "Eq. 29-31", "Sec. 4.2, 5 (kappa)", "Sec. 2 / Eq. 6"] {
+        for eq in [
+            "Eq. 1-2",
+            "Eq. 6-10, 15",
+            "Eq. 12-14",
+            "Eq. 16-18",
+            "Eq. 3",
+            "Eq. 4-5",
+            "Eq. 20-21",
+            "Eq. 24, 26-28",
+            "Eq. 25",
+            "Eq. 29-31",
+            "Sec. 4.2, 5 (kappa)",
+            "Sec. 2 / Eq. 6",
+        ] {
             assert!(get(eq).holds, "{eq}: {}", get(eq).measured);
         }
         for eq in ["Eq. 11", "Sec. 4.2 (spring at l_i = lo)", "Sec. 4.2 (outer boundary)"] {

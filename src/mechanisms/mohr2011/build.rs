@@ -14,11 +14,11 @@
 //!
 //! Cables: six, tension only, between the base and the end-effector, driven in pairs (Eq. 6).
 
-use crate::structure::{
-    Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Strut, Structure,
-    TorsionSpring, Vec3,
-};
 use super::analytic::SpringChain;
+use crate::structure::{
+    Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, ExternalLoad, Inertia, Joint, JointKind, Structure, Strut, TorsionSpring,
+    Vec3,
+};
 use nalgebra::Vector3;
 
 /// Model choices that the paper does not give (defaults in `Mohr2011::params`).
@@ -34,8 +34,10 @@ pub struct ModelChoices {
     pub cable_stiffness_n_per_m: Option<f64>,
     /// Strut (link) radius for drawing and interference [m].
     pub strut_radius_m: f64,
-    /// Gravity along -z [m/s^2] (0: the paper's assumption).
-    pub gravity_m_per_s2: f64,
+    /// Gravity along the paper's Z axis [m/s^2], carried by the end-effector (a payload): 0 is
+    /// the paper's assumption; negative pulls it towards the base (base below), positive away
+    /// from it (the mechanism hanging below its base, Section 5).
+    pub gravity_z_m_per_s2: f64,
 }
 
 /// What the analytic model supplies: the geometry at the start configuration.
@@ -58,7 +60,7 @@ fn arr(v: Vector3<f64>) -> Vec3 {
 }
 
 pub fn build(g: &Geometry, m: &ModelChoices) -> Structure {
-    let mut s = Structure { name: "mohr2011".into(), gravity: [0.0, 0.0, -m.gravity_m_per_s2], ..Default::default() };
+    let mut s = Structure { name: "mohr2011".into(), gravity: [0.0; 3], ..Default::default() };
     let base = s.add_body("base", BodyKind::Fixed, None);
     let a = g.legs.map(|c| c.a);
     let b = g.legs.map(|c| c.b);
@@ -70,8 +72,17 @@ pub fn build(g: &Geometry, m: &ModelChoices) -> Structure {
     let platform = s.add_body(
         "end_effector",
         BodyKind::Free,
-        Some(Inertia { mass_kg: m.platform_mass_kg, com: arr(centroid), principal_kg_m2: [ml2 / 6.0, ml2 / 6.0, ml2 / 3.0] }),
+        Some(Inertia {
+            mass_kg: m.platform_mass_kg,
+            com: arr(centroid),
+            principal_kg_m2: [ml2 / 6.0, ml2 / 6.0, ml2 / 3.0],
+        }),
     );
+    if m.gravity_z_m_per_s2 != 0.0 {
+        // The end-effector's weight only: the links are taken as massless for the load, as in
+        // the analytic statics (their inertia only shapes the motion).
+        s.loads.push(ExternalLoad { body: platform, force_n: [0.0, 0.0, m.platform_mass_kg * m.gravity_z_m_per_s2] });
+    }
     let a_nodes: Vec<usize> = (0..3).map(|i| s.add_node(&format!("A{}", i + 1), base, arr(a[i]))).collect();
     let b_nodes: Vec<usize> = (0..3).map(|i| s.add_node(&format!("B{}", i + 1), platform, arr(b[i]))).collect();
     let r = m.strut_radius_m;
@@ -145,7 +156,13 @@ pub fn build(g: &Geometry, m: &ModelChoices) -> Structure {
             None => CableLaw::Inextensible,
             Some(k) => CableLaw::Elastic { stiffness_n_per_m: k },
         };
-        s.cables.push(Cable { name: name.clone(), a: a_nodes[*ai], b: b_nodes[*bi], law, length_m: g.cable_lengths[c] });
+        s.cables.push(Cable {
+            name: name.clone(),
+            a: a_nodes[*ai],
+            b: b_nodes[*bi],
+            law,
+            length_m: g.cable_lengths[c],
+        });
         s.actuators.push(Actuator { symbol: symbol.clone(), target: ActuatorTarget::CableLength(c) });
     }
     s

@@ -3,7 +3,10 @@
 pub mod analytic;
 pub mod build;
 
-use super::{Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec, Solution, Values};
+use super::{
+    Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec, Solution,
+    Values,
+};
 use crate::sim::Snapshot;
 use crate::structure::Structure;
 use analytic::Params;
@@ -23,7 +26,7 @@ const PARAMS: &[ParamSpec] = &[
     ParamSpec { symbol: "m_link", unit: "kg", default: 0.1, description: "mass of each link of a virtual spring (not in the paper)", origin: Origin::ModelChoice },
     ParamSpec { symbol: "c_joint", unit: "N m s/rad", default: 2.0, description: "viscous damping of the leg joints (not in the paper: zero at rest, it only speeds settling)", origin: Origin::ModelChoice },
     ParamSpec { symbol: "k_cable", unit: "N/m", default: 0.0, description: "cable stiffness; 0 = inextensible, the paper's assumption (Section 3)", origin: Origin::ModelChoice },
-    ParamSpec { symbol: "g", unit: "m/s^2", default: 0.0, description: "gravity along -Z; 0 = the paper's assumption (Section 4); the end-effector mass carries it", origin: Origin::ModelChoice },
+    ParamSpec { symbol: "g_z", unit: "m/s^2", default: 0.0, description: "gravity along the paper's Z on the end-effector mass: 0 = the paper's assumption (Section 4); -9.81 base below; +9.81 hanging below the base (Section 5)", origin: Origin::ModelChoice },
     ParamSpec { symbol: "r_strut", unit: "m", default: 0.02, description: "link radius for drawing and interference (not in the paper)", origin: Origin::ModelChoice },
 ];
 
@@ -34,19 +37,84 @@ const INPUTS: &[InputSpec] = &[
 ];
 
 const QUANTITIES: &[QuantitySpec] = &[
-    QuantitySpec { symbol: "x", unit: "m", kind: QuantityKind::Length, description: "end-effector centroid x (Eq. 12)" },
-    QuantitySpec { symbol: "y", unit: "m", kind: QuantityKind::Length, description: "end-effector centroid y (Eq. 13)" },
-    QuantitySpec { symbol: "z", unit: "m", kind: QuantityKind::Length, description: "end-effector centroid z > 0 (Eq. 14)" },
-    QuantitySpec { symbol: "rotation", unit: "rad", kind: QuantityKind::Angle, description: "rotation angle of the end-effector from the base's orientation (0: pure translation, Section 2)" },
-    QuantitySpec { symbol: "l1", unit: "m", kind: QuantityKind::Length, description: "effective length of virtual spring 1, |A1B1| (Eq. 16)" },
-    QuantitySpec { symbol: "l2", unit: "m", kind: QuantityKind::Length, description: "effective length of virtual spring 2, |A2B2| (Eq. 16)" },
-    QuantitySpec { symbol: "l3", unit: "m", kind: QuantityKind::Length, description: "effective length of virtual spring 3, |A3B3| (Eq. 16)" },
-    QuantitySpec { symbol: "t1", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A2B3 (Eq. 26)" },
-    QuantitySpec { symbol: "t2", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A1B3 (Eq. 27)" },
-    QuantitySpec { symbol: "t3", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A1B2 (Eq. 28)" },
-    QuantitySpec { symbol: "t4", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A3B2 (Eq. 26)" },
-    QuantitySpec { symbol: "t5", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A3B1 (Eq. 27)" },
-    QuantitySpec { symbol: "t6", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable A2B1 (Eq. 28)" },
+    QuantitySpec {
+        symbol: "x",
+        unit: "m",
+        kind: QuantityKind::Length,
+        description: "end-effector centroid x (Eq. 12)",
+    },
+    QuantitySpec {
+        symbol: "y",
+        unit: "m",
+        kind: QuantityKind::Length,
+        description: "end-effector centroid y (Eq. 13)",
+    },
+    QuantitySpec {
+        symbol: "z",
+        unit: "m",
+        kind: QuantityKind::Length,
+        description: "end-effector centroid z > 0 (Eq. 14)",
+    },
+    QuantitySpec {
+        symbol: "rotation",
+        unit: "rad",
+        kind: QuantityKind::Angle,
+        description: "rotation angle of the end-effector from the base's orientation (0: pure translation, Section 2)",
+    },
+    QuantitySpec {
+        symbol: "l1",
+        unit: "m",
+        kind: QuantityKind::Length,
+        description: "effective length of virtual spring 1, |A1B1| (Eq. 16)",
+    },
+    QuantitySpec {
+        symbol: "l2",
+        unit: "m",
+        kind: QuantityKind::Length,
+        description: "effective length of virtual spring 2, |A2B2| (Eq. 16)",
+    },
+    QuantitySpec {
+        symbol: "l3",
+        unit: "m",
+        kind: QuantityKind::Length,
+        description: "effective length of virtual spring 3, |A3B3| (Eq. 16)",
+    },
+    QuantitySpec {
+        symbol: "t1",
+        unit: "N",
+        kind: QuantityKind::Magnitude,
+        description: "tension of cable A2B3 (Eq. 26)",
+    },
+    QuantitySpec {
+        symbol: "t2",
+        unit: "N",
+        kind: QuantityKind::Magnitude,
+        description: "tension of cable A1B3 (Eq. 27)",
+    },
+    QuantitySpec {
+        symbol: "t3",
+        unit: "N",
+        kind: QuantityKind::Magnitude,
+        description: "tension of cable A1B2 (Eq. 28)",
+    },
+    QuantitySpec {
+        symbol: "t4",
+        unit: "N",
+        kind: QuantityKind::Magnitude,
+        description: "tension of cable A3B2 (Eq. 26)",
+    },
+    QuantitySpec {
+        symbol: "t5",
+        unit: "N",
+        kind: QuantityKind::Magnitude,
+        description: "tension of cable A3B1 (Eq. 27)",
+    },
+    QuantitySpec {
+        symbol: "t6",
+        unit: "N",
+        kind: QuantityKind::Magnitude,
+        description: "tension of cable A2B1 (Eq. 28)",
+    },
 ];
 
 const QUERIES: &[QuerySpec] = &[
@@ -77,7 +145,7 @@ fn model_of(v: &Values) -> build::ModelChoices {
         joint_damping: v["c_joint"],
         cable_stiffness_n_per_m: (v["k_cable"] > 0.0).then_some(v["k_cable"]),
         strut_radius_m: v["r_strut"],
-        gravity_m_per_s2: v["g"],
+        gravity_z_m_per_s2: v["g_z"],
     }
 }
 
@@ -89,16 +157,35 @@ fn rho_of(inputs: &Values) -> Result<[f64; 3], String> {
     Ok([input(inputs, "rho1")?, input(inputs, "rho2")?, input(inputs, "rho3")?])
 }
 
-/// Analytic values at centroid `p`: position, spring lengths, tensions (closed form).
-fn values_at(pa: &Params, p: Vector3<f64>) -> Values {
+/// Cable tensions [N] at centroid `p` with an external force `load` [N] on the end-effector's
+/// centroid, from the full wrench balance (Eq. 19 with the load added: W_f f + W_t t + w = 0).
+pub fn tensions_with_load(pa: &Params, p: &Vector3<f64>, load: Vector3<f64>) -> [f64; 6] {
+    let f = analytic::spring_forces(pa, p);
+    let w = analytic::wf(pa, p) * nalgebra::Vector3::from(f) + nalgebra::Vector6::new(load.x, load.y, load.z, 0.0, 0.0, 0.0);
+    match analytic::wt(pa, p).lu().solve(&(-w)) {
+        Some(t) => [t[0], t[1], t[2], t[3], t[4], t[5]],
+        None => [f64::NAN; 6],
+    }
+}
+
+/// The end-effector's weight [N] along the paper's Z (zero in the paper's model).
+fn payload(params: &Values) -> Vector3<f64> {
+    Vector3::new(0.0, 0.0, params["m_platform"] * params["g_z"])
+}
+
+/// Analytic values at centroid `p`: position, spring lengths, tensions (closed form of
+/// Eq. 26-28 without load; the full wrench balance with the payload's weight when g_z != 0).
+fn values_at(params: &Values, p: Vector3<f64>) -> Values {
+    let pa = &params_of(params);
     let st = analytic::statics(pa, &p);
+    let tensions = if params["g_z"] == 0.0 { st.tensions_closed_form } else { tensions_with_load(pa, &p, payload(params)) };
     let mut v = Values::from([("x".into(), p.x), ("y".into(), p.y), ("z".into(), p.z), ("rotation".into(), 0.0)]);
     for i in 0..3 {
         v.insert(format!("l{}", i + 1), st.spring_lengths[i]);
         v.insert(format!("f{}", i + 1), st.spring_forces[i]);
     }
     for j in 0..6 {
-        v.insert(format!("t{}", j + 1), st.tensions_closed_form[j]);
+        v.insert(format!("t{}", j + 1), tensions[j]);
     }
     v
 }
@@ -132,7 +219,10 @@ impl Mechanism for Mohr2011 {
         let get = |k: &str| given.get(k).copied().ok_or((k.to_string(), format!("missing input '{k}'")));
         let p = Vector3::new(get("x")?, get("y")?, get("z")?);
         if !(p.z > 0.0 && p.iter().all(|c| c.is_finite())) {
-            return Err(("z".into(), format!("the end-effector must be above the base: z > 0 m (Section 4.1), got {}", p.z)));
+            return Err((
+                "z".into(),
+                format!("the end-effector must be above the base: z > 0 m (Section 4.1), got {}", p.z),
+            ));
         }
         let rho = analytic::ikp(&params_of(params), &p);
         Ok(Values::from([("rho1".into(), rho[0]), ("rho2".into(), rho[1]), ("rho3".into(), rho[2])]))
@@ -145,11 +235,14 @@ impl Mechanism for Mohr2011 {
                 return Err((sym.into(), format!("{sym} must be a finite number > 0 {what}, got {x}")));
             }
         }
-        for (sym, what) in [("c_joint", "N m s/rad"), ("k_cable", "N/m"), ("g", "m/s^2"), ("r_strut", "m")] {
+        for (sym, what) in [("c_joint", "N m s/rad"), ("k_cable", "N/m"), ("r_strut", "m")] {
             let x = v[sym];
             if !(x >= 0.0 && x.is_finite()) {
                 return Err((sym.into(), format!("{sym} must be a finite number >= 0 {what}, got {x}")));
             }
+        }
+        if !v["g_z"].is_finite() {
+            return Err(("g_z".into(), format!("g_z must be a finite number (m/s^2), got {}", v["g_z"])));
         }
         params_of(v).validate().map_err(|m| ("lo".to_string(), m))
     }
@@ -165,7 +258,10 @@ impl Mechanism for Mohr2011 {
             rho[i] = x;
         }
         let p = analytic::dkp(&pa, &rho).ok_or_else(|| {
-            ("rho1".to_string(), format!("cable lengths {rho:?} m are unreachable: Eq. 14 has no real z > 0 (the radicand is negative)"))
+            (
+                "rho1".to_string(),
+                format!("cable lengths {rho:?} m are unreachable: Eq. 14 has no real z > 0 (the radicand is negative)"),
+            )
         })?;
         // Kinematic workspace (Eq. 17-18): every virtual spring strictly between 0 and l_o.
         let st = analytic::statics(&pa, &p);
@@ -182,7 +278,9 @@ impl Mechanism for Mohr2011 {
 
     fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String> {
         let pa = params_of(params);
-        let centroid = || -> Result<Vector3<f64>, String> { Ok(Vector3::new(input(inputs, "x")?, input(inputs, "y")?, input(inputs, "z")?)) };
+        let centroid = || -> Result<Vector3<f64>, String> {
+            Ok(Vector3::new(input(inputs, "x")?, input(inputs, "y")?, input(inputs, "z")?))
+        };
         match query {
             "ikp" => {
                 let p = centroid()?;
@@ -195,7 +293,8 @@ impl Mechanism for Mohr2011 {
             }
             "dkp" => {
                 let rho = rho_of(inputs)?;
-                let p = analytic::dkp(&pa, &rho).ok_or_else(|| format!("cable lengths {rho:?} m are unreachable: Eq. 14 has no real z"))?;
+                let p = analytic::dkp(&pa, &rho)
+                    .ok_or_else(|| format!("cable lengths {rho:?} m are unreachable: Eq. 14 has no real z"))?;
                 let st = analytic::statics(&pa, &p);
                 Ok(vec![
                     Solution {
@@ -213,7 +312,7 @@ impl Mechanism for Mohr2011 {
             "statics" => {
                 let p = centroid()?;
                 let st = analytic::statics(&pa, &p);
-                let mut v = values_at(&pa, p);
+                let mut v = values_at(params, p);
                 for j in 0..6 {
                     v.insert(format!("t{}_full", j + 1), st.tensions_full[j]);
                 }
@@ -221,7 +320,11 @@ impl Mechanism for Mohr2011 {
                 v.insert("det_Wt_eq25".into(), analytic::det_wt_eq25(&pa, &p));
                 v.insert("in_kinematic_workspace".into(), f64::from(u8::from(st.in_kinematic_workspace)));
                 v.insert("in_static_workspace".into(), f64::from(u8::from(st.in_static_workspace)));
-                Ok(vec![Solution { label: "statics at the centroid".into(), values: v, stable: Some(st.in_static_workspace) }])
+                Ok(vec![Solution {
+                    label: "statics at the centroid".into(),
+                    values: v,
+                    stable: Some(st.in_static_workspace),
+                }])
             }
             other => Err(format!("unknown query '{other}' for mohr2011 (expected one of: ikp, dkp, statics)")),
         }
@@ -234,17 +337,20 @@ impl Mechanism for Mohr2011 {
         let drop = start.get("drop").copied().unwrap_or(DEFAULT_START_DROP_FRACTION);
         let p0 = Vector3::new(p.x, p.y, p.z * (1.0 - drop));
         let leg = |i: usize| {
-            analytic::spring_chain(&pa, &p0, i)
-                .ok_or_else(|| format!("virtual spring {} cannot be assembled at the start ({:?})", i + 1, p0.as_slice()))
+            analytic::spring_chain(&pa, &p0, i).ok_or_else(|| {
+                format!("virtual spring {} cannot be assembled at the start ({:?})", i + 1, p0.as_slice())
+            })
         };
         let g = build::Geometry {
             lo: pa.lo,
             kappa: pa.kappa,
             legs: [leg(0)?, leg(1)?, leg(2)?],
-            cables: (0..6).map(|j| {
-                let c = analytic::CABLES[j];
-                (cable_name(j), c.base, c.platform, cable_symbol(j))
-            }).collect(),
+            cables: (0..6)
+                .map(|j| {
+                    let c = analytic::CABLES[j];
+                    (cable_name(j), c.base, c.platform, cable_symbol(j))
+                })
+                .collect(),
             cable_lengths: (0..6).map(|j| inputs[&cable_symbol(j)]).collect(),
         };
         Ok(build::build(&g, &model_of(params)))
@@ -258,9 +364,8 @@ impl Mechanism for Mohr2011 {
         let pa = params_of(params);
         let rho = rho_of(inputs)?;
         let p = analytic::dkp(&pa, &rho).ok_or_else(|| format!("cable lengths {rho:?} m are unreachable"))?;
-        let expected = values_at(&pa, p);
-        let st = analytic::statics(&pa, &p);
-        let slack = (0..6).filter(|j| st.slack[*j]).map(cable_name).collect();
+        let expected = values_at(params, p);
+        let slack = (0..6).filter(|j| expected[&format!("t{}", j + 1)] < 0.0).map(cable_name).collect();
         Ok(Prediction {
             branches: vec![Solution { label: "z > 0 (Eq. 12-14)".into(), values: expected.clone(), stable: None }],
             expected,
@@ -298,9 +403,58 @@ impl Mechanism for Mohr2011 {
     }
 
     fn findings(&self, params: &Values) -> Vec<Finding> {
-        analytic::findings(&params_of(params))
+        let mut out: Vec<Finding> = analytic::findings(&params_of(params))
             .into_iter()
             .map(|f| Finding { equation: f.equation.to_string(), claim: f.claim, measured: f.measured, holds: f.holds })
-            .collect()
+            .collect();
+        out.push(gravity_finding(params));
+        out
+    }
+}
+
+/// Grid step of the static-workspace volume count [fraction of l_b].
+const VOLUME_GRID_STEP_LB: f64 = 0.125;
+
+/// Points of a grid (step `VOLUME_GRID_STEP_LB` l_b over the kinematic workspace's bounding
+/// box, z > 0) in the static workspace with the end-effector's weight along Z = `g_z`.
+pub fn static_workspace_count(params: &Values, g_z: f64) -> usize {
+    let pa = params_of(params);
+    let h = VOLUME_GRID_STEP_LB * pa.lb;
+    let reach = pa.lo + pa.lb; // every spring sphere lies within this of the origin
+    let n = (reach / h).ceil() as i64;
+    let load = Vector3::new(0.0, 0.0, params["m_platform"] * g_z);
+    let a2 = analytic::base_nodes(&pa).map(|a| 2.0 * a);
+    let mut count = 0;
+    for i in -n..=n {
+        for j in -n..=n {
+            for k in 1..=n {
+                let p = Vector3::new(i as f64 * h, j as f64 * h, k as f64 * h);
+                // Kinematic workspace (Eq. 17-18): every spring strictly shorter than l_o.
+                if a2.iter().any(|c| (p - c).norm() >= pa.lo) {
+                    continue;
+                }
+                if tensions_with_load(&pa, &p, load).iter().all(|t| *t > 0.0) {
+                    count += 1;
+                }
+            }
+        }
+    }
+    count
+}
+
+/// Section 5: gravity on a mechanism hanging below its base should enlarge the workspace.
+fn gravity_finding(params: &Values) -> Finding {
+    const G: f64 = 9.81;
+    let none = static_workspace_count(params, 0.0);
+    let hanging = static_workspace_count(params, G);
+    let upright = static_workspace_count(params, -G);
+    Finding {
+        equation: "Sec. 5 (gravity)".into(),
+        claim: "with gravity, a mechanism hanging below its base gains cable tension and a larger workspace".into(),
+        measured: format!(
+            "static-workspace grid points (step {VOLUME_GRID_STEP_LB} l_b, m = {} kg, kappa = {} N m/rad): {none} without gravity, {hanging} hanging (g along +Z), {upright} upright (g along -Z); the weight raises some tensions but unbalances the pairs (t_j != t_j+3), and the workspace then depends on m g / kappa, no longer independent of the stiffness",
+            params["m_platform"], params["kappa"]
+        ),
+        holds: hanging > none,
     }
 }

@@ -1,0 +1,100 @@
+//! The mohr2011 issue's bars: settled centroid, pure translation, taut cables and tensions
+//! against Eq. 12-14 and 26-28; exactly the predicted cables slack outside the static
+//! workspace; a trajectory across its boundary; the workspace classified by the dynamics.
+
+use std::path::Path;
+use tensegrity_testbed::report::ScenarioReport;
+use tensegrity_testbed::run::{run, RunOptions};
+use tensegrity_testbed::scenario;
+
+fn run_file(path: &str) -> ScenarioReport {
+    let sc = scenario::load(Path::new(path)).expect("scenario is valid");
+    run(&sc, &RunOptions::default())
+}
+
+/// A variant of a scenario file with its actuation replaced (same model and settings).
+fn run_variant(path: &str, actuation: &str) -> ScenarioReport {
+    let src = std::fs::read_to_string(path).expect("scenario file");
+    let head = &src[..src.find("[actuation]").expect("has [actuation]")];
+    let tail = &src[src.find("[[checks]]").expect("has checks")..];
+    let text = format!("{head}[actuation]\n{actuation}\n\n{tail}");
+    let sc = scenario::parse(Path::new(path), &text).expect("variant is valid");
+    run(&sc, &RunOptions::default())
+}
+
+/// Inside the static workspace (24 points, l_b = 2, l_o = 3 l_b): the centroid within 1e-9 l_b
+/// of Eq. 12-14, rotation below 1e-9 rad, every cable taut, tensions within 1e-7 of Eq. 26-28.
+#[test]
+fn static_workspace_points_match_eq12_14_and_eq26_28() {
+    let r = run_file("scenarios/mohr2011/static_workspace.toml");
+    assert!(r.passed, "{:?}", r.error);
+    assert!(r.points.len() >= 20, "{} points", r.points.len());
+    let lb = r.params["lb"];
+    for p in &r.points {
+        assert!(p.settled, "point {} did not settle", p.index);
+        assert!(p.slack_cables.is_empty(), "point {}: slack {:?}", p.index, p.slack_cables);
+        for q in ["x", "y", "z"] {
+            let e = (p.simulated[q] - p.analytic[q]).abs() / lb;
+            assert!(e <= 1e-9, "point {} {q}: {e:e} l_b", p.index);
+        }
+        assert!(p.simulated["rotation"].abs() <= 1e-9, "point {}: rotation {:e}", p.index, p.simulated["rotation"]);
+        for j in 1..=6 {
+            let t = format!("t{j}");
+            let e = ((p.simulated[&t] - p.analytic[&t]) / p.analytic[&t]).abs();
+            assert!(p.analytic[&t] > 0.0 && e <= 1e-7, "point {} {t}: {e:e}", p.index);
+        }
+    }
+}
+
+/// Outside the static workspace the cable pair that Eq. 26-28 makes negative goes slack, and
+/// only that pair; the end-effector settles elsewhere, at a reported distance.
+#[test]
+fn outside_the_static_workspace_exactly_the_predicted_pair_goes_slack() {
+    let r = run_variant(
+        "scenarios/mohr2011/outside_static.toml",
+        "continuation = false\npoints = [ { x = 0.0, y = 1.0, z = 0.5 }, { x = 2.0, y = 0.0, z = 1.5 } ]",
+    );
+    assert!(r.passed, "{:?}", r.error);
+    let expected: [&[&str]; 2] = [&["A1B2", "A2B1"], &["A1B3", "A3B1"]];
+    for (p, want) in r.points.iter().zip(expected) {
+        assert!(p.settled, "point {} did not settle", p.index);
+        let mut got = p.slack_cables.clone();
+        got.sort();
+        assert_eq!(got, want, "point {}", p.index);
+        assert_eq!(p.slack_agrees, Some(true));
+        let d = p.distance_from_analytic_m.expect("distance reported");
+        assert!(d > 0.1, "point {}: settled {d} m from the analytic point", p.index);
+    }
+    // Nothing to compare the checks with: they are not applicable, and say so.
+    assert!(r.checks.iter().all(|c| c.points_compared == 0 && c.passed));
+}
+
+/// Along a path that leaves the static workspace and comes back, the report gives the error
+/// at every tick and the ticks where cables were slack; it settles back within 1e-9.
+#[test]
+fn trajectory_across_the_boundary_reports_slack_ticks_and_resettles() {
+    let r = run_file("scenarios/mohr2011/trajectory.toml");
+    assert!(r.passed, "{:?}", r.error);
+    let x = r.checks.iter().find(|c| c.quantity == "x").expect("x checked");
+    assert!(x.ticks_compared >= 1200, "{} ticks compared", x.ticks_compared);
+    assert!(x.max_rel_error <= 1e-9);
+    // Pair rho1 (A2B3, A3B2) loses tension on the way out (t = 4 s is tick 400).
+    let late_slack =
+        r.slack_intervals.iter().filter(|i| i.cable == "A2B3" && i.last_tick >= 300 && i.first_tick <= 500).count();
+    assert!(late_slack >= 1, "{:?}", r.slack_intervals);
+}
+
+/// A small workspace slice classified by the dynamics agrees with Eq. 29-31 at every point
+/// away from the outer boundary.
+#[test]
+fn workspace_slice_by_dynamics_agrees_with_eq29_31() {
+    let r = run_variant(
+        "scenarios/mohr2011/workspace_grid_small.toml",
+        "skip_outside = true\ncontinuation = false\ngrid = { x = { from = -2.0, to = 2.0, count = 3 }, y = { from = -2.0, to = 2.0, count = 3 }, z = { from = 1.5, to = 1.5, count = 1 } }",
+    );
+    let w = r.workspace.as_ref().expect("workspace classification");
+    assert_eq!(w.points, 9);
+    assert!(w.analytic_inside > 0 && w.analytic_inside < 9, "{w:?}");
+    assert_eq!(w.agreement_percent, 100.0, "{w:?}");
+    assert!(r.passed);
+}
