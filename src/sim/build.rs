@@ -16,50 +16,22 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         return Err(SimError::Build("substeps and PGS iterations must be at least 1".into()));
     }
     let n = s.bodies.len();
-    // Driven bodies: children of actuated joints.
-    let mut driven = vec![false; n];
-    let mut driving_joint = vec![None; n];
+    // Actuated joints: position-controlled, each a kinematic degree of freedom of a multibody.
+    let mut actuated = vec![false; s.joints.len()];
     for a in &s.actuators {
         if let ActuatorTarget::Joint(j) = a.target {
-            let joint = &s.joints[j];
-            if driven[joint.child] {
-                return Err(SimError::Build(format!(
-                    "body '{}' is driven by two actuated joints",
-                    s.bodies[joint.child].name
-                )));
+            if actuated[j] {
+                return Err(SimError::Build(format!("joint '{}' is driven by two actuators", s.joints[j].name)));
             }
-            driven[joint.child] = true;
-            driving_joint[joint.child] = Some(j);
-        }
-    }
-    // Every driven body must hang from the ground through driven bodies only.
-    for b in 0..n {
-        let mut cur = b;
-        let mut hops = 0;
-        while driven[cur] {
-            let j = driving_joint[cur].expect("driven implies a driving joint");
-            cur = s.joints[j].parent;
-            hops += 1;
-            if hops > n {
-                return Err(SimError::Build("actuated joints form a loop".into()));
-            }
-        }
-        if driven[b] && s.bodies[cur].kind != BodyKind::Fixed {
-            return Err(SimError::Build(format!(
-                "actuated joint '{}' must hang from a fixed or driven body, not from free body '{}'",
-                s.joints[driving_joint[b].unwrap()].name,
-                s.bodies[cur].name
-            )));
+            actuated[j] = true;
         }
     }
 
     let mut bodies = RigidBodySet::new();
     let mut handles = Vec::with_capacity(n);
-    for (i, b) in s.bodies.iter().enumerate() {
+    for b in &s.bodies {
         let builder = if b.kind == BodyKind::Fixed {
             RigidBodyBuilder::fixed()
-        } else if driven[i] {
-            RigidBodyBuilder::kinematic_position_based()
         } else {
             let inertia = b.inertia.expect("validated: free bodies have inertia");
             RigidBodyBuilder::dynamic()
@@ -92,12 +64,15 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         }
     }
     for (j, joint) in s.joints.iter().enumerate() {
-        if driving_joint.contains(&Some(j)) {
-            continue; // ideal actuator: the child is placed kinematically
-        }
         let (mut h1, h2) = (handles[joint.parent], handles[joint.child]);
-        let child_is_free = s.bodies[joint.child].kind == BodyKind::Free && !driven[joint.child] && !roped[joint.child];
+        let child_is_free = s.bodies[joint.child].kind == BodyKind::Free && !roped[joint.child];
         let can_link = child_is_free && multibody_link_possible(&multibody_joints, h1, h2);
+        if actuated[j] && !can_link {
+            return Err(SimError::Build(format!(
+                "actuated joint '{}' must be part of a tree of joints from a fixed body: it closes a loop, or its child is held by an inextensible cable",
+                joint.name
+            )));
+        }
         if !can_link {
             joint_impulse[j] = Some(impulse_joints.insert(h1, h2, generic_joint(s, joint), true));
             continue;
@@ -139,6 +114,10 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
                 set_link_damping(&mut multibody_joints, h_first, joint.damping);
                 hidden_links.push(LinkRef { multibody_joint: h_first });
                 multibody_joints.insert(hidden, h2, second, true).expect("checked: no loop")
+            }
+            // An ideal position actuator: a kinematic degree of freedom, set by the command.
+            _ if actuated[j] => {
+                multibody_joints.insert_kinematic(h1, h2, generic_joint(s, joint), true).expect("checked: no loop")
             }
             _ => multibody_joints.insert(h1, h2, generic_joint(s, joint), true).expect("checked: no loop"),
         };
@@ -190,8 +169,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         soft_bodies: SoftBodySet::new(),
         ccd: CCDSolver::new(),
         handles,
-        driven,
-        driving_joint,
+        actuated,
         joint_links,
         hidden_links,
         joint_impulse,

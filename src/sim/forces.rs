@@ -173,7 +173,7 @@ impl Simulation {
         // Tree of joints (multibody links and actuator drives): parent of each body.
         let mut parent_joint: Vec<Option<usize>> = vec![None; nb];
         for (j, joint) in s.joints.iter().enumerate() {
-            if self.joint_links[j].is_some() || self.driving_joint[joint.child] == Some(j) {
+            if self.joint_links[j].is_some() {
                 parent_joint[joint.child] = Some(j);
             }
         }
@@ -312,7 +312,8 @@ impl Simulation {
         let torque = |value: f64| CoordinateForce { value, is_torque: true };
         let mut out = Vec::new();
         for (j, joint) in s.joints.iter().enumerate() {
-            if self.joint_links[j].is_none() {
+            // Only the free coordinates: an actuated joint's coordinate is set, not balanced.
+            if self.joint_links[j].is_none() || self.actuated[j] {
                 continue;
             }
             let w = tree.subtree_wrench(s, wrench, joint.child);

@@ -6,9 +6,9 @@
 //! - Free bodies hung from the ground or from an actuator by a tree of joints are rapier
 //!   *multibody* links (reduced coordinates): the joint constraints hold exactly, with no
 //!   solver offset. A joint that would close a loop becomes an impulse joint.
-//! - Position-controlled joint actuators are ideal: the bodies they move are kinematic and are
-//!   placed exactly at the commanded coordinate before every step. Their force is read from
-//!   the balance of everything they carry.
+//! - Position-controlled joint actuators are ideal: each is a kinematic degree of freedom of a
+//!   multibody, set exactly to the commanded coordinate; the bodies beyond it stay dynamic.
+//!   Their force is read from the balance of everything they carry.
 //! - Springs and elastic cables are explicit forces computed from the current geometry, so
 //!   their force law is exact at rest: F = k (l - l0), tension-only for cables.
 //! - Inextensible cables are rapier rope joints; their tension is read from the limit impulse.
@@ -19,7 +19,7 @@ mod build;
 mod forces;
 pub mod settle;
 
-use crate::structure::{ActuatorTarget, BodyKind, JointKind, Structure};
+use crate::structure::{ActuatorTarget, BodyKind, Structure};
 use rapier3d_f64::prelude::*;
 
 pub use build::structure_size;
@@ -78,10 +78,9 @@ pub struct Simulation {
     ccd: CCDSolver,
     /// rapier handle of each structure body.
     handles: Vec<RigidBodyHandle>,
-    /// Body moved by a position-controlled actuator (kinematic in rapier).
-    driven: Vec<bool>,
-    /// For each driven body: the joint that drives it.
-    driving_joint: Vec<Option<usize>>,
+    /// For each joint: whether an actuator sets its coordinate (a kinematic multibody degree
+    /// of freedom).
+    actuated: Vec<bool>,
     /// For each joint: the multibody link it made, if any.
     joint_links: Vec<Option<LinkRef>>,
     /// First halves of universal joints split into two multibody revolutes.
@@ -149,7 +148,7 @@ impl Simulation {
     }
 
     /// Sets every actuator's command (in structure order: m for lengths, rad for angles) and
-    /// moves the driven bodies there at once.
+    /// moves the actuated joints there at once.
     pub fn set_commands(&mut self, values: &[f64]) {
         assert_eq!(values.len(), self.structure.actuators.len(), "one command per actuator");
         self.commands.copy_from_slice(values);
@@ -163,7 +162,7 @@ impl Simulation {
                 }
             }
         }
-        self.place_driven_bodies();
+        self.apply_joint_commands();
     }
 
     /// Applies a constant external wrench (world frame, about the centre of mass) to a body
@@ -174,7 +173,6 @@ impl Simulation {
 
     /// Advances one time step. Fails if the state is no longer finite or leaves the box.
     pub fn step(&mut self) -> Result<(), SimError> {
-        self.place_driven_bodies();
         self.apply_member_forces();
         let gravity = Vector::new(self.structure.gravity[0], self.structure.gravity[1], self.structure.gravity[2]);
         self.pipeline.step(
@@ -234,9 +232,9 @@ impl Simulation {
         }
     }
 
-    /// Bodies that move under forces (neither fixed nor driven).
+    /// Bodies that move (not fixed).
     pub fn is_free(&self, body: usize) -> bool {
-        self.structure.bodies[body].kind == BodyKind::Free && !self.driven[body]
+        self.structure.bodies[body].kind == BodyKind::Free
     }
 
     pub fn snapshot(&self) -> Snapshot {
@@ -254,7 +252,8 @@ impl Simulation {
     /// the velocities: the perturbation used to classify an equilibrium.
     pub fn perturb_free_coordinates(&mut self, delta: f64) {
         let mut touched = Vec::new();
-        for link in self.joint_links.iter().flatten().chain(self.hidden_links.iter()) {
+        let free_links = self.joint_links.iter().zip(&self.actuated).filter(|(_, a)| !**a).filter_map(|(l, _)| l.as_ref());
+        for link in free_links.chain(self.hidden_links.iter()) {
             if let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) {
                 let assembly = mb.link(link_id).map(|l| (l.assembly_id(), l.joint().ndofs()));
                 if let Some((start, n)) = assembly {
@@ -283,52 +282,28 @@ impl Simulation {
         }
     }
 
-    /// Places every driven body at the pose its actuators command: the product of the joint
-    /// displacements from the ground up (ideal position control).
-    fn place_driven_bodies(&mut self) {
-        // Process in structure order repeatedly so parents come before children.
-        let n = self.structure.bodies.len();
-        let mut placed = vec![false; n];
-        for (b, d) in self.driven.iter().enumerate() {
-            if !d {
-                placed[b] = true;
+    /// Sets every actuated joint's coordinate to its command, with zero velocity (ideal
+    /// position control), and moves the bodies beyond it along.
+    fn apply_joint_commands(&mut self) {
+        for j in 0..self.structure.joints.len() {
+            if !self.actuated[j] {
+                continue;
             }
-        }
-        for _ in 0..n {
-            let mut progress = false;
-            for b in 0..n {
-                if placed[b] {
-                    continue;
-                }
-                let j = self.driving_joint[b].expect("a driven body has a driving joint");
-                let joint = &self.structure.joints[j];
-                if !placed[joint.parent] {
-                    continue;
-                }
-                let q = self.joint_command(j);
-                let parent_pose = *self.bodies[self.handles[joint.parent]].position();
-                let anchor = self.structure.nodes[joint.anchor].position;
-                let anchor = Vector::new(anchor[0], anchor[1], anchor[2]);
-                let rel = match &joint.kind {
-                    JointKind::Revolute { axis } => {
-                        let axis = Vector::new(axis[0], axis[1], axis[2]).normalize();
-                        let rot = Rotation::from_axis_angle(axis, q - joint.initial_coordinate);
-                        Pose::from_parts(anchor - rot * anchor, rot)
-                    }
-                    JointKind::Prismatic { axis } => {
-                        let axis = Vector::new(axis[0], axis[1], axis[2]).normalize();
-                        Pose::from_translation(axis * (q - joint.initial_coordinate))
-                    }
-                    _ => unreachable!("validated: only revolute and prismatic joints are actuated"),
-                };
-                let pose = parent_pose * rel;
-                self.bodies[self.handles[b]].set_position(pose, true);
-                placed[b] = true;
-                progress = true;
-            }
-            if !progress {
-                break;
-            }
+            let Some(link) = self.joint_links[j] else { continue };
+            let target = self.joint_command(j) - self.structure.joints[j].initial_coordinate;
+            let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) else { continue };
+            let Some((start, current)) = mb.link(link_id).map(|l| {
+                let axis = joint_free_axis(&l.joint().data);
+                (l.assembly_id(), l.joint().coords()[axis])
+            }) else {
+                continue;
+            };
+            let mut disp = vec![0.0; mb.ndofs()];
+            disp[start] = target - current;
+            mb.apply_displacements(&disp);
+            mb.generalized_velocity_mut()[start] = 0.0;
+            mb.forward_kinematics(&self.bodies, true);
+            mb.update_rigid_bodies(&mut self.bodies, true);
         }
     }
 
@@ -340,4 +315,11 @@ impl Simulation {
             .map(|i| self.commands[i])
             .unwrap_or(self.structure.joints[joint].initial_coordinate)
     }
+}
+
+/// Index (0..6: linear x, y, z, angular x, y, z) of the single free axis of a one-degree-of-
+/// freedom joint, where its coordinate lives in `MultibodyJoint::coords`.
+fn joint_free_axis(data: &GenericJoint) -> usize {
+    let locked = data.locked_axes.bits();
+    (0..6).find(|k| locked & (1 << k) == 0).unwrap_or(0)
 }
