@@ -2,6 +2,7 @@
 //! pure functions) and `build.rs` (parameters -> [`Structure`]); `mod.rs` ties them to the
 //! [`Mechanism`] trait that the rest of the testbed uses.
 
+pub mod furet2018;
 pub mod ji2014;
 pub mod mohr2011;
 
@@ -160,7 +161,7 @@ pub trait Mechanism: Send + Sync {
 
 /// All built-in mechanisms.
 pub fn registry() -> Vec<Box<dyn Mechanism>> {
-    vec![Box::new(ji2014::Ji2014), Box::new(mohr2011::Mohr2011)]
+    vec![Box::new(ji2014::Ji2014), Box::new(mohr2011::Mohr2011), Box::new(furet2018::Furet2018)]
 }
 
 pub fn find(name: &str) -> Option<Box<dyn Mechanism>> {

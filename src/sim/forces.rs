@@ -186,6 +186,8 @@ impl Simulation {
         let scale = self.length_scale_m;
         let base = self.coordinate_forces(&tree, &wrench, true);
         let closure_loads = self.closure_unit_loads();
+        // Fitted reaction of each loop-closing joint on its child: (force, moment about the anchor).
+        let mut closure_reaction = vec![(Vector::ZERO, Vector::ZERO); s.joints.len()];
         if !closure_loads.is_empty() && !base.is_empty() {
             let rows = base.len();
             let cols = closure_loads.len();
@@ -198,7 +200,7 @@ impl Simulation {
             };
             let mut g = nalgebra::DMatrix::<f64>::zeros(rows, cols);
             for (k, load) in closure_loads.iter().enumerate() {
-                let col = self.coordinate_forces(&tree, load, false);
+                let col = self.coordinate_forces(&tree, &load.loads, false);
                 for (r, c) in col.iter().enumerate() {
                     g[(r, k)] = scaled(c);
                 }
@@ -209,9 +211,11 @@ impl Simulation {
             if let Ok(lambda) = svd.solve(&(-r0), tol) {
                 for (k, load) in closure_loads.iter().enumerate() {
                     for b in 0..nb {
-                        wrench[b].0 += load[b].0 * lambda[k];
-                        wrench[b].1 += load[b].1 * lambda[k];
+                        wrench[b].0 += load.loads[b].0 * lambda[k];
+                        wrench[b].1 += load.loads[b].1 * lambda[k];
                     }
+                    closure_reaction[load.joint].0 += load.force * lambda[k];
+                    closure_reaction[load.joint].1 += load.moment * lambda[k];
                 }
             }
         }
@@ -231,6 +235,17 @@ impl Simulation {
         for a in &s.actuators {
             let f = match a.target {
                 ActuatorTarget::CableLength(c) => out.cable_tension_n[c],
+                // Locked off the tree: its torque (force) is the fitted closure reaction.
+                ActuatorTarget::Joint(j) if self.joint_impulse[j].is_some() => {
+                    let joint = &s.joints[j];
+                    let parent_rot = self.bodies[self.handles[joint.parent]].position().rotation;
+                    let (f, m) = closure_reaction[j];
+                    match &joint.kind {
+                        JointKind::Revolute { axis } => m.dot((parent_rot * v(*axis)).normalize()),
+                        JointKind::Prismatic { axis } => f.dot((parent_rot * v(*axis)).normalize()),
+                        _ => f64::NAN,
+                    }
+                }
                 ActuatorTarget::Joint(j) => {
                     let joint = &s.joints[j];
                     let w = subtree_wrench(joint.child);
@@ -261,6 +276,15 @@ pub(crate) fn relative_angle(parent: Rotation, child: Rotation, axis: Vector) ->
 /// Singular values below this fraction of the largest are treated as zero when fitting the
 /// reactions of loop-closing joints (redundant closures).
 const CLOSURE_SVD_RELATIVE_TOLERANCE: f64 = 1e-12;
+
+/// One unknown reaction component of a loop-closing joint: a unit force or moment on the child
+/// (and its opposite on the parent), as body loads.
+struct ClosureComponent {
+    joint: usize,
+    force: Vector,
+    moment: Vector,
+    loads: Vec<Wrench>,
+}
 
 /// One free coordinate's generalized force: a force [N] or a torque [N m].
 #[derive(Clone, Copy, Debug)]
@@ -344,7 +368,7 @@ impl Simulation {
                 JointKind::Spherical => {
                     out.extend([torque(m.x), torque(m.y), torque(m.z)]);
                 }
-                JointKind::Fixed => {}
+                JointKind::Fixed | JointKind::PlanarPin { .. } => {}
             }
         }
         // Free bodies with no parent joint: all six coordinates.
@@ -360,7 +384,7 @@ impl Simulation {
 
     /// For every reaction component of every loop-closing joint: the body loads of a unit
     /// reaction (child +, parent -), world frame.
-    fn closure_unit_loads(&self) -> Vec<Vec<Wrench>> {
+    fn closure_unit_loads(&self) -> Vec<ClosureComponent> {
         let s = &self.structure;
         let nb = s.bodies.len();
         let axes = [Vector::X, Vector::Y, Vector::Z];
@@ -375,6 +399,9 @@ impl Simulation {
             // Directions the joint transmits: forces, then moments.
             let (forces, moments): (Vec<Vector>, Vec<Vector>) = match &joint.kind {
                 JointKind::Spherical => (axes.to_vec(), vec![]),
+                // An actuated (locked) revolute also carries the torque about its axis.
+                JointKind::Revolute { axis } if self.actuated[j] => (axes.to_vec(), axes.to_vec()),
+                JointKind::Prismatic { .. } if self.actuated[j] => (axes.to_vec(), axes.to_vec()),
                 JointKind::Revolute { axis } => {
                     let a = (parent_rot * v(*axis)).normalize();
                     (axes.to_vec(), orthogonal_pair(a).to_vec())
@@ -389,18 +416,22 @@ impl Simulation {
                     (axes.to_vec(), vec![a1.cross(a2).normalize()])
                 }
                 JointKind::Fixed => (axes.to_vec(), axes.to_vec()),
+                JointKind::PlanarPin { axis } => {
+                    let a = (parent_rot * v(*axis)).normalize();
+                    (orthogonal_pair(a).to_vec(), vec![])
+                }
             };
             for f in forces {
                 let mut w = vec![(Vector::ZERO, Vector::ZERO); nb];
                 w[joint.child] = (f, anchor.cross(f));
                 w[joint.parent] = (-f, -anchor.cross(f));
-                out.push(w);
+                out.push(ClosureComponent { joint: j, force: f, moment: Vector::ZERO, loads: w });
             }
             for m in moments {
                 let mut w = vec![(Vector::ZERO, Vector::ZERO); nb];
                 w[joint.child] = (Vector::ZERO, m);
                 w[joint.parent] = (Vector::ZERO, -m);
-                out.push(w);
+                out.push(ClosureComponent { joint: j, force: Vector::ZERO, moment: m, loads: w });
             }
         }
         out

@@ -289,6 +289,14 @@ impl Simulation {
             if !self.actuated[j] {
                 continue;
             }
+            if let Some(h) = self.joint_impulse[j] {
+                let target = self.joint_command(j) - self.structure.joints[j].initial_coordinate;
+                let axis = build::free_axis_of(&self.structure.joints[j].kind);
+                if let Some(joint) = self.impulse_joints.get_mut(h, true) {
+                    joint.data.set_limits(axis, [target, target]);
+                }
+                continue;
+            }
             let Some(link) = self.joint_links[j] else { continue };
             let target = self.joint_command(j) - self.structure.joints[j].initial_coordinate;
             let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) else { continue };
