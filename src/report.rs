@@ -93,6 +93,11 @@ pub struct PointReport {
     pub distance_from_analytic_m: Option<f64>,
     /// Settled, and every check within its tolerance at this point.
     pub within_tolerance: bool,
+    /// Smallest strut clearance at the settled state [m] (with an `[interference]` section;
+    /// None when no pair came within the margin).
+    pub min_clearance_m: Option<f64>,
+    /// No strut pair below the interference threshold at the settled state.
+    pub interference_free: Option<bool>,
 }
 
 /// Workspace classification, analytic against dynamic, over the points of a run whose
@@ -110,6 +115,10 @@ pub struct WorkspaceAgreement {
     pub disagreements: Vec<usize>,
     /// The scenario's pass threshold, if it is a workspace sweep.
     pub min_agreement_percent: Option<f64>,
+    /// With an `[interference]` section: the points inside by the dynamics whose struts are
+    /// clear of each other, and their share of the inside points.
+    pub inside_interference_free: Option<usize>,
+    pub interference_free_percent_of_inside: Option<f64>,
 }
 
 impl WorkspaceAgreement {
@@ -123,6 +132,9 @@ impl WorkspaceAgreement {
         let disagreements: Vec<usize> =
             classified.iter().filter(|p| analytic(p) != simulated(p)).map(|p| p.index).collect();
         let n = classified.len();
+        let inside: Vec<&&PointReport> = classified.iter().filter(|p| simulated(p)).collect();
+        let free = inside.iter().filter(|p| p.interference_free == Some(true)).count();
+        let checked = inside.iter().any(|p| p.interference_free.is_some());
         Some(WorkspaceAgreement {
             points: n,
             analytic_inside: classified.iter().filter(|p| analytic(p)).count(),
@@ -131,6 +143,9 @@ impl WorkspaceAgreement {
             agreement_percent: 100.0 * (n - disagreements.len()) as f64 / n as f64,
             disagreements,
             min_agreement_percent: None,
+            inside_interference_free: checked.then_some(free),
+            interference_free_percent_of_inside: (checked && !inside.is_empty())
+                .then(|| 100.0 * free as f64 / inside.len() as f64),
         })
     }
 }
@@ -283,6 +298,12 @@ impl Report {
                     w.agreement_percent,
                     if w.disagreements.is_empty() { String::new() } else { format!(" (disagree at points {:?})", w.disagreements) }
                 ));
+                if let (Some(f), Some(pc)) = (w.inside_interference_free, w.interference_free_percent_of_inside) {
+                    out.push_str(&format!(
+                        "   interference-free: {f} of the {} point(s) inside ({pc:.2} %)\n",
+                        w.simulated_inside
+                    ));
+                }
             }
             if s.skipped_points > 0 {
                 out.push_str(&format!(

@@ -505,6 +505,13 @@ fn settle_point(
     } else {
         runner.compare.settle_point(&landed, &simulated, s.settled);
     }
+    let (min_clearance_m, interference_free) = match (&runner.interference, &sc.interference) {
+        (Some(i), Some(set)) => {
+            let c = i.measure(&runner.sim.structure, &s.snapshot.nodes).iter().map(|p| p.clearance_m).reduce(f64::min);
+            (c, Some(c.is_none_or(|c| c >= set.threshold_m)))
+        }
+        _ => (None, None),
+    };
     let within_tolerance = s.settled
         && !outside
         && sc.checks.iter().all(|c| match (landed.get(&c.quantity), simulated.get(&c.quantity)) {
@@ -529,6 +536,8 @@ fn settle_point(
         slack_agrees,
         distance_from_analytic_m,
         within_tolerance,
+        min_clearance_m,
+        interference_free,
     });
     Ok(())
 }

@@ -221,7 +221,12 @@ fn plan_tree(s: &Structure, roped: &[bool], actuated: &[bool]) -> Result<Vec<boo
 
 /// One planning pass: the forest of links (joints not `banned`), then the links to cut so that
 /// no closure joins two bodies of one multibody.
-fn plan_forest(s: &Structure, roped: &[bool], actuated: &[bool], banned: &[bool]) -> Result<(Vec<bool>, Vec<usize>), SimError> {
+fn plan_forest(
+    s: &Structure,
+    roped: &[bool],
+    actuated: &[bool],
+    banned: &[bool],
+) -> Result<(Vec<bool>, Vec<usize>), SimError> {
     let n = s.bodies.len();
     let mut parent_joint: Vec<Option<usize>> = vec![None; n];
     let mut is_link = vec![false; s.joints.len()];
@@ -292,7 +297,10 @@ fn plan_forest(s: &Structure, roped: &[bool], actuated: &[bool], banned: &[bool]
                 cuts.push(pj);
             }
             None => {
-                return Err(SimError::Build(format!("joint '{}' closes a loop made only of actuated joints", joint.name)))
+                return Err(SimError::Build(format!(
+                    "joint '{}' closes a loop made only of actuated joints",
+                    joint.name
+                )))
             }
         }
     }

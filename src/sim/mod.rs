@@ -252,7 +252,8 @@ impl Simulation {
     /// the velocities: the perturbation used to classify an equilibrium.
     pub fn perturb_free_coordinates(&mut self, delta: f64) {
         let mut touched = Vec::new();
-        let free_links = self.joint_links.iter().zip(&self.actuated).filter(|(_, a)| !**a).filter_map(|(l, _)| l.as_ref());
+        let free_links =
+            self.joint_links.iter().zip(&self.actuated).filter(|(_, a)| !**a).filter_map(|(l, _)| l.as_ref());
         for link in free_links.chain(self.hidden_links.iter()) {
             if let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) {
                 let assembly = mb.link(link_id).map(|l| (l.assembly_id(), l.joint().ndofs()));

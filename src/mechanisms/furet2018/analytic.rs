@@ -326,7 +326,8 @@ pub fn loop_closure_eq5(p: &Params, phi1: f64, alpha1: f64, psi2: f64, alpha2: f
     (
         -2.0 * l * b * alpha1.sin() * phi1.sin() - 2.0 * l * b * (alpha1.cos() + 1.0) * phi1.cos()
             + 2.0 * b * b * (alpha1.cos() + 1.0),
-        2.0 * l * b * alpha2.sin() * psi2.sin() + 2.0 * l * b * (alpha2.cos() + 1.0) * psi2.cos()
+        2.0 * l * b * alpha2.sin() * psi2.sin()
+            + 2.0 * l * b * (alpha2.cos() + 1.0) * psi2.cos()
             + 2.0 * b * b * (alpha2.cos() + 1.0),
     )
 }
@@ -474,14 +475,11 @@ pub fn quartic_coefficients(p: &Params, x: f64, y: f64) -> [f64; 5] {
     let (b2, b4) = (b * b, b * b * b * b);
     let (x2, y2) = (x * x, y * y);
     let r4 = (x2 + y2) * (x2 + y2);
-    let a4 = (l + b).powi(2)
-        * (2.0 * l3 * x + 5.0 * l2 * x2 + l2 * y2 + 4.0 * l * x * x2 + 4.0 * l * x * y2 + b2 * y2 + r4);
-    let a3 = -4.0 * l * y * (l + b)
-        * (l3 + 4.0 * l2 * x - l * b2 + 2.0 * l * x2 + 2.0 * l * y2 - 2.0 * b2 * x);
-    let a2 = 2.0
-        * (-3.0 * l4 * x2 + 9.0 * l4 * y2 + l2 * b2 * x2 - 10.0 * l2 * b2 * y2 + l2 * r4 + b4 * y2 + b2 * r4);
-    let a1 = 4.0 * l * y * (b - l)
-        * (l3 - 4.0 * l2 * x - l * b2 + 2.0 * l * x2 + 2.0 * l * y2 + 2.0 * b2 * x);
+    let a4 =
+        (l + b).powi(2) * (2.0 * l3 * x + 5.0 * l2 * x2 + l2 * y2 + 4.0 * l * x * x2 + 4.0 * l * x * y2 + b2 * y2 + r4);
+    let a3 = -4.0 * l * y * (l + b) * (l3 + 4.0 * l2 * x - l * b2 + 2.0 * l * x2 + 2.0 * l * y2 - 2.0 * b2 * x);
+    let a2 = 2.0 * (-3.0 * l4 * x2 + 9.0 * l4 * y2 + l2 * b2 * x2 - 10.0 * l2 * b2 * y2 + l2 * r4 + b4 * y2 + b2 * r4);
+    let a1 = 4.0 * l * y * (b - l) * (l3 - 4.0 * l2 * x - l * b2 + 2.0 * l * x2 + 2.0 * l * y2 + 2.0 * b2 * x);
     let a0 = (b - l).powi(2)
         * (-2.0 * l3 * x + 5.0 * l2 * x2 + l2 * y2 - 4.0 * l * x * x2 - 4.0 * l * x * y2 + b2 * y2 + r4);
     [a4, a3, a2, a1, a0]
@@ -498,7 +496,8 @@ pub fn quartic_coefficients_eq7_11_as_printed(p: &Params, x: f64, y: f64) -> [f6
         * (b2 * y2 + x2 * x2 + 2.0 * x2 * y2 + y2 * y2 + 4.0 * x2 * x + 4.0 * x * y2 + 5.0 * x2 + y2 + 2.0 * x);
     let a3 = 4.0 * y * (b + 1.0) * (2.0 * b2 * x + b2 - 2.0 * x2 - 2.0 * y2 - 4.0 * x - 1.0);
     let a2 = 2.0
-        * (b2 * b2 * y2 + b2 * x2 * x2 + 2.0 * b2 * x2 * y2 + b2 * y2 * y2 + b2 * x2 - 10.0 * b2 * y2 + x2 * x2
+        * (b2 * b2 * y2 + b2 * x2 * x2 + 2.0 * b2 * x2 * y2 + b2 * y2 * y2 + b2 * x2 - 10.0 * b2 * y2
+            + x2 * x2
             + 2.0 * x2 * y2
             + y2 * y2
             - 3.0 * x2
@@ -560,10 +559,22 @@ fn poly_eval(c: &[f64], z: Complex<f64>) -> (Complex<f64>, Complex<f64>) {
 /// (`c[0] != 0`), via the companion-matrix eigenvalues, each Newton-polished.
 fn quartic_roots(c: &[f64; 5]) -> Vec<Complex<f64>> {
     let m = Matrix4::new(
-        -c[1] / c[0], -c[2] / c[0], -c[3] / c[0], -c[4] / c[0],
-        1.0, 0.0, 0.0, 0.0,
-        0.0, 1.0, 0.0, 0.0,
-        0.0, 0.0, 1.0, 0.0,
+        -c[1] / c[0],
+        -c[2] / c[0],
+        -c[3] / c[0],
+        -c[4] / c[0],
+        1.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
     );
     m.complex_eigenvalues()
         .iter()
@@ -614,14 +625,21 @@ fn make_solution(p: &Params, x: f64, y: f64, t1: f64, t2: f64) -> IkSolution {
         theta2: t2,
         phi1: wrap_angle(base_joint_angle_a(p, t1)),
         det_j: d,
-        aspect: if d > 0.0 { 1 } else if d < 0.0 { -1 } else { 0 },
+        aspect: if d > 0.0 {
+            1
+        } else if d < 0.0 {
+            -1
+        } else {
+            0
+        },
         residual: (fx - x).hypot(fy - y),
     }
 }
 
 fn push_unique(out: &mut Vec<IkSolution>, s: IkSolution) {
     let dup = out.iter().any(|o| {
-        wrap_angle(o.theta1 - s.theta1).abs() < IK_DUPLICATE_TOL && wrap_angle(o.theta2 - s.theta2).abs() < IK_DUPLICATE_TOL
+        wrap_angle(o.theta1 - s.theta1).abs() < IK_DUPLICATE_TOL
+            && wrap_angle(o.theta2 - s.theta2).abs() < IK_DUPLICATE_TOL
     });
     if !dup {
         out.push(s);
@@ -846,7 +864,13 @@ pub fn min_abs_det_along(p: &Params, path: &[(f64, f64)], samples_per_segment: u
     let mut sign = 0i8;
     let mut visit = |t1: f64, t2: f64| {
         let d = det_jacobian(p, t1, t2);
-        let s = if d > 0.0 { 1 } else if d < 0.0 { -1 } else { 0 };
+        let s = if d > 0.0 {
+            1
+        } else if d < 0.0 {
+            -1
+        } else {
+            0
+        };
         if s == 0 || (sign != 0 && s != sign) {
             mn = 0.0;
         }
@@ -1043,8 +1067,12 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         }
         f.push(finding("Eq. 2", "DK of n mechanisms in series as a virtual nR arm with link l_i(theta_i) at angle (pi-2th_i)/2 + sum_{j<=i} 2th_j",
             format!("max error vs node chain (n = 2, 3) {e2:.1e} m"), e2 < 1e-12 * l));
-        f.push(finding("Eq. 3", "x = -l1 sin th1 - l2 sin(2th1+th2), y = l1 cos th1 + l2 cos(2th1+th2)",
-            format!("max error vs node chain {e3:.1e} m"), e3 < 1e-12 * l));
+        f.push(finding(
+            "Eq. 3",
+            "x = -l1 sin th1 - l2 sin(2th1+th2), y = l1 cos th1 + l2 cos(2th1+th2)",
+            format!("max error vs node chain {e3:.1e} m"),
+            e3 < 1e-12 * l,
+        ));
     }
 
     // Eq. 4, 5, 12.
@@ -1061,12 +1089,20 @@ pub fn findings(p: &Params) -> Vec<Finding> {
             let ta = (p.l * phi1.sin() * t1.sin() - half * t1.cos()).abs(); // tan(alpha/2) = half / (L sin phi)
             e12 = e12.max(ta).max(wrap_angle(theta_from_base_joint_angle_a(p, phi1) - t1).abs());
         }
-        f.push(finding("Eq. 4", "x = -b/2 + L cos phi1 + L cos(psi2 + alpha1) + b/2 cos(alpha1 + alpha2), y likewise",
-            format!("with phi1, psi2 the base-joint angles: max error {e4:.1e} m"), e4 < 1e-12 * l));
+        f.push(finding(
+            "Eq. 4",
+            "x = -b/2 + L cos phi1 + L cos(psi2 + alpha1) + b/2 cos(alpha1 + alpha2), y likewise",
+            format!("with phi1, psi2 the base-joint angles: max error {e4:.1e} m"),
+            e4 < 1e-12 * l,
+        ));
         f.push(finding("Eq. 5", "loop closures of X1 (phi1, alpha1) and X2 (psi2, alpha2)",
             format!("max |residual| {e5:.1e} m^2 on the crossed mode; both are 4b cos th [b cos th -/+ L cos(angle - th)] so they also vanish at alpha = pi (parallelogram/change point)"), e5 < 1e-12 * l * l));
-        f.push(finding("Eq. 12", "tan(alpha1/2) = (-L cos phi1 + b)/(L sin phi1)",
-            format!("max error (cross-multiplied, and theta recovered by atan2) {e12:.1e}"), e12 < 1e-12 * l));
+        f.push(finding(
+            "Eq. 12",
+            "tan(alpha1/2) = (-L cos phi1 + b)/(L sin phi1)",
+            format!("max error (cross-multiplied, and theta recovered by atan2) {e12:.1e}"),
+            e12 < 1e-12 * l,
+        ));
     }
 
     // Eq. 6-11.
@@ -1110,9 +1146,14 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let (x, y) = PAPER_FIG3_POINT;
         let s = inverse_kinematics(&q, x, y);
         let npos = s.iter().filter(|v| v.aspect > 0).count();
-        let txt: Vec<String> = s.iter().map(|v| format!("({:.4}, {:.4}) detJ {:+.4}", v.theta1, v.theta2, v.det_j)).collect();
-        f.push(finding("Fig. 3", "L = 1, b = 2/3, (x, y) = (0.03, 1.6): four inverse solutions",
-            format!("{} solutions (theta1, theta2) [rad]: {}; {} with det J > 0", s.len(), txt.join(", "), npos), s.len() == 4));
+        let txt: Vec<String> =
+            s.iter().map(|v| format!("({:.4}, {:.4}) detJ {:+.4}", v.theta1, v.theta2, v.det_j)).collect();
+        f.push(finding(
+            "Fig. 3",
+            "L = 1, b = 2/3, (x, y) = (0.03, 1.6): four inverse solutions",
+            format!("{} solutions (theta1, theta2) [rad]: {}; {} with det J > 0", s.len(), txt.join(", "), npos),
+            s.len() == 4,
+        ));
     }
 
     // Eq. 13.
@@ -1151,8 +1192,12 @@ pub fn findings(p: &Params) -> Vec<Finding> {
             e14_match = e14_match.max(dmin);
         }
         let l2 = p.l * p.l;
-        f.push(finding("Sec. 3", "det J = 0 for theta1 = -theta2 +- pi; the end point is then the origin",
-            format!("max |det J| there {e_fold:.1e} m^2; max |(x, y)| {e_origin:.1e} m"), e_fold < 1e-12 * l2 && e_origin < 1e-12 * l));
+        f.push(finding(
+            "Sec. 3",
+            "det J = 0 for theta1 = -theta2 +- pi; the end point is then the origin",
+            format!("max |det J| there {e_fold:.1e} m^2; max |(x, y)| {e_origin:.1e} m"),
+            e_fold < 1e-12 * l2 && e_origin < 1e-12 * l,
+        ));
         f.push(finding("Eq. 14", "second singular family theta1 = atan2(-sin th2 (4b^4c^4 - 4L^2b^2c^2 - L^2b^2 + L^4), cos th2 (4b^4c^4 - 4b^4c^2 - 4L^2b^2c^2 + 3L^2b^2 + L^4))",
             format!("max |det J| on it {e14:.1e} m^2; it coincides with the second numeric root of det J = 0 in theta1 (max distance {e14_match:.1e} rad); exactly two roots per theta2 at 40 samples: {nroots_ok}"), e14 < 1e-12 * l2 && e14_match < 1e-9 && nroots_ok));
     }
@@ -1161,8 +1206,12 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     {
         let q = Params::PAPER;
         let na = aspect_count(&q, 256);
-        f.push(finding("Sec. 3 / Fig. 4", "L = 1, b = 2/3: the singularities divide the joint torus into two aspects",
-            format!("{na} connected components of sign(det J) on a 256 x 256 torus grid"), na == 2));
+        f.push(finding(
+            "Sec. 3 / Fig. 4",
+            "L = 1, b = 2/3: the singularities divide the joint torus into two aspects",
+            format!("{na} connected components of sign(det J) on a 256 x 256 torus grid"),
+            na == 2,
+        ));
         let (x, y) = PAPER_FIG3_POINT;
         let s = inverse_kinematics(&q, x, y);
         let pos: Vec<&IkSolution> = s.iter().filter(|v| v.aspect > 0).collect();
@@ -1170,7 +1219,9 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let mut mins = Vec::new();
         for grp in [&pos, &neg] {
             if grp.len() == 2 {
-                if let Some(path) = nonsingular_path(&q, (grp[0].theta1, grp[0].theta2), (grp[1].theta1, grp[1].theta2), 192) {
+                if let Some(path) =
+                    nonsingular_path(&q, (grp[0].theta1, grp[0].theta2), (grp[1].theta1, grp[1].theta2), 192)
+                {
                     mins.push(min_abs_det_along(&q, &path, 200));
                 }
             }
@@ -1185,7 +1236,10 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let mut both = true;
         for &b in &PAPER_FIG5_B {
             let r = region_area_fractions(&Params { l: 1.0, b }, grid);
-            txt.push(format!("b = {b:.3}: workspace {:.3} m^2, 2-sol {:.4}, 4-sol {:.4}, other {:.4}", r.workspace_area, r.frac_2, r.frac_4, r.frac_other));
+            txt.push(format!(
+                "b = {b:.3}: workspace {:.3} m^2, 2-sol {:.4}, 4-sol {:.4}, other {:.4}",
+                r.workspace_area, r.frac_2, r.frac_4, r.frac_other
+            ));
             fr4.push(r.frac_4);
             // both aspects cover the workspace: equal counts in each aspect at sample points
             let qb = Params { l: 1.0, b };
@@ -1253,10 +1307,22 @@ mod tests {
             assert_relative_eq!((g.top_right - g.top_left).norm(), P.b, epsilon = 1e-14);
             assert_relative_eq!((g.top_right - g.base_left).norm(), P.l, epsilon = 1e-14);
             assert_relative_eq!((g.top_left - g.base_right).norm(), P.l, epsilon = 1e-14);
-            assert_relative_eq!((g.top_left - g.base_left).norm(), midline_length(&P, th) - P.b * th.sin(), epsilon = 1e-14);
-            assert_relative_eq!((g.top_right - g.base_right).norm(), midline_length(&P, th) + P.b * th.sin(), epsilon = 1e-14);
+            assert_relative_eq!(
+                (g.top_left - g.base_left).norm(),
+                midline_length(&P, th) - P.b * th.sin(),
+                epsilon = 1e-14
+            );
+            assert_relative_eq!(
+                (g.top_right - g.base_right).norm(),
+                midline_length(&P, th) + P.b * th.sin(),
+                epsilon = 1e-14
+            );
             // Eq. 1: mid-line = mean spring length
-            assert_relative_eq!(0.5 * (g.spring_left + g.spring_right), (1.0 - (4.0 / 9.0) * th.cos().powi(2)).sqrt(), epsilon = 1e-14);
+            assert_relative_eq!(
+                0.5 * (g.spring_left + g.spring_right),
+                (1.0 - (4.0 / 9.0) * th.cos().powi(2)).sqrt(),
+                epsilon = 1e-14
+            );
             if crossed_mode_margin(th) > 0.05 {
                 assert!(seg_intersect(g.base_left, g.top_right, g.base_right, g.top_left), "bars cross at th = {th}");
             }
@@ -1370,7 +1436,11 @@ mod tests {
             assert_relative_eq!(j[(0, 1)], (c.0 - d.0) / (2.0 * h), epsilon = 1e-8);
             assert_relative_eq!(j[(1, 1)], (c.1 - d.1) / (2.0 * h), epsilon = 1e-8);
             let l1l2 = midline_length(&P, t1) * midline_length(&P, t2);
-            assert_relative_eq!(det_jacobian_eq13_corrected(&P, t1, t2), l1l2 * det_jacobian(&P, t1, t2), epsilon = 1e-13);
+            assert_relative_eq!(
+                det_jacobian_eq13_corrected(&P, t1, t2),
+                l1l2 * det_jacobian(&P, t1, t2),
+                epsilon = 1e-13
+            );
         }
     }
 
@@ -1382,7 +1452,11 @@ mod tests {
         assert_relative_eq!(want, 0.043_494_3, epsilon = 1e-6);
         assert_relative_eq!(det_jacobian_eq13_as_printed(&P, t1, t2), 0.017_859_0, epsilon = 1e-6);
         // and printed Eq. 13 does not vanish on the fold singularity theta1 = pi - theta2
-        assert_relative_eq!(det_jacobian_eq13_as_printed(&P, singular_theta1_folded(0.5), 0.5), EQ13_FOLD_VALUE, epsilon = 1e-6);
+        assert_relative_eq!(
+            det_jacobian_eq13_as_printed(&P, singular_theta1_folded(0.5), 0.5),
+            EQ13_FOLD_VALUE,
+            epsilon = 1e-6
+        );
     }
 
     #[test]
@@ -1473,7 +1547,9 @@ mod tests {
                 let (x, y) = direct_kinematics(&q, t1, t2);
                 let s = inverse_kinematics(&q, x, y);
                 assert!(s.len() == 2 || s.len() == 4, "count {} at b = {b}", s.len());
-                assert!(s.iter().any(|v| wrap_angle(v.theta1 - t1).abs() < 1e-9 && wrap_angle(v.theta2 - t2).abs() < 1e-9));
+                assert!(s
+                    .iter()
+                    .any(|v| wrap_angle(v.theta1 - t1).abs() < 1e-9 && wrap_angle(v.theta2 - t2).abs() < 1e-9));
                 assert!(s.iter().all(|v| v.residual < 1e-12));
                 assert_eq!(2 * s.iter().filter(|v| v.aspect > 0).count(), s.len());
                 let n = inverse_kinematics_numeric(&q, x, y, 3000);
@@ -1487,7 +1563,9 @@ mod tests {
         // theta1 = pi/2 means phi1 = pi (t = infinity)
         let (x, y) = direct_kinematics(&P, FRAC_PI_2, 0.7);
         let s = inverse_kinematics(&P, x, y);
-        assert!(s.iter().any(|v| wrap_angle(v.theta1 - FRAC_PI_2).abs() < 1e-9 && wrap_angle(v.theta2 - 0.7).abs() < 1e-9));
+        assert!(s
+            .iter()
+            .any(|v| wrap_angle(v.theta1 - FRAC_PI_2).abs() < 1e-9 && wrap_angle(v.theta2 - 0.7).abs() < 1e-9));
         assert!(inverse_kinematics(&P, 2.1, 0.0).is_empty());
         assert_eq!(solution_count(&P, 1.5, 1.5), 0);
         assert_eq!(solution_count(&P, 0.0, 0.0), usize::MAX);
@@ -1562,7 +1640,21 @@ mod tests {
     fn findings_report_expected_verdicts() {
         let f = findings(&P);
         let verdict = |e: &str| f.iter().find(|x| x.equation == e).unwrap_or_else(|| panic!("{e}")).holds;
-        for e in ["Eq. 1", "Eq. 2", "Eq. 3", "Eq. 4", "Eq. 5", "Eq. 6-11", "Eq. 12", "Eq. 14", "Fig. 3", "Sec. 3", "Sec. 3 / Fig. 4", "Sec. 3 (cuspidal)", "Sec. 4 / Fig. 5"] {
+        for e in [
+            "Eq. 1",
+            "Eq. 2",
+            "Eq. 3",
+            "Eq. 4",
+            "Eq. 5",
+            "Eq. 6-11",
+            "Eq. 12",
+            "Eq. 14",
+            "Fig. 3",
+            "Sec. 3",
+            "Sec. 3 / Fig. 4",
+            "Sec. 3 (cuspidal)",
+            "Sec. 4 / Fig. 5",
+        ] {
             assert!(verdict(e), "{e} should hold: {:?}", f.iter().find(|x| x.equation == e));
         }
         assert!(!verdict("Eq. 13"));

@@ -13,9 +13,7 @@
 //! collisions): bar A-C is drawn at z = +dz and bar B-D at z = -dz, the joints' axes along Z.
 
 use super::analytic::{self, Params};
-use crate::structure::{
-    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Strut, Structure, Vec3,
-};
+use crate::structure::{Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut, Vec3};
 use nalgebra::Vector2;
 
 /// Model choices that the paper does not give (defaults in `Furet2018::params`).
@@ -54,7 +52,8 @@ pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64) -> Structur
     let r = m.strut_radius_m;
     let z = [0.0, 0.0, 1.0];
     let mut below = base; // the body carrying this X's base bar
-    let mut below_nodes = (s.add_node("A1", base, at(xs[0].base_left, 0.0)), s.add_node("B1", base, at(xs[0].base_right, 0.0)));
+    let mut below_nodes =
+        (s.add_node("A1", base, at(xs[0].base_left, 0.0)), s.add_node("B1", base, at(xs[0].base_right, 0.0)));
     s.struts.push(Strut { name: "base A1B1".into(), a: below_nodes.0, b: below_nodes.1, radius_m: r });
     for (i, x) in xs.iter().enumerate() {
         let k = i + 1;
@@ -99,7 +98,8 @@ pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64) -> Structur
         s.joints.push(joint(format!("X{k} B"), below, bd, b, x.joint_angle_b, m.joint_damping));
         // The loop closes at D with a planar pin: the other three joints already hold the
         // loop in the plane, so a full revolute joint would over-constrain it.
-        s.joints.push(Joint { kind: JointKind::PlanarPin { axis: z }, ..joint(format!("X{k} D"), bd, top, d, 0.0, 0.0) });
+        s.joints
+            .push(Joint { kind: JointKind::PlanarPin { axis: z }, ..joint(format!("X{k} D"), bd, top, d, 0.0, 0.0) });
         s.actuators.push(Actuator { symbol: format!("phi{k}"), target: ActuatorTarget::Joint(actuated) });
         below = top;
         below_nodes = (d, c);

@@ -36,16 +36,49 @@ const PARAMS: &[ParamSpec] = &[
 ];
 
 const INPUTS: &[InputSpec] = &[
-    InputSpec { symbol: "theta1", unit: "rad", description: "angle of X1's mid-line from its base normal (Eq. 1-3); set through the base-joint angle phi1" },
-    InputSpec { symbol: "theta2", unit: "rad", description: "angle of X2's mid-line from its base normal; set through phi2" },
+    InputSpec {
+        symbol: "theta1",
+        unit: "rad",
+        description: "angle of X1's mid-line from its base normal (Eq. 1-3); set through the base-joint angle phi1",
+    },
+    InputSpec {
+        symbol: "theta2",
+        unit: "rad",
+        description: "angle of X2's mid-line from its base normal; set through phi2",
+    },
 ];
 
 const QUANTITIES: &[QuantitySpec] = &[
-    QuantitySpec { symbol: "x", unit: "m", kind: QuantityKind::Length, description: "x of the top-bar midpoint of X2 (Eq. 3)" },
-    QuantitySpec { symbol: "y", unit: "m", kind: QuantityKind::Length, description: "y of the top-bar midpoint of X2 (Eq. 3)" },
-    QuantitySpec { symbol: "theta1", unit: "rad", kind: QuantityKind::Angle, description: "theta1 read off the simulated nodes of X1" },
-    QuantitySpec { symbol: "theta2", unit: "rad", kind: QuantityKind::Angle, description: "theta2 read off the simulated nodes of X2" },
-    QuantitySpec { symbol: "detJ", unit: "m^2/rad^2", kind: QuantityKind::Magnitude, description: "det J (derived; Eq. 13 as printed is wrong, see findings) at the simulated (theta1, theta2)" },
+    QuantitySpec {
+        symbol: "x",
+        unit: "m",
+        kind: QuantityKind::Length,
+        description: "x of the top-bar midpoint of X2 (Eq. 3)",
+    },
+    QuantitySpec {
+        symbol: "y",
+        unit: "m",
+        kind: QuantityKind::Length,
+        description: "y of the top-bar midpoint of X2 (Eq. 3)",
+    },
+    QuantitySpec {
+        symbol: "theta1",
+        unit: "rad",
+        kind: QuantityKind::Angle,
+        description: "theta1 read off the simulated nodes of X1",
+    },
+    QuantitySpec {
+        symbol: "theta2",
+        unit: "rad",
+        kind: QuantityKind::Angle,
+        description: "theta2 read off the simulated nodes of X2",
+    },
+    QuantitySpec {
+        symbol: "detJ",
+        unit: "m^2/rad^2",
+        kind: QuantityKind::Magnitude,
+        description: "det J (derived; Eq. 13 as printed is wrong, see findings) at the simulated (theta1, theta2)",
+    },
 ];
 
 const QUERIES: &[QuerySpec] = &[
@@ -127,7 +160,13 @@ impl Mechanism for Furet2018 {
             }
         }
         if v["L"] <= v["b"] {
-            return Err(("b".into(), format!("b must be shorter than L (the X assembles only if L > b, Section 2): L = {}, b = {}", v["L"], v["b"])));
+            return Err((
+                "b".into(),
+                format!(
+                    "b must be shorter than L (the X assembles only if L > b, Section 2): L = {}, b = {}",
+                    v["L"], v["b"]
+                ),
+            ));
         }
         Ok(())
     }
@@ -158,7 +197,9 @@ impl Mechanism for Furet2018 {
                 let (x, y) = (input(inputs, "x")?, input(inputs, "y")?);
                 let sols = analytic::ik_query(&p, x, y);
                 if sols.is_empty() {
-                    return Err(format!("({x}, {y}) is outside the workspace: the quartic (Eq. 6-11) has no real root"));
+                    return Err(format!(
+                        "({x}, {y}) is outside the workspace: the quartic (Eq. 6-11) has no real root"
+                    ));
                 }
                 Ok(sols
                     .iter()

@@ -16,8 +16,8 @@
 
 use super::analytic::SpringChain;
 use crate::structure::{
-    Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, ExternalLoad, Inertia, Joint, JointKind, Structure, Strut, TorsionSpring,
-    Vec3,
+    Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, ExternalLoad, Inertia, Joint, JointKind, Spring, Structure,
+    Strut, TorsionSpring, Vec3,
 };
 use nalgebra::Vector3;
 
@@ -53,6 +53,9 @@ pub struct Geometry {
     pub cables: Vec<(String, usize, usize, String)>,
     /// Unstretched length of each cable at the start [m] (Eq. 6 with the commanded rho).
     pub cable_lengths: Vec<f64>,
+    /// Straight-strut variant: each leg a straight strut A_i-B_i, a linear spring of this
+    /// stiffness [N/m] and free length l_o, instead of the two-link virtual spring.
+    pub straight_stiffness_n_per_m: Option<f64>,
 }
 
 fn arr(v: Vector3<f64>) -> Vec3 {
@@ -90,6 +93,55 @@ pub fn build(g: &Geometry, m: &ModelChoices) -> Structure {
         s.struts.push(Strut { name: format!("A{}A{}", i + 1, j + 1), a: a_nodes[i], b: a_nodes[j], radius_m: r });
         s.struts.push(Strut { name: format!("B{}B{}", i + 1, j + 1), a: b_nodes[i], b: b_nodes[j], radius_m: r });
     }
+    if let Some(k) = g.straight_stiffness_n_per_m {
+        for i in 0..3 {
+            s.springs.push(Spring {
+                name: format!("leg{} spring", i + 1),
+                a: a_nodes[i],
+                b: b_nodes[i],
+                stiffness_n_per_m: k,
+                rest_length_m: g.lo,
+            });
+            s.struts.push(Strut {
+                name: format!("leg{} (straight)", i + 1),
+                a: a_nodes[i],
+                b: b_nodes[i],
+                radius_m: r,
+            });
+        }
+    } else {
+        add_two_link_legs(&mut s, g, m, base, platform, &a_nodes);
+    }
+    for (c, (name, ai, bi, symbol)) in g.cables.iter().enumerate() {
+        let law = match m.cable_stiffness_n_per_m {
+            None => CableLaw::Inextensible,
+            Some(k) => CableLaw::Elastic { stiffness_n_per_m: k },
+        };
+        s.cables.push(Cable {
+            name: name.clone(),
+            a: a_nodes[*ai],
+            b: b_nodes[*bi],
+            law,
+            length_m: g.cable_lengths[c],
+        });
+        s.actuators.push(Actuator { symbol: symbol.clone(), target: ActuatorTarget::CableLength(c) });
+    }
+    s
+}
+
+/// The paper's virtual compression springs (Fig. 2): two links per leg, universal joint at A_i,
+/// knee with the torsion spring of Eq. 4, spherical joint at B_i.
+fn add_two_link_legs(
+    s: &mut Structure,
+    g: &Geometry,
+    m: &ModelChoices,
+    base: usize,
+    platform: usize,
+    a_nodes: &[usize],
+) {
+    let a = g.legs.map(|c| c.a);
+    let b = g.legs.map(|c| c.b);
+    let r = m.strut_radius_m;
     // A link: a slender rod of length l_o/2; an isotropic inertia m (l_o/2)^2 / 12 keeps it
     // well conditioned (quasi-static results do not depend on it).
     let link_inertia = |com: Vector3<f64>| Inertia {
@@ -151,19 +203,4 @@ pub fn build(g: &Geometry, m: &ModelChoices) -> Structure {
             damping: 0.0,
         });
     }
-    for (c, (name, ai, bi, symbol)) in g.cables.iter().enumerate() {
-        let law = match m.cable_stiffness_n_per_m {
-            None => CableLaw::Inextensible,
-            Some(k) => CableLaw::Elastic { stiffness_n_per_m: k },
-        };
-        s.cables.push(Cable {
-            name: name.clone(),
-            a: a_nodes[*ai],
-            b: b_nodes[*bi],
-            law,
-            length_m: g.cable_lengths[c],
-        });
-        s.actuators.push(Actuator { symbol: symbol.clone(), target: ActuatorTarget::CableLength(c) });
-    }
-    s
 }

@@ -27,6 +27,8 @@ const PARAMS: &[ParamSpec] = &[
     ParamSpec { symbol: "c_joint", unit: "N m s/rad", default: 2.0, description: "viscous damping of the leg joints (not in the paper: zero at rest, it only speeds settling)", origin: Origin::ModelChoice },
     ParamSpec { symbol: "k_cable", unit: "N/m", default: 0.0, description: "cable stiffness; 0 = inextensible, the paper's assumption (Section 3)", origin: Origin::ModelChoice },
     ParamSpec { symbol: "g_z", unit: "m/s^2", default: 0.0, description: "gravity along the paper's Z on the end-effector mass: 0 = the paper's assumption (Section 4); -9.81 base below; +9.81 hanging below the base (Section 5)", origin: Origin::ModelChoice },
+    ParamSpec { symbol: "straight", unit: "-", default: 0.0, description: "1: replace each virtual compression spring by one straight strut, a linear spring of stiffness k_straight and free length l_o (the design Section 2 rejects because the struts collide at their midpoints); 0: the paper's two-link springs", origin: Origin::ModelChoice },
+    ParamSpec { symbol: "k_straight", unit: "N/m", default: 5.0, description: "stiffness of a straight strut's spring (straight = 1; not in the paper)", origin: Origin::ModelChoice },
     ParamSpec { symbol: "r_strut", unit: "m", default: 0.02, description: "link radius for drawing and interference (not in the paper)", origin: Origin::ModelChoice },
 ];
 
@@ -159,12 +161,28 @@ fn rho_of(inputs: &Values) -> Result<[f64; 3], String> {
 
 /// Cable tensions [N] at centroid `p` with an external force `load` [N] on the end-effector's
 /// centroid, from the full wrench balance (Eq. 19 with the load added: W_f f + W_t t + w = 0).
-pub fn tensions_with_load(pa: &Params, p: &Vector3<f64>, load: Vector3<f64>) -> [f64; 6] {
-    let f = analytic::spring_forces(pa, p);
-    let w = analytic::wf(pa, p) * nalgebra::Vector3::from(f) + nalgebra::Vector6::new(load.x, load.y, load.z, 0.0, 0.0, 0.0);
+pub fn tensions_with_load(pa: &Params, p: &Vector3<f64>, f: [f64; 3], load: Vector3<f64>) -> [f64; 6] {
+    let w = analytic::wf(pa, p) * nalgebra::Vector3::from(f)
+        + nalgebra::Vector6::new(load.x, load.y, load.z, 0.0, 0.0, 0.0);
     match analytic::wt(pa, p).lu().solve(&(-w)) {
         Some(t) => [t[0], t[1], t[2], t[3], t[4], t[5]],
         None => [f64::NAN; 6],
+    }
+}
+
+/// Whether the legs are straight struts (the variant Section 2 rejects).
+fn is_straight(params: &Values) -> bool {
+    params["straight"] != 0.0
+}
+
+/// Internal force of each leg at centroid `p` [N] (compression negative): Eq. 5 for the
+/// paper's two-link springs; k (l - l_o) for straight struts.
+fn leg_forces(params: &Values, p: &Vector3<f64>) -> [f64; 3] {
+    let pa = params_of(params);
+    if is_straight(params) {
+        analytic::spring_lengths(&pa, p).map(|l| params["k_straight"] * (l - pa.lo))
+    } else {
+        analytic::spring_forces(&pa, p)
     }
 }
 
@@ -178,11 +196,16 @@ fn payload(params: &Values) -> Vector3<f64> {
 fn values_at(params: &Values, p: Vector3<f64>) -> Values {
     let pa = &params_of(params);
     let st = analytic::statics(pa, &p);
-    let tensions = if params["g_z"] == 0.0 { st.tensions_closed_form } else { tensions_with_load(pa, &p, payload(params)) };
+    let forces = leg_forces(params, &p);
+    let tensions = if params["g_z"] == 0.0 && !is_straight(params) {
+        st.tensions_closed_form
+    } else {
+        tensions_with_load(pa, &p, forces, payload(params))
+    };
     let mut v = Values::from([("x".into(), p.x), ("y".into(), p.y), ("z".into(), p.z), ("rotation".into(), 0.0)]);
     for i in 0..3 {
         v.insert(format!("l{}", i + 1), st.spring_lengths[i]);
-        v.insert(format!("f{}", i + 1), st.spring_forces[i]);
+        v.insert(format!("f{}", i + 1), forces[i]);
     }
     for j in 0..6 {
         v.insert(format!("t{}", j + 1), tensions[j]);
@@ -234,6 +257,18 @@ impl Mechanism for Mohr2011 {
             if !(x > 0.0 && x.is_finite()) {
                 return Err((sym.into(), format!("{sym} must be a finite number > 0 {what}, got {x}")));
             }
+        }
+        if !(v["straight"] == 0.0 || v["straight"] == 1.0) {
+            return Err((
+                "straight".into(),
+                format!("straight must be 0 (two-link springs) or 1 (straight struts), got {}", v["straight"]),
+            ));
+        }
+        if !(v["k_straight"] > 0.0 && v["k_straight"].is_finite()) {
+            return Err((
+                "k_straight".into(),
+                format!("k_straight must be a finite number > 0 N/m, got {}", v["k_straight"]),
+            ));
         }
         for (sym, what) in [("c_joint", "N m s/rad"), ("k_cable", "N/m"), ("r_strut", "m")] {
             let x = v[sym];
@@ -352,6 +387,7 @@ impl Mechanism for Mohr2011 {
                 })
                 .collect(),
             cable_lengths: (0..6).map(|j| inputs[&cable_symbol(j)]).collect(),
+            straight_stiffness_n_per_m: is_straight(params).then_some(params["k_straight"]),
         };
         Ok(build::build(&g, &model_of(params)))
     }
@@ -433,7 +469,7 @@ pub fn static_workspace_count(params: &Values, g_z: f64) -> usize {
                 if a2.iter().any(|c| (p - c).norm() >= pa.lo) {
                     continue;
                 }
-                if tensions_with_load(&pa, &p, load).iter().all(|t| *t > 0.0) {
+                if tensions_with_load(&pa, &p, leg_forces(params, &p), load).iter().all(|t| *t > 0.0) {
                     count += 1;
                 }
             }
