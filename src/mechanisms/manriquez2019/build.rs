@@ -1,0 +1,84 @@
+//! manriquez2019 parameters -> the generic structure.
+//!
+//! A fixed base; the moving platform, a free rigid body of the paper's mass under gravity,
+//! held by a universal joint at O (first axis z_W fixed in the base, second axis y_M fixed in
+//! the platform, Eq. 1-5), two inextensible cables of actuated length (Eq. 12-13) and two
+//! linear springs. Everything is placed at the start configuration (theta1, theta2).
+
+use super::analytic::{self, Params};
+use crate::structure::{
+    Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Strut, Structure, Vec3,
+};
+use nalgebra::Vector3;
+
+fn arr(v: Vector3<f64>) -> Vec3 {
+    [v.x, v.y, v.z]
+}
+
+/// Model choices the paper does not give.
+#[derive(Clone, Copy, Debug)]
+pub struct ModelChoices {
+    /// Viscous damping of the universal joint [N m s/rad] (zero at rest).
+    pub joint_damping: f64,
+    /// Strut radius for drawing and interference [m].
+    pub strut_radius_m: f64,
+}
+
+/// The structure at the start pose (theta1, theta2), cables at `cable_lengths` [m].
+pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64, cable_lengths: [f64; 2]) -> Structure {
+    let d = analytic::dynamic_model(p, theta1, theta2);
+    let mut s = Structure { name: "manriquez2019".into(), gravity: arr(d.gravity), ..Default::default() };
+    let base = s.add_body("base", BodyKind::Fixed, None);
+    // The inertia's diagonal in the platform frame, taken along the world axes: the statics do
+    // not depend on it (analytic::platform_inertia: a thin rod plus a cross).
+    let i = d.inertia_local;
+    let platform = s.add_body(
+        "platform",
+        BodyKind::Free,
+        Some(Inertia { mass_kg: d.mass, com: arr(d.com), principal_kg_m2: [i[(0, 0)], i[(1, 1)], i[(2, 2)]] }),
+    );
+    let o_base = s.add_node("O", base, arr(d.joint_centre));
+    let o_platform = s.add_node("M_O", platform, arr(d.joint_centre));
+    let g = s.add_node("G", platform, arr(d.com));
+    let q = analytic::points(p, theta1, theta2);
+    let m_node = s.add_node("M", platform, arr(q.m));
+    let r = m.strut_radius_m;
+    s.struts.push(Strut { name: "rod O-M".into(), a: o_platform, b: m_node, radius_m: r });
+    let _ = g;
+    for (k, (b, t)) in d.cables.iter().enumerate() {
+        let nb = s.add_node(&format!("B{}", k + 1), base, arr(*b));
+        let nt = s.add_node(&format!("C{}", k + 1), platform, arr(*t));
+        s.struts.push(Strut { name: format!("platform M-C{}", k + 1), a: m_node, b: nt, radius_m: r });
+        s.cables.push(Cable {
+            name: format!("cable {}", k + 1),
+            a: nb,
+            b: nt,
+            law: CableLaw::Inextensible,
+            length_m: cable_lengths[k],
+        });
+        s.actuators.push(Actuator { symbol: format!("L{}", k + 1), target: ActuatorTarget::CableLength(k) });
+    }
+    for (k, (b, t)) in d.springs.iter().enumerate() {
+        let nb = s.add_node(&format!("B{}", k + 3), base, arr(*b));
+        let nt = s.add_node(&format!("R{}", k + 1), platform, arr(*t));
+        s.struts.push(Strut { name: format!("platform M-R{}", k + 1), a: m_node, b: nt, radius_m: r });
+        s.springs.push(Spring {
+            name: format!("spring {}", k + 1),
+            a: nb,
+            b: nt,
+            stiffness_n_per_m: d.spring_k,
+            rest_length_m: d.spring_rest,
+        });
+    }
+    s.joints.push(Joint {
+        name: "universal O".into(),
+        kind: JointKind::Universal { axis1: arr(d.joint_axis_base), axis2: arr(d.joint_axis_platform) },
+        parent: base,
+        child: platform,
+        anchor: o_base,
+        initial_coordinate: 0.0,
+        torsion_spring: None,
+        damping: m.joint_damping,
+    });
+    s
+}
