@@ -98,3 +98,52 @@ fn workspace_slice_by_dynamics_agrees_with_eq29_31() {
     assert_eq!(w.agreement_percent, 100.0, "{w:?}");
     assert!(r.passed);
 }
+
+/// Elastic cables stretch by t/k: the dynamics settle where Eq. 12-14 on the stretched lengths
+/// (iterated with Eq. 26-28) says, 1.7e-3 m above the inextensible answer, within 1e-9 l_b.
+#[test]
+fn elastic_cables_settle_on_the_stretched_equilibrium() {
+    let r = run_variant("scenarios/mohr2011/elastic_cables.toml", "points = [ { x = 0.0, y = 0.0, z = 3.0 } ]");
+    assert!(r.passed, "{:?}", r.error);
+    let p = &r.points[0];
+    let stretch = p.analytic["z"] - 3.0;
+    assert!(stretch > 1e-3 && stretch < 3e-3, "stretch {stretch} m");
+    assert!((p.simulated["z"] - p.analytic["z"]).abs() <= 1e-9 * r.params["lb"]);
+}
+
+/// With straight struts (the design Section 2 rejects) all three struts cross at p/2: the
+/// interference observer reports each pair, from the first tick, with the closest points.
+#[test]
+fn straight_struts_collide_at_their_midpoints() {
+    let r = run_file("scenarios/mohr2011/straight_struts.toml");
+    assert!(!r.passed, "the collision must fail the run");
+    assert!(r.error.is_none(), "{:?}", r.error);
+    assert!(r.checks.iter().all(|c| c.passed), "the statics still hold");
+    let i = r.interference.as_ref().expect("interference section");
+    assert_eq!(i.violations.len(), 3, "{:?}", i.violations);
+    let radius = r.params["r_strut"];
+    for v in &i.violations {
+        assert!(v.pair.iter().all(|s| s.contains("straight")), "{:?}", v.pair);
+        assert_eq!(v.first_tick, 1);
+        assert!((v.min_clearance_m + 2.0 * radius).abs() <= 1e-9, "clearance {}", v.min_clearance_m);
+        // The closest points lie on the Z axis at half the end-effector's height (p/2).
+        let [a, b] = v.closest_points;
+        assert!(a[0].hypot(a[1]) <= 1e-6 && (a[2] - b[2]).abs() <= 1e-6, "{a:?} {b:?}");
+    }
+}
+
+/// Section 5's gravity: with a hanging 1 kg end-effector the loaded wrench balance matches the
+/// dynamics, and at (1, 1, 3) the weight makes one cable (A1B2) go slack.
+#[test]
+fn hanging_end_effector_matches_the_loaded_statics() {
+    let r = run_file("scenarios/mohr2011/gravity_hanging.toml");
+    assert!(r.passed, "{:?}", r.error);
+    let last = r.points.last().expect("points");
+    assert_eq!(last.slack_cables, vec!["A1B2".to_string()]);
+    assert_eq!(last.slack_agrees, Some(true));
+    for p in &r.points[..r.points.len() - 1] {
+        let e = ((p.simulated["t1"] - p.analytic["t1"]) / p.analytic["t1"]).abs();
+        assert!(e <= 1e-7, "point {}: t1 error {e:e}", p.index);
+        assert!(p.analytic["t1"] != p.analytic["t4"], "the load unbalances the pair");
+    }
+}

@@ -162,7 +162,12 @@ pub trait Mechanism: Send + Sync {
 
 /// All built-in mechanisms.
 pub fn registry() -> Vec<Box<dyn Mechanism>> {
-    vec![Box::new(ji2014::Ji2014), Box::new(mohr2011::Mohr2011), Box::new(furet2018::Furet2018), Box::new(manriquez2019::Manriquez2019)]
+    vec![
+        Box::new(ji2014::Ji2014),
+        Box::new(mohr2011::Mohr2011),
+        Box::new(furet2018::Furet2018),
+        Box::new(manriquez2019::Manriquez2019),
+    ]
 }
 
 pub fn find(name: &str) -> Option<Box<dyn Mechanism>> {

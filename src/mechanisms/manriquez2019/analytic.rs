@@ -224,7 +224,12 @@ impl Params {
                 return Err(format!("{name} must be finite and > 0, got {v}"));
             }
         }
-        for (name, v) in [("mass", self.mass), ("gravity", self.gravity), ("spring_k", self.spring_k), ("spring_rest", self.spring_rest)] {
+        for (name, v) in [
+            ("mass", self.mass),
+            ("gravity", self.gravity),
+            ("spring_k", self.spring_k),
+            ("spring_rest", self.spring_rest),
+        ] {
             if !v.is_finite() || v < 0.0 {
                 return Err(format!("{name} must be finite and >= 0, got {v}"));
             }
@@ -265,10 +270,22 @@ pub fn dh(theta: f64, d: f64, a: f64, alpha: f64) -> Matrix4<f64> {
     let (st, ct) = theta.sin_cos();
     let (sa, ca) = alpha.sin_cos();
     Matrix4::new(
-        ct, -st * ca, st * sa, a * ct, //
-        st, ct * ca, -ct * sa, a * st, //
-        0.0, sa, ca, d, //
-        0.0, 0.0, 0.0, 1.0,
+        ct,
+        -st * ca,
+        st * sa,
+        a * ct, //
+        st,
+        ct * ca,
+        -ct * sa,
+        a * st, //
+        0.0,
+        sa,
+        ca,
+        d, //
+        0.0,
+        0.0,
+        0.0,
+        1.0,
     )
 }
 
@@ -334,11 +351,7 @@ pub fn p_m1_eq8(p: &Params, theta1: f64, theta2: f64) -> Vector3<f64> {
     let (s1, c1) = theta1.sin_cos();
     let (s2, c2) = theta2.sin_cos();
     let h = 0.5 * p.l2;
-    Vector3::new(
-        c1 * (-s2 * h + p.a2 * c2) - s1 * h + p.l1,
-        s1 * (-s2 * h + p.a2 * c2) + c1 * h,
-        -c2 * h - p.a2 * s2,
-    )
+    Vector3::new(c1 * (-s2 * h + p.a2 * c2) - s1 * h + p.l1, s1 * (-s2 * h + p.a2 * c2) + c1 * h, -c2 * h - p.a2 * s2)
 }
 
 /// Eq. 9 as printed: `^W P_{M2}` [m].
@@ -346,11 +359,7 @@ pub fn p_m2_eq9(p: &Params, theta1: f64, theta2: f64) -> Vector3<f64> {
     let (s1, c1) = theta1.sin_cos();
     let (s2, c2) = theta2.sin_cos();
     let h = 0.5 * p.l2;
-    Vector3::new(
-        c1 * (s2 * h + p.a2 * c2) + s1 * h + p.l1,
-        s1 * (s2 * h + p.a2 * c2) - c1 * h,
-        c2 * h - p.a2 * s2,
-    )
+    Vector3::new(c1 * (s2 * h + p.a2 * c2) + s1 * h + p.l1, s1 * (s2 * h + p.a2 * c2) - c1 * h, c2 * h - p.a2 * s2)
 }
 
 /// Universal-joint centre `O` (origin of `Σ_0`) in `Σ_W` [m].
@@ -537,7 +546,9 @@ pub fn all_thetas_from_cable_lengths(p: &Params, lengths: [f64; 2]) -> Vec<(f64,
             let f = |k: usize| -START_SPAN_RAD + 2.0 * START_SPAN_RAD * k as f64 / (STARTS_PER_AXIS - 1) as f64;
             if let Some((a, b)) = theta_from_cable_lengths(p, lengths, (f(i) + 1e-3, f(j) - 1e-3)) {
                 let inside = a.abs() < std::f64::consts::FRAC_PI_2 && b.abs() < std::f64::consts::FRAC_PI_2;
-                if inside && !out.iter().any(|&(c, d)| (c - a).abs() < DUPLICATE_TOL_RAD && (d - b).abs() < DUPLICATE_TOL_RAD) {
+                if inside
+                    && !out.iter().any(|&(c, d)| (c - a).abs() < DUPLICATE_TOL_RAD && (d - b).abs() < DUPLICATE_TOL_RAD)
+                {
                     out.push((a, b));
                 }
             }
@@ -663,7 +674,11 @@ fn statics_regular_unchecked(p: &Params, theta1: f64, theta2: f64) -> Statics {
     ]);
     let scale = a.column(0).norm() * a.column(1).norm() * a.column(2).norm();
     let singular = !(a.determinant().abs() > SINGULAR_REL_DET * scale);
-    let x = if singular { Vector3::repeat(f64::NAN) } else { a.lu().solve(&(-known_moment)).unwrap_or_else(|| Vector3::repeat(f64::NAN)) };
+    let x = if singular {
+        Vector3::repeat(f64::NAN)
+    } else {
+        a.lu().solve(&(-known_moment)).unwrap_or_else(|| Vector3::repeat(f64::NAN))
+    };
     let t = [x[0], x[1]];
     // Eq. 22.
     let f_joint = -(t[0] * ucab[0] + t[1] * ucab[1] + fs[0] * uspr[0] + fs[1] * uspr[1] + weight);
@@ -909,7 +924,8 @@ fn finding(equation: &'static str, claim: &str, measured: String, holds: bool) -
 }
 
 /// Sample joint coordinates for the generic identities [rad].
-const SAMPLE_THETAS: [(f64, f64); 6] = [(0.0, 0.0), (0.3, 0.2), (-0.4, 0.35), (0.1, -0.3), (-0.5, -0.45), (0.52, -0.05)];
+const SAMPLE_THETAS: [(f64, f64); 6] =
+    [(0.0, 0.0), (0.3, 0.2), (-0.4, 0.35), (0.1, -0.3), (-0.5, -0.45), (0.52, -0.05)];
 
 /// Every printed equation and table checked against the derivation, with numbers.
 pub fn findings(p: &Params) -> Vec<Finding> {
@@ -923,7 +939,12 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let printed = Matrix4::new(c, 0.0, -s, 0.0, s, 0.0, c, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0);
         mat_err(&printed, &t_0_1(a))
     });
-    f.push(finding("Eq. 1-2", "^W T_0 = Trans_x(l1); ^0 T_1 = DH(θ1, d=0, a=0, α=-π/2)", format!("max entry error of printed Eq. 2 vs DH {e2:.1e}"), e2 < 1e-15));
+    f.push(finding(
+        "Eq. 1-2",
+        "^W T_0 = Trans_x(l1); ^0 T_1 = DH(θ1, d=0, a=0, α=-π/2)",
+        format!("max entry error of printed Eq. 2 vs DH {e2:.1e}"),
+        e2 < 1e-15,
+    ));
 
     // Eq. 3.
     let e3 = max_over(&|_, b| mat_err(&t_1_m_as_printed(p, b), &t_1_m(p, b)));
@@ -937,12 +958,22 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let e9 = (t_w_m2(p, a, b).fixed_view::<3, 1>(0, 3) - p_m2_eq9(p, a, b)).amax();
         e8.max(e9)
     });
-    f.push(finding("Eq. 4-9", "P_M1, P_M2 (Eq. 8-9) = translation of ^W T_0 ^0 T_1 ^1 T_M ^M T_Mi (derived Eq. 3)", format!("max error {:.1e} mm", to_mm(e69)), e69 < 1e-14));
+    f.push(finding(
+        "Eq. 4-9",
+        "P_M1, P_M2 (Eq. 8-9) = translation of ^W T_0 ^0 T_1 ^1 T_M ^M T_Mi (derived Eq. 3)",
+        format!("max error {:.1e} mm", to_mm(e69)),
+        e69 < 1e-14,
+    ));
 
     // Eq. 15.
     let e15 = max_over(&|a, b| mat_err(&t_w_m(p, a, b), &t_w_m_chain(p, a, b)));
     let e15p = max_over(&|a, b| mat_err(&t_w_m(p, a, b), &(t_w_0(p) * t_0_1(a) * t_1_m_as_printed(p, b))));
-    f.push(finding("Eq. 15", "^W T_M closed form", format!("max error vs derived chain {:.1e} m; vs chain with printed Eq. 3 {:.1} mm", e15, to_mm(e15p)), e15 < 1e-14));
+    f.push(finding(
+        "Eq. 15",
+        "^W T_M closed form",
+        format!("max error vs derived chain {:.1e} m; vs chain with printed Eq. 3 {:.1} mm", e15, to_mm(e15p)),
+        e15 < 1e-14,
+    ));
 
     // Eq. 12-13.
     let e12 = max_over(&|a, b| {
@@ -950,7 +981,12 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let b1 = cable_base_points(p);
         ((p_m1_eq8(p, a, b) - b1[0]).norm() - l[0]).abs().max(((p_m2_eq9(p, a, b) - b1[1]).norm() - l[1]).abs())
     });
-    f.push(finding("Eq. 12-13", "cable lengths = |P_Mi - B_i|", format!("max error {:.1e} m (B1, B2 not given in the paper; fitted)", e12), e12 < 1e-14));
+    f.push(finding(
+        "Eq. 12-13",
+        "cable lengths = |P_Mi - B_i|",
+        format!("max error {:.1e} m (B1, B2 not given in the paper; fitted)", e12),
+        e12 < 1e-14,
+    ));
 
     // Eq. 16-17.
     {
@@ -966,7 +1002,12 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         }
         f.push(finding("Eq. 16", "θ1 = atan2(t23, t13)",
             format!("= atan2(s1 s2, c1 s2): right only for θ2 > 0; gives θ1 ± π for θ2 < 0 and atan2(0,0) at θ2 = 0 (the home pose). {}. Correct: θ1 = atan2(-t12, t22) (max error {worst_d:.1e} rad)", txt.join("; ")), false));
-        f.push(finding("Eq. 17", "θ2 = atan2(-t31, t33)", format!("= atan2(s2, c2); with θ1 = atan2(-t12,t22) the round trip errs by at most {worst_d:.1e} rad"), worst_d < 1e-14));
+        f.push(finding(
+            "Eq. 17",
+            "θ2 = atan2(-t31, t33)",
+            format!("= atan2(s2, c2); with θ1 = atan2(-t12,t22) the round trip errs by at most {worst_d:.1e} rad"),
+            worst_d < 1e-14,
+        ));
     }
 
     // Eq. 18-23: determinacy.
@@ -1013,7 +1054,10 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     // Eq. 26-27.
     {
         let s = statics(p, TABLE3_EXPERIMENTS[0].0, TABLE3_EXPERIMENTS[0].1);
-        let literal = TABLE3_EXPERIMENTS.iter().filter(|&&(a, b)| equilibrium_eq27_as_printed(&statics(p, a, b), 1e-6, 1e-9)).count();
+        let literal = TABLE3_EXPERIMENTS
+            .iter()
+            .filter(|&&(a, b)| equilibrium_eq27_as_printed(&statics(p, a, b), 1e-6, 1e-9))
+            .count();
         let ours = TABLE3_EXPERIMENTS.iter().filter(|&&(a, b)| statics(p, a, b).equilibrium).count();
         f.push(finding("Eq. 26-27", "equilibrium iff |f_C|,|f_R| >= 0, |f_joint| <= 0, |m_joint| = 0",
             format!("read literally, |f| >= 0 is always true and |f_joint| <= 0, |m_joint| = 0 demand a joint without reaction, contradicting Table 5 (|f_joint| = 5.13 N, m_joint = 0.97 N*mm) and the model (|f_joint| = {:.3} N at exp. 1): {literal}/4 experiments pass literally, {ours}/4 pass the implemented condition (cables and springs in tension; the joint moment vanishes about its two free axes by construction)", s.joint_reaction_force.norm()), false));
@@ -1041,7 +1085,12 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     // Table 3 in workspace.
     {
         let ok = TABLE3_EXPERIMENTS.iter().all(|&(a, b)| stable_with_fixed_cables(p, a, b));
-        f.push(finding("Table 3 / Sec. 5", "the four experiments are equilibrium configurations", format!("all four are equilibria with both cables taut in the fitted model: {ok}"), ok));
+        f.push(finding(
+            "Table 3 / Sec. 5",
+            "the four experiments are equilibrium configurations",
+            format!("all four are equilibria with both cables taut in the fitted model: {ok}"),
+            ok,
+        ));
     }
     f
 }
@@ -1075,8 +1124,16 @@ mod tests {
     fn dh_chain_equals_eq15_and_eq8_eq9() {
         for &(a, b) in &SAMPLE_THETAS {
             assert_relative_eq!(t_w_m_chain(&P, a, b), t_w_m(&P, a, b), epsilon = 1e-14);
-            assert_relative_eq!(t_w_m1(&P, a, b).fixed_view::<3, 1>(0, 3).into_owned(), p_m1_eq8(&P, a, b), epsilon = 1e-14);
-            assert_relative_eq!(t_w_m2(&P, a, b).fixed_view::<3, 1>(0, 3).into_owned(), p_m2_eq9(&P, a, b), epsilon = 1e-14);
+            assert_relative_eq!(
+                t_w_m1(&P, a, b).fixed_view::<3, 1>(0, 3).into_owned(),
+                p_m1_eq8(&P, a, b),
+                epsilon = 1e-14
+            );
+            assert_relative_eq!(
+                t_w_m2(&P, a, b).fixed_view::<3, 1>(0, 3).into_owned(),
+                p_m2_eq9(&P, a, b),
+                epsilon = 1e-14
+            );
             let q = points(&P, a, b);
             assert_relative_eq!(q.cable_platform[0], p_m1_eq8(&P, a, b), epsilon = 1e-14);
         }
@@ -1151,11 +1208,19 @@ mod tests {
             let s = statics(&P, a, b);
             assert!(!s.singular);
             let q = points(&P, a, b);
-            let f: Vector3<f64> = (0..2).map(|i| s.cable_tensions[i] * s.cable_directions[i] + s.spring_forces[i] * s.spring_directions[i]).sum::<Vector3<f64>>()
-                + s.weight + s.joint_reaction_force;
-            let m: Vector3<f64> = (0..2).map(|i| (q.cable_platform[i] - q.o).cross(&(s.cable_tensions[i] * s.cable_directions[i]))
-                + (q.spring_platform[i] - q.o).cross(&(s.spring_forces[i] * s.spring_directions[i]))).sum::<Vector3<f64>>()
-                + (q.g - q.o).cross(&s.weight) + s.joint_reaction_moment;
+            let f: Vector3<f64> = (0..2)
+                .map(|i| s.cable_tensions[i] * s.cable_directions[i] + s.spring_forces[i] * s.spring_directions[i])
+                .sum::<Vector3<f64>>()
+                + s.weight
+                + s.joint_reaction_force;
+            let m: Vector3<f64> = (0..2)
+                .map(|i| {
+                    (q.cable_platform[i] - q.o).cross(&(s.cable_tensions[i] * s.cable_directions[i]))
+                        + (q.spring_platform[i] - q.o).cross(&(s.spring_forces[i] * s.spring_directions[i]))
+                })
+                .sum::<Vector3<f64>>()
+                + (q.g - q.o).cross(&s.weight)
+                + s.joint_reaction_moment;
             assert!(f.norm() < 1e-12 && m.norm() < 1e-13, "Eq. 22 {f:?}, Eq. 23 {m:?}");
             // The joint moment has no component about the two free axes.
             assert!(s.joint_reaction_moment.dot(&joint_axis_base()).abs() < 1e-15);

@@ -7,7 +7,7 @@
 
 use super::analytic::{self, Params};
 use crate::structure::{
-    Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Strut, Structure, Vec3,
+    Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut, Vec3,
 };
 use nalgebra::Vector3;
 

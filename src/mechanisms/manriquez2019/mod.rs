@@ -20,33 +20,132 @@ pub struct Manriquez2019;
 pub const DEFAULT_START_OFFSET_RAD: f64 = 0.03;
 
 const PARAMS: &[ParamSpec] = &[
-    ParamSpec { symbol: "a2", unit: "m", default: analytic::A2_MM / analytic::MM_PER_M, description: "distance from the joint to the platform centre M (Table 1: 210 mm)", origin: Origin::Paper },
-    ParamSpec { symbol: "l1", unit: "m", default: analytic::L1_MM / analytic::MM_PER_M, description: "offset of the joint O from the world origin along x (Table 1: 190 mm)", origin: Origin::Paper },
-    ParamSpec { symbol: "l2", unit: "m", default: analytic::L2_MM / analytic::MM_PER_M, description: "side of the platform square (Table 1: 220 mm)", origin: Origin::Paper },
-    ParamSpec { symbol: "m", unit: "kg", default: analytic::PLATFORM_MASS_KG, description: "platform mass (Section 3: 0.4732 kg)", origin: Origin::Paper },
-    ParamSpec { symbol: "g", unit: "m/s^2", default: analytic::GRAVITY_M_S2, description: "gravity along +x_W: the base above, the platform hanging (Table 5 forces this reading)", origin: Origin::Paper },
-    ParamSpec { symbol: "base_x", unit: "m", default: analytic::FIT_BASE_X_MM / analytic::MM_PER_M, description: "x of the base plane holding B1..B4 (not in the paper: fitted to Table 5)", origin: Origin::ModelChoice },
-    ParamSpec { symbol: "base_half", unit: "m", default: analytic::FIT_BASE_HALF_MM / analytic::MM_PER_M, description: "half-side of the base square B1..B4 (not in the paper: fitted to Table 5)", origin: Origin::ModelChoice },
-    ParamSpec { symbol: "k_spring", unit: "N/m", default: analytic::FIT_SPRING_K_N_PER_M, description: "spring stiffness (not in the paper: fitted to Table 5)", origin: Origin::ModelChoice },
-    ParamSpec { symbol: "l0_spring", unit: "m", default: analytic::FIT_SPRING_REST_MM / analytic::MM_PER_M, description: "spring free length (not in the paper: the fit drives it to 0)", origin: Origin::ModelChoice },
-    ParamSpec { symbol: "c_joint", unit: "N m s/rad", default: 0.05, description: "viscous damping of the universal joint (not in the paper: zero at rest)", origin: Origin::ModelChoice },
-    ParamSpec { symbol: "r_strut", unit: "m", default: 0.005, description: "strut radius for drawing and interference (not in the paper)", origin: Origin::ModelChoice },
+    ParamSpec {
+        symbol: "a2",
+        unit: "m",
+        default: analytic::A2_MM / analytic::MM_PER_M,
+        description: "distance from the joint to the platform centre M (Table 1: 210 mm)",
+        origin: Origin::Paper,
+    },
+    ParamSpec {
+        symbol: "l1",
+        unit: "m",
+        default: analytic::L1_MM / analytic::MM_PER_M,
+        description: "offset of the joint O from the world origin along x (Table 1: 190 mm)",
+        origin: Origin::Paper,
+    },
+    ParamSpec {
+        symbol: "l2",
+        unit: "m",
+        default: analytic::L2_MM / analytic::MM_PER_M,
+        description: "side of the platform square (Table 1: 220 mm)",
+        origin: Origin::Paper,
+    },
+    ParamSpec {
+        symbol: "m",
+        unit: "kg",
+        default: analytic::PLATFORM_MASS_KG,
+        description: "platform mass (Section 3: 0.4732 kg)",
+        origin: Origin::Paper,
+    },
+    ParamSpec {
+        symbol: "g",
+        unit: "m/s^2",
+        default: analytic::GRAVITY_M_S2,
+        description: "gravity along +x_W: the base above, the platform hanging (Table 5 forces this reading)",
+        origin: Origin::Paper,
+    },
+    ParamSpec {
+        symbol: "base_x",
+        unit: "m",
+        default: analytic::FIT_BASE_X_MM / analytic::MM_PER_M,
+        description: "x of the base plane holding B1..B4 (not in the paper: fitted to Table 5)",
+        origin: Origin::ModelChoice,
+    },
+    ParamSpec {
+        symbol: "base_half",
+        unit: "m",
+        default: analytic::FIT_BASE_HALF_MM / analytic::MM_PER_M,
+        description: "half-side of the base square B1..B4 (not in the paper: fitted to Table 5)",
+        origin: Origin::ModelChoice,
+    },
+    ParamSpec {
+        symbol: "k_spring",
+        unit: "N/m",
+        default: analytic::FIT_SPRING_K_N_PER_M,
+        description: "spring stiffness (not in the paper: fitted to Table 5)",
+        origin: Origin::ModelChoice,
+    },
+    ParamSpec {
+        symbol: "l0_spring",
+        unit: "m",
+        default: analytic::FIT_SPRING_REST_MM / analytic::MM_PER_M,
+        description: "spring free length (not in the paper: the fit drives it to 0)",
+        origin: Origin::ModelChoice,
+    },
+    ParamSpec {
+        symbol: "c_joint",
+        unit: "N m s/rad",
+        default: 0.05,
+        description: "viscous damping of the universal joint (not in the paper: zero at rest)",
+        origin: Origin::ModelChoice,
+    },
+    ParamSpec {
+        symbol: "r_strut",
+        unit: "m",
+        default: 0.005,
+        description: "strut radius for drawing and interference (not in the paper)",
+        origin: Origin::ModelChoice,
+    },
 ];
 
 const INPUTS: &[InputSpec] = &[
-    InputSpec { symbol: "theta1", unit: "rad", description: "joint angle about z_W; the cables are set to its lengths (Eq. 12-13)" },
-    InputSpec { symbol: "theta2", unit: "rad", description: "joint angle about y_M; the cables are set to its lengths (Eq. 12-13)" },
+    InputSpec {
+        symbol: "theta1",
+        unit: "rad",
+        description: "joint angle about z_W; the cables are set to its lengths (Eq. 12-13)",
+    },
+    InputSpec {
+        symbol: "theta2",
+        unit: "rad",
+        description: "joint angle about y_M; the cables are set to its lengths (Eq. 12-13)",
+    },
 ];
 
 const QUANTITIES: &[QuantitySpec] = &[
-    QuantitySpec { symbol: "theta1", unit: "rad", kind: QuantityKind::Angle, description: "settled joint angle about z_W" },
-    QuantitySpec { symbol: "theta2", unit: "rad", kind: QuantityKind::Angle, description: "settled joint angle about y_M" },
-    QuantitySpec { symbol: "f_C1", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable 1 (Eq. 18-23)" },
+    QuantitySpec {
+        symbol: "theta1",
+        unit: "rad",
+        kind: QuantityKind::Angle,
+        description: "settled joint angle about z_W",
+    },
+    QuantitySpec {
+        symbol: "theta2",
+        unit: "rad",
+        kind: QuantityKind::Angle,
+        description: "settled joint angle about y_M",
+    },
+    QuantitySpec {
+        symbol: "f_C1",
+        unit: "N",
+        kind: QuantityKind::Magnitude,
+        description: "tension of cable 1 (Eq. 18-23)",
+    },
     QuantitySpec { symbol: "f_C2", unit: "N", kind: QuantityKind::Magnitude, description: "tension of cable 2" },
     QuantitySpec { symbol: "f_R1", unit: "N", kind: QuantityKind::Magnitude, description: "force of spring 1" },
     QuantitySpec { symbol: "f_R2", unit: "N", kind: QuantityKind::Magnitude, description: "force of spring 2" },
-    QuantitySpec { symbol: "f_joint", unit: "N", kind: QuantityKind::Magnitude, description: "magnitude of the joint reaction force at O" },
-    QuantitySpec { symbol: "m_joint", unit: "N m", kind: QuantityKind::Magnitude, description: "joint reaction moment about z_W x y_M, signed as Table 5" },
+    QuantitySpec {
+        symbol: "f_joint",
+        unit: "N",
+        kind: QuantityKind::Magnitude,
+        description: "magnitude of the joint reaction force at O",
+    },
+    QuantitySpec {
+        symbol: "m_joint",
+        unit: "N m",
+        kind: QuantityKind::Magnitude,
+        description: "joint reaction moment about z_W x y_M, signed as Table 5",
+    },
 ];
 
 const QUERIES: &[QuerySpec] = &[
@@ -183,9 +282,19 @@ impl Mechanism for Manriquez2019 {
                 let st = analytic::statics(&p, t1, t2);
                 let mut v = statics_values(&p, t1, t2);
                 v.insert("equilibrium".into(), f64::from(u8::from(st.equilibrium)));
-                v.insert("stable_fixed_cables".into(), f64::from(u8::from(analytic::stable_with_fixed_cables(&p, t1, t2))));
-                let mut out = vec![Solution { label: "statics (SI; m_joint in N m)".into(), values: v, stable: Some(st.equilibrium) }];
-                if let Some(k) = analytic::TABLE3_EXPERIMENTS.iter().position(|(a, b)| (a - t1).abs() < 1e-9 && (b - t2).abs() < 1e-9) {
+                v.insert(
+                    "stable_fixed_cables".into(),
+                    f64::from(u8::from(analytic::stable_with_fixed_cables(&p, t1, t2))),
+                );
+                let mut out = vec![Solution {
+                    label: "statics (SI; m_joint in N m)".into(),
+                    values: v,
+                    stable: Some(st.equilibrium),
+                }];
+                if let Some(k) = analytic::TABLE3_EXPERIMENTS
+                    .iter()
+                    .position(|(a, b)| (a - t1).abs() < 1e-9 && (b - t2).abs() < 1e-9)
+                {
                     let t = analytic::TABLE5_ANALYTICAL[k];
                     out.push(Solution {
                         label: format!("Table 5, experiment {} (analytical column; m_joint in N mm)", k + 1),
@@ -206,12 +315,18 @@ impl Mechanism for Manriquez2019 {
                 let grid = analytic::paper_grid();
                 let n_eq = analytic::classify(&p, &grid).iter().filter(|e| **e).count();
                 Ok(vec![Solution {
-                    label: format!("grid of {} points (the paper reports n = {})", grid.len(), analytic::PAPER_N_CONFIGURATIONS),
+                    label: format!(
+                        "grid of {} points (the paper reports n = {})",
+                        grid.len(),
+                        analytic::PAPER_N_CONFIGURATIONS
+                    ),
                     values: Values::from([("points".into(), grid.len() as f64), ("equilibria".into(), n_eq as f64)]),
                     stable: None,
                 }])
             }
-            other => Err(format!("unknown query '{other}' for manriquez2019 (expected one of: fk, ik, statics, form_finding)")),
+            other => Err(format!(
+                "unknown query '{other}' for manriquez2019 (expected one of: fk, ik, statics, form_finding)"
+            )),
         }
     }
 

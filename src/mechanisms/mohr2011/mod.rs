@@ -170,6 +170,34 @@ pub fn tensions_with_load(pa: &Params, p: &Vector3<f64>, f: [f64; 3], load: Vect
     }
 }
 
+/// Fixed-point iterations of the elastic-cable equilibrium.
+const ELASTIC_ITERATIONS: usize = 200;
+
+/// End-effector position with elastic cables of stiffness k_cable: each taut cable is
+/// stretched to rho_j + t_j / k, so the centroid is Eq. 12-14 applied to the stretched lengths,
+/// with the tensions of Eq. 26-28 (or the loaded balance) there; solved by fixed-point
+/// iteration from the inextensible answer `p0`. (The two cables of a pair carry one tension
+/// without load; with a load, each pair is stretched by its mean tension.)
+fn elastic_equilibrium(params: &Values, rho: [f64; 3], p0: Vector3<f64>) -> Vector3<f64> {
+    let pa = params_of(params);
+    let k = params["k_cable"];
+    let mut p = p0;
+    for _ in 0..ELASTIC_ITERATIONS {
+        let v = values_at(params, p);
+        let mut stretched = rho;
+        for j in 0..3 {
+            let mean = 0.5 * (v[&format!("t{}", j + 1)] + v[&format!("t{}", j + 4)]);
+            stretched[analytic::CABLES[j].rho] = rho[analytic::CABLES[j].rho] + mean.max(0.0) / k;
+        }
+        match analytic::dkp(&pa, &stretched) {
+            Some(next) if (next - p).norm() <= f64::EPSILON * pa.lb => return next,
+            Some(next) => p = next,
+            None => return p,
+        }
+    }
+    p
+}
+
 /// Whether the legs are straight struts (the variant Section 2 rejects).
 fn is_straight(params: &Values) -> bool {
     params["straight"] != 0.0
@@ -400,6 +428,7 @@ impl Mechanism for Mohr2011 {
         let pa = params_of(params);
         let rho = rho_of(inputs)?;
         let p = analytic::dkp(&pa, &rho).ok_or_else(|| format!("cable lengths {rho:?} m are unreachable"))?;
+        let p = if params["k_cable"] > 0.0 { elastic_equilibrium(params, rho, p) } else { p };
         let expected = values_at(params, p);
         let slack = (0..6).filter(|j| expected[&format!("t{}", j + 1)] < 0.0).map(cable_name).collect();
         Ok(Prediction {
