@@ -28,7 +28,8 @@ pub struct BenchResult {
 }
 
 /// The built-in case sets: (mechanism, scenario file).
-pub const CASE_SETS: &[(&str, &str)] = &[("ji2014", "scenarios/ji2014/grid.toml")];
+pub const CASE_SETS: &[(&str, &str)] =
+    &[("ji2014", "scenarios/ji2014/grid.toml"), ("mohr2011", "scenarios/mohr2011/static_workspace.toml")];
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
@@ -65,7 +66,7 @@ pub fn bench_case_set(mechanism: &str, file: &Path, rounds: usize) -> Result<Ben
         us_per_step.push(r.settle.wall_s * 1e6 / r.settle.steps.max(1) as f64);
         all_settled &= r.settle.settled;
         if round == 0 {
-            let scale = r.params.get("L").copied().unwrap_or(1.0);
+            let scale = crate::mechanisms::find(mechanism).map_or(1.0, |m| m.length_scale(&r.params));
             for p in &r.points {
                 steps.push(p.steps as f64);
                 for c in &sc.checks {
@@ -89,4 +90,59 @@ pub fn bench_case_set(mechanism: &str, file: &Path, rounds: usize) -> Result<Ben
         max_error,
         all_settled,
     })
+}
+
+/// Time per tick of the interference observer's measurement for `n` struts.
+#[derive(Clone, Debug, Serialize)]
+pub struct InterferenceBench {
+    pub struts: usize,
+    /// Pairs measured in the narrow phase (within the margin) per tick.
+    pub pairs_measured: usize,
+    pub median_us_per_tick: f64,
+}
+
+/// Struts for the interference benchmark: `n` capsules of radius 0.01 m, length 0.5 m, in
+/// pseudo-random directions, centred on a jittered cubic lattice of spacing 0.5 m, so that each
+/// strut has a bounded number of neighbours (a structure, not a bundle).
+pub fn interference_capsules(n: usize) -> Vec<crate::observers::interference::Capsule> {
+    const SPACING_M: f64 = 0.5;
+    const HALF_LENGTH_M: f64 = 0.25;
+    const RADIUS_M: f64 = 0.01;
+    let side = (n as f64).cbrt().ceil() as usize;
+    // A fixed linear congruential sequence: the same struts every run.
+    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = move || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..n)
+        .map(|k| {
+            let (i, j, l) = (k % side, (k / side) % side, k / (side * side));
+            let c = [i as f64 * SPACING_M, j as f64 * SPACING_M, l as f64 * SPACING_M];
+            let (u, v) = (next() * 2.0 - 1.0, next() * std::f64::consts::TAU);
+            let s = (1.0 - u * u).sqrt();
+            let d = [s * v.cos() * HALF_LENGTH_M, s * v.sin() * HALF_LENGTH_M, u * HALF_LENGTH_M];
+            ([c[0] - d[0], c[1] - d[1], c[2] - d[2]], [c[0] + d[0], c[1] + d[1], c[2] + d[2]], RADIUS_M)
+        })
+        .collect()
+}
+
+/// Median time of one interference measurement (broad phase + narrow phase) for each size.
+pub fn bench_interference(sizes: &[usize], repeats: usize) -> Vec<InterferenceBench> {
+    const MARGIN_M: f64 = 0.1;
+    sizes
+        .iter()
+        .map(|&n| {
+            let caps = interference_capsules(n);
+            let mut times = Vec::new();
+            let mut pairs = 0;
+            for _ in 0..repeats.max(1) {
+                let t = std::time::Instant::now();
+                let out = crate::observers::interference::clearances(&caps, MARGIN_M, |_, _| false);
+                times.push(t.elapsed().as_secs_f64() * 1e6);
+                pairs = out.len();
+            }
+            InterferenceBench { struts: n, pairs_measured: pairs, median_us_per_tick: median(&mut times) }
+        })
+        .collect()
 }

@@ -313,6 +313,10 @@ fn cmd_findings(mechanism: &str, sets: &[String], json: bool) -> i32 {
     EXIT_PASS
 }
 
+/// Strut counts of the interference benchmark, and the repetitions whose median is reported.
+const INTERFERENCE_BENCH_SIZES: [usize; 3] = [10, 100, 1000];
+const INTERFERENCE_BENCH_REPEATS: usize = 201;
+
 fn cmd_bench(rounds: usize, json: bool) -> i32 {
     let mut results = Vec::new();
     for (m, file) in tensegrity_testbed::bench::CASE_SETS {
@@ -324,8 +328,14 @@ fn cmd_bench(rounds: usize, json: bool) -> i32 {
             }
         }
     }
+    let interference =
+        tensegrity_testbed::bench::bench_interference(&INTERFERENCE_BENCH_SIZES, INTERFERENCE_BENCH_REPEATS);
     if json {
-        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "results": results })).unwrap());
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({ "results": results, "interference": interference }))
+                .unwrap()
+        );
     } else {
         println!(
             "{:<10} {:>6} {:>7} {:>12} {:>12} {:>10} {:>12} {:>12}",
@@ -343,6 +353,11 @@ fn cmd_bench(rounds: usize, json: bool) -> i32 {
                 r.median_error,
                 r.max_error
             );
+        }
+        println!("\ninterference observer (broad + narrow phase), per tick:");
+        println!("{:>8} {:>14} {:>12}", "struts", "pairs measured", "us/tick");
+        for b in &interference {
+            println!("{:>8} {:>14} {:>12.2}", b.struts, b.pairs_measured, b.median_us_per_tick);
         }
     }
     if results.iter().all(|r| r.all_settled) {

@@ -115,9 +115,23 @@ impl Runner<'_> {
         let max_steps = (criteria.max_time_s / dt).ceil() as u64;
         let mut detector = SettleDetector::new();
         let mut last = None;
+        // Two phases when the scenario asks: approach with few PGS iterations, then finish
+        // with the full count once the motion has nearly stopped.
+        let mut approaching = self.sc.sim.approach_pgs_iterations.is_some();
+        if let Some(n) = self.sc.sim.approach_pgs_iterations {
+            self.sim.set_pgs_iterations(n);
+        }
+        let switch_speed = criteria.speed_tol_m_per_s * APPROACH_SWITCH_SPEED_FACTOR;
         for k in 1..=max_steps {
             let (snap, simulated) = self.step(inputs, prediction)?;
             let quiet = detector.update(&snap, dt, &criteria);
+            if approaching && detector.last_speed <= switch_speed {
+                approaching = false;
+                self.sim.set_pgs_iterations(self.sc.sim.pgs_iterations);
+                detector.reset();
+                continue;
+            }
+            let quiet = quiet && !approaching;
             if quiet && SettleDetector::residual_ok(&snap, &criteria) {
                 return Ok(Settled {
                     settled: true,
@@ -137,6 +151,7 @@ impl Runner<'_> {
                 (s, v)
             }
         };
+        self.sim.set_pgs_iterations(self.sc.sim.pgs_iterations);
         Ok(Settled { settled: false, steps: max_steps, final_speed: detector.last_speed, snapshot, simulated })
     }
 
@@ -189,6 +204,10 @@ impl Runner<'_> {
         Ok(Some(2.0 * torque / mechanisms::wrap_angle(q[0] - q[1])))
     }
 }
+
+/// The approach phase of a settle ends when the speed falls below the settle threshold times
+/// this factor (for a 1e-12 m/s threshold: 1e-6 m/s).
+const APPROACH_SWITCH_SPEED_FACTOR: f64 = 1e6;
 
 /// A perturbed equilibrium counts as returned when every node is back within this fraction of
 /// the perturbation (times the structure's length).

@@ -81,6 +81,9 @@ pub struct RawSim {
     pub dt: Option<Spanned<f64>>,
     pub substeps: Option<Spanned<i64>>,
     pub pgs_iterations: Option<Spanned<i64>>,
+    /// PGS iterations while approaching an equilibrium, before the final phase at
+    /// `pgs_iterations` (default: the same, one phase).
+    pub approach_pgs_iterations: Option<Spanned<i64>>,
     pub body_damping: Option<Spanned<f64>>,
     pub bounding_box: Option<Spanned<f64>>,
 }
@@ -311,6 +314,10 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         dt_s: positive(ctx, &raw.sim.dt, "sim.dt (time step, s)", SimSettings::default().dt_s)?,
         substeps: count(ctx, &raw.sim.substeps, "sim.substeps", 1, 64)?,
         pgs_iterations: count(ctx, &raw.sim.pgs_iterations, "sim.pgs_iterations", 8, 4096)?,
+        approach_pgs_iterations: match &raw.sim.approach_pgs_iterations {
+            None => None,
+            Some(_) => Some(count(ctx, &raw.sim.approach_pgs_iterations, "sim.approach_pgs_iterations", 8, 4096)?),
+        },
         body_damping_per_s: match &raw.sim.body_damping {
             None => 0.0,
             Some(s) => {

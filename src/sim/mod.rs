@@ -34,6 +34,9 @@ pub struct SimSettings {
     pub substeps: usize,
     /// rapier PGS iterations per substep (`num_internal_pgs_iterations`).
     pub pgs_iterations: usize,
+    /// PGS iterations while a settle approaches its equilibrium (cheaper, with a larger
+    /// impulse-joint offset); the last phase runs at `pgs_iterations`. None: one phase.
+    pub approach_pgs_iterations: Option<usize>,
     /// Half-size of the box that every node must stay inside, else the run diverged [m].
     pub bounding_box_m: f64,
     /// Linear and angular damping of free bodies [1/s] (applied after each step; it slows
@@ -43,7 +46,14 @@ pub struct SimSettings {
 
 impl Default for SimSettings {
     fn default() -> Self {
-        SimSettings { dt_s: 0.01, substeps: 1, pgs_iterations: 8, bounding_box_m: 1e3, body_damping_per_s: 0.0 }
+        SimSettings {
+            dt_s: 0.01,
+            substeps: 1,
+            pgs_iterations: 8,
+            approach_pgs_iterations: None,
+            bounding_box_m: 1e3,
+            body_damping_per_s: 0.0,
+        }
     }
 }
 
@@ -128,6 +138,11 @@ impl Simulation {
     pub fn new(structure: &Structure, settings: &SimSettings) -> Result<Self, SimError> {
         structure.validate().map_err(|e| SimError::Build(e.to_string()))?;
         build::build(structure, settings)
+    }
+
+    /// Sets rapier's PGS iterations per substep from now on.
+    pub fn set_pgs_iterations(&mut self, n: usize) {
+        self.params.num_internal_pgs_iterations = n.max(1);
     }
 
     pub fn tick(&self) -> u64 {
