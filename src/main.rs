@@ -2,6 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use tensegrity_testbed::mechanisms::{self, Origin, Values};
@@ -70,7 +71,25 @@ enum Command {
     },
 }
 
+/// Set by SIGINT or SIGTERM: the running scenario stops at its next tick, the reports of what
+/// ran are written, and the batch stops.
+static CANCEL: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(_signal: libc::c_int) {
+    CANCEL.store(true, Ordering::SeqCst);
+}
+
+fn install_signal_handlers() {
+    let handler = on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t;
+    // SAFETY: the handler only stores to an atomic, which is async-signal-safe.
+    unsafe {
+        libc::signal(libc::SIGINT, handler);
+        libc::signal(libc::SIGTERM, handler);
+    }
+}
+
 fn main() -> ExitCode {
+    install_signal_handlers();
     let cli = Cli::parse();
     let code = match cli.command {
         Command::Run { scenarios, json, record } => cmd_run(&scenarios, json.as_deref(), record.as_deref()),
@@ -151,8 +170,14 @@ fn cmd_run(paths: &[PathBuf], json: Option<&Path>, record: Option<&Path>) -> i32
     let several = scenarios.len() > 1;
     let mut report = Report { scenarios: vec![] };
     for sc in &scenarios {
-        let opts = RunOptions { record: record.map(|r| record_path(r, &sc.name, several)), cancel: None };
-        let r = run(sc, &opts);
+        if CANCEL.load(Ordering::SeqCst) {
+            eprintln!("interrupted: {} scenario(s) not run", scenarios.len() - report.scenarios.len());
+            break;
+        }
+        let opts = RunOptions { record: record.map(|r| record_path(r, &sc.name, several)), cancel: Some(&CANCEL) };
+        // A panic inside one scenario fails that scenario, with its message; the batch goes on.
+        let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(sc, &opts)))
+            .unwrap_or_else(|payload| tensegrity_testbed::run::panicked(sc, payload.as_ref()));
         report.scenarios.push(r);
     }
     print!("{}", report.to_table());
@@ -162,7 +187,7 @@ fn cmd_run(paths: &[PathBuf], json: Option<&Path>, record: Option<&Path>) -> i32
             return EXIT_FAIL;
         }
     }
-    if report.passed() {
+    if report.passed() && !CANCEL.load(Ordering::SeqCst) {
         EXIT_PASS
     } else {
         EXIT_FAIL

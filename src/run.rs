@@ -241,9 +241,42 @@ fn branch_of(
     }
 }
 
+/// The report of a scenario whose run panicked: failed, with the panic's message.
+pub fn panicked(sc: &Scenario, payload: &(dyn std::any::Any + Send)) -> ScenarioReport {
+    let msg = payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into());
+    ScenarioReport {
+        name: sc.name.clone(),
+        file: sc.file.display().to_string(),
+        mechanism: sc.mechanism.clone(),
+        passed: false,
+        params: sc.params.clone(),
+        settle: SettleSummary::default(),
+        checks: vec![],
+        points: vec![],
+        stiffness_probe: None,
+        slack_intervals: vec![],
+        workspace: None,
+        skipped_points: sc.skipped_points.len(),
+        interference: None,
+        findings: vec![],
+        error: Some(format!("panicked: {msg}")),
+    }
+}
+
+/// Test hook: a run of the scenario named by this variable panics (to test that a panic in one
+/// scenario of a batch fails that scenario and the batch goes on).
+pub const INJECT_PANIC_VAR: &str = "TENSEGRITY_INJECT_PANIC";
+
 /// Runs a validated scenario. Bad model input found late (for example a structure the
 /// simulator cannot build) is reported in `error` with `passed = false`.
 pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
+    if std::env::var(INJECT_PANIC_VAR).is_ok_and(|n| n == sc.name) {
+        panic!("injected by {INJECT_PANIC_VAR} (test hook)");
+    }
     let mech = mechanisms::find(&sc.mechanism).expect("validated mechanism");
     let mut report = ScenarioReport {
         name: sc.name.clone(),

@@ -1,0 +1,114 @@
+//! Fuzzing the scenario parser and validator: random mutations of the corpus scenarios in
+//! `tests/fuzz_corpus/` must give `Ok` or a located error, never a panic; a scenario that
+//! parses must build a structure and a simulation without panicking.
+//!
+//! The test suite runs a few hundred cases. The long run (documented in the README):
+//! `PROPTEST_CASES=1000000 cargo test --release --test fuzz_scenarios` (stop it after 10
+//! minutes or more; any failing input is saved under `proptest-regressions/`).
+
+use proptest::prelude::*;
+use std::path::Path;
+use tensegrity_testbed::mechanisms;
+use tensegrity_testbed::scenario;
+use tensegrity_testbed::sim::Simulation;
+
+fn corpus() -> Vec<String> {
+    let mut files: Vec<_> = std::fs::read_dir("tests/fuzz_corpus").unwrap().filter_map(|e| e.ok()).map(|e| e.path()).collect();
+    files.sort();
+    files.iter().map(|p| std::fs::read_to_string(p).unwrap()).collect()
+}
+
+/// Tokens that stress the parser and the validator.
+const TOKENS: &[&str] = &[
+    "nan", "inf", "-inf", "-1.0", "0", "0.0", "1e309", "-1e-300", "\"x\"", "[", "]", "{", "}", "=", ",", "\n", "[[checks]]",
+    "[actuation]", "[sim]", "[params]", "[start]", "[interference]", "[workspace]", "t = ", "points = []", "grid = {}",
+    "waypoints = [", "quantity = \"zeta\"", "mechanism = \"mohr2011\"", "mechanism = \"furet2018\"",
+    "mechanism = \"manriquez2019\"", "straight = 1.0", "count = 0", "count = 100000", "skip_outside = true",
+    "dt = 1e-300", "pgs_iterations = 0", "approach_pgs_iterations = 4096", "\u{0}", "é", "#",
+];
+
+#[derive(Clone, Debug)]
+enum Mutation {
+    Delete { at: usize, len: usize },
+    Insert { at: usize, token: usize },
+    ReplaceNumber { which: usize, token: usize },
+    SwapLines { a: usize, b: usize },
+}
+
+fn mutation() -> impl Strategy<Value = Mutation> {
+    prop_oneof![
+        (any::<usize>(), 1usize..40).prop_map(|(at, len)| Mutation::Delete { at, len }),
+        (any::<usize>(), 0..TOKENS.len()).prop_map(|(at, token)| Mutation::Insert { at, token }),
+        (any::<usize>(), 0..TOKENS.len()).prop_map(|(which, token)| Mutation::ReplaceNumber { which, token }),
+        (any::<usize>(), any::<usize>()).prop_map(|(a, b)| Mutation::SwapLines { a, b }),
+    ]
+}
+
+fn apply(text: &str, m: &Mutation) -> String {
+    let chars: Vec<char> = text.chars().collect();
+    let n = chars.len().max(1);
+    match m {
+        Mutation::Delete { at, len } => {
+            let a = at % n;
+            let b = (a + len).min(chars.len());
+            chars[..a].iter().chain(&chars[b..]).collect()
+        }
+        Mutation::Insert { at, token } => {
+            let a = at % n;
+            let mut s: String = chars[..a.min(chars.len())].iter().collect();
+            s.push_str(TOKENS[*token]);
+            s.extend(&chars[a.min(chars.len())..]);
+            s
+        }
+        Mutation::ReplaceNumber { which, token } => {
+            // Replace the which-th number-looking word.
+            let words: Vec<(usize, usize)> = text
+                .char_indices()
+                .filter(|(i, c)| c.is_ascii_digit() && (*i == 0 || !text.as_bytes()[i - 1].is_ascii_alphanumeric()))
+                .map(|(i, _)| (i, text[i..].find(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-')).map_or(text.len(), |e| i + e)))
+                .collect();
+            if words.is_empty() {
+                return text.to_string();
+            }
+            let (a, b) = words[which % words.len()];
+            format!("{}{}{}", &text[..a], TOKENS[*token], &text[b..])
+        }
+        Mutation::SwapLines { a, b } => {
+            let mut lines: Vec<&str> = text.lines().collect();
+            if lines.len() > 1 {
+                let (i, j) = (a % lines.len(), b % lines.len());
+                lines.swap(i, j);
+            }
+            lines.join("\n")
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, failure_persistence: Some(Box::new(proptest::test_runner::FileFailurePersistence::WithSource("regressions"))), ..ProptestConfig::default() })]
+
+    #[test]
+    fn mutated_scenarios_never_panic(seed in 0usize..1000, muts in proptest::collection::vec(mutation(), 1..6)) {
+        let corpus = corpus();
+        let mut text = corpus[seed % corpus.len()].clone();
+        for m in &muts {
+            text = apply(&text, m);
+        }
+        match scenario::parse(Path::new("fuzz.toml"), &text) {
+            Err(e) => {
+                // Every error is located.
+                prop_assert!(e.to_string().starts_with("fuzz.toml:"), "{}", e);
+            }
+            Ok(sc) => {
+                let m = mechanisms::find(&sc.mechanism).expect("validated mechanism");
+                let inputs = match &sc.actuation {
+                    scenario::Actuation::Points { points, .. } => points[0].clone(),
+                    scenario::Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
+                };
+                if let Ok(s) = m.build(&sc.params, &inputs, &sc.start) {
+                    let _ = Simulation::new(&s, &sc.sim);
+                }
+            }
+        }
+    }
+}

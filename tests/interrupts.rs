@@ -1,0 +1,71 @@
+//! Interrupted runs and panics: a run killed with SIGINT or SIGTERM stops at the next tick,
+//! writes its report (atomically, never truncating the previous file) and exits non-zero; a
+//! panic in one scenario of a batch fails that scenario and the batch goes on.
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn out_dir(tag: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("tensegrity-int-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn interrupt_with(signal: &str) {
+    let dir = out_dir(signal);
+    let json = dir.join("report.json");
+    std::fs::write(&json, "previous report").unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+        .args(["run", "scenarios/mohr2011/workspace_sweep.toml", "scenarios/ji2014/quick.toml", "--json"])
+        .arg(&json)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    std::thread::sleep(Duration::from_millis(1500));
+    let killed = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
+    assert!(killed.success());
+    let start = Instant::now();
+    let status = child.wait().expect("exits");
+    // It stops at the next tick: well within a second of the signal.
+    assert!(start.elapsed() < Duration::from_secs(5), "took {:?} to stop", start.elapsed());
+    assert_eq!(status.code(), Some(1), "{signal}: non-zero exit");
+    let text = std::fs::read_to_string(&json).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).expect("a complete JSON report replaced the old file");
+    let scenarios = v["scenarios"].as_array().unwrap();
+    assert_eq!(scenarios.len(), 1, "the batch stopped after the interrupted scenario");
+    let err = scenarios[0]["error"].as_str().unwrap();
+    assert!(err.contains("interrupted at tick"), "{err}");
+    assert_eq!(scenarios[0]["passed"], false);
+    let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains("partial")).collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn sigint_stops_the_run_writes_the_report_and_exits_1() {
+    interrupt_with("INT");
+}
+
+#[test]
+fn sigterm_stops_the_run_writes_the_report_and_exits_1() {
+    interrupt_with("TERM");
+}
+
+#[test]
+fn a_panic_fails_its_scenario_and_the_batch_goes_on() {
+    let dir = out_dir("panic");
+    let json = dir.join("report.json");
+    let out = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+        .args(["run", "scenarios/ji2014/quick.toml", "scenarios/mohr2011/quick.toml", "--json"])
+        .arg(&json)
+        .env(tensegrity_testbed::run::INJECT_PANIC_VAR, "ji2014-quick")
+        .output()
+        .expect("binary runs");
+    assert_eq!(out.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let s = v["scenarios"].as_array().unwrap();
+    assert_eq!(s.len(), 2);
+    assert_eq!(s[0]["passed"], false);
+    assert!(s[0]["error"].as_str().unwrap().starts_with("panicked: injected"), "{}", s[0]["error"]);
+    assert_eq!(s[1]["passed"], true, "the batch went on");
+}
