@@ -2,9 +2,9 @@
 
 use clap::{Parser, Subcommand};
 use std::io::Write;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 use tensegrity_testbed::mechanisms::{self, Origin, Values};
 use tensegrity_testbed::report::{Report, EXIT_BAD_INPUT, EXIT_FAIL, EXIT_PASS};
 use tensegrity_testbed::run::{run, RunOptions};

@@ -77,6 +77,8 @@ pub struct PointReport {
     pub residual_torque_nm: f64,
     /// Speed at the last tick of the settle [m/s].
     pub final_speed_m_per_s: f64,
+    /// Kinetic energy left at the last tick of the settle [J] (what an unsettled point still had).
+    pub final_kinetic_energy_j: f64,
     /// The analytic branch the dynamics landed on.
     pub branch: String,
     /// Stability from the perturbation test (None when not tested).

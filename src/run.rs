@@ -475,11 +475,12 @@ fn settle_point(
 ) -> Result<(), Stop> {
     let prediction = runner.mech.predict(&sc.params, inputs).map_err(Stop::Model)?;
     let s = runner.settle(inputs, &prediction)?;
+    let final_energy = runner.sim.kinetic_energy_j();
     runner.emit(&if s.settled {
         format!("point {index} settled after {} steps", s.steps)
     } else {
         format!(
-            "point {index} did NOT settle in {} s (speed {:.3e} m/s, residual {:.3e} N, {:.3e} N m)",
+            "point {index} did NOT settle in {} s (kinetic energy {final_energy:.3e} J, speed {:.3e} m/s, residual {:.3e} N, {:.3e} N m)",
             sc.settle.max_time_s,
             s.final_speed,
             s.snapshot.forces.residual.max_force_n,
@@ -580,6 +581,7 @@ fn settle_point(
         residual_force_n: s.snapshot.forces.residual.max_force_n,
         residual_torque_nm: s.snapshot.forces.residual.max_torque_nm,
         final_speed_m_per_s: s.final_speed,
+        final_kinetic_energy_j: final_energy,
         branch,
         stable,
         analytic_stable,

@@ -86,6 +86,11 @@ pub struct RawSim {
     pub approach_pgs_iterations: Option<Spanned<i64>>,
     pub body_damping: Option<Spanned<f64>>,
     pub bounding_box: Option<Spanned<f64>>,
+    /// Kinetic energy above which the run has diverged [J] (default 1e6).
+    pub max_kinetic_energy: Option<Spanned<f64>>,
+    /// Anchor gap of a loop-closing joint above which the run has diverged [m] (default 1 % of
+    /// the structure's size).
+    pub max_joint_gap: Option<Spanned<f64>>,
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -329,6 +334,16 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
             }
         },
         bounding_box_m: positive(ctx, &raw.sim.bounding_box, "sim.bounding_box (m)", 1e3)?,
+        max_kinetic_energy_j: positive(
+            ctx,
+            &raw.sim.max_kinetic_energy,
+            "sim.max_kinetic_energy (J)",
+            crate::sim::DEFAULT_MAX_KINETIC_ENERGY_J,
+        )?,
+        max_joint_gap_m: match &raw.sim.max_joint_gap {
+            None => None,
+            Some(_) => Some(positive(ctx, &raw.sim.max_joint_gap, "sim.max_joint_gap (m)", 0.0)?),
+        },
     };
     if sim.dt_s > 1.0 {
         let s = raw.sim.dt.as_ref().unwrap();

@@ -6,7 +6,11 @@ use std::process::Command;
 
 fn tensegrity(args: &[&str]) -> (i32, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_tensegrity")).args(args).output().expect("binary runs");
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
 }
 
 const JI: &str = r#"name = "ji"
@@ -72,7 +76,12 @@ fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
         ("wrong type for substeps", JI.replace("dt = 0.01", "dt = 0.01\nsubsteps = 1.5"), 8, "invalid type"),
         ("missing mechanism", JI.replace("mechanism = \"ji2014\"\n", ""), 1, "mechanism"),
         ("missing actuation", JI.replace("[actuation]\npoints = [ { L3 = 1.0, theta1 = 0.5 } ]\n", ""), 1, "actuation"),
-        ("checks nothing", JI.replace("[[checks]]\nquantity = \"theta2\"\ntolerance = 1e-9\n", ""), 1, "checks nothing"),
+        (
+            "checks nothing",
+            JI.replace("[[checks]]\nquantity = \"theta2\"\ntolerance = 1e-9\n", ""),
+            1,
+            "checks nothing",
+        ),
         // Values.
         ("negative length", JI.replace("L = 1.0", "L = -1.0"), 4, "> 0"),
         ("negative stiffness", JI.replace("K1 = 200.0", "K1 = -5.0"), 5, "> 0"),
@@ -109,19 +118,37 @@ fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
         ),
         ("two schedules", JI.replace("points =", "waypoints = []\npoints ="), 10, "exactly one"),
         ("missing input", JI.replace(", theta1 = 0.5", ""), 11, "missing input"),
-        ("grid count zero", JI.replace("points = [ { L3 = 1.0, theta1 = 0.5 } ]", "grid = { L3 = { from = 0.5, to = 1.0, count = 0 }, theta1 = { from = 0.1, to = 0.2, count = 2 } }"), 11, "count"),
+        (
+            "grid count zero",
+            JI.replace(
+                "points = [ { L3 = 1.0, theta1 = 0.5 } ]",
+                "grid = { L3 = { from = 0.5, to = 1.0, count = 0 }, theta1 = { from = 0.1, to = 0.2, count = 2 } }",
+            ),
+            11,
+            "count",
+        ),
         // Actuator targets outside the workspace.
         ("ji2014 theta1 beyond pi", JI.replace("theta1 = 0.5", "theta1 = 4.0"), 11, "[0, pi]"),
         ("ji2014 zero actuator length", JI.replace("L3 = 1.0", "L3 = 0.0"), 11, "> 0"),
         ("mohr2011 below the base", MOHR.replace("z = 3.0", "z = -1.0"), 7, "z > 0"),
         ("mohr2011 spring longer than l_o", MOHR.replace("z = 3.0", "z = 5.9"), 7, "l_o"),
-        ("mohr2011 unreachable cable lengths", MOHR.replace("{ x = 0.0, y = 0.0, z = 3.0 }", "{ rho1 = 0.1, rho2 = 5.0, rho3 = 0.1 }"), 7, "unreachable"),
+        (
+            "mohr2011 unreachable cable lengths",
+            MOHR.replace("{ x = 0.0, y = 0.0, z = 3.0 }", "{ rho1 = 0.1, rho2 = 5.0, rho3 = 0.1 }"),
+            7,
+            "unreachable",
+        ),
         ("mohr2011 l_o not positive", MOHR.replace("lo = 6.0", "lo = 0.0"), 5, "> 0"),
         ("mohr2011 straight not 0 or 1", MOHR.replace("lo = 6.0", "lo = 6.0\nstraight = 0.5"), 6, "straight"),
         ("furet2018 L not above b", FURET.replace("b = 0.6666666666666666", "b = 1.5"), 5, "shorter than L"),
         ("furet2018 change point", FURET.replace("theta1 = 0.2", "theta1 = 1.5707963267948966"), 7, "change point"),
         ("furet2018 angle beyond pi", FURET.replace("theta2 = -0.3", "theta2 = -4.0"), 7, "(-pi, pi)"),
-        ("manriquez2019 singular pose", MQ.replace("theta1 = 0.0941, theta2 = 0.0332", "theta1 = 0.0, theta2 = 0.0"), 4, "singular"),
+        (
+            "manriquez2019 singular pose",
+            MQ.replace("theta1 = 0.0941, theta2 = 0.0332", "theta1 = 0.0, theta2 = 0.0"),
+            4,
+            "singular",
+        ),
         ("manriquez2019 angle too large", MQ.replace("theta1 = 0.0941", "theta1 = 2.0"), 4, "(-pi/2, pi/2)"),
         ("manriquez2019 negative mass", MQ.replace("[actuation]", "[params]\nm = -0.4\n[actuation]"), 4, "> 0"),
     ]
@@ -141,7 +168,8 @@ fn every_malformed_scenario_gives_exit_2_with_file_line_and_column() {
         for cmd in ["check", "run"] {
             let (code, out, err) = tensegrity(&[cmd, file]);
             let prefix = format!("{file}:{line}:");
-            let col_ok = err.find(&prefix).is_some_and(|i| err[i + prefix.len()..].starts_with(|c: char| c.is_ascii_digit()));
+            let col_ok =
+                err.find(&prefix).is_some_and(|i| err[i + prefix.len()..].starts_with(|c: char| c.is_ascii_digit()));
             if code != 2 || err.contains("panicked") || !col_ok || !err.contains(word) {
                 failures.push(format!("{what} ({cmd}): exit {code}, expected line {line} and '{word}': {out}{err}"));
             }

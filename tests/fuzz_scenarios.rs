@@ -13,18 +13,55 @@ use tensegrity_testbed::scenario;
 use tensegrity_testbed::sim::Simulation;
 
 fn corpus() -> Vec<String> {
-    let mut files: Vec<_> = std::fs::read_dir("tests/fuzz_corpus").unwrap().filter_map(|e| e.ok()).map(|e| e.path()).collect();
+    let mut files: Vec<_> =
+        std::fs::read_dir("tests/fuzz_corpus").unwrap().filter_map(|e| e.ok()).map(|e| e.path()).collect();
     files.sort();
     files.iter().map(|p| std::fs::read_to_string(p).unwrap()).collect()
 }
 
 /// Tokens that stress the parser and the validator.
 const TOKENS: &[&str] = &[
-    "nan", "inf", "-inf", "-1.0", "0", "0.0", "1e309", "-1e-300", "\"x\"", "[", "]", "{", "}", "=", ",", "\n", "[[checks]]",
-    "[actuation]", "[sim]", "[params]", "[start]", "[interference]", "[workspace]", "t = ", "points = []", "grid = {}",
-    "waypoints = [", "quantity = \"zeta\"", "mechanism = \"mohr2011\"", "mechanism = \"furet2018\"",
-    "mechanism = \"manriquez2019\"", "straight = 1.0", "count = 0", "count = 100000", "skip_outside = true",
-    "dt = 1e-300", "pgs_iterations = 0", "approach_pgs_iterations = 4096", "\u{0}", "é", "#",
+    "nan",
+    "inf",
+    "-inf",
+    "-1.0",
+    "0",
+    "0.0",
+    "1e309",
+    "-1e-300",
+    "\"x\"",
+    "[",
+    "]",
+    "{",
+    "}",
+    "=",
+    ",",
+    "\n",
+    "[[checks]]",
+    "[actuation]",
+    "[sim]",
+    "[params]",
+    "[start]",
+    "[interference]",
+    "[workspace]",
+    "t = ",
+    "points = []",
+    "grid = {}",
+    "waypoints = [",
+    "quantity = \"zeta\"",
+    "mechanism = \"mohr2011\"",
+    "mechanism = \"furet2018\"",
+    "mechanism = \"manriquez2019\"",
+    "straight = 1.0",
+    "count = 0",
+    "count = 100000",
+    "skip_outside = true",
+    "dt = 1e-300",
+    "pgs_iterations = 0",
+    "approach_pgs_iterations = 4096",
+    "\u{0}",
+    "é",
+    "#",
 ];
 
 #[derive(Clone, Debug)]
@@ -65,7 +102,14 @@ fn apply(text: &str, m: &Mutation) -> String {
             let words: Vec<(usize, usize)> = text
                 .char_indices()
                 .filter(|(i, c)| c.is_ascii_digit() && (*i == 0 || !text.as_bytes()[i - 1].is_ascii_alphanumeric()))
-                .map(|(i, _)| (i, text[i..].find(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-')).map_or(text.len(), |e| i + e)))
+                .map(|(i, _)| {
+                    (
+                        i,
+                        text[i..]
+                            .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-'))
+                            .map_or(text.len(), |e| i + e),
+                    )
+                })
                 .collect();
             if words.is_empty() {
                 return text.to_string();

@@ -37,7 +37,11 @@ fn interrupt_with(signal: &str) {
     let err = scenarios[0]["error"].as_str().unwrap();
     assert!(err.contains("interrupted at tick"), "{err}");
     assert_eq!(scenarios[0]["passed"], false);
-    let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains("partial")).collect();
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("partial"))
+        .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
 

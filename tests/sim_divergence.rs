@@ -58,3 +58,69 @@ fn a_free_body_on_a_zero_length_spring_settles_on_the_anchor() {
     let f = sim.member_forces();
     assert!(f.residual.max_force_n < 1e-9, "residual {:e} N", f.residual.max_force_n);
 }
+
+/// An absurdly stiff spring (1e12 N/m on 1 kg, explicit, dt = 0.01 s) blows up: the energy
+/// check stops the run within a few ticks and says so.
+#[test]
+fn an_absurd_stiffness_is_caught_by_the_energy_check_within_a_few_ticks() {
+    use tensegrity_testbed::structure::Spring;
+    let mut s = Structure::default();
+    let g = s.add_body("ground", BodyKind::Fixed, None);
+    let b = s.add_body(
+        "bob",
+        BodyKind::Free,
+        Some(Inertia { mass_kg: 1.0, com: [1.0, 0.0, 0.0], principal_kg_m2: [0.1; 3] }),
+    );
+    let a = s.add_node("A", g, [0.0; 3]);
+    let p = s.add_node("P", b, [1.0, 0.0, 0.0]);
+    s.springs.push(Spring { name: "stiff".into(), a, b: p, stiffness_n_per_m: 1e12, rest_length_m: 0.5 });
+    let mut sim = Simulation::new(&s, &SimSettings { dt_s: 0.01, ..Default::default() }).unwrap();
+    let err = (0..100).find_map(|_| sim.step().err()).expect("diverges");
+    match err {
+        SimError::Diverged { tick, what, .. } => {
+            assert!(tick <= 5, "caught at tick {tick}");
+            assert!(what.contains("kinetic energy") || what.contains("not finite"), "{what}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// A loop-closing joint torn open by a load it cannot carry within one step (1e9 N on a
+/// 1 kg body held by an impulse joint) is caught by the joint-gap check.
+#[test]
+fn a_joint_that_comes_apart_is_reported_with_its_gap() {
+    use tensegrity_testbed::structure::{Cable, CableLaw, ExternalLoad, Joint, JointKind};
+    let mut s = Structure::default();
+    let g = s.add_body("ground", BodyKind::Fixed, None);
+    let b = s.add_body(
+        "bob",
+        BodyKind::Free,
+        Some(Inertia { mass_kg: 1.0, com: [1.0, 0.0, 0.0], principal_kg_m2: [0.1; 3] }),
+    );
+    let a = s.add_node("A", g, [0.0; 3]);
+    let c = s.add_node("C", g, [1.0, 1.0, 0.0]);
+    let p = s.add_node("P", b, [1.0, 0.0, 0.0]);
+    // The cable keeps the bob a plain body, so the joint at A is an impulse (loop) joint.
+    s.cables.push(Cable { name: "c".into(), a: c, b: p, law: CableLaw::Inextensible, length_m: 2.0 });
+    s.joints.push(Joint {
+        name: "pivot".into(),
+        kind: JointKind::Spherical,
+        parent: g,
+        child: b,
+        anchor: a,
+        initial_coordinate: 0.0,
+        torsion_spring: None,
+        damping: 0.0,
+    });
+    s.loads.push(ExternalLoad { body: b, force_n: [1e9, 0.0, 0.0] });
+    let settings = SimSettings { dt_s: 0.01, bounding_box_m: 1e12, max_kinetic_energy_j: 1e30, ..Default::default() };
+    let mut sim = Simulation::new(&s, &settings).unwrap();
+    let err = (0..100).find_map(|_| sim.step().err()).expect("diverges");
+    match err {
+        SimError::Diverged { tick, what, .. } => {
+            assert!(tick <= 10, "caught at tick {tick}");
+            assert!(what.contains("joint 'pivot' came apart"), "{what}");
+        }
+        other => panic!("{other:?}"),
+    }
+}

@@ -142,6 +142,9 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
     params.dt = settings.dt_s;
     params.num_solver_iterations = settings.substeps;
     params.num_internal_pgs_iterations = settings.pgs_iterations;
+    // rapier caps body speeds at 400 m/s by default: a numerical blow-up would then look like
+    // a bounded oscillation. Uncapped, it shows as divergence (energy, bounding box, NaN).
+    params.normalized_max_linear_velocity = Real::MAX;
 
     let length_scale_m = structure_size(s);
     let commands: Vec<f64> = s

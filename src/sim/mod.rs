@@ -42,7 +42,19 @@ pub struct SimSettings {
     /// Linear and angular damping of free bodies [1/s] (applied after each step; it slows
     /// motion but does not move the equilibrium).
     pub body_damping_per_s: f64,
+    /// Kinetic energy above which the run has diverged [J].
+    pub max_kinetic_energy_j: f64,
+    /// Separation of a loop-closing joint's anchors above which the run has diverged [m]
+    /// (None: 1 % of the structure's size).
+    pub max_joint_gap_m: Option<f64>,
 }
+
+/// Default kinetic-energy limit [J]: far above anything a settling mechanism of this testbed
+/// holds (a few J), far below what a numerical blow-up reaches within a few ticks.
+pub const DEFAULT_MAX_KINETIC_ENERGY_J: f64 = 1e6;
+
+/// Default limit of a loop-closing joint's anchor gap, as a fraction of the structure's size.
+pub const DEFAULT_JOINT_GAP_FRACTION: f64 = 1e-2;
 
 impl Default for SimSettings {
     fn default() -> Self {
@@ -53,6 +65,8 @@ impl Default for SimSettings {
             approach_pgs_iterations: None,
             bounding_box_m: 1e3,
             body_damping_per_s: 0.0,
+            max_kinetic_energy_j: DEFAULT_MAX_KINETIC_ENERGY_J,
+            max_joint_gap_m: None,
         }
     }
 }
@@ -216,6 +230,17 @@ impl Simulation {
             if p.iter().any(|c| !c.is_finite()) {
                 return Err(self.diverged(format!("node '{}' position is not finite", n.name)));
             }
+        }
+        // Energy before position: a blow-up is named for what it is.
+        let energy = self.kinetic_energy_j();
+        if !energy.is_finite() || energy > self.settings.max_kinetic_energy_j {
+            return Err(self.diverged(format!(
+                "kinetic energy {energy:.3e} J exceeds the limit {:.3e} J (sim.max_kinetic_energy)",
+                self.settings.max_kinetic_energy_j
+            )));
+        }
+        for (i, n) in self.structure.nodes.iter().enumerate() {
+            let p = self.node_position(i);
             if p.iter().any(|c| c.abs() > limit) {
                 return Err(self.diverged(format!(
                     "node '{}' left the bounding box of half-size {limit} m (at [{:.3e}, {:.3e}, {:.3e}])",
@@ -223,7 +248,38 @@ impl Simulation {
                 )));
             }
         }
+        let gap_limit = self.settings.max_joint_gap_m.unwrap_or(DEFAULT_JOINT_GAP_FRACTION * self.length_scale_m);
+        for (j, joint) in self.structure.joints.iter().enumerate() {
+            if self.joint_impulse[j].is_none() {
+                continue;
+            }
+            let gap = self.joint_gap_m(j);
+            if !(gap <= gap_limit) {
+                return Err(self.diverged(format!(
+                    "joint '{}' came apart: its anchors are {gap:.3e} m apart (limit {gap_limit:.3e} m, sim.max_joint_gap)",
+                    joint.name
+                )));
+            }
+        }
         Ok(())
+    }
+
+    /// Kinetic energy of every moving body [J].
+    pub fn kinetic_energy_j(&self) -> f64 {
+        (0..self.structure.bodies.len())
+            .filter(|b| self.is_free(*b))
+            .map(|b| self.bodies[self.handles[b]].kinetic_energy())
+            .sum()
+    }
+
+    /// Distance between a joint's anchor as carried by its parent and by its child [m].
+    pub fn joint_gap_m(&self, joint: usize) -> f64 {
+        let j = &self.structure.joints[joint];
+        let a = self.structure.nodes[j.anchor].position;
+        let a = Vector::new(a[0], a[1], a[2]);
+        let p = self.bodies[self.handles[j.parent]].position().transform_point(a);
+        let c = self.bodies[self.handles[j.child]].position().transform_point(a);
+        (p - c).length()
     }
 
     fn diverged(&self, what: String) -> SimError {
