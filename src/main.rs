@@ -41,6 +41,29 @@ enum Command {
     },
     /// List the mechanisms, their parameters (units, defaults) and their queries.
     List,
+    /// Settle every point of a scenario's grid in parallel; write a CSV and a JSON summary.
+    Sweep {
+        scenario: PathBuf,
+        /// The CSV (one row per point); default: print the summary only.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// The JSON summary.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Worker threads.
+        #[arg(long, default_value_t = 2)]
+        jobs: usize,
+        /// Run the K-th of N interleaved slices of the grid (for job arrays), as K/N.
+        #[arg(long)]
+        shard: Option<String>,
+    },
+    /// Join the CSVs of a sharded sweep into one, rows in grid order.
+    Merge {
+        #[arg(required = true)]
+        csvs: Vec<PathBuf>,
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// The analytic model alone: print every result of a query.
     Solve {
         mechanism: String,
@@ -103,6 +126,10 @@ fn main() -> ExitCode {
             Err(code) => code,
         },
         Command::List => cmd_list(),
+        Command::Sweep { scenario, out, json, jobs, shard } => {
+            cmd_sweep(&scenario, out.as_deref(), json.as_deref(), jobs, shard.as_deref())
+        }
+        Command::Merge { csvs, out } => cmd_merge(&csvs, &out),
         Command::Solve { mechanism, query, set, json } => cmd_solve(&mechanism, &query, &set, json),
         Command::Findings { mechanism, set, json } => cmd_findings(&mechanism, &set, json),
         Command::Bench { rounds, json } => cmd_bench(rounds, json),
@@ -191,6 +218,97 @@ fn cmd_run(paths: &[PathBuf], json: Option<&Path>, record: Option<&Path>) -> i32
         EXIT_PASS
     } else {
         EXIT_FAIL
+    }
+}
+
+fn cmd_sweep(path: &Path, out: Option<&Path>, json: Option<&Path>, jobs: usize, shard: Option<&str>) -> i32 {
+    let sc = match load_all(&[path.to_path_buf()]) {
+        Ok(mut s) => s.remove(0),
+        Err(code) => return code,
+    };
+    let shard = match shard.map(tensegrity_testbed::sweep::parse_shard).transpose() {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} points, {per_sec}, {eta} left")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let progress = |done: usize, total: usize| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    };
+    let result = tensegrity_testbed::sweep::sweep(&sc, jobs, shard, Some(&CANCEL), &progress);
+    bar.finish_and_clear();
+    let (rows, summary) = match result {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    println!(
+        "{}: {} point(s), {} settled, {} within tolerance, {:.2} s wall on {} job(s){}",
+        summary.scenario,
+        summary.points,
+        summary.settled,
+        summary.within_tolerance,
+        summary.wall_s,
+        summary.jobs,
+        summary.shard.as_ref().map(|s| format!(", shard {s}")).unwrap_or_default()
+    );
+    if let Some(w) = &summary.workspace {
+        println!("workspace agreement {:.2} % ({} of {} points)", w.agreement_percent, w.agree, w.points);
+    }
+    for e in &summary.errors {
+        println!("stopped: {e}");
+    }
+    if let Some(o) = out {
+        if let Err(e) = write_atomic(o, &tensegrity_testbed::sweep::to_csv(&rows)) {
+            eprintln!("error: cannot write {}: {e}", o.display());
+            return EXIT_FAIL;
+        }
+    }
+    if let Some(j) = json {
+        if let Err(e) = write_atomic(j, &serde_json::to_string_pretty(&summary).unwrap_or_default()) {
+            eprintln!("error: cannot write {}: {e}", j.display());
+            return EXIT_FAIL;
+        }
+    }
+    if summary.errors.is_empty() && !CANCEL.load(Ordering::SeqCst) {
+        EXIT_PASS
+    } else {
+        EXIT_FAIL
+    }
+}
+
+fn cmd_merge(csvs: &[PathBuf], out: &Path) -> i32 {
+    let mut texts = Vec::new();
+    for p in csvs {
+        match std::fs::read_to_string(p) {
+            Ok(t) => texts.push((p.display().to_string(), t)),
+            Err(e) => {
+                eprintln!("error: cannot read {}: {e}", p.display());
+                return EXIT_BAD_INPUT;
+            }
+        }
+    }
+    match tensegrity_testbed::sweep::merge_csv(&texts) {
+        Ok(text) => match write_atomic(out, &text) {
+            Ok(()) => EXIT_PASS,
+            Err(e) => {
+                eprintln!("error: cannot write {}: {e}", out.display());
+                EXIT_FAIL
+            }
+        },
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_BAD_INPUT
+        }
     }
 }
 
