@@ -201,8 +201,11 @@ const HIDDEN_LINK_MASS_FRACTION: f64 = 1e-3;
 /// Chooses which joints are multibody links (the rest become impulse joints). A joint is a
 /// link when its child is free, not held by an inextensible cable, has no link yet, and its
 /// parent hangs (through links) from a fixed body: a spanning forest rooted at the ground, in
-/// joint order. (Multibodies rooted at a free body let impulse joints on their links drift:
-/// measured on furet2018, gaps of 0.1 m.) A loop-closing joint
+/// joint order. Measured on furet2018 (`scenarios/furet2018/FINDINGS.md`): multibodies
+/// rooted at a free body let the impulse joints on their links drift (gaps of 0.1 m); a loop
+/// closed between two links of one multibody holds at the velocity level but its position
+/// error is not corrected (exact for a configuration built in place and held, a gap after an
+/// actuator jump). A loop-closing joint
 /// whose two bodies would sit in the same multibody is a problem: rapier did not correct the
 /// position error of such a joint (measured on furet2018: a 3.7e-5 m gap at D1 that stayed), so
 /// the forest is cut on that loop, at the first non-actuated link above the closure's child,
@@ -264,6 +267,11 @@ fn plan_forest(
         }
         let (u, v) = (joint.parent, joint.child);
         if root(&parent_joint, &is_link, u) != root(&parent_joint, &is_link, v) {
+            continue;
+        }
+        // A planar pin closes a planar loop inside its multibody: cutting there would leave the
+        // rest of the mechanism hanging from a free body (worse, measured on furet2018).
+        if matches!(joint.kind, JointKind::PlanarPin { .. }) {
             continue;
         }
         // Ancestors of u (bodies), to find where v's path meets u's.
