@@ -156,6 +156,7 @@ impl WorkspaceAgreement {
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct InterferenceReport {
     /// Smallest clearance seen over the run [m] (None: no pair ever came within the margin).
+    #[serde(rename = "min_clearance")]
     pub min_clearance_m: Option<f64>,
     pub closest_pair: Option<[String; 2]>,
     pub closest_points: Option<[[f64; 3]; 2]>,
@@ -169,6 +170,18 @@ pub struct InterferenceReport {
     pub informative: bool,
     pub passed: bool,
     pub violations: Vec<InterferenceViolation>,
+    /// Every pair that came within the margin: its smallest clearance over the run.
+    pub pairs: Vec<PairClearanceReport>,
+}
+
+/// The smallest clearance of one strut pair over the run.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PairClearanceReport {
+    pub pair: [String; 2],
+    #[serde(rename = "min_clearance")]
+    pub min_clearance_m: f64,
+    pub tick_of_min: u64,
+    pub closest_points: [[f64; 3]; 2],
 }
 
 /// One interval of ticks in which a pair's clearance stayed below the threshold.
@@ -177,6 +190,7 @@ pub struct InterferenceViolation {
     pub pair: [String; 2],
     pub first_tick: u64,
     pub last_tick: u64,
+    #[serde(rename = "min_clearance")]
     pub min_clearance_m: f64,
     pub tick_of_min: u64,
     /// Closest points on the two strut axes at the minimum [m].
@@ -369,7 +383,11 @@ impl Report {
                     fmt_values(&p.inputs),
                     fmt_errors(&p.analytic, &p.simulated),
                     p.branch,
-                    if p.settled { "" } else { ", NOT SETTLED" }
+                    if p.settled {
+                        String::new()
+                    } else {
+                        format!(", NOT SETTLED: kinetic energy {:.3e} J left", p.final_kinetic_energy_j)
+                    }
                 ));
             }
             if s.points.len() > shown {

@@ -193,24 +193,32 @@ fn a_settle_that_never_comes_fails_with_exit_1() {
     let json = p.with_extension("json");
     let (code, out, err) = tensegrity(&["run", p.to_str().unwrap(), "--json", json.to_str().unwrap()]);
     assert_eq!(code, 1, "{out}{err}");
-    assert!(out.contains("NOT SETTLED"), "{out}");
+    assert!(out.contains("NOT SETTLED: kinetic energy"), "{out}");
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["scenarios"][0]["settle"]["settled"], false);
     assert_eq!(v["scenarios"][0]["passed"], false);
+    assert!(v["scenarios"][0]["points"][0]["final_kinetic_energy_j"].as_f64().unwrap() > 0.0);
 }
 
-/// A time step far too large for stiff springs never passes: rapier clamps velocities, so
-/// the state stays finite, but the run fails (it ends on the wrong branch or does not settle).
+/// A time step far too large for stiff springs diverges: the run stops, says what diverged and
+/// when, fails (exit 1), and still writes the report and the recording up to that tick.
 #[test]
-fn an_absurd_time_step_never_passes() {
+fn an_absurd_time_step_diverges_and_still_writes_report_and_recording() {
     let text = VALID
         .replace("L = 1.0", "L = 1.0\nK1 = 1e9\nK2 = 1e9\nc_D1 = 0.0")
         .replace("[actuation]", "[sim]\ndt = 0.5\n[settle]\nmax_time = 50.0\n[actuation]");
     let p = temp_file("diverge.toml", &text);
     let json = p.with_extension("json");
-    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap(), "--json", json.to_str().unwrap()]);
+    let rrd = p.with_extension("rrd");
+    let (code, out, err) =
+        tensegrity(&["run", p.to_str().unwrap(), "--json", json.to_str().unwrap(), "--record", rrd.to_str().unwrap()]);
     assert_eq!(code, 1, "{out}{err}");
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    assert_eq!(v["scenarios"][0]["passed"], false);
+    let s = &v["scenarios"][0];
+    assert_eq!(s["passed"], false);
+    let e = s["error"].as_str().expect("the divergence is reported");
+    assert!(e.contains("diverged at tick"), "{e}");
+    assert!(std::fs::metadata(&rrd).map(|m| m.len() > 0).unwrap_or(false), "recording written");
+    assert!(!rrd.with_extension("rrd.partial").exists());
     assert!(!err.contains("panicked"));
 }

@@ -73,3 +73,29 @@ fn a_panic_fails_its_scenario_and_the_batch_goes_on() {
     assert!(s[0]["error"].as_str().unwrap().starts_with("panicked: injected"), "{}", s[0]["error"]);
     assert_eq!(s[1]["passed"], true, "the batch went on");
 }
+
+/// A sweep killed with SIGINT writes the rows it has (a complete CSV, never a truncated one)
+/// and exits 1.
+#[test]
+fn an_interrupted_sweep_writes_the_rows_it_has() {
+    let dir = out_dir("sweep");
+    let csv = dir.join("sweep.csv");
+    std::fs::write(&csv, "previous").unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+        .args(["sweep", "scenarios/mohr2011/workspace_sweep.toml", "--jobs", "2", "--out"])
+        .arg(&csv)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    std::thread::sleep(Duration::from_millis(2500));
+    assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(1));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert!(lines.next().unwrap().starts_with("index,"), "a CSV replaced the old file");
+    let rows: Vec<&str> = lines.collect();
+    assert!(!rows.is_empty() && rows.len() < 474, "{} rows", rows.len());
+    assert!(rows.iter().all(|r| r.split(',').count() > 10), "no truncated row");
+}

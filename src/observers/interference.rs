@@ -9,7 +9,7 @@
 //! configuration) always touch there and are excluded, as are pairs the scenario lists.
 
 use super::{Observer, Tick};
-use crate::report::{InterferenceReport, InterferenceViolation};
+use crate::report::{InterferenceReport, InterferenceViolation, PairClearanceReport};
 use crate::structure::Structure;
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector;
@@ -196,6 +196,16 @@ impl Interference {
             informative: self.settings.informative,
             passed: self.settings.informative || violations.is_empty(),
             violations,
+            pairs: self
+                .stats
+                .iter()
+                .map(|((i, j), st)| PairClearanceReport {
+                    pair: [self.names[*i].clone(), self.names[*j].clone()],
+                    min_clearance_m: st.min_clearance_m,
+                    tick_of_min: st.tick_of_min,
+                    closest_points: st.points_at_min,
+                })
+                .collect(),
         }
     }
 
