@@ -5,6 +5,7 @@
 //! [`sim`]ulation -> [`observers`] -> [`report`].
 
 pub mod bench;
+pub mod custom;
 pub mod mechanisms;
 pub mod observers;
 pub mod report;

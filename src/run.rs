@@ -173,7 +173,13 @@ impl Runner<'_> {
             .map(|(a, b)| crate::structure::distance(*a, *b))
             .fold(0.0, f64::max);
         // Back within a small fraction of the perturbation: the same equilibrium.
-        Ok(after.settled && moved < RETURN_FRACTION * delta * self.sim.length_scale_m)
+        let back = after.settled && moved < RETURN_FRACTION * delta * self.sim.length_scale_m;
+        self.emit(&format!(
+            "after the perturbation: {} {} steps, largest node displacement from before {moved:.3e} m",
+            if after.settled { "settled in" } else { "did NOT settle in" },
+            after.steps
+        ));
+        Ok(back)
     }
 
     /// Stiffness by the probe: +tau and -tau on the probe body, K = 2 tau / (q+ - q-).
@@ -277,7 +283,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
     if std::env::var(INJECT_PANIC_VAR).is_ok_and(|n| n == sc.name) {
         panic!("injected by {INJECT_PANIC_VAR} (test hook)");
     }
-    let mech = mechanisms::find(&sc.mechanism).expect("validated mechanism");
+    let mech = sc.mechanism();
     let mut report = ScenarioReport {
         name: sc.name.clone(),
         file: sc.file.display().to_string(),
@@ -305,7 +311,11 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         .build(&sc.params, &first_inputs, &sc.start)
         .and_then(|s| Simulation::new(&s, &sc.sim).map_err(|e| e.to_string()))
     {
-        Ok(s) => s,
+        Ok(mut s) => {
+            // The first point's commands (a no-op where the build already placed them).
+            s.set_commands(&mech.commands(&sc.params, &first_inputs));
+            s
+        }
         Err(e) => {
             report.error = Some(e);
             return report;

@@ -51,6 +51,90 @@ pub struct RawScenario {
     pub interference: Option<Spanned<RawInterference>>,
     #[serde(default)]
     pub workspace: Option<RawWorkspace>,
+    /// `mechanism = "custom"`: the structure itself.
+    #[serde(default)]
+    pub structure: Option<Spanned<RawStructure>>,
+}
+
+type Xyz = Spanned<[f64; 3]>;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawStructure {
+    /// Gravity [m/s^2] (default none).
+    pub gravity: Option<Xyz>,
+    #[serde(default)]
+    pub bodies: Vec<RawBody>,
+    #[serde(default)]
+    pub struts: Vec<RawMember>,
+    #[serde(default)]
+    pub springs: Vec<RawMember>,
+    #[serde(default)]
+    pub cables: Vec<RawMember>,
+    #[serde(default)]
+    pub joints: Vec<RawJoint>,
+    #[serde(default)]
+    pub actuators: Vec<RawActuator>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBody {
+    pub name: Spanned<String>,
+    /// Welded to the world (default false).
+    pub fixed: Option<bool>,
+    /// Mass of a free body [kg].
+    pub mass: Option<Spanned<f64>>,
+    /// Principal moments about the centre of mass, along the world axes [kg m^2] (default:
+    /// isotropic, mass times the square of the body's size over 12).
+    pub inertia: Option<Xyz>,
+    /// Named nodes with their coordinates [m] (the centre of mass is their mean).
+    pub nodes: BTreeMap<Spanned<String>, Xyz>,
+}
+
+/// A strut, spring or cable between two named nodes.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawMember {
+    pub name: Spanned<String>,
+    pub a: Spanned<String>,
+    pub b: Spanned<String>,
+    /// Struts: radius [m] (default 0.01).
+    pub radius: Option<Spanned<f64>>,
+    /// Springs: stiffness [N/m] (required); cables: stiffness of an elastic cable (absent:
+    /// inextensible).
+    pub stiffness: Option<Spanned<f64>>,
+    /// Springs: free length [m]; cables: unstretched length [m]. Absent: the initial distance.
+    pub length: Option<Spanned<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawJoint {
+    pub name: Spanned<String>,
+    /// revolute, prismatic, spherical, universal, fixed or planar_pin.
+    pub kind: Spanned<String>,
+    pub parent: Spanned<String>,
+    pub child: Spanned<String>,
+    /// The node at the joint's centre.
+    pub at: Spanned<String>,
+    pub axis: Option<Xyz>,
+    /// Universal joints: the second axis (fixed in the child).
+    pub axis2: Option<Xyz>,
+    /// Revolute joints: a linear torsion spring [N m/rad], at rest in the given geometry plus
+    /// `torsion_rest` [rad].
+    pub torsion_stiffness: Option<Spanned<f64>>,
+    pub torsion_rest: Option<Spanned<f64>>,
+    /// Viscous damping [N m s/rad or N s/m].
+    pub damping: Option<Spanned<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawActuator {
+    pub symbol: Spanned<String>,
+    pub joint: Option<Spanned<String>>,
+    pub cable: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -133,6 +217,8 @@ pub struct RawActuation {
 pub struct RawCheck {
     pub quantity: Spanned<String>,
     pub tolerance: Spanned<f64>,
+    /// Custom structures only: the expected value (there is no analytic model).
+    pub value: Option<Spanned<f64>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -179,6 +265,18 @@ pub struct Scenario {
     pub min_agreement_percent: Option<f64>,
     /// Grid points dropped by `skip_outside`, with the reason.
     pub skipped_points: Vec<(Values, String)>,
+    /// `mechanism = "custom"`: the mechanism built from the file.
+    pub custom: Option<crate::custom::Custom>,
+}
+
+impl Scenario {
+    /// The scenario's mechanism: a built-in one, or the file's own structure.
+    pub fn mechanism(&self) -> Box<dyn Mechanism> {
+        match &self.custom {
+            Some(c) => Box::new(c.clone()),
+            None => mechanisms::find(&self.mechanism).expect("validated mechanism"),
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -289,13 +387,51 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     if raw.name.get_ref().trim().is_empty() {
         return Err(ctx.err(&raw.name, "name must not be empty"));
     }
-    let mech: Box<dyn Mechanism> = mechanisms::find(raw.mechanism.get_ref()).ok_or_else(|| {
-        let known: Vec<_> = mechanisms::registry().iter().map(|m| m.name()).collect();
-        ctx.err(
-            &raw.mechanism,
-            format!("unknown mechanism '{}' (expected one of: {})", raw.mechanism.get_ref(), known.join(", ")),
-        )
-    })?;
+    let custom =
+        match (raw.mechanism.get_ref().as_str(), &raw.structure) {
+            ("custom", Some(st)) => {
+                let structure = structure_from_file(ctx, st)?;
+                let mut expected = Values::new();
+                for c in &raw.checks {
+                    let v = c.value.as_ref().ok_or_else(|| {
+                        ctx.err(
+                            &c.quantity,
+                            "a custom structure has no analytic model: give the expected value (value = ...)",
+                        )
+                    })?;
+                    expected.insert(c.quantity.get_ref().clone(), finite(ctx, v, "value")?);
+                }
+                Some(crate::custom::Custom::new(structure, expected))
+            }
+            ("custom", None) => return Err(ctx.err(
+                &raw.mechanism,
+                "mechanism = \"custom\" needs a [structure] table (bodies, struts, springs, cables, joints, actuators)",
+            )),
+            (_, Some(st)) => return Err(ctx.err(st, "a [structure] table goes with mechanism = \"custom\" only")),
+            _ => None,
+        };
+    if custom.is_none() {
+        if let Some(v) = raw.checks.iter().find_map(|c| c.value.as_ref()) {
+            return Err(ctx.err(
+                v,
+                "value is for custom structures; a built-in mechanism's checks compare with its analytic model",
+            ));
+        }
+    }
+    let mech: Box<dyn Mechanism> = match &custom {
+        Some(c) => Box::new(c.clone()),
+        None => mechanisms::find(raw.mechanism.get_ref()).ok_or_else(|| {
+            let known: Vec<_> = mechanisms::registry().iter().map(|m| m.name()).collect();
+            ctx.err(
+                &raw.mechanism,
+                format!(
+                    "unknown mechanism '{}' (expected one of: {}, custom)",
+                    raw.mechanism.get_ref(),
+                    known.join(", ")
+                ),
+            )
+        })?,
+    };
     let m = mech.as_ref();
 
     // Parameters: known symbols, finite, then the mechanism's own ranges.
@@ -582,7 +718,8 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         }
         checks.push(Check { quantity: q.symbol.into(), kind: q.kind, unit: q.unit.into(), tolerance: tol });
     }
-    if checks.is_empty() && raw.probe.is_none() {
+    // A custom structure is checked by its settling and force balance even without [[checks]].
+    if checks.is_empty() && raw.probe.is_none() && custom.is_none() {
         return Err(ctx
             .err_at(0, "the scenario checks nothing: add at least one [[checks]] entry (quantity, tolerance)".into()));
     }
@@ -699,5 +836,237 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         interference,
         min_agreement_percent,
         skipped_points,
+        custom,
     })
 }
+
+/// Builds the structure of a `[structure]` table; every bad reference, zero-length member or
+/// massless free body is an error at its place in the file.
+fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Result<crate::structure::Structure, ScenarioError> {
+    use crate::structure::{
+        Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut,
+        TorsionSpring,
+    };
+    let r = raw.get_ref();
+    let xyz = |v: &Xyz, what: &str| -> Result<[f64; 3], ScenarioError> {
+        let a = *v.get_ref();
+        if a.iter().all(|c| c.is_finite()) {
+            Ok(a)
+        } else {
+            Err(ctx.err(v, format!("{what} must be three finite numbers, got {a:?}")))
+        }
+    };
+    let mut s = Structure { name: "custom".into(), ..Default::default() };
+    if let Some(g) = &r.gravity {
+        s.gravity = xyz(g, "gravity")?;
+    }
+    if r.bodies.is_empty() {
+        return Err(ctx.err(raw, "[structure] needs at least one body ([[structure.bodies]])"));
+    }
+    let mut body_names: Vec<String> = Vec::new();
+    for b in &r.bodies {
+        if body_names.contains(b.name.get_ref()) {
+            return Err(ctx.err(&b.name, format!("duplicate body name '{}'", b.name.get_ref())));
+        }
+        body_names.push(b.name.get_ref().clone());
+        if b.nodes.is_empty() {
+            return Err(ctx.err(
+                &b.name,
+                format!("body '{}' needs at least one node (nodes = {{ N1 = [x, y, z] }})", b.name.get_ref()),
+            ));
+        }
+        let mut pts = Vec::new();
+        for (n, p) in &b.nodes {
+            pts.push((n, xyz(p, "a node's coordinates")?));
+        }
+        let fixed = b.fixed.unwrap_or(false);
+        let inertia = if fixed {
+            None
+        } else {
+            let m = b.mass.as_ref().ok_or_else(|| {
+                ctx.err(
+                    &b.name,
+                    format!("free body '{}' needs a mass > 0 kg (mass = ...), or fixed = true", b.name.get_ref()),
+                )
+            })?;
+            let mass = finite(ctx, m, "mass")?;
+            if mass <= 0.0 {
+                return Err(ctx.err(m, format!("mass must be > 0 kg, got {mass}")));
+            }
+            let n = pts.len() as f64;
+            let com = [0, 1, 2].map(|k| pts.iter().map(|(_, p)| p[k]).sum::<f64>() / n);
+            let size = pts
+                .iter()
+                .flat_map(|(_, a)| pts.iter().map(move |(_, b)| crate::structure::distance(*a, *b)))
+                .fold(MIN_BODY_SIZE_M, f64::max);
+            let principal = match &b.inertia {
+                Some(i) => {
+                    let v = xyz(i, "inertia")?;
+                    if v.iter().any(|x| *x <= 0.0) {
+                        return Err(ctx.err(i, "inertia must be three moments > 0 kg m^2"));
+                    }
+                    v
+                }
+                None => [mass * size * size / 12.0; 3],
+            };
+            Some(Inertia { mass_kg: mass, com, principal_kg_m2: principal })
+        };
+        let id = s.add_body(b.name.get_ref(), if fixed { BodyKind::Fixed } else { BodyKind::Free }, inertia);
+        for (n, p) in pts {
+            if s.node_id(n.get_ref()).is_some() {
+                return Err(ctx.err(n, format!("duplicate node name '{}'", n.get_ref())));
+            }
+            s.add_node(n.get_ref(), id, p);
+        }
+    }
+    let node = |s: &Structure, n: &Spanned<String>| -> Result<usize, ScenarioError> {
+        s.node_id(n.get_ref()).ok_or_else(|| {
+            ctx.err(n, format!("unknown node '{}' (nodes are declared in the bodies' nodes tables)", n.get_ref()))
+        })
+    };
+    let body = |s: &Structure, n: &Spanned<String>| -> Result<usize, ScenarioError> {
+        s.body_id(n.get_ref()).ok_or_else(|| ctx.err(n, format!("unknown body '{}'", n.get_ref())))
+    };
+    let ends = |s: &Structure, m: &RawMember, what: &str| -> Result<(usize, usize, f64), ScenarioError> {
+        let (a, b) = (node(s, &m.a)?, node(s, &m.b)?);
+        let l = crate::structure::distance(s.nodes[a].position, s.nodes[b].position);
+        if l <= 0.0 {
+            return Err(ctx.err(&m.name, format!("{what} '{}' has zero length: its nodes coincide", m.name.get_ref())));
+        }
+        Ok((a, b, l))
+    };
+    let positive = |v: &Spanned<f64>, what: &str| -> Result<f64, ScenarioError> {
+        let x = finite(ctx, v, what)?;
+        if x > 0.0 {
+            Ok(x)
+        } else {
+            Err(ctx.err(v, format!("{what} must be > 0, got {x}")))
+        }
+    };
+    for m in &r.struts {
+        let (a, b, _) = ends(&s, m, "strut")?;
+        let radius = match &m.radius {
+            Some(v) => positive(v, "radius (m)")?,
+            None => DEFAULT_STRUT_RADIUS_M,
+        };
+        s.struts.push(Strut { name: m.name.get_ref().clone(), a, b, radius_m: radius });
+    }
+    for m in &r.springs {
+        let (a, b, l) = ends(&s, m, "spring")?;
+        let k = m.stiffness.as_ref().ok_or_else(|| ctx.err(&m.name, "a spring needs a stiffness (N/m)"))?;
+        let rest = match &m.length {
+            Some(v) => {
+                let x = finite(ctx, v, "length (m)")?;
+                if x < 0.0 {
+                    return Err(ctx.err(v, format!("a spring's free length must be >= 0 m, got {x}")));
+                }
+                x
+            }
+            None => l,
+        };
+        s.springs.push(Spring {
+            name: m.name.get_ref().clone(),
+            a,
+            b,
+            stiffness_n_per_m: positive(k, "stiffness (N/m)")?,
+            rest_length_m: rest,
+        });
+    }
+    for m in &r.cables {
+        let (a, b, l) = ends(&s, m, "cable")?;
+        let law = match &m.stiffness {
+            Some(k) => CableLaw::Elastic { stiffness_n_per_m: positive(k, "stiffness (N/m)")? },
+            None => CableLaw::Inextensible,
+        };
+        let length = match &m.length {
+            Some(v) => positive(v, "length (m)")?,
+            None => l,
+        };
+        s.cables.push(Cable { name: m.name.get_ref().clone(), a, b, law, length_m: length });
+    }
+    for j in &r.joints {
+        let axis = |v: &Option<Xyz>, what: &str| -> Result<[f64; 3], ScenarioError> {
+            let v = v
+                .as_ref()
+                .ok_or_else(|| ctx.err(&j.kind, format!("a {} joint needs {what} = [x, y, z]", j.kind.get_ref())))?;
+            let a = xyz(v, what)?;
+            if a.iter().all(|c| *c == 0.0) {
+                return Err(ctx.err(v, format!("{what} must not be zero")));
+            }
+            Ok(a)
+        };
+        let kind = match j.kind.get_ref().as_str() {
+            "revolute" => JointKind::Revolute { axis: axis(&j.axis, "axis")? },
+            "prismatic" => JointKind::Prismatic { axis: axis(&j.axis, "axis")? },
+            "spherical" => JointKind::Spherical,
+            "universal" => JointKind::Universal { axis1: axis(&j.axis, "axis")?, axis2: axis(&j.axis2, "axis2")? },
+            "fixed" => JointKind::Fixed,
+            "planar_pin" => JointKind::PlanarPin { axis: axis(&j.axis, "axis")? },
+            other => {
+                return Err(ctx.err(
+                    &j.kind,
+                    format!("unknown joint kind '{other}' (expected revolute, prismatic, spherical, universal, fixed or planar_pin)"),
+                ))
+            }
+        };
+        let (parent, child, at) = (body(&s, &j.parent)?, body(&s, &j.child)?, node(&s, &j.at)?);
+        let torsion_spring = match &j.torsion_stiffness {
+            Some(k) => Some(TorsionSpring {
+                stiffness_nm_per_rad: positive(k, "torsion_stiffness (N m/rad)")?,
+                rest_angle_rad: match &j.torsion_rest {
+                    Some(v) => finite(ctx, v, "torsion_rest")?,
+                    None => 0.0,
+                },
+            }),
+            None => None,
+        };
+        let damping = match &j.damping {
+            Some(v) => {
+                let x = finite(ctx, v, "damping")?;
+                if x < 0.0 {
+                    return Err(ctx.err(v, format!("damping must be >= 0, got {x}")));
+                }
+                x
+            }
+            None => 0.0,
+        };
+        s.joints.push(Joint {
+            name: j.name.get_ref().clone(),
+            kind,
+            parent,
+            child,
+            anchor: at,
+            initial_coordinate: 0.0,
+            torsion_spring,
+            damping,
+        });
+    }
+    for a in &r.actuators {
+        let target = match (&a.joint, &a.cable) {
+            (Some(j), None) => ActuatorTarget::Joint(
+                s.joints
+                    .iter()
+                    .position(|x| &x.name == j.get_ref())
+                    .ok_or_else(|| ctx.err(j, format!("unknown joint '{}'", j.get_ref())))?,
+            ),
+            (None, Some(c)) => ActuatorTarget::CableLength(
+                s.cables
+                    .iter()
+                    .position(|x| &x.name == c.get_ref())
+                    .ok_or_else(|| ctx.err(c, format!("unknown cable '{}'", c.get_ref())))?,
+            ),
+            _ => {
+                return Err(ctx.err(&a.symbol, "an actuator drives exactly one of: joint = \"name\", cable = \"name\""))
+            }
+        };
+        s.actuators.push(Actuator { symbol: a.symbol.get_ref().clone(), target });
+    }
+    s.validate().map_err(|e| ctx.err(raw, format!("the structure is not valid: {e}")))?;
+    Ok(s)
+}
+
+/// Smallest size used for a body's default inertia [m].
+const MIN_BODY_SIZE_M: f64 = 1e-3;
+
+/// Strut radius when the file gives none [m].
+const DEFAULT_STRUT_RADIUS_M: f64 = 0.01;

@@ -99,7 +99,7 @@ impl Simulation {
     }
 
     /// World position of a free body's centre of mass, from its current pose [m].
-    fn world_com(&self, body: usize) -> Vector {
+    pub(super) fn world_com(&self, body: usize) -> Vector {
         let local = self.structure.bodies[body].inertia.map_or([0.0; 3], |i| i.com);
         self.bodies[self.handles[body]].position().transform_point(v(local))
     }

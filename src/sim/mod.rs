@@ -345,6 +345,23 @@ impl Simulation {
                 mb.generalized_velocity_mut().fill(0.0);
             }
         }
+        // Plain free bodies (not multibody links): shift by delta times the structure's size
+        // along a fixed oblique direction and turn by delta about an oblique axis through the
+        // centre of mass.
+        let shift = Vector::new(1.0, 2.0, 3.0).normalize() * (delta * self.length_scale_m);
+        let turn = Rotation::from_axis_angle(Vector::new(3.0, -1.0, 2.0).normalize(), delta);
+        for b in 0..self.structure.bodies.len() {
+            let h = self.handles[b];
+            if self.is_free(b) && self.multibody_joints.rigid_body_link(h).is_none() {
+                let com = self.world_com(b);
+                let pose = *self.bodies[h].position();
+                let moved = Pose::from_translation(com + shift)
+                    * Pose::from_rotation(turn)
+                    * Pose::from_translation(-com)
+                    * pose;
+                self.bodies[h].set_position(moved, true);
+            }
+        }
         for (b, &h) in self.handles.iter().enumerate() {
             if self.is_free(b) {
                 let rb = &mut self.bodies[h];

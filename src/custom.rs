@@ -1,0 +1,223 @@
+//! A mechanism described in a scenario file (`mechanism = "custom"` and a `[structure]`
+//! table): no analytic model, only what the dynamics can check on their own (settling, the
+//! force balance, cable slackness, member forces, stability, interference), plus optional
+//! expected values given in the file (`[[checks]]` with `value`).
+
+use crate::mechanisms::{
+    Finding, InputSpec, Mechanism, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec, Solution, Values,
+};
+use crate::sim::Snapshot;
+use crate::structure::{ActuatorTarget, Structure};
+
+/// The mechanism built from a file's `[structure]`.
+#[derive(Clone, Debug)]
+pub struct Custom {
+    pub structure: Structure,
+    inputs: &'static [InputSpec],
+    quantities: &'static [QuantitySpec],
+    /// Expected values from the file's checks, by quantity.
+    pub expected: Values,
+}
+
+/// Leaks a string for the `'static` specs of a file-described mechanism (one per file).
+fn leak(s: String) -> &'static str {
+    Box::leak(s.into_boxed_str())
+}
+
+impl Custom {
+    pub fn new(structure: Structure, expected: Values) -> Self {
+        let mut symbols: Vec<String> = Vec::new();
+        for a in &structure.actuators {
+            if !symbols.contains(&a.symbol) {
+                symbols.push(a.symbol.clone());
+            }
+        }
+        let inputs: Vec<InputSpec> = symbols
+            .into_iter()
+            .map(|s| InputSpec {
+                symbol: leak(s),
+                unit: "m or rad",
+                description: "actuator command from the structure file",
+            })
+            .collect();
+        let mut quantities = Vec::new();
+        for n in &structure.nodes {
+            for c in ["x", "y", "z"] {
+                quantities.push(QuantitySpec {
+                    symbol: leak(format!("{}.{c}", n.name)),
+                    unit: "m",
+                    kind: QuantityKind::Length,
+                    description: "node coordinate",
+                });
+            }
+        }
+        let members = structure
+            .springs
+            .iter()
+            .map(|m| &m.name)
+            .chain(structure.cables.iter().map(|m| &m.name))
+            .chain(structure.struts.iter().map(|m| &m.name));
+        for name in members {
+            quantities.push(QuantitySpec {
+                symbol: leak(format!("{name}.force")),
+                unit: "N",
+                kind: QuantityKind::Magnitude,
+                description: "member force, tension positive (struts: from the balance of their end nodes)",
+            });
+        }
+        Custom {
+            structure,
+            inputs: Box::leak(inputs.into_boxed_slice()),
+            quantities: Box::leak(quantities.into_boxed_slice()),
+            expected,
+        }
+    }
+
+    /// Axial force of each strut, tension positive [N]: minus the member forces on its end
+    /// nodes along the strut (averaged over both ends), so it balances them.
+    fn strut_forces(&self, snap: &Snapshot) -> Vec<f64> {
+        let s = &self.structure;
+        let node_force = |node: usize| -> [f64; 3] {
+            let mut f = [0.0; 3];
+            let mut add = |a: usize, b: usize, t: f64| {
+                let (pa, pb) = (snap.nodes[a], snap.nodes[b]);
+                let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+                let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                if l > 0.0 {
+                    for k in 0..3 {
+                        f[k] += t * d[k] / l;
+                    }
+                }
+            };
+            for (i, m) in s.springs.iter().enumerate() {
+                if m.a == node {
+                    add(m.a, m.b, snap.forces.spring_force_n[i]);
+                } else if m.b == node {
+                    add(m.b, m.a, snap.forces.spring_force_n[i]);
+                }
+            }
+            for (i, m) in s.cables.iter().enumerate() {
+                if m.a == node {
+                    add(m.a, m.b, snap.forces.cable_tension_n[i]);
+                } else if m.b == node {
+                    add(m.b, m.a, snap.forces.cable_tension_n[i]);
+                }
+            }
+            f
+        };
+        s.struts
+            .iter()
+            .map(|st| {
+                let (pa, pb) = (snap.nodes[st.a], snap.nodes[st.b]);
+                let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+                let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(f64::MIN_POSITIVE);
+                let u = [d[0] / l, d[1] / l, d[2] / l];
+                let (fa, fb) = (node_force(st.a), node_force(st.b));
+                // Strut tension t pulls a towards b: t u + fa = 0 at a, -t u + fb = 0 at b.
+                let ta = -(fa[0] * u[0] + fa[1] * u[1] + fa[2] * u[2]);
+                let tb = fb[0] * u[0] + fb[1] * u[1] + fb[2] * u[2];
+                0.5 * (ta + tb)
+            })
+            .collect()
+    }
+}
+
+impl Mechanism for Custom {
+    fn name(&self) -> &'static str {
+        "custom"
+    }
+    fn title(&self) -> &'static str {
+        "a structure described in the scenario file (no analytic model)"
+    }
+    fn params(&self) -> &'static [ParamSpec] {
+        &[]
+    }
+    fn inputs(&self) -> &'static [InputSpec] {
+        self.inputs
+    }
+    fn quantities(&self) -> &'static [QuantitySpec] {
+        self.quantities
+    }
+    fn queries(&self) -> &'static [QuerySpec] {
+        &[]
+    }
+    fn validate_params(&self, _params: &Values) -> Result<(), (String, String)> {
+        Ok(())
+    }
+    fn validate_inputs(&self, _params: &Values, inputs: &Values) -> Result<(), (String, String)> {
+        for i in self.inputs {
+            let x =
+                inputs.get(i.symbol).copied().ok_or((i.symbol.to_string(), format!("missing input {}", i.symbol)))?;
+            if !x.is_finite() {
+                return Err((i.symbol.into(), format!("{} must be finite, got {x}", i.symbol)));
+            }
+        }
+        for a in &self.structure.actuators {
+            if let ActuatorTarget::CableLength(_) = a.target {
+                if inputs.get(&a.symbol).is_some_and(|l| *l <= 0.0) {
+                    return Err((a.symbol.clone(), format!("cable length {} must be > 0 m", a.symbol)));
+                }
+            }
+        }
+        Ok(())
+    }
+    fn solve(&self, query: &str, _params: &Values, _inputs: &Values) -> Result<Vec<Solution>, String> {
+        Err(format!("a custom structure has no analytic model (no query '{query}')"))
+    }
+    fn build(&self, _params: &Values, inputs: &Values, _start: &Values) -> Result<Structure, String> {
+        let mut s = self.structure.clone();
+        for a in &s.actuators {
+            if let (ActuatorTarget::CableLength(c), Some(l)) = (&a.target, inputs.get(&a.symbol)) {
+                s.cables[*c].length_m = *l;
+            }
+        }
+        Ok(s)
+    }
+    fn commands(&self, _params: &Values, inputs: &Values) -> Vec<f64> {
+        self.structure
+            .actuators
+            .iter()
+            .map(|a| {
+                inputs.get(&a.symbol).copied().unwrap_or(match a.target {
+                    ActuatorTarget::Joint(j) => self.structure.joints[j].initial_coordinate,
+                    ActuatorTarget::CableLength(c) => self.structure.cables[c].length_m,
+                })
+            })
+            .collect()
+    }
+    fn predict(&self, _params: &Values, _inputs: &Values) -> Result<Prediction, String> {
+        Ok(Prediction {
+            expected: self.expected.clone(),
+            branches: vec![Solution {
+                label: "expected values from the file".into(),
+                values: self.expected.clone(),
+                stable: None,
+            }],
+            expected_slack: None,
+        })
+    }
+    fn observe(&self, _params: &Values, s: &Structure, snap: &Snapshot) -> Values {
+        let mut v = Values::new();
+        for (i, n) in s.nodes.iter().enumerate() {
+            for (k, c) in ["x", "y", "z"].iter().enumerate() {
+                v.insert(format!("{}.{c}", n.name), snap.nodes[i][k]);
+            }
+        }
+        for (i, m) in s.springs.iter().enumerate() {
+            v.insert(format!("{}.force", m.name), snap.forces.spring_force_n[i]);
+        }
+        for (i, m) in s.cables.iter().enumerate() {
+            v.insert(format!("{}.force", m.name), snap.forces.cable_tension_n[i]);
+        }
+        for (m, f) in s.struts.iter().zip(self.strut_forces(snap)) {
+            v.insert(format!("{}.force", m.name), f);
+        }
+        v
+    }
+    fn length_scale(&self, _params: &Values) -> f64 {
+        crate::sim::structure_size(&self.structure)
+    }
+    fn findings(&self, _params: &Values) -> Vec<Finding> {
+        Vec::new()
+    }
+}
