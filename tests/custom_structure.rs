@@ -105,3 +105,14 @@ fn structure_errors_name_file_line_and_column() {
         assert!(after.chars().next().unwrap().is_ascii_digit(), "{what}: no line:col in {err}");
     }
 }
+
+/// The README's example of a custom structure is a complete scenario that passes.
+#[test]
+fn the_readme_example_runs_and_passes() {
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let start = readme.find("name = \"Snelson X module\"\nmechanism = \"custom\"").expect("example in README");
+    let text = &readme[start..start + readme[start..].find("```").unwrap()];
+    let sc = scenario::parse(Path::new("README.md"), text).expect("the example parses");
+    let r = run(&sc, &RunOptions::default());
+    assert!(r.passed, "{:?}", r.error);
+}
