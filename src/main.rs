@@ -33,6 +33,13 @@ enum Command {
         /// Record to this .rrd file (with several scenarios: one file each, named FILE-<scenario>.rrd).
         #[arg(long)]
         record: Option<PathBuf>,
+        /// Stream live to a running rerun viewer or server instead (default: rerun's own address,
+        /// rerun+http://127.0.0.1:9876/proxy).
+        #[arg(long, num_args = 0..=1, default_missing_value = "", value_name = "ADDR")]
+        connect: Option<String>,
+        /// Record every N-th tick only (thins long runs).
+        #[arg(long, default_value_t = 1, value_name = "N")]
+        record_every: u64,
     },
     /// Validate scenario files without running them.
     Check {
@@ -115,7 +122,9 @@ fn main() -> ExitCode {
     install_signal_handlers();
     let cli = Cli::parse();
     let code = match cli.command {
-        Command::Run { scenarios, json, record } => cmd_run(&scenarios, json.as_deref(), record.as_deref()),
+        Command::Run { scenarios, json, record, connect, record_every } => {
+            cmd_run(&scenarios, json.as_deref(), record.as_deref(), connect.as_deref(), record_every)
+        }
         Command::Check { scenarios } => match load_all(&scenarios) {
             Ok(list) => {
                 for s in &list {
@@ -183,7 +192,13 @@ fn record_path(base: &Path, name: &str, several: bool) -> PathBuf {
     base.with_file_name(format!("{stem}-{safe}.rrd"))
 }
 
-fn cmd_run(paths: &[PathBuf], json: Option<&Path>, record: Option<&Path>) -> i32 {
+fn cmd_run(
+    paths: &[PathBuf],
+    json: Option<&Path>,
+    record: Option<&Path>,
+    connect: Option<&str>,
+    record_every: u64,
+) -> i32 {
     let scenarios = match load_all(paths) {
         Ok(s) => s,
         Err(code) => return code,
@@ -201,7 +216,12 @@ fn cmd_run(paths: &[PathBuf], json: Option<&Path>, record: Option<&Path>) -> i32
             eprintln!("interrupted: {} scenario(s) not run", scenarios.len() - report.scenarios.len());
             break;
         }
-        let opts = RunOptions { record: record.map(|r| record_path(r, &sc.name, several)), cancel: Some(&CANCEL) };
+        let opts = RunOptions {
+            record: record.map(|r| record_path(r, &sc.name, several)),
+            cancel: Some(&CANCEL),
+            connect: connect.map(str::to_string),
+            record_every,
+        };
         // A panic inside one scenario fails that scenario, with its message; the batch goes on.
         let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(sc, &opts)))
             .unwrap_or_else(|payload| tensegrity_testbed::run::panicked(sc, payload.as_ref()));

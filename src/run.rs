@@ -21,6 +21,10 @@ pub struct RunOptions<'a> {
     pub record: Option<PathBuf>,
     /// Set from a signal handler: the run stops at the next tick and reports what it has.
     pub cancel: Option<&'a AtomicBool>,
+    /// Stream live to a rerun viewer at this address ("" for rerun's default) instead of a file.
+    pub connect: Option<String>,
+    /// Record every N-th tick only (0 or 1: every tick).
+    pub record_every: u64,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -43,6 +47,8 @@ struct Runner<'a> {
     recorder: Option<Recorder>,
     cancel: Option<&'a AtomicBool>,
     steps: u64,
+    /// The analytic ghost nodes for the last inputs (recordings only).
+    ghost: Option<(Values, Option<Vec<[f64; 3]>>)>,
 }
 
 /// Result of one settle.
@@ -75,8 +81,12 @@ impl Runner<'_> {
         self.steps += 1;
         let snap = self.sim.snapshot();
         let simulated = self.observe(&snap);
-        // The ghost overlay is only drawn in recordings.
-        let ghost = if self.recorder.is_some() { self.mech.analytic_nodes(&self.sc.params, inputs) } else { None };
+        // The ghost overlay is only drawn in recordings, and only recomputed when the inputs
+        // change.
+        if self.recorder.is_some() && self.ghost.as_ref().is_none_or(|(i, _)| i != inputs) {
+            self.ghost = Some((inputs.clone(), self.mech.analytic_nodes(&self.sc.params, inputs)));
+        }
+        let ghost = self.ghost.as_ref().and_then(|(_, g)| g.clone());
         let tick = Tick {
             structure: &self.sim.structure,
             snapshot: &snap,
@@ -330,9 +340,15 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         }
     };
     let record_path = opts.record.clone().or_else(|| sc.record.clone());
-    let recorder = match record_path.as_ref().map(|p| Recorder::create(p, "tensegrity-testbed", 1)) {
+    let every = opts.record_every.max(1);
+    let recorder = match opts
+        .connect
+        .as_deref()
+        .map(|url| Recorder::connect(url, "tensegrity-testbed", every))
+        .or_else(|| record_path.as_ref().map(|p| Recorder::create(p, "tensegrity-testbed", every).map(Some)))
+    {
         None => None,
-        Some(Ok(r)) => Some(r),
+        Some(Ok(r)) => r,
         Some(Err(e)) => {
             report.error = Some(e.to_string());
             return report;
@@ -349,6 +365,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         recorder,
         cancel: opts.cancel,
         steps: 0,
+        ghost: None,
     };
     if let Some(r) = runner.recorder.as_mut() {
         r.document("scenario", &sc.source);

@@ -19,10 +19,38 @@ pub enum RecordError {
 
 pub struct Recorder {
     rec: rerun::RecordingStream,
-    partial: PathBuf,
-    target: PathBuf,
+    target: Target,
     every: u64,
 }
+
+/// Where a recording goes.
+enum Target {
+    /// An `.rrd` file, written to `partial` and renamed to `path` when complete.
+    File { partial: PathBuf, path: PathBuf },
+    /// A live stream to a rerun viewer or server.
+    Live { url: String },
+}
+
+/// How long the end of a live stream waits for a viewer to take the data [s].
+const LIVE_FLUSH_TIMEOUT_S: f64 = 2.0;
+
+/// How long to wait for a viewer to accept a connection before streaming [s].
+const CONNECT_PROBE_TIMEOUT_S: f64 = 0.5;
+
+/// Whether something accepts TCP connections at the host and port of a rerun URL such as
+/// `rerun+http://127.0.0.1:9876/proxy`.
+fn listening(url: &str) -> bool {
+    use std::net::ToSocketAddrs;
+    let rest = url.split("://").nth(1).unwrap_or(url);
+    let authority = rest.split('/').next().unwrap_or(rest);
+    let Ok(addrs) = authority.to_socket_addrs() else { return false };
+    addrs.into_iter().any(|a| {
+        std::net::TcpStream::connect_timeout(&a, std::time::Duration::from_secs_f64(CONNECT_PROBE_TIMEOUT_S)).is_ok()
+    })
+}
+
+/// rerun's own default address for a live viewer.
+pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
 
 fn f32x3(p: [f64; 3]) -> [f32; 3] {
     [p[0] as f32, p[1] as f32, p[2] as f32]
@@ -53,7 +81,23 @@ impl Recorder {
         }
         let partial = path.with_extension("rrd.partial");
         let rec = rerun::RecordingStreamBuilder::new(app).save(&partial).map_err(|e| io(e.to_string()))?;
-        Ok(Recorder { rec, partial, target: path.to_path_buf(), every: every.max(1) })
+        Ok(Recorder { rec, target: Target::File { partial, path: path.to_path_buf() }, every: every.max(1) })
+    }
+
+    /// Streams the same data live to a rerun viewer or server at `url` (rerun's default when
+    /// empty). A run never fails or waits because nobody listens: the end of the run says so once.
+    pub fn connect(url: &str, app: &'static str, every: u64) -> Result<Option<Self>, RecordError> {
+        let url = if url.is_empty() { DEFAULT_CONNECT_URL.to_string() } else { url.to_string() };
+        // rerun's gRPC sink blocks the logging calls while nobody listens (measured: a run
+        // stalled for good): check that a viewer or server answers first.
+        if !listening(&url) {
+            eprintln!("note: no rerun viewer or server listens at {url}; the run goes on without streaming");
+            return Ok(None);
+        }
+        let rec = rerun::RecordingStreamBuilder::new(app)
+            .connect_grpc_opts(url.clone())
+            .map_err(|e| RecordError::Io { path: url.clone(), message: e.to_string() })?;
+        Ok(Some(Recorder { rec, target: Target::Live { url }, every: every.max(1) }))
     }
 
     /// Stores a text document (static: it belongs to the whole run).
@@ -67,15 +111,26 @@ impl Recorder {
         let _ = self.rec.log(entity, &rerun::Scalars::single(value));
     }
 
-    /// Flushes and moves the recording to its final name.
-    pub fn finish(self) -> Result<PathBuf, RecordError> {
-        self.rec
-            .flush_blocking()
-            .map_err(|e| RecordError::Io { path: self.target.display().to_string(), message: e.to_string() })?;
-        drop(self.rec);
-        std::fs::rename(&self.partial, &self.target)
-            .map_err(|e| RecordError::Io { path: self.target.display().to_string(), message: e.to_string() })?;
-        Ok(self.target)
+    /// Flushes and moves the recording to its final name (a live stream: waits a moment for
+    /// the viewer, and says once if none took the data).
+    pub fn finish(self) -> Result<Option<PathBuf>, RecordError> {
+        match self.target {
+            Target::File { partial, path } => {
+                self.rec
+                    .flush_blocking()
+                    .map_err(|e| RecordError::Io { path: path.display().to_string(), message: e.to_string() })?;
+                drop(self.rec);
+                std::fs::rename(&partial, &path)
+                    .map_err(|e| RecordError::Io { path: path.display().to_string(), message: e.to_string() })?;
+                Ok(Some(path))
+            }
+            Target::Live { url } => {
+                if self.rec.flush_with_timeout(std::time::Duration::from_secs_f64(LIVE_FLUSH_TIMEOUT_S)).is_err() {
+                    eprintln!("note: no rerun viewer took the live stream at {url}; the run went on without it");
+                }
+                Ok(None)
+            }
+        }
     }
 }
 

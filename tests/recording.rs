@@ -1,0 +1,83 @@
+//! A recording is never assumed to be right: a written `.rrd` is decoded again and the entities
+//! and ticks it holds are checked.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+use tensegrity_testbed::run::{run, RunOptions};
+use tensegrity_testbed::scenario;
+
+/// Entity paths and the set of `tick` values logged for each.
+fn read_back(path: &Path) -> BTreeMap<String, BTreeSet<i64>> {
+    let file = std::io::BufReader::new(std::fs::File::open(path).expect("recording exists"));
+    let mut out: BTreeMap<String, BTreeSet<i64>> = BTreeMap::new();
+    for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
+        let msg = msg.expect("decodes");
+        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg {
+            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).expect("a chunk");
+            let ticks = out.entry(chunk.entity_path().to_string()).or_default();
+            if let Some(col) = chunk.timelines().iter().find(|(name, _)| name.as_str() == "tick").map(|(_, c)| c) {
+                ticks.extend(col.times_raw().iter().copied());
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn a_recorded_run_holds_every_entity_at_every_tick() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-rec-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rrd = dir.join("mohr.rrd");
+    let sc = scenario::load(Path::new("scenarios/mohr2011/trajectory.toml")).unwrap();
+    let r = run(&sc, &RunOptions { record: Some(rrd.clone()), ..RunOptions::default() });
+    assert!(r.passed, "{:?}", r.error);
+    assert!(!rrd.with_extension("rrd.partial").exists());
+    let entities = read_back(&rrd);
+    let ticks = r.settle.steps as usize;
+    for e in [
+        "/structure/nodes",
+        "/structure/struts",
+        "/structure/cables",
+        "/analytic/nodes",
+        "/errors/x",
+        "/forces/cable/A2B3",
+        "/residual/force_n",
+    ] {
+        let t =
+            entities.get(e).unwrap_or_else(|| panic!("{e} missing; have {:?}", entities.keys().collect::<Vec<_>>()));
+        assert_eq!(t.len(), ticks, "{e}: {} ticks recorded of {ticks}", t.len());
+        assert_eq!(*t.iter().next().unwrap(), 1);
+        assert_eq!(*t.iter().last().unwrap(), ticks as i64);
+    }
+    assert!(entities.contains_key("/events"), "events recorded");
+    assert!(entities.contains_key("/scenario") && entities.contains_key("/report"), "documents recorded");
+}
+
+/// `record_every = N` keeps every N-th tick only.
+#[test]
+fn record_every_thins_the_recording() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-rec-every-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rrd = dir.join("thin.rrd");
+    let sc = scenario::load(Path::new("scenarios/ji2014/quick.toml")).unwrap();
+    let r = run(&sc, &RunOptions { record: Some(rrd.clone()), record_every: 10, ..RunOptions::default() });
+    assert!(r.passed, "{:?}", r.error);
+    let ticks = &read_back(&rrd)["/structure/nodes"];
+    assert_eq!(ticks.len() as u64, r.settle.steps / 10);
+    assert!(ticks.iter().all(|t| t % 10 == 0));
+}
+
+/// Streaming to an address where no viewer listens neither fails nor stalls the run: it says
+/// so once and goes on.
+#[test]
+fn connect_without_a_viewer_goes_on() {
+    let start = std::time::Instant::now();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+        .args(["run", "scenarios/ji2014/quick.toml", "--connect", "rerun+http://127.0.0.1:1/proxy"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("no rerun viewer").count(), 1, "{err}");
+    assert!(start.elapsed() < std::time::Duration::from_secs(10));
+}
