@@ -1,8 +1,9 @@
 //! Recording a run to a rerun `.rrd` file, headless.
 //!
 //! Entities: `structure/{nodes,struts,springs,cables}` (springs and cables coloured by force),
-//! `analytic/nodes` (the analytic prediction as a ghost overlay), `errors/<quantity>`,
-//! `forces/<member>`, `inputs/<symbol>`, `speed`, and `events` (text log). The scenario file
+//! `analytic/{nodes,struts}` (the analytic prediction as a ghost overlay), and time series with
+//! one named series per quantity or member: `errors`, `forces/{springs,cables,actuators}`,
+//! `inputs`, `residual`; `interference/min_clearance_m`; `events` (text log). The scenario file
 //! and the report summary are stored as documents. Timelines: `tick` and `sim_time`.
 //! The file is written to `<path>.partial` and renamed when the run ends, so a reader never
 //! sees a half-written recording under the final name.
@@ -21,6 +22,8 @@ pub struct Recorder {
     rec: rerun::RecordingStream,
     target: Target,
     every: u64,
+    /// Series entities whose names were logged (once, as static data).
+    named: std::collections::BTreeSet<String>,
 }
 
 /// Where a recording goes.
@@ -81,7 +84,12 @@ impl Recorder {
         }
         let partial = path.with_extension("rrd.partial");
         let rec = rerun::RecordingStreamBuilder::new(app).save(&partial).map_err(|e| io(e.to_string()))?;
-        Ok(Recorder { rec, target: Target::File { partial, path: path.to_path_buf() }, every: every.max(1) })
+        Ok(Recorder {
+            rec,
+            target: Target::File { partial, path: path.to_path_buf() },
+            every: every.max(1),
+            named: Default::default(),
+        })
     }
 
     /// Streams the same data live to a rerun viewer or server at `url` (rerun's default when
@@ -97,12 +105,23 @@ impl Recorder {
         let rec = rerun::RecordingStreamBuilder::new(app)
             .connect_grpc_opts(url.clone())
             .map_err(|e| RecordError::Io { path: url.clone(), message: e.to_string() })?;
-        Ok(Some(Recorder { rec, target: Target::Live { url }, every: every.max(1) }))
+        Ok(Some(Recorder { rec, target: Target::Live { url }, every: every.max(1), named: Default::default() }))
     }
 
     /// Stores a text document (static: it belongs to the whole run).
     pub fn document(&mut self, entity: &str, text: &str) {
         let _ = self.rec.log_static(entity, &rerun::TextDocument::new(text));
+    }
+
+    /// Logs several named series under one entity at the current time (names once, static).
+    fn series(&mut self, entity: &str, names: Vec<String>, values: Vec<f64>) {
+        if values.is_empty() {
+            return;
+        }
+        if self.named.insert(entity.to_string()) {
+            let _ = self.rec.log_static(entity, &rerun::SeriesLines::new().with_names(names));
+        }
+        let _ = self.rec.log(entity, &rerun::Scalars::new(values));
     }
 
     /// Logs one scalar time series value at `tick`.
@@ -191,24 +210,31 @@ impl Observer for Recorder {
             let _ = rec
                 .log("analytic/struts", &rerun::LineStrips3D::new(ghost_struts).with_colors([[80u8, 220, 120, 120]]));
         }
-        for (q, a) in &t.prediction.expected {
-            if let Some(sv) = t.simulated.get(q) {
-                let e = if q.starts_with("theta") { wrap_angle(sv - a) } else { sv - a };
-                let _ = rec.log(format!("errors/{q}"), &rerun::Scalars::single(e));
-            }
-        }
-        for (i, m) in s.springs.iter().enumerate() {
-            let _ = rec.log(format!("forces/spring/{}", m.name), &rerun::Scalars::single(f.spring_force_n[i]));
-        }
-        for (i, m) in s.cables.iter().enumerate() {
-            let _ = rec.log(format!("forces/cable/{}", m.name), &rerun::Scalars::single(f.cable_tension_n[i]));
-        }
-        for (i, a) in s.actuators.iter().enumerate() {
-            let _ = rec.log(format!("inputs/{}", a.symbol), &rerun::Scalars::single(snap.actuator_values[i]));
-            let _ = rec.log(format!("forces/actuator/{}", a.symbol), &rerun::Scalars::single(f.actuator_force[i]));
-        }
-        let _ = rec.log("residual/force_n", &rerun::Scalars::single(f.residual.max_force_n));
-        let _ = rec.log("residual/torque_nm", &rerun::Scalars::single(f.residual.max_torque_nm));
+        // Time series: one entity per family, one named series per member or quantity (one
+        // log call each, which keeps the cost per tick down).
+        let (names, errors): (Vec<String>, Vec<f64>) = t
+            .prediction
+            .expected
+            .iter()
+            .filter_map(|(q, a)| {
+                let sv = t.simulated.get(q)?;
+                Some((q.clone(), if q.starts_with("theta") { wrap_angle(sv - a) } else { sv - a }))
+            })
+            .unzip();
+        self.series("errors", names, errors);
+        let springs = s.springs.iter().map(|m| m.name.clone()).collect();
+        self.series("forces/springs", springs, f.spring_force_n.clone());
+        let cables = s.cables.iter().map(|m| m.name.clone()).collect();
+        self.series("forces/cables", cables, f.cable_tension_n.clone());
+        let actuators: Vec<String> =
+            s.actuators.iter().enumerate().map(|(i, a)| format!("{} #{}", a.symbol, i + 1)).collect();
+        self.series("forces/actuators", actuators.clone(), f.actuator_force.clone());
+        self.series("inputs", actuators, snap.actuator_values.clone());
+        self.series(
+            "residual",
+            vec!["force_n".into(), "torque_nm".into()],
+            vec![f.residual.max_force_n, f.residual.max_torque_nm],
+        );
     }
 
     fn event(&mut self, tick: u64, text: &str) {
