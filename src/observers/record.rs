@@ -164,51 +164,67 @@ impl Observer for Recorder {
         rec.set_time_sequence("tick", snap.tick as i64);
         rec.set_duration_secs("sim_time", snap.time_s);
         let pts: Vec<[f32; 3]> = snap.nodes.iter().map(|p| f32x3(*p)).collect();
-        let labels: Vec<String> = s.nodes.iter().map(|n| n.name.clone()).collect();
-        let _ = rec.log(
-            "structure/nodes",
-            &rerun::Points3D::new(pts.clone()).with_labels(labels.clone()).with_radii([0.02f32]),
-        );
+        // What does not change (labels, radii, fixed colours) is logged once, as static data;
+        // every tick carries only positions and force colours.
+        if self.named.insert("structure".into()) {
+            let names = |v: Vec<&String>| v.into_iter().cloned().collect::<Vec<_>>();
+            let _ = rec.log_static(
+                "structure/nodes",
+                &rerun::Points3D::update_fields()
+                    .with_labels(names(s.nodes.iter().map(|n| &n.name).collect()))
+                    .with_radii([0.02f32]),
+            );
+            let _ = rec.log_static(
+                "structure/struts",
+                &rerun::LineStrips3D::update_fields()
+                    .with_radii(s.struts.iter().map(|m| m.radius_m as f32).collect::<Vec<_>>())
+                    .with_colors([[200u8, 200, 200, 255]])
+                    .with_labels(names(s.struts.iter().map(|m| &m.name).collect())),
+            );
+            let _ = rec.log_static(
+                "structure/springs",
+                &rerun::LineStrips3D::update_fields().with_labels(names(s.springs.iter().map(|m| &m.name).collect())),
+            );
+            let _ = rec.log_static(
+                "structure/cables",
+                &rerun::LineStrips3D::update_fields().with_labels(names(s.cables.iter().map(|m| &m.name).collect())),
+            );
+            let _ = rec.log_static(
+                "analytic/nodes",
+                &rerun::Points3D::update_fields().with_colors([[80u8, 220, 120, 160]]).with_radii([0.015f32]),
+            );
+            let _ = rec.log_static(
+                "analytic/struts",
+                &rerun::LineStrips3D::update_fields().with_colors([[80u8, 220, 120, 120]]),
+            );
+        }
+        let _ = rec.log("structure/nodes", &rerun::Points3D::new(pts.clone()));
         let strips = |pairs: Vec<(usize, usize)>| -> Vec<Vec<[f32; 3]>> {
             pairs.into_iter().map(|(a, b)| vec![pts[a], pts[b]]).collect()
         };
-        let _ = rec.log(
-            "structure/struts",
-            &rerun::LineStrips3D::new(strips(s.struts.iter().map(|m| (m.a, m.b)).collect()))
-                .with_radii(s.struts.iter().map(|m| m.radius_m as f32).collect::<Vec<_>>())
-                .with_colors([[200u8, 200, 200, 255]])
-                .with_labels(s.struts.iter().map(|m| m.name.clone()).collect::<Vec<_>>()),
-        );
+        let _ = rec
+            .log("structure/struts", &rerun::LineStrips3D::new(strips(s.struts.iter().map(|m| (m.a, m.b)).collect())));
         let f = &snap.forces;
         let max_f = f.spring_force_n.iter().chain(&f.cable_tension_n).fold(0.0f64, |m, x| m.max(x.abs()));
         if !s.springs.is_empty() {
             let _ = rec.log(
                 "structure/springs",
                 &rerun::LineStrips3D::new(strips(s.springs.iter().map(|m| (m.a, m.b)).collect()))
-                    .with_colors(f.spring_force_n.iter().map(|x| force_colour(*x, max_f)).collect::<Vec<_>>())
-                    .with_labels(s.springs.iter().map(|m| m.name.clone()).collect::<Vec<_>>()),
+                    .with_colors(f.spring_force_n.iter().map(|x| force_colour(*x, max_f)).collect::<Vec<_>>()),
             );
         }
         if !s.cables.is_empty() {
             let _ = rec.log(
                 "structure/cables",
                 &rerun::LineStrips3D::new(strips(s.cables.iter().map(|m| (m.a, m.b)).collect()))
-                    .with_colors(f.cable_tension_n.iter().map(|x| force_colour(*x, max_f)).collect::<Vec<_>>())
-                    .with_labels(s.cables.iter().map(|m| m.name.clone()).collect::<Vec<_>>()),
+                    .with_colors(f.cable_tension_n.iter().map(|x| force_colour(*x, max_f)).collect::<Vec<_>>()),
             );
         }
         if let Some(ghost) = t.ghost_nodes {
             let g: Vec<[f32; 3]> = ghost.iter().map(|p| f32x3(*p)).collect();
-            let _ = rec.log(
-                "analytic/nodes",
-                &rerun::Points3D::new(g.clone())
-                    .with_labels(labels)
-                    .with_colors([[80u8, 220, 120, 160]])
-                    .with_radii([0.015f32]),
-            );
+            let _ = rec.log("analytic/nodes", &rerun::Points3D::new(g.clone()));
             let ghost_struts: Vec<Vec<[f32; 3]>> = s.struts.iter().map(|m| vec![g[m.a], g[m.b]]).collect();
-            let _ = rec
-                .log("analytic/struts", &rerun::LineStrips3D::new(ghost_struts).with_colors([[80u8, 220, 120, 120]]));
+            let _ = rec.log("analytic/struts", &rerun::LineStrips3D::new(ghost_struts));
         }
         // Time series: one entity per family, one named series per member or quantity (one
         // log call each, which keeps the cost per tick down).
