@@ -103,13 +103,22 @@ fn a_missing_file_gives_exit_2() {
 
 #[test]
 fn every_shipped_scenario_is_valid() {
-    for entry in std::fs::read_dir("scenarios/ji2014").unwrap() {
-        let p = entry.unwrap().path();
-        if p.extension().is_some_and(|e| e == "toml") {
-            let (code, out, err) = tensegrity(&["check", p.to_str().unwrap()]);
-            assert_eq!(code, 0, "{}: {out}{err}", p.display());
+    let mut checked = 0;
+    for dir in std::fs::read_dir("scenarios").unwrap() {
+        let dir = dir.unwrap().path();
+        if !dir.is_dir() {
+            continue;
+        }
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let p = entry.unwrap().path();
+            if p.extension().is_some_and(|e| e == "toml") {
+                let (code, out, err) = tensegrity(&["check", p.to_str().unwrap()]);
+                assert_eq!(code, 0, "{}: {out}{err}", p.display());
+                checked += 1;
+            }
         }
     }
+    assert!(checked >= 25, "{checked} scenario files checked");
 }
 
 #[test]
