@@ -6,6 +6,7 @@
 
 pub mod bench;
 pub mod custom;
+pub mod figures;
 pub mod mechanisms;
 pub mod observers;
 pub mod report;

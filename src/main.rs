@@ -64,6 +64,17 @@ enum Command {
         #[arg(long)]
         shard: Option<String>,
     },
+    /// Draw one of the papers' figures (analytic, with the dynamics' verdict) as PNG and SVG.
+    Figure {
+        /// The figure's name (`tensegrity figure --list`).
+        name: Option<String>,
+        /// Directory for NAME.png and NAME.svg.
+        #[arg(long, default_value = "assets/figures")]
+        out: PathBuf,
+        /// List the figures.
+        #[arg(long)]
+        list: bool,
+    },
     /// Join the CSVs of a sharded sweep into one, rows in grid order.
     Merge {
         #[arg(required = true)]
@@ -139,6 +150,7 @@ fn main() -> ExitCode {
             cmd_sweep(&scenario, out.as_deref(), json.as_deref(), jobs, shard.as_deref())
         }
         Command::Merge { csvs, out } => cmd_merge(&csvs, &out),
+        Command::Figure { name, out, list } => cmd_figure(name.as_deref(), &out, list),
         Command::Solve { mechanism, query, set, json } => cmd_solve(&mechanism, &query, &set, json),
         Command::Findings { mechanism, set, json } => cmd_findings(&mechanism, &set, json),
         Command::Bench { rounds, json } => cmd_bench(rounds, json),
@@ -303,6 +315,30 @@ fn cmd_sweep(path: &Path, out: Option<&Path>, json: Option<&Path>, jobs: usize, 
         EXIT_PASS
     } else {
         EXIT_FAIL
+    }
+}
+
+fn cmd_figure(name: Option<&str>, out: &Path, list: bool) -> i32 {
+    let name = match (name, list) {
+        (Some(n), false) => n,
+        _ => {
+            for (n, what) in tensegrity_testbed::figures::FIGURES {
+                println!("{n}: {what}");
+            }
+            return if list { EXIT_PASS } else { EXIT_BAD_INPUT };
+        }
+    };
+    match tensegrity_testbed::figures::draw(name, out) {
+        Ok(files) => {
+            for f in files {
+                println!("wrote {}", f.display());
+            }
+            EXIT_PASS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_BAD_INPUT
+        }
     }
 }
 

@@ -1,0 +1,161 @@
+//! `tensegrity figure NAME`: the papers' figures, redrawn from the analytic model with the
+//! dynamics' verdict overlaid, as PNG and SVG (plotters; text in the bundled DejaVu Sans).
+
+use crate::mechanisms::ji2014::analytic as ji;
+use crate::run::{run, RunOptions};
+use crate::scenario;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// The figures this command draws: (name, what it shows).
+pub const FIGURES: &[(&str, &str)] = &[(
+    "ji2014-fig4",
+    "ji2014 Fig. 4-6: energy U, torque tau and stiffness K against theta2 (L3 = 6, K1 = 100, K2 = 10, theta1 = pi/10), with the equilibrium the dynamics settled on",
+)];
+
+/// Samples of a curve against theta2.
+const CURVE_SAMPLES: usize = 721;
+
+/// Figure size in pixels.
+const SIZE: (u32, u32) = (900, 1100);
+
+static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+
+fn register_font() -> Result<(), String> {
+    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+        .map_err(|_| "the bundled font is invalid".to_string())
+}
+
+/// Draws figure `name` into `dir` as NAME.png and NAME.svg; returns the files written.
+pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
+    register_font()?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let data = match name {
+        "ji2014-fig4" => ji2014_fig4_data()?,
+        other => {
+            let known: Vec<_> = FIGURES.iter().map(|(n, _)| *n).collect();
+            return Err(format!("unknown figure '{other}' (expected one of: {})", known.join(", ")));
+        }
+    };
+    let png = dir.join(format!("{name}.png"));
+    let svg = dir.join(format!("{name}.svg"));
+    ji2014_fig4_plot(BitMapBackend::new(&png, SIZE).into_drawing_area(), &data)?;
+    ji2014_fig4_plot(SVGBackend::new(&svg, SIZE).into_drawing_area(), &data)?;
+    Ok(vec![png, svg])
+}
+
+struct Fig4 {
+    theta2: Vec<f64>,
+    u: Vec<f64>,
+    tau: Vec<f64>,
+    k: Vec<f64>,
+    /// Analytic equilibria: (theta2, stable).
+    equilibria: Vec<(f64, bool)>,
+    /// Where the dynamics settled (theta2), from `scenarios/ji2014/fig4.toml`.
+    simulated: f64,
+    params: ji::Params,
+    l3: f64,
+    theta1: f64,
+}
+
+fn ji2014_fig4_data() -> Result<Fig4, String> {
+    let sc = scenario::load(Path::new("scenarios/ji2014/fig4.toml")).map_err(|e| e.to_string())?;
+    let report = run(&sc, &RunOptions::default());
+    let point = report.points.first().ok_or("the fig4 scenario settled no point")?;
+    if !point.settled {
+        return Err("the fig4 scenario did not settle".into());
+    }
+    let params = ji::Params { l: sc.params["L"], k1: sc.params["K1"], k2: sc.params["K2"] };
+    let (l3, theta1) = (point.inputs["L3"], point.inputs["theta1"]);
+    let theta2: Vec<f64> = (0..CURVE_SAMPLES)
+        .map(|i| -std::f64::consts::PI + std::f64::consts::TAU * i as f64 / (CURVE_SAMPLES - 1) as f64)
+        .collect();
+    Ok(Fig4 {
+        u: theta2.iter().map(|t| ji::potential_energy(&params, l3, theta1, *t)).collect(),
+        tau: theta2.iter().map(|t| ji::torque(&params, l3, theta1, *t)).collect(),
+        k: theta2.iter().map(|t| ji::stiffness(&params, l3, theta1, *t)).collect(),
+        equilibria: ji::equilibria(&params, l3, theta1).iter().map(|e| (e.theta2, e.stable)).collect(),
+        simulated: point.simulated["theta2"],
+        theta2,
+        params,
+        l3,
+        theta1,
+    })
+}
+
+fn range(v: &[f64]) -> std::ops::Range<f64> {
+    let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+    let pad = 0.05 * (hi - lo).max(1e-12);
+    (lo - pad)..(hi + pad)
+}
+
+fn ji2014_fig4_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig4) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled(
+            &format!(
+                "ji2014, L3 = {} m, theta1 = {:.4} rad, K1 = {} N/m, K2 = {} N/m",
+                d.l3, d.theta1, d.params.k1, d.params.k2
+            ),
+            ("sans-serif", 22),
+        )
+        .map_err(err)?;
+    let panels = root.split_evenly((3, 1));
+    let curves: [(&str, &str, &Vec<f64>, RGBColor, SeriesLabelPosition); 3] = [
+        ("U [J] (Eq. 4)", "energy", &d.u, BLUE, SeriesLabelPosition::UpperRight),
+        ("tau [N m] (Eq. 41)", "torque", &d.tau, GREEN, SeriesLabelPosition::UpperRight),
+        ("K [N m/rad] (Eq. 42)", "stiffness", &d.k, MAGENTA, SeriesLabelPosition::LowerRight),
+    ];
+    for (panel, (ylabel, what, ys, colour, legend_at)) in panels.iter().zip(curves) {
+        let mut chart = ChartBuilder::on(panel)
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .caption(format!("{what} against theta2"), ("sans-serif", 18))
+            .build_cartesian_2d(-std::f64::consts::PI..std::f64::consts::PI, range(ys))
+            .map_err(err)?;
+        chart.configure_mesh().x_desc("theta2 [rad]").y_desc(ylabel).draw().map_err(err)?;
+        chart
+            .draw_series(LineSeries::new(d.theta2.iter().copied().zip(ys.iter().copied()), colour.stroke_width(2)))
+            .map_err(err)?
+            .label(format!("analytic {what}"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+        let value_at = |t: f64| -> f64 {
+            match what {
+                "energy" => ji::potential_energy(&d.params, d.l3, d.theta1, t),
+                "torque" => ji::torque(&d.params, d.l3, d.theta1, t),
+                _ => ji::stiffness(&d.params, d.l3, d.theta1, t),
+            }
+        };
+        for (t, stable) in &d.equilibria {
+            let (label, style) = if *stable {
+                ("analytic energy minimum", BLACK.filled())
+            } else {
+                ("analytic energy maximum", BLACK.stroke_width(2))
+            };
+            chart
+                .draw_series(std::iter::once(Circle::new((*t, value_at(*t)), 7, style)))
+                .map_err(err)?
+                .label(label)
+                .legend(move |(x, y)| Circle::new((x + 10, y), 5, style));
+        }
+        let sim = d.simulated;
+        chart
+            .draw_series(std::iter::once(TriangleMarker::new((sim, value_at(sim)), 9, RED.filled())))
+            .map_err(err)?
+            .label(format!("dynamics settled at theta2 = {sim:.9} rad"))
+            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, RED.filled()));
+        chart
+            .configure_series_labels()
+            .position(legend_at)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .draw()
+            .map_err(err)?;
+    }
+    root.present().map_err(err)?;
+    Ok(())
+}
