@@ -9,10 +9,19 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// The figures this command draws: (name, what it shows).
-pub const FIGURES: &[(&str, &str)] = &[(
-    "ji2014-fig4",
-    "ji2014 Fig. 4-6: energy U, torque tau and stiffness K against theta2 (L3 = 6, K1 = 100, K2 = 10, theta1 = pi/10), with the equilibrium the dynamics settled on",
-)];
+pub const FIGURES: &[(&str, &str)] = &[
+    (
+        "ji2014-fig4",
+        "ji2014 Fig. 4-6: energy U, torque tau and stiffness K against theta2 (L3 = 6, K1 = 100, K2 = 10, theta1 = pi/10), with the equilibrium the dynamics settled on",
+    ),
+    (
+        "mohr2011-fig5",
+        "mohr2011 Fig. 5: the horizontal slice z = 3 m of the static and kinematic workspaces (l_b = 2, l_o = 3 l_b), with a 9 x 9 grid classified by the dynamics",
+    ),
+];
+
+/// Cells per side of an analytic workspace map.
+const MAP_CELLS: usize = 120;
 
 /// Samples of a curve against theta2.
 const CURVE_SAMPLES: usize = 721;
@@ -31,17 +40,24 @@ fn register_font() -> Result<(), String> {
 pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
     register_font()?;
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let data = match name {
-        "ji2014-fig4" => ji2014_fig4_data()?,
+    let png = dir.join(format!("{name}.png"));
+    let svg = dir.join(format!("{name}.svg"));
+    match name {
+        "ji2014-fig4" => {
+            let data = ji2014_fig4_data()?;
+            ji2014_fig4_plot(BitMapBackend::new(&png, SIZE).into_drawing_area(), &data)?;
+            ji2014_fig4_plot(SVGBackend::new(&svg, SIZE).into_drawing_area(), &data)?;
+        }
+        "mohr2011-fig5" => {
+            let data = mohr2011_fig5_data()?;
+            mohr2011_fig5_plot(BitMapBackend::new(&png, MAP_SIZE).into_drawing_area(), &data)?;
+            mohr2011_fig5_plot(SVGBackend::new(&svg, MAP_SIZE).into_drawing_area(), &data)?;
+        }
         other => {
             let known: Vec<_> = FIGURES.iter().map(|(n, _)| *n).collect();
             return Err(format!("unknown figure '{other}' (expected one of: {})", known.join(", ")));
         }
-    };
-    let png = dir.join(format!("{name}.png"));
-    let svg = dir.join(format!("{name}.svg"));
-    ji2014_fig4_plot(BitMapBackend::new(&png, SIZE).into_drawing_area(), &data)?;
-    ji2014_fig4_plot(SVGBackend::new(&svg, SIZE).into_drawing_area(), &data)?;
+    }
     Ok(vec![png, svg])
 }
 
@@ -156,6 +172,124 @@ fn ji2014_fig4_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig4) 
             .draw()
             .map_err(err)?;
     }
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// Size of a workspace map in pixels.
+const MAP_SIZE: (u32, u32) = (900, 820);
+
+/// Height of the mohr2011 slice [m] and half-width of the map [m].
+const MOHR_SLICE_Z_M: f64 = 3.0;
+const MOHR_HALF_WIDTH_M: f64 = 4.0;
+
+struct Fig5 {
+    /// Analytic class per cell centre: (x, y, region).
+    cells: Vec<(f64, f64, crate::mechanisms::mohr2011::analytic::Region)>,
+    cell: f64,
+    /// Dynamics: (x, y, inside the static workspace by the dynamics).
+    points: Vec<(f64, f64, bool)>,
+    agreement: f64,
+}
+
+fn mohr2011_fig5_data() -> Result<Fig5, String> {
+    use crate::mechanisms::mohr2011::analytic as mohr;
+    let p = mohr::Params { lb: 2.0, lo: 6.0, kappa: 10.0, l_min: 0.0 };
+    let cell = 2.0 * MOHR_HALF_WIDTH_M / MAP_CELLS as f64;
+    let mut cells = Vec::new();
+    for i in 0..MAP_CELLS {
+        for j in 0..MAP_CELLS {
+            let (x, y) = (-MOHR_HALF_WIDTH_M + (i as f64 + 0.5) * cell, -MOHR_HALF_WIDTH_M + (j as f64 + 0.5) * cell);
+            cells.push((x, y, mohr::classify(&p, &nalgebra::Vector3::new(x, y, MOHR_SLICE_Z_M)).region));
+        }
+    }
+    // The dynamics: the small workspace grid scenario, at this slice, 9 x 9 points.
+    let path = Path::new("scenarios/mohr2011/workspace_grid_small.toml");
+    let src = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let start = src.find("grid = {").ok_or("workspace_grid_small.toml has no grid")?;
+    let end = start + src[start..].find('\n').unwrap_or(src.len() - start);
+    let grid = format!(
+        "grid = {{ x = {{ from = -{h}, to = {h}, count = 9 }}, y = {{ from = -{h}, to = {h}, count = 9 }}, z = {{ from = {z}, to = {z}, count = 1 }} }}",
+        h = MOHR_HALF_WIDTH_M - 0.5,
+        z = MOHR_SLICE_Z_M
+    );
+    let text = format!("{}{}{}", &src[..start], grid, &src[end..]);
+    let sc = scenario::parse(path, &text).map_err(|e| e.to_string())?;
+    let (rows, summary) = crate::sweep::sweep(&sc, 2, None, None, &|_, _| {}).map_err(|e| e.to_string())?;
+    let points = rows
+        .iter()
+        .map(|r| {
+            let q = &r.point;
+            (q.analytic["x"], q.analytic["y"], q.settled && q.slack_cables.is_empty() && q.within_tolerance)
+        })
+        .collect();
+    Ok(Fig5 { cells, cell, points, agreement: summary.workspace.map_or(f64::NAN, |w| w.agreement_percent) })
+}
+
+fn mohr2011_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig5) -> Result<(), String> {
+    use crate::mechanisms::mohr2011::analytic::Region;
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let h = MOHR_HALF_WIDTH_M;
+    let mut chart = ChartBuilder::on(&root)
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(55)
+        .caption(
+            format!(
+                "mohr2011, slice z = {MOHR_SLICE_Z_M} m (l_b = 2, l_o = 6): analytic classes, dynamics' verdict (agreement {:.1} %)",
+                d.agreement
+            ),
+            ("sans-serif", 17),
+        )
+        .build_cartesian_2d(-h..h, -h..h)
+        .map_err(err)?;
+    chart.configure_mesh().x_desc("x [m]").y_desc("y [m]").draw().map_err(err)?;
+    let static_c = RGBColor(170, 215, 255);
+    let kin_c = RGBColor(235, 235, 235);
+    let half = d.cell / 2.0;
+    chart
+        .draw_series(d.cells.iter().filter(|(_, _, r)| *r != Region::OutsideKinematic).map(|(x, y, r)| {
+            let c = if *r == Region::Static { static_c } else { kin_c };
+            Rectangle::new([(x - half, y - half), (x + half, y + half)], c.filled())
+        }))
+        .map_err(err)?;
+    // Legend entries for the background classes.
+    chart
+        .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
+        .map_err(err)?
+        .label("static workspace (Eq. 29-31)")
+        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 15, y + 5)], static_c.filled()));
+    chart
+        .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
+        .map_err(err)?
+        .label("kinematic only (a cable pair slack)")
+        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 15, y + 5)], kin_c.filled()));
+    chart
+        .draw_series(
+            d.points.iter().filter(|(_, _, inside)| *inside).map(|(x, y, _)| Circle::new((*x, *y), 6, GREEN.filled())),
+        )
+        .map_err(err)?
+        .label("dynamics: settled, every cable taut, within 1e-9")
+        .legend(|(x, y)| Circle::new((x + 8, y), 5, GREEN.filled()));
+    chart
+        .draw_series(
+            d.points
+                .iter()
+                .filter(|(_, _, inside)| !*inside)
+                .map(|(x, y, _)| Cross::new((*x, *y), 6, RED.stroke_width(2))),
+        )
+        .map_err(err)?
+        .label("dynamics: a cable slack or not settled")
+        .legend(|(x, y)| Cross::new((x + 8, y), 5, RED.stroke_width(2)));
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
     root.present().map_err(err)?;
     Ok(())
 }
