@@ -15,6 +15,10 @@ pub const FIGURES: &[(&str, &str)] = &[
         "ji2014 Fig. 4-6: energy U, torque tau and stiffness K against theta2 (L3 = 6, K1 = 100, K2 = 10, theta1 = pi/10), with the equilibrium the dynamics settled on",
     ),
     (
+        "furet2018-fig5",
+        "furet2018 Fig. 5: workspace regions by number of inverse solutions (2 or 4) for b = 2/5, 2/3, 9/10 (L = 1), with the paper's Fig. 3 point",
+    ),
+    (
         "mohr2011-fig5",
         "mohr2011 Fig. 5: the horizontal slice z = 3 m of the static and kinematic workspaces (l_b = 2, l_o = 3 l_b), with a 9 x 9 grid classified by the dynamics",
     ),
@@ -47,6 +51,11 @@ pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
             let data = ji2014_fig4_data()?;
             ji2014_fig4_plot(BitMapBackend::new(&png, SIZE).into_drawing_area(), &data)?;
             ji2014_fig4_plot(SVGBackend::new(&svg, SIZE).into_drawing_area(), &data)?;
+        }
+        "furet2018-fig5" => {
+            let data = furet2018_fig5_data();
+            furet2018_fig5_plot(BitMapBackend::new(&png, (1500, 560)).into_drawing_area(), &data)?;
+            furet2018_fig5_plot(SVGBackend::new(&svg, (1500, 560)).into_drawing_area(), &data)?;
         }
         "mohr2011-fig5" => {
             let data = mohr2011_fig5_data()?;
@@ -290,6 +299,99 @@ fn mohr2011_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig5
         .label_font(("sans-serif", 13))
         .draw()
         .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// The b values of furet2018's Fig. 5 (L = 1).
+const FURET_FIG5_B: [f64; 3] = [2.0 / 5.0, 2.0 / 3.0, 9.0 / 10.0];
+
+/// Cells per side of a furet2018 solution-count map over [-2L, 2L]^2.
+const FURET_MAP_CELLS: usize = 160;
+
+struct FuretFig5 {
+    /// Per b: (b, cells (x, y, count), area fractions (2, 4)).
+    panels: Vec<(f64, Vec<(f64, f64, usize)>, (f64, f64))>,
+    cell: f64,
+}
+
+fn furet2018_fig5_data() -> FuretFig5 {
+    use crate::mechanisms::furet2018::analytic as furet;
+    let half = 2.0;
+    let cell = 2.0 * half / FURET_MAP_CELLS as f64;
+    let panels = FURET_FIG5_B
+        .iter()
+        .map(|&b| {
+            let p = furet::Params { l: 1.0, b };
+            let mut cells = Vec::new();
+            for i in 0..FURET_MAP_CELLS {
+                for j in 0..FURET_MAP_CELLS {
+                    let (x, y) = (-half + (i as f64 + 0.5) * cell, -half + (j as f64 + 0.5) * cell);
+                    cells.push((x, y, furet::solution_count(&p, x, y)));
+                }
+            }
+            let n = cells.iter().filter(|c| c.2 > 0 && c.2 != usize::MAX).count().max(1) as f64;
+            let f2 = cells.iter().filter(|c| c.2 == 2).count() as f64 / n;
+            let f4 = cells.iter().filter(|c| c.2 == 4).count() as f64 / n;
+            (b, cells, (f2, f4))
+        })
+        .collect();
+    FuretFig5 { panels, cell }
+}
+
+fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &FuretFig5) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled("furet2018 (L = 1): workspace by number of inverse solutions (analytic, Eq. 6-12)", ("sans-serif", 20))
+        .map_err(err)?;
+    let two = RGBColor(190, 220, 250);
+    let four = RGBColor(250, 170, 120);
+    let half = d.cell / 2.0;
+    for (area, (b, cells, (f2, f4))) in root.split_evenly((1, 3)).iter().zip(&d.panels) {
+        let mut chart = ChartBuilder::on(area)
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(45)
+            .caption(
+                format!("b = {b:.3} m: 2 solutions {:.1} %, 4 solutions {:.1} %", 100.0 * f2, 100.0 * f4),
+                ("sans-serif", 15),
+            )
+            .build_cartesian_2d(-2.0..2.0, -2.0..2.0)
+            .map_err(err)?;
+        chart.configure_mesh().disable_mesh().x_desc("x [m]").y_desc("y [m]").draw().map_err(err)?;
+        chart
+            .draw_series(cells.iter().filter(|c| c.2 == 2 || c.2 == 4).map(|(x, y, n)| {
+                let c = if *n == 4 { four } else { two };
+                Rectangle::new([(x - half, y - half), (x + half, y + half)], c.filled())
+            }))
+            .map_err(err)?;
+        chart
+            .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
+            .map_err(err)?
+            .label("2 solutions")
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 15, y + 5)], two.filled()));
+        chart
+            .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
+            .map_err(err)?
+            .label("4 solutions")
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 15, y + 5)], four.filled()));
+        if (*b - 2.0 / 3.0).abs() < 1e-12 {
+            chart
+                .draw_series(std::iter::once(TriangleMarker::new((0.03, 1.6), 7, BLACK.filled())))
+                .map_err(err)?
+                .label("Fig. 3 point (0.03, 1.6): 4 solutions")
+                .legend(|(x, y)| TriangleMarker::new((x + 8, y), 5, BLACK.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 12))
+            .draw()
+            .map_err(err)?;
+    }
     root.present().map_err(err)?;
     Ok(())
 }
