@@ -357,7 +357,8 @@ fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fur
                 format!("b = {b:.3} m: 2 solutions {:.1} %, 4 solutions {:.1} %", 100.0 * f2, 100.0 * f4),
                 ("sans-serif", 15),
             )
-            .build_cartesian_2d(-2.0..2.0, -2.0..2.0)
+            // Headroom above the workspace for the legend.
+            .build_cartesian_2d(-2.0..2.0, -2.0..2.8)
             .map_err(err)?;
         chart.configure_mesh().disable_mesh().x_desc("x [m]").y_desc("y [m]").draw().map_err(err)?;
         chart
