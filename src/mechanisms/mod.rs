@@ -183,6 +183,34 @@ pub fn with_defaults(m: &dyn Mechanism, given: &Values) -> Values {
     out
 }
 
+/// Checks that every `(symbol, unit)` parameter is a finite number > 0; the error names the
+/// first that is not.
+pub fn require_positive(v: &Values, specs: &[(&str, &str)]) -> Result<(), (String, String)> {
+    for (sym, unit) in specs {
+        let x = v[*sym];
+        if !(x > 0.0 && x.is_finite()) {
+            return Err((sym.to_string(), format!("{sym} must be a finite number > 0 {unit}, got {x}")));
+        }
+    }
+    Ok(())
+}
+
+/// Checks that every `(symbol, unit)` parameter is a finite number >= 0.
+pub fn require_non_negative(v: &Values, specs: &[(&str, &str)]) -> Result<(), (String, String)> {
+    for (sym, unit) in specs {
+        let x = v[*sym];
+        if !(x >= 0.0 && x.is_finite()) {
+            return Err((sym.to_string(), format!("{sym} must be a finite number >= 0 {unit}, got {x}")));
+        }
+    }
+    Ok(())
+}
+
+/// The value of input `key`, or an error naming it.
+pub fn input(inputs: &Values, key: &str) -> Result<f64, String> {
+    inputs.get(key).copied().ok_or_else(|| format!("missing input '{key}'"))
+}
+
 /// Wraps an angle difference to (-pi, pi].
 pub fn wrap_angle(a: f64) -> f64 {
     let two_pi = std::f64::consts::TAU;

@@ -5,8 +5,8 @@ pub mod analytic;
 pub mod build;
 
 use super::{
-    wrap_angle, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec,
-    Solution, Values,
+    input, wrap_angle, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec,
+    QuerySpec, Solution, Values,
 };
 use crate::sim::Snapshot;
 use crate::structure::Structure;
@@ -103,10 +103,6 @@ fn model_of(v: &Values) -> build::ModelChoices {
     }
 }
 
-fn input(inputs: &Values, key: &str) -> Result<f64, String> {
-    inputs.get(key).copied().ok_or_else(|| format!("missing input '{key}'"))
-}
-
 fn dk_values(p: &Params, th1: f64, th2: f64) -> Values {
     let (x, y) = analytic::direct_kinematics(p, th1, th2);
     Values::from([
@@ -147,18 +143,8 @@ impl Mechanism for Furet2018 {
     }
 
     fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
-        for (sym, what) in [("L", "m"), ("b", "m"), ("k_spring", "N/m"), ("m_bar", "kg")] {
-            let x = v[sym];
-            if !(x > 0.0 && x.is_finite()) {
-                return Err((sym.into(), format!("{sym} must be a finite number > 0 {what}, got {x}")));
-            }
-        }
-        for (sym, what) in [("l0_spring", "m"), ("c_joint", "N m s/rad"), ("dz", "m"), ("r_strut", "m")] {
-            let x = v[sym];
-            if !(x >= 0.0 && x.is_finite()) {
-                return Err((sym.into(), format!("{sym} must be a finite number >= 0 {what}, got {x}")));
-            }
-        }
+        super::require_positive(v, &[("L", "m"), ("b", "m"), ("k_spring", "N/m"), ("m_bar", "kg")])?;
+        super::require_non_negative(v, &[("l0_spring", "m"), ("c_joint", "N m s/rad"), ("dz", "m"), ("r_strut", "m")])?;
         if v["L"] <= v["b"] {
             return Err((
                 "b".into(),

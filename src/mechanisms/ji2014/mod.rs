@@ -4,8 +4,8 @@ pub mod analytic;
 pub mod build;
 
 use super::{
-    wrap_angle, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec,
-    Solution, StiffnessProbe, Values,
+    input, wrap_angle, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec,
+    QuerySpec, Solution, StiffnessProbe, Values,
 };
 use crate::sim::Snapshot;
 use crate::structure::Structure;
@@ -132,10 +132,6 @@ fn model_of(v: &Values) -> build::ModelChoices {
     build::ModelChoices { platform_mass_kg: v["m_platform"], pivot_damping: v["c_D1"], strut_radius_m: v["r_strut"] }
 }
 
-fn input(inputs: &Values, key: &str) -> Result<f64, String> {
-    inputs.get(key).copied().ok_or_else(|| format!("missing input '{key}'"))
-}
-
 /// Analytic statics at an equilibrium: spring forces and the actuator's axial force.
 fn statics(p: &Params, l3: f64, theta1: f64, theta2: f64) -> (f64, f64, f64) {
     let n = analytic::nodes(p, l3, theta1, theta2);
@@ -213,18 +209,8 @@ impl Mechanism for Ji2014 {
     }
 
     fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
-        for (sym, what) in [("L", "m"), ("K1", "N/m"), ("K2", "N/m"), ("m_platform", "kg")] {
-            let x = v[sym];
-            if !(x > 0.0 && x.is_finite()) {
-                return Err((sym.into(), format!("{sym} must be a finite number > 0 {what}, got {x}")));
-            }
-        }
-        for (sym, what) in [("c_D1", "N m s/rad"), ("r_strut", "m")] {
-            let x = v[sym];
-            if !(x >= 0.0 && x.is_finite()) {
-                return Err((sym.into(), format!("{sym} must be a finite number >= 0 {what}, got {x}")));
-            }
-        }
+        super::require_positive(v, &[("L", "m"), ("K1", "N/m"), ("K2", "N/m"), ("m_platform", "kg")])?;
+        super::require_non_negative(v, &[("c_D1", "N m s/rad"), ("r_strut", "m")])?;
         Ok(())
     }
 

@@ -5,8 +5,8 @@ pub mod analytic;
 pub mod build;
 
 use super::{
-    wrap_angle, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec,
-    Solution, Values,
+    input, wrap_angle, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec,
+    QuerySpec, Solution, Values,
 };
 use crate::sim::Snapshot;
 use crate::structure::Structure;
@@ -170,10 +170,6 @@ pub fn params_of(v: &Values) -> Params {
     }
 }
 
-fn input(inputs: &Values, key: &str) -> Result<f64, String> {
-    inputs.get(key).copied().ok_or_else(|| format!("missing input '{key}'"))
-}
-
 fn statics_values(p: &Params, th1: f64, th2: f64) -> Values {
     let s = analytic::statics(p, th1, th2);
     Values::from([
@@ -217,18 +213,11 @@ impl Mechanism for Manriquez2019 {
     }
 
     fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
-        for (sym, what) in [("a2", "m"), ("l2", "m"), ("m", "kg"), ("base_half", "m"), ("k_spring", "N/m")] {
-            let x = v[sym];
-            if !(x > 0.0 && x.is_finite()) {
-                return Err((sym.into(), format!("{sym} must be a finite number > 0 {what}, got {x}")));
-            }
-        }
-        for (sym, what) in [("g", "m/s^2"), ("l0_spring", "m"), ("c_joint", "N m s/rad"), ("r_strut", "m")] {
-            let x = v[sym];
-            if !(x >= 0.0 && x.is_finite()) {
-                return Err((sym.into(), format!("{sym} must be a finite number >= 0 {what}, got {x}")));
-            }
-        }
+        super::require_positive(v, &[("a2", "m"), ("l2", "m"), ("m", "kg"), ("base_half", "m"), ("k_spring", "N/m")])?;
+        super::require_non_negative(
+            v,
+            &[("g", "m/s^2"), ("l0_spring", "m"), ("c_joint", "N m s/rad"), ("r_strut", "m")],
+        )?;
         params_of(v).validate().map_err(|e| ("base_x".to_string(), e))
     }
 

@@ -4,8 +4,8 @@ pub mod analytic;
 pub mod build;
 
 use super::{
-    Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec, Solution,
-    Values,
+    input, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec,
+    Solution, Values,
 };
 use crate::sim::Snapshot;
 use crate::structure::Structure;
@@ -151,10 +151,6 @@ fn model_of(v: &Values) -> build::ModelChoices {
     }
 }
 
-fn input(inputs: &Values, key: &str) -> Result<f64, String> {
-    inputs.get(key).copied().ok_or_else(|| format!("missing input '{key}'"))
-}
-
 fn rho_of(inputs: &Values) -> Result<[f64; 3], String> {
     Ok([input(inputs, "rho1")?, input(inputs, "rho2")?, input(inputs, "rho3")?])
 }
@@ -280,30 +276,18 @@ impl Mechanism for Mohr2011 {
     }
 
     fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
-        for (sym, what) in [("lb", "m"), ("lo", "m"), ("kappa", "N m/rad"), ("m_platform", "kg"), ("m_link", "kg")] {
-            let x = v[sym];
-            if !(x > 0.0 && x.is_finite()) {
-                return Err((sym.into(), format!("{sym} must be a finite number > 0 {what}, got {x}")));
-            }
-        }
+        super::require_positive(
+            v,
+            &[("lb", "m"), ("lo", "m"), ("kappa", "N m/rad"), ("m_platform", "kg"), ("m_link", "kg")],
+        )?;
         if !(v["straight"] == 0.0 || v["straight"] == 1.0) {
             return Err((
                 "straight".into(),
                 format!("straight must be 0 (two-link springs) or 1 (straight struts), got {}", v["straight"]),
             ));
         }
-        if !(v["k_straight"] > 0.0 && v["k_straight"].is_finite()) {
-            return Err((
-                "k_straight".into(),
-                format!("k_straight must be a finite number > 0 N/m, got {}", v["k_straight"]),
-            ));
-        }
-        for (sym, what) in [("c_joint", "N m s/rad"), ("k_cable", "N/m"), ("r_strut", "m")] {
-            let x = v[sym];
-            if !(x >= 0.0 && x.is_finite()) {
-                return Err((sym.into(), format!("{sym} must be a finite number >= 0 {what}, got {x}")));
-            }
-        }
+        super::require_positive(v, &[("k_straight", "N/m")])?;
+        super::require_non_negative(v, &[("c_joint", "N m s/rad"), ("k_cable", "N/m"), ("r_strut", "m")])?;
         if !v["g_z"].is_finite() {
             return Err(("g_z".into(), format!("g_z must be a finite number (m/s^2), got {}", v["g_z"])));
         }
