@@ -172,14 +172,7 @@ fn ji2014_fig4_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig4) 
             .map_err(err)?
             .label(format!("dynamics settled at theta2 = {sim:.9} rad"))
             .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, RED.filled()));
-        chart
-            .configure_series_labels()
-            .position(legend_at)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 13))
-            .draw()
-            .map_err(err)?;
+        legend_box(&mut chart, legend_at, 13).map_err(err)?;
     }
     root.present().map_err(err)?;
     Ok(())
@@ -264,16 +257,8 @@ fn mohr2011_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig5
         }))
         .map_err(err)?;
     // Legend entries for the background classes.
-    chart
-        .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
-        .map_err(err)?
-        .label("static workspace (Eq. 29-31)")
-        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 15, y + 5)], static_c.filled()));
-    chart
-        .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
-        .map_err(err)?
-        .label("kinematic only (a cable pair slack)")
-        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 15, y + 5)], kin_c.filled()));
+    swatch(&mut chart, "static workspace (Eq. 29-31)", static_c).map_err(err)?;
+    swatch(&mut chart, "kinematic only (a cable pair slack)", kin_c).map_err(err)?;
     chart
         .draw_series(
             d.points.iter().filter(|(_, _, inside)| *inside).map(|(x, y, _)| Circle::new((*x, *y), 6, GREEN.filled())),
@@ -291,14 +276,7 @@ fn mohr2011_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig5
         .map_err(err)?
         .label("dynamics: a cable slack or not settled")
         .legend(|(x, y)| Cross::new((x + 8, y), 5, RED.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(err)?;
+    legend_box(&mut chart, SeriesLabelPosition::LowerRight, 13).map_err(err)?;
     root.present().map_err(err)?;
     Ok(())
 }
@@ -367,16 +345,8 @@ fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fur
                 Rectangle::new([(x - half, y - half), (x + half, y + half)], c.filled())
             }))
             .map_err(err)?;
-        chart
-            .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
-            .map_err(err)?
-            .label("2 solutions")
-            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 15, y + 5)], two.filled()));
-        chart
-            .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
-            .map_err(err)?
-            .label("4 solutions")
-            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 15, y + 5)], four.filled()));
+        swatch(&mut chart, "2 solutions", two).map_err(err)?;
+        swatch(&mut chart, "4 solutions", four).map_err(err)?;
         if (*b - 2.0 / 3.0).abs() < 1e-12 {
             chart
                 .draw_series(std::iter::once(TriangleMarker::new((0.03, 1.6), 7, BLACK.filled())))
@@ -384,15 +354,40 @@ fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fur
                 .label("Fig. 3 point (0.03, 1.6): 4 solutions")
                 .legend(|(x, y)| TriangleMarker::new((x + 8, y), 5, BLACK.filled()));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 12))
-            .draw()
-            .map_err(err)?;
+        legend_box(&mut chart, SeriesLabelPosition::UpperLeft, 12).map_err(err)?;
     }
     root.present().map_err(err)?;
     Ok(())
+}
+
+type Chart<'a, DB> =
+    ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
+
+/// A legend entry for a filled region of colour `colour` (the region itself is drawn cell by
+/// cell, without a label).
+fn swatch<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    label: &str,
+    colour: RGBColor,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    chart
+        .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())?
+        .label(label)
+        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 15, y + 5)], colour.filled()));
+    Ok(())
+}
+
+/// The legend box of every figure: framed, on a translucent white background.
+fn legend_box<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    position: SeriesLabelPosition,
+    font_px: u32,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", font_px))
+        .draw()
 }
