@@ -233,6 +233,7 @@ fn cmd_run(
             cancel: Some(&CANCEL),
             connect: connect.map(str::to_string),
             record_every,
+            skip_findings: false,
         };
         // A panic inside one scenario fails that scenario, with its message; the batch goes on.
         let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(sc, &opts)))

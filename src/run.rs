@@ -25,6 +25,8 @@ pub struct RunOptions<'a> {
     pub connect: Option<String>,
     /// Record every N-th tick only (0 or 1: every tick).
     pub record_every: u64,
+    /// Leave the findings out of the report (a sweep's blocks: the summary has none).
+    pub skip_findings: bool,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -308,7 +310,11 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         workspace: None,
         skipped_points: sc.skipped_points.len(),
         interference: None,
-        findings: mech.findings(&sc.params).into_iter().map(Into::into).collect(),
+        findings: if opts.skip_findings {
+            Vec::new()
+        } else {
+            mech.findings(&sc.params).into_iter().map(Into::into).collect()
+        },
         error: None,
     };
     // Wall time counts the simulation, not the findings computed above.

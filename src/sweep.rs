@@ -100,7 +100,7 @@ pub fn sweep(
                 sub.actuation =
                     Actuation::Points { points: block.iter().map(|(_, v)| v.clone()).collect(), continuation };
                 sub.record = None;
-                let r = run(&sub, &RunOptions { cancel, ..RunOptions::default() });
+                let r = run(&sub, &RunOptions { cancel, skip_findings: true, ..RunOptions::default() });
                 let rows = r
                     .points
                     .into_iter()
