@@ -2,16 +2,9 @@
 //! rejected by `tensegrity check` and `tensegrity run` with exit 2 and a message that names
 //! `file.toml:LINE:COL` and says what was expected.
 
-use std::process::Command;
+mod common;
 
-fn tensegrity(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_tensegrity")).args(args).output().expect("binary runs");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
+use common::tensegrity;
 
 const JI: &str = r#"name = "ji"
 mechanism = "ji2014"

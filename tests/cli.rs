@@ -1,15 +1,8 @@
 //! The command line: exit codes 0 / 1 / 2, file:line:col errors, solve, list, record.
 
-use std::process::Command;
+mod common;
 
-fn tensegrity(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_tensegrity")).args(args).output().expect("binary runs");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::tensegrity;
 
 fn temp_file(name: &str, text: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("tensegrity-cli-{}", std::process::id()));

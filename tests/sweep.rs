@@ -1,16 +1,9 @@
 //! Sweeps: bit-identical whatever the number of jobs; four interleaved shards merged give the
 //! unsharded rows within the scenario's tolerances.
 
-use std::process::Command;
+mod common;
 
-fn tensegrity(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_tensegrity")).args(args).output().expect("binary runs");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
+use common::tensegrity;
 
 fn dir() -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("tensegrity-sweep-{}", std::process::id()));
