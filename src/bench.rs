@@ -146,3 +146,90 @@ pub fn bench_interference(sizes: &[usize], repeats: usize) -> Vec<InterferenceBe
         })
         .collect()
 }
+
+/// One case set written for a peer simulator (`tensegrity bench --export-cases DIR`): the same
+/// points, parameters, time step, settle criterion and the testbed's analytic values, so that a
+/// peer settles exactly the testbed's cases and is scored by exactly its error measure.
+#[derive(Clone, Debug, Serialize)]
+pub struct PeerCaseSet {
+    pub mechanism: String,
+    pub scenario: String,
+    pub params: crate::mechanisms::Values,
+    pub dt_s: f64,
+    pub speed_tol_m_per_s: f64,
+    pub window_steps: u64,
+    pub max_time_s: f64,
+    /// The mechanism's characteristic length [m]: length errors are divided by it.
+    pub length_scale_m: f64,
+    /// The checked quantities: `kind` is "length" (error / length_scale_m), "angle" (wrapped,
+    /// rad) or "magnitude" (error / |analytic|).
+    pub checks: Vec<PeerCheck>,
+    pub cases: Vec<PeerCase>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct PeerCheck {
+    pub quantity: String,
+    pub kind: &'static str,
+    pub tolerance: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct PeerCase {
+    pub inputs: crate::mechanisms::Values,
+    /// Every analytic quantity of the testbed's prediction at this case.
+    pub analytic: crate::mechanisms::Values,
+    /// Node positions of the testbed's start state (the scenario's `[start]`) [m].
+    pub start_nodes: std::collections::BTreeMap<String, [f64; 3]>,
+    /// Node positions at the analytic equilibrium, where the model gives them [m].
+    pub analytic_nodes: Option<std::collections::BTreeMap<String, [f64; 3]>>,
+}
+
+/// The case set of `file` for a peer simulator.
+pub fn peer_case_set(mechanism: &str, file: &Path) -> Result<PeerCaseSet, String> {
+    use crate::mechanisms::QuantityKind;
+    let sc = scenario::load(file).map_err(|e| e.to_string())?;
+    let m = sc.mechanism();
+    let params = crate::mechanisms::with_defaults(m.as_ref(), &sc.params);
+    let Actuation::Points { points, .. } = &sc.actuation else {
+        return Err(format!("{}: a bench case set needs [actuation] points or a grid", file.display()));
+    };
+    let mut cases = Vec::new();
+    for p in points {
+        // The scenario's loader already turned alternative inputs into the mechanism's inputs.
+        let inputs = p.clone();
+        let prediction = m.predict(&params, &inputs)?;
+        let start = m.build(&params, &inputs, &sc.start)?;
+        let name = |i: usize| start.nodes[i].name.clone();
+        let start_nodes = start.nodes.iter().enumerate().map(|(i, n)| (name(i), n.position)).collect();
+        let analytic_nodes = m
+            .analytic_nodes(&params, &inputs)
+            .map(|ps| ps.into_iter().enumerate().map(|(i, p)| (name(i), p)).collect());
+        cases.push(PeerCase { inputs, analytic: prediction.expected, start_nodes, analytic_nodes });
+    }
+    let checks = sc
+        .checks
+        .iter()
+        .map(|c| PeerCheck {
+            quantity: c.quantity.clone(),
+            kind: match c.kind {
+                QuantityKind::Length => "length",
+                QuantityKind::Angle => "angle",
+                QuantityKind::Magnitude => "magnitude",
+            },
+            tolerance: c.tolerance,
+        })
+        .collect();
+    Ok(PeerCaseSet {
+        mechanism: mechanism.into(),
+        scenario: file.display().to_string(),
+        length_scale_m: m.length_scale(&params),
+        params,
+        dt_s: sc.sim.dt_s,
+        speed_tol_m_per_s: sc.settle.speed_tol_m_per_s,
+        window_steps: sc.settle.window_steps,
+        max_time_s: sc.settle.max_time_s,
+        checks,
+        cases,
+    })
+}

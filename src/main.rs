@@ -101,6 +101,11 @@ enum Command {
         /// Print JSON instead of a table.
         #[arg(long)]
         json: bool,
+        /// Write each case set as DIR/MECHANISM.json for a peer simulator (parameters, time
+        /// step, settle criterion, inputs, analytic values, start and analytic node positions)
+        /// and stop.
+        #[arg(long, value_name = "DIR")]
+        export_cases: Option<PathBuf>,
     },
     /// Check every printed equation of a mechanism's paper against the testbed's derivation.
     Findings {
@@ -153,7 +158,8 @@ fn main() -> ExitCode {
         Command::Figure { name, out, list } => cmd_figure(name.as_deref(), &out, list),
         Command::Solve { mechanism, query, set, json } => cmd_solve(&mechanism, &query, &set, json),
         Command::Findings { mechanism, set, json } => cmd_findings(&mechanism, &set, json),
-        Command::Bench { rounds, json } => cmd_bench(rounds, json),
+        Command::Bench { export_cases: Some(dir), .. } => cmd_export_cases(&dir),
+        Command::Bench { rounds, json, export_cases: None } => cmd_bench(rounds, json),
     };
     ExitCode::from(code as u8)
 }
@@ -516,6 +522,30 @@ fn cmd_findings(mechanism: &str, sets: &[String], json: bool) -> i32 {
 /// Strut counts of the interference benchmark, and the repetitions whose median is reported.
 const INTERFERENCE_BENCH_SIZES: [usize; 3] = [10, 100, 1000];
 const INTERFERENCE_BENCH_REPEATS: usize = 201;
+
+fn cmd_export_cases(dir: &Path) -> i32 {
+    if let Err(e) = std::fs::create_dir_all(dir) {
+        eprintln!("error: cannot create {}: {e}", dir.display());
+        return EXIT_BAD_INPUT;
+    }
+    for (m, file) in tensegrity_testbed::bench::CASE_SETS {
+        let set = match tensegrity_testbed::bench::peer_case_set(m, Path::new(file)) {
+            Ok(s) => s,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return EXIT_BAD_INPUT;
+            }
+        };
+        let path = dir.join(format!("{m}.json"));
+        let text = serde_json::to_string_pretty(&set).expect("case set serialises");
+        if let Err(e) = write_atomic(&path, &text) {
+            eprintln!("error: cannot write {}: {e}", path.display());
+            return EXIT_BAD_INPUT;
+        }
+        println!("wrote {} ({} cases)", path.display(), set.cases.len());
+    }
+    EXIT_PASS
+}
 
 fn cmd_bench(rounds: usize, json: bool) -> i32 {
     let mut results = Vec::new();
