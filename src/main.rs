@@ -106,6 +106,9 @@ enum Command {
         /// and stop.
         #[arg(long, value_name = "DIR")]
         export_cases: Option<PathBuf>,
+        /// Only this mechanism's case set (repeatable; default: all).
+        #[arg(long = "mechanism", value_name = "NAME")]
+        mechanisms: Vec<String>,
     },
     /// Check every printed equation of a mechanism's paper against the testbed's derivation.
     Findings {
@@ -159,7 +162,7 @@ fn main() -> ExitCode {
         Command::Solve { mechanism, query, set, json } => cmd_solve(&mechanism, &query, &set, json),
         Command::Findings { mechanism, set, json } => cmd_findings(&mechanism, &set, json),
         Command::Bench { export_cases: Some(dir), .. } => cmd_export_cases(&dir),
-        Command::Bench { rounds, json, export_cases: None } => cmd_bench(rounds, json),
+        Command::Bench { rounds, json, export_cases: None, mechanisms } => cmd_bench(rounds, json, &mechanisms),
     };
     ExitCode::from(code as u8)
 }
@@ -547,9 +550,16 @@ fn cmd_export_cases(dir: &Path) -> i32 {
     EXIT_PASS
 }
 
-fn cmd_bench(rounds: usize, json: bool) -> i32 {
+fn cmd_bench(rounds: usize, json: bool, only: &[String]) -> i32 {
     let mut results = Vec::new();
+    if let Some(bad) = only.iter().find(|m| !tensegrity_testbed::bench::CASE_SETS.iter().any(|(n, _)| n == m)) {
+        eprintln!("error: no bench case set for mechanism '{bad}'");
+        return EXIT_BAD_INPUT;
+    }
     for (m, file) in tensegrity_testbed::bench::CASE_SETS {
+        if !only.is_empty() && !only.iter().any(|o| o == m) {
+            continue;
+        }
         match tensegrity_testbed::bench::bench_case_set(m, Path::new(file), rounds) {
             Ok(r) => results.push(r),
             Err(e) => {
@@ -558,8 +568,12 @@ fn cmd_bench(rounds: usize, json: bool) -> i32 {
             }
         }
     }
-    let interference =
-        tensegrity_testbed::bench::bench_interference(&INTERFERENCE_BENCH_SIZES, INTERFERENCE_BENCH_REPEATS);
+    // The interference observer's scaling is measured with the full bench only.
+    let interference = if only.is_empty() {
+        tensegrity_testbed::bench::bench_interference(&INTERFERENCE_BENCH_SIZES, INTERFERENCE_BENCH_REPEATS)
+    } else {
+        Vec::new()
+    };
     if json {
         println!(
             "{}",
@@ -584,10 +598,12 @@ fn cmd_bench(rounds: usize, json: bool) -> i32 {
                 r.max_error
             );
         }
-        println!("\ninterference observer (broad + narrow phase), per tick:");
-        println!("{:>8} {:>14} {:>12}", "struts", "pairs measured", "us/tick");
-        for b in &interference {
-            println!("{:>8} {:>14} {:>12.2}", b.struts, b.pairs_measured, b.median_us_per_tick);
+        if !interference.is_empty() {
+            println!("\ninterference observer (broad + narrow phase), per tick:");
+            println!("{:>8} {:>14} {:>12}", "struts", "pairs measured", "us/tick");
+            for b in &interference {
+                println!("{:>8} {:>14} {:>12.2}", b.struts, b.pairs_measured, b.median_us_per_tick);
+            }
         }
     }
     if results.iter().all(|r| r.all_settled) {
