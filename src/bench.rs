@@ -44,8 +44,9 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-/// Runs one case set `rounds` times.
-pub fn bench_case_set(mechanism: &str, file: &Path, rounds: usize) -> Result<BenchResult, String> {
+/// The case set's scenario as the bench runs it: every point built afresh (no continuation),
+/// no stability test, no stiffness probe, no recording.
+fn bench_scenario(file: &Path) -> Result<scenario::Scenario, String> {
     let mut sc = scenario::load(file).map_err(|e| e.to_string())?;
     sc.stability_perturbation = None;
     sc.probe = None;
@@ -53,42 +54,176 @@ pub fn bench_case_set(mechanism: &str, file: &Path, rounds: usize) -> Result<Ben
     if let Actuation::Points { continuation, .. } = &mut sc.actuation {
         *continuation = false;
     }
-    let mut rates = Vec::new();
-    let mut us_per_step = Vec::new();
-    let mut steps = Vec::new();
-    let mut errors = Vec::new();
-    let mut all_settled = true;
-    let mut cases = 0;
-    for round in 0..rounds.max(1) {
-        let r = run(&sc, &RunOptions::default());
-        cases = r.points.len();
-        rates.push(cases as f64 / r.settle.wall_s);
-        us_per_step.push(r.settle.wall_s * 1e6 / r.settle.steps.max(1) as f64);
-        all_settled &= r.settle.settled;
-        if round == 0 {
-            let scale = crate::mechanisms::find(mechanism).map_or(1.0, |m| m.length_scale(&r.params));
-            for p in &r.points {
-                steps.push(p.steps as f64);
-                for c in &sc.checks {
-                    if let (Some(a), Some(s)) = (p.analytic.get(&c.quantity), p.simulated.get(&c.quantity)) {
-                        errors.push(crate::observers::compare::error(c.kind, *a, *s, scale).1);
-                    }
-                }
+    Ok(sc)
+}
+
+/// What one round over a case set measured.
+#[derive(Clone, Debug, Default)]
+struct Round {
+    cases: usize,
+    cases_per_s: f64,
+    us_per_step: f64,
+    /// Steps of each case.
+    steps: Vec<f64>,
+    /// Normalised error of every checked quantity of every case.
+    errors: Vec<f64>,
+    all_settled: bool,
+}
+
+fn testbed_round(mechanism: &str, sc: &scenario::Scenario) -> Round {
+    let r = run(sc, &RunOptions { skip_findings: true, ..Default::default() });
+    let scale = crate::mechanisms::find(mechanism).map_or(1.0, |m| m.length_scale(&r.params));
+    let mut round = Round {
+        cases: r.points.len(),
+        cases_per_s: r.points.len() as f64 / r.settle.wall_s,
+        us_per_step: r.settle.wall_s * 1e6 / r.settle.steps.max(1) as f64,
+        all_settled: r.settle.settled,
+        ..Default::default()
+    };
+    for p in &r.points {
+        round.steps.push(p.steps as f64);
+        for c in &sc.checks {
+            if let (Some(a), Some(s)) = (p.analytic.get(&c.quantity), p.simulated.get(&c.quantity)) {
+                round.errors.push(crate::observers::compare::error(c.kind, *a, *s, scale).1);
             }
         }
     }
-    let max_error = errors.iter().copied().fold(0.0, f64::max);
-    Ok(BenchResult {
+    round
+}
+
+/// Medians over rounds of the rates; steps and errors of the first round (every round settles
+/// the same cases the same way).
+fn summarize(mechanism: &str, scenario: &str, mut rounds: Vec<Round>) -> BenchResult {
+    let mut rates: Vec<f64> = rounds.iter().map(|r| r.cases_per_s).collect();
+    let mut us: Vec<f64> = rounds.iter().map(|r| r.us_per_step).collect();
+    let all_settled = rounds.iter().all(|r| r.all_settled);
+    let first = rounds.swap_remove(0);
+    let (mut steps, mut errors) = (first.steps, first.errors);
+    BenchResult {
         mechanism: mechanism.into(),
-        scenario: file.display().to_string(),
-        cases,
-        rounds: rounds.max(1),
+        scenario: scenario.into(),
+        cases: first.cases,
+        rounds: rates.len(),
         median_cases_per_s: median(&mut rates),
         median_steps_per_case: median(&mut steps),
-        median_us_per_step: median(&mut us_per_step),
+        median_us_per_step: median(&mut us),
         median_error: median(&mut errors),
-        max_error,
+        max_error: errors.iter().copied().fold(0.0, f64::max),
         all_settled,
+    }
+}
+
+/// Runs one case set `rounds` times.
+pub fn bench_case_set(mechanism: &str, file: &Path, rounds: usize) -> Result<BenchResult, String> {
+    let sc = bench_scenario(file)?;
+    let rounds = (0..rounds.max(1)).map(|_| testbed_round(mechanism, &sc)).collect();
+    Ok(summarize(mechanism, &file.display().to_string(), rounds))
+}
+
+/// The testbed and a peer simulator on the same case set, measured in the same run.
+#[derive(Clone, Debug, Serialize)]
+pub struct PeerComparison {
+    pub mechanism: String,
+    pub testbed: BenchResult,
+    pub peer: BenchResult,
+    /// The peer's own description (simulator, version, variant).
+    pub peer_name: String,
+    /// Testbed / peer: above 1 the testbed settles more cases per second.
+    pub ratio_cases_per_s: f64,
+    /// Testbed / peer: below 1 the testbed needs fewer steps per case.
+    pub ratio_steps_per_case: f64,
+    /// Testbed / peer: below 1 a testbed step costs less.
+    pub ratio_us_per_step: f64,
+    /// Testbed / peer: below 1 the testbed is more accurate.
+    pub ratio_median_error: f64,
+    pub ratio_max_error: f64,
+}
+
+/// One round of a peer simulator: `command` is run with the case-set file and `--rounds 1`
+/// appended and must print one JSON object (see `benches/peers/mujoco/README.md`).
+fn peer_round(command: &[String], cases_file: &Path) -> Result<(Round, String), String> {
+    let (program, args) = command.split_first().ok_or("empty peer command")?;
+    let out = std::process::Command::new(program)
+        .args(args)
+        .arg(cases_file)
+        .args(["--rounds", "1"])
+        .output()
+        .map_err(|e| format!("cannot run the peer '{}': {e}", command.join(" ")))?;
+    if !out.status.success() {
+        return Err(format!(
+            "the peer '{}' failed ({}): {}",
+            command.join(" "),
+            out.status,
+            String::from_utf8_lossy(&out.stderr).trim()
+        ));
+    }
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .map_err(|e| format!("the peer '{}' printed no JSON object: {e}", command.join(" ")))?;
+    let num = |key: &str| {
+        v.get(key).and_then(serde_json::Value::as_f64).ok_or_else(|| format!("the peer's JSON has no number '{key}'"))
+    };
+    let cases = v.get("cases").and_then(|c| c.as_array()).ok_or("the peer's JSON has no 'cases' list")?;
+    let mut round = Round {
+        cases: cases.len(),
+        cases_per_s: num("median_cases_per_s")?,
+        us_per_step: num("median_us_per_step")?,
+        all_settled: true,
+        ..Default::default()
+    };
+    for c in cases {
+        round.steps.push(c.get("steps").and_then(|s| s.as_f64()).ok_or("a peer case has no 'steps'")?);
+        round.all_settled &= c.get("settled").and_then(|s| s.as_bool()).unwrap_or(false);
+        if let Some(errs) = c.get("errors").and_then(|e| e.as_object()) {
+            round.errors.extend(errs.values().filter_map(|e| e.as_f64()));
+        }
+    }
+    let name = ["simulator", "mujoco_version", "variant"]
+        .iter()
+        .filter_map(|k| v.get(*k).map(|x| format!("{k} {}", x.as_str().map_or_else(|| x.to_string(), str::to_string))))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Ok((round, name))
+}
+
+/// Runs the case set through the testbed and through the peer, alternating, `rounds` times
+/// each, so that both see the same machine load. The case set is written to `dir` first.
+pub fn bench_against_peer(
+    mechanism: &str,
+    file: &Path,
+    rounds: usize,
+    peer: &[String],
+    dir: &Path,
+) -> Result<PeerComparison, String> {
+    let sc = bench_scenario(file)?;
+    let set = peer_case_set(mechanism, file)?;
+    let cases_file = dir.join(format!("{mechanism}.json"));
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    std::fs::write(&cases_file, serde_json::to_string_pretty(&set).expect("case set serialises"))
+        .map_err(|e| format!("cannot write {}: {e}", cases_file.display()))?;
+    let mut ours = Vec::new();
+    let mut theirs = Vec::new();
+    let mut peer_name = String::new();
+    for _ in 0..rounds.max(1) {
+        ours.push(testbed_round(mechanism, &sc));
+        let (round, name) = peer_round(peer, &cases_file)?;
+        if round.cases != set.cases.len() {
+            return Err(format!("the peer settled {} cases of {}", round.cases, set.cases.len()));
+        }
+        theirs.push(round);
+        peer_name = name;
+    }
+    let testbed = summarize(mechanism, &file.display().to_string(), ours);
+    let peer = summarize(mechanism, &peer.join(" "), theirs);
+    Ok(PeerComparison {
+        mechanism: mechanism.into(),
+        ratio_cases_per_s: testbed.median_cases_per_s / peer.median_cases_per_s,
+        ratio_steps_per_case: testbed.median_steps_per_case / peer.median_steps_per_case,
+        ratio_us_per_step: testbed.median_us_per_step / peer.median_us_per_step,
+        ratio_median_error: testbed.median_error / peer.median_error,
+        ratio_max_error: testbed.max_error / peer.max_error,
+        testbed,
+        peer,
+        peer_name,
     })
 }
 

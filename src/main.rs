@@ -109,6 +109,11 @@ enum Command {
         /// Only this mechanism's case set (repeatable; default: all).
         #[arg(long = "mechanism", value_name = "NAME")]
         mechanisms: Vec<String>,
+        /// Also run each case set through a peer simulator, alternating rounds with the
+        /// testbed, and print the ratios. CMD gets the case-set file and `--rounds 1` appended
+        /// (default: the MuJoCo peer, `python3 benches/peers/mujoco/peer.py`).
+        #[arg(long, value_name = "CMD", num_args = 0..=1, default_missing_value = DEFAULT_PEER)]
+        peer: Option<String>,
     },
     /// Check every printed equation of a mechanism's paper against the testbed's derivation.
     Findings {
@@ -162,7 +167,12 @@ fn main() -> ExitCode {
         Command::Solve { mechanism, query, set, json } => cmd_solve(&mechanism, &query, &set, json),
         Command::Findings { mechanism, set, json } => cmd_findings(&mechanism, &set, json),
         Command::Bench { export_cases: Some(dir), .. } => cmd_export_cases(&dir),
-        Command::Bench { rounds, json, export_cases: None, mechanisms } => cmd_bench(rounds, json, &mechanisms),
+        Command::Bench { rounds, json, export_cases: None, mechanisms, peer: Some(peer) } => {
+            cmd_bench_peer(rounds, json, &mechanisms, &peer)
+        }
+        Command::Bench { rounds, json, export_cases: None, mechanisms, peer: None } => {
+            cmd_bench(rounds, json, &mechanisms)
+        }
     };
     ExitCode::from(code as u8)
 }
@@ -550,16 +560,94 @@ fn cmd_export_cases(dir: &Path) -> i32 {
     EXIT_PASS
 }
 
-fn cmd_bench(rounds: usize, json: bool, only: &[String]) -> i32 {
-    let mut results = Vec::new();
+/// The MuJoCo peer of `benches/peers/mujoco/`.
+const DEFAULT_PEER: &str = "python3 benches/peers/mujoco/peer.py";
+
+/// The built-in case sets that `--mechanism` selects (all when none is named).
+fn selected_case_sets(only: &[String]) -> Result<Vec<(&'static str, &'static str)>, i32> {
     if let Some(bad) = only.iter().find(|m| !tensegrity_testbed::bench::CASE_SETS.iter().any(|(n, _)| n == m)) {
         eprintln!("error: no bench case set for mechanism '{bad}'");
-        return EXIT_BAD_INPUT;
+        return Err(EXIT_BAD_INPUT);
     }
-    for (m, file) in tensegrity_testbed::bench::CASE_SETS {
-        if !only.is_empty() && !only.iter().any(|o| o == m) {
-            continue;
+    Ok(tensegrity_testbed::bench::CASE_SETS
+        .iter()
+        .filter(|(m, _)| only.is_empty() || only.iter().any(|o| o == m))
+        .copied()
+        .collect())
+}
+
+fn cmd_bench_peer(rounds: usize, json: bool, only: &[String], peer: &str) -> i32 {
+    let sets = match selected_case_sets(only) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    let command: Vec<String> = peer.split_whitespace().map(str::to_string).collect();
+    let dir = std::env::temp_dir().join(format!("tensegrity-bench-peer-{}", std::process::id()));
+    let mut out = Vec::new();
+    for (m, file) in sets {
+        eprintln!("{m}: {rounds} rounds, testbed and peer alternating ...");
+        match tensegrity_testbed::bench::bench_against_peer(m, Path::new(file), rounds, &command, &dir) {
+            Ok(c) => out.push(c),
+            Err(e) => {
+                eprintln!("error: {e}");
+                let _ = std::fs::remove_dir_all(&dir);
+                return EXIT_BAD_INPUT;
+            }
         }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "comparisons": out })).unwrap());
+    } else {
+        println!(
+            "{:<10} {:<8} {:>6} {:>10} {:>11} {:>9} {:>11} {:>11}",
+            "mechanism", "side", "cases", "cases/s", "steps/case", "us/step", "median err", "max err"
+        );
+        for c in &out {
+            for (side, r) in [("testbed", &c.testbed), ("peer", &c.peer)] {
+                println!(
+                    "{:<10} {:<8} {:>6} {:>10.1} {:>11.1} {:>9.2} {:>11.2e} {:>11.2e}{}",
+                    c.mechanism,
+                    side,
+                    r.cases,
+                    r.median_cases_per_s,
+                    r.median_steps_per_case,
+                    r.median_us_per_step,
+                    r.median_error,
+                    r.max_error,
+                    if r.all_settled { "" } else { "  (not all settled)" }
+                );
+            }
+            println!(
+                "{:<10} {:<8} {:>6} {:>10.2} {:>11.2} {:>9.2} {:>11.2e} {:>11.2e}",
+                c.mechanism,
+                "ratio",
+                "",
+                c.ratio_cases_per_s,
+                c.ratio_steps_per_case,
+                c.ratio_us_per_step,
+                c.ratio_median_error,
+                c.ratio_max_error
+            );
+        }
+        if let Some(c) = out.first() {
+            println!("\npeer: {} ({})", c.peer.scenario, c.peer_name);
+        }
+    }
+    if out.iter().all(|c| c.testbed.all_settled) {
+        EXIT_PASS
+    } else {
+        EXIT_FAIL
+    }
+}
+
+fn cmd_bench(rounds: usize, json: bool, only: &[String]) -> i32 {
+    let mut results = Vec::new();
+    let sets = match selected_case_sets(only) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    for (m, file) in sets {
         match tensegrity_testbed::bench::bench_case_set(m, Path::new(file), rounds) {
             Ok(r) => results.push(r),
             Err(e) => {

@@ -1,0 +1,249 @@
+#!/usr/bin/env python3
+"""MuJoCo peer of the testbed's settle benchmark (issue #11).
+
+    python3 peer.py CASES.json [--variant tuned|usual] [--rounds N]
+
+CASES.json is a case set written by `tensegrity bench --export-cases DIR`. For each case the
+peer sets the inputs, starts from the testbed's start state (`start_nodes`), steps until it
+is settled by the testbed's criterion, reads the checked quantities and scores them with the
+testbed's error measure. One JSON object goes to stdout (see README.md).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+import sys
+import time
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from models import MECHANISMS, MechanismPeer, SolverSettings  # noqa: E402
+
+#: The testbed's start state must be reproduced to this fraction of the length scale.
+START_MATCH_TOL_OF_LENGTH_SCALE = 1e-12
+
+
+# --------------------------------------------------------------------------------------------
+# Variants: MuJoCo's usual settings, and the settings tuned for this benchmark (README.md
+# documents what was tried and measured).
+# --------------------------------------------------------------------------------------------
+
+#: Default constraint softness and damping of MuJoCo (solref, solimp) and of the testbed.
+USUAL = dict(integrator="Euler", solver="Newton")
+
+TUNED = {
+    "ji2014": dict(
+        integrator="implicitfast",
+        solver="Newton",
+        iterations=100,
+        tolerance=1e-12,
+        solref=(0.02, 1.0),
+        solimp=(0.9999, 0.9999, 0.001, 0.5, 2.0),
+    ),
+    "mohr2011": dict(
+        integrator="implicitfast",
+        solver="Newton",
+        iterations=100,
+        tolerance=1e-12,
+        solref=(0.02, 1.0),
+        solimp=(0.9999, 0.9999, 0.001, 0.5, 2.0),
+    ),
+}
+
+
+def settings_for(mechanism: str, variant: str, dt_s: float, overrides: dict) -> SolverSettings:
+    base = USUAL if variant == "usual" else TUNED[mechanism]
+    fields = dict(base)
+    fields.setdefault("timestep_s", dt_s)
+    fields.update(overrides)
+    return SolverSettings(**fields)
+
+
+# --------------------------------------------------------------------------------------------
+# Settle criterion and error measure: exactly the testbed's
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SettleCriterion:
+    """Every node's speed (its displacement over one step / dt) at most `speed_tol_m_per_s`
+    for `window_steps` consecutive steps; give up after `max_time_s` of simulated time."""
+
+    speed_tol_m_per_s: float
+    window_steps: int
+    max_time_s: float
+
+
+def settle(peer: MechanismPeer, criterion: SettleCriterion, dt_s: float) -> tuple[int, bool]:
+    """Steps until settled. Returns (mj_step calls, settled).
+
+    After `mj_step`, `data` holds the forward pass of the state the step started from, so the
+    node positions seen after step k are those of state k-1: the speeds are those of the
+    testbed, one step late, and the state read at the end is the one that was checked (its
+    forces come from the same forward pass)."""
+    m, d = peer.model, peer.data
+    step = mujoco.mj_step
+    max_steps = math.ceil(criterion.max_time_s / dt_s)
+    # Compare squared displacements per step with (speed_tol dt)^2: no sqrt, no division.
+    max_moved_sq_m2 = (criterion.speed_tol_m_per_s * dt_s) ** 2
+    window = criterion.window_steps
+    nodes = peer.node_positions()  # a view into data: always the latest forward pass
+    previous = np.empty_like(nodes)
+    moved = np.empty_like(nodes)
+    step(m, d)
+    previous[:] = nodes  # no speed yet for the first state, as the testbed
+    quiet_steps = 0
+    for k in range(2, max_steps + 1):
+        step(m, d)
+        np.subtract(nodes, previous, out=moved)
+        previous[:] = nodes
+        np.multiply(moved, moved, out=moved)
+        if moved.sum(axis=1).max() <= max_moved_sq_m2:
+            quiet_steps += 1
+            if quiet_steps >= window:
+                return k, True
+        else:
+            quiet_steps = 0
+    return max_steps, False
+
+
+def wrap_to_pi(angle_rad: float) -> float:
+    return math.atan2(math.sin(angle_rad), math.cos(angle_rad))
+
+
+def error(kind: str, simulated: float, analytic: float, length_scale_m: float) -> float:
+    """The testbed's normalised error of one checked quantity."""
+    if kind == "length":
+        return abs(simulated - analytic) / length_scale_m
+    if kind == "angle":
+        return abs(wrap_to_pi(simulated - analytic))
+    if kind == "magnitude":
+        return abs(simulated - analytic) / abs(analytic)
+    raise ValueError(f"unknown check kind {kind!r}")
+
+
+# --------------------------------------------------------------------------------------------
+# The benchmark
+# --------------------------------------------------------------------------------------------
+
+
+def run_case(peer: MechanismPeer, case: dict, criterion: SettleCriterion, dt_s: float):
+    """One timed case: reset, inputs, start state, settle, read. Returns (steps, settled,
+    values, wall_s)."""
+    t0 = time.perf_counter()
+    peer.set_case(case["inputs"], case["start_nodes"])
+    steps, settled = settle(peer, criterion, dt_s)
+    values = peer.observe()
+    return steps, settled, values, time.perf_counter() - t0
+
+
+def bench(case_set: dict, variant: str, rounds: int, overrides: dict) -> dict:
+    mechanism = case_set["mechanism"]
+    settings = settings_for(mechanism, variant, case_set["dt_s"], overrides)
+    peer = MECHANISMS[mechanism](case_set["params"], settings)
+    criterion = SettleCriterion(
+        speed_tol_m_per_s=case_set["speed_tol_m_per_s"],
+        window_steps=case_set["window_steps"],
+        max_time_s=case_set["max_time_s"],
+    )
+    scale_m = case_set["length_scale_m"]
+    cases = case_set["cases"]
+
+    # Untimed: every start state must be the testbed's.
+    for i, case in enumerate(cases):
+        peer.set_case(case["inputs"], case["start_nodes"])
+        mismatch = peer.start_mismatch_m(case["start_nodes"])
+        if mismatch > START_MATCH_TOL_OF_LENGTH_SCALE * scale_m:
+            raise SystemExit(f"case {i}: start state off the testbed's by {mismatch:.3e} m")
+
+    per_case_wall = [[] for _ in cases]
+    first_round = []
+    round_rates, round_us_per_step = [], []
+    for r in range(rounds):
+        wall_total, steps_total = 0.0, 0
+        for i, case in enumerate(cases):
+            steps, settled, values, wall = run_case(peer, case, criterion, settings.timestep_s)
+            wall_total += wall
+            steps_total += steps
+            per_case_wall[i].append(wall)
+            if r == 0:
+                first_round.append((steps, settled, values))
+        round_rates.append(len(cases) / wall_total)
+        round_us_per_step.append(wall_total * 1e6 / max(steps_total, 1))
+
+    out_cases, pooled_errors = [], []
+    for i, (case, (steps, settled, values)) in enumerate(zip(cases, first_round)):
+        errors = {
+            c["quantity"]: error(c["kind"], values[c["quantity"]], case["analytic"][c["quantity"]], scale_m)
+            for c in case_set["checks"]
+        }
+        pooled_errors.extend(errors.values())
+        out_cases.append(
+            {
+                "inputs": case["inputs"],
+                "steps": steps,
+                "wall_s": statistics.median(per_case_wall[i]),
+                "settled": settled,
+                "errors": errors,
+            }
+        )
+    return {
+        "mechanism": mechanism,
+        "variant": variant,
+        "mujoco_version": mujoco.__version__,
+        "rounds": rounds,
+        "settings": asdict(settings),
+        "cases": out_cases,
+        "all_settled": all(c["settled"] for c in out_cases),
+        "median_cases_per_s": statistics.median(round_rates),
+        "median_steps_per_case": statistics.median(c["steps"] for c in out_cases),
+        "median_us_per_step": statistics.median(round_us_per_step),
+        "median_error": statistics.median(pooled_errors),
+        "max_error": max(pooled_errors),
+    }
+
+
+def parse_override(text: str) -> tuple[str, object]:
+    """`--set name=value` for trying settings: a number, a tuple `a,b,...` or a word."""
+    name, value = text.split("=", 1)
+    if "," in value:
+        return name, tuple(float(v) for v in value.split(","))
+    for cast in (int, float):
+        try:
+            return name, cast(value)
+        except ValueError:
+            pass
+    if value in ("true", "false"):
+        return name, value == "true"
+    return name, value
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("cases", type=Path, help="case set JSON from `tensegrity bench --export-cases DIR`")
+    ap.add_argument("--variant", choices=("tuned", "usual"), default="tuned")
+    ap.add_argument("--rounds", type=int, default=5, help="timed rounds; rates are medians over rounds")
+    ap.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="override one SolverSettings field (for tuning), e.g. --set timestep_s=0.005",
+    )
+    args = ap.parse_args()
+    case_set = json.loads(args.cases.read_text())
+    overrides = dict(parse_override(s) for s in args.set)
+    result = bench(case_set, args.variant, max(1, args.rounds), overrides)
+    json.dump(result, sys.stdout, indent=1)
+    sys.stdout.write("\n")
+
+
+if __name__ == "__main__":
+    main()
