@@ -174,6 +174,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         joint_links,
         hidden_links,
         joint_impulse,
+        internal_closures: Vec::new(),
         cable_ropes,
         cable_lengths: s.cables.iter().map(|c| c.length_m).collect(),
         commands: commands.clone(),
@@ -190,6 +191,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         tick: 0,
         length_scale_m,
     };
+    sim.internal_closures = sim.find_internal_closures();
     sim.set_commands(&commands);
     Ok(sim)
 }

@@ -439,7 +439,7 @@ impl Simulation {
 }
 
 /// Two unit vectors orthogonal to `a` and to each other.
-fn orthogonal_pair(a: Vector) -> [Vector; 2] {
+pub(super) fn orthogonal_pair(a: Vector) -> [Vector; 2] {
     let helper = if a.x.abs() < 0.9 { Vector::X } else { Vector::Y };
     let u = a.cross(helper).normalize();
     [u, a.cross(u)]

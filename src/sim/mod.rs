@@ -17,6 +17,7 @@
 
 mod build;
 mod forces;
+mod projection;
 pub mod settle;
 
 use crate::structure::{ActuatorTarget, BodyKind, Structure};
@@ -111,6 +112,8 @@ pub struct Simulation {
     hidden_links: Vec<LinkRef>,
     /// For each joint: the impulse joint it made, if any (loop closures).
     joint_impulse: Vec<Option<ImpulseJointHandle>>,
+    /// Loop closures inside one multibody, closed by position projection after each step.
+    internal_closures: Vec<projection::InternalClosure>,
     /// For each inextensible cable: its rope joint.
     cable_ropes: Vec<Option<ImpulseJointHandle>>,
     /// Current unstretched cable lengths [m].
@@ -219,6 +222,7 @@ impl Simulation {
             &(),
             &(),
         );
+        self.project_internal_closures();
         self.tick += 1;
         self.check_divergence()
     }
@@ -372,8 +376,15 @@ impl Simulation {
     }
 
     /// Sets every actuated joint's coordinate to its command, with zero velocity (ideal
-    /// position control), and moves the bodies beyond it along.
+    /// position control), and moves the bodies beyond it along. Where loops close inside a
+    /// multibody, the move is made in increments of at most [`MAX_CLOSED_LOOP_INCREMENT`], each
+    /// followed by the closure projection, so that the loops follow the actuators continuously
+    /// and stay on their assembly mode.
     fn apply_joint_commands(&mut self) {
+        // (multibody joint, total displacement) of every actuated link. The degree-of-freedom
+        // index is read afresh before each move: forward kinematics may re-root a multibody,
+        // which shifts the indices.
+        let mut moves = Vec::new();
         for j in 0..self.structure.joints.len() {
             if !self.actuated[j] {
                 continue;
@@ -388,19 +399,31 @@ impl Simulation {
             }
             let Some(link) = self.joint_links[j] else { continue };
             let target = self.joint_command(j) - self.structure.joints[j].initial_coordinate;
-            let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) else { continue };
-            let Some((start, current)) = mb.link(link_id).map(|l| {
-                let axis = joint_free_axis(&l.joint().data);
-                (l.assembly_id(), l.joint().coords()[axis])
-            }) else {
+            let Some((mb, link_id)) = self.multibody_joints.get(link.multibody_joint) else { continue };
+            let Some(current) = mb.link(link_id).map(|l| l.joint().coords()[joint_free_axis(&l.joint().data)]) else {
                 continue;
             };
-            let mut disp = vec![0.0; mb.ndofs()];
-            disp[start] = target - current;
-            mb.apply_displacements(&disp);
-            mb.generalized_velocity_mut()[start] = 0.0;
-            mb.forward_kinematics(&self.bodies, true);
-            mb.update_rigid_bodies(&mut self.bodies, true);
+            moves.push((link.multibody_joint, target - current));
+        }
+        let largest = moves.iter().fold(0.0_f64, |m, (_, d)| m.max(d.abs()));
+        let increments = if self.internal_closures.is_empty() {
+            1
+        } else {
+            ((largest / MAX_CLOSED_LOOP_INCREMENT).ceil() as usize).max(1)
+        };
+        for _ in 0..increments {
+            for &(handle, total) in &moves {
+                let Some((mb, link_id)) = self.multibody_joints.get_mut(handle) else { continue };
+                mb.forward_kinematics(&self.bodies, true);
+                let Some(start) = mb.link(link_id).map(|l| l.assembly_id()) else { continue };
+                let mut disp = vec![0.0; mb.ndofs()];
+                disp[start] = total / increments as f64;
+                mb.apply_displacements(&disp);
+                mb.generalized_velocity_mut()[start] = 0.0;
+                mb.forward_kinematics(&self.bodies, true);
+                mb.update_rigid_bodies(&mut self.bodies, true);
+            }
+            self.project_internal_closures();
         }
     }
 
@@ -413,6 +436,11 @@ impl Simulation {
             .unwrap_or(self.structure.joints[joint].initial_coordinate)
     }
 }
+
+/// Largest move of an actuated coordinate (rad or m) between two closure projections when an
+/// actuator command jumps: small enough that the projection, started from the previous
+/// configuration, lands on the same assembly mode of each loop.
+const MAX_CLOSED_LOOP_INCREMENT: f64 = 0.01;
 
 /// Index (0..6: linear x, y, z, angular x, y, z) of the single free axis of a one-degree-of-
 /// freedom joint, where its coordinate lives in `MultibodyJoint::coords`.

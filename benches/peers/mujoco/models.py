@@ -31,6 +31,7 @@ class SolverSettings:
     timestep_s: float
     # MJCF names: "Euler", "implicitfast", "implicit", "discrete", "RK4".
     integrator: str = "Euler"
+    # "Newton", "CG" or "PGS".
     solver: str = "Newton"
     iterations: int = 100
     tolerance: float = 1e-8
@@ -44,6 +45,9 @@ class SolverSettings:
     refsafe: bool = True
     # Multiplies the testbed's joint damping (c_D1 for ji2014, c_joint for mohr2011).
     damping_scale: float = 1.0
+    # Viscous damping along mohr2011's cables [N s/m] (none in the testbed). Zero at rest, so
+    # the equilibrium is unchanged; MuJoCo applies it to slack cables too.
+    cable_damping_n_s_per_m: float = 0.0
 
     def option_xml(self) -> str:
         flags = "" if self.refsafe else '<flag refsafe="disable"/>'
@@ -95,10 +99,6 @@ def matrix_to_quat(r: np.ndarray) -> np.ndarray:
     q = np.zeros(4)
     mujoco.mju_mat2Quat(q, r.reshape(9))
     return q
-
-
-def wrap_to_pi(angle_rad: float) -> float:
-    return (angle_rad + math.pi) % (2.0 * math.pi) - math.pi
 
 
 # --------------------------------------------------------------------------------------------
@@ -341,12 +341,16 @@ class Mohr2011(MechanismPeer):
           {ee_sites}
         </body>"""
         if self.cable_stiffness > 0.0:
-            cable_law = lambda j: f'stiffness="{self.cable_stiffness!r}" springlength="0 0"'  # noqa: E731
+            # Tension-only elastic: a dead-band spring, slack below the commanded length
+            # (set per case as the band's upper end).
+            cable_law = f'stiffness="{self.cable_stiffness!r}" springlength="0 0"'
         else:
-            cable_law = lambda j: 'limited="true" range="0 1"'  # noqa: E731
+            # Inextensible and tension-only: an upper length limit (set per case).
+            cable_law = 'limited="true" range="0 1"'
+        cable_damping = f'damping="{settings.cable_damping_n_s_per_m!r}"'
         cables = "".join(
-            f'<spatial name="A{a}B{b}" {cable_law(j)}><site site="A{a}"/><site site="B{b}"/></spatial>'
-            for j, (a, b, _) in enumerate(MOHR2011_CABLES)
+            f'<spatial name="A{a}B{b}" {cable_law} {cable_damping}><site site="A{a}"/><site site="B{b}"/></spatial>'
+            for a, b, _ in MOHR2011_CABLES
         )
         base_sites = "".join(f'<site name="A{i + 1}" pos="{vec(self.base[i])}"/>' for i in range(3))
         xml = f"""
