@@ -33,8 +33,31 @@ pub struct ScenarioReport {
     /// Present when the scenario has an `[interference]` section.
     pub interference: Option<InterferenceReport>,
     pub findings: Vec<FindingReport>,
+    /// Along a scheduled trajectory: the range of every simulated quantity over its ticks
+    /// (for example the smallest |det J| on a path that must avoid singularities).
+    pub trajectory_ranges: std::collections::BTreeMap<String, QuantityRange>,
     /// Why the run stopped early (divergence, interruption), if it did.
     pub error: Option<String>,
+}
+
+/// Smallest, largest and smallest absolute value of a quantity over the ticks of a trajectory.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+pub struct QuantityRange {
+    pub min: f64,
+    pub max: f64,
+    pub min_abs: f64,
+}
+
+impl QuantityRange {
+    pub fn of(v: f64) -> Self {
+        QuantityRange { min: v, max: v, min_abs: v.abs() }
+    }
+
+    pub fn include(&mut self, v: f64) {
+        self.min = self.min.min(v);
+        self.max = self.max.max(v);
+        self.min_abs = self.min_abs.min(v.abs());
+    }
 }
 
 #[derive(Clone, Debug, Serialize, PartialEq, Default)]
@@ -374,6 +397,12 @@ impl Report {
             }
             for (b, n) in &branches {
                 out.push_str(&format!("   landed on: {b}: {n} point(s)\n"));
+            }
+            for (q, r) in &s.trajectory_ranges {
+                out.push_str(&format!(
+                    "   along the trajectory: {q} from {:.6e} to {:.6e}, smallest |{q}| {:.6e}\n",
+                    r.min, r.max, r.min_abs
+                ));
             }
             let shown = s.points.len().min(MAX_POINTS_IN_TABLE);
             for p in &s.points[..shown] {

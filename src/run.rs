@@ -281,6 +281,7 @@ pub fn panicked(sc: &Scenario, payload: &(dyn std::any::Any + Send)) -> Scenario
         skipped_points: sc.skipped_points.len(),
         interference: None,
         findings: vec![],
+        trajectory_ranges: Default::default(),
         error: Some(format!("panicked: {msg}")),
     }
 }
@@ -310,6 +311,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         workspace: None,
         skipped_points: sc.skipped_points.len(),
         interference: None,
+        trajectory_ranges: Default::default(),
         findings: if opts.skip_findings {
             Vec::new()
         } else {
@@ -473,7 +475,14 @@ fn run_actuation(
                 let cmds = runner.mech.commands(&sc.params, &inputs);
                 runner.sim.set_commands(&cmds);
                 let prediction = runner.mech.predict(&sc.params, &inputs).map_err(Stop::Model)?;
-                runner.step(&inputs, &prediction)?;
+                let (_, simulated) = runner.step(&inputs, &prediction)?;
+                for (q, v) in simulated {
+                    report
+                        .trajectory_ranges
+                        .entry(q)
+                        .and_modify(|r| r.include(v))
+                        .or_insert_with(|| crate::report::QuantityRange::of(v));
+                }
             }
             let inputs = waypoints.last().unwrap().1.clone();
             runner.emit("schedule done: settling at the last waypoint");

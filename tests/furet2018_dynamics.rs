@@ -1,0 +1,63 @@
+//! issue 4's bars for furet2018's dynamics: the four inverse solutions, a joint-space
+//! trajectory and a cuspidal path, settled in rapier with the loops closed by projection.
+
+use std::path::Path;
+use tensegrity_testbed::report::ScenarioReport;
+use tensegrity_testbed::run::{run, RunOptions};
+use tensegrity_testbed::scenario;
+
+fn run_file(path: &str) -> ScenarioReport {
+    let sc = scenario::load(Path::new(path)).expect("scenario is valid");
+    run(&sc, &RunOptions::default())
+}
+
+/// Target of the paper's Fig. 3 [m] (L = 1, b = 2/3).
+const TARGET: (f64, f64) = (0.03, 1.6);
+
+/// Each of the four inverse solutions, driven to one after the other, puts the top-bar midpoint
+/// within 1e-9 L of the target, with the joint angles within 1e-9 rad of the solution.
+#[test]
+fn the_four_inverse_solutions_reach_the_target_within_1e_9_of_l() {
+    let r = run_file("scenarios/furet2018/ik_solutions.toml");
+    assert!(r.passed, "{:?}", r.error);
+    assert_eq!(r.points.len(), 4);
+    let l = r.params["L"];
+    for p in &r.points {
+        assert!(p.settled);
+        let (ex, ey) = ((p.simulated["x"] - TARGET.0).abs() / l, (p.simulated["y"] - TARGET.1).abs() / l);
+        assert!(ex <= 1e-9 && ey <= 1e-9, "solution {}: end point off by ({ex:e}, {ey:e}) L", p.index);
+        for q in ["theta1", "theta2"] {
+            assert!((p.simulated[q] - p.inputs[q]).abs() <= 1e-9, "solution {} {q}", p.index);
+        }
+    }
+    // Two solutions per aspect: the sign of det J alternates along the list.
+    let signs: Vec<bool> = r.points.iter().map(|p| p.simulated["detJ"] > 0.0).collect();
+    assert_eq!(signs, [true, false, true, false]);
+}
+
+/// Along a joint-space trajectory through both aspects the top-bar midpoint matches Eq. 3
+/// within 1e-9 L at every waypoint.
+#[test]
+fn a_joint_space_trajectory_matches_eq_3_within_1e_9_of_l_at_every_waypoint() {
+    let r = run_file("scenarios/furet2018/trajectory.toml");
+    assert!(r.passed, "{:?}", r.error);
+    assert_eq!(r.points.len(), 8);
+    for c in &r.checks {
+        assert!(c.max_rel_error <= 1e-9, "{}: {:e}", c.quantity, c.max_rel_error);
+        assert!(c.ticks_compared > 0);
+    }
+}
+
+/// Cuspidality: the path from solution 1 to solution 3 (same aspect) keeps det J >= 0.13,
+/// the end point comes back to the target and the joint angles end on the other solution.
+#[test]
+fn the_cuspidal_path_changes_solution_without_crossing_a_singularity() {
+    let r = run_file("scenarios/furet2018/cuspidal_path.toml");
+    assert!(r.passed, "{:?}", r.error);
+    let det = r.trajectory_ranges["detJ"];
+    assert!(det.min > 0.13 && det.min < 0.1316, "smallest det J along the path {}", det.min);
+    let end = &r.points[0];
+    assert!((end.simulated["x"] - TARGET.0).abs() <= 1e-9 && (end.simulated["y"] - TARGET.1).abs() <= 1e-9);
+    assert!((end.simulated["theta1"] - 0.283463664203).abs() <= 1e-9, "{}", end.simulated["theta1"]);
+    assert!((end.simulated["theta2"] - -0.843622868024).abs() <= 1e-9, "{}", end.simulated["theta2"]);
+}
