@@ -61,3 +61,35 @@ fn the_cuspidal_path_changes_solution_without_crossing_a_singularity() {
     assert!((end.simulated["theta1"] - 0.283463664203).abs() <= 1e-9, "{}", end.simulated["theta1"]);
     assert!((end.simulated["theta2"] - -0.843622868024).abs() <= 1e-9, "{}", end.simulated["theta2"]);
 }
+
+/// Fig. 5 twice: at every grid point the dynamics reach (x, y) from each of its inverse
+/// solutions within 1e-9 L, so the count of solutions the simulation reaches equals the
+/// quartic's count at every one of the 169 points.
+#[test]
+fn the_workspace_grid_reaches_every_inverse_solution_within_1e_9_of_l() {
+    use tensegrity_testbed::mechanisms::furet2018::analytic;
+    let r = run_file("scenarios/furet2018/workspace_grid.toml");
+    assert!(r.passed, "{:?}", r.error);
+    let p = analytic::Params { l: r.params["L"], b: r.params["b"] };
+    let key = |x: f64, y: f64| ((x * 1e6).round() as i64, (y * 1e6).round() as i64);
+    let mut reached = std::collections::BTreeMap::new();
+    for q in &r.points {
+        let (x, y) = (q.analytic["x"], q.analytic["y"]);
+        let within = (q.simulated["x"] - x).abs() <= 1e-9 && (q.simulated["y"] - y).abs() <= 1e-9;
+        assert!(q.settled && within, "point {} off its target", q.index);
+        *reached.entry(key(x, y)).or_insert(0usize) += 1;
+    }
+    let mut by_count = [0usize; 5];
+    for i in 0..13 {
+        for j in 0..13 {
+            let (x, y) = (-1.8 + 0.3 * i as f64, -0.2 + 2.2 * j as f64 / 12.0);
+            let analytic = analytic::ik_query(&p, x, y).len();
+            let simulated = reached.get(&key(x, y)).copied().unwrap_or(0);
+            assert_eq!(simulated, analytic, "solutions at ({x}, {y})");
+            by_count[analytic] += 1;
+        }
+    }
+    assert_eq!(r.points.len(), 244);
+    assert_eq!(r.skipped_points, 4 * 169 - 244);
+    assert!(by_count[4] > 0, "the grid meets the 4-solution region: {by_count:?}");
+}

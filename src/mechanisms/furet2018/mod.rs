@@ -157,6 +157,28 @@ impl Mechanism for Furet2018 {
         Ok(())
     }
 
+    fn alternative_inputs(&self) -> &'static [&'static [&'static str]] {
+        &[&["x", "y", "solution"]]
+    }
+
+    /// (x, y, solution k): the k-th inverse solution (1-based, in the order `solve furet2018
+    /// ik` prints them) of the end point (x, y).
+    fn convert_inputs(&self, params: &Values, given: &Values) -> Result<Values, (String, String)> {
+        let get = |k: &str| given.get(k).copied().ok_or((k.to_string(), format!("missing input '{k}'")));
+        let (x, y, k) = (get("x")?, get("y")?, get("solution")?);
+        if !(k >= 1.0 && k.fract() == 0.0) {
+            return Err(("solution".into(), format!("solution must be a whole number from 1, got {k}")));
+        }
+        let sols = analytic::ik_query(&params_of(params), x, y);
+        let Some(s) = sols.get(k as usize - 1) else {
+            return Err((
+                "solution".into(),
+                format!("({x}, {y}) has {} inverse solution(s) (Eq. 6-12), not a solution {k}", sols.len()),
+            ));
+        };
+        Ok(Values::from([("theta1".into(), s.theta1), ("theta2".into(), s.theta2)]))
+    }
+
     fn validate_inputs(&self, _params: &Values, inputs: &Values) -> Result<(), (String, String)> {
         for s in ["theta1", "theta2"] {
             let t = inputs.get(s).copied().ok_or((s.to_string(), format!("missing input {s} [rad]")))?;
