@@ -136,6 +136,8 @@ impl Simulation {
             let rest = self.cable_lengths[c];
             let tension = match cable.law {
                 CableLaw::Elastic { stiffness_n_per_m } => (stiffness_n_per_m * (l - rest)).max(0.0),
+                // Held at its length by the projection: its tension is fitted below.
+                CableLaw::Inextensible if self.cable_held_by_projection(c) => 0.0,
                 CableLaw::Inextensible => self.cable_ropes[c]
                     .and_then(|h| self.impulse_joints.get(h))
                     .map(|j| j.data.limits[0].impulse.abs() * inv_h)
@@ -185,7 +187,8 @@ impl Simulation {
         // added to the bodies' loads.
         let scale = self.length_scale_m;
         let base = self.coordinate_forces(&tree, &wrench, true);
-        let closure_loads = self.closure_unit_loads();
+        let mut closure_loads = self.closure_unit_loads();
+        closure_loads.extend(self.projected_cable_unit_loads());
         // Fitted reaction of each loop-closing joint on its child: (force, moment about the anchor).
         let mut closure_reaction = vec![(Vector::ZERO, Vector::ZERO); s.joints.len()];
         if !closure_loads.is_empty() && !base.is_empty() {
@@ -214,12 +217,26 @@ impl Simulation {
                         wrench[b].0 += load.loads[b].0 * lambda[k];
                         wrench[b].1 += load.loads[b].1 * lambda[k];
                     }
-                    closure_reaction[load.joint].0 += load.force * lambda[k];
-                    closure_reaction[load.joint].1 += load.moment * lambda[k];
+                    match load.member {
+                        ClosureMember::Joint(j) => {
+                            closure_reaction[j].0 += load.force * lambda[k];
+                            closure_reaction[j].1 += load.moment * lambda[k];
+                        }
+                        ClosureMember::Cable(c) => {
+                            out.cable_tension_n[c] = lambda[k];
+                            out.cable_slack[c] = lambda[k] <= 0.0;
+                        }
+                    }
                 }
             }
         }
         let mut residual = Residual::default();
+        // A held cable whose fitted tension is negative would have to push: no equilibrium.
+        for (c, cable) in s.cables.iter().enumerate() {
+            if matches!(cable.law, CableLaw::Inextensible) && self.cable_held_by_projection(c) {
+                residual.max_force_n = residual.max_force_n.max((-out.cable_tension_n[c]).max(0.0));
+            }
+        }
         for c in self.coordinate_forces(&tree, &wrench, true) {
             if c.is_torque {
                 residual.max_torque_nm = residual.max_torque_nm.max(c.value.abs());
@@ -277,10 +294,18 @@ pub(crate) fn relative_angle(parent: Rotation, child: Rotation, axis: Vector) ->
 /// reactions of loop-closing joints (redundant closures).
 const CLOSURE_SVD_RELATIVE_TOLERANCE: f64 = 1e-12;
 
+/// What carries an unknown reaction: a loop-closing joint, or an inextensible cable held at its
+/// length by the projection (its tension).
+#[derive(Clone, Copy, Debug)]
+enum ClosureMember {
+    Joint(usize),
+    Cable(usize),
+}
+
 /// One unknown reaction component of a loop-closing joint: a unit force or moment on the child
-/// (and its opposite on the parent), as body loads.
+/// (and its opposite on the parent), as body loads; or the unit tension of a held cable.
 struct ClosureComponent {
-    joint: usize,
+    member: ClosureMember,
     force: Vector,
     moment: Vector,
     loads: Vec<Wrench>,
@@ -382,6 +407,29 @@ impl Simulation {
         out
     }
 
+    /// For every inextensible cable held at its length by the projection: the body loads of a
+    /// unit tension (pulling its two nodes together).
+    fn projected_cable_unit_loads(&self) -> Vec<ClosureComponent> {
+        let s = &self.structure;
+        let nb = s.bodies.len();
+        let mut out = Vec::new();
+        for (c, cable) in s.cables.iter().enumerate() {
+            if !self.cable_held_by_projection(c) {
+                continue;
+            }
+            let (pa, pb) = (v(self.node_position(cable.a)), v(self.node_position(cable.b)));
+            let d = (pb - pa).normalize();
+            let mut w = vec![(Vector::ZERO, Vector::ZERO); nb];
+            let (ba, bb) = (s.nodes[cable.a].body, s.nodes[cable.b].body);
+            w[ba].0 += d;
+            w[ba].1 += pa.cross(d);
+            w[bb].0 -= d;
+            w[bb].1 -= pb.cross(d);
+            out.push(ClosureComponent { member: ClosureMember::Cable(c), force: d, moment: Vector::ZERO, loads: w });
+        }
+        out
+    }
+
     /// For every reaction component of every loop-closing joint: the body loads of a unit
     /// reaction (child +, parent -), world frame.
     fn closure_unit_loads(&self) -> Vec<ClosureComponent> {
@@ -425,13 +473,23 @@ impl Simulation {
                 let mut w = vec![(Vector::ZERO, Vector::ZERO); nb];
                 w[joint.child] = (f, anchor.cross(f));
                 w[joint.parent] = (-f, -anchor.cross(f));
-                out.push(ClosureComponent { joint: j, force: f, moment: Vector::ZERO, loads: w });
+                out.push(ClosureComponent {
+                    member: ClosureMember::Joint(j),
+                    force: f,
+                    moment: Vector::ZERO,
+                    loads: w,
+                });
             }
             for m in moments {
                 let mut w = vec![(Vector::ZERO, Vector::ZERO); nb];
                 w[joint.child] = (Vector::ZERO, m);
                 w[joint.parent] = (Vector::ZERO, -m);
-                out.push(ClosureComponent { joint: j, force: Vector::ZERO, moment: m, loads: w });
+                out.push(ClosureComponent {
+                    member: ClosureMember::Joint(j),
+                    force: Vector::ZERO,
+                    moment: m,
+                    loads: w,
+                });
             }
         }
         out

@@ -163,3 +163,274 @@ impl Simulation {
         largest
     }
 }
+
+/// Plain free bodies (not multibody links) held by impulse joints and inextensible cables to
+/// each other or to fixed bodies: a group whose constraints the projection can close.
+///
+/// rapier holds these constraints at the velocity level too; under a steady load (gravity on
+/// manriquez2019's platform) the position offset it leaves grows like dt^2 and shrank only
+/// slowly with PGS iterations (3e-5 rad at dt = 2 ms). After each step the group's body poses
+/// are moved (Gauss-Newton, minimum norm, rotations scaled by the structure's size) until every
+/// joint's anchor gap and angular rows and every taut cable's stretch vanish to round-off; the
+/// velocities lose the components that would open a joint or stretch a taut cable. Member
+/// forces are still read from rapier (cable tensions from the rope impulses).
+#[derive(Clone, Debug, Default)]
+pub(super) struct PlainGroup {
+    /// Structure body indices of the group's free plain bodies.
+    bodies: Vec<usize>,
+    /// Impulse joints (structure indices) between the group's bodies or to fixed bodies.
+    joints: Vec<usize>,
+    /// Inextensible cables with a rope joint.
+    cables: Vec<usize>,
+}
+
+/// A cable within this fraction of the structure's size of its length counts as taut.
+const TAUT_TOLERANCE_FRACTION: f64 = 1e-12;
+
+impl Simulation {
+    /// A rope cable is taut when stretched to its length (within round-off) or when rapier's
+    /// rope pulled in the last step.
+    fn cable_is_taut(&self, c: usize) -> bool {
+        let cable = &self.structure.cables[c];
+        let l = crate::structure::distance(self.node_position(cable.a), self.node_position(cable.b));
+        let inv_h = self.settings.substeps as f64 / self.settings.dt_s;
+        let impulse = self.cable_ropes[c]
+            .and_then(|h| self.impulse_joints.get(h))
+            .map_or(0.0, |j| j.data.limits[0].impulse.abs() * inv_h);
+        l >= self.cable_lengths[c] - TAUT_TOLERANCE_FRACTION * self.length_scale_m || impulse > 0.0
+    }
+
+    /// Whether cable `c` is taut and held at its length by the plain-group projection (its
+    /// tension is then fitted from the equilibrium, not read from rapier's impulse).
+    pub(super) fn cable_held_by_projection(&self, c: usize) -> bool {
+        self.plain_groups.iter().any(|g| g.cables.contains(&c)) && self.cable_is_taut(c)
+    }
+
+    /// Groups of plain free bodies whose every constraint the projection handles. A group that
+    /// touches a multibody link, an actuated joint or a joint kind without projection rows is
+    /// left to rapier alone.
+    pub(super) fn find_plain_groups(&self) -> Vec<PlainGroup> {
+        let s = &self.structure;
+        let n = s.bodies.len();
+        let plain = |b: usize| self.is_free(b) && self.multibody_joints.rigid_body_link(self.handles[b]).is_none();
+        let fixed = |b: usize| s.bodies[b].kind == crate::structure::BodyKind::Fixed;
+        // Union-find over bodies joined by a constraint.
+        let mut parent: Vec<usize> = (0..n).collect();
+        fn find(p: &mut [usize], mut x: usize) -> usize {
+            while p[x] != x {
+                p[x] = p[p[x]];
+                x = p[x];
+            }
+            x
+        }
+        let mut edges: Vec<(usize, usize)> = Vec::new();
+        for (j, joint) in s.joints.iter().enumerate() {
+            if self.joint_impulse[j].is_some() {
+                edges.push((joint.parent, joint.child));
+            }
+        }
+        for (c, cable) in s.cables.iter().enumerate() {
+            if self.cable_ropes[c].is_some() {
+                edges.push((s.nodes[cable.a].body, s.nodes[cable.b].body));
+            }
+        }
+        for &(a, b) in &edges {
+            if !fixed(a) && !fixed(b) {
+                let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+                parent[ra] = rb;
+            }
+        }
+        let mut groups: Vec<(usize, PlainGroup, bool)> = Vec::new();
+        let group_of = |root: usize, groups: &mut Vec<(usize, PlainGroup, bool)>| -> usize {
+            if let Some(i) = groups.iter().position(|g| g.0 == root) {
+                i
+            } else {
+                groups.push((root, PlainGroup::default(), true));
+                groups.len() - 1
+            }
+        };
+        let movable = |b: usize| if fixed(b) { None } else { Some(b) };
+        for (j, joint) in s.joints.iter().enumerate() {
+            if self.joint_impulse[j].is_none() {
+                continue;
+            }
+            let Some(b) = movable(joint.child).or(movable(joint.parent)) else { continue };
+            let root = find(&mut parent, b);
+            let g = group_of(root, &mut groups);
+            groups[g].1.joints.push(j);
+            let supported = matches!(
+                joint.kind,
+                JointKind::Spherical
+                    | JointKind::Revolute { .. }
+                    | JointKind::Universal { .. }
+                    | JointKind::PlanarPin { .. }
+            );
+            groups[g].2 &= supported && !self.actuated[j];
+        }
+        for (c, cable) in s.cables.iter().enumerate() {
+            if self.cable_ropes[c].is_none() {
+                continue;
+            }
+            let (a, b) = (s.nodes[cable.a].body, s.nodes[cable.b].body);
+            let Some(m) = movable(a).or(movable(b)) else { continue };
+            let root = find(&mut parent, m);
+            let g = group_of(root, &mut groups);
+            groups[g].1.cables.push(c);
+        }
+        for (b, _) in s.bodies.iter().enumerate() {
+            if fixed(b) {
+                continue;
+            }
+            let root = find(&mut parent, b);
+            if let Some(g) = groups.iter_mut().find(|g| g.0 == root) {
+                g.1.bodies.push(b);
+                g.2 &= plain(b);
+            }
+        }
+        groups.into_iter().filter(|(_, g, ok)| *ok && !g.bodies.is_empty()).map(|(_, g, _)| g).collect()
+    }
+
+    /// The constraint rows of a plain group: joint anchor gaps and angular rows, then the
+    /// stretch of each cable in `taut`. Lengths in m; angular rows (dimensionless) times the
+    /// structure's size, so that every row is a length.
+    fn plain_rows(&self, g: &PlainGroup, taut: &[usize], out: &mut Vec<f64>) {
+        let s = &self.structure;
+        let scale = self.length_scale_m;
+        let pose = |b: usize| *self.bodies[self.handles[b]].position();
+        let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
+        for &j in &g.joints {
+            let joint = &s.joints[j];
+            let (pp, pc) = (pose(joint.parent), pose(joint.child));
+            let a = vec3(s.nodes[joint.anchor].position);
+            let gap = pc.transform_point(a) - pp.transform_point(a);
+            match joint.kind {
+                JointKind::PlanarPin { axis } => {
+                    let n = (pp.rotation * vec3(axis)).normalize();
+                    for t in super::forces::orthogonal_pair(n) {
+                        out.push(gap.dot(t));
+                    }
+                }
+                JointKind::Revolute { axis } => {
+                    out.extend([gap.x, gap.y, gap.z]);
+                    let ap = (pp.rotation * vec3(axis)).normalize();
+                    let ac = (pc.rotation * vec3(axis)).normalize();
+                    for t in super::forces::orthogonal_pair(ap) {
+                        out.push(ac.dot(t) * scale);
+                    }
+                }
+                JointKind::Universal { axis1, axis2 } => {
+                    out.extend([gap.x, gap.y, gap.z]);
+                    let a1 = pp.rotation * vec3(axis1).normalize();
+                    let a2 = pc.rotation * vec3(axis2).normalize();
+                    out.push((a1.dot(a2) - vec3(axis1).normalize().dot(vec3(axis2).normalize())) * scale);
+                }
+                _ => out.extend([gap.x, gap.y, gap.z]),
+            }
+        }
+        for &c in taut {
+            let cable = &s.cables[c];
+            let (pa, pb) = (self.node_position(cable.a), self.node_position(cable.b));
+            out.push(crate::structure::distance(pa, pb) - self.cable_lengths[c]);
+        }
+    }
+
+    /// Moves body `b` by a translation `t` [m] and a rotation `r` [rad, rotation vector] about
+    /// its centre of mass.
+    fn nudge(&mut self, b: usize, t: Vector, r: Vector) {
+        let com = self.world_com(b);
+        let h = self.handles[b];
+        let pose = *self.bodies[h].position();
+        let moved = Pose::from_translation(com + t)
+            * Pose::from_rotation(Rotation::from_scaled_axis(r))
+            * Pose::from_translation(-com)
+            * pose;
+        self.bodies[h].set_position(moved, true);
+    }
+
+    /// Closes every plain group's joints and taut cables to round-off and projects the bodies'
+    /// velocities. Returns the largest row left [m].
+    pub(super) fn project_plain_groups(&mut self) -> f64 {
+        let groups = std::mem::take(&mut self.plain_groups);
+        let scale = self.length_scale_m;
+        let mut largest = 0.0_f64;
+        for g in &groups {
+            let taut: Vec<usize> = g.cables.iter().copied().filter(|&c| self.cable_is_taut(c)).collect();
+            let ndof = 6 * g.bodies.len();
+            let unit = |k: usize, h: f64| -> (Vector, Vector) {
+                let mut t = Vector::ZERO;
+                let mut r = Vector::ZERO;
+                if k % 6 < 3 {
+                    t[k % 6] = h;
+                } else {
+                    r[k % 6 - 3] = h / scale;
+                }
+                (t, r)
+            };
+            let tol = GAP_TOLERANCE_FRACTION * scale;
+            let mut jac = nalgebra::DMatrix::<f64>::zeros(0, ndof);
+            for _ in 0..MAX_ITERATIONS {
+                let mut g0 = Vec::new();
+                self.plain_rows(g, &taut, &mut g0);
+                if g0.is_empty() {
+                    break;
+                }
+                let gmax = g0.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+                jac = nalgebra::DMatrix::<f64>::zeros(g0.len(), ndof);
+                for k in 0..ndof {
+                    let b = g.bodies[k / 6];
+                    let saved = *self.bodies[self.handles[b]].position();
+                    let (t, r) = unit(k, FD_STEP);
+                    self.nudge(b, t, r);
+                    let mut gk = Vec::new();
+                    self.plain_rows(g, &taut, &mut gk);
+                    self.bodies[self.handles[b]].set_position(saved, true);
+                    for (row, (gi, g0i)) in gk.iter().zip(&g0).enumerate() {
+                        jac[(row, k)] = (gi - g0i) / FD_STEP;
+                    }
+                }
+                if gmax <= tol {
+                    break;
+                }
+                let svd = jac.clone().svd(true, true);
+                let cut = SVD_RELATIVE_TOLERANCE * svd.singular_values.max();
+                let Ok(step) = svd.solve(&-nalgebra::DVector::from_vec(g0), cut) else { break };
+                for (i, &b) in g.bodies.iter().enumerate() {
+                    let t = Vector::new(step[6 * i], step[6 * i + 1], step[6 * i + 2]);
+                    let r = Vector::new(step[6 * i + 3], step[6 * i + 4], step[6 * i + 5]) / scale;
+                    self.nudge(b, t, r);
+                }
+            }
+            let mut left = Vec::new();
+            self.plain_rows(g, &taut, &mut left);
+            largest = largest.max(left.iter().fold(0.0_f64, |m, x| m.max(x.abs())));
+            if jac.nrows() == 0 {
+                continue;
+            }
+            // Velocities u = [v, w L] per body: remove J^+ (J u) over every row, taut cables
+            // included (they were just held at their length: a cable goes slack when rapier's
+            // rope stops pulling, and is then no longer taut here).
+            let u = nalgebra::DVector::from_iterator(
+                ndof,
+                g.bodies.iter().flat_map(|&b| {
+                    let rb = &self.bodies[self.handles[b]];
+                    let (v, w) = (rb.linvel(), rb.angvel() * scale);
+                    [v.x, v.y, v.z, w.x, w.y, w.z]
+                }),
+            );
+            let jk = jac;
+            let svd = jk.clone().svd(true, true);
+            let cut = SVD_RELATIVE_TOLERANCE * svd.singular_values.max();
+            if let Ok(du) = svd.solve(&(&jk * &u), cut) {
+                for (i, &b) in g.bodies.iter().enumerate() {
+                    let rb = &mut self.bodies[self.handles[b]];
+                    let v = rb.linvel() - Vector::new(du[6 * i], du[6 * i + 1], du[6 * i + 2]);
+                    let w = rb.angvel() - Vector::new(du[6 * i + 3], du[6 * i + 4], du[6 * i + 5]) / scale;
+                    rb.set_linvel(v, true);
+                    rb.set_angvel(w, true);
+                }
+            }
+        }
+        self.plain_groups = groups;
+        largest
+    }
+}

@@ -2,8 +2,8 @@
 
 Each model is generated from the case set's `params` with the same geometry, masses, inertias
 and force laws as the testbed's `src/mechanisms/<name>/build.rs`, and compiled once per case
-set. A case changes only run-time fields (equality targets, tendon ranges) and the state
-(`qpos`), so that every case of a set runs on the same compiled `MjModel`.
+set. A case changes only run-time fields (tendon ranges) and the state (`qpos`, mocap
+poses), so that every case of a set runs on the same compiled `MjModel`.
 
 Conventions: SI units, angles in radians (`compiler angle="radian"`), no gravity (both papers
 are quasi-static without gravity; mohr2011's optional payload weight is an applied force on
@@ -221,19 +221,17 @@ class Ji2014(MechanismPeer):
 """
         super().__init__(xml)
         m = self.model
-        self.stiffness_n_per_m = np.array([params["K1"], params["K2"]])
-        # (platform node, base node) of each spring, in tendon order.
-        self.spring_ends = (("D2", "C2"), ("D3", "C3"))
+        self.stiffness_n_per_m = (params["K1"], params["K2"])
         self.rod_mocap = m.body_mocapid[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "actuator_rod")]
         self.pivot_qpos = m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "D1")]
-        self.actuator_axis = np.zeros(3)
+        self.actuator_axis = (1.0, 0.0, 0.0)
 
     def set_case(self, inputs, start_nodes):
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
         theta1, l3 = inputs["theta1"], inputs["L3"]
-        self.actuator_axis[:] = (math.cos(theta1), math.sin(theta1), 0.0)
-        d.mocap_pos[self.rod_mocap] = l3 * self.actuator_axis
+        self.actuator_axis = (math.cos(theta1), math.sin(theta1), 0.0)
+        d.mocap_pos[self.rod_mocap] = [l3 * a for a in self.actuator_axis]
         d.mocap_quat[self.rod_mocap] = (math.cos(0.5 * theta1), 0.0, 0.0, math.sin(0.5 * theta1))
         d1, d3 = np.asarray(start_nodes["D1"]), np.asarray(start_nodes["D3"])
         theta2 = math.atan2(d3[1] - d1[1], d3[0] - d1[0])
@@ -241,21 +239,21 @@ class Ji2014(MechanismPeer):
 
     def observe(self):
         d = self.data
-        d1, d3 = self.node("D1"), self.node("D3")
-        # Zero free length: each spring pulls its platform node towards its base node with
-        # k times the tendon length.
-        forces_n = self.stiffness_n_per_m * d.ten_length
-        on_platform = np.zeros(3)
-        for force, (platform_node, base_node) in zip(forces_n, self.spring_ends):
-            on_platform += force * unit(self.node(base_node) - self.node(platform_node))
+        k1, k2 = self.stiffness_n_per_m
+        # Plain floats: a handful of numbers, where numpy's per-call cost would dominate.
+        c2, c3, d1, d2, d3 = (d.site_xpos[self.site_of[n]].tolist() for n in ("C2", "C3", "D1", "D2", "D3"))
+        axis_x, axis_y, axis_z = self.actuator_axis
+        # Zero free length: spring K pulls its platform node towards its base node with the
+        # force k (base - platform), of magnitude k times the tendon length.
+        on_platform = [k1 * (c2[i] - d2[i]) + k2 * (c3[i] - d3[i]) for i in range(3)]
         return {
             "theta2": math.atan2(d3[1] - d1[1], d3[0] - d1[0]),
-            "x": float(d3[0]),
-            "y": float(d3[1]),
-            "F_K1": float(forces_n[0]),
-            "F_K2": float(forces_n[1]),
+            "x": d3[0],
+            "y": d3[1],
+            "F_K1": k1 * float(d.ten_length[0]),
+            "F_K2": k2 * float(d.ten_length[1]),
             # The actuator balances the springs at D1: its axial force on D1 along C1->D1.
-            "F_L3": -float(on_platform @ self.actuator_axis),
+            "F_L3": -(on_platform[0] * axis_x + on_platform[1] * axis_y + on_platform[2] * axis_z),
         }
 
 
@@ -299,7 +297,6 @@ class Mohr2011(MechanismPeer):
         self.base = lb * np.array([[-0.5, -sqrt3 / 6.0, 0.0], [0.5, -sqrt3 / 6.0, 0.0], [0.0, sqrt3 / 3.0, 0.0]])
         self.e1 = np.array([unit(np.cross(Z_AXIS, a)) for a in self.base])
         self.e2_ref = np.array([np.cross(e1, Z_AXIS) for e1 in self.e1])
-        self.half_lo = half_lo
         damping = params["c_joint"] * settings.damping_scale
         link_mass = params["m_link"]
         link_inertia = link_mass * lo * lo * MOHR2011_LINK_INERTIA_PER_MASS_LO2
@@ -380,7 +377,6 @@ class Mohr2011(MechanismPeer):
         }
         self.end_effector = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "end_effector")
         self.tendon_ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_TENDON, f"A{a}B{b}") for a, b, _ in MOHR2011_CABLES]
-        self.ee_centroid_local = self.base[0].copy()
 
     def leg_coordinates(self, i: int, start_nodes) -> tuple[float, float, float, np.ndarray]:
         """Universal angles (about e1, then about the carried e2), knee bend [rad] and the upper
