@@ -123,6 +123,15 @@ pub struct PointReport {
     pub min_clearance_m: Option<f64>,
     /// No strut pair below the interference threshold at the settled state.
     pub interference_free: Option<bool>,
+    /// The paper's printed values at this point, where it prints any (never checked).
+    pub paper: Option<PaperValues>,
+}
+
+/// A paper's own printed values at a point: its source (table, column) and the values.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PaperValues {
+    pub source: String,
+    pub values: Values,
 }
 
 /// Workspace classification, analytic against dynamic, over the points of a run whose
@@ -418,6 +427,23 @@ impl Report {
                         format!(", NOT SETTLED: kinetic energy {:.3e} J left", p.final_kinetic_energy_j)
                     }
                 ));
+                if let Some(paper) = &p.paper {
+                    // The paper's value beside the testbed's analytic one, with their relative
+                    // difference.
+                    let beside: Vec<String> = paper
+                        .values
+                        .iter()
+                        .map(|(q, v)| match p.analytic.get(q.trim_start_matches("ansys_")) {
+                            Some(a) if *a != 0.0 => format!("{q}={v:.6} ({:+.1e})", (v - a) / a.abs()),
+                            _ => format!("{q}={v:.6}"),
+                        })
+                        .collect();
+                    out.push_str(&format!(
+                        "              paper, {}: {}  (relative difference from the testbed's analytic value)\n",
+                        paper.source,
+                        beside.join(" ")
+                    ));
+                }
             }
             if s.points.len() > shown {
                 out.push_str(&format!("   ... {} more point(s) in the JSON report\n", s.points.len() - shown));

@@ -634,6 +634,10 @@ fn settle_point(
         within_tolerance,
         min_clearance_m,
         interference_free,
+        paper: runner
+            .mech
+            .paper_values(&sc.params, inputs)
+            .map(|(source, values)| crate::report::PaperValues { source, values }),
     });
     Ok(())
 }

@@ -148,6 +148,12 @@ pub trait Mechanism: Send + Sync {
     fn observe(&self, params: &Values, structure: &Structure, snap: &Snapshot) -> Values;
     /// Characteristic length [m] used to normalise length errors.
     fn length_scale(&self, params: &Values) -> f64;
+    /// The paper's own printed values at `inputs`, where it prints any (for example a table of
+    /// forces): (source, values in the testbed's units). Shown beside the testbed's analytic and
+    /// simulated values in reports, never checked against: a printed table can be wrong.
+    fn paper_values(&self, _params: &Values, _inputs: &Values) -> Option<(String, Values)> {
+        None
+    }
     /// Analytic node positions (structure order) at the expected equilibrium, for the ghost
     /// overlay of recordings.
     fn analytic_nodes(&self, _params: &Values, _inputs: &Values) -> Option<Vec<[f64; 3]>> {

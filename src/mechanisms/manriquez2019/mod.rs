@@ -155,6 +155,9 @@ const QUERIES: &[QuerySpec] = &[
     QuerySpec { name: "form_finding", inputs: &[], description: "the form-finding grid of Section 4 (121 x 121 from -0.5236 rad in steps of 0.0087) classified by the statics" },
 ];
 
+/// N mm per N m: Table 5 gives the joint moment in N mm.
+const N_MM_PER_N_M: f64 = 1e3;
+
 pub fn params_of(v: &Values) -> Params {
     Params {
         a2: v["a2"],
@@ -344,6 +347,22 @@ impl Mechanism for Manriquez2019 {
             expected: v,
             expected_slack: Some(slack),
         })
+    }
+
+    /// Table 5's analytical and ANSYS columns at the four experiments of Table 3 (m_joint
+    /// converted from N mm to N m).
+    fn paper_values(&self, _params: &Values, inputs: &Values) -> Option<(String, Values)> {
+        let (t1, t2) = (inputs.get("theta1")?, inputs.get("theta2")?);
+        let k =
+            analytic::TABLE3_EXPERIMENTS.iter().position(|(a, b)| (a - t1).abs() < 1e-9 && (b - t2).abs() < 1e-9)?;
+        let mut v = Values::new();
+        for (column, table) in [("", analytic::TABLE5_ANALYTICAL[k]), ("ansys_", analytic::TABLE5_ANSYS[k])] {
+            for (i, q) in ["f_C1", "f_C2", "f_R1", "f_R2", "f_joint"].iter().enumerate() {
+                v.insert(format!("{column}{q}"), table[i]);
+            }
+            v.insert(format!("{column}m_joint"), table[5] / N_MM_PER_N_M);
+        }
+        Some((format!("Table 5, experiment {} (analytical; ansys_: ANSYS column)", k + 1), v))
     }
 
     fn observe(&self, params: &Values, s: &Structure, snap: &Snapshot) -> Values {
