@@ -116,7 +116,9 @@ class MechanismPeer:
         self.xml = xml
         self.model = mujoco.MjModel.from_xml_string(xml)
         self.data = mujoco.MjData(self.model)
-        self.site_of = {n: mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.node_names}
+        self.site_of = {
+            n: mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.node_names
+        }
         # Every site is a node, so the settle check reads `site_xpos` whole.
         assert sorted(self.site_of.values()) == list(range(self.model.nsite)), "a site that is not a node"
 
@@ -182,7 +184,9 @@ class Ji2014(MechanismPeer):
         sqrt3 = math.sqrt(3.0)
         c1, c2, c3 = (0.0, 0.0, 0.0), (-side_m, -sqrt3 * side_m, 0.0), (side_m, -sqrt3 * side_m, 0.0)
         # Platform nodes in its own frame (origin D1, x along D1D3).
-        d2_local = side_m * np.array([math.cos(JI2014_PLATFORM_CORNER_RAD), math.sin(JI2014_PLATFORM_CORNER_RAD), 0.0])
+        d2_local = side_m * np.array(
+            [math.cos(JI2014_PLATFORM_CORNER_RAD), math.sin(JI2014_PLATFORM_CORNER_RAD), 0.0]
+        )
         d3_local = np.array([side_m, 0.0, 0.0])
         centroid_local = (d2_local + d3_local) / 3.0
         # Three point masses m/3 at the vertices: I_z = m L^2 / 3, I_x = I_y = m L^2 / 6.
@@ -202,7 +206,8 @@ class Ji2014(MechanismPeer):
       <site name="L3_tip" pos="0 0 0"/>
       <body name="platform">
         <joint name="D1" type="hinge" axis="0 0 1" damping="{pivot_damping!r}"/>
-        <inertial pos="{vec(centroid_local)}" mass="{platform_mass_kg!r}" diaginertia="{vec(platform_inertia)}"/>
+        <inertial pos="{vec(centroid_local)}" mass="{platform_mass_kg!r}"
+                  diaginertia="{vec(platform_inertia)}"/>
         <site name="D1" pos="0 0 0"/>
         <site name="D2" pos="{vec(d2_local)}"/>
         <site name="D3" pos="{vec(d3_local)}"/>
@@ -282,9 +287,8 @@ class Mohr2011(MechanismPeer):
     the end-effector at the top of leg 1 with the identity orientation.
     """
 
-    node_names = (
-        ("A1", "A2", "A3", "B1", "B2", "B3")
-        + tuple(f"{n}{i}{s}" for i in (1, 2, 3) for n, s in (("K", ""), ("A", "_leg"), ("K", "_upper"), ("B", "_leg")))
+    node_names = ("A1", "A2", "A3", "B1", "B2", "B3") + tuple(
+        f"{n}{i}{s}" for i in (1, 2, 3) for n, s in (("K", ""), ("A", "_leg"), ("K", "_upper"), ("B", "_leg"))
     )
 
     def __init__(self, params: dict[str, float], settings: SolverSettings):
@@ -294,7 +298,9 @@ class Mohr2011(MechanismPeer):
         half_lo = 0.5 * lo
         sqrt3 = math.sqrt(3.0)
         # Eq. 1: base nodes a_i; Eq. 2: end-effector nodes B_i = p - a_i.
-        self.base = lb * np.array([[-0.5, -sqrt3 / 6.0, 0.0], [0.5, -sqrt3 / 6.0, 0.0], [0.0, sqrt3 / 3.0, 0.0]])
+        self.base = lb * np.array(
+            [[-0.5, -sqrt3 / 6.0, 0.0], [0.5, -sqrt3 / 6.0, 0.0], [0.0, sqrt3 / 3.0, 0.0]]
+        )
         self.e1 = np.array([unit(np.cross(Z_AXIS, a)) for a in self.base])
         self.e2_ref = np.array([np.cross(e1, Z_AXIS) for e1 in self.e1])
         damping = params["c_joint"] * settings.damping_scale
@@ -308,7 +314,10 @@ class Mohr2011(MechanismPeer):
 
         def leg(i: int, end_effector: str) -> str:
             n = i + 1
-            link = f'<inertial pos="0 0 {half_lo / 2.0!r}" mass="{link_mass!r}" diaginertia="{vec((link_inertia,) * 3)}"/>'
+            link = (
+                f'<inertial pos="0 0 {half_lo / 2.0!r}" mass="{link_mass!r}" '
+                f'diaginertia="{vec((link_inertia,) * 3)}"/>'
+            )
             return f"""
     <body name="leg{n}_lower" pos="{vec(self.base[i])}">
       <joint name="U{n}_base" type="hinge" axis="{vec(self.e1[i])}" damping="{damping!r}"/>
@@ -346,7 +355,8 @@ class Mohr2011(MechanismPeer):
             cable_law = 'limited="true" range="0 1"'
         cable_damping = f'damping="{settings.cable_damping_n_s_per_m!r}"'
         cables = "".join(
-            f'<spatial name="A{a}B{b}" {cable_law} {cable_damping}><site site="A{a}"/><site site="B{b}"/></spatial>'
+            f'<spatial name="A{a}B{b}" {cable_law} {cable_damping}>'
+            f'<site site="A{a}"/><site site="B{b}"/></spatial>'
             for a, b, _ in MOHR2011_CABLES
         )
         base_sites = "".join(f'<site name="A{i + 1}" pos="{vec(self.base[i])}"/>' for i in range(3))
@@ -370,13 +380,15 @@ class Mohr2011(MechanismPeer):
 """
         super().__init__(xml)
         m = self.model
-        jid = lambda name: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)  # noqa: E731
+        leg_joints = [name for n in (1, 2, 3) for name in (f"U{n}_base", f"U{n}_knee", f"knee{n}")]
         self.qpos_of = {
-            name: m.jnt_qposadr[jid(name)]
-            for name in ["S1"] + [f"{j}{n}{s}" for n in (1, 2, 3) for j, s in (("U", "_base"), ("U", "_knee"), ("knee", ""))]
+            name: m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)]
+            for name in ["S1", *leg_joints]
         }
         self.end_effector = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "end_effector")
-        self.tendon_ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_TENDON, f"A{a}B{b}") for a, b, _ in MOHR2011_CABLES]
+        self.tendon_ids = [
+            mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_TENDON, f"A{a}B{b}") for a, b, _ in MOHR2011_CABLES
+        ]
 
     def leg_coordinates(self, i: int, start_nodes) -> tuple[float, float, float, np.ndarray]:
         """Universal angles (about e1, then about the carried e2), knee bend [rad] and the upper

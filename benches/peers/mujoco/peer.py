@@ -17,7 +17,7 @@ import math
 import statistics
 import sys
 import time
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import mujoco
@@ -42,14 +42,15 @@ USUAL: dict = {}
 #: Tuned per mechanism (README.md: what was tried and measured).
 TUNED = {
     # No constraint rows at all (the actuator is placed, the springs are passive tendons): only
-    # the time step and the damping matter. Fewest steps with every case settled and margin
-    # on both sides: a step 10x the testbed's, the pivot damping 3x the testbed's.
+    # the time step and the damping matter. Fewest steps with every case settled, and every
+    # case still settled at 2x or 4x damping or at dt 0.08 s: a step 10x the testbed's, the
+    # pivot damping 3x the testbed's (overdamped).
     "ji2014": dict(integrator="implicitfast", timestep_s=0.1, damping_scale=3.0),
     # Cables and loop closures are soft constraints whose equilibrium offset is about
-    # (1 - solimp) (solref timeconst)^2 x load / mass: the stiffest impedance MuJoCo allows
-    # (0.9999), the smallest timeconst refsafe allows (2 dt, critically damped), and dt
-    # traded against steps (error ~ dt^2). Cable damping (zero at rest) stops the chatter of
-    # nearly slack cables, which otherwise never settle.
+    # (1 - d) timeconst^2 x load / mass: the highest impedance d MuJoCo allows (0.9999), the
+    # smallest timeconst refsafe allows (2 dt, critically damped), and dt traded against
+    # steps (error ~ dt^2). Cable damping (zero at rest) stops the chatter of nearly slack
+    # cables, which otherwise never settle.
     "mohr2011": dict(
         integrator="implicitfast",
         timestep_s=0.003,
