@@ -140,7 +140,7 @@ def error(kind: str, simulated: float, analytic: float, length_scale_m: float) -
     if kind == "angle":
         return abs(wrap_to_pi(simulated - analytic))
     if kind == "magnitude":
-        return abs(simulated - analytic) / abs(analytic)
+        return abs(simulated - analytic) / abs(analytic) if analytic != 0.0 else math.inf
     raise ValueError(f"unknown check kind {kind!r}")
 
 
@@ -210,6 +210,7 @@ def bench(case_set: dict, variant: str, rounds: int, overrides: dict) -> dict:
             }
         )
     return {
+        "simulator": "mujoco",
         "mechanism": mechanism,
         "variant": variant,
         "mujoco_version": mujoco.__version__,
@@ -223,6 +224,17 @@ def bench(case_set: dict, variant: str, rounds: int, overrides: dict) -> dict:
         "median_error": statistics.median(pooled_errors),
         "max_error": max(pooled_errors),
     }
+
+
+def finite_or_null(value):
+    """`value` with every non-finite float replaced by None (JSON null), recursively."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: finite_or_null(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite_or_null(v) for v in value]
+    return value
 
 
 def parse_override(text: str) -> tuple[str, object]:
@@ -256,7 +268,8 @@ def main() -> None:
     case_set = json.loads(args.cases.read_text())
     overrides = dict(parse_override(s) for s in args.set)
     result = bench(case_set, args.variant, max(1, args.rounds), overrides)
-    json.dump(result, sys.stdout, indent=1)
+    # Strict JSON (a diverged case would give NaN or infinity): such numbers become null.
+    json.dump(finite_or_null(result), sys.stdout, indent=1, allow_nan=False)
     sys.stdout.write("\n")
 
 
