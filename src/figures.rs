@@ -8,6 +8,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
+mod manriquez2019;
+
 /// The figures this command draws: (name, what it shows).
 pub const FIGURES: &[(&str, &str)] = &[
     (
@@ -17,6 +19,10 @@ pub const FIGURES: &[(&str, &str)] = &[
     (
         "furet2018-fig5",
         "furet2018 Fig. 5: workspace regions by number of inverse solutions (2 or 4) for b = 2/5, 2/3, 9/10 (L = 1), with the paper's Fig. 3 point",
+    ),
+    (
+        "manriquez2019-fig6",
+        "manriquez2019 Fig. 6-7: the form-finding grid of Table 2 as positions of M, in 3D and in the Y-Z plane, classified by the statics, with the dynamics' verdict on 41 x 41 poses",
     ),
     (
         "mohr2011-fig5",
@@ -61,6 +67,11 @@ pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
             let data = mohr2011_fig5_data()?;
             mohr2011_fig5_plot(BitMapBackend::new(&png, MAP_SIZE).into_drawing_area(), &data)?;
             mohr2011_fig5_plot(SVGBackend::new(&svg, MAP_SIZE).into_drawing_area(), &data)?;
+        }
+        "manriquez2019-fig6" => {
+            let data = manriquez2019::data()?;
+            manriquez2019::plot(BitMapBackend::new(&png, manriquez2019::SIZE).into_drawing_area(), &data)?;
+            manriquez2019::plot(SVGBackend::new(&svg, manriquez2019::SIZE).into_drawing_area(), &data)?;
         }
         other => {
             let known: Vec<_> = FIGURES.iter().map(|(n, _)| *n).collect();

@@ -43,11 +43,17 @@ class SolverSettings:
     # MuJoCo's refsafe flag: clamp timeconst to >= 2 dt (Euler/implicit*), or replace rows the
     # step cannot resolve (discrete). Disabling it lets a small timeconst through.
     refsafe: bool = True
-    # Multiplies the testbed's joint damping (c_D1 for ji2014, c_joint for mohr2011).
-    damping_scale: float = 1.0
+    # Viscous damping of the damped joints [N m s/rad] (ji2014's pivot D1, mohr2011's universal
+    # joints and knees); None: the case set's (c_D1, c_joint), as the testbed.
+    joint_damping_nms_per_rad: float | None = None
     # Viscous damping along mohr2011's cables [N s/m] (none in the testbed). Zero at rest, so
     # the equilibrium is unchanged; MuJoCo applies it to slack cables too.
     cable_damping_n_s_per_m: float = 0.0
+
+    def joint_damping_or(self, case_set_damping_nms_per_rad: float) -> float:
+        if self.joint_damping_nms_per_rad is None:
+            return case_set_damping_nms_per_rad
+        return self.joint_damping_nms_per_rad
 
     def option_xml(self) -> str:
         flags = "" if self.refsafe else '<flag refsafe="disable"/>'
@@ -192,7 +198,7 @@ class Ji2014(MechanismPeer):
         # Three point masses m/3 at the vertices: I_z = m L^2 / 3, I_x = I_y = m L^2 / 6.
         ml2 = platform_mass_kg * side_m * side_m
         platform_inertia = (ml2 / 6.0, ml2 / 6.0, ml2 / 3.0)
-        pivot_damping = params["c_D1"] * settings.damping_scale
+        pivot_damping = settings.joint_damping_or(params["c_D1"])
         xml = f"""
 <mujoco model="ji2014">
   <compiler angle="radian"/>
@@ -303,7 +309,7 @@ class Mohr2011(MechanismPeer):
         )
         self.e1 = np.array([unit(np.cross(Z_AXIS, a)) for a in self.base])
         self.e2_ref = np.array([np.cross(e1, Z_AXIS) for e1 in self.e1])
-        damping = params["c_joint"] * settings.damping_scale
+        damping = settings.joint_damping_or(params["c_joint"])
         link_mass = params["m_link"]
         link_inertia = link_mass * lo * lo * MOHR2011_LINK_INERTIA_PER_MASS_LO2
         platform_mass = params["m_platform"]
