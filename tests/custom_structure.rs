@@ -6,10 +6,8 @@ use tensegrity_testbed::mechanisms::furet2018::analytic as furet;
 use tensegrity_testbed::report::ScenarioReport;
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
-
-fn run_file(path: &str) -> ScenarioReport {
-    run(&scenario::load(Path::new(path)).expect("valid"), &RunOptions::default())
-}
+mod common;
+use common::run_file;
 
 type P3 = [f64; 3];
 fn node(r: &ScenarioReport, n: &str) -> P3 {

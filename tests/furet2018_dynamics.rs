@@ -1,15 +1,8 @@
 //! issue 4's bars for furet2018's dynamics: the four inverse solutions, a joint-space
 //! trajectory and a cuspidal path, settled in rapier with the loops closed by projection.
 
-use std::path::Path;
-use tensegrity_testbed::report::ScenarioReport;
-use tensegrity_testbed::run::{run, RunOptions};
-use tensegrity_testbed::scenario;
-
-fn run_file(path: &str) -> ScenarioReport {
-    let sc = scenario::load(Path::new(path)).expect("scenario is valid");
-    run(&sc, &RunOptions::default())
-}
+mod common;
+use common::run_file;
 
 /// Target of the paper's Fig. 3 [m] (L = 1, b = 2/3).
 const TARGET: (f64, f64) = (0.03, 1.6);

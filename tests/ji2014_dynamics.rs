@@ -1,14 +1,7 @@
 //! The core issue's bars, checked on the ji2014 scenarios through the library.
 
-use std::path::Path;
-use tensegrity_testbed::report::ScenarioReport;
-use tensegrity_testbed::run::{run, RunOptions};
-use tensegrity_testbed::scenario;
-
-fn run_file(path: &str) -> ScenarioReport {
-    let sc = scenario::load(Path::new(path)).expect("scenario is valid");
-    run(&sc, &RunOptions::default())
-}
+mod common;
+use common::run_file;
 
 /// Settled theta2 and D3 within 1e-9 (relative to L) of the analytic energy minimum over the
 /// whole 110-point grid, with the stability verdict agreeing with the sign of K.

@@ -1,14 +1,9 @@
 //! issue 5's bars for manriquez2019's dynamics: Table 3's experiments and the form-finding grid.
 
 use std::path::Path;
-use tensegrity_testbed::report::ScenarioReport;
-use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
-
-fn run_file(path: &str) -> ScenarioReport {
-    let sc = scenario::load(Path::new(path)).expect("scenario is valid");
-    run(&sc, &RunOptions::default())
-}
+mod common;
+use common::run_file;
 
 /// The four experiments of Table 3 settle with the joint angles within 1e-9 rad and every force
 /// (cables, springs, joint reaction force and moment) within 1e-7 of the analytic statics, and

@@ -6,11 +6,8 @@ use std::path::Path;
 use tensegrity_testbed::report::ScenarioReport;
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
-
-fn run_file(path: &str) -> ScenarioReport {
-    let sc = scenario::load(Path::new(path)).expect("scenario is valid");
-    run(&sc, &RunOptions::default())
-}
+mod common;
+use common::run_file;
 
 /// A variant of a scenario file with its actuation replaced (same model and settings).
 fn run_variant(path: &str, actuation: &str) -> ScenarioReport {

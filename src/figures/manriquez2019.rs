@@ -64,10 +64,9 @@ pub(super) fn data() -> Result<Data, String> {
     Ok(Data { analytic, dynamics, agreement_percent: summary.workspace.map_or(f64::NAN, |w| w.agreement_percent) })
 }
 
+/// The padded range of coordinate `k` of the points.
 fn bounds(points: &[([f64; 3], bool)], k: usize) -> std::ops::Range<f64> {
-    let (lo, hi) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (q, _)| (a.min(q[k]), b.max(q[k])));
-    let pad = 0.05 * (hi - lo);
-    (lo - pad)..(hi + pad)
+    super::range(&points.iter().map(|(q, _)| q[k]).collect::<Vec<_>>())
 }
 
 pub(super) fn plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Data) -> Result<(), String> {

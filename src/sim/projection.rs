@@ -26,6 +26,14 @@ const FD_STEP: f64 = 1e-7;
 /// zero (redundant closure rows).
 const SVD_RELATIVE_TOLERANCE: f64 = 1e-10;
 
+/// The minimum-norm least-squares solution x of `a x = b`, singular values below
+/// [`SVD_RELATIVE_TOLERANCE`] of the largest dropped (redundant rows).
+fn min_norm_solve(a: &nalgebra::DMatrix<f64>, b: &nalgebra::DVector<f64>) -> Option<nalgebra::DVector<f64>> {
+    let svd = a.clone().svd(true, true);
+    let cut = SVD_RELATIVE_TOLERANCE * svd.singular_values.max();
+    svd.solve(b, cut).ok()
+}
+
 /// A loop-closing joint inside one multibody: the rows of its gap that the projection zeroes.
 #[derive(Clone, Debug)]
 pub(super) struct InternalClosure {
@@ -129,9 +137,7 @@ impl Simulation {
                 if gmax <= tol {
                     break;
                 }
-                let svd = jac.clone().svd(true, true);
-                let cut = SVD_RELATIVE_TOLERANCE * svd.singular_values.max();
-                let Ok(step) = svd.solve(&-nalgebra::DVector::from_vec(g0), cut) else { break };
+                let Some(step) = min_norm_solve(&jac, &-nalgebra::DVector::from_vec(g0)) else { break };
                 disp.fill(0.0);
                 for (col, &dof) in free.iter().enumerate() {
                     disp[dof] = step[col];
@@ -148,9 +154,7 @@ impl Simulation {
                         free.iter().map(|&d| mb.generalized_velocity()[d]),
                     );
                     let jv = &jac * &v;
-                    let svd = jac.clone().svd(true, true);
-                    let cut = SVD_RELATIVE_TOLERANCE * svd.singular_values.max();
-                    if let Ok(dv) = svd.solve(&jv, cut) {
+                    if let Some(dv) = min_norm_solve(&jac, &jv) {
                         let mut gv = mb.generalized_velocity_mut();
                         for (col, &dof) in free.iter().enumerate() {
                             gv[dof] -= dv[col];
@@ -391,9 +395,7 @@ impl Simulation {
                 if gmax <= tol {
                     break;
                 }
-                let svd = jac.clone().svd(true, true);
-                let cut = SVD_RELATIVE_TOLERANCE * svd.singular_values.max();
-                let Ok(step) = svd.solve(&-nalgebra::DVector::from_vec(g0), cut) else { break };
+                let Some(step) = min_norm_solve(&jac, &-nalgebra::DVector::from_vec(g0)) else { break };
                 for (i, &b) in g.bodies.iter().enumerate() {
                     let t = Vector::new(step[6 * i], step[6 * i + 1], step[6 * i + 2]);
                     let r = Vector::new(step[6 * i + 3], step[6 * i + 4], step[6 * i + 5]) / scale;
@@ -418,9 +420,7 @@ impl Simulation {
                 }),
             );
             let jk = jac;
-            let svd = jk.clone().svd(true, true);
-            let cut = SVD_RELATIVE_TOLERANCE * svd.singular_values.max();
-            if let Ok(du) = svd.solve(&(&jk * &u), cut) {
+            if let Some(du) = min_norm_solve(&jk, &(&jk * &u)) {
                 for (i, &b) in g.bodies.iter().enumerate() {
                     let rb = &mut self.bodies[self.handles[b]];
                     let v = rb.linvel() - Vector::new(du[6 * i], du[6 * i + 1], du[6 * i + 2]);
