@@ -43,6 +43,8 @@ fn a_recorded_run_holds_every_entity_at_every_tick() {
         "/forces/cables",
         "/inputs",
         "/residual",
+        "/errors_log10",
+        "/energy/kinetic_j",
     ] {
         let t =
             entities.get(e).unwrap_or_else(|| panic!("{e} missing; have {:?}", entities.keys().collect::<Vec<_>>()));
