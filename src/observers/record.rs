@@ -6,7 +6,8 @@
 //! (log10 of their magnitude: rerun 0.36 plots have no log axis), `forces/{springs,cables,actuators}`,
 //! `inputs`, `residual`, `energy/kinetic_j`; `interference/min_clearance_m`; `events` (text log).
 //! The scenario file and the report summary are stored as documents. Timelines: `tick` and
-//! `sim_time`.
+//! `sim_time`. A blueprint ([`blueprint`]) stored at the start of the recording lays the viewer
+//! out: the 3D structure, the error, force and energy plots, the events and the documents.
 //!
 //! Per-tick data is buffered per entity and sent in blocks of ticks as one chunk each
 //! (`send_columns`): one `log` call per entity and tick cost more than the simulation step.
@@ -269,7 +270,10 @@ impl Recorder {
             }
         }
         let partial = path.with_extension("rrd.partial");
-        let rec = rerun::RecordingStreamBuilder::new(app).save(&partial).map_err(|e| io(e.to_string()))?;
+        let rec = rerun::RecordingStreamBuilder::new(app)
+            .with_blueprint(blueprint())
+            .save(&partial)
+            .map_err(|e| io(e.to_string()))?;
         Ok(Recorder::new(rec, Target::File { partial, path: path.to_path_buf() }, every))
     }
 
@@ -299,6 +303,7 @@ impl Recorder {
             return Ok(None);
         }
         let rec = rerun::RecordingStreamBuilder::new(app)
+            .with_blueprint(blueprint())
             .connect_grpc_opts(url.clone())
             .map_err(|e| RecordError::Io { path: url.clone(), message: e.to_string() })?;
         Ok(Some(Recorder::new(rec, Target::Live { url }, every)))
@@ -485,4 +490,49 @@ impl Observer for Recorder {
         }
         let _ = self.rec.log("events", &rerun::TextLog::new(text));
     }
+}
+
+/// The viewer layout stored in every recording: the structure in 3D with the analytic ghost
+/// (left, over tabs of events and the two documents), and on the right the errors (log10 of
+/// their magnitude, and signed), the member forces, and the kinetic energy with the other
+/// series in tabs. The time cursor follows the end of the recording: the settled state.
+pub fn blueprint() -> rerun::blueprint::Blueprint {
+    use rerun::blueprint::components::{PanelState, PlayState};
+    use rerun::blueprint::{
+        Blueprint, BlueprintPanel, Horizontal, SelectionPanel, Spatial3DView, Tabs, TextDocumentView, TextLogView,
+        TimePanel, TimeSeriesView, Vertical,
+    };
+    let series = |name: &str, entities: &[&str]| TimeSeriesView::new(name).with_contents(entities.iter().copied());
+    let structure = Spatial3DView::new("structure (red tension, blue compression, green analytic)")
+        .with_contents(["+ /structure/**", "+ /analytic/**"])
+        .with_defaults(&rerun::LineStrips3D::update_fields().with_show_labels(false))
+        .with_defaults(&rerun::Points3D::update_fields().with_show_labels(false));
+    let documents = Tabs::new([
+        TextLogView::new("events").with_contents(["/events"]).into(),
+        TextDocumentView::new("scenario").with_contents(["/scenario"]).into(),
+        TextDocumentView::new("report").with_contents(["/report"]).into(),
+    ]);
+    let left = Vertical::new([structure.into(), documents.into()]).with_row_shares([0.68, 0.32]);
+    let errors = Tabs::new([
+        series("log10 |simulated - analytic|", &["/errors_log10"]).into(),
+        series("simulated - analytic", &["/errors"]).into(),
+    ]);
+    let forces = series("member forces [N] (cables: tension)", &["/forces/springs", "/forces/cables"]);
+    let others = Tabs::new([
+        series("kinetic energy [J]", &["/energy/**"]).into(),
+        series("residual (max force N, torque N m)", &["/residual"]).into(),
+        series("actuator forces", &["/forces/actuators"]).into(),
+        series("inputs", &["/inputs"]).into(),
+        series("min clearance [m]", &["/interference/**"]).into(),
+    ]);
+    let right = Vertical::new([errors.into(), forces.into(), others.into()]);
+    Blueprint::new(Horizontal::new([left.into(), right.into()]).with_column_shares([0.55, 0.45]))
+        .with_blueprint_panel(BlueprintPanel::from_state(PanelState::Collapsed))
+        .with_selection_panel(SelectionPanel::from_state(PanelState::Collapsed))
+        .with_time_panel(
+            TimePanel::new()
+                .with_state(PanelState::Collapsed)
+                .with_timeline("tick")
+                .with_play_state(PlayState::Following),
+        )
 }
