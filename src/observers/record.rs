@@ -9,7 +9,7 @@
 //! `sim_time`. A blueprint ([`blueprint`]) stored at the start of the recording lays the viewer
 //! out: the 3D structure, the error, force and energy plots, the events and the documents.
 //!
-//! Per-tick data is buffered per entity and sent in blocks of ticks as one chunk each
+//! Per-tick data and events are buffered per entity and sent in blocks of ticks as one chunk each
 //! (`send_columns`): one `log` call per entity and tick cost more than the simulation step.
 //! The file is written to `<path>.partial` and renamed when the run ends, so a reader never
 //! sees a half-written recording under the final name.
@@ -57,6 +57,8 @@ enum Kind {
     Segments,
     /// `Scalars`, one per named series.
     Scalars,
+    /// `TextLog` lines, one per row.
+    Text,
 }
 
 /// The rows of one entity since the last send: time columns, the number of instances per row,
@@ -70,6 +72,7 @@ struct Column {
     points: Vec<[f32; 3]>,
     colors: Vec<[u8; 4]>,
     values: Vec<f64>,
+    texts: Vec<String>,
 }
 
 impl Column {
@@ -83,6 +86,7 @@ impl Column {
             points: Vec::new(),
             colors: Vec::new(),
             values: Vec::new(),
+            texts: Vec::new(),
         }
     }
 
@@ -119,40 +123,63 @@ impl Column {
         self.row(tick, time_s, self.values.len() - before);
     }
 
-    /// Sends the buffered rows as one chunk and empties the buffer.
+    fn push_text(&mut self, tick: u64, time_s: f64, text: &str) {
+        self.row(tick, time_s, 1);
+        self.texts.push(text.to_string());
+    }
+
+    /// Sends the buffered rows as one chunk and empties the buffer (keeping its capacity).
     fn send(&mut self, rec: &rerun::RecordingStream) {
         if self.ticks.is_empty() {
             return;
         }
         let times = [
-            rerun::TimeColumn::new_sequence("tick", std::mem::take(&mut self.ticks)),
-            rerun::TimeColumn::new_duration_secs("sim_time", std::mem::take(&mut self.secs)),
+            rerun::TimeColumn::new_sequence("tick", self.ticks.drain(..)),
+            rerun::TimeColumn::new_duration_secs("sim_time", self.secs.drain(..)),
         ];
-        let lengths = std::mem::take(&mut self.lengths);
-        let lengths = lengths.iter().copied();
+        let lengths = self.lengths.iter().copied();
         let columns: Result<Vec<_>, _> = match self.kind {
             Kind::Points => rerun::Points3D::update_fields()
                 .with_positions(self.points.drain(..))
                 .columns(lengths)
                 .map(Iterator::collect),
-            Kind::Segments => {
-                let strips = self.points.chunks_exact(2).map(|p| rerun::LineStrip3D::from_iter([p[0], p[1]]));
-                let mut strips = rerun::LineStrips3D::update_fields().with_strips(strips);
+            Kind::Segments => segments(&self.points).and_then(|array| {
+                let mut strips = rerun::LineStrips3D::update_fields();
+                strips.strips =
+                    Some(rerun::SerializedComponentBatch::new(array, rerun::LineStrips3D::descriptor_strips()));
                 if !self.colors.is_empty() {
                     strips = strips.with_colors(self.colors.drain(..));
                 }
-                self.points.clear();
                 strips.columns(lengths).map(Iterator::collect)
-            }
+            }),
             Kind::Scalars => rerun::Scalars::update_fields()
                 .with_scalars(self.values.drain(..))
                 .columns(lengths)
                 .map(Iterator::collect),
+            Kind::Text => rerun::TextLog::update_fields()
+                .with_many_text(self.texts.drain(..))
+                .columns(lengths)
+                .map(Iterator::collect),
         };
+        self.points.clear();
+        self.lengths.clear();
         if let Ok(columns) = columns {
             let _ = rec.send_columns(self.entity.as_str(), times, columns);
         }
     }
+}
+
+/// Line strips of two points each, `points` taken in pairs, as one arrow array built directly:
+/// the component's own conversion allocates a vector per strip.
+fn segments(points: &[[f32; 3]]) -> rerun::SerializationResult<rerun::external::arrow::array::ArrayRef> {
+    use rerun::external::arrow::{array::ListArray, buffer::OffsetBuffer, datatypes::DataType};
+    use rerun::Loggable as _;
+    let DataType::List(field) = rerun::LineStrip3D::arrow_datatype() else {
+        unreachable!("a line strip is a list of points")
+    };
+    let values = rerun::datatypes::Vec3D::to_arrow(points.iter().map(|p| rerun::datatypes::Vec3D(*p)))?;
+    let offsets = OffsetBuffer::from_lengths(std::iter::repeat_n(2, points.len() / 2));
+    Ok(std::sync::Arc::new(ListArray::try_new(field, offsets, values, None)?))
 }
 
 /// Every per-tick entity of a recording.
@@ -171,6 +198,7 @@ struct Columns {
     inputs: Column,
     residual: Column,
     kinetic_energy: Column,
+    events: Column,
 }
 
 impl Columns {
@@ -190,10 +218,11 @@ impl Columns {
             inputs: Column::new("inputs", Kind::Scalars),
             residual: Column::new("residual", Kind::Scalars),
             kinetic_energy: Column::new("energy/kinetic_j", Kind::Scalars),
+            events: Column::new("events", Kind::Text),
         }
     }
 
-    fn all(&mut self) -> [&mut Column; 14] {
+    fn all(&mut self) -> [&mut Column; 15] {
         [
             &mut self.nodes,
             &mut self.struts,
@@ -209,6 +238,7 @@ impl Columns {
             &mut self.inputs,
             &mut self.residual,
             &mut self.kinetic_energy,
+            &mut self.events,
         ]
     }
 }
@@ -483,12 +513,11 @@ impl Observer for Recorder {
         }
     }
 
+    /// Buffers an event (every one, whatever `record_every`) at `tick`: the last tick seen, or
+    /// the start.
     fn event(&mut self, tick: u64, text: &str) {
-        self.rec.set_time_sequence("tick", tick as i64);
-        if tick == self.last_tick {
-            self.rec.set_duration_secs("sim_time", self.last_time_s);
-        }
-        let _ = self.rec.log("events", &rerun::TextLog::new(text));
+        let time_s = if tick == self.last_tick { self.last_time_s } else { 0.0 };
+        self.columns.events.push_text(tick, time_s, text);
     }
 }
 
