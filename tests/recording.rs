@@ -6,18 +6,32 @@ use std::path::Path;
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
 
-/// Entity paths and the set of `tick` values logged for each.
-fn read_back(path: &Path) -> BTreeMap<String, BTreeSet<i64>> {
+/// What a recording file holds: per entity of the recording store, the set of `tick` values
+/// logged; the entities of its blueprint store; and whether that blueprint is activated.
+struct Contents {
+    entities: BTreeMap<String, BTreeSet<i64>>,
+    blueprint: BTreeSet<String>,
+    blueprint_activated: bool,
+}
+
+fn read_back(path: &Path) -> Contents {
     let file = std::io::BufReader::new(std::fs::File::open(path).expect("recording exists"));
-    let mut out: BTreeMap<String, BTreeSet<i64>> = BTreeMap::new();
+    let mut out = Contents { entities: BTreeMap::new(), blueprint: BTreeSet::new(), blueprint_activated: false };
     for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
-        let msg = msg.expect("decodes");
-        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg {
-            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).expect("a chunk");
-            let ticks = out.entry(chunk.entity_path().to_string()).or_default();
-            if let Some(col) = chunk.timelines().iter().find(|(name, _)| name.as_str() == "tick").map(|(_, c)| c) {
-                ticks.extend(col.times_raw().iter().copied());
+        match msg.expect("decodes") {
+            re_log_types::LogMsg::ArrowMsg(store, arrow) => {
+                let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).expect("a chunk");
+                if store.kind() == re_log_types::StoreKind::Blueprint {
+                    out.blueprint.insert(chunk.entity_path().to_string());
+                    continue;
+                }
+                let ticks = out.entities.entry(chunk.entity_path().to_string()).or_default();
+                if let Some(col) = chunk.timelines().iter().find(|(name, _)| name.as_str() == "tick").map(|(_, c)| c) {
+                    ticks.extend(col.times_raw().iter().copied());
+                }
             }
+            re_log_types::LogMsg::BlueprintActivationCommand(cmd) => out.blueprint_activated |= cmd.make_active,
+            re_log_types::LogMsg::SetStoreInfo(_) => {}
         }
     }
     out
@@ -32,7 +46,8 @@ fn a_recorded_run_holds_every_entity_at_every_tick() {
     let r = run(&sc, &RunOptions { record: Some(rrd.clone()), ..RunOptions::default() });
     assert!(r.passed, "{:?}", r.error);
     assert!(!rrd.with_extension("rrd.partial").exists());
-    let entities = read_back(&rrd);
+    let contents = read_back(&rrd);
+    let entities = &contents.entities;
     let ticks = r.settle.steps as usize;
     for e in [
         "/structure/nodes",
@@ -43,6 +58,8 @@ fn a_recorded_run_holds_every_entity_at_every_tick() {
         "/forces/cables",
         "/inputs",
         "/residual",
+        "/errors_log10",
+        "/energy/kinetic_j",
     ] {
         let t =
             entities.get(e).unwrap_or_else(|| panic!("{e} missing; have {:?}", entities.keys().collect::<Vec<_>>()));
@@ -52,6 +69,12 @@ fn a_recorded_run_holds_every_entity_at_every_tick() {
     }
     assert!(entities.contains_key("/events"), "events recorded");
     assert!(entities.contains_key("/scenario") && entities.contains_key("/report"), "documents recorded");
+    // The layout travels with the data: a blueprint store with a viewport and its views,
+    // activated when the file is opened.
+    let bp = &contents.blueprint;
+    assert!(bp.contains("/viewport") && bp.contains("/time_panel"), "blueprint stored; have {bp:?}");
+    assert!(bp.iter().filter(|e| e.starts_with("/view/") && e.ends_with("/ViewContents")).count() >= 8, "{bp:?}");
+    assert!(contents.blueprint_activated, "blueprint activated");
 }
 
 /// `record_every = N` keeps every N-th tick only.
@@ -63,7 +86,7 @@ fn record_every_thins_the_recording() {
     let sc = scenario::load(Path::new("scenarios/ji2014/quick.toml")).unwrap();
     let r = run(&sc, &RunOptions { record: Some(rrd.clone()), record_every: 10, ..RunOptions::default() });
     assert!(r.passed, "{:?}", r.error);
-    let ticks = &read_back(&rrd)["/structure/nodes"];
+    let ticks = &read_back(&rrd).entities["/structure/nodes"];
     assert_eq!(ticks.len() as u64, r.settle.steps / 10);
     assert!(ticks.iter().all(|t| t % 10 == 0));
 }

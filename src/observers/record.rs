@@ -2,9 +2,15 @@
 //!
 //! Entities: `structure/{nodes,struts,springs,cables}` (springs and cables coloured by force),
 //! `analytic/{nodes,struts}` (the analytic prediction as a ghost overlay), and time series with
-//! one named series per quantity or member: `errors`, `forces/{springs,cables,actuators}`,
-//! `inputs`, `residual`; `interference/min_clearance_m`; `events` (text log). The scenario file
-//! and the report summary are stored as documents. Timelines: `tick` and `sim_time`.
+//! one named series per quantity or member: `errors` (simulated - analytic), `errors_log10`
+//! (log10 of their magnitude: rerun 0.36 plots have no log axis), `forces/{springs,cables,actuators}`,
+//! `inputs`, `residual`, `energy/kinetic_j`; `interference/min_clearance_m`; `events` (text log).
+//! The scenario file and the report summary are stored as documents. Timelines: `tick` and
+//! `sim_time`. A blueprint ([`blueprint`]) stored at the start of the recording lays the viewer
+//! out: the 3D structure, the error, force and energy plots, the events and the documents.
+//!
+//! Per-tick data and events are buffered per entity and sent in blocks of ticks as one chunk each
+//! (`send_columns`): one `log` call per entity and tick cost more than the simulation step.
 //! The file is written to `<path>.partial` and renamed when the run ends, so a reader never
 //! sees a half-written recording under the final name.
 
@@ -22,8 +28,219 @@ pub struct Recorder {
     rec: rerun::RecordingStream,
     target: Target,
     every: u64,
-    /// Series entities whose names were logged (once, as static data).
-    named: std::collections::BTreeSet<String>,
+    /// Whether the static parts (labels, radii, fixed colours, series names) were logged.
+    statics_logged: bool,
+    /// Per-tick data waiting to be sent.
+    columns: Columns,
+    /// Scalar series logged through [`Recorder::scalar`], by entity.
+    extra: Vec<Column>,
+    /// Ticks buffered since the last send, and when that was.
+    pending: usize,
+    last_send: std::time::Instant,
+    /// The last tick seen and its simulated time [s] (for events and extra scalars).
+    last_tick: u64,
+    last_time_s: f64,
+}
+
+/// Ticks buffered per entity before they are sent as one chunk.
+const BLOCK_TICKS: usize = 1024;
+
+/// Longest buffered data waits before it is sent, so a live viewer stays current [s].
+const BLOCK_MAX_AGE_S: f64 = 0.25;
+
+/// What one buffered entity holds per tick.
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    /// `Points3D` positions.
+    Points,
+    /// `LineStrips3D` of two points each, with per-strip colours when given.
+    Segments,
+    /// `Scalars`, one per named series.
+    Scalars,
+    /// `TextLog` lines, one per row.
+    Text,
+}
+
+/// The rows of one entity since the last send: time columns, the number of instances per row,
+/// and the instances of all rows end to end.
+struct Column {
+    entity: String,
+    kind: Kind,
+    ticks: Vec<i64>,
+    secs: Vec<f64>,
+    lengths: Vec<usize>,
+    points: Vec<[f32; 3]>,
+    colors: Vec<[u8; 4]>,
+    values: Vec<f64>,
+    texts: Vec<String>,
+}
+
+impl Column {
+    fn new(entity: &str, kind: Kind) -> Self {
+        Column {
+            entity: entity.to_string(),
+            kind,
+            ticks: Vec::new(),
+            secs: Vec::new(),
+            lengths: Vec::new(),
+            points: Vec::new(),
+            colors: Vec::new(),
+            values: Vec::new(),
+            texts: Vec::new(),
+        }
+    }
+
+    fn row(&mut self, tick: u64, time_s: f64, len: usize) {
+        self.ticks.push(tick as i64);
+        self.secs.push(time_s);
+        self.lengths.push(len);
+    }
+
+    fn push_points(&mut self, tick: u64, time_s: f64, points: impl ExactSizeIterator<Item = [f64; 3]>) {
+        self.row(tick, time_s, points.len());
+        self.points.extend(points.map(f32x3));
+    }
+
+    /// One segment per pair of node indices into `nodes`.
+    fn push_segments(
+        &mut self,
+        tick: u64,
+        time_s: f64,
+        nodes: &[[f64; 3]],
+        pairs: impl Iterator<Item = (usize, usize)>,
+    ) {
+        let before = self.points.len();
+        for (a, b) in pairs {
+            self.points.push(f32x3(nodes[a]));
+            self.points.push(f32x3(nodes[b]));
+        }
+        self.row(tick, time_s, (self.points.len() - before) / 2);
+    }
+
+    fn push_values(&mut self, tick: u64, time_s: f64, values: impl IntoIterator<Item = f64>) {
+        let before = self.values.len();
+        self.values.extend(values);
+        self.row(tick, time_s, self.values.len() - before);
+    }
+
+    fn push_text(&mut self, tick: u64, time_s: f64, text: &str) {
+        self.row(tick, time_s, 1);
+        self.texts.push(text.to_string());
+    }
+
+    /// Sends the buffered rows as one chunk and empties the buffer (keeping its capacity).
+    fn send(&mut self, rec: &rerun::RecordingStream) {
+        if self.ticks.is_empty() {
+            return;
+        }
+        let times = [
+            rerun::TimeColumn::new_sequence("tick", self.ticks.drain(..)),
+            rerun::TimeColumn::new_duration_secs("sim_time", self.secs.drain(..)),
+        ];
+        let lengths = self.lengths.iter().copied();
+        let columns: Result<Vec<_>, _> = match self.kind {
+            Kind::Points => rerun::Points3D::update_fields()
+                .with_positions(self.points.drain(..))
+                .columns(lengths)
+                .map(Iterator::collect),
+            Kind::Segments => segments(&self.points).and_then(|array| {
+                let mut strips = rerun::LineStrips3D::update_fields();
+                strips.strips =
+                    Some(rerun::SerializedComponentBatch::new(array, rerun::LineStrips3D::descriptor_strips()));
+                if !self.colors.is_empty() {
+                    strips = strips.with_colors(self.colors.drain(..));
+                }
+                strips.columns(lengths).map(Iterator::collect)
+            }),
+            Kind::Scalars => rerun::Scalars::update_fields()
+                .with_scalars(self.values.drain(..))
+                .columns(lengths)
+                .map(Iterator::collect),
+            Kind::Text => rerun::TextLog::update_fields()
+                .with_many_text(self.texts.drain(..))
+                .columns(lengths)
+                .map(Iterator::collect),
+        };
+        self.points.clear();
+        self.lengths.clear();
+        if let Ok(columns) = columns {
+            let _ = rec.send_columns(self.entity.as_str(), times, columns);
+        }
+    }
+}
+
+/// Line strips of two points each, `points` taken in pairs, as one arrow array built directly:
+/// the component's own conversion allocates a vector per strip.
+fn segments(points: &[[f32; 3]]) -> rerun::SerializationResult<rerun::external::arrow::array::ArrayRef> {
+    use rerun::external::arrow::{array::ListArray, buffer::OffsetBuffer, datatypes::DataType};
+    use rerun::Loggable as _;
+    let DataType::List(field) = rerun::LineStrip3D::arrow_datatype() else {
+        unreachable!("a line strip is a list of points")
+    };
+    let values = rerun::datatypes::Vec3D::to_arrow(points.iter().map(|p| rerun::datatypes::Vec3D(*p)))?;
+    let offsets = OffsetBuffer::from_lengths(std::iter::repeat_n(2, points.len() / 2));
+    Ok(std::sync::Arc::new(ListArray::try_new(field, offsets, values, None)?))
+}
+
+/// Every per-tick entity of a recording.
+struct Columns {
+    nodes: Column,
+    struts: Column,
+    springs: Column,
+    cables: Column,
+    ghost_nodes: Column,
+    ghost_struts: Column,
+    errors: Column,
+    errors_log10: Column,
+    spring_forces: Column,
+    cable_forces: Column,
+    actuator_forces: Column,
+    inputs: Column,
+    residual: Column,
+    kinetic_energy: Column,
+    events: Column,
+}
+
+impl Columns {
+    fn new() -> Self {
+        Columns {
+            nodes: Column::new("structure/nodes", Kind::Points),
+            struts: Column::new("structure/struts", Kind::Segments),
+            springs: Column::new("structure/springs", Kind::Segments),
+            cables: Column::new("structure/cables", Kind::Segments),
+            ghost_nodes: Column::new("analytic/nodes", Kind::Points),
+            ghost_struts: Column::new("analytic/struts", Kind::Segments),
+            errors: Column::new("errors", Kind::Scalars),
+            errors_log10: Column::new("errors_log10", Kind::Scalars),
+            spring_forces: Column::new("forces/springs", Kind::Scalars),
+            cable_forces: Column::new("forces/cables", Kind::Scalars),
+            actuator_forces: Column::new("forces/actuators", Kind::Scalars),
+            inputs: Column::new("inputs", Kind::Scalars),
+            residual: Column::new("residual", Kind::Scalars),
+            kinetic_energy: Column::new("energy/kinetic_j", Kind::Scalars),
+            events: Column::new("events", Kind::Text),
+        }
+    }
+
+    fn all(&mut self) -> [&mut Column; 15] {
+        [
+            &mut self.nodes,
+            &mut self.struts,
+            &mut self.springs,
+            &mut self.cables,
+            &mut self.ghost_nodes,
+            &mut self.ghost_struts,
+            &mut self.errors,
+            &mut self.errors_log10,
+            &mut self.spring_forces,
+            &mut self.cable_forces,
+            &mut self.actuator_forces,
+            &mut self.inputs,
+            &mut self.residual,
+            &mut self.kinetic_energy,
+            &mut self.events,
+        ]
+    }
 }
 
 /// Where a recording goes.
@@ -83,13 +300,26 @@ impl Recorder {
             }
         }
         let partial = path.with_extension("rrd.partial");
-        let rec = rerun::RecordingStreamBuilder::new(app).save(&partial).map_err(|e| io(e.to_string()))?;
-        Ok(Recorder {
+        let rec = rerun::RecordingStreamBuilder::new(app)
+            .with_blueprint(blueprint())
+            .save(&partial)
+            .map_err(|e| io(e.to_string()))?;
+        Ok(Recorder::new(rec, Target::File { partial, path: path.to_path_buf() }, every))
+    }
+
+    fn new(rec: rerun::RecordingStream, target: Target, every: u64) -> Self {
+        Recorder {
             rec,
-            target: Target::File { partial, path: path.to_path_buf() },
+            target,
             every: every.max(1),
-            named: Default::default(),
-        })
+            statics_logged: false,
+            columns: Columns::new(),
+            extra: Vec::new(),
+            pending: 0,
+            last_send: std::time::Instant::now(),
+            last_tick: 0,
+            last_time_s: 0.0,
+        }
     }
 
     /// Streams the same data live to a rerun viewer or server at `url` (rerun's default when
@@ -103,9 +333,10 @@ impl Recorder {
             return Ok(None);
         }
         let rec = rerun::RecordingStreamBuilder::new(app)
+            .with_blueprint(blueprint())
             .connect_grpc_opts(url.clone())
             .map_err(|e| RecordError::Io { path: url.clone(), message: e.to_string() })?;
-        Ok(Some(Recorder { rec, target: Target::Live { url }, every: every.max(1), named: Default::default() }))
+        Ok(Some(Recorder::new(rec, Target::Live { url }, every)))
     }
 
     /// Stores a text document (static: it belongs to the whole run).
@@ -113,26 +344,88 @@ impl Recorder {
         let _ = self.rec.log_static(entity, &rerun::TextDocument::new(text));
     }
 
-    /// Logs several named series under one entity at the current time (names once, static).
-    fn series(&mut self, entity: &str, names: Vec<String>, values: Vec<f64>) {
-        if values.is_empty() {
+    /// Buffers one scalar time series value at `tick` (every `record_every`-th tick, like the
+    /// rest).
+    pub fn scalar(&mut self, tick: u64, entity: &str, value: f64) {
+        if tick % self.every != 0 {
             return;
         }
-        if self.named.insert(entity.to_string()) {
-            let _ = self.rec.log_static(entity, &rerun::SeriesLines::new().with_names(names));
-        }
-        let _ = self.rec.log(entity, &rerun::Scalars::new(values));
+        // Called right after `tick` for the same tick: its time is the last one seen.
+        let time_s = self.last_time_s;
+        let column = match self.extra.iter().position(|c| c.entity == entity) {
+            Some(i) => &mut self.extra[i],
+            None => {
+                self.extra.push(Column::new(entity, Kind::Scalars));
+                self.extra.last_mut().expect("just pushed")
+            }
+        };
+        column.push_values(tick, time_s, [value]);
     }
 
-    /// Logs one scalar time series value at `tick`.
-    pub fn scalar(&mut self, tick: u64, entity: &str, value: f64) {
-        self.rec.set_time_sequence("tick", tick as i64);
-        let _ = self.rec.log(entity, &rerun::Scalars::single(value));
+    /// Sends every buffered tick.
+    fn send(&mut self) {
+        for c in self.columns.all().into_iter().chain(self.extra.iter_mut()) {
+            c.send(&self.rec);
+        }
+        self.pending = 0;
+        self.last_send = std::time::Instant::now();
+    }
+
+    /// Logs what does not change during the run once, as static data: labels, radii, fixed
+    /// colours and series names. Every tick then carries only positions, force colours and values.
+    fn log_statics(&self, t: &Tick, error_names: &[String]) {
+        let s = t.structure;
+        let rec = &self.rec;
+        let names = |v: Vec<&String>| v.into_iter().cloned().collect::<Vec<_>>();
+        let _ = rec.log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP());
+        let _ = rec.log_static(
+            "structure/nodes",
+            &rerun::Points3D::update_fields()
+                .with_labels(names(s.nodes.iter().map(|n| &n.name).collect()))
+                .with_radii([0.02f32]),
+        );
+        let _ = rec.log_static(
+            "structure/struts",
+            &rerun::LineStrips3D::update_fields()
+                .with_radii(s.struts.iter().map(|m| m.radius_m as f32).collect::<Vec<_>>())
+                .with_colors([[200u8, 200, 200, 255]])
+                .with_labels(names(s.struts.iter().map(|m| &m.name).collect())),
+        );
+        let _ = rec.log_static(
+            "structure/springs",
+            &rerun::LineStrips3D::update_fields().with_labels(names(s.springs.iter().map(|m| &m.name).collect())),
+        );
+        let _ = rec.log_static(
+            "structure/cables",
+            &rerun::LineStrips3D::update_fields().with_labels(names(s.cables.iter().map(|m| &m.name).collect())),
+        );
+        let _ = rec.log_static(
+            "analytic/nodes",
+            &rerun::Points3D::update_fields().with_colors([[80u8, 220, 120, 160]]).with_radii([0.015f32]),
+        );
+        let _ = rec
+            .log_static("analytic/struts", &rerun::LineStrips3D::update_fields().with_colors([[80u8, 220, 120, 120]]));
+        let series = |entity: &str, names: Vec<String>| {
+            if !names.is_empty() {
+                let _ = rec.log_static(entity, &rerun::SeriesLines::new().with_names(names));
+            }
+        };
+        series("errors", error_names.to_vec());
+        series("errors_log10", error_names.to_vec());
+        series("forces/springs", s.springs.iter().map(|m| m.name.clone()).collect());
+        series("forces/cables", s.cables.iter().map(|m| m.name.clone()).collect());
+        let actuators: Vec<String> =
+            s.actuators.iter().enumerate().map(|(i, a)| format!("{} #{}", a.symbol, i + 1)).collect();
+        series("forces/actuators", actuators.clone());
+        series("inputs", actuators);
+        series("residual", vec!["force_n".into(), "torque_nm".into()]);
+        series("energy/kinetic_j", vec!["kinetic energy".into()]);
     }
 
     /// Flushes and moves the recording to its final name (a live stream: waits a moment for
     /// the viewer, and says once if none took the data).
-    pub fn finish(self) -> Result<Option<PathBuf>, RecordError> {
+    pub fn finish(mut self) -> Result<Option<PathBuf>, RecordError> {
+        self.send();
         match self.target {
             Target::File { partial, path } => {
                 self.rec
@@ -153,108 +446,122 @@ impl Recorder {
     }
 }
 
+/// Errors below this magnitude are drawn at its log10 in `errors_log10` (an error can be exactly 0).
+const LOG10_FLOOR: f64 = 1e-20;
+
 impl Observer for Recorder {
     fn tick(&mut self, t: &Tick) {
         let snap = t.snapshot;
+        self.last_tick = snap.tick;
+        self.last_time_s = snap.time_s;
         if snap.tick % self.every != 0 {
             return;
         }
         let s = t.structure;
-        let rec = &self.rec;
-        rec.set_time_sequence("tick", snap.tick as i64);
-        rec.set_duration_secs("sim_time", snap.time_s);
-        let pts: Vec<[f32; 3]> = snap.nodes.iter().map(|p| f32x3(*p)).collect();
-        // What does not change (labels, radii, fixed colours) is logged once, as static data;
-        // every tick carries only positions and force colours.
-        if self.named.insert("structure".into()) {
-            let names = |v: Vec<&String>| v.into_iter().cloned().collect::<Vec<_>>();
-            let _ = rec.log_static(
-                "structure/nodes",
-                &rerun::Points3D::update_fields()
-                    .with_labels(names(s.nodes.iter().map(|n| &n.name).collect()))
-                    .with_radii([0.02f32]),
-            );
-            let _ = rec.log_static(
-                "structure/struts",
-                &rerun::LineStrips3D::update_fields()
-                    .with_radii(s.struts.iter().map(|m| m.radius_m as f32).collect::<Vec<_>>())
-                    .with_colors([[200u8, 200, 200, 255]])
-                    .with_labels(names(s.struts.iter().map(|m| &m.name).collect())),
-            );
-            let _ = rec.log_static(
-                "structure/springs",
-                &rerun::LineStrips3D::update_fields().with_labels(names(s.springs.iter().map(|m| &m.name).collect())),
-            );
-            let _ = rec.log_static(
-                "structure/cables",
-                &rerun::LineStrips3D::update_fields().with_labels(names(s.cables.iter().map(|m| &m.name).collect())),
-            );
-            let _ = rec.log_static(
-                "analytic/nodes",
-                &rerun::Points3D::update_fields().with_colors([[80u8, 220, 120, 160]]).with_radii([0.015f32]),
-            );
-            let _ = rec.log_static(
-                "analytic/struts",
-                &rerun::LineStrips3D::update_fields().with_colors([[80u8, 220, 120, 120]]),
-            );
-        }
-        let _ = rec.log("structure/nodes", &rerun::Points3D::new(pts.clone()));
-        let strips = |pairs: Vec<(usize, usize)>| -> Vec<Vec<[f32; 3]>> {
-            pairs.into_iter().map(|(a, b)| vec![pts[a], pts[b]]).collect()
-        };
-        let _ = rec
-            .log("structure/struts", &rerun::LineStrips3D::new(strips(s.struts.iter().map(|m| (m.a, m.b)).collect())));
-        let f = &snap.forces;
-        let max_f = f.spring_force_n.iter().chain(&f.cable_tension_n).fold(0.0f64, |m, x| m.max(x.abs()));
-        if !s.springs.is_empty() {
-            let _ = rec.log(
-                "structure/springs",
-                &rerun::LineStrips3D::new(strips(s.springs.iter().map(|m| (m.a, m.b)).collect()))
-                    .with_colors(f.spring_force_n.iter().map(|x| force_colour(*x, max_f)).collect::<Vec<_>>()),
-            );
-        }
-        if !s.cables.is_empty() {
-            let _ = rec.log(
-                "structure/cables",
-                &rerun::LineStrips3D::new(strips(s.cables.iter().map(|m| (m.a, m.b)).collect()))
-                    .with_colors(f.cable_tension_n.iter().map(|x| force_colour(*x, max_f)).collect::<Vec<_>>()),
-            );
-        }
-        if let Some(ghost) = t.ghost_nodes {
-            let g: Vec<[f32; 3]> = ghost.iter().map(|p| f32x3(*p)).collect();
-            let _ = rec.log("analytic/nodes", &rerun::Points3D::new(g.clone()));
-            let ghost_struts: Vec<Vec<[f32; 3]>> = s.struts.iter().map(|m| vec![g[m.a], g[m.b]]).collect();
-            let _ = rec.log("analytic/struts", &rerun::LineStrips3D::new(ghost_struts));
-        }
-        // Time series: one entity per family, one named series per member or quantity (one
-        // log call each, which keeps the cost per tick down).
-        let (names, errors): (Vec<String>, Vec<f64>) = t
+        let (tick, time) = (snap.tick, snap.time_s);
+        let (names, errors): (Vec<&String>, Vec<f64>) = t
             .prediction
             .expected
             .iter()
             .filter_map(|(q, a)| {
                 let sv = t.simulated.get(q)?;
-                Some((q.clone(), if q.starts_with("theta") { wrap_angle(sv - a) } else { sv - a }))
+                Some((q, if q.starts_with("theta") { wrap_angle(sv - a) } else { sv - a }))
             })
             .unzip();
-        self.series("errors", names, errors);
-        let springs = s.springs.iter().map(|m| m.name.clone()).collect();
-        self.series("forces/springs", springs, f.spring_force_n.clone());
-        let cables = s.cables.iter().map(|m| m.name.clone()).collect();
-        self.series("forces/cables", cables, f.cable_tension_n.clone());
-        let actuators: Vec<String> =
-            s.actuators.iter().enumerate().map(|(i, a)| format!("{} #{}", a.symbol, i + 1)).collect();
-        self.series("forces/actuators", actuators.clone(), f.actuator_force.clone());
-        self.series("inputs", actuators, snap.actuator_values.clone());
-        self.series(
-            "residual",
-            vec!["force_n".into(), "torque_nm".into()],
-            vec![f.residual.max_force_n, f.residual.max_torque_nm],
-        );
+        if !self.statics_logged {
+            self.statics_logged = true;
+            self.log_statics(t, &names.into_iter().cloned().collect::<Vec<_>>());
+        }
+        let c = &mut self.columns;
+        let nodes = &snap.nodes;
+        c.nodes.push_points(tick, time, nodes.iter().copied());
+        c.struts.push_segments(tick, time, nodes, s.struts.iter().map(|m| (m.a, m.b)));
+        let f = &snap.forces;
+        let max_f = f.spring_force_n.iter().chain(&f.cable_tension_n).fold(0.0f64, |m, x| m.max(x.abs()));
+        if !s.springs.is_empty() {
+            c.springs.push_segments(tick, time, nodes, s.springs.iter().map(|m| (m.a, m.b)));
+            c.springs.colors.extend(f.spring_force_n.iter().map(|x| force_colour(*x, max_f)));
+        }
+        if !s.cables.is_empty() {
+            c.cables.push_segments(tick, time, nodes, s.cables.iter().map(|m| (m.a, m.b)));
+            c.cables.colors.extend(f.cable_tension_n.iter().map(|x| force_colour(*x, max_f)));
+        }
+        if let Some(ghost) = t.ghost_nodes {
+            c.ghost_nodes.push_points(tick, time, ghost.iter().copied());
+            c.ghost_struts.push_segments(tick, time, ghost, s.struts.iter().map(|m| (m.a, m.b)));
+        }
+        // Time series: one entity per family, one named series per member or quantity.
+        if !errors.is_empty() {
+            c.errors_log10.push_values(tick, time, errors.iter().map(|e| e.abs().max(LOG10_FLOOR).log10()));
+            c.errors.push_values(tick, time, errors);
+        }
+        for (column, values) in [
+            (&mut c.spring_forces, &f.spring_force_n),
+            (&mut c.cable_forces, &f.cable_tension_n),
+            (&mut c.actuator_forces, &f.actuator_force),
+            (&mut c.inputs, &snap.actuator_values),
+        ] {
+            if !values.is_empty() {
+                column.push_values(tick, time, values.iter().copied());
+            }
+        }
+        c.residual.push_values(tick, time, [f.residual.max_force_n, f.residual.max_torque_nm]);
+        c.kinetic_energy.push_values(tick, time, [snap.kinetic_energy_j]);
+        self.pending += 1;
+        if self.pending >= BLOCK_TICKS || self.last_send.elapsed().as_secs_f64() >= BLOCK_MAX_AGE_S {
+            self.send();
+        }
     }
 
+    /// Buffers an event (every one, whatever `record_every`) at `tick`: the last tick seen, or
+    /// the start.
     fn event(&mut self, tick: u64, text: &str) {
-        self.rec.set_time_sequence("tick", tick as i64);
-        let _ = self.rec.log("events", &rerun::TextLog::new(text));
+        let time_s = if tick == self.last_tick { self.last_time_s } else { 0.0 };
+        self.columns.events.push_text(tick, time_s, text);
     }
+}
+
+/// The viewer layout stored in every recording: the structure in 3D with the analytic ghost
+/// (left, over tabs of events and the two documents), and on the right the errors (log10 of
+/// their magnitude, and signed), the member forces, and the kinetic energy with the other
+/// series in tabs. The time cursor follows the end of the recording: the settled state.
+pub fn blueprint() -> rerun::blueprint::Blueprint {
+    use rerun::blueprint::components::{PanelState, PlayState};
+    use rerun::blueprint::{
+        Blueprint, BlueprintPanel, Horizontal, SelectionPanel, Spatial3DView, Tabs, TextDocumentView, TextLogView,
+        TimePanel, TimeSeriesView, Vertical,
+    };
+    let series = |name: &str, entities: &[&str]| TimeSeriesView::new(name).with_contents(entities.iter().copied());
+    let structure = Spatial3DView::new("structure (red tension, blue compression, green analytic)")
+        .with_contents(["+ /structure/**", "+ /analytic/**"])
+        .with_defaults(&rerun::LineStrips3D::update_fields().with_show_labels(false))
+        .with_defaults(&rerun::Points3D::update_fields().with_show_labels(false));
+    let documents = Tabs::new([
+        TextLogView::new("events").with_contents(["/events"]).into(),
+        TextDocumentView::new("scenario").with_contents(["/scenario"]).into(),
+        TextDocumentView::new("report").with_contents(["/report"]).into(),
+    ]);
+    let left = Vertical::new([structure.into(), documents.into()]).with_row_shares([0.68, 0.32]);
+    let errors = Tabs::new([
+        series("log10 |simulated - analytic|", &["/errors_log10"]).into(),
+        series("simulated - analytic", &["/errors"]).into(),
+    ]);
+    let forces = series("member forces [N] (cables: tension)", &["/forces/springs", "/forces/cables"]);
+    let others = Tabs::new([
+        series("kinetic energy [J]", &["/energy/**"]).into(),
+        series("residual (max force N, torque N m)", &["/residual"]).into(),
+        series("actuator forces", &["/forces/actuators"]).into(),
+        series("inputs", &["/inputs"]).into(),
+        series("min clearance [m]", &["/interference/**"]).into(),
+    ]);
+    let right = Vertical::new([errors.into(), forces.into(), others.into()]);
+    Blueprint::new(Horizontal::new([left.into(), right.into()]).with_column_shares([0.55, 0.45]))
+        .with_blueprint_panel(BlueprintPanel::from_state(PanelState::Collapsed))
+        .with_selection_panel(SelectionPanel::from_state(PanelState::Collapsed))
+        .with_time_panel(
+            TimePanel::new()
+                .with_state(PanelState::Collapsed)
+                .with_timeline("tick")
+                .with_play_state(PlayState::Following),
+        )
 }

@@ -150,6 +150,8 @@ pub struct Snapshot {
     pub forces: MemberForces,
     /// Actuator commands, in structure order (m or rad).
     pub actuator_values: Vec<f64>,
+    /// Kinetic energy of the free bodies [J].
+    pub kinetic_energy_j: f64,
 }
 
 impl Simulation {
@@ -323,6 +325,7 @@ impl Simulation {
             body_poses: (0..self.structure.bodies.len()).map(|b| self.body_pose(b)).collect(),
             forces: self.member_forces(),
             actuator_values: self.commands.clone(),
+            kinetic_energy_j: self.kinetic_energy_j(),
         }
     }
 
