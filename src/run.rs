@@ -81,7 +81,9 @@ impl Runner<'_> {
         }
         self.sim.step()?;
         self.steps += 1;
-        let snap = self.sim.snapshot();
+        // The residual (a least-squares fit) is computed per tick only for recordings; the
+        // settle loop asks for it once the motion has stopped.
+        let snap = self.sim.snapshot_with(self.recorder.is_some());
         let simulated = self.observe(&snap);
         // The ghost overlay is only drawn in recordings, and only recomputed when the inputs
         // change.
@@ -135,7 +137,7 @@ impl Runner<'_> {
         }
         let switch_speed = criteria.speed_tol_m_per_s * APPROACH_SWITCH_SPEED_FACTOR;
         for k in 1..=max_steps {
-            let (snap, simulated) = self.step(inputs, prediction)?;
+            let (mut snap, simulated) = self.step(inputs, prediction)?;
             let quiet = detector.update(&snap, dt, &criteria);
             if approaching && detector.last_speed <= switch_speed {
                 approaching = false;
@@ -144,6 +146,9 @@ impl Runner<'_> {
                 continue;
             }
             let quiet = quiet && !approaching;
+            if quiet && snap.forces.residual.is_none() {
+                snap.forces = self.sim.member_forces();
+            }
             if quiet && SettleDetector::residual_ok(&snap, &criteria) {
                 return Ok(Settled {
                     settled: true,
@@ -156,7 +161,13 @@ impl Runner<'_> {
             last = Some((snap, simulated));
         }
         let (snapshot, simulated) = match last {
-            Some(x) => x,
+            // The last state is the simulation's current one: its residual can still be had.
+            Some((mut snap, simulated)) => {
+                if snap.forces.residual.is_none() {
+                    snap.forces = self.sim.member_forces();
+                }
+                (snap, simulated)
+            }
             None => {
                 let s = self.sim.snapshot();
                 let v = self.observe(&s);
@@ -525,8 +536,8 @@ fn settle_point(
             "point {index} did NOT settle in {} s (kinetic energy {final_energy:.3e} J, speed {:.3e} m/s, residual {:.3e} N, {:.3e} N m)",
             sc.settle.max_time_s,
             s.final_speed,
-            s.snapshot.forces.residual.max_force_n,
-            s.snapshot.forces.residual.max_torque_nm
+            s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_force_n),
+            s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_torque_nm)
         )
     });
     let mut simulated = s.simulated.clone();
@@ -620,8 +631,8 @@ fn settle_point(
         simulated,
         settled: s.settled,
         steps: s.steps,
-        residual_force_n: s.snapshot.forces.residual.max_force_n,
-        residual_torque_nm: s.snapshot.forces.residual.max_torque_nm,
+        residual_force_n: s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_force_n),
+        residual_torque_nm: s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_torque_nm),
         final_speed_m_per_s: s.final_speed,
         final_kinetic_energy_j: final_energy,
         branch,

@@ -505,7 +505,9 @@ impl Observer for Recorder {
                 column.push_values(tick, time, values.iter().copied());
             }
         }
-        c.residual.push_values(tick, time, [f.residual.max_force_n, f.residual.max_torque_nm]);
+        if let Some(r) = &f.residual {
+            c.residual.push_values(tick, time, [r.max_force_n, r.max_torque_nm]);
+        }
         c.kinetic_energy.push_values(tick, time, [snap.kinetic_energy_j]);
         self.pending += 1;
         if self.pending >= BLOCK_TICKS || self.last_send.elapsed().as_secs_f64() >= BLOCK_MAX_AGE_S {

@@ -20,14 +20,15 @@ pub struct MemberForces {
     /// Force [N] or torque [N m] each actuator exerts along its joint axis (or the cable
     /// tension for a winch), in actuator order.
     pub actuator_force: Vec<f64>,
-    pub residual: Residual,
+    /// None when the snapshot was taken without it (see [`Simulation::member_forces_with`]).
+    pub residual: Option<Residual>,
 }
 
 /// Equilibrium residual: the generalized forces of member forces, gravity and probe loads on
 /// every free coordinate (a joint's free axes, summed over the subtree it carries). Zero at an
 /// exact equilibrium. Computed from the force laws, not from the solver; the reactions of
 /// loop-closing joints, which no force law gives, are fitted by least squares.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Residual {
     /// Largest residual force on a translational coordinate [N].
     pub max_force_n: f64,
@@ -106,6 +107,22 @@ impl Simulation {
 
     /// Reads every member force and computes the equilibrium residual.
     pub fn member_forces(&self) -> MemberForces {
+        self.member_forces_with(true)
+    }
+
+    /// Whether the member forces themselves need the fit of the loop-closure reactions: a
+    /// joint actuator's force where loops close, or a cable held by the projection.
+    fn forces_need_closure_fit(&self) -> bool {
+        let s = &self.structure;
+        let closures = self.joint_impulse.iter().any(Option::is_some);
+        let joint_actuators = s.actuators.iter().any(|a| matches!(a.target, ActuatorTarget::Joint(_)));
+        (closures && joint_actuators) || (0..s.cables.len()).any(|c| self.cable_held_by_projection(c))
+    }
+
+    /// Reads every member force; the equilibrium residual (a least-squares fit of the loop
+    /// reactions, the costliest part) only when `with_residual` or when the forces need the fit.
+    /// The settle loop asks for it only once the motion has stopped.
+    pub fn member_forces_with(&self, with_residual: bool) -> MemberForces {
         let s = &self.structure;
         let nb = s.bodies.len();
         let mut wrench: Vec<Wrench> = vec![(Vector::ZERO, Vector::ZERO); nb];
@@ -185,8 +202,9 @@ impl Simulation {
         // a least-squares fit: the reactions that best balance every free coordinate. At an
         // equilibrium the fit is exact and the residual is zero; the fitted reactions are
         // added to the bodies' loads.
+        let fit = with_residual || self.forces_need_closure_fit();
         let scale = self.length_scale_m;
-        let base = self.coordinate_forces(&tree, &wrench, true);
+        let base = if fit { self.coordinate_forces(&tree, &wrench, true) } else { Vec::new() };
         let mut closure_loads = self.closure_unit_loads();
         closure_loads.extend(self.projected_cable_unit_loads());
         // Fitted reaction of each loop-closing joint on its child: (force, moment about the anchor).
@@ -231,20 +249,23 @@ impl Simulation {
             }
         }
         let mut residual = Residual::default();
+        let fitted = fit;
         // A held cable whose fitted tension is negative would have to push: no equilibrium.
         for (c, cable) in s.cables.iter().enumerate() {
             if matches!(cable.law, CableLaw::Inextensible) && self.cable_held_by_projection(c) {
                 residual.max_force_n = residual.max_force_n.max((-out.cable_tension_n[c]).max(0.0));
             }
         }
-        for c in self.coordinate_forces(&tree, &wrench, true) {
-            if c.is_torque {
-                residual.max_torque_nm = residual.max_torque_nm.max(c.value.abs());
-            } else {
-                residual.max_force_n = residual.max_force_n.max(c.value.abs());
+        if fitted {
+            for c in self.coordinate_forces(&tree, &wrench, true) {
+                if c.is_torque {
+                    residual.max_torque_nm = residual.max_torque_nm.max(c.value.abs());
+                } else {
+                    residual.max_force_n = residual.max_force_n.max(c.value.abs());
+                }
             }
+            out.residual = Some(residual);
         }
-        out.residual = residual;
         let subtree_wrench = |root: usize| -> Wrench { tree.subtree_wrench(s, &wrench, root) };
         let about = |w: Wrench, p: Vector| -> Vector { w.1 - p.cross(w.0) };
 

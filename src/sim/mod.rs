@@ -317,13 +317,20 @@ impl Simulation {
         self.structure.bodies[body].kind == BodyKind::Free
     }
 
+    /// The state now, with the equilibrium residual.
     pub fn snapshot(&self) -> Snapshot {
+        self.snapshot_with(true)
+    }
+
+    /// The state now; the residual only when `with_residual` (see
+    /// [`Simulation::member_forces_with`]).
+    pub fn snapshot_with(&self, with_residual: bool) -> Snapshot {
         Snapshot {
             tick: self.tick,
             time_s: self.time_s(),
             nodes: (0..self.structure.nodes.len()).map(|i| self.node_position(i)).collect(),
             body_poses: (0..self.structure.bodies.len()).map(|b| self.body_pose(b)).collect(),
-            forces: self.member_forces(),
+            forces: self.member_forces_with(with_residual),
             actuator_values: self.commands.clone(),
             kinetic_energy_j: self.kinetic_energy_j(),
         }

@@ -69,9 +69,10 @@ impl SettleDetector {
         self.quiet_steps = 0;
     }
 
-    /// Whether the residual of `snap` meets the criteria.
+    /// Whether the residual of `snap` meets the criteria (false when it was not computed).
     pub fn residual_ok(snap: &Snapshot, criteria: &SettleCriteria) -> bool {
-        let r = &snap.forces.residual;
-        r.max_force_n <= criteria.residual_force_tol_n && r.max_torque_nm <= criteria.residual_torque_tol_nm
+        snap.forces.residual.as_ref().is_some_and(|r| {
+            r.max_force_n <= criteria.residual_force_tol_n && r.max_torque_nm <= criteria.residual_torque_tol_nm
+        })
     }
 }
