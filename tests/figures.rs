@@ -34,3 +34,38 @@ fn mohr2011_fig5_shows_the_slice_and_the_dynamics_verdict() {
         assert!(svg.contains(text), "the SVG has '{text}'");
     }
 }
+
+/// Draws figure `name` into a fresh directory; returns the PNG bytes and the SVG text.
+fn draw(name: &str) -> (Vec<u8>, String) {
+    let dir = std::env::temp_dir().join(format!("tensegrity-{name}-{}", std::process::id()));
+    let out = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+        .args(["figure", name, "--out", dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let png = std::fs::read(dir.join(format!("{name}.png"))).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "a PNG file");
+    assert!(png.len() > 10_000);
+    let svg = std::fs::read_to_string(dir.join(format!("{name}.svg"))).unwrap();
+    assert!(svg.starts_with("<svg"), "an SVG file");
+    (png, svg)
+}
+
+/// The number printed in `svg` right after `before` (up to the next space).
+fn number_after(svg: &str, before: &str) -> f64 {
+    let at = svg.find(before).unwrap_or_else(|| panic!("the SVG has '{before}'")) + before.len();
+    let text: String = svg[at..].chars().take_while(|c| c.is_ascii_digit() || *c == '.' || *c == '-').collect();
+    text.parse().unwrap_or_else(|_| panic!("a number after '{before}': '{text}'"))
+}
+
+#[test]
+fn ji2014_fig2_shows_the_singular_curves_and_the_grid_verdict() {
+    let (_, svg) = draw("ji2014-fig2");
+    for text in ["theta1 [rad]", "L3 [m]", "det J [m/rad]", "110 of 110 points agree (100.0 %)", "(7 of 110 points)"] {
+        assert!(svg.contains(text), "the SVG has '{text}'");
+    }
+    // Curve i is singular but stiff: K = (L/2)|eta| at L3 = 0 (FINDINGS.md: 346.41 N m/rad).
+    assert!((number_after(&svg, "but not free: K = ") - 346.4).abs() < 0.05);
+    // Curve ii is not singular: FINDINGS.md's smallest |det J| for L3 >= 0.3 m is 0.118 m/rad.
+    assert!((number_after(&svg, "NOT singular, det J &gt;= ") - 0.118).abs() < 1e-3);
+}

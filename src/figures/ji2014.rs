@@ -1,0 +1,296 @@
+//! ji2014's workspace figures: Fig. 2 (actuator workspace with the singular curves of Section
+//! 4.2), redrawn from the derived model, with the dynamics' verdict of
+//! `scenarios/ji2014/grid.toml` on top.
+
+use super::{colour_at, colour_bar, legend_panel, zero_contour, Glyph, LIGHT_BLUES};
+use crate::mechanisms::ji2014::analytic as ji;
+use crate::mechanisms::ji2014::PAPER_ROOT_MARK;
+use crate::run::{run, RunOptions};
+use crate::scenario;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::f64::consts::PI;
+use std::path::Path;
+
+/// Size of an actuator- or Cartesian-workspace figure in pixels.
+const SIZE: (u32, u32) = (1000, 1080);
+/// Height of the legend panel under the chart [px].
+const LEGEND_PX: u32 = 250;
+/// Width of the colour bar beside the chart [px].
+const COLOUR_BAR_PX: u32 = 120;
+/// Cells per side of an analytic map.
+const CELLS: usize = 160;
+/// Samples along an analytic curve.
+const CURVE_SAMPLES: usize = 400;
+/// `L3` from which curves ii and iv are scanned for their smallest `|det J|` [m] (as in
+/// FINDINGS.md; `det J` is proportional to `L3`, so it vanishes at `L3 = 0` on every curve).
+const DET_SCAN_L3_MIN_M: f64 = 0.3;
+/// Smallest `L3` of the contour maps [m] (`det J / L3` is undefined at `L3 = 0`).
+const L3_MAP_MIN_M: f64 = 1e-6;
+
+/// One point of `scenarios/ji2014/grid.toml` as the dynamics settled it.
+struct GridPoint {
+    l3: f64,
+    theta1: f64,
+    /// Settled on the analytic branch with the stability the perturbation test found equal to
+    /// the analytic sign of K.
+    agrees: bool,
+    /// The branch landed on is the root that Eq. 5 picks with theta2 in [0, pi].
+    paper_root: bool,
+}
+
+fn grid_points() -> Result<(ji::Params, Vec<GridPoint>), String> {
+    let sc = scenario::load(Path::new("scenarios/ji2014/grid.toml")).map_err(|e| e.to_string())?;
+    let report = run(&sc, &RunOptions { skip_findings: true, ..Default::default() });
+    if let Some(e) = report.error {
+        return Err(format!("grid.toml: {e}"));
+    }
+    let p = ji::Params { l: sc.params["L"], k1: sc.params["K1"], k2: sc.params["K2"] };
+    let points = report
+        .points
+        .iter()
+        .map(|q| GridPoint {
+            l3: q.inputs["L3"],
+            theta1: q.inputs["theta1"],
+            agrees: q.settled && q.within_tolerance && q.stable.is_some() && q.stable == q.analytic_stable,
+            paper_root: q.branch.ends_with(PAPER_ROOT_MARK),
+        })
+        .collect();
+    Ok((p, points))
+}
+
+/// `det J` [m/rad] at the stable equilibrium (the corrected Eq. 23-24).
+fn det_j_stable(p: &ji::Params, l3: f64, theta1: f64) -> f64 {
+    let e = ji::equilibria(p, l3, theta1)[0];
+    ji::det_jacobian_closed_form(p, l3, theta1, e.theta2)
+}
+
+pub(super) struct Fig2 {
+    p: ji::Params,
+    l3_max: f64,
+    /// (theta1, L3, det J) at cell centres.
+    cells: Vec<(f64, f64, f64)>,
+    cell: (f64, f64),
+    det_max: f64,
+    /// Curve iii (eta1 = 0, Eq. 28) and curve iv (Eq. 33) as (theta1, L3) polylines.
+    curve_iii: Vec<(f64, f64)>,
+    curve_iv: Vec<(f64, f64)>,
+    /// Zero sets inside the workspace of the derived Phi1 (curve v, Eq. 30) and of Eq. 24 as
+    /// printed, both at the paper's root of Eq. 5.
+    curve_v: Vec<Vec<(f64, f64)>>,
+    curve_v_printed: Vec<Vec<(f64, f64)>>,
+    /// K at L3 = 0 [N m/rad]; min det J on curve ii and iv, max |det J| on curve iii [m/rad].
+    k_at_l3_zero: f64,
+    det_min_ii: f64,
+    det_max_iii: f64,
+    det_min_iv: f64,
+    neutral: (f64, f64),
+    v_radius_m: f64,
+    points: Vec<GridPoint>,
+}
+
+pub(super) fn fig2_data() -> Result<Fig2, String> {
+    let (p, points) = grid_points()?;
+    let l3_max = ji::PAPER_L3_MAX_OVER_L * p.l;
+    let cell = (PI / CELLS as f64, l3_max / CELLS as f64);
+    let mut cells = Vec::with_capacity(CELLS * CELLS);
+    for i in 0..CELLS {
+        for j in 0..CELLS {
+            let (t1, l3) = ((i as f64 + 0.5) * cell.0, (j as f64 + 0.5) * cell.1);
+            cells.push((t1, l3, det_j_stable(&p, l3, t1)));
+        }
+    }
+    let det_max = cells.iter().map(|c| c.2).fold(0.0, f64::max);
+    let samples = |lo: f64, hi: f64| (0..=CURVE_SAMPLES).map(move |k| lo + (hi - lo) * k as f64 / CURVE_SAMPLES as f64);
+    let curve_iii: Vec<(f64, f64)> =
+        samples(0.0, l3_max).filter_map(|l3| ji::curve_iii_theta1(&p, l3).map(|t1| (t1, l3))).collect();
+    let curve_iv: Vec<(f64, f64)> = samples(0.0, PI)
+        .map(|t1| (t1, ji::curve_iv_l3(&p, t1)))
+        .filter(|(_, l3)| (0.0..=l3_max).contains(l3))
+        .collect();
+    // Curve v: Phi1 = 0 (Eq. 30), as det J / L3 = Phi1 / Phi2 (Eq. 23) so that the factor eta1
+    // the two share cancels (their common zero, curve iii, is drawn on its own). Derived at the
+    // stable equilibrium; Eq. 24 as printed at the paper's root of Eq. 5 and at the stable one.
+    let det_over_l3 = |printed: bool, paper_root: bool| {
+        move |t1: f64, l3: f64| {
+            let th2 = if paper_root { ji::fk_paper(&p, l3, t1).theta2 } else { ji::equilibria(&p, l3, t1)[0].theta2 };
+            let det = if printed {
+                ji::det_jacobian_eq23(&p, l3, t1, th2)
+            } else {
+                ji::det_jacobian_eq23_corrected(&p, l3, t1, th2)
+            };
+            det.map_or(f64::NAN, |v| v / l3)
+        }
+    };
+    let curve_v = zero_contour(&det_over_l3(false, false), 0.0..PI, L3_MAP_MIN_M..l3_max, CELLS);
+    let mut curve_v_printed = zero_contour(&det_over_l3(true, true), 0.0..PI, L3_MAP_MIN_M..l3_max, CELLS);
+    curve_v_printed.extend(zero_contour(&det_over_l3(true, false), 0.0..PI, L3_MAP_MIN_M..l3_max, CELLS));
+    let k_at_l3_zero = ji::equilibria(&p, 0.0, 0.0)[0].stiffness;
+    let det_min_ii = samples(DET_SCAN_L3_MIN_M, l3_max)
+        .flat_map(|l3| [det_j_stable(&p, l3, 0.0), det_j_stable(&p, l3, PI)])
+        .map(f64::abs)
+        .fold(f64::INFINITY, f64::min);
+    let det_max_iii = curve_iii.iter().map(|(t1, l3)| det_j_stable(&p, *l3, *t1).abs()).fold(0.0, f64::max);
+    let det_min_iv = curve_iv
+        .iter()
+        .filter(|(_, l3)| *l3 >= DET_SCAN_L3_MIN_M)
+        .map(|(t1, l3)| det_j_stable(&p, *l3, *t1).abs())
+        .fold(f64::INFINITY, f64::min);
+    let d1_star = ji::neutral_point(&p);
+    let v_radius_m = p.l * (p.k1 + 2.0 * p.k2) / (2.0 * (p.k1 * p.k1 + p.k1 * p.k2 + p.k2 * p.k2).sqrt());
+    Ok(Fig2 {
+        p,
+        l3_max,
+        cells,
+        cell,
+        det_max,
+        curve_iii,
+        curve_iv,
+        curve_v,
+        curve_v_printed,
+        k_at_l3_zero,
+        det_min_ii,
+        det_max_iii,
+        det_min_iv,
+        neutral: (d1_star.x, d1_star.y),
+        v_radius_m,
+        points,
+    })
+}
+
+/// Colours of the singular curves.
+const CURVE_I: RGBColor = RGBColor(0, 0, 0);
+const CURVE_II: RGBColor = RGBColor(230, 120, 0);
+const CURVE_III: RGBColor = RGBColor(200, 0, 0);
+const CURVE_IV: RGBColor = RGBColor(150, 0, 170);
+const CURVE_V: RGBColor = RGBColor(0, 140, 60);
+const CURVE_VI: RGBColor = RGBColor(90, 90, 90);
+/// Markers of the dynamics.
+const AGREE: RGBColor = RGBColor(255, 255, 255);
+const AGREE_PAPER_ROOT: RGBColor = RGBColor(255, 200, 0);
+const DISAGREE: RGBColor = RGBColor(230, 0, 0);
+/// A diamond marker's corners [px].
+const DIAMOND_PX: [(i32, i32); 4] = [(0, -8), (8, 0), (0, 8), (-8, 0)];
+
+pub(super) fn fig2_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig2) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let agree = d.points.iter().filter(|q| q.agrees).count();
+    let n = d.points.len();
+    let root = root
+        .titled(
+            &format!(
+                "ji2014 Fig. 2: actuator workspace and singular curves (L = {} m, K1 = {} N/m, K2 = {} N/m)",
+                d.p.l, d.p.k1, d.p.k2
+            ),
+            ("sans-serif", 20),
+        )
+        .map_err(err)?;
+    let (top, legend) = root.split_vertically(SIZE.1 - LEGEND_PX - 30);
+    let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
+    let mut chart = ChartBuilder::on(&plot)
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .caption(
+            format!(
+                "colour: det J at the stable equilibrium (Eq. 23, corrected Eq. 24); dynamics (grid.toml): {agree} of {n} points agree ({:.1} %)",
+                100.0 * agree as f64 / n as f64
+            ),
+            ("sans-serif", 16),
+        )
+        .build_cartesian_2d(-0.08..PI + 0.08, -0.06..d.l3_max + 0.06)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("theta1 [rad]")
+        .y_desc("L3 [m]")
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(err)?;
+    let (hx, hy) = (d.cell.0 / 2.0, d.cell.1 / 2.0);
+    chart
+        .draw_series(d.cells.iter().map(|(t1, l3, det)| {
+            let c = colour_at(LIGHT_BLUES, det / d.det_max);
+            Rectangle::new([(t1 - hx, l3 - hy), (t1 + hx, l3 + hy)], c.filled())
+        }))
+        .map_err(err)?;
+    // Curve vi (Eq. 31) and ii (Eq. 27): the edges of the range, ii dashed (not singular).
+    chart.draw_series(LineSeries::new([(0.0, d.l3_max), (PI, d.l3_max)], CURVE_VI.stroke_width(3))).map_err(err)?;
+    for t1 in [0.0, PI] {
+        chart
+            .draw_series(DashedLineSeries::new([(t1, 0.0), (t1, d.l3_max)], 10, 6, CURVE_II.stroke_width(4).into()))
+            .map_err(err)?;
+    }
+    chart
+        .draw_series(DashedLineSeries::new(d.curve_iii.iter().copied(), 10, 6, CURVE_III.stroke_width(3).into()))
+        .map_err(err)?;
+    chart
+        .draw_series(DashedLineSeries::new(d.curve_iv.iter().copied(), 10, 6, CURVE_IV.stroke_width(3).into()))
+        .map_err(err)?;
+    for line in &d.curve_v {
+        chart.draw_series(LineSeries::new(line.iter().copied(), CURVE_V.stroke_width(3))).map_err(err)?;
+    }
+    for line in &d.curve_v_printed {
+        chart
+            .draw_series(DashedLineSeries::new(line.iter().copied(), 6, 4, CURVE_V.stroke_width(2).into()))
+            .map_err(err)?;
+    }
+    // Curve i (Eq. 26), the one singular curve: drawn last among the curves.
+    chart.draw_series(LineSeries::new([(0.0, 0.0), (PI, 0.0)], CURVE_I.stroke_width(4))).map_err(err)?;
+    // The dynamics.
+    chart
+        .draw_series(d.points.iter().filter(|q| q.agrees && !q.paper_root).map(|q| {
+            EmptyElement::at((q.theta1, q.l3))
+                + Circle::new((0, 0), 5, AGREE.filled())
+                + Circle::new((0, 0), 5, BLACK.stroke_width(1))
+        }))
+        .map_err(err)?;
+    chart
+        .draw_series(d.points.iter().filter(|q| q.agrees && q.paper_root).map(|q| {
+            EmptyElement::at((q.theta1, q.l3))
+                + Polygon::new(DIAMOND_PX.to_vec(), AGREE_PAPER_ROOT.filled())
+                + PathElement::new([&DIAMOND_PX[..], &DIAMOND_PX[..1]].concat(), BLACK.stroke_width(1))
+        }))
+        .map_err(err)?;
+    chart
+        .draw_series(
+            d.points.iter().filter(|q| !q.agrees).map(|q| Cross::new((q.theta1, q.l3), 7, DISAGREE.stroke_width(3))),
+        )
+        .map_err(err)?;
+    colour_bar(&bar, LIGHT_BLUES, 0.0, d.det_max, "det J [m/rad]").map_err(err)?;
+    let paper_roots = d.points.iter().filter(|q| q.paper_root).count();
+    let v_entry = if d.curve_v.is_empty() && d.curve_v_printed.is_empty() {
+        (
+            Glyph::Note,
+            format!(
+                "v: Phi1 = 0 (Eq. 30): |eta| = L (K1+2K2), a circle of radius {:.3} m about D1* = ({:.3}, {:.3}) m, below the X axis: not in this workspace (printed Eq. 24 neither)",
+                d.v_radius_m, d.neutral.0, d.neutral.1
+            ),
+        )
+    } else {
+        (Glyph::Line(CURVE_V, 3), "v: Phi1 = 0 (Eq. 30; dashed: Eq. 24 as printed)".to_string())
+    };
+    let entries = vec![
+        (Glyph::Line(CURVE_I, 4), format!("i: L3 = 0 (Eq. 26): det J = 0, singular; but not free: K = {:.1} N m/rad", d.k_at_l3_zero)),
+        (Glyph::Dashed(CURVE_II, 4), format!("ii: sin theta1 = 0 (Eq. 27): NOT singular, det J >= {:.3} m/rad for L3 >= {DET_SCAN_L3_MIN_M} m; only the edge of the range", d.det_min_ii)),
+        (Glyph::Dashed(CURVE_III, 3), format!("iii: eta1 = 0 (Eq. 28): NOT singular, |det J| <= {:.2} m/rad (finite); Eq. 5's [0, pi] root jumps by pi here", d.det_max_iii)),
+        (Glyph::Dashed(CURVE_IV, 3), format!("iv: theta1 = theta2 (Eq. 33): NOT singular, det J >= {:.3} m/rad for L3 >= {DET_SCAN_L3_MIN_M} m", d.det_min_iv)),
+        v_entry,
+        (Glyph::Line(CURVE_VI, 3), "vi: L3 = 2L (Eq. 31): the actuator's limit, not a singularity".to_string()),
+        (Glyph::Dot(AGREE), "dynamics: settled on the energy minimum within 1e-9, stable by perturbation, as K > 0 says".to_string()),
+        (Glyph::Diamond(AGREE_PAPER_ROOT), format!("the same, and the minimum is the root Eq. 5 picks in [0, pi] ({paper_roots} of {n} points)")),
+        (Glyph::Cross(DISAGREE), "dynamics and analytic stability disagree, or not settled".to_string()),
+        (Glyph::Note, format!("Dashed: printed singular curves that prove not singular. Elsewhere Eq. 5's [0, pi] root is the energy maximum ({} of {n} points).", n - paper_roots)),
+    ];
+    legend_panel(&legend.margin(0, 8, 10, 10), &entries, 1, 13).map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+pub(super) fn draw_fig2(png: &Path, svg: &Path) -> Result<(), String> {
+    let d = fig2_data()?;
+    fig2_plot(BitMapBackend::new(png, SIZE).into_drawing_area(), &d)?;
+    fig2_plot(SVGBackend::new(svg, SIZE).into_drawing_area(), &d)
+}
