@@ -21,6 +21,10 @@ pub const FIGURES: &[(&str, &str)] = &[
         "ji2014 Fig. 2: actuator workspace (theta1, L3) with det J and the singular curves i-vi of Section 4.2 as derived (which printed ones are not singular), with the 110 points of grid.toml settled by the dynamics",
     ),
     (
+        "ji2014-fig3",
+        "ji2014 Fig. 3: Cartesian workspace of D3 (how many stable inputs reach each point) with the images of the curves and the printed Eq. 34-37, with the settled D3 of grid.toml",
+    ),
+    (
         "furet2018-fig5",
         "furet2018 Fig. 5: workspace regions by number of inverse solutions (2 or 4) for b = 2/5, 2/3, 9/10 (L = 1), with the paper's Fig. 3 point",
     ),
@@ -59,6 +63,7 @@ pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
             ji2014_fig4_plot(SVGBackend::new(&svg, SIZE).into_drawing_area(), &data)?;
         }
         "ji2014-fig2" => ji2014::draw_fig2(&png, &svg)?,
+        "ji2014-fig3" => ji2014::draw_fig3(&png, &svg)?,
         "furet2018-fig5" => {
             let data = furet2018_fig5_data();
             furet2018_fig5_plot(BitMapBackend::new(&png, (1500, 560)).into_drawing_area(), &data)?;

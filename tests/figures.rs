@@ -69,3 +69,15 @@ fn ji2014_fig2_shows_the_singular_curves_and_the_grid_verdict() {
     // Curve ii is not singular: FINDINGS.md's smallest |det J| for L3 >= 0.3 m is 0.118 m/rad.
     assert!((number_after(&svg, "NOT singular, det J &gt;= ") - 0.118).abs() < 1e-3);
 }
+
+#[test]
+fn ji2014_fig3_maps_the_workspace_and_the_settled_d3() {
+    let (_, svg) = draw("ji2014-fig3");
+    for text in ["x [m]", "y [m]", "110 of 110 settled D3 agree", "Eq. 37 as printed"] {
+        assert!(svg.contains(text), "the SVG has '{text}'");
+    }
+    // Curve i (L3 = 0) maps to the single point D3 = (-sqrt3/2, -1/2) L (FINDINGS.md, Eq. 26).
+    assert!((number_after(&svg, "maps to ONE point (") + 0.866).abs() < 1e-3);
+    // The stable equilibria cover 4.17 m^2 of the plane (160 x 160 cells over 6.4 m x 4.8 m).
+    assert!((number_after(&svg, "stable equilibrium of one input (L3, theta1): ") - 4.17).abs() < 0.02);
+}

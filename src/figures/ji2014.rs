@@ -37,6 +37,10 @@ struct GridPoint {
     agrees: bool,
     /// The branch landed on is the root that Eq. 5 picks with theta2 in [0, pi].
     paper_root: bool,
+    /// Settled D3 [m] and its distance from the analytic D3 [m].
+    x: f64,
+    y: f64,
+    d3_error_m: f64,
 }
 
 fn grid_points() -> Result<(ji::Params, Vec<GridPoint>), String> {
@@ -54,6 +58,9 @@ fn grid_points() -> Result<(ji::Params, Vec<GridPoint>), String> {
             theta1: q.inputs["theta1"],
             agrees: q.settled && q.within_tolerance && q.stable.is_some() && q.stable == q.analytic_stable,
             paper_root: q.branch.ends_with(PAPER_ROOT_MARK),
+            x: q.simulated["x"],
+            y: q.simulated["y"],
+            d3_error_m: (q.simulated["x"] - q.analytic["x"]).hypot(q.simulated["y"] - q.analytic["y"]),
         })
         .collect();
     Ok((p, points))
@@ -293,4 +300,256 @@ pub(super) fn draw_fig2(png: &Path, svg: &Path) -> Result<(), String> {
     let d = fig2_data()?;
     fig2_plot(BitMapBackend::new(png, SIZE).into_drawing_area(), &d)?;
     fig2_plot(SVGBackend::new(svg, SIZE).into_drawing_area(), &d)
+}
+
+/// Which equilibria of the actuator workspace reach a point of the plane.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Reach {
+    /// The stable equilibrium of one input (L3, theta1).
+    StableOnce,
+    /// The stable equilibria of two inputs.
+    StableTwice,
+    /// Only the energy maximum of some input (where the paper's Eq. 5 root mostly is).
+    OnlyUnstable,
+}
+
+/// How the actuator workspace (`0 <= L3 <= l3_max`, `0 <= theta1 <= pi`) reaches `(x, y)`, by
+/// the closed-form inverse kinematics (Eq. 48, each solution verified by Eq. 5).
+fn reach(p: &ji::Params, l3_max: f64, x: f64, y: f64) -> Option<Reach> {
+    let sols: Vec<_> = ji::inverse_kinematics(p, x, y).into_iter().filter(|s| s.l3 <= l3_max).collect();
+    match sols.iter().filter(|s| s.stable).count() {
+        0 if !sols.is_empty() => Some(Reach::OnlyUnstable),
+        0 => None,
+        1 => Some(Reach::StableOnce),
+        _ => Some(Reach::StableTwice),
+    }
+}
+
+/// D3 [m] of the stable equilibrium of the inputs.
+fn d3_stable(p: &ji::Params, l3: f64, theta1: f64) -> (f64, f64) {
+    let e = ji::equilibria(p, l3, theta1)[0];
+    (e.x, e.y)
+}
+
+/// Cartesian window of Fig. 3 [m]: x and y ranges (the reach circle 3L fits).
+const FIG3_X_M: (f64, f64) = (-3.2, 3.2);
+const FIG3_Y_M: (f64, f64) = (-1.6, 3.2);
+
+pub(super) struct Fig3 {
+    p: ji::Params,
+    /// (x, y, reach) at cell centres.
+    cells: Vec<(f64, f64, Reach)>,
+    cell: (f64, f64),
+    /// Area fractions [m^2] of the three reach classes.
+    areas_m2: [f64; 3],
+    /// Images through the stable equilibrium of curves ii (theta1 = 0, theta1 = pi), iii, iv and
+    /// vi, and of curve i (one point).
+    image_ii: [Vec<(f64, f64)>; 2],
+    image_iii: Vec<(f64, f64)>,
+    image_iv: Vec<(f64, f64)>,
+    image_vi: Vec<(f64, f64)>,
+    image_i: (f64, f64),
+    /// Largest |Eq. 36 as printed| / (K1 L) on the image of curve iii.
+    eq36_residual: f64,
+    /// Range of |D3| / L on the image of curve iv.
+    iv_radius: (f64, f64),
+    /// The dynamics: grid.toml's points where they settled.
+    points: Vec<GridPoint>,
+    /// Largest distance of a settled D3 from the analytic one, relative to L.
+    max_d3_error: f64,
+}
+
+pub(super) fn fig3_data() -> Result<Fig3, String> {
+    let (p, grid) = grid_points()?;
+    let l3_max = ji::PAPER_L3_MAX_OVER_L * p.l;
+    let cell = ((FIG3_X_M.1 - FIG3_X_M.0) / CELLS as f64, (FIG3_Y_M.1 - FIG3_Y_M.0) / CELLS as f64);
+    let mut cells = Vec::new();
+    let mut areas_m2 = [0.0; 3];
+    for i in 0..CELLS {
+        for j in 0..CELLS {
+            let (x, y) = (FIG3_X_M.0 + (i as f64 + 0.5) * cell.0, FIG3_Y_M.0 + (j as f64 + 0.5) * cell.1);
+            if let Some(r) = reach(&p, l3_max, x, y) {
+                let k = match r {
+                    Reach::StableOnce => 0,
+                    Reach::StableTwice => 1,
+                    Reach::OnlyUnstable => 2,
+                };
+                areas_m2[k] += cell.0 * cell.1;
+                cells.push((x, y, r));
+            }
+        }
+    }
+    let samples = |lo: f64, hi: f64| (0..=CURVE_SAMPLES).map(move |k| lo + (hi - lo) * k as f64 / CURVE_SAMPLES as f64);
+    let image_ii = [0.0, PI].map(|t1| samples(0.0, l3_max).map(|l3| d3_stable(&p, l3, t1)).collect());
+    let image_iii: Vec<(f64, f64)> =
+        samples(0.0, l3_max).filter_map(|l3| ji::curve_iii_theta1(&p, l3).map(|t1| d3_stable(&p, l3, t1))).collect();
+    let iv_inputs: Vec<(f64, f64)> = samples(0.0, PI)
+        .map(|t1| (t1, ji::curve_iv_l3(&p, t1)))
+        .filter(|(_, l3)| (0.0..=l3_max).contains(l3))
+        .collect();
+    let image_iv: Vec<(f64, f64)> = iv_inputs.iter().map(|(t1, l3)| d3_stable(&p, *l3, *t1)).collect();
+    let image_vi = samples(0.0, PI).map(|t1| d3_stable(&p, l3_max, t1)).collect();
+    let eq36_residual =
+        image_iii.iter().map(|(x, y)| ji::curve_iii_eq36_as_printed(&p, *x, *y).abs()).fold(0.0, f64::max)
+            / (p.k1 * p.l);
+    let radii = image_iv.iter().map(|(x, y)| x.hypot(*y) / p.l);
+    let iv_radius = radii.fold((f64::INFINITY, 0.0_f64), |(lo, hi), r| (lo.min(r), hi.max(r)));
+    let max_d3_error = grid.iter().map(|q| q.d3_error_m).fold(0.0, f64::max) / p.l;
+    Ok(Fig3 {
+        p,
+        cells,
+        cell,
+        areas_m2,
+        image_ii,
+        image_iii,
+        image_iv,
+        image_vi,
+        image_i: d3_stable(&p, 0.0, 0.0),
+        eq36_residual,
+        iv_radius,
+        points: grid,
+        max_d3_error,
+    })
+}
+
+/// Background colours of Fig. 3.
+const REACH_ONCE: RGBColor = RGBColor(198, 219, 239);
+const REACH_TWICE: RGBColor = RGBColor(120, 175, 220);
+const REACH_UNSTABLE: RGBColor = RGBColor(228, 228, 228);
+
+/// Points along a circle of radius `r` [m] about the origin.
+fn circle(r: f64) -> Vec<(f64, f64)> {
+    (0..=CURVE_SAMPLES)
+        .map(|k| 2.0 * PI * k as f64 / CURVE_SAMPLES as f64)
+        .map(|a| (r * a.cos(), r * a.sin()))
+        .collect()
+}
+
+pub(super) fn fig3_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig3) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let agree = d.points.iter().filter(|q| q.agrees).count();
+    let n = d.points.len();
+    let root = root
+        .titled(
+            &format!(
+                "ji2014 Fig. 3: Cartesian workspace of D3 and the images of the curves (L = {} m, K1 = {} N/m, K2 = {} N/m)",
+                d.p.l, d.p.k1, d.p.k2
+            ),
+            ("sans-serif", 19),
+        )
+        .map_err(err)?;
+    let (plot, legend) = root.split_vertically(SIZE.1 - FIG3_LEGEND_PX - 30);
+    let mut chart = ChartBuilder::on(&plot)
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .caption(
+            format!(
+                "dynamics (grid.toml): {agree} of {n} settled D3 agree, largest distance from the analytic D3 {:.1e} L",
+                d.max_d3_error
+            ),
+            ("sans-serif", 16),
+        )
+        .build_cartesian_2d(FIG3_X_M.0..FIG3_X_M.1, FIG3_Y_M.0..FIG3_Y_M.1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x [m]")
+        .y_desc("y [m]")
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(err)?;
+    let (hx, hy) = (d.cell.0 / 2.0, d.cell.1 / 2.0);
+    chart
+        .draw_series(d.cells.iter().map(|(x, y, r)| {
+            let c = match r {
+                Reach::StableOnce => REACH_ONCE,
+                Reach::StableTwice => REACH_TWICE,
+                Reach::OnlyUnstable => REACH_UNSTABLE,
+            };
+            Rectangle::new([(x - hx, y - hy), (x + hx, y + hy)], c.filled())
+        }))
+        .map_err(err)?;
+    // The printed Cartesian curves (Eq. 34, 36, 37), thin dashed.
+    let dashed = |pts: Vec<(f64, f64)>, c: RGBColor| DashedLineSeries::new(pts, 8, 5, c.stroke_width(2).into());
+    chart.draw_series(dashed(circle(d.p.l), CURVE_I)).map_err(err)?;
+    chart.draw_series(dashed(circle(3.0 * d.p.l), CURVE_IV)).map_err(err)?;
+    // Eq. 36 as printed is a line: y = (2 sqrt3 K1 x + 2 sqrt3 L (K2 - K1)) / (K1 + 2 K2).
+    let eq36 = |x: f64| {
+        (2.0 * ji::SQRT_3 * d.p.k1 * x + 2.0 * ji::SQRT_3 * d.p.l * (d.p.k2 - d.p.k1)) / (d.p.k1 + 2.0 * d.p.k2)
+    };
+    let eq36_line: Vec<(f64, f64)> = (0..=CURVE_SAMPLES)
+        .map(|k| FIG3_X_M.0 + (FIG3_X_M.1 - FIG3_X_M.0) * k as f64 / CURVE_SAMPLES as f64)
+        .map(|x| (x, eq36(x)))
+        .filter(|(_, y)| (FIG3_Y_M.0..=FIG3_Y_M.1).contains(y))
+        .collect();
+    chart.draw_series(dashed(eq36_line, CURVE_III)).map_err(err)?;
+    // The images of the actuator-space curves through the stable equilibrium, solid.
+    for line in &d.image_ii {
+        chart.draw_series(LineSeries::new(line.iter().copied(), CURVE_II.stroke_width(3))).map_err(err)?;
+    }
+    chart.draw_series(LineSeries::new(d.image_iii.iter().copied(), CURVE_III.stroke_width(4))).map_err(err)?;
+    chart.draw_series(LineSeries::new(d.image_iv.iter().copied(), CURVE_IV.stroke_width(3))).map_err(err)?;
+    chart.draw_series(LineSeries::new(d.image_vi.iter().copied(), CURVE_VI.stroke_width(3))).map_err(err)?;
+    chart.draw_series(std::iter::once(TriangleMarker::new(d.image_i, 9, CURVE_I.filled()))).map_err(err)?;
+    chart
+        .draw_series(d.points.iter().filter(|q| q.agrees).map(|q| {
+            EmptyElement::at((q.x, q.y))
+                + Circle::new((0, 0), 4, AGREE.filled())
+                + Circle::new((0, 0), 4, BLACK.stroke_width(1))
+        }))
+        .map_err(err)?;
+    chart
+        .draw_series(d.points.iter().filter(|q| !q.agrees).map(|q| Cross::new((q.x, q.y), 7, DISAGREE.stroke_width(3))))
+        .map_err(err)?;
+    let entries = vec![
+        (Glyph::Fill(REACH_ONCE), format!("stable equilibrium of one input (L3, theta1): {:.2} m^2", d.areas_m2[0])),
+        (Glyph::Fill(REACH_TWICE), format!("stable equilibrium of two inputs: {:.2} m^2", d.areas_m2[1])),
+        (
+            Glyph::Fill(REACH_UNSTABLE),
+            format!("only an energy maximum (most of the paper's Eq. 5 roots): {:.2} m^2", d.areas_m2[2]),
+        ),
+        (Glyph::Triangle(CURVE_I), format!("i: L3 = 0 maps to ONE point ({:.3}, {:.3}) m", d.image_i.0, d.image_i.1)),
+        (
+            Glyph::Dashed(CURVE_I, 2),
+            "Eq. 34 as printed (x^2 + y^2 = L^2): |D3 - D1| = L, not the image of i".to_string(),
+        ),
+        (
+            Glyph::Line(CURVE_II, 3),
+            "ii: images of theta1 = 0 and theta1 = pi (curves, not the region Sec. 5.2 says)".to_string(),
+        ),
+        (Glyph::Line(CURVE_III, 4), "iii: image of eta1 = 0, on the line of theta2 = pi".to_string()),
+        (
+            Glyph::Dashed(CURVE_III, 2),
+            format!("Eq. 36 as printed (assumes theta2 = 0): off by up to {:.2} K1 L on the image", d.eq36_residual),
+        ),
+        (
+            Glyph::Line(CURVE_IV, 3),
+            format!("iv: image of Eq. 33, |D3| = L - L3 from {:.3} to {:.3} L", d.iv_radius.0, d.iv_radius.1),
+        ),
+        (
+            Glyph::Dashed(CURVE_IV, 2),
+            "Eq. 37 as printed (x^2 + y^2 = 9 L^2): only the reach circle of the maximum".to_string(),
+        ),
+        (
+            Glyph::Line(CURVE_VI, 3),
+            "vi: image of L3 = 2L; v (Phi1 = 0) has no image: it lies outside the actuator workspace".to_string(),
+        ),
+        (Glyph::Dot(AGREE), "dynamics: settled D3 on the stable analytic D3 within 1e-9 L, stable".to_string()),
+        (Glyph::Cross(DISAGREE), "dynamics: disagrees with the analytic stability, or not settled".to_string()),
+    ];
+    legend_panel(&legend.margin(0, 8, 10, 10), &entries, 1, 13).map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// Height of Fig. 3's legend panel [px].
+const FIG3_LEGEND_PX: u32 = 310;
+
+pub(super) fn draw_fig3(png: &Path, svg: &Path) -> Result<(), String> {
+    let d = fig3_data()?;
+    fig3_plot(BitMapBackend::new(png, SIZE).into_drawing_area(), &d)?;
+    fig3_plot(SVGBackend::new(svg, SIZE).into_drawing_area(), &d)
 }
