@@ -25,6 +25,10 @@ pub const FIGURES: &[(&str, &str)] = &[
         "ji2014 Fig. 3: Cartesian workspace of D3 (how many stable inputs reach each point) with the images of the curves and the printed Eq. 34-37, with the settled D3 of grid.toml",
     ),
     (
+        "ji2014-fig7",
+        "ji2014 Fig. 7: stiffness K at the stable equilibrium over the actuator workspace (colour map, contours, symmetry line), with the dynamics' torque probe at 16 points (stiffness_grid.toml)",
+    ),
+    (
         "furet2018-fig5",
         "furet2018 Fig. 5: workspace regions by number of inverse solutions (2 or 4) for b = 2/5, 2/3, 9/10 (L = 1), with the paper's Fig. 3 point",
     ),
@@ -64,6 +68,7 @@ pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
         }
         "ji2014-fig2" => ji2014::draw_fig2(&png, &svg)?,
         "ji2014-fig3" => ji2014::draw_fig3(&png, &svg)?,
+        "ji2014-fig7" => ji2014::draw_fig7(&png, &svg)?,
         "furet2018-fig5" => {
             let data = furet2018_fig5_data();
             furet2018_fig5_plot(BitMapBackend::new(&png, (1500, 560)).into_drawing_area(), &data)?;
@@ -440,6 +445,8 @@ pub(crate) fn colour_at(anchors: &ColourAnchors, t: f64) -> RGBColor {
 
 /// Steps of a colour bar.
 const COLOUR_BAR_STEPS: usize = 200;
+/// A colour bar spanning at least this much is labelled in whole units.
+const COLOUR_BAR_INTEGER_SPAN: f64 = 10.0;
 
 /// A vertical colour bar for values `lo..hi` of the map `anchors`, with its axis label.
 pub(crate) fn colour_bar<DB: DrawingBackend>(
@@ -463,6 +470,7 @@ pub(crate) fn colour_bar<DB: DrawingBackend>(
         .y_desc(label)
         .axis_desc_style(("sans-serif", 15))
         .label_style(("sans-serif", 13))
+        .y_label_formatter(&|v| if hi - lo >= COLOUR_BAR_INTEGER_SPAN { format!("{v:.0}") } else { format!("{v:.2}") })
         .draw()?;
     let step = (hi - lo) / COLOUR_BAR_STEPS as f64;
     chart.draw_series((0..COLOUR_BAR_STEPS).map(|k| {

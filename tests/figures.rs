@@ -51,10 +51,10 @@ fn draw(name: &str) -> (Vec<u8>, String) {
     (png, svg)
 }
 
-/// The number printed in `svg` right after `before` (up to the next space).
+/// The number printed in `svg` right after `before` (digits, sign, point and exponent).
 fn number_after(svg: &str, before: &str) -> f64 {
     let at = svg.find(before).unwrap_or_else(|| panic!("the SVG has '{before}'")) + before.len();
-    let text: String = svg[at..].chars().take_while(|c| c.is_ascii_digit() || *c == '.' || *c == '-').collect();
+    let text: String = svg[at..].chars().take_while(|c| c.is_ascii_digit() || ".-+e".contains(*c)).collect();
     text.parse().unwrap_or_else(|_| panic!("a number after '{before}': '{text}'"))
 }
 
@@ -80,4 +80,21 @@ fn ji2014_fig3_maps_the_workspace_and_the_settled_d3() {
     assert!((number_after(&svg, "maps to ONE point (") + 0.866).abs() < 1e-3);
     // The stable equilibria cover 4.17 m^2 of the plane (160 x 160 cells over 6.4 m x 4.8 m).
     assert!((number_after(&svg, "stable equilibrium of one input (L3, theta1): ") - 4.17).abs() < 0.02);
+}
+
+#[test]
+fn ji2014_fig7_maps_the_stiffness_with_the_probe() {
+    let (_, svg) = draw("ji2014-fig7");
+    for text in ["theta1 [rad]", "L3 [m]", "K [N m/rad]", "(0 points; tolerance 1e-4)"] {
+        assert!(svg.contains(text), "the SVG has '{text}'");
+    }
+    // The probe measures K of Eq. 42 far inside the scenario's 1e-4 (a few 1e-9).
+    assert!(number_after(&svg, "max relative error ") < 1e-7);
+    // |K| is symmetric about the direction opposite the neutral point D1* (FINDINGS.md: 1.2373).
+    assert!((number_after(&svg, "theta1 = ") - 1.2373).abs() < 1e-4);
+    // K does not grow with L3 everywhere: next to theta1 = pi it falls while L3 < e(theta1).D1*,
+    // which is at most -D1*.x = 0.4286 m (FINDINGS.md).
+    assert!((number_after(&svg, "it falls first, up to L3 = ") - 0.43).abs() < 0.02);
+    // Eq. 47 as printed is the stiffness of the maximum on most of the map (eta1 > 0).
+    assert!((number_after(&svg, "is the maximum): ") - 96.2).abs() < 0.5);
 }

@@ -1,8 +1,9 @@
-//! ji2014's workspace figures: Fig. 2 (actuator workspace with the singular curves of Section
-//! 4.2), redrawn from the derived model, with the dynamics' verdict of
-//! `scenarios/ji2014/grid.toml` on top.
+//! ji2014's workspace figures, redrawn from the derived model with the dynamics on top: Fig. 2-3
+//! (actuator and Cartesian workspaces with the singular curves of Section 4.2 and 5.2, and the
+//! points of `scenarios/ji2014/grid.toml`), Fig. 7-8 (the stiffness over both workspaces, and the
+//! torque probe of `scenarios/ji2014/stiffness_grid.toml`).
 
-use super::{colour_at, colour_bar, legend_panel, zero_contour, Glyph, LIGHT_BLUES};
+use super::{colour_at, colour_bar, legend_panel, zero_contour, Glyph, LIGHT_BLUES, VIRIDIS};
 use crate::mechanisms::ji2014::analytic as ji;
 use crate::mechanisms::ji2014::PAPER_ROOT_MARK;
 use crate::run::{run, RunOptions};
@@ -206,7 +207,7 @@ pub(super) fn fig2_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fi
             ),
             ("sans-serif", 16),
         )
-        .build_cartesian_2d(-0.08..PI + 0.08, -0.06..d.l3_max + 0.06)
+        .build_cartesian_2d(-MAP_PAD_RAD..PI + MAP_PAD_RAD, -MAP_PAD_M..d.l3_max + MAP_PAD_M)
         .map_err(err)?;
     chart
         .configure_mesh()
@@ -552,4 +553,281 @@ pub(super) fn draw_fig3(png: &Path, svg: &Path) -> Result<(), String> {
     let d = fig3_data()?;
     fig3_plot(BitMapBackend::new(png, SIZE).into_drawing_area(), &d)?;
     fig3_plot(SVGBackend::new(svg, SIZE).into_drawing_area(), &d)
+}
+
+// ---------------------------------------------------------------------------
+// Fig. 7-8: the stiffness at the stable equilibrium, with the dynamics' probe.
+// ---------------------------------------------------------------------------
+
+/// One point of `scenarios/ji2014/stiffness_grid.toml`: the dynamics' torque probe.
+struct Probe {
+    l3: f64,
+    theta1: f64,
+    /// Settled D3 [m].
+    x: f64,
+    y: f64,
+    /// |K_probe - K| / K, K of Eq. 42 at the stable equilibrium; infinite when the probe failed.
+    rel_error: f64,
+}
+
+fn probe_points() -> Result<(ji::Params, Vec<Probe>, f64), String> {
+    let sc = scenario::load(Path::new("scenarios/ji2014/stiffness_grid.toml")).map_err(|e| e.to_string())?;
+    let report = run(&sc, &RunOptions { skip_findings: true, ..Default::default() });
+    if let Some(e) = report.error {
+        return Err(format!("stiffness_grid.toml: {e}"));
+    }
+    let p = ji::Params { l: sc.params["L"], k1: sc.params["K1"], k2: sc.params["K2"] };
+    let probes = report
+        .points
+        .iter()
+        .map(|q| Probe {
+            l3: q.inputs["L3"],
+            theta1: q.inputs["theta1"],
+            x: q.simulated["x"],
+            y: q.simulated["y"],
+            rel_error: match (q.simulated.get("K"), q.analytic.get("K")) {
+                (Some(k), Some(ka)) if q.settled => ((k - ka) / ka).abs(),
+                _ => f64::INFINITY,
+            },
+        })
+        .collect();
+    let tolerance = sc.probe.as_ref().map_or(f64::NAN, |pr| pr.tolerance);
+    Ok((p, probes, tolerance))
+}
+
+/// Relative-error classes of the probe markers: below the first bound, below the second, above.
+const PROBE_ERROR_BOUNDS: [f64; 2] = [1e-9, 1e-6];
+
+/// Stiffness levels drawn as contour lines [N m/rad].
+const K_CONTOUR_STEP: f64 = 100.0;
+
+/// Draws the probe markers, one series per error class (white circle, white diamond, red cross).
+fn draw_probes<DB: DrawingBackend>(
+    chart: &mut ChartContext<
+        '_,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    probes: &[Probe],
+    at: &dyn Fn(&Probe) -> (f64, f64),
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let [lo, hi] = PROBE_ERROR_BOUNDS;
+    chart.draw_series(probes.iter().filter(|q| q.rel_error < lo).map(|q| {
+        EmptyElement::at(at(q)) + Circle::new((0, 0), 7, AGREE.filled()) + Circle::new((0, 0), 7, BLACK.stroke_width(2))
+    }))?;
+    chart.draw_series(probes.iter().filter(|q| (lo..hi).contains(&q.rel_error)).map(|q| {
+        EmptyElement::at(at(q))
+            + Polygon::new(DIAMOND_PX.to_vec(), AGREE.filled())
+            + PathElement::new([&DIAMOND_PX[..], &DIAMOND_PX[..1]].concat(), BLACK.stroke_width(2))
+    }))?;
+    chart.draw_series(
+        probes.iter().filter(|q| q.rel_error >= hi).map(|q| Cross::new(at(q), 8, DISAGREE.stroke_width(3))),
+    )?;
+    Ok(())
+}
+
+/// Legend entries of the probe markers, with their counts.
+fn probe_entries(probes: &[Probe], tolerance: f64) -> Vec<(Glyph, String)> {
+    let [lo, hi] = PROBE_ERROR_BOUNDS;
+    let count = |f: &dyn Fn(f64) -> bool| probes.iter().filter(|q| f(q.rel_error)).count();
+    vec![
+        (
+            Glyph::Dot(AGREE),
+            format!("dynamics' torque probe: |K_probe - K| / K < {lo:.0e} ({} points)", count(&|e| e < lo)),
+        ),
+        (
+            Glyph::Diamond(AGREE),
+            format!("the same, {lo:.0e} to {hi:.0e} ({} points)", count(&|e| (lo..hi).contains(&e))),
+        ),
+        (
+            Glyph::Cross(DISAGREE),
+            format!(
+                "the same, {hi:.0e} or more, or the probe failed ({} points; tolerance {tolerance:.0e})",
+                count(&|e| e >= hi)
+            ),
+        ),
+    ]
+}
+
+pub(super) struct Fig7 {
+    p: ji::Params,
+    l3_max: f64,
+    /// (theta1, L3, K) at cell centres.
+    cells: Vec<(f64, f64, f64)>,
+    cell: (f64, f64),
+    /// The colour scale [N m/rad]: the smallest K rounded down to K_CONTOUR_STEP, the largest K.
+    k_min: f64,
+    k_max: f64,
+    /// Contour lines of K, every K_CONTOUR_STEP.
+    contours: Vec<Vec<(f64, f64)>>,
+    /// theta1 [rad] of the line |K| is symmetric about (the direction opposite D1*).
+    symmetry_theta1: f64,
+    curve_iii: Vec<(f64, f64)>,
+    /// Columns (theta1) of the map where K does not grow with L3, the smallest theta1 [rad] of
+    /// them, and the largest L3 [m] of their minima of K.
+    columns_not_growing: usize,
+    falls_from_theta1: f64,
+    falls_up_to_l3: f64,
+    /// Share of the cells where Eq. 47 as printed is negative (the paper's root is the maximum).
+    eq47_negative: f64,
+    probes: Vec<Probe>,
+    tolerance: f64,
+}
+
+/// K [N m/rad] at the stable equilibrium, K = (L/2)|eta| (Eq. 42 at the minimum).
+fn k_stable(p: &ji::Params, l3: f64, theta1: f64) -> f64 {
+    ji::equilibria(p, l3, theta1)[0].stiffness
+}
+
+pub(super) fn fig7_data() -> Result<Fig7, String> {
+    let (p, probes, tolerance) = probe_points()?;
+    let l3_max = ji::PAPER_L3_MAX_OVER_L * p.l;
+    let cell = (PI / CELLS as f64, l3_max / CELLS as f64);
+    let mut cells = Vec::with_capacity(CELLS * CELLS);
+    let mut negative = 0usize;
+    for i in 0..CELLS {
+        for j in 0..CELLS {
+            let (t1, l3) = ((i as f64 + 0.5) * cell.0, (j as f64 + 0.5) * cell.1);
+            cells.push((t1, l3, k_stable(&p, l3, t1)));
+            if ji::stiffness_eq47(&p, l3, t1) < 0.0 {
+                negative += 1;
+            }
+        }
+    }
+    let k_max = cells.iter().map(|c| c.2).fold(0.0, f64::max);
+    let k_min = (cells.iter().map(|c| c.2).fold(f64::INFINITY, f64::min) / K_CONTOUR_STEP).floor() * K_CONTOUR_STEP;
+    let mut contours = Vec::new();
+    let mut level = K_CONTOUR_STEP;
+    while level < k_max {
+        contours.extend(zero_contour(&|t1, l3| k_stable(&p, l3, t1) - level, 0.0..PI, 0.0..l3_max, CELLS));
+        level += K_CONTOUR_STEP;
+    }
+    // Cells are stored column by column (theta1 outer, L3 inner).
+    let not_growing: Vec<&[(f64, f64, f64)]> =
+        cells.chunks(CELLS).filter(|column| column.windows(2).any(|w| w[1].2 <= w[0].2)).collect();
+    let falls_from_theta1 = not_growing.iter().map(|c| c[0].0).fold(f64::INFINITY, f64::min);
+    let falls_up_to_l3 =
+        not_growing.iter().filter_map(|c| c.iter().min_by(|a, b| a.2.total_cmp(&b.2)).map(|m| m.1)).fold(0.0, f64::max);
+    let columns_not_growing = not_growing.len();
+    let d1_star = ji::neutral_point(&p);
+    let curve_iii = (0..=CURVE_SAMPLES)
+        .map(|k| l3_max * k as f64 / CURVE_SAMPLES as f64)
+        .filter_map(|l3| ji::curve_iii_theta1(&p, l3).map(|t1| (t1, l3)))
+        .collect();
+    Ok(Fig7 {
+        p,
+        l3_max,
+        cells,
+        cell,
+        k_min,
+        k_max,
+        contours,
+        symmetry_theta1: (-d1_star.y).atan2(-d1_star.x),
+        curve_iii,
+        columns_not_growing,
+        falls_from_theta1,
+        falls_up_to_l3,
+        eq47_negative: negative as f64 / (CELLS * CELLS) as f64,
+        probes,
+        tolerance,
+    })
+}
+
+/// The paper's symmetry line of Fig. 7, theta1 = 0.3 rad (Section 6.2).
+const PAPER_FIG7_SYMMETRY_THETA1: f64 = 0.3;
+/// Height of Fig. 7's and Fig. 8's legend panel [px].
+const FIG7_LEGEND_PX: u32 = 190;
+/// Margins of the actuator-space charts around the workspace, so that markers on its edges show
+/// whole [rad], [m].
+const MAP_PAD_RAD: f64 = 0.08;
+const MAP_PAD_M: f64 = 0.06;
+/// Colour of the contour lines of K and of the symmetry lines.
+const K_LINES: RGBColor = RGBColor(255, 255, 255);
+const PAPER_LINE: RGBColor = RGBColor(255, 120, 0);
+/// The white lines of the map, as the legend (on white) shows them.
+const LEGEND_WHITE_LINE: RGBColor = RGBColor(150, 150, 150);
+
+pub(super) fn fig7_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig7) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let max_err = d.probes.iter().map(|q| q.rel_error).fold(0.0, f64::max);
+    let root = root
+        .titled(
+            &format!(
+                "ji2014 Fig. 7: stiffness K over the actuator workspace (L = {} m, K1 = {} N/m, K2 = {} N/m)",
+                d.p.l, d.p.k1, d.p.k2
+            ),
+            ("sans-serif", 20),
+        )
+        .map_err(err)?;
+    let (top, legend) = root.split_vertically(SIZE.1 - FIG7_LEGEND_PX - 30);
+    let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
+    let mut chart = ChartBuilder::on(&plot)
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .caption(
+            format!(
+                "colour: K = (L/2)|eta| at the stable equilibrium (Eq. 42); probe (stiffness_grid.toml): max relative error {max_err:.1e}"
+            ),
+            ("sans-serif", 16),
+        )
+        .build_cartesian_2d(-MAP_PAD_RAD..PI + MAP_PAD_RAD, -MAP_PAD_M..d.l3_max + MAP_PAD_M)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("theta1 [rad]")
+        .y_desc("L3 [m]")
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(err)?;
+    let (hx, hy) = (d.cell.0 / 2.0, d.cell.1 / 2.0);
+    chart
+        .draw_series(d.cells.iter().map(|(t1, l3, k)| {
+            let c = colour_at(VIRIDIS, (k - d.k_min) / (d.k_max - d.k_min));
+            Rectangle::new([(t1 - hx, l3 - hy), (t1 + hx, l3 + hy)], c.filled())
+        }))
+        .map_err(err)?;
+    for line in &d.contours {
+        chart.draw_series(LineSeries::new(line.iter().copied(), K_LINES.mix(0.6).stroke_width(1))).map_err(err)?;
+    }
+    chart
+        .draw_series(LineSeries::new(
+            [(d.symmetry_theta1, 0.0), (d.symmetry_theta1, d.l3_max)],
+            K_LINES.stroke_width(3),
+        ))
+        .map_err(err)?;
+    chart
+        .draw_series(DashedLineSeries::new(
+            [(PAPER_FIG7_SYMMETRY_THETA1, 0.0), (PAPER_FIG7_SYMMETRY_THETA1, d.l3_max)],
+            10,
+            6,
+            PAPER_LINE.stroke_width(3).into(),
+        ))
+        .map_err(err)?;
+    chart
+        .draw_series(DashedLineSeries::new(d.curve_iii.iter().copied(), 10, 6, CURVE_III.stroke_width(3).into()))
+        .map_err(err)?;
+    draw_probes(&mut chart, &d.probes, &|q| (q.theta1, q.l3)).map_err(err)?;
+    colour_bar(&bar, VIRIDIS, d.k_min, d.k_max, "K [N m/rad]").map_err(err)?;
+    let mut entries = vec![
+        (Glyph::Line(LEGEND_WHITE_LINE, 1), format!(
+                "contour lines of K every {K_CONTOUR_STEP} N m/rad. The paper: K grows with L3. It does in {} of {CELLS} columns; for theta1 > {:.2} rad it falls first, up to L3 = {:.2} m",
+                CELLS - d.columns_not_growing, d.falls_from_theta1, d.falls_up_to_l3
+            )),
+        (Glyph::Line(LEGEND_WHITE_LINE, 3), format!("theta1 = {:.4} rad: K is exactly symmetric about it (the direction opposite D1*)", d.symmetry_theta1)),
+        (Glyph::Dashed(PAPER_LINE, 3), format!("theta1 = {PAPER_FIG7_SYMMETRY_THETA1} rad: the symmetry line Section 6.2 reads off Fig. 7 (wrong)")),
+        (Glyph::Dashed(CURVE_III, 3), format!("eta1 = 0 (to its right Eq. 47 as printed is NEGATIVE, -K, as the paper's root is the maximum): {:.1} % of the map", 100.0 * d.eq47_negative)),
+    ];
+    entries.extend(probe_entries(&d.probes, d.tolerance));
+    legend_panel(&legend.margin(0, 8, 10, 10), &entries, 1, 13).map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+pub(super) fn draw_fig7(png: &Path, svg: &Path) -> Result<(), String> {
+    let d = fig7_data()?;
+    fig7_plot(BitMapBackend::new(png, SIZE).into_drawing_area(), &d)?;
+    fig7_plot(SVGBackend::new(svg, SIZE).into_drawing_area(), &d)
 }
