@@ -29,6 +29,10 @@ pub const FIGURES: &[(&str, &str)] = &[
         "ji2014 Fig. 7: stiffness K at the stable equilibrium over the actuator workspace (colour map, contours, symmetry line), with the dynamics' torque probe at 16 points (stiffness_grid.toml)",
     ),
     (
+        "ji2014-fig8",
+        "ji2014 Fig. 8: stiffness K at the stable equilibrium over the Cartesian workspace of D3 (colour map, contours, the paper's symmetry line x = 0), with the dynamics' torque probe at the settled D3 of stiffness_grid.toml",
+    ),
+    (
         "furet2018-fig5",
         "furet2018 Fig. 5: workspace regions by number of inverse solutions (2 or 4) for b = 2/5, 2/3, 9/10 (L = 1), with the paper's Fig. 3 point",
     ),
@@ -69,6 +73,7 @@ pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
         "ji2014-fig2" => ji2014::draw_fig2(&png, &svg)?,
         "ji2014-fig3" => ji2014::draw_fig3(&png, &svg)?,
         "ji2014-fig7" => ji2014::draw_fig7(&png, &svg)?,
+        "ji2014-fig8" => ji2014::draw_fig8(&png, &svg)?,
         "furet2018-fig5" => {
             let data = furet2018_fig5_data();
             furet2018_fig5_plot(BitMapBackend::new(&png, (1500, 560)).into_drawing_area(), &data)?;

@@ -98,3 +98,14 @@ fn ji2014_fig7_maps_the_stiffness_with_the_probe() {
     // Eq. 47 as printed is the stiffness of the maximum on most of the map (eta1 > 0).
     assert!((number_after(&svg, "is the maximum): ") - 96.2).abs() < 0.5);
 }
+
+#[test]
+fn ji2014_fig8_maps_the_stiffness_over_the_cartesian_workspace() {
+    let (_, svg) = draw("ji2014-fig8");
+    for text in ["x [m]", "y [m]", "K [N m/rad]", "It does in 145 of 145 columns", "(0 points; tolerance 1e-4)"] {
+        assert!(svg.contains(text), "the SVG has '{text}'");
+    }
+    assert!(number_after(&svg, "max relative error ") < 1e-7);
+    // The paper's "approximately symmetric about x = 0": K(x, y) and K(-x, y) differ by 23 %.
+    assert!((number_after(&svg, "differ by up to ") - 23.0).abs() < 1.5);
+}

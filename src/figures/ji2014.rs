@@ -831,3 +831,167 @@ pub(super) fn draw_fig7(png: &Path, svg: &Path) -> Result<(), String> {
     fig7_plot(BitMapBackend::new(png, SIZE).into_drawing_area(), &d)?;
     fig7_plot(SVGBackend::new(svg, SIZE).into_drawing_area(), &d)
 }
+
+/// Cartesian window of Fig. 8 [m]: the stable part of Fig. 3's workspace.
+const FIG8_X_M: (f64, f64) = (-2.1, 1.2);
+const FIG8_Y_M: (f64, f64) = (-1.2, 1.6);
+/// The paper's symmetry line of Fig. 8, x = 0 (Section 6.2).
+const PAPER_FIG8_SYMMETRY_X_M: f64 = 0.0;
+
+/// K [N m/rad] of the stable equilibrium whose D3 is `(x, y)`, from an input of the actuator
+/// workspace (closed-form IK, Eq. 48); None outside the stable workspace.
+fn k_at_d3(p: &ji::Params, l3_max: f64, x: f64, y: f64) -> Option<f64> {
+    ji::inverse_kinematics(p, x, y).into_iter().find(|s| s.stable && s.l3 <= l3_max).map(|s| s.stiffness)
+}
+
+pub(super) struct Fig8 {
+    p: ji::Params,
+    /// (x, y, K) at the cell centres inside the stable workspace.
+    cells: Vec<(f64, f64, f64)>,
+    cell: (f64, f64),
+    k_min: f64,
+    k_max: f64,
+    contours: Vec<Vec<(f64, f64)>>,
+    /// Largest |K(x, y) - K(-x, y)| / K(x, y) over the cells whose mirror image is inside too,
+    /// and how many such cells there are.
+    mirror_asymmetry: f64,
+    mirrored_cells: usize,
+    /// Columns (x) of the map, and those where K grows with y over all their cells.
+    columns: usize,
+    columns_growing_with_y: usize,
+    probes: Vec<Probe>,
+    tolerance: f64,
+}
+
+pub(super) fn fig8_data() -> Result<Fig8, String> {
+    let (p, probes, tolerance) = probe_points()?;
+    let l3_max = ji::PAPER_L3_MAX_OVER_L * p.l;
+    let cell = ((FIG8_X_M.1 - FIG8_X_M.0) / CELLS as f64, (FIG8_Y_M.1 - FIG8_Y_M.0) / CELLS as f64);
+    let (mut cells, mut mirror_asymmetry, mut mirrored_cells) = (Vec::new(), 0.0_f64, 0usize);
+    let (mut columns, mut columns_growing_with_y) = (0usize, 0usize);
+    for i in 0..CELLS {
+        let x = FIG8_X_M.0 + (i as f64 + 0.5) * cell.0;
+        let column: Vec<(f64, f64, f64)> = (0..CELLS)
+            .map(|j| FIG8_Y_M.0 + (j as f64 + 0.5) * cell.1)
+            .filter_map(|y| k_at_d3(&p, l3_max, x, y).map(|k| (x, y, k)))
+            .collect();
+        if column.len() > 1 {
+            columns += 1;
+            if column.windows(2).all(|w| w[1].2 > w[0].2) {
+                columns_growing_with_y += 1;
+            }
+        }
+        for &(x, y, k) in &column {
+            if let Some(km) = k_at_d3(&p, l3_max, 2.0 * PAPER_FIG8_SYMMETRY_X_M - x, y) {
+                mirrored_cells += 1;
+                mirror_asymmetry = mirror_asymmetry.max((k - km).abs() / k);
+            }
+        }
+        cells.extend(column);
+    }
+    let k_max = cells.iter().map(|c| c.2).fold(0.0, f64::max);
+    let k_min = (cells.iter().map(|c| c.2).fold(f64::INFINITY, f64::min) / K_CONTOUR_STEP).floor() * K_CONTOUR_STEP;
+    let mut contours = Vec::new();
+    let mut level = k_min + K_CONTOUR_STEP;
+    while level < k_max {
+        let f = |x: f64, y: f64| k_at_d3(&p, l3_max, x, y).map_or(f64::NAN, |k| k - level);
+        contours.extend(zero_contour(&f, FIG8_X_M.0..FIG8_X_M.1, FIG8_Y_M.0..FIG8_Y_M.1, CELLS));
+        level += K_CONTOUR_STEP;
+    }
+    Ok(Fig8 {
+        p,
+        cells,
+        cell,
+        k_min,
+        k_max,
+        contours,
+        mirror_asymmetry,
+        mirrored_cells,
+        columns,
+        columns_growing_with_y,
+        probes,
+        tolerance,
+    })
+}
+
+pub(super) fn fig8_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig8) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let max_err = d.probes.iter().map(|q| q.rel_error).fold(0.0, f64::max);
+    let root = root
+        .titled(
+            &format!(
+                "ji2014 Fig. 8: stiffness K over the Cartesian workspace (L = {} m, K1 = {} N/m, K2 = {} N/m)",
+                d.p.l, d.p.k1, d.p.k2
+            ),
+            ("sans-serif", 20),
+        )
+        .map_err(err)?;
+    let (top, legend) = root.split_vertically(SIZE.1 - FIG7_LEGEND_PX - 30);
+    let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
+    let mut chart = ChartBuilder::on(&plot)
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .caption(
+            format!("colour: K at the stable equilibrium with D3 = (x, y) (Eq. 42, IK by Eq. 48); probe: max relative error {max_err:.1e}"),
+            ("sans-serif", 16),
+        )
+        .build_cartesian_2d(FIG8_X_M.0..FIG8_X_M.1, FIG8_Y_M.0..FIG8_Y_M.1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x [m]")
+        .y_desc("y [m]")
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(err)?;
+    let (hx, hy) = (d.cell.0 / 2.0, d.cell.1 / 2.0);
+    chart
+        .draw_series(d.cells.iter().map(|(x, y, k)| {
+            let c = colour_at(VIRIDIS, (k - d.k_min) / (d.k_max - d.k_min));
+            Rectangle::new([(x - hx, y - hy), (x + hx, y + hy)], c.filled())
+        }))
+        .map_err(err)?;
+    for line in &d.contours {
+        chart.draw_series(LineSeries::new(line.iter().copied(), K_LINES.mix(0.6).stroke_width(1))).map_err(err)?;
+    }
+    chart
+        .draw_series(DashedLineSeries::new(
+            [(PAPER_FIG8_SYMMETRY_X_M, FIG8_Y_M.0), (PAPER_FIG8_SYMMETRY_X_M, FIG8_Y_M.1)],
+            10,
+            6,
+            PAPER_LINE.stroke_width(3).into(),
+        ))
+        .map_err(err)?;
+    draw_probes(&mut chart, &d.probes, &|q| (q.x, q.y)).map_err(err)?;
+    colour_bar(&bar, VIRIDIS, d.k_min, d.k_max, "K [N m/rad]").map_err(err)?;
+    let mut entries = vec![
+        (
+            Glyph::Line(LEGEND_WHITE_LINE, 1),
+            format!(
+                "contour lines of K every {K_CONTOUR_STEP} N m/rad. The paper: for a given x, K grows with y. It does in {} of {} columns",
+                d.columns_growing_with_y, d.columns
+            ),
+        ),
+        (
+            Glyph::Dashed(PAPER_LINE, 3),
+            format!(
+                "x = 0: the paper's symmetry line; K(x, y) and K(-x, y) differ by up to {:.0} % ({} cells with both inside)",
+                100.0 * d.mirror_asymmetry,
+                d.mirrored_cells
+            ),
+        ),
+    ];
+    entries.extend(probe_entries(&d.probes, d.tolerance));
+    legend_panel(&legend.margin(0, 8, 10, 10), &entries, 1, 13).map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+pub(super) fn draw_fig8(png: &Path, svg: &Path) -> Result<(), String> {
+    let d = fig8_data()?;
+    fig8_plot(BitMapBackend::new(png, SIZE).into_drawing_area(), &d)?;
+    fig8_plot(SVGBackend::new(svg, SIZE).into_drawing_area(), &d)
+}
