@@ -9,6 +9,7 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
 mod ji2014;
+mod mohr2011;
 
 /// The figures this command draws: (name, what it shows).
 pub const FIGURES: &[(&str, &str)] = &[
@@ -31,6 +32,10 @@ pub const FIGURES: &[(&str, &str)] = &[
     (
         "ji2014-fig8",
         "ji2014 Fig. 8: stiffness K at the stable equilibrium over the Cartesian workspace of D3 (colour map, contours, the paper's symmetry line x = 0), with the dynamics' torque probe at the settled D3 of stiffness_grid.toml",
+    ),
+    (
+        "mohr2011-fig4",
+        "mohr2011 Fig. 4: horizontal slices z = 1-5 m of the kinematic workspace (l_b = 2, l_o = 3 l_b) with the static boundary and the base triangle, with 9 x 9 points per slice settled by the dynamics",
     ),
     (
         "furet2018-fig5",
@@ -74,6 +79,7 @@ pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
         "ji2014-fig3" => ji2014::draw_fig3(&png, &svg)?,
         "ji2014-fig7" => ji2014::draw_fig7(&png, &svg)?,
         "ji2014-fig8" => ji2014::draw_fig8(&png, &svg)?,
+        "mohr2011-fig4" => mohr2011::draw_fig4(&png, &svg)?,
         "furet2018-fig5" => {
             let data = furet2018_fig5_data();
             furet2018_fig5_plot(BitMapBackend::new(&png, (1500, 560)).into_drawing_area(), &data)?;
@@ -583,6 +589,8 @@ pub(crate) enum Glyph {
     Diamond(RGBColor),
     /// A cross.
     Cross(RGBColor),
+    /// An open ring.
+    Ring(RGBColor),
     /// A filled triangle.
     Triangle(RGBColor),
     /// Text only (a note under the other entries).
@@ -641,6 +649,7 @@ fn draw_glyph<DB: DrawingBackend>(
             area.draw(&PathElement::new([pts.clone(), vec![pts[0]]].concat(), BLACK.stroke_width(1)))?;
         }
         Glyph::Cross(c) => area.draw(&Cross::new(mid, 6, c.stroke_width(2)))?,
+        Glyph::Ring(c) => area.draw(&Circle::new(mid, 8, c.stroke_width(2)))?,
         Glyph::Triangle(c) => area.draw(&TriangleMarker::new(mid, 7, c.filled()))?,
         Glyph::Note => {}
     }

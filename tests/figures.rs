@@ -109,3 +109,17 @@ fn ji2014_fig8_maps_the_stiffness_over_the_cartesian_workspace() {
     // The paper's "approximately symmetric about x = 0": K(x, y) and K(-x, y) differ by 23 %.
     assert!((number_after(&svg, "differ by up to ") - 23.0).abs() < 1.5);
 }
+
+#[test]
+fn mohr2011_fig4_shows_the_slices_and_the_dynamics_verdict() {
+    let (_, svg) = draw("mohr2011-fig4");
+    for text in ["x [m]", "y [m]", "kinematic workspace (Eq. 17-18, z &gt; 0)", "base triangle A1A2A3"] {
+        assert!(svg.contains(text), "the SVG has '{text}'");
+    }
+    // The slice z = 3 m is Fig. 5's: kinematic 31.0 m^2, static 27.2 m^2, every point agrees.
+    assert!(svg.contains("z = 3 m: kinematic 31.0 m^2 (static 27.2 m^2); dynamics agree 100 %"));
+    // 9 x 9 points per slice at z = 1-5 m: 188 can be assembled, 179 agree (the others sit on a
+    // boundary and are not at rest in the settle time).
+    assert_eq!(number_after(&svg, "9 x 9 points per slice: "), 179.0);
+    assert_eq!(number_after(&svg, "9 x 9 points per slice: 179 of "), 188.0);
+}
