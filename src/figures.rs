@@ -38,6 +38,10 @@ pub const FIGURES: &[(&str, &str)] = &[
         "mohr2011 Fig. 4: horizontal slices z = 1-5 m of the kinematic workspace (l_b = 2, l_o = 3 l_b) with the static boundary and the base triangle, with 9 x 9 points per slice settled by the dynamics",
     ),
     (
+        "mohr2011-fig6",
+        "mohr2011 Fig. 6: the static workspace (l_b = 2, l_o = 3 l_b) in the vertical slices x = 0 and y = 0, with 9 x 9 points per slice settled by the dynamics",
+    ),
+    (
         "furet2018-fig5",
         "furet2018 Fig. 5: workspace regions by number of inverse solutions (2 or 4) for b = 2/5, 2/3, 9/10 (L = 1), with the paper's Fig. 3 point",
     ),
@@ -80,6 +84,7 @@ pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
         "ji2014-fig7" => ji2014::draw_fig7(&png, &svg)?,
         "ji2014-fig8" => ji2014::draw_fig8(&png, &svg)?,
         "mohr2011-fig4" => mohr2011::draw_fig4(&png, &svg)?,
+        "mohr2011-fig6" => mohr2011::draw_fig6(&png, &svg)?,
         "furet2018-fig5" => {
             let data = furet2018_fig5_data();
             furet2018_fig5_plot(BitMapBackend::new(&png, (1500, 560)).into_drawing_area(), &data)?;

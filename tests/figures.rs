@@ -123,3 +123,16 @@ fn mohr2011_fig4_shows_the_slices_and_the_dynamics_verdict() {
     assert_eq!(number_after(&svg, "9 x 9 points per slice: "), 179.0);
     assert_eq!(number_after(&svg, "9 x 9 points per slice: 179 of "), 188.0);
 }
+
+#[test]
+fn mohr2011_fig6_shows_two_vertical_slices_and_the_dynamics_verdict() {
+    let (_, svg) = draw("mohr2011-fig6");
+    for text in ["z [m]", "static workspace (Eq. 17-18 and 29-31)", "x = 0: static", "y = 0: static"] {
+        assert!(svg.contains(text), "the SVG has '{text}'");
+    }
+    // The static workspace reaches z = 5.51 m on the Z axis (spheres of radius l_o = 6 m about
+    // 2 a_i, |2 a_i| = 2.31 m: sqrt(36 - 2.31^2) = 5.54 m, less half a cell).
+    assert!((number_after(&svg, "up to z = ") - 5.51).abs() < 0.03);
+    assert_eq!(number_after(&svg, "9 x 9 points per slice: "), 111.0);
+    assert_eq!(number_after(&svg, "9 x 9 points per slice: 111 of "), 116.0);
+}

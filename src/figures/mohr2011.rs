@@ -1,6 +1,7 @@
 //! mohr2011's workspace figures: Fig. 4 (horizontal slices of the kinematic workspace, Eq.
-//! 17-18, at several heights) and Fig. 6 (the static workspace, Eq. 29-31, in two vertical
-//! slices), each with small dynamics grids from `scenarios/mohr2011/workspace_grid_small.toml`.
+//! 17-18, at several heights) and Fig. 6 (the paper's 3D view of the static workspace, Eq.
+//! 29-31, drawn as two vertical slices), each with small dynamics grids from
+//! `scenarios/mohr2011/workspace_grid_small.toml`.
 
 use super::{legend_panel, zero_contour, Glyph};
 use crate::mechanisms::mohr2011::analytic::{self as mohr, Region};
@@ -290,4 +291,187 @@ pub(super) fn draw_fig4(png: &Path, svg: &Path) -> Result<(), String> {
     let d = fig4_data()?;
     fig4_plot(BitMapBackend::new(png, FIG4_SIZE).into_drawing_area(), &d)?;
     fig4_plot(SVGBackend::new(svg, FIG4_SIZE).into_drawing_area(), &d)
+}
+
+// ---------------------------------------------------------------------------
+// Fig. 6: the static workspace, in two vertical slices.
+// ---------------------------------------------------------------------------
+
+/// The two vertical planes of Fig. 6: x = 0 (the mechanism's plane of symmetry, through A3 and
+/// the Z axis) and y = 0 (through the centroid O, parallel to A1A2).
+#[derive(Clone, Copy)]
+enum Plane {
+    X0,
+    Y0,
+}
+
+impl Plane {
+    /// The centroid at horizontal coordinate `h` and height `z` [m].
+    fn point(self, h: f64, z: f64) -> Vector3<f64> {
+        match self {
+            Plane::X0 => Vector3::new(0.0, h, z),
+            Plane::Y0 => Vector3::new(h, 0.0, z),
+        }
+    }
+    /// The horizontal coordinate of a centroid in this plane.
+    fn horizontal(self, c: &Vector3<f64>) -> f64 {
+        match self {
+            Plane::X0 => c.y,
+            Plane::Y0 => c.x,
+        }
+    }
+    fn name(self) -> &'static str {
+        match self {
+            Plane::X0 => "x = 0",
+            Plane::Y0 => "y = 0",
+        }
+    }
+    fn axis(self) -> &'static str {
+        match self {
+            Plane::X0 => "y [m]",
+            Plane::Y0 => "x [m]",
+        }
+    }
+}
+
+/// Height of the vertical slices [m] (the kinematic workspace ends below 5.6 m) and the heights
+/// of the dynamics grid [m] (z = 0 is the singular base plane, Section 4.2).
+const FIG6_Z_MAX_M: f64 = 6.0;
+const FIG6_GRID_Z_M: (f64, f64) = (0.6, 5.4);
+const FIG6_SIZE: (u32, u32) = (1300, 860);
+const FIG6_LEGEND_PX: u32 = 150;
+
+struct VerticalSlice {
+    plane: Plane,
+    /// (horizontal, z, region) at the cell centres inside the kinematic workspace.
+    cells: Vec<(f64, f64, Region)>,
+    cell: (f64, f64),
+    /// Areas [m^2] of the kinematic and the static workspace in the slice.
+    areas_m2: (f64, f64),
+    /// Highest point [m] of the static workspace in the slice.
+    static_top_m: f64,
+    grid: Grid,
+}
+
+pub(super) struct Fig6 {
+    p: mohr::Params,
+    slices: Vec<VerticalSlice>,
+}
+
+fn fig6_data() -> Result<Fig6, String> {
+    let p = paper_params();
+    let cell = (2.0 * HALF_WIDTH_M / CELLS as f64, FIG6_Z_MAX_M / CELLS as f64);
+    let g = GRID_HALF_WIDTH_M;
+    let mut slices = Vec::new();
+    for plane in [Plane::X0, Plane::Y0] {
+        let mut cells = Vec::new();
+        let (mut kinematic, mut statics, mut static_top_m) = (0usize, 0usize, 0.0_f64);
+        for i in 0..CELLS {
+            for j in 0..CELLS {
+                let (h, z) = (-HALF_WIDTH_M + (i as f64 + 0.5) * cell.0, (j as f64 + 0.5) * cell.1);
+                let region = mohr::classify(&p, &plane.point(h, z)).region;
+                if region != Region::OutsideKinematic {
+                    kinematic += 1;
+                    if region == Region::Static {
+                        statics += 1;
+                        static_top_m = static_top_m.max(z);
+                    }
+                    cells.push((h, z, region));
+                }
+            }
+        }
+        let fixed = range_toml(0.0, 0.0, 1);
+        let across = range_toml(-g, g, GRID_COUNT);
+        let (x, y) = match plane {
+            Plane::X0 => (fixed, across),
+            Plane::Y0 => (across, fixed),
+        };
+        let grid = format!("{{ x = {x}, y = {y}, z = {} }}", range_toml(FIG6_GRID_Z_M.0, FIG6_GRID_Z_M.1, GRID_COUNT));
+        let area = cell.0 * cell.1;
+        slices.push(VerticalSlice {
+            plane,
+            cells,
+            cell,
+            areas_m2: (kinematic as f64 * area, statics as f64 * area),
+            static_top_m,
+            grid: dynamics_grid(&grid)?,
+        });
+    }
+    Ok(Fig6 { p, slices })
+}
+
+const STATIC: RGBColor = RGBColor(170, 215, 255);
+const KINEMATIC_ONLY: RGBColor = RGBColor(225, 225, 225);
+
+fn fig6_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig6) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled(
+            &format!(
+                "mohr2011 Fig. 6: the static workspace in two vertical slices (l_b = {} m, l_o = {} m)",
+                d.p.lb, d.p.lo
+            ),
+            ("sans-serif", 20),
+        )
+        .map_err(err)?;
+    let (top, legend) = root.split_vertically(FIG6_SIZE.1 - FIG6_LEGEND_PX - 30);
+    let h = HALF_WIDTH_M;
+    for (area, s) in top.split_evenly((1, 2)).iter().zip(&d.slices) {
+        let mut chart = ChartBuilder::on(area)
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .caption(
+                format!(
+                    "{}: static {:.1} m^2 of kinematic {:.1} m^2, up to z = {:.2} m; dynamics agree {:.0} %",
+                    s.plane.name(),
+                    s.areas_m2.1,
+                    s.areas_m2.0,
+                    s.static_top_m,
+                    s.grid.agreement_percent()
+                ),
+                ("sans-serif", 15),
+            )
+            .build_cartesian_2d(-h..h, 0.0..FIG6_Z_MAX_M)
+            .map_err(err)?;
+        chart.configure_mesh().disable_mesh().x_desc(s.plane.axis()).y_desc("z [m]").draw().map_err(err)?;
+        let (hx, hz) = (s.cell.0 / 2.0, s.cell.1 / 2.0);
+        chart
+            .draw_series(s.cells.iter().map(|(x, z, r)| {
+                let c = if *r == Region::Static { STATIC } else { KINEMATIC_ONLY };
+                Rectangle::new([(x - hx, z - hz), (x + hx, z + hz)], c.filled())
+            }))
+            .map_err(err)?;
+        // The base A1A2A3 seen edge-on: its extent in this plane.
+        let base: Vec<f64> = mohr::base_nodes(&d.p).iter().map(|a| s.plane.horizontal(a)).collect();
+        let (lo, hi) = base.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+        chart.draw_series(LineSeries::new([(lo, 0.0), (hi, 0.0)], BASE.stroke_width(5))).map_err(err)?;
+        let plane = s.plane;
+        draw_grid(&mut chart, &s.grid, &move |c| (plane.horizontal(c), c.z)).map_err(err)?;
+    }
+    let (points, agree) = d
+        .slices
+        .iter()
+        .flat_map(|s| &s.grid.points)
+        .fold((0, 0), |(n, a), q| (n + 1, a + usize::from(q.analytic_static == q.dynamics_static)));
+    let entries = vec![
+        (Glyph::Fill(STATIC), "static workspace (Eq. 17-18 and 29-31)".to_string()),
+        (Glyph::Fill(KINEMATIC_ONLY), "kinematic only: a cable pair would be slack".to_string()),
+        (Glyph::Line(BASE, 5), "the base triangle A1A2A3, edge-on (z = 0)".to_string()),
+        (Glyph::Note, format!("9 x 9 points per slice: {agree} of {points} assembled points agree")),
+        (Glyph::Dot(HELD), "dynamics: held there, every cable taut, within 1e-9".to_string()),
+        (Glyph::Cross(NOT_HELD), "dynamics: assembled, but a cable pair went slack".to_string()),
+        (Glyph::Ring(DISAGREE), format!("differs from the analytic class: not at rest in {SETTLE_MAX_TIME_S} s")),
+        (Glyph::Dot(NOT_ASSEMBLED), "cannot be assembled: a spring longer than l_o".to_string()),
+    ];
+    legend_panel(&legend.margin(0, 8, 10, 10), &entries, 2, 14).map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+pub(super) fn draw_fig6(png: &Path, svg: &Path) -> Result<(), String> {
+    let d = fig6_data()?;
+    fig6_plot(BitMapBackend::new(png, FIG6_SIZE).into_drawing_area(), &d)?;
+    fig6_plot(SVGBackend::new(svg, FIG6_SIZE).into_drawing_area(), &d)
 }
