@@ -8,6 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
+mod furet2018;
 mod ji2014;
 mod mohr2011;
 
@@ -40,6 +41,10 @@ pub const FIGURES: &[(&str, &str)] = &[
     (
         "mohr2011-fig6",
         "mohr2011 Fig. 6: the static workspace (l_b = 2, l_o = 3 l_b) in the vertical slices x = 0 and y = 0, with 9 x 9 points per slice settled by the dynamics",
+    ),
+    (
+        "furet2018-fig4",
+        "furet2018 Fig. 4: the two aspects and the singular curves (theta1 = -theta2 +- pi, Eq. 14) in the joint space (L = 1, b = 2/3), where the printed Eq. 13 differs, and Fig. 3's four solutions with non-singular paths",
     ),
     (
         "furet2018-fig5",
@@ -85,6 +90,7 @@ pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
         "ji2014-fig8" => ji2014::draw_fig8(&png, &svg)?,
         "mohr2011-fig4" => mohr2011::draw_fig4(&png, &svg)?,
         "mohr2011-fig6" => mohr2011::draw_fig6(&png, &svg)?,
+        "furet2018-fig4" => furet2018::draw_fig4(&png, &svg)?,
         "furet2018-fig5" => {
             let data = furet2018_fig5_data();
             furet2018_fig5_plot(BitMapBackend::new(&png, (1500, 560)).into_drawing_area(), &data)?;

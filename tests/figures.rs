@@ -136,3 +136,20 @@ fn mohr2011_fig6_shows_two_vertical_slices_and_the_dynamics_verdict() {
     assert_eq!(number_after(&svg, "9 x 9 points per slice: "), 111.0);
     assert_eq!(number_after(&svg, "9 x 9 points per slice: 111 of "), 116.0);
 }
+
+#[test]
+fn furet2018_fig4_shows_the_aspects_and_where_eq13_differs() {
+    let (_, svg) = draw("furet2018-fig4");
+    for text in ["theta1 [rad]", "theta2 [rad]", "zero set of Eq. 13 as printed", "two in each (cuspidal)"] {
+        assert!(svg.contains(text), "the SVG has '{text}'");
+    }
+    // The derived det J vanishes on both families; the printed Eq. 13 does not (FINDINGS.md:
+    // -0.0859605 on the folded line at theta2 = 0.5 rad).
+    assert!(number_after(&svg, "|det J| &lt;= ") < 1e-12);
+    assert!((number_after(&svg, "Eq. 13 as printed gives ") + 0.0859605).abs() < 1e-7);
+    // Two aspects of about equal size; the printed form has the wrong sign on 5.8 % of them.
+    assert!((number_after(&svg, "aspect det J &gt; 0: ") - 50.0).abs() < 0.5);
+    assert!((number_after(&svg, "has the other sign (") - 5.8).abs() < 0.2);
+    // The non-singular paths of FINDINGS.md between the two solutions of each aspect.
+    assert!((number_after(&svg, "smallest |det J| ") - 0.1349).abs() < 1e-4);
+}
