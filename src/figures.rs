@@ -15,16 +15,16 @@ mod mohr2011;
 /// The figures this command draws: (name, what it shows).
 pub const FIGURES: &[(&str, &str)] = &[
     (
-        "ji2014-fig4",
-        "ji2014 Fig. 4-6: energy U, torque tau and stiffness K against theta2 (L3 = 6, K1 = 100, K2 = 10, theta1 = pi/10), with the equilibrium the dynamics settled on",
-    ),
-    (
         "ji2014-fig2",
         "ji2014 Fig. 2: actuator workspace (theta1, L3) with det J and the singular curves i-vi of Section 4.2 as derived (which printed ones are not singular), with the 110 points of grid.toml settled by the dynamics",
     ),
     (
         "ji2014-fig3",
         "ji2014 Fig. 3: Cartesian workspace of D3 (how many stable inputs reach each point) with the images of the curves and the printed Eq. 34-37, with the settled D3 of grid.toml",
+    ),
+    (
+        "ji2014-fig4",
+        "ji2014 Fig. 4-6: energy U, torque tau and stiffness K against theta2 (L3 = 6, K1 = 100, K2 = 10, theta1 = pi/10), with the equilibrium the dynamics settled on",
     ),
     (
         "ji2014-fig7",
@@ -39,6 +39,10 @@ pub const FIGURES: &[(&str, &str)] = &[
         "mohr2011 Fig. 4: horizontal slices z = 1-5 m of the kinematic workspace (l_b = 2, l_o = 3 l_b) with the static boundary and the base triangle, with 9 x 9 points per slice settled by the dynamics",
     ),
     (
+        "mohr2011-fig5",
+        "mohr2011 Fig. 5: the horizontal slice z = 3 m of the static and kinematic workspaces (l_b = 2, l_o = 3 l_b), with a 9 x 9 grid classified by the dynamics",
+    ),
+    (
         "mohr2011-fig6",
         "mohr2011 Fig. 6: the static workspace (l_b = 2, l_o = 3 l_b) in the vertical slices x = 0 and y = 0, with 9 x 9 points per slice settled by the dynamics",
     ),
@@ -49,10 +53,6 @@ pub const FIGURES: &[(&str, &str)] = &[
     (
         "furet2018-fig5",
         "furet2018 Fig. 5: workspace regions by number of inverse solutions (2 or 4) for b = 2/5, 2/3, 9/10 (L = 1), with the paper's Fig. 3 point",
-    ),
-    (
-        "mohr2011-fig5",
-        "mohr2011 Fig. 5: the horizontal slice z = 3 m of the static and kinematic workspaces (l_b = 2, l_o = 3 l_b), with a 9 x 9 grid classified by the dynamics",
     ),
 ];
 
@@ -288,13 +288,12 @@ fn mohr2011_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig5
     chart.configure_mesh().x_desc("x [m]").y_desc("y [m]").draw().map_err(err)?;
     let static_c = RGBColor(170, 215, 255);
     let kin_c = RGBColor(235, 235, 235);
-    let half = d.cell / 2.0;
-    chart
-        .draw_series(d.cells.iter().filter(|(_, _, r)| *r != Region::OutsideKinematic).map(|(x, y, r)| {
-            let c = if *r == Region::Static { static_c } else { kin_c };
-            Rectangle::new([(x - half, y - half), (x + half, y + half)], c.filled())
-        }))
-        .map_err(err)?;
+    let colours = d
+        .cells
+        .iter()
+        .filter(|(_, _, r)| *r != Region::OutsideKinematic)
+        .map(|(x, y, r)| (*x, *y, if *r == Region::Static { static_c } else { kin_c }));
+    chart.draw_series(cell_runs(colours, (d.cell, d.cell))).map_err(err)?;
     // Legend entries for the background classes.
     swatch(&mut chart, "static workspace (Eq. 29-31)", static_c).map_err(err)?;
     swatch(&mut chart, "kinematic only (a cable pair slack)", kin_c).map_err(err)?;
@@ -364,7 +363,6 @@ fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fur
         .map_err(err)?;
     let two = RGBColor(190, 220, 250);
     let four = RGBColor(250, 170, 120);
-    let half = d.cell / 2.0;
     for (area, (b, cells, (f2, f4))) in root.split_evenly((1, 3)).iter().zip(&d.panels) {
         let mut chart = ChartBuilder::on(area)
             .margin(10)
@@ -378,12 +376,9 @@ fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fur
             .build_cartesian_2d(-2.0..2.0, -2.0..2.8)
             .map_err(err)?;
         chart.configure_mesh().disable_mesh().x_desc("x [m]").y_desc("y [m]").draw().map_err(err)?;
-        chart
-            .draw_series(cells.iter().filter(|c| c.2 == 2 || c.2 == 4).map(|(x, y, n)| {
-                let c = if *n == 4 { four } else { two };
-                Rectangle::new([(x - half, y - half), (x + half, y + half)], c.filled())
-            }))
-            .map_err(err)?;
+        let colours =
+            cells.iter().filter(|c| c.2 == 2 || c.2 == 4).map(|(x, y, n)| (*x, *y, if *n == 4 { four } else { two }));
+        chart.draw_series(cell_runs(colours, (d.cell, d.cell))).map_err(err)?;
         swatch(&mut chart, "2 solutions", two).map_err(err)?;
         swatch(&mut chart, "4 solutions", four).map_err(err)?;
         if (*b - 2.0 / 3.0).abs() < 1e-12 {
@@ -665,4 +660,23 @@ fn draw_glyph<DB: DrawingBackend>(
         Glyph::Note => {}
     }
     Ok(())
+}
+
+/// Map cells (centre x, centre y, colour), in column order (x outer, y rising), merged into
+/// vertical runs of one colour: the same picture with far fewer rectangles (the SVG files
+/// shrink by the run length). `cell` is the cell size (x, y).
+pub(crate) fn cell_runs(
+    cells: impl IntoIterator<Item = (f64, f64, RGBColor)>,
+    cell: (f64, f64),
+) -> Vec<Rectangle<(f64, f64)>> {
+    let (hx, hy) = (cell.0 / 2.0, cell.1 / 2.0);
+    // A run: column x, first and last centre y, colour.
+    let mut runs: Vec<(f64, f64, f64, RGBColor)> = Vec::new();
+    for (x, y, c) in cells {
+        match runs.last_mut() {
+            Some(r) if (r.0 - x).abs() < 1e-9 * hx && r.3 == c && (y - r.2 - cell.1).abs() < 1e-6 * cell.1 => r.2 = y,
+            _ => runs.push((x, y, y, c)),
+        }
+    }
+    runs.into_iter().map(|(x, y0, y1, c)| Rectangle::new([(x - hx, y0 - hy), (x + hx, y1 + hy)], c.filled())).collect()
 }

@@ -1,7 +1,7 @@
 //! furet2018's Fig. 4: the singular curves and the two aspects in the joint space
 //! (theta1, theta2), from the derived det J, with where the printed Eq. 13 differs.
 
-use super::{legend_panel, zero_contour, Glyph};
+use super::{cell_runs, legend_panel, zero_contour, Glyph};
 use crate::mechanisms::furet2018::analytic as furet;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -173,14 +173,11 @@ fn fig4_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig4) -> Resu
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(err)?;
-    let h = d.cell / 2.0;
-    chart
-        .draw_series(d.cells.iter().map(|(t1, t2, aspect, wrong)| {
-            let base = if *aspect > 0 { PLUS } else { MINUS };
-            let c = if *wrong { darken(base, WRONG_SIGN_SHADE) } else { base };
-            Rectangle::new([(t1 - h, t2 - h), (t1 + h, t2 + h)], c.filled())
-        }))
-        .map_err(err)?;
+    let colours = d.cells.iter().map(|(t1, t2, aspect, wrong)| {
+        let base = if *aspect > 0 { PLUS } else { MINUS };
+        (*t1, *t2, if *wrong { darken(base, WRONG_SIGN_SHADE) } else { base })
+    });
+    chart.draw_series(cell_runs(colours, (d.cell, d.cell))).map_err(err)?;
     for line in &d.printed_zero {
         chart
             .draw_series(DashedLineSeries::new(line.iter().copied(), 7, 5, PRINTED.stroke_width(2).into()))

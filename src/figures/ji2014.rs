@@ -3,7 +3,7 @@
 //! points of `scenarios/ji2014/grid.toml`), Fig. 7-8 (the stiffness over both workspaces, and the
 //! torque probe of `scenarios/ji2014/stiffness_grid.toml`).
 
-use super::{colour_at, colour_bar, legend_panel, zero_contour, Glyph, LIGHT_BLUES, VIRIDIS};
+use super::{cell_runs, colour_at, colour_bar, legend_panel, zero_contour, Glyph, LIGHT_BLUES, VIRIDIS};
 use crate::mechanisms::ji2014::analytic as ji;
 use crate::mechanisms::ji2014::PAPER_ROOT_MARK;
 use crate::run::{run, RunOptions};
@@ -217,13 +217,8 @@ pub(super) fn fig2_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fi
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(err)?;
-    let (hx, hy) = (d.cell.0 / 2.0, d.cell.1 / 2.0);
-    chart
-        .draw_series(d.cells.iter().map(|(t1, l3, det)| {
-            let c = colour_at(LIGHT_BLUES, det / d.det_max);
-            Rectangle::new([(t1 - hx, l3 - hy), (t1 + hx, l3 + hy)], c.filled())
-        }))
-        .map_err(err)?;
+    let colours = d.cells.iter().map(|(t1, l3, det)| (*t1, *l3, colour_at(LIGHT_BLUES, det / d.det_max)));
+    chart.draw_series(cell_runs(colours, d.cell)).map_err(err)?;
     // Curve vi (Eq. 31) and ii (Eq. 27): the edges of the range, ii dashed (not singular).
     chart.draw_series(LineSeries::new([(0.0, d.l3_max), (PI, d.l3_max)], CURVE_VI.stroke_width(3))).map_err(err)?;
     for t1 in [0.0, PI] {
@@ -462,17 +457,15 @@ pub(super) fn fig3_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fi
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(err)?;
-    let (hx, hy) = (d.cell.0 / 2.0, d.cell.1 / 2.0);
-    chart
-        .draw_series(d.cells.iter().map(|(x, y, r)| {
-            let c = match r {
-                Reach::StableOnce => REACH_ONCE,
-                Reach::StableTwice => REACH_TWICE,
-                Reach::OnlyUnstable => REACH_UNSTABLE,
-            };
-            Rectangle::new([(x - hx, y - hy), (x + hx, y + hy)], c.filled())
-        }))
-        .map_err(err)?;
+    let colours = d.cells.iter().map(|(x, y, r)| {
+        let c = match r {
+            Reach::StableOnce => REACH_ONCE,
+            Reach::StableTwice => REACH_TWICE,
+            Reach::OnlyUnstable => REACH_UNSTABLE,
+        };
+        (*x, *y, c)
+    });
+    chart.draw_series(cell_runs(colours, d.cell)).map_err(err)?;
     // The printed Cartesian curves (Eq. 34, 36, 37), thin dashed.
     let dashed = |pts: Vec<(f64, f64)>, c: RGBColor| DashedLineSeries::new(pts, 8, 5, c.stroke_width(2).into());
     chart.draw_series(dashed(circle(d.p.l), CURVE_I)).map_err(err)?;
@@ -782,13 +775,8 @@ pub(super) fn fig7_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fi
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(err)?;
-    let (hx, hy) = (d.cell.0 / 2.0, d.cell.1 / 2.0);
-    chart
-        .draw_series(d.cells.iter().map(|(t1, l3, k)| {
-            let c = colour_at(VIRIDIS, (k - d.k_min) / (d.k_max - d.k_min));
-            Rectangle::new([(t1 - hx, l3 - hy), (t1 + hx, l3 + hy)], c.filled())
-        }))
-        .map_err(err)?;
+    let colours = d.cells.iter().map(|(t1, l3, k)| (*t1, *l3, colour_at(VIRIDIS, (k - d.k_min) / (d.k_max - d.k_min))));
+    chart.draw_series(cell_runs(colours, d.cell)).map_err(err)?;
     for line in &d.contours {
         chart.draw_series(LineSeries::new(line.iter().copied(), K_LINES.mix(0.6).stroke_width(1))).map_err(err)?;
     }
@@ -947,13 +935,8 @@ pub(super) fn fig8_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fi
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(err)?;
-    let (hx, hy) = (d.cell.0 / 2.0, d.cell.1 / 2.0);
-    chart
-        .draw_series(d.cells.iter().map(|(x, y, k)| {
-            let c = colour_at(VIRIDIS, (k - d.k_min) / (d.k_max - d.k_min));
-            Rectangle::new([(x - hx, y - hy), (x + hx, y + hy)], c.filled())
-        }))
-        .map_err(err)?;
+    let colours = d.cells.iter().map(|(x, y, k)| (*x, *y, colour_at(VIRIDIS, (k - d.k_min) / (d.k_max - d.k_min))));
+    chart.draw_series(cell_runs(colours, d.cell)).map_err(err)?;
     for line in &d.contours {
         chart.draw_series(LineSeries::new(line.iter().copied(), K_LINES.mix(0.6).stroke_width(1))).map_err(err)?;
     }

@@ -3,7 +3,7 @@
 //! 29-31, drawn as two vertical slices), each with small dynamics grids from
 //! `scenarios/mohr2011/workspace_grid_small.toml`.
 
-use super::{legend_panel, zero_contour, Glyph};
+use super::{cell_runs, legend_panel, zero_contour, Glyph};
 use crate::mechanisms::mohr2011::analytic::{self as mohr, Region};
 use crate::scenario;
 use nalgebra::Vector3;
@@ -207,7 +207,6 @@ fn fig4_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig4) -> Resu
         .map_err(err)?;
     let areas = root.split_evenly((2, 3));
     let h = HALF_WIDTH_M;
-    let half = d.cell / 2.0;
     for (area, s) in areas.iter().zip(&d.slices) {
         let mut chart = ChartBuilder::on(area)
             .margin(8)
@@ -227,11 +226,7 @@ fn fig4_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig4) -> Resu
             .map_err(err)?;
         chart.configure_mesh().disable_mesh().x_desc("x [m]").y_desc("y [m]").draw().map_err(err)?;
         chart
-            .draw_series(
-                s.cells
-                    .iter()
-                    .map(|(x, y)| Rectangle::new([(x - half, y - half), (x + half, y + half)], KINEMATIC.filled())),
-            )
+            .draw_series(cell_runs(s.cells.iter().map(|(x, y)| (*x, *y, KINEMATIC)), (d.cell, d.cell)))
             .map_err(err)?;
         for line in &s.static_boundary {
             chart
@@ -436,13 +431,9 @@ fn fig6_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig6) -> Resu
             .build_cartesian_2d(-h..h, 0.0..FIG6_Z_MAX_M)
             .map_err(err)?;
         chart.configure_mesh().disable_mesh().x_desc(s.plane.axis()).y_desc("z [m]").draw().map_err(err)?;
-        let (hx, hz) = (s.cell.0 / 2.0, s.cell.1 / 2.0);
-        chart
-            .draw_series(s.cells.iter().map(|(x, z, r)| {
-                let c = if *r == Region::Static { STATIC } else { KINEMATIC_ONLY };
-                Rectangle::new([(x - hx, z - hz), (x + hx, z + hz)], c.filled())
-            }))
-            .map_err(err)?;
+        let colours =
+            s.cells.iter().map(|(x, z, r)| (*x, *z, if *r == Region::Static { STATIC } else { KINEMATIC_ONLY }));
+        chart.draw_series(cell_runs(colours, s.cell)).map_err(err)?;
         // The base A1A2A3 seen edge-on: its extent in this plane.
         let base: Vec<f64> = mohr::base_nodes(&d.p).iter().map(|a| s.plane.horizontal(a)).collect();
         let (lo, hi) = base.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
