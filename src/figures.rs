@@ -8,13 +8,48 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
+mod furet2018;
+mod ji2014;
 mod manriquez2019;
+mod mohr2011;
 
 /// The figures this command draws: (name, what it shows).
 pub const FIGURES: &[(&str, &str)] = &[
     (
+        "ji2014-fig2",
+        "ji2014 Fig. 2: actuator workspace (theta1, L3) with det J and the singular curves i-vi of Section 4.2 as derived (which printed ones are not singular), with the 110 points of grid.toml settled by the dynamics",
+    ),
+    (
+        "ji2014-fig3",
+        "ji2014 Fig. 3: Cartesian workspace of D3 (how many stable inputs reach each point) with the images of the curves and the printed Eq. 34-37, with the settled D3 of grid.toml",
+    ),
+    (
         "ji2014-fig4",
         "ji2014 Fig. 4-6: energy U, torque tau and stiffness K against theta2 (L3 = 6, K1 = 100, K2 = 10, theta1 = pi/10), with the equilibrium the dynamics settled on",
+    ),
+    (
+        "ji2014-fig7",
+        "ji2014 Fig. 7: stiffness K at the stable equilibrium over the actuator workspace (colour map, contours, symmetry line), with the dynamics' torque probe at 16 points (stiffness_grid.toml)",
+    ),
+    (
+        "ji2014-fig8",
+        "ji2014 Fig. 8: stiffness K at the stable equilibrium over the Cartesian workspace of D3 (colour map, contours, the paper's symmetry line x = 0), with the dynamics' torque probe at the settled D3 of stiffness_grid.toml",
+    ),
+    (
+        "mohr2011-fig4",
+        "mohr2011 Fig. 4: horizontal slices z = 1-5 m of the kinematic workspace (l_b = 2, l_o = 3 l_b) with the static boundary and the base triangle, with 9 x 9 points per slice settled by the dynamics",
+    ),
+    (
+        "mohr2011-fig5",
+        "mohr2011 Fig. 5: the horizontal slice z = 3 m of the static and kinematic workspaces (l_b = 2, l_o = 3 l_b), with a 9 x 9 grid classified by the dynamics",
+    ),
+    (
+        "mohr2011-fig6",
+        "mohr2011 Fig. 6: the static workspace (l_b = 2, l_o = 3 l_b) in the vertical slices x = 0 and y = 0, with 9 x 9 points per slice settled by the dynamics",
+    ),
+    (
+        "furet2018-fig4",
+        "furet2018 Fig. 4: the two aspects and the singular curves (theta1 = -theta2 +- pi, Eq. 14) in the joint space (L = 1, b = 2/3), where the printed Eq. 13 differs, and Fig. 3's four solutions with non-singular paths",
     ),
     (
         "furet2018-fig5",
@@ -23,10 +58,6 @@ pub const FIGURES: &[(&str, &str)] = &[
     (
         "manriquez2019-fig6",
         "manriquez2019 Fig. 6-7: the form-finding grid of Table 2 as positions of M, in 3D and in the Y-Z plane, classified by the statics, with the dynamics' verdict on 41 x 41 poses",
-    ),
-    (
-        "mohr2011-fig5",
-        "mohr2011 Fig. 5: the horizontal slice z = 3 m of the static and kinematic workspaces (l_b = 2, l_o = 3 l_b), with a 9 x 9 grid classified by the dynamics",
     ),
 ];
 
@@ -58,8 +89,15 @@ pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
             ji2014_fig4_plot(BitMapBackend::new(&png, SIZE).into_drawing_area(), &data)?;
             ji2014_fig4_plot(SVGBackend::new(&svg, SIZE).into_drawing_area(), &data)?;
         }
+        "ji2014-fig2" => ji2014::draw_fig2(&png, &svg)?,
+        "ji2014-fig3" => ji2014::draw_fig3(&png, &svg)?,
+        "ji2014-fig7" => ji2014::draw_fig7(&png, &svg)?,
+        "ji2014-fig8" => ji2014::draw_fig8(&png, &svg)?,
+        "mohr2011-fig4" => mohr2011::draw_fig4(&png, &svg)?,
+        "mohr2011-fig6" => mohr2011::draw_fig6(&png, &svg)?,
+        "furet2018-fig4" => furet2018::draw_fig4(&png, &svg)?,
         "furet2018-fig5" => {
-            let data = furet2018_fig5_data();
+            let data = furet2018_fig5_data()?;
             furet2018_fig5_plot(BitMapBackend::new(&png, (1500, 560)).into_drawing_area(), &data)?;
             furet2018_fig5_plot(SVGBackend::new(&svg, (1500, 560)).into_drawing_area(), &data)?;
         }
@@ -260,13 +298,12 @@ fn mohr2011_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig5
     chart.configure_mesh().x_desc("x [m]").y_desc("y [m]").draw().map_err(err)?;
     let static_c = RGBColor(170, 215, 255);
     let kin_c = RGBColor(235, 235, 235);
-    let half = d.cell / 2.0;
-    chart
-        .draw_series(d.cells.iter().filter(|(_, _, r)| *r != Region::OutsideKinematic).map(|(x, y, r)| {
-            let c = if *r == Region::Static { static_c } else { kin_c };
-            Rectangle::new([(x - half, y - half), (x + half, y + half)], c.filled())
-        }))
-        .map_err(err)?;
+    let colours = d
+        .cells
+        .iter()
+        .filter(|(_, _, r)| *r != Region::OutsideKinematic)
+        .map(|(x, y, r)| (*x, *y, if *r == Region::Static { static_c } else { kin_c }));
+    chart.draw_series(cell_runs(colours, (d.cell, d.cell))).map_err(err)?;
     // Legend entries for the background classes.
     swatch(&mut chart, "static workspace (Eq. 29-31)", static_c).map_err(err)?;
     swatch(&mut chart, "kinematic only (a cable pair slack)", kin_c).map_err(err)?;
@@ -302,9 +339,27 @@ struct FuretFig5 {
     /// Per b: (b, cells (x, y, count), area fractions (2, 4)).
     panels: Vec<(f64, Vec<(f64, f64, usize)>, (f64, f64))>,
     cell: f64,
+    /// Dynamics at b = 2/3 (`scenarios/furet2018/workspace_grid.toml`): per end point (x, y),
+    /// the number of inverse solutions the simulation reached within the checks' tolerance.
+    reached: Vec<(f64, f64, usize)>,
 }
 
-fn furet2018_fig5_data() -> FuretFig5 {
+/// The number of inverse solutions the dynamics reached at each end point of
+/// `workspace_grid.toml` (every solution of each grid point built, settled and checked).
+fn furet2018_reached_counts() -> Result<Vec<(f64, f64, usize)>, String> {
+    let sc = scenario::load(Path::new("scenarios/furet2018/workspace_grid.toml")).map_err(|e| e.to_string())?;
+    let r = run(&sc, &RunOptions { skip_findings: true, ..Default::default() });
+    let mut counts: std::collections::BTreeMap<(i64, i64), (f64, f64, usize)> = Default::default();
+    // Grid coordinates keyed to the micrometre.
+    let key = |v: f64| (v * 1e6).round() as i64;
+    for p in r.points.iter().filter(|p| p.settled && p.within_tolerance) {
+        let (x, y) = (p.analytic["x"], p.analytic["y"]);
+        counts.entry((key(x), key(y))).or_insert((x, y, 0)).2 += 1;
+    }
+    Ok(counts.into_values().collect())
+}
+
+fn furet2018_fig5_data() -> Result<FuretFig5, String> {
     use crate::mechanisms::furet2018::analytic as furet;
     let half = 2.0;
     let cell = 2.0 * half / FURET_MAP_CELLS as f64;
@@ -325,7 +380,7 @@ fn furet2018_fig5_data() -> FuretFig5 {
             (b, cells, (f2, f4))
         })
         .collect();
-    FuretFig5 { panels, cell }
+    Ok(FuretFig5 { panels, cell, reached: furet2018_reached_counts()? })
 }
 
 fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &FuretFig5) -> Result<(), String> {
@@ -336,7 +391,6 @@ fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fur
         .map_err(err)?;
     let two = RGBColor(190, 220, 250);
     let four = RGBColor(250, 170, 120);
-    let half = d.cell / 2.0;
     for (area, (b, cells, (f2, f4))) in root.split_evenly((1, 3)).iter().zip(&d.panels) {
         let mut chart = ChartBuilder::on(area)
             .margin(10)
@@ -350,12 +404,9 @@ fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fur
             .build_cartesian_2d(-2.0..2.0, -2.0..2.8)
             .map_err(err)?;
         chart.configure_mesh().disable_mesh().x_desc("x [m]").y_desc("y [m]").draw().map_err(err)?;
-        chart
-            .draw_series(cells.iter().filter(|c| c.2 == 2 || c.2 == 4).map(|(x, y, n)| {
-                let c = if *n == 4 { four } else { two };
-                Rectangle::new([(x - half, y - half), (x + half, y + half)], c.filled())
-            }))
-            .map_err(err)?;
+        let colours =
+            cells.iter().filter(|c| c.2 == 2 || c.2 == 4).map(|(x, y, n)| (*x, *y, if *n == 4 { four } else { two }));
+        chart.draw_series(cell_runs(colours, (d.cell, d.cell))).map_err(err)?;
         swatch(&mut chart, "2 solutions", two).map_err(err)?;
         swatch(&mut chart, "4 solutions", four).map_err(err)?;
         if (*b - 2.0 / 3.0).abs() < 1e-12 {
@@ -364,6 +415,19 @@ fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fur
                 .map_err(err)?
                 .label("Fig. 3 point (0.03, 1.6): 4 solutions")
                 .legend(|(x, y)| TriangleMarker::new((x + 8, y), 5, BLACK.filled()));
+            for (n, label) in [(2, "dynamics: 2 solutions reached"), (4, "dynamics: 4 solutions reached")] {
+                let size = if n == 4 { 5 } else { 2 };
+                chart
+                    .draw_series(
+                        d.reached
+                            .iter()
+                            .filter(|r| r.2 == n)
+                            .map(move |r| Circle::new((r.0, r.1), size, BLACK.filled())),
+                    )
+                    .map_err(err)?
+                    .label(label)
+                    .legend(move |(x, y)| Circle::new((x + 8, y), size, BLACK.filled()));
+            }
         }
         legend_box(&mut chart, SeriesLabelPosition::UpperLeft, 12).map_err(err)?;
     }
@@ -401,4 +465,259 @@ fn legend_box<'a, DB: DrawingBackend + 'a>(
         .border_style(BLACK)
         .label_font(("sans-serif", font_px))
         .draw()
+}
+
+// ---------------------------------------------------------------------------
+// Helpers of the workspace maps (colour maps, colour bars, contours, legend panels).
+// ---------------------------------------------------------------------------
+
+/// Anchors of a sequential colour map from `t = 0` to `t = 1` (equally spaced).
+pub(crate) type ColourAnchors = [(u8, u8, u8)];
+
+/// Viridis, sampled at 9 equally spaced points (perceptually uniform, readable in grey).
+pub(crate) const VIRIDIS: &ColourAnchors = &[
+    (68, 1, 84),
+    (71, 44, 122),
+    (59, 81, 139),
+    (44, 113, 142),
+    (33, 144, 141),
+    (39, 173, 129),
+    (92, 200, 99),
+    (170, 220, 50),
+    (253, 231, 37),
+];
+
+/// A light white-to-blue map: dark markers and coloured curves stay readable on it.
+pub(crate) const LIGHT_BLUES: &ColourAnchors = &[(250, 252, 255), (198, 219, 239), (140, 190, 226), (80, 150, 205)];
+
+/// The colour at `t` in [0, 1] (clamped) of a map given by its anchors, linearly interpolated.
+pub(crate) fn colour_at(anchors: &ColourAnchors, t: f64) -> RGBColor {
+    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    let s = t * (anchors.len() - 1) as f64;
+    let i = (s.floor() as usize).min(anchors.len() - 2);
+    let f = s - i as f64;
+    let (a, b) = (anchors[i], anchors[i + 1]);
+    let mix = |p: u8, q: u8| (p as f64 + (q as f64 - p as f64) * f).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// Steps of a colour bar.
+const COLOUR_BAR_STEPS: usize = 200;
+/// A colour bar spanning at least this much is labelled in whole units.
+const COLOUR_BAR_INTEGER_SPAN: f64 = 10.0;
+
+/// A vertical colour bar for values `lo..hi` of the map `anchors`, with its axis label.
+pub(crate) fn colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    anchors: &ColourAnchors,
+    lo: f64,
+    hi: f64,
+    label: &str,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(60)
+        .margin_bottom(60)
+        .margin_right(10)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..1.0, lo..hi)?;
+    chart
+        .configure_mesh()
+        .disable_x_axis()
+        .disable_x_mesh()
+        .disable_y_mesh()
+        .y_desc(label)
+        .axis_desc_style(("sans-serif", 15))
+        .label_style(("sans-serif", 13))
+        .y_label_formatter(&|v| if hi - lo >= COLOUR_BAR_INTEGER_SPAN { format!("{v:.0}") } else { format!("{v:.2}") })
+        .draw()?;
+    let step = (hi - lo) / COLOUR_BAR_STEPS as f64;
+    chart.draw_series((0..COLOUR_BAR_STEPS).map(|k| {
+        let y = lo + step * k as f64;
+        let c = colour_at(anchors, (k as f64 + 0.5) / COLOUR_BAR_STEPS as f64);
+        Rectangle::new([(0.0, y), (1.0, y + step)], c.filled())
+    }))?;
+    Ok(())
+}
+
+/// The zero set of `f` on a `cells x cells` grid over `xs x ys`, by marching squares, as
+/// polylines (segments chained through the grid edges they cross). NaN values cut a curve.
+pub(crate) fn zero_contour(
+    f: &dyn Fn(f64, f64) -> f64,
+    xs: std::ops::Range<f64>,
+    ys: std::ops::Range<f64>,
+    cells: usize,
+) -> Vec<Vec<(f64, f64)>> {
+    use std::collections::HashMap;
+    let n = cells + 1;
+    let (hx, hy) = ((xs.end - xs.start) / cells as f64, (ys.end - ys.start) / cells as f64);
+    let at = |i: usize, j: usize| (xs.start + hx * i as f64, ys.start + hy * j as f64);
+    let v: Vec<f64> = (0..n * n).map(|k| f(at(k / n, k % n).0, at(k / n, k % n).1)).collect();
+    let val = |i: usize, j: usize| v[i * n + j];
+    // An edge: (vertical?, i, j) from node (i, j) to (i + 1, j) or (i, j + 1).
+    type Edge = (bool, usize, usize);
+    let mut crossing: HashMap<Edge, (f64, f64)> = HashMap::new();
+    let mut cross = |e: Edge| -> Option<Edge> {
+        let (i1, j1) = if e.0 { (e.1, e.2 + 1) } else { (e.1 + 1, e.2) };
+        let (a, b) = (val(e.1, e.2), val(i1, j1));
+        if !(a.is_finite() && b.is_finite()) || (a >= 0.0) == (b >= 0.0) {
+            return None;
+        }
+        let t = a / (a - b);
+        let (p, q) = (at(e.1, e.2), at(i1, j1));
+        crossing.entry(e).or_insert((p.0 + t * (q.0 - p.0), p.1 + t * (q.1 - p.1)));
+        Some(e)
+    };
+    let mut segments: Vec<(Edge, Edge)> = Vec::new();
+    for i in 0..cells {
+        for j in 0..cells {
+            let edges = [(false, i, j), (true, i + 1, j), (false, i, j + 1), (true, i, j)];
+            let hits: Vec<Edge> = edges.iter().filter_map(|e| cross(*e)).collect();
+            match hits.len() {
+                2 => segments.push((hits[0], hits[1])),
+                4 => {
+                    // A saddle: pair the crossings by the sign at the centre.
+                    let centre = 0.25 * (val(i, j) + val(i + 1, j) + val(i + 1, j + 1) + val(i, j + 1));
+                    if (centre >= 0.0) == (val(i, j) >= 0.0) {
+                        segments.push((hits[0], hits[1]));
+                        segments.push((hits[2], hits[3]));
+                    } else {
+                        segments.push((hits[0], hits[3]));
+                        segments.push((hits[1], hits[2]));
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    // Chain the segments into polylines through their shared edges.
+    let mut by_edge: HashMap<Edge, Vec<usize>> = HashMap::new();
+    for (k, (a, b)) in segments.iter().enumerate() {
+        by_edge.entry(*a).or_default().push(k);
+        by_edge.entry(*b).or_default().push(k);
+    }
+    let mut used = vec![false; segments.len()];
+    let mut lines = Vec::new();
+    for start in 0..segments.len() {
+        if used[start] {
+            continue;
+        }
+        used[start] = true;
+        let mut chain: std::collections::VecDeque<Edge> = [segments[start].0, segments[start].1].into();
+        for forward in [true, false] {
+            loop {
+                let end = if forward { *chain.back().unwrap() } else { *chain.front().unwrap() };
+                let Some(&k) = by_edge[&end].iter().find(|k| !used[**k]) else { break };
+                used[k] = true;
+                let next = if segments[k].0 == end { segments[k].1 } else { segments[k].0 };
+                if forward {
+                    chain.push_back(next);
+                } else {
+                    chain.push_front(next);
+                }
+            }
+        }
+        lines.push(chain.iter().map(|e| crossing[e]).collect());
+    }
+    lines
+}
+
+/// What a legend entry shows.
+#[derive(Clone, Copy)]
+pub(crate) enum Glyph {
+    /// A filled region.
+    Fill(RGBColor),
+    /// A line of the given width.
+    Line(RGBColor, u32),
+    /// A dashed line of the given width.
+    Dashed(RGBColor, u32),
+    /// A filled circle with a black rim.
+    Dot(RGBColor),
+    /// A filled diamond with a black rim.
+    Diamond(RGBColor),
+    /// A cross.
+    Cross(RGBColor),
+    /// An open ring.
+    Ring(RGBColor),
+    /// A filled triangle.
+    Triangle(RGBColor),
+    /// Text only (a note under the other entries).
+    Note,
+}
+
+/// Pixel size of a legend row and of the glyph column.
+const LEGEND_ROW_PX: i32 = 22;
+const LEGEND_GLYPH_PX: i32 = 34;
+
+/// A legend in its own area (below or beside a chart), `columns` columns, framed.
+pub(crate) fn legend_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(Glyph, String)],
+    columns: usize,
+    font_px: u32,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (w, h) = area.dim_in_pixel();
+    area.draw(&Rectangle::new([(4, 2), (w as i32 - 4, h as i32 - 2)], BLACK.stroke_width(1)))?;
+    let rows = entries.len().div_ceil(columns.max(1)) as i32;
+    let col_w = (w as i32 - 20) / columns.max(1) as i32;
+    for (k, (glyph, label)) in entries.iter().enumerate() {
+        let (col, row) = (k as i32 / rows, k as i32 % rows);
+        let (x, y) = (14 + col * col_w, 12 + row * LEGEND_ROW_PX + LEGEND_ROW_PX / 2);
+        draw_glyph(area, *glyph, (x, y))?;
+        let tx = if matches!(glyph, Glyph::Note) { x } else { x + LEGEND_GLYPH_PX };
+        area.draw(&Text::new(
+            label.clone(),
+            (tx, y - font_px as i32 / 2 - 1),
+            ("sans-serif", font_px).into_font().color(&BLACK),
+        ))?;
+    }
+    Ok(())
+}
+
+/// Draws a legend glyph with its left end at pixel `(x, y)`.
+fn draw_glyph<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    glyph: Glyph,
+    (x, y): (i32, i32),
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let mid = (x + 12, y);
+    match glyph {
+        Glyph::Fill(c) => area.draw(&Rectangle::new([(x, y - 7), (x + 24, y + 7)], c.filled()))?,
+        Glyph::Line(c, w) => area.draw(&PathElement::new(vec![(x, y), (x + 26, y)], c.stroke_width(w)))?,
+        Glyph::Dashed(c, w) => {
+            area.draw(&plotters::element::DashedPathElement::new(vec![(x, y), (x + 26, y)], 6, 4, c.stroke_width(w)))?
+        }
+        Glyph::Dot(c) => {
+            area.draw(&Circle::new(mid, 6, c.filled()))?;
+            area.draw(&Circle::new(mid, 6, BLACK.stroke_width(1)))?;
+        }
+        Glyph::Diamond(c) => {
+            let pts = vec![(mid.0, mid.1 - 8), (mid.0 + 8, mid.1), (mid.0, mid.1 + 8), (mid.0 - 8, mid.1)];
+            area.draw(&Polygon::new(pts.clone(), c.filled()))?;
+            area.draw(&PathElement::new([pts.clone(), vec![pts[0]]].concat(), BLACK.stroke_width(1)))?;
+        }
+        Glyph::Cross(c) => area.draw(&Cross::new(mid, 6, c.stroke_width(2)))?,
+        Glyph::Ring(c) => area.draw(&Circle::new(mid, 8, c.stroke_width(2)))?,
+        Glyph::Triangle(c) => area.draw(&TriangleMarker::new(mid, 7, c.filled()))?,
+        Glyph::Note => {}
+    }
+    Ok(())
+}
+
+/// Map cells (centre x, centre y, colour), in column order (x outer, y rising), merged into
+/// vertical runs of one colour: the same picture with far fewer rectangles (the SVG files
+/// shrink by the run length). `cell` is the cell size (x, y).
+pub(crate) fn cell_runs(
+    cells: impl IntoIterator<Item = (f64, f64, RGBColor)>,
+    cell: (f64, f64),
+) -> Vec<Rectangle<(f64, f64)>> {
+    let (hx, hy) = (cell.0 / 2.0, cell.1 / 2.0);
+    // A run: column x, first and last centre y, colour.
+    let mut runs: Vec<(f64, f64, f64, RGBColor)> = Vec::new();
+    for (x, y, c) in cells {
+        match runs.last_mut() {
+            Some(r) if (r.0 - x).abs() < 1e-9 * hx && r.3 == c && (y - r.2 - cell.1).abs() < 1e-6 * cell.1 => r.2 = y,
+            _ => runs.push((x, y, y, c)),
+        }
+    }
+    runs.into_iter().map(|(x, y0, y1, c)| Rectangle::new([(x - hx, y0 - hy), (x + hx, y1 + hy)], c.filled())).collect()
 }

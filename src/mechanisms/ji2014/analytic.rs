@@ -1317,8 +1317,20 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         let w = Params::PAPER_WORKSPACE;
         let c = neutral_point(&w);
         let axis = wrap_angle((-c.y).atan2(-c.x));
+        // |K| grows with L3 along the ray of th1 iff L3 > e(th1).D1* (d|L3 e - D1*|/dL3 =
+        // (L3 - e.D1*)/|L3 e - D1*|): it falls with L3 where e(th1).D1* > 0, for L3 below it.
+        const SCAN: usize = 100_000;
+        let falling: Vec<(f64, f64)> = (0..=SCAN)
+            .map(|k| PI * k as f64 / SCAN as f64)
+            .map(|t| (t, c.x * t.cos() + c.y * t.sin()))
+            .filter(|(_, d)| *d > 0.0)
+            .collect();
+        let grows = match (falling.first(), falling.iter().map(|f| f.1).reduce(f64::max)) {
+            (Some((t_lo, _)), Some(l3_hi)) => format!("it increases with L3 except in the corner th1 > {t_lo:.4} rad, L3 < e(th1).D1* <= {l3_hi:.4} m, where it falls with L3 (K = {:.2} N*m/rad at L3 = 0, {:.2} at th1 = pi, L3 = {l3_hi:.4} m)", stiffness_stable_closed_form(&w, 0.0, PI), stiffness_stable_closed_form(&w, l3_hi, PI)),
+            _ => "it increases with L3 for every th1 in [0,pi] (holds)".to_string(),
+        };
         f.push(finding("Fig. 7 text", "stiffness distribution approximately symmetric about th1 = 0.3; stiffness increases with L3",
-            format!("|K| = L sqrt(K1^2+K1K2+K2^2) |D1 - D1*| with D1* = ({:.4},{:.4}) m, so |K| is EXACTLY symmetric about th1 = {axis:.4} rad (the direction opposite D1*), not 0.3; it increases with L3 for every th1 in [0,pi] (holds). Note the paper's FK gives the negative (unstable) value of K wherever eta1 > 0", c.x, c.y),
+            format!("|K| = L sqrt(K1^2+K1K2+K2^2) |D1 - D1*| with D1* = ({:.4},{:.4}) m, so |K| is EXACTLY symmetric about th1 = {axis:.4} rad (the direction opposite D1*), not 0.3; {grows}. Note the paper's FK gives the negative (unstable) value of K wherever eta1 > 0", c.x, c.y),
             false));
     }
     f
