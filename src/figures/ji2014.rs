@@ -740,78 +740,130 @@ const PAPER_LINE: RGBColor = RGBColor(255, 120, 0);
 /// The white lines of the map, as the legend (on white) shows them.
 const LEGEND_WHITE_LINE: RGBColor = RGBColor(150, 150, 150);
 
-pub(super) fn fig7_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig7) -> Result<(), String> {
+/// A line drawn over a stiffness map: points, colour, width, dashed or solid.
+struct MapLine {
+    points: Vec<(f64, f64)>,
+    colour: RGBColor,
+    width: u32,
+    dashed: bool,
+}
+
+/// What Fig. 7 and Fig. 8 share: a colour map of K with its contour lines, lines over it, the
+/// torque probes, a colour bar and the legend panel.
+struct StiffnessMap<'a> {
+    title: String,
+    caption: String,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+    x_desc: &'static str,
+    y_desc: &'static str,
+    /// (x, y, K) at the cell centres.
+    cells: &'a [(f64, f64, f64)],
+    cell: (f64, f64),
+    k_min: f64,
+    k_max: f64,
+    contours: &'a [Vec<(f64, f64)>],
+    lines: Vec<MapLine>,
+    probes: &'a [Probe],
+    /// Where a probe is drawn in the map's coordinates.
+    probe_at: &'a dyn Fn(&Probe) -> (f64, f64),
+    tolerance: f64,
+    legend: Vec<(Glyph, String)>,
+}
+
+fn stiffness_map_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, m: StiffnessMap) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
     root.fill(&WHITE).map_err(err)?;
-    let max_err = d.probes.iter().map(|q| q.rel_error).fold(0.0, f64::max);
-    let root = root
-        .titled(
-            &format!(
-                "ji2014 Fig. 7: stiffness K over the actuator workspace (L = {} m, K1 = {} N/m, K2 = {} N/m)",
-                d.p.l, d.p.k1, d.p.k2
-            ),
-            ("sans-serif", 20),
-        )
-        .map_err(err)?;
+    let root = root.titled(&m.title, ("sans-serif", 20)).map_err(err)?;
     let (top, legend) = root.split_vertically(SIZE.1 - FIG7_LEGEND_PX - 30);
     let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
     let mut chart = ChartBuilder::on(&plot)
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(60)
-        .caption(
-            format!(
-                "colour: K = (L/2)|eta| at the stable equilibrium (Eq. 42); probe (stiffness_grid.toml): max relative error {max_err:.1e}"
-            ),
-            ("sans-serif", 16),
-        )
-        .build_cartesian_2d(-MAP_PAD_RAD..PI + MAP_PAD_RAD, -MAP_PAD_M..d.l3_max + MAP_PAD_M)
+        .caption(m.caption, ("sans-serif", 16))
+        .build_cartesian_2d(m.x, m.y)
         .map_err(err)?;
     chart
         .configure_mesh()
         .disable_mesh()
-        .x_desc("theta1 [rad]")
-        .y_desc("L3 [m]")
+        .x_desc(m.x_desc)
+        .y_desc(m.y_desc)
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(err)?;
-    let colours = d.cells.iter().map(|(t1, l3, k)| (*t1, *l3, colour_at(VIRIDIS, (k - d.k_min) / (d.k_max - d.k_min))));
-    chart.draw_series(cell_runs(colours, d.cell)).map_err(err)?;
-    for line in &d.contours {
+    let colours = m.cells.iter().map(|(x, y, k)| (*x, *y, colour_at(VIRIDIS, (k - m.k_min) / (m.k_max - m.k_min))));
+    chart.draw_series(cell_runs(colours, m.cell)).map_err(err)?;
+    for line in m.contours {
         chart.draw_series(LineSeries::new(line.iter().copied(), K_LINES.mix(0.6).stroke_width(1))).map_err(err)?;
     }
-    chart
-        .draw_series(LineSeries::new(
-            [(d.symmetry_theta1, 0.0), (d.symmetry_theta1, d.l3_max)],
-            K_LINES.stroke_width(3),
-        ))
-        .map_err(err)?;
-    chart
-        .draw_series(DashedLineSeries::new(
-            [(PAPER_FIG7_SYMMETRY_THETA1, 0.0), (PAPER_FIG7_SYMMETRY_THETA1, d.l3_max)],
-            10,
-            6,
-            PAPER_LINE.stroke_width(3).into(),
-        ))
-        .map_err(err)?;
-    chart
-        .draw_series(DashedLineSeries::new(d.curve_iii.iter().copied(), 10, 6, CURVE_III.stroke_width(3).into()))
-        .map_err(err)?;
-    draw_probes(&mut chart, &d.probes, &|q| (q.theta1, q.l3)).map_err(err)?;
-    colour_bar(&bar, VIRIDIS, d.k_min, d.k_max, "K [N m/rad]").map_err(err)?;
-    let mut entries = vec![
-        (Glyph::Line(LEGEND_WHITE_LINE, 1), format!(
-                "contour lines of K every {K_CONTOUR_STEP} N m/rad. The paper: K grows with L3. It does in {} of {CELLS} columns; for theta1 > {:.2} rad it falls first, up to L3 = {:.2} m",
-                CELLS - d.columns_not_growing, d.falls_from_theta1, d.falls_up_to_l3
-            )),
-        (Glyph::Line(LEGEND_WHITE_LINE, 3), format!("theta1 = {:.4} rad: K is exactly symmetric about it (the direction opposite D1*)", d.symmetry_theta1)),
-        (Glyph::Dashed(PAPER_LINE, 3), format!("theta1 = {PAPER_FIG7_SYMMETRY_THETA1} rad: the symmetry line Section 6.2 reads off Fig. 7 (wrong)")),
-        (Glyph::Dashed(CURVE_III, 3), format!("eta1 = 0 (to its right Eq. 47 as printed is NEGATIVE, -K, as the paper's root is the maximum): {:.1} % of the map", 100.0 * d.eq47_negative)),
-    ];
-    entries.extend(probe_entries(&d.probes, d.tolerance));
+    for l in &m.lines {
+        let style = l.colour.stroke_width(l.width);
+        if l.dashed {
+            chart.draw_series(DashedLineSeries::new(l.points.iter().copied(), 10, 6, style.into())).map_err(err)?;
+        } else {
+            chart.draw_series(LineSeries::new(l.points.iter().copied(), style)).map_err(err)?;
+        }
+    }
+    draw_probes(&mut chart, m.probes, m.probe_at).map_err(err)?;
+    colour_bar(&bar, VIRIDIS, m.k_min, m.k_max, "K [N m/rad]").map_err(err)?;
+    let mut entries = m.legend;
+    entries.extend(probe_entries(m.probes, m.tolerance));
     legend_panel(&legend.margin(0, 8, 10, 10), &entries, 1, 13).map_err(err)?;
     root.present().map_err(err)?;
     Ok(())
+}
+
+pub(super) fn fig7_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig7) -> Result<(), String> {
+    let max_err = d.probes.iter().map(|q| q.rel_error).fold(0.0, f64::max);
+    stiffness_map_plot(
+        root,
+        StiffnessMap {
+            title: format!(
+                "ji2014 Fig. 7: stiffness K over the actuator workspace (L = {} m, K1 = {} N/m, K2 = {} N/m)",
+                d.p.l, d.p.k1, d.p.k2
+            ),
+            caption: format!(
+                "colour: K = (L/2)|eta| at the stable equilibrium (Eq. 42); probe (stiffness_grid.toml): max relative error {max_err:.1e}"
+            ),
+            x: -MAP_PAD_RAD..PI + MAP_PAD_RAD,
+            y: -MAP_PAD_M..d.l3_max + MAP_PAD_M,
+            x_desc: "theta1 [rad]",
+            y_desc: "L3 [m]",
+            cells: &d.cells,
+            cell: d.cell,
+            k_min: d.k_min,
+            k_max: d.k_max,
+            contours: &d.contours,
+            lines: vec![
+                MapLine {
+                    points: vec![(d.symmetry_theta1, 0.0), (d.symmetry_theta1, d.l3_max)],
+                    colour: K_LINES,
+                    width: 3,
+                    dashed: false,
+                },
+                MapLine {
+                    points: vec![(PAPER_FIG7_SYMMETRY_THETA1, 0.0), (PAPER_FIG7_SYMMETRY_THETA1, d.l3_max)],
+                    colour: PAPER_LINE,
+                    width: 3,
+                    dashed: true,
+                },
+                MapLine { points: d.curve_iii.clone(), colour: CURVE_III, width: 3, dashed: true },
+            ],
+            probes: &d.probes,
+            probe_at: &|q| (q.theta1, q.l3),
+            tolerance: d.tolerance,
+            legend: vec![
+                (Glyph::Line(LEGEND_WHITE_LINE, 1), format!(
+                    "contour lines of K every {K_CONTOUR_STEP} N m/rad. The paper: K grows with L3. It does in {} of {CELLS} columns; for theta1 > {:.2} rad it falls first, up to L3 = {:.2} m",
+                    CELLS - d.columns_not_growing, d.falls_from_theta1, d.falls_up_to_l3
+                )),
+                (Glyph::Line(LEGEND_WHITE_LINE, 3), format!("theta1 = {:.4} rad: K is exactly symmetric about it (the direction opposite D1*)", d.symmetry_theta1)),
+                (Glyph::Dashed(PAPER_LINE, 3), format!("theta1 = {PAPER_FIG7_SYMMETRY_THETA1} rad: the symmetry line Section 6.2 reads off Fig. 7 (wrong)")),
+                (Glyph::Dashed(CURVE_III, 3), format!("eta1 = 0 (to its right Eq. 47 as printed is NEGATIVE, -K, as the paper's root is the maximum): {:.1} % of the map", 100.0 * d.eq47_negative)),
+            ],
+        },
+    )
 }
 
 pub(super) fn draw_fig7(png: &Path, svg: &Path) -> Result<(), String> {
@@ -903,74 +955,52 @@ pub(super) fn fig8_data() -> Result<Fig8, String> {
 }
 
 pub(super) fn fig8_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig8) -> Result<(), String> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    root.fill(&WHITE).map_err(err)?;
     let max_err = d.probes.iter().map(|q| q.rel_error).fold(0.0, f64::max);
-    let root = root
-        .titled(
-            &format!(
+    stiffness_map_plot(
+        root,
+        StiffnessMap {
+            title: format!(
                 "ji2014 Fig. 8: stiffness K over the Cartesian workspace (L = {} m, K1 = {} N/m, K2 = {} N/m)",
                 d.p.l, d.p.k1, d.p.k2
             ),
-            ("sans-serif", 20),
-        )
-        .map_err(err)?;
-    let (top, legend) = root.split_vertically(SIZE.1 - FIG7_LEGEND_PX - 30);
-    let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
-    let mut chart = ChartBuilder::on(&plot)
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .caption(
-            format!("colour: K at the stable equilibrium with D3 = (x, y) (Eq. 42, IK by Eq. 48); probe: max relative error {max_err:.1e}"),
-            ("sans-serif", 16),
-        )
-        .build_cartesian_2d(FIG8_X_M.0..FIG8_X_M.1, FIG8_Y_M.0..FIG8_Y_M.1)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("x [m]")
-        .y_desc("y [m]")
-        .axis_desc_style(("sans-serif", 16))
-        .draw()
-        .map_err(err)?;
-    let colours = d.cells.iter().map(|(x, y, k)| (*x, *y, colour_at(VIRIDIS, (k - d.k_min) / (d.k_max - d.k_min))));
-    chart.draw_series(cell_runs(colours, d.cell)).map_err(err)?;
-    for line in &d.contours {
-        chart.draw_series(LineSeries::new(line.iter().copied(), K_LINES.mix(0.6).stroke_width(1))).map_err(err)?;
-    }
-    chart
-        .draw_series(DashedLineSeries::new(
-            [(PAPER_FIG8_SYMMETRY_X_M, FIG8_Y_M.0), (PAPER_FIG8_SYMMETRY_X_M, FIG8_Y_M.1)],
-            10,
-            6,
-            PAPER_LINE.stroke_width(3).into(),
-        ))
-        .map_err(err)?;
-    draw_probes(&mut chart, &d.probes, &|q| (q.x, q.y)).map_err(err)?;
-    colour_bar(&bar, VIRIDIS, d.k_min, d.k_max, "K [N m/rad]").map_err(err)?;
-    let mut entries = vec![
-        (
-            Glyph::Line(LEGEND_WHITE_LINE, 1),
-            format!(
-                "contour lines of K every {K_CONTOUR_STEP} N m/rad. The paper: for a given x, K grows with y. It does in {} of {} columns",
-                d.columns_growing_with_y, d.columns
-            ),
-        ),
-        (
-            Glyph::Dashed(PAPER_LINE, 3),
-            format!(
-                "x = 0: the paper's symmetry line; K(x, y) and K(-x, y) differ by up to {:.0} % ({} cells with both inside)",
-                100.0 * d.mirror_asymmetry,
-                d.mirrored_cells
-            ),
-        ),
-    ];
-    entries.extend(probe_entries(&d.probes, d.tolerance));
-    legend_panel(&legend.margin(0, 8, 10, 10), &entries, 1, 13).map_err(err)?;
-    root.present().map_err(err)?;
-    Ok(())
+            caption: format!("colour: K at the stable equilibrium with D3 = (x, y) (Eq. 42, IK by Eq. 48); probe: max relative error {max_err:.1e}"),
+            x: FIG8_X_M.0..FIG8_X_M.1,
+            y: FIG8_Y_M.0..FIG8_Y_M.1,
+            x_desc: "x [m]",
+            y_desc: "y [m]",
+            cells: &d.cells,
+            cell: d.cell,
+            k_min: d.k_min,
+            k_max: d.k_max,
+            contours: &d.contours,
+            lines: vec![MapLine {
+                points: vec![(PAPER_FIG8_SYMMETRY_X_M, FIG8_Y_M.0), (PAPER_FIG8_SYMMETRY_X_M, FIG8_Y_M.1)],
+                colour: PAPER_LINE,
+                width: 3,
+                dashed: true,
+            }],
+            probes: &d.probes,
+            probe_at: &|q| (q.x, q.y),
+            tolerance: d.tolerance,
+            legend: vec![
+                (
+                    Glyph::Line(LEGEND_WHITE_LINE, 1),
+                    format!(
+                        "contour lines of K every {K_CONTOUR_STEP} N m/rad. The paper: for a given x, K grows with y. It does in {} of {} columns",
+                        d.columns_growing_with_y, d.columns
+                    ),
+                ),
+                (
+                    Glyph::Dashed(PAPER_LINE, 3),
+                    format!(
+                        "x = 0: the paper's symmetry line; K(x, y) and K(-x, y) differ by up to {:.0} % ({} cells with both inside)",
+                        100.0 * d.mirror_asymmetry,
+                        d.mirrored_cells
+                    ),
+                ),
+            ],
+        },
+    )
 }
 
 pub(super) fn draw_fig8(png: &Path, svg: &Path) -> Result<(), String> {
