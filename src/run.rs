@@ -81,9 +81,10 @@ impl Runner<'_> {
         }
         self.sim.step()?;
         self.steps += 1;
-        // The residual (a least-squares fit) is computed per tick only for recordings; the
-        // settle loop asks for it once the motion has stopped.
-        let snap = self.sim.snapshot_with(self.recorder.is_some());
+        // The residual (a least-squares fit, the costliest read-out) is left out here: the
+        // settle loop computes it once the motion has stopped, and only those ticks carry it
+        // (into the recording too).
+        let snap = self.sim.snapshot_with(false);
         let simulated = self.observe(&snap);
         // The ghost overlay is only drawn in recordings, and only recomputed when the inputs
         // change.
@@ -148,6 +149,9 @@ impl Runner<'_> {
             let quiet = quiet && !approaching;
             if quiet && snap.forces.residual.is_none() {
                 snap.forces = self.sim.member_forces();
+                if let (Some(rec), Some(r)) = (self.recorder.as_mut(), &snap.forces.residual) {
+                    rec.residual(snap.tick, r);
+                }
             }
             if quiet && SettleDetector::residual_ok(&snap, &criteria) {
                 return Ok(Settled {

@@ -4,7 +4,7 @@
 //! `analytic/{nodes,struts}` (the analytic prediction as a ghost overlay), and time series with
 //! one named series per quantity or member: `errors` (simulated - analytic), `errors_log10`
 //! (log10 of their magnitude: rerun 0.36 plots have no log axis), `forces/{springs,cables,actuators}`,
-//! `inputs`, `residual`, `energy/kinetic_j`; `interference/min_clearance_m`; `events` (text log).
+//! `inputs`, `residual` (at the ticks where the settle loop computed it), `energy/kinetic_j`; `interference/min_clearance_m`; `events` (text log).
 //! The scenario file and the report summary are stored as documents. Timelines: `tick` and
 //! `sim_time`. A blueprint ([`blueprint`]) stored at the start of the recording lays the viewer
 //! out: the 3D structure, the error, force and energy plots, the events and the documents.
@@ -337,6 +337,16 @@ impl Recorder {
             .connect_grpc_opts(url.clone())
             .map_err(|e| RecordError::Io { path: url.clone(), message: e.to_string() })?;
         Ok(Some(Recorder::new(rec, Target::Live { url }, every)))
+    }
+
+    /// Buffers the equilibrium residual of `tick`, computed after the tick was recorded (the
+    /// settle loop computes it only once the motion has stopped).
+    pub fn residual(&mut self, tick: u64, r: &crate::sim::Residual) {
+        if tick % self.every != 0 {
+            return;
+        }
+        let time_s = self.last_time_s;
+        self.columns.residual.push_values(tick, time_s, [r.max_force_n, r.max_torque_nm]);
     }
 
     /// Stores a text document (static: it belongs to the whole run).
