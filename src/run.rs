@@ -622,12 +622,25 @@ fn settle_point(
         }
         _ => (None, None),
     };
-    let within_tolerance = s.settled
-        && !outside
-        && sc.checks.iter().all(|c| match (landed.get(&c.quantity), simulated.get(&c.quantity)) {
-            (Some(a), Some(b)) => compare::error(c.kind, *a, *b, runner.mech.length_scale(&sc.params)).1 <= c.tolerance,
-            _ => false,
-        });
+    // Every check at this point: (quantity, normalised error, tolerance); a missing value fails.
+    let scale = runner.mech.length_scale(&sc.params);
+    let point_checks: Vec<(&str, f64, f64)> = sc
+        .checks
+        .iter()
+        .map(|c| {
+            let e = match (landed.get(&c.quantity), simulated.get(&c.quantity)) {
+                (Some(a), Some(b)) => compare::error(c.kind, *a, *b, scale).1,
+                _ => f64::INFINITY,
+            };
+            (c.quantity.as_str(), e, c.tolerance)
+        })
+        .collect();
+    if s.settled && !outside {
+        for (q, e, tol) in point_checks.iter().filter(|(_, e, tol)| !(e <= tol)) {
+            runner.emit(&format!("point {index}: check {q} failed: error {e:.3e} > tolerance {tol:.1e}"));
+        }
+    }
+    let within_tolerance = s.settled && !outside && point_checks.iter().all(|(_, e, tol)| e <= tol);
     report.points.push(PointReport {
         index,
         inputs: inputs.clone(),

@@ -109,3 +109,31 @@ fn connect_without_a_viewer_goes_on() {
     assert_eq!(err.matches("no rerun viewer").count(), 1, "{err}");
     assert!(start.elapsed() < std::time::Duration::from_secs(10));
 }
+
+/// A check that fails at a settle point is an event of the recording, with the quantity, its
+/// error and the tolerance (a tolerance of 1e-30 on theta2 fails at every point).
+#[test]
+fn a_failed_check_is_an_event_of_the_recording() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-rec-fail-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rrd = dir.join("fail.rrd");
+    let path = Path::new("scenarios/ji2014/quick.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let text = format!("{text}\n[[checks]]\nquantity = \"theta2\"\ntolerance = 1e-30\n");
+    let sc = scenario::parse(path, &text).expect("valid");
+    let r = run(&sc, &RunOptions { record: Some(rrd.clone()), ..RunOptions::default() });
+    assert!(!r.passed);
+    let file = std::io::BufReader::new(std::fs::File::open(&rrd).unwrap());
+    let mut events = String::new();
+    for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
+        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.unwrap() {
+            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).unwrap();
+            if chunk.entity_path().to_string() == "/events" {
+                events.push_str(&format!("{chunk}"));
+            }
+        }
+    }
+    assert!(events.contains("point 0: check theta2 failed: error"), "{events}");
+    assert!(events.contains("> tolerance 1.0e-30"), "{events}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
