@@ -74,6 +74,18 @@ impl Runner<'_> {
         }
     }
 
+    /// Computes the equilibrium residual of `snap`, the simulation's current state, where the
+    /// tick left it out, and records it.
+    fn add_residual(&mut self, snap: &mut Snapshot) {
+        if snap.forces.residual.is_some() {
+            return;
+        }
+        snap.forces = self.sim.member_forces();
+        if let (Some(rec), Some(r)) = (self.recorder.as_mut(), &snap.forces.residual) {
+            rec.residual(snap.tick, r);
+        }
+    }
+
     /// One step followed by every observer.
     fn step(&mut self, inputs: &Values, prediction: &Prediction) -> Result<(Snapshot, Values), Stop> {
         if self.cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
@@ -147,11 +159,8 @@ impl Runner<'_> {
                 continue;
             }
             let quiet = quiet && !approaching;
-            if quiet && snap.forces.residual.is_none() {
-                snap.forces = self.sim.member_forces();
-                if let (Some(rec), Some(r)) = (self.recorder.as_mut(), &snap.forces.residual) {
-                    rec.residual(snap.tick, r);
-                }
+            if quiet {
+                self.add_residual(&mut snap);
             }
             if quiet && SettleDetector::residual_ok(&snap, &criteria) {
                 return Ok(Settled {
@@ -167,9 +176,7 @@ impl Runner<'_> {
         let (snapshot, simulated) = match last {
             // The last state is the simulation's current one: its residual can still be had.
             Some((mut snap, simulated)) => {
-                if snap.forces.residual.is_none() {
-                    snap.forces = self.sim.member_forces();
-                }
+                self.add_residual(&mut snap);
                 (snap, simulated)
             }
             None => {

@@ -111,12 +111,11 @@ impl Simulation {
     }
 
     /// Whether the member forces themselves need the fit of the loop-closure reactions: a
-    /// joint actuator's force where loops close, or a cable held by the projection.
-    fn forces_need_closure_fit(&self) -> bool {
-        let s = &self.structure;
+    /// joint actuator's force where loops close, or a cable held by the projection (`held`).
+    fn forces_need_closure_fit(&self, held: &[bool]) -> bool {
         let closures = self.joint_impulse.iter().any(Option::is_some);
-        let joint_actuators = s.actuators.iter().any(|a| matches!(a.target, ActuatorTarget::Joint(_)));
-        (closures && joint_actuators) || (0..s.cables.len()).any(|c| self.cable_held_by_projection(c))
+        let joint_actuators = self.structure.actuators.iter().any(|a| matches!(a.target, ActuatorTarget::Joint(_)));
+        (closures && joint_actuators) || held.contains(&true)
     }
 
     /// Reads every member force; the equilibrium residual (a least-squares fit of the loop
@@ -124,6 +123,8 @@ impl Simulation {
     /// The settle loop asks for it only once the motion has stopped.
     pub fn member_forces_with(&self, with_residual: bool) -> MemberForces {
         let s = &self.structure;
+        // Cables held at their length by the projection: their tension is fitted, not read.
+        let held: Vec<bool> = (0..s.cables.len()).map(|c| self.cable_held_by_projection(c)).collect();
         let nb = s.bodies.len();
         let mut wrench: Vec<Wrench> = vec![(Vector::ZERO, Vector::ZERO); nb];
         #[allow(clippy::type_complexity)]
@@ -154,7 +155,7 @@ impl Simulation {
             let tension = match cable.law {
                 CableLaw::Elastic { stiffness_n_per_m } => (stiffness_n_per_m * (l - rest)).max(0.0),
                 // Held at its length by the projection: its tension is fitted below.
-                CableLaw::Inextensible if self.cable_held_by_projection(c) => 0.0,
+                CableLaw::Inextensible if held[c] => 0.0,
                 CableLaw::Inextensible => self.cable_ropes[c]
                     .and_then(|h| self.impulse_joints.get(h))
                     .map(|j| j.data.limits[0].impulse.abs() * inv_h)
@@ -202,11 +203,11 @@ impl Simulation {
         // a least-squares fit: the reactions that best balance every free coordinate. At an
         // equilibrium the fit is exact and the residual is zero; the fitted reactions are
         // added to the bodies' loads.
-        let fit = with_residual || self.forces_need_closure_fit();
+        let fit = with_residual || self.forces_need_closure_fit(&held);
         let scale = self.length_scale_m;
         let base = if fit { self.coordinate_forces(&tree, &wrench, true) } else { Vec::new() };
         let mut closure_loads = self.closure_unit_loads();
-        closure_loads.extend(self.projected_cable_unit_loads());
+        closure_loads.extend(self.projected_cable_unit_loads(&held));
         // Fitted reaction of each loop-closing joint on its child: (force, moment about the anchor).
         let mut closure_reaction = vec![(Vector::ZERO, Vector::ZERO); s.joints.len()];
         if !closure_loads.is_empty() && !base.is_empty() {
@@ -252,7 +253,7 @@ impl Simulation {
         let fitted = fit;
         // A held cable whose fitted tension is negative would have to push: no equilibrium.
         for (c, cable) in s.cables.iter().enumerate() {
-            if matches!(cable.law, CableLaw::Inextensible) && self.cable_held_by_projection(c) {
+            if matches!(cable.law, CableLaw::Inextensible) && held[c] {
                 residual.max_force_n = residual.max_force_n.max((-out.cable_tension_n[c]).max(0.0));
             }
         }
@@ -430,12 +431,12 @@ impl Simulation {
 
     /// For every inextensible cable held at its length by the projection: the body loads of a
     /// unit tension (pulling its two nodes together).
-    fn projected_cable_unit_loads(&self) -> Vec<ClosureComponent> {
+    fn projected_cable_unit_loads(&self, held: &[bool]) -> Vec<ClosureComponent> {
         let s = &self.structure;
         let nb = s.bodies.len();
         let mut out = Vec::new();
         for (c, cable) in s.cables.iter().enumerate() {
-            if !self.cable_held_by_projection(c) {
+            if !held[c] {
                 continue;
             }
             let (pa, pb) = (v(self.node_position(cable.a)), v(self.node_position(cable.b)));

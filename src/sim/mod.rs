@@ -395,8 +395,8 @@ impl Simulation {
     /// and stay on their assembly mode.
     fn apply_joint_commands(&mut self) {
         // (multibody joint, total displacement) of every actuated link. The degree-of-freedom
-        // index is read afresh before each move: forward kinematics may re-root a multibody,
-        // which shifts the indices.
+        // index is read at each move: forward kinematics may re-root a multibody, which shifts
+        // the indices.
         let mut moves = Vec::new();
         for j in 0..self.structure.joints.len() {
             if !self.actuated[j] {
@@ -424,10 +424,16 @@ impl Simulation {
         } else {
             ((largest / MAX_CLOSED_LOOP_INCREMENT).ceil() as usize).max(1)
         };
+        // Forward kinematics settles each multibody's root (and so its degree-of-freedom
+        // indices) before the first move; every move below ends with it again.
+        for &(handle, _) in &moves {
+            if let Some((mb, _)) = self.multibody_joints.get_mut(handle) {
+                mb.forward_kinematics(&self.bodies, true);
+            }
+        }
         for _ in 0..increments {
             for &(handle, total) in &moves {
                 let Some((mb, link_id)) = self.multibody_joints.get_mut(handle) else { continue };
-                mb.forward_kinematics(&self.bodies, true);
                 let Some(start) = mb.link(link_id).map(|l| l.assembly_id()) else { continue };
                 let mut disp = vec![0.0; mb.ndofs()];
                 disp[start] = total / increments as f64;

@@ -34,6 +34,48 @@ fn min_norm_solve(a: &nalgebra::DMatrix<f64>, b: &nalgebra::DVector<f64>) -> Opt
     svd.solve(b, cut).ok()
 }
 
+/// Gauss-Newton onto a constraint manifold: `displace` moves `ndof` coordinates by a step (in
+/// coordinate space), `rows` evaluates the constraint rows [m]. Iterates until every row is
+/// within [`GAP_TOLERANCE_FRACTION`] of the structure's size (at most [`MAX_ITERATIONS`]);
+/// returns the Jacobian at the last point (forward differences of `rows`) and the largest row
+/// left.
+fn close_rows(
+    sim: &mut Simulation,
+    ndof: usize,
+    rows: &dyn Fn(&Simulation) -> Vec<f64>,
+    displace: &dyn Fn(&mut Simulation, &[f64]),
+) -> (nalgebra::DMatrix<f64>, f64) {
+    let largest = |g: &[f64]| g.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let tol = GAP_TOLERANCE_FRACTION * sim.length_scale_m;
+    let mut jac = nalgebra::DMatrix::<f64>::zeros(0, ndof);
+    let mut step = vec![0.0; ndof];
+    for _ in 0..MAX_ITERATIONS {
+        let g0 = rows(sim);
+        if g0.is_empty() {
+            break;
+        }
+        jac = nalgebra::DMatrix::<f64>::zeros(g0.len(), ndof);
+        for k in 0..ndof {
+            step.fill(0.0);
+            step[k] = FD_STEP;
+            displace(sim, &step);
+            let g = rows(sim);
+            step[k] = -FD_STEP;
+            displace(sim, &step);
+            for (row, (gi, g0i)) in g.iter().zip(&g0).enumerate() {
+                jac[(row, k)] = (gi - g0i) / FD_STEP;
+            }
+        }
+        if largest(&g0) <= tol {
+            break;
+        }
+        let Some(dq) = min_norm_solve(&jac, &-nalgebra::DVector::from_vec(g0)) else { break };
+        displace(sim, dq.as_slice());
+    }
+    let left = largest(&rows(sim));
+    (jac, left)
+}
+
 /// A loop-closing joint inside one multibody: the rows of its gap that the projection zeroes.
 #[derive(Clone, Debug)]
 pub(super) struct InternalClosure {
@@ -115,36 +157,16 @@ impl Simulation {
             if free.is_empty() {
                 continue;
             }
-            let tol = GAP_TOLERANCE_FRACTION * self.length_scale_m;
-            let mut jac = nalgebra::DMatrix::<f64>::zeros(0, free.len());
-            let mut disp = vec![0.0; ndofs];
-            for _ in 0..MAX_ITERATIONS {
-                let g0 = self.closure_gaps(&closures, mb_index);
-                let gmax = g0.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-                // Jacobian by forward differences of the multibody's own kinematics.
-                jac = nalgebra::DMatrix::<f64>::zeros(g0.len(), free.len());
-                for (col, &dof) in free.iter().enumerate() {
-                    disp.fill(0.0);
-                    disp[dof] = FD_STEP;
-                    self.displace(mb_index, &disp);
-                    let g = self.closure_gaps(&closures, mb_index);
-                    disp[dof] = -FD_STEP;
-                    self.displace(mb_index, &disp);
-                    for (row, (gi, g0i)) in g.iter().zip(&g0).enumerate() {
-                        jac[(row, col)] = (gi - g0i) / FD_STEP;
-                    }
+            // Coordinates of the projection: the free degrees of freedom, in order.
+            let displace_free = |sim: &mut Simulation, dq: &[f64]| {
+                let mut disp = vec![0.0; ndofs];
+                for (d, &dof) in dq.iter().zip(&free) {
+                    disp[dof] = *d;
                 }
-                if gmax <= tol {
-                    break;
-                }
-                let Some(step) = min_norm_solve(&jac, &-nalgebra::DVector::from_vec(g0)) else { break };
-                disp.fill(0.0);
-                for (col, &dof) in free.iter().enumerate() {
-                    disp[dof] = step[col];
-                }
-                self.displace(mb_index, &disp);
-            }
-            let left = self.closure_gaps(&closures, mb_index).iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+                sim.displace(mb_index, &disp);
+            };
+            let gaps = |sim: &Simulation| sim.closure_gaps(&closures, mb_index);
+            let (jac, left) = close_rows(self, free.len(), &gaps, &displace_free);
             largest = largest.max(left);
             // Velocities: remove the part that opens the loops, qdot -= J^+ (J qdot).
             if jac.nrows() > 0 {
@@ -360,51 +382,23 @@ impl Simulation {
         for g in &groups {
             let taut: Vec<usize> = g.cables.iter().copied().filter(|&c| self.cable_is_taut(c)).collect();
             let ndof = 6 * g.bodies.len();
-            let unit = |k: usize, h: f64| -> (Vector, Vector) {
-                let mut t = Vector::ZERO;
-                let mut r = Vector::ZERO;
-                if k % 6 < 3 {
-                    t[k % 6] = h;
-                } else {
-                    r[k % 6 - 3] = h / scale;
-                }
-                (t, r)
-            };
-            let tol = GAP_TOLERANCE_FRACTION * scale;
-            let mut jac = nalgebra::DMatrix::<f64>::zeros(0, ndof);
-            for _ in 0..MAX_ITERATIONS {
-                let mut g0 = Vec::new();
-                self.plain_rows(g, &taut, &mut g0);
-                if g0.is_empty() {
-                    break;
-                }
-                let gmax = g0.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-                jac = nalgebra::DMatrix::<f64>::zeros(g0.len(), ndof);
-                for k in 0..ndof {
-                    let b = g.bodies[k / 6];
-                    let saved = *self.bodies[self.handles[b]].position();
-                    let (t, r) = unit(k, FD_STEP);
-                    self.nudge(b, t, r);
-                    let mut gk = Vec::new();
-                    self.plain_rows(g, &taut, &mut gk);
-                    self.bodies[self.handles[b]].set_position(saved, true);
-                    for (row, (gi, g0i)) in gk.iter().zip(&g0).enumerate() {
-                        jac[(row, k)] = (gi - g0i) / FD_STEP;
+            // Coordinates of the projection: per body a translation [m] and a rotation vector
+            // times the structure's size [m], about the centre of mass.
+            let nudge_all = |sim: &mut Simulation, dq: &[f64]| {
+                for (i, &b) in g.bodies.iter().enumerate() {
+                    let q = &dq[6 * i..6 * i + 6];
+                    if q.iter().any(|x| *x != 0.0) {
+                        sim.nudge(b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / scale);
                     }
                 }
-                if gmax <= tol {
-                    break;
-                }
-                let Some(step) = min_norm_solve(&jac, &-nalgebra::DVector::from_vec(g0)) else { break };
-                for (i, &b) in g.bodies.iter().enumerate() {
-                    let t = Vector::new(step[6 * i], step[6 * i + 1], step[6 * i + 2]);
-                    let r = Vector::new(step[6 * i + 3], step[6 * i + 4], step[6 * i + 5]) / scale;
-                    self.nudge(b, t, r);
-                }
-            }
-            let mut left = Vec::new();
-            self.plain_rows(g, &taut, &mut left);
-            largest = largest.max(left.iter().fold(0.0_f64, |m, x| m.max(x.abs())));
+            };
+            let rows = |sim: &Simulation| {
+                let mut out = Vec::new();
+                sim.plain_rows(g, &taut, &mut out);
+                out
+            };
+            let (jac, left) = close_rows(self, ndof, &rows, &nudge_all);
+            largest = largest.max(left);
             if jac.nrows() == 0 {
                 continue;
             }
@@ -419,8 +413,7 @@ impl Simulation {
                     [v.x, v.y, v.z, w.x, w.y, w.z]
                 }),
             );
-            let jk = jac;
-            if let Some(du) = min_norm_solve(&jk, &(&jk * &u)) {
+            if let Some(du) = min_norm_solve(&jac, &(&jac * &u)) {
                 for (i, &b) in g.bodies.iter().enumerate() {
                     let rb = &mut self.bodies[self.handles[b]];
                     let v = rb.linvel() - Vector::new(du[6 * i], du[6 * i + 1], du[6 * i + 2]);
