@@ -34,21 +34,22 @@ fn min_norm_solve(a: &nalgebra::DMatrix<f64>, b: &nalgebra::DVector<f64>) -> Opt
     svd.solve(b, cut).ok()
 }
 
-/// Gauss-Newton onto a constraint manifold: `displace` moves `ndof` coordinates by a step (in
-/// coordinate space), `rows` evaluates the constraint rows [m]. Iterates until every row is
-/// within [`GAP_TOLERANCE_FRACTION`] of the structure's size (at most [`MAX_ITERATIONS`]);
-/// returns the Jacobian at the last point (forward differences of `rows`) and the largest row
-/// left.
+/// Gauss-Newton onto a constraint manifold of `ndof` coordinates: `rows` evaluates the
+/// constraint rows [m]; `probe(sim, k, h)` evaluates them with coordinate k moved by h and puts
+/// the state back (each caller restores in its own exact way); `displace` moves every coordinate
+/// by a step. Iterates until every row is within [`GAP_TOLERANCE_FRACTION`] of the structure's
+/// size (at most [`MAX_ITERATIONS`]); returns the Jacobian at the last point (forward
+/// differences) and the largest row left.
 fn close_rows(
     sim: &mut Simulation,
     ndof: usize,
     rows: &dyn Fn(&Simulation) -> Vec<f64>,
+    probe: &dyn Fn(&mut Simulation, usize, f64) -> Vec<f64>,
     displace: &dyn Fn(&mut Simulation, &[f64]),
 ) -> (nalgebra::DMatrix<f64>, f64) {
     let largest = |g: &[f64]| g.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     let tol = GAP_TOLERANCE_FRACTION * sim.length_scale_m;
     let mut jac = nalgebra::DMatrix::<f64>::zeros(0, ndof);
-    let mut step = vec![0.0; ndof];
     for _ in 0..MAX_ITERATIONS {
         let g0 = rows(sim);
         if g0.is_empty() {
@@ -56,13 +57,7 @@ fn close_rows(
         }
         jac = nalgebra::DMatrix::<f64>::zeros(g0.len(), ndof);
         for k in 0..ndof {
-            step.fill(0.0);
-            step[k] = FD_STEP;
-            displace(sim, &step);
-            let g = rows(sim);
-            step[k] = -FD_STEP;
-            displace(sim, &step);
-            for (row, (gi, g0i)) in g.iter().zip(&g0).enumerate() {
+            for (row, (gi, g0i)) in probe(sim, k, FD_STEP).iter().zip(&g0).enumerate() {
                 jac[(row, k)] = (gi - g0i) / FD_STEP;
             }
         }
@@ -166,7 +161,17 @@ impl Simulation {
                 sim.displace(mb_index, &disp);
             };
             let gaps = |sim: &Simulation| sim.closure_gaps(&closures, mb_index);
-            let (jac, left) = close_rows(self, free.len(), &gaps, &displace_free);
+            // A probe moves one free coordinate and back.
+            let probe = |sim: &mut Simulation, k: usize, h: f64| {
+                let mut dq = vec![0.0; free.len()];
+                dq[k] = h;
+                displace_free(sim, &dq);
+                let g = gaps(sim);
+                dq[k] = -h;
+                displace_free(sim, &dq);
+                g
+            };
+            let (jac, left) = close_rows(self, free.len(), &gaps, &probe, &displace_free);
             largest = largest.max(left);
             // Velocities: remove the part that opens the loops, qdot -= J^+ (J qdot).
             if jac.nrows() > 0 {
@@ -387,9 +392,7 @@ impl Simulation {
             let nudge_all = |sim: &mut Simulation, dq: &[f64]| {
                 for (i, &b) in g.bodies.iter().enumerate() {
                     let q = &dq[6 * i..6 * i + 6];
-                    if q.iter().any(|x| *x != 0.0) {
-                        sim.nudge(b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / scale);
-                    }
+                    sim.nudge(b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / scale);
                 }
             };
             let rows = |sim: &Simulation| {
@@ -397,7 +400,18 @@ impl Simulation {
                 sim.plain_rows(g, &taut, &mut out);
                 out
             };
-            let (jac, left) = close_rows(self, ndof, &rows, &nudge_all);
+            // A probe nudges one body along one coordinate and restores its pose exactly.
+            let probe = |sim: &mut Simulation, k: usize, h: f64| {
+                let b = g.bodies[k / 6];
+                let saved = *sim.bodies[sim.handles[b]].position();
+                let mut q = [0.0; 6];
+                q[k % 6] = h;
+                sim.nudge(b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / scale);
+                let out = rows(sim);
+                sim.bodies[sim.handles[b]].set_position(saved, true);
+                out
+            };
+            let (jac, left) = close_rows(self, ndof, &rows, &probe, &nudge_all);
             largest = largest.max(left);
             if jac.nrows() == 0 {
                 continue;
