@@ -46,7 +46,7 @@ fn median(v: &mut [f64]) -> f64 {
 
 /// The case set's scenario as the bench runs it: every point built afresh (no continuation),
 /// no stability test, no stiffness probe, no recording.
-fn bench_scenario(file: &Path) -> Result<scenario::Scenario, String> {
+pub fn bench_scenario(file: &Path) -> Result<scenario::Scenario, String> {
     let mut sc = scenario::load(file).map_err(|e| e.to_string())?;
     sc.stability_perturbation = None;
     sc.probe = None;
@@ -195,7 +195,7 @@ pub fn bench_against_peer(
     dir: &Path,
 ) -> Result<PeerComparison, String> {
     let sc = bench_scenario(file)?;
-    let set = peer_case_set(mechanism, file)?;
+    let set = peer_case_set(mechanism, &sc)?;
     let cases_file = dir.join(format!("{mechanism}.json"));
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     std::fs::write(&cases_file, serde_json::to_string_pretty(&set).expect("case set serialises"))
@@ -320,10 +320,10 @@ pub struct PeerCase {
     pub analytic_nodes: Option<std::collections::BTreeMap<String, [f64; 3]>>,
 }
 
-/// The case set of `file` for a peer simulator.
-pub fn peer_case_set(mechanism: &str, file: &Path) -> Result<PeerCaseSet, String> {
+/// The case set of scenario `sc` for a peer simulator.
+pub fn peer_case_set(mechanism: &str, sc: &scenario::Scenario) -> Result<PeerCaseSet, String> {
     use crate::mechanisms::QuantityKind;
-    let sc = scenario::load(file).map_err(|e| e.to_string())?;
+    let file = &sc.file;
     let m = sc.mechanism();
     let params = crate::mechanisms::with_defaults(m.as_ref(), &sc.params);
     let Actuation::Points { points, .. } = &sc.actuation else {

@@ -542,7 +542,9 @@ fn cmd_export_cases(dir: &Path) -> i32 {
         return EXIT_BAD_INPUT;
     }
     for (m, file) in tensegrity_testbed::bench::CASE_SETS {
-        let set = match tensegrity_testbed::bench::peer_case_set(m, Path::new(file)) {
+        let set = match tensegrity_testbed::bench::bench_scenario(Path::new(file))
+            .and_then(|sc| tensegrity_testbed::bench::peer_case_set(m, &sc))
+        {
             Ok(s) => s,
             Err(e) => {
                 eprintln!("error: {e}");
