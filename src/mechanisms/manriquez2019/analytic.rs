@@ -86,6 +86,16 @@ pub const PAPER_N_CONFIGURATIONS: usize = 14761;
 /// Table 3: `(θ1, θ2)` [rad] of the four numerical experiments.
 pub const TABLE3_EXPERIMENTS: [(f64, f64); 4] =
     [(0.0941, 0.0332), (0.0854, -0.0277), (-0.0625, 0.0245), (-0.0799, -0.0364)];
+
+/// Joint angles within this of a Table 3 experiment [rad] are that experiment.
+const TABLE3_MATCH_RAD: f64 = 1e-9;
+
+/// The index of the Table 3 experiment at (theta1, theta2), if any.
+pub fn table3_experiment(theta1: f64, theta2: f64) -> Option<usize> {
+    TABLE3_EXPERIMENTS
+        .iter()
+        .position(|(a, b)| (a - theta1).abs() < TABLE3_MATCH_RAD && (b - theta2).abs() < TABLE3_MATCH_RAD)
+}
 /// Table 5, "Analytical" column, per experiment:
 /// `[|f_C1| N, |f_C2| N, |f_R1| N, |f_R2| N, |f_joint| N, m_joint N*mm]`.
 pub const TABLE5_ANALYTICAL: [[f64; 6]; 4] = [

@@ -155,6 +155,9 @@ const QUERIES: &[QuerySpec] = &[
     QuerySpec { name: "form_finding", inputs: &[], description: "the form-finding grid of Section 4 (121 x 121 from -0.5236 rad in steps of 0.0087) classified by the statics" },
 ];
 
+/// The forces of a Table 5 row, in its column order (the sixth column is the joint moment).
+const TABLE5_FORCES: [&str; 5] = ["f_C1", "f_C2", "f_R1", "f_R2", "f_joint"];
+
 /// N mm per N m: Table 5 gives the joint moment in N mm.
 const N_MM_PER_N_M: f64 = 1e3;
 
@@ -283,21 +286,13 @@ impl Mechanism for Manriquez2019 {
                     values: v,
                     stable: Some(st.equilibrium),
                 }];
-                if let Some(k) = analytic::TABLE3_EXPERIMENTS
-                    .iter()
-                    .position(|(a, b)| (a - t1).abs() < 1e-9 && (b - t2).abs() < 1e-9)
-                {
+                if let Some(k) = analytic::table3_experiment(t1, t2) {
                     let t = analytic::TABLE5_ANALYTICAL[k];
+                    let mut values: Values = TABLE5_FORCES.iter().zip(t).map(|(q, f)| (q.to_string(), f)).collect();
+                    values.insert("m_joint_Nmm".into(), t[5]);
                     out.push(Solution {
                         label: format!("Table 5, experiment {} (analytical column; m_joint in N mm)", k + 1),
-                        values: Values::from([
-                            ("f_C1".into(), t[0]),
-                            ("f_C2".into(), t[1]),
-                            ("f_R1".into(), t[2]),
-                            ("f_R2".into(), t[3]),
-                            ("f_joint".into(), t[4]),
-                            ("m_joint_Nmm".into(), t[5]),
-                        ]),
+                        values,
                         stable: None,
                     });
                 }
@@ -353,12 +348,11 @@ impl Mechanism for Manriquez2019 {
     /// converted from N mm to N m).
     fn paper_values(&self, _params: &Values, inputs: &Values) -> Option<(String, Values)> {
         let (t1, t2) = (inputs.get("theta1")?, inputs.get("theta2")?);
-        let k =
-            analytic::TABLE3_EXPERIMENTS.iter().position(|(a, b)| (a - t1).abs() < 1e-9 && (b - t2).abs() < 1e-9)?;
+        let k = analytic::table3_experiment(*t1, *t2)?;
         let mut v = Values::new();
         for (column, table) in [("", analytic::TABLE5_ANALYTICAL[k]), ("ansys_", analytic::TABLE5_ANSYS[k])] {
-            for (i, q) in ["f_C1", "f_C2", "f_R1", "f_R2", "f_joint"].iter().enumerate() {
-                v.insert(format!("{column}{q}"), table[i]);
+            for (q, f) in TABLE5_FORCES.iter().zip(table) {
+                v.insert(format!("{column}{q}"), f);
             }
             v.insert(format!("{column}m_joint"), table[5] / N_MM_PER_N_M);
         }
