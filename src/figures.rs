@@ -133,9 +133,19 @@ struct Fig4 {
     theta1: f64,
 }
 
+/// Loads and runs a scenario whose results a figure draws (findings left out); a run that
+/// stopped early (divergence, bad model) is an error naming the file.
+pub(super) fn run_scenario(path: &str) -> Result<(scenario::Scenario, crate::report::ScenarioReport), String> {
+    let sc = scenario::load(Path::new(path)).map_err(|e| e.to_string())?;
+    let report = run(&sc, &RunOptions { skip_findings: true, ..Default::default() });
+    match &report.error {
+        Some(e) => Err(format!("{path}: {e}")),
+        None => Ok((sc, report)),
+    }
+}
+
 fn ji2014_fig4_data() -> Result<Fig4, String> {
-    let sc = scenario::load(Path::new("scenarios/ji2014/fig4.toml")).map_err(|e| e.to_string())?;
-    let report = run(&sc, &RunOptions::default());
+    let (sc, report) = run_scenario("scenarios/ji2014/fig4.toml")?;
     let point = report.points.first().ok_or("the fig4 scenario settled no point")?;
     if !point.settled {
         return Err("the fig4 scenario did not settle".into());
@@ -347,8 +357,7 @@ struct FuretFig5 {
 /// The number of inverse solutions the dynamics reached at each end point of
 /// `workspace_grid.toml` (every solution of each grid point built, settled and checked).
 fn furet2018_reached_counts() -> Result<Vec<(f64, f64, usize)>, String> {
-    let sc = scenario::load(Path::new("scenarios/furet2018/workspace_grid.toml")).map_err(|e| e.to_string())?;
-    let r = run(&sc, &RunOptions { skip_findings: true, ..Default::default() });
+    let (_, r) = run_scenario("scenarios/furet2018/workspace_grid.toml")?;
     let mut counts: std::collections::BTreeMap<(i64, i64), (f64, f64, usize)> = Default::default();
     // Grid coordinates keyed to the micrometre.
     let key = |v: f64| (v * 1e6).round() as i64;

@@ -52,12 +52,11 @@ pub(super) struct Fig4 {
     cusp_miss_m: f64,
 }
 
-/// Runs a furet2018 scenario for the figure's dynamics overlay.
+/// Runs a furet2018 scenario for the figure's dynamics overlay: it must pass.
 fn run_scenario(path: &str) -> Result<crate::report::ScenarioReport, String> {
-    let sc = crate::scenario::load(Path::new(path)).map_err(|e| e.to_string())?;
-    let r = crate::run::run(&sc, &crate::run::RunOptions { skip_findings: true, ..Default::default() });
+    let (_, r) = super::run_scenario(path)?;
     if !r.passed {
-        return Err(format!("{path} did not pass: {:?}", r.error));
+        return Err(format!("{path} did not pass"));
     }
     Ok(r)
 }

@@ -6,8 +6,6 @@
 use super::{cell_runs, colour_at, colour_bar, legend_panel, zero_contour, Glyph, LIGHT_BLUES, VIRIDIS};
 use crate::mechanisms::ji2014::analytic as ji;
 use crate::mechanisms::ji2014::PAPER_ROOT_MARK;
-use crate::run::{run, RunOptions};
-use crate::scenario;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::f64::consts::PI;
@@ -45,11 +43,7 @@ struct GridPoint {
 }
 
 fn grid_points() -> Result<(ji::Params, Vec<GridPoint>), String> {
-    let sc = scenario::load(Path::new("scenarios/ji2014/grid.toml")).map_err(|e| e.to_string())?;
-    let report = run(&sc, &RunOptions { skip_findings: true, ..Default::default() });
-    if let Some(e) = report.error {
-        return Err(format!("grid.toml: {e}"));
-    }
+    let (sc, report) = super::run_scenario("scenarios/ji2014/grid.toml")?;
     let p = ji::Params { l: sc.params["L"], k1: sc.params["K1"], k2: sc.params["K2"] };
     let points = report
         .points
@@ -564,11 +558,7 @@ struct Probe {
 }
 
 fn probe_points() -> Result<(ji::Params, Vec<Probe>, f64), String> {
-    let sc = scenario::load(Path::new("scenarios/ji2014/stiffness_grid.toml")).map_err(|e| e.to_string())?;
-    let report = run(&sc, &RunOptions { skip_findings: true, ..Default::default() });
-    if let Some(e) = report.error {
-        return Err(format!("stiffness_grid.toml: {e}"));
-    }
+    let (sc, report) = super::run_scenario("scenarios/ji2014/stiffness_grid.toml")?;
     let p = ji::Params { l: sc.params["L"], k1: sc.params["K1"], k2: sc.params["K2"] };
     let probes = report
         .points
