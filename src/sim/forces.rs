@@ -228,9 +228,7 @@ impl Simulation {
                 }
             }
             let r0 = nalgebra::DVector::<f64>::from_iterator(rows, base.iter().map(scaled));
-            let svd = g.clone().svd(true, true);
-            let tol = CLOSURE_SVD_RELATIVE_TOLERANCE * svd.singular_values.max();
-            if let Ok(lambda) = svd.solve(&(-r0), tol) {
+            if let Some(lambda) = super::least_squares::min_norm_solve(&g, &(-r0), CLOSURE_SVD_RELATIVE_TOLERANCE) {
                 for (k, load) in closure_loads.iter().enumerate() {
                     for b in 0..nb {
                         wrench[b].0 += load.loads[b].0 * lambda[k];

@@ -17,6 +17,7 @@
 
 mod build;
 mod forces;
+mod least_squares;
 mod projection;
 pub mod settle;
 

@@ -26,41 +26,32 @@ const FD_STEP: f64 = 1e-7;
 /// zero (redundant closure rows).
 const SVD_RELATIVE_TOLERANCE: f64 = 1e-10;
 
-/// The minimum-norm least-squares solution x of `a x = b`, singular values below
-/// [`SVD_RELATIVE_TOLERANCE`] of the largest dropped (redundant rows).
+/// The minimum-norm least-squares solution of `a x = b` for the projection (redundant closure
+/// rows dropped by [`SVD_RELATIVE_TOLERANCE`]).
 fn min_norm_solve(a: &nalgebra::DMatrix<f64>, b: &nalgebra::DVector<f64>) -> Option<nalgebra::DVector<f64>> {
-    let svd = a.clone().svd(true, true);
-    let cut = SVD_RELATIVE_TOLERANCE * svd.singular_values.max();
-    svd.solve(b, cut).ok()
+    super::least_squares::min_norm_solve(a, b, SVD_RELATIVE_TOLERANCE)
 }
 
 /// Gauss-Newton onto a constraint manifold of `ndof` coordinates: `rows` evaluates the
-/// constraint rows [m]; `probe(sim, k, h)` evaluates them with coordinate k moved by h and puts
-/// the state back (each caller restores in its own exact way); `displace` moves every coordinate
-/// by a step. Iterates until every row is within [`GAP_TOLERANCE_FRACTION`] of the structure's
-/// size (at most [`MAX_ITERATIONS`]); returns the Jacobian at the last point (forward
-/// differences) and the largest row left.
+/// constraint rows [m]; `jacobian(sim, rows)` their derivatives by the coordinates at the
+/// current state (rows x ndof); `displace` moves every coordinate by a step. Iterates until
+/// every row is within [`GAP_TOLERANCE_FRACTION`] of the structure's size (at most
+/// [`MAX_ITERATIONS`]); returns the Jacobian at the last point and the largest row left.
 fn close_rows(
     sim: &mut Simulation,
-    ndof: usize,
     rows: &dyn Fn(&Simulation) -> Vec<f64>,
-    probe: &dyn Fn(&mut Simulation, usize, f64) -> Vec<f64>,
+    jacobian: &dyn Fn(&mut Simulation, &[f64]) -> nalgebra::DMatrix<f64>,
     displace: &dyn Fn(&mut Simulation, &[f64]),
 ) -> (nalgebra::DMatrix<f64>, f64) {
     let largest = |g: &[f64]| g.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     let tol = GAP_TOLERANCE_FRACTION * sim.length_scale_m;
-    let mut jac = nalgebra::DMatrix::<f64>::zeros(0, ndof);
+    let mut jac = nalgebra::DMatrix::<f64>::zeros(0, 0);
     for _ in 0..MAX_ITERATIONS {
         let g0 = rows(sim);
         if g0.is_empty() {
             break;
         }
-        jac = nalgebra::DMatrix::<f64>::zeros(g0.len(), ndof);
-        for k in 0..ndof {
-            for (row, (gi, g0i)) in probe(sim, k, FD_STEP).iter().zip(&g0).enumerate() {
-                jac[(row, k)] = (gi - g0i) / FD_STEP;
-            }
-        }
+        jac = jacobian(sim, &g0);
         if largest(&g0) <= tol {
             break;
         }
@@ -69,6 +60,39 @@ fn close_rows(
     }
     let left = largest(&rows(sim));
     (jac, left)
+}
+
+/// The Jacobian of `rows` by forward differences: `probe(sim, k, h)` evaluates the rows with
+/// coordinate k moved by h and puts the state back.
+fn forward_difference_jacobian(
+    sim: &mut Simulation,
+    ndof: usize,
+    g0: &[f64],
+    probe: &dyn Fn(&mut Simulation, usize, f64) -> Vec<f64>,
+) -> nalgebra::DMatrix<f64> {
+    let mut jac = nalgebra::DMatrix::<f64>::zeros(g0.len(), ndof);
+    for k in 0..ndof {
+        for (row, (gi, g0i)) in probe(sim, k, FD_STEP).iter().zip(g0).enumerate() {
+            jac[(row, k)] = (gi - g0i) / FD_STEP;
+        }
+    }
+    jac
+}
+
+/// A body's first-order motion per unit of one coordinate: velocity `v` of the point `at`
+/// and angular velocity `w`.
+#[derive(Clone, Copy, Debug)]
+struct Twist {
+    v: Vector,
+    w: Vector,
+    at: Vector,
+}
+
+impl Twist {
+    /// The motion of the body's point `p`.
+    fn of_point(&self, p: Vector) -> Vector {
+        self.v + self.w.cross(p - self.at)
+    }
 }
 
 /// A loop-closing joint inside one multibody: the rows of its gap that the projection zeroes.
@@ -120,6 +144,17 @@ impl Simulation {
         rows
     }
 
+    /// The free coordinates of a multibody: every degree of freedom of a link that no actuator
+    /// sets.
+    fn free_dofs(&self, multibody: MultibodyIndex) -> Vec<usize> {
+        self.multibody_joints.get_multibody(multibody).map_or_else(Vec::new, |mb| {
+            mb.links()
+                .filter(|l| !l.joint().kinematic)
+                .flat_map(|l| l.assembly_id()..l.assembly_id() + l.joint().ndofs())
+                .collect()
+        })
+    }
+
     /// Moves the multibody's coordinates by `disp` and places its bodies there.
     fn displace(&mut self, multibody: MultibodyIndex, disp: &[f64]) {
         if let Some(mb) = self.multibody_joints.get_multibody_mut(multibody) {
@@ -143,12 +178,7 @@ impl Simulation {
         for &mb_index in &multibodies {
             let Some(mb) = self.multibody_joints.get_multibody(mb_index) else { continue };
             let ndofs = mb.ndofs();
-            // The free coordinates: every degree of freedom of a link that no actuator sets.
-            let free: Vec<usize> = mb
-                .links()
-                .filter(|l| !l.joint().kinematic)
-                .flat_map(|l| l.assembly_id()..l.assembly_id() + l.joint().ndofs())
-                .collect();
+            let free = self.free_dofs(mb_index);
             if free.is_empty() {
                 continue;
             }
@@ -171,7 +201,8 @@ impl Simulation {
                 displace_free(sim, &dq);
                 g
             };
-            let (jac, left) = close_rows(self, free.len(), &gaps, &probe, &displace_free);
+            let jacobian = |sim: &mut Simulation, g0: &[f64]| forward_difference_jacobian(sim, free.len(), g0, &probe);
+            let (jac, left) = close_rows(self, &gaps, &jacobian, &displace_free);
             largest = largest.max(left);
             // Velocities: remove the part that opens the loops, qdot -= J^+ (J qdot).
             if jac.nrows() > 0 {
@@ -195,20 +226,26 @@ impl Simulation {
     }
 }
 
-/// Plain free bodies (not multibody links) held by impulse joints and inextensible cables to
-/// each other or to fixed bodies: a group whose constraints the projection can close.
+/// Free bodies held by impulse joints and inextensible cables to each other or to fixed
+/// bodies: a group whose constraints the projection can close. Its coordinates are the poses
+/// of its plain bodies and the free coordinates of the multibodies whose links it touches
+/// (mohr2011's legs, each a multibody hung from the base, hold the end-effector, a plain body,
+/// by spherical impulse joints).
 ///
 /// rapier holds these constraints at the velocity level too; under a steady load (gravity on
 /// manriquez2019's platform) the position offset it leaves grows like dt^2 and shrank only
-/// slowly with PGS iterations (3e-5 rad at dt = 2 ms). After each step the group's body poses
-/// are moved (Gauss-Newton, minimum norm, rotations scaled by the structure's size) until every
-/// joint's anchor gap and angular rows and every taut cable's stretch vanish to round-off; the
-/// velocities lose the components that would open a joint or stretch a taut cable. Member
-/// forces are still read from rapier (cable tensions from the rope impulses).
+/// slowly with PGS iterations (3e-5 rad at dt = 2 ms; on mohr2011 1e-9 took 64 to 512 PGS
+/// iterations). After each step the group's coordinates are moved (Gauss-Newton, minimum norm,
+/// rotations of plain bodies scaled by the structure's size) until every joint's anchor gap and
+/// angular rows and every taut cable's stretch vanish to round-off; the velocities lose the
+/// components that would open a joint or stretch a taut cable. The tensions of the cables held
+/// this way are fitted from the equilibrium (`forces.rs`).
 #[derive(Clone, Debug, Default)]
 pub(super) struct PlainGroup {
     /// Structure body indices of the group's free plain bodies.
     bodies: Vec<usize>,
+    /// Multibodies whose links the group's joints or cables touch.
+    multibodies: Vec<MultibodyIndex>,
     /// Impulse joints (structure indices) between the group's bodies or to fixed bodies.
     joints: Vec<usize>,
     /// Inextensible cables with a rope joint.
@@ -237,13 +274,15 @@ impl Simulation {
         self.plain_groups.iter().any(|g| g.cables.contains(&c)) && self.cable_is_taut(c)
     }
 
-    /// Groups of plain free bodies whose every constraint the projection handles. A group that
-    /// touches a multibody link, an actuated joint or a joint kind without projection rows is
-    /// left to rapier alone.
+    /// Groups of free bodies whose every constraint the projection handles. A group that
+    /// touches an actuated joint, a joint kind without projection rows, or a multibody with a
+    /// loop inside (closed by [`Self::project_internal_closures`]) is left to rapier alone.
     pub(super) fn find_plain_groups(&self) -> Vec<PlainGroup> {
         let s = &self.structure;
         let n = s.bodies.len();
-        let plain = |b: usize| self.is_free(b) && self.multibody_joints.rigid_body_link(self.handles[b]).is_none();
+        let multibody_of = |b: usize| self.multibody_joints.rigid_body_link(self.handles[b]).map(|l| l.multibody);
+        let looped: Vec<MultibodyIndex> = self.internal_closures.iter().map(|c| c.multibody).collect();
+        let plain = |b: usize| self.is_free(b) && multibody_of(b).is_none();
         let fixed = |b: usize| s.bodies[b].kind == crate::structure::BodyKind::Fixed;
         // Union-find over bodies joined by a constraint.
         let mut parent: Vec<usize> = (0..n).collect();
@@ -263,6 +302,14 @@ impl Simulation {
         for (c, cable) in s.cables.iter().enumerate() {
             if self.cable_ropes[c].is_some() {
                 edges.push((s.nodes[cable.a].body, s.nodes[cable.b].body));
+            }
+        }
+        // The links of one multibody move together: one group.
+        for a in 0..n {
+            for b in a + 1..n {
+                if multibody_of(a).is_some() && multibody_of(a) == multibody_of(b) {
+                    edges.push((a, b));
+                }
             }
         }
         for &(a, b) in &edges {
@@ -314,11 +361,23 @@ impl Simulation {
             }
             let root = find(&mut parent, b);
             if let Some(g) = groups.iter_mut().find(|g| g.0 == root) {
-                g.1.bodies.push(b);
-                g.2 &= plain(b);
+                if plain(b) {
+                    g.1.bodies.push(b);
+                } else if let Some(m) = multibody_of(b) {
+                    g.2 &= !looped.contains(&m);
+                    if !g.1.multibodies.contains(&m) {
+                        g.1.multibodies.push(m);
+                    }
+                } else {
+                    g.2 = false;
+                }
             }
         }
-        groups.into_iter().filter(|(_, g, ok)| *ok && !g.bodies.is_empty()).map(|(_, g, _)| g).collect()
+        groups
+            .into_iter()
+            .filter(|(_, g, ok)| *ok && !(g.bodies.is_empty() && g.multibodies.is_empty()))
+            .map(|(_, g, _)| g)
+            .collect()
     }
 
     /// The constraint rows of a plain group: joint anchor gaps and angular rows, then the
@@ -365,6 +424,57 @@ impl Simulation {
         }
     }
 
+    /// The rates of [`Self::plain_rows`] (same order and scaling) when each body moves with
+    /// its twist (`None`: the body stays). Exact to first order at a closed joint; the terms
+    /// that multiply a gap are dropped (the gap is round-off once projected).
+    fn plain_row_rates(&self, g: &PlainGroup, taut: &[usize], twists: &[Option<Twist>], out: &mut Vec<f64>) {
+        let s = &self.structure;
+        let scale = self.length_scale_m;
+        let pose = |b: usize| *self.bodies[self.handles[b]].position();
+        let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
+        let point_rate = |b: usize, p: Vector| twists[b].map_or(Vector::ZERO, |t| t.of_point(p));
+        let spin = |b: usize| twists[b].map_or(Vector::ZERO, |t| t.w);
+        for &j in &g.joints {
+            let joint = &s.joints[j];
+            let (pp, pc) = (pose(joint.parent), pose(joint.child));
+            let a = vec3(s.nodes[joint.anchor].position);
+            let gap_rate =
+                point_rate(joint.child, pc.transform_point(a)) - point_rate(joint.parent, pp.transform_point(a));
+            let (wp, wc) = (spin(joint.parent), spin(joint.child));
+            match joint.kind {
+                JointKind::PlanarPin { axis } => {
+                    let n = (pp.rotation * vec3(axis)).normalize();
+                    for t in super::forces::orthogonal_pair(n) {
+                        out.push(gap_rate.dot(t));
+                    }
+                }
+                JointKind::Revolute { axis } => {
+                    out.extend([gap_rate.x, gap_rate.y, gap_rate.z]);
+                    let ap = (pp.rotation * vec3(axis)).normalize();
+                    let ac = (pc.rotation * vec3(axis)).normalize();
+                    for t in super::forces::orthogonal_pair(ap) {
+                        out.push((wc.cross(ac).dot(t) + ac.dot(wp.cross(t))) * scale);
+                    }
+                }
+                JointKind::Universal { axis1, axis2 } => {
+                    out.extend([gap_rate.x, gap_rate.y, gap_rate.z]);
+                    let a1 = pp.rotation * vec3(axis1).normalize();
+                    let a2 = pc.rotation * vec3(axis2).normalize();
+                    out.push((wp.cross(a1).dot(a2) + a1.dot(wc.cross(a2))) * scale);
+                }
+                _ => out.extend([gap_rate.x, gap_rate.y, gap_rate.z]),
+            }
+        }
+        for &c in taut {
+            let cable = &s.cables[c];
+            let (pa, pb) = (vec3(self.node_position(cable.a)), vec3(self.node_position(cable.b)));
+            let d = pb - pa;
+            let l = d.length();
+            let rate = point_rate(s.nodes[cable.b].body, pb) - point_rate(s.nodes[cable.a].body, pa);
+            out.push(if l > 0.0 { rate.dot(d / l) } else { 0.0 });
+        }
+    }
+
     /// Moves body `b` by a translation `t` [m] and a rotation `r` [rad, rotation vector] about
     /// its centre of mass.
     fn nudge(&mut self, b: usize, t: Vector, r: Vector) {
@@ -378,21 +488,54 @@ impl Simulation {
         self.bodies[h].set_position(moved, true);
     }
 
-    /// Closes every plain group's joints and taut cables to round-off and projects the bodies'
-    /// velocities. Returns the largest row left [m].
+    /// Closes every plain group's joints and taut cables to round-off and projects the
+    /// velocities of its bodies and multibodies. Returns the largest row left [m].
     pub(super) fn project_plain_groups(&mut self) -> f64 {
         let groups = std::mem::take(&mut self.plain_groups);
         let scale = self.length_scale_m;
         let mut largest = 0.0_f64;
         for g in &groups {
             let taut: Vec<usize> = g.cables.iter().copied().filter(|&c| self.cable_is_taut(c)).collect();
-            let ndof = 6 * g.bodies.len();
-            // Coordinates of the projection: per body a translation [m] and a rotation vector
-            // times the structure's size [m], about the centre of mass.
-            let nudge_all = |sim: &mut Simulation, dq: &[f64]| {
+            // Coordinates of the projection: per plain body a translation [m] and a rotation
+            // vector times the structure's size [m], about the centre of mass; then each
+            // multibody's free coordinates [m or rad].
+            // (The free coordinates are read here: rapier counts a fixed root's six degrees of
+            // freedom until its first forward kinematics.)
+            let multibodies: Vec<(MultibodyIndex, Vec<usize>)> =
+                g.multibodies.iter().map(|&m| (m, self.free_dofs(m))).collect();
+            // The body Jacobians at the current coordinates (the Jacobian below reads them).
+            for &m in &g.multibodies {
+                if let Some(mb) = self.multibody_joints.get_multibody_mut(m) {
+                    mb.forward_kinematics(&self.bodies, false);
+                }
+            }
+            let n_plain = 6 * g.bodies.len();
+            let ndof = n_plain + multibodies.iter().map(|(_, d)| d.len()).sum::<usize>();
+            // The multibody and its degree of freedom behind coordinate k >= n_plain.
+            let multibody_dof = |k: usize| {
+                let mut k = k - n_plain;
+                for (m, dofs) in &multibodies {
+                    if k < dofs.len() {
+                        return (*m, dofs[k]);
+                    }
+                    k -= dofs.len();
+                }
+                unreachable!("coordinate index within the group's count")
+            };
+            let displace_all = |sim: &mut Simulation, dq: &[f64]| {
                 for (i, &b) in g.bodies.iter().enumerate() {
                     let q = &dq[6 * i..6 * i + 6];
                     sim.nudge(b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / scale);
+                }
+                let mut k = n_plain;
+                for (m, dofs) in &multibodies {
+                    let Some(mb) = sim.multibody_joints.get_multibody(*m) else { continue };
+                    let mut disp = vec![0.0; mb.ndofs()];
+                    for &dof in dofs {
+                        disp[dof] = dq[k];
+                        k += 1;
+                    }
+                    sim.displace(*m, &disp);
                 }
             };
             let rows = |sim: &Simulation| {
@@ -400,33 +543,65 @@ impl Simulation {
                 sim.plain_rows(g, &taut, &mut out);
                 out
             };
-            // A probe nudges one body along one coordinate and restores its pose exactly.
-            let probe = |sim: &mut Simulation, k: usize, h: f64| {
-                let b = g.bodies[k / 6];
-                let saved = *sim.bodies[sim.handles[b]].position();
-                let mut q = [0.0; 6];
-                q[k % 6] = h;
-                sim.nudge(b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / scale);
-                let out = rows(sim);
-                sim.bodies[sim.handles[b]].set_position(saved, true);
-                out
+            // The Jacobian from each coordinate's twists of the bodies it moves: a plain body's
+            // unit translation or rotation about its centre of mass, a multibody link's column
+            // of rapier's body Jacobian (centre-of-mass velocity and angular velocity).
+            let jacobian = |sim: &mut Simulation, g0: &[f64]| {
+                let mut jac = nalgebra::DMatrix::<f64>::zeros(g0.len(), ndof);
+                let mut twists: Vec<Option<Twist>> = vec![None; sim.structure.bodies.len()];
+                for k in 0..ndof {
+                    twists.iter_mut().for_each(|t| *t = None);
+                    if k < n_plain {
+                        let b = g.bodies[k / 6];
+                        let mut q = [Vector::ZERO; 2];
+                        q[(k % 6) / 3][k % 3] = 1.0;
+                        twists[b] = Some(Twist { v: q[0], w: q[1] / scale, at: sim.world_com(b) });
+                    } else {
+                        let (m, dof) = multibody_dof(k);
+                        let Some(mb) = sim.multibody_joints.get_multibody(m) else { continue };
+                        for (b, twist) in twists.iter_mut().enumerate() {
+                            let h = sim.handles[b];
+                            let Some(link) = sim.multibody_joints.rigid_body_link(h).filter(|l| l.multibody == m)
+                            else {
+                                continue;
+                            };
+                            let col = mb.body_jacobian(link.id).column(dof);
+                            *twist = Some(Twist {
+                                v: Vector::new(col[0], col[1], col[2]),
+                                w: Vector::new(col[3], col[4], col[5]),
+                                at: sim.bodies[h].center_of_mass(),
+                            });
+                        }
+                    }
+                    let mut column = Vec::with_capacity(g0.len());
+                    sim.plain_row_rates(g, &taut, &twists, &mut column);
+                    for (r, x) in column.into_iter().enumerate() {
+                        jac[(r, k)] = x;
+                    }
+                }
+                jac
             };
-            let (jac, left) = close_rows(self, ndof, &rows, &probe, &nudge_all);
+            let (jac, left) = close_rows(self, &rows, &jacobian, &displace_all);
             largest = largest.max(left);
             if jac.nrows() == 0 {
                 continue;
             }
-            // Velocities u = [v, w L] per body: remove J^+ (J u) over every row, taut cables
-            // included (they were just held at their length: a cable goes slack when rapier's
-            // rope stops pulling, and is then no longer taut here).
-            let u = nalgebra::DVector::from_iterator(
-                ndof,
-                g.bodies.iter().flat_map(|&b| {
-                    let rb = &self.bodies[self.handles[b]];
-                    let (v, w) = (rb.linvel(), rb.angvel() * scale);
-                    [v.x, v.y, v.z, w.x, w.y, w.z]
-                }),
-            );
+            // Velocities u = [v, w L] per plain body, then the multibodies' free generalized
+            // velocities: remove J^+ (J u) over every row, taut cables included (they were just
+            // held at their length: a cable goes slack when rapier's rope stops pulling, and is
+            // then no longer taut here).
+            let mut u = nalgebra::DVector::<f64>::zeros(ndof);
+            for (i, &b) in g.bodies.iter().enumerate() {
+                let rb = &self.bodies[self.handles[b]];
+                let (v, w) = (rb.linvel(), rb.angvel() * scale);
+                for (r, x) in [v.x, v.y, v.z, w.x, w.y, w.z].into_iter().enumerate() {
+                    u[6 * i + r] = x;
+                }
+            }
+            for k in n_plain..ndof {
+                let (m, dof) = multibody_dof(k);
+                u[k] = self.multibody_joints.get_multibody(m).map_or(0.0, |mb| mb.generalized_velocity()[dof]);
+            }
             if let Some(du) = min_norm_solve(&jac, &(&jac * &u)) {
                 for (i, &b) in g.bodies.iter().enumerate() {
                     let rb = &mut self.bodies[self.handles[b]];
@@ -434,6 +609,12 @@ impl Simulation {
                     let w = rb.angvel() - Vector::new(du[6 * i + 3], du[6 * i + 4], du[6 * i + 5]) / scale;
                     rb.set_linvel(v, true);
                     rb.set_angvel(w, true);
+                }
+                for k in n_plain..ndof {
+                    let (m, dof) = multibody_dof(k);
+                    if let Some(mb) = self.multibody_joints.get_multibody_mut(m) {
+                        mb.generalized_velocity_mut()[dof] -= du[k];
+                    }
                 }
             }
         }
