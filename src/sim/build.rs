@@ -178,6 +178,8 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         plain_groups: Vec::new(),
         cable_ropes,
         cable_lengths: s.cables.iter().map(|c| c.length_m).collect(),
+        secant: vec![None; s.joints.len()],
+        dof_inertia: vec![0.0; s.joints.len()],
         commands: commands.clone(),
         probe_loads: vec![([0.0; 3], [0.0; 3]); n],
         external_loads: {
@@ -331,7 +333,7 @@ pub(super) fn free_axis_of(kind: &JointKind) -> JointAxis {
 }
 
 /// Sets the damping of every degree of freedom of a multibody link [N s/m or N m s/rad].
-fn set_link_damping(set: &mut MultibodyJointSet, link: MultibodyJointHandle, damping: f64) {
+pub(super) fn set_link_damping(set: &mut MultibodyJointSet, link: MultibodyJointHandle, damping: f64) {
     if let Some((mb, link_id)) = set.get_mut(link) {
         let (start, ndofs) = {
             let l = mb.link(link_id).expect("link just inserted");
