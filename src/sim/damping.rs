@@ -3,17 +3,18 @@
 //! Joint damping is implicit in rapier's multibody step: with damping c, inertia I and the
 //! explicit generalized force tau(q) of the springs, one step of length dt moves a coordinate by
 //! dq = dt (I v + dt tau) / (I + dt c). With c = dt k, k = -dtau/dq the local stiffness, and
-//! dt^2 k >> I, that is Newton's step tau / k: the error contracts by about I / (dt^2 k) per step
-//! from wherever the motion starts (the momentum term I v is what is left). A fixed c fits one
+//! dt^2 k >> I, that is nearly Newton's step tau / k; the momentum term I v is what is left, and
+//! the schedule accounts for it too. A fixed c fits one
 //! stiffness only: too little overshoots (and can jump to another equilibrium branch), too much
 //! creeps (BENCHMARKS.md's scan on ji2014).
 //!
 //! The schedule estimates k for every damped revolute or prismatic multibody joint from the
 //! simulation itself, by the secant of its generalized force over its coordinate between two
-//! steps, and sets c = dt k before the step. Where the secant is not positive (no previous step,
-//! no motion, or an unstable region where the stiffness is negative) the joint keeps the
-//! structure's damping. Damping is zero at rest, so the equilibrium is the same as with any
-//! fixed damping; only the path to it changes.
+//! steps (the last estimate when the joint hardly moved), and sets before each step the damping
+//! that makes the step Newton's, its momentum included (`newton_damping`). With no estimate
+//! (the first step after a start) or a stiffness that is not positive (an unstable region) the
+//! joint keeps the structure's damping. Damping is zero at rest, so the equilibrium is the same
+//! as with any fixed damping; only the path to it changes.
 
 use super::Simulation;
 use crate::structure::JointKind;
@@ -47,6 +48,8 @@ const SECANT_MIN_STEP: f64 = 1e-12;
 pub(super) struct SecantPoint {
     coordinate: f64,
     force: f64,
+    /// The stiffness estimate used for the step from here [N m/rad or N/m].
+    stiffness: Option<f64>,
 }
 
 impl Simulation {
@@ -104,14 +107,14 @@ impl Simulation {
             JointKind::Revolute { axis } => {
                 let a = Vector::new(axis[0], axis[1], axis[2]);
                 let coordinate = super::forces::relative_angle(parent.rotation, child.rotation, a);
-                SecantPoint { coordinate, force: moment.dot((parent.rotation * a).normalize()) }
+                SecantPoint { coordinate, force: moment.dot((parent.rotation * a).normalize()), stiffness: None }
             }
             JointKind::Prismatic { axis } => {
                 let a = (parent.rotation * Vector::new(axis[0], axis[1], axis[2])).normalize();
                 let coordinate = (child.transform_point(anchor_local) - anchor).dot(a);
-                SecantPoint { coordinate, force: force.dot(a) }
+                SecantPoint { coordinate, force: force.dot(a), stiffness: None }
             }
-            _ => SecantPoint { coordinate: 0.0, force: 0.0 },
+            _ => SecantPoint { coordinate: 0.0, force: 0.0, stiffness: None },
         }
     }
 
@@ -131,30 +134,31 @@ impl Simulation {
                 continue;
             }
             let Some((mb_index, dof)) = self.dof_of(j) else { continue };
-            let now = self.coordinate_and_force(j);
+            let mut now = self.coordinate_and_force(j);
             let mut damping = self.structure.joints[j].damping;
-            if let Some(last) = self.secant[j] {
-                if self.dof_inertia[j] <= 0.0 {
-                    // Once per start, after a step (rapier's mass properties are current only
-                    // then): the joint's effective inertia, every other coordinate free.
-                    if let Some(mb) = self.multibody_joints.get_multibody_mut(mb_index) {
-                        let inv = mb.dof_inverse_inertia(&self.bodies)[dof];
-                        self.dof_inertia[j] = if inv > 0.0 { 1.0 / inv } else { 0.0 };
+            now.stiffness = match self.secant[j] {
+                // A new start: no estimate yet, the structure's damping for this step.
+                None => None,
+                Some(last) => {
+                    if self.dof_inertia[j] <= 0.0 {
+                        // After the first step (rapier's mass data are current only then): the
+                        // joint's effective inertia, every other coordinate free.
+                        if let Some(mb) = self.multibody_joints.get_multibody_mut(mb_index) {
+                            let inv = mb.dof_inverse_inertia(&self.bodies)[dof];
+                            self.dof_inertia[j] = if inv > 0.0 { 1.0 / inv } else { 0.0 };
+                        }
+                    }
+                    // The secant, or the last estimate when the joint hardly moved.
+                    let dq = now.coordinate - last.coordinate;
+                    if dq.abs() > SECANT_MIN_STEP {
+                        Some(-(now.force - last.force) / dq)
+                    } else {
+                        last.stiffness
                     }
                 }
-                let dq = now.coordinate - last.coordinate;
-                if dq.abs() > SECANT_MIN_STEP {
-                    let stiffness = -(now.force - last.force) / dq;
-                    if stiffness > 0.0 {
-                        damping = newton_damping(
-                            dt,
-                            stiffness,
-                            self.dof_inertia[j],
-                            self.dof_velocity(mb_index, dof),
-                            now.force,
-                        );
-                    }
-                }
+            };
+            if let Some(k) = now.stiffness.filter(|k| *k > 0.0) {
+                damping = newton_damping(dt, k, self.dof_inertia[j], self.dof_velocity(mb_index, dof), now.force);
             }
             self.secant[j] = Some(now);
             if let Some(link) = self.joint_links[j] {
