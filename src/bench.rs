@@ -70,8 +70,14 @@ struct Round {
     all_settled: bool,
 }
 
+/// One timed pass over the case set, after an untimed one: the peer too goes over every case
+/// untimed first (its start-state check) in the process that then times them, so both sides
+/// are timed warm (the testbed's cold pass, right after a peer round, measured up to 1.5x
+/// slower).
 fn testbed_round(mechanism: &str, sc: &scenario::Scenario) -> Round {
-    let r = run(sc, &RunOptions { skip_findings: true, ..Default::default() });
+    let opts = RunOptions { skip_findings: true, ..Default::default() };
+    let _warm_up = run(sc, &opts);
+    let r = run(sc, &opts);
     let scale = crate::mechanisms::find(mechanism).map_or(1.0, |m| m.length_scale(&r.params));
     let mut round = Round {
         cases: r.points.len(),
