@@ -80,7 +80,7 @@ impl Simulation {
 
     /// Joint `j`'s coordinate [rad or m] and the generalized force [N m or N] of the loads
     /// applied for the coming step (member forces, external loads and gravity on every body it
-    /// carries).
+    /// carries, and its own torsion spring).
     fn coordinate_and_force(&self, j: usize) -> SecantPoint {
         let s = &self.structure;
         let joint = &s.joints[j];
@@ -107,7 +107,12 @@ impl Simulation {
             JointKind::Revolute { axis } => {
                 let a = Vector::new(axis[0], axis[1], axis[2]);
                 let coordinate = super::forces::relative_angle(parent.rotation, child.rotation, a);
-                SecantPoint { coordinate, force: moment.dot((parent.rotation * a).normalize()), stiffness: None }
+                // The joint's own torsion spring (a rapier motor, not a user force).
+                let spring = joint.torsion_spring.as_ref().map_or(0.0, |t| {
+                    -t.stiffness_nm_per_rad * (joint.initial_coordinate + coordinate - t.rest_angle_rad)
+                });
+                let force = moment.dot((parent.rotation * a).normalize()) + spring;
+                SecantPoint { coordinate, force, stiffness: None }
             }
             JointKind::Prismatic { axis } => {
                 let a = (parent.rotation * Vector::new(axis[0], axis[1], axis[2])).normalize();
