@@ -4,7 +4,7 @@
 //! expected values given in the file (`[[checks]]` with `value`).
 
 use crate::mechanisms::{
-    Finding, InputSpec, Mechanism, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec, Solution, Values,
+    Finding, InputSpec, Mechanism, MechanismSpec, Prediction, QuantityKind, QuantitySpec, Solution, Values,
 };
 use crate::sim::Snapshot;
 use crate::structure::{ActuatorTarget, Structure};
@@ -13,8 +13,8 @@ use crate::structure::{ActuatorTarget, Structure};
 #[derive(Clone, Debug)]
 pub struct Custom {
     pub structure: Structure,
-    inputs: &'static [InputSpec],
-    quantities: &'static [QuantitySpec],
+    /// Name, title and the symbols of the file's actuators and checks.
+    spec: MechanismSpec,
     /// Expected values from the file's checks, by quantity.
     pub expected: Values,
 }
@@ -67,8 +67,16 @@ impl Custom {
         }
         Custom {
             structure,
-            inputs: Box::leak(inputs.into_boxed_slice()),
-            quantities: Box::leak(quantities.into_boxed_slice()),
+            spec: MechanismSpec {
+                name: "custom",
+                title: "a structure described in the scenario file (no analytic model)",
+                params: &[],
+                inputs: Box::leak(inputs.into_boxed_slice()),
+                quantities: Box::leak(quantities.into_boxed_slice()),
+                queries: &[],
+                start_keys: &[],
+                alternative_inputs: &[],
+            },
             expected,
         }
     }
@@ -123,29 +131,14 @@ impl Custom {
 }
 
 impl Mechanism for Custom {
-    fn name(&self) -> &'static str {
-        "custom"
-    }
-    fn title(&self) -> &'static str {
-        "a structure described in the scenario file (no analytic model)"
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &[]
-    }
-    fn inputs(&self) -> &'static [InputSpec] {
-        self.inputs
-    }
-    fn quantities(&self) -> &'static [QuantitySpec] {
-        self.quantities
-    }
-    fn queries(&self) -> &'static [QuerySpec] {
-        &[]
+    fn spec(&self) -> &MechanismSpec {
+        &self.spec
     }
     fn validate_params(&self, _params: &Values) -> Result<(), (String, String)> {
         Ok(())
     }
     fn validate_inputs(&self, _params: &Values, inputs: &Values) -> Result<(), (String, String)> {
-        for i in self.inputs {
+        for i in self.spec.inputs {
             let x =
                 inputs.get(i.symbol).copied().ok_or((i.symbol.to_string(), format!("missing input {}", i.symbol)))?;
             if !x.is_finite() {

@@ -108,26 +108,53 @@ pub struct StiffnessProbe {
     pub analytic: String,
 }
 
-/// A mechanism from a paper: its analytic model and how to build it for the simulator.
-pub trait Mechanism: Send + Sync {
-    fn name(&self) -> &'static str;
-    fn title(&self) -> &'static str;
-    fn params(&self) -> &'static [ParamSpec];
-    fn inputs(&self) -> &'static [InputSpec];
-    fn quantities(&self) -> &'static [QuantitySpec];
-    fn queries(&self) -> &'static [QuerySpec];
+/// What a mechanism is, as data: its name and title and the symbols a scenario may use.
+#[derive(Clone, Copy, Debug)]
+pub struct MechanismSpec {
+    pub name: &'static str,
+    pub title: &'static str,
+    pub params: &'static [ParamSpec],
+    pub inputs: &'static [InputSpec],
+    pub quantities: &'static [QuantitySpec],
+    pub queries: &'static [QuerySpec],
     /// Keys accepted in a scenario's `[start]` table: (key, meaning).
-    fn start_keys(&self) -> &'static [(&'static str, &'static str)] {
-        &[]
-    }
-    /// Checks parameter values; the message names the parameter and the accepted range.
-    fn validate_params(&self, params: &Values) -> Result<(), (String, String)>;
+    pub start_keys: &'static [(&'static str, &'static str)],
     /// Other sets of symbols a scenario may give instead of the inputs (for example the
     /// end-effector position of a cable-driven mechanism); [`Mechanism::convert_inputs`] turns
     /// them into inputs through the analytic inverse model.
-    fn alternative_inputs(&self) -> &'static [&'static [&'static str]] {
-        &[]
+    pub alternative_inputs: &'static [&'static [&'static str]],
+}
+
+/// A mechanism from a paper: its analytic model and how to build it for the simulator.
+pub trait Mechanism: Send + Sync {
+    /// The mechanism's name, title and symbols.
+    fn spec(&self) -> &MechanismSpec;
+    fn name(&self) -> &'static str {
+        self.spec().name
     }
+    fn title(&self) -> &'static str {
+        self.spec().title
+    }
+    fn params(&self) -> &'static [ParamSpec] {
+        self.spec().params
+    }
+    fn inputs(&self) -> &'static [InputSpec] {
+        self.spec().inputs
+    }
+    fn quantities(&self) -> &'static [QuantitySpec] {
+        self.spec().quantities
+    }
+    fn queries(&self) -> &'static [QuerySpec] {
+        self.spec().queries
+    }
+    fn start_keys(&self) -> &'static [(&'static str, &'static str)] {
+        self.spec().start_keys
+    }
+    fn alternative_inputs(&self) -> &'static [&'static [&'static str]] {
+        self.spec().alternative_inputs
+    }
+    /// Checks parameter values; the message names the parameter and the accepted range.
+    fn validate_params(&self, params: &Values) -> Result<(), (String, String)>;
     /// Converts one of the [`Mechanism::alternative_inputs`] sets into inputs;
     /// `Err((symbol, message))` when it has no solution.
     fn convert_inputs(&self, _params: &Values, given: &Values) -> Result<Values, (String, String)> {

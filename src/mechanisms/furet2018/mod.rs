@@ -5,8 +5,8 @@ pub mod analytic;
 pub mod build;
 
 use super::{
-    input, wrap_angle, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec,
-    QuerySpec, Solution, Values,
+    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind,
+    QuantitySpec, QuerySpec, Solution, Values,
 };
 use crate::sim::Snapshot;
 use crate::structure::Structure;
@@ -122,26 +122,22 @@ fn theta_of(a: [f64; 3], b: [f64; 3], d: [f64; 3], c: [f64; 3]) -> f64 {
     wrap_angle(my.atan2(mx) - base - std::f64::consts::FRAC_PI_2)
 }
 
-impl Mechanism for Furet2018 {
-    fn name(&self) -> &'static str {
-        "furet2018"
-    }
-    fn title(&self) -> &'static str {
-        "Furet, Lettl, Wenger (2018): planar manipulator of two Snelson X mechanisms in series, cuspidal"
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        PARAMS
-    }
-    fn inputs(&self) -> &'static [InputSpec] {
-        INPUTS
-    }
-    fn quantities(&self) -> &'static [QuantitySpec] {
-        QUANTITIES
-    }
-    fn queries(&self) -> &'static [QuerySpec] {
-        QUERIES
-    }
+/// The mechanism as data (name, title, symbols).
+const SPEC: MechanismSpec = MechanismSpec {
+    name: "furet2018",
+    title: "Furet, Lettl, Wenger (2018): planar manipulator of two Snelson X mechanisms in series, cuspidal",
+    params: PARAMS,
+    inputs: INPUTS,
+    quantities: QUANTITIES,
+    queries: QUERIES,
+    start_keys: &[],
+    alternative_inputs: &[&["x", "y", "solution"]],
+};
 
+impl Mechanism for Furet2018 {
+    fn spec(&self) -> &MechanismSpec {
+        &SPEC
+    }
     fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
         super::require_positive(v, &[("L", "m"), ("b", "m"), ("k_spring", "N/m"), ("m_bar", "kg")])?;
         super::require_non_negative(v, &[("l0_spring", "m"), ("c_joint", "N m s/rad"), ("dz", "m"), ("r_strut", "m")])?;
@@ -155,10 +151,6 @@ impl Mechanism for Furet2018 {
             ));
         }
         Ok(())
-    }
-
-    fn alternative_inputs(&self) -> &'static [&'static [&'static str]] {
-        &[&["x", "y", "solution"]]
     }
 
     /// (x, y, solution k): the k-th inverse solution (1-based, in the order `solve furet2018
@@ -178,7 +170,6 @@ impl Mechanism for Furet2018 {
         };
         Ok(Values::from([("theta1".into(), s.theta1), ("theta2".into(), s.theta2)]))
     }
-
     fn validate_inputs(&self, _params: &Values, inputs: &Values) -> Result<(), (String, String)> {
         for s in ["theta1", "theta2"] {
             let t = inputs.get(s).copied().ok_or((s.to_string(), format!("missing input {s} [rad]")))?;
@@ -191,7 +182,6 @@ impl Mechanism for Furet2018 {
         }
         Ok(())
     }
-
     fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String> {
         let p = params_of(params);
         match query {
@@ -258,17 +248,14 @@ impl Mechanism for Furet2018 {
             other => Err(format!("unknown query '{other}' for furet2018 (expected one of: dk, ik, workspace, path)")),
         }
     }
-
     fn build(&self, params: &Values, inputs: &Values, _start: &Values) -> Result<Structure, String> {
         let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
         Ok(build::build(&params_of(params), &model_of(params), t1, t2))
     }
-
     fn commands(&self, params: &Values, inputs: &Values) -> Vec<f64> {
         let p = params_of(params);
         vec![analytic::base_joint_angle_a(&p, inputs["theta1"]), analytic::base_joint_angle_a(&p, inputs["theta2"])]
     }
-
     fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
         let p = params_of(params);
         let v = dk_values(&p, input(inputs, "theta1")?, input(inputs, "theta2")?);
@@ -278,7 +265,6 @@ impl Mechanism for Furet2018 {
             expected_slack: None,
         })
     }
-
     fn observe(&self, params: &Values, s: &Structure, snap: &Snapshot) -> Values {
         let n = |name: &str| snap.nodes[s.node_id(name).expect("furet2018 node")];
         let th1 = theta_of(n("A1"), n("B1"), n("D1"), n("C1"));
@@ -292,16 +278,13 @@ impl Mechanism for Furet2018 {
             ("detJ".into(), analytic::det_jacobian(&params_of(params), th1, th2)),
         ])
     }
-
     fn length_scale(&self, params: &Values) -> f64 {
         params["L"]
     }
-
     fn analytic_nodes(&self, params: &Values, inputs: &Values) -> Option<Vec<[f64; 3]>> {
         let s = self.build(params, inputs, &Values::new()).ok()?;
         Some(s.nodes.iter().map(|n| n.position).collect())
     }
-
     fn findings(&self, params: &Values) -> Vec<Finding> {
         analytic::findings(&params_of(params))
             .into_iter()

@@ -4,8 +4,8 @@ pub mod analytic;
 pub mod build;
 
 use super::{
-    input, wrap_angle, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec,
-    QuerySpec, Solution, StiffnessProbe, Values,
+    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind,
+    QuantitySpec, QuerySpec, Solution, StiffnessProbe, Values,
 };
 use crate::sim::Snapshot;
 use crate::structure::Structure;
@@ -180,40 +180,31 @@ pub const PAPER_ROOT_MARK: &str = " (the root of Eq. 5 with theta2 in [0, pi])";
 /// Two roots closer than this are the same root [rad] (the two roots are pi apart).
 const SAME_ROOT_RAD: f64 = 1e-9;
 
+/// The mechanism as data (name, title, symbols).
+const SPEC: MechanismSpec = MechanismSpec {
+    name: "ji2014",
+    title: "Ji, Li, Lin (2014): planar tensegrity parallel mechanism, two springs, actuator (L3, theta1)",
+    params: PARAMS,
+    inputs: INPUTS,
+    quantities: QUANTITIES,
+    queries: QUERIES,
+    start_keys: &[
+        ("theta2", "start angle of strut D1D3 [rad]"),
+        ("theta2_offset", "start this far from the stable root [rad] (default 0.5)"),
+        ("at_unstable_root", "1: start exactly on the energy maximum"),
+    ],
+    alternative_inputs: &[],
+};
+
 impl Mechanism for Ji2014 {
-    fn name(&self) -> &'static str {
-        "ji2014"
+    fn spec(&self) -> &MechanismSpec {
+        &SPEC
     }
-    fn title(&self) -> &'static str {
-        "Ji, Li, Lin (2014): planar tensegrity parallel mechanism, two springs, actuator (L3, theta1)"
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        PARAMS
-    }
-    fn inputs(&self) -> &'static [InputSpec] {
-        INPUTS
-    }
-    fn quantities(&self) -> &'static [QuantitySpec] {
-        QUANTITIES
-    }
-    fn queries(&self) -> &'static [QuerySpec] {
-        QUERIES
-    }
-
-    fn start_keys(&self) -> &'static [(&'static str, &'static str)] {
-        &[
-            ("theta2", "start angle of strut D1D3 [rad]"),
-            ("theta2_offset", "start this far from the stable root [rad] (default 0.5)"),
-            ("at_unstable_root", "1: start exactly on the energy maximum"),
-        ]
-    }
-
     fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
         super::require_positive(v, &[("L", "m"), ("K1", "N/m"), ("K2", "N/m"), ("m_platform", "kg")])?;
         super::require_non_negative(v, &[("c_D1", "N m s/rad"), ("r_strut", "m")])?;
         Ok(())
     }
-
     fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), (String, String)> {
         let l = params["L"];
         let l3 = inputs.get("L3").copied().ok_or(("L3".to_string(), "missing input L3 [m]".to_string()))?;
@@ -243,7 +234,6 @@ impl Mechanism for Ji2014 {
         }
         Ok(())
     }
-
     fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String> {
         let p = params_of(params);
         match query {
@@ -294,7 +284,6 @@ impl Mechanism for Ji2014 {
             other => Err(format!("unknown query '{other}' for ji2014 (expected one of: fk, ik, jacobian)")),
         }
     }
-
     fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, String> {
         let p = params_of(params);
         let (l3, th1) = (input(inputs, "L3")?, input(inputs, "theta1")?);
@@ -308,11 +297,9 @@ impl Mechanism for Ji2014 {
         };
         Ok(build::build(&p, &model_of(params), l3, th1, theta2))
     }
-
     fn commands(&self, _params: &Values, inputs: &Values) -> Vec<f64> {
         vec![inputs["L3"], inputs["theta1"]]
     }
-
     fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
         let p = params_of(params);
         let (l3, th1) = (input(inputs, "L3")?, input(inputs, "theta1")?);
@@ -323,7 +310,6 @@ impl Mechanism for Ji2014 {
             expected_slack: None,
         })
     }
-
     fn observe(&self, _params: &Values, s: &Structure, snap: &Snapshot) -> Values {
         let at = |name: &str| snap.nodes[s.node_id(name).expect("ji2014 node")];
         let (d1, d3) = (at("D1"), at("D3"));
@@ -341,11 +327,9 @@ impl Mechanism for Ji2014 {
         }
         v
     }
-
     fn length_scale(&self, params: &Values) -> f64 {
         params["L"]
     }
-
     fn analytic_nodes(&self, params: &Values, inputs: &Values) -> Option<Vec<[f64; 3]>> {
         let p = params_of(params);
         let (l3, th1) = (*inputs.get("L3")?, *inputs.get("theta1")?);
@@ -354,7 +338,6 @@ impl Mechanism for Ji2014 {
         // Structure order: C1, C2, C3, L3_tip, D1, D2, D3.
         Some([n.c1, n.c2, n.c3, n.d1, n.d1, n.d2, n.d3].iter().map(|v| [v.x, v.y, 0.0]).collect())
     }
-
     fn stiffness_probe(&self) -> Option<StiffnessProbe> {
         Some(StiffnessProbe {
             body: "platform".into(),
@@ -363,7 +346,6 @@ impl Mechanism for Ji2014 {
             analytic: "K".into(),
         })
     }
-
     fn findings(&self, params: &Values) -> Vec<Finding> {
         analytic::findings(&params_of(params))
             .into_iter()

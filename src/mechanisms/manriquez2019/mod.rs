@@ -5,8 +5,8 @@ pub mod analytic;
 pub mod build;
 
 use super::{
-    input, wrap_angle, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec,
-    QuerySpec, Solution, Values,
+    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind,
+    QuantitySpec, QuerySpec, Solution, Values,
 };
 use crate::sim::Snapshot;
 use crate::structure::Structure;
@@ -195,29 +195,23 @@ fn angles_of(r: &Matrix3<f64>) -> (f64, f64) {
     ((-r[(0, 1)]).atan2(r[(1, 1)]), (-r[(2, 0)]).atan2(r[(2, 2)]))
 }
 
-impl Mechanism for Manriquez2019 {
-    fn name(&self) -> &'static str {
-        "manriquez2019"
-    }
-    fn title(&self) -> &'static str {
-        "Manriquez-Padilla et al. (2019): class-2 tensegrity robot, universal joint, two cables, two springs, gravity"
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        PARAMS
-    }
-    fn inputs(&self) -> &'static [InputSpec] {
-        INPUTS
-    }
-    fn quantities(&self) -> &'static [QuantitySpec] {
-        QUANTITIES
-    }
-    fn queries(&self) -> &'static [QuerySpec] {
-        QUERIES
-    }
-    fn start_keys(&self) -> &'static [(&'static str, &'static str)] {
-        &[("offset", "start both joint angles this far from the target [rad] (default 0.03)")]
-    }
+/// The mechanism as data (name, title, symbols).
+const SPEC: MechanismSpec = MechanismSpec {
+    name: "manriquez2019",
+    title:
+        "Manriquez-Padilla et al. (2019): class-2 tensegrity robot, universal joint, two cables, two springs, gravity",
+    params: PARAMS,
+    inputs: INPUTS,
+    quantities: QUANTITIES,
+    queries: QUERIES,
+    start_keys: &[("offset", "start both joint angles this far from the target [rad] (default 0.03)")],
+    alternative_inputs: &[],
+};
 
+impl Mechanism for Manriquez2019 {
+    fn spec(&self) -> &MechanismSpec {
+        &SPEC
+    }
     fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
         super::require_positive(v, &[("a2", "m"), ("l2", "m"), ("m", "kg"), ("base_half", "m"), ("k_spring", "N/m")])?;
         super::require_non_negative(
@@ -226,7 +220,6 @@ impl Mechanism for Manriquez2019 {
         )?;
         params_of(v).validate().map_err(|e| ("base_x".to_string(), e))
     }
-
     fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), (String, String)> {
         for s in ["theta1", "theta2"] {
             let t = inputs.get(s).copied().ok_or((s.to_string(), format!("missing input {s} [rad]")))?;
@@ -240,7 +233,6 @@ impl Mechanism for Manriquez2019 {
         }
         Ok(())
     }
-
     fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String> {
         let p = params_of(params);
         match query {
@@ -316,7 +308,6 @@ impl Mechanism for Manriquez2019 {
             )),
         }
     }
-
     fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, String> {
         let p = params_of(params);
         let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
@@ -324,11 +315,9 @@ impl Mechanism for Manriquez2019 {
         let m = build::ModelChoices { joint_damping: params["c_joint"], strut_radius_m: params["r_strut"] };
         Ok(build::build(&p, &m, t1 + off, t2 + off, analytic::cable_lengths(&p, t1, t2)))
     }
-
     fn commands(&self, params: &Values, inputs: &Values) -> Vec<f64> {
         analytic::cable_lengths(&params_of(params), inputs["theta1"], inputs["theta2"]).to_vec()
     }
-
     fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
         let p = params_of(params);
         let v = statics_values(&p, input(inputs, "theta1")?, input(inputs, "theta2")?);
@@ -358,7 +347,6 @@ impl Mechanism for Manriquez2019 {
         }
         Some((format!("Table 5, experiment {} (analytical; ansys_: ANSYS column)", k + 1), v))
     }
-
     fn observe(&self, params: &Values, s: &Structure, snap: &Snapshot) -> Values {
         let p = params_of(params);
         let at = |n: &str| Vector3::from(snap.nodes[s.node_id(n).expect("manriquez2019 node")]);
@@ -401,11 +389,9 @@ impl Mechanism for Manriquez2019 {
             ("m_joint".into(), -moment.dot(&n)),
         ])
     }
-
     fn length_scale(&self, params: &Values) -> f64 {
         params["a2"]
     }
-
     fn findings(&self, params: &Values) -> Vec<Finding> {
         analytic::findings(&params_of(params))
             .into_iter()

@@ -4,8 +4,8 @@ pub mod analytic;
 pub mod build;
 
 use super::{
-    input, Finding, InputSpec, Mechanism, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec, QuerySpec,
-    Solution, Values,
+    input, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec,
+    QuerySpec, Solution, Values,
 };
 use crate::sim::Snapshot;
 use crate::structure::Structure;
@@ -237,30 +237,21 @@ fn values_at(params: &Values, p: Vector3<f64>) -> Values {
     v
 }
 
+/// The mechanism as data (name, title, symbols).
+const SPEC: MechanismSpec = MechanismSpec {
+    name: "mohr2011",
+    title: "Mohr, Arsenault (2011): translational 3-DOF tensegrity mechanism, six cables in pairs, three virtual compression springs",
+    params: PARAMS,
+    inputs: INPUTS,
+    quantities: QUANTITIES,
+    queries: QUERIES,
+    start_keys: &[("drop", "start the end-effector this fraction of its height below the analytic point (default 0.1)")],
+    alternative_inputs: &[&["x", "y", "z"]],
+};
+
 impl Mechanism for Mohr2011 {
-    fn name(&self) -> &'static str {
-        "mohr2011"
-    }
-    fn title(&self) -> &'static str {
-        "Mohr, Arsenault (2011): translational 3-DOF tensegrity mechanism, six cables in pairs, three virtual compression springs"
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        PARAMS
-    }
-    fn inputs(&self) -> &'static [InputSpec] {
-        INPUTS
-    }
-    fn quantities(&self) -> &'static [QuantitySpec] {
-        QUANTITIES
-    }
-    fn queries(&self) -> &'static [QuerySpec] {
-        QUERIES
-    }
-    fn start_keys(&self) -> &'static [(&'static str, &'static str)] {
-        &[("drop", "start the end-effector this fraction of its height below the analytic point (default 0.1)")]
-    }
-    fn alternative_inputs(&self) -> &'static [&'static [&'static str]] {
-        &[&["x", "y", "z"]]
+    fn spec(&self) -> &MechanismSpec {
+        &SPEC
     }
     fn convert_inputs(&self, params: &Values, given: &Values) -> Result<Values, (String, String)> {
         let get = |k: &str| given.get(k).copied().ok_or((k.to_string(), format!("missing input '{k}'")));
@@ -274,7 +265,6 @@ impl Mechanism for Mohr2011 {
         let rho = analytic::ikp(&params_of(params), &p);
         Ok(Values::from([("rho1".into(), rho[0]), ("rho2".into(), rho[1]), ("rho3".into(), rho[2])]))
     }
-
     fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
         super::require_positive(
             v,
@@ -293,7 +283,6 @@ impl Mechanism for Mohr2011 {
         }
         params_of(v).validate().map_err(|m| ("lo".to_string(), m))
     }
-
     fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), (String, String)> {
         let pa = params_of(params);
         let mut rho = [0.0; 3];
@@ -322,7 +311,6 @@ impl Mechanism for Mohr2011 {
         }
         Ok(())
     }
-
     fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String> {
         let pa = params_of(params);
         let centroid = || -> Result<Vector3<f64>, String> {
@@ -376,7 +364,6 @@ impl Mechanism for Mohr2011 {
             other => Err(format!("unknown query '{other}' for mohr2011 (expected one of: ikp, dkp, statics)")),
         }
     }
-
     fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, String> {
         let pa = params_of(params);
         let rho = rho_of(inputs)?;
@@ -403,11 +390,9 @@ impl Mechanism for Mohr2011 {
         };
         Ok(build::build(&g, &model_of(params)))
     }
-
     fn commands(&self, _params: &Values, inputs: &Values) -> Vec<f64> {
         (0..6).map(|j| inputs[&cable_symbol(j)]).collect()
     }
-
     fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
         let pa = params_of(params);
         let rho = rho_of(inputs)?;
@@ -421,7 +406,6 @@ impl Mechanism for Mohr2011 {
             expected_slack: Some(slack),
         })
     }
-
     fn observe(&self, _params: &Values, s: &Structure, snap: &Snapshot) -> Values {
         let node = |name: &str| Vector3::from(snap.nodes[s.node_id(name).expect("mohr2011 node")]);
         let b = [node("B1"), node("B2"), node("B3")];
@@ -441,16 +425,13 @@ impl Mechanism for Mohr2011 {
         }
         v
     }
-
     fn length_scale(&self, params: &Values) -> f64 {
         params["lb"]
     }
-
     fn analytic_nodes(&self, params: &Values, inputs: &Values) -> Option<Vec<[f64; 3]>> {
         let s = self.build(params, inputs, &Values::from([("drop".into(), 0.0)])).ok()?;
         Some(s.nodes.iter().map(|n| n.position).collect())
     }
-
     fn findings(&self, params: &Values) -> Vec<Finding> {
         let mut out: Vec<Finding> = analytic::findings(&params_of(params))
             .into_iter()
