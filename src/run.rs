@@ -288,6 +288,11 @@ pub fn panicked(sc: &Scenario, payload: &(dyn std::any::Any + Send)) -> Scenario
         .map(|s| s.to_string())
         .or_else(|| payload.downcast_ref::<String>().cloned())
         .unwrap_or_else(|| "unknown panic".into());
+    ScenarioReport { error: Some(format!("panicked: {msg}")), ..empty_report(sc) }
+}
+
+/// The report of `sc` before anything has run: not passed, no points, no findings.
+fn empty_report(sc: &Scenario) -> ScenarioReport {
     ScenarioReport {
         name: sc.name.clone(),
         file: sc.file.display().to_string(),
@@ -304,7 +309,7 @@ pub fn panicked(sc: &Scenario, payload: &(dyn std::any::Any + Send)) -> Scenario
         interference: None,
         findings: vec![],
         trajectory_ranges: Default::default(),
-        error: Some(format!("panicked: {msg}")),
+        error: None,
     }
 }
 
@@ -320,26 +325,12 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
     }
     let mech = sc.mechanism();
     let mut report = ScenarioReport {
-        name: sc.name.clone(),
-        file: sc.file.display().to_string(),
-        mechanism: sc.mechanism.clone(),
-        passed: false,
-        params: sc.params.clone(),
-        settle: SettleSummary::default(),
-        checks: vec![],
-        points: vec![],
-        stiffness_probe: None,
-        slack_intervals: vec![],
-        workspace: None,
-        skipped_points: sc.skipped_points.len(),
-        interference: None,
-        trajectory_ranges: Default::default(),
         findings: if opts.skip_findings {
             Vec::new()
         } else {
             mech.findings(&sc.params).into_iter().map(Into::into).collect()
         },
-        error: None,
+        ..empty_report(sc)
     };
     // Wall time counts the simulation, not the findings computed above.
     let wall = Instant::now();
