@@ -176,16 +176,14 @@ fn range(v: &[f64]) -> std::ops::Range<f64> {
 
 fn ji2014_fig4_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig4) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    root.fill(&WHITE).map_err(err)?;
-    let root = root
-        .titled(
-            &format!(
-                "ji2014, L3 = {} m, theta1 = {:.4} rad, K1 = {} N/m, K2 = {} N/m",
-                d.l3, d.theta1, d.params.k1, d.params.k2
-            ),
-            ("sans-serif", 22),
-        )
-        .map_err(err)?;
+    let root = titled_page(
+        root,
+        &format!(
+            "ji2014, L3 = {} m, theta1 = {:.4} rad, K1 = {} N/m, K2 = {} N/m",
+            d.l3, d.theta1, d.params.k1, d.params.k2
+        ),
+        22,
+    )?;
     let panels = root.split_evenly((3, 1));
     let curves: [(&str, &str, &Vec<f64>, RGBColor, SeriesLabelPosition); 3] = [
         ("U [J] (Eq. 4)", "energy", &d.u, BLUE, SeriesLabelPosition::UpperRight),
@@ -394,10 +392,8 @@ fn furet2018_fig5_data() -> Result<FuretFig5, String> {
 
 fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &FuretFig5) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    root.fill(&WHITE).map_err(err)?;
-    let root = root
-        .titled("furet2018 (L = 1): workspace by number of inverse solutions (analytic, Eq. 6-12)", ("sans-serif", 20))
-        .map_err(err)?;
+    let root =
+        titled_page(root, "furet2018 (L = 1): workspace by number of inverse solutions (analytic, Eq. 6-12)", 20)?;
     let two = RGBColor(190, 220, 250);
     let four = RGBColor(250, 170, 120);
     for (area, (b, cells, (f2, f4))) in root.split_evenly((1, 3)).iter().zip(&d.panels) {
@@ -459,6 +455,17 @@ fn swatch<'a, DB: DrawingBackend + 'a>(
         .label(label)
         .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 15, y + 5)], colour.filled()));
     Ok(())
+}
+
+/// A figure's page: white, with its title on top in a font of `font_px`; the area below it.
+pub(crate) fn titled_page<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    font_px: u32,
+) -> Result<DrawingArea<DB, Shift>, String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    root.titled(title, ("sans-serif", font_px)).map_err(err)
 }
 
 /// The legend box of every figure: framed, on a translucent white background.

@@ -173,16 +173,14 @@ fn darken(colour: RGBColor, shade: f64) -> RGBColor {
 
 fn fig4_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig4) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    root.fill(&WHITE).map_err(err)?;
-    let root = root
-        .titled(
-            &format!(
-                "furet2018 Fig. 4: singular curves and aspects in the joint space (L = {} m, b = {:.3} m)",
-                d.p.l, d.p.b
-            ),
-            ("sans-serif", 20),
-        )
-        .map_err(err)?;
+    let root = super::titled_page(
+        root,
+        &format!(
+            "furet2018 Fig. 4: singular curves and aspects in the joint space (L = {} m, b = {:.3} m)",
+            d.p.l, d.p.b
+        ),
+        20,
+    )?;
     let (top, legend) = root.split_vertically(SIZE.1 - LEGEND_PX - 30);
     let mut chart = ChartBuilder::on(&top)
         .margin(15)

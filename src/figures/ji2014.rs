@@ -176,18 +176,16 @@ const DIAMOND_PX: [(i32, i32); 4] = [(0, -8), (8, 0), (0, 8), (-8, 0)];
 
 pub(super) fn fig2_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig2) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    root.fill(&WHITE).map_err(err)?;
     let agree = d.points.iter().filter(|q| q.agrees).count();
     let n = d.points.len();
-    let root = root
-        .titled(
-            &format!(
-                "ji2014 Fig. 2: actuator workspace and singular curves (L = {} m, K1 = {} N/m, K2 = {} N/m)",
-                d.p.l, d.p.k1, d.p.k2
-            ),
-            ("sans-serif", 20),
-        )
-        .map_err(err)?;
+    let root = super::titled_page(
+        root,
+        &format!(
+            "ji2014 Fig. 2: actuator workspace and singular curves (L = {} m, K1 = {} N/m, K2 = {} N/m)",
+            d.p.l, d.p.k1, d.p.k2
+        ),
+        20,
+    )?;
     let (top, legend) = root.split_vertically(SIZE.1 - LEGEND_PX - 30);
     let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
     let mut chart = ChartBuilder::on(&plot)
@@ -417,18 +415,16 @@ fn circle(r: f64) -> Vec<(f64, f64)> {
 
 pub(super) fn fig3_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig3) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    root.fill(&WHITE).map_err(err)?;
     let agree = d.points.iter().filter(|q| q.agrees).count();
     let n = d.points.len();
-    let root = root
-        .titled(
-            &format!(
-                "ji2014 Fig. 3: Cartesian workspace of D3 and the images of the curves (L = {} m, K1 = {} N/m, K2 = {} N/m)",
-                d.p.l, d.p.k1, d.p.k2
-            ),
-            ("sans-serif", 19),
-        )
-        .map_err(err)?;
+    let root = super::titled_page(
+        root,
+        &format!(
+            "ji2014 Fig. 3: Cartesian workspace of D3 and the images of the curves (L = {} m, K1 = {} N/m, K2 = {} N/m)",
+            d.p.l, d.p.k1, d.p.k2
+        ),
+        19,
+    )?;
     let (plot, legend) = root.split_vertically(SIZE.1 - FIG3_LEGEND_PX - 30);
     let mut chart = ChartBuilder::on(&plot)
         .margin(15)
@@ -763,8 +759,7 @@ struct StiffnessMap<'a> {
 
 fn stiffness_map_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, m: StiffnessMap) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    root.fill(&WHITE).map_err(err)?;
-    let root = root.titled(&m.title, ("sans-serif", 20)).map_err(err)?;
+    let root = super::titled_page(root, &m.title, 20)?;
     let (top, legend) = root.split_vertically(SIZE.1 - FIG7_LEGEND_PX - 30);
     let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
     let mut chart = ChartBuilder::on(&plot)

@@ -71,16 +71,14 @@ fn bounds(points: &[([f64; 3], bool)], k: usize) -> std::ops::Range<f64> {
 
 pub(super) fn plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Data) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    root.fill(&WHITE).map_err(err)?;
-    let root = root
-        .titled(
-            &format!(
-                "manriquez2019 Fig. 6-7: form-finding grid (Table 2, 121 x 121), point M; dynamics on 41 x 41 poses agree at {:.1} %",
-                d.agreement_percent
-            ),
-            ("sans-serif", 19),
-        )
-        .map_err(err)?;
+    let root = super::titled_page(
+        root,
+        &format!(
+            "manriquez2019 Fig. 6-7: form-finding grid (Table 2, 121 x 121), point M; dynamics on 41 x 41 poses agree at {:.1} %",
+            d.agreement_percent
+        ),
+        19,
+    )?;
     let (left, right) = root.split_horizontally(SIZE.0 / 2);
     let equilibrium = RGBColor(220, 40, 40);
     let not_equilibrium = RGBColor(60, 90, 220);

@@ -192,19 +192,17 @@ fn base_triangle(p: &mohr::Params) -> Vec<(f64, f64)> {
 
 fn fig4_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig4) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    root.fill(&WHITE).map_err(err)?;
     let points: usize = d.slices.iter().map(|s| s.grid.points.len()).sum();
     let agree: usize =
         d.slices.iter().flat_map(|s| &s.grid.points).filter(|q| q.analytic_static == q.dynamics_static).count();
-    let root = root
-        .titled(
-            &format!(
-                "mohr2011 Fig. 4: horizontal slices of the kinematic workspace (l_b = {} m, l_min = 0, l_max = l_o = {} m)",
-                d.p.lb, d.p.lo
-            ),
-            ("sans-serif", 20),
-        )
-        .map_err(err)?;
+    let root = super::titled_page(
+        root,
+        &format!(
+            "mohr2011 Fig. 4: horizontal slices of the kinematic workspace (l_b = {} m, l_min = 0, l_max = l_o = {} m)",
+            d.p.lb, d.p.lo
+        ),
+        20,
+    )?;
     let areas = root.split_evenly((2, 3));
     let h = HALF_WIDTH_M;
     for (area, s) in areas.iter().zip(&d.slices) {
@@ -400,16 +398,14 @@ const KINEMATIC_ONLY: RGBColor = RGBColor(225, 225, 225);
 
 fn fig6_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig6) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    root.fill(&WHITE).map_err(err)?;
-    let root = root
-        .titled(
-            &format!(
-                "mohr2011 Fig. 6: the static workspace in two vertical slices (l_b = {} m, l_o = {} m)",
-                d.p.lb, d.p.lo
-            ),
-            ("sans-serif", 20),
-        )
-        .map_err(err)?;
+    let root = super::titled_page(
+        root,
+        &format!(
+            "mohr2011 Fig. 6: the static workspace in two vertical slices (l_b = {} m, l_o = {} m)",
+            d.p.lb, d.p.lo
+        ),
+        20,
+    )?;
     let (top, legend) = root.split_vertically(FIG6_SIZE.1 - FIG6_LEGEND_PX - 30);
     let h = HALF_WIDTH_M;
     for (area, s) in top.split_evenly((1, 2)).iter().zip(&d.slices) {
