@@ -440,7 +440,7 @@ fn furet2018_fig5_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fur
     Ok(())
 }
 
-type Chart<'a, DB> =
+pub(crate) type Chart<'a, DB> =
     ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
 
 /// A legend entry for a filled region of colour `colour` (the region itself is drawn cell by
@@ -466,6 +466,34 @@ pub(crate) fn titled_page<DB: DrawingBackend>(
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
     root.fill(&WHITE).map_err(err)?;
     root.titled(title, ("sans-serif", font_px)).map_err(err)
+}
+
+/// The chart of a workspace map on `area`: `caption` above, axes over the ranges [rad or m]
+/// labelled (x, y), no grid lines (the map's cells cover it).
+pub(crate) fn map_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+    (x_desc, y_desc): (&str, &str),
+) -> Result<Chart<'a, DB>, String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
+    let mut chart = ChartBuilder::on(area)
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .caption(caption, ("sans-serif", 16))
+        .build_cartesian_2d(x, y)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
 }
 
 /// The legend box of every figure: framed, on a translucent white background.

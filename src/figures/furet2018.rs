@@ -182,24 +182,13 @@ fn fig4_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig4) -> Resu
         20,
     )?;
     let (top, legend) = root.split_vertically(SIZE.1 - LEGEND_PX - 30);
-    let mut chart = ChartBuilder::on(&top)
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .caption(
-            "colour: sign of det J (derived from Eq. 3); crosses: the dynamics' settled solutions",
-            ("sans-serif", 16),
-        )
-        .build_cartesian_2d(-PI..PI, -PI..PI)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("theta1 [rad]")
-        .y_desc("theta2 [rad]")
-        .axis_desc_style(("sans-serif", 16))
-        .draw()
-        .map_err(err)?;
+    let mut chart = super::map_chart(
+        &top,
+        "colour: sign of det J (derived from Eq. 3); crosses: the dynamics' settled solutions",
+        -PI..PI,
+        -PI..PI,
+        ("theta1 [rad]", "theta2 [rad]"),
+    )?;
     let colours = d.cells.iter().map(|(t1, t2, aspect, wrong)| {
         let base = if *aspect > 0 { PLUS } else { MINUS };
         (*t1, *t2, if *wrong { darken(base, WRONG_SIGN_SHADE) } else { base })

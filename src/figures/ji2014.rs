@@ -188,27 +188,10 @@ pub(super) fn fig2_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fi
     )?;
     let (top, legend) = root.split_vertically(SIZE.1 - LEGEND_PX - 30);
     let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
-    let mut chart = ChartBuilder::on(&plot)
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .caption(
-            format!(
+    let mut chart = super::map_chart(&plot, &format!(
                 "colour: det J at the stable equilibrium (Eq. 23, corrected Eq. 24); dynamics (grid.toml): {agree} of {n} points agree ({:.1} %)",
                 100.0 * agree as f64 / n as f64
-            ),
-            ("sans-serif", 16),
-        )
-        .build_cartesian_2d(-MAP_PAD_RAD..PI + MAP_PAD_RAD, -MAP_PAD_M..d.l3_max + MAP_PAD_M)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("theta1 [rad]")
-        .y_desc("L3 [m]")
-        .axis_desc_style(("sans-serif", 16))
-        .draw()
-        .map_err(err)?;
+            ), -MAP_PAD_RAD..PI + MAP_PAD_RAD, -MAP_PAD_M..d.l3_max + MAP_PAD_M, ("theta1 [rad]", "L3 [m]"))?;
     let colours = d.cells.iter().map(|(t1, l3, det)| (*t1, *l3, colour_at(LIGHT_BLUES, det / d.det_max)));
     chart.draw_series(cell_runs(colours, d.cell)).map_err(err)?;
     // Curve vi (Eq. 31) and ii (Eq. 27): the edges of the range, ii dashed (not singular).
@@ -426,27 +409,16 @@ pub(super) fn fig3_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fi
         19,
     )?;
     let (plot, legend) = root.split_vertically(SIZE.1 - FIG3_LEGEND_PX - 30);
-    let mut chart = ChartBuilder::on(&plot)
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .caption(
-            format!(
-                "dynamics (grid.toml): {agree} of {n} settled D3 agree, largest distance from the analytic D3 {:.1e} L",
-                d.max_d3_error
-            ),
-            ("sans-serif", 16),
-        )
-        .build_cartesian_2d(FIG3_X_M.0..FIG3_X_M.1, FIG3_Y_M.0..FIG3_Y_M.1)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("x [m]")
-        .y_desc("y [m]")
-        .axis_desc_style(("sans-serif", 16))
-        .draw()
-        .map_err(err)?;
+    let mut chart = super::map_chart(
+        &plot,
+        &format!(
+            "dynamics (grid.toml): {agree} of {n} settled D3 agree, largest distance from the analytic D3 {:.1e} L",
+            d.max_d3_error
+        ),
+        FIG3_X_M.0..FIG3_X_M.1,
+        FIG3_Y_M.0..FIG3_Y_M.1,
+        ("x [m]", "y [m]"),
+    )?;
     let colours = d.cells.iter().map(|(x, y, r)| {
         let c = match r {
             Reach::StableOnce => REACH_ONCE,
@@ -762,21 +734,7 @@ fn stiffness_map_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, m: Stiff
     let root = super::titled_page(root, &m.title, 20)?;
     let (top, legend) = root.split_vertically(SIZE.1 - FIG7_LEGEND_PX - 30);
     let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
-    let mut chart = ChartBuilder::on(&plot)
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .caption(m.caption, ("sans-serif", 16))
-        .build_cartesian_2d(m.x, m.y)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(m.x_desc)
-        .y_desc(m.y_desc)
-        .axis_desc_style(("sans-serif", 16))
-        .draw()
-        .map_err(err)?;
+    let mut chart = super::map_chart(&plot, &m.caption, m.x, m.y, (m.x_desc, m.y_desc))?;
     let colours = m.cells.iter().map(|(x, y, k)| (*x, *y, colour_at(VIRIDIS, (k - m.k_min) / (m.k_max - m.k_min))));
     chart.draw_series(cell_runs(colours, m.cell)).map_err(err)?;
     for line in m.contours {
