@@ -124,7 +124,7 @@ impl Simulation {
     pub fn member_forces_with(&self, with_residual: bool) -> MemberForces {
         let s = &self.structure;
         // Cables held at their length by the projection: their tension is fitted, not read.
-        let held: Vec<bool> = (0..s.cables.len()).map(|c| self.cable_held_by_projection(c)).collect();
+        let held = self.cables_held_by_projection();
         let nb = s.bodies.len();
         let mut wrench: Vec<Wrench> = vec![(Vector::ZERO, Vector::ZERO); nb];
         #[allow(clippy::type_complexity)]

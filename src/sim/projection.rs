@@ -268,19 +268,27 @@ impl Simulation {
         l >= self.cable_lengths[c] - TAUT_TOLERANCE_FRACTION * self.length_scale_m || impulse > 0.0
     }
 
-    /// Whether cable `c` is taut and held at its length by the plain-group projection (its
+    /// For every cable: whether it is taut and held at its length by a group's projection (its
     /// tension is then fitted from the equilibrium, not read from rapier's impulse).
-    pub(super) fn cable_held_by_projection(&self, c: usize) -> bool {
-        self.plain_groups.iter().any(|g| g.cables.contains(&c) && self.group_is_projected(g)) && self.cable_is_taut(c)
+    pub(super) fn cables_held_by_projection(&self) -> Vec<bool> {
+        let mut held = vec![false; self.structure.cables.len()];
+        for g in &self.plain_groups {
+            for c in self.projected_taut_cables(g).unwrap_or_default() {
+                held[c] = true;
+            }
+        }
+        held
     }
 
-    /// Whether the projection closes group `g` now. A group with multibodies (mohr2011's legs)
-    /// only while every one of its cables is taut: with a cable slack its end-effector has a
-    /// free motion that rapier's step and the projection then hold still together short of
-    /// the equilibrium (measured on gravity_hanging.toml's (1, 1, 3): at rest 5e-3 N m from
-    /// it), so the group is left to rapier alone until the cables are taut again.
-    fn group_is_projected(&self, g: &PlainGroup) -> bool {
-        g.multibodies.is_empty() || g.cables.iter().all(|&c| self.cable_is_taut(c))
+    /// The taut cables of group `g` when the projection closes it now, else None. A group with
+    /// multibodies (mohr2011's legs) is closed only while every one of its cables is taut: with
+    /// a cable slack its end-effector has a free motion that rapier's step and the projection
+    /// then hold still together short of the equilibrium (measured on gravity_hanging.toml's
+    /// (1, 1, 3): at rest 5e-3 N m from it), so the group is left to rapier alone until the
+    /// cables are taut again.
+    fn projected_taut_cables(&self, g: &PlainGroup) -> Option<Vec<usize>> {
+        let taut: Vec<usize> = g.cables.iter().copied().filter(|&c| self.cable_is_taut(c)).collect();
+        (g.multibodies.is_empty() || taut.len() == g.cables.len()).then_some(taut)
     }
 
     /// Groups of free bodies whose every constraint the projection handles. A group that
@@ -504,10 +512,7 @@ impl Simulation {
         let scale = self.length_scale_m;
         let mut largest = 0.0_f64;
         for g in &groups {
-            if !self.group_is_projected(g) {
-                continue;
-            }
-            let taut: Vec<usize> = g.cables.iter().copied().filter(|&c| self.cable_is_taut(c)).collect();
+            let Some(taut) = self.projected_taut_cables(g) else { continue };
             // Coordinates of the projection: per plain body a translation [m] and a rotation
             // vector times the structure's size [m], about the centre of mass; then each
             // multibody's free coordinates [m or rad].
