@@ -179,7 +179,6 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         cable_ropes,
         cable_lengths: s.cables.iter().map(|c| c.length_m).collect(),
         secant: vec![None; s.joints.len()],
-        dof_inertia: vec![0.0; s.joints.len()],
         commands: commands.clone(),
         probe_loads: vec![([0.0; 3], [0.0; 3]); n],
         external_loads: {

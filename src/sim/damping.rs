@@ -50,6 +50,9 @@ pub(super) struct SecantPoint {
     force: f64,
     /// The stiffness estimate used for the step from here [N m/rad or N/m].
     stiffness: Option<f64>,
+    /// The joint's effective inertia [kg m^2 or kg], every other coordinate free (0: not yet
+    /// known; rapier's mass data are current only after the first step).
+    inertia: f64,
 }
 
 impl Simulation {
@@ -62,26 +65,10 @@ impl Simulation {
             && matches!(joint.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. })
     }
 
-    /// Whether body `b` hangs (through multibody links) from joint `j`'s child.
-    fn carried_by(&self, mut b: usize, j: usize) -> bool {
-        let s = &self.structure;
-        let root = s.joints[j].child;
-        for _ in 0..=s.bodies.len() {
-            if b == root {
-                return true;
-            }
-            match (0..s.joints.len()).find(|&k| self.joint_links[k].is_some() && s.joints[k].child == b) {
-                Some(k) => b = s.joints[k].parent,
-                None => return false,
-            }
-        }
-        false
-    }
-
     /// Joint `j`'s coordinate [rad or m] and the generalized force [N m or N] of the loads
     /// applied for the coming step (member forces, external loads and gravity on every body it
     /// carries, and its own torsion spring).
-    fn coordinate_and_force(&self, j: usize) -> SecantPoint {
+    fn coordinate_and_force(&self, j: usize, tree: &super::forces::Tree) -> SecantPoint {
         let s = &self.structure;
         let joint = &s.joints[j];
         let parent = *self.bodies[self.handles[joint.parent]].position();
@@ -94,7 +81,7 @@ impl Simulation {
         let g = Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]);
         let (mut force, mut moment) = (Vector::ZERO, Vector::ZERO);
         for b in 0..s.bodies.len() {
-            if !self.is_free(b) || !self.carried_by(b, j) {
+            if !self.is_free(b) || !tree.descends_from(s, b, joint.child) {
                 continue;
             }
             let rb = &self.bodies[self.handles[b]];
@@ -112,14 +99,14 @@ impl Simulation {
                     -t.stiffness_nm_per_rad * (joint.initial_coordinate + coordinate - t.rest_angle_rad)
                 });
                 let force = moment.dot((parent.rotation * a).normalize()) + spring;
-                SecantPoint { coordinate, force, stiffness: None }
+                SecantPoint { coordinate, force, stiffness: None, inertia: 0.0 }
             }
             JointKind::Prismatic { axis } => {
                 let a = (parent.rotation * Vector::new(axis[0], axis[1], axis[2])).normalize();
                 let coordinate = (child.transform_point(anchor_local) - anchor).dot(a);
-                SecantPoint { coordinate, force: force.dot(a), stiffness: None }
+                SecantPoint { coordinate, force: force.dot(a), stiffness: None, inertia: 0.0 }
             }
-            _ => SecantPoint { coordinate: 0.0, force: 0.0, stiffness: None },
+            _ => SecantPoint { coordinate: 0.0, force: 0.0, stiffness: None, inertia: 0.0 },
         }
     }
 
@@ -134,23 +121,23 @@ impl Simulation {
     /// Sets every scheduled joint's damping for the coming step (after the loads are applied).
     pub(super) fn schedule_damping(&mut self) {
         let dt = self.settings.dt_s;
+        let tree = self.link_tree();
         for j in 0..self.structure.joints.len() {
             if !self.scheduled(j) {
                 continue;
             }
             let Some((mb_index, dof)) = self.dof_of(j) else { continue };
-            let mut now = self.coordinate_and_force(j);
+            let mut now = self.coordinate_and_force(j, &tree);
             let mut damping = self.structure.joints[j].damping;
             now.stiffness = match self.secant[j] {
                 // A new start: no estimate yet, the structure's damping for this step.
                 None => None,
                 Some(last) => {
-                    if self.dof_inertia[j] <= 0.0 {
-                        // After the first step (rapier's mass data are current only then): the
-                        // joint's effective inertia, every other coordinate free.
+                    now.inertia = last.inertia;
+                    if now.inertia <= 0.0 {
                         if let Some(mb) = self.multibody_joints.get_multibody_mut(mb_index) {
                             let inv = mb.dof_inverse_inertia(&self.bodies)[dof];
-                            self.dof_inertia[j] = if inv > 0.0 { 1.0 / inv } else { 0.0 };
+                            now.inertia = if inv > 0.0 { 1.0 / inv } else { 0.0 };
                         }
                     }
                     // The secant, or the last estimate when the joint hardly moved.
@@ -163,7 +150,7 @@ impl Simulation {
                 }
             };
             if let Some(k) = now.stiffness.filter(|k| *k > 0.0) {
-                damping = newton_damping(dt, k, self.dof_inertia[j], self.dof_velocity(mb_index, dof), now.force);
+                damping = newton_damping(dt, k, now.inertia, self.dof_velocity(mb_index, dof), now.force);
             }
             self.secant[j] = Some(now);
             if let Some(link) = self.joint_links[j] {
@@ -179,7 +166,6 @@ impl Simulation {
     /// Forgets the secant history (a new start: the next step uses the structure's damping).
     pub(super) fn reset_secant(&mut self) {
         self.secant.iter_mut().for_each(|s| *s = None);
-        self.dof_inertia.iter_mut().for_each(|i| *i = 0.0);
     }
 }
 

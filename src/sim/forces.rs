@@ -190,14 +190,7 @@ impl Simulation {
             }
         }
 
-        // Tree of joints (multibody links and actuator drives): parent of each body.
-        let mut parent_joint: Vec<Option<usize>> = vec![None; nb];
-        for (j, joint) in s.joints.iter().enumerate() {
-            if self.joint_links[j].is_some() {
-                parent_joint[joint.child] = Some(j);
-            }
-        }
-        let tree = Tree { parent_joint };
+        let tree = self.link_tree();
 
         // Loop-closing joints carry reactions that no force law gives. They are the unknowns of
         // a least-squares fit: the reactions that best balance every free coordinate. At an
@@ -339,13 +332,13 @@ struct CoordinateForce {
 }
 
 /// The tree of joints that carry bodies (multibody links and actuator drives).
-struct Tree {
+pub(super) struct Tree {
     /// The joint each body hangs from, if any.
     parent_joint: Vec<Option<usize>>,
 }
 
 impl Tree {
-    fn descends_from(&self, s: &crate::structure::Structure, mut b: usize, ancestor: usize) -> bool {
+    pub(super) fn descends_from(&self, s: &crate::structure::Structure, mut b: usize, ancestor: usize) -> bool {
         for _ in 0..=self.parent_joint.len() {
             if b == ancestor {
                 return true;
@@ -372,6 +365,18 @@ impl Tree {
 }
 
 impl Simulation {
+    /// The tree of the multibody links: the joint each body hangs from.
+    pub(super) fn link_tree(&self) -> Tree {
+        let s = &self.structure;
+        let mut parent_joint: Vec<Option<usize>> = vec![None; s.bodies.len()];
+        for (j, joint) in s.joints.iter().enumerate() {
+            if self.joint_links[j].is_some() {
+                parent_joint[joint.child] = Some(j);
+            }
+        }
+        Tree { parent_joint }
+    }
+
     /// Generalized force on every free coordinate for the body loads `wrench` (force, moment
     /// about the world origin), torsion springs included when `with_springs`.
     fn coordinate_forces(&self, tree: &Tree, wrench: &[Wrench], with_springs: bool) -> Vec<CoordinateForce> {

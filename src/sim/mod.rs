@@ -128,8 +128,6 @@ pub struct Simulation {
     cable_lengths: Vec<f64>,
     /// For each joint: its last coordinate and generalized force (the secant damping schedule).
     secant: Vec<Option<damping::SecantPoint>>,
-    /// For each joint: its effective inertia [kg m^2 or kg] at the schedule's last start.
-    dof_inertia: Vec<f64>,
     /// Current actuator commands, in actuator order.
     commands: Vec<f64>,
     /// External loads [N] and [N m] applied to bodies (probes), world frame, about the body's
