@@ -175,7 +175,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         hidden_links,
         joint_impulse,
         internal_closures: Vec::new(),
-        plain_groups: Vec::new(),
+        projected_groups: Vec::new(),
         cable_ropes,
         cable_lengths: s.cables.iter().map(|c| c.length_m).collect(),
         secant: vec![None; s.joints.len()],
@@ -194,7 +194,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         length_scale_m,
     };
     sim.internal_closures = sim.find_internal_closures();
-    sim.plain_groups = sim.find_plain_groups();
+    sim.projected_groups = sim.find_projected_groups();
     sim.set_commands(&commands);
     Ok(sim)
 }

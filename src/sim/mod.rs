@@ -120,8 +120,9 @@ pub struct Simulation {
     joint_impulse: Vec<Option<ImpulseJointHandle>>,
     /// Loop closures inside one multibody, closed by position projection after each step.
     internal_closures: Vec<projection::InternalClosure>,
-    /// Plain bodies whose joints and taut cables are closed by position projection.
-    plain_groups: Vec<projection::PlainGroup>,
+    /// Groups of free bodies (plain bodies and multibodies) whose joints and taut cables are
+    /// closed by position projection.
+    projected_groups: Vec<projection::ProjectedGroup>,
     /// For each inextensible cable: its rope joint.
     cable_ropes: Vec<Option<ImpulseJointHandle>>,
     /// Current unstretched cable lengths [m].
@@ -239,7 +240,7 @@ impl Simulation {
             &(),
         );
         self.project_internal_closures();
-        self.project_plain_groups();
+        self.project_groups();
         self.tick += 1;
         self.check_divergence()
     }

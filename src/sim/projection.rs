@@ -241,7 +241,7 @@ impl Simulation {
 /// components that would open a joint or stretch a taut cable. The tensions of the cables held
 /// this way are fitted from the equilibrium (`forces.rs`).
 #[derive(Clone, Debug, Default)]
-pub(super) struct PlainGroup {
+pub(super) struct ProjectedGroup {
     /// Structure body indices of the group's free plain bodies.
     bodies: Vec<usize>,
     /// Multibodies whose links the group's joints or cables touch.
@@ -272,7 +272,7 @@ impl Simulation {
     /// tension is then fitted from the equilibrium, not read from rapier's impulse).
     pub(super) fn cables_held_by_projection(&self) -> Vec<bool> {
         let mut held = vec![false; self.structure.cables.len()];
-        for g in &self.plain_groups {
+        for g in &self.projected_groups {
             for c in self.projected_taut_cables(g).unwrap_or_default() {
                 held[c] = true;
             }
@@ -286,7 +286,7 @@ impl Simulation {
     /// then hold still together short of the equilibrium (measured on gravity_hanging.toml's
     /// (1, 1, 3): at rest 5e-3 N m from it), so the group is left to rapier alone until the
     /// cables are taut again.
-    fn projected_taut_cables(&self, g: &PlainGroup) -> Option<Vec<usize>> {
+    fn projected_taut_cables(&self, g: &ProjectedGroup) -> Option<Vec<usize>> {
         let taut: Vec<usize> = g.cables.iter().copied().filter(|&c| self.cable_is_taut(c)).collect();
         (g.multibodies.is_empty() || taut.len() == g.cables.len()).then_some(taut)
     }
@@ -294,7 +294,7 @@ impl Simulation {
     /// Groups of free bodies whose every constraint the projection handles. A group that
     /// touches an actuated joint, a joint kind without projection rows, or a multibody with a
     /// loop inside (closed by [`Self::project_internal_closures`]) is left to rapier alone.
-    pub(super) fn find_plain_groups(&self) -> Vec<PlainGroup> {
+    pub(super) fn find_projected_groups(&self) -> Vec<ProjectedGroup> {
         let s = &self.structure;
         let n = s.bodies.len();
         let multibody_of = |b: usize| self.multibody_joints.rigid_body_link(self.handles[b]).map(|l| l.multibody);
@@ -335,12 +335,12 @@ impl Simulation {
                 parent[ra] = rb;
             }
         }
-        let mut groups: Vec<(usize, PlainGroup, bool)> = Vec::new();
-        let group_of = |root: usize, groups: &mut Vec<(usize, PlainGroup, bool)>| -> usize {
+        let mut groups: Vec<(usize, ProjectedGroup, bool)> = Vec::new();
+        let group_of = |root: usize, groups: &mut Vec<(usize, ProjectedGroup, bool)>| -> usize {
             if let Some(i) = groups.iter().position(|g| g.0 == root) {
                 i
             } else {
-                groups.push((root, PlainGroup::default(), true));
+                groups.push((root, ProjectedGroup::default(), true));
                 groups.len() - 1
             }
         };
@@ -397,10 +397,10 @@ impl Simulation {
             .collect()
     }
 
-    /// The constraint rows of a plain group: joint anchor gaps and angular rows, then the
+    /// The constraint rows of a projected group: joint anchor gaps and angular rows, then the
     /// stretch of each cable in `taut`. Lengths in m; angular rows (dimensionless) times the
     /// structure's size, so that every row is a length.
-    fn plain_rows(&self, g: &PlainGroup, taut: &[usize], out: &mut Vec<f64>) {
+    fn group_rows(&self, g: &ProjectedGroup, taut: &[usize], out: &mut Vec<f64>) {
         let s = &self.structure;
         let scale = self.length_scale_m;
         let pose = |b: usize| *self.bodies[self.handles[b]].position();
@@ -441,10 +441,10 @@ impl Simulation {
         }
     }
 
-    /// The rates of [`Self::plain_rows`] (same order and scaling) when each body moves with
+    /// The rates of [`Self::group_rows`] (same order and scaling) when each body moves with
     /// its twist (`None`: the body stays). Exact to first order at a closed joint; the terms
     /// that multiply a gap are dropped (the gap is round-off once projected).
-    fn plain_row_rates(&self, g: &PlainGroup, taut: &[usize], twists: &[Option<Twist>], out: &mut Vec<f64>) {
+    fn group_row_rates(&self, g: &ProjectedGroup, taut: &[usize], twists: &[Option<Twist>], out: &mut Vec<f64>) {
         let s = &self.structure;
         let scale = self.length_scale_m;
         let pose = |b: usize| *self.bodies[self.handles[b]].position();
@@ -505,10 +505,10 @@ impl Simulation {
         self.bodies[h].set_position(moved, true);
     }
 
-    /// Closes every plain group's joints and taut cables to round-off and projects the
+    /// Closes every projected group's joints and taut cables to round-off and projects the
     /// velocities of its bodies and multibodies. Returns the largest row left [m].
-    pub(super) fn project_plain_groups(&mut self) -> f64 {
-        let groups = std::mem::take(&mut self.plain_groups);
+    pub(super) fn project_groups(&mut self) -> f64 {
+        let groups = std::mem::take(&mut self.projected_groups);
         let scale = self.length_scale_m;
         let mut largest = 0.0_f64;
         for g in &groups {
@@ -557,7 +557,7 @@ impl Simulation {
             };
             let rows = |sim: &Simulation| {
                 let mut out = Vec::new();
-                sim.plain_rows(g, &taut, &mut out);
+                sim.group_rows(g, &taut, &mut out);
                 out
             };
             // The Jacobian from each coordinate's twists of the bodies it moves: a plain body's
@@ -591,7 +591,7 @@ impl Simulation {
                         }
                     }
                     let mut column = Vec::with_capacity(g0.len());
-                    sim.plain_row_rates(g, &taut, &twists, &mut column);
+                    sim.group_row_rates(g, &taut, &twists, &mut column);
                     for (r, x) in column.into_iter().enumerate() {
                         jac[(r, k)] = x;
                     }
@@ -635,7 +635,7 @@ impl Simulation {
                 }
             }
         }
-        self.plain_groups = groups;
+        self.projected_groups = groups;
         largest
     }
 }
