@@ -120,26 +120,10 @@ impl Simulation {
         out
     }
 
-    /// The gap rows of one closure: the anchor as carried by the child minus as carried by the
-    /// parent, in the plane normal to the pin axis (two rows) [m].
-    fn closure_rows(&self, c: &InternalClosure, out: &mut Vec<f64>) {
-        let j = &self.structure.joints[c.joint];
-        let a = self.structure.nodes[j.anchor].position;
-        let a = Vector::new(a[0], a[1], a[2]);
-        let parent = self.bodies[self.handles[j.parent]].position();
-        let child = self.bodies[self.handles[j.child]].position();
-        let gap = child.transform_point(a) - parent.transform_point(a);
-        let JointKind::PlanarPin { axis } = j.kind else { return };
-        let n = (parent.rotation * Vector::new(axis[0], axis[1], axis[2])).normalize();
-        for t in super::forces::orthogonal_pair(n) {
-            out.push(gap.dot(t));
-        }
-    }
-
     fn closure_gaps(&self, closures: &[InternalClosure], multibody: MultibodyIndex) -> Vec<f64> {
         let mut rows = Vec::new();
         for c in closures.iter().filter(|c| c.multibody == multibody) {
-            self.closure_rows(c, &mut rows);
+            self.joint_rows(c.joint, &mut rows);
         }
         rows
     }
@@ -397,42 +381,49 @@ impl Simulation {
             .collect()
     }
 
-    /// The constraint rows of a projected group: joint anchor gaps and angular rows, then the
-    /// stretch of each cable in `taut`. Lengths in m; angular rows (dimensionless) times the
-    /// structure's size, so that every row is a length.
-    fn group_rows(&self, g: &ProjectedGroup, taut: &[usize], out: &mut Vec<f64>) {
+    /// The constraint rows of one joint: its anchor gap (for a planar pin only the two
+    /// components across its axis) and its angular rows. Lengths in m; angular rows
+    /// (dimensionless) times the structure's size, so that every row is a length.
+    fn joint_rows(&self, j: usize, out: &mut Vec<f64>) {
         let s = &self.structure;
         let scale = self.length_scale_m;
         let pose = |b: usize| *self.bodies[self.handles[b]].position();
         let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
-        for &j in &g.joints {
-            let joint = &s.joints[j];
-            let (pp, pc) = (pose(joint.parent), pose(joint.child));
-            let a = vec3(s.nodes[joint.anchor].position);
-            let gap = pc.transform_point(a) - pp.transform_point(a);
-            match joint.kind {
-                JointKind::PlanarPin { axis } => {
-                    let n = (pp.rotation * vec3(axis)).normalize();
-                    for t in super::forces::orthogonal_pair(n) {
-                        out.push(gap.dot(t));
-                    }
+        let joint = &s.joints[j];
+        let (pp, pc) = (pose(joint.parent), pose(joint.child));
+        let a = vec3(s.nodes[joint.anchor].position);
+        let gap = pc.transform_point(a) - pp.transform_point(a);
+        match joint.kind {
+            JointKind::PlanarPin { axis } => {
+                let n = (pp.rotation * vec3(axis)).normalize();
+                for t in super::forces::orthogonal_pair(n) {
+                    out.push(gap.dot(t));
                 }
-                JointKind::Revolute { axis } => {
-                    out.extend([gap.x, gap.y, gap.z]);
-                    let ap = (pp.rotation * vec3(axis)).normalize();
-                    let ac = (pc.rotation * vec3(axis)).normalize();
-                    for t in super::forces::orthogonal_pair(ap) {
-                        out.push(ac.dot(t) * scale);
-                    }
-                }
-                JointKind::Universal { axis1, axis2 } => {
-                    out.extend([gap.x, gap.y, gap.z]);
-                    let a1 = pp.rotation * vec3(axis1).normalize();
-                    let a2 = pc.rotation * vec3(axis2).normalize();
-                    out.push((a1.dot(a2) - vec3(axis1).normalize().dot(vec3(axis2).normalize())) * scale);
-                }
-                _ => out.extend([gap.x, gap.y, gap.z]),
             }
+            JointKind::Revolute { axis } => {
+                out.extend([gap.x, gap.y, gap.z]);
+                let ap = (pp.rotation * vec3(axis)).normalize();
+                let ac = (pc.rotation * vec3(axis)).normalize();
+                for t in super::forces::orthogonal_pair(ap) {
+                    out.push(ac.dot(t) * scale);
+                }
+            }
+            JointKind::Universal { axis1, axis2 } => {
+                out.extend([gap.x, gap.y, gap.z]);
+                let a1 = pp.rotation * vec3(axis1).normalize();
+                let a2 = pc.rotation * vec3(axis2).normalize();
+                out.push((a1.dot(a2) - vec3(axis1).normalize().dot(vec3(axis2).normalize())) * scale);
+            }
+            _ => out.extend([gap.x, gap.y, gap.z]),
+        }
+    }
+
+    /// The constraint rows of a projected group: each joint's ([`Self::joint_rows`]), then the
+    /// stretch of each cable in `taut` [m].
+    fn group_rows(&self, g: &ProjectedGroup, taut: &[usize], out: &mut Vec<f64>) {
+        let s = &self.structure;
+        for &j in &g.joints {
+            self.joint_rows(j, out);
         }
         for &c in taut {
             let cable = &s.cables[c];
