@@ -168,8 +168,8 @@ pub struct RawSim {
     /// PGS iterations while approaching an equilibrium, before the final phase at
     /// `pgs_iterations` (default: the same, one phase).
     pub approach_pgs_iterations: Option<Spanned<i64>>,
-    /// The secant damping schedule (default false: the structure's fixed damping).
-    pub secant_damping: Option<Spanned<bool>>,
+    /// The Newton damping schedule (default false: the structure's fixed damping).
+    pub newton_damping: Option<Spanned<bool>>,
     pub body_damping: Option<Spanned<f64>>,
     pub bounding_box: Option<Spanned<f64>>,
     /// Kinetic energy above which the run has diverged [J] (default 1e6).
@@ -461,7 +461,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
             None => None,
             Some(_) => Some(count(ctx, &raw.sim.approach_pgs_iterations, "sim.approach_pgs_iterations", 8, 4096)?),
         },
-        secant_damping: raw.sim.secant_damping.as_ref().is_some_and(|b| *b.get_ref()),
+        newton_damping: raw.sim.newton_damping.as_ref().is_some_and(|b| *b.get_ref()),
         body_damping_per_s: match &raw.sim.body_damping {
             None => 0.0,
             Some(s) => {

@@ -102,33 +102,34 @@ fn member_forces_match_analytic_statics() {
     }
 }
 
-/// The secant damping schedule (grid.toml) against the fixed pivot damping it starts from
-/// (80 N m s/rad, same dt): the same equilibria within 1e-12 rad, in fewer than half the steps
-/// (measured 8 against 20 per point, BENCHMARKS.md). No continuation, so that each point starts
-/// from the same state with either damping.
+/// The Newton damping schedule (grid.toml) against the fixed pivot damping of the scenario
+/// (80 N m s/rad, same dt): the same equilibria within 1e-12 rad and the same stability
+/// verdicts, in at most a third of the steps (measured medians 6 against 20 per point,
+/// BENCHMARKS.md). No continuation, so that each point starts from the same state with either
+/// damping.
 #[test]
-fn secant_damping_reaches_the_same_equilibria_in_under_half_the_steps() {
+fn newton_damping_reaches_the_same_equilibria_in_a_third_of_the_steps() {
     use std::path::Path;
     use tensegrity_testbed::scenario;
     let path = Path::new("scenarios/ji2014/grid.toml");
     let text = std::fs::read_to_string(path).unwrap().replace("continuation = true", "continuation = false");
-    let schedule = "secant_damping = true";
+    let schedule = "newton_damping = true";
     assert_eq!(text.matches(schedule).count(), 1);
     let run = |text: &str| {
         let sc = scenario::parse(path, text).expect("valid");
         tensegrity_testbed::run::run(&sc, &Default::default())
     };
-    let secant = run(&text);
-    let fixed = run(&text.replace(schedule, "secant_damping = false"));
-    assert!(secant.passed && fixed.passed, "{:?} {:?}", secant.error, fixed.error);
+    let newton = run(&text);
+    let fixed = run(&text.replace(schedule, "newton_damping = false"));
+    assert!(newton.passed && fixed.passed, "{:?} {:?}", newton.error, fixed.error);
     let median = |r: &tensegrity_testbed::report::ScenarioReport| {
         let mut s: Vec<u64> = r.points.iter().map(|p| p.steps).collect();
         s.sort_unstable();
         s[s.len() / 2] as f64
     };
-    let (ms, mf) = (median(&secant), median(&fixed));
-    assert!(ms * 2.0 < mf, "median steps per point: secant {ms}, fixed {mf}");
-    for (a, b) in secant.points.iter().zip(&fixed.points) {
+    let (mn, mf) = (median(&newton), median(&fixed));
+    assert!(mn * 3.0 <= mf, "median steps per point: Newton {mn}, fixed {mf}");
+    for (a, b) in newton.points.iter().zip(&fixed.points) {
         let d = tensegrity_testbed::mechanisms::wrap_angle(a.simulated["theta2"] - b.simulated["theta2"]).abs();
         assert!(d < 1e-12, "point {}: theta2 differs by {d:e} rad", a.index);
         assert_eq!(a.stable, b.stable, "point {}: stability verdict", a.index);

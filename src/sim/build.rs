@@ -178,7 +178,6 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         projected_groups: Vec::new(),
         cable_ropes,
         cable_lengths: s.cables.iter().map(|c| c.length_m).collect(),
-        secant: vec![None; s.joints.len()],
         commands: commands.clone(),
         probe_loads: vec![([0.0; 3], [0.0; 3]); n],
         external_loads: {

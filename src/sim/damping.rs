@@ -1,58 +1,86 @@
-//! The secant damping schedule (`sim.secant_damping = true`), a settling strategy.
+//! The Newton damping schedule (`sim.newton_damping = true`), a settling strategy.
 //!
-//! Joint damping is implicit in rapier's multibody step: with damping c, inertia I and the
-//! explicit generalized force tau(q) of the springs, one step of length dt moves a coordinate by
-//! dq = dt (I v + dt tau) / (I + dt c). With c = dt k, k = -dtau/dq the local stiffness, and
-//! dt^2 k >> I, that is nearly Newton's step tau / k; the momentum term I v is what is left, and
-//! the schedule accounts for it too. A fixed c fits one
-//! stiffness only: too little overshoots (and can jump to another equilibrium branch), too much
-//! creeps (BENCHMARKS.md's scan on ji2014).
+//! Joint damping is implicit in rapier's multibody step: from rest, with damping c, effective
+//! inertia I and the explicit generalized force tau(q) of the loads, one step of length dt moves
+//! a coordinate by dq = dt^2 tau / (I + dt c). With I + dt c = dt^2 k, k = -dtau/dq the tangent
+//! stiffness, that is Newton's step tau / k. A fixed c fits one stiffness only: too little
+//! overshoots (and can jump to another equilibrium branch), too much creeps (BENCHMARKS.md's
+//! scan on ji2014).
 //!
-//! The schedule estimates k for every damped revolute or prismatic multibody joint from the
-//! simulation itself, by the secant of its generalized force over its coordinate between two
-//! steps (the last estimate when the joint hardly moved), and sets before each step the damping
-//! that makes the step Newton's, its momentum included (`newton_damping`). With no estimate
-//! (the first step after a start) or a stiffness that is not positive (an unstable region) the
-//! joint keeps the structure's damping. Damping is zero at rest, so the equilibrium is the same
-//! as with any fixed damping; only the path to it changes.
+//! Before every step the schedule takes each damped revolute or prismatic multibody joint
+//! (not actuated), computes its generalized force tau and tangent stiffness k from the force
+//! laws (springs, elastic cables, gravity and external loads on the bodies it carries, its own
+//! torsion spring; every other coordinate held), and where k > 0 it quenches the joint's
+//! velocity (kinetic damping, as in dynamic relaxation) and sets the damping that makes the
+//! step Newton's. Where k <= 0 (near an unstable equilibrium) the joint keeps the structure's
+//! damping and its momentum: it moves away as the dynamics say. Velocity and damping are zero
+//! at rest, so the equilibrium is the same as with any fixed damping; only the path to it
+//! changes.
 
+use super::forces::Tree;
 use super::Simulation;
-use crate::structure::JointKind;
+use crate::structure::{CableLaw, JointKind};
 use rapier3d_f64::prelude::*;
 
-/// The damping that makes rapier's implicit step a Newton step. One step moves the coordinate
-/// by dt v' with (I + dt c) v' = p, p = I v + dt tau the momentum after the impulse of the
-/// force; Newton's step is s = tau / k. Equal when c = (dt p / s - I) / dt, which is at least 0
-/// when p carries the coordinate at least as far as s. When p points away from Newton's point
-/// (momentum left from the last step, against the force), no damping reaches it and the best
-/// is to stop: [`STOP_DAMPING_FACTOR`] times the scale I / dt + dt k. When p falls short even
-/// undamped, 0.
-fn newton_damping(dt: f64, stiffness: f64, inertia: f64, velocity: f64, force: f64) -> f64 {
-    let newton_step = force / stiffness;
-    let momentum = inertia * velocity + dt * force;
-    if momentum * newton_step <= 0.0 {
-        return STOP_DAMPING_FACTOR * (inertia / dt + dt * stiffness);
-    }
-    ((dt * momentum / newton_step - inertia) / dt).max(0.0)
+/// The damping [N m s/rad or N s/m] that makes rapier's implicit step from rest Newton's:
+/// I + dt c = dt^2 k. When even the undamped step falls short of Newton's point
+/// (dt^2 k < I), 0.
+fn newton_damping(dt: f64, stiffness: f64, inertia: f64) -> f64 {
+    (dt * stiffness - inertia / dt).max(0.0)
 }
 
-/// Damping, relative to the scale I / dt + dt k, that stops a joint within one step (its
-/// velocity falls by this factor).
-const STOP_DAMPING_FACTOR: f64 = 1e6;
-
-/// A coordinate change below this [rad or m] gives no secant (round-off would dominate).
-const SECANT_MIN_STEP: f64 = 1e-12;
-
-/// The last step's coordinate and generalized force of one damped joint.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct SecantPoint {
-    coordinate: f64,
+/// One joint's load for the coming step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct JointLoad {
+    /// Generalized force of the applied loads [N m or N].
     force: f64,
-    /// The stiffness estimate used for the step from here [N m/rad or N/m].
-    stiffness: Option<f64>,
-    /// The joint's effective inertia [kg m^2 or kg], every other coordinate free (0: not yet
-    /// known; rapier's mass data are current only after the first step).
+    /// Tangent stiffness -d(force)/dq, every other coordinate held [N m/rad or N/m].
+    stiffness: f64,
+    /// Inertia of the bodies the joint carries about (along) its axis, every other coordinate
+    /// held [kg m^2 or kg].
     inertia: f64,
+}
+
+/// How the bodies a joint carries move with its coordinate: a point x moves by `rate(x)` per
+/// unit coordinate, and that rate changes by `rate_change(x)` per unit coordinate.
+struct JointMotion {
+    axis: Vector,
+    anchor: Vector,
+    revolute: bool,
+}
+
+impl JointMotion {
+    fn rate(&self, x: Vector) -> Vector {
+        if self.revolute {
+            self.axis.cross(x - self.anchor)
+        } else {
+            self.axis
+        }
+    }
+
+    fn rate_change(&self, x: Vector) -> Vector {
+        if self.revolute {
+            self.axis.cross(self.rate(x))
+        } else {
+            Vector::ZERO
+        }
+    }
+
+    /// Stiffness contribution -d(rate(x) . F)/dq of a force F at a carried point x that does
+    /// not depend on the coordinate (gravity, external loads).
+    fn constant_force_stiffness(&self, x: Vector, f: Vector) -> f64 {
+        -self.rate_change(x).dot(f)
+    }
+
+    /// Stiffness contribution of a tension member of tension `t` [N], force-law slope
+    /// `slope` [N/m] and length `l` [m] along `unit` (from the carried end x towards the
+    /// held one), when only the end x moves: the carried end feels F = t unit, and
+    /// dF/dq = -(slope unit unit^T + t / l (1 - unit unit^T)) rate(x).
+    fn member_stiffness(&self, x: Vector, unit: Vector, t: f64, slope: f64, l: f64) -> f64 {
+        let r = self.rate(x);
+        let along = unit.dot(r);
+        -self.rate_change(x).dot(unit * t) + slope * along * along + t / l * (r.length_squared() - along * along)
+    }
 }
 
 impl Simulation {
@@ -65,10 +93,9 @@ impl Simulation {
             && matches!(joint.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. })
     }
 
-    /// Joint `j`'s coordinate [rad or m] and the generalized force [N m or N] of the loads
-    /// applied for the coming step (member forces, external loads and gravity on every body it
-    /// carries, and its own torsion spring).
-    fn coordinate_and_force(&self, j: usize, tree: &super::forces::Tree) -> SecantPoint {
+    /// Joint `j`'s generalized force, tangent stiffness and inertia for the coming step (after
+    /// the member forces are applied).
+    fn joint_load(&self, j: usize, tree: &Tree) -> JointLoad {
         let s = &self.structure;
         let joint = &s.joints[j];
         let parent = *self.bodies[self.handles[joint.parent]].position();
@@ -77,37 +104,82 @@ impl Simulation {
             let a = s.nodes[joint.anchor].position;
             Vector::new(a[0], a[1], a[2])
         };
-        let anchor = parent.transform_point(anchor_local);
+        let (axis_local, revolute) = match joint.kind {
+            JointKind::Revolute { axis } => (axis, true),
+            JointKind::Prismatic { axis } => (axis, false),
+            _ => unreachable!("scheduled joints are revolute or prismatic"),
+        };
+        let motion = JointMotion {
+            axis: (parent.rotation * Vector::new(axis_local[0], axis_local[1], axis_local[2])).normalize(),
+            anchor: parent.transform_point(anchor_local),
+            revolute,
+        };
+        let carried = |b: usize| self.is_free(b) && tree.descends_from(s, b, joint.child);
         let g = Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]);
-        let (mut force, mut moment) = (Vector::ZERO, Vector::ZERO);
-        for b in 0..s.bodies.len() {
-            if !self.is_free(b) || !tree.descends_from(s, b, joint.child) {
-                continue;
-            }
+        let mut load = JointLoad { force: 0.0, stiffness: 0.0, inertia: 0.0 };
+        // Loads on the carried bodies as rapier will apply them (member forces were put on the
+        // bodies as a force at the centre of mass plus its moment): their generalized force.
+        for b in (0..s.bodies.len()).filter(|b| carried(*b)) {
             let rb = &self.bodies[self.handles[b]];
             let com = rb.center_of_mass();
-            let f = rb.user_force() + g * rb.mass() * rb.gravity_scale();
-            force += f;
-            moment += (com - anchor).cross(f) + rb.user_torque();
+            let gravity = g * rb.mass() * rb.gravity_scale();
+            let f = rb.user_force() + gravity;
+            load.force += motion.rate(com).dot(f) + if revolute { motion.axis.dot(rb.user_torque()) } else { 0.0 };
+            // Forces that do not change with the coordinate: gravity and the external loads.
+            let (probe, _) = self.probe_loads[b];
+            let e = self.external_loads[b];
+            let constant = gravity + Vector::new(probe[0] + e[0], probe[1] + e[1], probe[2] + e[2]);
+            load.stiffness += motion.constant_force_stiffness(com, constant);
+            let inertia = s.bodies[b].inertia.expect("free bodies have inertia");
+            load.inertia += if revolute {
+                let u = rb.position().rotation.inverse() * motion.axis;
+                let p = inertia.principal_kg_m2;
+                p[0] * u.x * u.x
+                    + p[1] * u.y * u.y
+                    + p[2] * u.z * u.z
+                    + inertia.mass_kg * motion.axis.cross(com - motion.anchor).length_squared()
+            } else {
+                inertia.mass_kg
+            };
         }
-        match joint.kind {
-            JointKind::Revolute { axis } => {
-                let a = Vector::new(axis[0], axis[1], axis[2]);
-                let coordinate = super::forces::relative_angle(parent.rotation, child.rotation, a);
-                // The joint's own torsion spring (a rapier motor, not a user force).
-                let spring = joint.torsion_spring.as_ref().map_or(0.0, |t| {
-                    -t.stiffness_nm_per_rad * (joint.initial_coordinate + coordinate - t.rest_angle_rad)
-                });
-                let force = moment.dot((parent.rotation * a).normalize()) + spring;
-                SecantPoint { coordinate, force, stiffness: None, inertia: 0.0 }
+        // Springs and elastic cables with one end carried: their force changes with the
+        // coordinate (a member with both ends carried moves rigidly and adds nothing).
+        let members = s.springs.iter().map(|sp| (sp.a, sp.b, sp.stiffness_n_per_m, sp.rest_length_m)).chain(
+            s.cables.iter().enumerate().filter_map(|(c, cable)| match cable.law {
+                CableLaw::Elastic { stiffness_n_per_m } => {
+                    Some((cable.a, cable.b, stiffness_n_per_m, self.cable_lengths[c]))
+                }
+                CableLaw::Inextensible => None,
+            }),
+        );
+        let is_spring = s.springs.len();
+        for (m, (a, b, k, rest)) in members.enumerate() {
+            let (a_carried, b_carried) = (carried(s.nodes[a].body), carried(s.nodes[b].body));
+            if a_carried == b_carried {
+                continue;
             }
-            JointKind::Prismatic { axis } => {
-                let a = (parent.rotation * Vector::new(axis[0], axis[1], axis[2])).normalize();
-                let coordinate = (child.transform_point(anchor_local) - anchor).dot(a);
-                SecantPoint { coordinate, force: force.dot(a), stiffness: None, inertia: 0.0 }
+            let (x, other) = if a_carried { (a, b) } else { (b, a) };
+            let (px, po) = (Vector::from(self.node_position(x)), Vector::from(self.node_position(other)));
+            let d = po - px;
+            let l = d.length();
+            if l <= 0.0 {
+                continue;
             }
-            _ => SecantPoint { coordinate: 0.0, force: 0.0, stiffness: None, inertia: 0.0 },
+            let stretch = l - rest;
+            // Springs push and pull; cables only pull.
+            if m >= is_spring && stretch <= 0.0 {
+                continue;
+            }
+            load.stiffness += motion.member_stiffness(px, d / l, k * stretch, k, l);
         }
+        if let Some(t) = &joint.torsion_spring {
+            if revolute {
+                let coordinate = super::forces::relative_angle(parent.rotation, child.rotation, motion.axis);
+                load.force -= t.stiffness_nm_per_rad * (joint.initial_coordinate + coordinate - t.rest_angle_rad);
+                load.stiffness += t.stiffness_nm_per_rad;
+            }
+        }
+        load
     }
 
     /// The joint's degree of freedom in its multibody: (multibody, index), if a link.
@@ -118,7 +190,8 @@ impl Simulation {
         Some((index, mb.link(id)?.assembly_id()))
     }
 
-    /// Sets every scheduled joint's damping for the coming step (after the loads are applied).
+    /// Sets every scheduled joint's velocity and damping for the coming step (after the loads
+    /// are applied).
     pub(super) fn schedule_damping(&mut self) {
         let dt = self.settings.dt_s;
         let tree = self.link_tree();
@@ -127,45 +200,18 @@ impl Simulation {
                 continue;
             }
             let Some((mb_index, dof)) = self.dof_of(j) else { continue };
-            let mut now = self.coordinate_and_force(j, &tree);
+            let load = self.joint_load(j, &tree);
             let mut damping = self.structure.joints[j].damping;
-            now.stiffness = match self.secant[j] {
-                // A new start: no estimate yet, the structure's damping for this step.
-                None => None,
-                Some(last) => {
-                    now.inertia = last.inertia;
-                    if now.inertia <= 0.0 {
-                        if let Some(mb) = self.multibody_joints.get_multibody_mut(mb_index) {
-                            let inv = mb.dof_inverse_inertia(&self.bodies)[dof];
-                            now.inertia = if inv > 0.0 { 1.0 / inv } else { 0.0 };
-                        }
-                    }
-                    // The secant, or the last estimate when the joint hardly moved.
-                    let dq = now.coordinate - last.coordinate;
-                    if dq.abs() > SECANT_MIN_STEP {
-                        Some(-(now.force - last.force) / dq)
-                    } else {
-                        last.stiffness
-                    }
+            if load.stiffness > 0.0 && load.inertia > 0.0 {
+                damping = newton_damping(dt, load.stiffness, load.inertia);
+                if let Some(mb) = self.multibody_joints.get_multibody_mut(mb_index) {
+                    mb.generalized_velocity_mut()[dof] = 0.0;
                 }
-            };
-            if let Some(k) = now.stiffness.filter(|k| *k > 0.0) {
-                damping = newton_damping(dt, k, now.inertia, self.dof_velocity(mb_index, dof), now.force);
             }
-            self.secant[j] = Some(now);
             if let Some(link) = self.joint_links[j] {
                 super::build::set_link_damping(&mut self.multibody_joints, link.multibody_joint, damping);
             }
         }
-    }
-
-    fn dof_velocity(&self, multibody: MultibodyIndex, dof: usize) -> f64 {
-        self.multibody_joints.get_multibody(multibody).map_or(0.0, |mb| mb.generalized_velocity()[dof])
-    }
-
-    /// Forgets the secant history (a new start: the next step uses the structure's damping).
-    pub(super) fn reset_secant(&mut self) {
-        self.secant.iter_mut().for_each(|s| *s = None);
     }
 }
 
@@ -178,35 +224,47 @@ mod tests {
         dt * (inertia * v + dt * tau) / (inertia + dt * c)
     }
 
-    /// From rest, and with momentum along the force, the scheduled damping makes the step
-    /// Newton's tau / k to round-off.
+    /// From rest the scheduled damping makes the step Newton's tau / k to round-off.
     #[test]
     fn scheduled_damping_turns_the_step_into_newtons() {
         let (dt, k, inertia) = (0.15, 200.0, 2.0 / 3.0);
-        for (v, tau) in [(0.0, -12.0), (-0.05, -12.0), (0.3, 40.0)] {
-            let c = newton_damping(dt, k, inertia, v, tau);
-            let dq = step(dt, c, inertia, v, tau);
-            assert!((dq - tau / k).abs() < 1e-15, "v {v}, tau {tau}: step {dq} against {}", tau / k);
+        for tau in [-12.0, 5.6e-7, 40.0] {
+            let c = newton_damping(dt, k, inertia);
+            let dq = step(dt, c, inertia, 0.0, tau);
+            assert!((dq - tau / k).abs() <= 1e-15 * (tau / k).abs(), "tau {tau}: step {dq} against {}", tau / k);
         }
     }
 
-    /// Momentum against the force (left over from the last step): the damping stops the joint,
-    /// the step is at most 1e-6 of what the momentum alone would carry.
+    /// Stiffness too small to reach Newton's point even undamped: no damping at all.
     #[test]
-    fn momentum_against_the_force_is_stopped() {
-        let (dt, k, inertia) = (0.15, 200.0, 2.0 / 3.0);
-        let (v, tau) = (-4.8e-4, 5.6e-7);
-        let c = newton_damping(dt, k, inertia, v, tau);
-        let dq = step(dt, c, inertia, v, tau);
-        let coasting = step(dt, 0.0, inertia, v, tau);
-        assert!(dq.abs() <= 1e-6 * coasting.abs(), "step {dq:e} against {coasting:e} undamped");
-    }
-
-    /// Momentum too small to reach Newton's point even undamped: no damping at all.
-    #[test]
-    fn short_momentum_gets_no_damping() {
+    fn short_step_gets_no_damping() {
         // With dt^2 k / I < 1 an undamped step from rest falls short of tau / k.
         let (dt, k, inertia) = (0.01, 200.0, 2.0 / 3.0);
-        assert_eq!(newton_damping(dt, k, inertia, 0.0, -12.0), 0.0);
+        assert_eq!(newton_damping(dt, k, inertia), 0.0);
+    }
+
+    /// The tangent stiffness of a zero-free-length spring on a revolute joint matches the
+    /// central difference of its generalized force to 1e-8 relative.
+    #[test]
+    fn member_stiffness_is_the_derivative_of_the_generalized_force() {
+        let motion = JointMotion { axis: Vector::Z, anchor: Vector::new(0.3, -0.2, 0.0), revolute: true };
+        let held = Vector::new(-1.0, 0.5, 0.0);
+        let (k, rest) = (200.0, 0.25);
+        // The carried node at angle q about the anchor, radius 0.8 m.
+        let node = |q: f64| motion.anchor + Vector::new(0.8 * q.cos(), 0.8 * q.sin(), 0.0);
+        let tau = |q: f64| {
+            let x = node(q);
+            let d = held - x;
+            let l = d.length();
+            motion.rate(x).dot(d / l * k * (l - rest))
+        };
+        let q = 0.7;
+        let h = 1e-5;
+        let numeric = -(tau(q + h) - tau(q - h)) / (2.0 * h);
+        let x = node(q);
+        let d = held - x;
+        let l = d.length();
+        let analytic = motion.member_stiffness(x, d / l, k * (l - rest), k, l);
+        assert!((analytic - numeric).abs() <= 1e-8 * numeric.abs(), "{analytic} against {numeric}");
     }
 }

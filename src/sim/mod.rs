@@ -40,9 +40,10 @@ pub struct SimSettings {
     /// PGS iterations while a settle approaches its equilibrium (cheaper, with a larger
     /// impulse-joint offset); the last phase runs at `pgs_iterations`. None: one phase.
     pub approach_pgs_iterations: Option<usize>,
-    /// The secant damping schedule (`damping.rs`): each damped revolute or prismatic joint's
-    /// damping set to dt times its secant stiffness before every step (a settling strategy).
-    pub secant_damping: bool,
+    /// The Newton damping schedule (`damping.rs`): before every step each damped revolute or
+    /// prismatic joint's velocity is quenched and its damping set so that the step is a Newton
+    /// step on its tangent stiffness (a settling strategy).
+    pub newton_damping: bool,
     /// Half-size of the box that every node must stay inside, else the run diverged [m].
     pub bounding_box_m: f64,
     /// Linear and angular damping of free bodies [1/s] (applied after each step; it slows
@@ -69,7 +70,7 @@ impl Default for SimSettings {
             substeps: 1,
             pgs_iterations: 8,
             approach_pgs_iterations: None,
-            secant_damping: false,
+            newton_damping: false,
             bounding_box_m: 1e3,
             body_damping_per_s: 0.0,
             max_kinetic_energy_j: DEFAULT_MAX_KINETIC_ENERGY_J,
@@ -127,8 +128,6 @@ pub struct Simulation {
     cable_ropes: Vec<Option<ImpulseJointHandle>>,
     /// Current unstretched cable lengths [m].
     cable_lengths: Vec<f64>,
-    /// For each joint: its last coordinate and generalized force (the secant damping schedule).
-    secant: Vec<Option<damping::SecantPoint>>,
     /// Current actuator commands, in actuator order.
     commands: Vec<f64>,
     /// External loads [N] and [N m] applied to bodies (probes), world frame, about the body's
@@ -197,7 +196,6 @@ impl Simulation {
     pub fn set_commands(&mut self, values: &[f64]) {
         assert_eq!(values.len(), self.structure.actuators.len(), "one command per actuator");
         self.commands.copy_from_slice(values);
-        self.reset_secant();
         for (i, a) in self.structure.actuators.iter().enumerate() {
             if let ActuatorTarget::CableLength(c) = a.target {
                 self.cable_lengths[c] = values[i];
@@ -220,7 +218,7 @@ impl Simulation {
     /// Advances one time step. Fails if the state is no longer finite or leaves the box.
     pub fn step(&mut self) -> Result<(), SimError> {
         self.apply_member_forces();
-        if self.settings.secant_damping {
+        if self.settings.newton_damping {
             self.schedule_damping();
         }
         let gravity = Vector::new(self.structure.gravity[0], self.structure.gravity[1], self.structure.gravity[2]);
@@ -352,7 +350,6 @@ impl Simulation {
     /// Displaces every free joint coordinate of every multibody by `delta` (rad or m) and zeroes
     /// the velocities: the perturbation used to classify an equilibrium.
     pub fn perturb_free_coordinates(&mut self, delta: f64) {
-        self.reset_secant();
         let mut touched = Vec::new();
         let free_links =
             self.joint_links.iter().zip(&self.actuated).filter(|(_, a)| !**a).filter_map(|(l, _)| l.as_ref());
