@@ -467,9 +467,13 @@ fn run_actuation(
                         runner.sim.set_commands(&cmds);
                     } else {
                         let s = runner.mech.build(&sc.params, inputs, &sc.start).map_err(Stop::Model)?;
-                        let tick = runner.sim.tick();
-                        runner.sim = Simulation::new(&s, &sc.sim)?;
-                        runner.sim.set_tick(tick);
+                        // The same structure placed anew: restarted in place where it can be
+                        // (no rebuild of the rapier sets), else built afresh.
+                        if !runner.sim.restart_from(&s) {
+                            let tick = runner.sim.tick();
+                            runner.sim = Simulation::new(&s, &sc.sim)?;
+                            runner.sim.set_tick(tick);
+                        }
                     }
                     runner.emit(&format!("point {i}: inputs {inputs:?}"));
                 }

@@ -121,7 +121,8 @@ impl Simulation {
         // bodies as a force at the centre of mass plus its moment): their generalized force.
         for b in (0..s.bodies.len()).filter(|b| carried(*b)) {
             let rb = &self.bodies[self.handles[b]];
-            let com = rb.center_of_mass();
+            // From the current pose: rapier's cached centre of mass is stale before the first step.
+            let com = self.world_com(b);
             let gravity = g * rb.mass() * rb.gravity_scale();
             let f = rb.user_force() + gravity;
             load.force += motion.rate(com).dot(f) + if revolute { motion.axis.dot(rb.user_torque()) } else { 0.0 };

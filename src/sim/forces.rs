@@ -351,6 +351,16 @@ impl Tree {
         false
     }
 
+    /// Number of joints between body `b` and the root of its tree.
+    pub(super) fn depth(&self, s: &crate::structure::Structure, mut b: usize) -> usize {
+        let mut depth = 0;
+        while let (Some(j), true) = (self.parent_joint[b], depth < self.parent_joint.len()) {
+            depth += 1;
+            b = s.joints[j].parent;
+        }
+        depth
+    }
+
     /// Sum of the wrenches of `root` and every body hanging from it.
     fn subtree_wrench(&self, s: &crate::structure::Structure, wrench: &[Wrench], root: usize) -> Wrench {
         let mut w = (Vector::ZERO, Vector::ZERO);

@@ -20,6 +20,7 @@ mod damping;
 mod forces;
 mod least_squares;
 mod projection;
+mod restart;
 pub mod settle;
 
 use crate::structure::{ActuatorTarget, BodyKind, Structure};

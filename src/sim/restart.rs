@@ -1,0 +1,203 @@
+//! Restarting a built simulation from another placement of its structure, instead of building
+//! the rapier sets again (a grid without continuation starts every point from the scenario's
+//! start state: the same structure, its joints at other coordinates).
+//!
+//! Only structures whose every joint is a revolute or prismatic multibody link qualify (no
+//! loop closures, no ropes, no plain free bodies): their placement is their joint coordinates.
+//! The restarted state is checked against the new structure (every node, centre of mass and
+//! inertia tensor); anything else, or a failed check, asks the caller to build afresh.
+
+use super::Simulation;
+use crate::structure::{JointKind, Structure};
+use rapier3d_f64::prelude::*;
+
+/// Largest distance between a restarted node (or centre of mass) and the new structure's,
+/// relative to the structure's size: round-off of the joint transforms, far below any
+/// checked tolerance (1e-9).
+const PLACEMENT_TOLERANCE: f64 = 1e-12;
+
+impl Structure {
+    /// Whether `other` is this structure in another placement: the same bodies, members,
+    /// joints, actuators, loads and parameters; only node positions, centres of mass, joint
+    /// axes and initial coordinates (all of the initial configuration) may differ.
+    pub fn same_but_placement(&self, other: &Structure) -> bool {
+        if self.nodes.len() != other.nodes.len()
+            || self.bodies.len() != other.bodies.len()
+            || self.joints.len() != other.joints.len()
+        {
+            return false;
+        }
+        let mut o = other.clone();
+        for (n, m) in o.nodes.iter_mut().zip(&self.nodes) {
+            n.position = m.position;
+        }
+        for (b, c) in o.bodies.iter_mut().zip(&self.bodies) {
+            if let (Some(i), Some(j)) = (b.inertia.as_mut(), c.inertia) {
+                i.com = j.com;
+                i.principal_kg_m2 = j.principal_kg_m2;
+            }
+        }
+        for (j, k) in o.joints.iter_mut().zip(&self.joints) {
+            j.initial_coordinate = k.initial_coordinate;
+            match (&mut j.kind, &k.kind) {
+                (JointKind::Revolute { axis }, JointKind::Revolute { axis: a })
+                | (JointKind::Prismatic { axis }, JointKind::Prismatic { axis: a }) => *axis = *a,
+                _ => {}
+            }
+        }
+        o == *self
+    }
+}
+
+impl Simulation {
+    /// Whether the placement of this structure is its joint coordinates alone.
+    fn restartable(&self) -> bool {
+        let s = &self.structure;
+        self.hidden_links.is_empty()
+            && self.internal_closures.is_empty()
+            && self.projected_groups.is_empty()
+            && self.cable_ropes.iter().all(Option::is_none)
+            && self.joint_impulse.iter().all(Option::is_none)
+            && s.joints
+                .iter()
+                .zip(&self.joint_links)
+                .all(|(j, l)| l.is_some() && matches!(j.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. }))
+            && (0..s.bodies.len()).all(|b| !self.is_free(b) || s.joints.iter().any(|j| j.child == b))
+    }
+
+    /// Puts the simulation at rest in the start state of `s`, the same structure in another
+    /// placement (see [`Structure::same_but_placement`]), with the actuator commands `s` was
+    /// built with, and forgets the probe loads. Returns false when `s` does not qualify or the
+    /// restarted state does not reproduce it; the simulation must then be built afresh.
+    pub fn restart_from(&mut self, s: &Structure) -> bool {
+        if !self.restartable() || !self.structure.same_but_placement(s) {
+            return false;
+        }
+        // The commands `s` was built with (its actuated joints' initial coordinates); the
+        // actuated joints go there as for any new command.
+        for (i, a) in s.actuators.iter().enumerate() {
+            self.commands[i] = match a.target {
+                crate::structure::ActuatorTarget::Joint(j) => s.joints[j].initial_coordinate,
+                crate::structure::ActuatorTarget::CableLength(c) => s.cables[c].length_m,
+            };
+        }
+        self.cable_lengths.iter_mut().zip(&s.cables).for_each(|(l, c)| *l = c.length_m);
+        self.probe_loads.iter_mut().for_each(|p| *p = ([0.0; 3], [0.0; 3]));
+        self.apply_joint_commands();
+        // Then every free joint, parents first, turned (slid) so that a node of its child lands
+        // where `s` has it.
+        let tree = self.link_tree();
+        let mut order: Vec<usize> = (0..s.joints.len()).filter(|j| !self.actuated[*j]).collect();
+        order.sort_by_key(|&j| tree.depth(s, s.joints[j].child));
+        for j in order {
+            if !self.place_free_joint(j, s) {
+                return false;
+            }
+        }
+        for link in self.joint_links.iter().flatten() {
+            if let Some((mb, _)) = self.multibody_joints.get_mut(link.multibody_joint) {
+                mb.generalized_velocity_mut().fill(0.0);
+            }
+        }
+        for b in 0..self.structure.bodies.len() {
+            if self.is_free(b) {
+                let rb = &mut self.bodies[self.handles[b]];
+                rb.set_linvel(Vector::ZERO, false);
+                rb.set_angvel(AngVector::ZERO, false);
+            }
+        }
+        self.reproduces(s)
+    }
+
+    /// Moves free joint `j` so that a node of its child body (off the axis, for a revolute)
+    /// lands where `s` places it; false when the child has no such node.
+    fn place_free_joint(&mut self, j: usize, s: &Structure) -> bool {
+        let joint = &self.structure.joints[j];
+        let parent = *self.bodies[self.handles[joint.parent]].position();
+        let anchor = parent.transform_point(Vector::from(self.structure.nodes[joint.anchor].position));
+        let (axis_local, revolute) = match joint.kind {
+            JointKind::Revolute { axis } => (axis, true),
+            JointKind::Prismatic { axis } => (axis, false),
+            _ => return false,
+        };
+        let axis = (parent.rotation * Vector::from(axis_local)).normalize();
+        let off_axis = |x: Vector| (x - anchor).reject_from_normalized(axis);
+        let scale = self.length_scale_m;
+        let node = (0..self.structure.nodes.len()).find(|&n| {
+            self.structure.nodes[n].body == joint.child
+                && (!revolute || off_axis(Vector::from(self.node_position(n))).length() > 1e-3 * scale)
+        });
+        let Some(n) = node else { return false };
+        let (now, wanted) = (Vector::from(self.node_position(n)), Vector::from(s.nodes[n].position));
+        let displacement = if revolute {
+            let (a, b) = (off_axis(now), off_axis(wanted));
+            axis.dot(a.cross(b)).atan2(a.dot(b))
+        } else {
+            (wanted - now).dot(axis)
+        };
+        let Some(link) = self.joint_links[j] else { return false };
+        let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) else { return false };
+        let Some(dof) = mb.link(link_id).map(|l| l.assembly_id()) else { return false };
+        let mut disp = vec![0.0; mb.ndofs()];
+        disp[dof] = displacement;
+        mb.apply_displacements(&disp);
+        mb.forward_kinematics(&self.bodies, true);
+        mb.update_rigid_bodies(&mut self.bodies, true);
+        true
+    }
+
+    /// Whether every node, free body's centre of mass and inertia tensor is where `s` has it.
+    fn reproduces(&self, s: &Structure) -> bool {
+        let tol = PLACEMENT_TOLERANCE * self.length_scale_m;
+        let close = |a: Vector, b: [f64; 3]| (a - Vector::from(b)).length() <= tol;
+        let nodes = (0..s.nodes.len()).all(|i| close(Vector::from(self.node_position(i)), s.nodes[i].position));
+        let bodies = (0..s.bodies.len()).filter(|b| self.is_free(*b)).all(|b| {
+            let (Some(now), Some(then)) = (self.structure.bodies[b].inertia, s.bodies[b].inertia) else {
+                return false;
+            };
+            let rotation = self.bodies[self.handles[b]].position().rotation;
+            // The inertia tensor now, R diag(I) R^T, against the new structure's diag(I').
+            let scale = then.principal_kg_m2.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            let axes = [Vector::X, Vector::Y, Vector::Z];
+            let tensor_ok = axes.iter().enumerate().all(|(r, er)| {
+                axes.iter().enumerate().all(|(c, ec)| {
+                    let (lr, lc) = (rotation.inverse() * *er, rotation.inverse() * *ec);
+                    let p = now.principal_kg_m2;
+                    let value = p[0] * lr.x * lc.x + p[1] * lr.y * lc.y + p[2] * lr.z * lc.z;
+                    let wanted = if r == c { then.principal_kg_m2[r] } else { 0.0 };
+                    (value - wanted).abs() <= PLACEMENT_TOLERANCE * scale
+                })
+            });
+            close(self.world_com(b), then.com) && tensor_ok
+        });
+        nodes && bodies
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::structure::Structure;
+
+    /// A structure differs from a re-placed copy of itself only in placement, and from a copy
+    /// with another spring stiffness in more.
+    #[test]
+    fn placement_is_told_apart_from_parameters() {
+        let mut s = Structure::default();
+        let base = s.add_body("base", crate::structure::BodyKind::Fixed, None);
+        let a = s.add_node("A", base, [0.0, 0.0, 0.0]);
+        let b = s.add_node("B", base, [1.0, 0.0, 0.0]);
+        s.springs.push(crate::structure::Spring {
+            name: "K".into(),
+            a,
+            b,
+            stiffness_n_per_m: 100.0,
+            rest_length_m: 0.0,
+        });
+        let mut moved = s.clone();
+        moved.nodes[1].position = [0.0, 1.0, 0.0];
+        assert!(s.same_but_placement(&moved));
+        let mut stiffer = s.clone();
+        stiffer.springs[0].stiffness_n_per_m = 200.0;
+        assert!(!s.same_but_placement(&stiffer));
+    }
+}
