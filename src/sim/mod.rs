@@ -406,10 +406,8 @@ impl Simulation {
     /// followed by the closure projection, so that the loops follow the actuators continuously
     /// and stay on their assembly mode.
     fn apply_joint_commands(&mut self) {
-        // (multibody joint, total displacement) of every actuated link. The degree-of-freedom
-        // index is read at each move: forward kinematics may re-root a multibody, which shifts
-        // the indices.
-        let mut moves = Vec::new();
+        // (joint, total displacement) of every actuated link.
+        let mut moves: Vec<(usize, f64)> = Vec::new();
         for j in 0..self.structure.joints.len() {
             if !self.actuated[j] {
                 continue;
@@ -428,7 +426,7 @@ impl Simulation {
             let Some(current) = mb.link(link_id).map(|l| l.joint().coords()[joint_free_axis(&l.joint().data)]) else {
                 continue;
             };
-            moves.push((link.multibody_joint, target - current));
+            moves.push((j, target - current));
         }
         let largest = moves.iter().fold(0.0_f64, |m, (_, d)| m.max(d.abs()));
         let increments = if self.internal_closures.is_empty() {
@@ -436,21 +434,50 @@ impl Simulation {
         } else {
             ((largest / MAX_CLOSED_LOOP_INCREMENT).ceil() as usize).max(1)
         };
-        // Forward kinematics settles each multibody's root (and so its degree-of-freedom
-        // indices) before the first move; every move below ends with it again.
-        for &(handle, _) in &moves {
-            if let Some((mb, _)) = self.multibody_joints.get_mut(handle) {
+        // The multibodies moved. Forward kinematics settles each one's root (and so its
+        // degree-of-freedom indices, read below) before the first move.
+        let multibody_of = |sim: &Self, j: usize| {
+            sim.multibody_joints.rigid_body_link(sim.handles[sim.structure.joints[j].child]).copied()
+        };
+        let mut multibodies: Vec<MultibodyIndex> = Vec::new();
+        for &(j, _) in &moves {
+            if let Some(link) = multibody_of(self, j) {
+                if !multibodies.contains(&link.multibody) {
+                    multibodies.push(link.multibody);
+                }
+            }
+        }
+        for &m in &multibodies {
+            if let Some(mb) = self.multibody_joints.get_multibody_mut(m) {
                 mb.forward_kinematics(&self.bodies, true);
             }
         }
+        // Each multibody's moves at once: (degree of freedom, displacement per increment).
+        let steps: Vec<(MultibodyIndex, Vec<(usize, f64)>)> = multibodies
+            .iter()
+            .map(|&m| {
+                let dofs = moves
+                    .iter()
+                    .filter_map(|&(j, total)| {
+                        let link = multibody_of(self, j).filter(|l| l.multibody == m)?;
+                        let mb = self.multibody_joints.get_multibody(m)?;
+                        Some((mb.link(link.id)?.assembly_id(), total / increments as f64))
+                    })
+                    .collect();
+                (m, dofs)
+            })
+            .collect();
         for _ in 0..increments {
-            for &(handle, total) in &moves {
-                let Some((mb, link_id)) = self.multibody_joints.get_mut(handle) else { continue };
-                let Some(start) = mb.link(link_id).map(|l| l.assembly_id()) else { continue };
+            for (m, dofs) in &steps {
+                let Some(mb) = self.multibody_joints.get_multibody_mut(*m) else { continue };
                 let mut disp = vec![0.0; mb.ndofs()];
-                disp[start] = total / increments as f64;
+                for &(dof, d) in dofs {
+                    disp[dof] = d;
+                }
                 mb.apply_displacements(&disp);
-                mb.generalized_velocity_mut()[start] = 0.0;
+                for &(dof, _) in dofs {
+                    mb.generalized_velocity_mut()[dof] = 0.0;
+                }
                 mb.forward_kinematics(&self.bodies, true);
                 mb.update_rigid_bodies(&mut self.bodies, true);
             }

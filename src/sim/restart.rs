@@ -21,31 +21,42 @@ impl Structure {
     /// joints, actuators, loads and parameters; only node positions, centres of mass, joint
     /// axes and initial coordinates (all of the initial configuration) may differ.
     pub fn same_but_placement(&self, other: &Structure) -> bool {
-        if self.nodes.len() != other.nodes.len()
-            || self.bodies.len() != other.bodies.len()
-            || self.joints.len() != other.joints.len()
-        {
-            return false;
+        let same_body = |a: &crate::structure::Body, b: &crate::structure::Body| {
+            a.name == b.name
+                && a.kind == b.kind
+                && match (a.inertia, b.inertia) {
+                    (Some(i), Some(j)) => i.mass_kg == j.mass_kg,
+                    (None, None) => true,
+                    _ => false,
+                }
+        };
+        let same_node = |a: &crate::structure::Node, b: &crate::structure::Node| a.name == b.name && a.body == b.body;
+        let same_joint = |a: &crate::structure::Joint, b: &crate::structure::Joint| {
+            let kind = match (&a.kind, &b.kind) {
+                (JointKind::Revolute { .. }, JointKind::Revolute { .. })
+                | (JointKind::Prismatic { .. }, JointKind::Prismatic { .. }) => true,
+                (k, l) => k == l,
+            };
+            kind && a.name == b.name
+                && a.parent == b.parent
+                && a.child == b.child
+                && a.anchor == b.anchor
+                && a.torsion_spring == b.torsion_spring
+                && a.damping == b.damping
+        };
+        fn all<T>(a: &[T], b: &[T], same: impl Fn(&T, &T) -> bool) -> bool {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| same(x, y))
         }
-        let mut o = other.clone();
-        for (n, m) in o.nodes.iter_mut().zip(&self.nodes) {
-            n.position = m.position;
-        }
-        for (b, c) in o.bodies.iter_mut().zip(&self.bodies) {
-            if let (Some(i), Some(j)) = (b.inertia.as_mut(), c.inertia) {
-                i.com = j.com;
-                i.principal_kg_m2 = j.principal_kg_m2;
-            }
-        }
-        for (j, k) in o.joints.iter_mut().zip(&self.joints) {
-            j.initial_coordinate = k.initial_coordinate;
-            match (&mut j.kind, &k.kind) {
-                (JointKind::Revolute { axis }, JointKind::Revolute { axis: a })
-                | (JointKind::Prismatic { axis }, JointKind::Prismatic { axis: a }) => *axis = *a,
-                _ => {}
-            }
-        }
-        o == *self
+        self.name == other.name
+            && self.gravity == other.gravity
+            && self.struts == other.struts
+            && self.springs == other.springs
+            && self.cables == other.cables
+            && self.actuators == other.actuators
+            && self.loads == other.loads
+            && all(&self.bodies, &other.bodies, same_body)
+            && all(&self.nodes, &other.nodes, same_node)
+            && all(&self.joints, &other.joints, same_joint)
     }
 }
 

@@ -28,11 +28,14 @@ pub fn build(p: &Params, m: &ModelChoices, l3: f64, theta1: f64, theta2: f64) ->
     let nodes = analytic::nodes(p, l3, theta1, theta2);
     let xyz = |v: nalgebra::Vector2<f64>| [v.x, v.y, 0.0];
     let mut s = Structure { name: "ji2014".into(), gravity: [0.0; 3], ..Default::default() };
-    let nominal =
-        Some(Inertia { mass_kg: ACTUATOR_BODY_MASS_KG, com: [0.0; 3], principal_kg_m2: [ACTUATOR_BODY_MASS_KG; 3] });
+    // Centred where each body's placement carries it along: the housing turns about C1, the
+    // rod's tip is D1 (so every build of the mechanism is the same structure, placed anew).
+    let nominal = |com: [f64; 3]| {
+        Some(Inertia { mass_kg: ACTUATOR_BODY_MASS_KG, com, principal_kg_m2: [ACTUATOR_BODY_MASS_KG; 3] })
+    };
     let ground = s.add_body("base", BodyKind::Fixed, None);
-    let housing = s.add_body("actuator_housing", BodyKind::Free, nominal);
-    let rod = s.add_body("actuator_rod", BodyKind::Free, nominal);
+    let housing = s.add_body("actuator_housing", BodyKind::Free, nominal(xyz(nodes.c1)));
+    let rod = s.add_body("actuator_rod", BodyKind::Free, nominal(xyz(nodes.d1)));
     // Three point masses m/3 at the vertices of an equilateral triangle of side L:
     // I_z = m L^2 / 3 about the centroid, I_x = I_y = m L^2 / 6.
     let centroid = (nodes.d1 + nodes.d2 + nodes.d3) / 3.0;
