@@ -158,14 +158,15 @@ pub struct PeerComparison {
     pub ratio_max_error: f64,
 }
 
-/// One round of a peer simulator: `command` is run with the case-set file and `--rounds 1`
-/// appended and must print one JSON object (see `benches/peers/mujoco/README.md`).
+/// One round of a peer simulator: `command` is run with the case-set file, `--rounds 1` and
+/// `--min-round-wall-s` (the testbed's [`MIN_ROUND_WALL_S`]) appended and must print one JSON
+/// object (see `benches/peers/mujoco/README.md`).
 fn peer_round(command: &[String], cases_file: &Path) -> Result<(Round, String), String> {
     let (program, args) = command.split_first().ok_or("empty peer command")?;
     let out = std::process::Command::new(program)
         .args(args)
         .arg(cases_file)
-        .args(["--rounds", "1"])
+        .args(["--rounds", "1", "--min-round-wall-s", &MIN_ROUND_WALL_S.to_string()])
         .output()
         .map_err(|e| format!("cannot run the peer '{}': {e}", command.join(" ")))?;
     if !out.status.success() {

@@ -246,13 +246,17 @@ impl Simulation {
 
     fn check_divergence(&self) -> Result<(), SimError> {
         let limit = self.settings.bounding_box_m;
+        // Not finite, then energy, then outside the box: a blow-up is named for what it is.
+        let mut outside = None;
         for (i, n) in self.structure.nodes.iter().enumerate() {
             let p = self.node_position(i);
             if p.iter().any(|c| !c.is_finite()) {
                 return Err(self.diverged(format!("node '{}' position is not finite", n.name)));
             }
+            if outside.is_none() && p.iter().any(|c| c.abs() > limit) {
+                outside = Some((i, p));
+            }
         }
-        // Energy before position: a blow-up is named for what it is.
         let energy = self.kinetic_energy_j();
         if !energy.is_finite() || energy > self.settings.max_kinetic_energy_j {
             return Err(self.diverged(format!(
@@ -260,14 +264,11 @@ impl Simulation {
                 self.settings.max_kinetic_energy_j
             )));
         }
-        for (i, n) in self.structure.nodes.iter().enumerate() {
-            let p = self.node_position(i);
-            if p.iter().any(|c| c.abs() > limit) {
-                return Err(self.diverged(format!(
-                    "node '{}' left the bounding box of half-size {limit} m (at [{:.3e}, {:.3e}, {:.3e}])",
-                    n.name, p[0], p[1], p[2]
-                )));
-            }
+        if let Some((i, p)) = outside {
+            return Err(self.diverged(format!(
+                "node '{}' left the bounding box of half-size {limit} m (at [{:.3e}, {:.3e}, {:.3e}])",
+                self.structure.nodes[i].name, p[0], p[1], p[2]
+            )));
         }
         let gap_limit = self.settings.max_joint_gap_m.unwrap_or(DEFAULT_JOINT_GAP_FRACTION * self.length_scale_m);
         for (j, joint) in self.structure.joints.iter().enumerate() {
