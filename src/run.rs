@@ -67,10 +67,11 @@ impl Runner<'_> {
         self.mech.observe(&self.sc.params, &self.sim.structure, snap)
     }
 
-    fn emit(&mut self, text: &str) {
+    /// Records an event in the recording, if any (formatted only then).
+    fn emit(&mut self, text: impl std::fmt::Display) {
         let tick = self.sim.tick();
         if let Some(r) = self.recorder.as_mut() {
-            r.event(tick, text);
+            r.event(tick, &text.to_string());
         }
     }
 
@@ -198,7 +199,7 @@ impl Runner<'_> {
         delta: f64,
     ) -> Result<bool, Stop> {
         self.sim.perturb_free_coordinates(delta);
-        self.emit(&format!("perturbed every free coordinate by {delta}"));
+        self.emit(format_args!("perturbed every free coordinate by {delta}"));
         let after = self.settle(inputs, prediction)?;
         let moved = before
             .nodes
@@ -208,7 +209,7 @@ impl Runner<'_> {
             .fold(0.0, f64::max);
         // Back within a small fraction of the perturbation: the same equilibrium.
         let back = after.settled && moved < RETURN_FRACTION * delta * self.sim.length_scale_m;
-        self.emit(&format!(
+        self.emit(format_args!(
             "after the perturbation: {} {} steps, largest node displacement from before {moved:.3e} m",
             if after.settled { "settled in" } else { "did NOT settle in" },
             after.steps
@@ -231,7 +232,7 @@ impl Runner<'_> {
         for (i, sign) in [1.0, -1.0].iter().enumerate() {
             let t = [axis[0] * torque * sign, axis[1] * torque * sign, axis[2] * torque * sign];
             self.sim.set_probe_load(body, [0.0; 3], t);
-            self.emit(&format!("stiffness probe: torque {:+e} N m", torque * sign));
+            self.emit(format_args!("stiffness probe: torque {:+e} N m", torque * sign));
             let s = self.settle(inputs, prediction)?;
             if !s.settled {
                 self.sim.set_probe_load(body, [0.0; 3], [0.0; 3]);
@@ -395,7 +396,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
     let outcome = run_actuation(&mut runner, sc, &mut report, &mut probe_errors);
     if let Err(e) = outcome {
         report.error = Some(e.to_string());
-        runner.emit(&format!("run stopped: {e}"));
+        runner.emit(format_args!("run stopped: {e}"));
     }
 
     report.checks = runner.compare.reports();
@@ -475,7 +476,7 @@ fn run_actuation(
                             runner.sim.set_tick(tick);
                         }
                     }
-                    runner.emit(&format!("point {i}: inputs {inputs:?}"));
+                    runner.emit(format_args!("point {i}: inputs {inputs:?}"));
                 }
                 settle_point(runner, sc, i, inputs, report, probe_errors)?;
             }
@@ -535,17 +536,17 @@ fn settle_point(
     let prediction = runner.mech.predict(&sc.params, inputs).map_err(Stop::Model)?;
     let s = runner.settle(inputs, &prediction)?;
     let final_energy = runner.sim.kinetic_energy_j();
-    runner.emit(&if s.settled {
-        format!("point {index} settled after {} steps", s.steps)
+    if s.settled {
+        runner.emit(format_args!("point {index} settled after {} steps", s.steps));
     } else {
-        format!(
+        runner.emit(format_args!(
             "point {index} did NOT settle in {} s (kinetic energy {final_energy:.3e} J, speed {:.3e} m/s, residual {:.3e} N, {:.3e} N m)",
             sc.settle.max_time_s,
             s.final_speed,
             s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_force_n),
             s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_torque_nm)
-        )
-    });
+        ));
+    }
     let mut simulated = s.simulated.clone();
     let (branch, analytic_stable) = branch_of(runner.mech.as_ref(), sc, &prediction, &simulated);
     // The settled state is compared with the branch it landed on; landing on an analytically
@@ -558,7 +559,7 @@ fn settle_point(
         .unwrap_or_else(|| prediction.expected.clone());
     let wanted_unstable = sc.start.get("at_unstable_root").is_some_and(|f| *f != 0.0);
     if analytic_stable == Some(false) && !wanted_unstable {
-        runner.emit(&format!("point {index}: landed on the analytically unstable branch '{branch}'"));
+        runner.emit(format_args!("point {index}: landed on the analytically unstable branch '{branch}'"));
         report.error.get_or_insert(format!("point {index} settled on the analytically unstable branch '{branch}'"));
     }
     let stable = match sc.stability_perturbation {
@@ -566,7 +567,7 @@ fn settle_point(
         _ => None,
     };
     if let Some(st) = stable {
-        runner.emit(&format!("point {index}: equilibrium is {}", if st { "stable" } else { "unstable" }));
+        runner.emit(format_args!("point {index}: equilibrium is {}", if st { "stable" } else { "unstable" }));
     }
     if let (Some(p), true) = (&sc.probe, s.settled) {
         if let Some(k) = runner.probe(inputs, &prediction, p.torque_nm)? {
@@ -607,7 +608,7 @@ fn settle_point(
             .sqrt()
     });
     if slack_agrees == Some(false) {
-        runner.emit(&format!(
+        runner.emit(format_args!(
             "point {index}: slack cables {slack_cables:?} differ from the analytic {:?}",
             prediction.expected_slack
         ));
@@ -639,7 +640,7 @@ fn settle_point(
         .collect();
     if s.settled && !outside {
         for (q, e, tol) in point_checks.iter().filter(|(_, e, tol)| !(e <= tol)) {
-            runner.emit(&format!("point {index}: check {q} failed: error {e:.3e} > tolerance {tol:.1e}"));
+            runner.emit(format_args!("point {index}: check {q} failed: error {e:.3e} > tolerance {tol:.1e}"));
         }
     }
     let within_tolerance = s.settled && !outside && point_checks.iter().all(|(_, e, tol)| e <= tol);

@@ -191,7 +191,9 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         },
         tick: 0,
         length_scale_m,
+        tree: super::forces::Tree::default(),
     };
+    sim.tree = sim.link_tree();
     sim.internal_closures = sim.find_internal_closures();
     sim.projected_groups = sim.find_projected_groups();
     sim.set_commands(&commands);

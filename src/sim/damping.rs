@@ -17,7 +17,6 @@
 //! at rest, so the equilibrium is the same as with any fixed damping; only the path to it
 //! changes.
 
-use super::forces::Tree;
 use super::Simulation;
 use crate::structure::{CableLaw, JointKind};
 use rapier3d_f64::prelude::*;
@@ -95,7 +94,8 @@ impl Simulation {
 
     /// Joint `j`'s generalized force, tangent stiffness and inertia for the coming step (after
     /// the member forces are applied).
-    fn joint_load(&self, j: usize, tree: &Tree) -> JointLoad {
+    fn joint_load(&self, j: usize) -> JointLoad {
+        let tree = &self.tree;
         let s = &self.structure;
         let joint = &s.joints[j];
         let parent = *self.bodies[self.handles[joint.parent]].position();
@@ -195,13 +195,12 @@ impl Simulation {
     /// are applied).
     pub(super) fn schedule_damping(&mut self) {
         let dt = self.settings.dt_s;
-        let tree = self.link_tree();
         for j in 0..self.structure.joints.len() {
             if !self.scheduled(j) {
                 continue;
             }
             let Some((mb_index, dof)) = self.dof_of(j) else { continue };
-            let load = self.joint_load(j, &tree);
+            let load = self.joint_load(j);
             let mut damping = self.structure.joints[j].damping;
             if load.stiffness > 0.0 && load.inertia > 0.0 {
                 damping = newton_damping(dt, load.stiffness, load.inertia);

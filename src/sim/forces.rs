@@ -51,39 +51,16 @@ impl Simulation {
             rb.reset_forces(false);
             rb.reset_torques(false);
         }
-        let mut loads: Vec<(usize, Vector, Vector)> = Vec::new();
-        for sp in &self.structure.springs {
-            let (pa, pb) = (v(self.node_position(sp.a)), v(self.node_position(sp.b)));
-            let d = pb - pa;
-            let l = d.length();
-            if l > 0.0 {
-                let f = d / l * (sp.stiffness_n_per_m * (l - sp.rest_length_m));
-                loads.push((self.structure.nodes[sp.a].body, f, pa));
-                loads.push((self.structure.nodes[sp.b].body, -f, pb));
-            }
+        for i in 0..self.structure.springs.len() {
+            let sp = &self.structure.springs[i];
+            let (a, b, k, rest) = (sp.a, sp.b, sp.stiffness_n_per_m, sp.rest_length_m);
+            self.add_member_load(a, b, |l| k * (l - rest));
         }
-        for (c, cable) in self.structure.cables.iter().enumerate() {
+        for c in 0..self.structure.cables.len() {
+            let cable = &self.structure.cables[c];
             if let CableLaw::Elastic { stiffness_n_per_m } = cable.law {
-                let (pa, pb) = (v(self.node_position(cable.a)), v(self.node_position(cable.b)));
-                let d = pb - pa;
-                let l = d.length();
-                let t = (stiffness_n_per_m * (l - self.cable_lengths[c])).max(0.0);
-                if l > 0.0 && t > 0.0 {
-                    let f = d / l * t;
-                    loads.push((self.structure.nodes[cable.a].body, f, pa));
-                    loads.push((self.structure.nodes[cable.b].body, -f, pb));
-                }
-            }
-        }
-        // Force at the centre of mass plus its moment, with the centre of mass taken from the
-        // current pose: rapier's cached world centre of mass is stale before the first step,
-        // which gave a spurious kick of |c x F| there.
-        for (body, f, p) in loads {
-            if self.is_free(body) {
-                let com = self.world_com(body);
-                let rb = &mut self.bodies[self.handles[body]];
-                rb.add_force(f, false);
-                rb.add_torque((p - com).cross(f), false);
+                let (a, b, rest) = (cable.a, cable.b, self.cable_lengths[c]);
+                self.add_member_load(a, b, |l| (stiffness_n_per_m * (l - rest)).max(0.0));
             }
         }
         for b in 0..n {
@@ -95,6 +72,29 @@ impl Simulation {
                 let rb = &mut self.bodies[self.handles[b]];
                 rb.add_force(v(f), false);
                 rb.add_torque(v(t), false);
+            }
+        }
+    }
+
+    /// Puts the tension `tension(l)` [N] of a member of length l between nodes `a` and `b` on
+    /// their bodies, each as a force at the centre of mass plus its moment, with the centre of
+    /// mass taken from the current pose: rapier's cached world centre of mass is stale before
+    /// the first step, which gave a spurious kick of |c x F| there.
+    fn add_member_load(&mut self, a: usize, b: usize, tension: impl Fn(f64) -> f64) {
+        let (pa, pb) = (v(self.node_position(a)), v(self.node_position(b)));
+        let d = pb - pa;
+        let l = d.length();
+        let t = tension(l);
+        if l > 0.0 && t != 0.0 {
+            let f = d / l * t;
+            for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
+                let body = self.structure.nodes[node].body;
+                if self.is_free(body) {
+                    let com = self.world_com(body);
+                    let rb = &mut self.bodies[self.handles[body]];
+                    rb.add_force(f, false);
+                    rb.add_torque((p - com).cross(f), false);
+                }
             }
         }
     }
@@ -190,7 +190,7 @@ impl Simulation {
             }
         }
 
-        let tree = self.link_tree();
+        let tree = &self.tree;
 
         // Loop-closing joints carry reactions that no force law gives. They are the unknowns of
         // a least-squares fit: the reactions that best balance every free coordinate. At an
@@ -198,7 +198,7 @@ impl Simulation {
         // added to the bodies' loads.
         let fit = with_residual || self.forces_need_closure_fit(&held);
         let scale = self.length_scale_m;
-        let base = if fit { self.coordinate_forces(&tree, &wrench, true) } else { Vec::new() };
+        let base = if fit { self.coordinate_forces(tree, &wrench, true) } else { Vec::new() };
         let mut closure_loads = self.closure_unit_loads();
         closure_loads.extend(self.projected_cable_unit_loads(&held));
         // Fitted reaction of each loop-closing joint on its child: (force, moment about the anchor).
@@ -215,7 +215,7 @@ impl Simulation {
             };
             let mut g = nalgebra::DMatrix::<f64>::zeros(rows, cols);
             for (k, load) in closure_loads.iter().enumerate() {
-                let col = self.coordinate_forces(&tree, &load.loads, false);
+                let col = self.coordinate_forces(tree, &load.loads, false);
                 for (r, c) in col.iter().enumerate() {
                     g[(r, k)] = scaled(c);
                 }
@@ -249,7 +249,7 @@ impl Simulation {
             }
         }
         if fitted {
-            for c in self.coordinate_forces(&tree, &wrench, true) {
+            for c in self.coordinate_forces(tree, &wrench, true) {
                 if c.is_torque {
                     residual.max_torque_nm = residual.max_torque_nm.max(c.value.abs());
                 } else {
@@ -332,6 +332,7 @@ struct CoordinateForce {
 }
 
 /// The tree of joints that carry bodies (multibody links and actuator drives).
+#[derive(Clone, Debug, Default)]
 pub(super) struct Tree {
     /// The joint each body hangs from, if any.
     parent_joint: Vec<Option<usize>>,

@@ -129,6 +129,8 @@ pub struct Simulation {
     cable_ropes: Vec<Option<ImpulseJointHandle>>,
     /// Current unstretched cable lengths [m].
     cable_lengths: Vec<f64>,
+    /// The joint each body hangs from in the multibody forest (fixed at build).
+    tree: forces::Tree,
     /// Current actuator commands, in actuator order.
     commands: Vec<f64>,
     /// External loads [N] and [N m] applied to bodies (probes), world frame, about the body's

@@ -97,9 +97,8 @@ impl Simulation {
         self.apply_joint_commands();
         // Then every free joint, parents first, turned (slid) so that a node of its child lands
         // where `s` has it.
-        let tree = self.link_tree();
         let mut order: Vec<usize> = (0..s.joints.len()).filter(|j| !self.actuated[*j]).collect();
-        order.sort_by_key(|&j| tree.depth(s, s.joints[j].child));
+        order.sort_by_key(|&j| self.tree.depth(s, s.joints[j].child));
         for j in order {
             if !self.place_free_joint(j, s) {
                 return false;

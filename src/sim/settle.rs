@@ -53,7 +53,10 @@ impl SettleDetector {
             }
             None => f64::INFINITY,
         };
-        self.previous = Some(snap.nodes.clone());
+        match &mut self.previous {
+            Some(prev) => prev.clone_from(&snap.nodes),
+            None => self.previous = Some(snap.nodes.clone()),
+        }
         self.last_speed = speed;
         if speed <= criteria.speed_tol_m_per_s {
             self.quiet_steps += 1;
