@@ -243,6 +243,21 @@ mod tests {
         assert_eq!(newton_damping(dt, k, inertia), 0.0);
     }
 
+    /// A pendulum of mass m at radius r under gravity: tau = -m g r sin q about the pivot, so
+    /// the tangent stiffness is m g r cos q (to round-off).
+    #[test]
+    fn gravity_stiffness_of_a_pendulum_is_m_g_r_cos_q() {
+        let motion = JointMotion { axis: Vector::Z, anchor: Vector::ZERO, revolute: true };
+        let (m, g, r) = (2.0, 9.81, 0.7);
+        for q in [0.0, 0.4, 2.0] {
+            // q from the hanging position (straight down), counter-clockwise about z.
+            let bob = Vector::new(r * q.sin(), -r * q.cos(), 0.0);
+            let k = motion.constant_force_stiffness(bob, Vector::new(0.0, -m * g, 0.0));
+            let expected = m * g * r * q.cos();
+            assert!((k - expected).abs() <= 1e-12 * m * g * r, "q {q}: {k} against {expected}");
+        }
+    }
+
     /// The tangent stiffness of a zero-free-length spring on a revolute joint matches the
     /// central difference of its generalized force to 1e-8 relative.
     #[test]
