@@ -16,6 +16,10 @@ use rapier3d_f64::prelude::*;
 /// checked tolerance (1e-9).
 const PLACEMENT_TOLERANCE: f64 = 1e-12;
 
+/// A node placing a revolute joint's child must lie at least this far from the joint's axis,
+/// relative to the structure's size, for its angle about the axis to be well defined.
+const OFF_AXIS_FRACTION: f64 = 1e-3;
+
 impl Structure {
     /// Whether `other` is this structure in another placement: the same bodies, members,
     /// joints, actuators, loads and parameters; only node positions, centres of mass, joint
@@ -135,7 +139,7 @@ impl Simulation {
         let scale = self.length_scale_m;
         let node = (0..self.structure.nodes.len()).find(|&n| {
             self.structure.nodes[n].body == joint.child
-                && (!revolute || off_axis(Vector::from(self.node_position(n))).length() > 1e-3 * scale)
+                && (!revolute || off_axis(Vector::from(self.node_position(n))).length() > OFF_AXIS_FRACTION * scale)
         });
         let Some(n) = node else { return false };
         let (now, wanted) = (Vector::from(self.node_position(n)), Vector::from(s.nodes[n].position));
