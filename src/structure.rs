@@ -213,6 +213,18 @@ impl Structure {
         self.nodes.len() - 1
     }
 
+    /// The actuator commands the structure is built at, in actuator order: each actuated
+    /// joint's initial coordinate (rad or m), each winch's cable length (m).
+    pub fn initial_commands(&self) -> Vec<f64> {
+        self.actuators
+            .iter()
+            .map(|a| match a.target {
+                ActuatorTarget::Joint(j) => self.joints[j].initial_coordinate,
+                ActuatorTarget::CableLength(c) => self.cables[c].length_m,
+            })
+            .collect()
+    }
+
     pub fn node_id(&self, name: &str) -> Option<NodeId> {
         self.nodes.iter().position(|n| n.name == name)
     }

@@ -147,14 +147,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
     params.normalized_max_linear_velocity = Real::MAX;
 
     let length_scale_m = structure_size(s);
-    let commands: Vec<f64> = s
-        .actuators
-        .iter()
-        .map(|a| match a.target {
-            ActuatorTarget::Joint(j) => s.joints[j].initial_coordinate,
-            ActuatorTarget::CableLength(c) => s.cables[c].length_m,
-        })
-        .collect();
+    let commands = s.initial_commands();
     let mut sim = Simulation {
         structure: s.clone(),
         settings: settings.clone(),

@@ -99,7 +99,6 @@ impl Simulation {
         let s = &self.structure;
         let joint = &s.joints[j];
         let parent = *self.bodies[self.handles[joint.parent]].position();
-        let child = *self.bodies[self.handles[joint.child]].position();
         let anchor_local = {
             let a = s.nodes[joint.anchor].position;
             Vector::new(a[0], a[1], a[2])
@@ -173,12 +172,9 @@ impl Simulation {
             }
             load.stiffness += motion.member_stiffness(px, d / l, k * stretch, k, l);
         }
-        if let Some(t) = &joint.torsion_spring {
-            if revolute {
-                let coordinate = super::forces::relative_angle(parent.rotation, child.rotation, motion.axis);
-                load.force -= t.stiffness_nm_per_rad * (joint.initial_coordinate + coordinate - t.rest_angle_rad);
-                load.stiffness += t.stiffness_nm_per_rad;
-            }
+        if let (Some(t), true) = (&joint.torsion_spring, revolute) {
+            load.force += self.torsion_spring_torque(j);
+            load.stiffness += t.stiffness_nm_per_rad;
         }
         load
     }

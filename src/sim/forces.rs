@@ -99,6 +99,18 @@ impl Simulation {
         }
     }
 
+    /// Torque of joint `j`'s torsion spring at the joint's current angle [N m]: -k (q - q_rest),
+    /// q counted as the structure's coordinates are (initial coordinate plus the rotation since
+    /// the build). Zero without a spring or off a revolute joint.
+    pub(super) fn torsion_spring_torque(&self, j: usize) -> f64 {
+        let joint = &self.structure.joints[j];
+        let (Some(t), JointKind::Revolute { axis }) = (&joint.torsion_spring, &joint.kind) else { return 0.0 };
+        let parent_rot = self.bodies[self.handles[joint.parent]].position().rotation;
+        let child_rot = self.bodies[self.handles[joint.child]].position().rotation;
+        let q = joint.initial_coordinate + relative_angle(parent_rot, child_rot, v(*axis));
+        -t.stiffness_nm_per_rad * (q - t.rest_angle_rad)
+    }
+
     /// World position of a free body's centre of mass, from its current pose [m].
     pub(super) fn world_com(&self, body: usize) -> Vector {
         let local = self.structure.bodies[body].inertia.map_or([0.0; 3], |i| i.com);
@@ -410,13 +422,7 @@ impl Simulation {
                 JointKind::Revolute { axis } => {
                     let a = (parent_rot * v(*axis)).normalize();
                     // A torsion spring on this joint is a generalized force on its coordinate.
-                    let spring = match (&joint.torsion_spring, with_springs) {
-                        (Some(t), true) => {
-                            let q = joint.initial_coordinate + relative_angle(parent_rot, child_rot, v(*axis));
-                            -t.stiffness_nm_per_rad * (q - t.rest_angle_rad)
-                        }
-                        _ => 0.0,
-                    };
+                    let spring = if with_springs { self.torsion_spring_torque(j) } else { 0.0 };
                     out.push(torque(m.dot(a) + spring));
                 }
                 JointKind::Prismatic { axis } => {

@@ -88,17 +88,9 @@ impl Simulation {
         if !self.restartable() || !self.structure.same_but_placement(s) {
             return false;
         }
-        // The commands `s` was built with (its actuated joints' initial coordinates); the
-        // actuated joints go there as for any new command.
-        for (i, a) in s.actuators.iter().enumerate() {
-            self.commands[i] = match a.target {
-                crate::structure::ActuatorTarget::Joint(j) => s.joints[j].initial_coordinate,
-                crate::structure::ActuatorTarget::CableLength(c) => s.cables[c].length_m,
-            };
-        }
-        self.cable_lengths.iter_mut().zip(&s.cables).for_each(|(l, c)| *l = c.length_m);
         self.probe_loads.iter_mut().for_each(|p| *p = ([0.0; 3], [0.0; 3]));
-        self.apply_joint_commands();
+        // The actuators to the commands `s` was built at, as for any new command.
+        self.set_commands(&s.initial_commands());
         // Then every free joint, parents first, turned (slid) so that a node of its child lands
         // where `s` has it.
         let mut order: Vec<usize> = (0..s.joints.len()).filter(|j| !self.actuated[*j]).collect();
