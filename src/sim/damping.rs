@@ -42,10 +42,13 @@ struct JointLoad {
 
 /// How the bodies a joint carries move with its coordinate: a point x moves by `rate(x)` per
 /// unit coordinate, and that rate changes by `rate_change(x)` per unit coordinate.
-struct JointMotion {
-    axis: Vector,
-    anchor: Vector,
-    revolute: bool,
+pub(super) struct JointMotion {
+    /// The joint's axis in the world, unit.
+    pub(super) axis: Vector,
+    /// The joint's anchor in the world [m].
+    pub(super) anchor: Vector,
+    /// Revolute (turns about the axis) or prismatic (slides along it).
+    pub(super) revolute: bool,
 }
 
 impl JointMotion {
@@ -94,25 +97,29 @@ impl Simulation {
 
     /// Joint `j`'s generalized force, tangent stiffness and inertia for the coming step (after
     /// the member forces are applied).
+    /// Joint `j`'s axis and anchor as its parent now carries them, if revolute or prismatic.
+    pub(super) fn joint_motion(&self, j: usize) -> Option<JointMotion> {
+        let s = &self.structure;
+        let joint = &s.joints[j];
+        let (axis, revolute) = match joint.kind {
+            JointKind::Revolute { axis } => (axis, true),
+            JointKind::Prismatic { axis } => (axis, false),
+            _ => return None,
+        };
+        let parent = self.bodies[self.handles[joint.parent]].position();
+        Some(JointMotion {
+            axis: (parent.rotation * Vector::from(axis)).normalize(),
+            anchor: parent.transform_point(Vector::from(s.nodes[joint.anchor].position)),
+            revolute,
+        })
+    }
+
     fn joint_load(&self, j: usize) -> JointLoad {
         let tree = &self.tree;
         let s = &self.structure;
         let joint = &s.joints[j];
-        let parent = *self.bodies[self.handles[joint.parent]].position();
-        let anchor_local = {
-            let a = s.nodes[joint.anchor].position;
-            Vector::new(a[0], a[1], a[2])
-        };
-        let (axis_local, revolute) = match joint.kind {
-            JointKind::Revolute { axis } => (axis, true),
-            JointKind::Prismatic { axis } => (axis, false),
-            _ => unreachable!("scheduled joints are revolute or prismatic"),
-        };
-        let motion = JointMotion {
-            axis: (parent.rotation * Vector::new(axis_local[0], axis_local[1], axis_local[2])).normalize(),
-            anchor: parent.transform_point(anchor_local),
-            revolute,
-        };
+        let motion = self.joint_motion(j).expect("scheduled joints are revolute or prismatic");
+        let revolute = motion.revolute;
         let carried = |b: usize| self.is_free(b) && tree.descends_from(s, b, joint.child);
         let g = Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]);
         let mut load = JointLoad { force: 0.0, stiffness: 0.0, inertia: 0.0 };
@@ -177,14 +184,6 @@ impl Simulation {
             load.stiffness += t.stiffness_nm_per_rad;
         }
         load
-    }
-
-    /// The joint's degree of freedom in its multibody: (multibody, index), if a link.
-    fn dof_of(&self, j: usize) -> Option<(MultibodyIndex, usize)> {
-        let link = self.joint_links[j]?;
-        let (mb, id) = self.multibody_joints.get(link.multibody_joint)?;
-        let index = self.multibody_joints.rigid_body_link(self.handles[self.structure.joints[j].child])?.multibody;
-        Some((index, mb.link(id)?.assembly_id()))
     }
 
     /// Sets every scheduled joint's velocity and damping for the coming step (after the loads

@@ -439,14 +439,11 @@ impl Simulation {
         };
         // The multibodies moved. Forward kinematics settles each one's root (and so its
         // degree-of-freedom indices, read below) before the first move.
-        let multibody_of = |sim: &Self, j: usize| {
-            sim.multibody_joints.rigid_body_link(sim.handles[sim.structure.joints[j].child]).copied()
-        };
         let mut multibodies: Vec<MultibodyIndex> = Vec::new();
         for &(j, _) in &moves {
-            if let Some(link) = multibody_of(self, j) {
-                if !multibodies.contains(&link.multibody) {
-                    multibodies.push(link.multibody);
+            if let Some((m, _)) = self.dof_of(j) {
+                if !multibodies.contains(&m) {
+                    multibodies.push(m);
                 }
             }
         }
@@ -462,9 +459,8 @@ impl Simulation {
                 let dofs = moves
                     .iter()
                     .filter_map(|&(j, total)| {
-                        let link = multibody_of(self, j).filter(|l| l.multibody == m)?;
-                        let mb = self.multibody_joints.get_multibody(m)?;
-                        Some((mb.link(link.id)?.assembly_id(), total / increments as f64))
+                        let (mj, dof) = self.dof_of(j)?;
+                        (mj == m).then_some((dof, total / increments as f64))
                     })
                     .collect();
                 (m, dofs)
@@ -486,6 +482,15 @@ impl Simulation {
             }
             self.project_internal_closures();
         }
+    }
+
+    /// Joint `j`'s first degree of freedom in its multibody: (multibody, index), if a link.
+    /// The index can shift when forward kinematics re-roots the multibody: read it after.
+    pub(super) fn dof_of(&self, j: usize) -> Option<(MultibodyIndex, usize)> {
+        let link = self.joint_links[j]?;
+        let (mb, id) = self.multibody_joints.get(link.multibody_joint)?;
+        let index = self.multibody_joints.rigid_body_link(self.handles[self.structure.joints[j].child])?.multibody;
+        Some((index, mb.link(id)?.assembly_id()))
     }
 
     fn joint_command(&self, joint: usize) -> f64 {

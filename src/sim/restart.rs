@@ -118,32 +118,25 @@ impl Simulation {
     /// Moves free joint `j` so that a node of its child body (off the axis, for a revolute)
     /// lands where `s` places it; false when the child has no such node.
     fn place_free_joint(&mut self, j: usize, s: &Structure) -> bool {
-        let joint = &self.structure.joints[j];
-        let parent = *self.bodies[self.handles[joint.parent]].position();
-        let anchor = parent.transform_point(Vector::from(self.structure.nodes[joint.anchor].position));
-        let (axis_local, revolute) = match joint.kind {
-            JointKind::Revolute { axis } => (axis, true),
-            JointKind::Prismatic { axis } => (axis, false),
-            _ => return false,
-        };
-        let axis = (parent.rotation * Vector::from(axis_local)).normalize();
-        let off_axis = |x: Vector| (x - anchor).reject_from_normalized(axis);
+        let Some(motion) = self.joint_motion(j) else { return false };
+        let child = self.structure.joints[j].child;
+        let off_axis = |x: Vector| (x - motion.anchor).reject_from_normalized(motion.axis);
         let scale = self.length_scale_m;
         let node = (0..self.structure.nodes.len()).find(|&n| {
-            self.structure.nodes[n].body == joint.child
-                && (!revolute || off_axis(Vector::from(self.node_position(n))).length() > OFF_AXIS_FRACTION * scale)
+            self.structure.nodes[n].body == child
+                && (!motion.revolute
+                    || off_axis(Vector::from(self.node_position(n))).length() > OFF_AXIS_FRACTION * scale)
         });
         let Some(n) = node else { return false };
         let (now, wanted) = (Vector::from(self.node_position(n)), Vector::from(s.nodes[n].position));
-        let displacement = if revolute {
+        let displacement = if motion.revolute {
             let (a, b) = (off_axis(now), off_axis(wanted));
-            axis.dot(a.cross(b)).atan2(a.dot(b))
+            motion.axis.dot(a.cross(b)).atan2(a.dot(b))
         } else {
-            (wanted - now).dot(axis)
+            (wanted - now).dot(motion.axis)
         };
-        let Some(link) = self.joint_links[j] else { return false };
-        let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) else { return false };
-        let Some(dof) = mb.link(link_id).map(|l| l.assembly_id()) else { return false };
+        let Some((m, dof)) = self.dof_of(j) else { return false };
+        let Some(mb) = self.multibody_joints.get_multibody_mut(m) else { return false };
         let mut disp = vec![0.0; mb.ndofs()];
         disp[dof] = displacement;
         mb.apply_displacements(&disp);
