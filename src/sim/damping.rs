@@ -18,7 +18,7 @@
 //! changes.
 
 use super::Simulation;
-use crate::structure::{CableLaw, JointKind};
+use crate::structure::JointKind;
 use rapier3d_f64::prelude::*;
 
 /// The damping [N m s/rad or N s/m] that makes rapier's implicit step from rest Newton's:
@@ -151,33 +151,20 @@ impl Simulation {
         }
         // Springs and elastic cables with one end carried: their force changes with the
         // coordinate (a member with both ends carried moves rigidly and adds nothing).
-        let members = s.springs.iter().map(|sp| (sp.a, sp.b, sp.stiffness_n_per_m, sp.rest_length_m)).chain(
-            s.cables.iter().enumerate().filter_map(|(c, cable)| match cable.law {
-                CableLaw::Elastic { stiffness_n_per_m } => {
-                    Some((cable.a, cable.b, stiffness_n_per_m, self.cable_lengths[c]))
-                }
-                CableLaw::Inextensible => None,
-            }),
-        );
-        let is_spring = s.springs.len();
-        for (m, (a, b, k, rest)) in members.enumerate() {
-            let (a_carried, b_carried) = (carried(s.nodes[a].body), carried(s.nodes[b].body));
+        for i in 0..s.springs.len() + s.cables.len() {
+            let Some(m) = self.elastic_member(i) else { continue };
+            let (a_carried, b_carried) = (carried(s.nodes[m.a].body), carried(s.nodes[m.b].body));
             if a_carried == b_carried {
                 continue;
             }
-            let (x, other) = if a_carried { (a, b) } else { (b, a) };
+            let (x, other) = if a_carried { (m.a, m.b) } else { (m.b, m.a) };
             let (px, po) = (Vector::from(self.node_position(x)), Vector::from(self.node_position(other)));
             let d = po - px;
             let l = d.length();
-            if l <= 0.0 {
+            if l <= 0.0 || !m.engaged(l) {
                 continue;
             }
-            let stretch = l - rest;
-            // Springs push and pull; cables only pull.
-            if m >= is_spring && stretch <= 0.0 {
-                continue;
-            }
-            load.stiffness += motion.member_stiffness(px, d / l, k * stretch, k, l);
+            load.stiffness += motion.member_stiffness(px, d / l, m.tension_n(l), m.stiffness_n_per_m, l);
         }
         if let (Some(t), true) = (&joint.torsion_spring, revolute) {
             load.force += self.torsion_spring_torque(j);

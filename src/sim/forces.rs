@@ -38,6 +38,34 @@ pub struct Residual {
 
 type Wrench = (Vector, Vector); // (force, moment about the world origin)
 
+/// A member whose force follows from its length: a spring (pushes and pulls) or an elastic
+/// cable (pulls only).
+pub(super) struct ElasticMember {
+    pub(super) a: usize,
+    pub(super) b: usize,
+    pub(super) stiffness_n_per_m: f64,
+    pub(super) rest_length_m: f64,
+    pub(super) tension_only: bool,
+}
+
+impl ElasticMember {
+    /// Whether the member carries force at length `l` [m] (a cable goes slack when not
+    /// stretched).
+    pub(super) fn engaged(&self, l: f64) -> bool {
+        !self.tension_only || l > self.rest_length_m
+    }
+
+    /// Tension at length `l` [m]: k (l - l0), at least 0 for a cable [N].
+    pub(super) fn tension_n(&self, l: f64) -> f64 {
+        let t = self.stiffness_n_per_m * (l - self.rest_length_m);
+        if self.tension_only {
+            t.max(0.0)
+        } else {
+            t
+        }
+    }
+}
+
 fn v(a: [f64; 3]) -> Vector {
     Vector::new(a[0], a[1], a[2])
 }
@@ -51,16 +79,9 @@ impl Simulation {
             rb.reset_forces(false);
             rb.reset_torques(false);
         }
-        for i in 0..self.structure.springs.len() {
-            let sp = &self.structure.springs[i];
-            let (a, b, k, rest) = (sp.a, sp.b, sp.stiffness_n_per_m, sp.rest_length_m);
-            self.add_member_load(a, b, |l| k * (l - rest));
-        }
-        for c in 0..self.structure.cables.len() {
-            let cable = &self.structure.cables[c];
-            if let CableLaw::Elastic { stiffness_n_per_m } = cable.law {
-                let (a, b, rest) = (cable.a, cable.b, self.cable_lengths[c]);
-                self.add_member_load(a, b, |l| (stiffness_n_per_m * (l - rest)).max(0.0));
+        for i in 0..self.structure.springs.len() + self.structure.cables.len() {
+            if let Some(m) = self.elastic_member(i) {
+                self.add_member_load(&m);
             }
         }
         for b in 0..n {
@@ -76,15 +97,42 @@ impl Simulation {
         }
     }
 
-    /// Puts the tension `tension(l)` [N] of a member of length l between nodes `a` and `b` on
-    /// their bodies, each as a force at the centre of mass plus its moment, with the centre of
-    /// mass taken from the current pose: rapier's cached world centre of mass is stale before
-    /// the first step, which gave a spurious kick of |c x F| there.
-    fn add_member_load(&mut self, a: usize, b: usize, tension: impl Fn(f64) -> f64) {
+    /// Member `i` of the springs followed by the cables, if its force follows from its length
+    /// (a spring, or an elastic cable at its current rest length).
+    pub(super) fn elastic_member(&self, i: usize) -> Option<ElasticMember> {
+        let s = &self.structure;
+        if let Some(sp) = s.springs.get(i) {
+            return Some(ElasticMember {
+                a: sp.a,
+                b: sp.b,
+                stiffness_n_per_m: sp.stiffness_n_per_m,
+                rest_length_m: sp.rest_length_m,
+                tension_only: false,
+            });
+        }
+        let c = i - s.springs.len();
+        match s.cables.get(c)?.law {
+            CableLaw::Elastic { stiffness_n_per_m } => Some(ElasticMember {
+                a: s.cables[c].a,
+                b: s.cables[c].b,
+                stiffness_n_per_m,
+                rest_length_m: self.cable_lengths[c],
+                tension_only: true,
+            }),
+            CableLaw::Inextensible => None,
+        }
+    }
+
+    /// Puts the tension of member `m` on the bodies of its two nodes, each as a force at the
+    /// centre of mass plus its moment, with the centre of mass taken from the current pose:
+    /// rapier's cached world centre of mass is stale before the first step, which gave a
+    /// spurious kick of |c x F| there.
+    fn add_member_load(&mut self, m: &ElasticMember) {
+        let (a, b) = (m.a, m.b);
         let (pa, pb) = (v(self.node_position(a)), v(self.node_position(b)));
         let d = pb - pa;
         let l = d.length();
-        let t = tension(l);
+        let t = m.tension_n(l);
         if l > 0.0 && t != 0.0 {
             let f = d / l * t;
             for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
