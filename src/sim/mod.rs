@@ -394,6 +394,12 @@ impl Simulation {
                 self.bodies[h].set_position(moved, true);
             }
         }
+        self.zero_body_velocities();
+    }
+
+    /// Sets every free body's linear and angular velocity to zero (multibody links as well:
+    /// their generalized velocities are the caller's).
+    fn zero_body_velocities(&mut self) {
         for (b, &h) in self.handles.iter().enumerate() {
             if self.is_free(b) {
                 let rb = &mut self.bodies[h];

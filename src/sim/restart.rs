@@ -105,13 +105,7 @@ impl Simulation {
                 mb.generalized_velocity_mut().fill(0.0);
             }
         }
-        for b in 0..self.structure.bodies.len() {
-            if self.is_free(b) {
-                let rb = &mut self.bodies[self.handles[b]];
-                rb.set_linvel(Vector::ZERO, false);
-                rb.set_angvel(AngVector::ZERO, false);
-            }
-        }
+        self.zero_body_velocities();
         self.reproduces(s)
     }
 
