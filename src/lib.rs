@@ -15,3 +15,4 @@ pub mod scenario;
 pub mod sim;
 pub mod structure;
 pub mod sweep;
+pub mod verdict;

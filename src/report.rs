@@ -19,6 +19,13 @@ pub struct ScenarioReport {
     pub file: String,
     pub mechanism: String,
     pub passed: bool,
+    /// The parts of the verdict that failed (empty when `passed`), named as `[expect] failing`
+    /// names them.
+    pub failures: Vec<crate::verdict::Failure>,
+    /// What the scenario declares it must do (`[expect]`), if it declares it.
+    pub expect: Option<crate::verdict::Expectation>,
+    /// Whether the run did what `[expect]` declares (absent without `[expect]`).
+    pub as_expected: Option<bool>,
     pub params: Values,
     pub settle: SettleSummary,
     pub checks: Vec<CheckReport>,
@@ -259,6 +266,23 @@ impl From<Finding> for FindingReport {
     }
 }
 
+impl ScenarioReport {
+    /// "PASS", or "FAIL (what failed)", with whether that is what the scenario declares.
+    pub fn verdict_line(&self) -> String {
+        let names = |f: &[crate::verdict::Failure]| f.iter().map(|f| f.to_string()).collect::<Vec<_>>().join(", ");
+        let mut line = if self.passed { "PASS".to_string() } else { format!("FAIL ({})", names(&self.failures)) };
+        match (&self.expect, self.as_expected) {
+            (Some(_), Some(true)) if !self.passed => line.push_str(", as the scenario expects"),
+            (Some(e), Some(false)) if e.failing.is_empty() => line.push_str(", NOT as expected (expect: pass)"),
+            (Some(e), Some(false)) => {
+                line.push_str(&format!(", NOT as expected (expect: fail in {})", names(&e.failing)))
+            }
+            _ => {}
+        }
+        line
+    }
+}
+
 impl Report {
     pub fn passed(&self) -> bool {
         self.scenarios.iter().all(|s| s.passed)
@@ -272,13 +296,7 @@ impl Report {
     pub fn to_table(&self) -> String {
         let mut out = String::new();
         for s in &self.scenarios {
-            out.push_str(&format!(
-                "== {} ({}) [{}]: {}\n",
-                s.name,
-                s.mechanism,
-                s.file,
-                if s.passed { "PASS" } else { "FAIL" }
-            ));
+            out.push_str(&format!("== {} ({}) [{}]: {}\n", s.name, s.mechanism, s.file, s.verdict_line()));
             out.push_str(&format!(
                 "   settle: {} point(s), all settled: {}, {} steps, {:.3} s simulated, {:.3} s wall\n",
                 s.points.len(),

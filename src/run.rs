@@ -10,6 +10,7 @@ use crate::report::{PointReport, ProbeReport, ScenarioReport, SettleSummary};
 use crate::scenario::{Actuation, Scenario};
 use crate::sim::settle::SettleDetector;
 use crate::sim::{SimError, Simulation, Snapshot};
+use crate::verdict;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -289,7 +290,17 @@ pub fn panicked(sc: &Scenario, payload: &(dyn std::any::Any + Send)) -> Scenario
         .map(|s| s.to_string())
         .or_else(|| payload.downcast_ref::<String>().cloned())
         .unwrap_or_else(|| "unknown panic".into());
-    ScenarioReport { error: Some(format!("panicked: {msg}")), ..empty_report(sc) }
+    let mut report = ScenarioReport { error: Some(format!("panicked: {msg}")), ..empty_report(sc) };
+    conclude(&mut report, sc);
+    report
+}
+
+/// The verdict of a finished report: its failures (the one pass policy, [`verdict::failures`]),
+/// whether it passed, and whether that is what the scenario declares.
+fn conclude(report: &mut ScenarioReport, sc: &Scenario) {
+    report.failures = verdict::failures(report, sc.min_agreement_percent);
+    report.passed = report.failures.is_empty();
+    report.as_expected = sc.expect.as_ref().map(|e| e.met_by(&report.failures));
 }
 
 /// The report of `sc` before anything has run: not passed, no points, no findings.
@@ -299,6 +310,9 @@ fn empty_report(sc: &Scenario) -> ScenarioReport {
         file: sc.file.display().to_string(),
         mechanism: sc.mechanism.clone(),
         passed: false,
+        failures: vec![],
+        expect: sc.expect.clone(),
+        as_expected: None,
         params: sc.params.clone(),
         settle: SettleSummary::default(),
         checks: vec![],
@@ -350,6 +364,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         }
         Err(e) => {
             report.error = Some(e);
+            conclude(&mut report, sc);
             return report;
         }
     };
@@ -358,6 +373,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         Some(Ok(i)) => Some(i),
         Some(Err(e)) => {
             report.error = Some(e);
+            conclude(&mut report, sc);
             return report;
         }
     };
@@ -373,6 +389,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         Some(Ok(r)) => r,
         Some(Err(e)) => {
             report.error = Some(e.to_string());
+            conclude(&mut report, sc);
             return report;
         }
     };
@@ -422,32 +439,14 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
             passed: complete && max <= p.tolerance,
         });
     }
-    let stability_agrees = report
-        .points
-        .iter()
-        .all(|p| p.stable.is_none() || p.analytic_stable.is_none() || p.stable == p.analytic_stable);
-    if let (Some(min), Some(w)) = (sc.min_agreement_percent, &report.workspace) {
-        // A workspace sweep passes on the agreement of the two classifications; per-point
-        // settling and checks are what the classification is made of.
-        report.passed = report.error.is_none()
-            && w.agreement_percent >= min
-            && report.interference.as_ref().is_none_or(|i| i.passed);
-    } else {
-        report.passed = report.error.is_none()
-            && report.settle.settled
-            && report.checks.iter().all(|c| c.passed)
-            && report.stiffness_probe.as_ref().is_none_or(|p| p.passed)
-            && stability_agrees
-            && report.points.iter().all(|p| p.slack_agrees != Some(false))
-            && report.interference.as_ref().is_none_or(|i| i.passed);
-    }
+    conclude(&mut report, sc);
     if let Some(r) = runner.recorder.take() {
         let mut r = r;
         r.document("report", &serde_json::to_string_pretty(&report).unwrap_or_default());
         r.event(runner.sim.tick(), if report.passed { "run passed" } else { "run FAILED" });
         if let Err(e) = r.finish() {
-            report.passed = false;
             report.error.get_or_insert(e.to_string());
+            conclude(&mut report, sc);
         }
     }
     report

@@ -54,6 +54,20 @@ pub struct RawScenario {
     /// `mechanism = "custom"`: the structure itself.
     #[serde(default)]
     pub structure: Option<Spanned<RawStructure>>,
+    /// What the run must do: pass, or fail in named parts.
+    #[serde(default)]
+    pub expect: Option<Spanned<RawExpect>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawExpect {
+    /// "pass" or "fail".
+    pub verdict: Spanned<String>,
+    /// With "fail": every part of the verdict that must fail, and no other
+    /// (see [`crate::verdict::FAILURE_NAMES`]).
+    #[serde(default)]
+    pub failing: Vec<Spanned<String>>,
 }
 
 type Xyz = Spanned<[f64; 3]>;
@@ -269,6 +283,8 @@ pub struct Scenario {
     pub skipped_points: Vec<(Values, String)>,
     /// `mechanism = "custom"`: the mechanism built from the file.
     pub custom: Option<crate::custom::Custom>,
+    /// `[expect]`: what the run must do, if the file declares it.
+    pub expect: Option<crate::verdict::Expectation>,
 }
 
 impl Scenario {
@@ -821,6 +837,10 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
             Some(settings)
         }
     };
+    let expect = match &raw.expect {
+        None => None,
+        Some(e) => Some(expectation(ctx, e, &checks)?),
+    };
     Ok(Scenario {
         file: path.to_path_buf(),
         source: ctx.source.to_string(),
@@ -840,7 +860,40 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         min_agreement_percent,
         skipped_points,
         custom,
+        expect,
     })
+}
+
+/// `[expect]`: `verdict = "pass"`, or `"fail"` with the parts that must fail (`failing`), each
+/// a part this scenario has (a `check:` names one of its `[[checks]]`).
+fn expectation(
+    ctx: &Ctx,
+    raw: &Spanned<RawExpect>,
+    checks: &[Check],
+) -> Result<crate::verdict::Expectation, ScenarioError> {
+    use crate::verdict::{Expectation, Failure};
+    let e = raw.get_ref();
+    let mut failing = Vec::new();
+    for f in &e.failing {
+        let failure: Failure = f.get_ref().parse().map_err(|m: String| ctx.err(f, m))?;
+        if let Failure::Check(q) = &failure {
+            if !checks.iter().any(|c| &c.quantity == q) {
+                let known: Vec<_> = checks.iter().map(|c| c.quantity.as_str()).collect();
+                return Err(ctx.err(f, format!("'{q}' is not among this scenario's checks ({})", known.join(", "))));
+            }
+        }
+        failing.push(failure);
+    }
+    match e.verdict.get_ref().as_str() {
+        "pass" if failing.is_empty() => Ok(Expectation::PASS),
+        "pass" => Err(ctx.err(&e.failing[0], "expect.failing goes with verdict = \"fail\"")),
+        "fail" if failing.is_empty() => Err(ctx.err(
+            &e.verdict,
+            "verdict = \"fail\" needs expect.failing: the parts that must fail (for example [\"interference\"])",
+        )),
+        "fail" => Ok(Expectation { failing }),
+        other => Err(ctx.err(&e.verdict, format!("expect.verdict must be \"pass\" or \"fail\", got '{other}'"))),
+    }
 }
 
 /// Builds the structure of a `[structure]` table; every bad reference, zero-length member or
