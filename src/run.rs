@@ -255,7 +255,14 @@ const APPROACH_SWITCH_SPEED_FACTOR: f64 = 1e6;
 /// the perturbation (times the structure's length).
 const RETURN_FRACTION: f64 = 1e-2;
 
-/// Which analytic branch a simulated state matches (nearest in the checked quantities).
+/// A settled state lies on an analytic branch when every compared quantity is within this
+/// normalised distance of it (lengths / length scale, angles in rad); farther from every
+/// branch it lies on none of them, whatever the nearest is called.
+const BRANCH_MATCH_DISTANCE: f64 = 1e-3;
+
+/// Which analytic branch a simulated state lies on (nearest in the compared quantities, and
+/// within [`BRANCH_MATCH_DISTANCE`]): its label and analytic stability. A state on none of
+/// them is labelled so, with the nearest named.
 fn branch_of(
     mech: &dyn Mechanism,
     sc: &Scenario,
@@ -278,10 +285,14 @@ fn branch_of(
         }
     }
     match best {
-        Some((_, b)) => (b.label.clone(), b.stable),
+        Some((d, b)) if d <= BRANCH_MATCH_DISTANCE => (b.label.clone(), b.stable),
+        Some((_, b)) => (format!("{NO_BRANCH} (nearest: {})", b.label), None),
         None => ("unknown".into(), None),
     }
 }
+
+/// The label of a settled state that lies on none of the analytic branches.
+pub const NO_BRANCH: &str = "none of the analytic branches";
 
 /// The report of a scenario whose run panicked: failed, with the panic's message.
 pub fn panicked(sc: &Scenario, payload: &(dyn std::any::Any + Send)) -> ScenarioReport {

@@ -108,6 +108,23 @@ fn elastic_cables_settle_on_the_stretched_equilibrium() {
     assert!((p.simulated["z"] - p.analytic["z"]).abs() <= 1e-9 * r.params["lb"]);
 }
 
+/// A settled state far from every analytic branch is labelled as on none of them, never with
+/// the nearest one's name: with continuation, elastic_cables.toml's cable lengths jump between
+/// points and throw the end-effector through the base (z < 0, the mirror assembly), and the
+/// run fails on z.
+#[test]
+fn a_state_on_the_mirror_assembly_is_on_none_of_the_branches_and_fails() {
+    let r = run_variant(
+        "scenarios/mohr2011/elastic_cables.toml",
+        "continuation = true\npoints = [ { x = 0.0, y = 0.0, z = 3.0 }, { x = 0.3, y = -0.2, z = 2.5 } ]",
+    );
+    assert_eq!(r.points[0].branch, "z > 0 (Eq. 12-14)");
+    let p = &r.points[1];
+    assert!(p.settled && p.simulated["z"] < -2.0, "z = {} m", p.simulated["z"]);
+    assert_eq!(p.branch, format!("{} (nearest: z > 0 (Eq. 12-14))", tensegrity_testbed::run::NO_BRANCH));
+    assert_eq!(r.failures, vec![tensegrity_testbed::verdict::Failure::Check("z".into())]);
+}
+
 /// With straight struts (the design Section 2 rejects) all three struts cross at p/2: the
 /// interference observer reports each pair, from the first tick, with the closest points.
 #[test]
