@@ -6,7 +6,7 @@
 use crate::mechanisms::{
     Finding, InputSpec, Mechanism, MechanismSpec, Prediction, QuantityKind, QuantitySpec, Solution, Values,
 };
-use crate::sim::Snapshot;
+use crate::snapshot::Snapshot;
 use crate::structure::{ActuatorTarget, Structure};
 
 /// The mechanism built from a file's `[structure]`.

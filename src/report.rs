@@ -21,9 +21,9 @@ pub struct ScenarioReport {
     pub passed: bool,
     /// The parts of the verdict that failed (empty when `passed`), named as `[expect] failing`
     /// names them.
-    pub failures: Vec<crate::verdict::Failure>,
+    pub failures: Vec<crate::settings::Failure>,
     /// What the scenario declares it must do (`[expect]`), if it declares it.
-    pub expect: Option<crate::verdict::Expectation>,
+    pub expect: Option<crate::settings::Expectation>,
     /// Whether the run did what `[expect]` declares (absent without `[expect]`).
     pub as_expected: Option<bool>,
     pub params: Values,
@@ -269,7 +269,7 @@ impl From<Finding> for FindingReport {
 impl ScenarioReport {
     /// "PASS", or "FAIL (what failed)", with whether that is what the scenario declares.
     pub fn verdict_line(&self) -> String {
-        let names = |f: &[crate::verdict::Failure]| f.iter().map(|f| f.to_string()).collect::<Vec<_>>().join(", ");
+        let names = |f: &[crate::settings::Failure]| f.iter().map(|f| f.to_string()).collect::<Vec<_>>().join(", ");
         let mut line = if self.passed { "PASS".to_string() } else { format!("FAIL ({})", names(&self.failures)) };
         match (&self.expect, self.as_expected) {
             (Some(_), Some(true)) if !self.passed => line.push_str(", as the scenario expects"),

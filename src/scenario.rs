@@ -4,9 +4,8 @@
 //! expected. Parsing is two passes: serde for the shape (unknown keys, wrong types, missing
 //! fields), then [`validate`] for the values (ranges, the mechanism's own rules).
 
-use crate::mechanisms::{self, Mechanism, QuantityKind, Values};
-use crate::sim::settle::SettleCriteria;
-use crate::sim::SimSettings;
+use crate::mechanisms::{self, Mechanism, Values};
+use crate::settings::{Check, Probe, SettleCriteria, SimSettings};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -65,7 +64,7 @@ pub struct RawExpect {
     /// "pass" or "fail".
     pub verdict: Spanned<String>,
     /// With "fail": every part of the verdict that must fail, and no other
-    /// (see [`crate::verdict::FAILURE_NAMES`]).
+    /// (see [`crate::settings::FAILURE_NAMES`]).
     #[serde(default)]
     pub failing: Vec<Spanned<String>>,
 }
@@ -276,7 +275,7 @@ pub struct Scenario {
     pub stability_perturbation: Option<f64>,
     pub probe: Option<Probe>,
     pub record: Option<PathBuf>,
-    pub interference: Option<crate::observers::interference::InterferenceSettings>,
+    pub interference: Option<crate::settings::InterferenceSettings>,
     /// Workspace sweep: pass on this agreement percentage instead of on every check.
     pub min_agreement_percent: Option<f64>,
     /// Grid points dropped by `skip_outside`, with the reason.
@@ -284,7 +283,7 @@ pub struct Scenario {
     /// `mechanism = "custom"`: the mechanism built from the file.
     pub custom: Option<crate::custom::Custom>,
     /// `[expect]`: what the run must do, if the file declares it.
-    pub expect: Option<crate::verdict::Expectation>,
+    pub expect: Option<crate::settings::Expectation>,
 }
 
 impl Scenario {
@@ -301,21 +300,6 @@ impl Scenario {
 pub enum Actuation {
     Points { points: Vec<Values>, continuation: bool },
     Schedule { waypoints: Vec<(f64, Values)> },
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct Check {
-    pub quantity: String,
-    pub kind: QuantityKind,
-    pub unit: String,
-    /// On the normalised error (see `QuantityKind`).
-    pub tolerance: f64,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct Probe {
-    pub torque_nm: f64,
-    pub tolerance: f64,
 }
 
 /// Reads and validates a scenario file.
@@ -493,7 +477,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
             ctx,
             &raw.sim.max_kinetic_energy,
             "sim.max_kinetic_energy (J)",
-            crate::sim::DEFAULT_MAX_KINETIC_ENERGY_J,
+            crate::settings::DEFAULT_MAX_KINETIC_ENERGY_J,
         )?,
         max_joint_gap_m: match &raw.sim.max_joint_gap {
             None => None,
@@ -820,7 +804,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
             }
             let exclude = i.get_ref().exclude.iter().map(|e| e.get_ref().clone()).collect();
             // Strut names are checked against the built structure.
-            let settings = crate::observers::interference::InterferenceSettings {
+            let settings = crate::settings::InterferenceSettings {
                 threshold_m: threshold,
                 margin_m: margin,
                 informative: i.get_ref().informative.unwrap_or(false),
@@ -870,8 +854,8 @@ fn expectation(
     ctx: &Ctx,
     raw: &Spanned<RawExpect>,
     checks: &[Check],
-) -> Result<crate::verdict::Expectation, ScenarioError> {
-    use crate::verdict::{Expectation, Failure};
+) -> Result<crate::settings::Expectation, ScenarioError> {
+    use crate::settings::{Expectation, Failure};
     let e = raw.get_ref();
     let mut failing = Vec::new();
     for f in &e.failing {

@@ -122,7 +122,7 @@ fn a_state_on_the_mirror_assembly_is_on_none_of_the_branches_and_fails() {
     let p = &r.points[1];
     assert!(p.settled && p.simulated["z"] < -2.0, "z = {} m", p.simulated["z"]);
     assert_eq!(p.branch, format!("{} (nearest: z > 0 (Eq. 12-14))", tensegrity_testbed::run::NO_BRANCH));
-    assert_eq!(r.failures, vec![tensegrity_testbed::verdict::Failure::Check("z".into())]);
+    assert_eq!(r.failures, vec![tensegrity_testbed::settings::Failure::Check("z".into())]);
 }
 
 /// With straight struts (the design Section 2 rejects) all three struts cross at p/2: the

@@ -2,7 +2,8 @@
 //! (the next point of a grid without continuation) moves as a fresh build of that placement.
 
 use tensegrity_testbed::mechanisms::{self, Values};
-use tensegrity_testbed::sim::{SimSettings, Simulation};
+use tensegrity_testbed::settings::SimSettings;
+use tensegrity_testbed::sim::Simulation;
 use tensegrity_testbed::structure::Structure;
 
 fn values(pairs: &[(&str, f64)]) -> Values {

@@ -1,6 +1,7 @@
 //! Divergence is detected and reported with what diverged and when.
 
-use tensegrity_testbed::sim::{SimError, SimSettings, Simulation};
+use tensegrity_testbed::settings::SimSettings;
+use tensegrity_testbed::sim::{SimError, Simulation};
 use tensegrity_testbed::structure::{BodyKind, Inertia, Structure};
 
 /// An unsupported body under gravity leaves a 10 m box after about sqrt(2 * 10 / 9.81) = 1.43 s;

@@ -7,7 +7,7 @@ pub mod ji2014;
 pub mod manriquez2019;
 pub mod mohr2011;
 
-use crate::sim::Snapshot;
+use crate::snapshot::Snapshot;
 use crate::structure::Structure;
 use std::collections::BTreeMap;
 

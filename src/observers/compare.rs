@@ -1,9 +1,9 @@
 //! Analytic versus simulated, tick by tick and at the settle points.
 
-use super::{Observer, Tick};
+use super::{Note, Observer, SettlePoint, Tick};
 use crate::mechanisms::{wrap_angle, QuantityKind};
-use crate::report::CheckReport;
-use crate::scenario::Check;
+use crate::report::{CheckReport, PointReport, ScenarioReport};
+use crate::settings::Check;
 
 /// Error of `simulated` against `analytic` for a quantity: (absolute, normalised).
 /// Lengths are normalised by `length_scale`, angles are wrapped and taken in rad, other
@@ -68,7 +68,7 @@ impl Compare {
     }
 
     /// Records the errors at a settle point (settled or not: an unsettled point fails).
-    pub fn settle_point(
+    fn record_point(
         &mut self,
         analytic: &crate::mechanisms::Values,
         simulated: &crate::mechanisms::Values,
@@ -89,12 +89,18 @@ impl Compare {
         }
     }
 
-    /// Notes a settle point where the analytic model does not apply (for example a cable it
-    /// predicts slack): nothing to compare there.
-    pub fn outside_point(&mut self) {
-        for a in &mut self.acc {
-            a.outside_points += 1;
-        }
+    /// Every check's normalised error at one point (a missing value: infinite).
+    fn point_errors(&self, p: &PointReport) -> Vec<(&Check, f64)> {
+        self.acc
+            .iter()
+            .map(|a| {
+                let e = match (p.analytic.get(&a.check.quantity), p.simulated.get(&a.check.quantity)) {
+                    (Some(x), Some(y)) => error(a.check.kind, *x, *y, self.length_scale).1,
+                    _ => f64::INFINITY,
+                };
+                (&a.check, e)
+            })
+            .collect()
     }
 
     pub fn reports(&self) -> Vec<CheckReport> {
@@ -120,7 +126,7 @@ impl Compare {
 }
 
 impl Observer for Compare {
-    fn tick(&mut self, t: &Tick) {
+    fn tick(&mut self, t: &Tick, _notes: &mut Vec<Note>) {
         for a in &mut self.acc {
             if let (Some(&x), Some(&y)) =
                 (t.prediction.expected.get(&a.check.quantity), t.simulated.get(&a.check.quantity))
@@ -131,5 +137,32 @@ impl Observer for Compare {
                 a.ticks += 1;
             }
         }
+    }
+
+    /// Outside the analytic model's validity (a cable it predicts slack) the point is counted
+    /// but not compared; elsewhere every check's error is recorded, and the point is within
+    /// tolerance when it settled and every check passes there.
+    fn settle_point(&mut self, p: &SettlePoint, point: &mut PointReport, notes: &mut Vec<Note>) {
+        if p.outside_model {
+            self.acc.iter_mut().for_each(|a| a.outside_points += 1);
+            point.within_tolerance = false;
+            return;
+        }
+        self.record_point(&point.analytic, &point.simulated, point.settled);
+        let errors = self.point_errors(point);
+        if point.settled {
+            for (c, e) in errors.iter().filter(|(c, e)| !(*e <= c.tolerance)) {
+                notes.push(Note::Event(format!(
+                    "point {}: check {} failed: error {e:.3e} > tolerance {:.1e}",
+                    point.index, c.quantity, c.tolerance
+                )));
+            }
+        }
+        let within = point.settled && errors.iter().all(|(c, e)| *e <= c.tolerance);
+        point.within_tolerance = within;
+    }
+
+    fn finish(&mut self, report: &mut ScenarioReport) {
+        report.checks = self.reports();
     }
 }

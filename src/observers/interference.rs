@@ -8,8 +8,9 @@
 //! Pairs that meet at a joint (a shared node, or endpoints that coincide in the initial
 //! configuration) always touch there and are excluded, as are pairs the scenario lists.
 
-use super::{Observer, Tick};
-use crate::report::{InterferenceReport, InterferenceViolation, PairClearanceReport};
+use super::{Note, Observer, SettlePoint, Tick};
+use crate::report::{InterferenceReport, InterferenceViolation, PairClearanceReport, PointReport, ScenarioReport};
+use crate::settings::InterferenceSettings;
 use crate::structure::Structure;
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector;
@@ -17,18 +18,8 @@ use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use parry3d_f64::query::details::closest_points_segment_segment_with_locations_nD;
 use std::collections::BTreeMap;
 
-/// Settings from the scenario's `[interference]` section.
-#[derive(Clone, Debug, PartialEq)]
-pub struct InterferenceSettings {
-    /// A pair whose clearance falls below this is a violation [m] (0: only actual overlap).
-    pub threshold_m: f64,
-    /// Pairs farther apart than this are not measured [m] (the broad phase's inflation).
-    pub margin_m: f64,
-    /// Violations are reported but do not fail the run.
-    pub informative: bool,
-    /// Further pairs to exclude, by strut name.
-    pub exclude: Vec<(String, String)>,
-}
+/// The time series of the smallest clearance at each tick (in the recording).
+const MIN_CLEARANCE_SERIES: &str = "interference/min_clearance_m";
 
 /// Endpoints closer than this fraction of the structure's size count as the same joint.
 const COINCIDENT_FRACTION: f64 = 1e-9;
@@ -107,10 +98,6 @@ pub struct Interference {
     pairs_checked: usize,
     stats: BTreeMap<(usize, usize), PairStats>,
     ticks: u64,
-    /// Smallest clearance at the last tick [m] (None: no pair within the margin).
-    pub last_min_clearance_m: Option<f64>,
-    /// Violations that began at the last tick: (pair names, clearance).
-    pub new_violations: Vec<(String, String, f64)>,
 }
 
 impl Interference {
@@ -155,8 +142,6 @@ impl Interference {
             pairs_checked,
             stats: BTreeMap::new(),
             ticks: 0,
-            last_min_clearance_m: None,
-            new_violations: Vec::new(),
         })
     }
 
@@ -228,12 +213,13 @@ impl Interference {
 }
 
 impl Observer for Interference {
-    fn tick(&mut self, t: &Tick) {
+    fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>) {
         let tick = t.snapshot.tick;
         self.ticks += 1;
-        self.new_violations.clear();
         let measured = self.measure(t.structure, &t.snapshot.nodes);
-        self.last_min_clearance_m = measured.iter().map(|p| p.clearance_m).reduce(f64::min);
+        if let Some(c) = measured.iter().map(|p| p.clearance_m).reduce(f64::min) {
+            notes.push(Note::Scalar(MIN_CLEARANCE_SERIES, c));
+        }
         let threshold = self.settings.threshold_m;
         let mut below = std::collections::BTreeSet::new();
         for p in &measured {
@@ -257,7 +243,10 @@ impl Observer for Interference {
                     None => {
                         st.open = Some((tick, tick));
                         st.open_min = (f64::INFINITY, tick, p.points);
-                        self.new_violations.push((self.names[p.i].clone(), self.names[p.j].clone(), p.clearance_m));
+                        notes.push(Note::Event(format!(
+                            "interference: {} / {} clearance {:.3e} m",
+                            self.names[p.i], self.names[p.j], p.clearance_m
+                        )));
                     }
                 }
                 if p.clearance_m < st.open_min.0 {
@@ -276,5 +265,16 @@ impl Observer for Interference {
             st.violations.push(v);
             st.open = None;
         }
+    }
+
+    /// The smallest clearance at the settled state, and whether it stays above the threshold.
+    fn settle_point(&mut self, p: &SettlePoint, point: &mut PointReport, _notes: &mut Vec<Note>) {
+        let c = self.measure(p.structure, &p.snapshot.nodes).iter().map(|m| m.clearance_m).reduce(f64::min);
+        point.min_clearance_m = c;
+        point.interference_free = Some(c.is_none_or(|c| c >= self.settings.threshold_m));
+    }
+
+    fn finish(&mut self, report: &mut ScenarioReport) {
+        report.interference = Some(self.report());
     }
 }

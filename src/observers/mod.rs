@@ -1,6 +1,10 @@
-//! Observers, each fed one snapshot per tick: `compare` (analytic versus simulated), `slack`
-//! (cable slackness intervals), `interference` (parry distances between struts) and `record`
-//! (rerun).
+//! Observers watch a run: each is fed one snapshot per tick and each settle point, and puts
+//! what it gathered into the report at the end. They are held as one list ([`observers`]):
+//! `compare` (analytic versus simulated), `slack` (cable slackness intervals), `interference`
+//! (parry distances between struts) and `record` (rerun).
+//!
+//! Adding an observer: its own file here implementing [`Observer`], and one line in
+//! [`observers`].
 
 pub mod compare;
 pub mod interference;
@@ -8,7 +12,9 @@ pub mod record;
 pub mod slack;
 
 use crate::mechanisms::{Prediction, Values};
-use crate::sim::Snapshot;
+use crate::report::{PointReport, ScenarioReport};
+use crate::settings::{Check, InterferenceSettings};
+use crate::snapshot::{Residual, Snapshot};
 use crate::structure::Structure;
 
 /// What every observer sees at a tick.
@@ -18,13 +24,76 @@ pub struct Tick<'a> {
     pub inputs: &'a Values,
     pub prediction: &'a Prediction,
     pub simulated: &'a Values,
-    /// Analytic node positions for the ghost overlay, when the mechanism gives them.
+    /// Analytic node positions for the ghost overlay (only for observers that record).
     pub ghost_nodes: Option<&'a [[f64; 3]]>,
 }
 
-/// Something that watches a run tick by tick.
+/// What the observers see of a settle point besides its report (which holds the inputs, the
+/// analytic and simulated values and whether it settled).
+pub struct SettlePoint<'a> {
+    pub structure: &'a Structure,
+    /// The settled state (or the last one, when the settle ran out of time).
+    pub snapshot: &'a Snapshot,
+    /// The analytic model does not apply here (it predicts a slack cable): nothing to compare.
+    pub outside_model: bool,
+}
+
+/// Something an observer or the run tells the others at a tick (the recorder writes it down).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Note {
+    /// A line of the event log.
+    Event(String),
+    /// One value of a named time series.
+    Scalar(&'static str, f64),
+}
+
+/// Something that watches a run.
 pub trait Observer {
-    fn tick(&mut self, t: &Tick);
-    /// A text event (settled, perturbed, check failed...).
-    fn event(&mut self, _tick: u64, _text: &str) {}
+    /// After every step; what the observer has to tell the others goes into `notes`.
+    fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>);
+    /// Whether this observer writes the run down (it then gets the events, the residuals and
+    /// the analytic ghost nodes, which cost something to make).
+    fn records(&self) -> bool {
+        false
+    }
+    /// A note of the run or of another observer at `tick`.
+    fn note(&mut self, _tick: u64, _note: &Note) {}
+    /// The equilibrium residual computed after `tick` (the settle loop computes it only once
+    /// the motion has stopped).
+    fn residual(&mut self, _tick: u64, _r: &Residual) {}
+    /// A settle point: fill in what this observer measures there (`point` has the rest).
+    fn settle_point(&mut self, _p: &SettlePoint, _point: &mut PointReport, _notes: &mut Vec<Note>) {}
+    /// The run is over: put what was gathered into the report.
+    fn finish(&mut self, _report: &mut ScenarioReport) {}
+    /// The verdict is in (`report` is final): write what carries it. An error fails the run.
+    fn close(&mut self, _tick: u64, _report: &ScenarioReport) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// What the observers of a run are made from.
+pub struct Setup<'a> {
+    pub structure: &'a Structure,
+    pub checks: &'a [Check],
+    /// The mechanism's length scale [m], for normalised errors.
+    pub length_scale_m: f64,
+    pub interference: Option<&'a InterferenceSettings>,
+    /// A recording, when the run writes one (made last: nothing is written when another
+    /// observer cannot start).
+    pub recording: Option<record::Recording<'a>>,
+}
+
+/// Every observer of a run, in the order they see each tick.
+pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
+    let mut list: Vec<Box<dyn Observer>> =
+        vec![Box::new(compare::Compare::new(setup.checks, setup.length_scale_m)), Box::new(slack::SlackTracker::new())];
+    if let Some(settings) = setup.interference {
+        list.push(Box::new(interference::Interference::new(setup.structure, settings)?));
+    }
+    if let Some(r) = &setup.recording {
+        if let Some(recorder) = record::Recorder::start(r)? {
+            list.push(Box::new(recorder));
+        }
+    }
+    Ok(list)
 }

@@ -14,8 +14,9 @@
 //! The file is written to `<path>.partial` and renamed when the run ends, so a reader never
 //! sees a half-written recording under the final name.
 
-use super::{Observer, Tick};
+use super::{Note, Observer, Tick};
 use crate::mechanisms::wrap_angle;
+use crate::report::ScenarioReport;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
@@ -23,6 +24,27 @@ pub enum RecordError {
     #[error("cannot record to {path}: {message}")]
     Io { path: String, message: String },
 }
+
+/// Where a recording goes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RecordTarget {
+    /// An `.rrd` file, written to `<path>.partial` and renamed when complete.
+    File(PathBuf),
+    /// A live rerun viewer or server at this address ("" for rerun's default).
+    Live(String),
+}
+
+/// A run's recording: where, how often, and the scenario text stored with it.
+pub struct Recording<'a> {
+    pub target: RecordTarget,
+    /// Every N-th tick is recorded (events always).
+    pub every: u64,
+    /// The scenario file's text, stored as a document.
+    pub scenario: &'a str,
+}
+
+/// The application name recordings carry.
+const APP: &str = "tensegrity-testbed";
 
 pub struct Recorder {
     rec: rerun::RecordingStream,
@@ -291,6 +313,20 @@ fn force_colour(force: f64, max_abs: f64) -> [u8; 4] {
 }
 
 impl Recorder {
+    /// Starts the recording `r` with the scenario stored in it (None: a live viewer that
+    /// nobody runs).
+    pub fn start(r: &Recording) -> Result<Option<Self>, String> {
+        let recorder = match &r.target {
+            RecordTarget::File(path) => Recorder::create(path, APP, r.every).map(Some),
+            RecordTarget::Live(url) => Recorder::connect(url, APP, r.every),
+        };
+        let mut recorder = recorder.map_err(|e| e.to_string())?;
+        if let Some(rec) = recorder.as_mut() {
+            rec.document("scenario", r.scenario);
+        }
+        Ok(recorder)
+    }
+
     /// Starts a recording that will be renamed to `path` by [`Recorder::finish`].
     pub fn create(path: &Path, app: &'static str, every: u64) -> Result<Self, RecordError> {
         let io = |e: String| RecordError::Io { path: path.display().to_string(), message: e };
@@ -337,16 +373,6 @@ impl Recorder {
             .connect_grpc_opts(url.clone())
             .map_err(|e| RecordError::Io { path: url.clone(), message: e.to_string() })?;
         Ok(Some(Recorder::new(rec, Target::Live { url }, every)))
-    }
-
-    /// Buffers the equilibrium residual of `tick`, computed after the tick was recorded (the
-    /// settle loop computes it only once the motion has stopped).
-    pub fn residual(&mut self, tick: u64, r: &crate::sim::Residual) {
-        if tick % self.every != 0 {
-            return;
-        }
-        let time_s = self.last_time_s;
-        self.columns.residual.push_values(tick, time_s, [r.max_force_n, r.max_torque_nm]);
     }
 
     /// Stores a text document (static: it belongs to the whole run).
@@ -433,21 +459,20 @@ impl Recorder {
     }
 
     /// Flushes and moves the recording to its final name (a live stream: waits a moment for
-    /// the viewer, and says once if none took the data).
-    pub fn finish(mut self) -> Result<Option<PathBuf>, RecordError> {
+    /// the viewer, and says once if none took the data). The recorder records nothing after.
+    pub fn finish(&mut self) -> Result<Option<PathBuf>, RecordError> {
         self.send();
-        match self.target {
+        let rec = std::mem::replace(&mut self.rec, rerun::RecordingStream::disabled());
+        match &self.target {
             Target::File { partial, path } => {
-                self.rec
-                    .flush_blocking()
-                    .map_err(|e| RecordError::Io { path: path.display().to_string(), message: e.to_string() })?;
-                drop(self.rec);
-                std::fs::rename(&partial, &path)
-                    .map_err(|e| RecordError::Io { path: path.display().to_string(), message: e.to_string() })?;
-                Ok(Some(path))
+                let io = |e: String| RecordError::Io { path: path.display().to_string(), message: e };
+                rec.flush_blocking().map_err(|e| io(e.to_string()))?;
+                drop(rec);
+                std::fs::rename(partial, path).map_err(|e| io(e.to_string()))?;
+                Ok(Some(path.clone()))
             }
             Target::Live { url } => {
-                if self.rec.flush_with_timeout(std::time::Duration::from_secs_f64(LIVE_FLUSH_TIMEOUT_S)).is_err() {
+                if rec.flush_with_timeout(std::time::Duration::from_secs_f64(LIVE_FLUSH_TIMEOUT_S)).is_err() {
                     eprintln!("note: no rerun viewer took the live stream at {url}; the run went on without it");
                 }
                 Ok(None)
@@ -460,7 +485,7 @@ impl Recorder {
 const LOG10_FLOOR: f64 = 1e-20;
 
 impl Observer for Recorder {
-    fn tick(&mut self, t: &Tick) {
+    fn tick(&mut self, t: &Tick, _notes: &mut Vec<Note>) {
         let snap = t.snapshot;
         self.last_tick = snap.tick;
         self.last_time_s = snap.time_s;
@@ -525,11 +550,36 @@ impl Observer for Recorder {
         }
     }
 
+    fn records(&self) -> bool {
+        true
+    }
+
     /// Buffers an event (every one, whatever `record_every`) at `tick`: the last tick seen, or
-    /// the start.
-    fn event(&mut self, tick: u64, text: &str) {
-        let time_s = if tick == self.last_tick { self.last_time_s } else { 0.0 };
-        self.columns.events.push_text(tick, time_s, text);
+    /// the start; or one value of a named series.
+    fn note(&mut self, tick: u64, note: &Note) {
+        match note {
+            Note::Event(text) => {
+                let time_s = if tick == self.last_tick { self.last_time_s } else { 0.0 };
+                self.columns.events.push_text(tick, time_s, text);
+            }
+            Note::Scalar(entity, value) => self.scalar(tick, entity, *value),
+        }
+    }
+
+    /// Buffers the equilibrium residual of `tick`, computed after the tick was recorded.
+    fn residual(&mut self, tick: u64, r: &crate::snapshot::Residual) {
+        if tick % self.every != 0 {
+            return;
+        }
+        let time_s = self.last_time_s;
+        self.columns.residual.push_values(tick, time_s, [r.max_force_n, r.max_torque_nm]);
+    }
+
+    /// Stores the final report, the verdict as the last event, and writes the file.
+    fn close(&mut self, tick: u64, report: &ScenarioReport) -> Result<(), String> {
+        self.document("report", &serde_json::to_string_pretty(report).unwrap_or_default());
+        self.note(tick, &Note::Event(if report.passed { "run passed" } else { "run FAILED" }.into()));
+        self.finish().map(|_| ()).map_err(|e| e.to_string())
     }
 }
 

@@ -1,8 +1,8 @@
 //! Cable slackness, tick by tick: the intervals of ticks in which each cable carried no
 //! tension.
 
-use super::{Observer, Tick};
-use crate::report::SlackInterval;
+use super::{Note, Observer, Tick};
+use crate::report::{ScenarioReport, SlackInterval};
 
 #[derive(Default)]
 pub struct SlackTracker {
@@ -10,8 +10,6 @@ pub struct SlackTracker {
     open: Vec<Option<(u64, u64)>>,
     names: Vec<String>,
     closed: Vec<SlackInterval>,
-    /// Cables whose state changed at the last tick: (name, now slack).
-    pub changes: Vec<(String, bool)>,
 }
 
 impl SlackTracker {
@@ -33,20 +31,19 @@ impl SlackTracker {
 }
 
 impl Observer for SlackTracker {
-    fn tick(&mut self, t: &Tick) {
+    fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>) {
         let slack = &t.snapshot.forces.cable_slack;
         if self.open.len() != slack.len() {
             self.open = vec![None; slack.len()];
             self.names = t.structure.cables.iter().map(|c| c.name.clone()).collect();
         }
-        self.changes.clear();
         let tick = t.snapshot.tick;
         for (c, &is_slack) in slack.iter().enumerate() {
             match (&mut self.open[c], is_slack) {
                 (Some(iv), true) => iv.1 = tick,
                 (None, true) => {
                     self.open[c] = Some((tick, tick));
-                    self.changes.push((self.names[c].clone(), true));
+                    notes.push(Note::Event(format!("cable {} went slack", self.names[c])));
                 }
                 (Some((first, last)), false) => {
                     self.closed.push(SlackInterval {
@@ -55,10 +52,14 @@ impl Observer for SlackTracker {
                         last_tick: *last,
                     });
                     self.open[c] = None;
-                    self.changes.push((self.names[c].clone(), false));
+                    notes.push(Note::Event(format!("cable {} went taut", self.names[c])));
                 }
                 (None, false) => {}
             }
         }
+    }
+
+    fn finish(&mut self, report: &mut ScenarioReport) {
+        report.slack_intervals = self.intervals();
     }
 }

@@ -1,40 +1,9 @@
 //! Member forces: applying the explicit ones every step, reading all of them back, and the
 //! equilibrium residual computed from them independently of the solver.
 
-use super::Simulation;
+use super::{MemberForces, Residual, Simulation};
 use crate::structure::{ActuatorTarget, CableLaw, JointKind};
 use rapier3d_f64::prelude::*;
-
-/// Forces in every member at one instant. Tension is positive.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct MemberForces {
-    /// Spring force k (l - l0) [N], in structure order.
-    pub spring_force_n: Vec<f64>,
-    pub spring_length_m: Vec<f64>,
-    /// Cable tension [N] (0 when slack).
-    pub cable_tension_n: Vec<f64>,
-    pub cable_length_m: Vec<f64>,
-    /// Unstretched (commanded) cable length [m].
-    pub cable_rest_length_m: Vec<f64>,
-    pub cable_slack: Vec<bool>,
-    /// Force [N] or torque [N m] each actuator exerts along its joint axis (or the cable
-    /// tension for a winch), in actuator order.
-    pub actuator_force: Vec<f64>,
-    /// None when the snapshot was taken without it (see [`Simulation::member_forces_with`]).
-    pub residual: Option<Residual>,
-}
-
-/// Equilibrium residual: the generalized forces of member forces, gravity and probe loads on
-/// every free coordinate (a joint's free axes, summed over the subtree it carries). Zero at an
-/// exact equilibrium. Computed from the force laws, not from the solver; the reactions of
-/// loop-closing joints, which no force law gives, are fitted by least squares.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Residual {
-    /// Largest residual force on a translational coordinate [N].
-    pub max_force_n: f64,
-    /// Largest residual torque on a rotational coordinate [N m].
-    pub max_torque_nm: f64,
-}
 
 type Wrench = (Vector, Vector); // (force, moment about the world origin)
 

@@ -21,64 +21,13 @@ mod forces;
 mod least_squares;
 mod projection;
 mod restart;
-pub mod settle;
 
 use crate::structure::{ActuatorTarget, BodyKind, Structure};
 use rapier3d_f64::prelude::*;
 
+use crate::settings::{SimSettings, DEFAULT_JOINT_GAP_FRACTION};
+use crate::snapshot::{BodyPose, MemberForces, Residual, Snapshot};
 pub use build::structure_size;
-pub use forces::{MemberForces, Residual};
-
-/// Numerical settings of the integrator, all from the scenario file.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SimSettings {
-    /// Time step [s].
-    pub dt_s: f64,
-    /// rapier substeps per step (`num_solver_iterations`).
-    pub substeps: usize,
-    /// rapier PGS iterations per substep (`num_internal_pgs_iterations`).
-    pub pgs_iterations: usize,
-    /// PGS iterations while a settle approaches its equilibrium (cheaper, with a larger
-    /// impulse-joint offset); the last phase runs at `pgs_iterations`. None: one phase.
-    pub approach_pgs_iterations: Option<usize>,
-    /// The Newton damping schedule (`damping.rs`): before every step each damped revolute or
-    /// prismatic joint's velocity is quenched and its damping set so that the step is a Newton
-    /// step on its tangent stiffness (a settling strategy).
-    pub newton_damping: bool,
-    /// Half-size of the box that every node must stay inside, else the run diverged [m].
-    pub bounding_box_m: f64,
-    /// Linear and angular damping of free bodies [1/s] (applied after each step; it slows
-    /// motion but does not move the equilibrium).
-    pub body_damping_per_s: f64,
-    /// Kinetic energy above which the run has diverged [J].
-    pub max_kinetic_energy_j: f64,
-    /// Separation of a loop-closing joint's anchors above which the run has diverged [m]
-    /// (None: 1 % of the structure's size).
-    pub max_joint_gap_m: Option<f64>,
-}
-
-/// Default kinetic-energy limit [J]: far above anything a settling mechanism of this testbed
-/// holds (a few J), far below what a numerical blow-up reaches within a few ticks.
-pub const DEFAULT_MAX_KINETIC_ENERGY_J: f64 = 1e6;
-
-/// Default limit of a loop-closing joint's anchor gap, as a fraction of the structure's size.
-pub const DEFAULT_JOINT_GAP_FRACTION: f64 = 1e-2;
-
-impl Default for SimSettings {
-    fn default() -> Self {
-        SimSettings {
-            dt_s: 0.01,
-            substeps: 1,
-            pgs_iterations: 8,
-            approach_pgs_iterations: None,
-            newton_damping: false,
-            bounding_box_m: 1e3,
-            body_damping_per_s: 0.0,
-            max_kinetic_energy_j: DEFAULT_MAX_KINETIC_ENERGY_J,
-            max_joint_gap_m: None,
-        }
-    }
-}
 
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum SimError {
@@ -141,28 +90,6 @@ pub struct Simulation {
     tick: u64,
     /// Characteristic length of the structure [m], for speeds and tolerances.
     pub length_scale_m: f64,
-}
-
-/// Pose of a body as translation and rotation (unit quaternion `[x, y, z, w]`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BodyPose {
-    pub translation: [f64; 3],
-    pub rotation_xyzw: [f64; 4],
-}
-
-/// One tick's state, handed to every observer.
-#[derive(Clone, Debug)]
-pub struct Snapshot {
-    pub tick: u64,
-    pub time_s: f64,
-    /// World position of every node, in structure order [m].
-    pub nodes: Vec<[f64; 3]>,
-    pub body_poses: Vec<BodyPose>,
-    pub forces: MemberForces,
-    /// Actuator commands, in structure order (m or rad).
-    pub actuator_values: Vec<f64>,
-    /// Kinetic energy of the free bodies [J].
-    pub kinetic_energy_j: f64,
 }
 
 impl Simulation {

@@ -7,7 +7,7 @@ use super::{
     input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind,
     QuantitySpec, QuerySpec, Solution, StiffnessProbe, Values,
 };
-use crate::sim::Snapshot;
+use crate::snapshot::Snapshot;
 use crate::structure::Structure;
 use analytic::Params;
 

@@ -8,7 +8,7 @@ use super::{
     input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind,
     QuantitySpec, QuerySpec, Solution, Values,
 };
-use crate::sim::Snapshot;
+use crate::snapshot::Snapshot;
 use crate::structure::Structure;
 use analytic::Params;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};

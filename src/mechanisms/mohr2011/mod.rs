@@ -7,7 +7,7 @@ use super::{
     input, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec,
     QuerySpec, Solution, Values,
 };
-use crate::sim::Snapshot;
+use crate::snapshot::Snapshot;
 use crate::structure::Structure;
 use analytic::Params;
 use nalgebra::Vector3;

@@ -1,0 +1,263 @@
+//! Running one scenario: scenario -> model -> simulation -> observers -> report.
+//!
+//! `runner.rs` holds the running state and the one step every phase goes through,
+//! `settle.rs` the settle loop, `point.rs` one settle point (branch, stability, probe,
+//! read-out) and `verdict.rs` the pass policy.
+
+mod point;
+mod runner;
+mod settle;
+pub mod verdict;
+
+use crate::mechanisms::{Mechanism, Values};
+use crate::observers::record::{RecordTarget, Recording};
+use crate::observers::{self, Setup};
+use crate::report::{ProbeReport, ScenarioReport, SettleSummary, WorkspaceAgreement};
+use crate::scenario::{Actuation, Scenario};
+use crate::sim::{SimError, Simulation};
+use runner::Runner;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+pub use point::NO_BRANCH;
+pub use settle::SettleDetector;
+
+/// How a run is observed beyond the comparison.
+#[derive(Default)]
+pub struct RunOptions<'a> {
+    /// Record to this `.rrd` file (overrides the scenario's `[record]`).
+    pub record: Option<PathBuf>,
+    /// Set from a signal handler: the run stops at the next tick and reports what it has.
+    pub cancel: Option<&'a AtomicBool>,
+    /// Stream live to a rerun viewer at this address ("" for rerun's default) instead of a file.
+    pub connect: Option<String>,
+    /// Record every N-th tick only (0 or 1: every tick).
+    pub record_every: u64,
+    /// Leave the findings out of the report (a sweep's blocks: the summary has none).
+    pub skip_findings: bool,
+}
+
+#[derive(Debug, thiserror::Error)]
+enum Stop {
+    #[error("{0}")]
+    Sim(#[from] SimError),
+    #[error("interrupted at tick {0}")]
+    Interrupted(u64),
+    #[error("{0}")]
+    Model(String),
+}
+
+/// The report of a scenario whose run panicked: failed, with the panic's message.
+pub fn panicked(sc: &Scenario, payload: &(dyn std::any::Any + Send)) -> ScenarioReport {
+    let msg = payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into());
+    let mut report = ScenarioReport { error: Some(format!("panicked: {msg}")), ..empty_report(sc) };
+    verdict::conclude(&mut report, sc);
+    report
+}
+
+/// The report of `sc` before anything has run: not passed, no points, no findings.
+fn empty_report(sc: &Scenario) -> ScenarioReport {
+    ScenarioReport {
+        name: sc.name.clone(),
+        file: sc.file.display().to_string(),
+        mechanism: sc.mechanism.clone(),
+        passed: false,
+        failures: vec![],
+        expect: sc.expect.clone(),
+        as_expected: None,
+        params: sc.params.clone(),
+        settle: SettleSummary::default(),
+        checks: vec![],
+        points: vec![],
+        stiffness_probe: None,
+        slack_intervals: vec![],
+        workspace: None,
+        skipped_points: sc.skipped_points.len(),
+        interference: None,
+        findings: vec![],
+        trajectory_ranges: Default::default(),
+        error: None,
+    }
+}
+
+/// Test hook: a run of the scenario named by this variable panics (to test that a panic in one
+/// scenario of a batch fails that scenario and the batch goes on).
+pub const INJECT_PANIC_VAR: &str = "TENSEGRITY_INJECT_PANIC";
+
+/// Runs a validated scenario. Bad model input found late (for example a structure the
+/// simulator cannot build) is reported in `error` with `passed = false`.
+pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
+    if std::env::var(INJECT_PANIC_VAR).is_ok_and(|n| n == sc.name) {
+        panic!("injected by {INJECT_PANIC_VAR} (test hook)");
+    }
+    let mech = sc.mechanism();
+    let mut report = ScenarioReport {
+        findings: if opts.skip_findings {
+            Vec::new()
+        } else {
+            mech.findings(&sc.params).into_iter().map(Into::into).collect()
+        },
+        ..empty_report(sc)
+    };
+    // Wall time counts the simulation, not the findings computed above.
+    let wall = Instant::now();
+    let mut runner = match start(mech, sc, opts) {
+        Ok(r) => r,
+        Err(e) => {
+            report.error = Some(e);
+            verdict::conclude(&mut report, sc);
+            return report;
+        }
+    };
+    let mut probe_errors: Vec<f64> = Vec::new();
+    if let Err(e) = run_actuation(&mut runner, sc, &mut report, &mut probe_errors) {
+        report.error = Some(e.to_string());
+        runner.emit(format_args!("run stopped: {e}"));
+    }
+    finish(&mut runner, &mut report, &probe_errors, wall);
+    report
+}
+
+/// The simulation at the first point, and the observers of the run.
+fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) -> Result<Runner<'a>, String> {
+    let first_inputs = match &sc.actuation {
+        Actuation::Points { points, .. } => points[0].clone(),
+        Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
+    };
+    let structure = mech.build(&sc.params, &first_inputs, &sc.start)?;
+    let mut sim = Simulation::new(&structure, &sc.sim).map_err(|e| e.to_string())?;
+    // The first point's commands (a no-op where the build already placed them).
+    sim.set_commands(&mech.commands(&sc.params, &first_inputs));
+    let target = match (&opts.connect, opts.record.clone().or_else(|| sc.record.clone())) {
+        (Some(url), _) => Some(RecordTarget::Live(url.clone())),
+        (None, Some(path)) => Some(RecordTarget::File(path)),
+        (None, None) => None,
+    };
+    let observers = observers::observers(Setup {
+        structure: &sim.structure,
+        checks: &sc.checks,
+        length_scale_m: mech.length_scale(&sc.params),
+        interference: sc.interference.as_ref(),
+        recording: target.map(|target| Recording { target, every: opts.record_every.max(1), scenario: &sc.source }),
+    })?;
+    Ok(Runner::new(mech, sc, sim, observers, opts.cancel))
+}
+
+/// The report's summaries and verdict once the run is over; then the observers write what
+/// carries the verdict (a recording that cannot be written fails the run).
+fn finish(runner: &mut Runner, report: &mut ScenarioReport, probe_errors: &[f64], wall: Instant) {
+    let sc = runner.sc;
+    for o in &mut runner.observers {
+        o.finish(report);
+    }
+    report.workspace = WorkspaceAgreement::from_points(&report.points).map(|mut w| {
+        w.min_agreement_percent = sc.min_agreement_percent;
+        w
+    });
+    report.settle = SettleSummary {
+        settled: !report.points.is_empty() && report.points.iter().all(|p| p.settled),
+        steps: runner.steps,
+        sim_time_s: runner.sim.time_s(),
+        wall_s: wall.elapsed().as_secs_f64(),
+    };
+    if let Some(p) = &sc.probe {
+        let max = probe_errors.iter().copied().fold(0.0, f64::max);
+        let complete = !probe_errors.is_empty() && probe_errors.len() == report.points.len();
+        report.stiffness_probe = Some(ProbeReport {
+            torque_nm: p.torque_nm,
+            tolerance: p.tolerance,
+            max_rel_error: if complete { max } else { f64::INFINITY },
+            passed: complete && max <= p.tolerance,
+        });
+    }
+    verdict::conclude(report, sc);
+    let tick = runner.sim.tick();
+    let mut failed = None;
+    for o in &mut runner.observers {
+        if let Err(e) = o.close(tick, report) {
+            failed.get_or_insert(e);
+        }
+    }
+    if let Some(e) = failed {
+        report.error.get_or_insert(e);
+        verdict::conclude(report, sc);
+    }
+}
+
+/// Settles every point in turn, or follows the waypoints tick by tick and settles at the last.
+fn run_actuation(
+    runner: &mut Runner,
+    sc: &Scenario,
+    report: &mut ScenarioReport,
+    probe_errors: &mut Vec<f64>,
+) -> Result<(), Stop> {
+    match &sc.actuation {
+        Actuation::Points { points, continuation } => {
+            for (i, inputs) in points.iter().enumerate() {
+                if i > 0 {
+                    if *continuation {
+                        let cmds = runner.mech.commands(&sc.params, inputs);
+                        runner.sim.set_commands(&cmds);
+                    } else {
+                        let s = runner.mech.build(&sc.params, inputs, &sc.start).map_err(Stop::Model)?;
+                        // The same structure placed anew: restarted in place where it can be
+                        // (no rebuild of the rapier sets), else built afresh.
+                        if !runner.sim.restart_from(&s) {
+                            let tick = runner.sim.tick();
+                            runner.sim = Simulation::new(&s, &sc.sim)?;
+                            runner.sim.set_tick(tick);
+                        }
+                    }
+                    runner.emit(format_args!("point {i}: inputs {inputs:?}"));
+                }
+                point::settle_point(runner, sc, i, inputs, report, probe_errors)?;
+            }
+        }
+        Actuation::Schedule { waypoints } => {
+            let end = waypoints.last().unwrap().0;
+            let dt = sc.sim.dt_s;
+            loop {
+                let t = runner.sim.time_s() + dt;
+                if t > end + 0.5 * dt {
+                    break;
+                }
+                let inputs = interpolate(waypoints, t);
+                let cmds = runner.mech.commands(&sc.params, &inputs);
+                runner.sim.set_commands(&cmds);
+                let prediction = runner.mech.predict(&sc.params, &inputs).map_err(Stop::Model)?;
+                let (_, simulated) = runner.step(&inputs, &prediction)?;
+                for (q, v) in simulated {
+                    report
+                        .trajectory_ranges
+                        .entry(q)
+                        .and_modify(|r| r.include(v))
+                        .or_insert_with(|| crate::report::QuantityRange::of(v));
+                }
+            }
+            let inputs = waypoints.last().unwrap().1.clone();
+            runner.emit("schedule done: settling at the last waypoint");
+            point::settle_point(runner, sc, 0, &inputs, report, probe_errors)?;
+        }
+    }
+    Ok(())
+}
+
+/// Linear interpolation of the waypoints at time `t`, held at the last.
+pub fn interpolate(waypoints: &[(f64, Values)], t: f64) -> Values {
+    if t <= waypoints[0].0 {
+        return waypoints[0].1.clone();
+    }
+    for w in waypoints.windows(2) {
+        let ((t0, a), (t1, b)) = (&w[0], &w[1]);
+        if t <= *t1 {
+            let s = (t - t0) / (t1 - t0);
+            return a.iter().map(|(k, x)| (k.clone(), x + (b[k] - x) * s)).collect();
+        }
+    }
+    waypoints.last().unwrap().1.clone()
+}

@@ -1,0 +1,235 @@
+//! One settle point: settle, say which analytic branch the state lies on, test its stability by
+//! perturbation, probe its stiffness, and read it out into a [`PointReport`] with the
+//! observers.
+
+use super::runner::Runner;
+use super::Stop;
+use crate::mechanisms::{self, Mechanism, Prediction, Values};
+use crate::observers::compare;
+use crate::observers::SettlePoint;
+use crate::report::{PointReport, ScenarioReport};
+use crate::scenario::Scenario;
+use crate::snapshot::Snapshot;
+
+impl Runner<'_> {
+    /// Perturbs every free coordinate and settles again: stable if it comes back.
+    fn classify(
+        &mut self,
+        inputs: &Values,
+        prediction: &Prediction,
+        before: &Snapshot,
+        delta: f64,
+    ) -> Result<bool, Stop> {
+        self.sim.perturb_free_coordinates(delta);
+        self.emit(format_args!("perturbed every free coordinate by {delta}"));
+        let after = self.settle(inputs, prediction)?;
+        let moved = before
+            .nodes
+            .iter()
+            .zip(&after.snapshot.nodes)
+            .map(|(a, b)| crate::structure::distance(*a, *b))
+            .fold(0.0, f64::max);
+        // Back within a small fraction of the perturbation: the same equilibrium.
+        let back = after.settled && moved < RETURN_FRACTION * delta * self.sim.length_scale_m;
+        self.emit(format_args!(
+            "after the perturbation: {} {} steps, largest node displacement from before {moved:.3e} m",
+            if after.settled { "settled in" } else { "did NOT settle in" },
+            after.steps
+        ));
+        Ok(back)
+    }
+
+    /// Stiffness by the probe: +tau and -tau on the probe body, K = 2 tau / (q+ - q-).
+    fn probe(&mut self, inputs: &Values, prediction: &Prediction, torque: f64) -> Result<Option<f64>, Stop> {
+        let Some(spec) = self.mech.stiffness_probe() else {
+            return Ok(None);
+        };
+        let body = self
+            .sim
+            .structure
+            .body_id(&spec.body)
+            .ok_or_else(|| Stop::Model(format!("probe body '{}' not found", spec.body)))?;
+        let axis = spec.torque_axis;
+        let mut q = [0.0; 2];
+        for (i, sign) in [1.0, -1.0].iter().enumerate() {
+            let t = [axis[0] * torque * sign, axis[1] * torque * sign, axis[2] * torque * sign];
+            self.sim.set_probe_load(body, [0.0; 3], t);
+            self.emit(format_args!("stiffness probe: torque {:+e} N m", torque * sign));
+            let s = self.settle(inputs, prediction)?;
+            if !s.settled {
+                self.sim.set_probe_load(body, [0.0; 3], [0.0; 3]);
+                return Ok(None);
+            }
+            q[i] = s.simulated[&spec.coordinate];
+        }
+        self.sim.set_probe_load(body, [0.0; 3], [0.0; 3]);
+        self.settle(inputs, prediction)?;
+        Ok(Some(2.0 * torque / mechanisms::wrap_angle(q[0] - q[1])))
+    }
+}
+
+/// A perturbed equilibrium counts as returned when every node is back within this fraction of
+/// the perturbation (times the structure's length).
+const RETURN_FRACTION: f64 = 1e-2;
+
+/// A settled state lies on an analytic branch when every compared quantity is within this
+/// normalised distance of it (lengths / length scale, angles in rad); farther from every
+/// branch it lies on none of them, whatever the nearest is called.
+const BRANCH_MATCH_DISTANCE: f64 = 1e-3;
+
+/// Which analytic branch a simulated state lies on (nearest in the compared quantities, and
+/// within [`BRANCH_MATCH_DISTANCE`]): its label and analytic stability. A state on none of
+/// them is labelled so, with the nearest named.
+fn branch_of(
+    mech: &dyn Mechanism,
+    sc: &Scenario,
+    prediction: &Prediction,
+    simulated: &Values,
+) -> (String, Option<bool>) {
+    let scale = mech.length_scale(&sc.params);
+    let mut best: Option<(f64, &mechanisms::Solution)> = None;
+    for b in &prediction.branches {
+        let mut d: f64 = 0.0;
+        for q in mech.quantities() {
+            if let (Some(a), Some(s)) = (b.values.get(q.symbol), simulated.get(q.symbol)) {
+                if q.kind != mechanisms::QuantityKind::Magnitude {
+                    d = d.max(compare::error(q.kind, *a, *s, scale).1);
+                }
+            }
+        }
+        if best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, b));
+        }
+    }
+    match best {
+        Some((d, b)) if d <= BRANCH_MATCH_DISTANCE => (b.label.clone(), b.stable),
+        Some((_, b)) => (format!("{NO_BRANCH} (nearest: {})", b.label), None),
+        None => ("unknown".into(), None),
+    }
+}
+
+/// The label of a settled state that lies on none of the analytic branches.
+pub const NO_BRANCH: &str = "none of the analytic branches";
+
+/// Settles the point `index` at `inputs` and adds its report.
+pub(super) fn settle_point(
+    runner: &mut Runner,
+    sc: &Scenario,
+    index: usize,
+    inputs: &Values,
+    report: &mut ScenarioReport,
+    probe_errors: &mut Vec<f64>,
+) -> Result<(), Stop> {
+    let prediction = runner.mech.predict(&sc.params, inputs).map_err(Stop::Model)?;
+    let s = runner.settle(inputs, &prediction)?;
+    let final_energy = runner.sim.kinetic_energy_j();
+    if s.settled {
+        runner.emit(format_args!("point {index} settled after {} steps", s.steps));
+    } else {
+        runner.emit(format_args!(
+            "point {index} did NOT settle in {} s (kinetic energy {final_energy:.3e} J, speed {:.3e} m/s, residual {:.3e} N, {:.3e} N m)",
+            sc.settle.max_time_s,
+            s.final_speed,
+            s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_force_n),
+            s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_torque_nm)
+        ));
+    }
+    let mut simulated = s.simulated.clone();
+    let (branch, analytic_stable) = branch_of(runner.mech.as_ref(), sc, &prediction, &simulated);
+    // The settled state is compared with the branch it landed on; landing on an analytically
+    // unstable branch is a failure unless the scenario deliberately starts there.
+    let landed = prediction
+        .branches
+        .iter()
+        .find(|b| b.label == branch)
+        .map(|b| b.values.clone())
+        .unwrap_or_else(|| prediction.expected.clone());
+    let wanted_unstable = sc.start.get("at_unstable_root").is_some_and(|f| *f != 0.0);
+    if analytic_stable == Some(false) && !wanted_unstable {
+        runner.emit(format_args!("point {index}: landed on the analytically unstable branch '{branch}'"));
+        report.error.get_or_insert(format!("point {index} settled on the analytically unstable branch '{branch}'"));
+    }
+    let stable = match sc.stability_perturbation {
+        Some(d) if s.settled => Some(runner.classify(inputs, &prediction, &s.snapshot, d)?),
+        _ => None,
+    };
+    if let Some(st) = stable {
+        runner.emit(format_args!("point {index}: equilibrium is {}", if st { "stable" } else { "unstable" }));
+    }
+    if let (Some(p), true) = (&sc.probe, s.settled) {
+        if let Some(k) = runner.probe(inputs, &prediction, p.torque_nm)? {
+            simulated.insert("K".into(), k);
+            if let Some(ka) = landed.get("K") {
+                probe_errors.push(((k - ka) / ka).abs());
+            }
+        }
+    }
+    let slack_cables = slack_cables(runner, &s.snapshot);
+    let slack_agrees = prediction.expected_slack.as_ref().map(|e| {
+        let mut e = e.clone();
+        e.sort();
+        let mut got = slack_cables.clone();
+        got.sort();
+        e == got
+    });
+    if slack_agrees == Some(false) {
+        runner.emit(format_args!(
+            "point {index}: slack cables {slack_cables:?} differ from the analytic {:?}",
+            prediction.expected_slack
+        ));
+    }
+    let outside = prediction.expected_slack.as_ref().is_some_and(|e| !e.is_empty());
+    let mut point = PointReport {
+        index,
+        inputs: inputs.clone(),
+        settled: s.settled,
+        steps: s.steps,
+        residual_force_n: s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_force_n),
+        residual_torque_nm: s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_torque_nm),
+        final_speed_m_per_s: s.final_speed,
+        final_kinetic_energy_j: final_energy,
+        branch,
+        stable,
+        analytic_stable,
+        slack_cables,
+        expected_slack: prediction.expected_slack.clone(),
+        slack_agrees,
+        // Outside the analytic model's validity the analytic point is no equilibrium: report
+        // the distance from it instead of checking against it.
+        distance_from_analytic_m: outside.then(|| distance_m(runner.mech.as_ref(), &landed, &simulated)),
+        // Filled in by the observers:
+        within_tolerance: false,
+        min_clearance_m: None,
+        interference_free: None,
+        paper: runner
+            .mech
+            .paper_values(&sc.params, inputs)
+            .map(|(source, values)| crate::report::PaperValues { source, values }),
+        analytic: landed,
+        simulated,
+    };
+    let seen = SettlePoint { structure: &runner.sim.structure, snapshot: &s.snapshot, outside_model: outside };
+    for o in runner.observers.iter_mut() {
+        o.settle_point(&seen, &mut point, &mut runner.notes);
+    }
+    runner.hand_out_notes();
+    report.points.push(point);
+    Ok(())
+}
+
+/// The cables slack in `snap`, by name.
+fn slack_cables(runner: &Runner, snap: &Snapshot) -> Vec<String> {
+    let cables = &runner.sim.structure.cables;
+    cables.iter().zip(&snap.forces.cable_slack).filter(|(_, sl)| **sl).map(|(c, _)| c.name.clone()).collect()
+}
+
+/// Euclidean distance of the simulated lengths from the analytic ones [m].
+fn distance_m(mech: &dyn Mechanism, analytic: &Values, simulated: &Values) -> f64 {
+    mech.quantities()
+        .iter()
+        .filter(|q| q.kind == mechanisms::QuantityKind::Length)
+        .filter_map(|q| Some(simulated.get(q.symbol)? - analytic.get(q.symbol)?))
+        .map(|d| d * d)
+        .sum::<f64>()
+        .sqrt()
+}

@@ -1,0 +1,111 @@
+//! The state of one running scenario: its mechanism, its simulation and its observers, and the
+//! one step that every phase (settle, perturbation, probe, trajectory) goes through.
+
+use super::Stop;
+use crate::mechanisms::{Mechanism, Prediction, Values};
+use crate::observers::{Note, Observer, Tick};
+use crate::scenario::Scenario;
+use crate::sim::Simulation;
+use crate::snapshot::Snapshot;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+pub(super) struct Runner<'a> {
+    pub mech: Box<dyn Mechanism>,
+    pub sc: &'a Scenario,
+    pub sim: Simulation,
+    pub observers: Vec<Box<dyn Observer>>,
+    /// Whether an observer writes the run down: events and ghost nodes are made only then.
+    recording: bool,
+    /// Notes of the observers at the current tick, handed to every observer after it.
+    pub notes: Vec<Note>,
+    cancel: Option<&'a AtomicBool>,
+    /// Steps over the whole run.
+    pub steps: u64,
+    /// The analytic ghost nodes for the last inputs (recordings only).
+    ghost: Option<(Values, Option<Vec<[f64; 3]>>)>,
+}
+
+impl<'a> Runner<'a> {
+    pub fn new(
+        mech: Box<dyn Mechanism>,
+        sc: &'a Scenario,
+        sim: Simulation,
+        observers: Vec<Box<dyn Observer>>,
+        cancel: Option<&'a AtomicBool>,
+    ) -> Self {
+        let recording = observers.iter().any(|o| o.records());
+        Runner { mech, sc, sim, observers, recording, notes: Vec::new(), cancel, steps: 0, ghost: None }
+    }
+
+    /// The mechanism's quantities in a snapshot of this simulation.
+    pub fn observe(&self, snap: &Snapshot) -> Values {
+        self.mech.observe(&self.sc.params, &self.sim.structure, snap)
+    }
+
+    /// Tells every observer an event of the run (formatted only when one records).
+    pub fn emit(&mut self, text: impl std::fmt::Display) {
+        if self.recording {
+            self.notes.push(Note::Event(text.to_string()));
+            self.hand_out_notes();
+        }
+    }
+
+    /// Hands the notes gathered at this tick to every observer.
+    pub fn hand_out_notes(&mut self) {
+        let tick = self.sim.tick();
+        if self.recording {
+            for note in &self.notes {
+                for o in &mut self.observers {
+                    o.note(tick, note);
+                }
+            }
+        }
+        self.notes.clear();
+    }
+
+    /// Computes the equilibrium residual of `snap`, the simulation's current state, where the
+    /// tick left it out, and hands it to the observers.
+    pub fn add_residual(&mut self, snap: &mut Snapshot) {
+        if snap.forces.residual.is_some() {
+            return;
+        }
+        snap.forces = self.sim.member_forces();
+        if let Some(r) = &snap.forces.residual {
+            for o in &mut self.observers {
+                o.residual(snap.tick, r);
+            }
+        }
+    }
+
+    /// One step followed by every observer.
+    pub fn step(&mut self, inputs: &Values, prediction: &Prediction) -> Result<(Snapshot, Values), Stop> {
+        if self.cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
+            return Err(Stop::Interrupted(self.sim.tick()));
+        }
+        self.sim.step()?;
+        self.steps += 1;
+        // The residual (a least-squares fit, the costliest read-out) is left out here: the
+        // settle loop computes it once the motion has stopped, and only those ticks carry it
+        // (into the recording too).
+        let snap = self.sim.snapshot_with(false);
+        let simulated = self.observe(&snap);
+        // The ghost overlay is only drawn in recordings, and only recomputed when the inputs
+        // change.
+        if self.recording && self.ghost.as_ref().is_none_or(|(i, _)| i != inputs) {
+            self.ghost = Some((inputs.clone(), self.mech.analytic_nodes(&self.sc.params, inputs)));
+        }
+        let tick = Tick {
+            structure: &self.sim.structure,
+            snapshot: &snap,
+            inputs,
+            prediction,
+            simulated: &simulated,
+            ghost_nodes: self.ghost.as_ref().and_then(|(_, g)| g.as_deref()),
+        };
+        for o in &mut self.observers {
+            o.tick(&tick, &mut self.notes);
+        }
+        self.hand_out_notes();
+        Ok((snap, simulated))
+    }
+}

@@ -1,0 +1,202 @@
+//! Plain configuration types, read from a scenario file and handed to the simulation and the
+//! observers. Nothing here parses, builds or steps anything: `scenario` fills them in, `sim`
+//! and `observers` read them, and neither needs the other.
+
+use crate::mechanisms::QuantityKind;
+use std::fmt;
+
+/// Numerical settings of the integrator, all from the scenario file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimSettings {
+    /// Time step [s].
+    pub dt_s: f64,
+    /// rapier substeps per step (`num_solver_iterations`).
+    pub substeps: usize,
+    /// rapier PGS iterations per substep (`num_internal_pgs_iterations`).
+    pub pgs_iterations: usize,
+    /// PGS iterations while a settle approaches its equilibrium (cheaper, with a larger
+    /// impulse-joint offset); the last phase runs at `pgs_iterations`. None: one phase.
+    pub approach_pgs_iterations: Option<usize>,
+    /// The Newton damping schedule (`damping.rs`): before every step each damped revolute or
+    /// prismatic joint's velocity is quenched and its damping set so that the step is a Newton
+    /// step on its tangent stiffness (a settling strategy).
+    pub newton_damping: bool,
+    /// Half-size of the box that every node must stay inside, else the run diverged [m].
+    pub bounding_box_m: f64,
+    /// Linear and angular damping of free bodies [1/s] (applied after each step; it slows
+    /// motion but does not move the equilibrium).
+    pub body_damping_per_s: f64,
+    /// Kinetic energy above which the run has diverged [J].
+    pub max_kinetic_energy_j: f64,
+    /// Separation of a loop-closing joint's anchors above which the run has diverged [m]
+    /// (None: 1 % of the structure's size).
+    pub max_joint_gap_m: Option<f64>,
+}
+
+/// Default kinetic-energy limit [J]: far above anything a settling mechanism of this testbed
+/// holds (a few J), far below what a numerical blow-up reaches within a few ticks.
+pub const DEFAULT_MAX_KINETIC_ENERGY_J: f64 = 1e6;
+
+/// Default limit of a loop-closing joint's anchor gap, as a fraction of the structure's size.
+pub const DEFAULT_JOINT_GAP_FRACTION: f64 = 1e-2;
+
+impl Default for SimSettings {
+    fn default() -> Self {
+        SimSettings {
+            dt_s: 0.01,
+            substeps: 1,
+            pgs_iterations: 8,
+            approach_pgs_iterations: None,
+            newton_damping: false,
+            bounding_box_m: 1e3,
+            body_damping_per_s: 0.0,
+            max_kinetic_energy_j: DEFAULT_MAX_KINETIC_ENERGY_J,
+            max_joint_gap_m: None,
+        }
+    }
+}
+
+/// When a run counts as settled. All from the scenario file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SettleCriteria {
+    /// Largest node speed allowed while settled [m/s].
+    pub speed_tol_m_per_s: f64,
+    /// Consecutive steps the speed must stay below the threshold.
+    pub window_steps: u64,
+    /// Largest residual force on a free coordinate [N].
+    pub residual_force_tol_n: f64,
+    /// Largest residual torque on a free coordinate [N m].
+    pub residual_torque_tol_nm: f64,
+    /// Simulated time allowed for one settle [s]; past it the settle fails.
+    pub max_time_s: f64,
+}
+
+impl Default for SettleCriteria {
+    fn default() -> Self {
+        SettleCriteria {
+            speed_tol_m_per_s: 1e-10,
+            window_steps: 10,
+            residual_force_tol_n: 1e-7,
+            residual_torque_tol_nm: 1e-7,
+            max_time_s: 60.0,
+        }
+    }
+}
+
+/// Settings from the scenario's `[interference]` section.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InterferenceSettings {
+    /// A pair whose clearance falls below this is a violation [m] (0: only actual overlap).
+    pub threshold_m: f64,
+    /// Pairs farther apart than this are not measured [m] (the broad phase's inflation).
+    pub margin_m: f64,
+    /// Violations are reported but do not fail the run.
+    pub informative: bool,
+    /// Further pairs to exclude, by strut name.
+    pub exclude: Vec<(String, String)>,
+}
+
+/// One `[[checks]]` entry: a quantity compared with the analytic model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Check {
+    pub quantity: String,
+    pub kind: QuantityKind,
+    pub unit: String,
+    /// On the normalised error (see `QuantityKind`).
+    pub tolerance: f64,
+}
+
+/// The stiffness probe (`[probe]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Probe {
+    pub torque_nm: f64,
+    pub tolerance: f64,
+}
+
+/// One part of a run's verdict that failed.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Failure {
+    /// The run stopped early (divergence, interruption, a model error, a panic, a recording
+    /// that could not be written): `error`.
+    Error,
+    /// A settle point did not settle within `settle.max_time`: `settle`.
+    Settle,
+    /// A `[[checks]]` quantity exceeded its tolerance: `check:QUANTITY`.
+    Check(String),
+    /// The stiffness probe disagreed with the analytic stiffness: `probe`.
+    Probe,
+    /// The perturbation test disagreed with the analytic stability: `stability`.
+    Stability,
+    /// The slack cables differ from the analytic model's: `slack`.
+    Slack,
+    /// Two members came closer than the interference threshold: `interference`.
+    Interference,
+    /// A workspace sweep's agreement fell below `workspace.min_agreement_percent`: `workspace`.
+    Workspace,
+}
+
+/// The names a scenario may give in `[expect] failing` (a check is `check:QUANTITY`).
+pub const FAILURE_NAMES: &[&str] =
+    &["error", "settle", "check:QUANTITY", "probe", "stability", "slack", "interference", "workspace"];
+
+impl fmt::Display for Failure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Failure::Error => f.write_str("error"),
+            Failure::Settle => f.write_str("settle"),
+            Failure::Check(q) => write!(f, "check:{q}"),
+            Failure::Probe => f.write_str("probe"),
+            Failure::Stability => f.write_str("stability"),
+            Failure::Slack => f.write_str("slack"),
+            Failure::Interference => f.write_str("interference"),
+            Failure::Workspace => f.write_str("workspace"),
+        }
+    }
+}
+
+impl std::str::FromStr for Failure {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Ok(match s {
+            "error" => Failure::Error,
+            "settle" => Failure::Settle,
+            "probe" => Failure::Probe,
+            "stability" => Failure::Stability,
+            "slack" => Failure::Slack,
+            "interference" => Failure::Interference,
+            "workspace" => Failure::Workspace,
+            _ => match s.strip_prefix("check:") {
+                Some(q) if !q.is_empty() => Failure::Check(q.to_string()),
+                _ => return Err(format!("unknown failure '{s}' (expected one of: {})", FAILURE_NAMES.join(", "))),
+            },
+        })
+    }
+}
+
+impl serde::Serialize for Failure {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+/// What a scenario declares it must do: pass, or fail in exactly these parts.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct Expectation {
+    /// Empty: the run must pass. Otherwise the run must fail in these parts and no other.
+    pub failing: Vec<Failure>,
+}
+
+impl Expectation {
+    pub const PASS: Expectation = Expectation { failing: Vec::new() };
+
+    /// Whether a run that failed in `failures` did what was declared (the order is free).
+    pub fn met_by(&self, failures: &[Failure]) -> bool {
+        let mut want = self.failing.clone();
+        want.sort();
+        want.dedup();
+        let mut got = failures.to_vec();
+        got.sort();
+        got.dedup();
+        want == got
+    }
+}
