@@ -208,7 +208,7 @@ impl Mechanism for Custom {
         v
     }
     fn length_scale(&self, _params: &Values) -> f64 {
-        crate::sim::structure_size(&self.structure)
+        crate::structure::structure_size(&self.structure)
     }
     fn findings(&self, _params: &Values) -> Vec<Finding> {
         Vec::new()

@@ -815,7 +815,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
                 Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
             };
             let structure = m.build(&params, &first, &start).map_err(|e| ctx.err(&raw.actuation, e))?;
-            if let Err(e) = crate::observers::interference::Interference::new(&structure, &settings) {
+            if let Err(e) = settings.check_strut_names(&structure) {
                 return Err(ctx.err(i, e));
             }
             Some(settings)

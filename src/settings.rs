@@ -3,6 +3,7 @@
 //! and `observers` read them, and neither needs the other.
 
 use crate::mechanisms::QuantityKind;
+use crate::structure::Structure;
 use std::fmt;
 
 /// Numerical settings of the integrator, all from the scenario file.
@@ -94,6 +95,23 @@ pub struct InterferenceSettings {
     pub informative: bool,
     /// Further pairs to exclude, by strut name.
     pub exclude: Vec<(String, String)>,
+}
+
+impl InterferenceSettings {
+    /// Whether every excluded pair names struts of `s` (else the error names the first that
+    /// does not, and the struts there are).
+    pub fn check_strut_names(&self, s: &Structure) -> Result<(), String> {
+        for name in self.exclude.iter().flat_map(|(a, b)| [a, b]) {
+            if !s.struts.iter().any(|t| &t.name == name) {
+                let struts: Vec<&str> = s.struts.iter().map(|t| t.name.as_str()).collect();
+                return Err(format!(
+                    "interference exclusion names strut '{name}', which does not exist (struts: {})",
+                    struts.join(", ")
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// One `[[checks]]` entry: a quantity compared with the analytic model.

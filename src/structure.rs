@@ -462,3 +462,14 @@ mod tests {
         assert!(matches!(s.validate(), Err(StructureError::Invalid { what: "spring", .. })));
     }
 }
+
+/// Largest distance between two nodes of the structure [m] (at least 1e-3 m).
+pub fn structure_size(s: &Structure) -> f64 {
+    let mut l: f64 = 1e-3;
+    for a in &s.nodes {
+        for b in &s.nodes {
+            l = l.max(distance(a.position, b.position));
+        }
+    }
+    l
+}

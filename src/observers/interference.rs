@@ -104,7 +104,7 @@ impl Interference {
     /// Sets up the pairs for `s`. Unknown strut names in `exclude` are an error.
     pub fn new(s: &Structure, settings: &InterferenceSettings) -> Result<Self, String> {
         let n = s.struts.len();
-        let size = crate::sim::structure_size(s);
+        let size = crate::structure::structure_size(s);
         let mut excluded = vec![vec![false; n]; n];
         let ends = |k: usize| [s.struts[k].a, s.struts[k].b];
         for i in 0..n {
@@ -121,16 +121,10 @@ impl Interference {
                 excluded[j][i] = meet;
             }
         }
+        settings.check_strut_names(s)?;
+        let id = |name: &str| s.struts.iter().position(|t| t.name == name).expect("checked above");
         for (a, b) in &settings.exclude {
-            let find = |name: &str| {
-                s.struts.iter().position(|t| t.name == name).ok_or_else(|| {
-                    format!(
-                        "interference exclusion names strut '{name}', which does not exist (struts: {})",
-                        s.struts.iter().map(|t| t.name.as_str()).collect::<Vec<_>>().join(", ")
-                    )
-                })
-            };
-            let (i, j) = (find(a)?, find(b)?);
+            let (i, j) = (id(a), id(b));
             excluded[i][j] = true;
             excluded[j][i] = true;
         }

@@ -146,7 +146,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
     // a bounded oscillation. Uncapped, it shows as divergence (energy, bounding box, NaN).
     params.normalized_max_linear_velocity = Real::MAX;
 
-    let length_scale_m = structure_size(s);
+    let length_scale_m = crate::structure::structure_size(s);
     let commands = s.initial_commands();
     let mut sim = Simulation {
         structure: s.clone(),
@@ -393,15 +393,4 @@ fn generic_joint(s: &Structure, joint: &Joint) -> GenericJoint {
 
 fn glam_mat3(x: Vector, y: Vector, z: Vector) -> rapier3d_f64::glamx::DMat3 {
     rapier3d_f64::glamx::DMat3::from_cols(x, y, z)
-}
-
-/// Largest distance between two nodes of the structure [m] (at least 1e-3 m).
-pub fn structure_size(s: &Structure) -> f64 {
-    let mut l: f64 = 1e-3;
-    for a in &s.nodes {
-        for b in &s.nodes {
-            l = l.max(crate::structure::distance(a.position, b.position));
-        }
-    }
-    l
 }

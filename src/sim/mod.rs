@@ -27,7 +27,6 @@ use rapier3d_f64::prelude::*;
 
 use crate::settings::{SimSettings, DEFAULT_JOINT_GAP_FRACTION};
 use crate::snapshot::{BodyPose, MemberForces, Residual, Snapshot};
-pub use build::structure_size;
 
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum SimError {
