@@ -139,7 +139,7 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         (None, None) => None,
     };
     let observers = observers::observers(Setup {
-        structure: &sim.structure,
+        structure: &sim.structure(),
         checks: &sc.checks,
         length_scale_m: mech.length_scale(&sc.params),
         interference: sc.interference.as_ref(),

@@ -30,7 +30,7 @@ impl Runner<'_> {
             .map(|(a, b)| crate::structure::distance(*a, *b))
             .fold(0.0, f64::max);
         // Back within a small fraction of the perturbation: the same equilibrium.
-        let back = after.settled && moved < RETURN_FRACTION * delta * self.sim.length_scale_m;
+        let back = after.settled && moved < RETURN_FRACTION * delta * self.sim.length_scale_m();
         self.emit(format_args!(
             "after the perturbation: {} {} steps, largest node displacement from before {moved:.3e} m",
             if after.settled { "settled in" } else { "did NOT settle in" },
@@ -46,7 +46,7 @@ impl Runner<'_> {
         };
         let body = self
             .sim
-            .structure
+            .structure()
             .body_id(&spec.body)
             .ok_or_else(|| Stop::Model(format!("probe body '{}' not found", spec.body)))?;
         let axis = spec.torque_axis;
@@ -208,7 +208,7 @@ pub(super) fn settle_point(
         analytic: landed,
         simulated,
     };
-    let seen = SettlePoint { structure: &runner.sim.structure, snapshot: &s.snapshot, outside_model: outside };
+    let seen = SettlePoint { structure: &runner.sim.structure(), snapshot: &s.snapshot, outside_model: outside };
     for o in runner.observers.iter_mut() {
         o.settle_point(&seen, &mut point, &mut runner.notes);
     }
@@ -219,7 +219,7 @@ pub(super) fn settle_point(
 
 /// The cables slack in `snap`, by name.
 fn slack_cables(runner: &Runner, snap: &Snapshot) -> Vec<String> {
-    let cables = &runner.sim.structure.cables;
+    let cables = &runner.sim.structure().cables;
     cables.iter().zip(&snap.forces.cable_slack).filter(|(_, sl)| **sl).map(|(c, _)| c.name.clone()).collect()
 }
 

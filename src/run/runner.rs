@@ -39,7 +39,7 @@ impl<'a> Runner<'a> {
 
     /// The mechanism's quantities in a snapshot of this simulation.
     pub fn observe(&self, snap: &Snapshot) -> Values {
-        self.mech.observe(&self.sc.params, &self.sim.structure, snap)
+        self.mech.observe(&self.sc.params, &self.sim.structure(), snap)
     }
 
     /// Tells every observer an event of the run (formatted only when one records).
@@ -95,7 +95,7 @@ impl<'a> Runner<'a> {
             self.ghost = Some((inputs.clone(), self.mech.analytic_nodes(&self.sc.params, inputs)));
         }
         let tick = Tick {
-            structure: &self.sim.structure,
+            structure: &self.sim.structure(),
             snapshot: &snap,
             inputs,
             prediction,

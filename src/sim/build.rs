@@ -1,6 +1,6 @@
 //! Structure -> rapier sets.
 
-use super::{LinkRef, SimError, SimSettings, Simulation};
+use super::{LinkRef, Model, SimError, SimSettings, Simulation};
 use crate::structure::{ActuatorTarget, BodyKind, CableLaw, Joint, JointKind, Structure, Vec3};
 use rapier3d_f64::prelude::*;
 
@@ -148,9 +148,31 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
 
     let length_scale_m = crate::structure::structure_size(s);
     let commands = s.initial_commands();
-    let mut sim = Simulation {
+    let model = Model {
         structure: s.clone(),
         settings: settings.clone(),
+        handles,
+        actuated,
+        joint_links,
+        hidden_links,
+        joint_impulse,
+        internal_closures: Vec::new(),
+        projected_groups: Vec::new(),
+        cable_ropes,
+        external_loads: {
+            let mut l = vec![[0.0; 3]; n];
+            for load in &s.loads {
+                for k in 0..3 {
+                    l[load.body][k] += load.force_n[k];
+                }
+            }
+            l
+        },
+        length_scale_m,
+        tree: super::forces::Tree::default(),
+    };
+    let mut sim = Simulation {
+        model,
         pipeline: PhysicsPipeline::new(),
         params,
         islands: IslandManager::new(),
@@ -162,33 +184,14 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         multibody_joints,
         soft_bodies: SoftBodySet::new(),
         ccd: CCDSolver::new(),
-        handles,
-        actuated,
-        joint_links,
-        hidden_links,
-        joint_impulse,
-        internal_closures: Vec::new(),
-        projected_groups: Vec::new(),
-        cable_ropes,
         cable_lengths: s.cables.iter().map(|c| c.length_m).collect(),
         commands: commands.clone(),
         probe_loads: vec![([0.0; 3], [0.0; 3]); n],
-        external_loads: {
-            let mut l = vec![[0.0; 3]; n];
-            for load in &s.loads {
-                for k in 0..3 {
-                    l[load.body][k] += load.force_n[k];
-                }
-            }
-            l
-        },
         tick: 0,
-        length_scale_m,
-        tree: super::forces::Tree::default(),
     };
-    sim.tree = sim.link_tree();
-    sim.internal_closures = sim.find_internal_closures();
-    sim.projected_groups = sim.find_projected_groups();
+    sim.model.tree = sim.link_tree();
+    sim.model.internal_closures = sim.find_internal_closures();
+    sim.model.projected_groups = sim.find_projected_groups();
     sim.set_commands(&commands);
     Ok(sim)
 }

@@ -88,9 +88,9 @@ impl JointMotion {
 impl Simulation {
     /// The joints the schedule drives: damped, free, revolute or prismatic multibody links.
     fn scheduled(&self, j: usize) -> bool {
-        let joint = &self.structure.joints[j];
-        self.joint_links[j].is_some()
-            && !self.actuated[j]
+        let joint = &self.model.structure.joints[j];
+        self.model.joint_links[j].is_some()
+            && !self.model.actuated[j]
             && joint.damping > 0.0
             && matches!(joint.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. })
     }
@@ -99,14 +99,14 @@ impl Simulation {
     /// the member forces are applied).
     /// Joint `j`'s axis and anchor as its parent now carries them, if revolute or prismatic.
     pub(super) fn joint_motion(&self, j: usize) -> Option<JointMotion> {
-        let s = &self.structure;
+        let s = &self.model.structure;
         let joint = &s.joints[j];
         let (axis, revolute) = match joint.kind {
             JointKind::Revolute { axis } => (axis, true),
             JointKind::Prismatic { axis } => (axis, false),
             _ => return None,
         };
-        let parent = self.bodies[self.handles[joint.parent]].position();
+        let parent = self.bodies[self.model.handles[joint.parent]].position();
         Some(JointMotion {
             axis: (parent.rotation * Vector::from(axis)).normalize(),
             anchor: parent.transform_point(Vector::from(s.nodes[joint.anchor].position)),
@@ -115,8 +115,8 @@ impl Simulation {
     }
 
     fn joint_load(&self, j: usize) -> JointLoad {
-        let tree = &self.tree;
-        let s = &self.structure;
+        let tree = &self.model.tree;
+        let s = &self.model.structure;
         let joint = &s.joints[j];
         let motion = self.joint_motion(j).expect("scheduled joints are revolute or prismatic");
         let revolute = motion.revolute;
@@ -126,7 +126,7 @@ impl Simulation {
         // Loads on the carried bodies as rapier will apply them (member forces were put on the
         // bodies as a force at the centre of mass plus its moment): their generalized force.
         for b in (0..s.bodies.len()).filter(|b| carried(*b)) {
-            let rb = &self.bodies[self.handles[b]];
+            let rb = &self.bodies[self.model.handles[b]];
             // From the current pose: rapier's cached centre of mass is stale before the first step.
             let com = self.world_com(b);
             let gravity = g * rb.mass() * rb.gravity_scale();
@@ -134,7 +134,7 @@ impl Simulation {
             load.force += motion.rate(com).dot(f) + if revolute { motion.axis.dot(rb.user_torque()) } else { 0.0 };
             // Forces that do not change with the coordinate: gravity and the external loads.
             let (probe, _) = self.probe_loads[b];
-            let e = self.external_loads[b];
+            let e = self.model.external_loads[b];
             let constant = gravity + Vector::new(probe[0] + e[0], probe[1] + e[1], probe[2] + e[2]);
             load.stiffness += motion.constant_force_stiffness(com, constant);
             let inertia = s.bodies[b].inertia.expect("free bodies have inertia");
@@ -176,21 +176,21 @@ impl Simulation {
     /// Sets every scheduled joint's velocity and damping for the coming step (after the loads
     /// are applied).
     pub(super) fn schedule_damping(&mut self) {
-        let dt = self.settings.dt_s;
-        for j in 0..self.structure.joints.len() {
+        let dt = self.model.settings.dt_s;
+        for j in 0..self.model.structure.joints.len() {
             if !self.scheduled(j) {
                 continue;
             }
             let Some((mb_index, dof)) = self.dof_of(j) else { continue };
             let load = self.joint_load(j);
-            let mut damping = self.structure.joints[j].damping;
+            let mut damping = self.model.structure.joints[j].damping;
             if load.stiffness > 0.0 && load.inertia > 0.0 {
                 damping = newton_damping(dt, load.stiffness, load.inertia);
                 if let Some(mb) = self.multibody_joints.get_multibody_mut(mb_index) {
                     mb.generalized_velocity_mut()[dof] = 0.0;
                 }
             }
-            if let Some(link) = self.joint_links[j] {
+            if let Some(link) = self.model.joint_links[j] {
                 super::build::set_link_damping(&mut self.multibody_joints, link.multibody_joint, damping);
             }
         }

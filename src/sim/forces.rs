@@ -42,13 +42,13 @@ fn v(a: [f64; 3]) -> Vector {
 impl Simulation {
     /// Puts the explicit forces (springs, elastic cables, probes) on the bodies for the next step.
     pub(super) fn apply_member_forces(&mut self) {
-        let n = self.structure.bodies.len();
+        let n = self.model.structure.bodies.len();
         for b in 0..n {
-            let rb = &mut self.bodies[self.handles[b]];
+            let rb = &mut self.bodies[self.model.handles[b]];
             rb.reset_forces(false);
             rb.reset_torques(false);
         }
-        for i in 0..self.structure.springs.len() + self.structure.cables.len() {
+        for i in 0..self.model.structure.springs.len() + self.model.structure.cables.len() {
             if let Some(m) = self.elastic_member(i) {
                 self.add_member_load(&m);
             }
@@ -56,10 +56,10 @@ impl Simulation {
         for b in 0..n {
             let (mut f, t) = self.probe_loads[b];
             for k in 0..3 {
-                f[k] += self.external_loads[b][k];
+                f[k] += self.model.external_loads[b][k];
             }
             if self.is_free(b) && (f != [0.0; 3] || t != [0.0; 3]) {
-                let rb = &mut self.bodies[self.handles[b]];
+                let rb = &mut self.bodies[self.model.handles[b]];
                 rb.add_force(v(f), false);
                 rb.add_torque(v(t), false);
             }
@@ -69,7 +69,7 @@ impl Simulation {
     /// Member `i` of the springs followed by the cables, if its force follows from its length
     /// (a spring, or an elastic cable at its current rest length).
     pub(super) fn elastic_member(&self, i: usize) -> Option<ElasticMember> {
-        let s = &self.structure;
+        let s = &self.model.structure;
         if let Some(sp) = s.springs.get(i) {
             return Some(ElasticMember {
                 a: sp.a,
@@ -105,10 +105,10 @@ impl Simulation {
         if l > 0.0 && t != 0.0 {
             let f = d / l * t;
             for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
-                let body = self.structure.nodes[node].body;
+                let body = self.model.structure.nodes[node].body;
                 if self.is_free(body) {
                     let com = self.world_com(body);
-                    let rb = &mut self.bodies[self.handles[body]];
+                    let rb = &mut self.bodies[self.model.handles[body]];
                     rb.add_force(f, false);
                     rb.add_torque((p - com).cross(f), false);
                 }
@@ -120,18 +120,18 @@ impl Simulation {
     /// q counted as the structure's coordinates are (initial coordinate plus the rotation since
     /// the build). Zero without a spring or off a revolute joint.
     pub(super) fn torsion_spring_torque(&self, j: usize) -> f64 {
-        let joint = &self.structure.joints[j];
+        let joint = &self.model.structure.joints[j];
         let (Some(t), JointKind::Revolute { axis }) = (&joint.torsion_spring, &joint.kind) else { return 0.0 };
-        let parent_rot = self.bodies[self.handles[joint.parent]].position().rotation;
-        let child_rot = self.bodies[self.handles[joint.child]].position().rotation;
+        let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
+        let child_rot = self.bodies[self.model.handles[joint.child]].position().rotation;
         let q = joint.initial_coordinate + relative_angle(parent_rot, child_rot, v(*axis));
         -t.stiffness_nm_per_rad * (q - t.rest_angle_rad)
     }
 
     /// World position of a free body's centre of mass, from its current pose [m].
     pub(super) fn world_com(&self, body: usize) -> Vector {
-        let local = self.structure.bodies[body].inertia.map_or([0.0; 3], |i| i.com);
-        self.bodies[self.handles[body]].position().transform_point(v(local))
+        let local = self.model.structure.bodies[body].inertia.map_or([0.0; 3], |i| i.com);
+        self.bodies[self.model.handles[body]].position().transform_point(v(local))
     }
 
     /// Reads every member force and computes the equilibrium residual.
@@ -142,8 +142,9 @@ impl Simulation {
     /// Whether the member forces themselves need the fit of the loop-closure reactions: a
     /// joint actuator's force where loops close, or a cable held by the projection (`held`).
     fn forces_need_closure_fit(&self, held: &[bool]) -> bool {
-        let closures = self.joint_impulse.iter().any(Option::is_some);
-        let joint_actuators = self.structure.actuators.iter().any(|a| matches!(a.target, ActuatorTarget::Joint(_)));
+        let closures = self.model.joint_impulse.iter().any(Option::is_some);
+        let joint_actuators =
+            self.model.structure.actuators.iter().any(|a| matches!(a.target, ActuatorTarget::Joint(_)));
         (closures && joint_actuators) || held.contains(&true)
     }
 
@@ -151,7 +152,7 @@ impl Simulation {
     /// reactions, the costliest part) only when `with_residual` or when the forces need the fit.
     /// The settle loop asks for it only once the motion has stopped.
     pub fn member_forces_with(&self, with_residual: bool) -> MemberForces {
-        let s = &self.structure;
+        let s = &self.model.structure;
         // Cables held at their length by the projection: their tension is fitted, not read.
         let held = self.cables_held_by_projection();
         let nb = s.bodies.len();
@@ -175,7 +176,7 @@ impl Simulation {
                 push(&mut wrench, s.nodes[sp.b].body, -f, pb);
             }
         }
-        let inv_h = self.settings.substeps as f64 / self.settings.dt_s;
+        let inv_h = self.model.settings.substeps as f64 / self.model.settings.dt_s;
         for (c, cable) in s.cables.iter().enumerate() {
             let (pa, pb) = (v(self.node_position(cable.a)), v(self.node_position(cable.b)));
             let d = pb - pa;
@@ -185,7 +186,7 @@ impl Simulation {
                 CableLaw::Elastic { stiffness_n_per_m } => (stiffness_n_per_m * (l - rest)).max(0.0),
                 // Held at its length by the projection: its tension is fitted below.
                 CableLaw::Inextensible if held[c] => 0.0,
-                CableLaw::Inextensible => self.cable_ropes[c]
+                CableLaw::Inextensible => self.model.cable_ropes[c]
                     .and_then(|h| self.impulse_joints.get(h))
                     .map(|j| j.data.limits[0].impulse.abs() * inv_h)
                     .unwrap_or(0.0),
@@ -204,14 +205,14 @@ impl Simulation {
         for (b, body) in s.bodies.iter().enumerate() {
             if self.is_free(b) {
                 if let Some(i) = body.inertia {
-                    let com = self.bodies[self.handles[b]].position().transform_point(v(i.com));
+                    let com = self.bodies[self.model.handles[b]].position().transform_point(v(i.com));
                     let f = g * i.mass_kg;
                     wrench[b].0 += f;
                     wrench[b].1 += com.cross(f);
                 }
                 let (mut pf, pt) = self.probe_loads[b];
                 for k in 0..3 {
-                    pf[k] += self.external_loads[b][k];
+                    pf[k] += self.model.external_loads[b][k];
                 }
                 let com = self.world_com(b);
                 wrench[b].0 += v(pf);
@@ -219,14 +220,14 @@ impl Simulation {
             }
         }
 
-        let tree = &self.tree;
+        let tree = &self.model.tree;
 
         // Loop-closing joints carry reactions that no force law gives. They are the unknowns of
         // a least-squares fit: the reactions that best balance every free coordinate. At an
         // equilibrium the fit is exact and the residual is zero; the fitted reactions are
         // added to the bodies' loads.
         let fit = with_residual || self.forces_need_closure_fit(&held);
-        let scale = self.length_scale_m;
+        let scale = self.model.length_scale_m;
         let base = if fit { self.coordinate_forces(tree, &wrench, true) } else { Vec::new() };
         let mut closure_loads = self.closure_unit_loads();
         closure_loads.extend(self.projected_cable_unit_loads(&held));
@@ -295,9 +296,9 @@ impl Simulation {
             let f = match a.target {
                 ActuatorTarget::CableLength(c) => out.cable_tension_n[c],
                 // Locked off the tree: its torque (force) is the fitted closure reaction.
-                ActuatorTarget::Joint(j) if self.joint_impulse[j].is_some() => {
+                ActuatorTarget::Joint(j) if self.model.joint_impulse[j].is_some() => {
                     let joint = &s.joints[j];
-                    let parent_rot = self.bodies[self.handles[joint.parent]].position().rotation;
+                    let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
                     let (f, m) = closure_reaction[j];
                     match &joint.kind {
                         JointKind::Revolute { axis } => m.dot((parent_rot * v(*axis)).normalize()),
@@ -309,7 +310,7 @@ impl Simulation {
                     let joint = &s.joints[j];
                     let w = subtree_wrench(joint.child);
                     let anchor = v(self.node_position(joint.anchor));
-                    let parent_rot = self.bodies[self.handles[joint.parent]].position().rotation;
+                    let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
                     match &joint.kind {
                         JointKind::Revolute { axis } => -about(w, anchor).dot((parent_rot * v(*axis)).normalize()),
                         JointKind::Prismatic { axis } => -w.0.dot((parent_rot * v(*axis)).normalize()),
@@ -407,10 +408,10 @@ impl Tree {
 impl Simulation {
     /// The tree of the multibody links: the joint each body hangs from.
     pub(super) fn link_tree(&self) -> Tree {
-        let s = &self.structure;
+        let s = &self.model.structure;
         let mut parent_joint: Vec<Option<usize>> = vec![None; s.bodies.len()];
         for (j, joint) in s.joints.iter().enumerate() {
-            if self.joint_links[j].is_some() {
+            if self.model.joint_links[j].is_some() {
                 parent_joint[joint.child] = Some(j);
             }
         }
@@ -420,20 +421,20 @@ impl Simulation {
     /// Generalized force on every free coordinate for the body loads `wrench` (force, moment
     /// about the world origin), torsion springs included when `with_springs`.
     fn coordinate_forces(&self, tree: &Tree, wrench: &[Wrench], with_springs: bool) -> Vec<CoordinateForce> {
-        let s = &self.structure;
+        let s = &self.model.structure;
         let about = |w: Wrench, p: Vector| -> Vector { w.1 - p.cross(w.0) };
         let force = |value: f64| CoordinateForce { value, is_torque: false };
         let torque = |value: f64| CoordinateForce { value, is_torque: true };
         let mut out = Vec::new();
         for (j, joint) in s.joints.iter().enumerate() {
             // Only the free coordinates: an actuated joint's coordinate is set, not balanced.
-            if self.joint_links[j].is_none() || self.actuated[j] {
+            if self.model.joint_links[j].is_none() || self.model.actuated[j] {
                 continue;
             }
             let w = tree.subtree_wrench(s, wrench, joint.child);
             let anchor = v(self.node_position(joint.anchor));
-            let parent_rot = self.bodies[self.handles[joint.parent]].position().rotation;
-            let child_rot = self.bodies[self.handles[joint.child]].position().rotation;
+            let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
+            let child_rot = self.bodies[self.model.handles[joint.child]].position().rotation;
             let m = about(w, anchor);
             match &joint.kind {
                 JointKind::Revolute { axis } => {
@@ -469,7 +470,7 @@ impl Simulation {
     /// For every inextensible cable held at its length by the projection: the body loads of a
     /// unit tension (pulling its two nodes together).
     fn projected_cable_unit_loads(&self, held: &[bool]) -> Vec<ClosureComponent> {
-        let s = &self.structure;
+        let s = &self.model.structure;
         let nb = s.bodies.len();
         let mut out = Vec::new();
         for (c, cable) in s.cables.iter().enumerate() {
@@ -492,23 +493,23 @@ impl Simulation {
     /// For every reaction component of every loop-closing joint: the body loads of a unit
     /// reaction (child +, parent -), world frame.
     fn closure_unit_loads(&self) -> Vec<ClosureComponent> {
-        let s = &self.structure;
+        let s = &self.model.structure;
         let nb = s.bodies.len();
         let axes = [Vector::X, Vector::Y, Vector::Z];
         let mut out = Vec::new();
         for (j, joint) in s.joints.iter().enumerate() {
-            if self.joint_impulse[j].is_none() {
+            if self.model.joint_impulse[j].is_none() {
                 continue;
             }
             let anchor = v(self.node_position(joint.anchor));
-            let parent_rot = self.bodies[self.handles[joint.parent]].position().rotation;
-            let child_rot = self.bodies[self.handles[joint.child]].position().rotation;
+            let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
+            let child_rot = self.bodies[self.model.handles[joint.child]].position().rotation;
             // Directions the joint transmits: forces, then moments.
             let (forces, moments): (Vec<Vector>, Vec<Vector>) = match &joint.kind {
                 JointKind::Spherical => (axes.to_vec(), vec![]),
                 // An actuated (locked) revolute also carries the torque about its axis.
-                JointKind::Revolute { axis } if self.actuated[j] => (axes.to_vec(), axes.to_vec()),
-                JointKind::Prismatic { .. } if self.actuated[j] => (axes.to_vec(), axes.to_vec()),
+                JointKind::Revolute { axis } if self.model.actuated[j] => (axes.to_vec(), axes.to_vec()),
+                JointKind::Prismatic { .. } if self.model.actuated[j] => (axes.to_vec(), axes.to_vec()),
                 JointKind::Revolute { axis } => {
                     let a = (parent_rot * v(*axis)).normalize();
                     (axes.to_vec(), orthogonal_pair(a).to_vec())

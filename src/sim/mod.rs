@@ -42,21 +42,12 @@ struct LinkRef {
     multibody_joint: MultibodyJointHandle,
 }
 
-/// The mutable state that steps: rapier sets and the current commands.
-pub struct Simulation {
+/// What a simulation is built from and keeps for its whole life (MuJoCo's `mjModel`): the
+/// structure and settings, and how the build mapped them onto rapier (handles, multibody
+/// links, loop closures, rope joints, the link tree, constant loads). Only the build writes it.
+pub struct Model {
     pub structure: Structure,
     pub settings: SimSettings,
-    pipeline: PhysicsPipeline,
-    params: IntegrationParameters,
-    islands: IslandManager,
-    broad_phase: BroadPhaseBvh,
-    narrow_phase: NarrowPhase,
-    bodies: RigidBodySet,
-    colliders: ColliderSet,
-    impulse_joints: ImpulseJointSet,
-    multibody_joints: MultibodyJointSet,
-    soft_bodies: SoftBodySet,
-    ccd: CCDSolver,
     /// rapier handle of each structure body.
     handles: Vec<RigidBodyHandle>,
     /// For each joint: whether an actuator sets its coordinate (a kinematic multibody degree
@@ -75,23 +66,55 @@ pub struct Simulation {
     projected_groups: Vec<projection::ProjectedGroup>,
     /// For each inextensible cable: its rope joint.
     cable_ropes: Vec<Option<ImpulseJointHandle>>,
-    /// Current unstretched cable lengths [m].
-    cable_lengths: Vec<f64>,
     /// The joint each body hangs from in the multibody forest (fixed at build).
     tree: forces::Tree,
+    /// The structure's constant external forces, summed per body [N].
+    external_loads: Vec<[f64; 3]>,
+    /// Characteristic length of the structure [m], for speeds and tolerances.
+    pub length_scale_m: f64,
+}
+
+/// The mutable state that steps (MuJoCo's `mjData`): rapier's sets and pipeline, the current
+/// commands, cable lengths and probe loads, and the tick; [`Model`] says what it simulates.
+pub struct Simulation {
+    model: Model,
+    pipeline: PhysicsPipeline,
+    params: IntegrationParameters,
+    islands: IslandManager,
+    broad_phase: BroadPhaseBvh,
+    narrow_phase: NarrowPhase,
+    bodies: RigidBodySet,
+    colliders: ColliderSet,
+    impulse_joints: ImpulseJointSet,
+    multibody_joints: MultibodyJointSet,
+    soft_bodies: SoftBodySet,
+    ccd: CCDSolver,
+    /// Current unstretched cable lengths [m].
+    cable_lengths: Vec<f64>,
     /// Current actuator commands, in actuator order.
     commands: Vec<f64>,
     /// External loads [N] and [N m] applied to bodies (probes), world frame, about the body's
     /// centre of mass.
     probe_loads: Vec<([f64; 3], [f64; 3])>,
-    /// The structure's constant external forces, summed per body [N].
-    external_loads: Vec<[f64; 3]>,
     tick: u64,
-    /// Characteristic length of the structure [m], for speeds and tolerances.
-    pub length_scale_m: f64,
 }
 
 impl Simulation {
+    /// What this simulation simulates: the structure, settings and build plan.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The structure being simulated.
+    pub fn structure(&self) -> &Structure {
+        &self.model.structure
+    }
+
+    /// Characteristic length of the structure [m], for speeds and tolerances.
+    pub fn length_scale_m(&self) -> f64 {
+        self.model.length_scale_m
+    }
+
     /// Builds rapier sets for `structure`. The structure must have passed `validate`.
     pub fn new(structure: &Structure, settings: &SimSettings) -> Result<Self, SimError> {
         structure.validate().map_err(|e| SimError::Build(e.to_string()))?;
@@ -113,7 +136,7 @@ impl Simulation {
     }
 
     pub fn time_s(&self) -> f64 {
-        self.tick as f64 * self.settings.dt_s
+        self.tick as f64 * self.model.settings.dt_s
     }
 
     pub fn commands(&self) -> &[f64] {
@@ -123,12 +146,12 @@ impl Simulation {
     /// Sets every actuator's command (in structure order: m for lengths, rad for angles) and
     /// moves the actuated joints there at once.
     pub fn set_commands(&mut self, values: &[f64]) {
-        assert_eq!(values.len(), self.structure.actuators.len(), "one command per actuator");
+        assert_eq!(values.len(), self.model.structure.actuators.len(), "one command per actuator");
         self.commands.copy_from_slice(values);
-        for (i, a) in self.structure.actuators.iter().enumerate() {
+        for (i, a) in self.model.structure.actuators.iter().enumerate() {
             if let ActuatorTarget::CableLength(c) = a.target {
                 self.cable_lengths[c] = values[i];
-                if let Some(h) = self.cable_ropes[c] {
+                if let Some(h) = self.model.cable_ropes[c] {
                     if let Some(j) = self.impulse_joints.get_mut(h, true) {
                         j.data.set_limits(JointAxis::LinX, [0.0, values[i]]);
                     }
@@ -147,10 +170,14 @@ impl Simulation {
     /// Advances one time step. Fails if the state is no longer finite or leaves the box.
     pub fn step(&mut self) -> Result<(), SimError> {
         self.apply_member_forces();
-        if self.settings.newton_damping {
+        if self.model.settings.newton_damping {
             self.schedule_damping();
         }
-        let gravity = Vector::new(self.structure.gravity[0], self.structure.gravity[1], self.structure.gravity[2]);
+        let gravity = Vector::new(
+            self.model.structure.gravity[0],
+            self.model.structure.gravity[1],
+            self.model.structure.gravity[2],
+        );
         self.pipeline.step(
             gravity,
             &self.params,
@@ -173,10 +200,10 @@ impl Simulation {
     }
 
     fn check_divergence(&self) -> Result<(), SimError> {
-        let limit = self.settings.bounding_box_m;
+        let limit = self.model.settings.bounding_box_m;
         // Not finite, then energy, then outside the box: a blow-up is named for what it is.
         let mut outside = None;
-        for (i, n) in self.structure.nodes.iter().enumerate() {
+        for (i, n) in self.model.structure.nodes.iter().enumerate() {
             let p = self.node_position(i);
             if p.iter().any(|c| !c.is_finite()) {
                 return Err(self.diverged(format!("node '{}' position is not finite", n.name)));
@@ -186,21 +213,22 @@ impl Simulation {
             }
         }
         let energy = self.kinetic_energy_j();
-        if !energy.is_finite() || energy > self.settings.max_kinetic_energy_j {
+        if !energy.is_finite() || energy > self.model.settings.max_kinetic_energy_j {
             return Err(self.diverged(format!(
                 "kinetic energy {energy:.3e} J exceeds the limit {:.3e} J (sim.max_kinetic_energy)",
-                self.settings.max_kinetic_energy_j
+                self.model.settings.max_kinetic_energy_j
             )));
         }
         if let Some((i, p)) = outside {
             return Err(self.diverged(format!(
                 "node '{}' left the bounding box of half-size {limit} m (at [{:.3e}, {:.3e}, {:.3e}])",
-                self.structure.nodes[i].name, p[0], p[1], p[2]
+                self.model.structure.nodes[i].name, p[0], p[1], p[2]
             )));
         }
-        let gap_limit = self.settings.max_joint_gap_m.unwrap_or(DEFAULT_JOINT_GAP_FRACTION * self.length_scale_m);
-        for (j, joint) in self.structure.joints.iter().enumerate() {
-            if self.joint_impulse[j].is_none() {
+        let gap_limit =
+            self.model.settings.max_joint_gap_m.unwrap_or(DEFAULT_JOINT_GAP_FRACTION * self.model.length_scale_m);
+        for (j, joint) in self.model.structure.joints.iter().enumerate() {
+            if self.model.joint_impulse[j].is_none() {
                 continue;
             }
             let gap = self.joint_gap_m(j);
@@ -216,19 +244,19 @@ impl Simulation {
 
     /// Kinetic energy of every moving body [J].
     pub fn kinetic_energy_j(&self) -> f64 {
-        (0..self.structure.bodies.len())
+        (0..self.model.structure.bodies.len())
             .filter(|b| self.is_free(*b))
-            .map(|b| self.bodies[self.handles[b]].kinetic_energy())
+            .map(|b| self.bodies[self.model.handles[b]].kinetic_energy())
             .sum()
     }
 
     /// Distance between a joint's anchor as carried by its parent and by its child [m].
     pub fn joint_gap_m(&self, joint: usize) -> f64 {
-        let j = &self.structure.joints[joint];
-        let a = self.structure.nodes[j.anchor].position;
+        let j = &self.model.structure.joints[joint];
+        let a = self.model.structure.nodes[j.anchor].position;
         let a = Vector::new(a[0], a[1], a[2]);
-        let p = self.bodies[self.handles[j.parent]].position().transform_point(a);
-        let c = self.bodies[self.handles[j.child]].position().transform_point(a);
+        let p = self.bodies[self.model.handles[j.parent]].position().transform_point(a);
+        let c = self.bodies[self.model.handles[j.child]].position().transform_point(a);
         (p - c).length()
     }
 
@@ -238,14 +266,14 @@ impl Simulation {
 
     /// World position of a node [m].
     pub fn node_position(&self, node: usize) -> [f64; 3] {
-        let n = &self.structure.nodes[node];
-        let pose = self.bodies[self.handles[n.body]].position();
+        let n = &self.model.structure.nodes[node];
+        let pose = self.bodies[self.model.handles[n.body]].position();
         let p = pose.transform_point(Vector::new(n.position[0], n.position[1], n.position[2]));
         [p.x, p.y, p.z]
     }
 
     pub fn body_pose(&self, body: usize) -> BodyPose {
-        let pose = self.bodies[self.handles[body]].position();
+        let pose = self.bodies[self.model.handles[body]].position();
         let q = pose.rotation;
         BodyPose {
             translation: [pose.translation.x, pose.translation.y, pose.translation.z],
@@ -255,7 +283,7 @@ impl Simulation {
 
     /// Bodies that move (not fixed).
     pub fn is_free(&self, body: usize) -> bool {
-        self.structure.bodies[body].kind == BodyKind::Free
+        self.model.structure.bodies[body].kind == BodyKind::Free
     }
 
     /// The state now, with the equilibrium residual.
@@ -269,8 +297,8 @@ impl Simulation {
         Snapshot {
             tick: self.tick,
             time_s: self.time_s(),
-            nodes: (0..self.structure.nodes.len()).map(|i| self.node_position(i)).collect(),
-            body_poses: (0..self.structure.bodies.len()).map(|b| self.body_pose(b)).collect(),
+            nodes: (0..self.model.structure.nodes.len()).map(|i| self.node_position(i)).collect(),
+            body_poses: (0..self.model.structure.bodies.len()).map(|b| self.body_pose(b)).collect(),
             forces: self.member_forces_with(with_residual),
             actuator_values: self.commands.clone(),
             kinetic_energy_j: self.kinetic_energy_j(),
@@ -281,9 +309,14 @@ impl Simulation {
     /// the velocities: the perturbation used to classify an equilibrium.
     pub fn perturb_free_coordinates(&mut self, delta: f64) {
         let mut touched = Vec::new();
-        let free_links =
-            self.joint_links.iter().zip(&self.actuated).filter(|(_, a)| !**a).filter_map(|(l, _)| l.as_ref());
-        for link in free_links.chain(self.hidden_links.iter()) {
+        let free_links = self
+            .model
+            .joint_links
+            .iter()
+            .zip(&self.model.actuated)
+            .filter(|(_, a)| !**a)
+            .filter_map(|(l, _)| l.as_ref());
+        for link in free_links.chain(self.model.hidden_links.iter()) {
             if let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) {
                 let assembly = mb.link(link_id).map(|l| (l.assembly_id(), l.joint().ndofs()));
                 if let Some((start, n)) = assembly {
@@ -306,10 +339,10 @@ impl Simulation {
         // Plain free bodies (not multibody links): shift by delta times the structure's size
         // along a fixed oblique direction and turn by delta about an oblique axis through the
         // centre of mass.
-        let shift = Vector::new(1.0, 2.0, 3.0).normalize() * (delta * self.length_scale_m);
+        let shift = Vector::new(1.0, 2.0, 3.0).normalize() * (delta * self.model.length_scale_m);
         let turn = Rotation::from_axis_angle(Vector::new(3.0, -1.0, 2.0).normalize(), delta);
-        for b in 0..self.structure.bodies.len() {
-            let h = self.handles[b];
+        for b in 0..self.model.structure.bodies.len() {
+            let h = self.model.handles[b];
             if self.is_free(b) && self.multibody_joints.rigid_body_link(h).is_none() {
                 let com = self.world_com(b);
                 let pose = *self.bodies[h].position();
@@ -326,7 +359,7 @@ impl Simulation {
     /// Sets every free body's linear and angular velocity to zero (multibody links as well:
     /// their generalized velocities are the caller's).
     fn zero_body_velocities(&mut self) {
-        for (b, &h) in self.handles.iter().enumerate() {
+        for (b, &h) in self.model.handles.iter().enumerate() {
             if self.is_free(b) {
                 let rb = &mut self.bodies[h];
                 rb.set_linvel(Vector::ZERO, true);
@@ -343,20 +376,20 @@ impl Simulation {
     fn apply_joint_commands(&mut self) {
         // (joint, total displacement) of every actuated link.
         let mut moves: Vec<(usize, f64)> = Vec::new();
-        for j in 0..self.structure.joints.len() {
-            if !self.actuated[j] {
+        for j in 0..self.model.structure.joints.len() {
+            if !self.model.actuated[j] {
                 continue;
             }
-            if let Some(h) = self.joint_impulse[j] {
-                let target = self.joint_command(j) - self.structure.joints[j].initial_coordinate;
-                let axis = build::free_axis_of(&self.structure.joints[j].kind);
+            if let Some(h) = self.model.joint_impulse[j] {
+                let target = self.joint_command(j) - self.model.structure.joints[j].initial_coordinate;
+                let axis = build::free_axis_of(&self.model.structure.joints[j].kind);
                 if let Some(joint) = self.impulse_joints.get_mut(h, true) {
                     joint.data.set_limits(axis, [target, target]);
                 }
                 continue;
             }
-            let Some(link) = self.joint_links[j] else { continue };
-            let target = self.joint_command(j) - self.structure.joints[j].initial_coordinate;
+            let Some(link) = self.model.joint_links[j] else { continue };
+            let target = self.joint_command(j) - self.model.structure.joints[j].initial_coordinate;
             let Some((mb, link_id)) = self.multibody_joints.get(link.multibody_joint) else { continue };
             let Some(current) = mb.link(link_id).map(|l| l.joint().coords()[joint_free_axis(&l.joint().data)]) else {
                 continue;
@@ -364,7 +397,7 @@ impl Simulation {
             moves.push((j, target - current));
         }
         let largest = moves.iter().fold(0.0_f64, |m, (_, d)| m.max(d.abs()));
-        let increments = if self.internal_closures.is_empty() {
+        let increments = if self.model.internal_closures.is_empty() {
             1
         } else {
             ((largest / MAX_CLOSED_LOOP_INCREMENT).ceil() as usize).max(1)
@@ -419,19 +452,21 @@ impl Simulation {
     /// Joint `j`'s first degree of freedom in its multibody: (multibody, index), if a link.
     /// The index can shift when forward kinematics re-roots the multibody: read it after.
     pub(super) fn dof_of(&self, j: usize) -> Option<(MultibodyIndex, usize)> {
-        let link = self.joint_links[j]?;
+        let link = self.model.joint_links[j]?;
         let (mb, id) = self.multibody_joints.get(link.multibody_joint)?;
-        let index = self.multibody_joints.rigid_body_link(self.handles[self.structure.joints[j].child])?.multibody;
+        let index =
+            self.multibody_joints.rigid_body_link(self.model.handles[self.model.structure.joints[j].child])?.multibody;
         Some((index, mb.link(id)?.assembly_id()))
     }
 
     fn joint_command(&self, joint: usize) -> f64 {
-        self.structure
+        self.model
+            .structure
             .actuators
             .iter()
             .position(|a| a.target == ActuatorTarget::Joint(joint))
             .map(|i| self.commands[i])
-            .unwrap_or(self.structure.joints[joint].initial_coordinate)
+            .unwrap_or(self.model.structure.joints[joint].initial_coordinate)
     }
 }
 

@@ -44,7 +44,7 @@ fn close_rows(
     displace: &dyn Fn(&mut Simulation, &[f64]),
 ) -> (nalgebra::DMatrix<f64>, f64) {
     let largest = |g: &[f64]| g.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    let tol = GAP_TOLERANCE_FRACTION * sim.length_scale_m;
+    let tol = GAP_TOLERANCE_FRACTION * sim.model.length_scale_m;
     let mut jac = nalgebra::DMatrix::<f64>::zeros(0, 0);
     for _ in 0..MAX_ITERATIONS {
         let g0 = rows(sim);
@@ -106,11 +106,11 @@ impl Simulation {
     /// The loop-closing joints whose two bodies are links of the same multibody.
     pub(super) fn find_internal_closures(&self) -> Vec<InternalClosure> {
         let mut out = Vec::new();
-        for (j, joint) in self.structure.joints.iter().enumerate() {
-            if self.joint_impulse[j].is_none() || !matches!(joint.kind, JointKind::PlanarPin { .. }) {
+        for (j, joint) in self.model.structure.joints.iter().enumerate() {
+            if self.model.joint_impulse[j].is_none() || !matches!(joint.kind, JointKind::PlanarPin { .. }) {
                 continue;
             }
-            let link = |b: usize| self.multibody_joints.rigid_body_link(self.handles[b]).map(|l| l.multibody);
+            let link = |b: usize| self.multibody_joints.rigid_body_link(self.model.handles[b]).map(|l| l.multibody);
             if let (Some(a), Some(b)) = (link(joint.parent), link(joint.child)) {
                 if a == b {
                     out.push(InternalClosure { joint: j, multibody: a });
@@ -151,7 +151,7 @@ impl Simulation {
     /// Closes every loop inside a multibody to round-off and projects the velocities onto the
     /// closures' tangent space. Returns the largest gap left [m].
     pub(super) fn project_internal_closures(&mut self) -> f64 {
-        let closures = std::mem::take(&mut self.internal_closures);
+        let closures = std::mem::take(&mut self.model.internal_closures);
         let mut largest = 0.0_f64;
         let mut multibodies: Vec<MultibodyIndex> = Vec::new();
         for c in &closures {
@@ -205,7 +205,7 @@ impl Simulation {
                 }
             }
         }
-        self.internal_closures = closures;
+        self.model.internal_closures = closures;
         largest
     }
 }
@@ -243,20 +243,20 @@ impl Simulation {
     /// A rope cable is taut when stretched to its length (within round-off) or when rapier's
     /// rope pulled in the last step.
     fn cable_is_taut(&self, c: usize) -> bool {
-        let cable = &self.structure.cables[c];
+        let cable = &self.model.structure.cables[c];
         let l = crate::structure::distance(self.node_position(cable.a), self.node_position(cable.b));
-        let inv_h = self.settings.substeps as f64 / self.settings.dt_s;
-        let impulse = self.cable_ropes[c]
+        let inv_h = self.model.settings.substeps as f64 / self.model.settings.dt_s;
+        let impulse = self.model.cable_ropes[c]
             .and_then(|h| self.impulse_joints.get(h))
             .map_or(0.0, |j| j.data.limits[0].impulse.abs() * inv_h);
-        l >= self.cable_lengths[c] - TAUT_TOLERANCE_FRACTION * self.length_scale_m || impulse > 0.0
+        l >= self.cable_lengths[c] - TAUT_TOLERANCE_FRACTION * self.model.length_scale_m || impulse > 0.0
     }
 
     /// For every cable: whether it is taut and held at its length by a group's projection (its
     /// tension is then fitted from the equilibrium, not read from rapier's impulse).
     pub(super) fn cables_held_by_projection(&self) -> Vec<bool> {
-        let mut held = vec![false; self.structure.cables.len()];
-        for g in &self.projected_groups {
+        let mut held = vec![false; self.model.structure.cables.len()];
+        for g in &self.model.projected_groups {
             for c in self.projected_taut_cables(g).unwrap_or_default() {
                 held[c] = true;
             }
@@ -279,10 +279,10 @@ impl Simulation {
     /// touches an actuated joint, a joint kind without projection rows, or a multibody with a
     /// loop inside (closed by [`Self::project_internal_closures`]) is left to rapier alone.
     pub(super) fn find_projected_groups(&self) -> Vec<ProjectedGroup> {
-        let s = &self.structure;
+        let s = &self.model.structure;
         let n = s.bodies.len();
-        let multibody_of = |b: usize| self.multibody_joints.rigid_body_link(self.handles[b]).map(|l| l.multibody);
-        let looped: Vec<MultibodyIndex> = self.internal_closures.iter().map(|c| c.multibody).collect();
+        let multibody_of = |b: usize| self.multibody_joints.rigid_body_link(self.model.handles[b]).map(|l| l.multibody);
+        let looped: Vec<MultibodyIndex> = self.model.internal_closures.iter().map(|c| c.multibody).collect();
         let plain = |b: usize| self.is_free(b) && multibody_of(b).is_none();
         let fixed = |b: usize| s.bodies[b].kind == crate::structure::BodyKind::Fixed;
         // Union-find over bodies joined by a constraint.
@@ -296,12 +296,12 @@ impl Simulation {
         }
         let mut edges: Vec<(usize, usize)> = Vec::new();
         for (j, joint) in s.joints.iter().enumerate() {
-            if self.joint_impulse[j].is_some() {
+            if self.model.joint_impulse[j].is_some() {
                 edges.push((joint.parent, joint.child));
             }
         }
         for (c, cable) in s.cables.iter().enumerate() {
-            if self.cable_ropes[c].is_some() {
+            if self.model.cable_ropes[c].is_some() {
                 edges.push((s.nodes[cable.a].body, s.nodes[cable.b].body));
             }
         }
@@ -330,7 +330,7 @@ impl Simulation {
         };
         let movable = |b: usize| if fixed(b) { None } else { Some(b) };
         for (j, joint) in s.joints.iter().enumerate() {
-            if self.joint_impulse[j].is_none() {
+            if self.model.joint_impulse[j].is_none() {
                 continue;
             }
             let Some(b) = movable(joint.child).or(movable(joint.parent)) else { continue };
@@ -344,10 +344,10 @@ impl Simulation {
                     | JointKind::Universal { .. }
                     | JointKind::PlanarPin { .. }
             );
-            groups[g].2 &= supported && !self.actuated[j];
+            groups[g].2 &= supported && !self.model.actuated[j];
         }
         for (c, cable) in s.cables.iter().enumerate() {
-            if self.cable_ropes[c].is_none() {
+            if self.model.cable_ropes[c].is_none() {
                 continue;
             }
             let (a, b) = (s.nodes[cable.a].body, s.nodes[cable.b].body);
@@ -385,9 +385,9 @@ impl Simulation {
     /// components across its axis) and its angular rows. Lengths in m; angular rows
     /// (dimensionless) times the structure's size, so that every row is a length.
     fn joint_rows(&self, j: usize, out: &mut Vec<f64>) {
-        let s = &self.structure;
-        let scale = self.length_scale_m;
-        let pose = |b: usize| *self.bodies[self.handles[b]].position();
+        let s = &self.model.structure;
+        let scale = self.model.length_scale_m;
+        let pose = |b: usize| *self.bodies[self.model.handles[b]].position();
         let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
         let joint = &s.joints[j];
         let (pp, pc) = (pose(joint.parent), pose(joint.child));
@@ -421,7 +421,7 @@ impl Simulation {
     /// The constraint rows of a projected group: each joint's ([`Self::joint_rows`]), then the
     /// stretch of each cable in `taut` [m].
     fn group_rows(&self, g: &ProjectedGroup, taut: &[usize], out: &mut Vec<f64>) {
-        let s = &self.structure;
+        let s = &self.model.structure;
         for &j in &g.joints {
             self.joint_rows(j, out);
         }
@@ -436,9 +436,9 @@ impl Simulation {
     /// its twist (`None`: the body stays). Exact to first order at a closed joint; the terms
     /// that multiply a gap are dropped (the gap is round-off once projected).
     fn group_row_rates(&self, g: &ProjectedGroup, taut: &[usize], twists: &[Option<Twist>], out: &mut Vec<f64>) {
-        let s = &self.structure;
-        let scale = self.length_scale_m;
-        let pose = |b: usize| *self.bodies[self.handles[b]].position();
+        let s = &self.model.structure;
+        let scale = self.model.length_scale_m;
+        let pose = |b: usize| *self.bodies[self.model.handles[b]].position();
         let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
         let point_rate = |b: usize, p: Vector| twists[b].map_or(Vector::ZERO, |t| t.of_point(p));
         let spin = |b: usize| twists[b].map_or(Vector::ZERO, |t| t.w);
@@ -487,7 +487,7 @@ impl Simulation {
     /// its centre of mass.
     fn nudge(&mut self, b: usize, t: Vector, r: Vector) {
         let com = self.world_com(b);
-        let h = self.handles[b];
+        let h = self.model.handles[b];
         let pose = *self.bodies[h].position();
         let moved = Pose::from_translation(com + t)
             * Pose::from_rotation(Rotation::from_scaled_axis(r))
@@ -499,8 +499,8 @@ impl Simulation {
     /// Closes every projected group's joints and taut cables to round-off and projects the
     /// velocities of its bodies and multibodies. Returns the largest row left [m].
     pub(super) fn project_groups(&mut self) -> f64 {
-        let groups = std::mem::take(&mut self.projected_groups);
-        let scale = self.length_scale_m;
+        let groups = std::mem::take(&mut self.model.projected_groups);
+        let scale = self.model.length_scale_m;
         let mut largest = 0.0_f64;
         for g in &groups {
             let Some(taut) = self.projected_taut_cables(g) else { continue };
@@ -556,7 +556,7 @@ impl Simulation {
             // of rapier's body Jacobian (centre-of-mass velocity and angular velocity).
             let jacobian = |sim: &mut Simulation, g0: &[f64]| {
                 let mut jac = nalgebra::DMatrix::<f64>::zeros(g0.len(), ndof);
-                let mut twists: Vec<Option<Twist>> = vec![None; sim.structure.bodies.len()];
+                let mut twists: Vec<Option<Twist>> = vec![None; sim.model.structure.bodies.len()];
                 for k in 0..ndof {
                     twists.iter_mut().for_each(|t| *t = None);
                     if k < n_plain {
@@ -568,7 +568,7 @@ impl Simulation {
                         let (m, dof) = multibody_dof(k);
                         let Some(mb) = sim.multibody_joints.get_multibody(m) else { continue };
                         for (b, twist) in twists.iter_mut().enumerate() {
-                            let h = sim.handles[b];
+                            let h = sim.model.handles[b];
                             let Some(link) = sim.multibody_joints.rigid_body_link(h).filter(|l| l.multibody == m)
                             else {
                                 continue;
@@ -600,7 +600,7 @@ impl Simulation {
             // then no longer taut here).
             let mut u = nalgebra::DVector::<f64>::zeros(ndof);
             for (i, &b) in g.bodies.iter().enumerate() {
-                let rb = &self.bodies[self.handles[b]];
+                let rb = &self.bodies[self.model.handles[b]];
                 let (v, w) = (rb.linvel(), rb.angvel() * scale);
                 for (r, x) in [v.x, v.y, v.z, w.x, w.y, w.z].into_iter().enumerate() {
                     u[6 * i + r] = x;
@@ -612,7 +612,7 @@ impl Simulation {
             }
             if let Some(du) = min_norm_solve(&jac, &(&jac * &u)) {
                 for (i, &b) in g.bodies.iter().enumerate() {
-                    let rb = &mut self.bodies[self.handles[b]];
+                    let rb = &mut self.bodies[self.model.handles[b]];
                     let v = rb.linvel() - Vector::new(du[6 * i], du[6 * i + 1], du[6 * i + 2]);
                     let w = rb.angvel() - Vector::new(du[6 * i + 3], du[6 * i + 4], du[6 * i + 5]) / scale;
                     rb.set_linvel(v, true);
@@ -626,7 +626,7 @@ impl Simulation {
                 }
             }
         }
-        self.projected_groups = groups;
+        self.model.projected_groups = groups;
         largest
     }
 }

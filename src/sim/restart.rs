@@ -67,15 +67,15 @@ impl Structure {
 impl Simulation {
     /// Whether the placement of this structure is its joint coordinates alone.
     fn restartable(&self) -> bool {
-        let s = &self.structure;
-        self.hidden_links.is_empty()
-            && self.internal_closures.is_empty()
-            && self.projected_groups.is_empty()
-            && self.cable_ropes.iter().all(Option::is_none)
-            && self.joint_impulse.iter().all(Option::is_none)
+        let s = &self.model.structure;
+        self.model.hidden_links.is_empty()
+            && self.model.internal_closures.is_empty()
+            && self.model.projected_groups.is_empty()
+            && self.model.cable_ropes.iter().all(Option::is_none)
+            && self.model.joint_impulse.iter().all(Option::is_none)
             && s.joints
                 .iter()
-                .zip(&self.joint_links)
+                .zip(&self.model.joint_links)
                 .all(|(j, l)| l.is_some() && matches!(j.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. }))
             && (0..s.bodies.len()).all(|b| !self.is_free(b) || s.joints.iter().any(|j| j.child == b))
     }
@@ -85,7 +85,7 @@ impl Simulation {
     /// built with, and forgets the probe loads. Returns false when `s` does not qualify or the
     /// restarted state does not reproduce it; the simulation must then be built afresh.
     pub fn restart_from(&mut self, s: &Structure) -> bool {
-        if !self.restartable() || !self.structure.same_but_placement(s) {
+        if !self.restartable() || !self.model.structure.same_but_placement(s) {
             return false;
         }
         self.probe_loads.iter_mut().for_each(|p| *p = ([0.0; 3], [0.0; 3]));
@@ -93,14 +93,14 @@ impl Simulation {
         self.set_commands(&s.initial_commands());
         // Then every free joint, parents first, turned (slid) so that a node of its child lands
         // where `s` has it.
-        let mut order: Vec<usize> = (0..s.joints.len()).filter(|j| !self.actuated[*j]).collect();
-        order.sort_by_key(|&j| self.tree.depth(s, s.joints[j].child));
+        let mut order: Vec<usize> = (0..s.joints.len()).filter(|j| !self.model.actuated[*j]).collect();
+        order.sort_by_key(|&j| self.model.tree.depth(s, s.joints[j].child));
         for j in order {
             if !self.place_free_joint(j, s) {
                 return false;
             }
         }
-        for link in self.joint_links.iter().flatten() {
+        for link in self.model.joint_links.iter().flatten() {
             if let Some((mb, _)) = self.multibody_joints.get_mut(link.multibody_joint) {
                 mb.generalized_velocity_mut().fill(0.0);
             }
@@ -113,11 +113,11 @@ impl Simulation {
     /// lands where `s` places it; false when the child has no such node.
     fn place_free_joint(&mut self, j: usize, s: &Structure) -> bool {
         let Some(motion) = self.joint_motion(j) else { return false };
-        let child = self.structure.joints[j].child;
+        let child = self.model.structure.joints[j].child;
         let off_axis = |x: Vector| (x - motion.anchor).reject_from_normalized(motion.axis);
-        let scale = self.length_scale_m;
-        let node = (0..self.structure.nodes.len()).find(|&n| {
-            self.structure.nodes[n].body == child
+        let scale = self.model.length_scale_m;
+        let node = (0..self.model.structure.nodes.len()).find(|&n| {
+            self.model.structure.nodes[n].body == child
                 && (!motion.revolute
                     || off_axis(Vector::from(self.node_position(n))).length() > OFF_AXIS_FRACTION * scale)
         });
@@ -141,14 +141,14 @@ impl Simulation {
 
     /// Whether every node, free body's centre of mass and inertia tensor is where `s` has it.
     fn reproduces(&self, s: &Structure) -> bool {
-        let tol = PLACEMENT_TOLERANCE * self.length_scale_m;
+        let tol = PLACEMENT_TOLERANCE * self.model.length_scale_m;
         let close = |a: Vector, b: [f64; 3]| (a - Vector::from(b)).length() <= tol;
         let nodes = (0..s.nodes.len()).all(|i| close(Vector::from(self.node_position(i)), s.nodes[i].position));
         let bodies = (0..s.bodies.len()).filter(|b| self.is_free(*b)).all(|b| {
-            let (Some(now), Some(then)) = (self.structure.bodies[b].inertia, s.bodies[b].inertia) else {
+            let (Some(now), Some(then)) = (self.model.structure.bodies[b].inertia, s.bodies[b].inertia) else {
                 return false;
             };
-            let rotation = self.bodies[self.handles[b]].position().rotation;
+            let rotation = self.bodies[self.model.handles[b]].position().rotation;
             // The inertia tensor now, R diag(I) R^T, against the new structure's diag(I').
             let scale = then.principal_kg_m2.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
             let axes = [Vector::X, Vector::Y, Vector::Z];
