@@ -296,189 +296,251 @@ impl Report {
     pub fn to_table(&self) -> String {
         let mut out = String::new();
         for s in &self.scenarios {
-            out.push_str(&format!("== {} ({}) [{}]: {}\n", s.name, s.mechanism, s.file, s.verdict_line()));
-            out.push_str(&format!(
-                "   settle: {} point(s), all settled: {}, {} steps, {:.3} s simulated, {:.3} s wall\n",
-                s.points.len(),
-                s.settle.settled,
-                s.settle.steps,
-                s.settle.sim_time_s,
-                s.settle.wall_s
-            ));
-            if let Some(e) = &s.error {
-                out.push_str(&format!("   stopped: {e}\n"));
-            }
-            out.push_str(&format!(
-                "   {:<10} {:>12} {:>12} {:>10} {:>12} {:>12}  {}\n",
-                "quantity", "max |err|", "max rel err", "tolerance", "transient", "rms trans.", "verdict"
-            ));
-            for c in &s.checks {
-                out.push_str(&format!(
-                    "   {:<10} {:>12.3e} {:>12.3e} {:>10.1e} {:>12.3e} {:>12.3e}  {}\n",
-                    c.quantity,
-                    c.max_abs_error,
-                    c.max_rel_error,
-                    c.tolerance,
-                    c.transient_max_abs_error,
-                    c.transient_rms_abs_error,
-                    if c.passed { "pass" } else { "FAIL" }
-                ));
-            }
-            if let Some(p) = &s.stiffness_probe {
-                out.push_str(&format!(
-                    "   stiffness probe (+-{} N m): max rel err {:.3e} (tolerance {:.1e}) {}\n",
-                    p.torque_nm,
-                    p.max_rel_error,
-                    p.tolerance,
-                    if p.passed { "pass" } else { "FAIL" }
-                ));
-            }
-            let slack_checked: Vec<_> = s.points.iter().filter(|p| p.slack_agrees.is_some()).collect();
-            if !slack_checked.is_empty() {
-                let agree = slack_checked.iter().filter(|p| p.slack_agrees == Some(true)).count();
-                out.push_str(&format!(
-                    "   slack cables: simulated set equals the analytic one at {agree} of {} point(s)\n",
-                    slack_checked.len()
-                ));
-                for p in slack_checked.iter().filter(|p| {
-                    p.expected_slack.as_ref().is_some_and(|e| !e.is_empty()) || p.slack_agrees == Some(false)
-                }) {
-                    out.push_str(&format!(
-                        "     point {:>4}: analytic slack [{}], simulated slack [{}]{}{}\n",
-                        p.index,
-                        p.expected_slack.as_deref().unwrap_or(&[]).join(", "),
-                        p.slack_cables.join(", "),
-                        p.distance_from_analytic_m
-                            .map(|d| format!(", {d:.3e} m from the analytic point"))
-                            .unwrap_or_default(),
-                        if p.slack_agrees == Some(false) { "  DISAGREE" } else { "" }
-                    ));
-                }
-            }
-            if let Some(w) = &s.workspace {
-                out.push_str(&format!(
-                    "   workspace: {} point(s), {} inside analytically, {} inside by the dynamics; agreement {:.2} %{}\n",
-                    w.points,
-                    w.analytic_inside,
-                    w.simulated_inside,
-                    w.agreement_percent,
-                    if w.disagreements.is_empty() { String::new() } else { format!(" (disagree at points {:?})", w.disagreements) }
-                ));
-                if let (Some(f), Some(pc)) = (w.inside_interference_free, w.interference_free_percent_of_inside) {
-                    out.push_str(&format!(
-                        "   interference-free: {f} of the {} point(s) inside ({pc:.2} %)\n",
-                        w.simulated_inside
-                    ));
-                }
-            }
-            if s.skipped_points > 0 {
-                out.push_str(&format!(
-                    "   skipped: {} grid point(s) outside the mechanism's domain\n",
-                    s.skipped_points
-                ));
-            }
-            if !s.slack_intervals.is_empty() {
-                out.push_str(&format!("   slack intervals ({}):", s.slack_intervals.len()));
-                for iv in s.slack_intervals.iter().take(MAX_POINTS_IN_TABLE) {
-                    out.push_str(&format!(" {} ticks {}-{};", iv.cable, iv.first_tick, iv.last_tick));
-                }
-                out.push('\n');
-            }
-            if let Some(i) = &s.interference {
-                out.push_str(&format!(
-                    "   interference: {} pair(s) checked over {} tick(s); min clearance {}; {} violation(s) below {:.3e} m{}\n",
-                    i.pairs_checked,
-                    i.ticks_checked,
-                    match (&i.min_clearance_m, &i.closest_pair) {
-                        (Some(c), Some([a, b])) => format!("{c:.6e} m ({a} / {b}, tick {})", i.tick_of_min.unwrap_or(0)),
-                        _ => format!("> {:.3e} m (no pair within the margin)", i.margin_m),
-                    },
-                    i.violations.len(),
-                    i.threshold_m,
-                    if i.informative { " (informative)" } else if i.passed { "" } else { "  FAIL" }
-                ));
-                for v in i.violations.iter().take(MAX_POINTS_IN_TABLE) {
-                    let [p, q] = v.closest_points;
-                    out.push_str(&format!(
-                        "     {} / {}: ticks {}-{}, min clearance {:.6e} m at tick {}, closest points ({:.6}, {:.6}, {:.6}) ({:.6}, {:.6}, {:.6})\n",
-                        v.pair[0], v.pair[1], v.first_tick, v.last_tick, v.min_clearance_m, v.tick_of_min,
-                        p[0], p[1], p[2], q[0], q[1], q[2]
-                    ));
-                }
-            }
-            let unstable = s.points.iter().filter(|p| p.stable == Some(false)).count();
-            let tested = s.points.iter().filter(|p| p.stable.is_some()).count();
-            let disagree = s
-                .points
-                .iter()
-                .filter(|p| p.stable.is_some() && p.analytic_stable.is_some() && p.stable != p.analytic_stable)
-                .count();
-            if tested > 0 {
-                out.push_str(&format!(
-                    "   stability: {tested} point(s) perturbed, {unstable} unstable, {disagree} disagree with the analytic sign of K\n"
-                ));
-            }
-            let mut branches: std::collections::BTreeMap<&str, usize> = std::collections::BTreeMap::new();
-            for p in &s.points {
-                *branches.entry(p.branch.as_str()).or_default() += 1;
-            }
-            for (b, n) in &branches {
-                out.push_str(&format!("   landed on: {b}: {n} point(s)\n"));
-            }
-            for (q, r) in &s.trajectory_ranges {
-                out.push_str(&format!(
-                    "   along the trajectory: {q} from {:.6e} to {:.6e}, smallest |{q}| {:.6e}\n",
-                    r.min, r.max, r.min_abs
-                ));
-            }
-            let shown = s.points.len().min(MAX_POINTS_IN_TABLE);
-            for p in &s.points[..shown] {
-                out.push_str(&format!(
-                    "   point {:>4}: {}  -> {}  [{}{}]\n",
-                    p.index,
-                    fmt_values(&p.inputs),
-                    fmt_errors(&p.analytic, &p.simulated),
-                    p.branch,
-                    if p.settled {
-                        String::new()
-                    } else {
-                        format!(", NOT SETTLED: kinetic energy {:.3e} J left", p.final_kinetic_energy_j)
-                    }
-                ));
-                if let Some(paper) = &p.paper {
-                    // The paper's value beside the testbed's analytic one, with their relative
-                    // difference.
-                    let beside: Vec<String> = paper
-                        .values
-                        .iter()
-                        .map(|(q, v)| match p.analytic.get(q.trim_start_matches("ansys_")) {
-                            Some(a) if *a != 0.0 => format!("{q}={v:.6} ({:+.1e})", (v - a) / a.abs()),
-                            _ => format!("{q}={v:.6}"),
-                        })
-                        .collect();
-                    out.push_str(&format!(
-                        "              paper, {}: {}  (relative difference from the testbed's analytic value)\n",
-                        paper.source,
-                        beside.join(" ")
-                    ));
-                }
-            }
-            if s.points.len() > shown {
-                out.push_str(&format!("   ... {} more point(s) in the JSON report\n", s.points.len() - shown));
-            }
-            let wrong: Vec<_> = s.findings.iter().filter(|f| !f.holds).collect();
-            if !s.findings.is_empty() {
-                out.push_str(&format!(
-                    "   findings: {} printed equation(s) checked, {} do not hold as printed:\n",
-                    s.findings.len(),
-                    wrong.len()
-                ));
-                for f in wrong {
-                    out.push_str(&format!("     - {}: {} ({})\n", f.equation, f.claim, f.measured));
-                }
-            }
+            s.write_table(&mut out);
         }
         out
+    }
+}
+
+impl ScenarioReport {
+    /// This scenario's part of the table.
+    fn write_table(&self, out: &mut String) {
+        self.table_header(out);
+        self.table_checks(out);
+        self.table_probe(out);
+        self.table_slack(out);
+        self.table_workspace(out);
+        self.table_intervals(out);
+        self.table_interference(out);
+        self.table_stability(out);
+        self.table_points(out);
+        self.table_findings(out);
+    }
+
+    /// The verdict line, the settle summary and why the run stopped, if it did.
+    fn table_header(&self, out: &mut String) {
+        out.push_str(&format!("== {} ({}) [{}]: {}\n", self.name, self.mechanism, self.file, self.verdict_line()));
+        out.push_str(&format!(
+            "   settle: {} point(s), all settled: {}, {} steps, {:.3} s simulated, {:.3} s wall\n",
+            self.points.len(),
+            self.settle.settled,
+            self.settle.steps,
+            self.settle.sim_time_s,
+            self.settle.wall_s
+        ));
+        if let Some(e) = &self.error {
+            out.push_str(&format!("   stopped: {e}\n"));
+        }
+    }
+
+    /// One row per check: errors at the settle points, transient errors, verdict.
+    fn table_checks(&self, out: &mut String) {
+        out.push_str(&format!(
+            "   {:<10} {:>12} {:>12} {:>10} {:>12} {:>12}  {}\n",
+            "quantity", "max |err|", "max rel err", "tolerance", "transient", "rms trans.", "verdict"
+        ));
+        for c in &self.checks {
+            out.push_str(&format!(
+                "   {:<10} {:>12.3e} {:>12.3e} {:>10.1e} {:>12.3e} {:>12.3e}  {}\n",
+                c.quantity,
+                c.max_abs_error,
+                c.max_rel_error,
+                c.tolerance,
+                c.transient_max_abs_error,
+                c.transient_rms_abs_error,
+                if c.passed { "pass" } else { "FAIL" }
+            ));
+        }
+    }
+
+    /// The stiffness probe, if any.
+    fn table_probe(&self, out: &mut String) {
+        if let Some(p) = &self.stiffness_probe {
+            out.push_str(&format!(
+                "   stiffness probe (+-{} N m): max rel err {:.3e} (tolerance {:.1e}) {}\n",
+                p.torque_nm,
+                p.max_rel_error,
+                p.tolerance,
+                if p.passed { "pass" } else { "FAIL" }
+            ));
+        }
+    }
+
+    /// Where the slack cables agree with the analytic ones, and the points where any is slack.
+    fn table_slack(&self, out: &mut String) {
+        let slack_checked: Vec<_> = self.points.iter().filter(|p| p.slack_agrees.is_some()).collect();
+        if !slack_checked.is_empty() {
+            let agree = slack_checked.iter().filter(|p| p.slack_agrees == Some(true)).count();
+            out.push_str(&format!(
+                "   slack cables: simulated set equals the analytic one at {agree} of {} point(s)\n",
+                slack_checked.len()
+            ));
+            for p in slack_checked
+                .iter()
+                .filter(|p| p.expected_slack.as_ref().is_some_and(|e| !e.is_empty()) || p.slack_agrees == Some(false))
+            {
+                out.push_str(&format!(
+                    "     point {:>4}: analytic slack [{}], simulated slack [{}]{}{}\n",
+                    p.index,
+                    p.expected_slack.as_deref().unwrap_or(&[]).join(", "),
+                    p.slack_cables.join(", "),
+                    p.distance_from_analytic_m
+                        .map(|d| format!(", {d:.3e} m from the analytic point"))
+                        .unwrap_or_default(),
+                    if p.slack_agrees == Some(false) { "  DISAGREE" } else { "" }
+                ));
+            }
+        }
+    }
+
+    /// The workspace classifications and their agreement.
+    fn table_workspace(&self, out: &mut String) {
+        if let Some(w) = &self.workspace {
+            out.push_str(&format!(
+                "   workspace: {} point(s), {} inside analytically, {} inside by the dynamics; agreement {:.2} %{}\n",
+                w.points,
+                w.analytic_inside,
+                w.simulated_inside,
+                w.agreement_percent,
+                if w.disagreements.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (disagree at points {:?})", w.disagreements)
+                }
+            ));
+            if let (Some(f), Some(pc)) = (w.inside_interference_free, w.interference_free_percent_of_inside) {
+                out.push_str(&format!(
+                    "   interference-free: {f} of the {} point(s) inside ({pc:.2} %)\n",
+                    w.simulated_inside
+                ));
+            }
+        }
+    }
+
+    /// Skipped grid points and the slack intervals.
+    fn table_intervals(&self, out: &mut String) {
+        if self.skipped_points > 0 {
+            out.push_str(&format!(
+                "   skipped: {} grid point(s) outside the mechanism's domain\n",
+                self.skipped_points
+            ));
+        }
+        if !self.slack_intervals.is_empty() {
+            out.push_str(&format!("   slack intervals ({}):", self.slack_intervals.len()));
+            for iv in self.slack_intervals.iter().take(MAX_POINTS_IN_TABLE) {
+                out.push_str(&format!(" {} ticks {}-{};", iv.cable, iv.first_tick, iv.last_tick));
+            }
+            out.push('\n');
+        }
+    }
+
+    /// Strut interference: the closest pair and every violation.
+    fn table_interference(&self, out: &mut String) {
+        if let Some(i) = &self.interference {
+            out.push_str(&format!(
+                "   interference: {} pair(s) checked over {} tick(s); min clearance {}; {} violation(s) below {:.3e} m{}\n",
+                i.pairs_checked,
+                i.ticks_checked,
+                match (&i.min_clearance_m, &i.closest_pair) {
+                    (Some(c), Some([a, b])) => format!("{c:.6e} m ({a} / {b}, tick {})", i.tick_of_min.unwrap_or(0)),
+                    _ => format!("> {:.3e} m (no pair within the margin)", i.margin_m),
+                },
+                i.violations.len(),
+                i.threshold_m,
+                if i.informative { " (informative)" } else if i.passed { "" } else { "  FAIL" }
+            ));
+            for v in i.violations.iter().take(MAX_POINTS_IN_TABLE) {
+                let [p, q] = v.closest_points;
+                out.push_str(&format!(
+                    "     {} / {}: ticks {}-{}, min clearance {:.6e} m at tick {}, closest points ({:.6}, {:.6}, {:.6}) ({:.6}, {:.6}, {:.6})\n",
+                    v.pair[0], v.pair[1], v.first_tick, v.last_tick, v.min_clearance_m, v.tick_of_min,
+                    p[0], p[1], p[2], q[0], q[1], q[2]
+                ));
+            }
+        }
+    }
+
+    /// Stability verdicts, the branches landed on, the ranges along a trajectory.
+    fn table_stability(&self, out: &mut String) {
+        let unstable = self.points.iter().filter(|p| p.stable == Some(false)).count();
+        let tested = self.points.iter().filter(|p| p.stable.is_some()).count();
+        let disagree = self
+            .points
+            .iter()
+            .filter(|p| p.stable.is_some() && p.analytic_stable.is_some() && p.stable != p.analytic_stable)
+            .count();
+        if tested > 0 {
+            out.push_str(&format!(
+                "   stability: {tested} point(s) perturbed, {unstable} unstable, {disagree} disagree with the analytic sign of K\n"
+            ));
+        }
+        let mut branches: std::collections::BTreeMap<&str, usize> = std::collections::BTreeMap::new();
+        for p in &self.points {
+            *branches.entry(p.branch.as_str()).or_default() += 1;
+        }
+        for (b, n) in &branches {
+            out.push_str(&format!("   landed on: {b}: {n} point(s)\n"));
+        }
+        for (q, r) in &self.trajectory_ranges {
+            out.push_str(&format!(
+                "   along the trajectory: {q} from {:.6e} to {:.6e}, smallest |{q}| {:.6e}\n",
+                r.min, r.max, r.min_abs
+            ));
+        }
+    }
+
+    /// The first settle points, with the paper's values where it prints them.
+    fn table_points(&self, out: &mut String) {
+        let shown = self.points.len().min(MAX_POINTS_IN_TABLE);
+        for p in &self.points[..shown] {
+            out.push_str(&format!(
+                "   point {:>4}: {}  -> {}  [{}{}]\n",
+                p.index,
+                fmt_values(&p.inputs),
+                fmt_errors(&p.analytic, &p.simulated),
+                p.branch,
+                if p.settled {
+                    String::new()
+                } else {
+                    format!(", NOT SETTLED: kinetic energy {:.3e} J left", p.final_kinetic_energy_j)
+                }
+            ));
+            if let Some(paper) = &p.paper {
+                // The paper's value beside the testbed's analytic one, with their relative
+                // difference.
+                let beside: Vec<String> = paper
+                    .values
+                    .iter()
+                    .map(|(q, v)| match p.analytic.get(q.trim_start_matches("ansys_")) {
+                        Some(a) if *a != 0.0 => format!("{q}={v:.6} ({:+.1e})", (v - a) / a.abs()),
+                        _ => format!("{q}={v:.6}"),
+                    })
+                    .collect();
+                out.push_str(&format!(
+                    "              paper, {}: {}  (relative difference from the testbed's analytic value)\n",
+                    paper.source,
+                    beside.join(" ")
+                ));
+            }
+        }
+        if self.points.len() > shown {
+            out.push_str(&format!("   ... {} more point(s) in the JSON report\n", self.points.len() - shown));
+        }
+    }
+
+    /// The printed equations that do not hold.
+    fn table_findings(&self, out: &mut String) {
+        let wrong: Vec<_> = self.findings.iter().filter(|f| !f.holds).collect();
+        if !self.findings.is_empty() {
+            out.push_str(&format!(
+                "   findings: {} printed equation(s) checked, {} do not hold as printed:\n",
+                self.findings.len(),
+                wrong.len()
+            ));
+            for f in wrong {
+                out.push_str(&format!("     - {}: {} ({})\n", f.equation, f.claim, f.measured));
+            }
+        }
     }
 }
 
