@@ -9,144 +9,13 @@ fn v(a: Vec3) -> Vector {
 }
 
 pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation, SimError> {
-    if !(settings.dt_s > 0.0 && settings.dt_s.is_finite()) {
-        return Err(SimError::Build(format!("time step must be > 0 s, got {}", settings.dt_s)));
-    }
-    if settings.substeps == 0 || settings.pgs_iterations == 0 {
-        return Err(SimError::Build("substeps and PGS iterations must be at least 1".into()));
-    }
+    check_settings(settings)?;
     let n = s.bodies.len();
-    // Actuated joints: position-controlled, each a kinematic degree of freedom of a multibody.
-    let mut actuated = vec![false; s.joints.len()];
-    for a in &s.actuators {
-        if let ActuatorTarget::Joint(j) = a.target {
-            if actuated[j] {
-                return Err(SimError::Build(format!("joint '{}' is driven by two actuators", s.joints[j].name)));
-            }
-            actuated[j] = true;
-        }
-    }
-
-    let mut bodies = RigidBodySet::new();
-    let mut handles = Vec::with_capacity(n);
-    for b in &s.bodies {
-        let builder = if b.kind == BodyKind::Fixed {
-            RigidBodyBuilder::fixed()
-        } else {
-            let inertia = b.inertia.expect("validated: free bodies have inertia");
-            RigidBodyBuilder::dynamic()
-                .can_sleep(false)
-                .additional_mass_properties(MassProperties::new(
-                    v(inertia.com),
-                    inertia.mass_kg,
-                    v(inertia.principal_kg_m2),
-                ))
-                .linear_damping(settings_body_damping(settings))
-                .angular_damping(settings_body_damping(settings))
-        };
-        handles.push(bodies.insert(builder.build()));
-    }
-
-    let mut impulse_joints = ImpulseJointSet::new();
-    let mut multibody_joints = MultibodyJointSet::new();
-    let mut joint_links = vec![None; s.joints.len()];
-    let mut joint_impulse = vec![None; s.joints.len()];
-    let mut hidden_links = Vec::new();
-    let mut fixed_roots: std::collections::BTreeMap<usize, RigidBodyHandle> = std::collections::BTreeMap::new();
-    // Bodies held by inextensible cables stay plain rigid bodies, joined by impulse joints:
-    // the configuration measured to 1e-13 on mohr2011.
-    let mut roped = vec![false; n];
-    for c in &s.cables {
-        if c.law == CableLaw::Inextensible {
-            roped[s.nodes[c.a].body] = true;
-            roped[s.nodes[c.b].body] = true;
-        }
-    }
-    let tree = plan_tree(s, &roped, &actuated)?;
-    for (j, joint) in s.joints.iter().enumerate() {
-        let (mut h1, h2) = (handles[joint.parent], handles[joint.child]);
-        if !tree[j] {
-            // An actuated joint off the tree is locked at its command by equal limits.
-            let mut data = generic_joint(s, joint);
-            if actuated[j] {
-                let q = 0.0; // the initial configuration; commands move the limits
-                data.set_limits(free_axis_of(&joint.kind), [q, q]);
-            }
-            joint_impulse[j] = Some(impulse_joints.insert(h1, h2, data, true));
-            continue;
-        }
-        // A multibody hung from a fixed body gets its own fixed root: impulse joints (cables)
-        // attached to a fixed body that is also a multibody root had no effect in rapier 0.36
-        // (measured: six rope joints from the base let the end-effector fly away).
-        if s.bodies[joint.parent].kind == BodyKind::Fixed {
-            let root =
-                *fixed_roots.entry(joint.parent).or_insert_with(|| bodies.insert(RigidBodyBuilder::fixed().build()));
-            h1 = root;
-        }
-        let link = match &joint.kind {
-            // rapier's 2-DoF multibody joints are `todo!()`: a universal joint becomes two
-            // revolute links through a hidden body that sits at the anchor.
-            JointKind::Universal { axis1, axis2 } => {
-                let anchor = v(s.nodes[joint.anchor].position);
-                let child = s.bodies[joint.child].inertia.expect("validated: free bodies have inertia");
-                let hidden = bodies.insert(
-                    RigidBodyBuilder::dynamic()
-                        .can_sleep(false)
-                        .gravity_scale(0.0)
-                        .additional_mass_properties(MassProperties::new(
-                            anchor,
-                            child.mass_kg * HIDDEN_LINK_MASS_FRACTION,
-                            v(child.principal_kg_m2) * HIDDEN_LINK_MASS_FRACTION,
-                        ))
-                        .build(),
-                );
-                let first = RevoluteJointBuilder::new(v(*axis1).normalize())
-                    .local_anchor1(anchor)
-                    .local_anchor2(anchor)
-                    .build();
-                let second = RevoluteJointBuilder::new(v(*axis2).normalize())
-                    .local_anchor1(anchor)
-                    .local_anchor2(anchor)
-                    .build();
-                let h_first = multibody_joints.insert(h1, hidden, first, true).expect("checked: no loop");
-                set_link_damping(&mut multibody_joints, h_first, joint.damping);
-                hidden_links.push(LinkRef { multibody_joint: h_first });
-                multibody_joints.insert(hidden, h2, second, true).expect("checked: no loop")
-            }
-            // An ideal position actuator: a kinematic degree of freedom, set by the command.
-            _ if actuated[j] => {
-                multibody_joints.insert_kinematic(h1, h2, generic_joint(s, joint), true).expect("checked: no loop")
-            }
-            _ => multibody_joints.insert(h1, h2, generic_joint(s, joint), true).expect("checked: no loop"),
-        };
-        set_link_damping(&mut multibody_joints, link, joint.damping);
-        joint_links[j] = Some(LinkRef { multibody_joint: link });
-    }
-
-    let mut cable_ropes = vec![None; s.cables.len()];
-    for (c, cable) in s.cables.iter().enumerate() {
-        if cable.law == CableLaw::Inextensible {
-            let (na, nb) = (&s.nodes[cable.a], &s.nodes[cable.b]);
-            if na.body == nb.body {
-                return Err(SimError::Build(format!("cable '{}' joins two nodes of the same body", cable.name)));
-            }
-            let rope = RopeJointBuilder::new(cable.length_m)
-                .local_anchor1(v(na.position))
-                .local_anchor2(v(nb.position))
-                .build();
-            cable_ropes[c] = Some(impulse_joints.insert(handles[na.body], handles[nb.body], rope, true));
-        }
-    }
-
-    let mut params = IntegrationParameters::default();
-    params.dt = settings.dt_s;
-    params.num_solver_iterations = settings.substeps;
-    params.num_internal_pgs_iterations = settings.pgs_iterations;
-    // rapier caps body speeds at 400 m/s by default: a numerical blow-up would then look like
-    // a bounded oscillation. Uncapped, it shows as divergence (energy, bounding box, NaN).
-    params.normalized_max_linear_velocity = Real::MAX;
-
-    let length_scale_m = crate::structure::structure_size(s);
+    let actuated = actuated_joints(s)?;
+    let (mut bodies, handles) = insert_bodies(s, settings);
+    let joints = insert_joints(s, &mut bodies, &handles, &actuated)?;
+    let Joints { mut impulse_joints, multibody_joints, joint_links, joint_impulse, hidden_links } = joints;
+    let cable_ropes = insert_ropes(s, &mut impulse_joints, &handles)?;
     let commands = s.initial_commands();
     let model = Model {
         structure: s.clone(),
@@ -159,22 +28,14 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         internal_closures: Vec::new(),
         projected_groups: Vec::new(),
         cable_ropes,
-        external_loads: {
-            let mut l = vec![[0.0; 3]; n];
-            for load in &s.loads {
-                for k in 0..3 {
-                    l[load.body][k] += load.force_n[k];
-                }
-            }
-            l
-        },
-        length_scale_m,
+        external_loads: external_loads(s),
+        length_scale_m: crate::structure::structure_size(s),
         tree: super::forces::Tree::default(),
     };
     let mut sim = Simulation {
         model,
         pipeline: PhysicsPipeline::new(),
-        params,
+        params: integration_parameters(settings),
         islands: IslandManager::new(),
         broad_phase: BroadPhaseBvh::new(),
         narrow_phase: NarrowPhase::new(),
@@ -194,6 +55,203 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
     sim.model.projected_groups = sim.find_projected_groups();
     sim.set_commands(&commands);
     Ok(sim)
+}
+
+fn check_settings(settings: &SimSettings) -> Result<(), SimError> {
+    if !(settings.dt_s > 0.0 && settings.dt_s.is_finite()) {
+        return Err(SimError::Build(format!("time step must be > 0 s, got {}", settings.dt_s)));
+    }
+    if settings.substeps == 0 || settings.pgs_iterations == 0 {
+        return Err(SimError::Build("substeps and PGS iterations must be at least 1".into()));
+    }
+    Ok(())
+}
+
+/// For each joint: whether an actuator drives it (position-controlled, a kinematic degree of
+/// freedom of a multibody). Two actuators on one joint are an error.
+fn actuated_joints(s: &Structure) -> Result<Vec<bool>, SimError> {
+    let mut actuated = vec![false; s.joints.len()];
+    for a in &s.actuators {
+        if let ActuatorTarget::Joint(j) = a.target {
+            if actuated[j] {
+                return Err(SimError::Build(format!("joint '{}' is driven by two actuators", s.joints[j].name)));
+            }
+            actuated[j] = true;
+        }
+    }
+    Ok(actuated)
+}
+
+/// One rapier body per structure body (free bodies never sleep, with explicit mass
+/// properties), and their handles in structure order.
+fn insert_bodies(s: &Structure, settings: &SimSettings) -> (RigidBodySet, Vec<RigidBodyHandle>) {
+    let mut bodies = RigidBodySet::new();
+    let mut handles = Vec::with_capacity(s.bodies.len());
+    for b in &s.bodies {
+        let builder = if b.kind == BodyKind::Fixed {
+            RigidBodyBuilder::fixed()
+        } else {
+            let inertia = b.inertia.expect("validated: free bodies have inertia");
+            RigidBodyBuilder::dynamic()
+                .can_sleep(false)
+                .additional_mass_properties(MassProperties::new(
+                    v(inertia.com),
+                    inertia.mass_kg,
+                    v(inertia.principal_kg_m2),
+                ))
+                .linear_damping(settings_body_damping(settings))
+                .angular_damping(settings_body_damping(settings))
+        };
+        handles.push(bodies.insert(builder.build()));
+    }
+    (bodies, handles)
+}
+
+/// The rapier joints of a structure: multibody links along the planned forest, impulse joints
+/// for the rest.
+struct Joints {
+    impulse_joints: ImpulseJointSet,
+    multibody_joints: MultibodyJointSet,
+    joint_links: Vec<Option<LinkRef>>,
+    joint_impulse: Vec<Option<ImpulseJointHandle>>,
+    hidden_links: Vec<LinkRef>,
+}
+
+fn insert_joints(
+    s: &Structure,
+    bodies: &mut RigidBodySet,
+    handles: &[RigidBodyHandle],
+    actuated: &[bool],
+) -> Result<Joints, SimError> {
+    let mut out = Joints {
+        impulse_joints: ImpulseJointSet::new(),
+        multibody_joints: MultibodyJointSet::new(),
+        joint_links: vec![None; s.joints.len()],
+        joint_impulse: vec![None; s.joints.len()],
+        hidden_links: Vec::new(),
+    };
+    let mut fixed_roots: std::collections::BTreeMap<usize, RigidBodyHandle> = std::collections::BTreeMap::new();
+    // Bodies held by inextensible cables stay plain rigid bodies, joined by impulse joints:
+    // the configuration measured to 1e-13 on mohr2011.
+    let mut roped = vec![false; s.bodies.len()];
+    for c in s.cables.iter().filter(|c| c.law == CableLaw::Inextensible) {
+        roped[s.nodes[c.a].body] = true;
+        roped[s.nodes[c.b].body] = true;
+    }
+    let tree = plan_tree(s, &roped, actuated)?;
+    for (j, joint) in s.joints.iter().enumerate() {
+        let (mut h1, h2) = (handles[joint.parent], handles[joint.child]);
+        if !tree[j] {
+            // An actuated joint off the tree is locked at its command by equal limits.
+            let mut data = generic_joint(s, joint);
+            if actuated[j] {
+                let q = 0.0; // the initial configuration; commands move the limits
+                data.set_limits(free_axis_of(&joint.kind), [q, q]);
+            }
+            out.joint_impulse[j] = Some(out.impulse_joints.insert(h1, h2, data, true));
+            continue;
+        }
+        // A multibody hung from a fixed body gets its own fixed root: impulse joints (cables)
+        // attached to a fixed body that is also a multibody root had no effect in rapier 0.36
+        // (measured: six rope joints from the base let the end-effector fly away).
+        if s.bodies[joint.parent].kind == BodyKind::Fixed {
+            let root =
+                *fixed_roots.entry(joint.parent).or_insert_with(|| bodies.insert(RigidBodyBuilder::fixed().build()));
+            h1 = root;
+        }
+        let mb = &mut out.multibody_joints;
+        let link = match &joint.kind {
+            JointKind::Universal { axis1, axis2 } => {
+                let (link, first) = insert_universal(s, joint, [*axis1, *axis2], bodies, mb, h1, h2);
+                out.hidden_links.push(first);
+                link
+            }
+            // An ideal position actuator: a kinematic degree of freedom, set by the command.
+            _ if actuated[j] => mb.insert_kinematic(h1, h2, generic_joint(s, joint), true).expect("checked: no loop"),
+            _ => mb.insert(h1, h2, generic_joint(s, joint), true).expect("checked: no loop"),
+        };
+        set_link_damping(mb, link, joint.damping);
+        out.joint_links[j] = Some(LinkRef { multibody_joint: link });
+    }
+    Ok(out)
+}
+
+/// rapier's 2-DoF multibody joints are `todo!()`: a universal joint becomes two revolute links
+/// through a hidden body that sits at the anchor. Returns the second link (the joint's own)
+/// and the first (hidden) one.
+fn insert_universal(
+    s: &Structure,
+    joint: &Joint,
+    axes: [Vec3; 2],
+    bodies: &mut RigidBodySet,
+    multibody_joints: &mut MultibodyJointSet,
+    h1: RigidBodyHandle,
+    h2: RigidBodyHandle,
+) -> (MultibodyJointHandle, LinkRef) {
+    let anchor = v(s.nodes[joint.anchor].position);
+    let child = s.bodies[joint.child].inertia.expect("validated: free bodies have inertia");
+    let hidden = bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .can_sleep(false)
+            .gravity_scale(0.0)
+            .additional_mass_properties(MassProperties::new(
+                anchor,
+                child.mass_kg * HIDDEN_LINK_MASS_FRACTION,
+                v(child.principal_kg_m2) * HIDDEN_LINK_MASS_FRACTION,
+            ))
+            .build(),
+    );
+    let revolute =
+        |axis: Vec3| RevoluteJointBuilder::new(v(axis).normalize()).local_anchor1(anchor).local_anchor2(anchor).build();
+    let h_first = multibody_joints.insert(h1, hidden, revolute(axes[0]), true).expect("checked: no loop");
+    set_link_damping(multibody_joints, h_first, joint.damping);
+    let second = multibody_joints.insert(hidden, h2, revolute(axes[1]), true).expect("checked: no loop");
+    (second, LinkRef { multibody_joint: h_first })
+}
+
+/// One rope joint per inextensible cable (None for elastic cables, which are explicit forces).
+fn insert_ropes(
+    s: &Structure,
+    impulse_joints: &mut ImpulseJointSet,
+    handles: &[RigidBodyHandle],
+) -> Result<Vec<Option<ImpulseJointHandle>>, SimError> {
+    let mut cable_ropes = vec![None; s.cables.len()];
+    for (c, cable) in s.cables.iter().enumerate() {
+        if cable.law == CableLaw::Inextensible {
+            let (na, nb) = (&s.nodes[cable.a], &s.nodes[cable.b]);
+            if na.body == nb.body {
+                return Err(SimError::Build(format!("cable '{}' joins two nodes of the same body", cable.name)));
+            }
+            let rope = RopeJointBuilder::new(cable.length_m)
+                .local_anchor1(v(na.position))
+                .local_anchor2(v(nb.position))
+                .build();
+            cable_ropes[c] = Some(impulse_joints.insert(handles[na.body], handles[nb.body], rope, true));
+        }
+    }
+    Ok(cable_ropes)
+}
+
+fn integration_parameters(settings: &SimSettings) -> IntegrationParameters {
+    let mut params = IntegrationParameters::default();
+    params.dt = settings.dt_s;
+    params.num_solver_iterations = settings.substeps;
+    params.num_internal_pgs_iterations = settings.pgs_iterations;
+    // rapier caps body speeds at 400 m/s by default: a numerical blow-up would then look like
+    // a bounded oscillation. Uncapped, it shows as divergence (energy, bounding box, NaN).
+    params.normalized_max_linear_velocity = Real::MAX;
+    params
+}
+
+/// The structure's constant external forces, summed per body [N].
+fn external_loads(s: &Structure) -> Vec<[f64; 3]> {
+    let mut l = vec![[0.0; 3]; s.bodies.len()];
+    for load in &s.loads {
+        for k in 0..3 {
+            l[load.body][k] += load.force_n[k];
+        }
+    }
+    l
 }
 
 /// Mass of the hidden body of a split universal joint, as a fraction of the child's: small, so

@@ -150,57 +150,82 @@ impl Simulation {
 
     /// Reads every member force; the equilibrium residual (a least-squares fit of the loop
     /// reactions, the costliest part) only when `with_residual` or when the forces need the fit.
-    /// The settle loop asks for it only once the motion has stopped.
     pub fn member_forces_with(&self, with_residual: bool) -> MemberForces {
-        let s = &self.model.structure;
         // Cables held at their length by the projection: their tension is fitted, not read.
         let held = self.cables_held_by_projection();
-        let nb = s.bodies.len();
-        let mut wrench: Vec<Wrench> = vec![(Vector::ZERO, Vector::ZERO); nb];
-        #[allow(clippy::type_complexity)]
-        let push = |w: &mut Vec<Wrench>, body: usize, f: Vector, p: Vector| {
-            w[body].0 += f;
-            w[body].1 += p.cross(f);
+        let (mut out, mut wrench) = self.member_loads(&held);
+        self.add_body_loads(&mut wrench);
+        // Loop-closing joints carry reactions that no force law gives. They are the unknowns of
+        // a least-squares fit: the reactions that best balance every free coordinate. At an
+        // equilibrium the fit is exact and the residual is zero; the fitted reactions are
+        // added to the bodies' loads.
+        let fit = with_residual || self.forces_need_closure_fit(&held);
+        let closure_reaction = if fit {
+            self.fit_closure_reactions(&held, &mut wrench, &mut out)
+        } else {
+            vec![(Vector::ZERO, Vector::ZERO); self.model.structure.joints.len()]
         };
-        let mut out = MemberForces::default();
-        for sp in &s.springs {
-            let (pa, pb) = (v(self.node_position(sp.a)), v(self.node_position(sp.b)));
+        if fit {
+            out.residual = Some(self.residual_of(&held, &wrench, &out));
+        }
+        out.actuator_force = self.actuator_forces(&wrench, &closure_reaction, &out);
+        out
+    }
+
+    /// Spring and cable forces at the current pose, and the wrench they put on each body
+    /// (force, moment about the world origin).
+    fn member_loads(&self, held: &[bool]) -> (MemberForces, Vec<Wrench>) {
+        let s = &self.model.structure;
+        let mut wrench: Vec<Wrench> = vec![(Vector::ZERO, Vector::ZERO); s.bodies.len()];
+        // The member from node a to node b at its current length l pulls both ends with
+        // `tension_at(l)`; returns (l, tension).
+        let mut pull = |a: usize, b: usize, tension_at: &dyn Fn(f64) -> f64| -> (f64, f64) {
+            let (pa, pb) = (v(self.node_position(a)), v(self.node_position(b)));
             let d = pb - pa;
             let l = d.length();
-            let force = sp.stiffness_n_per_m * (l - sp.rest_length_m);
+            let tension = tension_at(l);
+            if l > 0.0 {
+                let f = d / l * tension;
+                for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
+                    let w = &mut wrench[s.nodes[node].body];
+                    w.0 += f;
+                    w.1 += p.cross(f);
+                }
+            }
+            (l, tension)
+        };
+        let mut out = MemberForces::default();
+        for (i, sp) in s.springs.iter().enumerate() {
+            let m = self.elastic_member(i).expect("a spring is elastic");
+            let (l, force) = pull(sp.a, sp.b, &|l| m.tension_n(l));
             out.spring_force_n.push(force);
             out.spring_length_m.push(l);
-            if l > 0.0 {
-                let f = d / l * force;
-                push(&mut wrench, s.nodes[sp.a].body, f, pa);
-                push(&mut wrench, s.nodes[sp.b].body, -f, pb);
-            }
         }
         let inv_h = self.model.settings.substeps as f64 / self.model.settings.dt_s;
         for (c, cable) in s.cables.iter().enumerate() {
-            let (pa, pb) = (v(self.node_position(cable.a)), v(self.node_position(cable.b)));
-            let d = pb - pa;
-            let l = d.length();
-            let rest = self.cable_lengths[c];
-            let tension = match cable.law {
-                CableLaw::Elastic { stiffness_n_per_m } => (stiffness_n_per_m * (l - rest)).max(0.0),
-                // Held at its length by the projection: its tension is fitted below.
-                CableLaw::Inextensible if held[c] => 0.0,
-                CableLaw::Inextensible => self.model.cable_ropes[c]
-                    .and_then(|h| self.impulse_joints.get(h))
-                    .map(|j| j.data.limits[0].impulse.abs() * inv_h)
-                    .unwrap_or(0.0),
+            let (l, tension) = match self.elastic_member(s.springs.len() + c) {
+                Some(m) => pull(cable.a, cable.b, &|l| m.tension_n(l)),
+                // Held at its length by the projection: its tension is fitted later.
+                None if held[c] => pull(cable.a, cable.b, &|_| 0.0),
+                None => {
+                    let rope = self.model.cable_ropes[c]
+                        .and_then(|h| self.impulse_joints.get(h))
+                        .map(|j| j.data.limits[0].impulse.abs() * inv_h)
+                        .unwrap_or(0.0);
+                    pull(cable.a, cable.b, &|_| rope)
+                }
             };
             out.cable_tension_n.push(tension);
             out.cable_length_m.push(l);
-            out.cable_rest_length_m.push(rest);
+            out.cable_rest_length_m.push(self.cable_lengths[c]);
             out.cable_slack.push(tension <= 0.0);
-            if l > 0.0 {
-                let f = d / l * tension;
-                push(&mut wrench, s.nodes[cable.a].body, f, pa);
-                push(&mut wrench, s.nodes[cable.b].body, -f, pb);
-            }
         }
+        (out, wrench)
+    }
+
+    /// Adds gravity, the probe loads and the constant external loads of every free body.
+    fn add_body_loads(&self, wrench: &mut [Wrench]) {
+        let s = &self.model.structure;
         let g = v(s.gravity);
         for (b, body) in s.bodies.iter().enumerate() {
             if self.is_free(b) {
@@ -219,108 +244,101 @@ impl Simulation {
                 wrench[b].1 += com.cross(v(pf)) + v(pt);
             }
         }
+    }
 
+    /// Fits the reactions of the loop-closing joints and the tensions of the held cables by
+    /// least squares, adds them to `wrench` and `out`, and returns each closing joint's
+    /// reaction on its child (force, moment about the anchor).
+    fn fit_closure_reactions(&self, held: &[bool], wrench: &mut [Wrench], out: &mut MemberForces) -> Vec<Wrench> {
         let tree = &self.model.tree;
-
-        // Loop-closing joints carry reactions that no force law gives. They are the unknowns of
-        // a least-squares fit: the reactions that best balance every free coordinate. At an
-        // equilibrium the fit is exact and the residual is zero; the fitted reactions are
-        // added to the bodies' loads.
-        let fit = with_residual || self.forces_need_closure_fit(&held);
         let scale = self.model.length_scale_m;
-        let base = if fit { self.coordinate_forces(tree, &wrench, true) } else { Vec::new() };
+        let base = self.coordinate_forces(tree, wrench, true);
         let mut closure_loads = self.closure_unit_loads();
-        closure_loads.extend(self.projected_cable_unit_loads(&held));
-        // Fitted reaction of each loop-closing joint on its child: (force, moment about the anchor).
-        let mut closure_reaction = vec![(Vector::ZERO, Vector::ZERO); s.joints.len()];
-        if !closure_loads.is_empty() && !base.is_empty() {
-            let rows = base.len();
-            let cols = closure_loads.len();
-            let scaled = |c: &CoordinateForce| {
-                if c.is_torque {
-                    c.value / scale
-                } else {
-                    c.value
-                }
-            };
-            let mut g = nalgebra::DMatrix::<f64>::zeros(rows, cols);
-            for (k, load) in closure_loads.iter().enumerate() {
-                let col = self.coordinate_forces(tree, &load.loads, false);
-                for (r, c) in col.iter().enumerate() {
-                    g[(r, k)] = scaled(c);
-                }
+        closure_loads.extend(self.projected_cable_unit_loads(held));
+        let mut closure_reaction = vec![(Vector::ZERO, Vector::ZERO); self.model.structure.joints.len()];
+        if closure_loads.is_empty() || base.is_empty() {
+            return closure_reaction;
+        }
+        let scaled = |c: &CoordinateForce| if c.is_torque { c.value / scale } else { c.value };
+        let mut g = nalgebra::DMatrix::<f64>::zeros(base.len(), closure_loads.len());
+        for (k, load) in closure_loads.iter().enumerate() {
+            for (r, c) in self.coordinate_forces(tree, &load.loads, false).iter().enumerate() {
+                g[(r, k)] = scaled(c);
             }
-            let r0 = nalgebra::DVector::<f64>::from_iterator(rows, base.iter().map(scaled));
-            if let Some(lambda) = super::least_squares::min_norm_solve(&g, &(-r0), CLOSURE_SVD_RELATIVE_TOLERANCE) {
-                for (k, load) in closure_loads.iter().enumerate() {
-                    for b in 0..nb {
-                        wrench[b].0 += load.loads[b].0 * lambda[k];
-                        wrench[b].1 += load.loads[b].1 * lambda[k];
-                    }
-                    match load.member {
-                        ClosureMember::Joint(j) => {
-                            closure_reaction[j].0 += load.force * lambda[k];
-                            closure_reaction[j].1 += load.moment * lambda[k];
-                        }
-                        ClosureMember::Cable(c) => {
-                            out.cable_tension_n[c] = lambda[k];
-                            out.cable_slack[c] = lambda[k] <= 0.0;
-                        }
-                    }
+        }
+        let r0 = nalgebra::DVector::<f64>::from_iterator(base.len(), base.iter().map(scaled));
+        let Some(lambda) = super::least_squares::min_norm_solve(&g, &(-r0), CLOSURE_SVD_RELATIVE_TOLERANCE) else {
+            return closure_reaction;
+        };
+        for (k, load) in closure_loads.iter().enumerate() {
+            for (w, l) in wrench.iter_mut().zip(&load.loads) {
+                w.0 += l.0 * lambda[k];
+                w.1 += l.1 * lambda[k];
+            }
+            match load.member {
+                ClosureMember::Joint(j) => {
+                    closure_reaction[j].0 += load.force * lambda[k];
+                    closure_reaction[j].1 += load.moment * lambda[k];
+                }
+                ClosureMember::Cable(c) => {
+                    out.cable_tension_n[c] = lambda[k];
+                    out.cable_slack[c] = lambda[k] <= 0.0;
                 }
             }
         }
+        closure_reaction
+    }
+
+    /// The largest generalized force left on a free coordinate once every load is on the
+    /// bodies, and a held cable's push (a negative fitted tension: no equilibrium).
+    fn residual_of(&self, held: &[bool], wrench: &[Wrench], out: &MemberForces) -> Residual {
+        let s = &self.model.structure;
         let mut residual = Residual::default();
-        let fitted = fit;
-        // A held cable whose fitted tension is negative would have to push: no equilibrium.
         for (c, cable) in s.cables.iter().enumerate() {
             if matches!(cable.law, CableLaw::Inextensible) && held[c] {
                 residual.max_force_n = residual.max_force_n.max((-out.cable_tension_n[c]).max(0.0));
             }
         }
-        if fitted {
-            for c in self.coordinate_forces(tree, &wrench, true) {
-                if c.is_torque {
-                    residual.max_torque_nm = residual.max_torque_nm.max(c.value.abs());
-                } else {
-                    residual.max_force_n = residual.max_force_n.max(c.value.abs());
-                }
+        for c in self.coordinate_forces(&self.model.tree, wrench, true) {
+            if c.is_torque {
+                residual.max_torque_nm = residual.max_torque_nm.max(c.value.abs());
+            } else {
+                residual.max_force_n = residual.max_force_n.max(c.value.abs());
             }
-            out.residual = Some(residual);
         }
-        let subtree_wrench = |root: usize| -> Wrench { tree.subtree_wrench(s, &wrench, root) };
-        let about = |w: Wrench, p: Vector| -> Vector { w.1 - p.cross(w.0) };
+        residual
+    }
 
-        // Actuator forces: minus the load of everything the actuated joint carries.
-        for a in &s.actuators {
-            let f = match a.target {
+    /// Each actuator's force along its joint axis (or its cable's tension): minus the load of
+    /// everything the actuated joint carries, or the fitted reaction of a joint locked off the
+    /// tree.
+    fn actuator_forces(&self, wrench: &[Wrench], closure_reaction: &[Wrench], out: &MemberForces) -> Vec<f64> {
+        let s = &self.model.structure;
+        let about = |w: Wrench, p: Vector| -> Vector { w.1 - p.cross(w.0) };
+        let along = |joint: &crate::structure::Joint, force: Vector, moment: Vector| {
+            let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
+            match &joint.kind {
+                JointKind::Revolute { axis } => moment.dot((parent_rot * v(*axis)).normalize()),
+                JointKind::Prismatic { axis } => force.dot((parent_rot * v(*axis)).normalize()),
+                _ => f64::NAN,
+            }
+        };
+        s.actuators
+            .iter()
+            .map(|a| match a.target {
                 ActuatorTarget::CableLength(c) => out.cable_tension_n[c],
-                // Locked off the tree: its torque (force) is the fitted closure reaction.
                 ActuatorTarget::Joint(j) if self.model.joint_impulse[j].is_some() => {
-                    let joint = &s.joints[j];
-                    let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
                     let (f, m) = closure_reaction[j];
-                    match &joint.kind {
-                        JointKind::Revolute { axis } => m.dot((parent_rot * v(*axis)).normalize()),
-                        JointKind::Prismatic { axis } => f.dot((parent_rot * v(*axis)).normalize()),
-                        _ => f64::NAN,
-                    }
+                    along(&s.joints[j], f, m)
                 }
                 ActuatorTarget::Joint(j) => {
                     let joint = &s.joints[j];
-                    let w = subtree_wrench(joint.child);
+                    let w = self.model.tree.subtree_wrench(s, wrench, joint.child);
                     let anchor = v(self.node_position(joint.anchor));
-                    let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
-                    match &joint.kind {
-                        JointKind::Revolute { axis } => -about(w, anchor).dot((parent_rot * v(*axis)).normalize()),
-                        JointKind::Prismatic { axis } => -w.0.dot((parent_rot * v(*axis)).normalize()),
-                        _ => f64::NAN,
-                    }
+                    -along(joint, w.0, about(w, anchor))
                 }
-            };
-            out.actuator_force.push(f);
-        }
-        out
+            })
+            .collect()
     }
 }
 
