@@ -500,133 +500,171 @@ impl Simulation {
     /// velocities of its bodies and multibodies. Returns the largest row left [m].
     pub(super) fn project_groups(&mut self) -> f64 {
         let groups = std::mem::take(&mut self.model.projected_groups);
-        let scale = self.model.length_scale_m;
         let mut largest = 0.0_f64;
         for g in &groups {
             let Some(taut) = self.projected_taut_cables(g) else { continue };
-            // Coordinates of the projection: per plain body a translation [m] and a rotation
-            // vector times the structure's size [m], about the centre of mass; then each
-            // multibody's free coordinates [m or rad].
-            // (The free coordinates are read here: rapier counts a fixed root's six degrees of
-            // freedom until its first forward kinematics.)
-            let multibodies: Vec<(MultibodyIndex, Vec<usize>)> =
-                g.multibodies.iter().map(|&m| (m, self.free_dofs(m))).collect();
+            let coords = GroupCoordinates::of(self, g);
             // The body Jacobians at the current coordinates (the Jacobian below reads them).
             for &m in &g.multibodies {
                 if let Some(mb) = self.multibody_joints.get_multibody_mut(m) {
                     mb.forward_kinematics(&self.bodies, false);
                 }
             }
-            let n_plain = 6 * g.bodies.len();
-            let ndof = n_plain + multibodies.iter().map(|(_, d)| d.len()).sum::<usize>();
-            // The multibody and its degree of freedom behind coordinate k >= n_plain.
-            let multibody_dof = |k: usize| {
-                let mut k = k - n_plain;
-                for (m, dofs) in &multibodies {
-                    if k < dofs.len() {
-                        return (*m, dofs[k]);
-                    }
-                    k -= dofs.len();
-                }
-                unreachable!("coordinate index within the group's count")
-            };
-            let displace_all = |sim: &mut Simulation, dq: &[f64]| {
-                for (i, &b) in g.bodies.iter().enumerate() {
-                    let q = &dq[6 * i..6 * i + 6];
-                    sim.nudge(b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / scale);
-                }
-                let mut k = n_plain;
-                for (m, dofs) in &multibodies {
-                    let Some(mb) = sim.multibody_joints.get_multibody(*m) else { continue };
-                    let mut disp = vec![0.0; mb.ndofs()];
-                    for &dof in dofs {
-                        disp[dof] = dq[k];
-                        k += 1;
-                    }
-                    sim.displace(*m, &disp);
-                }
-            };
             let rows = |sim: &Simulation| {
                 let mut out = Vec::new();
                 sim.group_rows(g, &taut, &mut out);
                 out
             };
-            // The Jacobian from each coordinate's twists of the bodies it moves: a plain body's
-            // unit translation or rotation about its centre of mass, a multibody link's column
-            // of rapier's body Jacobian (centre-of-mass velocity and angular velocity).
-            let jacobian = |sim: &mut Simulation, g0: &[f64]| {
-                let mut jac = nalgebra::DMatrix::<f64>::zeros(g0.len(), ndof);
-                let mut twists: Vec<Option<Twist>> = vec![None; sim.model.structure.bodies.len()];
-                for k in 0..ndof {
-                    twists.iter_mut().for_each(|t| *t = None);
-                    if k < n_plain {
-                        let b = g.bodies[k / 6];
-                        let mut q = [Vector::ZERO; 2];
-                        q[(k % 6) / 3][k % 3] = 1.0;
-                        twists[b] = Some(Twist { v: q[0], w: q[1] / scale, at: sim.world_com(b) });
-                    } else {
-                        let (m, dof) = multibody_dof(k);
-                        let Some(mb) = sim.multibody_joints.get_multibody(m) else { continue };
-                        for (b, twist) in twists.iter_mut().enumerate() {
-                            let h = sim.model.handles[b];
-                            let Some(link) = sim.multibody_joints.rigid_body_link(h).filter(|l| l.multibody == m)
-                            else {
-                                continue;
-                            };
-                            let col = mb.body_jacobian(link.id).column(dof);
-                            *twist = Some(Twist {
-                                v: Vector::new(col[0], col[1], col[2]),
-                                w: Vector::new(col[3], col[4], col[5]),
-                                at: sim.bodies[h].center_of_mass(),
-                            });
-                        }
-                    }
-                    let mut column = Vec::with_capacity(g0.len());
-                    sim.group_row_rates(g, &taut, &twists, &mut column);
-                    for (r, x) in column.into_iter().enumerate() {
-                        jac[(r, k)] = x;
-                    }
-                }
-                jac
-            };
-            let (jac, left) = close_rows(self, &rows, &jacobian, &displace_all);
+            let jacobian = |sim: &mut Simulation, g0: &[f64]| coords.jacobian(sim, g, &taut, g0.len());
+            let displace = |sim: &mut Simulation, dq: &[f64]| coords.displace(sim, g, dq);
+            let (jac, left) = close_rows(self, &rows, &jacobian, &displace);
             largest = largest.max(left);
             if jac.nrows() == 0 {
                 continue;
             }
-            // Velocities u = [v, w L] per plain body, then the multibodies' free generalized
-            // velocities: remove J^+ (J u) over every row, taut cables included (they were just
-            // held at their length: a cable goes slack when rapier's rope stops pulling, and is
-            // then no longer taut here).
-            let mut u = nalgebra::DVector::<f64>::zeros(ndof);
-            for (i, &b) in g.bodies.iter().enumerate() {
-                let rb = &self.bodies[self.model.handles[b]];
-                let (v, w) = (rb.linvel(), rb.angvel() * scale);
-                for (r, x) in [v.x, v.y, v.z, w.x, w.y, w.z].into_iter().enumerate() {
-                    u[6 * i + r] = x;
-                }
-            }
-            for k in n_plain..ndof {
-                let (m, dof) = multibody_dof(k);
-                u[k] = self.multibody_joints.get_multibody(m).map_or(0.0, |mb| mb.generalized_velocity()[dof]);
-            }
+            // Remove J^+ (J u) from the velocities u over every row, taut cables included (they
+            // were just held at their length: a cable goes slack when rapier's rope stops
+            // pulling, and is then no longer taut here).
+            let u = coords.velocities(self, g);
             if let Some(du) = min_norm_solve(&jac, &(&jac * &u)) {
-                for (i, &b) in g.bodies.iter().enumerate() {
-                    let rb = &mut self.bodies[self.model.handles[b]];
-                    let v = rb.linvel() - Vector::new(du[6 * i], du[6 * i + 1], du[6 * i + 2]);
-                    let w = rb.angvel() - Vector::new(du[6 * i + 3], du[6 * i + 4], du[6 * i + 5]) / scale;
-                    rb.set_linvel(v, true);
-                    rb.set_angvel(w, true);
-                }
-                for k in n_plain..ndof {
-                    let (m, dof) = multibody_dof(k);
-                    if let Some(mb) = self.multibody_joints.get_multibody_mut(m) {
-                        mb.generalized_velocity_mut()[dof] -= du[k];
-                    }
-                }
+                coords.remove_velocities(self, g, &du);
             }
         }
         self.model.projected_groups = groups;
         largest
+    }
+}
+
+/// The coordinates of a projected group: per plain body a translation [m] and a rotation
+/// vector times the structure's size [m], about the centre of mass; then each multibody's free
+/// coordinates [m or rad].
+struct GroupCoordinates {
+    /// Six per plain body.
+    n_plain: usize,
+    /// Each multibody with its free degrees of freedom.
+    multibodies: Vec<(MultibodyIndex, Vec<usize>)>,
+    /// The structure's size [m], which scales rotations to lengths.
+    scale: f64,
+}
+
+impl GroupCoordinates {
+    /// The free coordinates are read here: rapier counts a fixed root's six degrees of freedom
+    /// until its first forward kinematics.
+    fn of(sim: &Simulation, g: &ProjectedGroup) -> Self {
+        GroupCoordinates {
+            n_plain: 6 * g.bodies.len(),
+            multibodies: g.multibodies.iter().map(|&m| (m, sim.free_dofs(m))).collect(),
+            scale: sim.model.length_scale_m,
+        }
+    }
+
+    fn count(&self) -> usize {
+        self.n_plain + self.multibodies.iter().map(|(_, d)| d.len()).sum::<usize>()
+    }
+
+    /// The multibody and its degree of freedom behind coordinate k >= n_plain.
+    fn multibody_dof(&self, k: usize) -> (MultibodyIndex, usize) {
+        let mut k = k - self.n_plain;
+        for (m, dofs) in &self.multibodies {
+            if k < dofs.len() {
+                return (*m, dofs[k]);
+            }
+            k -= dofs.len();
+        }
+        unreachable!("coordinate index within the group's count")
+    }
+
+    /// Moves every coordinate by `dq`.
+    fn displace(&self, sim: &mut Simulation, g: &ProjectedGroup, dq: &[f64]) {
+        for (i, &b) in g.bodies.iter().enumerate() {
+            let q = &dq[6 * i..6 * i + 6];
+            sim.nudge(b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / self.scale);
+        }
+        let mut k = self.n_plain;
+        for (m, dofs) in &self.multibodies {
+            let Some(mb) = sim.multibody_joints.get_multibody(*m) else { continue };
+            let mut disp = vec![0.0; mb.ndofs()];
+            for &dof in dofs {
+                disp[dof] = dq[k];
+                k += 1;
+            }
+            sim.displace(*m, &disp);
+        }
+    }
+
+    /// The Jacobian of the group's `rows` rows from each coordinate's twists of the bodies it
+    /// moves: a plain body's unit translation or rotation about its centre of mass, a
+    /// multibody link's column of rapier's body Jacobian (centre-of-mass velocity and angular
+    /// velocity).
+    fn jacobian(&self, sim: &Simulation, g: &ProjectedGroup, taut: &[usize], rows: usize) -> nalgebra::DMatrix<f64> {
+        let ndof = self.count();
+        let mut jac = nalgebra::DMatrix::<f64>::zeros(rows, ndof);
+        let mut twists: Vec<Option<Twist>> = vec![None; sim.model.structure.bodies.len()];
+        for k in 0..ndof {
+            twists.iter_mut().for_each(|t| *t = None);
+            if k < self.n_plain {
+                let b = g.bodies[k / 6];
+                let mut q = [Vector::ZERO; 2];
+                q[(k % 6) / 3][k % 3] = 1.0;
+                twists[b] = Some(Twist { v: q[0], w: q[1] / self.scale, at: sim.world_com(b) });
+            } else {
+                let (m, dof) = self.multibody_dof(k);
+                let Some(mb) = sim.multibody_joints.get_multibody(m) else { continue };
+                for (b, twist) in twists.iter_mut().enumerate() {
+                    let h = sim.model.handles[b];
+                    let Some(link) = sim.multibody_joints.rigid_body_link(h).filter(|l| l.multibody == m) else {
+                        continue;
+                    };
+                    let col = mb.body_jacobian(link.id).column(dof);
+                    *twist = Some(Twist {
+                        v: Vector::new(col[0], col[1], col[2]),
+                        w: Vector::new(col[3], col[4], col[5]),
+                        at: sim.bodies[h].center_of_mass(),
+                    });
+                }
+            }
+            let mut column = Vec::with_capacity(rows);
+            sim.group_row_rates(g, taut, &twists, &mut column);
+            for (r, x) in column.into_iter().enumerate() {
+                jac[(r, k)] = x;
+            }
+        }
+        jac
+    }
+
+    /// The velocities in these coordinates: u = [v, w L] per plain body, then the
+    /// multibodies' free generalized velocities.
+    fn velocities(&self, sim: &Simulation, g: &ProjectedGroup) -> nalgebra::DVector<f64> {
+        let ndof = self.count();
+        let mut u = nalgebra::DVector::<f64>::zeros(ndof);
+        for (i, &b) in g.bodies.iter().enumerate() {
+            let rb = &sim.bodies[sim.model.handles[b]];
+            let (v, w) = (rb.linvel(), rb.angvel() * self.scale);
+            for (r, x) in [v.x, v.y, v.z, w.x, w.y, w.z].into_iter().enumerate() {
+                u[6 * i + r] = x;
+            }
+        }
+        for k in self.n_plain..ndof {
+            let (m, dof) = self.multibody_dof(k);
+            u[k] = sim.multibody_joints.get_multibody(m).map_or(0.0, |mb| mb.generalized_velocity()[dof]);
+        }
+        u
+    }
+
+    /// Subtracts `du` (in these coordinates) from the bodies' and multibodies' velocities.
+    fn remove_velocities(&self, sim: &mut Simulation, g: &ProjectedGroup, du: &nalgebra::DVector<f64>) {
+        for (i, &b) in g.bodies.iter().enumerate() {
+            let rb = &mut sim.bodies[sim.model.handles[b]];
+            let v = rb.linvel() - Vector::new(du[6 * i], du[6 * i + 1], du[6 * i + 2]);
+            let w = rb.angvel() - Vector::new(du[6 * i + 3], du[6 * i + 4], du[6 * i + 5]) / self.scale;
+            rb.set_linvel(v, true);
+            rb.set_angvel(w, true);
+        }
+        for k in self.n_plain..self.count() {
+            let (m, dof) = self.multibody_dof(k);
+            if let Some(mb) = sim.multibody_joints.get_multibody_mut(m) {
+                mb.generalized_velocity_mut()[dof] -= du[k];
+            }
+        }
     }
 }
