@@ -241,6 +241,17 @@ impl Structure {
     /// Checks references, lengths and masses. Every built-in mechanism and every file-described
     /// structure goes through this before it reaches the simulator.
     pub fn validate(&self) -> Result<(), StructureError> {
+        self.validate_bodies()?;
+        self.validate_nodes()?;
+        self.validate_members()?;
+        self.validate_joints()?;
+        self.validate_actuators()?;
+        self.validate_loads()?;
+        Ok(())
+    }
+
+    /// Body names are unique; a free body has a finite mass and inertia > 0.
+    fn validate_bodies(&self) -> Result<(), StructureError> {
         let mut seen = std::collections::BTreeSet::new();
         for b in &self.bodies {
             if !seen.insert(&b.name) {
@@ -257,6 +268,11 @@ impl Structure {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Node names are unique, each on an existing body, at finite coordinates.
+    fn validate_nodes(&self) -> Result<(), StructureError> {
         let mut seen = std::collections::BTreeSet::new();
         for n in &self.nodes {
             if !seen.insert(&n.name) {
@@ -267,6 +283,11 @@ impl Structure {
                 return Err(invalid("node", &n.name, "coordinates must be finite numbers"));
             }
         }
+        Ok(())
+    }
+
+    /// Struts, springs and cables join existing distinct nodes, with finite positive sizes and stiffnesses.
+    fn validate_members(&self) -> Result<(), StructureError> {
         for s in &self.struts {
             self.check_member("strut", &s.name, s.a, s.b)?;
             if !(s.radius_m >= 0.0 && s.radius_m.is_finite()) {
@@ -293,6 +314,11 @@ impl Structure {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Joints join two different existing bodies (the child free) at an existing node, along finite non-zero axes; torsion springs on revolute joints only.
+    fn validate_joints(&self) -> Result<(), StructureError> {
         for j in &self.joints {
             self.check_body("joint", &j.name, j.parent)?;
             self.check_body("joint", &j.name, j.child)?;
@@ -321,6 +347,11 @@ impl Structure {
                 return Err(invalid("joint", &j.name, "damping must be a finite number >= 0"));
             }
         }
+        Ok(())
+    }
+
+    /// Actuators drive an existing revolute or prismatic joint without a torsion spring, or an existing cable.
+    fn validate_actuators(&self) -> Result<(), StructureError> {
         for a in &self.actuators {
             match a.target {
                 ActuatorTarget::Joint(j) => {
@@ -357,6 +388,11 @@ impl Structure {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// External loads act on existing bodies with finite forces.
+    fn validate_loads(&self) -> Result<(), StructureError> {
         for (i, load) in self.loads.iter().enumerate() {
             self.check_body("load", &format!("#{i}"), load.body)?;
             if load.force_n.iter().any(|f| !f.is_finite()) {
