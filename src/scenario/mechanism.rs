@@ -1,0 +1,63 @@
+//! `mechanism` and `[structure]`: a built-in mechanism by name, or the file's own structure.
+
+use super::error::{finite, Ctx, ScenarioError};
+use super::raw::RawScenario;
+use super::structure::structure_from_file;
+use crate::custom::Custom;
+use crate::mechanisms::{self, Mechanism, Values};
+
+/// `mechanism = "custom"`: the mechanism built from the `[structure]` table, with each check's
+/// expected value (required: there is no analytic model). A built-in mechanism: `None`, and
+/// neither a `[structure]` nor a check's value may be given.
+pub(super) fn custom(ctx: &Ctx, raw: &RawScenario) -> Result<Option<Custom>, ScenarioError> {
+    match (raw.mechanism.get_ref().as_str(), &raw.structure) {
+        ("custom", Some(st)) => {
+            let structure = structure_from_file(ctx, st)?;
+            let mut expected = Values::new();
+            for c in &raw.checks {
+                let v = c.value.as_ref().ok_or_else(|| {
+                    ctx.err(
+                        &c.quantity,
+                        "a custom structure has no analytic model: give the expected value (value = ...)",
+                    )
+                })?;
+                expected.insert(c.quantity.get_ref().clone(), finite(ctx, v, "value")?);
+            }
+            Ok(Some(Custom::new(structure, expected)))
+        }
+        ("custom", None) => Err(ctx.err(
+            &raw.mechanism,
+            "mechanism = \"custom\" needs a [structure] table (bodies, struts, springs, cables, joints, actuators)",
+        )),
+        (_, Some(st)) => Err(ctx.err(st, "a [structure] table goes with mechanism = \"custom\" only")),
+        _ => match raw.checks.iter().find_map(|c| c.value.as_ref()) {
+            Some(v) => Err(ctx.err(
+                v,
+                "value is for custom structures; a built-in mechanism's checks compare with its analytic model",
+            )),
+            None => Ok(None),
+        },
+    }
+}
+
+/// The scenario's mechanism: the custom one, or the built-in one `raw.mechanism` names.
+pub(super) fn mechanism(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    custom: Option<&Custom>,
+) -> Result<Box<dyn Mechanism>, ScenarioError> {
+    match custom {
+        Some(c) => Ok(Box::new(c.clone())),
+        None => mechanisms::find(raw.mechanism.get_ref()).ok_or_else(|| {
+            let known: Vec<_> = mechanisms::registry().iter().map(|m| m.name()).collect();
+            ctx.err(
+                &raw.mechanism,
+                format!(
+                    "unknown mechanism '{}' (expected one of: {}, custom)",
+                    raw.mechanism.get_ref(),
+                    known.join(", ")
+                ),
+            )
+        }),
+    }
+}

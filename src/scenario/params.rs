@@ -1,0 +1,25 @@
+//! `[params]` and `[start]`: named numbers the mechanism declares.
+
+use super::error::{known_keys, value_at, values, Ctx, ScenarioError};
+use super::raw::SpannedMap;
+use crate::mechanisms::{self, Mechanism, Values};
+
+/// Parameters: known symbols, finite, then the mechanism's own ranges; the result holds every
+/// parameter, the missing ones at the mechanism's defaults.
+pub(super) fn params(ctx: &Ctx, m: &dyn Mechanism, raw: &SpannedMap) -> Result<Values, ScenarioError> {
+    let known: Vec<_> = m.params().iter().map(|p| p.symbol).collect();
+    known_keys(ctx, raw, &known, "parameter", m.name())?;
+    let given = values(ctx, raw)?;
+    let params = mechanisms::with_defaults(m, &given);
+    if let Err((sym, msg)) = m.validate_params(&params) {
+        return Err(ctx.err_at(value_at(raw, &sym).unwrap_or(0), msg));
+    }
+    Ok(params)
+}
+
+/// The start of the free coordinates: known keys, finite.
+pub(super) fn start(ctx: &Ctx, m: &dyn Mechanism, raw: &SpannedMap) -> Result<Values, ScenarioError> {
+    let known: Vec<_> = m.start_keys().iter().map(|(key, _)| *key).collect();
+    known_keys(ctx, raw, &known, "start key", m.name())?;
+    values(ctx, raw)
+}

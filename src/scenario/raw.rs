@@ -1,0 +1,244 @@
+//! The shape of a scenario file, as serde reads it: every value keeps its span, so that
+//! [`super::validate`] can name the line and column of a value it rejects.
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use toml::Spanned;
+
+pub(super) type SpannedMap = BTreeMap<Spanned<String>, Spanned<f64>>;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawScenario {
+    pub(super) name: Spanned<String>,
+    #[serde(default)]
+    pub(super) description: String,
+    pub(super) mechanism: Spanned<String>,
+    #[serde(default)]
+    pub(super) params: SpannedMap,
+    #[serde(default)]
+    pub(super) sim: RawSim,
+    #[serde(default)]
+    pub(super) settle: RawSettle,
+    #[serde(default)]
+    pub(super) start: SpannedMap,
+    pub(super) actuation: Spanned<RawActuation>,
+    #[serde(default)]
+    pub(super) checks: Vec<RawCheck>,
+    #[serde(default)]
+    pub(super) stability: Option<RawStability>,
+    #[serde(default)]
+    pub(super) probe: Option<RawProbe>,
+    #[serde(default)]
+    pub(super) record: Option<RawRecord>,
+    #[serde(default)]
+    pub(super) interference: Option<Spanned<RawInterference>>,
+    #[serde(default)]
+    pub(super) workspace: Option<RawWorkspace>,
+    /// `mechanism = "custom"`: the structure itself.
+    #[serde(default)]
+    pub(super) structure: Option<Spanned<RawStructure>>,
+    /// What the run must do: pass, or fail in named parts.
+    #[serde(default)]
+    pub(super) expect: Option<Spanned<RawExpect>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawExpect {
+    /// "pass" or "fail".
+    pub(super) verdict: Spanned<String>,
+    /// With "fail": every part of the verdict that must fail, and no other
+    /// (see [`crate::settings::FAILURE_NAMES`]).
+    #[serde(default)]
+    pub(super) failing: Vec<Spanned<String>>,
+}
+
+pub(super) type Xyz = Spanned<[f64; 3]>;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawStructure {
+    /// Gravity [m/s^2] (default none).
+    pub(super) gravity: Option<Xyz>,
+    #[serde(default)]
+    pub(super) bodies: Vec<RawBody>,
+    #[serde(default)]
+    pub(super) struts: Vec<RawMember>,
+    #[serde(default)]
+    pub(super) springs: Vec<RawMember>,
+    #[serde(default)]
+    pub(super) cables: Vec<RawMember>,
+    #[serde(default)]
+    pub(super) joints: Vec<RawJoint>,
+    #[serde(default)]
+    pub(super) actuators: Vec<RawActuator>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawBody {
+    pub(super) name: Spanned<String>,
+    /// Welded to the world (default false).
+    pub(super) fixed: Option<bool>,
+    /// Mass of a free body [kg].
+    pub(super) mass: Option<Spanned<f64>>,
+    /// Principal moments about the centre of mass, along the world axes [kg m^2] (default:
+    /// isotropic, mass times the square of the body's size over 12).
+    pub(super) inertia: Option<Xyz>,
+    /// Named nodes with their coordinates [m] (the centre of mass is their mean).
+    pub(super) nodes: BTreeMap<Spanned<String>, Xyz>,
+}
+
+/// A strut, spring or cable between two named nodes.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawMember {
+    pub(super) name: Spanned<String>,
+    pub(super) a: Spanned<String>,
+    pub(super) b: Spanned<String>,
+    /// Struts: radius [m] (default 0.01).
+    pub(super) radius: Option<Spanned<f64>>,
+    /// Springs: stiffness [N/m] (required); cables: stiffness of an elastic cable (absent:
+    /// inextensible).
+    pub(super) stiffness: Option<Spanned<f64>>,
+    /// Springs: free length [m]; cables: unstretched length [m]. Absent: the initial distance.
+    pub(super) length: Option<Spanned<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawJoint {
+    pub(super) name: Spanned<String>,
+    /// revolute, prismatic, spherical, universal, fixed or planar_pin.
+    pub(super) kind: Spanned<String>,
+    pub(super) parent: Spanned<String>,
+    pub(super) child: Spanned<String>,
+    /// The node at the joint's centre.
+    pub(super) at: Spanned<String>,
+    pub(super) axis: Option<Xyz>,
+    /// Universal joints: the second axis (fixed in the child).
+    pub(super) axis2: Option<Xyz>,
+    /// Revolute joints: a linear torsion spring [N m/rad], at rest in the given geometry plus
+    /// `torsion_rest` [rad].
+    pub(super) torsion_stiffness: Option<Spanned<f64>>,
+    pub(super) torsion_rest: Option<Spanned<f64>>,
+    /// Viscous damping [N m s/rad or N s/m].
+    pub(super) damping: Option<Spanned<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawActuator {
+    pub(super) symbol: Spanned<String>,
+    pub(super) joint: Option<Spanned<String>>,
+    pub(super) cable: Option<Spanned<String>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawWorkspace {
+    /// The run passes when the analytic and dynamic workspace classifications agree at least
+    /// at this percentage of the points; checks and settling are then reported per point.
+    pub(super) min_agreement_percent: Spanned<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawInterference {
+    /// Clearance below which a pair violates [m] (default 0: actual overlap only).
+    pub(super) threshold: Option<Spanned<f64>>,
+    /// Pairs farther apart are not measured [m] (default: the mechanism's length scale).
+    pub(super) margin: Option<Spanned<f64>>,
+    /// Report violations without failing the run (default false).
+    pub(super) informative: Option<bool>,
+    /// Further strut pairs to exclude, by name.
+    #[serde(default)]
+    pub(super) exclude: Vec<Spanned<(String, String)>>,
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSim {
+    pub(super) dt: Option<Spanned<f64>>,
+    pub(super) substeps: Option<Spanned<i64>>,
+    pub(super) pgs_iterations: Option<Spanned<i64>>,
+    /// PGS iterations while approaching an equilibrium, before the final phase at
+    /// `pgs_iterations` (default: the same, one phase).
+    pub(super) approach_pgs_iterations: Option<Spanned<i64>>,
+    /// The Newton damping schedule (default false: the structure's fixed damping).
+    pub(super) newton_damping: Option<Spanned<bool>>,
+    pub(super) body_damping: Option<Spanned<f64>>,
+    pub(super) bounding_box: Option<Spanned<f64>>,
+    /// Kinetic energy above which the run has diverged [J] (default 1e6).
+    pub(super) max_kinetic_energy: Option<Spanned<f64>>,
+    /// Anchor gap of a loop-closing joint above which the run has diverged [m] (default 1 % of
+    /// the structure's size).
+    pub(super) max_joint_gap: Option<Spanned<f64>>,
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSettle {
+    pub(super) speed_tol: Option<Spanned<f64>>,
+    pub(super) window: Option<Spanned<i64>>,
+    pub(super) residual_force_tol: Option<Spanned<f64>>,
+    pub(super) residual_torque_tol: Option<Spanned<f64>>,
+    pub(super) max_time: Option<Spanned<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawRange {
+    pub(super) from: Spanned<f64>,
+    pub(super) to: Spanned<f64>,
+    pub(super) count: Spanned<i64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawActuation {
+    /// A grid of inputs, each settled one by one (row-major in the inputs' order).
+    pub(super) grid: Option<BTreeMap<Spanned<String>, Spanned<RawRange>>>,
+    /// Explicit input sets, each settled one by one.
+    pub(super) points: Option<Vec<Spanned<SpannedMap>>>,
+    /// Waypoints in time (key `t` in s), linearly interpolated, held at the last; the run is
+    /// compared tick by tick and settled after the last waypoint.
+    pub(super) waypoints: Option<Vec<Spanned<SpannedMap>>>,
+    /// Grid and points: start each point from the previous equilibrium (default true).
+    pub(super) continuation: Option<bool>,
+    /// Grid only: drop grid points outside the mechanism's domain (for example outside the
+    /// kinematic workspace) instead of rejecting the file; they are counted in the report.
+    pub(super) skip_outside: Option<bool>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawCheck {
+    pub(super) quantity: Spanned<String>,
+    pub(super) tolerance: Spanned<f64>,
+    /// Custom structures only: the expected value (there is no analytic model).
+    pub(super) value: Option<Spanned<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawStability {
+    /// Displacement of every free coordinate [rad or m].
+    pub(super) perturbation: Spanned<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawProbe {
+    /// Probe torque [N m] (applied as +torque and -torque).
+    pub(super) torque: Spanned<f64>,
+    /// Tolerance on the relative stiffness error.
+    pub(super) tolerance: Spanned<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawRecord {
+    pub(super) path: Spanned<String>,
+}

@@ -1,0 +1,272 @@
+//! `[structure]`: the bodies, members, joints and actuators of a `mechanism = "custom"` file,
+//! built into a [`Structure`].
+
+use super::error::{finite, positive_value, Ctx, ScenarioError};
+use super::raw::{RawActuator, RawBody, RawJoint, RawMember, RawStructure, Xyz};
+use crate::structure::{
+    Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut,
+    TorsionSpring,
+};
+use toml::Spanned;
+
+/// Smallest size used for a body's default inertia [m].
+const MIN_BODY_SIZE_M: f64 = 1e-3;
+
+/// Strut radius when the file gives none [m].
+const DEFAULT_STRUT_RADIUS_M: f64 = 0.01;
+
+/// Builds the structure of a `[structure]` table; every bad reference, zero-length member or
+/// massless free body is an error at its place in the file.
+pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Result<Structure, ScenarioError> {
+    let r = raw.get_ref();
+    let mut s = Structure { name: "custom".into(), ..Default::default() };
+    if let Some(g) = &r.gravity {
+        s.gravity = xyz(ctx, g, "gravity")?;
+    }
+    if r.bodies.is_empty() {
+        return Err(ctx.err(raw, "[structure] needs at least one body ([[structure.bodies]])"));
+    }
+    let mut body_names: Vec<String> = Vec::new();
+    for b in &r.bodies {
+        if body_names.contains(b.name.get_ref()) {
+            return Err(ctx.err(&b.name, format!("duplicate body name '{}'", b.name.get_ref())));
+        }
+        body_names.push(b.name.get_ref().clone());
+        add_body(ctx, &mut s, b)?;
+    }
+    // Each part refers only to the parts built before it.
+    s.struts = r.struts.iter().map(|m| strut(ctx, &s, m)).collect::<Result<_, _>>()?;
+    s.springs = r.springs.iter().map(|m| spring(ctx, &s, m)).collect::<Result<_, _>>()?;
+    s.cables = r.cables.iter().map(|m| cable(ctx, &s, m)).collect::<Result<_, _>>()?;
+    s.joints = r.joints.iter().map(|j| joint(ctx, &s, j)).collect::<Result<_, _>>()?;
+    s.actuators = r.actuators.iter().map(|a| actuator(ctx, &s, a)).collect::<Result<_, _>>()?;
+    s.validate().map_err(|e| ctx.err(raw, format!("the structure is not valid: {e}")))?;
+    Ok(s)
+}
+
+/// Three finite numbers.
+fn xyz(ctx: &Ctx, v: &Xyz, what: &str) -> Result<[f64; 3], ScenarioError> {
+    let a = *v.get_ref();
+    if a.iter().all(|c| c.is_finite()) {
+        Ok(a)
+    } else {
+        Err(ctx.err(v, format!("{what} must be three finite numbers, got {a:?}")))
+    }
+}
+
+/// Adds a body (at least one node, a mass if free) and its nodes (names unique in the
+/// structure) to `s`.
+fn add_body(ctx: &Ctx, s: &mut Structure, b: &RawBody) -> Result<(), ScenarioError> {
+    if b.nodes.is_empty() {
+        return Err(ctx.err(
+            &b.name,
+            format!("body '{}' needs at least one node (nodes = {{ N1 = [x, y, z] }})", b.name.get_ref()),
+        ));
+    }
+    let mut pts = Vec::new();
+    for (n, p) in &b.nodes {
+        pts.push((n, xyz(ctx, p, "a node's coordinates")?));
+    }
+    let fixed = b.fixed.unwrap_or(false);
+    let inertia = if fixed {
+        None
+    } else {
+        let points: Vec<[f64; 3]> = pts.iter().map(|(_, p)| *p).collect();
+        Some(inertia(ctx, b, &points)?)
+    };
+    let id = s.add_body(b.name.get_ref(), if fixed { BodyKind::Fixed } else { BodyKind::Free }, inertia);
+    for (n, p) in pts {
+        if s.node_id(n.get_ref()).is_some() {
+            return Err(ctx.err(n, format!("duplicate node name '{}'", n.get_ref())));
+        }
+        s.add_node(n.get_ref(), id, p);
+    }
+    Ok(())
+}
+
+/// The inertia of a free body with nodes at `pts`: its mass > 0 kg, the centre of mass at the
+/// nodes' mean, the principal moments as given (each > 0) or isotropic from the body's size.
+fn inertia(ctx: &Ctx, b: &RawBody, pts: &[[f64; 3]]) -> Result<Inertia, ScenarioError> {
+    let m = b.mass.as_ref().ok_or_else(|| {
+        ctx.err(&b.name, format!("free body '{}' needs a mass > 0 kg (mass = ...), or fixed = true", b.name.get_ref()))
+    })?;
+    let mass = finite(ctx, m, "mass")?;
+    if mass <= 0.0 {
+        return Err(ctx.err(m, format!("mass must be > 0 kg, got {mass}")));
+    }
+    let n = pts.len() as f64;
+    let com = [0, 1, 2].map(|k| pts.iter().map(|p| p[k]).sum::<f64>() / n);
+    let size = pts
+        .iter()
+        .flat_map(|a| pts.iter().map(move |b| crate::structure::distance(*a, *b)))
+        .fold(MIN_BODY_SIZE_M, f64::max);
+    let principal = match &b.inertia {
+        Some(i) => {
+            let v = xyz(ctx, i, "inertia")?;
+            if v.iter().any(|x| *x <= 0.0) {
+                return Err(ctx.err(i, "inertia must be three moments > 0 kg m^2"));
+            }
+            v
+        }
+        None => [mass * size * size / 12.0; 3],
+    };
+    Ok(Inertia { mass_kg: mass, com, principal_kg_m2: principal })
+}
+
+/// The id of a declared node.
+fn node(ctx: &Ctx, s: &Structure, n: &Spanned<String>) -> Result<usize, ScenarioError> {
+    s.node_id(n.get_ref()).ok_or_else(|| {
+        ctx.err(n, format!("unknown node '{}' (nodes are declared in the bodies' nodes tables)", n.get_ref()))
+    })
+}
+
+/// The id of a declared body.
+fn body(ctx: &Ctx, s: &Structure, n: &Spanned<String>) -> Result<usize, ScenarioError> {
+    s.body_id(n.get_ref()).ok_or_else(|| ctx.err(n, format!("unknown body '{}'", n.get_ref())))
+}
+
+/// A member's two nodes and the distance between them (> 0).
+fn ends(ctx: &Ctx, s: &Structure, m: &RawMember, what: &str) -> Result<(usize, usize, f64), ScenarioError> {
+    let (a, b) = (node(ctx, s, &m.a)?, node(ctx, s, &m.b)?);
+    let l = crate::structure::distance(s.nodes[a].position, s.nodes[b].position);
+    if l <= 0.0 {
+        return Err(ctx.err(&m.name, format!("{what} '{}' has zero length: its nodes coincide", m.name.get_ref())));
+    }
+    Ok((a, b, l))
+}
+
+/// A strut, with its radius > 0 (default [`DEFAULT_STRUT_RADIUS_M`]).
+fn strut(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Strut, ScenarioError> {
+    let (a, b, _) = ends(ctx, s, m, "strut")?;
+    let radius = match &m.radius {
+        Some(v) => positive_value(ctx, v, "radius (m)")?,
+        None => DEFAULT_STRUT_RADIUS_M,
+    };
+    Ok(Strut { name: m.name.get_ref().clone(), a, b, radius_m: radius })
+}
+
+/// A spring: its stiffness > 0 (required) and free length >= 0 (default: the initial distance).
+fn spring(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Spring, ScenarioError> {
+    let (a, b, l) = ends(ctx, s, m, "spring")?;
+    let k = m.stiffness.as_ref().ok_or_else(|| ctx.err(&m.name, "a spring needs a stiffness (N/m)"))?;
+    let rest = match &m.length {
+        Some(v) => {
+            let x = finite(ctx, v, "length (m)")?;
+            if x < 0.0 {
+                return Err(ctx.err(v, format!("a spring's free length must be >= 0 m, got {x}")));
+            }
+            x
+        }
+        None => l,
+    };
+    Ok(Spring {
+        name: m.name.get_ref().clone(),
+        a,
+        b,
+        stiffness_n_per_m: positive_value(ctx, k, "stiffness (N/m)")?,
+        rest_length_m: rest,
+    })
+}
+
+/// A cable: elastic with a stiffness > 0, else inextensible; its length > 0 (default: the
+/// initial distance).
+fn cable(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Cable, ScenarioError> {
+    let (a, b, l) = ends(ctx, s, m, "cable")?;
+    let law = match &m.stiffness {
+        Some(k) => CableLaw::Elastic { stiffness_n_per_m: positive_value(ctx, k, "stiffness (N/m)")? },
+        None => CableLaw::Inextensible,
+    };
+    let length = match &m.length {
+        Some(v) => positive_value(ctx, v, "length (m)")?,
+        None => l,
+    };
+    Ok(Cable { name: m.name.get_ref().clone(), a, b, law, length_m: length })
+}
+
+/// A joint between two declared bodies at a declared node, with its optional torsion spring
+/// (revolute joints) and damping >= 0.
+fn joint(ctx: &Ctx, s: &Structure, j: &RawJoint) -> Result<Joint, ScenarioError> {
+    let kind = joint_kind(ctx, j)?;
+    let (parent, child, at) = (body(ctx, s, &j.parent)?, body(ctx, s, &j.child)?, node(ctx, s, &j.at)?);
+    let torsion_spring = match &j.torsion_stiffness {
+        Some(k) => Some(TorsionSpring {
+            stiffness_nm_per_rad: positive_value(ctx, k, "torsion_stiffness (N m/rad)")?,
+            rest_angle_rad: match &j.torsion_rest {
+                Some(v) => finite(ctx, v, "torsion_rest")?,
+                None => 0.0,
+            },
+        }),
+        None => None,
+    };
+    let damping = match &j.damping {
+        Some(v) => {
+            let x = finite(ctx, v, "damping")?;
+            if x < 0.0 {
+                return Err(ctx.err(v, format!("damping must be >= 0, got {x}")));
+            }
+            x
+        }
+        None => 0.0,
+    };
+    Ok(Joint {
+        name: j.name.get_ref().clone(),
+        kind,
+        parent,
+        child,
+        anchor: at,
+        initial_coordinate: 0.0,
+        torsion_spring,
+        damping,
+    })
+}
+
+/// A joint's kind, with the axes it needs.
+fn joint_kind(ctx: &Ctx, j: &RawJoint) -> Result<JointKind, ScenarioError> {
+    Ok(match j.kind.get_ref().as_str() {
+        "revolute" => JointKind::Revolute { axis: axis(ctx, j, &j.axis, "axis")? },
+        "prismatic" => JointKind::Prismatic { axis: axis(ctx, j, &j.axis, "axis")? },
+        "spherical" => JointKind::Spherical,
+        "universal" => {
+            JointKind::Universal { axis1: axis(ctx, j, &j.axis, "axis")?, axis2: axis(ctx, j, &j.axis2, "axis2")? }
+        }
+        "fixed" => JointKind::Fixed,
+        "planar_pin" => JointKind::PlanarPin { axis: axis(ctx, j, &j.axis, "axis")? },
+        other => {
+            return Err(ctx.err(
+                &j.kind,
+                format!("unknown joint kind '{other}' (expected revolute, prismatic, spherical, universal, fixed or planar_pin)"),
+            ))
+        }
+    })
+}
+
+/// A joint's axis `what`: required by its kind, three finite numbers, not zero.
+fn axis(ctx: &Ctx, j: &RawJoint, v: &Option<Xyz>, what: &str) -> Result<[f64; 3], ScenarioError> {
+    let v =
+        v.as_ref().ok_or_else(|| ctx.err(&j.kind, format!("a {} joint needs {what} = [x, y, z]", j.kind.get_ref())))?;
+    let a = xyz(ctx, v, what)?;
+    if a.iter().all(|c| *c == 0.0) {
+        return Err(ctx.err(v, format!("{what} must not be zero")));
+    }
+    Ok(a)
+}
+
+/// An actuator driving exactly one declared joint or cable.
+fn actuator(ctx: &Ctx, s: &Structure, a: &RawActuator) -> Result<Actuator, ScenarioError> {
+    let target = match (&a.joint, &a.cable) {
+        (Some(j), None) => ActuatorTarget::Joint(
+            s.joints
+                .iter()
+                .position(|x| &x.name == j.get_ref())
+                .ok_or_else(|| ctx.err(j, format!("unknown joint '{}'", j.get_ref())))?,
+        ),
+        (None, Some(c)) => ActuatorTarget::CableLength(
+            s.cables
+                .iter()
+                .position(|x| &x.name == c.get_ref())
+                .ok_or_else(|| ctx.err(c, format!("unknown cable '{}'", c.get_ref())))?,
+        ),
+        _ => return Err(ctx.err(&a.symbol, "an actuator drives exactly one of: joint = \"name\", cable = \"name\"")),
+    };
+    Ok(Actuator { symbol: a.symbol.get_ref().clone(), target })
+}
