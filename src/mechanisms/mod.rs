@@ -2,10 +2,13 @@
 //! pure functions) and `build.rs` (parameters -> [`Structure`]); `mod.rs` ties them to the
 //! [`Mechanism`] trait that the rest of the testbed uses.
 
+mod finding;
 pub mod furet2018;
 pub mod ji2014;
 pub mod manriquez2019;
 pub mod mohr2011;
+
+pub use finding::{finding, Finding};
 
 use crate::snapshot::Snapshot;
 use crate::structure::Structure;
@@ -84,15 +87,6 @@ pub struct Prediction {
     /// says are slack here. A non-empty set means the analytic point is not an equilibrium:
     /// the settled state is not checked against it; the slack set is.
     pub expected_slack: Option<Vec<String>>,
-}
-
-/// A printed equation checked against the testbed's derivation.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Finding {
-    pub equation: String,
-    pub claim: String,
-    pub measured: String,
-    pub holds: bool,
 }
 
 /// A small load applied to a body to measure a stiffness in the simulation.

@@ -60,6 +60,7 @@
 //!   two aspects (`det J > 0` / `< 0`); two same-aspect solutions are joined by
 //!   [`nonsingular_path`] (the manipulator is cuspidal).
 
+use crate::mechanisms::{finding, Finding};
 use nalgebra::{Complex, Matrix2, Matrix4, Vector2};
 use std::collections::VecDeque;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -995,19 +996,6 @@ pub fn nonsingular_path(p: &Params, from: (f64, f64), to: (f64, f64), grid_n: us
 // ---------------------------------------------------------------------------
 // Findings.
 // ---------------------------------------------------------------------------
-
-/// One checked claim of the paper.
-#[derive(Clone, Debug)]
-pub struct Finding {
-    pub equation: &'static str,
-    pub claim: String,
-    pub measured: String,
-    pub holds: bool,
-}
-
-fn finding(equation: &'static str, claim: &str, measured: String, holds: bool) -> Finding {
-    Finding { equation, claim: claim.to_string(), measured, holds }
-}
 
 /// Representative joint angles [rad]: a 9 x 9 grid offset from the special values.
 fn sample_joints() -> Vec<(f64, f64)> {

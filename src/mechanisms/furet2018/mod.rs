@@ -287,8 +287,5 @@ impl Mechanism for Furet2018 {
     }
     fn findings(&self, params: &Values) -> Vec<Finding> {
         analytic::findings(&params_of(params))
-            .into_iter()
-            .map(|f| Finding { equation: f.equation.to_string(), claim: f.claim, measured: f.measured, holds: f.holds })
-            .collect()
     }
 }

@@ -28,6 +28,7 @@
 //! * Inverse kinematics in closed form from Eq. 48: `delta1 cos th2 - delta2
 //!   sin th2 + sqrt3 K1 L = 0` is one trigonometric equation in `th2` only.
 
+use crate::mechanisms::{finding, Finding};
 use nalgebra::{Matrix2, Vector2};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_3, PI};
 
@@ -800,19 +801,6 @@ pub fn stiffness_eq52(p: &Params, x: f64, y: f64) -> f64 {
 // ---------------------------------------------------------------------------
 // Findings.
 // ---------------------------------------------------------------------------
-
-/// One checked claim of the paper.
-#[derive(Clone, Debug)]
-pub struct Finding {
-    pub equation: &'static str,
-    pub claim: String,
-    pub measured: String,
-    pub holds: bool,
-}
-
-fn finding(equation: &'static str, claim: &str, measured: String, holds: bool) -> Finding {
-    Finding { equation, claim: claim.to_string(), measured, holds }
-}
 
 /// Representative inputs `(L3, theta1)` for `p`: `L3 in {0.25, 0.7, 1.3, 2} L`,
 /// `theta1 in {0.15, 0.9, 1.7, 2.6, 3.05}`.

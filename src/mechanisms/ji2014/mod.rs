@@ -348,8 +348,5 @@ impl Mechanism for Ji2014 {
     }
     fn findings(&self, params: &Values) -> Vec<Finding> {
         analytic::findings(&params_of(params))
-            .into_iter()
-            .map(|f| Finding { equation: f.equation.to_string(), claim: f.claim, measured: f.measured, holds: f.holds })
-            .collect()
     }
 }

@@ -47,6 +47,7 @@
 //! universal joint carries tension as well. As printed, Eq. 26-27 require
 //! `|f_joint| <= 0` and `|m_joint| = 0`, which Table 5 itself violates.
 
+use crate::mechanisms::{finding, Finding};
 use nalgebra::{Matrix2, Matrix3, Matrix4, Vector2, Vector3};
 
 // ---------------------------------------------------------------------------
@@ -919,19 +920,6 @@ pub fn count_equilibria(p: &Params, grid: &[(f64, f64)]) -> usize {
 // ---------------------------------------------------------------------------
 // Findings.
 // ---------------------------------------------------------------------------
-
-/// One checked claim of the paper.
-#[derive(Clone, Debug)]
-pub struct Finding {
-    pub equation: &'static str,
-    pub claim: String,
-    pub measured: String,
-    pub holds: bool,
-}
-
-fn finding(equation: &'static str, claim: &str, measured: String, holds: bool) -> Finding {
-    Finding { equation, claim: claim.to_string(), measured, holds }
-}
 
 /// Sample joint coordinates for the generic identities [rad].
 const SAMPLE_THETAS: [(f64, f64); 6] =

@@ -394,8 +394,5 @@ impl Mechanism for Manriquez2019 {
     }
     fn findings(&self, params: &Values) -> Vec<Finding> {
         analytic::findings(&params_of(params))
-            .into_iter()
-            .map(|f| Finding { equation: f.equation.to_string(), claim: f.claim, measured: f.measured, holds: f.holds })
-            .collect()
     }
 }

@@ -56,6 +56,7 @@
 //! * `det W_t = det[p+a1, p+a2, p+a3] * (-3/2 lb^4 z^2) / (rho1 rho2 rho3)^2`
 //!   `= -3 sqrt3/4 z^3 lb^6 / (rho1 rho2 rho3)^2` (Eq. 25 holds).
 
+use crate::mechanisms::Finding;
 use nalgebra::{Matrix3, Matrix6, Matrix6x3, Rotation3, Vector3, Vector6};
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -703,15 +704,6 @@ pub fn pair_difference_rotation_jacobian(p: &Params, centroid: &Vector3<f64>) ->
 // Findings: every printed equation checked numerically.
 // ---------------------------------------------------------------------------
 
-/// One numeric check of a printed equation or claim.
-#[derive(Clone, Debug)]
-pub struct Finding {
-    pub equation: &'static str,
-    pub claim: String,
-    pub measured: String,
-    pub holds: bool,
-}
-
 /// Deterministic sample of centroids inside the kinematic workspace [m].
 pub fn sample_points(p: &Params, n: usize) -> Vec<Vector3<f64>> {
     // Low-discrepancy R3 sequence (additive recurrence with 1/g, 1/g^2, 1/g^3,
@@ -758,7 +750,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     let side = (a[1] - a[0]).norm().max((a[2] - a[1]).norm()).max((a[0] - a[2]).norm());
     let cen = (a[0] + a[1] + a[2]).norm();
     out.push(Finding {
-        equation: "Eq. 1-2",
+        equation: "Eq. 1-2".into(),
         claim: "a_i equilateral of side lb centred at O, X along A1A2, Y through A3; b_i = -a_i (b3 read as lb(0,-sqrt3/3,0))".into(),
         measured: format!("max side {side:.15} (lb = {}), |sum a_i| = {cen:.1e}, a3.x = {}", p.lb, a[2].x),
         holds: (side - p.lb).abs() < tol * p.lb && cen < tol * p.lb,
@@ -776,7 +768,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         }
     }
     out.push(Finding {
-        equation: "Eq. 6-10, 15",
+        equation: "Eq. 6-10, 15".into(),
         claim: "paired cables equal and rho_j = |p + a_j|".into(),
         measured: format!(
             "{} points: max rel pair mismatch {worst_pair:.1e}, max rel |len - rho| {worst_rho:.1e}",
@@ -790,7 +782,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     let printed = rho_sq_eq11_as_printed(p, &c0, 0);
     let truth = ikp(p, &c0)[0].powi(2);
     out.push(Finding {
-        equation: "Eq. 11",
+        equation: "Eq. 11".into(),
         claim: "rho_i^2 = x^2+y^2+z^2+2x a_ix+2y a_iy+a_iy^2+a_iy^2".into(),
         measured: format!(
             "at p=(0,0,3): printed rho1^2 = {printed:.6}, |p+a1|^2 = {truth:.6} (last term must be a_ix^2: |a_i|^2 = lb^2/3); Eq. 12-14 do not inherit the typo"
@@ -810,7 +802,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
             .max((rad - 3.0 * p.lb * p.lb * c.z * c.z).abs() / (p.lb.powi(2) * rho.iter().map(|r| r * r).sum::<f64>()));
     }
     out.push(Finding {
-        equation: "Eq. 12-14",
+        equation: "Eq. 12-14".into(),
         claim: "x, y, z (z>0 branch) from rho1..3".into(),
         measured: format!("DKP(IKP(p)) = p to {worst_dkp:.1e} lb; radicand = 3 lb^2 z^2 to {worst_rad:.1e} rel"),
         holds: worst_dkp < 1e-8 && worst_rad < tol,
@@ -826,7 +818,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         }
     }
     out.push(Finding {
-        equation: "Eq. 16-18",
+        equation: "Eq. 16-18".into(),
         claim: "l_i = |p + b_i - a_i| = |p - 2 a_i|: spheres about 2 a_i of radius l_min, l_max".into(),
         measured: format!(
             "|B_i - A_i| vs |p - 2a_i|: max rel diff {worst_l:.1e}; z_max on the axis sqrt(lo^2 - 4 lb^2/3) = {:.6}",
@@ -850,13 +842,13 @@ pub fn findings(p: &Params) -> Vec<Finding> {
             worst_eq5.max((spring_force_eq5_as_printed(p, l) - spring_force(p, l)).abs() / spring_force(p, l).abs());
     }
     out.push(Finding {
-        equation: "Eq. 3",
+        equation: "Eq. 3".into(),
         claim: "theta = asin(l/lo) (links lo/2, knee angle 2 theta)".into(),
         measured: format!("l = 2 (lo/2) sin theta to {worst_geom:.1e} lo"),
         holds: worst_geom < tol,
     });
     out.push(Finding {
-        equation: "Eq. 4-5",
+        equation: "Eq. 4-5".into(),
         claim: "f = 2 kappa (2 asin(l/lo) - pi) / (lo sqrt(1-(l/lo)^2))".into(),
         measured: format!("equals dE/dl (central difference) to {worst_de:.1e} rel and tau/h to {worst_eq5:.1e} rel"),
         holds: worst_de < 1e-6 && worst_eq5 < tol,
@@ -868,7 +860,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     let f0 = spring_force(p, 0.0);
     let lim = spring_force_full_extension_limit(p);
     out.push(Finding {
-        equation: "Sec. 4.2 (spring at l_i = lo)",
+        equation: "Sec. 4.2 (spring at l_i = lo)".into(),
         claim: "fully extended springs no longer apply any compressive force".into(),
         measured: format!(
             "Eq. 5: f(0.999 lo) = {f999:.6} N, f((1-1e-9) lo) = {f1:.6} N -> -4 kappa/lo = {lim:.6} N (vs f(0) = -2 pi kappa/lo = {f0:.6} N); \
@@ -880,7 +872,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     // Eq. 20-21.
     let worst_wt = pts.iter().map(|c| (wt(p, c) - wt_as_printed(p, c)).abs().max()).fold(0.0f64, f64::max);
     out.push(Finding {
-        equation: "Eq. 20-21",
+        equation: "Eq. 20-21".into(),
         claim: "W_t top row n1 n2 n3 n1 n2 n3, moment arms b3 b3 b2 b2 b1 b1".into(),
         measured: format!("printed W_t = W_t from the six cables to {worst_wt:.1e} (cable j+3 is parallel to cable j)"),
         holds: worst_wt < tol,
@@ -896,7 +888,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         worst_w = worst_w.max(wrench(p, c, &s.spring_forces, &s.tensions_closed_form).norm() / (fscale * p.lo));
     }
     out.push(Finding {
-        equation: "Eq. 24, 26-28",
+        equation: "Eq. 24, 26-28".into(),
         claim: "t1=t4, t2=t5, t3=t6 = rho_j/2 (fh_j - fh_k - fh_l)".into(),
         measured: format!(
             "closed form vs 6x6 LU: max rel diff {worst_t:.1e}; wrench residual of closed form {worst_w:.1e} (rel)"
@@ -909,7 +901,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     let dder = max_rel(pts.iter().map(|c| (det_wt_derived(p, c), det_wt(p, c))));
     let cex = Vector3::new(0.3, -0.2, 2.0);
     out.push(Finding {
-        equation: "Eq. 25",
+        equation: "Eq. 25".into(),
         claim: "det W_t = -3 sqrt3/4 z^3 lb^6 / (rho1 rho2 rho3)^2".into(),
         measured: format!(
             "max rel diff from numeric det {d25:.1e} (block-elimination form {dder:.1e}); e.g. p = (0.3,-0.2,2): {:.10} vs {:.10}",
@@ -932,7 +924,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     }
     let nstat = pts.iter().filter(|c| classify(p, c).region == Region::Static).count();
     out.push(Finding {
-        equation: "Eq. 29-31",
+        equation: "Eq. 29-31".into(),
         claim: "all cables taut iff fh_j - fh_k - fh_l > 0, j = 1..3".into(),
         measured: format!(
             "{} points x 3 pairs: {mismatch} disagreements with the sign of the Eq. 24 tensions ({nstat} of the points static); \
@@ -946,7 +938,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     let q = Params { kappa: p.kappa * 1000.0, ..*p };
     let diff = pts.iter().filter(|c| classify(p, c) != classify(&q, c)).count();
     out.push(Finding {
-        equation: "Sec. 4.2, 5 (kappa)",
+        equation: "Sec. 4.2, 5 (kappa)".into(),
         claim: "static-workspace boundaries independent of the spring stiffness".into(),
         measured: format!(
             "classification with kappa and 1000 kappa differs at {diff} of {} points (f is linear in kappa)",
@@ -958,7 +950,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     // Sec. 4.2: outer boundary = kinematic boundary l_i = l_max.
     let ob = outer_boundary_survey(p, OUTER_SURVEY_N);
     out.push(Finding {
-        equation: "Sec. 4.2 (outer boundary)",
+        equation: "Sec. 4.2 (outer boundary)".into(),
         claim: "outer static boundaries = kinematic boundaries l_i = l_max, because the spring stops pushing there".into(),
         measured: format!(
             "on {} points of the sphere l_1 = lo inside the other two: {} static with Eq. 5 (f_1 -> -4 kappa/lo), \
@@ -976,7 +968,7 @@ pub fn findings(p: &Params) -> Vec<Finding> {
         min_det = min_det.min(j.determinant().abs() / (p.lb.powi(3)));
     }
     out.push(Finding {
-        equation: "Sec. 2 / Eq. 6",
+        equation: "Sec. 2 / Eq. 6".into(),
         claim: "cables taut and actuated in pairs keep the end-effector parallel to the base".into(),
         measured: format!(
             "locally true: the 3x3 Jacobian of the pair-length differences w.r.t. rotation is nonsingular, min |det|/lb^3 = {min_det:.2e} over {} points \

@@ -433,10 +433,7 @@ impl Mechanism for Mohr2011 {
         Some(s.nodes.iter().map(|n| n.position).collect())
     }
     fn findings(&self, params: &Values) -> Vec<Finding> {
-        let mut out: Vec<Finding> = analytic::findings(&params_of(params))
-            .into_iter()
-            .map(|f| Finding { equation: f.equation.to_string(), claim: f.claim, measured: f.measured, holds: f.holds })
-            .collect();
+        let mut out = analytic::findings(&params_of(params));
         out.push(gravity_finding(params));
         out
     }
