@@ -2,12 +2,14 @@
 //! pure functions) and `build.rs` (parameters -> [`Structure`]); `mod.rs` ties them to the
 //! [`Mechanism`] trait that the rest of the testbed uses.
 
+mod angle;
 mod finding;
 pub mod furet2018;
 pub mod ji2014;
 pub mod manriquez2019;
 pub mod mohr2011;
 
+pub use angle::wrap_angle;
 pub use finding::{finding, Finding};
 
 use crate::snapshot::Snapshot;
@@ -236,14 +238,4 @@ pub fn require_non_negative(v: &Values, specs: &[(&str, &str)]) -> Result<(), (S
 /// The value of input `key`, or an error naming it.
 pub fn input(inputs: &Values, key: &str) -> Result<f64, String> {
     inputs.get(key).copied().ok_or_else(|| format!("missing input '{key}'"))
-}
-
-/// Wraps an angle difference to (-pi, pi].
-pub fn wrap_angle(a: f64) -> f64 {
-    let two_pi = std::f64::consts::TAU;
-    let mut r = a.rem_euclid(two_pi);
-    if r > std::f64::consts::PI {
-        r -= two_pi;
-    }
-    r
 }

@@ -60,6 +60,8 @@
 //!   two aspects (`det J > 0` / `< 0`); two same-aspect solutions are joined by
 //!   [`nonsingular_path`] (the manipulator is cuspidal).
 
+/// Wraps an angle to `(-pi, pi]` (one definition for the testbed, in `mechanisms`).
+pub use crate::mechanisms::wrap_angle;
 use crate::mechanisms::{finding, Finding};
 use nalgebra::{Complex, Matrix2, Matrix4, Vector2};
 use std::collections::VecDeque;
@@ -123,16 +125,6 @@ impl Params {
             return Err(format!("L must be > b (assembly condition), got L = {} <= b = {}", self.l, self.b));
         }
         Ok(())
-    }
-}
-
-/// Wrap an angle to `(-pi, pi]`.
-pub fn wrap_angle(a: f64) -> f64 {
-    let t = a.rem_euclid(TWO_PI);
-    if t > PI {
-        t - TWO_PI
-    } else {
-        t
     }
 }
 

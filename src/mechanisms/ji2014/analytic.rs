@@ -28,14 +28,14 @@
 //! * Inverse kinematics in closed form from Eq. 48: `delta1 cos th2 - delta2
 //!   sin th2 + sqrt3 K1 L = 0` is one trigonometric equation in `th2` only.
 
+/// Wraps an angle to `(-pi, pi]` (one definition for the testbed, in `mechanisms`).
+pub use crate::mechanisms::wrap_angle;
 use crate::mechanisms::{finding, Finding};
 use nalgebra::{Matrix2, Vector2};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_3, PI};
 
 /// `sqrt(3)`, appears throughout the equilateral-triangle geometry.
 pub const SQRT_3: f64 = 1.732_050_807_568_877_2;
-/// Full turn [rad].
-const TWO_PI: f64 = 2.0 * PI;
 /// Eq. 31: the paper limits the actuator to `0 <= L3 <= 2L`.
 pub const PAPER_L3_MAX_OVER_L: f64 = 2.0;
 /// Figs. 4-6 example: actuator length `L3 = 6 m`.
@@ -206,16 +206,6 @@ pub fn stiffness_eq42(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
     let e = energy_coefficients_eq4(p, l3, theta1);
     let (s2, c2) = theta2.sin_cos();
     -e.a * c2 - e.b * s2
-}
-
-/// Wrap an angle to `(-pi, pi]`.
-pub fn wrap_angle(a: f64) -> f64 {
-    let t = a.rem_euclid(TWO_PI);
-    if t > PI {
-        t - TWO_PI
-    } else {
-        t
-    }
 }
 
 /// An equilibrium (`tau = 0`) for fixed inputs.
@@ -1331,6 +1321,8 @@ mod tests {
     use proptest::prelude::*;
 
     const P: Params = Params::PAPER_WORKSPACE;
+    /// Full turn [rad].
+    const TWO_PI: f64 = 2.0 * PI;
 
     /// Deterministic 64-bit LCG (Knuth MMIX constants) -> uniform [0, 1).
     struct Lcg(u64);
