@@ -2,6 +2,7 @@
 
 pub mod analytic;
 pub mod build;
+pub mod findings;
 
 use super::{
     input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind,
@@ -347,6 +348,6 @@ impl Mechanism for Ji2014 {
         })
     }
     fn findings(&self, params: &Values) -> Vec<Finding> {
-        analytic::findings(&params_of(params))
+        findings::findings(&params_of(params))
     }
 }
