@@ -3,6 +3,7 @@
 
 pub mod analytic;
 pub mod build;
+pub mod findings;
 
 use super::{
     input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind,
@@ -286,6 +287,6 @@ impl Mechanism for Furet2018 {
         Some(s.nodes.iter().map(|n| n.position).collect())
     }
     fn findings(&self, params: &Values) -> Vec<Finding> {
-        analytic::findings(&params_of(params))
+        findings::findings(&params_of(params))
     }
 }
