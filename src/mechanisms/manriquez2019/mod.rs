@@ -3,6 +3,7 @@
 
 pub mod analytic;
 pub mod build;
+pub mod findings;
 
 use super::{
     input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind,
@@ -393,6 +394,6 @@ impl Mechanism for Manriquez2019 {
         params["a2"]
     }
     fn findings(&self, params: &Values) -> Vec<Finding> {
-        analytic::findings(&params_of(params))
+        findings::findings(&params_of(params))
     }
 }
