@@ -2,6 +2,7 @@
 
 pub mod analytic;
 pub mod build;
+pub mod findings;
 
 use super::{
     input, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec,
@@ -433,7 +434,7 @@ impl Mechanism for Mohr2011 {
         Some(s.nodes.iter().map(|n| n.position).collect())
     }
     fn findings(&self, params: &Values) -> Vec<Finding> {
-        let mut out = analytic::findings(&params_of(params));
+        let mut out = findings::findings(&params_of(params));
         out.push(gravity_finding(params));
         out
     }
