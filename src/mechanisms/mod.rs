@@ -1,5 +1,6 @@
 //! The built-in mechanisms. Each one lives in its own folder: `analytic.rs` (the paper's model,
-//! pure functions) and `build.rs` (parameters -> [`Structure`]); `mod.rs` ties them to the
+//! pure functions), `findings.rs` (the paper's printed equations checked against that model,
+//! as [`Finding`]s) and `build.rs` (parameters -> [`Structure`]); `mod.rs` ties them to the
 //! [`Mechanism`] trait that the rest of the testbed uses.
 
 mod angle;
