@@ -166,18 +166,6 @@ impl Mechanism for Custom {
         }
         Ok(s)
     }
-    fn commands(&self, _params: &Values, inputs: &Values) -> Vec<f64> {
-        self.structure
-            .actuators
-            .iter()
-            .map(|a| {
-                inputs.get(&a.symbol).copied().unwrap_or(match a.target {
-                    ActuatorTarget::Joint(j) => self.structure.joints[j].initial_coordinate,
-                    ActuatorTarget::CableLength(c) => self.structure.cables[c].length_m,
-                })
-            })
-            .collect()
-    }
     fn predict(&self, _params: &Values, _inputs: &Values) -> Result<Prediction, String> {
         Ok(Prediction {
             expected: self.expected.clone(),

@@ -24,6 +24,21 @@ pub struct Snapshot {
     pub kinetic_energy_j: f64,
 }
 
+impl Snapshot {
+    /// The force of the spring or cable `name` of structure `s` [N] (tension positive).
+    pub fn member_force_n(&self, s: &crate::structure::Structure, name: &str) -> Option<f64> {
+        match s.spring_id(name) {
+            Some(i) => self.forces.spring_force_n.get(i).copied(),
+            None => self.forces.cable_tension_n.get(s.cable_id(name)?).copied(),
+        }
+    }
+
+    /// The force or torque of the actuator driven by `symbol` along its axis [N or N m].
+    pub fn actuator_force(&self, s: &crate::structure::Structure, symbol: &str) -> Option<f64> {
+        self.forces.actuator_force.get(s.actuator_id(symbol)?).copied()
+    }
+}
+
 /// Forces in every member at one instant. Tension is positive.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MemberForces {

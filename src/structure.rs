@@ -216,13 +216,34 @@ impl Structure {
     /// The actuator commands the structure is built at, in actuator order: each actuated
     /// joint's initial coordinate (rad or m), each winch's cable length (m).
     pub fn initial_commands(&self) -> Vec<f64> {
+        self.commands_from(&std::collections::BTreeMap::new())
+    }
+
+    /// Actuator commands in actuator order from values keyed by actuator symbol (m or rad);
+    /// an actuator whose symbol has no value keeps its drawn coordinate or cable length.
+    pub fn commands_from(&self, by_symbol: &std::collections::BTreeMap<String, f64>) -> Vec<f64> {
         self.actuators
             .iter()
-            .map(|a| match a.target {
-                ActuatorTarget::Joint(j) => self.joints[j].initial_coordinate,
-                ActuatorTarget::CableLength(c) => self.cables[c].length_m,
+            .map(|a| {
+                by_symbol.get(&a.symbol).copied().unwrap_or(match a.target {
+                    ActuatorTarget::Joint(j) => self.joints[j].initial_coordinate,
+                    ActuatorTarget::CableLength(c) => self.cables[c].length_m,
+                })
             })
             .collect()
+    }
+
+    pub fn spring_id(&self, name: &str) -> Option<usize> {
+        self.springs.iter().position(|m| m.name == name)
+    }
+
+    pub fn cable_id(&self, name: &str) -> Option<usize> {
+        self.cables.iter().position(|m| m.name == name)
+    }
+
+    /// The first actuator driven by input `symbol`.
+    pub fn actuator_id(&self, symbol: &str) -> Option<usize> {
+        self.actuators.iter().position(|a| a.symbol == symbol)
     }
 
     pub fn node_id(&self, name: &str) -> Option<NodeId> {

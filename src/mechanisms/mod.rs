@@ -164,8 +164,16 @@ pub trait Mechanism: Send + Sync {
     /// The structure at `inputs`, with the free coordinates started from `start` (symbols of
     /// free coordinates; missing ones take the mechanism's default start).
     fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, String>;
-    /// Actuator commands for `inputs`, in the structure's actuator order.
-    fn commands(&self, params: &Values, inputs: &Values) -> Vec<f64>;
+    /// Actuator commands for `inputs`, keyed by the structure's actuator symbols (m or rad;
+    /// default: the inputs themselves, for actuators named after them).
+    fn commands(&self, _params: &Values, inputs: &Values) -> Values {
+        inputs.clone()
+    }
+    /// Whether the `[start]` table deliberately starts the dynamics on an analytically
+    /// unstable branch (landing there is then what the scenario asks, not a failure).
+    fn starts_on_unstable_branch(&self, _start: &Values) -> bool {
+        false
+    }
     /// The analytic prediction for `inputs`.
     fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String>;
     /// The simulated quantities read off a snapshot.
@@ -178,8 +186,8 @@ pub trait Mechanism: Send + Sync {
     fn paper_values(&self, _params: &Values, _inputs: &Values) -> Option<(String, Values)> {
         None
     }
-    /// Analytic node positions (structure order) at the expected equilibrium, for the ghost
-    /// overlay of recordings.
+    /// Analytic node positions at the expected equilibrium, in the order of the structure's
+    /// nodes, for the ghost overlay of recordings.
     fn analytic_nodes(&self, _params: &Values, _inputs: &Values) -> Option<Vec<[f64; 3]>> {
         None
     }

@@ -132,7 +132,7 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
     let structure = mech.build(&sc.params, &first_inputs, &sc.start)?;
     let mut sim = Simulation::new(&structure, &sc.sim).map_err(|e| e.to_string())?;
     // The first point's commands (a no-op where the build already placed them).
-    sim.set_commands(&mech.commands(&sc.params, &first_inputs));
+    sim.set_commands(&structure.commands_from(&mech.commands(&sc.params, &first_inputs)));
     let target = match (&opts.connect, opts.record.clone().or_else(|| sc.record.clone())) {
         (Some(url), _) => Some(RecordTarget::Live(url.clone())),
         (None, Some(path)) => Some(RecordTarget::File(path)),
@@ -201,8 +201,7 @@ fn run_actuation(
             for (i, inputs) in points.iter().enumerate() {
                 if i > 0 {
                     if *continuation {
-                        let cmds = runner.mech.commands(&sc.params, inputs);
-                        runner.sim.set_commands(&cmds);
+                        runner.command(inputs);
                     } else {
                         let s = runner.mech.build(&sc.params, inputs, &sc.start).map_err(Stop::Model)?;
                         // The same structure placed anew: restarted in place where it can be
@@ -227,8 +226,7 @@ fn run_actuation(
                     break;
                 }
                 let inputs = interpolate(waypoints, t);
-                let cmds = runner.mech.commands(&sc.params, &inputs);
-                runner.sim.set_commands(&cmds);
+                runner.command(&inputs);
                 let prediction = runner.mech.predict(&sc.params, &inputs).map_err(Stop::Model)?;
                 let (_, simulated) = runner.step(&inputs, &prediction)?;
                 for (q, v) in simulated {

@@ -39,8 +39,9 @@ impl Runner<'_> {
         Ok(back)
     }
 
-    /// Stiffness by the probe: +tau and -tau on the probe body, K = 2 tau / (q+ - q-).
-    fn probe(&mut self, inputs: &Values, prediction: &Prediction, torque: f64) -> Result<Option<f64>, Stop> {
+    /// Stiffness by the probe: +tau and -tau on the probe body, K = 2 tau / (q+ - q-); with the
+    /// analytic quantity it is compared with.
+    fn probe(&mut self, inputs: &Values, prediction: &Prediction, torque: f64) -> Result<Option<(String, f64)>, Stop> {
         let Some(spec) = self.mech.stiffness_probe() else {
             return Ok(None);
         };
@@ -64,7 +65,7 @@ impl Runner<'_> {
         }
         self.sim.set_probe_load(body, [0.0; 3], [0.0; 3]);
         self.settle(inputs, prediction)?;
-        Ok(Some(2.0 * torque / mechanisms::wrap_angle(q[0] - q[1])))
+        Ok(Some((spec.analytic, 2.0 * torque / mechanisms::wrap_angle(q[0] - q[1]))))
     }
 }
 
@@ -144,7 +145,7 @@ pub(super) fn settle_point(
         .find(|b| b.label == branch)
         .map(|b| b.values.clone())
         .unwrap_or_else(|| prediction.expected.clone());
-    let wanted_unstable = sc.start.get("at_unstable_root").is_some_and(|f| *f != 0.0);
+    let wanted_unstable = runner.mech.starts_on_unstable_branch(&sc.start);
     if analytic_stable == Some(false) && !wanted_unstable {
         runner.emit(format_args!("point {index}: landed on the analytically unstable branch '{branch}'"));
         report.error.get_or_insert(format!("point {index} settled on the analytically unstable branch '{branch}'"));
@@ -157,11 +158,11 @@ pub(super) fn settle_point(
         runner.emit(format_args!("point {index}: equilibrium is {}", if st { "stable" } else { "unstable" }));
     }
     if let (Some(p), true) = (&sc.probe, s.settled) {
-        if let Some(k) = runner.probe(inputs, &prediction, p.torque_nm)? {
-            simulated.insert("K".into(), k);
-            if let Some(ka) = landed.get("K") {
+        if let Some((quantity, k)) = runner.probe(inputs, &prediction, p.torque_nm)? {
+            if let Some(ka) = landed.get(&quantity) {
                 probe_errors.push(((k - ka) / ka).abs());
             }
+            simulated.insert(quantity, k);
         }
     }
     let slack_cables = slack_cables(runner, &s.snapshot);

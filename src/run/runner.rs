@@ -37,6 +37,13 @@ impl<'a> Runner<'a> {
         Runner { mech, sc, sim, observers, recording, notes: Vec::new(), cancel, steps: 0, ghost: None }
     }
 
+    /// Commands every actuator for `inputs` (by its symbol).
+    pub fn command(&mut self, inputs: &Values) {
+        let by_symbol = self.mech.commands(&self.sc.params, inputs);
+        let commands = self.sim.structure().commands_from(&by_symbol);
+        self.sim.set_commands(&commands);
+    }
+
     /// The mechanism's quantities in a snapshot of this simulation.
     pub fn observe(&self, snap: &Snapshot) -> Values {
         self.mech.observe(&self.sc.params, &self.sim.structure(), snap)

@@ -253,9 +253,11 @@ impl Mechanism for Furet2018 {
         let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
         Ok(build::build(&params_of(params), &model_of(params), t1, t2))
     }
-    fn commands(&self, params: &Values, inputs: &Values) -> Vec<f64> {
+    /// Each module's actuated joint angle phi_k at A from its theta_k.
+    fn commands(&self, params: &Values, inputs: &Values) -> Values {
         let p = params_of(params);
-        vec![analytic::base_joint_angle_a(&p, inputs["theta1"]), analytic::base_joint_angle_a(&p, inputs["theta2"])]
+        let phi = |theta: &str| analytic::base_joint_angle_a(&p, inputs[theta]);
+        Values::from([("phi1".into(), phi("theta1")), ("phi2".into(), phi("theta2"))])
     }
     fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
         let p = params_of(params);

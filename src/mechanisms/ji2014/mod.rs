@@ -298,8 +298,8 @@ impl Mechanism for Ji2014 {
         };
         Ok(build::build(&p, &model_of(params), l3, th1, theta2))
     }
-    fn commands(&self, _params: &Values, inputs: &Values) -> Vec<f64> {
-        vec![inputs["L3"], inputs["theta1"]]
+    fn starts_on_unstable_branch(&self, start: &Values) -> bool {
+        start.get("at_unstable_root").is_some_and(|f| *f != 0.0)
     }
     fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
         let p = params_of(params);
@@ -319,12 +319,13 @@ impl Mechanism for Ji2014 {
             ("x".into(), d3[0]),
             ("y".into(), d3[1]),
         ]);
-        if let [f1, f2] = snap.forces.spring_force_n[..] {
-            v.insert("F_K1".into(), f1);
-            v.insert("F_K2".into(), f2);
+        for (quantity, member) in [("F_K1", "K1"), ("F_K2", "K2")] {
+            if let Some(f) = snap.member_force_n(s, member) {
+                v.insert(quantity.into(), f);
+            }
         }
-        if let Some(f) = snap.forces.actuator_force.first() {
-            v.insert("F_L3".into(), *f);
+        if let Some(f) = snap.actuator_force(s, "L3") {
+            v.insert("F_L3".into(), f);
         }
         v
     }

@@ -316,8 +316,10 @@ impl Mechanism for Manriquez2019 {
         let m = build::ModelChoices { joint_damping: params["c_joint"], strut_radius_m: params["r_strut"] };
         Ok(build::build(&p, &m, t1 + off, t2 + off, analytic::cable_lengths(&p, t1, t2)))
     }
-    fn commands(&self, params: &Values, inputs: &Values) -> Vec<f64> {
-        analytic::cable_lengths(&params_of(params), inputs["theta1"], inputs["theta2"]).to_vec()
+    /// The cables' lengths L1, L2 of Eq. 12-13 at the joint angles.
+    fn commands(&self, params: &Values, inputs: &Values) -> Values {
+        let [l1, l2] = analytic::cable_lengths(&params_of(params), inputs["theta1"], inputs["theta2"]);
+        Values::from([("L1".into(), l1), ("L2".into(), l2)])
     }
     fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
         let p = params_of(params);

@@ -391,9 +391,6 @@ impl Mechanism for Mohr2011 {
         };
         Ok(build::build(&g, &model_of(params)))
     }
-    fn commands(&self, _params: &Values, inputs: &Values) -> Vec<f64> {
-        (0..6).map(|j| inputs[&cable_symbol(j)]).collect()
-    }
     fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
         let pa = params_of(params);
         let rho = rho_of(inputs)?;
@@ -421,8 +418,10 @@ impl Mechanism for Mohr2011 {
         for i in 0..3 {
             v.insert(format!("l{}", i + 1), (b[i] - a[i]).norm());
         }
-        for (j, t) in snap.forces.cable_tension_n.iter().enumerate().take(6) {
-            v.insert(format!("t{}", j + 1), *t);
+        for j in 0..6 {
+            if let Some(t) = snap.member_force_n(s, &cable_name(j)) {
+                v.insert(format!("t{}", j + 1), t);
+            }
         }
         v
     }
