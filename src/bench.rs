@@ -353,8 +353,8 @@ pub fn peer_case_set(mechanism: &str, sc: &scenario::Scenario) -> Result<PeerCas
     for p in points {
         // The scenario's loader already turned alternative inputs into the mechanism's inputs.
         let inputs = p.clone();
-        let prediction = m.predict(&params, &inputs)?;
-        let start = m.build(&params, &inputs, &sc.start)?;
+        let prediction = m.predict(&params, &inputs).map_err(|e| e.to_string())?;
+        let start = m.build(&params, &inputs, &sc.start).map_err(|e| e.to_string())?;
         let name = |i: usize| start.nodes[i].name.clone();
         let start_nodes = start.nodes.iter().enumerate().map(|(i, n)| (name(i), n.position)).collect();
         let analytic_nodes = m

@@ -4,7 +4,7 @@
 //! expected values given in the file (`[[checks]]` with `value`).
 
 use crate::mechanisms::{
-    Finding, InputSpec, Mechanism, MechanismSpec, Prediction, QuantityKind, QuantitySpec, Solution, Values,
+    Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Prediction, QuantityKind, QuantitySpec, Solution, Values,
 };
 use crate::snapshot::Snapshot;
 use crate::structure::{ActuatorTarget, Structure};
@@ -134,30 +134,35 @@ impl Mechanism for Custom {
     fn spec(&self) -> &MechanismSpec {
         &self.spec
     }
-    fn validate_params(&self, _params: &Values) -> Result<(), (String, String)> {
+    fn validate_params(&self, _params: &Values) -> Result<(), ModelError> {
         Ok(())
     }
-    fn validate_inputs(&self, _params: &Values, inputs: &Values) -> Result<(), (String, String)> {
+    fn validate_inputs(&self, _params: &Values, inputs: &Values) -> Result<(), ModelError> {
         for i in self.spec.inputs {
-            let x =
-                inputs.get(i.symbol).copied().ok_or((i.symbol.to_string(), format!("missing input {}", i.symbol)))?;
+            let x = inputs
+                .get(i.symbol)
+                .copied()
+                .ok_or(ModelError::value(i.symbol, format!("missing input {}", i.symbol)))?;
             if !x.is_finite() {
-                return Err((i.symbol.into(), format!("{} must be finite, got {x}", i.symbol)));
+                return Err(ModelError::value(i.symbol, format!("{} must be finite, got {x}", i.symbol)));
             }
         }
         for a in &self.structure.actuators {
             if let ActuatorTarget::CableLength(_) = a.target {
                 if inputs.get(&a.symbol).is_some_and(|l| *l <= 0.0) {
-                    return Err((a.symbol.clone(), format!("cable length {} must be > 0 m", a.symbol)));
+                    return Err(ModelError::value(
+                        a.symbol.clone(),
+                        format!("cable length {} must be > 0 m", a.symbol),
+                    ));
                 }
             }
         }
         Ok(())
     }
-    fn solve(&self, query: &str, _params: &Values, _inputs: &Values) -> Result<Vec<Solution>, String> {
-        Err(format!("a custom structure has no analytic model (no query '{query}')"))
+    fn solve(&self, query: &str, _params: &Values, _inputs: &Values) -> Result<Vec<Solution>, ModelError> {
+        Err(ModelError::no_solution(format!("a custom structure has no analytic model (no query '{query}')")))
     }
-    fn build(&self, _params: &Values, inputs: &Values, _start: &Values) -> Result<Structure, String> {
+    fn build(&self, _params: &Values, inputs: &Values, _start: &Values) -> Result<Structure, ModelError> {
         let mut s = self.structure.clone();
         for a in &s.actuators {
             if let (ActuatorTarget::CableLength(c), Some(l)) = (&a.target, inputs.get(&a.symbol)) {
@@ -166,7 +171,7 @@ impl Mechanism for Custom {
         }
         Ok(s)
     }
-    fn predict(&self, _params: &Values, _inputs: &Values) -> Result<Prediction, String> {
+    fn predict(&self, _params: &Values, _inputs: &Values) -> Result<Prediction, ModelError> {
         Ok(Prediction {
             expected: self.expected.clone(),
             branches: vec![Solution {

@@ -443,7 +443,7 @@ fn parse_sets(
         }
     }
     let params = mechanisms::with_defaults(m, &params);
-    m.validate_params(&params).map_err(|(_, msg)| msg)?;
+    m.validate_params(&params).map_err(|e| e.to_string())?;
     Ok((params, inputs))
 }
 

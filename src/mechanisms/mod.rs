@@ -4,6 +4,7 @@
 //! [`Mechanism`] trait that the rest of the testbed uses.
 
 mod angle;
+mod error;
 mod finding;
 pub mod furet2018;
 pub mod ji2014;
@@ -11,6 +12,7 @@ pub mod manriquez2019;
 pub mod mohr2011;
 
 pub use angle::wrap_angle;
+pub use error::ModelError;
 pub use finding::{finding, Finding};
 
 use crate::snapshot::Snapshot;
@@ -151,19 +153,19 @@ pub trait Mechanism: Send + Sync {
         self.spec().alternative_inputs
     }
     /// Checks parameter values; the message names the parameter and the accepted range.
-    fn validate_params(&self, params: &Values) -> Result<(), (String, String)>;
+    fn validate_params(&self, params: &Values) -> Result<(), ModelError>;
     /// Converts one of the [`Mechanism::alternative_inputs`] sets into inputs;
-    /// `Err((symbol, message))` when it has no solution.
-    fn convert_inputs(&self, _params: &Values, given: &Values) -> Result<Values, (String, String)> {
+    /// a [`ModelError::Value`] naming the symbol when it has no solution.
+    fn convert_inputs(&self, _params: &Values, given: &Values) -> Result<Values, ModelError> {
         Ok(given.clone())
     }
-    /// Checks one set of inputs against the parameters; `Err((symbol, message))`.
-    fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), (String, String)>;
+    /// Checks one set of inputs against the parameters; the error names the input.
+    fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), ModelError>;
     /// The analytic model alone: every result of `query`.
-    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String>;
+    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, ModelError>;
     /// The structure at `inputs`, with the free coordinates started from `start` (symbols of
     /// free coordinates; missing ones take the mechanism's default start).
-    fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, String>;
+    fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, ModelError>;
     /// Actuator commands for `inputs`, keyed by the structure's actuator symbols (m or rad;
     /// default: the inputs themselves, for actuators named after them).
     fn commands(&self, _params: &Values, inputs: &Values) -> Values {
@@ -175,7 +177,7 @@ pub trait Mechanism: Send + Sync {
         false
     }
     /// The analytic prediction for `inputs`.
-    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String>;
+    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, ModelError>;
     /// The simulated quantities read off a snapshot.
     fn observe(&self, params: &Values, structure: &Structure, snap: &Snapshot) -> Values;
     /// Characteristic length [m] used to normalise length errors.
@@ -223,28 +225,28 @@ pub fn with_defaults(m: &dyn Mechanism, given: &Values) -> Values {
 
 /// Checks that every `(symbol, unit)` parameter is a finite number > 0; the error names the
 /// first that is not.
-pub fn require_positive(v: &Values, specs: &[(&str, &str)]) -> Result<(), (String, String)> {
+pub fn require_positive(v: &Values, specs: &[(&str, &str)]) -> Result<(), ModelError> {
     for (sym, unit) in specs {
         let x = v[*sym];
         if !(x > 0.0 && x.is_finite()) {
-            return Err((sym.to_string(), format!("{sym} must be a finite number > 0 {unit}, got {x}")));
+            return Err(ModelError::value(*sym, format!("{sym} must be a finite number > 0 {unit}, got {x}")));
         }
     }
     Ok(())
 }
 
 /// Checks that every `(symbol, unit)` parameter is a finite number >= 0.
-pub fn require_non_negative(v: &Values, specs: &[(&str, &str)]) -> Result<(), (String, String)> {
+pub fn require_non_negative(v: &Values, specs: &[(&str, &str)]) -> Result<(), ModelError> {
     for (sym, unit) in specs {
         let x = v[*sym];
         if !(x >= 0.0 && x.is_finite()) {
-            return Err((sym.to_string(), format!("{sym} must be a finite number >= 0 {unit}, got {x}")));
+            return Err(ModelError::value(*sym, format!("{sym} must be a finite number >= 0 {unit}, got {x}")));
         }
     }
     Ok(())
 }
 
 /// The value of input `key`, or an error naming it.
-pub fn input(inputs: &Values, key: &str) -> Result<f64, String> {
-    inputs.get(key).copied().ok_or_else(|| format!("missing input '{key}'"))
+pub fn input(inputs: &Values, key: &str) -> Result<f64, ModelError> {
+    inputs.get(key).copied().ok_or_else(|| ModelError::value(key, format!("missing input '{key}'")))
 }

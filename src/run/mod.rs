@@ -9,7 +9,7 @@ mod runner;
 mod settle;
 pub mod verdict;
 
-use crate::mechanisms::{Mechanism, Values};
+use crate::mechanisms::{Mechanism, ModelError, Values};
 use crate::observers::record::{RecordTarget, Recording};
 use crate::observers::{self, Setup};
 use crate::report::{ProbeReport, ScenarioReport, SettleSummary, WorkspaceAgreement};
@@ -45,7 +45,7 @@ enum Stop {
     #[error("interrupted at tick {0}")]
     Interrupted(u64),
     #[error("{0}")]
-    Model(String),
+    Model(#[from] ModelError),
 }
 
 /// The report of a scenario whose run panicked: failed, with the panic's message.
@@ -129,7 +129,7 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         Actuation::Points { points, .. } => points[0].clone(),
         Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
     };
-    let structure = mech.build(&sc.params, &first_inputs, &sc.start)?;
+    let structure = mech.build(&sc.params, &first_inputs, &sc.start).map_err(|e| e.to_string())?;
     let mut sim = Simulation::new(&structure, &sc.sim).map_err(|e| e.to_string())?;
     // The first point's commands (a no-op where the build already placed them).
     sim.set_commands(&structure.commands_from(&mech.commands(&sc.params, &first_inputs)));

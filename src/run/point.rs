@@ -4,7 +4,7 @@
 
 use super::runner::Runner;
 use super::Stop;
-use crate::mechanisms::{self, Mechanism, Prediction, Values};
+use crate::mechanisms::{self, Mechanism, ModelError, Prediction, Values};
 use crate::observers::compare;
 use crate::observers::SettlePoint;
 use crate::report::{PointReport, ScenarioReport};
@@ -49,7 +49,7 @@ impl Runner<'_> {
             .sim
             .structure()
             .body_id(&spec.body)
-            .ok_or_else(|| Stop::Model(format!("probe body '{}' not found", spec.body)))?;
+            .ok_or_else(|| Stop::Model(ModelError::no_solution(format!("probe body '{}' not found", spec.body))))?;
         let axis = spec.torque_axis;
         let mut q = [0.0; 2];
         for (i, sign) in [1.0, -1.0].iter().enumerate() {

@@ -4,7 +4,7 @@
 use super::error::{finite, value_at, values, Ctx, ScenarioError};
 use super::raw::{RawActuation, RawRange, SpannedMap};
 use super::{Actuation, MAX_POINTS};
-use crate::mechanisms::{Mechanism, Values};
+use crate::mechanisms::{Mechanism, ModelError, Values};
 use std::collections::BTreeMap;
 use toml::Spanned;
 
@@ -97,8 +97,10 @@ impl<'a> InputSets<'a> {
         if let Some(s) = input_syms.iter().find(|s| !map.keys().any(|k| k.get_ref() == **s)) {
             return Err(ctx.err(point, format!("missing input '{s}' (expected {})", self.expected)));
         }
-        let rejected =
-            |(sym, msg): (String, String)| ctx.err_at(value_at(map, &sym).unwrap_or(point.span().start), msg);
+        let rejected = |e: ModelError| {
+            let at = e.symbol().and_then(|sym| value_at(map, sym)).unwrap_or(point.span().start);
+            ctx.err_at(at, e.to_string())
+        };
         let mut vals = values(ctx, map)?;
         let t = vals.remove("t");
         if input_syms != self.native {
@@ -190,7 +192,7 @@ fn product(axes: &[(String, Vec<f64>)]) -> Vec<Values> {
 }
 
 /// One pass over the grid points: `step` gives a point's new form (`None`: the point as it
-/// is) or rejects it with (symbol, message). A rejected point goes to `skipped` with `skip`;
+/// is) or rejects it with a [`ModelError`]. A rejected point goes to `skipped` with `skip`;
 /// without, it is an error at that symbol's range, naming the point, followed by `hint`.
 fn grid_pass(
     ctx: &Ctx,
@@ -199,16 +201,16 @@ fn grid_pass(
     skip: bool,
     skipped: &mut Vec<(Values, String)>,
     hint: &str,
-    step: impl Fn(&Values) -> Result<Option<Values>, (String, String)>,
+    step: impl Fn(&Values) -> Result<Option<Values>, ModelError>,
 ) -> Result<Vec<Values>, ScenarioError> {
     let mut kept = Vec::new();
     for p in points {
         match step(&p) {
             Ok(q) => kept.push(q.unwrap_or(p)),
-            Err((_, msg)) if skip => skipped.push((p, msg)),
-            Err((sym, msg)) => {
-                let at = value_at(grid, &sym).unwrap_or(0);
-                return Err(ctx.err_at(at, format!("grid point {:?}: {msg}{hint}", p)));
+            Err(e) if skip => skipped.push((p, e.to_string())),
+            Err(e) => {
+                let at = e.symbol().and_then(|sym| value_at(grid, sym)).unwrap_or(0);
+                return Err(ctx.err_at(at, format!("grid point {:?}: {e}{hint}", p)));
             }
         }
     }

@@ -46,7 +46,8 @@ pub(super) fn interference(
         informative: i.get_ref().informative.unwrap_or(false),
         exclude,
     };
-    let structure = m.build(params, first_inputs(actuation), start).map_err(|e| ctx.err(raw_actuation, e))?;
+    let structure =
+        m.build(params, first_inputs(actuation), start).map_err(|e| ctx.err(raw_actuation, e.to_string()))?;
     if let Err(e) = settings.check_strut_names(&structure) {
         return Err(ctx.err(i, e));
     }

@@ -11,8 +11,9 @@ pub(super) fn params(ctx: &Ctx, m: &dyn Mechanism, raw: &SpannedMap) -> Result<V
     known_keys(ctx, raw, &known, "parameter", m.name())?;
     let given = values(ctx, raw)?;
     let params = mechanisms::with_defaults(m, &given);
-    if let Err((sym, msg)) = m.validate_params(&params) {
-        return Err(ctx.err_at(value_at(raw, &sym).unwrap_or(0), msg));
+    if let Err(e) = m.validate_params(&params) {
+        let at = e.symbol().and_then(|sym| value_at(raw, sym)).unwrap_or(0);
+        return Err(ctx.err_at(at, e.to_string()));
     }
     Ok(params)
 }

@@ -6,8 +6,8 @@ pub mod build;
 pub mod findings;
 
 use super::{
-    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind,
-    QuantitySpec, QuerySpec, Solution, Values,
+    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction,
+    QuantityKind, QuantitySpec, QuerySpec, Solution, Values,
 };
 use crate::snapshot::Snapshot;
 use crate::structure::Structure;
@@ -139,12 +139,12 @@ impl Mechanism for Furet2018 {
     fn spec(&self) -> &MechanismSpec {
         &SPEC
     }
-    fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
+    fn validate_params(&self, v: &Values) -> Result<(), ModelError> {
         super::require_positive(v, &[("L", "m"), ("b", "m"), ("k_spring", "N/m"), ("m_bar", "kg")])?;
         super::require_non_negative(v, &[("l0_spring", "m"), ("c_joint", "N m s/rad"), ("dz", "m"), ("r_strut", "m")])?;
         if v["L"] <= v["b"] {
-            return Err((
-                "b".into(),
+            return Err(ModelError::value(
+                "b",
                 format!(
                     "b must be shorter than L (the X assembles only if L > b, Section 2): L = {}, b = {}",
                     v["L"], v["b"]
@@ -156,34 +156,34 @@ impl Mechanism for Furet2018 {
 
     /// (x, y, solution k): the k-th inverse solution (1-based, in the order `solve furet2018
     /// ik` prints them) of the end point (x, y).
-    fn convert_inputs(&self, params: &Values, given: &Values) -> Result<Values, (String, String)> {
-        let get = |k: &str| given.get(k).copied().ok_or((k.to_string(), format!("missing input '{k}'")));
+    fn convert_inputs(&self, params: &Values, given: &Values) -> Result<Values, ModelError> {
+        let get = |k: &str| given.get(k).copied().ok_or(ModelError::value(k, format!("missing input '{k}'")));
         let (x, y, k) = (get("x")?, get("y")?, get("solution")?);
         if !(k >= 1.0 && k.fract() == 0.0) {
-            return Err(("solution".into(), format!("solution must be a whole number from 1, got {k}")));
+            return Err(ModelError::value("solution", format!("solution must be a whole number from 1, got {k}")));
         }
         let sols = analytic::ik_query(&params_of(params), x, y);
         let Some(s) = sols.get(k as usize - 1) else {
-            return Err((
-                "solution".into(),
+            return Err(ModelError::value(
+                "solution",
                 format!("({x}, {y}) has {} inverse solution(s) (Eq. 6-12), not a solution {k}", sols.len()),
             ));
         };
         Ok(Values::from([("theta1".into(), s.theta1), ("theta2".into(), s.theta2)]))
     }
-    fn validate_inputs(&self, _params: &Values, inputs: &Values) -> Result<(), (String, String)> {
+    fn validate_inputs(&self, _params: &Values, inputs: &Values) -> Result<(), ModelError> {
         for s in ["theta1", "theta2"] {
-            let t = inputs.get(s).copied().ok_or((s.to_string(), format!("missing input {s} [rad]")))?;
+            let t = inputs.get(s).copied().ok_or(ModelError::value(s, format!("missing input {s} [rad]")))?;
             if !(t.is_finite() && t.abs() < std::f64::consts::PI) {
-                return Err((s.into(), format!("{s} must lie in (-pi, pi) rad, got {t}")));
+                return Err(ModelError::value(s, format!("{s} must lie in (-pi, pi) rad, got {t}")));
             }
             if analytic::crossed_mode_margin(t) < CHANGE_POINT_MARGIN_RAD {
-                return Err((s.into(), format!("{s} = {t} is at a change point (theta = +-pi/2): the X's nodes are collinear and the base-joint actuator cannot keep it crossed")));
+                return Err(ModelError::value(s, format!("{s} = {t} is at a change point (theta = +-pi/2): the X's nodes are collinear and the base-joint actuator cannot keep it crossed")));
             }
         }
         Ok(())
     }
-    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String> {
+    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, ModelError> {
         let p = params_of(params);
         match query {
             "dk" => {
@@ -196,9 +196,9 @@ impl Mechanism for Furet2018 {
                 let (x, y) = (input(inputs, "x")?, input(inputs, "y")?);
                 let sols = analytic::ik_query(&p, x, y);
                 if sols.is_empty() {
-                    return Err(format!(
+                    return Err(ModelError::no_solution(format!(
                         "({x}, {y}) is outside the workspace: the quartic (Eq. 6-11) has no real root"
-                    ));
+                    )));
                 }
                 Ok(sols
                     .iter()
@@ -233,8 +233,11 @@ impl Mechanism for Furet2018 {
             "path" => {
                 let from = (input(inputs, "theta1")?, input(inputs, "theta2")?);
                 let to = (input(inputs, "theta1_end")?, input(inputs, "theta2_end")?);
-                let path = analytic::nonsingular_path(&p, from, to, PATH_GRID)
-                    .ok_or("no path that avoids det J = 0: the two configurations are in different aspects")?;
+                let path = analytic::nonsingular_path(&p, from, to, PATH_GRID).ok_or_else(|| {
+                    ModelError::no_solution(
+                        "no path that avoids det J = 0: the two configurations are in different aspects",
+                    )
+                })?;
                 let min_det = analytic::min_abs_det_along(&p, &path, 200);
                 Ok(path
                     .iter()
@@ -246,10 +249,12 @@ impl Mechanism for Furet2018 {
                     })
                     .collect())
             }
-            other => Err(format!("unknown query '{other}' for furet2018 (expected one of: dk, ik, workspace, path)")),
+            other => Err(ModelError::no_solution(format!(
+                "unknown query '{other}' for furet2018 (expected one of: dk, ik, workspace, path)"
+            ))),
         }
     }
-    fn build(&self, params: &Values, inputs: &Values, _start: &Values) -> Result<Structure, String> {
+    fn build(&self, params: &Values, inputs: &Values, _start: &Values) -> Result<Structure, ModelError> {
         let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
         Ok(build::build(&params_of(params), &model_of(params), t1, t2))
     }
@@ -259,7 +264,7 @@ impl Mechanism for Furet2018 {
         let phi = |theta: &str| analytic::base_joint_angle_a(&p, inputs[theta]);
         Values::from([("phi1".into(), phi("theta1")), ("phi2".into(), phi("theta2"))])
     }
-    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
+    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, ModelError> {
         let p = params_of(params);
         let v = dk_values(&p, input(inputs, "theta1")?, input(inputs, "theta2")?);
         Ok(Prediction {

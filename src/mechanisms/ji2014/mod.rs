@@ -5,8 +5,8 @@ pub mod build;
 pub mod findings;
 
 use super::{
-    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind,
-    QuantitySpec, QuerySpec, Solution, StiffnessProbe, Values,
+    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction,
+    QuantityKind, QuantitySpec, QuerySpec, Solution, StiffnessProbe, Values,
 };
 use crate::snapshot::Snapshot;
 use crate::structure::Structure;
@@ -201,41 +201,43 @@ impl Mechanism for Ji2014 {
     fn spec(&self) -> &MechanismSpec {
         &SPEC
     }
-    fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
+    fn validate_params(&self, v: &Values) -> Result<(), ModelError> {
         super::require_positive(v, &[("L", "m"), ("K1", "N/m"), ("K2", "N/m"), ("m_platform", "kg")])?;
         super::require_non_negative(v, &[("c_D1", "N m s/rad"), ("r_strut", "m")])?;
         Ok(())
     }
-    fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), (String, String)> {
+    fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), ModelError> {
         let l = params["L"];
-        let l3 = inputs.get("L3").copied().ok_or(("L3".to_string(), "missing input L3 [m]".to_string()))?;
-        let th =
-            inputs.get("theta1").copied().ok_or(("theta1".to_string(), "missing input theta1 [rad]".to_string()))?;
+        let l3 = inputs.get("L3").copied().ok_or(ModelError::value("L3", "missing input L3 [m]"))?;
+        let th = inputs.get("theta1").copied().ok_or(ModelError::value("theta1", "missing input theta1 [rad]"))?;
         if !(l3 > 0.0 && l3.is_finite()) {
-            return Err(("L3".into(), format!(
+            return Err(ModelError::value("L3", format!(
                 "L3 must be a finite number > 0 m (L3 = 0 is singularity i: the equilibrium does not depend on theta1), got {l3}"
             )));
         }
         if l3 > 1e3 * l {
-            return Err(("L3".into(), format!("L3 = {l3} m is more than 1000 L: outside any plausible workspace")));
+            return Err(ModelError::value(
+                "L3",
+                format!("L3 = {l3} m is more than 1000 L: outside any plausible workspace"),
+            ));
         }
         if !(0.0..=std::f64::consts::PI).contains(&th) {
-            return Err((
-                "theta1".into(),
+            return Err(ModelError::value(
+                "theta1",
                 format!("theta1 must lie in [0, pi] rad (Section 2: D1 above the X axis), got {th}"),
             ));
         }
         // Singularity iii (Eq. 28): eta1 = eta2 = 0 leaves theta2 undetermined.
         let (e1, e2) = analytic::eta(&params_of(params), l3, th);
         if e1.hypot(e2) < 1e-12 * params["K1"].max(params["K2"]) * l {
-            return Err((
-                "L3".into(),
-                "inputs on a singularity where eta1 = eta2 = 0: every theta2 is an equilibrium".into(),
+            return Err(ModelError::value(
+                "L3",
+                "inputs on a singularity where eta1 = eta2 = 0: every theta2 is an equilibrium",
             ));
         }
         Ok(())
     }
-    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String> {
+    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, ModelError> {
         let p = params_of(params);
         match query {
             "fk" => {
@@ -246,9 +248,9 @@ impl Mechanism for Ji2014 {
                 let (x, y) = (input(inputs, "x")?, input(inputs, "y")?);
                 let sols = analytic::inverse_kinematics(&p, x, y);
                 if sols.is_empty() {
-                    return Err(format!(
+                    return Err(ModelError::no_solution(format!(
                         "({x}, {y}) is not reachable: no equilibrium places D3 there with 0 <= theta1 <= pi"
-                    ));
+                    )));
                 }
                 Ok(sols
                     .iter()
@@ -282,10 +284,12 @@ impl Mechanism for Ji2014 {
                     stable: Some(e.stable),
                 }])
             }
-            other => Err(format!("unknown query '{other}' for ji2014 (expected one of: fk, ik, jacobian)")),
+            other => Err(ModelError::no_solution(format!(
+                "unknown query '{other}' for ji2014 (expected one of: fk, ik, jacobian)"
+            ))),
         }
     }
-    fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, String> {
+    fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, ModelError> {
         let p = params_of(params);
         let (l3, th1) = (input(inputs, "L3")?, input(inputs, "theta1")?);
         let eq = analytic::equilibria(&p, l3, th1);
@@ -301,7 +305,7 @@ impl Mechanism for Ji2014 {
     fn starts_on_unstable_branch(&self, start: &Values) -> bool {
         start.get("at_unstable_root").is_some_and(|f| *f != 0.0)
     }
-    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
+    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, ModelError> {
         let p = params_of(params);
         let (l3, th1) = (input(inputs, "L3")?, input(inputs, "theta1")?);
         let eqs = analytic::equilibria(&p, l3, th1);

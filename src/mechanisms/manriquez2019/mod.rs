@@ -6,8 +6,8 @@ pub mod build;
 pub mod findings;
 
 use super::{
-    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind,
-    QuantitySpec, QuerySpec, Solution, Values,
+    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction,
+    QuantityKind, QuantitySpec, QuerySpec, Solution, Values,
 };
 use crate::snapshot::Snapshot;
 use crate::structure::Structure;
@@ -213,28 +213,28 @@ impl Mechanism for Manriquez2019 {
     fn spec(&self) -> &MechanismSpec {
         &SPEC
     }
-    fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
+    fn validate_params(&self, v: &Values) -> Result<(), ModelError> {
         super::require_positive(v, &[("a2", "m"), ("l2", "m"), ("m", "kg"), ("base_half", "m"), ("k_spring", "N/m")])?;
         super::require_non_negative(
             v,
             &[("g", "m/s^2"), ("l0_spring", "m"), ("c_joint", "N m s/rad"), ("r_strut", "m")],
         )?;
-        params_of(v).validate().map_err(|e| ("base_x".to_string(), e))
+        params_of(v).validate().map_err(|e| ModelError::value("base_x", e))
     }
-    fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), (String, String)> {
+    fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), ModelError> {
         for s in ["theta1", "theta2"] {
-            let t = inputs.get(s).copied().ok_or((s.to_string(), format!("missing input {s} [rad]")))?;
+            let t = inputs.get(s).copied().ok_or(ModelError::value(s, format!("missing input {s} [rad]")))?;
             if !(t.is_finite() && t.abs() < std::f64::consts::FRAC_PI_2) {
-                return Err((s.into(), format!("{s} must lie in (-pi/2, pi/2) rad, got {t}")));
+                return Err(ModelError::value(s, format!("{s} must lie in (-pi/2, pi/2) rad, got {t}")));
             }
         }
         let st = analytic::statics(&params_of(params), inputs["theta1"], inputs["theta2"]);
         if st.singular {
-            return Err(("theta1".into(), "inputs on the singular pose where both cables lie in one plane through the joint: the cable tensions are not determined".into()));
+            return Err(ModelError::value("theta1", "inputs on the singular pose where both cables lie in one plane through the joint: the cable tensions are not determined"));
         }
         Ok(())
     }
-    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String> {
+    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, ModelError> {
         let p = params_of(params);
         match query {
             "fk" => {
@@ -258,7 +258,7 @@ impl Mechanism for Manriquez2019 {
             }
             "ik" => {
                 let m = Vector3::new(input(inputs, "x_m")?, input(inputs, "y_m")?, input(inputs, "z_m")?);
-                let (t1, t2) = analytic::ik_position(&p, &m)?;
+                let (t1, t2) = analytic::ik_position(&p, &m).map_err(ModelError::NoSolution)?;
                 Ok(vec![Solution {
                     label: "derived Eq. 16-17".into(),
                     values: Values::from([("theta1".into(), t1), ("theta2".into(), t2)]),
@@ -304,12 +304,12 @@ impl Mechanism for Manriquez2019 {
                     stable: None,
                 }])
             }
-            other => Err(format!(
+            other => Err(ModelError::no_solution(format!(
                 "unknown query '{other}' for manriquez2019 (expected one of: fk, ik, statics, form_finding)"
-            )),
+            ))),
         }
     }
-    fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, String> {
+    fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, ModelError> {
         let p = params_of(params);
         let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
         let off = start.get("offset").copied().unwrap_or(DEFAULT_START_OFFSET_RAD);
@@ -321,7 +321,7 @@ impl Mechanism for Manriquez2019 {
         let [l1, l2] = analytic::cable_lengths(&params_of(params), inputs["theta1"], inputs["theta2"]);
         Values::from([("L1".into(), l1), ("L2".into(), l2)])
     }
-    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
+    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, ModelError> {
         let p = params_of(params);
         let v = statics_values(&p, input(inputs, "theta1")?, input(inputs, "theta2")?);
         let slack = [("cable 1", v["f_C1"]), ("cable 2", v["f_C2"])]

@@ -5,8 +5,8 @@ pub mod build;
 pub mod findings;
 
 use super::{
-    input, Finding, InputSpec, Mechanism, MechanismSpec, Origin, ParamSpec, Prediction, QuantityKind, QuantitySpec,
-    QuerySpec, Solution, Values,
+    input, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction, QuantityKind,
+    QuantitySpec, QuerySpec, Solution, Values,
 };
 use crate::snapshot::Snapshot;
 use crate::structure::Structure;
@@ -152,7 +152,7 @@ fn model_of(v: &Values) -> build::ModelChoices {
     }
 }
 
-fn rho_of(inputs: &Values) -> Result<[f64; 3], String> {
+fn rho_of(inputs: &Values) -> Result<[f64; 3], ModelError> {
     Ok([input(inputs, "rho1")?, input(inputs, "rho2")?, input(inputs, "rho3")?])
 }
 
@@ -254,49 +254,49 @@ impl Mechanism for Mohr2011 {
     fn spec(&self) -> &MechanismSpec {
         &SPEC
     }
-    fn convert_inputs(&self, params: &Values, given: &Values) -> Result<Values, (String, String)> {
-        let get = |k: &str| given.get(k).copied().ok_or((k.to_string(), format!("missing input '{k}'")));
+    fn convert_inputs(&self, params: &Values, given: &Values) -> Result<Values, ModelError> {
+        let get = |k: &str| given.get(k).copied().ok_or(ModelError::value(k, format!("missing input '{k}'")));
         let p = Vector3::new(get("x")?, get("y")?, get("z")?);
         if !(p.z > 0.0 && p.iter().all(|c| c.is_finite())) {
-            return Err((
-                "z".into(),
+            return Err(ModelError::value(
+                "z",
                 format!("the end-effector must be above the base: z > 0 m (Section 4.1), got {}", p.z),
             ));
         }
         let rho = analytic::ikp(&params_of(params), &p);
         Ok(Values::from([("rho1".into(), rho[0]), ("rho2".into(), rho[1]), ("rho3".into(), rho[2])]))
     }
-    fn validate_params(&self, v: &Values) -> Result<(), (String, String)> {
+    fn validate_params(&self, v: &Values) -> Result<(), ModelError> {
         super::require_positive(
             v,
             &[("lb", "m"), ("lo", "m"), ("kappa", "N m/rad"), ("m_platform", "kg"), ("m_link", "kg")],
         )?;
         if !(v["straight"] == 0.0 || v["straight"] == 1.0) {
-            return Err((
-                "straight".into(),
+            return Err(ModelError::value(
+                "straight",
                 format!("straight must be 0 (two-link springs) or 1 (straight struts), got {}", v["straight"]),
             ));
         }
         super::require_positive(v, &[("k_straight", "N/m")])?;
         super::require_non_negative(v, &[("c_joint", "N m s/rad"), ("k_cable", "N/m"), ("r_strut", "m")])?;
         if !v["g_z"].is_finite() {
-            return Err(("g_z".into(), format!("g_z must be a finite number (m/s^2), got {}", v["g_z"])));
+            return Err(ModelError::value("g_z", format!("g_z must be a finite number (m/s^2), got {}", v["g_z"])));
         }
-        params_of(v).validate().map_err(|m| ("lo".to_string(), m))
+        params_of(v).validate().map_err(|m| ModelError::value("lo", m))
     }
-    fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), (String, String)> {
+    fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), ModelError> {
         let pa = params_of(params);
         let mut rho = [0.0; 3];
         for (i, s) in ["rho1", "rho2", "rho3"].iter().enumerate() {
-            let x = inputs.get(*s).copied().ok_or((s.to_string(), format!("missing input {s} [m]")))?;
+            let x = inputs.get(*s).copied().ok_or(ModelError::value(*s, format!("missing input {s} [m]")))?;
             if !(x > 0.0 && x.is_finite()) {
-                return Err((s.to_string(), format!("{s} must be a finite number > 0 m, got {x}")));
+                return Err(ModelError::value(*s, format!("{s} must be a finite number > 0 m, got {x}")));
             }
             rho[i] = x;
         }
         let p = analytic::dkp(&pa, &rho).ok_or_else(|| {
-            (
-                "rho1".to_string(),
+            ModelError::value(
+                "rho1",
                 format!("cable lengths {rho:?} m are unreachable: Eq. 14 has no real z > 0 (the radicand is negative)"),
             )
         })?;
@@ -304,7 +304,7 @@ impl Mechanism for Mohr2011 {
         let st = analytic::statics(&pa, &p);
         for (i, l) in st.spring_lengths.iter().enumerate() {
             if !(*l > 0.0 && *l < pa.lo) {
-                return Err(("rho1".to_string(), format!(
+                return Err(ModelError::value("rho1", format!(
                     "cable lengths {rho:?} m put the end-effector at ({:.6}, {:.6}, {:.6}) m, where virtual spring {} would be {l:.6} m long: outside 0 < l_i < l_o = {} m (Eq. 17-18)",
                     p.x, p.y, p.z, i + 1, pa.lo
                 )));
@@ -312,9 +312,9 @@ impl Mechanism for Mohr2011 {
         }
         Ok(())
     }
-    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, String> {
+    fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, ModelError> {
         let pa = params_of(params);
-        let centroid = || -> Result<Vector3<f64>, String> {
+        let centroid = || -> Result<Vector3<f64>, ModelError> {
             Ok(Vector3::new(input(inputs, "x")?, input(inputs, "y")?, input(inputs, "z")?))
         };
         match query {
@@ -329,8 +329,9 @@ impl Mechanism for Mohr2011 {
             }
             "dkp" => {
                 let rho = rho_of(inputs)?;
-                let p = analytic::dkp(&pa, &rho)
-                    .ok_or_else(|| format!("cable lengths {rho:?} m are unreachable: Eq. 14 has no real z"))?;
+                let p = analytic::dkp(&pa, &rho).ok_or_else(|| {
+                    ModelError::no_solution(format!("cable lengths {rho:?} m are unreachable: Eq. 14 has no real z"))
+                })?;
                 let st = analytic::statics(&pa, &p);
                 Ok(vec![
                     Solution {
@@ -362,18 +363,25 @@ impl Mechanism for Mohr2011 {
                     stable: Some(st.in_static_workspace),
                 }])
             }
-            other => Err(format!("unknown query '{other}' for mohr2011 (expected one of: ikp, dkp, statics)")),
+            other => Err(ModelError::no_solution(format!(
+                "unknown query '{other}' for mohr2011 (expected one of: ikp, dkp, statics)"
+            ))),
         }
     }
-    fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, String> {
+    fn build(&self, params: &Values, inputs: &Values, start: &Values) -> Result<Structure, ModelError> {
         let pa = params_of(params);
         let rho = rho_of(inputs)?;
-        let p = analytic::dkp(&pa, &rho).ok_or_else(|| format!("cable lengths {rho:?} m are unreachable"))?;
+        let p = analytic::dkp(&pa, &rho)
+            .ok_or_else(|| ModelError::no_solution(format!("cable lengths {rho:?} m are unreachable")))?;
         let drop = start.get("drop").copied().unwrap_or(DEFAULT_START_DROP_FRACTION);
         let p0 = Vector3::new(p.x, p.y, p.z * (1.0 - drop));
         let leg = |i: usize| {
             analytic::spring_chain(&pa, &p0, i).ok_or_else(|| {
-                format!("virtual spring {} cannot be assembled at the start ({:?})", i + 1, p0.as_slice())
+                ModelError::no_solution(format!(
+                    "virtual spring {} cannot be assembled at the start ({:?})",
+                    i + 1,
+                    p0.as_slice()
+                ))
             })
         };
         let g = build::Geometry {
@@ -391,10 +399,11 @@ impl Mechanism for Mohr2011 {
         };
         Ok(build::build(&g, &model_of(params)))
     }
-    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, String> {
+    fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, ModelError> {
         let pa = params_of(params);
         let rho = rho_of(inputs)?;
-        let p = analytic::dkp(&pa, &rho).ok_or_else(|| format!("cable lengths {rho:?} m are unreachable"))?;
+        let p = analytic::dkp(&pa, &rho)
+            .ok_or_else(|| ModelError::no_solution(format!("cable lengths {rho:?} m are unreachable")))?;
         let p = if params["k_cable"] > 0.0 { elastic_equilibrium(params, rho, p) } else { p };
         let expected = values_at(params, p);
         let slack = (0..6).filter(|j| expected[&format!("t{}", j + 1)] < 0.0).map(cable_name).collect();
