@@ -227,7 +227,7 @@ pub fn with_defaults(m: &dyn Mechanism, given: &Values) -> Values {
 /// first that is not.
 pub fn require_positive(v: &Values, specs: &[(&str, &str)]) -> Result<(), ModelError> {
     for (sym, unit) in specs {
-        let x = v[*sym];
+        let x = param(v, sym)?;
         if !(x > 0.0 && x.is_finite()) {
             return Err(ModelError::value(*sym, format!("{sym} must be a finite number > 0 {unit}, got {x}")));
         }
@@ -238,7 +238,7 @@ pub fn require_positive(v: &Values, specs: &[(&str, &str)]) -> Result<(), ModelE
 /// Checks that every `(symbol, unit)` parameter is a finite number >= 0.
 pub fn require_non_negative(v: &Values, specs: &[(&str, &str)]) -> Result<(), ModelError> {
     for (sym, unit) in specs {
-        let x = v[*sym];
+        let x = param(v, sym)?;
         if !(x >= 0.0 && x.is_finite()) {
             return Err(ModelError::value(*sym, format!("{sym} must be a finite number >= 0 {unit}, got {x}")));
         }
@@ -246,7 +246,28 @@ pub fn require_non_negative(v: &Values, specs: &[(&str, &str)]) -> Result<(), Mo
     Ok(())
 }
 
+/// The value of parameter `symbol`, or an error naming it (a symbol the mechanism's spec does
+/// not declare: [`with_defaults`] fills every declared one).
+pub fn param(params: &Values, symbol: &str) -> Result<f64, ModelError> {
+    params.get(symbol).copied().ok_or_else(|| ModelError::value(symbol, format!("missing parameter '{symbol}'")))
+}
+
 /// The value of input `key`, or an error naming it.
 pub fn input(inputs: &Values, key: &str) -> Result<f64, ModelError> {
     inputs.get(key).copied().ok_or_else(|| ModelError::value(key, format!("missing input '{key}'")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_missing_symbol_is_an_error_naming_it_not_a_panic() {
+        let v = Values::from([("L".to_string(), 1.0)]);
+        assert_eq!(param(&v, "L"), Ok(1.0));
+        assert_eq!(param(&v, "K1"), Err(ModelError::value("K1", "missing parameter 'K1'")));
+        assert_eq!(require_positive(&v, &[("L", "m"), ("K1", "N/m")]).unwrap_err().symbol(), Some("K1"));
+        assert_eq!(input(&v, "theta1").unwrap_err().to_string(), "missing input 'theta1'");
+        assert!(find("ji2014").unwrap().build(&with_defaults(&ji2014::Ji2014, &Values::new()), &v, &v).is_err());
+    }
 }

@@ -6,7 +6,7 @@ pub mod build;
 pub mod findings;
 
 use super::{
-    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction,
+    input, param, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction,
     QuantityKind, QuantitySpec, QuerySpec, Solution, Values,
 };
 use crate::snapshot::Snapshot;
@@ -142,13 +142,11 @@ impl Mechanism for Furet2018 {
     fn validate_params(&self, v: &Values) -> Result<(), ModelError> {
         super::require_positive(v, &[("L", "m"), ("b", "m"), ("k_spring", "N/m"), ("m_bar", "kg")])?;
         super::require_non_negative(v, &[("l0_spring", "m"), ("c_joint", "N m s/rad"), ("dz", "m"), ("r_strut", "m")])?;
-        if v["L"] <= v["b"] {
+        let (l, b) = (param(v, "L")?, param(v, "b")?);
+        if l <= b {
             return Err(ModelError::value(
                 "b",
-                format!(
-                    "b must be shorter than L (the X assembles only if L > b, Section 2): L = {}, b = {}",
-                    v["L"], v["b"]
-                ),
+                format!("b must be shorter than L (the X assembles only if L > b, Section 2): L = {}, b = {}", l, b),
             ));
         }
         Ok(())

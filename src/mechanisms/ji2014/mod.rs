@@ -5,7 +5,7 @@ pub mod build;
 pub mod findings;
 
 use super::{
-    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction,
+    input, param, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction,
     QuantityKind, QuantitySpec, QuerySpec, Solution, StiffnessProbe, Values,
 };
 use crate::snapshot::Snapshot;
@@ -207,7 +207,7 @@ impl Mechanism for Ji2014 {
         Ok(())
     }
     fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), ModelError> {
-        let l = params["L"];
+        let l = param(params, "L")?;
         let l3 = inputs.get("L3").copied().ok_or(ModelError::value("L3", "missing input L3 [m]"))?;
         let th = inputs.get("theta1").copied().ok_or(ModelError::value("theta1", "missing input theta1 [rad]"))?;
         if !(l3 > 0.0 && l3.is_finite()) {
@@ -229,7 +229,7 @@ impl Mechanism for Ji2014 {
         }
         // Singularity iii (Eq. 28): eta1 = eta2 = 0 leaves theta2 undetermined.
         let (e1, e2) = analytic::eta(&params_of(params), l3, th);
-        if e1.hypot(e2) < 1e-12 * params["K1"].max(params["K2"]) * l {
+        if e1.hypot(e2) < 1e-12 * param(params, "K1")?.max(param(params, "K2")?) * l {
             return Err(ModelError::value(
                 "L3",
                 "inputs on a singularity where eta1 = eta2 = 0: every theta2 is an equilibrium",

@@ -6,7 +6,7 @@ pub mod build;
 pub mod findings;
 
 use super::{
-    input, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction,
+    input, param, wrap_angle, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction,
     QuantityKind, QuantitySpec, QuerySpec, Solution, Values,
 };
 use crate::snapshot::Snapshot;
@@ -228,7 +228,7 @@ impl Mechanism for Manriquez2019 {
                 return Err(ModelError::value(s, format!("{s} must lie in (-pi/2, pi/2) rad, got {t}")));
             }
         }
-        let st = analytic::statics(&params_of(params), inputs["theta1"], inputs["theta2"]);
+        let st = analytic::statics(&params_of(params), input(inputs, "theta1")?, input(inputs, "theta2")?);
         if st.singular {
             return Err(ModelError::value("theta1", "inputs on the singular pose where both cables lie in one plane through the joint: the cable tensions are not determined"));
         }
@@ -313,7 +313,8 @@ impl Mechanism for Manriquez2019 {
         let p = params_of(params);
         let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
         let off = start.get("offset").copied().unwrap_or(DEFAULT_START_OFFSET_RAD);
-        let m = build::ModelChoices { joint_damping: params["c_joint"], strut_radius_m: params["r_strut"] };
+        let m =
+            build::ModelChoices { joint_damping: param(params, "c_joint")?, strut_radius_m: param(params, "r_strut")? };
         Ok(build::build(&p, &m, t1 + off, t2 + off, analytic::cable_lengths(&p, t1, t2)))
     }
     /// The cables' lengths L1, L2 of Eq. 12-13 at the joint angles.

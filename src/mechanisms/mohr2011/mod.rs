@@ -5,8 +5,8 @@ pub mod build;
 pub mod findings;
 
 use super::{
-    input, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction, QuantityKind,
-    QuantitySpec, QuerySpec, Solution, Values,
+    input, param, Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction,
+    QuantityKind, QuantitySpec, QuerySpec, Solution, Values,
 };
 use crate::snapshot::Snapshot;
 use crate::structure::Structure;
@@ -271,16 +271,18 @@ impl Mechanism for Mohr2011 {
             v,
             &[("lb", "m"), ("lo", "m"), ("kappa", "N m/rad"), ("m_platform", "kg"), ("m_link", "kg")],
         )?;
-        if !(v["straight"] == 0.0 || v["straight"] == 1.0) {
+        let straight = param(v, "straight")?;
+        if !(straight == 0.0 || straight == 1.0) {
             return Err(ModelError::value(
                 "straight",
-                format!("straight must be 0 (two-link springs) or 1 (straight struts), got {}", v["straight"]),
+                format!("straight must be 0 (two-link springs) or 1 (straight struts), got {straight}"),
             ));
         }
         super::require_positive(v, &[("k_straight", "N/m")])?;
         super::require_non_negative(v, &[("c_joint", "N m s/rad"), ("k_cable", "N/m"), ("r_strut", "m")])?;
-        if !v["g_z"].is_finite() {
-            return Err(ModelError::value("g_z", format!("g_z must be a finite number (m/s^2), got {}", v["g_z"])));
+        let g_z = param(v, "g_z")?;
+        if !g_z.is_finite() {
+            return Err(ModelError::value("g_z", format!("g_z must be a finite number (m/s^2), got {g_z}")));
         }
         params_of(v).validate().map_err(|m| ModelError::value("lo", m))
     }
@@ -394,8 +396,8 @@ impl Mechanism for Mohr2011 {
                     (cable_name(j), c.base, c.platform, cable_symbol(j))
                 })
                 .collect(),
-            cable_lengths: (0..6).map(|j| inputs[&cable_symbol(j)]).collect(),
-            straight_stiffness_n_per_m: is_straight(params).then_some(params["k_straight"]),
+            cable_lengths: (0..6).map(|j| input(inputs, &cable_symbol(j))).collect::<Result<_, _>>()?,
+            straight_stiffness_n_per_m: if is_straight(params) { Some(param(params, "k_straight")?) } else { None },
         };
         Ok(build::build(&g, &model_of(params)))
     }
@@ -404,7 +406,7 @@ impl Mechanism for Mohr2011 {
         let rho = rho_of(inputs)?;
         let p = analytic::dkp(&pa, &rho)
             .ok_or_else(|| ModelError::no_solution(format!("cable lengths {rho:?} m are unreachable")))?;
-        let p = if params["k_cable"] > 0.0 { elastic_equilibrium(params, rho, p) } else { p };
+        let p = if param(params, "k_cable")? > 0.0 { elastic_equilibrium(params, rho, p) } else { p };
         let expected = values_at(params, p);
         let slack = (0..6).filter(|j| expected[&format!("t{}", j + 1)] < 0.0).map(cable_name).collect();
         Ok(Prediction {
