@@ -130,9 +130,7 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
     };
     let structure = mech.build(&sc.params, &first_inputs, &sc.start).map_err(|e| e.to_string())?;
-    let mut sim = Simulation::new(&structure, &sc.sim).map_err(|e| e.to_string())?;
-    // The first point's commands (a no-op where the build already placed them).
-    sim.set_commands(&structure.commands_from(&mech.commands(&sc.params, &first_inputs)));
+    let sim = Simulation::new(&structure, &sc.sim).map_err(|e| e.to_string())?;
     let target = match (&opts.connect, opts.record.clone().or_else(|| sc.record.clone())) {
         (Some(url), _) => Some(RecordTarget::Live(url.clone())),
         (None, Some(path)) => Some(RecordTarget::File(path)),
@@ -145,7 +143,10 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         interference: sc.interference.as_ref(),
         recording: target.map(|target| Recording { target, every: opts.record_every.max(1), scenario: &sc.source }),
     })?;
-    Ok(Runner::new(mech, sc, sim, observers, opts.cancel))
+    let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel);
+    // The first point's commands (a no-op where the build already placed them).
+    runner.command(&first_inputs);
+    Ok(runner)
 }
 
 /// The report's summaries and verdict once the run is over; then the observers write what

@@ -295,7 +295,7 @@ impl Mechanism for Ji2014 {
         let eq = analytic::equilibria(&p, l3, th1);
         let theta2 = if let Some(t) = start.get("theta2") {
             *t
-        } else if start.get("at_unstable_root").is_some_and(|f| *f != 0.0) {
+        } else if self.starts_on_unstable_branch(start) {
             eq[1].theta2
         } else {
             eq[0].theta2 + start.get("theta2_offset").copied().unwrap_or(DEFAULT_START_OFFSET_RAD)
