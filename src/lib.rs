@@ -9,6 +9,7 @@ pub mod custom;
 pub mod figures;
 pub mod mechanisms;
 pub mod observers;
+pub mod output;
 pub mod report;
 pub mod run;
 pub mod scenario;

@@ -1,7 +1,6 @@
 //! The `tensegrity` command line.
 
 use clap::{Parser, Subcommand};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -57,7 +56,7 @@ enum Command {
         /// The JSON summary.
         #[arg(long)]
         json: Option<PathBuf>,
-        /// Worker threads.
+        /// Worker threads (at most the machine's threads; more is lowered, and said).
         #[arg(long, default_value_t = 2)]
         jobs: usize,
         /// Run the K-th of N interleaved slices of the grid (for job arrays), as K/N.
@@ -81,6 +80,9 @@ enum Command {
         csvs: Vec<PathBuf>,
         #[arg(long)]
         out: PathBuf,
+        /// Merge what is there even when points of the grid are missing (a shard left out).
+        #[arg(long)]
+        partial: bool,
     },
     /// The analytic model alone: print every result of a query.
     Solve {
@@ -144,6 +146,12 @@ fn install_signal_handlers() {
 
 fn main() -> ExitCode {
     install_signal_handlers();
+    // A closed pipe (`tensegrity list | head -1`) ends the process quietly, as it does any
+    // Unix filter, instead of a panic in println!.
+    // SAFETY: restoring the default disposition of SIGPIPE before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let code = match cli.command {
         Command::Run { scenarios, json, record, connect, record_every } => {
@@ -162,7 +170,7 @@ fn main() -> ExitCode {
         Command::Sweep { scenario, out, json, jobs, shard } => {
             cmd_sweep(&scenario, out.as_deref(), json.as_deref(), jobs, shard.as_deref())
         }
-        Command::Merge { csvs, out } => cmd_merge(&csvs, &out),
+        Command::Merge { csvs, out, partial } => cmd_merge(&csvs, &out, partial),
         Command::Figure { name, out, list } => cmd_figure(name.as_deref(), &out, list),
         Command::Solve { mechanism, query, set, json } => cmd_solve(&mechanism, &query, &set, json),
         Command::Findings { mechanism, set, json } => cmd_findings(&mechanism, &set, json),
@@ -197,20 +205,17 @@ fn load_all(paths: &[PathBuf]) -> Result<Vec<Scenario>, i32> {
     }
 }
 
-/// Writes `text` to `path` through a temporary file and a rename: never half-written.
-fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
-    if let Some(dir) = path.parent() {
-        if !dir.as_os_str().is_empty() {
-            std::fs::create_dir_all(dir)?;
-        }
-    }
-    let tmp = path.with_extension("partial");
-    {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(text.as_bytes())?;
-        f.sync_all()?;
-    }
-    std::fs::rename(&tmp, path)
+/// Writes `text` to `path` through a unique temporary file and a rename (`output`).
+fn write_atomic(path: &Path, text: &str) -> Result<(), String> {
+    tensegrity_testbed::output::write_atomic(path, text.as_bytes())
+}
+
+/// Refuses outputs that would destroy data (`output::check_outputs`): exit 2 before anything runs.
+fn check_outputs(inputs: &[PathBuf], outputs: Vec<(String, PathBuf)>) -> Result<(), i32> {
+    tensegrity_testbed::output::check_outputs(inputs, &outputs).map_err(|e| {
+        eprintln!("error: {e}");
+        EXIT_BAD_INPUT
+    })
 }
 
 fn record_path(base: &Path, name: &str, several: bool) -> PathBuf {
@@ -241,6 +246,17 @@ fn cmd_run(
         }
     }
     let several = scenarios.len() > 1;
+    let mut outputs: Vec<(String, PathBuf)> = json.map(|j| ("--json".to_string(), j.to_path_buf())).into_iter().collect();
+    if connect.is_none() {
+        for sc in &scenarios {
+            if let Some(r) = record.map(|r| record_path(r, &sc.name, several)).or_else(|| sc.record.clone()) {
+                outputs.push((format!("the recording of scenario '{}' ({})", sc.name, sc.file.display()), r));
+            }
+        }
+    }
+    if let Err(code) = check_outputs(paths, outputs) {
+        return code;
+    }
     let mut report = Report { scenarios: vec![] };
     for sc in &scenarios {
         if CANCEL.load(Ordering::SeqCst) {
@@ -262,7 +278,7 @@ fn cmd_run(
     print!("{}", report.to_table());
     if let Some(j) = json {
         if let Err(e) = write_atomic(j, &report.to_json()) {
-            eprintln!("error: cannot write the JSON report {}: {e}", j.display());
+            eprintln!("error: the JSON report: {e}");
             return EXIT_FAIL;
         }
     }
@@ -278,6 +294,14 @@ fn cmd_sweep(path: &Path, out: Option<&Path>, json: Option<&Path>, jobs: usize, 
         Ok(mut s) => s.remove(0),
         Err(code) => return code,
     };
+    let outputs = [("--out", out), ("--json", json)]
+        .into_iter()
+        .filter_map(|(what, p)| p.map(|p| (what.to_string(), p.to_path_buf())))
+        .collect();
+    if let Err(code) = check_outputs(&[path.to_path_buf()], outputs) {
+        return code;
+    }
+    let jobs = capped_jobs(jobs);
     let shard = match shard.map(tensegrity_testbed::sweep::parse_shard).transpose() {
         Ok(s) => s,
         Err(e) => {
@@ -320,22 +344,43 @@ fn cmd_sweep(path: &Path, out: Option<&Path>, json: Option<&Path>, jobs: usize, 
         println!("stopped: {e}");
     }
     if let Some(o) = out {
-        if let Err(e) = write_atomic(o, &tensegrity_testbed::sweep::to_csv(&rows)) {
-            eprintln!("error: cannot write {}: {e}", o.display());
+        let mech = sc.mechanism();
+        let is_angle = |q: &str| {
+            mech.quantities().iter().any(|s| s.symbol == q && s.kind == mechanisms::QuantityKind::Angle)
+        };
+        if let Err(e) = write_atomic(o, &tensegrity_testbed::sweep::to_csv(&rows, &is_angle)) {
+            eprintln!("error: {e}");
             return EXIT_FAIL;
         }
     }
     if let Some(j) = json {
         if let Err(e) = write_atomic(j, &serde_json::to_string_pretty(&summary).unwrap_or_default()) {
-            eprintln!("error: cannot write {}: {e}", j.display());
+            eprintln!("error: {e}");
             return EXIT_FAIL;
         }
     }
-    if summary.errors.is_empty() && !CANCEL.load(Ordering::SeqCst) {
+    if let Some(min) = summary.min_agreement_percent {
+        println!("required agreement {min:.2} %");
+    }
+    if !summary.disagreements.is_empty() {
+        println!("{} point(s) did not settle or are out of tolerance", summary.disagreements.len());
+    }
+    if summary.passed && !CANCEL.load(Ordering::SeqCst) {
+        println!("PASS");
         EXIT_PASS
     } else {
+        println!("FAIL");
         EXIT_FAIL
     }
+}
+
+/// `--jobs`, at least 1 and at most the machine's threads (lowered with a note on stderr).
+fn capped_jobs(jobs: usize) -> usize {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if jobs > threads {
+        eprintln!("note: --jobs {jobs} lowered to {threads}, the threads of this machine");
+    }
+    jobs.clamp(1, threads)
 }
 
 fn cmd_figure(name: Option<&str>, out: &Path, list: bool) -> i32 {
@@ -362,7 +407,10 @@ fn cmd_figure(name: Option<&str>, out: &Path, list: bool) -> i32 {
     }
 }
 
-fn cmd_merge(csvs: &[PathBuf], out: &Path) -> i32 {
+fn cmd_merge(csvs: &[PathBuf], out: &Path, partial: bool) -> i32 {
+    if let Err(code) = check_outputs(csvs, vec![("--out".into(), out.to_path_buf())]) {
+        return code;
+    }
     let mut texts = Vec::new();
     for p in csvs {
         match std::fs::read_to_string(p) {
@@ -373,11 +421,11 @@ fn cmd_merge(csvs: &[PathBuf], out: &Path) -> i32 {
             }
         }
     }
-    match tensegrity_testbed::sweep::merge_csv(&texts) {
+    match tensegrity_testbed::sweep::merge_csv(&texts, partial) {
         Ok(text) => match write_atomic(out, &text) {
             Ok(()) => EXIT_PASS,
             Err(e) => {
-                eprintln!("error: cannot write {}: {e}", out.display());
+                eprintln!("error: {e}");
                 EXIT_FAIL
             }
         },

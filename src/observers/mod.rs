@@ -77,7 +77,7 @@ pub struct Setup<'a> {
     pub checks: &'a [Check],
     /// The mechanism's length scale [m], for normalised errors.
     pub length_scale_m: f64,
-    pub interference: Option<&'a InterferenceSettings>,
+    pub interference: &'a InterferenceSettings,
     /// A recording, when the run writes one (made last: nothing is written when another
     /// observer cannot start).
     pub recording: Option<record::Recording<'a>>,
@@ -87,9 +87,7 @@ pub struct Setup<'a> {
 pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
     let mut list: Vec<Box<dyn Observer>> =
         vec![Box::new(compare::Compare::new(setup.checks, setup.length_scale_m)), Box::new(slack::SlackTracker::new())];
-    if let Some(settings) = setup.interference {
-        list.push(Box::new(interference::Interference::new(setup.structure, settings)?));
-    }
+    list.push(Box::new(interference::Interference::new(setup.structure, setup.interference)?));
     if let Some(r) = &setup.recording {
         if let Some(recorder) = record::Recorder::start(r)? {
             list.push(Box::new(recorder));

@@ -140,7 +140,7 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         structure: &sim.structure(),
         checks: &sc.checks,
         length_scale_m: mech.length_scale(&sc.params),
-        interference: sc.interference.as_ref(),
+        interference: &sc.interference,
         recording: target.map(|target| Recording { target, every: opts.record_every.max(1), scenario: &sc.source }),
     })?;
     let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel);

@@ -3,7 +3,7 @@
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
 use super::raw::{RawActuator, RawBody, RawJoint, RawMember, RawStructure, Xyz};
-use crate::structure::{
+use crate::structure::{DEFAULT_TENDON_RADIUS_M, 
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut,
     TorsionSpring,
 };
@@ -14,6 +14,21 @@ const MIN_BODY_SIZE_M: f64 = 1e-3;
 
 /// Strut radius when the file gives none [m].
 const DEFAULT_STRUT_RADIUS_M: f64 = 0.01;
+
+/// An error at the second use of a name among `names` (a check or a report would read only one).
+fn unique_names<'a>(
+    ctx: &Ctx,
+    what: &str,
+    names: impl Iterator<Item = &'a Spanned<String>>,
+) -> Result<(), ScenarioError> {
+    let mut seen = std::collections::BTreeSet::new();
+    for n in names {
+        if !seen.insert(n.get_ref().as_str()) {
+            return Err(ctx.err(n, format!("duplicate {what} name '{}'", n.get_ref())));
+        }
+    }
+    Ok(())
+}
 
 /// Builds the structure of a `[structure]` table; every bad reference, zero-length member or
 /// massless free body is an error at its place in the file.
@@ -34,6 +49,9 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
         body_names.push(b.name.get_ref().clone());
         add_body(ctx, &mut s, b)?;
     }
+    unique_names(ctx, "member (strut, spring or cable)", r.struts.iter().chain(&r.springs).chain(&r.cables).map(|m| &m.name))?;
+    unique_names(ctx, "joint", r.joints.iter().map(|j| &j.name))?;
+    unique_names(ctx, "actuator symbol", r.actuators.iter().map(|a| &a.symbol))?;
     // Each part refers only to the parts built before it.
     s.struts = r.struts.iter().map(|m| strut(ctx, &s, m)).collect::<Result<_, _>>()?;
     s.springs = r.springs.iter().map(|m| spring(ctx, &s, m)).collect::<Result<_, _>>()?;
@@ -46,13 +64,18 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
 
 /// Three finite numbers.
 fn xyz(ctx: &Ctx, v: &Xyz, what: &str) -> Result<[f64; 3], ScenarioError> {
-    let a = *v.get_ref();
-    if a.iter().all(|c| c.is_finite()) {
-        Ok(a)
-    } else {
-        Err(ctx.err(v, format!("{what} must be three finite numbers, got {a:?}")))
+    match v.get_ref().as_slice() {
+        &[x, y, z] if [x, y, z].iter().all(|c| c.is_finite() && c.abs() <= MAX_COORDINATE_M) => Ok([x, y, z]),
+        a => Err(ctx.err(
+            v,
+            format!("{what} must be three finite numbers of magnitude at most {MAX_COORDINATE_M:e}, got {a:?}"),
+        )),
     }
 }
+
+/// Largest magnitude of a coordinate, gravity or inertia component the file may give: beyond
+/// it products of two such numbers leave f64's range for the simulation's sums of squares.
+const MAX_COORDINATE_M: f64 = 1e6;
 
 /// Adds a body (at least one node, a mass if free) and its nodes (names unique in the
 /// structure) to `s`.
@@ -165,6 +188,7 @@ fn spring(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Spring, ScenarioErr
         b,
         stiffness_n_per_m: positive_value(ctx, k, "stiffness (N/m)")?,
         rest_length_m: rest,
+        radius_m: tendon_radius(ctx, m)?,
     })
 }
 
@@ -180,7 +204,15 @@ fn cable(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Cable, ScenarioError
         Some(v) => positive_value(ctx, v, "length (m)")?,
         None => l,
     };
-    Ok(Cable { name: m.name.get_ref().clone(), a, b, law, length_m: length })
+    Ok(Cable { name: m.name.get_ref().clone(), a, b, law, length_m: length, radius_m: tendon_radius(ctx, m)? })
+}
+
+/// A cable's or spring's radius > 0 (default [`DEFAULT_TENDON_RADIUS_M`]), for interference.
+fn tendon_radius(ctx: &Ctx, m: &RawMember) -> Result<f64, ScenarioError> {
+    match &m.radius {
+        Some(v) => positive_value(ctx, v, "radius (m)"),
+        None => Ok(DEFAULT_TENDON_RADIUS_M),
+    }
 }
 
 /// A joint between two declared bodies at a declared node, with its optional torsion spring

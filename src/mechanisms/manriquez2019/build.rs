@@ -6,7 +6,7 @@
 //! linear springs. Everything is placed at the start configuration (theta1, theta2).
 
 use super::analytic::{self, Params};
-use crate::structure::{
+use crate::structure::{DEFAULT_TENDON_RADIUS_M, 
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut, Vec3,
 };
 use nalgebra::Vector3;
@@ -55,6 +55,7 @@ pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64, cable_lengt
             b: nt,
             law: CableLaw::Inextensible,
             length_m: cable_lengths[k],
+            radius_m: DEFAULT_TENDON_RADIUS_M,
         });
         s.actuators.push(Actuator { symbol: format!("L{}", k + 1), target: ActuatorTarget::CableLength(k) });
     }
@@ -68,6 +69,7 @@ pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64, cable_lengt
             b: nt,
             stiffness_n_per_m: d.spring_k,
             rest_length_m: d.spring_rest,
+            radius_m: DEFAULT_TENDON_RADIUS_M,
         });
     }
     s.joints.push(Joint {

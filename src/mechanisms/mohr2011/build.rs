@@ -15,7 +15,7 @@
 //! Cables: six, tension only, between the base and the end-effector, driven in pairs (Eq. 6).
 
 use super::analytic::SpringChain;
-use crate::structure::{
+use crate::structure::{DEFAULT_TENDON_RADIUS_M, 
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, ExternalLoad, Inertia, Joint, JointKind, Spring, Structure,
     Strut, TorsionSpring, Vec3,
 };
@@ -101,6 +101,7 @@ pub fn build(g: &Geometry, m: &ModelChoices) -> Structure {
                 b: b_nodes[i],
                 stiffness_n_per_m: k,
                 rest_length_m: g.lo,
+                radius_m: DEFAULT_TENDON_RADIUS_M,
             });
             s.struts.push(Strut {
                 name: format!("leg{} (straight)", i + 1),
@@ -123,6 +124,7 @@ pub fn build(g: &Geometry, m: &ModelChoices) -> Structure {
             b: b_nodes[*bi],
             law,
             length_m: g.cable_lengths[c],
+            radius_m: DEFAULT_TENDON_RADIUS_M,
         });
         s.actuators.push(Actuator { symbol: symbol.clone(), target: ActuatorTarget::CableLength(c) });
     }
