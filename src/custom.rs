@@ -161,7 +161,8 @@ fn strut_reading(s: &Structure, st: &crate::structure::Strut) -> Option<StrutRea
         let node = &s.nodes[n];
         s.joints.iter().any(|j| {
             (j.parent == node.body || j.child == node.body)
-                && crate::structure::distance(s.nodes[j.anchor].position, node.position) <= JOINT_AT_NODE_FRACTION * size
+                && crate::structure::distance(s.nodes[j.anchor].position, node.position)
+                    <= JOINT_AT_NODE_FRACTION * size
         })
     };
     match (jointed(st.a), jointed(st.b)) {

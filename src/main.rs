@@ -131,6 +131,18 @@ enum Command {
 /// ran are written, and the batch stops.
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
+/// Set while the command runs a phase that stops by itself on [`CANCEL`] (the scenarios' runs and
+/// the writing of their reports). In every other phase (parsing, an analytic solve, findings,
+/// figures) a signal ends the command within [`SIGNAL_POLL_S`]: its temporary files are
+/// removed, its outputs stay as they were, exit 1.
+static STOPS_ITSELF: AtomicBool = AtomicBool::new(false);
+
+/// How often the main thread looks for a signal while the command's thread works [s].
+const SIGNAL_POLL_S: f64 = 0.05;
+
+/// Stack of the command's thread [bytes] (the main thread's usual 8 MiB, with room).
+const COMMAND_STACK_BYTES: usize = 64 << 20;
+
 extern "C" fn on_signal(_signal: libc::c_int) {
     CANCEL.store(true, Ordering::SeqCst);
 }
@@ -153,7 +165,39 @@ fn main() -> ExitCode {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     let cli = Cli::parse();
-    let code = match cli.command {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let worker = std::thread::Builder::new().stack_size(COMMAND_STACK_BYTES).spawn(move || {
+        let _ = tx.send(dispatch(cli));
+    });
+    if let Err(e) = worker {
+        eprintln!("error: cannot start the command's thread: {e}");
+        return ExitCode::from(EXIT_FAIL as u8);
+    }
+    loop {
+        match rx.recv_timeout(std::time::Duration::from_secs_f64(SIGNAL_POLL_S)) {
+            Ok(code) => return ExitCode::from(code as u8),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                if CANCEL.load(Ordering::SeqCst) && !STOPS_ITSELF.load(Ordering::SeqCst) {
+                    tensegrity_testbed::output::remove_partials();
+                    eprintln!("interrupted");
+                    return ExitCode::from(EXIT_FAIL as u8);
+                }
+            }
+            // The command's thread panicked (its message is printed): an internal error.
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                tensegrity_testbed::output::remove_partials();
+                return ExitCode::from(EXIT_INTERNAL_ERROR);
+            }
+        }
+    }
+}
+
+/// Exit code of a command that panicked (Rust's own for a panic in main).
+const EXIT_INTERNAL_ERROR: u8 = 101;
+
+/// Runs the command; its exit code.
+fn dispatch(cli: Cli) -> i32 {
+    match cli.command {
         Command::Run { scenarios, json, record, connect, record_every } => {
             cmd_run(&scenarios, json.as_deref(), record.as_deref(), connect.as_deref(), record_every)
         }
@@ -181,8 +225,7 @@ fn main() -> ExitCode {
         Command::Bench { rounds, json, export_cases: None, mechanisms, peer: None } => {
             cmd_bench(rounds, json, &mechanisms)
         }
-    };
-    ExitCode::from(code as u8)
+    }
 }
 
 /// Loads and validates every scenario; prints each error; exit code 2 if any is bad.
@@ -246,7 +289,8 @@ fn cmd_run(
         }
     }
     let several = scenarios.len() > 1;
-    let mut outputs: Vec<(String, PathBuf)> = json.map(|j| ("--json".to_string(), j.to_path_buf())).into_iter().collect();
+    let mut outputs: Vec<(String, PathBuf)> =
+        json.map(|j| ("--json".to_string(), j.to_path_buf())).into_iter().collect();
     if connect.is_none() {
         for sc in &scenarios {
             if let Some(r) = record.map(|r| record_path(r, &sc.name, several)).or_else(|| sc.record.clone()) {
@@ -257,6 +301,8 @@ fn cmd_run(
     if let Err(code) = check_outputs(paths, outputs) {
         return code;
     }
+    // From here on each run stops at its next tick on a signal and the reports are written.
+    STOPS_ITSELF.store(true, Ordering::SeqCst);
     let mut report = Report { scenarios: vec![] };
     for sc in &scenarios {
         if CANCEL.load(Ordering::SeqCst) {
@@ -302,6 +348,8 @@ fn cmd_sweep(path: &Path, out: Option<&Path>, json: Option<&Path>, jobs: usize, 
         return code;
     }
     let jobs = capped_jobs(jobs);
+    // From here on every block stops at its next tick on a signal and the outputs are written.
+    STOPS_ITSELF.store(true, Ordering::SeqCst);
     let shard = match shard.map(tensegrity_testbed::sweep::parse_shard).transpose() {
         Ok(s) => s,
         Err(e) => {
@@ -345,9 +393,8 @@ fn cmd_sweep(path: &Path, out: Option<&Path>, json: Option<&Path>, jobs: usize, 
     }
     if let Some(o) = out {
         let mech = sc.mechanism();
-        let is_angle = |q: &str| {
-            mech.quantities().iter().any(|s| s.symbol == q && s.kind == mechanisms::QuantityKind::Angle)
-        };
+        let is_angle =
+            |q: &str| mech.quantities().iter().any(|s| s.symbol == q && s.kind == mechanisms::QuantityKind::Angle);
         if let Err(e) = write_atomic(o, &tensegrity_testbed::sweep::to_csv(&rows, &is_angle)) {
             eprintln!("error: {e}");
             return EXIT_FAIL;

@@ -10,9 +10,29 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 
 /// Counter that keeps the temporary names of one process apart.
 static PARTIAL_SEQ: AtomicU64 = AtomicU64::new(0);
+
+/// The temporary files being written now, so that an interrupted process removes them.
+static IN_PROGRESS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Removes every temporary file still being written (an interrupted command calls this on its
+/// way out: its outputs stay as they were before it started).
+pub fn remove_partials() {
+    if let Ok(mut list) = IN_PROGRESS.lock() {
+        for p in list.drain(..) {
+            let _ = std::fs::remove_file(p);
+        }
+    }
+}
+
+fn forget_partial(p: &Path) {
+    if let Ok(mut list) = IN_PROGRESS.lock() {
+        list.retain(|q| q != p);
+    }
+}
 
 /// The path `p` stands for, for comparing paths: canonical where it exists, else its
 /// directory's canonical path joined with its name (or the path made absolute).
@@ -48,7 +68,11 @@ pub fn check_outputs(inputs: &[PathBuf], outputs: &[(String, PathBuf)]) -> Resul
     for (what, path) in outputs {
         let id = identity(path);
         if let Some(k) = ins.iter().position(|i| *i == id) {
-            return Err(format!("{what} {} is the input {}: refusing to overwrite it", path.display(), inputs[k].display()));
+            return Err(format!(
+                "{what} {} is the input {}: refusing to overwrite it",
+                path.display(),
+                inputs[k].display()
+            ));
         }
         if let Some((_, other)) = seen.iter().find(|(p, _)| *p == id) {
             return Err(format!("{what} and {other} both write {}: give each its own path", path.display()));
@@ -60,22 +84,35 @@ pub fn check_outputs(inputs: &[PathBuf], outputs: &[(String, PathBuf)]) -> Resul
 }
 
 /// A temporary name beside `path`, unique to this process and this call:
-/// `.NAME.PID.SEQ.partial` (hidden, so that a reader globbing the outputs skips it).
+/// `.NAME.PID.SEQ.partial.EXT` (hidden, so that a reader globbing the outputs skips it; the
+/// extension kept for writers that choose the format by it). Registered until [`commit`] or
+/// [`discard`], so that an interrupted process removes it ([`remove_partials`]).
 pub fn partial_path(path: &Path) -> PathBuf {
     let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_else(|| "output".into());
+    let ext = path.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
     let seq = PARTIAL_SEQ.fetch_add(1, Ordering::SeqCst);
-    path.with_file_name(format!(".{name}.{}.{seq}.partial", std::process::id()))
+    let p = path.with_file_name(format!(".{name}.{}.{seq}.partial{ext}", std::process::id()));
+    if let Ok(mut list) = IN_PROGRESS.lock() {
+        list.push(p.clone());
+    }
+    p
+}
+
+/// Removes the temporary file `partial` (a write that failed).
+pub fn discard(partial: &Path) {
+    let _ = std::fs::remove_file(partial);
+    forget_partial(partial);
 }
 
 /// Renames the complete temporary file `partial` over `path` (a regular file or nothing);
 /// removes `partial` when that fails.
 pub fn commit(partial: &Path, path: &Path) -> Result<(), String> {
-    let done = check_replaceable(path).and_then(|()| {
-        std::fs::rename(partial, path).map_err(|e| format!("cannot write {}: {e}", path.display()))
-    });
+    let done = check_replaceable(path)
+        .and_then(|()| std::fs::rename(partial, path).map_err(|e| format!("cannot write {}: {e}", path.display())));
     if done.is_err() {
         let _ = std::fs::remove_file(partial);
     }
+    forget_partial(partial);
     done
 }
 
@@ -93,7 +130,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
         f.sync_all()
     })();
     if let Err(e) = written {
-        let _ = std::fs::remove_file(&tmp);
+        discard(&tmp);
         return Err(format!("cannot write {}: {e}", path.display()));
     }
     commit(&tmp, path)

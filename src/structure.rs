@@ -494,14 +494,28 @@ mod tests {
     #[test]
     fn a_valid_structure_passes_validation() {
         let mut s = two_bodies();
-        s.springs.push(Spring { name: "k".into(), a: 0, b: 1, stiffness_n_per_m: 10.0, rest_length_m: 0.0, radius_m: DEFAULT_TENDON_RADIUS_M });
+        s.springs.push(Spring {
+            name: "k".into(),
+            a: 0,
+            b: 1,
+            stiffness_n_per_m: 10.0,
+            rest_length_m: 0.0,
+            radius_m: DEFAULT_TENDON_RADIUS_M,
+        });
         assert_eq!(s.validate(), Ok(()));
     }
 
     #[test]
     fn a_member_naming_an_unknown_node_is_rejected() {
         let mut s = two_bodies();
-        s.cables.push(Cable { name: "c".into(), a: 0, b: 7, law: CableLaw::Inextensible, length_m: 1.0, radius_m: DEFAULT_TENDON_RADIUS_M });
+        s.cables.push(Cable {
+            name: "c".into(),
+            a: 0,
+            b: 7,
+            law: CableLaw::Inextensible,
+            length_m: 1.0,
+            radius_m: DEFAULT_TENDON_RADIUS_M,
+        });
         assert!(matches!(s.validate(), Err(StructureError::DanglingReference { index: 7, .. })));
     }
 
@@ -523,7 +537,14 @@ mod tests {
     #[test]
     fn a_negative_spring_stiffness_is_rejected() {
         let mut s = two_bodies();
-        s.springs.push(Spring { name: "k".into(), a: 0, b: 1, stiffness_n_per_m: -1.0, rest_length_m: 0.0, radius_m: DEFAULT_TENDON_RADIUS_M });
+        s.springs.push(Spring {
+            name: "k".into(),
+            a: 0,
+            b: 1,
+            stiffness_n_per_m: -1.0,
+            rest_length_m: 0.0,
+            radius_m: DEFAULT_TENDON_RADIUS_M,
+        });
         assert!(matches!(s.validate(), Err(StructureError::Invalid { what: "spring", .. })));
     }
 }

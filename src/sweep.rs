@@ -260,9 +260,10 @@ pub fn merge_csv(texts: &[(String, String)], partial: bool) -> Result<String, Sw
             }
             let mut cells = line.split(',');
             let mut number = |col: usize| {
-                cells.next().and_then(|s| s.parse::<usize>().ok()).ok_or_else(|| {
-                    SweepError::BadInput(format!("{name}:{}:{col}: expected a whole number", k + 2))
-                })
+                cells
+                    .next()
+                    .and_then(|s| s.parse::<usize>().ok())
+                    .ok_or_else(|| SweepError::BadInput(format!("{name}:{}:{col}: expected a whole number", k + 2)))
             };
             let (idx, n) = (number(1)?, number(2)?);
             if *grid_points.get_or_insert(n) != n || idx >= n {
@@ -281,7 +282,8 @@ pub fn merge_csv(texts: &[(String, String)], partial: bool) -> Result<String, Sw
     let total = grid_points.unwrap_or(0);
     if !partial && rows.len() != total {
         let present: std::collections::BTreeSet<usize> = rows.iter().map(|(i, _)| *i).collect();
-        let missing: Vec<String> = (0..total).filter(|i| !present.contains(i)).take(10).map(|i| i.to_string()).collect();
+        let missing: Vec<String> =
+            (0..total).filter(|i| !present.contains(i)).take(10).map(|i| i.to_string()).collect();
         return Err(SweepError::BadInput(format!(
             "{} of the grid's {total} points are missing (first: {}): a shard left out? (--partial merges what is there)",
             total - rows.len(),

@@ -75,7 +75,14 @@ fn an_absurd_stiffness_is_caught_by_the_energy_check_within_a_few_ticks() {
     );
     let a = s.add_node("A", g, [0.0; 3]);
     let p = s.add_node("P", b, [1.0, 0.0, 0.0]);
-    s.springs.push(Spring { name: "stiff".into(), a, b: p, stiffness_n_per_m: 1e12, rest_length_m: 0.5, radius_m: 1e-3 });
+    s.springs.push(Spring {
+        name: "stiff".into(),
+        a,
+        b: p,
+        stiffness_n_per_m: 1e12,
+        rest_length_m: 0.5,
+        radius_m: 1e-3,
+    });
     let mut sim = Simulation::new(&s, &SimSettings { dt_s: 0.01, ..Default::default() }).unwrap();
     let err = (0..100).find_map(|_| sim.step().err()).expect("diverges");
     match err {

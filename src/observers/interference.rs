@@ -59,8 +59,20 @@ pub fn members(s: &Structure, tendons: bool) -> Vec<Member> {
         .map(|t| Member { name: t.name.clone(), kind: "strut", a: t.a, b: t.b, radius_m: t.radius_m })
         .collect();
     if tendons {
-        out.extend(s.cables.iter().map(|c| Member { name: c.name.clone(), kind: "cable", a: c.a, b: c.b, radius_m: c.radius_m }));
-        out.extend(s.springs.iter().map(|c| Member { name: c.name.clone(), kind: "spring", a: c.a, b: c.b, radius_m: c.radius_m }));
+        out.extend(s.cables.iter().map(|c| Member {
+            name: c.name.clone(),
+            kind: "cable",
+            a: c.a,
+            b: c.b,
+            radius_m: c.radius_m,
+        }));
+        out.extend(s.springs.iter().map(|c| Member {
+            name: c.name.clone(),
+            kind: "spring",
+            a: c.a,
+            b: c.b,
+            radius_m: c.radius_m,
+        }));
     }
     out
 }
@@ -177,7 +189,14 @@ impl Interference {
         }
         let n = members.len();
         let pairs_checked = n * n.saturating_sub(1) / 2 - excluded.iter().filter(|(i, j)| i != j).count();
-        Ok(Interference { settings: settings.clone(), members, excluded, pairs_checked, stats: BTreeMap::new(), ticks: 0 })
+        Ok(Interference {
+            settings: settings.clone(),
+            members,
+            excluded,
+            pairs_checked,
+            stats: BTreeMap::new(),
+            ticks: 0,
+        })
     }
 
     /// Capsules of the checked members at the node positions `nodes`.

@@ -470,7 +470,7 @@ impl Recorder {
                 let flushed = rec.flush_blocking();
                 drop(rec);
                 if let Err(e) = flushed {
-                    let _ = std::fs::remove_file(partial);
+                    crate::output::discard(partial);
                     return Err(io(e.to_string()));
                 }
                 crate::output::commit(partial, path).map_err(io)?;

@@ -228,7 +228,9 @@ fn points(
         return Err(ctx.err(whole, "actuation.points is empty: give at least one point"));
     }
     if list.len() > MAX_POINTS {
-        return Err(ctx.err(&list[MAX_POINTS], format!("actuation.points has {} points; at most {MAX_POINTS}", list.len())));
+        return Err(
+            ctx.err(&list[MAX_POINTS], format!("actuation.points has {} points; at most {MAX_POINTS}", list.len()))
+        );
     }
     list.iter().map(|p| inputs.check(ctx, p, false)).collect()
 }

@@ -20,7 +20,10 @@ pub(super) fn checks(
         if !has_probe && probed.as_deref() == Some(c.quantity.get_ref().as_str()) {
             return Err(ctx.err(
                 &c.quantity,
-                format!("quantity '{}' is measured by the stiffness probe: add a [probe] section", c.quantity.get_ref()),
+                format!(
+                    "quantity '{}' is measured by the stiffness probe: add a [probe] section",
+                    c.quantity.get_ref()
+                ),
             ));
         }
         let q = m.quantities().iter().find(|q| q.symbol == c.quantity.get_ref()).ok_or_else(|| {

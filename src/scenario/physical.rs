@@ -32,7 +32,8 @@ fn extent(s: &Structure) -> f64 {
 
 /// The structure at the first point of the scenario: within the sizes above, every node inside
 /// `sim.bounding_box`. Errors are located at the key that sets the value: the bounding box
-/// when the file gives it, else the first parameter (or the mechanism, or the structure).
+/// when the file gives it, else the parameter farthest from 1 in order of magnitude (or the
+/// structure, or the mechanism).
 pub(super) fn physical(
     ctx: &Ctx,
     raw: &RawScenario,
@@ -40,8 +41,13 @@ pub(super) fn physical(
     s: &Structure,
     sim: &SimSettings,
 ) -> Result<(), ScenarioError> {
+    // The parameter most likely to set a size: the one farthest from 1 in order of magnitude.
+    let extreme = raw.params.iter().max_by(|a, b| {
+        let order = |v: f64| v.abs().ln().abs();
+        order(*a.1.get_ref()).total_cmp(&order(*b.1.get_ref()))
+    });
     let at_model = |message: String| {
-        let e = match (raw.params.keys().next(), &raw.structure) {
+        let e = match (extreme.map(|(k, _)| k), &raw.structure) {
             (Some(k), _) => ctx.err(k, ""),
             (None, Some(st)) => ctx.err(st, ""),
             (None, None) => ctx.err(&raw.mechanism, ""),

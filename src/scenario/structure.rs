@@ -3,9 +3,9 @@
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
 use super::raw::{RawActuator, RawBody, RawJoint, RawMember, RawStructure, Xyz};
-use crate::structure::{DEFAULT_TENDON_RADIUS_M, 
+use crate::structure::{
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut,
-    TorsionSpring,
+    TorsionSpring, DEFAULT_TENDON_RADIUS_M,
 };
 use toml::Spanned;
 
@@ -49,7 +49,11 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
         body_names.push(b.name.get_ref().clone());
         add_body(ctx, &mut s, b)?;
     }
-    unique_names(ctx, "member (strut, spring or cable)", r.struts.iter().chain(&r.springs).chain(&r.cables).map(|m| &m.name))?;
+    unique_names(
+        ctx,
+        "member (strut, spring or cable)",
+        r.struts.iter().chain(&r.springs).chain(&r.cables).map(|m| &m.name),
+    )?;
     unique_names(ctx, "joint", r.joints.iter().map(|j| &j.name))?;
     unique_names(ctx, "actuator symbol", r.actuators.iter().map(|a| &a.symbol))?;
     // Each part refers only to the parts built before it.
@@ -114,8 +118,11 @@ fn inertia(ctx: &Ctx, b: &RawBody, pts: &[[f64; 3]]) -> Result<Inertia, Scenario
         ctx.err(&b.name, format!("free body '{}' needs a mass > 0 kg (mass = ...), or fixed = true", b.name.get_ref()))
     })?;
     let mass = finite(ctx, m, "mass")?;
-    if mass <= 0.0 {
-        return Err(ctx.err(m, format!("mass must be > 0 kg, got {mass}")));
+    let (lo, hi) = super::physical::BODY_MASS_KG;
+    if !(lo..=hi).contains(&mass) {
+        return Err(
+            ctx.err(m, format!("mass must lie in [{lo:e}, {hi:e}] kg (what the simulation handles), got {mass}"))
+        );
     }
     let n = pts.len() as f64;
     let com = [0, 1, 2].map(|k| pts.iter().map(|p| p[k]).sum::<f64>() / n);

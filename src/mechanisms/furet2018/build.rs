@@ -13,7 +13,10 @@
 //! collisions): bar A-C is drawn at z = +dz and bar B-D at z = -dz, the joints' axes along Z.
 
 use super::analytic::{self, Params};
-use crate::structure::{DEFAULT_TENDON_RADIUS_M, Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut, Vec3};
+use crate::structure::{
+    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut, Vec3,
+    DEFAULT_TENDON_RADIUS_M,
+};
 use nalgebra::Vector2;
 
 /// Model choices that the paper does not give (defaults in `Furet2018::params`).

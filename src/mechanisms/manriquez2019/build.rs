@@ -6,8 +6,9 @@
 //! linear springs. Everything is placed at the start configuration (theta1, theta2).
 
 use super::analytic::{self, Params};
-use crate::structure::{DEFAULT_TENDON_RADIUS_M, 
+use crate::structure::{
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut, Vec3,
+    DEFAULT_TENDON_RADIUS_M,
 };
 use nalgebra::Vector3;
 

@@ -15,9 +15,9 @@
 //! Cables: six, tension only, between the base and the end-effector, driven in pairs (Eq. 6).
 
 use super::analytic::SpringChain;
-use crate::structure::{DEFAULT_TENDON_RADIUS_M, 
+use crate::structure::{
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, ExternalLoad, Inertia, Joint, JointKind, Spring, Structure,
-    Strut, TorsionSpring, Vec3,
+    Strut, TorsionSpring, Vec3, DEFAULT_TENDON_RADIUS_M,
 };
 use nalgebra::Vector3;
 
