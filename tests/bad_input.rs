@@ -169,6 +169,7 @@ fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
         ("mohr2011 l_o not positive", MOHR.replace("lo = 6.0", "lo = 0.0"), 5, "> 0"),
         ("mohr2011 straight not 0 or 1", MOHR.replace("lo = 6.0", "lo = 6.0\nstraight = 0.5"), 6, "straight"),
         ("furet2018 L not above b", FURET.replace("b = 0.6666666666666666", "b = 1.5"), 5, "shorter than L"),
+        ("furet2018 L below the default b", FURET.replace("b = 0.6666666666666666\n", "").replace("L = 1.0", "L = 0.5"), 4, "shorter than L"),
         ("furet2018 change point", FURET.replace("theta1 = 0.2", "theta1 = 1.5707963267948966"), 7, "change point"),
         ("furet2018 angle beyond pi", FURET.replace("theta2 = -0.3", "theta2 = -4.0"), 7, "(-pi, pi)"),
         (
