@@ -16,7 +16,7 @@ use super::{Note, Observer, SettlePoint, Tick};
 use crate::report::{InterferenceReport, InterferenceViolation, PairClearanceReport, PointReport, ScenarioReport};
 use crate::settings::InterferenceSettings;
 use crate::structure::{distance, NodeId, Structure, Vec3};
-use parry3d_f64::bounding_volume::Aabb;
+use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::math::Vector;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use parry3d_f64::query::details::closest_points_segment_segment_with_locations_nD;
@@ -115,6 +115,12 @@ pub fn attached_pairs(s: &Structure, members: &[Member]) -> HashSet<(usize, usiz
     out
 }
 
+/// Up to this many capsules every pair is tested directly (boxes first); above it a bounding
+/// volume hierarchy finds the candidate pairs. Building the hierarchy every tick costs more
+/// than the direct test below a few dozen members (measured: 13 us a tick for the 12 members
+/// of the 3-strut prism with the hierarchy).
+const DIRECT_PAIRS_MAX_CAPSULES: usize = 48;
+
 /// Clearance of every pair of capsules closer than `margin_m`, except the excluded ones.
 pub fn clearances(capsules: &[Capsule], margin_m: f64, excluded: impl Fn(usize, usize) -> bool) -> Vec<PairClearance> {
     if capsules.len() < 2 {
@@ -129,27 +135,44 @@ pub fn clearances(capsules: &[Capsule], margin_m: f64, excluded: impl Fn(usize, 
             Aabb::new(a.min(b) - pad, a.max(b) + pad)
         })
         .collect();
-    let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &boxes);
     let mut out = Vec::new();
-    for (i, j) in bvh.leaf_pairs(&bvh, |n1, n2| n1.intersects(n2)) {
-        let (i, j) = (i as usize, j as usize);
-        if i >= j || excluded(i, j) {
-            continue;
+    let mut test = |i: usize, j: usize| {
+        if i < j && !excluded(i, j) {
+            if let Some(p) = pair_clearance(capsules, i, j, margin_m) {
+                out.push(p);
+            }
         }
-        let (a1, b1, r1) = capsules[i];
-        let (a2, b2, r2) = capsules[j];
-        let (a1, b1, a2, b2) = (vec3(a1), vec3(b1), vec3(a2), vec3(b2));
-        let (l1, l2) = closest_points_segment_segment_with_locations_nD((&a1, &b1), (&a2, &b2));
-        let s1 = parry3d_f64::shape::Segment::new(a1, b1);
-        let s2 = parry3d_f64::shape::Segment::new(a2, b2);
-        let (p1, p2) = (s1.point_at(&l1), s2.point_at(&l2));
-        let clearance_m = (p1 - p2).length() - r1 - r2;
-        if clearance_m <= margin_m {
-            out.push(PairClearance { i, j, clearance_m, points: [[p1.x, p1.y, p1.z], [p2.x, p2.y, p2.z]] });
+    };
+    if capsules.len() <= DIRECT_PAIRS_MAX_CAPSULES {
+        for i in 0..capsules.len() {
+            for j in i + 1..capsules.len() {
+                if boxes[i].intersects(&boxes[j]) {
+                    test(i, j);
+                }
+            }
+        }
+    } else {
+        let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &boxes);
+        for (i, j) in bvh.leaf_pairs(&bvh, |n1, n2| n1.intersects(n2)) {
+            test(i as usize, j as usize);
         }
     }
     out.sort_by_key(|p| (p.i, p.j));
     out
+}
+
+/// The clearance of capsules `i` and `j` (segment distance minus both radii) and the closest
+/// points on their axes, when it is within `margin_m`.
+fn pair_clearance(capsules: &[Capsule], i: usize, j: usize, margin_m: f64) -> Option<PairClearance> {
+    let (a1, b1, r1) = capsules[i];
+    let (a2, b2, r2) = capsules[j];
+    let (a1, b1, a2, b2) = (vec3(a1), vec3(b1), vec3(a2), vec3(b2));
+    let (l1, l2) = closest_points_segment_segment_with_locations_nD((&a1, &b1), (&a2, &b2));
+    let s1 = parry3d_f64::shape::Segment::new(a1, b1);
+    let s2 = parry3d_f64::shape::Segment::new(a2, b2);
+    let (p1, p2) = (s1.point_at(&l1), s2.point_at(&l2));
+    let clearance_m = (p1 - p2).length() - r1 - r2;
+    (clearance_m <= margin_m).then(|| PairClearance { i, j, clearance_m, points: [[p1.x, p1.y, p1.z], [p2.x, p2.y, p2.z]] })
 }
 
 #[derive(Clone, Debug)]
