@@ -189,6 +189,7 @@ fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
         // Duplicate names: a check on the name would read only one.
         ("duplicate member name", PIN.replace("name = \"k\"", "name = \"bar\""), 20, "duplicate"),
         ("duplicate joint name", PIN.replace("damping = 0.5", "damping = 0.5\n[[structure.joints]]\nname = \"pin\"\nkind = \"fixed\"\nparent = \"ground\"\nchild = \"bar\"\nat = \"Q\""), 34, "duplicate"),
+        ("a joint whose child is fixed, at the joint", PIN.replace("child = \"bar\"", "child = \"ground\"\nparent2 = 1").replace("parent2 = 1\n", "").replace("parent = \"ground\"", "parent = \"bar\""), 26, "fixed"),
         // Physical sizes the simulation cannot handle, found at check time.
         ("mass far too small", PIN.replace("mass = 1.0", "mass = 1e-320"), 13, "mass"),
         ("ji2014 L = 1e308", JI.replace("L = 1.0", "L = 1e308"), 4, ""),

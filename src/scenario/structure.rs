@@ -62,8 +62,35 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
     s.cables = r.cables.iter().map(|m| cable(ctx, &s, m)).collect::<Result<_, _>>()?;
     s.joints = r.joints.iter().map(|j| joint(ctx, &s, j)).collect::<Result<_, _>>()?;
     s.actuators = r.actuators.iter().map(|a| actuator(ctx, &s, a)).collect::<Result<_, _>>()?;
-    s.validate().map_err(|e| ctx.err(raw, format!("the structure is not valid: {e}")))?;
+    s.validate().map_err(|e| structure_error_at(ctx, raw, e))?;
     Ok(s)
+}
+
+/// A structure error at the entry it names (a joint, a member, an actuator or a body), else at
+/// the `[structure]` table.
+fn structure_error_at(ctx: &Ctx, raw: &Spanned<RawStructure>, e: crate::structure::StructureError) -> ScenarioError {
+    use crate::structure::StructureError as E;
+    let r = raw.get_ref();
+    let (what, name) = match &e {
+        E::Invalid { what, name, .. } | E::ZeroLength { what, name } | E::DanglingReference { what, name, .. } => {
+            (*what, name.as_str())
+        }
+        E::NoMass(name) | E::Duplicate(name) => ("body", name.as_str()),
+    };
+    let members = |list: &[RawMember]| list.iter().find(|m| m.name.get_ref() == name).map(|m| m.name.span());
+    let span = match what {
+        "joint" => r.joints.iter().find(|j| j.name.get_ref() == name).map(|j| j.name.span()),
+        "strut" => members(&r.struts),
+        "spring" => members(&r.springs),
+        "cable" => members(&r.cables),
+        "actuator" => r.actuators.iter().find(|a| a.symbol.get_ref() == name).map(|a| a.symbol.span()),
+        _ => r.bodies.iter().find(|b| b.name.get_ref() == name).map(|b| b.name.span()),
+    };
+    let message = format!("the structure is not valid: {e}");
+    match span {
+        Some(sp) => ctx.err_at(sp.start, message),
+        None => ctx.err(raw, message),
+    }
 }
 
 /// Three finite numbers.
