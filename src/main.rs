@@ -115,6 +115,16 @@ enum Command {
         #[arg(long, value_name = "CMD", num_args = 0..=1, default_missing_value = DEFAULT_PEER)]
         peer: Option<String>,
     },
+    /// Write a scenario's structure in another simulator's format.
+    Export {
+        #[command(subcommand)]
+        format: ExportFormat,
+    },
+    /// Read a structure from another tool's format and write it as a scenario file.
+    Import {
+        #[command(subcommand)]
+        format: ImportFormat,
+    },
     /// Check every printed equation of a mechanism's paper against the testbed's derivation.
     Findings {
         mechanism: String,
@@ -122,6 +132,60 @@ enum Command {
         set: Vec<String>,
         #[arg(long)]
         json: bool,
+    },
+}
+
+#[derive(Subcommand)]
+enum ExportFormat {
+    /// MuJoCo MJCF XML of the structure at the scenario's first actuation point.
+    Mjcf {
+        scenario: PathBuf,
+        /// The XML file (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// How the testbed's ideal actuators are written: `mocap` (bodies placed by actuated
+        /// joints are mocap bodies: exact) or `position` (position servos of gain --kp).
+        #[arg(long, default_value = "mocap", value_parser = ["mocap", "position"])]
+        actuators: String,
+        /// Gain of the position actuators on joints [N/m or N m/rad].
+        #[arg(long, default_value_t = 1e6)]
+        kp: f64,
+    },
+}
+
+#[derive(Subcommand)]
+enum ImportFormat {
+    /// An NTRT YAML model (nodes, pair_groups, builders, substructures, bond_groups).
+    Ntrt {
+        file: PathBuf,
+        /// The scenario file (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Keep NTRT's axes (y up) instead of mapping its y to the testbed's z.
+        #[arg(long)]
+        keep_axes: bool,
+    },
+    /// A node matrix N (3 x n) and connectivity matrices C_b (bars x n) and C_s (strings x n),
+    /// as CSV (Skelton and de Oliveira's notation, TsgFEM, MOTES).
+    Matrices {
+        n: PathBuf,
+        cb: PathBuf,
+        cs: PathBuf,
+        /// The scenario file (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Mass of each bar [kg].
+        #[arg(long, default_value_t = 1.0)]
+        bar_mass: f64,
+        /// Radius of each bar [m].
+        #[arg(long, default_value_t = 0.01)]
+        bar_radius: f64,
+        /// Stiffness of each string [N/m].
+        #[arg(long, default_value_t = 1000.0)]
+        string_stiffness: f64,
+        /// Tension of each string at its drawn length [N] (sets its rest length).
+        #[arg(long, default_value_t = 10.0)]
+        string_tension: f64,
     },
 }
 
@@ -166,6 +230,23 @@ fn main() -> ExitCode {
         Command::Figure { name, out, list } => cmd_figure(name.as_deref(), &out, list),
         Command::Solve { mechanism, query, set, json } => cmd_solve(&mechanism, &query, &set, json),
         Command::Findings { mechanism, set, json } => cmd_findings(&mechanism, &set, json),
+        Command::Import { format: ImportFormat::Ntrt { file, out, keep_axes } } => {
+            cmd_import_ntrt(&file, out.as_deref(), keep_axes)
+        }
+        Command::Import {
+            format: ImportFormat::Matrices { n, cb, cs, out, bar_mass, bar_radius, string_stiffness, string_tension },
+        } => {
+            let o = tensegrity_testbed::import::matrices::MatrixOptions {
+                bar_mass_kg: bar_mass,
+                bar_radius_m: bar_radius,
+                string_stiffness_n_per_m: string_stiffness,
+                string_tension_n: string_tension,
+            };
+            cmd_import_matrices(&[n, cb, cs], out.as_deref(), &o)
+        }
+        Command::Export { format: ExportFormat::Mjcf { scenario, out, actuators, kp } } => {
+            cmd_export_mjcf(&scenario, out.as_deref(), &actuators, kp)
+        }
         Command::Bench { export_cases: Some(dir), .. } => cmd_export_cases(&dir),
         Command::Bench { rounds, json, export_cases: None, mechanisms, peer: Some(peer) } => {
             cmd_bench_peer(rounds, json, &mechanisms, &peer)
@@ -417,6 +498,100 @@ fn cmd_list() -> i32 {
         }
     }
     EXIT_PASS
+}
+
+/// Writes `text` to `out` (never over `input`), or to stdout without `out`.
+fn write_output(out: Option<&Path>, input: &Path, text: &str) -> i32 {
+    let Some(o) = out else {
+        print!("{text}");
+        return EXIT_PASS;
+    };
+    let same = |a: &Path, b: &Path| a == b || std::fs::canonicalize(a).ok() == std::fs::canonicalize(b).ok();
+    if o.exists() && same(o, input) {
+        eprintln!("error: --out {} is the input file; choose another", o.display());
+        return EXIT_BAD_INPUT;
+    }
+    match write_atomic(o, text) {
+        Ok(()) => EXIT_PASS,
+        Err(e) => {
+            eprintln!("error: cannot write {}: {e}", o.display());
+            EXIT_FAIL
+        }
+    }
+}
+
+fn cmd_import_ntrt(path: &Path, out: Option<&Path>, keep_axes: bool) -> i32 {
+    use tensegrity_testbed::import::ntrt::{import, Axes};
+    let axes = if keep_axes { Axes::Keep } else { Axes::ZUp };
+    match import(path, axes) {
+        Ok(imported) => {
+            for s in &imported.skipped {
+                eprintln!("skipped: {s}");
+            }
+            write_output(out, path, &imported.toml)
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_BAD_INPUT
+        }
+    }
+}
+
+fn cmd_import_matrices(
+    inputs: &[PathBuf; 3],
+    out: Option<&Path>,
+    o: &tensegrity_testbed::import::matrices::MatrixOptions,
+) -> i32 {
+    let positive = [
+        ("--bar-mass", o.bar_mass_kg),
+        ("--bar-radius", o.bar_radius_m),
+        ("--string-stiffness", o.string_stiffness_n_per_m),
+    ];
+    if let Some((flag, x)) = positive.iter().find(|(_, x)| !(*x > 0.0 && x.is_finite())) {
+        eprintln!("error: {flag} must be a finite number > 0, got {x}");
+        return EXIT_BAD_INPUT;
+    }
+    if !(o.string_tension_n >= 0.0 && o.string_tension_n.is_finite()) {
+        eprintln!("error: --string-tension must be a finite number >= 0, got {}", o.string_tension_n);
+        return EXIT_BAD_INPUT;
+    }
+    if let Some(path) = out {
+        if inputs.iter().any(|i| path.exists() && std::fs::canonicalize(i).ok() == std::fs::canonicalize(path).ok()) {
+            eprintln!("error: --out {} is an input file; choose another", path.display());
+            return EXIT_BAD_INPUT;
+        }
+    }
+    match tensegrity_testbed::import::matrices::import(&inputs[0], &inputs[1], &inputs[2], o) {
+        Ok(imported) => write_output(out, &inputs[0], &imported.toml),
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_BAD_INPUT
+        }
+    }
+}
+
+fn cmd_export_mjcf(path: &Path, out: Option<&Path>, actuators: &str, kp: f64) -> i32 {
+    use tensegrity_testbed::export::{mjcf::ActuatorMode, scenario_mjcf};
+    let sc = match load_all(&[path.to_path_buf()]) {
+        Ok(mut s) => s.remove(0),
+        Err(code) => return code,
+    };
+    if !(kp > 0.0 && kp.is_finite()) {
+        eprintln!("error: --kp must be a finite number > 0, got {kp}");
+        return EXIT_BAD_INPUT;
+    }
+    let mode = if actuators == "position" { ActuatorMode::Position } else { ActuatorMode::Mocap };
+    let mjcf = match scenario_mjcf(&sc, mode, kp) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("error: {}: {e}", path.display());
+            return EXIT_BAD_INPUT;
+        }
+    };
+    for w in &mjcf.warnings {
+        eprintln!("warning: not exported: {w}");
+    }
+    write_output(out, path, &mjcf.xml)
 }
 
 /// Splits --set NAME=VALUE arguments into parameters and inputs of the mechanism.
