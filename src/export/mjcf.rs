@@ -26,7 +26,8 @@
 //!   [`ActuatorMode::Mocap`] a body hung from fixed or placed bodies by actuated joints only is
 //!   a mocap body at its drawn pose (placed, never integrated: the MuJoCo peer's model of
 //!   ji2014's actuator, `benches/peers/mujoco/README.md`), and the bodies it carries hang from it
-//!   as usual; in [`ActuatorMode::Position`] every actuated joint is an MJCF joint driven by a
+//!   as usual; an actuated joint whose parent moves is held at its command by a joint
+//!   equality (`polycoef` a0 = command - ref: a soft constraint, like the loop closures); in [`ActuatorMode::Position`] every actuated joint is an MJCF joint driven by a
 //!   `<position>` actuator of gain `joint_kp` (a servo: it sags by load / kp). A winch on an
 //!   elastic cable is a `<position>` actuator on its tendon with kp = the cable's stiffness and
 //!   force range [-max, 0]: tension k (l - command) when longer, none when shorter, the cable's
@@ -414,8 +415,31 @@ impl Writer<'_> {
                 )),
             }
         }
+        self.joint_locks(&mut rows);
         if !rows.is_empty() {
             let _ = write!(self.xml, "<equality>\n{rows}</equality>\n");
+        }
+    }
+
+    /// In [`ActuatorMode::Mocap`], an actuated forest joint whose parent moves cannot be placed
+    /// by a mocap body: it is held at its command by a joint equality (y - ref = a0).
+    fn joint_locks(&mut self, rows: &mut String) {
+        let (s, plan) = (self.s, self.plan);
+        if self.o.actuators != ActuatorMode::Mocap {
+            return;
+        }
+        for (i, a) in s.actuators.iter().enumerate() {
+            let ActuatorTarget::Joint(j) = a.target else { continue };
+            let joint = &s.joints[j];
+            if plan.tree_joint[joint.child] == Some(j) && !plan.mocap[joint.child] {
+                let offset = self.o.commands.get(i).copied().unwrap_or(joint.initial_coordinate) - joint.initial_coordinate;
+                let _ = writeln!(
+                    rows,
+                    "  <joint name=\"lock:{}\" joint1=\"{}\" polycoef=\"{offset:?} 0 0 0 0\"/>",
+                    esc(&joint.name),
+                    esc(&joint.name)
+                );
+            }
         }
     }
 
@@ -479,6 +503,13 @@ impl Writer<'_> {
                             "  <!-- {name} = {command:?}: joint {} places mocap body {} (move it with mocap_pos / mocap_quat) -->",
                             esc(&joint.name),
                             esc(&s.bodies[joint.child].name)
+                        );
+                    } else if plan.tree_joint[joint.child] == Some(j) && self.o.actuators == ActuatorMode::Mocap {
+                        let _ = writeln!(
+                            rows,
+                            "  <!-- {name} = {command:?}: joint {} held by the equality lock:{} (its eq_data[0] = command - ref) -->",
+                            esc(&joint.name),
+                            esc(&joint.name)
                         );
                     } else if plan.tree_joint[joint.child] == Some(j) {
                         let _ = writeln!(
