@@ -40,6 +40,10 @@ enum Command {
         /// Record every N-th tick only (thins long runs).
         #[arg(long, default_value_t = 1, value_name = "N")]
         record_every: u64,
+        /// Write every tick as a row of this CSV table at full f64 precision (with several
+        /// scenarios: one file each, named FILE-<scenario>.csv).
+        #[arg(long, value_name = "FILE.csv")]
+        table: Option<PathBuf>,
     },
     /// Validate scenario files without running them.
     Check {
@@ -210,8 +214,8 @@ fn main() -> ExitCode {
     install_signal_handlers();
     let cli = Cli::parse();
     let code = match cli.command {
-        Command::Run { scenarios, json, record, connect, record_every } => {
-            cmd_run(&scenarios, json.as_deref(), record.as_deref(), connect.as_deref(), record_every)
+        Command::Run { scenarios, json, record, connect, record_every, table } => {
+            cmd_run(&scenarios, json.as_deref(), record.as_deref(), connect.as_deref(), record_every, table.as_deref())
         }
         Command::Check { scenarios } => match load_all(&scenarios) {
             Ok(list) => {
@@ -304,12 +308,23 @@ fn record_path(base: &Path, name: &str, several: bool) -> PathBuf {
     base.with_file_name(format!("{stem}-{safe}.rrd"))
 }
 
+/// The table file of one scenario: `base` itself, or `base-<scenario>.csv` with several.
+fn table_path(base: &Path, name: &str, several: bool) -> PathBuf {
+    let rrd = record_path(base, name, several);
+    if several {
+        rrd.with_extension("csv")
+    } else {
+        rrd
+    }
+}
+
 fn cmd_run(
     paths: &[PathBuf],
     json: Option<&Path>,
     record: Option<&Path>,
     connect: Option<&str>,
     record_every: u64,
+    table: Option<&Path>,
 ) -> i32 {
     let scenarios = match load_all(paths) {
         Ok(s) => s,
@@ -334,6 +349,7 @@ fn cmd_run(
             connect: connect.map(str::to_string),
             record_every,
             skip_findings: false,
+            table: table.map(|t| table_path(t, &sc.name, several)),
         };
         // A panic inside one scenario fails that scenario, with its message; the batch goes on.
         let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(sc, &opts)))
