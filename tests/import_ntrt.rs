@@ -186,3 +186,33 @@ fn the_import_command_writes_a_scenario_that_checks() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// What the testbed does not model is listed, with its place: a box (tgBoxInfo), a sphere
+/// (tgSphereInfo on a node), a node_edge bond; the rest (two prisms joined node to node)
+/// still imports and checks.
+#[test]
+fn boxes_spheres_and_node_edge_bonds_are_listed_as_skipped() {
+    let dir = std::env::temp_dir().join(format!("import-ntrt-skips-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(Path::new(FIXTURES).join("prism3.yaml"), dir.join("prism.yaml")).unwrap();
+    let top = "substructures:\n  p/q:\n    path: prism.yaml\n    offset: [0, 2, 0]\n\
+               nodes:\n  ball: [3, 0, 0]\n  box_a: [4, 0, 0]\n  box_b: [5, 0, 0]\n\
+               pair_groups:\n  box:\n    - [box_a, box_b]\n\
+               builders:\n  ball:\n    class: tgSphereInfo\n    parameters:\n      radius: 0.5\n\
+               bond_groups:\n  string:\n    p/q/node_node:\n      - [t1, b1]\n      - [t2, b2]\n      - [t3, b3]\n\
+               \x20 joint:\n    p/q/node_edge:\n      - [t1, b1/b2]\n";
+    let file = dir.join("two.yaml");
+    std::fs::write(&file, top).unwrap();
+    let i = import(&file, Axes::ZUp).unwrap();
+    let has = |s: &str| i.skipped.iter().any(|k| k.contains(s));
+    assert!(has("tgBoxInfo 'box' between box_a and box_b"), "{:?}", i.skipped);
+    assert!(has("sphere node 'ball'"), "{:?}", i.skipped);
+    assert!(has("node_edge bond 'p/q/node_edge'"), "{:?}", i.skipped);
+    let sc = scenario::parse(Path::new("two.toml"), &i.toml).unwrap_or_else(|e| panic!("{e}\n{}", i.toml));
+    let s = &sc.custom.as_ref().unwrap().structure;
+    assert_eq!((s.struts.len(), s.cables.len()), (6, 21));
+    // q is offset by one step of 2 along NTRT's y (z here).
+    let (pb1, qb1) = (s.nodes[s.node_id("p.b1").unwrap()].position, s.nodes[s.node_id("q.b1").unwrap()].position);
+    assert_eq!(qb1[2] - pb1[2], 2.0);
+    std::fs::remove_dir_all(&dir).ok();
+}
