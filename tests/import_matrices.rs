@@ -45,7 +45,8 @@ fn prism_files(dir: &Path) -> [PathBuf; 3] {
         .map(|&(a, b)| row(a, b))
         .collect();
     let files = [dir.join("N.csv"), dir.join("Cb.csv"), dir.join("Cs.csv")];
-    for (f, text) in files.iter().zip([format!("# node matrix, one column per node\n{n}"), cb, cs]) {
+    let texts = [format!("# node matrix, one column per node\n{n}"), format!("# C_b: one row per bar\n\n{cb}"), cs];
+    for (f, text) in files.iter().zip(texts) {
         std::fs::write(f, text).unwrap();
     }
     files
@@ -98,14 +99,15 @@ fn a_prism_from_connectivity_matrices_settles_to_the_closed_form_twist() {
 }
 
 /// A node on two bars (class 2), a row without exactly one -1 and one 1, a row with too few
-/// columns and a value that is no number are errors naming the file and row.
+/// columns and a value that is no number are errors naming the file and the row's line
+/// (comments and blank lines counted).
 #[test]
 fn malformed_matrices_are_errors_at_their_row() {
     let dir = temp("bad");
     let [n, cb, cs] = prism_files(&dir);
     let good_cb = std::fs::read_to_string(&cb).unwrap();
     let cases = [
-        (&cb, good_cb.replacen("-1,0,0,0,1,0", "-1,0,0,0,0,1", 1), 2, "node 6 is on bars 1 and 2"),
+        (&cb, good_cb.replacen("-1,0,0,0,1,0", "-1,0,0,0,0,1", 1), 4, "node 6 is on bars 1 and 2"),
         (&cs, "-1,1,1,0,0,0\n".to_string(), 1, "one -1, one 1 and zeros"),
         (&cs, "-1,1,0,0,0,0\n-1,1,0,0\n".to_string(), 2, "values where the first row has 6"),
         (&n, "1,2,x,4,5,6\n0,0,0,0,0,0\n0,0,0,1,1,1\n".to_string(), 1, "'x' is not a finite number"),

@@ -26,8 +26,12 @@ pub struct MatrixOptions {
     pub string_tension_n: f64,
 }
 
-/// A CSV matrix of numbers: rows of comma- (or whitespace-) separated values; `#` comments.
-fn read_matrix(path: &Path) -> Result<Vec<Vec<f64>>, ImportError> {
+/// A row of a matrix file: its line in the file (from 1) and its values.
+type Row = (usize, Vec<f64>);
+
+/// A CSV matrix of numbers: rows of comma- (or whitespace-) separated values; `#` comments
+/// and blank lines skipped (each row keeps its line number).
+fn read_matrix(path: &Path) -> Result<Vec<Row>, ImportError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| ImportError {
         file: file.clone(),
@@ -71,16 +75,17 @@ fn read_matrix(path: &Path) -> Result<Vec<Vec<f64>>, ImportError> {
     if rows.is_empty() {
         return Err(ImportError { file, line: 0, col: 0, message: "the matrix is empty".into() });
     }
-    Ok(rows.into_iter().map(|(_, r)| r).collect())
+    Ok(rows)
 }
 
-/// The members of a connectivity matrix: (from node, to node) per row; value number `k` of a
-/// row is column `k` (node `k`).
-fn members(path: &Path, c: &[Vec<f64>], n: usize) -> Result<Vec<(usize, usize)>, ImportError> {
+/// The members of a connectivity matrix: (from node, to node, line) per row; value number
+/// `k` of a row is column `k` (node `k`).
+fn members(path: &Path, c: &[Row], n: usize) -> Result<Vec<(usize, usize, usize)>, ImportError> {
     let file = path.display().to_string();
-    let e = |row: usize, message: String| ImportError { file: file.clone(), line: row + 1, col: 1, message };
+    let e = |line: usize, message: String| ImportError { file: file.clone(), line, col: 1, message };
     let mut out = Vec::new();
-    for (i, row) in c.iter().enumerate() {
+    for (i, row) in c {
+        let i = *i;
         if row.len() != n {
             return Err(e(i, format!("{} columns, but N has {n} nodes", row.len())));
         }
@@ -89,7 +94,7 @@ fn members(path: &Path, c: &[Vec<f64>], n: usize) -> Result<Vec<(usize, usize)>,
         if from.len() != 1 || to.len() != 1 || row.iter().any(|x| ![-1.0, 0.0, 1.0].contains(x)) {
             return Err(e(i, "a member's row holds one -1, one 1 and zeros".into()));
         }
-        out.push((from[0], to[0]));
+        out.push((from[0], to[0], i));
     }
     Ok(out)
 }
@@ -105,18 +110,18 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
             message: format!("N must have 3 rows (x, y, z of each node), got {}", n.len()),
         });
     }
-    let count = n[0].len();
-    let nodes: Vec<Vec3> = (0..count).map(|k| [n[0][k], n[1][k], n[2][k]]).collect();
+    let count = n[0].1.len();
+    let nodes: Vec<Vec3> = (0..count).map(|k| [n[0].1[k], n[1].1[k], n[2].1[k]]).collect();
     let bars = members(cb_path, &read_matrix(cb_path)?, count)?;
     let strings = members(cs_path, &read_matrix(cs_path)?, count)?;
     let name = |k: usize| format!("n{}", k + 1);
     let mut on_bar: Vec<Option<usize>> = vec![None; count];
-    for (i, &(a, b)) in bars.iter().enumerate() {
+    for (i, &(a, b, line)) in bars.iter().enumerate() {
         for k in [a, b] {
             if let Some(j) = on_bar[k] {
                 return Err(ImportError {
                     file: cb_path.display().to_string(),
-                    line: i + 1,
+                    line,
                     col: 1,
                     message: format!(
                         "node {} is on bars {} and {}: only class-1 structures (no node on two bars)",
@@ -146,7 +151,7 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
             nodes: ground.iter().map(|&k| (name(k), nodes[k])).collect(),
         });
     }
-    for (i, &(a, b)) in bars.iter().enumerate() {
+    for (i, &(a, b, _)) in bars.iter().enumerate() {
         let l = distance(nodes[a], nodes[b]);
         let inertia = o.bar_mass_kg * (3.0 * o.bar_radius_m * o.bar_radius_m + l * l) / 12.0;
         draft.bodies.push(DraftBody {
@@ -163,13 +168,13 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
             radius_m: o.bar_radius_m,
         });
     }
-    for (i, &(a, b)) in strings.iter().enumerate() {
+    for (i, &(a, b, line)) in strings.iter().enumerate() {
         let l = distance(nodes[a], nodes[b]);
         let rest = l - o.string_tension_n / o.string_stiffness_n_per_m;
         if !(rest > 0.0) {
             return Err(ImportError {
                 file: cs_path.display().to_string(),
-                line: i + 1,
+                line,
                 col: 1,
                 message: format!(
                     "string {}: tension {} N at {} N/m leaves no rest length (drawn {l} m)",

@@ -10,15 +10,27 @@ pub mod matrices;
 pub mod ntrt;
 pub mod yaml;
 
-/// A rejected input, at a line and column of a file (both from 1; 0 when unknown).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}:{line}:{col}: {message}")]
+/// A rejected input, at a line and column of a file (both from 1; 0 for the file as a whole,
+/// which is then written `file: message`).
+#[derive(Debug, Clone, PartialEq)]
 pub struct ImportError {
     pub file: String,
     pub line: usize,
     pub col: usize,
     pub message: String,
 }
+
+impl std::fmt::Display for ImportError {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        if self.line == 0 {
+            write!(f, "{}: {}", self.file, self.message)
+        } else {
+            write!(f, "{}:{}:{}: {}", self.file, self.line, self.col, self.message)
+        }
+    }
+}
+
+impl std::error::Error for ImportError {}
 
 impl ImportError {
     pub fn at(file: &str, at: yaml::At, message: impl Into<String>) -> Self {
