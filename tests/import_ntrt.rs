@@ -216,3 +216,26 @@ fn boxes_spheres_and_node_edge_bonds_are_listed_as_skipped() {
     assert_eq!(qb1[2] - pb1[2], 2.0);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// As in NTRT, the last added builder whose tag words the pair has wins: verticals tagged
+/// "side string" take the later builder "side string" (200 N/m), not "string" (100 N/m); the
+/// name of each cable says which builder made it.
+#[test]
+fn the_last_matching_builder_wins_as_in_ntrt() {
+    let dir = std::env::temp_dir().join(format!("import-ntrt-builders-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let prism = std::fs::read_to_string(Path::new(FIXTURES).join("prism3.yaml")).unwrap();
+    let text = prism.replace("    - [b1, t1]", "  side string:\n    - [b1, t1]")
+        + "  side string:\n    class: tgBasicActuatorInfo\n    parameters:\n      stiffness: 200.0\n      pretension: 20.0\n";
+    let file = dir.join("sides.yaml");
+    std::fs::write(&file, &text).unwrap();
+    let i = import(&file, Axes::ZUp).unwrap();
+    let sc = scenario::parse(Path::new("sides.toml"), &i.toml).unwrap_or_else(|e| panic!("{e}\n{}", i.toml));
+    let s = &sc.custom.as_ref().unwrap().structure;
+    let side = s.cables.iter().find(|c| c.name == "side string b1-t1").expect("made by 'side string'");
+    assert_eq!(side.law, tensegrity_testbed::structure::CableLaw::Elastic { stiffness_n_per_m: 200.0 });
+    assert!((side.length_m - (1.5 - 20.0 / 200.0)).abs() <= 1e-15);
+    let bottom = s.cables.iter().find(|c| c.name == "string b1-b2").unwrap();
+    assert_eq!(bottom.law, tensegrity_testbed::structure::CableLaw::Elastic { stiffness_n_per_m: 100.0 });
+    std::fs::remove_dir_all(&dir).ok();
+}

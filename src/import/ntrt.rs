@@ -7,9 +7,9 @@
 //! `reference` or the substructure's centroid), scaled about their centroid, offset by
 //! `offset` times their place in the `a/b/c` list and translated; builders matched to pairs by
 //! tags (a pair's tags are the words of its group name; a builder matches when the pair has
-//! all of its words; a file's builders override those of its substructures, and the default
-//! `rod` (tgRodInfo, radius 0.5, density 1) and `string` (tgBasicActuatorInfo, stiffness 1000,
-//! pretension 0) builders are there unless overridden); `bond_groups` join nodes of adjacent
+//! all of its words; the last added matching builder wins, rigid ones before strings, so a
+//! file's builders override those of its substructures and the defaults `rod` (tgRodInfo,
+//! radius 0.5, density 1) and `string` (tgBasicActuatorInfo, stiffness 1000, pretension 0)); `bond_groups` join nodes of adjacent
 //! substructures of a `a/b/c/node_node` list; node paths `child.grandchild.node`.
 //!
 //! Made of it: each rod (tgRodInfo) a strut on a rigid body of mass density x pi r^2 x length
@@ -193,7 +193,10 @@ impl Sub {
 
 /// Everything the reading gathers across files.
 struct Reader {
-    builders: BTreeMap<String, Builder>,
+    /// (tag, builder) in the order NTRT adds them: the defaults, then each file's after its
+    /// substructures'. The last added that matches wins (tgStructureInfo::initRigidInfo and
+    /// initConnectorInfo search from the end), rigid builders before strings.
+    builders: Vec<(String, Builder)>,
     skipped: Vec<String>,
 }
 
@@ -252,7 +255,7 @@ pub fn import(path: &Path, axes: Axes) -> Result<Imported, ImportError> {
     Ok(Imported { toml: draft.to_toml(), skipped: r.skipped })
 }
 
-fn default_builders() -> BTreeMap<String, Builder> {
+fn default_builders() -> Vec<(String, Builder)> {
     let b =
         |class: &str, kind| Builder { class: class.into(), kind, params: BTreeMap::new(), file: "(default)".into() };
     [
@@ -262,6 +265,13 @@ fn default_builders() -> BTreeMap<String, Builder> {
         ("sphere".to_string(), b("tgSphereInfo", Kind::Sphere)),
     ]
     .into()
+}
+
+impl Kind {
+    /// Rods, boxes and spheres: NTRT tries these builders on a pair before the strings.
+    fn rigid(self) -> bool {
+        !matches!(self, Kind::String)
+    }
 }
 
 impl Reader {
@@ -406,7 +416,7 @@ impl Reader {
                     params.insert(name.to_string(), (value.to_string(), pv.at()));
                 }
             }
-            self.builders.insert(tag, Builder { class, kind, params, file: file.into() });
+            self.builders.push((tag, Builder { class, kind, params, file: file.into() }));
         }
         Ok(())
     }
@@ -558,26 +568,17 @@ fn flatten(sub: &Sub, prefix: &[usize], names: &[String], nodes: &mut Vec<(NodeR
 }
 
 impl Reader {
-    /// The builder a pair's tags select (every word of the builder's tag among the pair's).
-    fn builder_for(&self, pair: &Pair) -> Result<Option<(&String, &Builder)>, ImportError> {
-        let matches: Vec<(&String, &Builder)> = self
-            .builders
-            .iter()
-            .filter(|(tag, _)| tag.split_whitespace().all(|w| pair.tags.iter().any(|t| t == w)))
-            .collect();
-        match matches.as_slice() {
-            [] => Ok(None),
-            [one] => Ok(Some(*one)),
-            many => Err(err(
-                &pair.file,
-                pair.at,
-                format!(
-                    "the pair's tags '{}' match several builders ({}): NTRT's builders must not overlap",
-                    pair.tags.join(" "),
-                    many.iter().map(|(t, _)| t.as_str()).collect::<Vec<_>>().join(", ")
-                ),
-            )),
-        }
+    /// The builder a pair's tags select, as NTRT selects it: a builder matches when every word
+    /// of its tag is among the pair's tags; the last added rigid builder that matches, else the
+    /// last added string builder. Its index in [`Reader::builders`].
+    fn builder_for(&self, pair: &Pair) -> Option<usize> {
+        let matches = |(_, (tag, _)): &(usize, &(String, Builder))| {
+            tag.split_whitespace().all(|w| pair.tags.iter().any(|t| t == w))
+        };
+        let last = |rigid: bool| {
+            self.builders.iter().enumerate().rev().filter(|(_, (_, b))| b.kind.rigid() == rigid).find(matches)
+        };
+        last(true).or_else(|| last(false)).map(|(i, _)| i)
     }
 
     fn param(&self, b: &Builder, name: &str, default: f64) -> Result<f64, ImportError> {
@@ -612,7 +613,7 @@ impl Reader {
         let mut noted = std::collections::BTreeSet::new();
         for pair in &pairs {
             let (a, b) = (index[&pair.a], index[&pair.b]);
-            let Some((tag, builder)) = self.builder_for(pair)? else {
+            let Some(index) = self.builder_for(pair) else {
                 self.skipped.push(format!(
                     "{}:{}:{}: pair {}-{} (tags '{}') matches no builder: not built, as in NTRT",
                     pair.file,
@@ -624,7 +625,7 @@ impl Reader {
                 ));
                 continue;
             };
-            let (tag, builder) = (tag.clone(), builder.clone());
+            let (tag, builder) = self.builders[index].clone();
             let l = distance(pos(a), pos(b));
             if l <= 0.0 {
                 return Err(err(
@@ -635,7 +636,7 @@ impl Reader {
             }
             match builder.kind {
                 Kind::Rod => {
-                    if noted.insert(tag.clone()) {
+                    if noted.insert(index) {
                         self.note_unmodelled(&tag, &builder, &["radius", "density"]);
                     }
                     let r = self.param(&builder, "radius", DEFAULT_ROD_RADIUS)?;
@@ -655,7 +656,7 @@ impl Reader {
                     rods.push((a, b, r, mass));
                 }
                 Kind::String => {
-                    if noted.insert(tag.clone()) {
+                    if noted.insert(index) {
                         self.note_unmodelled(&tag, &builder, &["stiffness", "pretension"]);
                     }
                     let k = self.param(&builder, "stiffness", DEFAULT_STRING_STIFFNESS)?;
