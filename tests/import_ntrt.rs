@@ -239,3 +239,19 @@ fn the_last_matching_builder_wins_as_in_ntrt() {
     assert_eq!(bottom.law, tensegrity_testbed::structure::CableLaw::Elastic { stiffness_n_per_m: 100.0 });
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A model whose rods all share nodes is one rigid body, held fixed: the import still writes
+/// a finite time step and the scenario runs (nothing moves).
+#[test]
+fn a_single_compound_body_imports_with_finite_settings() {
+    let dir = std::env::temp_dir().join(format!("import-ntrt-compound-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("triangle.yaml");
+    std::fs::write(&file, "nodes:\n  a: [0, 0, 0]\n  b: [1, 0, 0]\n  c: [0, 1, 0]\npair_groups:\n  rod:\n    - [a, b]\n    - [b, c]\n    - [c, a]\n").unwrap();
+    let i = import(&file, Axes::ZUp).unwrap();
+    let sc = scenario::parse(Path::new("triangle.toml"), &i.toml).unwrap_or_else(|e| panic!("{e}\n{}", i.toml));
+    assert_eq!(sc.custom.as_ref().unwrap().structure.bodies.len(), 1);
+    assert!(sc.sim.dt_s > 0.0 && sc.sim.dt_s <= 0.1, "dt {}", sc.sim.dt_s);
+    run_text("triangle.toml", &i.toml);
+    std::fs::remove_dir_all(&dir).ok();
+}

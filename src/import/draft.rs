@@ -50,6 +50,8 @@ const DT_FRACTION: f64 = 0.05;
 /// Free-body damping [1/s] as a fraction of the fastest body's rate sqrt(sum k / m) (prism3:
 /// 0.2 x 10/s = 2/s, its own damping): zero at rest, it only speeds settling.
 const DAMPING_FRACTION: f64 = 0.2;
+/// The rate [1/s] the settings assume when no free body carries a cable.
+const FALLBACK_RATE_PER_S: f64 = 1.0;
 /// Settle speed tolerance per metre of structure [1/s].
 const SPEED_TOL_PER_M: f64 = 1e-12;
 /// Residual tolerances relative to a cable force scale (stiffness x size) [-].
@@ -117,7 +119,9 @@ impl Draft {
     /// limit from the slowest.
     fn settings(&self) -> String {
         let rates: Vec<f64> = self.body_rates().iter().filter(|(_, k)| *k > 0.0).map(|(m, k)| (k / m).sqrt()).collect();
-        let fastest = rates.iter().copied().fold(f64::MIN_POSITIVE, f64::max);
+        // Nothing elastic moves (all held, or no cable on a free body): the rate of a 1 s period.
+        let fastest = rates.iter().copied().fold(f64::NAN, f64::max);
+        let fastest = if fastest.is_finite() { fastest } else { FALLBACK_RATE_PER_S };
         let slowest = rates.iter().copied().fold(f64::INFINITY, f64::min).min(fastest);
         let size = self.size_m();
         let k_max = self.cables.iter().filter_map(|c| c.stiffness_n_per_m).fold(0.0, f64::max).max(1.0);
