@@ -154,6 +154,10 @@ enum ExportFormat {
         /// Gain of the position actuators on joints [N/m or N m/rad].
         #[arg(long, default_value_t = 1e6)]
         kp: f64,
+        /// Viscous damping along every cable [N s/m] (tendon damping, winch kv): zero at rest,
+        /// it only helps MuJoCo settle (the testbed's cables have none).
+        #[arg(long, default_value_t = 0.0)]
+        cable_damping: f64,
     },
 }
 
@@ -248,8 +252,8 @@ fn main() -> ExitCode {
             };
             cmd_import_matrices(&[n, cb, cs], out.as_deref(), &o)
         }
-        Command::Export { format: ExportFormat::Mjcf { scenario, out, actuators, kp } } => {
-            cmd_export_mjcf(&scenario, out.as_deref(), &actuators, kp)
+        Command::Export { format: ExportFormat::Mjcf { scenario, out, actuators, kp, cable_damping } } => {
+            cmd_export_mjcf(&scenario, out.as_deref(), &actuators, kp, cable_damping)
         }
         Command::Bench { export_cases: Some(dir), .. } => cmd_export_cases(&dir),
         Command::Bench { rounds, json, export_cases: None, mechanisms, peer: Some(peer) } => {
@@ -586,7 +590,7 @@ fn cmd_import_matrices(
     }
 }
 
-fn cmd_export_mjcf(path: &Path, out: Option<&Path>, actuators: &str, kp: f64) -> i32 {
+fn cmd_export_mjcf(path: &Path, out: Option<&Path>, actuators: &str, kp: f64, cable_damping: f64) -> i32 {
     use tensegrity_testbed::export::{mjcf::ActuatorMode, scenario_mjcf};
     let sc = match load_all(&[path.to_path_buf()]) {
         Ok(mut s) => s.remove(0),
@@ -596,8 +600,12 @@ fn cmd_export_mjcf(path: &Path, out: Option<&Path>, actuators: &str, kp: f64) ->
         eprintln!("error: --kp must be a finite number > 0, got {kp}");
         return EXIT_BAD_INPUT;
     }
+    if !(cable_damping >= 0.0 && cable_damping.is_finite()) {
+        eprintln!("error: --cable-damping must be a finite number >= 0, got {cable_damping}");
+        return EXIT_BAD_INPUT;
+    }
     let mode = if actuators == "position" { ActuatorMode::Position } else { ActuatorMode::Mocap };
-    let mjcf = match scenario_mjcf(&sc, mode, kp) {
+    let mjcf = match scenario_mjcf(&sc, mode, kp, cable_damping) {
         Ok(m) => m,
         Err(e) => {
             eprintln!("error: {}: {e}", path.display());

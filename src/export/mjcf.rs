@@ -64,6 +64,10 @@ pub struct MjcfOptions {
     pub joint_kp: f64,
     /// The actuator commands of the exported point, in actuator order (m or rad).
     pub commands: Vec<f64>,
+    /// Viscous damping along every cable [N s/m] (the testbed's cables have none; zero at
+    /// rest, so the equilibrium does not move, but MuJoCo damps slack cables too): each cable
+    /// tendon's `damping`, each winch's `kv`.
+    pub cable_damping_n_s_per_m: f64,
 }
 
 /// The XML, and what the export could not express (also written as comments in the XML).
@@ -432,7 +436,8 @@ impl Writer<'_> {
             let ActuatorTarget::Joint(j) = a.target else { continue };
             let joint = &s.joints[j];
             if plan.tree_joint[joint.child] == Some(j) && !plan.mocap[joint.child] {
-                let offset = self.o.commands.get(i).copied().unwrap_or(joint.initial_coordinate) - joint.initial_coordinate;
+                let offset =
+                    self.o.commands.get(i).copied().unwrap_or(joint.initial_coordinate) - joint.initial_coordinate;
                 let _ = writeln!(
                     rows,
                     "  <joint name=\"lock:{}\" joint1=\"{}\" polycoef=\"{offset:?} 0 0 0 0\"/>",
@@ -461,13 +466,17 @@ impl Writer<'_> {
         }
         for (c, cable) in s.cables.iter().enumerate() {
             let l = cable.length_m;
-            let law = match (cable.law.clone(), self.winched(c)) {
+            let mut law = match (cable.law.clone(), self.winched(c)) {
                 (CableLaw::Inextensible, _) => format!("limited=\"true\" range=\"0 {l:?}\""),
                 (CableLaw::Elastic { .. }, true) => String::new(),
                 (CableLaw::Elastic { stiffness_n_per_m }, false) => {
                     format!("stiffness=\"{stiffness_n_per_m:?}\" springlength=\"0 {l:?}\"")
                 }
             };
+            let damping = self.o.cable_damping_n_s_per_m;
+            if damping > 0.0 && !(self.winched(c) && matches!(cable.law, CableLaw::Elastic { .. })) {
+                let _ = write!(law, " damping=\"{damping:?}\"");
+            }
             self.spatial(&names.get(&cable.name), &law, cable.a, cable.b);
         }
         self.xml.push_str("</tendon>\n");
@@ -527,8 +536,9 @@ impl Writer<'_> {
                         CableLaw::Elastic { stiffness_n_per_m } => {
                             let _ = writeln!(
                                 rows,
-                                "  <position name=\"{name}\" tendon=\"{}\" kp=\"{stiffness_n_per_m:?}\" forcelimited=\"true\" forcerange=\"{:?} 0\"/>",
+                                "  <position name=\"{name}\" tendon=\"{}\" kp=\"{stiffness_n_per_m:?}\" kv=\"{:?}\" forcelimited=\"true\" forcerange=\"{:?} 0\"/>",
                                 esc(&cable.name),
+                                self.o.cable_damping_n_s_per_m,
                                 -WINCH_MAX_TENSION_N
                             );
                             ctrl.push(command);

@@ -6,7 +6,12 @@
 pub mod mjcf;
 
 /// The MJCF of a scenario's first structure, with the scenario's time step and body damping.
-pub fn scenario_mjcf(sc: &Scenario, actuators: mjcf::ActuatorMode, joint_kp: f64) -> Result<mjcf::Mjcf, String> {
+pub fn scenario_mjcf(
+    sc: &Scenario,
+    actuators: mjcf::ActuatorMode,
+    joint_kp: f64,
+    cable_damping_n_s_per_m: f64,
+) -> Result<mjcf::Mjcf, String> {
     let (s, commands) = first_structure(sc)?;
     let options = mjcf::MjcfOptions {
         model_name: sc.name.clone(),
@@ -15,6 +20,7 @@ pub fn scenario_mjcf(sc: &Scenario, actuators: mjcf::ActuatorMode, joint_kp: f64
         actuators,
         joint_kp,
         commands,
+        cable_damping_n_s_per_m,
     };
     Ok(mjcf::to_mjcf(&s, &options))
 }
