@@ -10,6 +10,7 @@ pub mod compare;
 pub mod interference;
 pub mod record;
 pub mod slack;
+pub mod table;
 
 use crate::mechanisms::{Prediction, Values};
 use crate::report::{PointReport, ScenarioReport};
@@ -81,6 +82,8 @@ pub struct Setup<'a> {
     /// A recording, when the run writes one (made last: nothing is written when another
     /// observer cannot start).
     pub recording: Option<record::Recording<'a>>,
+    /// A per-tick f64 table (CSV) to write, if the run writes one.
+    pub table: Option<std::path::PathBuf>,
 }
 
 /// Every observer of a run, in the order they see each tick.
@@ -88,6 +91,9 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
     let mut list: Vec<Box<dyn Observer>> =
         vec![Box::new(compare::Compare::new(setup.checks, setup.length_scale_m)), Box::new(slack::SlackTracker::new())];
     list.push(Box::new(interference::Interference::new(setup.structure, setup.interference)?));
+    if let Some(path) = &setup.table {
+        list.push(Box::new(table::Table::start(path)?));
+    }
     if let Some(r) = &setup.recording {
         if let Some(recorder) = record::Recorder::start(r)? {
             list.push(Box::new(recorder));

@@ -36,6 +36,8 @@ pub struct RunOptions<'a> {
     pub record_every: u64,
     /// Leave the findings out of the report (a sweep's blocks: the summary has none).
     pub skip_findings: bool,
+    /// Write every tick as a row of this CSV table (`observers::table`).
+    pub table: Option<PathBuf>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -186,6 +188,7 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         length_scale_m: mech.length_scale(&sc.params),
         interference: &sc.interference,
         recording: target.map(|target| Recording { target, every: opts.record_every.max(1), scenario: &sc.source }),
+        table: opts.table.clone(),
     })?;
     let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel);
     // The first point's commands (a no-op where the build already placed them).
