@@ -122,6 +122,8 @@ ProctrackType=proctrack/linuxproc
 TaskPlugin=task/none
 MpiDefault=none
 SchedulerType=sched/backfill
+# Start the next array task as soon as one ends (the default waits up to 3 s between them).
+SchedulerParameters=batch_sched_delay=0,sched_min_interval=0
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
 ReturnToService=2
@@ -135,7 +137,7 @@ export SLURM_CONF=$CONF
 
 munged --force --foreground --socket="$MUNGE_SOCKET" --key-file="$WORK/etc/munge.key" \
   --pid-file="$WORK/run/munged.pid" --log-file="$WORK/log/munged.log" \
-  --seed-file="$WORK/state/munged.seed" &
+  --seed-file="$WORK/state/munged.seed" 2>>"$WORK/log/munged.out" &
 STARTED_PIDS+=($!)
 echo $! >"$WORK/run/munged.pid"
 for _ in $(seq 50); do [ -S "$MUNGE_SOCKET" ] && break; sleep 0.1; done
@@ -177,11 +179,14 @@ exit \$rc
 EOF
 # `sweep` exits 1 when a shard's points are out of tolerance or below the agreement: the CSV is
 # still complete, so only the per-task codes below decide (0 or 1 is a run, anything else not).
-set +e
-timeout "$ARRAY_TIMEOUT_S" sbatch --wait "$WORK/shard.sbatch"
-array_rc=$?
-set -e
-echo "sbatch --wait exited $array_rc"
+# (`sbatch --wait` polls with a growing interval, up to half a minute late: poll squeue instead.)
+job=$(sbatch --parsable "$WORK/shard.sbatch")
+echo "submitted job array $job (tasks 1-$SHARDS)"
+deadline=$(( $(date +%s) + ARRAY_TIMEOUT_S ))
+while [ -n "$(squeue -h -j "$job" -o %i 2>/dev/null)" ]; do
+  [ "$(date +%s)" -lt "$deadline" ] || { echo "array $job not done after ${ARRAY_TIMEOUT_S} s" >&2; exit 1; }
+  sleep 0.5
+done
 bad=0
 for k in $(seq "$SHARDS"); do
   rc=$(cat "$OUT/rc-$k" 2>/dev/null || echo missing)
