@@ -9,7 +9,10 @@
 #   - the same header and the same rows (`index,grid_points` equal, row for row);
 #   - `simulated_Q` and `error_Q` of every quantity Q the scenario checks equal within that
 #     check's tolerance, on max(1, |a|, |b|) (a shard's continuation path may differ from the
-#     unsharded one, src/sweep.rs); every other column equal as text.
+#     unsharded one, src/sweep.rs; an angle may come out as pi or -pi), the other simulated
+#     numbers (unchecked quantities, min_clearance_m) within the loosest check's tolerance,
+#     `steps` (the path's length) only reported, every other column (the grid's inputs,
+#     analytic values, verdicts, branch, slack cables) equal as text.
 # Prints the time of each phase. Stops the daemons it started (trap) and exits non-zero on any
 # mismatch. Run as root; running it again starts from a clean state (idempotent).
 #
@@ -215,7 +218,9 @@ set -e
 phase_done unsharded "$t"
 
 python3 - "$SCENARIO" "$OUT/unsharded.csv" "$OUT/merged.csv" <<'PY'
-import csv, sys, tomllib
+import csv, math, sys, tomllib
+# Columns: index,grid_points, the grid's inputs, then analytic_/simulated_/error_ per quantity,
+# then the verdict columns (settled, steps, within_tolerance, stable, branch, slack ...).
 scenario, unsharded, merged = sys.argv[1:]
 with open(scenario, "rb") as f:
     tol = {c["quantity"]: float(c["tolerance"]) for c in tomllib.load(f).get("checks", [])}
@@ -228,28 +233,46 @@ if a[0] != b[0]:
 if len(a) != len(b):
     sys.exit(f"{len(a) - 1} unsharded rows, {len(b) - 1} merged")
 header = a[0]
-col_tol = {}
-for q, t in tol.items():
+# The settle's step count depends on where it starts (the continuation path): reported only.
+PATH_ONLY = {"steps"}
+# Unchecked simulated numbers (forces of unchecked quantities, clearance): the loosest check.
+loosest = max(tol.values(), default=0.0)
+def tolerance(name):
     for prefix in ("simulated_", "error_"):
-        if prefix + q in header:
-            col_tol[header.index(prefix + q)] = t
-identical, mismatches, worst = 0, [], 0.0
+        if name.startswith(prefix):
+            return tol.get(name[len(prefix):], loosest)
+    return loosest if name == "min_clearance_m" else None  # None: equal as text
+def difference(x, y):
+    """|x - y| on max(1, |x|, |y|); None when not numbers."""
+    try:
+        x, y = float(x), float(y)
+    except ValueError:
+        return None
+    d = abs(x - y)
+    # An angle at the wrap: pi and -pi are the same (its error column still has to agree).
+    if abs(abs(x) - math.pi) <= 1e-6 and abs(abs(y) - math.pi) <= 1e-6:
+        d = min(d, abs(abs(x) - abs(y)))
+    return d / max(1.0, abs(x), abs(y))
+identical, mismatches, steps_diff, worst = 0, [], 0, 0.0
 for ra, rb in zip(a[1:], b[1:]):
     if ra[:2] != rb[:2]:
         sys.exit(f"row order differs: index,grid_points {ra[:2]} vs {rb[:2]}")
     identical += ra == rb
-    for i, (x, y) in enumerate(zip(ra, rb)):
+    for name, x, y in zip(header, ra, rb):
         if x == y:
             continue
-        if i in col_tol and x and y:
-            d = abs(float(x) - float(y)) / max(1.0, abs(float(x)), abs(float(y)))
+        if name in PATH_ONLY:
+            steps_diff = max(steps_diff, abs(int(x) - int(y)))
+            continue
+        t, d = tolerance(name), difference(x, y)
+        if t is not None and d is not None and d <= t:
             worst = max(worst, d)
-            if d <= col_tol[i]:
-                continue
-        mismatches.append(f"index {ra[0]} {header[i]}: {x} vs {y}")
+            continue
+        mismatches.append(f"index {ra[0]} {name}: {x} vs {y}")
 n = len(a) - 1
-print(f"{n} rows, index 0..{n - 1} of {a[1][1]} in both; {identical} bit-identical; "
-      f"largest checked difference {worst:.3g}; {len(mismatches)} mismatch(es)")
+print(f"{n} rows, index 0..{n - 1} of {a[1][1]} in both; {identical} bit-identical; largest "
+      f"difference within tolerance {worst:.3g}; steps differ by up to {steps_diff}; "
+      f"{len(mismatches)} mismatch(es)")
 if mismatches:
     print("\n".join(mismatches[:20]), file=sys.stderr)
     sys.exit(1)
