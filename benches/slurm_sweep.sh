@@ -64,7 +64,13 @@ stop_daemons() {
   done
   STARTED_PIDS=()
 }
+JOB=""
 cleanup() {
+  # Stopped early: cancel the array first (slurmd's job steps outlive slurmd).
+  if [ -n "$JOB" ] && [ -n "$(squeue -h -j "$JOB" -o %i 2>/dev/null)" ]; then
+    scancel "$JOB" || true
+    for _ in $(seq 100); do [ -n "$(squeue -h -j "$JOB" -o %i 2>/dev/null)" ] || break; sleep 0.1; done
+  fi
   stop_daemons
   [ -z "$CREATED_POLICY" ] || rm -f /usr/sbin/policy-rc.d
 }
@@ -183,13 +189,14 @@ EOF
 # `sweep` exits 1 when a shard's points are out of tolerance or below the agreement: the CSV is
 # still complete, so only the per-task codes below decide (0 or 1 is a run, anything else not).
 # (`sbatch --wait` polls with a growing interval, up to half a minute late: poll squeue instead.)
-job=$(sbatch --parsable "$WORK/shard.sbatch")
-echo "submitted job array $job (tasks 1-$SHARDS)"
+JOB=$(sbatch --parsable "$WORK/shard.sbatch")
+echo "submitted job array $JOB (tasks 1-$SHARDS)"
 deadline=$(( $(date +%s) + ARRAY_TIMEOUT_S ))
-while [ -n "$(squeue -h -j "$job" -o %i 2>/dev/null)" ]; do
-  [ "$(date +%s)" -lt "$deadline" ] || { echo "array $job not done after ${ARRAY_TIMEOUT_S} s" >&2; exit 1; }
+while [ -n "$(squeue -h -j "$JOB" -o %i 2>/dev/null)" ]; do
+  [ "$(date +%s)" -lt "$deadline" ] || { echo "array $JOB not done after ${ARRAY_TIMEOUT_S} s" >&2; exit 1; }
   sleep 0.5
 done
+JOB=""
 bad=0
 for k in $(seq "$SHARDS"); do
   rc=$(cat "$OUT/rc-$k" 2>/dev/null || echo missing)
