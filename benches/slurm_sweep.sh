@@ -11,7 +11,8 @@
 #     check's tolerance, on max(1, |a|, |b|) (a shard's continuation path may differ from the
 #     unsharded one, src/sweep.rs; an angle may come out as pi or -pi), the other simulated
 #     numbers (unchecked quantities, min_clearance_m) within the loosest check's tolerance,
-#     `steps` (the path's length) only reported, every other column (the grid's inputs,
+#     `steps` (the path's length) only reported when the scenario continues from the previous
+#     point, every other column (the grid's inputs,
 #     analytic values, verdicts, branch, slack cables) equal as text.
 # Prints the time of each phase. Stops the daemons it started (trap) and exits non-zero on any
 # mismatch. Run as root; running it again starts from a clean state (idempotent).
@@ -230,7 +231,9 @@ import csv, math, sys, tomllib
 # then the verdict columns (settled, steps, within_tolerance, stable, branch, slack ...).
 scenario, unsharded, merged = sys.argv[1:]
 with open(scenario, "rb") as f:
-    tol = {c["quantity"]: float(c["tolerance"]) for c in tomllib.load(f).get("checks", [])}
+    sc = tomllib.load(f)
+tol = {c["quantity"]: float(c["tolerance"]) for c in sc.get("checks", [])}
+continuation = sc.get("actuation", {}).get("continuation", False)
 with open(unsharded, newline="") as f:
     a = list(csv.reader(f))
 with open(merged, newline="") as f:
@@ -240,8 +243,8 @@ if a[0] != b[0]:
 if len(a) != len(b):
     sys.exit(f"{len(a) - 1} unsharded rows, {len(b) - 1} merged")
 header = a[0]
-# The settle's step count depends on where it starts (the continuation path): reported only.
-PATH_ONLY = {"steps"}
+# With continuation the settle's step count depends on where it starts: reported only.
+PATH_ONLY = {"steps"} if continuation else set()
 # Unchecked simulated numbers (forces of unchecked quantities, clearance): the loosest check.
 loosest = max(tol.values(), default=0.0)
 def tolerance(name):
