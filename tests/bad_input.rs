@@ -217,3 +217,20 @@ fn every_malformed_scenario_gives_exit_2_with_file_line_and_column() {
     }
     assert!(failures.is_empty(), "{} failure(s):\n{}", failures.len(), failures.join("\n"));
 }
+
+/// A scenario file over 16 MiB (a list of a million points) is refused before it is parsed:
+/// exit 2 at line 1, at once.
+#[test]
+fn an_oversized_scenario_file_is_refused_before_parsing() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-big-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("many.toml");
+    let points = vec!["{ L3 = 1.0, theta1 = 0.5 }"; 1_000_001].join(", ");
+    std::fs::write(&p, JI.replace("points = [ { L3 = 1.0, theta1 = 0.5 } ]", &format!("points = [ {points} ]"))).unwrap();
+    let start = std::time::Instant::now();
+    let (code, _, err) = tensegrity(&["check", p.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains(":1:1:") && err.contains("at most 16777216"), "{err}");
+    assert!(start.elapsed() < std::time::Duration::from_secs(2), "{:?}", start.elapsed());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -100,14 +100,21 @@ impl Actuation {
 
 /// Reads and validates a scenario file.
 pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
-    let source = std::fs::read_to_string(path).map_err(|e| ScenarioError {
-        file: path.display().to_string(),
-        line: 1,
-        col: 1,
-        message: format!("cannot read the scenario file: {e}"),
-    })?;
+    let at_start = |message: String| ScenarioError { file: path.display().to_string(), line: 1, col: 1, message };
+    let bytes = std::fs::metadata(path).map_err(|e| at_start(format!("cannot read the scenario file: {e}")))?.len();
+    if bytes > MAX_SCENARIO_BYTES {
+        return Err(at_start(format!(
+            "the file is {bytes} bytes; a scenario is at most {MAX_SCENARIO_BYTES} (its parse takes about 75 times its size in memory: a grid describes up to a million points in one line)"
+        )));
+    }
+    let source =
+        std::fs::read_to_string(path).map_err(|e| at_start(format!("cannot read the scenario file: {e}")))?;
     parse(path, &source)
 }
+
+/// Largest scenario file read [bytes]: 16 MiB. A list of 1,000,001 points (28 MB) took 2.1 GB
+/// to parse before its length was checked.
+pub const MAX_SCENARIO_BYTES: u64 = 16 << 20;
 
 /// Parses and validates scenario text (`path` names it in errors).
 pub fn parse(path: &Path, source: &str) -> Result<Scenario, ScenarioError> {
