@@ -206,3 +206,24 @@ fn a_merge_with_a_shard_missing_fails_unless_partial() {
     let (code, _, err) = tensegrity(&["merge", &shards[0], &shards[1], &shards[2], "--out", out.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
 }
+
+/// A workspace sweep passes on its agreement, as `run` judges it: mohr2011's 7 x 7 slices agree
+/// at 96.10 % (74 of 77), which passes the file's 90 % and fails a required 99 % (exit 1, the
+/// summary giving both numbers).
+#[test]
+fn a_workspace_sweep_below_its_agreement_threshold_exits_1() {
+    let d = dir("agreement");
+    let text = std::fs::read_to_string("scenarios/mohr2011/workspace_grid_small.toml").unwrap();
+    let (code, out, err) = tensegrity(&["sweep", "scenarios/mohr2011/workspace_grid_small.toml"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("workspace agreement 96.10 %"), "{out}");
+    let strict = d.join("strict.toml");
+    std::fs::write(&strict, text.replace("min_agreement_percent = 90.0", "min_agreement_percent = 99.0")).unwrap();
+    let json = d.join("summary.json");
+    let (code, out, err) = tensegrity(&["sweep", strict.to_str().unwrap(), "--json", json.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["min_agreement_percent"], 99.0);
+    assert!((v["workspace"]["agreement_percent"].as_f64().unwrap() - 96.10).abs() < 0.01);
+    assert_eq!(v["passed"], false);
+}
