@@ -8,6 +8,7 @@ pub mod bench;
 pub mod custom;
 pub mod figures;
 pub mod mechanisms;
+pub mod model;
 pub mod observers;
 pub mod report;
 pub mod run;

@@ -8,6 +8,7 @@
 
 pub mod compare;
 pub mod interference;
+pub mod model;
 pub mod record;
 pub mod slack;
 
@@ -78,6 +79,8 @@ pub struct Setup<'a> {
     /// The mechanism's length scale [m], for normalised errors.
     pub length_scale_m: f64,
     pub interference: Option<&'a InterferenceSettings>,
+    /// The scenario file's own model (`[[quantities]]`, `[[predictions]]`, `[[equations]]`).
+    pub model: Option<&'a crate::model::spec::ModelSpec>,
     /// A recording, when the run writes one (made last: nothing is written when another
     /// observer cannot start).
     pub recording: Option<record::Recording<'a>>,
@@ -90,6 +93,7 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
     if let Some(settings) = setup.interference {
         list.push(Box::new(interference::Interference::new(setup.structure, settings)?));
     }
+    list.extend(setup.model.map(|spec| Box::new(model::ModelObserver::new(spec, setup.structure)) as Box<dyn Observer>));
     if let Some(r) = &setup.recording {
         if let Some(recorder) = record::Recorder::start(r)? {
             list.push(Box::new(recorder));

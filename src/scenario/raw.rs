@@ -1,6 +1,7 @@
 //! The shape of a scenario file, as serde reads it: every value keeps its span, so that
 //! [`super::validate`] can name the line and column of a value it rejects.
 
+use super::number::{Num, ParamMap};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use toml::Spanned;
@@ -14,8 +15,9 @@ pub(super) struct RawScenario {
     #[serde(default)]
     pub(super) description: String,
     pub(super) mechanism: Spanned<String>,
+    /// Numbers, expressions of other parameters, or tables { value, unit, description }.
     #[serde(default)]
-    pub(super) params: SpannedMap,
+    pub(super) params: ParamMap,
     #[serde(default)]
     pub(super) sim: RawSim,
     #[serde(default)]
@@ -41,6 +43,48 @@ pub(super) struct RawScenario {
     /// What the run must do: pass, or fail in named parts.
     #[serde(default)]
     pub(super) expect: Option<Spanned<RawExpect>>,
+    /// The file's own model: named expressions of the state.
+    #[serde(default)]
+    pub(super) quantities: Vec<RawQuantity>,
+    /// Closed forms of the parameters and inputs compared with the state.
+    #[serde(default)]
+    pub(super) predictions: Vec<RawPrediction>,
+    /// Residuals that must vanish at every settled state.
+    #[serde(default)]
+    pub(super) equations: Vec<RawEquation>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawQuantity {
+    pub(super) name: Spanned<String>,
+    /// An expression of the state, the parameters, the inputs, `t` and earlier quantities.
+    pub(super) expr: Spanned<String>,
+    /// For the listing and the report (default "-").
+    pub(super) unit: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawPrediction {
+    /// The compared symbol: a `[[quantities]]` name, a node coordinate, an observed quantity.
+    pub(super) quantity: Spanned<String>,
+    /// The name in the report and in `[expect] failing` (default: the quantity's).
+    pub(super) name: Option<Spanned<String>>,
+    /// A closed form of the parameters and inputs.
+    pub(super) formula: Spanned<String>,
+    /// length (m), angle (rad, wrapped) or relative.
+    pub(super) class: Spanned<String>,
+    pub(super) tolerance: Spanned<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawEquation {
+    pub(super) name: Spanned<String>,
+    /// An expression that must vanish at every settled state (same symbols as a quantity).
+    pub(super) residual: Spanned<String>,
+    pub(super) tolerance: Spanned<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -56,7 +100,10 @@ pub(super) struct RawExpect {
 
 pub(super) type Xyz = Spanned<[f64; 3]>;
 
-#[derive(Debug, Deserialize)]
+/// A node's coordinates: numbers or expressions of the parameters.
+pub(super) type Point = Spanned<[Spanned<Num>; 3]>;
+
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawStructure {
     /// Gravity [m/s^2] (default none).
@@ -75,38 +122,38 @@ pub(super) struct RawStructure {
     pub(super) actuators: Vec<RawActuator>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawBody {
     pub(super) name: Spanned<String>,
     /// Welded to the world (default false).
     pub(super) fixed: Option<bool>,
     /// Mass of a free body [kg].
-    pub(super) mass: Option<Spanned<f64>>,
+    pub(super) mass: Option<Spanned<Num>>,
     /// Principal moments about the centre of mass, along the world axes [kg m^2] (default:
     /// isotropic, mass times the square of the body's size over 12).
     pub(super) inertia: Option<Xyz>,
     /// Named nodes with their coordinates [m] (the centre of mass is their mean).
-    pub(super) nodes: BTreeMap<Spanned<String>, Xyz>,
+    pub(super) nodes: BTreeMap<Spanned<String>, Point>,
 }
 
 /// A strut, spring or cable between two named nodes.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawMember {
     pub(super) name: Spanned<String>,
     pub(super) a: Spanned<String>,
     pub(super) b: Spanned<String>,
     /// Struts: radius [m] (default 0.01).
-    pub(super) radius: Option<Spanned<f64>>,
+    pub(super) radius: Option<Spanned<Num>>,
     /// Springs: stiffness [N/m] (required); cables: stiffness of an elastic cable (absent:
     /// inextensible).
-    pub(super) stiffness: Option<Spanned<f64>>,
+    pub(super) stiffness: Option<Spanned<Num>>,
     /// Springs: free length [m]; cables: unstretched length [m]. Absent: the initial distance.
-    pub(super) length: Option<Spanned<f64>>,
+    pub(super) length: Option<Spanned<Num>>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawJoint {
     pub(super) name: Spanned<String>,
@@ -121,13 +168,13 @@ pub(super) struct RawJoint {
     pub(super) axis2: Option<Xyz>,
     /// Revolute joints: a linear torsion spring [N m/rad], at rest in the given geometry plus
     /// `torsion_rest` [rad].
-    pub(super) torsion_stiffness: Option<Spanned<f64>>,
-    pub(super) torsion_rest: Option<Spanned<f64>>,
+    pub(super) torsion_stiffness: Option<Spanned<Num>>,
+    pub(super) torsion_rest: Option<Spanned<Num>>,
     /// Viscous damping [N m s/rad or N s/m].
-    pub(super) damping: Option<Spanned<f64>>,
+    pub(super) damping: Option<Spanned<Num>>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawActuator {
     pub(super) symbol: Spanned<String>,

@@ -2,7 +2,7 @@
 //! built into a [`Structure`].
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
-use super::raw::{RawActuator, RawBody, RawJoint, RawMember, RawStructure, Xyz};
+use super::raw::{Point, RawActuator, RawBody, RawJoint, RawMember, RawStructure, Xyz};
 use crate::structure::{
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut,
     TorsionSpring,
@@ -54,6 +54,12 @@ fn xyz(ctx: &Ctx, v: &Xyz, what: &str) -> Result<[f64; 3], ScenarioError> {
     }
 }
 
+/// A node's coordinates: three finite numbers (the parameters' expressions already evaluated).
+fn point(ctx: &Ctx, p: &Point) -> Result<[f64; 3], ScenarioError> {
+    let c = p.get_ref();
+    Ok([finite(ctx, &c[0], "x (m)")?, finite(ctx, &c[1], "y (m)")?, finite(ctx, &c[2], "z (m)")?])
+}
+
 /// Adds a body (at least one node, a mass if free) and its nodes (names unique in the
 /// structure) to `s`.
 fn add_body(ctx: &Ctx, s: &mut Structure, b: &RawBody) -> Result<(), ScenarioError> {
@@ -65,7 +71,7 @@ fn add_body(ctx: &Ctx, s: &mut Structure, b: &RawBody) -> Result<(), ScenarioErr
     }
     let mut pts = Vec::new();
     for (n, p) in &b.nodes {
-        pts.push((n, xyz(ctx, p, "a node's coordinates")?));
+        pts.push((n, point(ctx, p)?));
     }
     let fixed = b.fixed.unwrap_or(false);
     let inertia = if fixed {

@@ -1,0 +1,6 @@
+//! A researcher's own model, stated in the scenario file: expressions of the parameters,
+//! inputs and the simulated state (`expr.rs`), and the quantities, predictions and implicit
+//! equations compiled from them (`spec.rs`), which the model observer evaluates.
+
+pub mod expr;
+pub mod spec;

@@ -1,0 +1,182 @@
+//! A researcher's own model in the scenario file: `[params]` expressions in a custom structure,
+//! `[[quantities]]`, `[[predictions]]` and `[[equations]]`, judged by the run; errors inside an
+//! expression located at `file:LINE:COL` inside the string.
+
+mod common;
+
+use common::{run_file, tensegrity};
+use std::path::Path;
+use tensegrity_testbed::run::{run, RunOptions};
+use tensegrity_testbed::scenario;
+use tensegrity_testbed::settings::Failure;
+
+const PRISM: &str = "scenarios/custom/prism3_model.toml";
+
+fn prism_text() -> String {
+    std::fs::read_to_string(PRISM).unwrap()
+}
+
+/// Line and column (from 1) of byte `offset` of `text`.
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset];
+    (before.matches('\n').count() + 1, before.rsplit('\n').next().unwrap().chars().count() + 1)
+}
+
+/// Parses `text` (a variant of a file) and returns its error, which must be located at the
+/// `nth` occurrence of `at` in the text plus `shift` bytes.
+fn error_at(text: &str, at: &str, shift: usize, msg: &str) {
+    let err = scenario::parse(Path::new("variant.toml"), text).expect_err(msg);
+    let offset = text.find(at).unwrap_or_else(|| panic!("'{at}' in the variant")) + shift;
+    let (line, col) = line_col(text, offset);
+    assert_eq!((err.line, err.col), (line, col), "{msg}: {err}");
+    assert!(err.message.contains(msg), "{err}");
+    assert!(err.to_string().starts_with(&format!("variant.toml:{line}:{col}: ")), "{err}");
+}
+
+/// The structure's numbers are the parameters' expressions evaluated: node T2 of the prism lies
+/// at r (cos, sin)(2 pi/3 + 130 deg), h (within 1e-15 m), and the cables have k = 100 N/m.
+#[test]
+fn parameter_expressions_place_the_nodes() {
+    let sc = scenario::load(Path::new(PRISM)).unwrap();
+    let s = &sc.custom.as_ref().unwrap().structure;
+    let t2 = s.nodes[s.node_id("T2").unwrap()].position;
+    let a = 2.0 * std::f64::consts::PI / 3.0 + 130f64.to_radians();
+    let want = [a.cos(), a.sin(), 1.5];
+    for k in 0..3 {
+        assert!((t2[k] - want[k]).abs() <= 1e-15, "T2 {t2:?} != {want:?}");
+    }
+    assert!((sc.params["twist0"] - 130f64.to_radians()).abs() <= 1e-15);
+    assert!((sc.params["step"] - 2.0 * std::f64::consts::PI / 3.0).abs() <= 1e-15);
+    let top23 = &s.cables[s.cable_id("top23").unwrap()];
+    assert_eq!(top23.length_m, 1.5);
+}
+
+/// A built-in mechanism's parameters may be expressions of each other (ji2014: K2 = K1/2).
+#[test]
+fn builtin_parameters_may_be_expressions() {
+    let text = std::fs::read_to_string("scenarios/ji2014/quick.toml").unwrap();
+    let text = text.replacen("K2 = 100.0", "K2 = \"K1/2\"", 1);
+    let sc = scenario::parse(Path::new("quick.toml"), &text).unwrap();
+    assert_eq!(sc.params["K2"], 100.0);
+    let bad = text.replacen("K1 = 200.0", "K1 = { value = 200.0, unit = \"N/mm\" }", 1);
+    error_at(&bad, "{ value = 200.0", 0, "parameter 'K1' is in N/m");
+}
+
+/// Errors in parameter and structure expressions are at their place inside the string.
+#[test]
+fn parameter_errors_are_located_inside_the_string() {
+    let good = prism_text();
+    let cyc = good.replacen("r = { value = 1.0", "r = { value = \"h/step\"", 1).replacen(
+        "value = \"2*pi/n\"",
+        "value = \"2*pi/n*r\"",
+        1,
+    );
+    error_at(&cyc, "\"h/step\"", 0, "parameter 'r' depends on itself");
+    let unknown = good.replacen("value = \"130*pi/180\"", "value = \"130*pi/180*q\"", 1);
+    error_at(&unknown, "130*pi/180*q", 11, "parameter 'twist0': unknown symbol 'q' (symbols here: h, k, l_poly");
+    let node = good.replacen("\"r*sin(step)\"", "\"r*sine(step)\"", 1);
+    error_at(&node, "r*sine(step)", 2, "a coordinate of node 'B2': unknown function 'sine'");
+    let stiff = good.replacen("stiffness = \"k\"", "stiffness = \"k*\"", 1);
+    assert!(scenario::parse(Path::new("v.toml"), &stiff).unwrap_err().message.contains("stiffness"));
+}
+
+/// Errors in quantities, predictions and equations are at their place inside the string and
+/// say what exists there.
+#[test]
+fn model_errors_are_located_inside_the_string() {
+    let good = prism_text();
+    let q = good.replacen("(B1.x + B2.x + B3.x)/3", "(B1.x + B2.x + B4.x)/3", 1);
+    error_at(&q, "B4.x", 0, "quantity 'cb_x': unknown symbol 'B4.x' (symbols here: B1.x, B1.y");
+    // A prediction's formula sees the parameters and inputs only.
+    let p = good.replacen("formula = \"pi/2 + pi/n\"", "formula = \"pi/2 + pi/n + 0*T1.x\"", 1);
+    error_at(&p, "T1.x\"", 0, "prediction 'twist' (parameters and inputs only): unknown symbol 'T1.x'");
+    let multi = good.replacen("u_z*w_x - u_x*w_z", "u_z*w_x - u_x*wz", 1);
+    error_at(&multi, "wz)", 0, "unknown symbol 'wz'");
+    let class = good.replacen("class = \"angle\"", "class = \"degrees\"", 1);
+    error_at(&class, "\"degrees\"", 0, "unknown class 'degrees' (expected one of: length, angle, relative)");
+    let unknown = good.replacen("quantity = \"twist\"", "quantity = \"twirl\"", 1);
+    error_at(&unknown, "\"twirl\"", 0, "unknown quantity 'twirl'");
+    let eq = good.replacen("abs(top12.force - top23.force)", "abs(top12.force - top24.force)", 1);
+    error_at(&eq, "top24.force", 0, "equation 'equal_top_tensions': unknown symbol 'top24.force'");
+    let clash = good.replacen("name = \"q_side\"", "name = \"k\"", 1);
+    error_at(&clash, "\"k\"\nexpr", 0, "quantity name 'k' is already a symbol");
+}
+
+/// The prism settles on the closed form stated in its file: twist pi/2 + pi/n, force densities
+/// strut : side = -1 and polygon : side = 1/(2 sin(pi/n)), each within its 1e-9; the equal
+/// tensions within 1e-7 N; the quantities are in the point's simulated values.
+#[test]
+fn the_prism_model_in_the_file_passes() {
+    let r = run_file(PRISM);
+    assert!(r.passed, "{:?} {:?}", r.failures, r.error);
+    assert_eq!(r.model_checks.len(), 5);
+    for c in &r.model_checks {
+        assert!(c.passed && c.max_error <= c.tolerance, "{c:?}");
+        assert_eq!(c.points_compared, 1);
+        assert!(c.ticks_compared > 100, "{c:?}");
+    }
+    let p = &r.points[0];
+    let twist = p.simulated["twist"];
+    let want = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI / 3.0;
+    assert!((twist - want).abs() <= 1e-9, "twist {twist}");
+    assert!((p.analytic["twist"] - want).abs() <= 1e-15);
+    assert!((p.simulated["polygon_to_side"] - 1.0 / 3f64.sqrt()).abs() <= 1e-9);
+    // The drawn twist is 130 degrees: the transient error starts at 20 degrees.
+    let tw = r.model_checks.iter().find(|c| c.name == "twist").unwrap();
+    assert!((tw.transient_max_error - 20f64.to_radians()).abs() <= 1e-3, "{tw:?}");
+}
+
+/// A prediction that does not hold fails the run as `prediction:NAME`, and an equation that
+/// does not vanish as `equation:NAME`; `[expect]` can declare both.
+#[test]
+fn a_wrong_prediction_fails_the_run_by_name() {
+    let text = prism_text()
+        .replacen("formula = \"pi/2 + pi/n\"", "formula = \"pi/2 + pi/(n+1)\"", 1)
+        .replacen("residual = \"max(abs(side1.force", "residual = \"1e-6 + max(abs(side1.force", 1)
+        .replacen(
+            "verdict = \"pass\"",
+            "verdict = \"fail\"\nfailing = [\"prediction:twist\", \"equation:equal_side_tensions\"]",
+            1,
+        );
+    let sc = scenario::parse(Path::new("wrong.toml"), &text).unwrap();
+    let r = run(&sc, &RunOptions::default());
+    assert!(!r.passed);
+    assert_eq!(
+        r.failures,
+        vec![Failure::Prediction("twist".into()), Failure::Equation("equal_side_tensions".into())]
+    );
+    assert_eq!(r.as_expected, Some(true));
+    let tw = r.model_checks.iter().find(|c| c.name == "twist").unwrap();
+    // pi/3 - pi/4 = 15 degrees off.
+    assert!((tw.max_error - 15f64.to_radians()).abs() <= 1e-9, "{tw:?}");
+}
+
+/// `tensegrity list FILE` lists a custom file's own parameters with their values and units,
+/// and the symbols its model may use.
+#[test]
+fn list_names_a_files_parameters_and_symbols() {
+    let (code, out, err) = tensegrity(&["list", PRISM]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("twist0       [rad] default 2.2689280275926285"), "{out}");
+    assert!(out.contains("    step         = 2.0943951023931953"), "{out}");
+    assert!(out.contains("model symbols"), "{out}");
+    assert!(out.contains(" side1.length ") && out.contains(" strut2.force ") && out.contains(" twist"), "{out}");
+}
+
+/// The README's tutorial file (a pinned bar between two zero-length springs) settles at the
+/// energy minimum q = atan2(k1 a, k2 b) within 1e-9 rad and the moment about the pin vanishes
+/// within 1e-9 N m.
+#[test]
+fn the_readme_tutorial_model_passes() {
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let start = readme.find("name = \"pinned bar between two springs\"").expect("tutorial in README");
+    let text = &readme[start..start + readme[start..].find("```").unwrap()];
+    let sc = scenario::parse(Path::new("README.md"), text).expect("the tutorial parses");
+    let r = run(&sc, &RunOptions::default());
+    assert!(r.passed, "{:?} {:?} {:?}", r.failures, r.error, r.model_checks);
+    let q = r.points[0].simulated["q"];
+    let want = (50.0f64 * 0.8).atan2(30.0 * 0.6);
+    assert!((q - want).abs() <= 1e-9, "q {q} != {want}");
+    let moment = r.model_checks.iter().find(|c| c.name == "moment").unwrap();
+    assert!(moment.max_error <= 1e-9, "{moment:?}");
+}
