@@ -39,6 +39,9 @@ pub struct Quantity {
     pub name: String,
     pub unit: String,
     pub expr: Expr,
+    /// A closed form: it uses parameters, inputs and closed-form quantities only (a
+    /// prediction's formula may then use it).
+    pub closed_form: bool,
 }
 
 /// How a prediction's error is measured.
@@ -122,6 +125,15 @@ impl ModelSpec {
     /// The names of every symbol, in order.
     pub fn names(&self) -> Vec<&str> {
         self.symbols.iter().map(|s| s.name.as_str()).collect()
+    }
+
+    /// Whether symbol `i` is a closed form of the parameters and inputs.
+    pub fn is_closed_form(&self, i: usize) -> bool {
+        match self.symbols[i].source {
+            Source::Param(_) | Source::Input(_) => true,
+            Source::Quantity(q) => self.quantities[q].closed_form,
+            _ => false,
+        }
     }
 
     /// Every symbol's value, given the inputs and a way to read the state's ones by symbol

@@ -105,8 +105,10 @@ fn compile(ctx: &Ctx, text: &Spanned<String>, symbols: &[&str], what: &str) -> R
 fn quantity(ctx: &Ctx, spec: &mut ModelSpec, q: &RawQuantity) -> Result<(), ScenarioError> {
     let name = new_name(ctx, spec, &q.name, "quantity")?;
     let expr = compile(ctx, &q.expr, &spec.names(), &format!("quantity '{name}'"))?;
+    let closed_form = expr.uses().iter().all(|&u| spec.is_closed_form(u));
     spec.symbols.push(Symbol { name: name.clone(), source: Source::Quantity(spec.quantities.len()) });
-    spec.quantities.push(Quantity { name, unit: q.unit.clone().unwrap_or_else(|| "-".into()), expr });
+    let unit = q.unit.clone().unwrap_or_else(|| "-".into());
+    spec.quantities.push(Quantity { name, unit, expr, closed_form });
     Ok(())
 }
 
@@ -130,16 +132,13 @@ fn prediction(ctx: &Ctx, spec: &mut ModelSpec, p: &RawPrediction) -> Result<(), 
         let at = p.name.as_ref().unwrap_or(&p.quantity);
         return Err(ctx.err(at, format!("two predictions named '{name}': give each a distinct name = \"...\"")));
     }
-    // The formula may use parameters and inputs: every other symbol is hidden from it.
-    let closed_form: Vec<&str> = spec
-        .symbols
-        .iter()
-        .map(|s| match s.source {
-            Source::Param(_) | Source::Input(_) => s.name.as_str(),
-            _ => "",
-        })
+    // The formula may use parameters, inputs and quantities of those only: every other symbol
+    // is hidden from it.
+    let closed_form: Vec<&str> = (0..spec.symbols.len())
+        .map(|i| if spec.is_closed_form(i) { spec.symbols[i].name.as_str() } else { "" })
         .collect();
-    let formula = compile(ctx, &p.formula, &closed_form, &format!("prediction '{name}' (parameters and inputs only)"))?;
+    let what = format!("prediction '{name}' (parameters, inputs and their quantities only)");
+    let formula = compile(ctx, &p.formula, &closed_form, &what)?;
     let class = ErrorClass::parse(p.class.get_ref()).ok_or_else(|| {
         ctx.err(
             &p.class,
