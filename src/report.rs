@@ -55,11 +55,13 @@ pub struct ScenarioReport {
 /// settle point (the verdict) and at every tick (transient errors, reported only).
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct ModelCheckReport {
-    /// "prediction" or "equation".
+    /// "prediction", "equation" or "energy".
     pub kind: String,
     pub name: String,
     /// A prediction's error class (length [m], angle [rad, wrapped], relative); "residual" for
-    /// an equation (|residual|).
+    /// an equation (|residual|); "coordinates" for the energy model (the largest coordinate
+    /// difference from the settled state to the stationary point it landed on, infinite when
+    /// that point is not a minimum).
     pub class: String,
     /// Largest error over the settle points (infinite at a point that did not settle).
     pub max_error: f64,
@@ -75,10 +77,10 @@ impl ModelCheckReport {
     /// The failure this entry is when it does not pass (`prediction:NAME`, `equation:NAME`).
     pub fn failure(&self) -> crate::settings::Failure {
         use crate::settings::Failure;
-        if self.kind == "equation" {
-            Failure::Equation(self.name.clone())
-        } else {
-            Failure::Prediction(self.name.clone())
+        match self.kind.as_str() {
+            "equation" => Failure::Equation(self.name.clone()),
+            "energy" => Failure::Energy,
+            _ => Failure::Prediction(self.name.clone()),
         }
     }
 }
@@ -168,6 +170,35 @@ pub struct PointReport {
     pub interference_free: Option<bool>,
     /// The paper's printed values at this point, where it prints any (never checked).
     pub paper: Option<PaperValues>,
+    /// The file's `[energy]` model at this point: its stationary points and which one the
+    /// dynamics landed on (absent without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub energy: Option<EnergyPointReport>,
+}
+
+/// The stationary points of a file's energy model at one settle point.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct EnergyPointReport {
+    /// The coordinates read off the settled state.
+    pub measured: Values,
+    /// Every stationary point found (from the settled state and the scan), in that order.
+    pub stationary: Vec<StationaryReport>,
+    /// The index in `stationary` of the one nearest the settled state.
+    pub landed: Option<usize>,
+    /// Largest coordinate difference (angles wrapped) from the settled state to it.
+    pub distance: f64,
+}
+
+/// One stationary point of an energy model.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct StationaryReport {
+    pub coordinates: Values,
+    /// Potential energy there.
+    pub energy: f64,
+    /// The Hessian's eigenvalues, ascending: the stiffnesses along its eigenvectors.
+    pub eigenvalues: Vec<f64>,
+    /// minimum, maximum, saddle or degenerate.
+    pub kind: String,
 }
 
 /// A paper's own printed values at a point: its source (table, column) and the values.

@@ -155,6 +155,8 @@ pub enum Failure {
     Prediction(String),
     /// A `[[equations]]` residual exceeded its tolerance: `equation:NAME`.
     Equation(String),
+    /// The dynamics settled away from the `[energy]` model's minima: `energy`.
+    Energy,
 }
 
 /// The names a scenario may give in `[expect] failing` (a check is `check:QUANTITY`).
@@ -170,6 +172,7 @@ pub const FAILURE_NAMES: &[&str] =
     "workspace",
     "prediction:NAME",
     "equation:NAME",
+    "energy",
 ];
 
 impl fmt::Display for Failure {
@@ -185,6 +188,7 @@ impl fmt::Display for Failure {
             Failure::Workspace => f.write_str("workspace"),
             Failure::Prediction(n) => write!(f, "prediction:{n}"),
             Failure::Equation(n) => write!(f, "equation:{n}"),
+            Failure::Energy => f.write_str("energy"),
         }
     }
 }
@@ -200,6 +204,7 @@ impl std::str::FromStr for Failure {
             "slack" => Failure::Slack,
             "interference" => Failure::Interference,
             "workspace" => Failure::Workspace,
+            "energy" => Failure::Energy,
             _ if s.strip_prefix("prediction:").is_some_and(|n| !n.is_empty()) => {
                 Failure::Prediction(s["prediction:".len()..].to_string())
             }

@@ -204,3 +204,53 @@ fn ji2014_restated_in_the_file_agrees_with_the_builtin_model() {
         assert!(d <= 1e-9, "point {}: {sim} against the built-in {builtin}", p.index);
     }
 }
+
+/// Eq. 4 as the file's energy model on the ji2014 grid: two stationary points at each of the
+/// 110 points, pi apart, a minimum and a maximum; the dynamics landed on the minimum within
+/// 1e-12 rad; its Hessian (the stiffness) is Eq. 42's L |eta| / 2 within 1e-12 relative; and
+/// Eq. 5's root in [0, pi) is the energy maximum exactly where the built-in model says the
+/// minimum is the other root (103 of 110 points).
+#[test]
+fn ji2014_energy_in_the_file_finds_and_classifies_both_equilibria() {
+    let r = run_file("scenarios/ji2014/model_in_file.toml");
+    assert!(r.passed, "{:?}", r.failures);
+    let sqrt3 = 3f64.sqrt();
+    let (l, k1, k2) = (1.0, 200.0, 100.0);
+    let mut paper_root_is_max = 0;
+    for p in &r.points {
+        let e = p.energy.as_ref().expect("energy at every point");
+        assert_eq!(e.stationary.len(), 2, "point {}", p.index);
+        assert!(e.distance <= 1e-12, "point {}: {}", p.index, e.distance);
+        let landed = &e.stationary[e.landed.unwrap()];
+        assert_eq!(landed.kind, "minimum");
+        let (l3, t1) = (p.inputs["L3"], p.inputs["theta1"]);
+        let eta1 = (k1 + 2.0 * k2) * l3 * t1.sin() - sqrt3 * k1 * l3 * t1.cos() + 2.0 * sqrt3 * k2 * l;
+        let eta2 = 2.0 * (2.0 * k1 - k2) * l + (k1 + 2.0 * k2) * l3 * t1.cos() + sqrt3 * k1 * l3 * t1.sin();
+        let k = l / 2.0 * eta1.hypot(eta2);
+        assert!((landed.eigenvalues[0] - k).abs() <= 1e-12 * k, "point {}: {:?} != {k}", p.index, landed.eigenvalues);
+        let gap = tensegrity_testbed::mechanisms::wrap_angle(e.stationary[0].coordinates["th"] - e.stationary[1].coordinates["th"]);
+        assert!((gap.abs() - std::f64::consts::PI).abs() <= 1e-12);
+        // Half-open: at L3 = 1, theta1 = 0 the roots are 0 and pi, and Eq. 5 gives 0.
+        let paper = e.stationary.iter().find(|s| (0.0..std::f64::consts::PI).contains(&s.coordinates["th"])).unwrap();
+        let builtin_says_paper_root_is_min = p.branch.contains("[0, pi]");
+        assert_eq!(paper.kind == "minimum", builtin_says_paper_root_is_min, "point {}", p.index);
+        paper_root_is_max += (paper.kind == "maximum") as usize;
+    }
+    assert_eq!(paper_root_is_max, 103);
+}
+
+/// `[energy]` errors: an unknown symbol in the potential (a state symbol is not a closed
+/// form), a potential without a symbolic derivative, a coordinate named like a symbol, at
+/// their place in the file.
+#[test]
+fn energy_errors_are_located() {
+    let good = std::fs::read_to_string("scenarios/ji2014/model_in_file.toml").unwrap();
+    let v = good.replacen("\"u0 + a*cos(th) + b*sin(th)\"", "\"u0 + a*cos(th) + b*sin(th) + x\"", 1);
+    error_at(&v, "x\"\ntolerance", 0, "energy potential (coordinates, parameters, inputs and their quantities): unknown symbol 'x'");
+    let d = good.replacen("\"u0 + a*cos(th) + b*sin(th)\"", "\"u0 + abs(a*cos(th)) + b*sin(th)\"", 1);
+    error_at(&d, "\"u0 + abs", 1, "no symbolic derivative");
+    let n = good.replacen("name = \"th\"", "name = \"theta2\"", 1);
+    error_at(&n, "\"theta2\"\nmeasured", 0, "coordinate name 'theta2' must be new");
+    let m = good.replacen("measured = \"theta2\"", "measured = \"theta3\"", 1);
+    error_at(&m, "theta3", 0, "coordinate 'th' measured: unknown symbol 'theta3'");
+}

@@ -114,12 +114,14 @@ pub struct ModelSpec {
     pub quantities: Vec<Quantity>,
     pub predictions: Vec<Prediction>,
     pub equations: Vec<Equation>,
+    /// `[energy]`: a potential and its coordinates.
+    pub energy: Option<super::energy::EnergySpec>,
 }
 
 impl ModelSpec {
     /// Whether the file states nothing to compare.
     pub fn is_empty(&self) -> bool {
-        self.quantities.is_empty() && self.predictions.is_empty() && self.equations.is_empty()
+        self.quantities.is_empty() && self.predictions.is_empty() && self.equations.is_empty() && self.energy.is_none()
     }
 
     /// The names of every symbol, in order.

@@ -5,7 +5,8 @@
 use super::{Note, Observer, SettlePoint, Tick};
 use crate::mechanisms::Values;
 use crate::model::spec::{ModelSpec, Source};
-use crate::report::{ModelCheckReport, PointReport, ScenarioReport};
+use crate::model::energy::Kind;
+use crate::report::{EnergyPointReport, ModelCheckReport, PointReport, ScenarioReport, StationaryReport};
 use crate::snapshot::Snapshot;
 use crate::structure::Structure;
 
@@ -94,6 +95,8 @@ pub struct ModelObserver {
     bind: Vec<Bind>,
     /// One per prediction, then one per equation.
     acc: Vec<Acc>,
+    /// The energy model's: the distance to the stationary point landed on.
+    energy: Acc,
 }
 
 impl ModelObserver {
@@ -109,6 +112,13 @@ impl ModelObserver {
             used[*u] = true;
         }
         spec.predictions.iter().for_each(|p| used[p.symbol] = true);
+        if let Some(e) = &spec.energy {
+            let exprs = e.coordinates.iter().map(|c| &c.measured).chain([&e.potential]).chain(&e.hessian);
+            let n = used.len();
+            for u in exprs.flat_map(|x| x.uses().iter()).filter(|u| **u < n) {
+                used[*u] = true;
+            }
+        }
         let bind = spec
             .symbols
             .iter()
@@ -119,6 +129,7 @@ impl ModelObserver {
             spec: spec.clone(),
             bind,
             acc: vec![Acc::default(); spec.predictions.len() + spec.equations.len()],
+            energy: Acc::default(),
         }
     }
 
@@ -146,6 +157,34 @@ impl ModelObserver {
         p.chain(self.spec.equations.iter().map(|e| (e.name.as_str(), e.tolerance)))
     }
 
+    /// The energy model at a settle point: its stationary points, the one nearest the settled
+    /// state, and the error counted (the distance to it; infinite when it is no minimum).
+    fn energy_point(&self, v: &[f64]) -> Option<(EnergyPointReport, f64)> {
+        let e = self.spec.energy.as_ref()?;
+        let measured = e.measured(v);
+        let mut values = v.to_vec();
+        values.resize(e.first_coordinate + e.coordinates.len(), 0.0);
+        let stationary = e.stationary_points(&mut values, &measured);
+        let landed = (0..stationary.len())
+            .min_by(|a, b| e.distance(&stationary[*a].coordinates, &measured).total_cmp(&e.distance(&stationary[*b].coordinates, &measured)));
+        let distance = landed.map_or(f64::INFINITY, |i| e.distance(&stationary[i].coordinates, &measured));
+        let error = match landed {
+            Some(i) if stationary[i].kind == Kind::Minimum => distance,
+            _ => f64::INFINITY,
+        };
+        let named = |x: &[f64]| e.coordinates.iter().zip(x).map(|(c, v)| (c.name.clone(), *v)).collect::<Values>();
+        let stationary = stationary
+            .iter()
+            .map(|s| StationaryReport {
+                coordinates: named(&s.coordinates),
+                energy: s.energy,
+                eigenvalues: s.eigenvalues.clone(),
+                kind: s.kind.name().into(),
+            })
+            .collect();
+        Some((EnergyPointReport { measured: named(&measured), stationary, landed, distance }, error))
+    }
+
     pub fn reports(&self) -> Vec<ModelCheckReport> {
         let kinds = self.spec.predictions.iter().map(|p| ("prediction", p.class.name()));
         let kinds = kinds.chain(self.spec.equations.iter().map(|_| ("equation", "residual")));
@@ -164,6 +203,18 @@ impl ModelObserver {
                 transient_rms_error: if a.ticks > 0 { (a.transient_sum_sq / a.ticks as f64).sqrt() } else { 0.0 },
                 ticks_compared: a.ticks,
             })
+            .chain(self.spec.energy.as_ref().map(|e| ModelCheckReport {
+                kind: "energy".into(),
+                name: "energy".into(),
+                class: "coordinates".into(),
+                max_error: self.energy.settled_max,
+                tolerance: e.tolerance,
+                passed: self.energy.points > 0 && self.energy.settled_max <= e.tolerance,
+                points_compared: self.energy.points,
+                transient_max_error: 0.0,
+                transient_rms_error: 0.0,
+                ticks_compared: 0,
+            }))
             .collect()
     }
 }
@@ -200,6 +251,18 @@ impl Observer for ModelObserver {
         }
         for (pr, (predicted, _, _)) in self.spec.predictions.iter().zip(&errors) {
             point.analytic.entry(self.spec.symbols[pr.symbol].name.clone()).or_insert(*predicted);
+        }
+        if let Some((report, error)) = self.energy_point(&v) {
+            self.energy.point(error, point.settled);
+            let tol = self.spec.energy.as_ref().map_or(0.0, |e| e.tolerance);
+            if point.settled && !(error <= tol) {
+                notes.push(Note::Event(format!(
+                    "point {}: energy: settled {:.3e} from a minimum (tolerance {tol:.1e})",
+                    point.index, error
+                )));
+                point.within_tolerance = false;
+            }
+            point.energy = Some(report);
         }
     }
 

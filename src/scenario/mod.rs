@@ -10,6 +10,7 @@
 
 mod actuation;
 mod checks;
+mod energy;
 mod error;
 mod expect;
 mod interference;

@@ -39,6 +39,9 @@ pub(super) fn model(
     for e in &raw.equations {
         equation(ctx, &mut spec, e)?;
     }
+    if let Some(e) = &raw.energy {
+        spec.energy = Some(super::energy::energy(ctx, &spec, e)?);
+    }
     Ok(Some(spec))
 }
 
@@ -47,7 +50,8 @@ fn first_entry(raw: &RawScenario) -> Option<usize> {
     let q = raw.quantities.first().map(|q| q.name.span().start);
     let p = raw.predictions.first().map(|p| p.quantity.span().start);
     let e = raw.equations.first().map(|e| e.name.span().start);
-    [q, p, e].into_iter().flatten().min()
+    let u = raw.energy.as_ref().map(|u| u.potential.span().start);
+    [q, p, e, u].into_iter().flatten().min()
 }
 
 /// The symbols of the state: nodes, members, observed quantities, inputs, parameters and `t`

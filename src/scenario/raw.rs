@@ -52,6 +52,32 @@ pub(super) struct RawScenario {
     /// Residuals that must vanish at every settled state.
     #[serde(default)]
     pub(super) equations: Vec<RawEquation>,
+    /// A potential energy in named coordinates: its stationary points and the one the
+    /// dynamics landed on.
+    #[serde(default)]
+    pub(super) energy: Option<RawEnergy>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawEnergy {
+    /// An expression of the coordinates, parameters, inputs and their quantities [J].
+    pub(super) potential: Spanned<String>,
+    /// On the largest coordinate difference from the settled state to its stationary point.
+    pub(super) tolerance: Spanned<f64>,
+    pub(super) coordinates: Vec<RawCoordinate>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawCoordinate {
+    pub(super) name: Spanned<String>,
+    /// An expression of the state giving the coordinate at a settled point.
+    pub(super) measured: Spanned<String>,
+    /// angle (compared wrapped) or length.
+    pub(super) class: Spanned<String>,
+    /// Further Newton starts.
+    pub(super) scan: Option<Spanned<RawRange>>,
 }
 
 #[derive(Debug, Deserialize)]
