@@ -254,3 +254,64 @@ fn energy_errors_are_located() {
     let m = good.replacen("measured = \"theta2\"", "measured = \"theta3\"", 1);
     error_at(&m, "theta3", 0, "coordinate 'th' measured: unknown symbol 'theta3'");
 }
+
+/// ji2014 described as a custom structure (`scenarios/custom/ji2014_in_file.toml`) settles the
+/// 110-point grid exactly as the built-in mechanism (grid.toml): the same steps at every
+/// point, theta2 and D3 within 1e-12, the same stability by perturbation.
+#[test]
+fn ji2014_as_a_custom_structure_matches_the_builtin_grid() {
+    let custom = run_file("scenarios/custom/ji2014_in_file.toml");
+    let builtin = run_file("scenarios/ji2014/grid.toml");
+    assert!(custom.passed && builtin.passed, "{:?}", custom.failures);
+    assert_eq!(custom.points.len(), 110);
+    for (c, b) in custom.points.iter().zip(&builtin.points) {
+        assert_eq!(c.inputs, b.inputs);
+        assert_eq!(c.steps, b.steps, "point {}", c.index);
+        assert_eq!(c.stable, b.stable, "point {}", c.index);
+        let d = tensegrity_testbed::mechanisms::wrap_angle(c.simulated["theta2"] - b.simulated["theta2"]);
+        assert!(d.abs() <= 1e-12, "point {}: {d}", c.index);
+        assert!((c.simulated["D3.x"] - b.simulated["x"]).abs() <= 1e-12);
+        assert!((c.simulated["D3.y"] - b.simulated["y"]).abs() <= 1e-12);
+    }
+}
+
+/// The custom ji2014 along the waypoints of scenarios/ji2014/trajectory.toml, drawn at the
+/// first waypoint's stable equilibrium (theta2_0 a parameter expression of Eq. 6-7): its
+/// prediction of theta2 compared tick by tick gives the same transient errors as the built-in
+/// check of theta2 (within 1e-9 rad), and the final hold settles within 1e-9.
+#[test]
+fn ji2014_custom_trajectory_is_compared_tick_by_tick() {
+    let text = std::fs::read_to_string("scenarios/custom/ji2014_in_file.toml").unwrap();
+    let grid_line = text.lines().find(|l| l.starts_with("grid = ")).unwrap().to_string();
+    let text = text
+        .replacen(&grid_line, "waypoints = [ { t = 0.0, L3 = 1.0, theta1 = 0.3 }, { t = 4.0, L3 = 1.8, theta1 = 1.2 }, { t = 10.0, L3 = 0.6, theta1 = 2.6 } ]", 1)
+        .replacen("continuation = true\n", "", 1)
+        .replacen("[stability]\nperturbation = 1e-3  # rad on theta2\n", "", 1)
+        .replacen("dt = 0.15\nnewton_damping = true", "dt = 0.005", 1)
+        .replacen("window = 3\nresidual_torque_tol = 1e-7\nmax_time = 30.0", "", 1)
+        // The hold settles to the default residual torque (1e-7 N m): Eq. 48's residual is
+        // 2 tau / L there.
+        .replacen("tolerance = 1e-8", "tolerance = 1e-6", 1)
+        // trajectory.toml keeps the mechanism's default pivot damping.
+        .replacen("c_D1 = { value = 80.0,", "c_D1 = { value = 20.0,", 1)
+        .replacen("value = 0.0, unit = \"rad\", description = \"drawn actuator angle", "value = 0.3, unit = \"rad\", description = \"drawn actuator angle", 1)
+        .replacen("axis = [1.0, 0.0, 0.0]", &format!("axis = [{}, {}, 0.0]", 0.3f64.cos(), 0.3f64.sin()), 1)
+        .replacen(
+            "theta2_0 = { value = -2.5,",
+            "eta1_0 = \"(K1 + 2*K2)*L3_0*sin(theta1_0) - sqrt(3)*K1*L3_0*cos(theta1_0) + 2*sqrt(3)*K2*L\"\n\
+             eta2_0 = \"2*(2*K1 - K2)*L + (K1 + 2*K2)*L3_0*cos(theta1_0) + sqrt(3)*K1*L3_0*sin(theta1_0)\"\n\
+             theta2_0 = { value = \"atan2(-eta1_0, -eta2_0)\",",
+            1,
+        );
+    let sc = scenario::parse(Path::new("ji2014_trajectory_variant.toml"), &text).expect("variant parses");
+    let custom = run(&sc, &RunOptions::default());
+    let builtin = run_file("scenarios/ji2014/trajectory.toml");
+    assert!(custom.passed && builtin.passed, "{:?} {:?}", custom.failures, custom.error);
+    let pred = custom.model_checks.iter().find(|c| c.name == "eq5_stable_root").unwrap();
+    let check = builtin.checks.iter().find(|c| c.quantity == "theta2").unwrap();
+    assert_eq!(pred.ticks_compared, check.ticks_compared);
+    assert!(pred.transient_max_error > 1e-3, "the platform lags the moving equilibrium: {pred:?}");
+    assert!((pred.transient_max_error - check.transient_max_abs_error).abs() <= 1e-9, "{pred:?} {check:?}");
+    assert!((pred.transient_rms_error - check.transient_rms_abs_error).abs() <= 1e-9, "{pred:?} {check:?}");
+    assert!(pred.max_error <= 1e-9);
+}

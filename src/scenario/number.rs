@@ -259,6 +259,7 @@ fn resolve_joint(j: &mut RawJoint, resolve: &mut Resolve) -> Result<(), Scenario
         (&mut j.torsion_stiffness, "torsion_stiffness"),
         (&mut j.torsion_rest, "torsion_rest"),
         (&mut j.damping, "damping"),
+        (&mut j.initial_coordinate, "initial_coordinate"),
     ];
     for (v, what) in fields {
         if let Some(v) = v {

@@ -198,6 +198,9 @@ pub(super) struct RawJoint {
     pub(super) torsion_rest: Option<Spanned<Num>>,
     /// Viscous damping [N m s/rad or N s/m].
     pub(super) damping: Option<Spanned<Num>>,
+    /// The joint's coordinate in the drawn geometry [rad or m] (default 0): an actuator's
+    /// command is then the coordinate itself, not its change from the drawing.
+    pub(super) initial_coordinate: Option<Spanned<Num>>,
 }
 
 #[derive(Clone, Debug, Deserialize)]

@@ -220,7 +220,10 @@ fn joint(ctx: &Ctx, s: &Structure, j: &RawJoint) -> Result<Joint, ScenarioError>
         parent,
         child,
         anchor: at,
-        initial_coordinate: 0.0,
+        initial_coordinate: match &j.initial_coordinate {
+            Some(v) => finite(ctx, v, "initial_coordinate")?,
+            None => 0.0,
+        },
         torsion_spring,
         damping,
     })
