@@ -126,3 +126,21 @@ fn hidden_symbols_are_unknown() {
     assert_eq!(e.offset, 4);
     assert!(e.message.contains("symbols here: a;"), "{}", e.message);
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2000))]
+    /// Any text from the grammar's characters compiles or fails with an offset inside it
+    /// (never a panic); what compiles evaluates, and its derivative compiles or fails cleanly.
+    #[test]
+    fn arbitrary_text_never_panics(text in "[xy0-9.eE+*/^(),{} -]{0,12}|[a-z0-9 .(),+*/^-]{0,16}") {
+        match Expr::compile(&text, &["x", "y", "pi2"]) {
+            Ok(e) => {
+                let _ = e.eval(&[0.5, -1.5, 2.0]);
+                if let Ok(d) = e.derivative(0) {
+                    let _ = d.eval(&[0.5, -1.5, 2.0]);
+                }
+            }
+            Err(err) => proptest::prop_assert!(err.offset <= text.len(), "{err} for {text:?}"),
+        }
+    }
+}
