@@ -160,8 +160,7 @@ pub enum Failure {
 }
 
 /// The names a scenario may give in `[expect] failing` (a check is `check:QUANTITY`).
-pub const FAILURE_NAMES: &[&str] =
-    &[
+pub const FAILURE_NAMES: &[&str] = &[
     "error",
     "settle",
     "check:QUANTITY",

@@ -89,7 +89,12 @@ fn model_errors_are_located_inside_the_string() {
     error_at(&q, "B4.x", 0, "quantity 'cb_x': unknown symbol 'B4.x' (symbols here: B1.x, B1.y");
     // A prediction's formula sees the parameters and inputs only.
     let p = good.replacen("formula = \"pi/2 + pi/n\"", "formula = \"pi/2 + pi/n + 0*T1.x\"", 1);
-    error_at(&p, "T1.x\"", 0, "prediction 'twist' (parameters, inputs and their quantities only): unknown symbol 'T1.x'");
+    error_at(
+        &p,
+        "T1.x\"",
+        0,
+        "prediction 'twist' (parameters, inputs and their quantities only): unknown symbol 'T1.x'",
+    );
     // ... and a quantity of the state is not a closed form either.
     let p = good.replacen("formula = \"pi/2 + pi/n\"", "formula = \"pi/2 + pi/n + 0*q_side\"", 1);
     error_at(&p, "0*q_side", 2, "unknown symbol 'q_side'");
@@ -144,10 +149,7 @@ fn a_wrong_prediction_fails_the_run_by_name() {
     let sc = scenario::parse(Path::new("wrong.toml"), &text).unwrap();
     let r = run(&sc, &RunOptions::default());
     assert!(!r.passed);
-    assert_eq!(
-        r.failures,
-        vec![Failure::Prediction("twist".into()), Failure::Equation("equal_side_tensions".into())]
-    );
+    assert_eq!(r.failures, vec![Failure::Prediction("twist".into()), Failure::Equation("equal_side_tensions".into())]);
     assert_eq!(r.as_expected, Some(true));
     let tw = r.model_checks.iter().find(|c| c.name == "twist").unwrap();
     // pi/3 - pi/4 = 15 degrees off.
@@ -228,7 +230,9 @@ fn ji2014_energy_in_the_file_finds_and_classifies_both_equilibria() {
         let eta2 = 2.0 * (2.0 * k1 - k2) * l + (k1 + 2.0 * k2) * l3 * t1.cos() + sqrt3 * k1 * l3 * t1.sin();
         let k = l / 2.0 * eta1.hypot(eta2);
         assert!((landed.eigenvalues[0] - k).abs() <= 1e-12 * k, "point {}: {:?} != {k}", p.index, landed.eigenvalues);
-        let gap = tensegrity_testbed::mechanisms::wrap_angle(e.stationary[0].coordinates["th"] - e.stationary[1].coordinates["th"]);
+        let gap = tensegrity_testbed::mechanisms::wrap_angle(
+            e.stationary[0].coordinates["th"] - e.stationary[1].coordinates["th"],
+        );
         assert!((gap.abs() - std::f64::consts::PI).abs() <= 1e-12);
         // Half-open: at L3 = 1, theta1 = 0 the roots are 0 and pi, and Eq. 5 gives 0.
         let paper = e.stationary.iter().find(|s| (0.0..std::f64::consts::PI).contains(&s.coordinates["th"])).unwrap();
@@ -246,7 +250,12 @@ fn ji2014_energy_in_the_file_finds_and_classifies_both_equilibria() {
 fn energy_errors_are_located() {
     let good = std::fs::read_to_string("scenarios/ji2014/model_in_file.toml").unwrap();
     let v = good.replacen("\"u0 + a*cos(th) + b*sin(th)\"", "\"u0 + a*cos(th) + b*sin(th) + x\"", 1);
-    error_at(&v, "x\"\ntolerance", 0, "energy potential (coordinates, parameters, inputs and their quantities): unknown symbol 'x'");
+    error_at(
+        &v,
+        "x\"\ntolerance",
+        0,
+        "energy potential (coordinates, parameters, inputs and their quantities): unknown symbol 'x'",
+    );
     let d = good.replacen("\"u0 + a*cos(th) + b*sin(th)\"", "\"u0 + abs(a*cos(th)) + b*sin(th)\"", 1);
     error_at(&d, "\"u0 + abs", 1, "no symbolic derivative");
     let n = good.replacen("name = \"th\"", "name = \"theta2\"", 1);

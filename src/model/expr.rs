@@ -70,8 +70,8 @@ impl Expr {
             return Err(err(0, "empty expression"));
         }
         let engine_text = Translator::new(text, symbols, &tokens).translate()?;
-        let flat = FlatEx::<f64>::parse(&engine_text)
-            .map_err(|e| err(0, format!("not a valid expression ({})", e.msg())))?;
+        let flat =
+            FlatEx::<f64>::parse(&engine_text).map_err(|e| err(0, format!("not a valid expression ({})", e.msg())))?;
         Ok(Expr { text: text.to_string(), order: order_of(&flat), flat })
     }
 
@@ -105,9 +105,11 @@ impl Expr {
     /// the expression does not use it). atan2, abs, min and max have no derivative here.
     pub fn derivative(&self, symbol: usize) -> Result<Expr, ExprError> {
         let flat = match self.order.iter().position(|&s| s == symbol) {
-            Some(var) => self.flat.clone().partial(var).map_err(|e| {
-                err(0, format!("no symbolic derivative of '{}' ({})", self.text, e.msg()))
-            })?,
+            Some(var) => self
+                .flat
+                .clone()
+                .partial(var)
+                .map_err(|e| err(0, format!("no symbolic derivative of '{}' ({})", self.text, e.msg())))?,
             None => FlatEx::<f64>::parse("0").map_err(|e| err(0, e.msg().to_string()))?,
         };
         Ok(Expr { text: format!("d({})/d[{symbol}]", self.text), order: order_of(&flat), flat })

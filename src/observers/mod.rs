@@ -93,7 +93,9 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
     if let Some(settings) = setup.interference {
         list.push(Box::new(interference::Interference::new(setup.structure, settings)?));
     }
-    list.extend(setup.model.map(|spec| Box::new(model::ModelObserver::new(spec, setup.structure)) as Box<dyn Observer>));
+    list.extend(
+        setup.model.map(|spec| Box::new(model::ModelObserver::new(spec, setup.structure)) as Box<dyn Observer>),
+    );
     if let Some(r) = &setup.recording {
         if let Some(recorder) = record::Recorder::start(r)? {
             list.push(Box::new(recorder));

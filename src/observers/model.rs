@@ -4,8 +4,8 @@
 
 use super::{Note, Observer, SettlePoint, Tick};
 use crate::mechanisms::Values;
-use crate::model::spec::{ModelSpec, Source};
 use crate::model::energy::Kind;
+use crate::model::spec::{ModelSpec, Source};
 use crate::report::{EnergyPointReport, ModelCheckReport, PointReport, ScenarioReport, StationaryReport};
 use crate::snapshot::Snapshot;
 use crate::structure::Structure;
@@ -165,8 +165,10 @@ impl ModelObserver {
         let mut values = v.to_vec();
         values.resize(e.first_coordinate + e.coordinates.len(), 0.0);
         let stationary = e.stationary_points(&mut values, &measured);
-        let landed = (0..stationary.len())
-            .min_by(|a, b| e.distance(&stationary[*a].coordinates, &measured).total_cmp(&e.distance(&stationary[*b].coordinates, &measured)));
+        let landed = (0..stationary.len()).min_by(|a, b| {
+            e.distance(&stationary[*a].coordinates, &measured)
+                .total_cmp(&e.distance(&stationary[*b].coordinates, &measured))
+        });
         let distance = landed.map_or(f64::INFINITY, |i| e.distance(&stationary[i].coordinates, &measured));
         let error = match landed {
             Some(i) if stationary[i].kind == Kind::Minimum => distance,
@@ -240,7 +242,10 @@ impl Observer for ModelObserver {
         for ((a, (_, _, e)), (name, tol)) in self.acc.iter_mut().zip(&errors).zip(&tolerances) {
             a.point(*e, point.settled);
             if point.settled && !(*e <= *tol) {
-                notes.push(Note::Event(format!("point {}: {name} failed: error {e:.3e} > tolerance {tol:.1e}", point.index)));
+                notes.push(Note::Event(format!(
+                    "point {}: {name} failed: error {e:.3e} > tolerance {tol:.1e}",
+                    point.index
+                )));
                 point.within_tolerance = false;
             }
         }

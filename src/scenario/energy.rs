@@ -15,7 +15,9 @@ const MAX_SCAN: i64 = 10_000;
 /// The compiled `[energy]` section of a model whose other sections are in `spec`.
 pub(super) fn energy(ctx: &Ctx, spec: &ModelSpec, raw: &RawEnergy) -> Result<EnergySpec, ScenarioError> {
     if raw.coordinates.is_empty() {
-        return Err(ctx.err(&raw.potential, "[energy] needs at least one [[energy.coordinates]] (name, measured, class)"));
+        return Err(
+            ctx.err(&raw.potential, "[energy] needs at least one [[energy.coordinates]] (name, measured, class)")
+        );
     }
     let state = spec.names();
     let mut coordinates = Vec::new();
@@ -24,16 +26,15 @@ pub(super) fn energy(ctx: &Ctx, spec: &ModelSpec, raw: &RawEnergy) -> Result<Ene
     }
     // The potential sees the closed forms (parameters, inputs, their quantities) and the
     // coordinates.
-    let mut names: Vec<&str> =
-        (0..state.len()).map(|i| if spec.is_closed_form(i) { state[i] } else { "" }).collect();
+    let mut names: Vec<&str> = (0..state.len()).map(|i| if spec.is_closed_form(i) { state[i] } else { "" }).collect();
     names.extend(coordinates.iter().map(|c: &Coordinate| c.name.as_str()));
     let at = raw.potential.span().start;
-    let potential = Expr::compile(raw.potential.get_ref(), &names)
-        .map_err(|e| expr_error(ctx, at, &e, "energy potential (coordinates, parameters, inputs and their quantities)"))?;
+    let potential = Expr::compile(raw.potential.get_ref(), &names).map_err(|e| {
+        expr_error(ctx, at, &e, "energy potential (coordinates, parameters, inputs and their quantities)")
+    })?;
     let first = state.len();
-    let derivative = |e: &Expr, i: usize| {
-        e.derivative(first + i).map_err(|e| expr_error(ctx, at, &e, "energy potential"))
-    };
+    let derivative =
+        |e: &Expr, i: usize| e.derivative(first + i).map_err(|e| expr_error(ctx, at, &e, "energy potential"));
     let n = coordinates.len();
     let gradient: Vec<Expr> = (0..n).map(|i| derivative(&potential, i)).collect::<Result<_, _>>()?;
     let mut hessian = Vec::with_capacity(n * n);

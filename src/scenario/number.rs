@@ -154,9 +154,10 @@ pub(super) fn param_values(ctx: &Ctx, raw: &ParamMap) -> Result<Values, Scenario
     for (i, (k, p)) in raw.iter().enumerate() {
         let e = match &p.get_ref().value {
             Num::Value(_) => None,
-            Num::Expr(text) => Some(Expr::compile(text, &names).map_err(|e| {
-                expr_error(ctx, param_start(p), &e, &format!("parameter '{}'", k.get_ref()))
-            })?),
+            Num::Expr(text) => Some(
+                Expr::compile(text, &names)
+                    .map_err(|e| expr_error(ctx, param_start(p), &e, &format!("parameter '{}'", k.get_ref())))?,
+            ),
         };
         compiled.push((i, e));
     }

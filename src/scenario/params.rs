@@ -15,7 +15,10 @@ pub(super) fn params(ctx: &Ctx, m: &dyn Mechanism, raw: &ParamMap) -> Result<Val
         let spec = m.params().iter().find(|s| s.symbol == k.get_ref());
         if let (Some(unit), Some(spec)) = (&p.get_ref().unit, spec) {
             if unit != spec.unit {
-                return Err(ctx.err(p, format!("parameter '{}' is in {} (unit = \"{}\"), not {unit}", spec.symbol, spec.unit, spec.unit)));
+                return Err(ctx.err(
+                    p,
+                    format!("parameter '{}' is in {} (unit = \"{}\"), not {unit}", spec.symbol, spec.unit, spec.unit),
+                ));
             }
         }
     }
