@@ -1,7 +1,9 @@
 //! A mechanism described in a scenario file (`mechanism = "custom"` and a `[structure]`
 //! table): no analytic model, only what the dynamics can check on their own (settling, the
 //! force balance, cable slackness, member forces, stability, interference), plus optional
-//! expected values given in the file (`[[checks]]` with `value`).
+//! expected values given in the file (`[[checks]]` with `value`) and the file's own model
+//! (`[params]`, `[[quantities]]`, `[[predictions]]`, `[[equations]]`, `[energy]`: see
+//! `crate::model`).
 
 use crate::mechanisms::{
     Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction, QuantityKind,
@@ -80,7 +82,7 @@ impl Custom {
             structure,
             spec: MechanismSpec {
                 name: "custom",
-                title: "a structure described in the scenario file (no analytic model)",
+                title: "a structure described in the scenario file (its model, if any, stated there too)",
                 params: &[],
                 inputs: Box::leak(inputs.into_boxed_slice()),
                 quantities: Box::leak(quantities.into_boxed_slice()),

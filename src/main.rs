@@ -424,6 +424,8 @@ fn print_mechanism(m: &dyn mechanisms::Mechanism) {
     println!("  parameters:");
     for p in m.params() {
         let origin = match p.origin {
+            // A custom file's own parameters.
+            _ if m.name() == "custom" => "file",
             Origin::Paper => "paper",
             Origin::ModelChoice => "model choice",
         };
