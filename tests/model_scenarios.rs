@@ -324,3 +324,17 @@ fn ji2014_custom_trajectory_is_compared_tick_by_tick() {
     assert!((pred.transient_rms_error - check.transient_rms_abs_error).abs() <= 1e-9, "{pred:?} {check:?}");
     assert!(pred.max_error <= 1e-9);
 }
+
+/// mohr2011's DKP (Eq. 12-14), IKP (Eq. 15) and tensions (Eq. 26-28 with Eq. 5 at Eq. 16's
+/// lengths) written in the file hold at quick.toml's three points within 1e-12 (m, or
+/// relative for the tensions).
+#[test]
+fn mohr2011_restated_in_the_file_holds() {
+    let r = run_file("scenarios/mohr2011/model_in_file.toml");
+    assert!(r.passed, "{:?} {:?}", r.failures, r.error);
+    assert_eq!(r.model_checks.len(), 10);
+    for c in &r.model_checks {
+        assert_eq!(c.points_compared, 3, "{c:?}");
+        assert!(c.max_error <= 1e-12, "{c:?}");
+    }
+}
