@@ -338,3 +338,29 @@ fn mohr2011_restated_in_the_file_holds() {
         assert!(c.max_error <= 1e-12, "{c:?}");
     }
 }
+
+/// Joint coordinates are symbols: on the custom ji2014 grid the actuated joints' coordinates
+/// equal the commands (theta1.angle = theta1, L3.slide = L3, within 1e-9) and the pivot's
+/// angle is theta2 - theta1 (the rod turns with theta1; within 1e-9 rad), at every point.
+#[test]
+fn joint_coordinates_are_symbols() {
+    let text = std::fs::read_to_string("scenarios/custom/ji2014_in_file.toml").unwrap().replacen(
+        "[energy]",
+        "[[equations]]\nname = \"theta1_joint\"\nresidual = \"theta1.angle - theta1\"\ntolerance = 1e-9\n\n\
+         [[equations]]\nname = \"L3_joint\"\nresidual = \"L3.slide - L3\"\ntolerance = 1e-9\n\n\
+         [[equations]]\nname = \"pivot\"\nresidual = \"sin(D1.angle - (theta2 - theta1))\"\ntolerance = 1e-9\n\n\
+         [energy]",
+        1,
+    );
+    let sc = scenario::parse(Path::new("joints.toml"), &text).expect("variant parses");
+    let r = run(&sc, &RunOptions::default());
+    assert!(r.passed, "{:?} {:?}", r.failures, r.model_checks);
+    for name in ["theta1_joint", "L3_joint", "pivot"] {
+        let c = r.model_checks.iter().find(|c| c.name == name).unwrap();
+        assert_eq!(c.points_compared, 110);
+        assert!(c.max_error <= 1e-9, "{c:?}");
+    }
+    let (code, out, _) = tensegrity(&["list", "scenarios/custom/ji2014_in_file.toml"]);
+    assert_eq!(code, 0);
+    assert!(out.contains(" theta1.angle ") && out.contains(" L3.slide ") && out.contains(" D1.angle "), "{out}");
+}

@@ -20,6 +20,12 @@ pub enum Source {
     MemberForce(String),
     /// Length of a spring, cable or strut (distance between its end nodes) [m].
     MemberLength(String),
+    /// Angle of a revolute joint [rad]: its initial coordinate plus the child's rotation
+    /// relative to the parent about the axis since the build.
+    JointAngle(String),
+    /// Slide of a prismatic joint [m]: its initial coordinate plus the child's displacement
+    /// relative to the parent along the axis since the build.
+    JointSlide(String),
     /// A quantity the mechanism observes (its `observe` values), by symbol.
     Observed(String),
     /// A `[[quantities]]` entry, by index.

@@ -8,7 +8,8 @@ use crate::model::energy::Kind;
 use crate::model::spec::{ModelSpec, Source};
 use crate::report::{EnergyPointReport, ModelCheckReport, PointReport, ScenarioReport, StationaryReport};
 use crate::snapshot::Snapshot;
-use crate::structure::Structure;
+use crate::structure::{JointKind, Structure};
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 /// How a state symbol is read from a snapshot of the run's structure.
 #[derive(Clone, Debug)]
@@ -24,6 +25,71 @@ enum Bind {
     /// Distance between a strut's end nodes.
     StrutLength(usize, usize),
     Observed(String),
+    /// A revolute joint: parent and child bodies, unit axis, initial coordinate.
+    JointAngle {
+        parent: usize,
+        child: usize,
+        axis: [f64; 3],
+        initial: f64,
+    },
+    /// A prismatic joint: parent and child bodies, the anchor at the build, unit axis,
+    /// initial coordinate.
+    JointSlide {
+        parent: usize,
+        child: usize,
+        anchor: [f64; 3],
+        axis: [f64; 3],
+        initial: f64,
+    },
+}
+
+/// The unit vector along `a` (zero stays zero).
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    if n > 0.0 {
+        a.map(|x| x / n)
+    } else {
+        a
+    }
+}
+
+/// A body's pose since the build (bodies are built at the identity).
+fn pose(snap: &Snapshot, body: usize) -> Option<Isometry3<f64>> {
+    let p = snap.body_poses.get(body)?;
+    let [x, y, z, w] = p.rotation_xyzw;
+    let r = UnitQuaternion::new_normalize(Quaternion::new(w, x, y, z));
+    Some(Isometry3::from_parts(Translation3::from(Vector3::from(p.translation)), r))
+}
+
+/// A joint's coordinate symbol, if its kind has one coordinate.
+fn joint_bind(s: &Structure, name: &str, angle: bool) -> Option<Bind> {
+    let j = s.joints.iter().find(|j| j.name == name)?;
+    let (parent, child, initial) = (j.parent, j.child, j.initial_coordinate);
+    match (&j.kind, angle) {
+        (JointKind::Revolute { axis }, true) => Some(Bind::JointAngle { parent, child, axis: unit(*axis), initial }),
+        (JointKind::Prismatic { axis }, false) => {
+            let anchor = s.nodes.get(j.anchor)?.position;
+            Some(Bind::JointSlide { parent, child, anchor, axis: unit(*axis), initial })
+        }
+        _ => None,
+    }
+}
+
+/// The rotation of `child` relative to `parent` about `axis` (parent frame) [rad], as the
+/// simulator counts a torsion spring's angle.
+fn joint_angle(snap: &Snapshot, parent: usize, child: usize, axis: [f64; 3]) -> Option<f64> {
+    let rel = pose(snap, parent)?.rotation.inverse() * pose(snap, child)?.rotation;
+    let s = rel.i * axis[0] + rel.j * axis[1] + rel.k * axis[2];
+    Some(2.0 * s.atan2(rel.w))
+}
+
+/// The displacement of `child` relative to `parent` at the anchor, along `axis` (parent
+/// frame) [m].
+fn joint_slide(snap: &Snapshot, parent: usize, child: usize, anchor: [f64; 3], axis: [f64; 3]) -> Option<f64> {
+    let (p, c) = (pose(snap, parent)?, pose(snap, child)?);
+    let a = Point3::from(anchor);
+    let d = p.inverse_transform_vector(&(c.transform_point(&a) - p.transform_point(&a)));
+    Some(d.dot(&Vector3::from(axis)))
 }
 
 impl Bind {
@@ -38,6 +104,8 @@ impl Bind {
             Source::MemberLength(m) => member(m, Bind::SpringLength, Bind::CableLength)
                 .or_else(|| s.struts.iter().find(|t| &t.name == m).map(|t| Bind::StrutLength(t.a, t.b))),
             Source::Observed(q) => Some(Bind::Observed(q.clone())),
+            Source::JointAngle(j) => joint_bind(s, j, true),
+            Source::JointSlide(j) => joint_bind(s, j, false),
             Source::Param(_) | Source::Input(_) | Source::Quantity(_) => None,
         };
         bound.unwrap_or(Bind::Unused)
@@ -58,6 +126,12 @@ impl Bind {
                 _ => f64::NAN,
             },
             Bind::Observed(q) => observed.get(q).copied().unwrap_or(f64::NAN),
+            Bind::JointAngle { parent, child, axis, initial } => {
+                joint_angle(snap, *parent, *child, *axis).map_or(f64::NAN, |q| initial + q)
+            }
+            Bind::JointSlide { parent, child, anchor, axis, initial } => {
+                joint_slide(snap, *parent, *child, *anchor, *axis).map_or(f64::NAN, |q| initial + q)
+            }
         }
     }
 }

@@ -1,6 +1,7 @@
 //! `[[quantities]]`, `[[predictions]]` and `[[equations]]`: the file's own model, compiled into
 //! a [`ModelSpec`] against the symbols of the mechanism's structure (node coordinates, member
-//! forces and lengths), its observed quantities, inputs and parameters, and time `t`. An error
+//! forces and lengths, revolute joints' angles and prismatic joints' slides), its observed
+//! quantities, inputs and parameters, and time `t`. An error
 //! inside an expression names its `file:LINE:COL` inside the string and the symbols there.
 
 use super::error::{positive_value, Ctx, ScenarioError};
@@ -10,6 +11,7 @@ use super::Actuation;
 use crate::mechanisms::{Mechanism, Values};
 use crate::model::expr::Expr;
 use crate::model::spec::{Equation, ErrorClass, ModelSpec, Prediction, Quantity, Source, Symbol};
+use crate::structure::JointKind;
 use toml::Spanned;
 
 /// The compiled model section, or None when the file states none.
@@ -75,6 +77,13 @@ fn state_symbols(s: &crate::structure::Structure, m: &dyn Mechanism, params: &Va
     }
     for st in &s.struts {
         add(format!("{}.length", st.name), Source::MemberLength(st.name.clone()));
+    }
+    for j in &s.joints {
+        match j.kind {
+            JointKind::Revolute { .. } => add(format!("{}.angle", j.name), Source::JointAngle(j.name.clone())),
+            JointKind::Prismatic { .. } => add(format!("{}.slide", j.name), Source::JointSlide(j.name.clone())),
+            _ => {}
+        }
     }
     for q in m.quantities() {
         add(q.symbol.to_string(), Source::Observed(q.symbol.to_string()));
