@@ -1,13 +1,14 @@
 //! A number or an expression of the file's parameters (`r = 0.5`, `h = "2*r"`), where a
 //! scenario takes a number: `[params]` entries and the numbers of a custom `[structure]`
-//! (node coordinates, masses, radii, stiffnesses, lengths, torsion springs, damping).
+//! (node coordinates, gravity, masses, inertias, radii, stiffnesses, lengths, joint axes,
+//! torsion springs, damping, initial coordinates).
 //!
 //! Parameters are evaluated in the order their expressions need (a cycle is an error), then
 //! the structure's expressions with every parameter's value. An error inside an expression
 //! names its `file:LINE:COL` inside the string.
 
 use super::error::{Ctx, ScenarioError};
-use super::raw::{RawBody, RawJoint, RawMember, RawStructure};
+use super::raw::{RawBody, RawJoint, RawMember, RawStructure, Xyz};
 use crate::mechanisms::Values;
 use crate::model::expr::{Expr, ExprError};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
@@ -219,6 +220,9 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
         *v = Spanned::new(v.span(), Num::Value(x));
         Ok(())
     };
+    if let Some(g) = &mut s.gravity {
+        resolve_xyz(g, "gravity", &mut resolve)?;
+    }
     for b in &mut s.bodies {
         resolve_body(b, &mut resolve)?;
     }
@@ -233,15 +237,19 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
 
 type Resolve<'a> = dyn FnMut(&mut Spanned<Num>, &str) -> Result<(), ScenarioError> + 'a;
 
+fn resolve_xyz(v: &mut Xyz, what: &str, resolve: &mut Resolve) -> Result<(), ScenarioError> {
+    v.get_mut().iter_mut().try_for_each(|c| resolve(c, what))
+}
+
 fn resolve_body(b: &mut RawBody, resolve: &mut Resolve) -> Result<(), ScenarioError> {
     if let Some(m) = &mut b.mass {
         resolve(m, "mass")?;
     }
+    if let Some(i) = &mut b.inertia {
+        resolve_xyz(i, "inertia", resolve)?;
+    }
     for (name, p) in &mut b.nodes {
-        let what = format!("a coordinate of node '{}'", name.get_ref());
-        for c in p.get_mut().iter_mut() {
-            resolve(c, &what)?;
-        }
+        resolve_xyz(p, &format!("a coordinate of node '{}'", name.get_ref()), resolve)?;
     }
     Ok(())
 }
@@ -256,6 +264,11 @@ fn resolve_member(m: &mut RawMember, resolve: &mut Resolve) -> Result<(), Scenar
 }
 
 fn resolve_joint(j: &mut RawJoint, resolve: &mut Resolve) -> Result<(), ScenarioError> {
+    for (v, what) in [(&mut j.axis, "axis"), (&mut j.axis2, "axis2")] {
+        if let Some(v) = v {
+            resolve_xyz(v, what, resolve)?;
+        }
+    }
     let fields = [
         (&mut j.torsion_stiffness, "torsion_stiffness"),
         (&mut j.torsion_rest, "torsion_rest"),

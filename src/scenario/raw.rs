@@ -124,10 +124,8 @@ pub(super) struct RawExpect {
     pub(super) failing: Vec<Spanned<String>>,
 }
 
-pub(super) type Xyz = Spanned<[f64; 3]>;
-
-/// A node's coordinates: numbers or expressions of the parameters.
-pub(super) type Point = Spanned<[Spanned<Num>; 3]>;
+/// Three numbers (coordinates, a vector), each a number or an expression of the parameters.
+pub(super) type Xyz = Spanned<[Spanned<Num>; 3]>;
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -160,7 +158,7 @@ pub(super) struct RawBody {
     /// isotropic, mass times the square of the body's size over 12).
     pub(super) inertia: Option<Xyz>,
     /// Named nodes with their coordinates [m] (the centre of mass is their mean).
-    pub(super) nodes: BTreeMap<Spanned<String>, Point>,
+    pub(super) nodes: BTreeMap<Spanned<String>, Xyz>,
 }
 
 /// A strut, spring or cable between two named nodes.

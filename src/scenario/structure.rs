@@ -2,7 +2,7 @@
 //! built into a [`Structure`].
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
-use super::raw::{Point, RawActuator, RawBody, RawJoint, RawMember, RawStructure, Xyz};
+use super::raw::{RawActuator, RawBody, RawJoint, RawMember, RawStructure, Xyz};
 use crate::structure::{
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut,
     TorsionSpring,
@@ -44,20 +44,14 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
     Ok(s)
 }
 
-/// Three finite numbers.
+/// Three finite numbers (the parameters' expressions already evaluated).
 fn xyz(ctx: &Ctx, v: &Xyz, what: &str) -> Result<[f64; 3], ScenarioError> {
-    let a = *v.get_ref();
+    let a = v.get_ref().each_ref().map(|c| c.get_ref().value());
     if a.iter().all(|c| c.is_finite()) {
         Ok(a)
     } else {
         Err(ctx.err(v, format!("{what} must be three finite numbers, got {a:?}")))
     }
-}
-
-/// A node's coordinates: three finite numbers (the parameters' expressions already evaluated).
-fn point(ctx: &Ctx, p: &Point) -> Result<[f64; 3], ScenarioError> {
-    let c = p.get_ref();
-    Ok([finite(ctx, &c[0], "x (m)")?, finite(ctx, &c[1], "y (m)")?, finite(ctx, &c[2], "z (m)")?])
 }
 
 /// Adds a body (at least one node, a mass if free) and its nodes (names unique in the
@@ -71,7 +65,7 @@ fn add_body(ctx: &Ctx, s: &mut Structure, b: &RawBody) -> Result<(), ScenarioErr
     }
     let mut pts = Vec::new();
     for (n, p) in &b.nodes {
-        pts.push((n, point(ctx, p)?));
+        pts.push((n, xyz(ctx, p, "a node's coordinates")?));
     }
     let fixed = b.fixed.unwrap_or(false);
     let inertia = if fixed {
