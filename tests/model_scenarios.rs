@@ -368,3 +368,40 @@ fn joint_coordinates_are_symbols() {
     assert_eq!(code, 0);
     assert!(out.contains(" theta1.angle ") && out.contains(" L3.slide ") && out.contains(" D1.angle "), "{out}");
 }
+
+/// A recorded run of the prism holds each prediction's and equation's error per tick as a
+/// series `model/NAME` at every tick of the run (5549).
+#[test]
+fn a_recorded_run_holds_the_model_errors_per_tick() {
+    let sc = scenario::load(Path::new(PRISM)).unwrap();
+    let path = std::env::temp_dir().join(format!("tensegrity-model-{}.rrd", std::process::id()));
+    let r = run(&sc, &RunOptions { record: Some(path.clone()), ..RunOptions::default() });
+    assert!(r.passed, "{:?}", r.error);
+    let file = std::io::BufReader::new(std::fs::File::open(&path).expect("recording exists"));
+    let mut ticks: std::collections::BTreeMap<String, std::collections::BTreeSet<i64>> = Default::default();
+    for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
+        if let re_log_types::LogMsg::ArrowMsg(store, arrow) = msg.expect("decodes") {
+            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).expect("a chunk");
+            let name = chunk.entity_path().to_string();
+            if store.kind() == re_log_types::StoreKind::Recording && name.starts_with("/model/") {
+                let col = chunk.timelines().iter().find(|(n, _)| n.as_str() == "tick").map(|(_, c)| c).unwrap();
+                ticks.entry(name).or_default().extend(col.times_raw().iter().copied());
+            }
+        }
+    }
+    std::fs::remove_file(&path).ok();
+    let names: Vec<&str> = ticks.keys().map(String::as_str).collect();
+    assert_eq!(
+        names,
+        [
+            "/model/equal_side_tensions",
+            "/model/equal_top_tensions",
+            "/model/polygon_to_side",
+            "/model/strut_to_side",
+            "/model/twist"
+        ]
+    );
+    for t in ticks.values() {
+        assert_eq!(t.len(), 5549);
+    }
+}

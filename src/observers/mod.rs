@@ -1,7 +1,8 @@
 //! Observers watch a run: each is fed one snapshot per tick and each settle point, and puts
 //! what it gathered into the report at the end. They are held as one list ([`observers`]):
 //! `compare` (analytic versus simulated), `slack` (cable slackness intervals), `interference`
-//! (parry distances between struts) and `record` (rerun).
+//! (parry distances between struts), `model` (the scenario file's own model) and `record`
+//! (rerun).
 //!
 //! Adding an observer: its own file here implementing [`Observer`], and one line in
 //! [`observers`].
@@ -93,9 +94,9 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
     if let Some(settings) = setup.interference {
         list.push(Box::new(interference::Interference::new(setup.structure, settings)?));
     }
-    list.extend(
-        setup.model.map(|spec| Box::new(model::ModelObserver::new(spec, setup.structure)) as Box<dyn Observer>),
-    );
+    if let Some(spec) = setup.model {
+        list.push(Box::new(model::ModelObserver::new(spec, setup.structure, setup.recording.is_some())));
+    }
     if let Some(r) = &setup.recording {
         if let Some(recorder) = record::Recorder::start(r)? {
             list.push(Box::new(recorder));

@@ -136,6 +136,13 @@ impl Bind {
     }
 }
 
+/// The recording's series of the model's errors, one per prediction and equation (named once
+/// per recorded run: the recorder takes static names).
+fn series_names(spec: &ModelSpec) -> Vec<&'static str> {
+    let names = spec.predictions.iter().map(|p| &p.name).chain(spec.equations.iter().map(|e| &e.name));
+    names.map(|n| &*Box::leak(format!("model/{n}").into_boxed_str())).collect()
+}
+
 /// Errors gathered for one prediction or equation.
 #[derive(Clone, Debug, Default)]
 struct Acc {
@@ -171,10 +178,15 @@ pub struct ModelObserver {
     acc: Vec<Acc>,
     /// The energy model's: the distance to the stationary point landed on.
     energy: Acc,
+    /// When the run is recorded: the series of each prediction's and equation's error per
+    /// tick (`model/NAME`), in the order of `acc`.
+    series: Option<Vec<&'static str>>,
 }
 
 impl ModelObserver {
-    pub fn new(spec: &ModelSpec, structure: &Structure) -> Self {
+    /// The observer of `spec` on the run's `structure`; `recorded`: the run is recorded (each
+    /// error per tick then goes to the recording).
+    pub fn new(spec: &ModelSpec, structure: &Structure, recorded: bool) -> Self {
         let mut used = vec![false; spec.symbols.len()];
         let exprs = spec
             .quantities
@@ -204,6 +216,7 @@ impl ModelObserver {
             bind,
             acc: vec![Acc::default(); spec.predictions.len() + spec.equations.len()],
             energy: Acc::default(),
+            series: recorded.then(|| series_names(spec)),
         }
     }
 
@@ -296,11 +309,14 @@ impl ModelObserver {
 }
 
 impl Observer for ModelObserver {
-    fn tick(&mut self, t: &Tick, _notes: &mut Vec<Note>) {
+    fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>) {
         let v = self.values(t.snapshot, t.inputs, t.simulated);
         let errors = self.errors(&v);
-        for (a, (_, _, e)) in self.acc.iter_mut().zip(errors) {
-            a.tick(e);
+        for (a, (_, _, e)) in self.acc.iter_mut().zip(&errors) {
+            a.tick(*e);
+        }
+        if let Some(series) = &self.series {
+            notes.extend(series.iter().zip(&errors).map(|(s, (_, _, e))| Note::Scalar(s, *e)));
         }
     }
 
