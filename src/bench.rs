@@ -45,12 +45,15 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// The case set's scenario as the bench runs it: every point built afresh (no continuation),
-/// no stability test, no stiffness probe, no recording.
+/// no stability test, no stiffness probe, no recording, no interference checks (the peer's
+/// tendons cannot collide, so it does none: the rates compare the same work; the checks' own
+/// cost is the bench's interference table and BENCHMARKS.md's).
 pub fn bench_scenario(file: &Path) -> Result<scenario::Scenario, String> {
     let mut sc = scenario::load(file).map_err(|e| e.to_string())?;
     sc.stability_perturbation = None;
     sc.probe = None;
     sc.record = None;
+    sc.interference.enabled = false;
     if let Actuation::Points { continuation, .. } = &mut sc.actuation {
         *continuation = false;
     }

@@ -69,13 +69,13 @@ impl Custom {
             .iter()
             .map(|m| &m.name)
             .chain(structure.cables.iter().map(|m| &m.name))
-            .chain(structure.struts.iter().map(|m| &m.name));
+            .chain(structure.struts.iter().filter(|t| strut_reading(&structure, t).is_some()).map(|m| &m.name));
         for name in members {
             quantities.push(QuantitySpec {
                 symbol: leak(format!("{name}.force")),
                 unit: "N",
                 kind: QuantityKind::Magnitude,
-                description: "member force, tension positive (struts: from the balance of their end nodes)",
+                description: "member force, tension positive (struts: from the balance of an end node without a joint; none for a strut on a fixed body or jointed at both ends)",
             });
         }
         Custom {
@@ -110,9 +110,9 @@ impl Custom {
         self
     }
 
-    /// Axial force of each strut, tension positive [N]: minus the member forces on its end
-    /// nodes along the strut (averaged over both ends), so it balances them.
-    fn strut_forces(&self, snap: &Snapshot) -> Vec<f64> {
+    /// Axial force of each strut whose force can be read ([`strut_reading`]), tension positive
+    /// [N]: minus the member forces on an end node along the strut, so that it balances them.
+    fn strut_forces(&self, snap: &Snapshot) -> Vec<(usize, f64)> {
         let s = &self.structure;
         let node_force = |node: usize| -> [f64; 3] {
             let mut f = [0.0; 3];
@@ -142,22 +142,69 @@ impl Custom {
             }
             f
         };
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         s.struts
             .iter()
-            .map(|st| {
+            .enumerate()
+            .filter_map(|(k, st)| {
+                let reading = strut_reading(s, st)?;
                 let (pa, pb) = (snap.nodes[st.a], snap.nodes[st.b]);
                 let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
-                let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(f64::MIN_POSITIVE);
+                let l = dot(d, d).sqrt().max(f64::MIN_POSITIVE);
                 let u = [d[0] / l, d[1] / l, d[2] / l];
-                let (fa, fb) = (node_force(st.a), node_force(st.b));
                 // Strut tension t pulls a towards b: t u + fa = 0 at a, -t u + fb = 0 at b.
-                let ta = -(fa[0] * u[0] + fa[1] * u[1] + fa[2] * u[2]);
-                let tb = fb[0] * u[0] + fb[1] * u[1] + fb[2] * u[2];
-                0.5 * (ta + tb)
+                let ta = || -dot(node_force(st.a), u);
+                let tb = || dot(node_force(st.b), u);
+                Some((
+                    k,
+                    match reading {
+                        StrutReading::BothEnds => 0.5 * (ta() + tb()),
+                        StrutReading::EndA => ta(),
+                        StrutReading::EndB => tb(),
+                    },
+                ))
             })
             .collect()
     }
 }
+
+/// Which end nodes carry a strut's axial force alone: an end with a joint also takes the
+/// joint's reaction, which the member forces do not show.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum StrutReading {
+    BothEnds,
+    EndA,
+    EndB,
+}
+
+/// How the axial force of `st` is read, or None when it cannot be: a strut on a fixed body
+/// (its force goes into the ground) or with a joint at both ends (the joints' reactions share
+/// the axial force in a way the body's balance does not determine).
+fn strut_reading(s: &Structure, st: &crate::structure::Strut) -> Option<StrutReading> {
+    let fixed = |n: usize| s.bodies[s.nodes[n].body].kind == crate::structure::BodyKind::Fixed;
+    if fixed(st.a) || fixed(st.b) {
+        return None;
+    }
+    let size = crate::structure::structure_size(s);
+    let jointed = |n: usize| {
+        let node = &s.nodes[n];
+        s.joints.iter().any(|j| {
+            (j.parent == node.body || j.child == node.body)
+                && crate::structure::distance(s.nodes[j.anchor].position, node.position)
+                    <= JOINT_AT_NODE_FRACTION * size
+        })
+    };
+    match (jointed(st.a), jointed(st.b)) {
+        (false, false) => Some(StrutReading::BothEnds),
+        (true, false) => Some(StrutReading::EndB),
+        (false, true) => Some(StrutReading::EndA),
+        (true, true) => None,
+    }
+}
+
+/// A joint anchored closer than this fraction of the structure's size to a strut's end node
+/// acts at that end.
+const JOINT_AT_NODE_FRACTION: f64 = 1e-9;
 
 impl Mechanism for Custom {
     fn spec(&self) -> &MechanismSpec {
@@ -224,8 +271,8 @@ impl Mechanism for Custom {
         for (i, m) in s.cables.iter().enumerate() {
             v.insert(format!("{}.force", m.name), snap.forces.cable_tension_n[i]);
         }
-        for (m, f) in s.struts.iter().zip(self.strut_forces(snap)) {
-            v.insert(format!("{}.force", m.name), f);
+        for (k, f) in self.strut_forces(snap) {
+            v.insert(format!("{}.force", s.struts[k].name), f);
         }
         v
     }

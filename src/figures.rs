@@ -77,12 +77,30 @@ fn register_font() -> Result<(), String> {
         .map_err(|_| "the bundled font is invalid".to_string())
 }
 
-/// Draws figure `name` into `dir` as NAME.png and NAME.svg; returns the files written.
+/// Draws figure `name` into `dir` as NAME.png and NAME.svg (each written to a temporary file
+/// and renamed when complete, `output`); returns the files written.
 pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
     register_font()?;
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let png = dir.join(format!("{name}.png"));
-    let svg = dir.join(format!("{name}.svg"));
+    let (png_out, svg_out) = (dir.join(format!("{name}.png")), dir.join(format!("{name}.svg")));
+    for p in [&png_out, &svg_out] {
+        crate::output::check_replaceable(p)?;
+    }
+    let (png, svg) = (crate::output::partial_path(&png_out), crate::output::partial_path(&svg_out));
+    let drawn = draw_to(name, &png, &svg);
+    if let Err(e) = drawn {
+        crate::output::discard(&png);
+        crate::output::discard(&svg);
+        return Err(e);
+    }
+    crate::output::commit(&png, &png_out)?;
+    crate::output::commit(&svg, &svg_out)?;
+    Ok(vec![png_out, svg_out])
+}
+
+/// Draws figure `name` to the files `png` and `svg`.
+fn draw_to(name: &str, png: &Path, svg: &Path) -> Result<(), String> {
+    let (png, svg) = (png.to_path_buf(), svg.to_path_buf());
     match name {
         "ji2014-fig4" => {
             let data = ji2014_fig4_data()?;
@@ -116,7 +134,7 @@ pub fn draw(name: &str, dir: &Path) -> Result<Vec<PathBuf>, String> {
             return Err(format!("unknown figure '{other}' (expected one of: {})", known.join(", ")));
         }
     }
-    Ok(vec![png, svg])
+    Ok(())
 }
 
 struct Fig4 {

@@ -10,6 +10,7 @@ pub mod figures;
 pub mod mechanisms;
 pub mod model;
 pub mod observers;
+pub mod output;
 pub mod report;
 pub mod run;
 pub mod scenario;

@@ -1,7 +1,6 @@
 //! The `tensegrity` command line.
 
 use clap::{Parser, Subcommand};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -59,7 +58,7 @@ enum Command {
         /// The JSON summary.
         #[arg(long)]
         json: Option<PathBuf>,
-        /// Worker threads.
+        /// Worker threads (at most the machine's threads; more is lowered, and said).
         #[arg(long, default_value_t = 2)]
         jobs: usize,
         /// Run the K-th of N interleaved slices of the grid (for job arrays), as K/N.
@@ -83,6 +82,9 @@ enum Command {
         csvs: Vec<PathBuf>,
         #[arg(long)]
         out: PathBuf,
+        /// Merge what is there even when points of the grid are missing (a shard left out).
+        #[arg(long)]
+        partial: bool,
     },
     /// The analytic model alone: print every result of a query.
     Solve {
@@ -131,6 +133,18 @@ enum Command {
 /// ran are written, and the batch stops.
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
+/// Set while the command runs a phase that stops by itself on [`CANCEL`] (the scenarios' runs and
+/// the writing of their reports). In every other phase (parsing, an analytic solve, findings,
+/// figures) a signal ends the command within [`SIGNAL_POLL_S`]: its temporary files are
+/// removed, its outputs stay as they were, exit 1.
+static STOPS_ITSELF: AtomicBool = AtomicBool::new(false);
+
+/// How often the main thread looks for a signal while the command's thread works [s].
+const SIGNAL_POLL_S: f64 = 0.05;
+
+/// Stack of the command's thread [bytes] (the main thread's usual 8 MiB, with room).
+const COMMAND_STACK_BYTES: usize = 64 << 20;
+
 extern "C" fn on_signal(_signal: libc::c_int) {
     CANCEL.store(true, Ordering::SeqCst);
 }
@@ -146,8 +160,46 @@ fn install_signal_handlers() {
 
 fn main() -> ExitCode {
     install_signal_handlers();
+    // A closed pipe (`tensegrity list | head -1`) ends the process quietly, as it does any
+    // Unix filter, instead of a panic in println!.
+    // SAFETY: restoring the default disposition of SIGPIPE before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
-    let code = match cli.command {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let worker = std::thread::Builder::new().stack_size(COMMAND_STACK_BYTES).spawn(move || {
+        let _ = tx.send(dispatch(cli));
+    });
+    if let Err(e) = worker {
+        eprintln!("error: cannot start the command's thread: {e}");
+        return ExitCode::from(EXIT_FAIL as u8);
+    }
+    loop {
+        match rx.recv_timeout(std::time::Duration::from_secs_f64(SIGNAL_POLL_S)) {
+            Ok(code) => return ExitCode::from(code as u8),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                if CANCEL.load(Ordering::SeqCst) && !STOPS_ITSELF.load(Ordering::SeqCst) {
+                    tensegrity_testbed::output::remove_partials();
+                    eprintln!("interrupted");
+                    return ExitCode::from(EXIT_FAIL as u8);
+                }
+            }
+            // The command's thread panicked (its message is printed): an internal error.
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                tensegrity_testbed::output::remove_partials();
+                return ExitCode::from(EXIT_INTERNAL_ERROR);
+            }
+        }
+    }
+}
+
+/// Exit code of a command that panicked (Rust's own for a panic in main).
+const EXIT_INTERNAL_ERROR: u8 = 101;
+
+/// Runs the command; its exit code.
+fn dispatch(cli: Cli) -> i32 {
+    match cli.command {
         Command::Run { scenarios, json, record, connect, record_every } => {
             cmd_run(&scenarios, json.as_deref(), record.as_deref(), connect.as_deref(), record_every)
         }
@@ -165,7 +217,7 @@ fn main() -> ExitCode {
         Command::Sweep { scenario, out, json, jobs, shard } => {
             cmd_sweep(&scenario, out.as_deref(), json.as_deref(), jobs, shard.as_deref())
         }
-        Command::Merge { csvs, out } => cmd_merge(&csvs, &out),
+        Command::Merge { csvs, out, partial } => cmd_merge(&csvs, &out, partial),
         Command::Figure { name, out, list } => cmd_figure(name.as_deref(), &out, list),
         Command::Solve { mechanism, query, set, json } => cmd_solve(&mechanism, &query, &set, json),
         Command::Findings { mechanism, set, json } => cmd_findings(&mechanism, &set, json),
@@ -176,8 +228,7 @@ fn main() -> ExitCode {
         Command::Bench { rounds, json, export_cases: None, mechanisms, peer: None } => {
             cmd_bench(rounds, json, &mechanisms)
         }
-    };
-    ExitCode::from(code as u8)
+    }
 }
 
 /// Loads and validates every scenario; prints each error; exit code 2 if any is bad.
@@ -200,20 +251,17 @@ fn load_all(paths: &[PathBuf]) -> Result<Vec<Scenario>, i32> {
     }
 }
 
-/// Writes `text` to `path` through a temporary file and a rename: never half-written.
-fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
-    if let Some(dir) = path.parent() {
-        if !dir.as_os_str().is_empty() {
-            std::fs::create_dir_all(dir)?;
-        }
-    }
-    let tmp = path.with_extension("partial");
-    {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(text.as_bytes())?;
-        f.sync_all()?;
-    }
-    std::fs::rename(&tmp, path)
+/// Writes `text` to `path` through a unique temporary file and a rename (`output`).
+fn write_atomic(path: &Path, text: &str) -> Result<(), String> {
+    tensegrity_testbed::output::write_atomic(path, text.as_bytes())
+}
+
+/// Refuses outputs that would destroy data (`output::check_outputs`): exit 2 before anything runs.
+fn check_outputs(inputs: &[PathBuf], outputs: Vec<(String, PathBuf)>) -> Result<(), i32> {
+    tensegrity_testbed::output::check_outputs(inputs, &outputs).map_err(|e| {
+        eprintln!("error: {e}");
+        EXIT_BAD_INPUT
+    })
 }
 
 fn record_path(base: &Path, name: &str, several: bool) -> PathBuf {
@@ -244,6 +292,20 @@ fn cmd_run(
         }
     }
     let several = scenarios.len() > 1;
+    let mut outputs: Vec<(String, PathBuf)> =
+        json.map(|j| ("--json".to_string(), j.to_path_buf())).into_iter().collect();
+    if connect.is_none() {
+        for sc in &scenarios {
+            if let Some(r) = record.map(|r| record_path(r, &sc.name, several)).or_else(|| sc.record.clone()) {
+                outputs.push((format!("the recording of scenario '{}' ({})", sc.name, sc.file.display()), r));
+            }
+        }
+    }
+    if let Err(code) = check_outputs(paths, outputs) {
+        return code;
+    }
+    // From here on each run stops at its next tick on a signal and the reports are written.
+    STOPS_ITSELF.store(true, Ordering::SeqCst);
     let mut report = Report { scenarios: vec![] };
     for sc in &scenarios {
         if CANCEL.load(Ordering::SeqCst) {
@@ -265,7 +327,7 @@ fn cmd_run(
     print!("{}", report.to_table());
     if let Some(j) = json {
         if let Err(e) = write_atomic(j, &report.to_json()) {
-            eprintln!("error: cannot write the JSON report {}: {e}", j.display());
+            eprintln!("error: the JSON report: {e}");
             return EXIT_FAIL;
         }
     }
@@ -281,6 +343,16 @@ fn cmd_sweep(path: &Path, out: Option<&Path>, json: Option<&Path>, jobs: usize, 
         Ok(mut s) => s.remove(0),
         Err(code) => return code,
     };
+    let outputs = [("--out", out), ("--json", json)]
+        .into_iter()
+        .filter_map(|(what, p)| p.map(|p| (what.to_string(), p.to_path_buf())))
+        .collect();
+    if let Err(code) = check_outputs(&[path.to_path_buf()], outputs) {
+        return code;
+    }
+    let jobs = capped_jobs(jobs);
+    // From here on every block stops at its next tick on a signal and the outputs are written.
+    STOPS_ITSELF.store(true, Ordering::SeqCst);
     let shard = match shard.map(tensegrity_testbed::sweep::parse_shard).transpose() {
         Ok(s) => s,
         Err(e) => {
@@ -323,22 +395,42 @@ fn cmd_sweep(path: &Path, out: Option<&Path>, json: Option<&Path>, jobs: usize, 
         println!("stopped: {e}");
     }
     if let Some(o) = out {
-        if let Err(e) = write_atomic(o, &tensegrity_testbed::sweep::to_csv(&rows)) {
-            eprintln!("error: cannot write {}: {e}", o.display());
+        let mech = sc.mechanism();
+        let is_angle =
+            |q: &str| mech.quantities().iter().any(|s| s.symbol == q && s.kind == mechanisms::QuantityKind::Angle);
+        if let Err(e) = write_atomic(o, &tensegrity_testbed::sweep::to_csv(&rows, &is_angle)) {
+            eprintln!("error: {e}");
             return EXIT_FAIL;
         }
     }
     if let Some(j) = json {
         if let Err(e) = write_atomic(j, &serde_json::to_string_pretty(&summary).unwrap_or_default()) {
-            eprintln!("error: cannot write {}: {e}", j.display());
+            eprintln!("error: {e}");
             return EXIT_FAIL;
         }
     }
-    if summary.errors.is_empty() && !CANCEL.load(Ordering::SeqCst) {
+    if let Some(min) = summary.min_agreement_percent {
+        println!("required agreement {min:.2} %");
+    }
+    if !summary.disagreements.is_empty() {
+        println!("{} point(s) did not settle or are out of tolerance", summary.disagreements.len());
+    }
+    if summary.passed && !CANCEL.load(Ordering::SeqCst) {
+        println!("PASS");
         EXIT_PASS
     } else {
+        println!("FAIL");
         EXIT_FAIL
     }
+}
+
+/// `--jobs`, at least 1 and at most the machine's threads (lowered with a note on stderr).
+fn capped_jobs(jobs: usize) -> usize {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if jobs > threads {
+        eprintln!("note: --jobs {jobs} lowered to {threads}, the threads of this machine");
+    }
+    jobs.clamp(1, threads)
 }
 
 fn cmd_figure(name: Option<&str>, out: &Path, list: bool) -> i32 {
@@ -365,7 +457,10 @@ fn cmd_figure(name: Option<&str>, out: &Path, list: bool) -> i32 {
     }
 }
 
-fn cmd_merge(csvs: &[PathBuf], out: &Path) -> i32 {
+fn cmd_merge(csvs: &[PathBuf], out: &Path, partial: bool) -> i32 {
+    if let Err(code) = check_outputs(csvs, vec![("--out".into(), out.to_path_buf())]) {
+        return code;
+    }
     let mut texts = Vec::new();
     for p in csvs {
         match std::fs::read_to_string(p) {
@@ -376,11 +471,11 @@ fn cmd_merge(csvs: &[PathBuf], out: &Path) -> i32 {
             }
         }
     }
-    match tensegrity_testbed::sweep::merge_csv(&texts) {
+    match tensegrity_testbed::sweep::merge_csv(&texts, partial) {
         Ok(text) => match write_atomic(out, &text) {
             Ok(()) => EXIT_PASS,
             Err(e) => {
-                eprintln!("error: cannot write {}: {e}", out.display());
+                eprintln!("error: {e}");
                 EXIT_FAIL
             }
         },

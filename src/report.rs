@@ -37,7 +37,8 @@ pub struct ScenarioReport {
     pub workspace: Option<WorkspaceAgreement>,
     /// Grid points dropped as outside the mechanism's domain (`actuation.skip_outside`).
     pub skipped_points: usize,
-    /// Present when the scenario has an `[interference]` section.
+    /// The interference checks (on unless the scenario turns them off; absent only when the
+    /// run stopped before its observers started).
     pub interference: Option<InterferenceReport>,
     pub findings: Vec<FindingReport>,
     /// Along a scheduled trajectory: the range of every simulated quantity over its ticks
@@ -153,6 +154,8 @@ pub struct PointReport {
     pub stable: Option<bool>,
     /// Stability from the analytic model (sign of the stiffness) for the branch landed on.
     pub analytic_stable: Option<bool>,
+    /// The stability the scenario expects here (`[stability] expect`), if it says.
+    pub expected_stable: Option<bool>,
     pub slack_cables: Vec<String>,
     /// Cables the analytic statics says are slack (mechanisms with cables only).
     pub expected_slack: Option<Vec<String>>,
@@ -258,16 +261,23 @@ impl WorkspaceAgreement {
     }
 }
 
-/// Strut interference over the run (parry capsule distances).
+/// Member interference over the run (parry capsule distances).
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct InterferenceReport {
+    /// False when the scenario turned the checks off (`[interference] enabled = false`): then
+    /// nothing was measured.
+    pub enabled: bool,
+    /// Cables and springs were checked too.
+    pub tendons: bool,
+    /// Members checked (struts, then cables and springs).
+    pub members_checked: usize,
     /// Smallest clearance seen over the run [m] (None: no pair ever came within the margin).
     #[serde(rename = "min_clearance")]
     pub min_clearance_m: Option<f64>,
     pub closest_pair: Option<[String; 2]>,
     pub closest_points: Option<[[f64; 3]; 2]>,
     pub tick_of_min: Option<u64>,
-    /// Strut pairs checked every tick (all pairs minus those meeting at a joint or excluded).
+    /// Member pairs checked every tick (all pairs minus those attached by construction or excluded).
     pub pairs_checked: usize,
     pub ticks_checked: u64,
     pub threshold_m: f64,
@@ -284,6 +294,8 @@ pub struct InterferenceReport {
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct PairClearanceReport {
     pub pair: [String; 2],
+    /// "strut", "cable" or "spring", for each of the pair.
+    pub kinds: [String; 2],
     #[serde(rename = "min_clearance")]
     pub min_clearance_m: f64,
     pub tick_of_min: u64,
@@ -294,12 +306,14 @@ pub struct PairClearanceReport {
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct InterferenceViolation {
     pub pair: [String; 2],
+    /// "strut", "cable" or "spring", for each of the pair.
+    pub kinds: [String; 2],
     pub first_tick: u64,
     pub last_tick: u64,
     #[serde(rename = "min_clearance")]
     pub min_clearance_m: f64,
     pub tick_of_min: u64,
-    /// Closest points on the two strut axes at the minimum [m].
+    /// Closest points on the two member axes at the minimum [m].
     pub closest_points: [[f64; 3]; 2],
 }
 
@@ -527,11 +541,15 @@ impl ScenarioReport {
         }
     }
 
-    /// Strut interference: the closest pair and every violation.
+    /// Member interference: the closest pair and every violation, or that it was off.
     fn table_interference(&self, out: &mut String) {
-        if let Some(i) = &self.interference {
+        if self.interference.as_ref().is_some_and(|i| !i.enabled) {
+            out.push_str("   interference: OFF (the scenario sets [interference] enabled = false)\n");
+        } else if let Some(i) = &self.interference {
             out.push_str(&format!(
-                "   interference: {} pair(s) checked over {} tick(s); min clearance {}; {} violation(s) below {:.3e} m{}\n",
+                "   interference: {} member(s){}, {} pair(s) checked over {} tick(s); min clearance {}; {} violation(s) below {:.3e} m{}\n",
+                i.members_checked,
+                if i.tendons { " incl. cables and springs" } else { ", struts only" },
                 i.pairs_checked,
                 i.ticks_checked,
                 match (&i.min_clearance_m, &i.closest_pair) {
@@ -545,8 +563,8 @@ impl ScenarioReport {
             for v in i.violations.iter().take(MAX_POINTS_IN_TABLE) {
                 let [p, q] = v.closest_points;
                 out.push_str(&format!(
-                    "     {} / {}: ticks {}-{}, min clearance {:.6e} m at tick {}, closest points ({:.6}, {:.6}, {:.6}) ({:.6}, {:.6}, {:.6})\n",
-                    v.pair[0], v.pair[1], v.first_tick, v.last_tick, v.min_clearance_m, v.tick_of_min,
+                    "     {} '{}' / {} '{}': ticks {}-{}, min clearance {:.6e} m at tick {}, closest points ({:.6}, {:.6}, {:.6}) ({:.6}, {:.6}, {:.6})\n",
+                    v.kinds[0], v.pair[0], v.kinds[1], v.pair[1], v.first_tick, v.last_tick, v.min_clearance_m, v.tick_of_min,
                     p[0], p[1], p[2], q[0], q[1], q[2]
                 ));
             }

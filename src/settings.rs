@@ -84,29 +84,53 @@ impl Default for SettleCriteria {
     }
 }
 
-/// Settings from the scenario's `[interference]` section.
+/// Settings of the interference checks (`[interference]`), which run in every scenario unless
+/// it turns them off: struts as capsules, cables and springs (tendons) as thinner capsules.
 #[derive(Clone, Debug, PartialEq)]
 pub struct InterferenceSettings {
+    /// False only when the scenario says `enabled = false` (the report says it was off).
+    pub enabled: bool,
+    /// Cables and springs are checked too (against struts and each other).
+    pub tendons: bool,
     /// A pair whose clearance falls below this is a violation [m] (0: only actual overlap).
     pub threshold_m: f64,
     /// Pairs farther apart than this are not measured [m] (the broad phase's inflation).
     pub margin_m: f64,
     /// Violations are reported but do not fail the run.
     pub informative: bool,
-    /// Further pairs to exclude, by strut name.
+    /// Further pairs to exclude, by member name (strut, cable or spring).
     pub exclude: Vec<(String, String)>,
 }
 
 impl InterferenceSettings {
-    /// Whether every excluded pair names struts of `s` (else the error names the first that
-    /// does not, and the struts there are).
-    pub fn check_strut_names(&self, s: &Structure) -> Result<(), String> {
+    /// The checks of a scenario without an `[interference]` section: on, tendons included,
+    /// threshold 0 (actual overlap), margin `margin_m` (the mechanism's length scale).
+    pub fn default_on(margin_m: f64) -> Self {
+        InterferenceSettings {
+            enabled: true,
+            tendons: true,
+            threshold_m: 0.0,
+            margin_m,
+            informative: false,
+            exclude: Vec::new(),
+        }
+    }
+
+    /// Whether every excluded pair names members of `s` (else the error names the first that
+    /// does not, and the members there are).
+    pub fn check_member_names(&self, s: &Structure) -> Result<(), String> {
+        let names: Vec<&str> = s
+            .struts
+            .iter()
+            .map(|t| t.name.as_str())
+            .chain(s.cables.iter().map(|c| c.name.as_str()))
+            .chain(s.springs.iter().map(|c| c.name.as_str()))
+            .collect();
         for name in self.exclude.iter().flat_map(|(a, b)| [a, b]) {
-            if !s.struts.iter().any(|t| &t.name == name) {
-                let struts: Vec<&str> = s.struts.iter().map(|t| t.name.as_str()).collect();
+            if !names.contains(&name.as_str()) {
                 return Err(format!(
-                    "interference exclusion names strut '{name}', which does not exist (struts: {})",
-                    struts.join(", ")
+                    "interference exclusion names member '{name}', which does not exist (members: {})",
+                    names.join(", ")
                 ));
             }
         }

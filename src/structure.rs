@@ -10,6 +10,10 @@ use std::collections::BTreeMap;
 /// A 3-vector in metres (or a unit axis).
 pub type Vec3 = [f64; 3];
 
+/// Radius of a cable or spring when nothing else is given [m]: a thin steel cable or wire
+/// spring; used by the interference checks (a tendon through a strut or another tendon).
+pub const DEFAULT_TENDON_RADIUS_M: f64 = 1e-3;
+
 /// Index of a body in [`Structure::bodies`].
 pub type BodyId = usize;
 /// Index of a node in [`Structure::nodes`].
@@ -72,6 +76,8 @@ pub struct Spring {
     pub stiffness_n_per_m: f64,
     /// Free length [m]; zero is allowed (a zero-free-length spring).
     pub rest_length_m: f64,
+    /// Radius of the segment used for interference checks and drawing [m].
+    pub radius_m: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -90,6 +96,8 @@ pub struct Cable {
     pub law: CableLaw,
     /// Unstretched length in the initial configuration [m] (an actuator may change it).
     pub length_m: f64,
+    /// Radius of the segment used for interference checks and drawing [m].
+    pub radius_m: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -486,14 +494,28 @@ mod tests {
     #[test]
     fn a_valid_structure_passes_validation() {
         let mut s = two_bodies();
-        s.springs.push(Spring { name: "k".into(), a: 0, b: 1, stiffness_n_per_m: 10.0, rest_length_m: 0.0 });
+        s.springs.push(Spring {
+            name: "k".into(),
+            a: 0,
+            b: 1,
+            stiffness_n_per_m: 10.0,
+            rest_length_m: 0.0,
+            radius_m: DEFAULT_TENDON_RADIUS_M,
+        });
         assert_eq!(s.validate(), Ok(()));
     }
 
     #[test]
     fn a_member_naming_an_unknown_node_is_rejected() {
         let mut s = two_bodies();
-        s.cables.push(Cable { name: "c".into(), a: 0, b: 7, law: CableLaw::Inextensible, length_m: 1.0 });
+        s.cables.push(Cable {
+            name: "c".into(),
+            a: 0,
+            b: 7,
+            law: CableLaw::Inextensible,
+            length_m: 1.0,
+            radius_m: DEFAULT_TENDON_RADIUS_M,
+        });
         assert!(matches!(s.validate(), Err(StructureError::DanglingReference { index: 7, .. })));
     }
 
@@ -515,7 +537,14 @@ mod tests {
     #[test]
     fn a_negative_spring_stiffness_is_rejected() {
         let mut s = two_bodies();
-        s.springs.push(Spring { name: "k".into(), a: 0, b: 1, stiffness_n_per_m: -1.0, rest_length_m: 0.0 });
+        s.springs.push(Spring {
+            name: "k".into(),
+            a: 0,
+            b: 1,
+            stiffness_n_per_m: -1.0,
+            rest_length_m: 0.0,
+            radius_m: DEFAULT_TENDON_RADIUS_M,
+        });
         assert!(matches!(s.validate(), Err(StructureError::Invalid { what: "spring", .. })));
     }
 }

@@ -31,6 +31,8 @@ pub enum SweepError {
 #[derive(Clone, Debug)]
 pub struct Row {
     pub index: usize,
+    /// Points in the whole grid (so that `merge` can tell a missing shard).
+    pub grid_points: usize,
     pub point: PointReport,
 }
 
@@ -46,10 +48,17 @@ pub struct SweepSummary {
     pub jobs: usize,
     pub wall_s: f64,
     pub workspace: Option<WorkspaceAgreement>,
+    /// The scenario's `[workspace] min_agreement_percent`: a workspace sweep passes on the
+    /// agreement instead of on every point (as `run` judges it).
+    pub min_agreement_percent: Option<f64>,
     /// Points that did not settle or had a check out of tolerance.
     pub disagreements: Vec<usize>,
     /// Errors of the blocks that stopped early (divergence, interruption).
     pub errors: Vec<String>,
+    /// The sweep's verdict, with `run`'s pass policy: no block stopped early, and either the
+    /// workspace agreement reaches `min_agreement_percent` or every point settled within
+    /// tolerance (points outside the model's validity aside).
+    pub passed: bool,
 }
 
 /// Parses `K/N` (1 <= K <= N).
@@ -82,6 +91,7 @@ pub fn sweep(
             )))
         }
     };
+    let grid_points = points.len();
     let indexed: Vec<(usize, Values)> =
         points.into_iter().enumerate().filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1)).collect();
     let blocks: Vec<&[(usize, Values)]> = indexed.chunks(BLOCK_POINTS).collect();
@@ -107,7 +117,7 @@ pub fn sweep(
                     .zip(block.iter())
                     .map(|(mut p, (i, _))| {
                         p.index = *i;
-                        Row { index: *i, point: p }
+                        Row { index: *i, grid_points, point: p }
                     })
                     .collect();
                 let n = done.fetch_add(block.len(), std::sync::atomic::Ordering::SeqCst) + block.len();
@@ -124,7 +134,7 @@ pub fn sweep(
     }
     rows.sort_by_key(|r| r.index);
     let reports: Vec<PointReport> = rows.iter().map(|r| r.point.clone()).collect();
-    let summary = SweepSummary {
+    let mut summary = SweepSummary {
         scenario: sc.name.clone(),
         mechanism: sc.mechanism.clone(),
         points: rows.len(),
@@ -134,6 +144,7 @@ pub fn sweep(
         jobs: jobs.max(1),
         wall_s: start.elapsed().as_secs_f64(),
         workspace: WorkspaceAgreement::from_points(&reports),
+        min_agreement_percent: sc.min_agreement_percent,
         disagreements: rows
             .iter()
             .filter(|r| {
@@ -143,7 +154,13 @@ pub fn sweep(
             .map(|r| r.index)
             .collect(),
         errors,
+        passed: false,
     };
+    summary.passed = summary.errors.is_empty()
+        && match (summary.min_agreement_percent, &summary.workspace) {
+            (Some(min), Some(w)) => w.agreement_percent >= min,
+            _ => summary.disagreements.is_empty() && summary.settled == summary.points,
+        };
     Ok((rows, summary))
 }
 
@@ -152,8 +169,9 @@ fn num(x: f64) -> String {
     format!("{x:?}")
 }
 
-/// The CSV of a sweep: one row per point, the full grid's index first.
-pub fn to_csv(rows: &[Row]) -> String {
+/// The CSV of a sweep: one row per point, the full grid's index and size first. `is_angle`
+/// names the quantities whose error is wrapped into (-pi, pi].
+pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool) -> String {
     let mut inputs: Vec<String> = Vec::new();
     let mut quantities: Vec<String> = Vec::new();
     for r in rows {
@@ -169,7 +187,7 @@ pub fn to_csv(rows: &[Row]) -> String {
         }
     }
     quantities.sort();
-    let mut header = vec!["index".to_string()];
+    let mut header = vec!["index".to_string(), "grid_points".to_string()];
     header.extend(inputs.iter().cloned());
     for q in &quantities {
         header.push(format!("analytic_{q}"));
@@ -194,13 +212,14 @@ pub fn to_csv(rows: &[Row]) -> String {
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
     for r in rows {
         let p = &r.point;
-        let mut cells = vec![r.index.to_string()];
+        let mut cells = vec![r.index.to_string(), r.grid_points.to_string()];
         cells.extend(inputs.iter().map(|k| opt(p.inputs.get(k).copied())));
         for q in &quantities {
             let (a, s) = (p.analytic.get(q).copied(), p.simulated.get(q).copied());
             cells.push(opt(a));
             cells.push(opt(s));
-            cells.push(opt(a.zip(s).map(|(a, s)| s - a)));
+            let error = |(a, s): (f64, f64)| if is_angle(q) { crate::mechanisms::wrap_angle(s - a) } else { s - a };
+            cells.push(opt(a.zip(s).map(error)));
         }
         cells.push(p.settled.to_string());
         cells.push(p.steps.to_string());
@@ -217,10 +236,11 @@ pub fn to_csv(rows: &[Row]) -> String {
 }
 
 /// Joins shard CSVs (same header) into one, rows ordered by grid index; a point present twice
-/// is an error.
-pub fn merge_csv(texts: &[(String, String)]) -> Result<String, SweepError> {
+/// is an error, and so is a point missing from the grid (a shard left out) unless `partial`.
+pub fn merge_csv(texts: &[(String, String)], partial: bool) -> Result<String, SweepError> {
     let mut header: Option<&str> = None;
     let mut rows: Vec<(usize, &str)> = Vec::new();
+    let mut grid_points: Option<usize> = None;
     for (name, text) in texts {
         let mut lines = text.lines();
         let h = lines.next().ok_or_else(|| SweepError::BadInput(format!("{name}: empty CSV")))?;
@@ -231,19 +251,44 @@ pub fn merge_csv(texts: &[(String, String)]) -> Result<String, SweepError> {
             }
             _ => {}
         }
+        if !h.starts_with("index,grid_points,") {
+            return Err(SweepError::BadInput(format!("{name}:1:1: expected a sweep CSV (index,grid_points,...)")));
+        }
         for (k, line) in lines.enumerate() {
             if line.is_empty() {
                 continue;
             }
-            let idx = line.split(',').next().and_then(|s| s.parse::<usize>().ok()).ok_or_else(|| {
-                SweepError::BadInput(format!("{name}:{}:1: expected a grid index in the first column", k + 2))
-            })?;
+            let mut cells = line.split(',');
+            let mut number = |col: usize| {
+                cells
+                    .next()
+                    .and_then(|s| s.parse::<usize>().ok())
+                    .ok_or_else(|| SweepError::BadInput(format!("{name}:{}:{col}: expected a whole number", k + 2)))
+            };
+            let (idx, n) = (number(1)?, number(2)?);
+            if *grid_points.get_or_insert(n) != n || idx >= n {
+                return Err(SweepError::BadInput(format!(
+                    "{name}:{}: point {idx} of a {n}-point grid does not fit the other files' grid",
+                    k + 2
+                )));
+            }
             rows.push((idx, line));
         }
     }
     rows.sort_by_key(|(i, _)| *i);
     if let Some(w) = rows.windows(2).find(|w| w[0].0 == w[1].0) {
         return Err(SweepError::BadInput(format!("grid point {} appears in more than one file", w[0].0)));
+    }
+    let total = grid_points.unwrap_or(0);
+    if !partial && rows.len() != total {
+        let present: std::collections::BTreeSet<usize> = rows.iter().map(|(i, _)| *i).collect();
+        let missing: Vec<String> =
+            (0..total).filter(|i| !present.contains(i)).take(10).map(|i| i.to_string()).collect();
+        return Err(SweepError::BadInput(format!(
+            "{} of the grid's {total} points are missing (first: {}): a shard left out? (--partial merges what is there)",
+            total - rows.len(),
+            missing.join(", ")
+        )));
     }
     let mut out = String::from(header.unwrap_or("index"));
     out.push('\n');

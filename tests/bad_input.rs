@@ -55,6 +55,41 @@ quantity = "theta1"
 tolerance = 1e-9
 "#;
 
+/// A pinned strut held by a spring (line numbers matter to the cases below).
+const PIN: &str = r#"name = "pin"
+mechanism = "custom"
+[actuation]
+points = [ {} ]
+[structure]
+gravity = [0.0, 0.0, 0.0]
+[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { O = [0.0, 0.0, 0.0], S = [1.0, 1.0, 0.0] }
+[[structure.bodies]]
+name = "bar"
+mass = 1.0
+nodes = { P = [0.0, 0.0, 0.0], Q = [1.0, 0.0, 0.0] }
+[[structure.struts]]
+name = "bar"
+a = "P"
+b = "Q"
+[[structure.springs]]
+name = "k"
+a = "Q"
+b = "S"
+stiffness = 10.0
+length = 0.5
+[[structure.joints]]
+name = "pin"
+kind = "revolute"
+parent = "ground"
+child = "bar"
+at = "P"
+axis = [0.0, 0.0, 1.0]
+damping = 0.5
+"#;
+
 /// (what, scenario text, expected line of the error, a word the message must contain).
 fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
     vec![
@@ -135,6 +170,7 @@ fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
         ("mohr2011 l_o not positive", MOHR.replace("lo = 6.0", "lo = 0.0"), 5, "> 0"),
         ("mohr2011 straight not 0 or 1", MOHR.replace("lo = 6.0", "lo = 6.0\nstraight = 0.5"), 6, "straight"),
         ("furet2018 L not above b", FURET.replace("b = 0.6666666666666666", "b = 1.5"), 5, "shorter than L"),
+        ("furet2018 L below the default b", FURET.replace("b = 0.6666666666666666\n", "").replace("L = 1.0", "L = 0.5"), 4, "shorter than L"),
         ("furet2018 change point", FURET.replace("theta1 = 0.2", "theta1 = 1.5707963267948966"), 7, "change point"),
         ("furet2018 angle beyond pi", FURET.replace("theta2 = -0.3", "theta2 = -4.0"), 7, "(-pi, pi)"),
         (
@@ -145,6 +181,53 @@ fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
         ),
         ("manriquez2019 angle too large", MQ.replace("theta1 = 0.0941", "theta1 = 2.0"), 4, "(-pi/2, pi/2)"),
         ("manriquez2019 negative mass", MQ.replace("[actuation]", "[params]\nm = -0.4\n[actuation]"), 4, "> 0"),
+        // Vectors of the wrong length or type (a 4th and 5th entry used to be ignored).
+        ("node with 4 coordinates", PIN.replace("Q = [1.0, 0.0, 0.0]", "Q = [1.0, 0.0, 0.0, 2.0]"), 14, "three"),
+        // A string is an expression of the parameters (none here).
+        ("node with junk and nan", PIN.replace("Q = [1.0, 0.0, 0.0]", "Q = [0, 1, 0, \"junk\", nan]"), 14, "unknown symbol 'junk'"),
+        ("node with a fourth number", PIN.replace("Q = [1.0, 0.0, 0.0]", "Q = [0, 1, 0, 2]"), 14, "three finite numbers"),
+        ("axis with 5 entries", PIN.replace("axis = [0.0, 0.0, 1.0]", "axis = [0.0, 0.0, 1.0, 0.0, 0.0]"), 31, "three"),
+        ("gravity with 4 entries", PIN.replace("gravity = [0.0, 0.0, 0.0]", "gravity = [0.0, 0.0, 0.0, 9.81]"), 6, "three"),
+        ("node at 1e300", PIN.replace("S = [1.0, 1.0, 0.0]", "S = [1e300, 1.0, 0.0]"), 10, "magnitude"),
+        // Duplicate names: a check on the name would read only one.
+        ("duplicate member name", PIN.replace("name = \"k\"", "name = \"bar\""), 20, "duplicate"),
+        ("duplicate joint name", PIN.replace("damping = 0.5", "damping = 0.5\n[[structure.joints]]\nname = \"pin\"\nkind = \"fixed\"\nparent = \"ground\"\nchild = \"bar\"\nat = \"Q\""), 34, "duplicate"),
+        ("a joint whose child is fixed, at the joint", PIN.replace("child = \"bar\"", "child = \"ground\"\nparent2 = 1").replace("parent2 = 1\n", "").replace("parent = \"ground\"", "parent = \"bar\""), 26, "fixed"),
+        // Physical sizes the simulation cannot handle, found at check time.
+        ("mass far too small", PIN.replace("mass = 1.0", "mass = 1e-320"), 13, "mass"),
+        ("ji2014 L = 1e308", JI.replace("L = 1.0", "L = 1e308"), 4, ""),
+        ("ji2014 L = 1e-300", JI.replace("L = 1.0", "L = 1e-300"), 11, "1000 L"),
+        ("ji2014 L = 1000 outside the bounding box", JI.replace("L = 1.0", "L = 1000.0"), 4, "bounding_box"),
+        // Bounded work.
+        ("time step of 5e-324 s", JI.replace("dt = 0.01", "dt = 5e-324"), 9, "steps per settle"),
+        ("1e10 steps per settle", JI.replace("dt = 0.01", "dt = 1e-9"), 9, "steps per settle"),
+        (
+            "waypoint at t = 1e300",
+            JI.replace("points = [ { L3 = 1.0, theta1 = 0.5 } ]", "waypoints = [ { t = 0.0, L3 = 1.0, theta1 = 0.5 }, { t = 1e300, L3 = 1.0, theta1 = 0.6 } ]"),
+            11,
+            "time steps away",
+        ),
+        (
+            "waypoints closer than dt",
+            JI.replace(
+                "points = [ { L3 = 1.0, theta1 = 0.5 } ]",
+                "waypoints = [ { t = 0.0, L3 = 1.0, theta1 = 0.5 }, { t = 1.0, L3 = 1.0, theta1 = 0.6 }, { t = 1.004, L3 = 1.0, theta1 = 0.7 } ]",
+            ),
+            11,
+            "never be reached",
+        ),
+        // Quantities and expectations that need a section.
+        ("stiffness check without a probe", JI.replace("quantity = \"theta2\"", "quantity = \"K\""), 13, "[probe]"),
+        ("stability expect misspelt", JI.replace("[actuation]", "[stability]\nperturbation = 1e-3\nexpect = \"stabel\"\n[actuation]"), 12, "stable"),
+        ("stability expect per point of the wrong length", JI.replace("[actuation]", "[stability]\nperturbation = 1e-3\nexpect = [\"stable\", \"stable\"]\n[actuation]"), 12, "one per point"),
+        ("interference exclusion of an unknown member", PIN.replace("[actuation]", "[interference]\nexclude = [[\"bar\", \"nope\"]]\n[actuation]"), 4, "'nope'"),
+        (
+            "force of a strut on a fixed body",
+            PIN.replace("[structure]", "[[checks]]\nquantity = \"post.force\"\nvalue = 1.0\ntolerance = 1e-9\n[structure]")
+                .replace("[[structure.springs]]", "[[structure.struts]]\nname = \"post\"\na = \"O\"\nb = \"S\"\n[[structure.springs]]"),
+            6,
+            "unknown quantity",
+        ),
     ]
 }
 

@@ -99,3 +99,68 @@ fn an_interrupted_sweep_writes_the_rows_it_has() {
     assert!(!rows.is_empty() && rows.len() < 474, "{} rows", rows.len());
     assert!(rows.iter().all(|r| r.split(',').count() > 10), "no truncated row");
 }
+
+/// Sends `signal` to a command `after` its start; returns its exit code, stderr and how long it
+/// took to stop after the signal.
+fn signal_after(args: &[&str], signal: &str, after: Duration) -> (Option<i32>, String, Duration) {
+    let child = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    std::thread::sleep(after);
+    let killed = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
+    assert!(killed.success());
+    let start = Instant::now();
+    let out = child.wait_with_output().expect("exits");
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned(), start.elapsed())
+}
+
+/// Parsing and validating (`check` of a million-point grid, about a second) stops on SIGTERM
+/// within half a second, exit 1.
+#[test]
+fn sigterm_stops_check_while_it_validates() {
+    let dir = out_dir("check");
+    let text = std::fs::read_to_string("scenarios/ji2014/grid.toml").unwrap();
+    let big = dir.join("big.toml");
+    let grid =
+        "grid = { L3 = { from = 0.2, to = 2.0, count = 1000 }, theta1 = { from = 0.0, to = 3.14159, count = 1000 } }";
+    let line = text.lines().find(|l| l.starts_with("grid =")).expect("a grid line");
+    std::fs::write(&big, text.replace(line, grid)).unwrap();
+    let (code, err, took) = signal_after(&["check", big.to_str().unwrap()], "TERM", Duration::from_millis(300));
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("interrupted"), "{err}");
+    assert!(took < Duration::from_millis(500), "took {took:?}");
+}
+
+/// Drawing a figure (manriquez2019 Fig. 6-7, about 2 s of dynamics) stops on SIGINT within half
+/// a second, exit 1, and leaves neither a figure nor a temporary file.
+#[test]
+fn sigint_stops_a_figure_and_leaves_no_file() {
+    let dir = out_dir("figure");
+    let (code, err, took) = signal_after(
+        &["figure", "manriquez2019-fig6", "--out", dir.to_str().unwrap()],
+        "INT",
+        Duration::from_millis(500),
+    );
+    assert_eq!(code, Some(1), "{err}");
+    assert!(took < Duration::from_millis(500), "took {took:?}");
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
+/// A run interrupted while it checks the paper's equations (before its first tick) stops at once
+/// too: the report says where it stopped.
+#[test]
+fn an_interrupted_findings_phase_is_reported() {
+    let flag = std::sync::atomic::AtomicBool::new(true);
+    let sc = tensegrity_testbed::scenario::load(std::path::Path::new("scenarios/mohr2011/quick.toml")).unwrap();
+    let r = tensegrity_testbed::run::run(
+        &sc,
+        &tensegrity_testbed::run::RunOptions { cancel: Some(&flag), ..Default::default() },
+    );
+    let err = r.error.as_deref().unwrap_or_default();
+    assert!(err.contains("interrupted while checking the paper's equations"), "{err}");
+    assert!(!r.passed);
+}

@@ -45,7 +45,11 @@ fn a_recorded_run_holds_every_entity_at_every_tick() {
     let sc = scenario::load(Path::new("scenarios/mohr2011/trajectory.toml")).unwrap();
     let r = run(&sc, &RunOptions { record: Some(rrd.clone()), ..RunOptions::default() });
     assert!(r.passed, "{:?}", r.error);
-    assert!(!rrd.with_extension("rrd.partial").exists());
+    let partials = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".partial"));
+    assert_eq!(partials.count(), 0, "no temporary file left");
     let contents = read_back(&rrd);
     let entities = &contents.entities;
     let ticks = r.settle.steps as usize;

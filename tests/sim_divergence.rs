@@ -47,7 +47,7 @@ fn a_free_body_on_a_zero_length_spring_settles_on_the_anchor() {
     );
     let a = s.add_node("anchor", g, [0.0; 3]);
     let p = s.add_node("P", b, [0.3, 0.2, 0.0]);
-    s.springs.push(Spring { name: "k".into(), a, b: p, stiffness_n_per_m: 100.0, rest_length_m: 0.0 });
+    s.springs.push(Spring { name: "k".into(), a, b: p, stiffness_n_per_m: 100.0, rest_length_m: 0.0, radius_m: 1e-3 });
     let settings = SimSettings { dt_s: 0.01, body_damping_per_s: 10.0, ..Default::default() };
     let mut sim = Simulation::new(&s, &settings).unwrap();
     for _ in 0..5000 {
@@ -75,7 +75,14 @@ fn an_absurd_stiffness_is_caught_by_the_energy_check_within_a_few_ticks() {
     );
     let a = s.add_node("A", g, [0.0; 3]);
     let p = s.add_node("P", b, [1.0, 0.0, 0.0]);
-    s.springs.push(Spring { name: "stiff".into(), a, b: p, stiffness_n_per_m: 1e12, rest_length_m: 0.5 });
+    s.springs.push(Spring {
+        name: "stiff".into(),
+        a,
+        b: p,
+        stiffness_n_per_m: 1e12,
+        rest_length_m: 0.5,
+        radius_m: 1e-3,
+    });
     let mut sim = Simulation::new(&s, &SimSettings { dt_s: 0.01, ..Default::default() }).unwrap();
     let err = (0..100).find_map(|_| sim.step().err()).expect("diverges");
     match err {
@@ -112,7 +119,7 @@ fn a_joint_that_comes_apart_is_reported_with_its_gap() {
     let c = s.add_node("C", g, [1.0, 1.0, 0.0]);
     let p = s.add_node("P", b, [1.0, 0.0, 0.0]);
     // The cable keeps the bob a plain body, so the joint at A is an impulse (loop) joint.
-    s.cables.push(Cable { name: "c".into(), a: c, b: p, law: CableLaw::Inextensible, length_m: 2.0 });
+    s.cables.push(Cable { name: "c".into(), a: c, b: p, law: CableLaw::Inextensible, length_m: 2.0, radius_m: 1e-3 });
     s.joints.push(Joint {
         name: "hinge".into(),
         kind: JointKind::Revolute { axis: [0.0, 0.0, 1.0] },

@@ -52,11 +52,12 @@ pub(super) struct Fig4 {
     cusp_miss_m: f64,
 }
 
-/// Runs a furet2018 scenario for the figure's dynamics overlay: it must pass.
+/// Runs a furet2018 scenario for the figure's dynamics overlay: it must meet its declared
+/// verdict (the modules' interference fails on purpose; everything the figure draws passes).
 fn run_scenario(path: &str) -> Result<crate::report::ScenarioReport, String> {
     let (_, r) = super::run_scenario(path)?;
-    if !r.passed {
-        return Err(format!("{path} did not pass"));
+    if r.as_expected != Some(true) {
+        return Err(format!("{path} did not meet its declared verdict (failures: {:?})", r.failures));
     }
     Ok(r)
 }

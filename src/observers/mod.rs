@@ -79,7 +79,7 @@ pub struct Setup<'a> {
     pub checks: &'a [Check],
     /// The mechanism's length scale [m], for normalised errors.
     pub length_scale_m: f64,
-    pub interference: Option<&'a InterferenceSettings>,
+    pub interference: &'a InterferenceSettings,
     /// The scenario file's own model (`[[quantities]]`, `[[predictions]]`, `[[equations]]`).
     pub model: Option<&'a crate::model::spec::ModelSpec>,
     /// A recording, when the run writes one (made last: nothing is written when another
@@ -91,9 +91,7 @@ pub struct Setup<'a> {
 pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
     let mut list: Vec<Box<dyn Observer>> =
         vec![Box::new(compare::Compare::new(setup.checks, setup.length_scale_m)), Box::new(slack::SlackTracker::new())];
-    if let Some(settings) = setup.interference {
-        list.push(Box::new(interference::Interference::new(setup.structure, settings)?));
-    }
+    list.push(Box::new(interference::Interference::new(setup.structure, setup.interference)?));
     if let Some(spec) = setup.model {
         list.push(Box::new(model::ModelObserver::new(spec, setup.structure, setup.recording.is_some())));
     }

@@ -335,7 +335,8 @@ impl Recorder {
                 std::fs::create_dir_all(dir).map_err(|e| io(e.to_string()))?;
             }
         }
-        let partial = path.with_extension("rrd.partial");
+        crate::output::check_replaceable(path).map_err(io)?;
+        let partial = crate::output::partial_path(path);
         let rec = rerun::RecordingStreamBuilder::new(app)
             .with_blueprint(blueprint())
             .save(&partial)
@@ -466,9 +467,13 @@ impl Recorder {
         match &self.target {
             Target::File { partial, path } => {
                 let io = |e: String| RecordError::Io { path: path.display().to_string(), message: e };
-                rec.flush_blocking().map_err(|e| io(e.to_string()))?;
+                let flushed = rec.flush_blocking();
                 drop(rec);
-                std::fs::rename(partial, path).map_err(|e| io(e.to_string()))?;
+                if let Err(e) = flushed {
+                    crate::output::discard(partial);
+                    return Err(io(e.to_string()));
+                }
+                crate::output::commit(partial, path).map_err(io)?;
                 Ok(Some(path.clone()))
             }
             Target::Live { url } => {

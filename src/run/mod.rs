@@ -86,6 +86,46 @@ fn empty_report(sc: &Scenario) -> ScenarioReport {
     }
 }
 
+/// Why a computation on a thread of its own gave no result.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum Halted {
+    #[error("interrupted")]
+    Interrupted,
+    #[error("panicked")]
+    Panicked,
+}
+
+/// How often a computation on a thread of its own is looked at for a cancellation [s].
+const CANCEL_POLL_S: f64 = 0.05;
+
+/// Runs `f` on a thread of its own and waits for its result, looking at `cancel` every
+/// [`CANCEL_POLL_S`]: an error when cancelled first (the thread is left to finish on its own,
+/// or to end with the process) or when it panicked. Analytic computations (findings, solves)
+/// have no ticks to stop at; this makes them interruptible without threading a flag through
+/// every model.
+pub fn interruptible<T: Send + 'static>(
+    cancel: Option<&AtomicBool>,
+    f: impl FnOnce() -> T + Send + 'static,
+) -> Result<T, Halted> {
+    let Some(cancel) = cancel else { return Ok(f()) };
+    let cancelled = || cancel.load(std::sync::atomic::Ordering::SeqCst);
+    if cancelled() {
+        return Err(Halted::Interrupted);
+    }
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(f());
+    });
+    loop {
+        match rx.recv_timeout(std::time::Duration::from_secs_f64(CANCEL_POLL_S)) {
+            Ok(v) => return Ok(v),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) if cancelled() => return Err(Halted::Interrupted),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => return Err(Halted::Panicked),
+        }
+    }
+}
+
 /// Test hook: a run of the scenario named by this variable panics (to test that a panic in one
 /// scenario of a batch fails that scenario and the batch goes on).
 pub const INJECT_PANIC_VAR: &str = "TENSEGRITY_INJECT_PANIC";
@@ -97,14 +137,18 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         panic!("injected by {INJECT_PANIC_VAR} (test hook)");
     }
     let mech = sc.mechanism();
-    let mut report = ScenarioReport {
-        findings: if opts.skip_findings {
-            Vec::new()
-        } else {
-            mech.findings(&sc.params).into_iter().map(Into::into).collect()
-        },
-        ..empty_report(sc)
-    };
+    let mut report = empty_report(sc);
+    if !opts.skip_findings {
+        let of = sc.clone();
+        match interruptible(opts.cancel, move || of.mechanism().findings(&of.params)) {
+            Ok(f) => report.findings = f.into_iter().map(Into::into).collect(),
+            Err(halted) => {
+                report.error = Some(format!("{halted} while checking the paper's equations (findings)"));
+                verdict::conclude(&mut report, sc);
+                return report;
+            }
+        }
+    }
     // Wall time counts the simulation, not the findings computed above.
     let wall = Instant::now();
     let mut runner = match start(mech, sc, opts) {
@@ -141,7 +185,7 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         structure: &sim.structure(),
         checks: &sc.checks,
         length_scale_m: mech.length_scale(&sc.params),
-        interference: sc.interference.as_ref(),
+        interference: &sc.interference,
         model: sc.model.as_ref(),
         recording: target.map(|target| Recording { target, every: opts.record_every.max(1), scenario: &sc.source }),
     })?;

@@ -192,6 +192,7 @@ pub(super) fn settle_point(
         branch,
         stable,
         analytic_stable,
+        expected_stable: sc.expected_stable(index),
         slack_cables,
         expected_slack: prediction.expected_slack.clone(),
         slack_agrees,

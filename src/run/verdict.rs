@@ -31,10 +31,13 @@ pub fn failures(report: &ScenarioReport, min_agreement_percent: Option<f64>) -> 
         if report.stiffness_probe.as_ref().is_some_and(|p| !p.passed) {
             out.push(Failure::Probe);
         }
-        let stability_agrees = report
-            .points
-            .iter()
-            .all(|p| p.stable.is_none() || p.analytic_stable.is_none() || p.stable == p.analytic_stable);
+        // The perturbation test must agree with the analytic stability and with the stability
+        // the scenario expects (a point that did not settle fails on `settle` instead).
+        let agrees = |p: &crate::report::PointReport, want: Option<bool>| {
+            p.stable.is_none() || want.is_none() || p.stable == want
+        };
+        let stability_agrees =
+            report.points.iter().all(|p| agrees(p, p.analytic_stable) && (!p.settled || agrees(p, p.expected_stable)));
         if !stability_agrees {
             out.push(Failure::Stability);
         }

@@ -227,6 +227,11 @@ fn points(
     if list.is_empty() {
         return Err(ctx.err(whole, "actuation.points is empty: give at least one point"));
     }
+    if list.len() > MAX_POINTS {
+        return Err(
+            ctx.err(&list[MAX_POINTS], format!("actuation.points has {} points; at most {MAX_POINTS}", list.len()))
+        );
+    }
     list.iter().map(|p| inputs.check(ctx, p, false)).collect()
 }
 

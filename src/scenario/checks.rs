@@ -1,14 +1,31 @@
 //! What the run is judged on: `[[checks]]`, `[stability]`, `[probe]` and `[workspace]`.
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
-use super::raw::{RawCheck, RawProbe, RawStability, RawWorkspace};
+use super::raw::{RawCheck, RawExpectedStability, RawProbe, RawStability, RawWorkspace};
+use super::Actuation;
 use crate::mechanisms::Mechanism;
 use crate::settings::{Check, Probe};
 
-/// `[[checks]]`: each a quantity of the mechanism, with a tolerance > 0.
-pub(super) fn checks(ctx: &Ctx, m: &dyn Mechanism, raw: &[RawCheck]) -> Result<Vec<Check>, ScenarioError> {
+/// `[[checks]]`: each a quantity of the mechanism, with a tolerance > 0; a quantity that only
+/// the stiffness probe measures needs `[probe]` (`has_probe`).
+pub(super) fn checks(
+    ctx: &Ctx,
+    m: &dyn Mechanism,
+    raw: &[RawCheck],
+    has_probe: bool,
+) -> Result<Vec<Check>, ScenarioError> {
+    let probed = m.stiffness_probe().map(|p| p.analytic);
     let mut checks = Vec::new();
     for c in raw {
+        if !has_probe && probed.as_deref() == Some(c.quantity.get_ref().as_str()) {
+            return Err(ctx.err(
+                &c.quantity,
+                format!(
+                    "quantity '{}' is measured by the stiffness probe: add a [probe] section",
+                    c.quantity.get_ref()
+                ),
+            ));
+        }
         let q = m.quantities().iter().find(|q| q.symbol == c.quantity.get_ref()).ok_or_else(|| {
             let known: Vec<_> = m.quantities().iter().map(|q| q.symbol).collect();
             ctx.err(
@@ -30,6 +47,38 @@ pub(super) fn stability(ctx: &Ctx, raw: &Option<RawStability>) -> Result<Option<
         return Err(ctx.err(&s.perturbation, format!("stability.perturbation must be in (0, 1) (rad or m), got {x}")));
     }
     Ok(Some(x))
+}
+
+/// `[stability] expect`: "stable" or "unstable" for every settle point (one entry), or a list
+/// with one entry per point of `points` or `grid` (a schedule settles once, after its last
+/// waypoint). Empty when the scenario does not say.
+pub(super) fn expected_stability(
+    ctx: &Ctx,
+    raw: &Option<RawStability>,
+    actuation: &Actuation,
+) -> Result<Vec<bool>, ScenarioError> {
+    let Some(e) = raw.as_ref().and_then(|s| s.expect.as_ref()) else { return Ok(Vec::new()) };
+    let word = |w: &String| match w.as_str() {
+        "stable" => Ok(true),
+        "unstable" => Ok(false),
+        other => Err(ctx.err(e, format!("stability.expect must be \"stable\" or \"unstable\", got \"{other}\""))),
+    };
+    match e.get_ref() {
+        RawExpectedStability::All(w) => Ok(vec![word(w)?]),
+        RawExpectedStability::PerPoint(list) => {
+            let points = match actuation {
+                Actuation::Points { points, .. } => points.len(),
+                Actuation::Schedule { .. } => 1,
+            };
+            if list.len() != points {
+                return Err(ctx.err(
+                    e,
+                    format!("stability.expect lists {} stabilities for {points} settle point(s): give one per point, or one word for all", list.len()),
+                ));
+            }
+            list.iter().map(word).collect()
+        }
+    }
 }
 
 /// `[probe]`: a torque > 0 N m and a tolerance > 0, for a mechanism that has a stiffness probe.

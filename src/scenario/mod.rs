@@ -9,6 +9,7 @@
 //! (in a fixed order: the first error found is the one reported).
 
 mod actuation;
+mod bounds;
 mod checks;
 mod energy;
 mod error;
@@ -18,6 +19,7 @@ mod mechanism;
 mod model;
 mod number;
 mod params;
+mod physical;
 mod raw;
 mod record;
 mod sim;
@@ -29,6 +31,7 @@ use error::Ctx;
 use raw::RawScenario;
 use std::path::{Path, PathBuf};
 
+pub use bounds::{MAX_STEPS_PER_RUN, MAX_STEPS_PER_SETTLE};
 pub use error::ScenarioError;
 
 /// A validated scenario, ready to run.
@@ -46,9 +49,12 @@ pub struct Scenario {
     pub actuation: Actuation,
     pub checks: Vec<Check>,
     pub stability_perturbation: Option<f64>,
+    /// `[stability] expect`: empty, one stability for every settle point, or one per point
+    /// (true: stable); see [`Scenario::expected_stable`].
+    pub expected_stability: Vec<bool>,
     pub probe: Option<Probe>,
     pub record: Option<PathBuf>,
-    pub interference: Option<crate::settings::InterferenceSettings>,
+    pub interference: crate::settings::InterferenceSettings,
     /// Workspace sweep: pass on this agreement percentage instead of on every check.
     pub min_agreement_percent: Option<f64>,
     /// Grid points dropped by `skip_outside`, with the reason.
@@ -62,6 +68,15 @@ pub struct Scenario {
 }
 
 impl Scenario {
+    /// The stability the scenario expects at settle point `index` (None: it does not say).
+    pub fn expected_stable(&self, index: usize) -> Option<bool> {
+        match self.expected_stability.as_slice() {
+            [] => None,
+            [all] => Some(*all),
+            list => list.get(index).copied(),
+        }
+    }
+
     /// The scenario's mechanism: a built-in one, or the file's own structure.
     pub fn mechanism(&self) -> Box<dyn Mechanism> {
         match &self.custom {
@@ -76,6 +91,16 @@ impl Scenario {
 pub enum Actuation {
     Points { points: Vec<Values>, continuation: bool },
     Schedule { waypoints: Vec<(f64, Values)> },
+}
+
+impl Actuation {
+    /// The inputs of the first point or waypoint (validation keeps both lists non-empty).
+    pub fn first_inputs(&self) -> &Values {
+        match self {
+            Actuation::Points { points, .. } => &points[0],
+            Actuation::Schedule { waypoints } => &waypoints[0].1,
+        }
+    }
 }
 
 /// Reads and validates a scenario file.
@@ -115,7 +140,8 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let settle = sim::settle(ctx, &raw.settle)?;
     let start = params::start(ctx, m, &raw.start)?;
     let (actuation, skipped_points) = actuation::actuation(ctx, m, &params, &raw.actuation)?;
-    let checks = checks::checks(ctx, m, &raw.checks)?;
+    bounds::bounds(ctx, &raw, &sim, &settle, &actuation)?;
+    let checks = checks::checks(ctx, m, &raw.checks, raw.probe.is_some())?;
     let model = model::model(ctx, &raw, m, &params, &start, &actuation)?;
     // A custom structure is checked by its settling and force balance even without [[checks]].
     if checks.is_empty() && raw.probe.is_none() && custom.is_none() && model.is_none() {
@@ -123,11 +149,13 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
             .err_at(0, "the scenario checks nothing: add at least one [[checks]] entry (quantity, tolerance)".into()));
     }
     let stability_perturbation = checks::stability(ctx, &raw.stability)?;
+    let expected_stability = checks::expected_stability(ctx, &raw.stability, &actuation)?;
     let probe = checks::probe(ctx, m, &raw.probe)?;
     let record = record::record(ctx, &raw.record)?;
     let min_agreement_percent = checks::workspace(ctx, &raw.workspace)?;
-    let interference =
-        interference::interference(ctx, &raw.interference, m, &params, &start, &actuation, &raw.actuation)?;
+    let first = physical::first_structure(ctx, &raw, m, &params, &start, actuation.first_inputs())?;
+    physical::physical(ctx, &raw, m, &first, &sim)?;
+    let interference = interference::interference(ctx, &raw.interference, m, &params, &first)?;
     let expect = match &raw.expect {
         None => None,
         Some(e) => Some(expect::expectation(ctx, e, &checks)?),
@@ -145,6 +173,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         actuation,
         checks,
         stability_perturbation,
+        expected_stability,
         probe,
         record,
         interference,

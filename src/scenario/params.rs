@@ -25,8 +25,19 @@ pub(super) fn params(ctx: &Ctx, m: &dyn Mechanism, raw: &ParamMap) -> Result<Val
     let given = param_values(ctx, raw)?;
     let params = mechanisms::with_defaults(m, &given);
     if let Err(e) = m.validate_params(&params) {
-        let at = e.symbol().and_then(|sym| value_at(raw, sym)).unwrap_or(0);
-        return Err(ctx.err_at(at, e.to_string()));
+        // At the symbol's key; when the file leaves that symbol at its default, at a given
+        // parameter the message names (b must be shorter than L: at L), else the first one.
+        let message = e.to_string();
+        let named = |k: &str| {
+            message.split(|c: char| !(c.is_alphanumeric() || c == '_')).any(|w| w == k)
+        };
+        let at = e
+            .symbol()
+            .and_then(|sym| value_at(raw, sym))
+            .or_else(|| raw.keys().find(|k| named(k.get_ref())).and_then(|k| value_at(raw, k.get_ref())))
+            .or_else(|| raw.keys().next().map(|k| k.span().start))
+            .unwrap_or(0);
+        return Err(ctx.err_at(at, message));
     }
     Ok(params)
 }

@@ -124,8 +124,10 @@ pub(super) struct RawExpect {
     pub(super) failing: Vec<Spanned<String>>,
 }
 
-/// Three numbers (coordinates, a vector), each a number or an expression of the parameters.
-pub(super) type Xyz = Spanned<[Spanned<Num>; 3]>;
+/// Three coordinates, each a number or an expression of the parameters; read as a list so
+/// that a list of another length is an error at its place (serde's fixed-size arrays left
+/// trailing entries unread).
+pub(super) type Xyz = Spanned<Vec<Spanned<Num>>>;
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -168,7 +170,8 @@ pub(super) struct RawMember {
     pub(super) name: Spanned<String>,
     pub(super) a: Spanned<String>,
     pub(super) b: Spanned<String>,
-    /// Struts: radius [m] (default 0.01).
+    /// Radius [m] for interference and drawing (struts: default 0.01; cables and springs:
+    /// default 0.001).
     pub(super) radius: Option<Spanned<Num>>,
     /// Springs: stiffness [N/m] (required); cables: stiffness of an elastic cable (absent:
     /// inextensible).
@@ -220,13 +223,17 @@ pub(super) struct RawWorkspace {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawInterference {
+    /// false turns the checks off, which the report says (default true).
+    pub(super) enabled: Option<bool>,
+    /// Check cables and springs too (default true).
+    pub(super) tendons: Option<bool>,
     /// Clearance below which a pair violates [m] (default 0: actual overlap only).
     pub(super) threshold: Option<Spanned<f64>>,
     /// Pairs farther apart are not measured [m] (default: the mechanism's length scale).
     pub(super) margin: Option<Spanned<f64>>,
     /// Report violations without failing the run (default false).
     pub(super) informative: Option<bool>,
-    /// Further strut pairs to exclude, by name.
+    /// Further member pairs to exclude, by name (struts, cables, springs).
     #[serde(default)]
     pub(super) exclude: Vec<Spanned<(String, String)>>,
 }
@@ -300,6 +307,15 @@ pub(super) struct RawCheck {
 pub(super) struct RawStability {
     /// Displacement of every free coordinate [rad or m].
     pub(super) perturbation: Spanned<f64>,
+    /// The stability every settle point must show ("stable" or "unstable"), or one per point.
+    pub(super) expect: Option<Spanned<RawExpectedStability>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub(super) enum RawExpectedStability {
+    All(String),
+    PerPoint(Vec<String>),
 }
 
 #[derive(Debug, Deserialize)]

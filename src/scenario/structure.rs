@@ -5,7 +5,7 @@ use super::error::{finite, positive_value, Ctx, ScenarioError};
 use super::raw::{RawActuator, RawBody, RawJoint, RawMember, RawStructure, Xyz};
 use crate::structure::{
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut,
-    TorsionSpring,
+    TorsionSpring, DEFAULT_TENDON_RADIUS_M,
 };
 use toml::Spanned;
 
@@ -14,6 +14,21 @@ const MIN_BODY_SIZE_M: f64 = 1e-3;
 
 /// Strut radius when the file gives none [m].
 const DEFAULT_STRUT_RADIUS_M: f64 = 0.01;
+
+/// An error at the second use of a name among `names` (a check or a report would read only one).
+fn unique_names<'a>(
+    ctx: &Ctx,
+    what: &str,
+    names: impl Iterator<Item = &'a Spanned<String>>,
+) -> Result<(), ScenarioError> {
+    let mut seen = std::collections::BTreeSet::new();
+    for n in names {
+        if !seen.insert(n.get_ref().as_str()) {
+            return Err(ctx.err(n, format!("duplicate {what} name '{}'", n.get_ref())));
+        }
+    }
+    Ok(())
+}
 
 /// Builds the structure of a `[structure]` table; every bad reference, zero-length member or
 /// massless free body is an error at its place in the file.
@@ -34,25 +49,65 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
         body_names.push(b.name.get_ref().clone());
         add_body(ctx, &mut s, b)?;
     }
+    unique_names(
+        ctx,
+        "member (strut, spring or cable)",
+        r.struts.iter().chain(&r.springs).chain(&r.cables).map(|m| &m.name),
+    )?;
+    unique_names(ctx, "joint", r.joints.iter().map(|j| &j.name))?;
+    unique_names(ctx, "actuator symbol", r.actuators.iter().map(|a| &a.symbol))?;
     // Each part refers only to the parts built before it.
     s.struts = r.struts.iter().map(|m| strut(ctx, &s, m)).collect::<Result<_, _>>()?;
     s.springs = r.springs.iter().map(|m| spring(ctx, &s, m)).collect::<Result<_, _>>()?;
     s.cables = r.cables.iter().map(|m| cable(ctx, &s, m)).collect::<Result<_, _>>()?;
     s.joints = r.joints.iter().map(|j| joint(ctx, &s, j)).collect::<Result<_, _>>()?;
     s.actuators = r.actuators.iter().map(|a| actuator(ctx, &s, a)).collect::<Result<_, _>>()?;
-    s.validate().map_err(|e| ctx.err(raw, format!("the structure is not valid: {e}")))?;
+    s.validate().map_err(|e| structure_error_at(ctx, raw, e))?;
     Ok(s)
+}
+
+/// A structure error at the entry it names (a joint, a member, an actuator or a body), else at
+/// the `[structure]` table.
+fn structure_error_at(ctx: &Ctx, raw: &Spanned<RawStructure>, e: crate::structure::StructureError) -> ScenarioError {
+    use crate::structure::StructureError as E;
+    let r = raw.get_ref();
+    let (what, name) = match &e {
+        E::Invalid { what, name, .. } | E::ZeroLength { what, name } | E::DanglingReference { what, name, .. } => {
+            (*what, name.as_str())
+        }
+        E::NoMass(name) | E::Duplicate(name) => ("body", name.as_str()),
+    };
+    let members = |list: &[RawMember]| list.iter().find(|m| m.name.get_ref() == name).map(|m| m.name.span());
+    let span = match what {
+        "joint" => r.joints.iter().find(|j| j.name.get_ref() == name).map(|j| j.name.span()),
+        "strut" => members(&r.struts),
+        "spring" => members(&r.springs),
+        "cable" => members(&r.cables),
+        "actuator" => r.actuators.iter().find(|a| a.symbol.get_ref() == name).map(|a| a.symbol.span()),
+        _ => r.bodies.iter().find(|b| b.name.get_ref() == name).map(|b| b.name.span()),
+    };
+    let message = format!("the structure is not valid: {e}");
+    match span {
+        Some(sp) => ctx.err_at(sp.start, message),
+        None => ctx.err(raw, message),
+    }
 }
 
 /// Three finite numbers (the parameters' expressions already evaluated).
 fn xyz(ctx: &Ctx, v: &Xyz, what: &str) -> Result<[f64; 3], ScenarioError> {
-    let a = v.get_ref().each_ref().map(|c| c.get_ref().value());
-    if a.iter().all(|c| c.is_finite()) {
-        Ok(a)
-    } else {
-        Err(ctx.err(v, format!("{what} must be three finite numbers, got {a:?}")))
+    let a: Vec<f64> = v.get_ref().iter().map(|c| c.get_ref().value()).collect();
+    match a.as_slice() {
+        &[x, y, z] if [x, y, z].iter().all(|c| c.is_finite() && c.abs() <= MAX_COORDINATE_M) => Ok([x, y, z]),
+        a => Err(ctx.err(
+            v,
+            format!("{what} must be three finite numbers of magnitude at most {MAX_COORDINATE_M:e}, got {a:?}"),
+        )),
     }
 }
+
+/// Largest magnitude of a coordinate, gravity or inertia component the file may give: beyond
+/// it products of two such numbers leave f64's range for the simulation's sums of squares.
+const MAX_COORDINATE_M: f64 = 1e6;
 
 /// Adds a body (at least one node, a mass if free) and its nodes (names unique in the
 /// structure) to `s`.
@@ -91,8 +146,11 @@ fn inertia(ctx: &Ctx, b: &RawBody, pts: &[[f64; 3]]) -> Result<Inertia, Scenario
         ctx.err(&b.name, format!("free body '{}' needs a mass > 0 kg (mass = ...), or fixed = true", b.name.get_ref()))
     })?;
     let mass = finite(ctx, m, "mass")?;
-    if mass <= 0.0 {
-        return Err(ctx.err(m, format!("mass must be > 0 kg, got {mass}")));
+    let (lo, hi) = super::physical::BODY_MASS_KG;
+    if !(lo..=hi).contains(&mass) {
+        return Err(
+            ctx.err(m, format!("mass must lie in [{lo:e}, {hi:e}] kg (what the simulation handles), got {mass}"))
+        );
     }
     let n = pts.len() as f64;
     let com = [0, 1, 2].map(|k| pts.iter().map(|p| p[k]).sum::<f64>() / n);
@@ -165,6 +223,7 @@ fn spring(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Spring, ScenarioErr
         b,
         stiffness_n_per_m: positive_value(ctx, k, "stiffness (N/m)")?,
         rest_length_m: rest,
+        radius_m: tendon_radius(ctx, m)?,
     })
 }
 
@@ -180,7 +239,15 @@ fn cable(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Cable, ScenarioError
         Some(v) => positive_value(ctx, v, "length (m)")?,
         None => l,
     };
-    Ok(Cable { name: m.name.get_ref().clone(), a, b, law, length_m: length })
+    Ok(Cable { name: m.name.get_ref().clone(), a, b, law, length_m: length, radius_m: tendon_radius(ctx, m)? })
+}
+
+/// A cable's or spring's radius > 0 (default [`DEFAULT_TENDON_RADIUS_M`]), for interference.
+fn tendon_radius(ctx: &Ctx, m: &RawMember) -> Result<f64, ScenarioError> {
+    match &m.radius {
+        Some(v) => positive_value(ctx, v, "radius (m)"),
+        None => Ok(DEFAULT_TENDON_RADIUS_M),
+    }
 }
 
 /// A joint between two declared bodies at a declared node, with its optional torsion spring

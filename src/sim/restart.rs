@@ -185,6 +185,7 @@ mod tests {
             b,
             stiffness_n_per_m: 100.0,
             rest_length_m: 0.0,
+            radius_m: crate::structure::DEFAULT_TENDON_RADIUS_M,
         });
         let mut moved = s.clone();
         moved.nodes[1].position = [0.0, 1.0, 0.0];

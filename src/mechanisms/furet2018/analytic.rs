@@ -547,9 +547,18 @@ fn poly_eval(c: &[f64], z: Complex<f64>) -> (Complex<f64>, Complex<f64>) {
     (v, d)
 }
 
+/// Iterations allowed to the companion matrix's Schur decomposition: a quartic converges in
+/// tens; non-finite or astronomically scaled coefficients (a target at 1e100 m) never do, and
+/// nalgebra's default would iterate without end.
+const SCHUR_MAX_ITERATIONS: usize = 10_000;
+
 /// Complex roots of the quartic with highest-degree-first coefficients `c`
-/// (`c[0] != 0`), via the companion-matrix eigenvalues, each Newton-polished.
+/// (`c[0] != 0`), via the companion-matrix eigenvalues, each Newton-polished. None found (an
+/// empty list) when a coefficient is not finite or the decomposition does not converge.
 fn quartic_roots(c: &[f64; 5]) -> Vec<Complex<f64>> {
+    if !c.iter().all(|x| x.is_finite()) || c[0] == 0.0 {
+        return Vec::new();
+    }
     let m = Matrix4::new(
         -c[1] / c[0],
         -c[2] / c[0],
@@ -568,7 +577,11 @@ fn quartic_roots(c: &[f64; 5]) -> Vec<Complex<f64>> {
         1.0,
         0.0,
     );
-    m.complex_eigenvalues()
+    let Some(schur) = nalgebra::linalg::Schur::try_new(m, f64::EPSILON, SCHUR_MAX_ITERATIONS) else {
+        return Vec::new();
+    };
+    schur
+        .complex_eigenvalues()
         .iter()
         .map(|&z0| {
             let mut z = z0;

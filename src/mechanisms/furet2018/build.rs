@@ -13,7 +13,10 @@
 //! collisions): bar A-C is drawn at z = +dz and bar B-D at z = -dz, the joints' axes along Z.
 
 use super::analytic::{self, Params};
-use crate::structure::{Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut, Vec3};
+use crate::structure::{
+    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut, Vec3,
+    DEFAULT_TENDON_RADIUS_M,
+};
 use nalgebra::Vector2;
 
 /// Model choices that the paper does not give (defaults in `Furet2018::params`).
@@ -80,6 +83,7 @@ pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64) -> Structur
                 b: nb,
                 stiffness_n_per_m: m.spring_stiffness_n_per_m,
                 rest_length_m: m.spring_rest_length_m,
+                radius_m: DEFAULT_TENDON_RADIUS_M,
             });
         }
         let joint = |name: String, parent, child, anchor, q0: f64, damping: f64| Joint {

@@ -7,7 +7,9 @@
 //! joints about z keep the motion in the plane.
 
 use super::analytic::{self, Params};
-use crate::structure::{Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut};
+use crate::structure::{
+    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut, DEFAULT_TENDON_RADIUS_M,
+};
 
 /// Model choices that the paper does not give (defaults in `Ji2014::params`).
 #[derive(Clone, Copy, Debug)]
@@ -65,8 +67,22 @@ pub fn build(p: &Params, m: &ModelChoices, l3: f64, theta1: f64, theta2: f64) ->
     if l3 > 0.0 {
         s.struts.push(Strut { name: "C1D1 (actuator L3)".into(), a: c1, b: tip, radius_m: r });
     }
-    s.springs.push(Spring { name: "K1".into(), a: d2, b: c2, stiffness_n_per_m: p.k1, rest_length_m: 0.0 });
-    s.springs.push(Spring { name: "K2".into(), a: d3, b: c3, stiffness_n_per_m: p.k2, rest_length_m: 0.0 });
+    s.springs.push(Spring {
+        name: "K1".into(),
+        a: d2,
+        b: c2,
+        stiffness_n_per_m: p.k1,
+        rest_length_m: 0.0,
+        radius_m: DEFAULT_TENDON_RADIUS_M,
+    });
+    s.springs.push(Spring {
+        name: "K2".into(),
+        a: d3,
+        b: c3,
+        stiffness_n_per_m: p.k2,
+        rest_length_m: 0.0,
+        radius_m: DEFAULT_TENDON_RADIUS_M,
+    });
     let z = [0.0, 0.0, 1.0];
     s.joints.push(Joint {
         name: "theta1".into(),

@@ -8,6 +8,7 @@
 use super::analytic::{self, Params};
 use crate::structure::{
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut, Vec3,
+    DEFAULT_TENDON_RADIUS_M,
 };
 use nalgebra::Vector3;
 
@@ -55,6 +56,7 @@ pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64, cable_lengt
             b: nt,
             law: CableLaw::Inextensible,
             length_m: cable_lengths[k],
+            radius_m: DEFAULT_TENDON_RADIUS_M,
         });
         s.actuators.push(Actuator { symbol: format!("L{}", k + 1), target: ActuatorTarget::CableLength(k) });
     }
@@ -68,6 +70,7 @@ pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64, cable_lengt
             b: nt,
             stiffness_n_per_m: d.spring_k,
             rest_length_m: d.spring_rest,
+            radius_m: DEFAULT_TENDON_RADIUS_M,
         });
     }
     s.joints.push(Joint {

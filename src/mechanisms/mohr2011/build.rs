@@ -17,7 +17,7 @@
 use super::analytic::SpringChain;
 use crate::structure::{
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, ExternalLoad, Inertia, Joint, JointKind, Spring, Structure,
-    Strut, TorsionSpring, Vec3,
+    Strut, TorsionSpring, Vec3, DEFAULT_TENDON_RADIUS_M,
 };
 use nalgebra::Vector3;
 
@@ -101,6 +101,7 @@ pub fn build(g: &Geometry, m: &ModelChoices) -> Structure {
                 b: b_nodes[i],
                 stiffness_n_per_m: k,
                 rest_length_m: g.lo,
+                radius_m: DEFAULT_TENDON_RADIUS_M,
             });
             s.struts.push(Strut {
                 name: format!("leg{} (straight)", i + 1),
@@ -123,6 +124,7 @@ pub fn build(g: &Geometry, m: &ModelChoices) -> Structure {
             b: b_nodes[*bi],
             law,
             length_m: g.cable_lengths[c],
+            radius_m: DEFAULT_TENDON_RADIUS_M,
         });
         s.actuators.push(Actuator { symbol: symbol.clone(), target: ActuatorTarget::CableLength(c) });
     }

@@ -98,7 +98,11 @@ pub fn findings(p: &Params) -> Vec<Finding> {
     let mut worst_rad = 0.0f64;
     for c in &pts {
         let rho = ikp(p, c);
-        let d = dkp(p, &rho).expect("assembles");
+        // A point whose own cable lengths do not assemble again is a failed round trip.
+        let Some(d) = dkp(p, &rho) else {
+            worst_dkp = f64::INFINITY;
+            continue;
+        };
         worst_dkp = worst_dkp.max((d - c).norm() / p.lb);
         let rad = dkp_radicand_eq14(p, &rho);
         worst_rad = worst_rad

@@ -450,15 +450,18 @@ impl Mechanism for Mohr2011 {
     }
 }
 
-/// Grid step of the static-workspace volume count [fraction of l_b].
-const VOLUME_GRID_STEP_LB: f64 = 0.125;
+/// Grid cells of the static-workspace volume count along each half-axis of the kinematic
+/// workspace's bounding box (reach l_o + l_b): a fixed count, so that the work does not grow
+/// with l_o / l_b (it had grown with its cube: minutes at l_o = 60 l_b). At the paper's
+/// l_o = 3 l_b the step is 0.125 l_b.
+const VOLUME_GRID_CELLS: f64 = 32.0;
 
-/// Points of a grid (step `VOLUME_GRID_STEP_LB` l_b over the kinematic workspace's bounding
-/// box, z > 0) in the static workspace with the end-effector's weight along Z = `g_z`.
+/// Points of a grid (step (l_o + l_b) / `VOLUME_GRID_CELLS` over the kinematic workspace's
+/// bounding box, z > 0) in the static workspace with the end-effector's weight along Z = `g_z`.
 pub fn static_workspace_count(params: &Values, g_z: f64) -> usize {
     let pa = params_of(params);
-    let h = VOLUME_GRID_STEP_LB * pa.lb;
     let reach = pa.lo + pa.lb; // every spring sphere lies within this of the origin
+    let h = reach / VOLUME_GRID_CELLS;
     let n = (reach / h).ceil() as i64;
     let load = Vector3::new(0.0, 0.0, params["m_platform"] * g_z);
     let a2 = analytic::base_nodes(&pa).map(|a| 2.0 * a);
@@ -490,8 +493,10 @@ fn gravity_finding(params: &Values) -> Finding {
         equation: "Sec. 5 (gravity)".into(),
         claim: "with gravity, a mechanism hanging below its base gains cable tension and a larger workspace".into(),
         measured: format!(
-            "static-workspace grid points (step {VOLUME_GRID_STEP_LB} l_b, m = {} kg, kappa = {} N m/rad): {none} without gravity, {hanging} hanging (g along +Z), {upright} upright (g along -Z); the weight raises some tensions but unbalances the pairs (t_j != t_j+3), and the workspace then depends on m g / kappa, no longer independent of the stiffness",
-            params["m_platform"], params["kappa"]
+            "static-workspace grid points (step {} l_b, m = {} kg, kappa = {} N m/rad): {none} without gravity, {hanging} hanging (g along +Z), {upright} upright (g along -Z); the weight raises some tensions but unbalances the pairs (t_j != t_j+3), and the workspace then depends on m g / kappa, no longer independent of the stiffness",
+            (params["lo"] + params["lb"]) / VOLUME_GRID_CELLS / params["lb"],
+            params["m_platform"],
+            params["kappa"]
         ),
         holds: hanging > none,
     }
