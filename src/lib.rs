@@ -6,7 +6,9 @@
 
 pub mod bench;
 pub mod custom;
+pub mod export;
 pub mod figures;
+pub mod import;
 pub mod mechanisms;
 pub mod model;
 pub mod observers;

@@ -39,6 +39,10 @@ enum Command {
         /// Record every N-th tick only (thins long runs).
         #[arg(long, default_value_t = 1, value_name = "N")]
         record_every: u64,
+        /// Write every tick as a row of this CSV table at full f64 precision (with several
+        /// scenarios: one file each, named FILE-<scenario>.csv).
+        #[arg(long, value_name = "FILE.csv")]
+        table: Option<PathBuf>,
     },
     /// Validate scenario files without running them.
     Check {
@@ -119,6 +123,16 @@ enum Command {
         #[arg(long, value_name = "CMD", num_args = 0..=1, default_missing_value = DEFAULT_PEER)]
         peer: Option<String>,
     },
+    /// Write a scenario's structure in another simulator's format.
+    Export {
+        #[command(subcommand)]
+        format: ExportFormat,
+    },
+    /// Read a structure from another tool's format and write it as a scenario file.
+    Import {
+        #[command(subcommand)]
+        format: ImportFormat,
+    },
     /// Check every printed equation of a mechanism's paper against the testbed's derivation.
     Findings {
         mechanism: String,
@@ -126,6 +140,64 @@ enum Command {
         set: Vec<String>,
         #[arg(long)]
         json: bool,
+    },
+}
+
+#[derive(Subcommand)]
+enum ExportFormat {
+    /// MuJoCo MJCF XML of the structure at the scenario's first actuation point.
+    Mjcf {
+        scenario: PathBuf,
+        /// The XML file (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// How the testbed's ideal actuators are written: `mocap` (bodies placed by actuated
+        /// joints are mocap bodies: exact) or `position` (position servos of gain --kp).
+        #[arg(long, default_value = "mocap", value_parser = ["mocap", "position"])]
+        actuators: String,
+        /// Gain of the position actuators on joints [N/m or N m/rad].
+        #[arg(long, default_value_t = 1e6)]
+        kp: f64,
+        /// Viscous damping along every cable [N s/m] (tendon damping, winch kv): zero at rest,
+        /// it only helps MuJoCo settle (the testbed's cables have none).
+        #[arg(long, default_value_t = 0.0)]
+        cable_damping: f64,
+    },
+}
+
+#[derive(Subcommand)]
+enum ImportFormat {
+    /// An NTRT YAML model (nodes, pair_groups, builders, substructures, bond_groups).
+    Ntrt {
+        file: PathBuf,
+        /// The scenario file (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Keep NTRT's axes (y up) instead of mapping its y to the testbed's z.
+        #[arg(long)]
+        keep_axes: bool,
+    },
+    /// A node matrix N (3 x n) and connectivity matrices C_b (bars x n) and C_s (strings x n),
+    /// as CSV (Skelton and de Oliveira's notation, TsgFEM, MOTES).
+    Matrices {
+        n: PathBuf,
+        cb: PathBuf,
+        cs: PathBuf,
+        /// The scenario file (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Mass of each bar [kg].
+        #[arg(long, default_value_t = 1.0)]
+        bar_mass: f64,
+        /// Radius of each bar [m].
+        #[arg(long, default_value_t = 0.01)]
+        bar_radius: f64,
+        /// Stiffness of each string [N/m].
+        #[arg(long, default_value_t = 1000.0)]
+        string_stiffness: f64,
+        /// Tension of each string at its drawn length [N] (sets its rest length).
+        #[arg(long, default_value_t = 10.0)]
+        string_tension: f64,
     },
 }
 
@@ -200,8 +272,8 @@ const EXIT_INTERNAL_ERROR: u8 = 101;
 /// Runs the command; its exit code.
 fn dispatch(cli: Cli) -> i32 {
     match cli.command {
-        Command::Run { scenarios, json, record, connect, record_every } => {
-            cmd_run(&scenarios, json.as_deref(), record.as_deref(), connect.as_deref(), record_every)
+        Command::Run { scenarios, json, record, connect, record_every, table } => {
+            cmd_run(&scenarios, json.as_deref(), record.as_deref(), connect.as_deref(), record_every, table.as_deref())
         }
         Command::Check { scenarios } => match load_all(&scenarios) {
             Ok(list) => {
@@ -221,6 +293,23 @@ fn dispatch(cli: Cli) -> i32 {
         Command::Figure { name, out, list } => cmd_figure(name.as_deref(), &out, list),
         Command::Solve { mechanism, query, set, json } => cmd_solve(&mechanism, &query, &set, json),
         Command::Findings { mechanism, set, json } => cmd_findings(&mechanism, &set, json),
+        Command::Import { format: ImportFormat::Ntrt { file, out, keep_axes } } => {
+            cmd_import_ntrt(&file, out.as_deref(), keep_axes)
+        }
+        Command::Import {
+            format: ImportFormat::Matrices { n, cb, cs, out, bar_mass, bar_radius, string_stiffness, string_tension },
+        } => {
+            let o = tensegrity_testbed::import::matrices::MatrixOptions {
+                bar_mass_kg: bar_mass,
+                bar_radius_m: bar_radius,
+                string_stiffness_n_per_m: string_stiffness,
+                string_tension_n: string_tension,
+            };
+            cmd_import_matrices(&[n, cb, cs], out.as_deref(), &o)
+        }
+        Command::Export { format: ExportFormat::Mjcf { scenario, out, actuators, kp, cable_damping } } => {
+            cmd_export_mjcf(&scenario, out.as_deref(), &actuators, kp, cable_damping)
+        }
         Command::Bench { export_cases: Some(dir), .. } => cmd_export_cases(&dir),
         Command::Bench { rounds, json, export_cases: None, mechanisms, peer: Some(peer) } => {
             cmd_bench_peer(rounds, json, &mechanisms, &peer)
@@ -274,12 +363,23 @@ fn record_path(base: &Path, name: &str, several: bool) -> PathBuf {
     base.with_file_name(format!("{stem}-{safe}.rrd"))
 }
 
+/// The table file of one scenario: `base` itself, or `base-<scenario>.csv` with several.
+fn table_path(base: &Path, name: &str, several: bool) -> PathBuf {
+    let rrd = record_path(base, name, several);
+    if several {
+        rrd.with_extension("csv")
+    } else {
+        rrd
+    }
+}
+
 fn cmd_run(
     paths: &[PathBuf],
     json: Option<&Path>,
     record: Option<&Path>,
     connect: Option<&str>,
     record_every: u64,
+    table: Option<&Path>,
 ) -> i32 {
     let scenarios = match load_all(paths) {
         Ok(s) => s,
@@ -301,6 +401,11 @@ fn cmd_run(
             }
         }
     }
+    for sc in &scenarios {
+        if let Some(t) = table.map(|t| table_path(t, &sc.name, several)) {
+            outputs.push((format!("the table of scenario '{}' ({})", sc.name, sc.file.display()), t));
+        }
+    }
     if let Err(code) = check_outputs(paths, outputs) {
         return code;
     }
@@ -318,6 +423,7 @@ fn cmd_run(
             connect: connect.map(str::to_string),
             record_every,
             skip_findings: false,
+            table: table.map(|t| table_path(t, &sc.name, several)),
         };
         // A panic inside one scenario fails that scenario, with its message; the batch goes on.
         let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(sc, &opts)))
@@ -542,6 +648,103 @@ fn print_mechanism(m: &dyn mechanisms::Mechanism) {
     for q in m.queries() {
         println!("    {:<12} inputs {}: {}", q.name, q.inputs.join(" "), q.description);
     }
+}
+
+/// Writes `text` to `out` (never over an input, `output::check_outputs`), or to stdout
+/// without `out`.
+fn write_output(out: Option<&Path>, inputs: &[PathBuf], text: &str) -> i32 {
+    let Some(o) = out else {
+        print!("{text}");
+        return EXIT_PASS;
+    };
+    if let Err(code) = check_outputs(inputs, vec![("--out".into(), o.to_path_buf())]) {
+        return code;
+    }
+    match write_atomic(o, text) {
+        Ok(()) => EXIT_PASS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_FAIL
+        }
+    }
+}
+
+fn cmd_import_ntrt(path: &Path, out: Option<&Path>, keep_axes: bool) -> i32 {
+    use tensegrity_testbed::import::ntrt::{import, Axes};
+    let axes = if keep_axes { Axes::Keep } else { Axes::ZUp };
+    match import(path, axes) {
+        Ok(imported) => {
+            for s in &imported.skipped {
+                eprintln!("skipped: {s}");
+            }
+            write_output(out, &[path.to_path_buf()], &imported.toml)
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_BAD_INPUT
+        }
+    }
+}
+
+fn cmd_import_matrices(
+    inputs: &[PathBuf; 3],
+    out: Option<&Path>,
+    o: &tensegrity_testbed::import::matrices::MatrixOptions,
+) -> i32 {
+    let positive = [
+        ("--bar-mass", o.bar_mass_kg),
+        ("--bar-radius", o.bar_radius_m),
+        ("--string-stiffness", o.string_stiffness_n_per_m),
+    ];
+    if let Some((flag, x)) = positive.iter().find(|(_, x)| !(*x > 0.0 && x.is_finite())) {
+        eprintln!("error: {flag} must be a finite number > 0, got {x}");
+        return EXIT_BAD_INPUT;
+    }
+    if !(o.string_tension_n >= 0.0 && o.string_tension_n.is_finite()) {
+        eprintln!("error: --string-tension must be a finite number >= 0, got {}", o.string_tension_n);
+        return EXIT_BAD_INPUT;
+    }
+    if let Some(path) = out {
+        if inputs.iter().any(|i| path.exists() && std::fs::canonicalize(i).ok() == std::fs::canonicalize(path).ok()) {
+            eprintln!("error: --out {} is an input file; choose another", path.display());
+            return EXIT_BAD_INPUT;
+        }
+    }
+    match tensegrity_testbed::import::matrices::import(&inputs[0], &inputs[1], &inputs[2], o) {
+        Ok(imported) => write_output(out, inputs.as_slice(), &imported.toml),
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_BAD_INPUT
+        }
+    }
+}
+
+fn cmd_export_mjcf(path: &Path, out: Option<&Path>, actuators: &str, kp: f64, cable_damping: f64) -> i32 {
+    use tensegrity_testbed::export::{mjcf::ActuatorMode, scenario_mjcf};
+    let sc = match load_all(&[path.to_path_buf()]) {
+        Ok(mut s) => s.remove(0),
+        Err(code) => return code,
+    };
+    if !(kp > 0.0 && kp.is_finite()) {
+        eprintln!("error: --kp must be a finite number > 0, got {kp}");
+        return EXIT_BAD_INPUT;
+    }
+    if !(cable_damping >= 0.0 && cable_damping.is_finite()) {
+        eprintln!("error: --cable-damping must be a finite number >= 0, got {cable_damping}");
+        return EXIT_BAD_INPUT;
+    }
+    let mode = if actuators == "position" { ActuatorMode::Position } else { ActuatorMode::Mocap };
+    let mjcf = match scenario_mjcf(&sc, mode, kp, cable_damping) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("error: {}: {e}", path.display());
+            return EXIT_BAD_INPUT;
+        }
+    };
+    for w in &mjcf.warnings {
+        eprintln!("warning: not exported: {w}");
+    }
+    write_output(out, &[path.to_path_buf()], &mjcf.xml)
 }
 
 /// Splits --set NAME=VALUE arguments into parameters and inputs of the mechanism.

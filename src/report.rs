@@ -134,7 +134,7 @@ pub struct CheckReport {
     pub points_compared: usize,
 }
 
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, PartialEq, Default)]
 pub struct PointReport {
     pub index: usize,
     pub inputs: Values,

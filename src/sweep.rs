@@ -298,3 +298,28 @@ pub fn merge_csv(texts: &[(String, String)], partial: bool) -> Result<String, Sw
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An angle simulated at pi against an analytic -pi (the same angle) has error 0 in the
+    /// CSV, not -2 pi; a length's error is the plain difference.
+    #[test]
+    fn csv_angle_errors_are_wrapped_and_length_errors_are_not() {
+        let pi = std::f64::consts::PI;
+        let point = PointReport {
+            analytic: Values::from([("theta2".into(), -pi), ("x".into(), 1.0)]),
+            simulated: Values::from([("theta2".into(), pi), ("x".into(), 1.25)]),
+            ..PointReport::default()
+        };
+        let csv = to_csv(&[Row { index: 0, grid_points: 1, point }], &|q| q == "theta2");
+        let mut lines = csv.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let row: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let cell = |name: &str| row[header.iter().position(|h| *h == name).unwrap()].parse::<f64>().unwrap();
+        assert!(cell("error_theta2").abs() <= 1e-15, "{}", cell("error_theta2"));
+        assert_eq!(cell("error_x"), 0.25);
+        assert_eq!(&header[..2], &["index", "grid_points"]);
+    }
+}

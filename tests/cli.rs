@@ -276,3 +276,16 @@ fn extreme_values_give_answers_not_hangs_or_panics() {
     assert!(out.contains("Eq. 12-14") && !err.contains("panicked"), "{out}{err}");
     assert!(start.elapsed() < std::time::Duration::from_secs(30), "{:?}", start.elapsed());
 }
+
+/// `solve manriquez2019 fk` prints the cable ends P_M1 and P_M2 (Eq. 8-9) beside M, G and the
+/// cable lengths, each cable length equal to the distance from its base point to its end.
+#[test]
+fn manriquez2019_fk_prints_the_cable_ends_of_eq8_9() {
+    let (code, out, err) = tensegrity(&["solve", "manriquez2019", "fk", "--set", "theta1=0.0941", "--set", "theta2=0.0332", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let values = &v["solutions"][0]["values"];
+    for k in ["x_M1", "y_M1", "z_M1", "x_M2", "y_M2", "z_M2", "L1", "L2"] {
+        assert!(values[k].is_number(), "{k} in {values}");
+    }
+}

@@ -10,7 +10,6 @@
 
 use proptest::prelude::*;
 use std::path::Path;
-use tensegrity_testbed::mechanisms;
 use tensegrity_testbed::scenario;
 use tensegrity_testbed::sim::Simulation;
 
@@ -171,7 +170,8 @@ proptest! {
                 prop_assert!(e.to_string().starts_with("fuzz.toml:"), "{}", e);
             }
             Ok(sc) => {
-                let m = mechanisms::find(&sc.mechanism).expect("validated mechanism");
+                // The scenario's mechanism: a built-in one or its own [structure].
+                let m = sc.mechanism();
                 let inputs = match &sc.actuation {
                     scenario::Actuation::Points { points, .. } => points[0].clone(),
                     scenario::Actuation::Schedule { waypoints } => waypoints[0].1.clone(),

@@ -12,6 +12,7 @@ pub mod interference;
 pub mod model;
 pub mod record;
 pub mod slack;
+pub mod table;
 
 use crate::mechanisms::{Prediction, Values};
 use crate::report::{PointReport, ScenarioReport};
@@ -85,6 +86,8 @@ pub struct Setup<'a> {
     /// A recording, when the run writes one (made last: nothing is written when another
     /// observer cannot start).
     pub recording: Option<record::Recording<'a>>,
+    /// A per-tick f64 table (CSV) to write, if the run writes one.
+    pub table: Option<std::path::PathBuf>,
 }
 
 /// Every observer of a run, in the order they see each tick.
@@ -94,6 +97,9 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
     list.push(Box::new(interference::Interference::new(setup.structure, setup.interference)?));
     if let Some(spec) = setup.model {
         list.push(Box::new(model::ModelObserver::new(spec, setup.structure, setup.recording.is_some())));
+    }
+    if let Some(path) = &setup.table {
+        list.push(Box::new(table::Table::start(path)?));
     }
     if let Some(r) = &setup.recording {
         if let Some(recorder) = record::Recorder::start(r)? {

@@ -36,6 +36,8 @@ pub struct RunOptions<'a> {
     pub record_every: u64,
     /// Leave the findings out of the report (a sweep's blocks: the summary has none).
     pub skip_findings: bool,
+    /// Write every tick as a row of this CSV table (`observers::table`).
+    pub table: Option<PathBuf>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -188,6 +190,7 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         interference: &sc.interference,
         model: sc.model.as_ref(),
         recording: target.map(|target| Recording { target, every: opts.record_every.max(1), scenario: &sc.source }),
+        table: opts.table.clone(),
     })?;
     let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel);
     // The first point's commands (a no-op where the build already placed them).

@@ -8,7 +8,7 @@
 //! names its `file:LINE:COL` inside the string.
 
 use super::error::{Ctx, ScenarioError};
-use super::raw::{RawBody, RawJoint, RawMember, RawStructure, Xyz};
+use super::raw::{RawBody, RawJoint, RawStructure, Xyz};
 use crate::mechanisms::Values;
 use crate::model::expr::{Expr, ExprError};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
@@ -227,7 +227,10 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
         resolve_body(b, &mut resolve)?;
     }
     for m in s.struts.iter_mut().chain(s.springs.iter_mut()).chain(s.cables.iter_mut()) {
-        resolve_member(m, &mut resolve)?;
+        resolve_member(&mut m.radius, &mut m.stiffness, &mut m.length, &mut resolve)?;
+    }
+    for g in s.strut_groups.iter_mut().chain(s.spring_groups.iter_mut()).chain(s.cable_groups.iter_mut()) {
+        resolve_member(&mut g.radius, &mut g.stiffness, &mut g.length, &mut resolve)?;
     }
     for j in &mut s.joints {
         resolve_joint(j, &mut resolve)?;
@@ -254,8 +257,14 @@ fn resolve_body(b: &mut RawBody, resolve: &mut Resolve) -> Result<(), ScenarioEr
     Ok(())
 }
 
-fn resolve_member(m: &mut RawMember, resolve: &mut Resolve) -> Result<(), ScenarioError> {
-    for (v, what) in [(&mut m.radius, "radius"), (&mut m.stiffness, "stiffness"), (&mut m.length, "length")] {
+/// A member's (or a member group's) radius, stiffness and length.
+fn resolve_member(
+    radius: &mut Option<Spanned<Num>>,
+    stiffness: &mut Option<Spanned<Num>>,
+    length: &mut Option<Spanned<Num>>,
+    resolve: &mut Resolve,
+) -> Result<(), ScenarioError> {
+    for (v, what) in [(radius, "radius"), (stiffness, "stiffness"), (length, "length")] {
         if let Some(v) = v {
             resolve(v, what)?;
         }

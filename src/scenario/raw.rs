@@ -146,6 +146,14 @@ pub(super) struct RawStructure {
     pub(super) joints: Vec<RawJoint>,
     #[serde(default)]
     pub(super) actuators: Vec<RawActuator>,
+    /// Compact form: struts, springs and cables sharing their properties, listed by node
+    /// pairs (after the one-table-per-member entries above).
+    #[serde(default)]
+    pub(super) strut_groups: Vec<RawMemberGroup>,
+    #[serde(default)]
+    pub(super) spring_groups: Vec<RawMemberGroup>,
+    #[serde(default)]
+    pub(super) cable_groups: Vec<RawMemberGroup>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -331,4 +339,19 @@ pub(super) struct RawProbe {
 #[serde(deny_unknown_fields)]
 pub(super) struct RawRecord {
     pub(super) path: Spanned<String>,
+}
+
+/// Members of one kind sharing their properties: one member per node pair, named
+/// "<name>:<a>-<b>" or by `names` (one per pair, in order).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawMemberGroup {
+    pub(super) name: Spanned<String>,
+    /// `[["A", "B"], ["B", "C"], ...]`: the two nodes of each member.
+    pub(super) pairs: Spanned<Vec<Spanned<Vec<Spanned<String>>>>>,
+    pub(super) names: Option<Spanned<Vec<Spanned<String>>>>,
+    /// As in [`RawMember`]: struts' radius, springs' and cables' stiffness and length.
+    pub(super) radius: Option<Spanned<Num>>,
+    pub(super) stiffness: Option<Spanned<Num>>,
+    pub(super) length: Option<Spanned<Num>>,
 }

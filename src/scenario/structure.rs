@@ -2,6 +2,7 @@
 //! built into a [`Structure`].
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
+use super::raw::RawMemberGroup;
 use super::raw::{RawActuator, RawBody, RawJoint, RawMember, RawStructure, Xyz};
 use crate::structure::{
     Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut,
@@ -60,6 +61,7 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
     s.struts = r.struts.iter().map(|m| strut(ctx, &s, m)).collect::<Result<_, _>>()?;
     s.springs = r.springs.iter().map(|m| spring(ctx, &s, m)).collect::<Result<_, _>>()?;
     s.cables = r.cables.iter().map(|m| cable(ctx, &s, m)).collect::<Result<_, _>>()?;
+    add_member_groups(ctx, &mut s, r)?;
     s.joints = r.joints.iter().map(|j| joint(ctx, &s, j)).collect::<Result<_, _>>()?;
     s.actuators = r.actuators.iter().map(|a| actuator(ctx, &s, a)).collect::<Result<_, _>>()?;
     s.validate().map_err(|e| structure_error_at(ctx, raw, e))?;
@@ -339,4 +341,90 @@ fn actuator(ctx: &Ctx, s: &Structure, a: &RawActuator) -> Result<Actuator, Scena
         _ => return Err(ctx.err(&a.symbol, "an actuator drives exactly one of: joint = \"name\", cable = \"name\"")),
     };
     Ok(Actuator { symbol: a.symbol.get_ref().clone(), target })
+}
+
+/// The compact member groups (`strut_groups`, `spring_groups`, `cable_groups`): each pair of a
+/// group becomes one member with the group's properties, checked as a member of its own table
+/// would be; errors point at the pair (or the property) at fault.
+fn add_member_groups(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(), ScenarioError> {
+    for g in &r.strut_groups {
+        for m in group_members(ctx, g)? {
+            unique_member(ctx, &m, s.struts.iter().map(|x| &x.name), "strut")?;
+            let st = strut(ctx, s, &m)?;
+            s.struts.push(st);
+        }
+    }
+    for g in &r.spring_groups {
+        for m in group_members(ctx, g)? {
+            unique_member(ctx, &m, s.springs.iter().map(|x| &x.name), "spring")?;
+            let sp = spring(ctx, s, &m)?;
+            s.springs.push(sp);
+        }
+    }
+    for g in &r.cable_groups {
+        for m in group_members(ctx, g)? {
+            unique_member(ctx, &m, s.cables.iter().map(|x| &x.name), "cable")?;
+            let c = cable(ctx, s, &m)?;
+            s.cables.push(c);
+        }
+    }
+    Ok(())
+}
+
+/// A group's members as if each had its own table: the name (given, or "<group>:<a>-<b>")
+/// located at its pair.
+fn group_members(ctx: &Ctx, g: &RawMemberGroup) -> Result<Vec<RawMember>, ScenarioError> {
+    if g.name.get_ref().trim().is_empty() {
+        return Err(ctx.err(&g.name, "a member group's name must not be empty"));
+    }
+    let pairs = g.pairs.get_ref();
+    if pairs.is_empty() {
+        return Err(ctx.err(&g.pairs, "pairs must list at least one pair of nodes, e.g. [[\"A\", \"B\"]]"));
+    }
+    if let Some(names) = &g.names {
+        if names.get_ref().len() != pairs.len() {
+            return Err(ctx.err(
+                names,
+                format!(
+                    "names has {} entries for {} pairs: give one name per pair",
+                    names.get_ref().len(),
+                    pairs.len()
+                ),
+            ));
+        }
+    }
+    let mut out = Vec::new();
+    for (i, pair) in pairs.iter().enumerate() {
+        let [a, b] = pair.get_ref().as_slice() else {
+            return Err(
+                ctx.err(pair, format!("a pair is two node names [\"A\", \"B\"], got {} names", pair.get_ref().len()))
+            );
+        };
+        let name = match &g.names {
+            Some(names) => names.get_ref()[i].clone(),
+            None => toml::Spanned::new(pair.span(), format!("{}:{}-{}", g.name.get_ref(), a.get_ref(), b.get_ref())),
+        };
+        out.push(RawMember {
+            name,
+            a: a.clone(),
+            b: b.clone(),
+            radius: g.radius.clone(),
+            stiffness: g.stiffness.clone(),
+            length: g.length.clone(),
+        });
+    }
+    Ok(out)
+}
+
+/// A group's member name must not repeat a member of the same kind.
+fn unique_member<'a>(
+    ctx: &Ctx,
+    m: &RawMember,
+    mut existing: impl Iterator<Item = &'a String>,
+    what: &str,
+) -> Result<(), ScenarioError> {
+    if existing.any(|n| n == m.name.get_ref()) {
+        return Err(ctx.err(&m.name, format!("duplicate {what} name '{}'", m.name.get_ref())));
+    }
+    Ok(())
 }

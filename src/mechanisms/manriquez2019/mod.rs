@@ -241,8 +241,9 @@ impl Mechanism for Manriquez2019 {
                 let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
                 let q = analytic::points(&p, t1, t2);
                 let l = analytic::cable_lengths(&p, t1, t2);
+                let [m1, m2] = q.cable_platform;
                 Ok(vec![Solution {
-                    label: "Eq. 15 (lengths in m)".into(),
+                    label: "Eq. 8-9 (cable ends P_M1, P_M2 through the DH chain), Eq. 15 (lengths in m)".into(),
                     values: Values::from([
                         ("x_m".into(), q.m.x),
                         ("y_m".into(), q.m.y),
@@ -250,6 +251,12 @@ impl Mechanism for Manriquez2019 {
                         ("x_G".into(), q.g.x),
                         ("y_G".into(), q.g.y),
                         ("z_G".into(), q.g.z),
+                        ("x_M1".into(), m1.x),
+                        ("y_M1".into(), m1.y),
+                        ("z_M1".into(), m1.z),
+                        ("x_M2".into(), m2.x),
+                        ("y_M2".into(), m2.y),
+                        ("z_M2".into(), m2.z),
                         ("L1".into(), l[0]),
                         ("L2".into(), l[1]),
                     ]),

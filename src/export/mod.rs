@@ -1,0 +1,44 @@
+//! Structures out to other simulators' formats. `mjcf.rs`: MuJoCo's MJCF XML.
+//!
+//! An export reads a validated scenario's structure (a built-in mechanism built at its first
+//! actuation point, or a file's own `[structure]`) and writes text; it steps nothing.
+
+pub mod mjcf;
+
+/// The MJCF of a scenario's first structure, with the scenario's time step and body damping.
+pub fn scenario_mjcf(
+    sc: &Scenario,
+    actuators: mjcf::ActuatorMode,
+    joint_kp: f64,
+    cable_damping_n_s_per_m: f64,
+) -> Result<mjcf::Mjcf, String> {
+    let (s, commands) = first_structure(sc)?;
+    let options = mjcf::MjcfOptions {
+        model_name: sc.name.clone(),
+        timestep_s: sc.sim.dt_s,
+        body_damping_per_s: sc.sim.body_damping_per_s,
+        actuators,
+        joint_kp,
+        commands,
+        cable_damping_n_s_per_m,
+    };
+    Ok(mjcf::to_mjcf(&s, &options))
+}
+
+use crate::scenario::{Actuation, Scenario};
+use crate::structure::Structure;
+
+/// The structure a scenario starts its run with, built at the first point's (or first
+/// waypoint's) inputs from the scenario's `[start]` as `run` builds it, and the actuator
+/// commands of that point (actuator order, m or rad).
+pub fn first_structure(sc: &Scenario) -> Result<(Structure, Vec<f64>), String> {
+    let first_inputs = match &sc.actuation {
+        Actuation::Points { points, .. } => points[0].clone(),
+        Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
+    };
+    let mech = sc.mechanism();
+    let s = mech.build(&sc.params, &first_inputs, &sc.start).map_err(|e| e.to_string())?;
+    s.validate().map_err(|e| format!("the structure is not valid: {e}"))?;
+    let commands = s.commands_from(&mech.commands(&sc.params, &first_inputs));
+    Ok((s, commands))
+}

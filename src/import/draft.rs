@@ -1,0 +1,189 @@
+//! The plain structure an import makes (bodies with their nodes, struts, cables) and the
+//! scenario file it is written as, with simulation settings chosen from its stiffness and
+//! masses.
+
+use crate::structure::{distance, Vec3};
+use std::fmt::Write;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct DraftBody {
+    pub name: String,
+    pub fixed: bool,
+    /// Mass [kg] of a free body.
+    pub mass_kg: f64,
+    /// Principal moments along the world axes [kg m^2] (None: the file format's default).
+    pub inertia_kg_m2: Option<Vec3>,
+    pub nodes: Vec<(String, Vec3)>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct DraftStrut {
+    pub name: String,
+    pub a: String,
+    pub b: String,
+    pub radius_m: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct DraftCable {
+    pub name: String,
+    pub a: String,
+    pub b: String,
+    /// [N/m]; None: inextensible.
+    pub stiffness_n_per_m: Option<f64>,
+    /// Unstretched length [m].
+    pub length_m: f64,
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Draft {
+    pub name: String,
+    pub description: String,
+    pub bodies: Vec<DraftBody>,
+    pub struts: Vec<DraftStrut>,
+    pub cables: Vec<DraftCable>,
+}
+
+/// Time step as a fraction of the fastest body's period scale sqrt(m / sum k) (the prism of
+/// `scenarios/custom/prism3.toml`: 0.05 x sqrt(1 kg / 100 N/m) = 0.005 s, its own step).
+const DT_FRACTION: f64 = 0.05;
+/// Free-body damping [1/s] as a fraction of the fastest body's rate sqrt(sum k / m) (prism3:
+/// 0.2 x 10/s = 2/s, its own damping): zero at rest, it only speeds settling.
+const DAMPING_FRACTION: f64 = 0.2;
+/// The rate [1/s] the settings assume when no free body carries a cable.
+const FALLBACK_RATE_PER_S: f64 = 1.0;
+/// Settle speed tolerance per metre of structure [1/s].
+const SPEED_TOL_PER_M: f64 = 1e-12;
+/// Residual tolerances relative to a cable force scale (stiffness x size) [-].
+const RESIDUAL_FRACTION: f64 = 1e-10;
+/// Settle time limit [s], in periods of the slowest body: generous, the limit fails a run.
+const MAX_TIME_PERIODS: f64 = 4000.0;
+
+/// A TOML basic string.
+pub fn quote(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            c if (c as u32) < 0x20 => {
+                let _ = write!(out, "\\u{:04X}", c as u32);
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// The body of a TOML multi-line basic string.
+fn multiline(s: &str) -> String {
+    s.replace('\\', "\\\\").replace("\"\"\"", "\"\"\\\"")
+}
+
+fn xyz(v: Vec3) -> String {
+    format!("[{:?}, {:?}, {:?}]", v[0], v[1], v[2])
+}
+
+impl Draft {
+    fn position(&self, node: &str) -> Option<Vec3> {
+        self.bodies.iter().flat_map(|b| &b.nodes).find(|(n, _)| n == node).map(|(_, p)| *p)
+    }
+
+    /// Size of the structure [m]: the largest distance between two nodes (at least 1e-3).
+    pub fn size_m(&self) -> f64 {
+        let all: Vec<Vec3> = self.bodies.iter().flat_map(|b| b.nodes.iter().map(|(_, p)| *p)).collect();
+        all.iter().flat_map(|a| all.iter().map(move |b| distance(*a, *b))).fold(1e-3, f64::max)
+    }
+
+    /// For each free body: (mass, sum of the stiffness of the cables on it).
+    fn body_rates(&self) -> Vec<(f64, f64)> {
+        self.bodies
+            .iter()
+            .filter(|b| !b.fixed)
+            .map(|b| {
+                let on = |n: &str| b.nodes.iter().any(|(m, _)| m == n);
+                let k: f64 = self
+                    .cables
+                    .iter()
+                    .filter(|c| on(&c.a) != on(&c.b))
+                    .map(|c| c.stiffness_n_per_m.unwrap_or(0.0))
+                    .sum();
+                (b.mass_kg, k)
+            })
+            .collect()
+    }
+
+    /// The `[sim]` and `[settle]` tables: a step and a damping from the fastest body, a time
+    /// limit from the slowest.
+    fn settings(&self) -> String {
+        let rates: Vec<f64> = self.body_rates().iter().filter(|(_, k)| *k > 0.0).map(|(m, k)| (k / m).sqrt()).collect();
+        // Nothing elastic moves (all held, or no cable on a free body): the rate of a 1 s period.
+        let fastest = rates.iter().copied().fold(f64::NAN, f64::max);
+        let fastest = if fastest.is_finite() { fastest } else { FALLBACK_RATE_PER_S };
+        let slowest = rates.iter().copied().fold(f64::INFINITY, f64::min).min(fastest);
+        let size = self.size_m();
+        let k_max = self.cables.iter().filter_map(|c| c.stiffness_n_per_m).fold(0.0, f64::max).max(1.0);
+        let residual = RESIDUAL_FRACTION * k_max * size;
+        format!(
+            "[sim]\ndt = {:?}\nbody_damping = {:?}\n\n[settle]\nspeed_tol = {:?}\nwindow = 10\nresidual_force_tol = {residual:?}\nresidual_torque_tol = {:?}\nmax_time = {:?}\n",
+            DT_FRACTION / fastest,
+            DAMPING_FRACTION * fastest,
+            SPEED_TOL_PER_M * size,
+            residual * size,
+            (MAX_TIME_PERIODS / slowest).ceil()
+        )
+    }
+
+    /// The scenario file: name, description, settings, one point, the structure.
+    pub fn to_toml(&self) -> String {
+        let mut t = String::new();
+        let _ = writeln!(t, "name = {}", quote(&self.name));
+        let _ = writeln!(t, "description = \"\"\"\n{}\n\"\"\"", multiline(&self.description));
+        t.push_str("mechanism = \"custom\"\n\n");
+        t.push_str(&self.settings());
+        t.push_str("\n[actuation]\npoints = [ {} ]\n\n[structure]\n");
+        for b in &self.bodies {
+            let _ = writeln!(t, "\n[[structure.bodies]]\nname = {}", quote(&b.name));
+            if b.fixed {
+                t.push_str("fixed = true\n");
+            } else {
+                let _ = writeln!(t, "mass = {:?}", b.mass_kg);
+                if let Some(i) = b.inertia_kg_m2 {
+                    let _ = writeln!(t, "inertia = {}", xyz(i));
+                }
+            }
+            let nodes: Vec<String> = b.nodes.iter().map(|(n, p)| format!("{} = {}", quote(n), xyz(*p))).collect();
+            let _ = writeln!(t, "nodes = {{ {} }}", nodes.join(", "));
+        }
+        for s in &self.struts {
+            let _ = writeln!(
+                t,
+                "\n[[structure.struts]]\nname = {}\na = {}\nb = {}\nradius = {:?}",
+                quote(&s.name),
+                quote(&s.a),
+                quote(&s.b),
+                s.radius_m
+            );
+        }
+        for c in &self.cables {
+            let drawn = match (self.position(&c.a), self.position(&c.b)) {
+                (Some(a), Some(b)) => format!("  # drawn {:?} m", distance(a, b)),
+                _ => String::new(),
+            };
+            let _ = writeln!(
+                t,
+                "\n[[structure.cables]]\nname = {}\na = {}\nb = {}",
+                quote(&c.name),
+                quote(&c.a),
+                quote(&c.b)
+            );
+            if let Some(k) = c.stiffness_n_per_m {
+                let _ = writeln!(t, "stiffness = {k:?}");
+            }
+            let _ = writeln!(t, "length = {:?}{drawn}", c.length_m);
+        }
+        t
+    }
+}

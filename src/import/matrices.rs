@@ -1,0 +1,208 @@
+//! A structure in the notation of Skelton and de Oliveira (Tensegrity Systems, 2009), used by
+//! TsgFEM and MOTES: a node matrix N (3 x n, one column per node, m) and connectivity matrices
+//! C_b (bars x n) and C_s (strings x n) whose rows hold one -1 and one 1 (the member runs from
+//! the -1 node to the 1 node; the sign does not matter here) and zeros, as CSV files.
+//!
+//! Made of it: each bar a strut on its own rigid body (a class-1 structure: no node on two
+//! bars); nodes on no bar are fixed points (one fixed body "ground"); without such points the
+//! first bar's body is held fixed to remove the rigid motion. Each string an elastic
+//! tension-only cable whose rest length is the drawn length minus its initial tension over its
+//! stiffness. Member properties come from [`MatrixOptions`].
+
+use super::draft::{Draft, DraftBody, DraftCable, DraftStrut};
+use super::{ImportError, Imported};
+use crate::structure::{distance, Vec3};
+use std::path::Path;
+
+#[derive(Clone, Debug)]
+pub struct MatrixOptions {
+    /// Mass of each bar [kg].
+    pub bar_mass_kg: f64,
+    /// Radius of each bar [m].
+    pub bar_radius_m: f64,
+    /// Stiffness of each string [N/m].
+    pub string_stiffness_n_per_m: f64,
+    /// Tension of each string at its drawn length [N] (sets its rest length).
+    pub string_tension_n: f64,
+}
+
+/// A row of a matrix file: its line in the file (from 1) and its values.
+type Row = (usize, Vec<f64>);
+
+/// A CSV matrix of numbers: rows of comma- (or whitespace-) separated values; `#` comments
+/// and blank lines skipped (each row keeps its line number).
+fn read_matrix(path: &Path) -> Result<Vec<Row>, ImportError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| ImportError {
+        file: file.clone(),
+        line: 0,
+        col: 0,
+        message: format!("cannot read: {e}"),
+    })?;
+    let mut rows = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let mut row = Vec::new();
+        let mut col = 1;
+        for field in line.split(|c: char| c == ',' || c == ';' || c.is_whitespace()) {
+            if field.is_empty() {
+                continue;
+            }
+            let x: f64 = field.parse().ok().filter(|x: &f64| x.is_finite()).ok_or_else(|| ImportError {
+                file: file.clone(),
+                line: i + 1,
+                col,
+                message: format!("'{field}' is not a finite number"),
+            })?;
+            row.push(x);
+            col += 1;
+        }
+        if let Some(first) = rows.first().map(|r: &(usize, Vec<f64>)| r.1.len()) {
+            if row.len() != first {
+                return Err(ImportError {
+                    file,
+                    line: i + 1,
+                    col: 1,
+                    message: format!("{} values where the first row has {first}", row.len()),
+                });
+            }
+        }
+        rows.push((i + 1, row));
+    }
+    if rows.is_empty() {
+        return Err(ImportError { file, line: 0, col: 0, message: "the matrix is empty".into() });
+    }
+    Ok(rows)
+}
+
+/// The members of a connectivity matrix: (from node, to node, line) per row; value number
+/// `k` of a row is column `k` (node `k`).
+fn members(path: &Path, c: &[Row], n: usize) -> Result<Vec<(usize, usize, usize)>, ImportError> {
+    let file = path.display().to_string();
+    let e = |line: usize, message: String| ImportError { file: file.clone(), line, col: 1, message };
+    let mut out = Vec::new();
+    for (i, row) in c {
+        let i = *i;
+        if row.len() != n {
+            return Err(e(i, format!("{} columns, but N has {n} nodes", row.len())));
+        }
+        let from: Vec<usize> = (0..n).filter(|&k| row[k] == -1.0).collect();
+        let to: Vec<usize> = (0..n).filter(|&k| row[k] == 1.0).collect();
+        if from.len() != 1 || to.len() != 1 || row.iter().any(|x| ![-1.0, 0.0, 1.0].contains(x)) {
+            return Err(e(i, "a member's row holds one -1, one 1 and zeros".into()));
+        }
+        out.push((from[0], to[0], i));
+    }
+    Ok(out)
+}
+
+/// Imports N, C_b and C_s.
+pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) -> Result<Imported, ImportError> {
+    let n = read_matrix(n_path)?;
+    if n.len() != 3 {
+        return Err(ImportError {
+            file: n_path.display().to_string(),
+            line: 0,
+            col: 0,
+            message: format!("N must have 3 rows (x, y, z of each node), got {}", n.len()),
+        });
+    }
+    let count = n[0].1.len();
+    let nodes: Vec<Vec3> = (0..count).map(|k| [n[0].1[k], n[1].1[k], n[2].1[k]]).collect();
+    let bars = members(cb_path, &read_matrix(cb_path)?, count)?;
+    let strings = members(cs_path, &read_matrix(cs_path)?, count)?;
+    let name = |k: usize| format!("n{}", k + 1);
+    let mut on_bar: Vec<Option<usize>> = vec![None; count];
+    for (i, &(a, b, line)) in bars.iter().enumerate() {
+        for k in [a, b] {
+            if let Some(j) = on_bar[k] {
+                return Err(ImportError {
+                    file: cb_path.display().to_string(),
+                    line,
+                    col: 1,
+                    message: format!(
+                        "node {} is on bars {} and {}: only class-1 structures (no node on two bars)",
+                        k + 1,
+                        j + 1,
+                        i + 1
+                    ),
+                });
+            }
+            on_bar[k] = Some(i);
+        }
+    }
+    let ground: Vec<usize> = (0..count).filter(|&k| on_bar[k].is_none()).collect();
+    let mut draft = Draft {
+        name: format!(
+            "{} (from N, C_b, C_s)",
+            n_path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default()
+        ),
+        ..Default::default()
+    };
+    if !ground.is_empty() {
+        draft.bodies.push(DraftBody {
+            name: "ground".into(),
+            fixed: true,
+            mass_kg: 0.0,
+            inertia_kg_m2: None,
+            nodes: ground.iter().map(|&k| (name(k), nodes[k])).collect(),
+        });
+    }
+    for (i, &(a, b, _)) in bars.iter().enumerate() {
+        let l = distance(nodes[a], nodes[b]);
+        let inertia = o.bar_mass_kg * (3.0 * o.bar_radius_m * o.bar_radius_m + l * l) / 12.0;
+        draft.bodies.push(DraftBody {
+            name: format!("bar{}", i + 1),
+            fixed: ground.is_empty() && i == 0,
+            mass_kg: o.bar_mass_kg,
+            inertia_kg_m2: Some([inertia; 3]),
+            nodes: vec![(name(a), nodes[a]), (name(b), nodes[b])],
+        });
+        draft.struts.push(DraftStrut {
+            name: format!("bar{}", i + 1),
+            a: name(a),
+            b: name(b),
+            radius_m: o.bar_radius_m,
+        });
+    }
+    for (i, &(a, b, line)) in strings.iter().enumerate() {
+        let l = distance(nodes[a], nodes[b]);
+        let rest = l - o.string_tension_n / o.string_stiffness_n_per_m;
+        if !(rest > 0.0) {
+            return Err(ImportError {
+                file: cs_path.display().to_string(),
+                line,
+                col: 1,
+                message: format!(
+                    "string {}: tension {} N at {} N/m leaves no rest length (drawn {l} m)",
+                    i + 1,
+                    o.string_tension_n,
+                    o.string_stiffness_n_per_m
+                ),
+            });
+        }
+        draft.cables.push(DraftCable {
+            name: format!("string{}", i + 1),
+            a: name(a),
+            b: name(b),
+            stiffness_n_per_m: Some(o.string_stiffness_n_per_m),
+            length_m: rest,
+        });
+    }
+    draft.description = format!(
+        "Imported from N = {}, C_b = {}, C_s = {} (Skelton and de Oliveira's notation) by `tensegrity import matrices`.\n\
+         Node k is n<k> (column k of N); bar i is strut bar<i> on its own body of {} kg, radius {} m; string i is the elastic tension-only cable string<i> of {} N/m at {} N when drawn (rest length = drawn - tension / stiffness).\n{}",
+        n_path.display(),
+        cb_path.display(),
+        cs_path.display(),
+        o.bar_mass_kg,
+        o.bar_radius_m,
+        o.string_stiffness_n_per_m,
+        o.string_tension_n,
+        if ground.is_empty() { "No node is off the bars: bar1 is held fixed to remove the rigid motion.".to_string() } else { format!("{} node(s) on no bar are fixed points (body 'ground').", ground.len()) }
+    );
+    Ok(Imported { toml: draft.to_toml(), skipped: Vec::new() })
+}

@@ -1,0 +1,47 @@
+//! Structures in from other tools' formats, written out as this testbed's scenario files
+//! (`mechanism = "custom"`). `ntrt.rs`: NTRT's YAML model files; `yaml.rs`: YAML with line and
+//! column; `draft.rs`: the plain structure an import makes and its TOML text.
+//!
+//! An import reads text and writes text: it builds and steps nothing. The written scenario is
+//! then loaded like any other, so everything it says is validated again.
+
+pub mod draft;
+pub mod matrices;
+pub mod ntrt;
+pub mod yaml;
+
+/// A rejected input, at a line and column of a file (both from 1; 0 for the file as a whole,
+/// which is then written `file: message`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImportError {
+    pub file: String,
+    pub line: usize,
+    pub col: usize,
+    pub message: String,
+}
+
+impl std::fmt::Display for ImportError {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        if self.line == 0 {
+            write!(f, "{}: {}", self.file, self.message)
+        } else {
+            write!(f, "{}:{}:{}: {}", self.file, self.line, self.col, self.message)
+        }
+    }
+}
+
+impl std::error::Error for ImportError {}
+
+impl ImportError {
+    pub fn at(file: &str, at: yaml::At, message: impl Into<String>) -> Self {
+        ImportError { file: file.into(), line: at.line, col: at.col, message: message.into() }
+    }
+}
+
+/// What an import made: the scenario text, and everything of the source it left out (also
+/// listed in the scenario's description).
+#[derive(Debug, Clone)]
+pub struct Imported {
+    pub toml: String,
+    pub skipped: Vec<String>,
+}
