@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::tensegrity;
+use common::{tensegrity, PINNED_STRUT as PIN};
 
 const JI: &str = r#"name = "ji"
 mechanism = "ji2014"
@@ -55,40 +55,6 @@ quantity = "theta1"
 tolerance = 1e-9
 "#;
 
-/// A pinned strut held by a spring (line numbers matter to the cases below).
-const PIN: &str = r#"name = "pin"
-mechanism = "custom"
-[actuation]
-points = [ {} ]
-[structure]
-gravity = [0.0, 0.0, 0.0]
-[[structure.bodies]]
-name = "ground"
-fixed = true
-nodes = { O = [0.0, 0.0, 0.0], S = [1.0, 1.0, 0.0] }
-[[structure.bodies]]
-name = "bar"
-mass = 1.0
-nodes = { P = [0.0, 0.0, 0.0], Q = [1.0, 0.0, 0.0] }
-[[structure.struts]]
-name = "bar"
-a = "P"
-b = "Q"
-[[structure.springs]]
-name = "k"
-a = "Q"
-b = "S"
-stiffness = 10.0
-length = 0.5
-[[structure.joints]]
-name = "pin"
-kind = "revolute"
-parent = "ground"
-child = "bar"
-at = "P"
-axis = [0.0, 0.0, 1.0]
-damping = 0.5
-"#;
 
 /// (what, scenario text, expected line of the error, a word the message must contain).
 fn cases() -> Vec<(&'static str, String, usize, &'static str)> {

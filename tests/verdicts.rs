@@ -132,39 +132,9 @@ fn interference_off_is_an_explicit_reported_choice() {
 /// force is read at Q, where no joint acts (reading it at the pin as well had halved it).
 #[test]
 fn a_pinned_strut_reports_its_whole_axial_force() {
-    let text = r#"name = "pin"
-mechanism = "custom"
-[actuation]
-points = [ {} ]
-[structure]
-[[structure.bodies]]
-name = "ground"
-fixed = true
-nodes = { O = [0.0, 0.0, 0.0], S = [2.0, 1.0, 0.0] }
-[[structure.bodies]]
-name = "bar"
-mass = 1.0
-nodes = { P = [0.0, 0.0, 0.0], Q = [1.0, 0.0, 0.0] }
-[[structure.struts]]
-name = "bar"
-a = "P"
-b = "Q"
-[[structure.springs]]
-name = "k"
-a = "Q"
-b = "S"
-stiffness = 10.0
-length = 0.5
-[[structure.joints]]
-name = "pin"
-kind = "revolute"
-parent = "ground"
-child = "bar"
-at = "P"
-axis = [0.0, 0.0, 1.0]
-damping = 0.5
-"#;
-    let r = run_text("pin.toml", text);
+    // The ground point S at (2, 1, 0): the spring stretched, pulling Q outwards.
+    let text = common::PINNED_STRUT.replace("S = [1.0, 1.0, 0.0]", "S = [2.0, 1.0, 0.0]");
+    let r = run_text("pin.toml", &text);
     assert!(r.passed, "{:?} {:?}", r.failures, r.error);
     let p = &r.points[0];
     // At equilibrium the spring lies along the bar (no moment about the pin) and pulls Q away

@@ -19,3 +19,40 @@ pub fn run_file(path: &str) -> tensegrity_testbed::report::ScenarioReport {
     let sc = tensegrity_testbed::scenario::load(std::path::Path::new(path)).expect("scenario is valid");
     tensegrity_testbed::run::run(&sc, &tensegrity_testbed::run::RunOptions::default())
 }
+
+/// A bar pinned to the ground at P (a revolute joint about z) and held by a spring from its
+/// free end Q to the ground point S. `tests/bad_input.rs` locates errors by its line numbers.
+#[allow(dead_code)]
+pub const PINNED_STRUT: &str = r#"name = "pin"
+mechanism = "custom"
+[actuation]
+points = [ {} ]
+[structure]
+gravity = [0.0, 0.0, 0.0]
+[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { O = [0.0, 0.0, 0.0], S = [1.0, 1.0, 0.0] }
+[[structure.bodies]]
+name = "bar"
+mass = 1.0
+nodes = { P = [0.0, 0.0, 0.0], Q = [1.0, 0.0, 0.0] }
+[[structure.struts]]
+name = "bar"
+a = "P"
+b = "Q"
+[[structure.springs]]
+name = "k"
+a = "Q"
+b = "S"
+stiffness = 10.0
+length = 0.5
+[[structure.joints]]
+name = "pin"
+kind = "revolute"
+parent = "ground"
+child = "bar"
+at = "P"
+axis = [0.0, 0.0, 1.0]
+damping = 0.5
+"#;
