@@ -1,5 +1,8 @@
-//! Every tick as one row of a CSV table, at full f64 precision: readable by pandas, polars or
-//! any spreadsheet without the rerun SDK (whose recordings store positions as f32).
+//! Every tick as one row of a table at full f64 precision, readable by pandas, polars or any
+//! spreadsheet without the rerun SDK (whose recordings store positions as f32): CSV, or an Arrow
+//! IPC file when the name ends in `.arrow`, `.feather` or `.ipc` (`tick` a UInt64 column, every
+//! other column Float64, nulls where the CSV leaves a cell empty; written in record batches of
+//! [`ARROW_BATCH_ROWS`] rows).
 //!
 //! Columns, fixed at the first tick: `tick`, `time_s`, `kinetic_energy_j`, the inputs
 //! (`input:SYMBOL`), every node's coordinates (`node:NAME.x`, `.y`, `.z`, m), every spring's
@@ -13,16 +16,35 @@
 use super::{Observer, Tick};
 use crate::report::ScenarioReport;
 use crate::structure::ActuatorTarget;
+use arrow_array::{ArrayRef, Float64Array, RecordBatch, UInt64Array};
+use arrow_schema::{DataType, Field, Schema};
 use std::fmt::Write as _;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Rows buffered before an Arrow record batch is written.
+pub const ARROW_BATCH_ROWS: usize = 8192;
+
+/// The file endings that select the Arrow IPC format.
+const ARROW_ENDINGS: &[&str] = &["arrow", "feather", "ipc"];
+
+/// Input, simulated and analytic keys, fixed at the first tick.
+type Keys = (Vec<String>, Vec<String>, Vec<String>);
+
+/// Where the rows go.
+enum Sink {
+    Csv(std::io::BufWriter<std::fs::File>),
+    /// The file until the first tick gives the schema, then its writer; the rows not yet written
+    /// as a batch (tick, then every other column).
+    Arrow { file: Option<std::fs::File>, writer: Option<arrow_ipc::writer::FileWriter<std::fs::File>>, ticks: Vec<u64>, columns: Vec<Vec<Option<f64>>> },
+}
 
 pub struct Table {
     path: PathBuf,
     partial: PathBuf,
-    out: std::io::BufWriter<std::fs::File>,
-    /// Input, simulated and analytic keys, fixed at the first tick (None before it).
-    keys: Option<(Vec<String>, Vec<String>, Vec<String>)>,
+    sink: Sink,
+    keys: Option<Keys>,
     /// The first write error, reported when the run closes.
     error: Option<String>,
 }
@@ -37,7 +59,8 @@ fn field(s: &str) -> String {
 }
 
 impl Table {
-    /// Starts the table at `path` (its directory is made if needed).
+    /// Starts the table at `path` (its directory is made if needed); Arrow IPC for the endings
+    /// in [`ARROW_ENDINGS`], CSV otherwise.
     pub fn start(path: &Path) -> Result<Self, String> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
@@ -48,12 +71,19 @@ impl Table {
             crate::output::discard(&partial);
             format!("cannot write the table {}: {e}", path.display())
         })?;
-        Ok(Table { path: path.to_path_buf(), partial, out: std::io::BufWriter::new(file), keys: None, error: None })
+        let arrow = path.extension().and_then(|e| e.to_str()).is_some_and(|e| ARROW_ENDINGS.contains(&e));
+        let sink = if arrow {
+            Sink::Arrow { file: Some(file), writer: None, ticks: Vec::new(), columns: Vec::new() }
+        } else {
+            Sink::Csv(std::io::BufWriter::new(file))
+        };
+        Ok(Table { path: path.to_path_buf(), partial, sink, keys: None, error: None })
     }
 
-    fn header(&self, t: &Tick, keys: &(Vec<String>, Vec<String>, Vec<String>)) -> String {
+    /// The column names after `tick`.
+    fn columns(t: &Tick, keys: &Keys) -> Vec<String> {
         let s = t.structure;
-        let mut cols: Vec<String> = vec!["tick".into(), "time_s".into(), "kinetic_energy_j".into()];
+        let mut cols: Vec<String> = vec!["time_s".into(), "kinetic_energy_j".into()];
         cols.extend(keys.0.iter().map(|k| format!("input:{k}")));
         for n in &s.nodes {
             cols.extend(["x", "y", "z"].map(|c| format!("node:{}.{c}", n.name)));
@@ -70,37 +100,95 @@ impl Table {
         }));
         cols.extend(keys.1.iter().map(|k| format!("sim:{k}")));
         cols.extend(keys.2.iter().map(|k| format!("analytic:{k}")));
-        cols.iter().map(|c| field(c)).collect::<Vec<_>>().join(",")
+        cols
     }
 
-    fn row(t: &Tick, keys: &(Vec<String>, Vec<String>, Vec<String>)) -> String {
+    /// The values of one tick, in the order of [`Table::columns`] (None: no value there).
+    fn values(t: &Tick, keys: &Keys) -> Vec<Option<f64>> {
         let snap = t.snapshot;
-        let mut r = format!("{},{:?},{:?}", snap.tick, snap.time_s, snap.kinetic_energy_j);
-        let mut put = |v: Option<f64>| {
-            r.push(',');
-            if let Some(x) = v {
-                let _ = write!(r, "{x:?}");
-            }
-        };
-        for k in &keys.0 {
-            put(t.inputs.get(k).copied());
-        }
-        for p in &snap.nodes {
-            for x in p {
-                put(Some(*x));
-            }
-        }
+        let mut v = vec![Some(snap.time_s), Some(snap.kinetic_energy_j)];
+        v.extend(keys.0.iter().map(|k| t.inputs.get(k).copied()));
+        v.extend(snap.nodes.iter().flatten().map(|x| Some(*x)));
         let f = &snap.forces;
-        for x in f.spring_force_n.iter().chain(&f.cable_tension_n).chain(&f.actuator_force) {
-            put(Some(*x));
+        v.extend(f.spring_force_n.iter().chain(&f.cable_tension_n).chain(&f.actuator_force).map(|x| Some(*x)));
+        v.extend(keys.1.iter().map(|k| t.simulated.get(k).copied()));
+        v.extend(keys.2.iter().map(|k| t.prediction.expected.get(k).copied()));
+        v
+    }
+
+    /// Writes one tick (`header`: the column names, at the first tick).
+    fn write(&mut self, tick: u64, header: Option<Vec<String>>, values: Vec<Option<f64>>) -> Result<(), String> {
+        let fail = |e: &dyn std::fmt::Display| format!("cannot write the table {}: {e}", self.path.display());
+        match &mut self.sink {
+            Sink::Csv(out) => {
+                let mut text = String::new();
+                if let Some(h) = header {
+                    let names: Vec<String> = std::iter::once("tick".to_string()).chain(h).map(|c| field(&c)).collect();
+                    text.push_str(&names.join(","));
+                    text.push('\n');
+                }
+                let _ = write!(text, "{tick}");
+                for x in values {
+                    text.push(',');
+                    if let Some(x) = x {
+                        let _ = write!(text, "{x:?}");
+                    }
+                }
+                text.push('\n');
+                out.write_all(text.as_bytes()).map_err(|e| fail(&e))
+            }
+            Sink::Arrow { file, writer, ticks, columns } => {
+                if let Some(h) = header {
+                    let mut fields = vec![Field::new("tick", DataType::UInt64, false)];
+                    fields.extend(h.iter().map(|c| Field::new(c, DataType::Float64, true)));
+                    let f = file.take().ok_or_else(|| fail(&"the file is gone"))?;
+                    *writer = Some(arrow_ipc::writer::FileWriter::try_new(f, &Schema::new(fields)).map_err(|e| fail(&e))?);
+                    *columns = vec![Vec::with_capacity(ARROW_BATCH_ROWS); h.len()];
+                }
+                ticks.push(tick);
+                for (c, x) in columns.iter_mut().zip(values) {
+                    c.push(x);
+                }
+                if ticks.len() >= ARROW_BATCH_ROWS {
+                    Self::flush_batch(writer, ticks, columns).map_err(|e| fail(&e))?;
+                }
+                Ok(())
+            }
         }
-        for k in &keys.1 {
-            put(t.simulated.get(k).copied());
+    }
+
+    /// Writes the buffered rows as one record batch.
+    fn flush_batch(
+        writer: &mut Option<arrow_ipc::writer::FileWriter<std::fs::File>>,
+        ticks: &mut Vec<u64>,
+        columns: &mut [Vec<Option<f64>>],
+    ) -> Result<(), arrow_schema::ArrowError> {
+        let Some(w) = writer.as_mut() else { return Ok(()) };
+        if ticks.is_empty() {
+            return Ok(());
         }
-        for k in &keys.2 {
-            put(t.prediction.expected.get(k).copied());
+        let mut arrays: Vec<ArrayRef> = vec![Arc::new(UInt64Array::from(std::mem::take(ticks)))];
+        arrays.extend(columns.iter_mut().map(|c| Arc::new(Float64Array::from(std::mem::take(c))) as ArrayRef));
+        w.write(&RecordBatch::try_new(w.schema().clone(), arrays)?)
+    }
+
+    /// Finishes the file (the last batch and the Arrow footer, or the CSV buffer) and syncs it.
+    fn finish_file(&mut self) -> Result<(), String> {
+        let fail = |e: &dyn std::fmt::Display| format!("cannot write the table {}: {e}", self.path.display());
+        match &mut self.sink {
+            Sink::Csv(out) => out.flush().and_then(|_| out.get_ref().sync_all()).map_err(|e| fail(&e)),
+            Sink::Arrow { file, writer, ticks, columns } => {
+                Self::flush_batch(writer, ticks, columns).map_err(|e| fail(&e))?;
+                match (writer.take(), file.take()) {
+                    (Some(mut w), _) => {
+                        w.finish().map_err(|e| fail(&e))?;
+                        w.into_inner().and_then(|f| f.sync_all().map_err(Into::into)).map_err(|e| fail(&e))
+                    }
+                    (None, Some(f)) => f.sync_all().map_err(|e| fail(&e)),
+                    (None, None) => Ok(()),
+                }
+            }
         }
-        r
     }
 }
 
@@ -109,33 +197,29 @@ impl Observer for Table {
         if self.error.is_some() {
             return;
         }
-        let mut text = String::new();
-        if self.keys.is_none() {
-            let keys = (
-                t.inputs.keys().cloned().collect(),
-                t.simulated.keys().cloned().collect(),
-                t.prediction.expected.keys().cloned().collect(),
-            );
-            text.push_str(&self.header(t, &keys));
-            text.push('\n');
-            self.keys = Some(keys);
-        }
-        let keys = self.keys.as_ref().expect("set above");
-        text.push_str(&Self::row(t, keys));
-        text.push('\n');
-        if let Err(e) = self.out.write_all(text.as_bytes()) {
-            self.error = Some(format!("cannot write the table {}: {e}", self.partial.display()));
+        let header = match &self.keys {
+            Some(_) => None,
+            None => {
+                let keys: Keys = (
+                    t.inputs.keys().cloned().collect(),
+                    t.simulated.keys().cloned().collect(),
+                    t.prediction.expected.keys().cloned().collect(),
+                );
+                let h = Self::columns(t, &keys);
+                self.keys = Some(keys);
+                Some(h)
+            }
+        };
+        let values = Self::values(t, self.keys.as_ref().expect("set above"));
+        if let Err(e) = self.write(t.snapshot.tick, header, values) {
+            self.error = Some(e);
         }
     }
 
     fn close(&mut self, _tick: u64, _report: &ScenarioReport) -> Result<(), String> {
         let written = match self.error.take() {
             Some(e) => Err(e),
-            None => self
-                .out
-                .flush()
-                .and_then(|_| self.out.get_ref().sync_all())
-                .map_err(|e| format!("cannot write the table {}: {e}", self.path.display())),
+            None => self.finish_file(),
         };
         match written {
             Ok(()) => crate::output::commit(&self.partial, &self.path),
