@@ -1,10 +1,13 @@
 //! A mechanism described in a scenario file (`mechanism = "custom"` and a `[structure]`
 //! table): no analytic model, only what the dynamics can check on their own (settling, the
 //! force balance, cable slackness, member forces, stability, interference), plus optional
-//! expected values given in the file (`[[checks]]` with `value`).
+//! expected values given in the file (`[[checks]]` with `value`) and the file's own model
+//! (`[params]`, `[[quantities]]`, `[[predictions]]`, `[[equations]]`, `[energy]`: see
+//! `crate::model`).
 
 use crate::mechanisms::{
-    Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Prediction, QuantityKind, QuantitySpec, Solution, Values,
+    Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction, QuantityKind,
+    QuantitySpec, Solution, Values,
 };
 use crate::snapshot::Snapshot;
 use crate::structure::{ActuatorTarget, Structure};
@@ -17,6 +20,16 @@ pub struct Custom {
     spec: MechanismSpec,
     /// Expected values from the file's checks, by quantity.
     pub expected: Values,
+}
+
+/// A parameter a custom file declares in `[params]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FileParam {
+    pub symbol: String,
+    /// Its value in the file (an expression's value once evaluated).
+    pub value: f64,
+    pub unit: String,
+    pub description: String,
 }
 
 /// Leaks a string for the `'static` specs of a file-described mechanism (one per file).
@@ -69,7 +82,7 @@ impl Custom {
             structure,
             spec: MechanismSpec {
                 name: "custom",
-                title: "a structure described in the scenario file (no analytic model)",
+                title: "a structure described in the scenario file (its model, if any, stated there too)",
                 params: &[],
                 inputs: Box::leak(inputs.into_boxed_slice()),
                 quantities: Box::leak(quantities.into_boxed_slice()),
@@ -79,6 +92,22 @@ impl Custom {
             },
             expected,
         }
+    }
+
+    /// The mechanism with the parameters its file declares (their values are the defaults).
+    pub fn with_params(mut self, params: Vec<FileParam>) -> Self {
+        let specs: Vec<ParamSpec> = params
+            .into_iter()
+            .map(|p| ParamSpec {
+                symbol: leak(p.symbol),
+                unit: leak(p.unit),
+                default: p.value,
+                description: leak(p.description),
+                origin: Origin::Paper,
+            })
+            .collect();
+        self.spec.params = Box::leak(specs.into_boxed_slice());
+        self
     }
 
     /// Axial force of each strut whose force can be read ([`strut_reading`]), tension positive

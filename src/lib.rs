@@ -10,6 +10,7 @@ pub mod export;
 pub mod figures;
 pub mod import;
 pub mod mechanisms;
+pub mod model;
 pub mod observers;
 pub mod output;
 pub mod report;

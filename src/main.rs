@@ -49,8 +49,10 @@ enum Command {
         #[arg(required = true)]
         scenarios: Vec<PathBuf>,
     },
-    /// List the mechanisms, their parameters (units, defaults) and their queries.
-    List,
+    /// List the mechanisms, their parameters (units, defaults) and their queries; with a
+    /// scenario file, that file's mechanism (a custom file's own parameters with their values)
+    /// and the symbols its model's expressions may use.
+    List { scenario: Option<PathBuf> },
     /// Settle every point of a scenario's grid in parallel; write a CSV and a JSON summary.
     Sweep {
         scenario: PathBuf,
@@ -282,7 +284,8 @@ fn dispatch(cli: Cli) -> i32 {
             }
             Err(code) => code,
         },
-        Command::List => cmd_list(),
+        Command::List { scenario: None } => cmd_list(),
+        Command::List { scenario: Some(file) } => cmd_list_file(&file),
         Command::Sweep { scenario, out, json, jobs, shard } => {
             cmd_sweep(&scenario, out.as_deref(), json.as_deref(), jobs, shard.as_deref())
         }
@@ -591,33 +594,60 @@ fn cmd_merge(csvs: &[PathBuf], out: &Path, partial: bool) -> i32 {
 
 fn cmd_list() -> i32 {
     for m in mechanisms::registry() {
-        println!("{}: {}", m.name(), m.title());
-        println!("  parameters:");
-        for p in m.params() {
-            let origin = match p.origin {
-                Origin::Paper => "paper",
-                Origin::ModelChoice => "model choice",
-            };
-            println!("    {:<12} [{}] default {} ({}): {}", p.symbol, p.unit, p.default, origin, p.description);
-        }
-        println!("  inputs:");
-        for i in m.inputs() {
-            println!("    {:<12} [{}] {}", i.symbol, i.unit, i.description);
-        }
-        println!("  start keys ([start] table):");
-        for (k, what) in m.start_keys() {
-            println!("    {k:<16} {what}");
-        }
-        println!("  checkable quantities:");
-        for q in m.quantities() {
-            println!("    {:<12} [{}] {}", q.symbol, q.unit, q.description);
-        }
-        println!("  queries (tensegrity solve {} QUERY --set NAME=VALUE ...):", m.name());
-        for q in m.queries() {
-            println!("    {:<12} inputs {}: {}", q.name, q.inputs.join(" "), q.description);
-        }
+        print_mechanism(m.as_ref());
     }
     EXIT_PASS
+}
+
+/// `list FILE`: the file's mechanism with the parameter values the file gives, then the
+/// symbols of its model section, if it has one.
+fn cmd_list_file(file: &std::path::Path) -> i32 {
+    let sc = match load_all(&[file.to_path_buf()]) {
+        Ok(mut list) => list.remove(0),
+        Err(code) => return code,
+    };
+    let m = sc.mechanism();
+    print_mechanism(m.as_ref());
+    println!("  parameter values in {}:", file.display());
+    for (k, v) in &sc.params {
+        println!("    {k:<12} = {v}");
+    }
+    if let Some(model) = &sc.model {
+        println!("  model symbols (for [[quantities]], [[predictions]], [[equations]]):");
+        println!("    {}", model.names().join(" "));
+    }
+    EXIT_PASS
+}
+
+/// A mechanism's parameters, inputs, start keys, quantities and queries.
+fn print_mechanism(m: &dyn mechanisms::Mechanism) {
+    println!("{}: {}", m.name(), m.title());
+    println!("  parameters:");
+    for p in m.params() {
+        let origin = match p.origin {
+            // A custom file's own parameters.
+            _ if m.name() == "custom" => "file",
+            Origin::Paper => "paper",
+            Origin::ModelChoice => "model choice",
+        };
+        println!("    {:<12} [{}] default {} ({}): {}", p.symbol, p.unit, p.default, origin, p.description);
+    }
+    println!("  inputs:");
+    for i in m.inputs() {
+        println!("    {:<12} [{}] {}", i.symbol, i.unit, i.description);
+    }
+    println!("  start keys ([start] table):");
+    for (k, what) in m.start_keys() {
+        println!("    {k:<16} {what}");
+    }
+    println!("  checkable quantities:");
+    for q in m.quantities() {
+        println!("    {:<12} [{}] {}", q.symbol, q.unit, q.description);
+    }
+    println!("  queries (tensegrity solve {} QUERY --set NAME=VALUE ...):", m.name());
+    for q in m.queries() {
+        println!("    {:<12} inputs {}: {}", q.name, q.inputs.join(" "), q.description);
+    }
 }
 
 /// Writes `text` to `out` (never over an input, `output::check_outputs`), or to stdout

@@ -46,6 +46,44 @@ pub struct ScenarioReport {
     pub trajectory_ranges: std::collections::BTreeMap<String, QuantityRange>,
     /// Why the run stopped early (divergence, interruption), if it did.
     pub error: Option<String>,
+    /// The file's own model: its `[[predictions]]` and `[[equations]]`, judged (absent from the
+    /// JSON when the file states none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub model_checks: Vec<ModelCheckReport>,
+}
+
+/// A `[[predictions]]` or `[[equations]]` entry of the scenario file's model, judged at every
+/// settle point (the verdict) and at every tick (transient errors, reported only).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ModelCheckReport {
+    /// "prediction", "equation" or "energy".
+    pub kind: String,
+    pub name: String,
+    /// A prediction's error class (length [m], angle [rad, wrapped], relative); "residual" for
+    /// an equation (|residual|); "coordinates" for the energy model (the largest coordinate
+    /// difference from the settled state to the stationary point it landed on, infinite when
+    /// that point is not a minimum).
+    pub class: String,
+    /// Largest error over the settle points (infinite at a point that did not settle).
+    pub max_error: f64,
+    pub tolerance: f64,
+    pub passed: bool,
+    pub points_compared: usize,
+    pub transient_max_error: f64,
+    pub transient_rms_error: f64,
+    pub ticks_compared: u64,
+}
+
+impl ModelCheckReport {
+    /// The failure this entry is when it does not pass (`prediction:NAME`, `equation:NAME`).
+    pub fn failure(&self) -> crate::settings::Failure {
+        use crate::settings::Failure;
+        match self.kind.as_str() {
+            "equation" => Failure::Equation(self.name.clone()),
+            "energy" => Failure::Energy,
+            _ => Failure::Prediction(self.name.clone()),
+        }
+    }
 }
 
 /// Smallest, largest and smallest absolute value of a quantity over the ticks of a trajectory.
@@ -135,6 +173,35 @@ pub struct PointReport {
     pub interference_free: Option<bool>,
     /// The paper's printed values at this point, where it prints any (never checked).
     pub paper: Option<PaperValues>,
+    /// The file's `[energy]` model at this point: its stationary points and which one the
+    /// dynamics landed on (absent without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub energy: Option<EnergyPointReport>,
+}
+
+/// The stationary points of a file's energy model at one settle point.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct EnergyPointReport {
+    /// The coordinates read off the settled state.
+    pub measured: Values,
+    /// Every stationary point found (from the settled state and the scan), in that order.
+    pub stationary: Vec<StationaryReport>,
+    /// The index in `stationary` of the one nearest the settled state.
+    pub landed: Option<usize>,
+    /// Largest coordinate difference (angles wrapped) from the settled state to it.
+    pub distance: f64,
+}
+
+/// One stationary point of an energy model.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct StationaryReport {
+    pub coordinates: Values,
+    /// Potential energy there.
+    pub energy: f64,
+    /// The Hessian's eigenvalues, ascending: the stiffnesses along its eigenvectors.
+    pub eigenvalues: Vec<f64>,
+    /// minimum, maximum, saddle or degenerate.
+    pub kind: String,
 }
 
 /// A paper's own printed values at a point: its source (table, column) and the values.
@@ -321,6 +388,7 @@ impl ScenarioReport {
     fn write_table(&self, out: &mut String) {
         self.table_header(out);
         self.table_checks(out);
+        self.table_model(out);
         self.table_probe(out);
         self.table_slack(out);
         self.table_workspace(out);
@@ -363,6 +431,31 @@ impl ScenarioReport {
                 c.transient_max_abs_error,
                 c.transient_rms_abs_error,
                 if c.passed { "pass" } else { "FAIL" }
+            ));
+        }
+    }
+
+    /// One row per prediction and equation of the file's model.
+    fn table_model(&self, out: &mut String) {
+        if self.model_checks.is_empty() {
+            return;
+        }
+        let w = self.model_checks.iter().map(|c| c.name.len()).max().unwrap_or(0).max("model".len());
+        out.push_str(&format!(
+            "   {:<w$} {:>12} {:>10} {:>12} {:>12}  {}\n",
+            "model", "max err", "tolerance", "transient", "rms trans.", "verdict"
+        ));
+        for c in &self.model_checks {
+            out.push_str(&format!(
+                "   {:<w$} {:>12.3e} {:>10.1e} {:>12.3e} {:>12.3e}  {} ({} {})\n",
+                c.name,
+                c.max_error,
+                c.tolerance,
+                c.transient_max_error,
+                c.transient_rms_error,
+                if c.passed { "pass" } else { "FAIL" },
+                c.kind,
+                c.class
             ));
         }
     }

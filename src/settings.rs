@@ -175,11 +175,28 @@ pub enum Failure {
     Interference,
     /// A workspace sweep's agreement fell below `workspace.min_agreement_percent`: `workspace`.
     Workspace,
+    /// A `[[predictions]]` entry of the file's model exceeded its tolerance: `prediction:NAME`.
+    Prediction(String),
+    /// A `[[equations]]` residual exceeded its tolerance: `equation:NAME`.
+    Equation(String),
+    /// The dynamics settled away from the `[energy]` model's minima: `energy`.
+    Energy,
 }
 
 /// The names a scenario may give in `[expect] failing` (a check is `check:QUANTITY`).
-pub const FAILURE_NAMES: &[&str] =
-    &["error", "settle", "check:QUANTITY", "probe", "stability", "slack", "interference", "workspace"];
+pub const FAILURE_NAMES: &[&str] = &[
+    "error",
+    "settle",
+    "check:QUANTITY",
+    "probe",
+    "stability",
+    "slack",
+    "interference",
+    "workspace",
+    "prediction:NAME",
+    "equation:NAME",
+    "energy",
+];
 
 impl fmt::Display for Failure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -192,6 +209,9 @@ impl fmt::Display for Failure {
             Failure::Slack => f.write_str("slack"),
             Failure::Interference => f.write_str("interference"),
             Failure::Workspace => f.write_str("workspace"),
+            Failure::Prediction(n) => write!(f, "prediction:{n}"),
+            Failure::Equation(n) => write!(f, "equation:{n}"),
+            Failure::Energy => f.write_str("energy"),
         }
     }
 }
@@ -207,6 +227,13 @@ impl std::str::FromStr for Failure {
             "slack" => Failure::Slack,
             "interference" => Failure::Interference,
             "workspace" => Failure::Workspace,
+            "energy" => Failure::Energy,
+            _ if s.strip_prefix("prediction:").is_some_and(|n| !n.is_empty()) => {
+                Failure::Prediction(s["prediction:".len()..].to_string())
+            }
+            _ if s.strip_prefix("equation:").is_some_and(|n| !n.is_empty()) => {
+                Failure::Equation(s["equation:".len()..].to_string())
+            }
             _ => match s.strip_prefix("check:") {
                 Some(q) if !q.is_empty() => Failure::Check(q.to_string()),
                 _ => return Err(format!("unknown failure '{s}' (expected one of: {})", FAILURE_NAMES.join(", "))),

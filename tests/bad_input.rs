@@ -66,7 +66,8 @@ fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
         ("unknown sim key", JI.replace("dt = 0.01", "dtt = 0.01"), 7, "unknown"),
         ("unknown settle key", JI.replace("max_time = 10.0", "maxtime = 10.0"), 9, "unknown"),
         ("unknown actuation key", JI.replace("points =", "pointz ="), 11, "unknown field"),
-        ("wrong type for a parameter", JI.replace("L = 1.0", "L = \"one\""), 4, "invalid type"),
+        ("wrong type for a parameter", JI.replace("L = 1.0", "L = true"), 4, "invalid type"),
+        ("unknown symbol in a parameter", JI.replace("L = 1.0", "L = \"one\""), 4, "unknown symbol 'one'"),
         ("wrong type for substeps", JI.replace("dt = 0.01", "dt = 0.01\nsubsteps = 1.5"), 8, "invalid type"),
         ("missing mechanism", JI.replace("mechanism = \"ji2014\"\n", ""), 1, "mechanism"),
         ("missing actuation", JI.replace("[actuation]\npoints = [ { L3 = 1.0, theta1 = 0.5 } ]\n", ""), 1, "actuation"),
@@ -148,7 +149,9 @@ fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
         ("manriquez2019 negative mass", MQ.replace("[actuation]", "[params]\nm = -0.4\n[actuation]"), 4, "> 0"),
         // Vectors of the wrong length or type (a 4th and 5th entry used to be ignored).
         ("node with 4 coordinates", PIN.replace("Q = [1.0, 0.0, 0.0]", "Q = [1.0, 0.0, 0.0, 2.0]"), 14, "three"),
-        ("node with junk and nan", PIN.replace("Q = [1.0, 0.0, 0.0]", "Q = [0, 1, 0, \"junk\", nan]"), 14, "invalid type"),
+        // A string is an expression of the parameters (none here).
+        ("node with junk and nan", PIN.replace("Q = [1.0, 0.0, 0.0]", "Q = [0, 1, 0, \"junk\", nan]"), 14, "unknown symbol 'junk'"),
+        ("node with a fourth number", PIN.replace("Q = [1.0, 0.0, 0.0]", "Q = [0, 1, 0, 2]"), 14, "three finite numbers"),
         ("axis with 5 entries", PIN.replace("axis = [0.0, 0.0, 1.0]", "axis = [0.0, 0.0, 1.0, 0.0, 0.0]"), 31, "three"),
         ("gravity with 4 entries", PIN.replace("gravity = [0.0, 0.0, 0.0]", "gravity = [0.0, 0.0, 0.0, 9.81]"), 6, "three"),
         ("node at 1e300", PIN.replace("S = [1.0, 1.0, 0.0]", "S = [1e300, 1.0, 0.0]"), 10, "magnitude"),

@@ -1,13 +1,15 @@
 //! Observers watch a run: each is fed one snapshot per tick and each settle point, and puts
 //! what it gathered into the report at the end. They are held as one list ([`observers`]):
 //! `compare` (analytic versus simulated), `slack` (cable slackness intervals), `interference`
-//! (parry distances between struts) and `record` (rerun).
+//! (parry distances between struts), `model` (the scenario file's own model) and `record`
+//! (rerun).
 //!
 //! Adding an observer: its own file here implementing [`Observer`], and one line in
 //! [`observers`].
 
 pub mod compare;
 pub mod interference;
+pub mod model;
 pub mod record;
 pub mod slack;
 pub mod table;
@@ -79,6 +81,8 @@ pub struct Setup<'a> {
     /// The mechanism's length scale [m], for normalised errors.
     pub length_scale_m: f64,
     pub interference: &'a InterferenceSettings,
+    /// The scenario file's own model (`[[quantities]]`, `[[predictions]]`, `[[equations]]`).
+    pub model: Option<&'a crate::model::spec::ModelSpec>,
     /// A recording, when the run writes one (made last: nothing is written when another
     /// observer cannot start).
     pub recording: Option<record::Recording<'a>>,
@@ -91,6 +95,9 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
     let mut list: Vec<Box<dyn Observer>> =
         vec![Box::new(compare::Compare::new(setup.checks, setup.length_scale_m)), Box::new(slack::SlackTracker::new())];
     list.push(Box::new(interference::Interference::new(setup.structure, setup.interference)?));
+    if let Some(spec) = setup.model {
+        list.push(Box::new(model::ModelObserver::new(spec, setup.structure, setup.recording.is_some())));
+    }
     if let Some(path) = &setup.table {
         list.push(Box::new(table::Table::start(path)?));
     }

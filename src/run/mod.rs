@@ -84,6 +84,7 @@ fn empty_report(sc: &Scenario) -> ScenarioReport {
         findings: vec![],
         trajectory_ranges: Default::default(),
         error: None,
+        model_checks: vec![],
     }
 }
 
@@ -187,6 +188,7 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         checks: &sc.checks,
         length_scale_m: mech.length_scale(&sc.params),
         interference: &sc.interference,
+        model: sc.model.as_ref(),
         recording: target.map(|target| Recording { target, every: opts.record_every.max(1), scenario: &sc.source }),
         table: opts.table.clone(),
     })?;

@@ -203,6 +203,7 @@ pub(super) fn settle_point(
         within_tolerance: false,
         min_clearance_m: None,
         interference_free: None,
+        energy: None,
         paper: runner
             .mech
             .paper_values(&sc.params, inputs)

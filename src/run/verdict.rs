@@ -27,6 +27,7 @@ pub fn failures(report: &ScenarioReport, min_agreement_percent: Option<f64>) -> 
             out.push(Failure::Settle);
         }
         out.extend(report.checks.iter().filter(|c| !c.passed).map(|c| Failure::Check(c.quantity.clone())));
+        out.extend(report.model_checks.iter().filter(|c| !c.passed).map(|c| c.failure()));
         if report.stiffness_probe.as_ref().is_some_and(|p| !p.passed) {
             out.push(Failure::Probe);
         }

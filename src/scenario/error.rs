@@ -38,9 +38,26 @@ impl Ctx<'_> {
     }
 }
 
+/// A number read from the file: a plain one, or an expression's value.
+pub(super) trait Numeric {
+    fn number(&self) -> f64;
+}
+
+impl Numeric for f64 {
+    fn number(&self) -> f64 {
+        *self
+    }
+}
+
+impl Numeric for super::number::Num {
+    fn number(&self) -> f64 {
+        self.value()
+    }
+}
+
 /// The value, if it is a finite number.
-pub(super) fn finite(ctx: &Ctx, v: &Spanned<f64>, what: &str) -> Result<f64, ScenarioError> {
-    let x = *v.get_ref();
+pub(super) fn finite<N: Numeric>(ctx: &Ctx, v: &Spanned<N>, what: &str) -> Result<f64, ScenarioError> {
+    let x = v.get_ref().number();
     if x.is_finite() {
         Ok(x)
     } else {
@@ -49,7 +66,7 @@ pub(super) fn finite(ctx: &Ctx, v: &Spanned<f64>, what: &str) -> Result<f64, Sce
 }
 
 /// The value, if it is a finite number > 0.
-pub(super) fn positive_value(ctx: &Ctx, v: &Spanned<f64>, what: &str) -> Result<f64, ScenarioError> {
+pub(super) fn positive_value<N: Numeric>(ctx: &Ctx, v: &Spanned<N>, what: &str) -> Result<f64, ScenarioError> {
     let x = finite(ctx, v, what)?;
     if x > 0.0 {
         Ok(x)
@@ -99,9 +116,9 @@ pub(super) fn value_at<V>(map: &BTreeMap<Spanned<String>, Spanned<V>>, key: &str
 
 /// Rejects the first key of `map` that is not in `known`: "unknown {what} 'k' for {mechanism}
 /// (expected one of: ...)".
-pub(super) fn known_keys(
+pub(super) fn known_keys<V>(
     ctx: &Ctx,
-    map: &SpannedMap,
+    map: &BTreeMap<Spanned<String>, V>,
     known: &[&str],
     what: &str,
     mechanism: &str,

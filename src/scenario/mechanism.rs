@@ -1,9 +1,10 @@
 //! `mechanism` and `[structure]`: a built-in mechanism by name, or the file's own structure.
 
 use super::error::{finite, Ctx, ScenarioError};
+use super::number::{param_values, resolve_structure, ParamMap};
 use super::raw::RawScenario;
 use super::structure::structure_from_file;
-use crate::custom::Custom;
+use crate::custom::{Custom, FileParam};
 use crate::mechanisms::{self, Mechanism, Values};
 
 /// `mechanism = "custom"`: the mechanism built from the `[structure]` table, with each check's
@@ -12,7 +13,10 @@ use crate::mechanisms::{self, Mechanism, Values};
 pub(super) fn custom(ctx: &Ctx, raw: &RawScenario) -> Result<Option<Custom>, ScenarioError> {
     match (raw.mechanism.get_ref().as_str(), &raw.structure) {
         ("custom", Some(st)) => {
-            let structure = structure_from_file(ctx, st)?;
+            let params = param_values(ctx, &raw.params)?;
+            let mut st = st.clone();
+            resolve_structure(ctx, st.get_mut(), &params)?;
+            let structure = structure_from_file(ctx, &st)?;
             let mut expected = Values::new();
             for c in &raw.checks {
                 let v = c.value.as_ref().ok_or_else(|| {
@@ -23,7 +27,7 @@ pub(super) fn custom(ctx: &Ctx, raw: &RawScenario) -> Result<Option<Custom>, Sce
                 })?;
                 expected.insert(c.quantity.get_ref().clone(), finite(ctx, v, "value")?);
             }
-            Ok(Some(Custom::new(structure, expected)))
+            Ok(Some(Custom::new(structure, expected).with_params(param_specs(&raw.params, &params))))
         }
         ("custom", None) => Err(ctx.err(
             &raw.mechanism,
@@ -60,4 +64,22 @@ pub(super) fn mechanism(
             )
         }),
     }
+}
+
+/// The parameters a custom file declares: each with its value, unit and description.
+fn param_specs(raw: &ParamMap, values: &Values) -> Vec<FileParam> {
+    raw.iter()
+        .map(|(k, p)| {
+            let p = p.get_ref();
+            FileParam {
+                symbol: k.get_ref().clone(),
+                value: values.get(k.get_ref()).copied().unwrap_or(f64::NAN),
+                unit: p.unit.clone().unwrap_or_else(|| "-".into()),
+                description: p.description.clone().unwrap_or_else(|| match &p.value {
+                    super::number::Num::Expr(e) => format!("= {e}"),
+                    super::number::Num::Value(_) => "from the file".into(),
+                }),
+            }
+        })
+        .collect()
 }

@@ -11,10 +11,13 @@
 mod actuation;
 mod bounds;
 mod checks;
+mod energy;
 mod error;
 mod expect;
 mod interference;
 mod mechanism;
+mod model;
+mod number;
 mod params;
 mod physical;
 mod raw;
@@ -60,6 +63,8 @@ pub struct Scenario {
     pub custom: Option<crate::custom::Custom>,
     /// `[expect]`: what the run must do, if the file declares it.
     pub expect: Option<crate::settings::Expectation>,
+    /// `[[quantities]]`, `[[predictions]]`, `[[equations]]`: the file's own model, if any.
+    pub model: Option<crate::model::spec::ModelSpec>,
 }
 
 impl Scenario {
@@ -144,8 +149,9 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let (actuation, skipped_points) = actuation::actuation(ctx, m, &params, &raw.actuation)?;
     bounds::bounds(ctx, &raw, &sim, &settle, &actuation)?;
     let checks = checks::checks(ctx, m, &raw.checks, raw.probe.is_some())?;
+    let model = model::model(ctx, &raw, m, &params, &start, &actuation)?;
     // A custom structure is checked by its settling and force balance even without [[checks]].
-    if checks.is_empty() && raw.probe.is_none() && custom.is_none() {
+    if checks.is_empty() && raw.probe.is_none() && custom.is_none() && model.is_none() {
         return Err(ctx
             .err_at(0, "the scenario checks nothing: add at least one [[checks]] entry (quantity, tolerance)".into()));
     }
@@ -182,5 +188,6 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         skipped_points,
         custom,
         expect,
+        model,
     })
 }

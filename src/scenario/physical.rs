@@ -42,9 +42,13 @@ pub(super) fn physical(
     sim: &SimSettings,
 ) -> Result<(), ScenarioError> {
     // The parameter most likely to set a size: the one farthest from 1 in order of magnitude.
+    // (A parameter given as an expression counts as order 0.)
     let extreme = raw.params.iter().max_by(|a, b| {
-        let order = |v: f64| v.abs().ln().abs();
-        order(*a.1.get_ref()).total_cmp(&order(*b.1.get_ref()))
+        let order = |p: &super::number::RawParam| match p.value {
+            super::number::Num::Value(v) => v.abs().ln().abs(),
+            super::number::Num::Expr(_) => 0.0,
+        };
+        order(a.1.get_ref()).total_cmp(&order(b.1.get_ref()))
     });
     let at_model = |message: String| {
         let e = match (extreme.map(|(k, _)| k), &raw.structure) {

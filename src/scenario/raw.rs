@@ -1,6 +1,7 @@
 //! The shape of a scenario file, as serde reads it: every value keeps its span, so that
 //! [`super::validate`] can name the line and column of a value it rejects.
 
+use super::number::{Num, ParamMap};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use toml::Spanned;
@@ -14,8 +15,9 @@ pub(super) struct RawScenario {
     #[serde(default)]
     pub(super) description: String,
     pub(super) mechanism: Spanned<String>,
+    /// Numbers, expressions of other parameters, or tables { value, unit, description }.
     #[serde(default)]
-    pub(super) params: SpannedMap,
+    pub(super) params: ParamMap,
     #[serde(default)]
     pub(super) sim: RawSim,
     #[serde(default)]
@@ -41,6 +43,74 @@ pub(super) struct RawScenario {
     /// What the run must do: pass, or fail in named parts.
     #[serde(default)]
     pub(super) expect: Option<Spanned<RawExpect>>,
+    /// The file's own model: named expressions of the state.
+    #[serde(default)]
+    pub(super) quantities: Vec<RawQuantity>,
+    /// Closed forms of the parameters and inputs compared with the state.
+    #[serde(default)]
+    pub(super) predictions: Vec<RawPrediction>,
+    /// Residuals that must vanish at every settled state.
+    #[serde(default)]
+    pub(super) equations: Vec<RawEquation>,
+    /// A potential energy in named coordinates: its stationary points and the one the
+    /// dynamics landed on.
+    #[serde(default)]
+    pub(super) energy: Option<RawEnergy>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawEnergy {
+    /// An expression of the coordinates, parameters, inputs and their quantities [J].
+    pub(super) potential: Spanned<String>,
+    /// On the largest coordinate difference from the settled state to its stationary point.
+    pub(super) tolerance: Spanned<f64>,
+    pub(super) coordinates: Vec<RawCoordinate>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawCoordinate {
+    pub(super) name: Spanned<String>,
+    /// An expression of the state giving the coordinate at a settled point.
+    pub(super) measured: Spanned<String>,
+    /// angle (compared wrapped) or length.
+    pub(super) class: Spanned<String>,
+    /// Further Newton starts.
+    pub(super) scan: Option<Spanned<RawRange>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawQuantity {
+    pub(super) name: Spanned<String>,
+    /// An expression of the state, the parameters, the inputs, `t` and earlier quantities.
+    pub(super) expr: Spanned<String>,
+    /// For the listing and the report (default "-").
+    pub(super) unit: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawPrediction {
+    /// The compared symbol: a `[[quantities]]` name, a node coordinate, an observed quantity.
+    pub(super) quantity: Spanned<String>,
+    /// The name in the report and in `[expect] failing` (default: the quantity's).
+    pub(super) name: Option<Spanned<String>>,
+    /// A closed form of the parameters and inputs.
+    pub(super) formula: Spanned<String>,
+    /// length (m), angle (rad, wrapped) or relative.
+    pub(super) class: Spanned<String>,
+    pub(super) tolerance: Spanned<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawEquation {
+    pub(super) name: Spanned<String>,
+    /// An expression that must vanish at every settled state (same symbols as a quantity).
+    pub(super) residual: Spanned<String>,
+    pub(super) tolerance: Spanned<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -54,11 +124,12 @@ pub(super) struct RawExpect {
     pub(super) failing: Vec<Spanned<String>>,
 }
 
-/// Three coordinates; read as a list so that a list of another length is an error at its place
-/// (serde's fixed-size arrays left trailing entries unread).
-pub(super) type Xyz = Spanned<Vec<f64>>;
+/// Three coordinates, each a number or an expression of the parameters; read as a list so
+/// that a list of another length is an error at its place (serde's fixed-size arrays left
+/// trailing entries unread).
+pub(super) type Xyz = Spanned<Vec<Spanned<Num>>>;
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawStructure {
     /// Gravity [m/s^2] (default none).
@@ -85,14 +156,14 @@ pub(super) struct RawStructure {
     pub(super) cable_groups: Vec<RawMemberGroup>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawBody {
     pub(super) name: Spanned<String>,
     /// Welded to the world (default false).
     pub(super) fixed: Option<bool>,
     /// Mass of a free body [kg].
-    pub(super) mass: Option<Spanned<f64>>,
+    pub(super) mass: Option<Spanned<Num>>,
     /// Principal moments about the centre of mass, along the world axes [kg m^2] (default:
     /// isotropic, mass times the square of the body's size over 12).
     pub(super) inertia: Option<Xyz>,
@@ -101,7 +172,7 @@ pub(super) struct RawBody {
 }
 
 /// A strut, spring or cable between two named nodes.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawMember {
     pub(super) name: Spanned<String>,
@@ -109,15 +180,15 @@ pub(super) struct RawMember {
     pub(super) b: Spanned<String>,
     /// Radius [m] for interference and drawing (struts: default 0.01; cables and springs:
     /// default 0.001).
-    pub(super) radius: Option<Spanned<f64>>,
+    pub(super) radius: Option<Spanned<Num>>,
     /// Springs: stiffness [N/m] (required); cables: stiffness of an elastic cable (absent:
     /// inextensible).
-    pub(super) stiffness: Option<Spanned<f64>>,
+    pub(super) stiffness: Option<Spanned<Num>>,
     /// Springs: free length [m]; cables: unstretched length [m]. Absent: the initial distance.
-    pub(super) length: Option<Spanned<f64>>,
+    pub(super) length: Option<Spanned<Num>>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawJoint {
     pub(super) name: Spanned<String>,
@@ -132,13 +203,16 @@ pub(super) struct RawJoint {
     pub(super) axis2: Option<Xyz>,
     /// Revolute joints: a linear torsion spring [N m/rad], at rest in the given geometry plus
     /// `torsion_rest` [rad].
-    pub(super) torsion_stiffness: Option<Spanned<f64>>,
-    pub(super) torsion_rest: Option<Spanned<f64>>,
+    pub(super) torsion_stiffness: Option<Spanned<Num>>,
+    pub(super) torsion_rest: Option<Spanned<Num>>,
     /// Viscous damping [N m s/rad or N s/m].
-    pub(super) damping: Option<Spanned<f64>>,
+    pub(super) damping: Option<Spanned<Num>>,
+    /// The joint's coordinate in the drawn geometry [rad or m] (default 0): an actuator's
+    /// command is then the coordinate itself, not its change from the drawing.
+    pub(super) initial_coordinate: Option<Spanned<Num>>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawActuator {
     pub(super) symbol: Spanned<String>,
@@ -269,7 +343,7 @@ pub(super) struct RawRecord {
 
 /// Members of one kind sharing their properties: one member per node pair, named
 /// "<name>:<a>-<b>" or by `names` (one per pair, in order).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawMemberGroup {
     pub(super) name: Spanned<String>,
@@ -277,7 +351,7 @@ pub(super) struct RawMemberGroup {
     pub(super) pairs: Spanned<Vec<Spanned<Vec<Spanned<String>>>>>,
     pub(super) names: Option<Spanned<Vec<Spanned<String>>>>,
     /// As in [`RawMember`]: struts' radius, springs' and cables' stiffness and length.
-    pub(super) radius: Option<Spanned<f64>>,
-    pub(super) stiffness: Option<Spanned<f64>>,
-    pub(super) length: Option<Spanned<f64>>,
+    pub(super) radius: Option<Spanned<Num>>,
+    pub(super) stiffness: Option<Spanned<Num>>,
+    pub(super) length: Option<Spanned<Num>>,
 }

@@ -95,9 +95,10 @@ fn structure_error_at(ctx: &Ctx, raw: &Spanned<RawStructure>, e: crate::structur
     }
 }
 
-/// Three finite numbers.
+/// Three finite numbers (the parameters' expressions already evaluated).
 fn xyz(ctx: &Ctx, v: &Xyz, what: &str) -> Result<[f64; 3], ScenarioError> {
-    match v.get_ref().as_slice() {
+    let a: Vec<f64> = v.get_ref().iter().map(|c| c.get_ref().value()).collect();
+    match a.as_slice() {
         &[x, y, z] if [x, y, z].iter().all(|c| c.is_finite() && c.abs() <= MAX_COORDINATE_M) => Ok([x, y, z]),
         a => Err(ctx.err(
             v,
@@ -282,7 +283,10 @@ fn joint(ctx: &Ctx, s: &Structure, j: &RawJoint) -> Result<Joint, ScenarioError>
         parent,
         child,
         anchor: at,
-        initial_coordinate: 0.0,
+        initial_coordinate: match &j.initial_coordinate {
+            Some(v) => finite(ctx, v, "initial_coordinate")?,
+            None => 0.0,
+        },
         torsion_spring,
         damping,
     })

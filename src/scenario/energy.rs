@@ -1,0 +1,86 @@
+//! `[energy]`: a potential in named coordinates, compiled with its symbolic gradient and
+//! Hessian into an [`EnergySpec`]; each coordinate with how it is read off the settled state.
+
+use super::error::{finite, positive_value, Ctx, ScenarioError};
+use super::number::expr_error;
+use super::raw::{RawCoordinate, RawEnergy, RawRange};
+use crate::model::energy::{Coordinate, EnergySpec};
+use crate::model::expr::Expr;
+use crate::model::spec::{ErrorClass, ModelSpec};
+use toml::Spanned;
+
+/// Largest number of Newton starts a coordinate's scan may ask for.
+const MAX_SCAN: i64 = 10_000;
+
+/// The compiled `[energy]` section of a model whose other sections are in `spec`.
+pub(super) fn energy(ctx: &Ctx, spec: &ModelSpec, raw: &RawEnergy) -> Result<EnergySpec, ScenarioError> {
+    if raw.coordinates.is_empty() {
+        return Err(
+            ctx.err(&raw.potential, "[energy] needs at least one [[energy.coordinates]] (name, measured, class)")
+        );
+    }
+    let state = spec.names();
+    let mut coordinates = Vec::new();
+    for c in &raw.coordinates {
+        coordinates.push(coordinate(ctx, &state, &coordinates, c)?);
+    }
+    // The potential sees the closed forms (parameters, inputs, their quantities) and the
+    // coordinates.
+    let mut names: Vec<&str> = (0..state.len()).map(|i| if spec.is_closed_form(i) { state[i] } else { "" }).collect();
+    names.extend(coordinates.iter().map(|c: &Coordinate| c.name.as_str()));
+    let at = raw.potential.span().start;
+    let potential = Expr::compile(raw.potential.get_ref(), &names).map_err(|e| {
+        expr_error(ctx, at, &e, "energy potential (coordinates, parameters, inputs and their quantities)")
+    })?;
+    let first = state.len();
+    let derivative =
+        |e: &Expr, i: usize| e.derivative(first + i).map_err(|e| expr_error(ctx, at, &e, "energy potential"));
+    let n = coordinates.len();
+    let gradient: Vec<Expr> = (0..n).map(|i| derivative(&potential, i)).collect::<Result<_, _>>()?;
+    let mut hessian = Vec::with_capacity(n * n);
+    for g in &gradient {
+        for j in 0..n {
+            hessian.push(derivative(g, j)?);
+        }
+    }
+    let tolerance = positive_value(ctx, &raw.tolerance, "energy.tolerance")?;
+    Ok(EnergySpec { potential, gradient, hessian, coordinates, first_coordinate: first, tolerance })
+}
+
+/// One coordinate: a new name, its measured expression of the state, its class and scan.
+fn coordinate(
+    ctx: &Ctx,
+    state: &[&str],
+    before: &[Coordinate],
+    c: &RawCoordinate,
+) -> Result<Coordinate, ScenarioError> {
+    let name = c.name.get_ref().clone();
+    if name.trim().is_empty() || state.contains(&name.as_str()) || before.iter().any(|b| b.name == name) {
+        return Err(ctx.err(
+            &c.name,
+            format!("coordinate name '{name}' must be new (not empty, not a symbol of this scenario, not twice)"),
+        ));
+    }
+    let measured = Expr::compile(c.measured.get_ref(), state)
+        .map_err(|e| expr_error(ctx, c.measured.span().start, &e, &format!("coordinate '{name}' measured")))?;
+    let class = match c.class.get_ref().as_str() {
+        "angle" => ErrorClass::Angle,
+        "length" => ErrorClass::Length,
+        other => {
+            return Err(ctx.err(&c.class, format!("unknown coordinate class '{other}' (expected angle or length)")))
+        }
+    };
+    let scan = c.scan.as_ref().map(|s| scan(ctx, s)).transpose()?;
+    Ok(Coordinate { name, measured, class, scan })
+}
+
+/// A scan: from, to (finite) and a count from 1 to [`MAX_SCAN`].
+fn scan(ctx: &Ctx, s: &Spanned<RawRange>) -> Result<(f64, f64, usize), ScenarioError> {
+    let r = s.get_ref();
+    let (from, to) = (finite(ctx, &r.from, "scan.from")?, finite(ctx, &r.to, "scan.to")?);
+    let n = *r.count.get_ref();
+    if !(1..=MAX_SCAN).contains(&n) {
+        return Err(ctx.err(&r.count, format!("scan.count must be a whole number from 1 to {MAX_SCAN}, got {n}")));
+    }
+    Ok((from, to, n as usize))
+}

@@ -1,0 +1,293 @@
+//! A number or an expression of the file's parameters (`r = 0.5`, `h = "2*r"`), where a
+//! scenario takes a number: `[params]` entries and the numbers of a custom `[structure]`
+//! (node coordinates, gravity, masses, inertias, radii, stiffnesses, lengths, joint axes,
+//! torsion springs, damping, initial coordinates).
+//!
+//! Parameters are evaluated in the order their expressions need (a cycle is an error), then
+//! the structure's expressions with every parameter's value. An error inside an expression
+//! names its `file:LINE:COL` inside the string.
+
+use super::error::{Ctx, ScenarioError};
+use super::raw::{RawBody, RawJoint, RawStructure, Xyz};
+use crate::mechanisms::Values;
+use crate::model::expr::{Expr, ExprError};
+use serde::de::{self, Deserializer, MapAccess, Visitor};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::fmt;
+use toml::Spanned;
+
+/// A number, or an expression of the parameters not evaluated yet.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) enum Num {
+    Value(f64),
+    Expr(String),
+}
+
+impl Num {
+    /// The value (NaN for an expression not evaluated yet, which the finite-number checks
+    /// then reject).
+    pub(super) fn value(&self) -> f64 {
+        match self {
+            Num::Value(x) => *x,
+            Num::Expr(_) => f64::NAN,
+        }
+    }
+}
+
+struct NumVisitor;
+
+impl Visitor<'_> for NumVisitor {
+    type Value = Num;
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a number or an expression string")
+    }
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<Num, E> {
+        Ok(Num::Value(v))
+    }
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<Num, E> {
+        Ok(Num::Value(v as f64))
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<Num, E> {
+        Ok(Num::Value(v as f64))
+    }
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<Num, E> {
+        Ok(Num::Expr(v.to_string()))
+    }
+}
+
+impl<'de> Deserialize<'de> for Num {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Num, D::Error> {
+        d.deserialize_any(NumVisitor)
+    }
+}
+
+/// One `[params]` entry: `r = 0.5`, `h = "2*r"`, or `r = { value = 0.5, unit = "m",
+/// description = "..." }` (value a number or an expression).
+#[derive(Clone, Debug)]
+pub(super) struct RawParam {
+    pub(super) value: Num,
+    /// Where the value lies in the table form (the plain form: the entry's own span).
+    pub(super) value_span: Option<std::ops::Range<usize>>,
+    pub(super) unit: Option<String>,
+    pub(super) description: Option<String>,
+}
+
+struct ParamVisitor;
+
+impl<'de> Visitor<'de> for ParamVisitor {
+    type Value = RawParam;
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a number, an expression string, or a table { value, unit, description }")
+    }
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<RawParam, E> {
+        Ok(RawParam::plain(Num::Value(v)))
+    }
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<RawParam, E> {
+        Ok(RawParam::plain(Num::Value(v as f64)))
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<RawParam, E> {
+        Ok(RawParam::plain(Num::Value(v as f64)))
+    }
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<RawParam, E> {
+        Ok(RawParam::plain(Num::Expr(v.to_string())))
+    }
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<RawParam, A::Error> {
+        let mut p = RawParam { value: Num::Value(f64::NAN), value_span: None, unit: None, description: None };
+        while let Some(key) = map.next_key::<String>()? {
+            match key.as_str() {
+                "value" => {
+                    let v: Spanned<Num> = map.next_value()?;
+                    p.value_span = Some(v.span());
+                    p.value = v.into_inner();
+                }
+                "unit" => p.unit = Some(map.next_value()?),
+                "description" => p.description = Some(map.next_value()?),
+                other => {
+                    return Err(de::Error::unknown_field(other, &["value", "unit", "description"]));
+                }
+            }
+        }
+        if p.value_span.is_none() {
+            return Err(de::Error::missing_field("value"));
+        }
+        Ok(p)
+    }
+}
+
+impl RawParam {
+    fn plain(value: Num) -> Self {
+        RawParam { value, value_span: None, unit: None, description: None }
+    }
+}
+
+impl<'de> Deserialize<'de> for RawParam {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<RawParam, D::Error> {
+        d.deserialize_any(ParamVisitor)
+    }
+}
+
+pub(super) type ParamMap = BTreeMap<Spanned<String>, Spanned<RawParam>>;
+
+/// A scenario error for an expression error inside the string value that starts at byte
+/// `value_start` of the file (its opening quote or quotes).
+pub(super) fn expr_error(ctx: &Ctx, value_start: usize, e: &ExprError, what: &str) -> ScenarioError {
+    let rest = &ctx.source[value_start.min(ctx.source.len())..];
+    let quotes = if rest.starts_with("\"\"\"") || rest.starts_with("'''") { 3 } else { 1 };
+    // Escapes in the string shift the offset; never land inside a character.
+    let mut at = (value_start + quotes + e.offset).min(ctx.source.len());
+    while !ctx.source.is_char_boundary(at) {
+        at -= 1;
+    }
+    ctx.err_at(at, format!("{what}: {}", e.message))
+}
+
+/// Where a parameter's value starts in the file.
+fn param_start(p: &Spanned<RawParam>) -> usize {
+    p.get_ref().value_span.as_ref().map_or(p.span().start, |s| s.start)
+}
+
+/// Every `[params]` entry's value, each expression evaluated with the values of the
+/// parameters it names (a parameter that names itself through others is an error).
+pub(super) fn param_values(ctx: &Ctx, raw: &ParamMap) -> Result<Values, ScenarioError> {
+    let names: Vec<&str> = raw.keys().map(|k| k.get_ref().as_str()).collect();
+    let mut compiled: Vec<(usize, Option<Expr>)> = Vec::new();
+    for (i, (k, p)) in raw.iter().enumerate() {
+        let e = match &p.get_ref().value {
+            Num::Value(_) => None,
+            Num::Expr(text) => Some(
+                Expr::compile(text, &names)
+                    .map_err(|e| expr_error(ctx, param_start(p), &e, &format!("parameter '{}'", k.get_ref())))?,
+            ),
+        };
+        compiled.push((i, e));
+    }
+    let mut values = vec![f64::NAN; names.len()];
+    let mut done = vec![false; names.len()];
+    // Evaluate whatever is ready, as many rounds as there are parameters.
+    for _ in 0..=names.len() {
+        for (i, e) in &compiled {
+            if done[*i] {
+                continue;
+            }
+            match e {
+                None => values[*i] = raw.values().nth(*i).map_or(f64::NAN, |p| p.get_ref().value.value()),
+                Some(e) if e.uses().iter().all(|u| done[*u]) => {
+                    let x = e.eval(&values);
+                    values[*i] = x;
+                }
+                Some(_) => continue,
+            }
+            done[*i] = true;
+        }
+    }
+    let mut out = Values::new();
+    for (i, (k, p)) in raw.iter().enumerate() {
+        if !done[i] {
+            return Err(ctx.err_at(
+                param_start(p),
+                format!("parameter '{}' depends on itself through other parameters", k.get_ref()),
+            ));
+        }
+        if !values[i].is_finite() {
+            return Err(ctx.err_at(
+                param_start(p),
+                format!("parameter '{}' must be a finite number, got {}", k.get_ref(), values[i]),
+            ));
+        }
+        out.insert(k.get_ref().clone(), values[i]);
+    }
+    Ok(out)
+}
+
+/// The value of a number or expression of the parameters `params`.
+fn evaluate(ctx: &Ctx, v: &Spanned<Num>, params: &Values, what: &str) -> Result<f64, ScenarioError> {
+    match v.get_ref() {
+        Num::Value(x) => Ok(*x),
+        Num::Expr(text) => {
+            let names: Vec<&str> = params.keys().map(String::as_str).collect();
+            let values: Vec<f64> = params.values().copied().collect();
+            let e = Expr::compile(text, &names).map_err(|e| expr_error(ctx, v.span().start, &e, what))?;
+            Ok(e.eval(&values))
+        }
+    }
+}
+
+/// Replaces every expression of a custom `[structure]` by its value with `params`.
+pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values) -> Result<(), ScenarioError> {
+    let mut resolve = |v: &mut Spanned<Num>, what: &str| -> Result<(), ScenarioError> {
+        let x = evaluate(ctx, v, params, what)?;
+        *v = Spanned::new(v.span(), Num::Value(x));
+        Ok(())
+    };
+    if let Some(g) = &mut s.gravity {
+        resolve_xyz(g, "gravity", &mut resolve)?;
+    }
+    for b in &mut s.bodies {
+        resolve_body(b, &mut resolve)?;
+    }
+    for m in s.struts.iter_mut().chain(s.springs.iter_mut()).chain(s.cables.iter_mut()) {
+        resolve_member(&mut m.radius, &mut m.stiffness, &mut m.length, &mut resolve)?;
+    }
+    for g in s.strut_groups.iter_mut().chain(s.spring_groups.iter_mut()).chain(s.cable_groups.iter_mut()) {
+        resolve_member(&mut g.radius, &mut g.stiffness, &mut g.length, &mut resolve)?;
+    }
+    for j in &mut s.joints {
+        resolve_joint(j, &mut resolve)?;
+    }
+    Ok(())
+}
+
+type Resolve<'a> = dyn FnMut(&mut Spanned<Num>, &str) -> Result<(), ScenarioError> + 'a;
+
+fn resolve_xyz(v: &mut Xyz, what: &str, resolve: &mut Resolve) -> Result<(), ScenarioError> {
+    v.get_mut().iter_mut().try_for_each(|c| resolve(c, what))
+}
+
+fn resolve_body(b: &mut RawBody, resolve: &mut Resolve) -> Result<(), ScenarioError> {
+    if let Some(m) = &mut b.mass {
+        resolve(m, "mass")?;
+    }
+    if let Some(i) = &mut b.inertia {
+        resolve_xyz(i, "inertia", resolve)?;
+    }
+    for (name, p) in &mut b.nodes {
+        resolve_xyz(p, &format!("a coordinate of node '{}'", name.get_ref()), resolve)?;
+    }
+    Ok(())
+}
+
+/// A member's (or a member group's) radius, stiffness and length.
+fn resolve_member(
+    radius: &mut Option<Spanned<Num>>,
+    stiffness: &mut Option<Spanned<Num>>,
+    length: &mut Option<Spanned<Num>>,
+    resolve: &mut Resolve,
+) -> Result<(), ScenarioError> {
+    for (v, what) in [(radius, "radius"), (stiffness, "stiffness"), (length, "length")] {
+        if let Some(v) = v {
+            resolve(v, what)?;
+        }
+    }
+    Ok(())
+}
+
+fn resolve_joint(j: &mut RawJoint, resolve: &mut Resolve) -> Result<(), ScenarioError> {
+    for (v, what) in [(&mut j.axis, "axis"), (&mut j.axis2, "axis2")] {
+        if let Some(v) = v {
+            resolve_xyz(v, what, resolve)?;
+        }
+    }
+    let fields = [
+        (&mut j.torsion_stiffness, "torsion_stiffness"),
+        (&mut j.torsion_rest, "torsion_rest"),
+        (&mut j.damping, "damping"),
+        (&mut j.initial_coordinate, "initial_coordinate"),
+    ];
+    for (v, what) in fields {
+        if let Some(v) = v {
+            resolve(v, what)?;
+        }
+    }
+    Ok(())
+}
