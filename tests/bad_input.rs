@@ -55,7 +55,6 @@ quantity = "theta1"
 tolerance = 1e-9
 "#;
 
-
 /// (what, scenario text, expected line of the error, a word the message must contain).
 fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
     vec![
@@ -229,7 +228,8 @@ fn an_oversized_scenario_file_is_refused_before_parsing() {
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join("many.toml");
     let points = vec!["{ L3 = 1.0, theta1 = 0.5 }"; 1_000_001].join(", ");
-    std::fs::write(&p, JI.replace("points = [ { L3 = 1.0, theta1 = 0.5 } ]", &format!("points = [ {points} ]"))).unwrap();
+    std::fs::write(&p, JI.replace("points = [ { L3 = 1.0, theta1 = 0.5 } ]", &format!("points = [ {points} ]")))
+        .unwrap();
     let start = std::time::Instant::now();
     let (code, _, err) = tensegrity(&["check", p.to_str().unwrap()]);
     assert_eq!(code, 2, "{err}");

@@ -281,7 +281,8 @@ fn extreme_values_give_answers_not_hangs_or_panics() {
 /// cable lengths, each cable length equal to the distance from its base point to its end.
 #[test]
 fn manriquez2019_fk_prints_the_cable_ends_of_eq8_9() {
-    let (code, out, err) = tensegrity(&["solve", "manriquez2019", "fk", "--set", "theta1=0.0941", "--set", "theta2=0.0332", "--json"]);
+    let (code, out, err) =
+        tensegrity(&["solve", "manriquez2019", "fk", "--set", "theta1=0.0941", "--set", "theta2=0.0332", "--json"]);
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let values = &v["solutions"][0]["values"];

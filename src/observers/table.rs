@@ -37,7 +37,12 @@ enum Sink {
     Csv(std::io::BufWriter<std::fs::File>),
     /// The file until the first tick gives the schema, then its writer; the rows not yet written
     /// as a batch (tick, then every other column).
-    Arrow { file: Option<std::fs::File>, writer: Option<arrow_ipc::writer::FileWriter<std::fs::File>>, ticks: Vec<u64>, columns: Vec<Vec<Option<f64>>> },
+    Arrow {
+        file: Option<std::fs::File>,
+        writer: Option<arrow_ipc::writer::FileWriter<std::fs::File>>,
+        ticks: Vec<u64>,
+        columns: Vec<Vec<Option<f64>>>,
+    },
 }
 
 pub struct Table {
@@ -142,7 +147,8 @@ impl Table {
                     let mut fields = vec![Field::new("tick", DataType::UInt64, false)];
                     fields.extend(h.iter().map(|c| Field::new(c, DataType::Float64, true)));
                     let f = file.take().ok_or_else(|| fail(&"the file is gone"))?;
-                    *writer = Some(arrow_ipc::writer::FileWriter::try_new(f, &Schema::new(fields)).map_err(|e| fail(&e))?);
+                    *writer =
+                        Some(arrow_ipc::writer::FileWriter::try_new(f, &Schema::new(fields)).map_err(|e| fail(&e))?);
                     *columns = vec![Vec::with_capacity(ARROW_BATCH_ROWS); h.len()];
                 }
                 ticks.push(tick);

@@ -112,8 +112,7 @@ pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
             "the file is {bytes} bytes; a scenario is at most {MAX_SCENARIO_BYTES} (its parse takes about 75 times its size in memory: a grid describes up to a million points in one line)"
         )));
     }
-    let source =
-        std::fs::read_to_string(path).map_err(|e| at_start(format!("cannot read the scenario file: {e}")))?;
+    let source = std::fs::read_to_string(path).map_err(|e| at_start(format!("cannot read the scenario file: {e}")))?;
     parse(path, &source)
 }
 

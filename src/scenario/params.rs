@@ -28,9 +28,7 @@ pub(super) fn params(ctx: &Ctx, m: &dyn Mechanism, raw: &ParamMap) -> Result<Val
         // At the symbol's key; when the file leaves that symbol at its default, at a given
         // parameter the message names (b must be shorter than L: at L), else the first one.
         let message = e.to_string();
-        let named = |k: &str| {
-            message.split(|c: char| !(c.is_alphanumeric() || c == '_')).any(|w| w == k)
-        };
+        let named = |k: &str| message.split(|c: char| !(c.is_alphanumeric() || c == '_')).any(|w| w == k);
         let at = e
             .symbol()
             .and_then(|sym| value_at(raw, sym))
