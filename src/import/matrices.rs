@@ -33,12 +33,7 @@ type Row = (usize, Vec<f64>);
 /// and blank lines skipped (each row keeps its line number).
 fn read_matrix(path: &Path) -> Result<Vec<Row>, ImportError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| ImportError {
-        file: file.clone(),
-        line: 0,
-        col: 0,
-        message: format!("cannot read: {e}"),
-    })?;
+    let text = super::read_text(path)?;
     let mut rows = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();

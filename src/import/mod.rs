@@ -20,6 +20,16 @@ pub struct ImportError {
     pub message: String,
 }
 
+/// The text of an input file, or an error naming it.
+pub(crate) fn read_text(path: &std::path::Path) -> Result<String, ImportError> {
+    std::fs::read_to_string(path).map_err(|e| ImportError {
+        file: path.display().to_string(),
+        line: 0,
+        col: 0,
+        message: format!("cannot read: {e}"),
+    })
+}
+
 impl std::fmt::Display for ImportError {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
         if self.line == 0 {

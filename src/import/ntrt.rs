@@ -287,12 +287,7 @@ impl Reader {
                 message: format!("substructures nest deeper than {MAX_DEPTH} levels (does a file include itself?)"),
             });
         }
-        let text = std::fs::read_to_string(path).map_err(|e| ImportError {
-            file: file.clone(),
-            line: 0,
-            col: 0,
-            message: format!("cannot read: {e}"),
-        })?;
+        let text = super::read_text(path)?;
         let root = yaml::parse(&text).map_err(|e| err(&file, e.at, format!("YAML syntax: {}", e.message)))?;
         only_keys(&file, &root, ROOT_KEYS, "an NTRT model file")?;
         let mut sub = Sub { name: name.into(), ..Default::default() };
