@@ -309,12 +309,32 @@ impl Interference {
 
 impl Observer for Interference {
     fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>) {
+        if self.settings.enabled {
+            self.check(t.snapshot.tick, &t.snapshot.nodes, notes);
+        }
+    }
+
+    /// The smallest clearance at the settled state, and whether it stays above the threshold.
+    fn settle_point(&mut self, p: &SettlePoint, point: &mut PointReport, _notes: &mut Vec<Note>) {
         if !self.settings.enabled {
             return;
         }
-        let tick = t.snapshot.tick;
+        let c = self.measure(&p.snapshot.nodes).iter().map(|m| m.clearance_m).reduce(f64::min);
+        point.min_clearance_m = c;
+        point.interference_free = Some(c.is_none_or(|c| c >= self.settings.threshold_m));
+    }
+
+    fn finish(&mut self, report: &mut ScenarioReport) {
+        report.interference = Some(self.report());
+    }
+}
+
+impl Interference {
+    /// Measures the members at `nodes` (tick `tick`) and keeps each pair's smallest clearance
+    /// and the intervals below the threshold.
+    fn check(&mut self, tick: u64, nodes: &[[f64; 3]], notes: &mut Vec<Note>) {
         self.ticks += 1;
-        let measured = self.measure(&t.snapshot.nodes);
+        let measured = self.measure(nodes);
         if let Some(c) = measured.iter().map(|p| p.clearance_m).reduce(f64::min) {
             notes.push(Note::Scalar(MIN_CLEARANCE_SERIES, c));
         }
@@ -366,17 +386,4 @@ impl Observer for Interference {
         }
     }
 
-    /// The smallest clearance at the settled state, and whether it stays above the threshold.
-    fn settle_point(&mut self, p: &SettlePoint, point: &mut PointReport, _notes: &mut Vec<Note>) {
-        if !self.settings.enabled {
-            return;
-        }
-        let c = self.measure(&p.snapshot.nodes).iter().map(|m| m.clearance_m).reduce(f64::min);
-        point.min_clearance_m = c;
-        point.interference_free = Some(c.is_none_or(|c| c >= self.settings.threshold_m));
-    }
-
-    fn finish(&mut self, report: &mut ScenarioReport) {
-        report.interference = Some(self.report());
-    }
 }
