@@ -242,6 +242,7 @@ impl Simulation {
     /// One relaxation step (before the member forces are applied): the shifted Newton step on
     /// the energy, its shift raised until the energy decreases (Levenberg-Marquardt), then
     /// every free body at rest.
+    #[inline(never)]
     pub(super) fn relax(&mut self) {
         let dofs = self.relaxation_dofs();
         let (h, f) = self.relaxation_system(&dofs);
