@@ -298,20 +298,36 @@ impl Simulation {
 mod tests {
     use super::*;
 
-    /// The 3-strut prism of the scale bench, 20 degrees short of its equilibrium twist.
-    fn twisted_prism() -> Simulation {
-        let n = 3;
-        let twist = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI / n as f64 - 0.35;
-        let s = crate::bench::scale::prism(n, twist);
+    /// Two free bodies hung from a fixed triangle by cables stretched to 1.6 times their rest
+    /// length, joined by a spring compressed to 0.8 times its free length, with gravity.
+    fn hung_bodies() -> Simulation {
+        use crate::structure::{BodyKind, Cable, Inertia, Spring};
+        let mut s = Structure { gravity: [0.0, 0.0, -9.81], ..Default::default() };
+        let ground = s.add_body("ground", BodyKind::Fixed, None);
+        let fixed = [("g0", [0.0, 0.0, 2.0]), ("g1", [1.0, 0.0, 2.0]), ("g2", [0.0, 1.0, 2.0])]
+            .map(|(name, p)| s.add_node(name, ground, p));
+        let inertia = |com| Inertia { mass_kg: 0.7, com, principal_kg_m2: [0.05, 0.08, 0.03] };
+        let one = s.add_body("one", BodyKind::Free, Some(inertia([0.55, 0.4, 1.2])));
+        let two = s.add_body("two", BodyKind::Free, Some(inertia([0.1, 0.1, 1.2])));
+        let (p, q) = (s.add_node("p", one, [0.3, 0.2, 1.0]), s.add_node("q", one, [0.8, 0.6, 1.4]));
+        let (r, u) = (s.add_node("r", two, [-0.2, 0.5, 0.8]), s.add_node("u", two, [0.4, -0.3, 1.6]));
+        let length = |s: &Structure, a: usize, b: usize| crate::structure::distance(s.nodes[a].position, s.nodes[b].position);
+        for (a, b) in [(fixed[0], p), (fixed[1], p), (fixed[2], q), (fixed[0], r), (fixed[1], u), (fixed[2], u), (q, r)] {
+            let law = CableLaw::Elastic { stiffness_n_per_m: 150.0 };
+            let length_m = length(&s, a, b) / 1.6;
+            s.cables.push(Cable { name: format!("c{a}{b}"), a, b, law, length_m, radius_m: 0.001 });
+        }
+        let rest_length_m = length(&s, p, u) / 0.8;
+        s.springs.push(Spring { name: "s".into(), a: p, b: u, stiffness_n_per_m: 80.0, rest_length_m, radius_m: 0.001 });
         Simulation::new(&s, &crate::settings::SimSettings::default()).unwrap()
     }
 
-    /// Away from equilibrium, f is minus the gradient of the energy and H its Hessian in the
-    /// bodies' coordinates: central differences of the energy agree within 1e-6 of the largest
+    /// Away from equilibrium (tension, compression and gravity), f is minus the gradient of
+    /// the energy and H its Hessian in the bodies' coordinates: central differences of the energy agree within 1e-6 of the largest
     /// entry (step 1e-4 m or rad).
     #[test]
     fn force_and_hessian_are_the_derivatives_of_the_energy() {
-        let sim = twisted_prism();
+        let sim = hung_bodies();
         let dofs = sim.relaxation_dofs();
         let (h, f) = sim.relaxation_system(&dofs);
         let n = f.len();
