@@ -15,7 +15,7 @@
 //! force over |lambda|; modes softer than [`SOFT_MODE_RATIO`] of the stiffest, such as a free
 //! rotation of the whole structure, are left to the dynamics), shortened until E decreases
 //! (Armijo), and zeroes every body's velocity (kinetic damping). Then the ordinary rapier step
-//! follows.
+//! follows. Without a step (no stiffness at all, as a body in free fall) the velocities stay.
 //!
 //! - The equilibrium stays the dynamics' own: at an equilibrium f = 0 and the step is zero,
 //!   and the settle loop turns the relaxation off once the motion has stopped, so that its
@@ -241,7 +241,8 @@ impl Simulation {
 
     /// One relaxation step (before the member forces are applied): the shifted Newton step on
     /// the energy, its shift raised until the energy decreases (Levenberg-Marquardt), then
-    /// every free body at rest.
+    /// every free body at rest. Without a step (no stiffness, as a body in free fall, or no
+    /// decrease found) the velocities stay: the dynamics move alone.
     #[inline(never)]
     pub(super) fn relax(&mut self) {
         let dofs = self.relaxation_dofs();
@@ -266,13 +267,13 @@ impl Simulation {
             let round_off = alpha * predicted <= ENERGY_ROUND_OFF * scale;
             if change <= -ARMIJO * alpha * predicted || round_off {
                 self.move_bodies(&dofs, &step, alpha);
+                self.zero_body_velocities();
                 let next = shift * SHIFT_DECAY;
                 self.relaxation_shift = if next < MIN_SHIFT_RATIO { 0.0 } else { next };
                 break;
             }
             shift = if shift == 0.0 { MIN_SHIFT_RATIO } else { shift * SHIFT_GROWTH };
         }
-        self.zero_body_velocities();
     }
 
     /// Moves every free body by `alpha` times `step` (translation of the centre of mass, then
