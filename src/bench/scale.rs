@@ -15,7 +15,7 @@
 use crate::run::SettleDetector;
 use crate::settings::{SettleCriteria, SimSettings};
 use crate::sim::Simulation;
-use crate::structure::{BodyKind, Cable, CableLaw, Inertia, Strut, Structure, Vec3};
+use crate::structure::{BodyKind, Cable, CableLaw, Inertia, Structure, Strut, Vec3};
 use serde::Serialize;
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -134,8 +134,7 @@ fn twist_error(nodes: &[Vec3], n: usize) -> f64 {
 /// `relaxation = false`: the plain dynamics (body damping alone), for comparison.
 pub fn settle_prism(n: usize, relaxation: bool) -> Result<ScaleCase, String> {
     let s = prism(n, FRAC_PI_2 + PI / n as f64 - START_TWIST_OFFSET_FRACTION * 2.0 * PI / n as f64);
-    let settings =
-        SimSettings { dt_s: DT_S, body_damping_per_s: BODY_DAMPING_PER_S, relaxation, ..Default::default() };
+    let settings = SimSettings { dt_s: DT_S, body_damping_per_s: BODY_DAMPING_PER_S, relaxation, ..Default::default() };
     let criteria = SettleCriteria {
         speed_tol_m_per_s: 1e-12,
         window_steps: 10,

@@ -252,7 +252,7 @@ impl Simulation {
         for trial in 1..=MAX_TRIALS {
             let step = modes.step(shift);
             let predicted = f.dot(&step);
-            if !(predicted > 0.0) {
+            if predicted.is_nan() || predicted <= 0.0 {
                 break;
             }
             // A step beyond the limits is a rejected trial (the shift shortens the soft modes'
@@ -312,14 +312,23 @@ mod tests {
         let two = s.add_body("two", BodyKind::Free, Some(inertia([0.1, 0.1, 1.2])));
         let (p, q) = (s.add_node("p", one, [0.3, 0.2, 1.0]), s.add_node("q", one, [0.8, 0.6, 1.4]));
         let (r, u) = (s.add_node("r", two, [-0.2, 0.5, 0.8]), s.add_node("u", two, [0.4, -0.3, 1.6]));
-        let length = |s: &Structure, a: usize, b: usize| crate::structure::distance(s.nodes[a].position, s.nodes[b].position);
-        for (a, b) in [(fixed[0], p), (fixed[1], p), (fixed[2], q), (fixed[0], r), (fixed[1], u), (fixed[2], u), (q, r)] {
+        let length =
+            |s: &Structure, a: usize, b: usize| crate::structure::distance(s.nodes[a].position, s.nodes[b].position);
+        for (a, b) in [(fixed[0], p), (fixed[1], p), (fixed[2], q), (fixed[0], r), (fixed[1], u), (fixed[2], u), (q, r)]
+        {
             let law = CableLaw::Elastic { stiffness_n_per_m: 150.0 };
             let length_m = length(&s, a, b) / 1.6;
             s.cables.push(Cable { name: format!("c{a}{b}"), a, b, law, length_m, radius_m: 0.001 });
         }
         let rest_length_m = length(&s, p, u) / 0.8;
-        s.springs.push(Spring { name: "s".into(), a: p, b: u, stiffness_n_per_m: 80.0, rest_length_m, radius_m: 0.001 });
+        s.springs.push(Spring {
+            name: "s".into(),
+            a: p,
+            b: u,
+            stiffness_n_per_m: 80.0,
+            rest_length_m,
+            radius_m: 0.001,
+        });
         Simulation::new(&s, &crate::settings::SimSettings::default()).unwrap()
     }
 
@@ -342,7 +351,8 @@ mod tests {
             assert!((grad + f[i]).abs() <= 1e-6 * largest_f, "f[{i}] = {} against {}", f[i], -grad);
             for j in 0..n {
                 let (ei, ej) = (unit(i), unit(j));
-                let second = (energy(&(&ei + &ej)) - energy(&(&ei - &ej)) - energy(&(&ej - &ei)) + energy(&(-&ei - &ej)))
+                let second = (energy(&(&ei + &ej)) - energy(&(&ei - &ej)) - energy(&(&ej - &ei))
+                    + energy(&(-&ei - &ej)))
                     / (4.0 * step * step);
                 let sym = 0.5 * (h[(i, j)] + h[(j, i)]);
                 assert!((sym - second).abs() <= 1e-6 * largest_h, "H[{i},{j}] = {sym} against {second}");
