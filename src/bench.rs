@@ -4,6 +4,8 @@
 //! (no continuation, no stability test): the same work a peer simulator would do per case.
 //! Several rounds are run and medians reported, so that one noisy round does not decide.
 
+pub mod scale;
+
 use crate::run::{run, RunOptions};
 use crate::scenario::{self, Actuation};
 use serde::Serialize;

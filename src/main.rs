@@ -122,6 +122,10 @@ enum Command {
         /// (default: the MuJoCo peer, `python3 benches/peers/mujoco/peer.py`).
         #[arg(long, value_name = "CMD", num_args = 0..=1, default_missing_value = DEFAULT_PEER)]
         peer: Option<String>,
+        /// Settle regular n-strut prisms (n = 3 .. 128) from a twisted start instead: steps,
+        /// wall time and the twist error against the closed form pi/2 + pi/n.
+        #[arg(long)]
+        scale: bool,
     },
     /// Write a scenario's structure in another simulator's format.
     Export {
@@ -310,11 +314,12 @@ fn dispatch(cli: Cli) -> i32 {
         Command::Export { format: ExportFormat::Mjcf { scenario, out, actuators, kp, cable_damping } } => {
             cmd_export_mjcf(&scenario, out.as_deref(), &actuators, kp, cable_damping)
         }
+        Command::Bench { scale: true, json, .. } => cmd_bench_scale(json),
         Command::Bench { export_cases: Some(dir), .. } => cmd_export_cases(&dir),
-        Command::Bench { rounds, json, export_cases: None, mechanisms, peer: Some(peer) } => {
+        Command::Bench { rounds, json, export_cases: None, mechanisms, peer: Some(peer), .. } => {
             cmd_bench_peer(rounds, json, &mechanisms, &peer)
         }
-        Command::Bench { rounds, json, export_cases: None, mechanisms, peer: None } => {
+        Command::Bench { rounds, json, export_cases: None, mechanisms, peer: None, .. } => {
             cmd_bench(rounds, json, &mechanisms)
         }
     }
@@ -894,6 +899,40 @@ fn cmd_export_cases(dir: &Path) -> i32 {
 const DEFAULT_PEER: &str = "python3 benches/peers/mujoco/peer.py";
 
 /// The built-in case sets that `--mechanism` selects (all when none is named).
+/// Strut counts of `tensegrity bench --scale`.
+const SCALE_BENCH_STRUTS: [usize; 10] = [3, 4, 6, 8, 12, 16, 24, 32, 64, 128];
+
+fn cmd_bench_scale(json: bool) -> i32 {
+    let mut cases = Vec::new();
+    if !json {
+        println!(
+            "{:>6} {:>7} {:>8} {:>7} {:>10} {:>14} {:>12}",
+            "struts", "cables", "settled", "steps", "wall s", "twist err rad", "residual N"
+        );
+    }
+    for n in SCALE_BENCH_STRUTS {
+        match tensegrity_testbed::bench::scale::settle_prism(n, true) {
+            Ok(c) => {
+                if !json {
+                    println!(
+                        "{:>6} {:>7} {:>8} {:>7} {:>10.4} {:>14.2e} {:>12.2e}",
+                        c.struts, c.cables, c.settled, c.steps, c.wall_s, c.twist_error_rad, c.residual_force_n
+                    );
+                }
+                cases.push(c);
+            }
+            Err(e) => {
+                eprintln!("error: {n}-strut prism: {e}");
+                return 1;
+            }
+        }
+    }
+    if json {
+        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "scale": cases })).unwrap());
+    }
+    0
+}
+
 fn selected_case_sets(only: &[String]) -> Result<Vec<(&'static str, &'static str)>, i32> {
     if let Some(bad) = only.iter().find(|m| !tensegrity_testbed::bench::CASE_SETS.iter().any(|(n, _)| n == m)) {
         eprintln!("error: no bench case set for mechanism '{bad}'");

@@ -22,6 +22,11 @@ pub struct SimSettings {
     /// prismatic joint's velocity is quenched and its damping set so that the step is a Newton
     /// step on its tangent stiffness (a settling strategy).
     pub newton_damping: bool,
+    /// Static relaxation (`relaxation.rs`) of structures of free bodies held by springs and
+    /// elastic cables: a saddle-free Newton step on the potential energy and the bodies at
+    /// rest before every step (a settling strategy; on by default, ignored where it does not
+    /// apply).
+    pub relaxation: bool,
     /// Half-size of the box that every node must stay inside, else the run diverged [m].
     pub bounding_box_m: f64,
     /// Linear and angular damping of free bodies [1/s] (applied after each step; it slows
@@ -49,6 +54,7 @@ impl Default for SimSettings {
             pgs_iterations: 8,
             approach_pgs_iterations: None,
             newton_damping: false,
+            relaxation: true,
             bounding_box_m: 1e3,
             body_damping_per_s: 0.0,
             max_kinetic_energy_j: DEFAULT_MAX_KINETIC_ENERGY_J,

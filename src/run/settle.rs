@@ -39,9 +39,15 @@ impl Runner<'_> {
             self.sim.set_pgs_iterations(n);
         }
         let switch_speed = criteria.speed_tol_m_per_s * APPROACH_SWITCH_SPEED_FACTOR;
+        // The static relaxation (where it runs) stops once the motion has: the quiet window
+        // and the residual check are then plain steps of the dynamics.
+        let relaxation = self.sim.relaxing();
         for k in 1..=max_steps {
             let (mut snap, simulated) = self.step(inputs, prediction)?;
             let quiet = detector.update(&snap, dt, &criteria);
+            if relaxation {
+                self.sim.set_relaxation(detector.last_speed > criteria.speed_tol_m_per_s);
+            }
             if approaching && detector.last_speed <= switch_speed {
                 approaching = false;
                 self.sim.set_pgs_iterations(self.sc.sim.pgs_iterations);
@@ -53,6 +59,7 @@ impl Runner<'_> {
                 self.add_residual(&mut snap);
             }
             if quiet && SettleDetector::residual_ok(&snap, &criteria) {
+                self.sim.set_relaxation(relaxation);
                 return Ok(Settled {
                     settled: true,
                     steps: k,
@@ -76,6 +83,7 @@ impl Runner<'_> {
             }
         };
         self.sim.set_pgs_iterations(self.sc.sim.pgs_iterations);
+        self.sim.set_relaxation(relaxation);
         Ok(Settled { settled: false, steps: max_steps, final_speed: detector.last_speed, snapshot, simulated })
     }
 }

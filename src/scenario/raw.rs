@@ -257,6 +257,8 @@ pub(super) struct RawSim {
     pub(super) approach_pgs_iterations: Option<Spanned<i64>>,
     /// The Newton damping schedule (default false: the structure's fixed damping).
     pub(super) newton_damping: Option<Spanned<bool>>,
+    /// Static relaxation of free bodies held by springs and elastic cables (default true).
+    pub(super) relaxation: Option<Spanned<bool>>,
     pub(super) body_damping: Option<Spanned<f64>>,
     pub(super) bounding_box: Option<Spanned<f64>>,
     /// Kinetic energy above which the run has diverged [J] (default 1e6).

@@ -16,6 +16,7 @@ pub(super) fn sim(ctx: &Ctx, raw: &RawSim) -> Result<SimSettings, ScenarioError>
             Some(_) => Some(count(ctx, &raw.approach_pgs_iterations, "sim.approach_pgs_iterations", 8, 4096)?),
         },
         newton_damping: raw.newton_damping.as_ref().is_some_and(|b| *b.get_ref()),
+        relaxation: raw.relaxation.as_ref().is_none_or(|b| *b.get_ref()),
         body_damping_per_s: match &raw.body_damping {
             None => 0.0,
             Some(s) => {

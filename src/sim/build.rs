@@ -31,6 +31,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         external_loads: external_loads(s),
         length_scale_m: crate::structure::structure_size(s),
         tree: super::forces::Tree::default(),
+        relaxation_applies: super::relaxation::applies(s),
     };
     let mut sim = Simulation {
         model,
@@ -49,11 +50,14 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         commands: commands.clone(),
         probe_loads: vec![([0.0; 3], [0.0; 3]); n],
         tick: 0,
+        relaxing: false,
+        relaxation_shift: 0.0,
     };
     sim.model.tree = sim.link_tree();
     sim.model.internal_closures = sim.find_internal_closures();
     sim.model.projected_groups = sim.find_projected_groups();
     sim.set_commands(&commands);
+    sim.set_relaxation(true);
     Ok(sim)
 }
 

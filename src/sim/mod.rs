@@ -20,6 +20,7 @@ mod damping;
 mod forces;
 mod least_squares;
 mod projection;
+mod relaxation;
 mod restart;
 
 use crate::structure::{ActuatorTarget, BodyKind, Structure};
@@ -72,6 +73,8 @@ pub struct Model {
     external_loads: Vec<[f64; 3]>,
     /// Characteristic length of the structure [m], for speeds and tolerances.
     pub length_scale_m: f64,
+    /// Whether the static relaxation applies to this structure (`relaxation.rs`).
+    relaxation_applies: bool,
 }
 
 /// The mutable state that steps (MuJoCo's `mjData`): rapier's sets and pipeline, the current
@@ -97,6 +100,11 @@ pub struct Simulation {
     /// centre of mass.
     probe_loads: Vec<([f64; 3], [f64; 3])>,
     tick: u64,
+    /// Whether the static relaxation runs before each step (the settings' choice where it
+    /// applies; the settle loop turns it off for its quiet window).
+    relaxing: bool,
+    /// The relaxation's current shift, a fraction of the stiffest mode (`relaxation.rs`).
+    relaxation_shift: f64,
 }
 
 impl Simulation {
@@ -124,6 +132,16 @@ impl Simulation {
     /// Sets rapier's PGS iterations per substep from now on.
     pub fn set_pgs_iterations(&mut self, n: usize) {
         self.params.num_internal_pgs_iterations = n.max(1);
+    }
+
+    /// Turns the static relaxation on (where the settings ask for it and it applies) or off.
+    pub fn set_relaxation(&mut self, on: bool) {
+        self.relaxing = on && self.model.settings.relaxation && self.model.relaxation_applies;
+    }
+
+    /// Whether the static relaxation runs before each step.
+    pub fn relaxing(&self) -> bool {
+        self.relaxing
     }
 
     pub fn tick(&self) -> u64 {
@@ -169,6 +187,9 @@ impl Simulation {
 
     /// Advances one time step. Fails if the state is no longer finite or leaves the box.
     pub fn step(&mut self) -> Result<(), SimError> {
+        if self.relaxing {
+            self.relax();
+        }
         self.apply_member_forces();
         if self.model.settings.newton_damping {
             self.schedule_damping();
