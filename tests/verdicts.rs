@@ -20,9 +20,7 @@ fn run_text(name: &str, text: &str) -> ScenarioReport {
 
 /// An n-strut prism in the README's format: bottom node i joined by strut i to top node i, the
 /// top polygon turned by `twist_rad` from the bottom, polygon and side cables elastic (100 N/m)
-/// at 90 % of their drawn length, strut 1 held, settled by body damping alone (`relaxation =
-/// false`: the static relaxation's first step would pull crossed struts apart before the
-/// first checked tick). `extra` is appended (more members, sections).
+/// at 90 % of their drawn length, strut 1 held. `extra` is appended (more members, sections).
 fn prism(n: usize, twist_rad: f64, extra: &str) -> String {
     let (r, h) = (1.0, 1.5);
     let at = |k: usize, z: f64, phase: f64| {
@@ -32,7 +30,7 @@ fn prism(n: usize, twist_rad: f64, extra: &str) -> String {
     let dist =
         |p: [f64; 3], q: [f64; 3]| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
     let mut s = format!(
-        "name = \"prism{n}\"\nmechanism = \"custom\"\n[sim]\ndt = 0.005\nbody_damping = 2.0\nrelaxation = false\n[settle]\nspeed_tol = 1e-10\nmax_time = 60.0\n[actuation]\npoints = [ {{}} ]\n{extra}\n[structure]\n"
+        "name = \"prism{n}\"\nmechanism = \"custom\"\n[sim]\ndt = 0.005\nbody_damping = 2.0\n[settle]\nspeed_tol = 1e-10\nmax_time = 60.0\n[actuation]\npoints = [ {{}} ]\n{extra}\n[structure]\n"
     );
     for k in 0..n {
         let (b, t) = (at(k, 0.0, 0.0), at(k, h, twist_rad));
@@ -57,8 +55,8 @@ fn prism(n: usize, twist_rad: f64, extra: &str) -> String {
 }
 
 /// A prism drawn with its top turned by pi has every strut through the axis at mid-height:
-/// the struts pass through each other from the first tick, and the run fails on interference
-/// alone with each strut pair named.
+/// the struts pass through each other as drawn (tick 0, before any settling step moves them),
+/// and the run fails on interference with each strut pair named.
 #[test]
 fn a_prism_whose_struts_pass_through_each_other_fails_on_interference() {
     for n in [3, 4] {
@@ -67,11 +65,10 @@ fn a_prism_whose_struts_pass_through_each_other_fails_on_interference() {
         let i = r.interference.as_ref().expect("interference report");
         assert!(i.enabled && i.tendons);
         let strut_pairs: Vec<_> =
-            i.violations.iter().filter(|v| v.kinds == ["strut", "strut"] && v.first_tick == 1).collect();
-        assert!(strut_pairs.len() >= n - 1, "n = {n}: {:?}", i.violations);
-        // Two capsules of radius 0.02 m with crossing axes: clearance -0.04 m (after the first
-        // step, which moves the struts by about a millimetre).
-        assert!(strut_pairs.iter().all(|v| (v.min_clearance_m + 0.04).abs() <= 2e-3), "{strut_pairs:?}");
+            i.violations.iter().filter(|v| v.kinds == ["strut", "strut"] && v.first_tick == 0).collect();
+        assert_eq!(strut_pairs.len(), n * (n - 1) / 2, "n = {n}: every pair crosses on the axis: {:?}", i.violations);
+        // Two capsules of radius 0.02 m with crossing axes: clearance -0.04 m as drawn.
+        assert!(strut_pairs.iter().all(|v| (v.min_clearance_m + 0.04).abs() <= 1e-9), "{strut_pairs:?}");
     }
 }
 
@@ -114,7 +111,7 @@ fn a_cable_drawn_through_a_strut_is_reported_with_the_pair_and_the_tick() {
     let v =
         i.violations.iter().find(|v| v.pair == ["strut0", "through"]).unwrap_or_else(|| panic!("{:?}", i.violations));
     assert_eq!(v.kinds, ["strut", "cable"]);
-    assert_eq!(v.first_tick, 1);
+    assert_eq!(v.first_tick, 0);
     // The axes cross: clearance = -(0.02 + 0.001) m.
     assert!((v.min_clearance_m + 0.021).abs() <= 1e-9, "{}", v.min_clearance_m);
 }

@@ -217,14 +217,15 @@ impl Interference {
         }
         let n = members.len();
         let pairs_checked = n * n.saturating_sub(1) / 2 - excluded.iter().filter(|(i, j)| i != j).count();
-        Ok(Interference {
-            settings: settings.clone(),
-            members,
-            excluded,
-            pairs_checked,
-            stats: BTreeMap::new(),
-            ticks: 0,
-        })
+        let mut observer =
+            Interference { settings: settings.clone(), members, excluded, pairs_checked, stats: BTreeMap::new(), ticks: 0 };
+        if settings.enabled {
+            // Tick 0, the structure as drawn: members drawn through each other interfere before
+            // any settling method (the static relaxation's first step among them) moves them.
+            let drawn: Vec<[f64; 3]> = s.nodes.iter().map(|n| n.position).collect();
+            observer.check(0, &drawn, &mut Vec::new());
+        }
+        Ok(observer)
     }
 
     /// Capsules of the checked members at the node positions `nodes`.
