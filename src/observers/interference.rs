@@ -217,8 +217,14 @@ impl Interference {
         }
         let n = members.len();
         let pairs_checked = n * n.saturating_sub(1) / 2 - excluded.iter().filter(|(i, j)| i != j).count();
-        let mut observer =
-            Interference { settings: settings.clone(), members, excluded, pairs_checked, stats: BTreeMap::new(), ticks: 0 };
+        let mut observer = Interference {
+            settings: settings.clone(),
+            members,
+            excluded,
+            pairs_checked,
+            stats: BTreeMap::new(),
+            ticks: 0,
+        };
         if settings.enabled {
             // Tick 0, the structure as drawn: members drawn through each other interfere before
             // any settling method (the static relaxation's first step among them) moves them.
@@ -386,5 +392,4 @@ impl Interference {
             st.open = None;
         }
     }
-
 }
