@@ -3,29 +3,10 @@
 use std::path::Path;
 use std::process::Command;
 use tensegrity_testbed::mechanisms::furet2018::analytic as furet;
-use tensegrity_testbed::report::ScenarioReport;
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
 mod common;
-use common::run_file;
-
-type P3 = [f64; 3];
-fn node(r: &ScenarioReport, n: &str) -> P3 {
-    let s = &r.points[0].simulated;
-    [s[&format!("{n}.x")], s[&format!("{n}.y")], s[&format!("{n}.z")]]
-}
-fn sub(a: P3, b: P3) -> P3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: P3, b: P3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: P3, b: P3) -> P3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-fn norm(a: P3) -> f64 {
-    dot(a, a).sqrt()
-}
+use common::{cross, dot, node, norm, run_file, sub, P3};
 
 /// The prism settles with the top triangle turned by pi/2 + pi/3 = 150 degrees from the bottom
 /// (within 1e-8 rad), force densities side : strut : polygon = 1 : -1 : 1/sqrt(3) (within 1e-8),

@@ -9,9 +9,7 @@ use tensegrity_testbed::report::ScenarioReport;
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
 mod common;
-use common::tensegrity;
-
-type P3 = [f64; 3];
+use common::{cross, dot, node, norm, sub, tensegrity, P3};
 
 const FIXTURES: &str = "tests/fixtures/ntrt";
 
@@ -25,24 +23,6 @@ fn run_text(name: &str, toml: &str) -> ScenarioReport {
     let r = run(&sc, &RunOptions::default());
     assert!(r.passed, "{name}: {:?} {:?}", r.error, r.failures);
     r
-}
-
-fn node(r: &ScenarioReport, n: &str) -> P3 {
-    let s = &r.points[0].simulated;
-    [s[&format!("{n}.x")], s[&format!("{n}.y")], s[&format!("{n}.z")]]
-}
-
-fn sub(a: P3, b: P3) -> P3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: P3, b: P3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: P3, b: P3) -> P3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-fn norm(a: P3) -> f64 {
-    dot(a, a).sqrt()
 }
 
 /// The prism imports with NTRT's y mapped to z (the drawn bottom at z = 0, the top at

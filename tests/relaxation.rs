@@ -7,6 +7,8 @@ use std::path::Path;
 use tensegrity_testbed::report::ScenarioReport;
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
+mod common;
+use common::{node, P3};
 
 /// Runs scenario text as if read from `name`.
 fn run_text(name: &str, text: &str) -> ScenarioReport {
@@ -19,11 +21,6 @@ fn without_relaxation(text: &str) -> String {
     text.replacen("[sim]\n", "[sim]\nrelaxation = false\n", 1)
 }
 
-type P3 = [f64; 3];
-fn node(r: &ScenarioReport, n: &str) -> P3 {
-    let s = &r.points[0].simulated;
-    [s[&format!("{n}.x")], s[&format!("{n}.y")], s[&format!("{n}.z")]]
-}
 fn dist(a: P3, b: P3) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }

@@ -56,3 +56,34 @@ at = "P"
 axis = [0.0, 0.0, 1.0]
 damping = 0.5
 "#;
+
+/// A 3-vector [m].
+#[allow(dead_code)]
+pub type P3 = [f64; 3];
+
+/// The settled coordinates of node `n` at a report's first point.
+#[allow(dead_code)]
+pub fn node(r: &tensegrity_testbed::report::ScenarioReport, n: &str) -> P3 {
+    let s = &r.points[0].simulated;
+    [s[&format!("{n}.x")], s[&format!("{n}.y")], s[&format!("{n}.z")]]
+}
+
+#[allow(dead_code)]
+pub fn sub(a: P3, b: P3) -> P3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[allow(dead_code)]
+pub fn dot(a: P3, b: P3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[allow(dead_code)]
+pub fn cross(a: P3, b: P3) -> P3 {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+#[allow(dead_code)]
+pub fn norm(a: P3) -> f64 {
+    dot(a, a).sqrt()
+}
