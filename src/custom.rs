@@ -20,6 +20,10 @@ pub struct Custom {
     spec: MechanismSpec,
     /// Expected values from the file's checks, by quantity.
     pub expected: Values,
+    /// The parameters `structure` was resolved with.
+    params: Values,
+    /// The structure at the other sets of parameters a sweep over them settles at.
+    variants: Vec<(Values, Structure)>,
 }
 
 /// A parameter a custom file declares in `[params]`.
@@ -91,11 +95,30 @@ impl Custom {
                 alternative_inputs: &[],
             },
             expected,
+            params: Values::new(),
+            variants: Vec::new(),
         }
+    }
+
+    /// The mechanism with its structure at other sets of parameters (a sweep over them).
+    pub fn with_variants(mut self, variants: Vec<(Values, Structure)>) -> Self {
+        self.variants = variants;
+        self
+    }
+
+    /// The structure resolved with `params`: the file's own, or one of its variants.
+    fn structure_at(&self, params: &Values) -> Result<&Structure, ModelError> {
+        if params == &self.params || params.is_empty() {
+            return Ok(&self.structure);
+        }
+        self.variants.iter().find(|(p, _)| p == params).map(|(_, s)| s).ok_or_else(|| {
+            ModelError::no_solution(format!("the file's structure was not resolved with the parameters {params:?}"))
+        })
     }
 
     /// The mechanism with the parameters its file declares (their values are the defaults).
     pub fn with_params(mut self, params: Vec<FileParam>) -> Self {
+        self.params = params.iter().map(|p| (p.symbol.clone(), p.value)).collect();
         let specs: Vec<ParamSpec> = params
             .into_iter()
             .map(|p| ParamSpec {
@@ -238,8 +261,8 @@ impl Mechanism for Custom {
     fn solve(&self, query: &str, _params: &Values, _inputs: &Values) -> Result<Vec<Solution>, ModelError> {
         Err(ModelError::no_solution(format!("a custom structure has no analytic model (no query '{query}')")))
     }
-    fn build(&self, _params: &Values, inputs: &Values, _start: &Values) -> Result<Structure, ModelError> {
-        let mut s = self.structure.clone();
+    fn build(&self, params: &Values, inputs: &Values, _start: &Values) -> Result<Structure, ModelError> {
+        let mut s = self.structure_at(params)?.clone();
         for a in &s.actuators {
             if let (ActuatorTarget::CableLength(c), Some(l)) = (&a.target, inputs.get(&a.symbol)) {
                 s.cables[*c].length_m = *l;
@@ -276,8 +299,8 @@ impl Mechanism for Custom {
         }
         v
     }
-    fn length_scale(&self, _params: &Values) -> f64 {
-        crate::structure::structure_size(&self.structure)
+    fn length_scale(&self, params: &Values) -> f64 {
+        crate::structure::structure_size(self.structure_at(params).unwrap_or(&self.structure))
     }
     fn findings(&self, _params: &Values) -> Vec<Finding> {
         Vec::new()

@@ -406,3 +406,21 @@ fn a_recorded_run_holds_the_model_errors_per_tick() {
         assert_eq!(t.len() as u64, r.settle.steps, "a value at every tick");
     }
 }
+
+/// `[expect] failing` names parts the scenario has: a prediction or an equation of its own
+/// model, `energy` only with an `[energy]` section, `probe` only with a `[probe]`; else the
+/// error is at the name and lists what there is.
+#[test]
+fn expected_failures_name_parts_of_the_file_s_model() {
+    let text = prism_text();
+    let cases = [
+        ("prediction:nope", "'nope' is not among this scenario's [[predictions]] (twist"),
+        ("equation:nope", "'nope' is not among this scenario's [[equations]] ("),
+        ("energy", "'energy' needs an [energy] section"),
+        ("probe", "'probe' needs a [probe] section"),
+    ];
+    for (name, msg) in cases {
+        let variant = text.replacen("verdict = \"pass\"", &format!("verdict = \"fail\"\nfailing = [\"{name}\"]"), 1);
+        error_at(&variant, &format!("\"{name}\""), 0, msg);
+    }
+}

@@ -144,16 +144,17 @@ impl ModelSpec {
         }
     }
 
-    /// Every symbol's value, given the inputs and a way to read the state's ones by symbol
-    /// index (`state`: time, nodes, members, observed quantities; NaN when absent); the
-    /// quantities evaluated in order.
-    pub fn values(&self, inputs: &Values, state: impl Fn(usize) -> f64) -> Vec<f64> {
+    /// Every symbol's value, given the inputs, the parameters (a sweep over parameters
+    /// changes them; one absent keeps the scenario's value) and a way to read the state's
+    /// ones by symbol index (`state`: time, nodes, members, observed quantities; NaN when
+    /// absent); the quantities evaluated in order.
+    pub fn values(&self, inputs: &Values, params: &Values, state: impl Fn(usize) -> f64) -> Vec<f64> {
         let mut v: Vec<f64> = self
             .symbols
             .iter()
             .enumerate()
             .map(|(i, s)| match &s.source {
-                Source::Param(x) => *x,
+                Source::Param(x) => params.get(&s.name).copied().unwrap_or(*x),
                 Source::Input(name) => inputs.get(name).copied().unwrap_or(f64::NAN),
                 Source::Quantity(_) => f64::NAN,
                 _ => state(i),

@@ -25,6 +25,8 @@ pub struct Tick<'a> {
     pub structure: &'a Structure,
     pub snapshot: &'a Snapshot,
     pub inputs: &'a Values,
+    /// Every parameter's value at this tick (a sweep over parameters changes them).
+    pub params: &'a Values,
     pub prediction: &'a Prediction,
     pub simulated: &'a Values,
     /// Analytic node positions for the ghost overlay (only for observers that record).
@@ -37,6 +39,8 @@ pub struct SettlePoint<'a> {
     pub structure: &'a Structure,
     /// The settled state (or the last one, when the settle ran out of time).
     pub snapshot: &'a Snapshot,
+    /// Every parameter's value at this point.
+    pub params: &'a Values,
     /// The analytic model does not apply here (it predicts a slack cable): nothing to compare.
     pub outside_model: bool,
 }

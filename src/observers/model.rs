@@ -221,8 +221,8 @@ impl ModelObserver {
     }
 
     /// Every symbol's value in this state.
-    fn values(&self, snap: &Snapshot, inputs: &Values, observed: &Values) -> Vec<f64> {
-        self.spec.values(inputs, |i| self.bind[i].read(snap, observed))
+    fn values(&self, snap: &Snapshot, inputs: &Values, params: &Values, observed: &Values) -> Vec<f64> {
+        self.spec.values(inputs, params, |i| self.bind[i].read(snap, observed))
     }
 
     /// Each prediction's (predicted, simulated, error), then each equation's (0, residual,
@@ -310,7 +310,7 @@ impl ModelObserver {
 
 impl Observer for ModelObserver {
     fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>) {
-        let v = self.values(t.snapshot, t.inputs, t.simulated);
+        let v = self.values(t.snapshot, t.inputs, t.params, t.simulated);
         let errors = self.errors(&v);
         for (a, (_, _, e)) in self.acc.iter_mut().zip(&errors) {
             a.tick(*e);
@@ -326,7 +326,7 @@ impl Observer for ModelObserver {
         if p.outside_model {
             return;
         }
-        let v = self.values(p.snapshot, &point.inputs, &point.simulated);
+        let v = self.values(p.snapshot, &point.inputs, p.params, &point.simulated);
         let errors = self.errors(&v);
         let tolerances: Vec<(String, f64)> = self.tolerances().map(|(n, t)| (n.to_string(), t)).collect();
         for ((a, (_, _, e)), (name, tol)) in self.acc.iter_mut().zip(&errors).zip(&tolerances) {

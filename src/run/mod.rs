@@ -176,7 +176,8 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         Actuation::Points { points, .. } => points[0].clone(),
         Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
     };
-    let structure = mech.build(&sc.params, &first_inputs, &sc.start).map_err(|e| e.to_string())?;
+    let params = sc.params_at(&first_inputs);
+    let structure = mech.build(&params, &first_inputs, &sc.start).map_err(|e| e.to_string())?;
     let sim = Simulation::new(&structure, &sc.sim).map_err(|e| e.to_string())?;
     let target = match (&opts.connect, opts.record.clone().or_else(|| sc.record.clone())) {
         (Some(url), _) => Some(RecordTarget::Live(url.clone())),
@@ -186,13 +187,13 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
     let observers = observers::observers(Setup {
         structure: &sim.structure(),
         checks: &sc.checks,
-        length_scale_m: mech.length_scale(&sc.params),
+        length_scale_m: mech.length_scale(&params),
         interference: &sc.interference,
         model: sc.model.as_ref(),
         recording: target.map(|target| Recording { target, every: opts.record_every.max(1), scenario: &sc.source }),
         table: opts.table.clone(),
     })?;
-    let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel);
+    let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel, params);
     // The first point's commands (a no-op where the build already placed them).
     runner.command(&first_inputs);
     Ok(runner)
@@ -249,11 +250,21 @@ fn run_actuation(
     match &sc.actuation {
         Actuation::Points { points, continuation } => {
             for (i, inputs) in points.iter().enumerate() {
-                if i > 0 {
+                let params = sc.params_at(inputs);
+                if i > 0 && params != runner.params {
+                    // Other parameters (a sweep over them): another structure, built afresh.
+                    let s = runner.mech.build(&params, inputs, &sc.start).map_err(Stop::Model)?;
+                    let tick = runner.sim.tick();
+                    runner.sim = Simulation::new(&s, &sc.sim)?;
+                    runner.sim.set_tick(tick);
+                    runner.params = params;
+                    runner.command(inputs);
+                    runner.emit(format_args!("point {i}: parameters and inputs {inputs:?}"));
+                } else if i > 0 {
                     if *continuation {
                         runner.command(inputs);
                     } else {
-                        let s = runner.mech.build(&sc.params, inputs, &sc.start).map_err(Stop::Model)?;
+                        let s = runner.mech.build(&runner.params, inputs, &sc.start).map_err(Stop::Model)?;
                         // The same structure placed anew: restarted in place where it can be
                         // (no rebuild of the rapier sets), else built afresh.
                         if !runner.sim.restart_from(&s) {
@@ -277,7 +288,7 @@ fn run_actuation(
                 }
                 let inputs = interpolate(waypoints, t);
                 runner.command(&inputs);
-                let prediction = runner.mech.predict(&sc.params, &inputs).map_err(Stop::Model)?;
+                let prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
                 let (_, simulated) = runner.step(&inputs, &prediction)?;
                 for (q, v) in simulated {
                     report

@@ -83,11 +83,11 @@ const BRANCH_MATCH_DISTANCE: f64 = 1e-3;
 /// them is labelled so, with the nearest named.
 fn branch_of(
     mech: &dyn Mechanism,
-    sc: &Scenario,
+    params: &Values,
     prediction: &Prediction,
     simulated: &Values,
 ) -> (String, Option<bool>) {
-    let scale = mech.length_scale(&sc.params);
+    let scale = mech.length_scale(params);
     let mut best: Option<(f64, &mechanisms::Solution)> = None;
     for b in &prediction.branches {
         let mut d: f64 = 0.0;
@@ -121,7 +121,7 @@ pub(super) fn settle_point(
     report: &mut ScenarioReport,
     probe_errors: &mut Vec<f64>,
 ) -> Result<(), Stop> {
-    let prediction = runner.mech.predict(&sc.params, inputs).map_err(Stop::Model)?;
+    let prediction = runner.mech.predict(&runner.params, inputs).map_err(Stop::Model)?;
     let s = runner.settle(inputs, &prediction)?;
     let final_energy = runner.sim.kinetic_energy_j();
     if s.settled {
@@ -136,7 +136,7 @@ pub(super) fn settle_point(
         ));
     }
     let mut simulated = s.simulated.clone();
-    let (branch, analytic_stable) = branch_of(runner.mech.as_ref(), sc, &prediction, &simulated);
+    let (branch, analytic_stable) = branch_of(runner.mech.as_ref(), &runner.params, &prediction, &simulated);
     // The settled state is compared with the branch it landed on; landing on an analytically
     // unstable branch is a failure unless the scenario deliberately starts there.
     let landed = prediction
@@ -206,12 +206,17 @@ pub(super) fn settle_point(
         energy: None,
         paper: runner
             .mech
-            .paper_values(&sc.params, inputs)
+            .paper_values(&runner.params, inputs)
             .map(|(source, values)| crate::report::PaperValues { source, values }),
         analytic: landed,
         simulated,
     };
-    let seen = SettlePoint { structure: &runner.sim.structure(), snapshot: &s.snapshot, outside_model: outside };
+    let seen = SettlePoint {
+        structure: &runner.sim.structure(),
+        snapshot: &s.snapshot,
+        params: &runner.params,
+        outside_model: outside,
+    };
     for o in runner.observers.iter_mut() {
         o.settle_point(&seen, &mut point, &mut runner.notes);
     }

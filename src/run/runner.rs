@@ -12,6 +12,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 pub(super) struct Runner<'a> {
     pub mech: Box<dyn Mechanism>,
     pub sc: &'a Scenario,
+    /// Every parameter's value at the current point (a sweep over parameters changes them).
+    pub params: crate::mechanisms::Values,
     pub sim: Simulation,
     pub observers: Vec<Box<dyn Observer>>,
     /// Whether an observer writes the run down: events and ghost nodes are made only then.
@@ -32,21 +34,22 @@ impl<'a> Runner<'a> {
         sim: Simulation,
         observers: Vec<Box<dyn Observer>>,
         cancel: Option<&'a AtomicBool>,
+        params: Values,
     ) -> Self {
         let recording = observers.iter().any(|o| o.records());
-        Runner { mech, sc, sim, observers, recording, notes: Vec::new(), cancel, steps: 0, ghost: None }
+        Runner { mech, sc, params, sim, observers, recording, notes: Vec::new(), cancel, steps: 0, ghost: None }
     }
 
     /// Commands every actuator for `inputs` (by its symbol).
     pub fn command(&mut self, inputs: &Values) {
-        let by_symbol = self.mech.commands(&self.sc.params, inputs);
+        let by_symbol = self.mech.commands(&self.params, inputs);
         let commands = self.sim.structure().commands_from(&by_symbol);
         self.sim.set_commands(&commands);
     }
 
     /// The mechanism's quantities in a snapshot of this simulation.
     pub fn observe(&self, snap: &Snapshot) -> Values {
-        self.mech.observe(&self.sc.params, &self.sim.structure(), snap)
+        self.mech.observe(&self.params, &self.sim.structure(), snap)
     }
 
     /// Tells every observer an event of the run (formatted only when one records).
@@ -99,12 +102,13 @@ impl<'a> Runner<'a> {
         // The ghost overlay is only drawn in recordings, and only recomputed when the inputs
         // change.
         if self.recording && self.ghost.as_ref().is_none_or(|(i, _)| i != inputs) {
-            self.ghost = Some((inputs.clone(), self.mech.analytic_nodes(&self.sc.params, inputs)));
+            self.ghost = Some((inputs.clone(), self.mech.analytic_nodes(&self.params, inputs)));
         }
         let tick = Tick {
             structure: &self.sim.structure(),
             snapshot: &snap,
             inputs,
+            params: &self.params,
             prediction,
             simulated: &simulated,
             ghost_nodes: self.ghost.as_ref().and_then(|(_, g)| g.as_deref()),

@@ -1,10 +1,14 @@
 //! `[actuation]`: the inputs to settle at (a grid or explicit points) or to follow in time
-//! (waypoints), each set in the mechanism's own inputs or in one of its alternative sets.
+//! (waypoints), each set in the mechanism's own inputs or in one of its alternative sets. A
+//! grid or a point may also set parameters (a sweep over parameters): its values then hold
+//! those parameters beside the inputs, and every parameter that depends on them follows.
 
 use super::error::{finite, value_at, values, Ctx, ScenarioError};
+use super::params::params_at;
 use super::raw::{RawActuation, RawRange, SpannedMap};
 use super::{Actuation, MAX_POINTS};
 use crate::mechanisms::{Mechanism, ModelError, Values};
+use crate::model::params::ParamTable;
 use std::collections::BTreeMap;
 use toml::Spanned;
 
@@ -19,6 +23,7 @@ const SKIP_HINT: &str = " (or set actuation.skip_outside = true to drop such poi
 pub(super) fn actuation(
     ctx: &Ctx,
     m: &dyn Mechanism,
+    table: &ParamTable,
     params: &Values,
     raw: &Spanned<RawActuation>,
 ) -> Result<(Actuation, Vec<(Values, String)>), ScenarioError> {
@@ -31,7 +36,7 @@ pub(super) fn actuation(
     if act.skip_outside.is_some() && act.grid.is_none() {
         return Err(ctx.err(raw, "skip_outside applies to a grid only"));
     }
-    let inputs = InputSets::new(m, params);
+    let inputs = InputSets::new(m, table, params);
     let continuation = act.continuation.unwrap_or(true);
     let actuation = if let Some(g) = &act.grid {
         let skip = act.skip_outside.unwrap_or(false);
@@ -47,9 +52,13 @@ pub(super) fn actuation(
     Ok((actuation, skipped_points))
 }
 
-/// The input symbols a mechanism accepts, with what checking a set of inputs needs.
+/// The input symbols a mechanism accepts, with what checking a set of inputs needs; and the
+/// parameters a point may set as well (a sweep over parameters).
 struct InputSets<'a> {
     m: &'a dyn Mechanism,
+    /// The file's parameters, to evaluate again at a point that sets some.
+    table: &'a ParamTable,
+    /// Every parameter's value in the scenario.
     params: &'a Values,
     /// The mechanism's own inputs.
     native: Vec<&'static str>,
@@ -61,33 +70,69 @@ struct InputSets<'a> {
 
 impl<'a> InputSets<'a> {
     /// The sets `m` accepts, to be checked against `params`.
-    fn new(m: &'a dyn Mechanism, params: &'a Values) -> Self {
+    fn new(m: &'a dyn Mechanism, table: &'a ParamTable, params: &'a Values) -> Self {
         let native: Vec<&'static str> = m.inputs().iter().map(|i| i.symbol).collect();
         let mut sets = vec![native.clone()];
         sets.extend(m.alternative_inputs().iter().map(|s| s.to_vec()));
-        let expected = sets.iter().map(|s| s.join(", ")).collect::<Vec<_>>().join("; or ");
-        InputSets { m, params, native, sets, expected }
+        let mut expected = sets.iter().map(|s| s.join(", ")).collect::<Vec<_>>().join("; or ");
+        if !params.is_empty() {
+            let names: Vec<&str> = params.keys().map(String::as_str).collect();
+            expected = format!("{expected}; and any parameter: {}", names.join(", "));
+        }
+        InputSets { m, table, params, native, sets, expected }
     }
 
-    /// The set a table of keys belongs to: the first that contains its first key.
+    /// Whether `key` names a parameter (an input of the same name is the input).
+    fn is_param(&self, key: &str) -> bool {
+        self.params.contains_key(key) && !self.sets.iter().any(|s| s.contains(&key))
+    }
+
+    /// The set a table of keys belongs to: the first that contains its first input key.
     fn set_of(&self, keys: &[&str]) -> Vec<&'static str> {
-        self.sets.iter().find(|s| keys.iter().any(|k| s.contains(k))).cloned().unwrap_or_else(|| self.native.clone())
+        let inputs: Vec<&str> = keys.iter().copied().filter(|k| !self.is_param(k)).collect();
+        self.sets.iter().find(|s| inputs.iter().any(|k| s.contains(k))).cloned().unwrap_or_else(|| self.native.clone())
+    }
+
+    /// A point's parameters, checked by the mechanism, and its inputs converted to the
+    /// mechanism's own when they are in another set (`input_syms`); its parameter entries
+    /// kept beside them.
+    fn convert(&self, input_syms: &[&str], point: &Values) -> Result<Values, ModelError> {
+        let params = params_at(self.table, self.params, point);
+        self.m.validate_params(&params)?;
+        let (set, mut inputs): (Values, Values) =
+            point.iter().map(|(k, v)| (k.clone(), *v)).partition(|(k, _)| self.is_param(k));
+        if input_syms != self.native {
+            inputs = self.m.convert_inputs(&params, &inputs)?;
+        }
+        inputs.extend(set);
+        Ok(inputs)
+    }
+
+    /// A converted point's inputs checked against its parameters.
+    fn validate(&self, point: &Values) -> Result<(), ModelError> {
+        self.m.validate_inputs(&params_at(self.table, self.params, point), point)
     }
 
     /// One point or waypoint (`allow_t`: with its time `t`, kept as given): the symbols of one
     /// accepted set, all of them and no other, finite, converted to the mechanism's inputs and
-    /// checked against the parameters.
+    /// checked against the parameters; a point (not a waypoint) may set parameters too.
     fn check(&self, ctx: &Ctx, point: &Spanned<SpannedMap>, allow_t: bool) -> Result<Values, ScenarioError> {
         let map = point.get_ref();
         let keys: Vec<&str> = map.keys().map(|k| k.get_ref().as_str()).filter(|k| *k != "t").collect();
         let input_syms = self.set_of(&keys);
         for k in map.keys() {
-            if !(input_syms.contains(&k.get_ref().as_str()) || (allow_t && k.get_ref() == "t")) {
+            let key = k.get_ref().as_str();
+            if self.is_param(key) && allow_t {
+                return Err(ctx.err(
+                    k,
+                    format!("parameter '{key}' cannot follow waypoints (a parameter changes the structure): sweep it with actuation.grid or actuation.points"),
+                ));
+            }
+            if !(input_syms.contains(&key) || self.is_param(key) || (allow_t && key == "t")) {
                 return Err(ctx.err(
                     k,
                     format!(
-                        "unknown input '{}' (expected {}{})",
-                        k.get_ref(),
+                        "unknown input '{key}' (expected {}{})",
                         self.expected,
                         if allow_t { ", and t" } else { "" }
                     ),
@@ -103,13 +148,11 @@ impl<'a> InputSets<'a> {
         };
         let mut vals = values(ctx, map)?;
         let t = vals.remove("t");
-        if input_syms != self.native {
-            vals = self.m.convert_inputs(self.params, &vals).map_err(rejected)?;
-        }
+        vals = self.convert(&input_syms, &vals).map_err(rejected)?;
+        self.validate(&vals).map_err(rejected)?;
         if let Some(t) = t {
             vals.insert("t".into(), t);
         }
-        self.m.validate_inputs(self.params, &vals).map_err(rejected)?;
         Ok(vals)
     }
 }
@@ -127,12 +170,18 @@ fn grid(
 ) -> Result<Vec<Values>, ScenarioError> {
     let keys: Vec<&str> = grid.keys().map(|k| k.get_ref().as_str()).collect();
     let input_syms = inputs.set_of(&keys);
-    if let Some(k) = grid.keys().find(|k| !input_syms.contains(&k.get_ref().as_str())) {
+    let known = |k: &str| input_syms.contains(&k) || inputs.is_param(k);
+    if let Some(k) = grid.keys().find(|k| !known(k.get_ref())) {
         return Err(
             ctx.err(k, format!("unknown input '{}' in actuation.grid (expected {})", k.get_ref(), inputs.expected))
         );
     }
+    // The parameters first: the inputs vary fastest, so that continuation follows them at one
+    // set of parameters (a new set rebuilds the structure).
     let mut axes: Vec<(String, Vec<f64>)> = Vec::new();
+    for (k, r) in grid.iter().filter(|(k, _)| inputs.is_param(k.get_ref())) {
+        axes.push((k.get_ref().clone(), axis(ctx, r.get_ref())?));
+    }
     for s in &input_syms {
         let (_, r) = grid
             .iter()
@@ -144,12 +193,10 @@ fn grid(
     if total > MAX_POINTS {
         return Err(ctx.err(whole, format!("the grid has {total} points; at most {MAX_POINTS}")));
     }
-    let mut points = product(&axes);
-    if input_syms != inputs.native {
-        let convert = |p: &Values| inputs.m.convert_inputs(inputs.params, p).map(Some);
-        points = grid_pass(ctx, grid, points, skip, skipped, "", convert)?;
-    }
-    let check = |p: &Values| inputs.m.validate_inputs(inputs.params, p).map(|()| None);
+    let points = product(&axes);
+    let convert = |p: &Values| inputs.convert(&input_syms, p).map(Some);
+    let points = grid_pass(ctx, grid, points, skip, skipped, "", convert)?;
+    let check = |p: &Values| inputs.validate(p).map(|()| None);
     let kept = grid_pass(ctx, grid, points, skip, skipped, SKIP_HINT, check)?;
     if kept.is_empty() {
         return Err(

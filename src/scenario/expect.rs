@@ -2,27 +2,65 @@
 
 use super::error::{Ctx, ScenarioError};
 use super::raw::RawExpect;
+use crate::model::spec::ModelSpec;
 use crate::settings::Check;
 use toml::Spanned;
 
+/// The parts of a scenario that `[expect] failing` may name.
+pub(super) struct Parts<'a> {
+    pub checks: &'a [Check],
+    pub model: Option<&'a ModelSpec>,
+    pub probe: bool,
+}
+
+/// Names in a message: `none` for an empty list.
+fn listed(names: Vec<&str>) -> String {
+    if names.is_empty() {
+        "none".into()
+    } else {
+        names.join(", ")
+    }
+}
+
+/// Whether the scenario has the part `failure` names; else the message saying what it has.
+fn has_part(parts: &Parts, failure: &crate::settings::Failure) -> Result<(), String> {
+    use crate::settings::Failure;
+    let model = parts.model;
+    match failure {
+        Failure::Check(q) if !parts.checks.iter().any(|c| &c.quantity == q) => Err(format!(
+            "'{q}' is not among this scenario's checks ({})",
+            listed(parts.checks.iter().map(|c| c.quantity.as_str()).collect())
+        )),
+        Failure::Prediction(p) if !model.is_some_and(|m| m.predictions.iter().any(|x| &x.name == p)) => Err(format!(
+            "'{p}' is not among this scenario's [[predictions]] ({})",
+            listed(model.map_or(vec![], |m| m.predictions.iter().map(|x| x.name.as_str()).collect()))
+        )),
+        Failure::Equation(q) if !model.is_some_and(|m| m.equations.iter().any(|x| &x.name == q)) => Err(format!(
+            "'{q}' is not among this scenario's [[equations]] ({})",
+            listed(model.map_or(vec![], |m| m.equations.iter().map(|x| x.name.as_str()).collect()))
+        )),
+        Failure::Energy if !model.is_some_and(|m| m.energy.is_some()) => {
+            Err("'energy' needs an [energy] section in this scenario".into())
+        }
+        Failure::Probe if !parts.probe => Err("'probe' needs a [probe] section in this scenario".into()),
+        _ => Ok(()),
+    }
+}
+
 /// `[expect]`: `verdict = "pass"`, or `"fail"` with the parts that must fail (`failing`), each
-/// a part this scenario has (a `check:` names one of its `[[checks]]`).
+/// a part this scenario has (a `check:` names one of its `[[checks]]`, a `prediction:` or
+/// `equation:` one of its model's entries).
 pub(super) fn expectation(
     ctx: &Ctx,
     raw: &Spanned<RawExpect>,
-    checks: &[Check],
+    parts: &Parts,
 ) -> Result<crate::settings::Expectation, ScenarioError> {
     use crate::settings::{Expectation, Failure};
     let e = raw.get_ref();
     let mut failing = Vec::new();
     for f in &e.failing {
         let failure: Failure = f.get_ref().parse().map_err(|m: String| ctx.err(f, m))?;
-        if let Failure::Check(q) = &failure {
-            if !checks.iter().any(|c| &c.quantity == q) {
-                let known: Vec<_> = checks.iter().map(|c| c.quantity.as_str()).collect();
-                return Err(ctx.err(f, format!("'{q}' is not among this scenario's checks ({})", known.join(", "))));
-            }
-        }
+        has_part(parts, &failure).map_err(|m| ctx.err(f, m))?;
         failing.push(failure);
     }
     match e.verdict.get_ref().as_str() {

@@ -2,10 +2,13 @@
 
 use super::error::{finite, Ctx, ScenarioError};
 use super::number::{param_values, resolve_structure, ParamMap};
+use super::params::params_at;
 use super::raw::RawScenario;
 use super::structure::structure_from_file;
+use super::Actuation;
 use crate::custom::{Custom, FileParam};
 use crate::mechanisms::{self, Mechanism, Values};
+use crate::model::params::ParamTable;
 
 /// `mechanism = "custom"`: the mechanism built from the `[structure]` table, with each check's
 /// expected value (required: there is no analytic model). A built-in mechanism: `None`, and
@@ -42,6 +45,54 @@ pub(super) fn custom(ctx: &Ctx, raw: &RawScenario) -> Result<Option<Custom>, Sce
             None => Ok(None),
         },
     }
+}
+
+/// Largest number of distinct parameter sets a sweep over parameters may ask for (each is a
+/// structure of its own, built and checked at read).
+pub const MAX_PARAMETER_SETS: usize = 10_000;
+
+/// The distinct sets of parameters the actuation's points ask for, in their order (the
+/// scenario's own set when no point sets a parameter).
+pub(super) fn parameter_sets(table: &ParamTable, params: &Values, actuation: &Actuation) -> Vec<Values> {
+    let points: Vec<&Values> = match actuation {
+        Actuation::Points { points, .. } => points.iter().collect(),
+        Actuation::Schedule { waypoints } => waypoints.iter().map(|(_, v)| v).collect(),
+    };
+    let mut sets: Vec<Values> = Vec::new();
+    for p in points {
+        let set = params_at(table, params, p);
+        if sets.last() != Some(&set) && !sets.contains(&set) {
+            sets.push(set);
+        }
+    }
+    sets
+}
+
+/// The custom structure at every set of parameters in `sets` besides the file's own, each
+/// resolved and read as the file's own is (an error names the set).
+pub(super) fn with_variants(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    custom: Custom,
+    params: &Values,
+    sets: &[Values],
+) -> Result<Custom, ScenarioError> {
+    let Some(st) = &raw.structure else { return Ok(custom) };
+    if sets.len() > MAX_PARAMETER_SETS {
+        return Err(ctx.err(
+            &raw.actuation,
+            format!("the actuation asks for {} sets of parameters; at most {MAX_PARAMETER_SETS}", sets.len()),
+        ));
+    }
+    let mut variants = Vec::new();
+    for set in sets.iter().filter(|set| *set != params) {
+        let mut st = st.clone();
+        let at_set =
+            |e: ScenarioError| ScenarioError { message: format!("{} (with the parameters {set:?})", e.message), ..e };
+        resolve_structure(ctx, st.get_mut(), set).map_err(at_set)?;
+        variants.push((set.clone(), structure_from_file(ctx, &st).map_err(at_set)?));
+    }
+    Ok(custom.with_variants(variants))
 }
 
 /// The scenario's mechanism: the custom one, or the built-in one `raw.mechanism` names.

@@ -42,7 +42,10 @@ pub struct Scenario {
     pub name: String,
     pub description: String,
     pub mechanism: String,
+    /// Every parameter's value (the mechanism's defaults where the file gives none).
     pub params: Values,
+    /// The file's `[params]`, to evaluate again at a point that sets some ([`Scenario::params_at`]).
+    pub param_table: crate::model::params::ParamTable,
     pub sim: SimSettings,
     pub settle: SettleCriteria,
     pub start: Values,
@@ -75,6 +78,12 @@ impl Scenario {
             [all] => Some(*all),
             list => list.get(index).copied(),
         }
+    }
+
+    /// Every parameter's value at a settle point or waypoint: the point's own where it sets
+    /// some (a sweep over parameters), with every parameter that depends on them.
+    pub fn params_at(&self, point: &Values) -> Values {
+        params::params_at(&self.param_table, &self.params, point)
     }
 
     /// The scenario's mechanism: a built-in one, or the file's own structure.
@@ -142,10 +151,11 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let mech = mechanism::mechanism(ctx, &raw, custom.as_ref())?;
     let m = mech.as_ref();
     let params = params::params(ctx, m, &raw.params)?;
+    let param_table = number::param_table(ctx, &raw.params)?;
     let sim = sim::sim(ctx, &raw.sim)?;
     let settle = sim::settle(ctx, &raw.settle)?;
     let start = params::start(ctx, m, &raw.start)?;
-    let (actuation, skipped_points) = actuation::actuation(ctx, m, &params, &raw.actuation)?;
+    let (actuation, skipped_points) = actuation::actuation(ctx, m, &param_table, &params, &raw.actuation)?;
     bounds::bounds(ctx, &raw, &sim, &settle, &actuation)?;
     let checks = checks::checks(ctx, m, &raw.checks, raw.probe.is_some())?;
     let model = model::model(ctx, &raw, m, &params, &start, &actuation)?;
@@ -159,12 +169,29 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let probe = checks::probe(ctx, m, &raw.probe)?;
     let record = record::record(ctx, &raw.record)?;
     let min_agreement_percent = checks::workspace(ctx, &raw.workspace)?;
-    let first = physical::first_structure(ctx, &raw, m, &params, &start, actuation.first_inputs())?;
+    // Every set of parameters the points ask for (a sweep over parameters): the custom
+    // structure resolved with each, and each structure checked as the first point's is.
+    let parameter_sets = mechanism::parameter_sets(&param_table, &params, &actuation);
+    let custom = match custom {
+        Some(c) => Some(mechanism::with_variants(ctx, &raw, c, &params, &parameter_sets)?),
+        None => None,
+    };
+    let mech = mechanism::mechanism(ctx, &raw, custom.as_ref())?;
+    let m = mech.as_ref();
+    let first_params = params::params_at(&param_table, &params, actuation.first_inputs());
+    let first = physical::first_structure(ctx, &raw, m, &first_params, &start, actuation.first_inputs())?;
     physical::physical(ctx, &raw, m, &first, &sim)?;
-    let interference = interference::interference(ctx, &raw.interference, m, &params, &first)?;
+    for set in parameter_sets.iter().skip(1) {
+        let s = physical::first_structure(ctx, &raw, m, set, &start, actuation.first_inputs())?;
+        physical::physical(ctx, &raw, m, &s, &sim)?;
+    }
+    let interference = interference::interference(ctx, &raw.interference, m, &first_params, &first)?;
     let expect = match &raw.expect {
         None => None,
-        Some(e) => Some(expect::expectation(ctx, e, &checks)?),
+        Some(e) => {
+            let parts = expect::Parts { checks: &checks, model: model.as_ref(), probe: probe.is_some() };
+            Some(expect::expectation(ctx, e, &parts)?)
+        }
     };
     Ok(Scenario {
         file: path.to_path_buf(),
@@ -173,6 +200,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         description: raw.description,
         mechanism: m.name().into(),
         params,
+        param_table,
         sim,
         settle,
         start,

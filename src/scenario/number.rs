@@ -11,6 +11,7 @@ use super::error::{Ctx, ScenarioError};
 use super::raw::{RawBody, RawJoint, RawStructure, Xyz};
 use crate::mechanisms::Values;
 use crate::model::expr::{Expr, ExprError};
+use crate::model::params::{Cycle, ParamTable};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -147,57 +148,37 @@ fn param_start(p: &Spanned<RawParam>) -> usize {
     p.get_ref().value_span.as_ref().map_or(p.span().start, |s| s.start)
 }
 
-/// Every `[params]` entry's value, each expression evaluated with the values of the
-/// parameters it names (a parameter that names itself through others is an error).
-pub(super) fn param_values(ctx: &Ctx, raw: &ParamMap) -> Result<Values, ScenarioError> {
+/// The file's `[params]` as a table, each expression compiled against the parameter names
+/// (a parameter that names itself through others is an error at it).
+pub(super) fn param_table(ctx: &Ctx, raw: &ParamMap) -> Result<ParamTable, ScenarioError> {
     let names: Vec<&str> = raw.keys().map(|k| k.get_ref().as_str()).collect();
-    let mut compiled: Vec<(usize, Option<Expr>)> = Vec::new();
-    for (i, (k, p)) in raw.iter().enumerate() {
-        let e = match &p.get_ref().value {
-            Num::Value(_) => None,
-            Num::Expr(text) => Some(
-                Expr::compile(text, &names)
-                    .map_err(|e| expr_error(ctx, param_start(p), &e, &format!("parameter '{}'", k.get_ref())))?,
-            ),
-        };
-        compiled.push((i, e));
+    let mut definitions = Vec::new();
+    for (k, p) in raw {
+        definitions.push(match &p.get_ref().value {
+            Num::Value(x) => Ok(*x),
+            Num::Expr(text) => Err(Expr::compile(text, &names)
+                .map_err(|e| expr_error(ctx, param_start(p), &e, &format!("parameter '{}'", k.get_ref())))?),
+        });
     }
-    let mut values = vec![f64::NAN; names.len()];
-    let mut done = vec![false; names.len()];
-    // Evaluate whatever is ready, as many rounds as there are parameters.
-    for _ in 0..=names.len() {
-        for (i, e) in &compiled {
-            if done[*i] {
-                continue;
-            }
-            match e {
-                None => values[*i] = raw.values().nth(*i).map_or(f64::NAN, |p| p.get_ref().value.value()),
-                Some(e) if e.uses().iter().all(|u| done[*u]) => {
-                    let x = e.eval(&values);
-                    values[*i] = x;
-                }
-                Some(_) => continue,
-            }
-            done[*i] = true;
+    ParamTable::new(names.iter().map(|n| n.to_string()).collect(), definitions).map_err(|Cycle(i)| {
+        let (k, p) = raw.iter().nth(i).expect("a cycle names a parameter");
+        ctx.err_at(param_start(p), format!("parameter '{}' depends on itself through other parameters", k.get_ref()))
+    })
+}
+
+/// Every `[params]` entry's value, each expression evaluated with the values of the
+/// parameters it names, and each finite.
+pub(super) fn param_values(ctx: &Ctx, raw: &ParamMap) -> Result<Values, ScenarioError> {
+    let values = param_table(ctx, raw)?.evaluate(&Values::new());
+    for (k, p) in raw {
+        let x = values[k.get_ref()];
+        if !x.is_finite() {
+            return Err(
+                ctx.err_at(param_start(p), format!("parameter '{}' must be a finite number, got {x}", k.get_ref()))
+            );
         }
     }
-    let mut out = Values::new();
-    for (i, (k, p)) in raw.iter().enumerate() {
-        if !done[i] {
-            return Err(ctx.err_at(
-                param_start(p),
-                format!("parameter '{}' depends on itself through other parameters", k.get_ref()),
-            ));
-        }
-        if !values[i].is_finite() {
-            return Err(ctx.err_at(
-                param_start(p),
-                format!("parameter '{}' must be a finite number, got {}", k.get_ref(), values[i]),
-            ));
-        }
-        out.insert(k.get_ref().clone(), values[i]);
-    }
-    Ok(out)
+    Ok(values)
 }
 
 /// The value of a number or expression of the parameters `params`.

@@ -4,6 +4,7 @@ use super::error::{known_keys, value_at, values, Ctx, ScenarioError};
 use super::number::{param_values, ParamMap};
 use super::raw::SpannedMap;
 use crate::mechanisms::{self, Mechanism, Values};
+use crate::model::params::ParamTable;
 
 /// Parameters: known symbols, each a finite number or an expression of the others, in the
 /// mechanism's unit where the file names one, then the mechanism's own ranges; the result
@@ -45,4 +46,19 @@ pub(super) fn start(ctx: &Ctx, m: &dyn Mechanism, raw: &SpannedMap) -> Result<Va
     let known: Vec<_> = m.start_keys().iter().map(|(key, _)| *key).collect();
     known_keys(ctx, raw, &known, "start key", m.name())?;
     values(ctx, raw)
+}
+
+/// Every parameter's value at a settle point that sets some of them (a sweep over
+/// parameters): the scenario's values `base` (every parameter of the mechanism), the point's
+/// entries that name a parameter in their place, and the file's expressions of those
+/// evaluated again.
+pub(crate) fn params_at(table: &ParamTable, base: &Values, point: &Values) -> Values {
+    let set: Values = point.iter().filter(|(k, _)| base.contains_key(*k)).map(|(k, v)| (k.clone(), *v)).collect();
+    if set.is_empty() {
+        return base.clone();
+    }
+    let mut out = base.clone();
+    out.extend(table.evaluate(&set));
+    out.extend(set);
+    out
 }
