@@ -163,6 +163,10 @@ pub enum ActuatorTarget {
     Joint(JointId),
     /// Winch: the cable's unstretched length follows the command.
     CableLength(usize),
+    /// A node of a fixed body moved directly: the body (with every node on it) is displaced
+    /// from its drawn place by the command [m] along `direction` (a unit vector, world);
+    /// several such actuators on one body add up.
+    FixedNode { node: usize, direction: Vec3 },
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -227,6 +231,26 @@ impl Structure {
         self.commands_from(&std::collections::BTreeMap::new())
     }
 
+    /// Moves the nodes of every fixed body that carries a moved node ([`ActuatorTarget::FixedNode`])
+    /// to where `commands` (actuator order) place them: the drawing of the structure at those
+    /// commands, for a reader that has no such actuator.
+    pub fn displace_fixed_nodes(&mut self, commands: &[f64]) {
+        let mut offsets: Vec<Vec3> = vec![[0.0; 3]; self.bodies.len()];
+        for (a, command) in self.actuators.iter().zip(commands) {
+            if let ActuatorTarget::FixedNode { node, direction } = a.target {
+                let o = &mut offsets[self.nodes[node].body];
+                for k in 0..3 {
+                    o[k] += direction[k] * command;
+                }
+            }
+        }
+        for n in &mut self.nodes {
+            for k in 0..3 {
+                n.position[k] += offsets[n.body][k];
+            }
+        }
+    }
+
     /// Actuator commands in actuator order from values keyed by actuator symbol (m or rad);
     /// an actuator whose symbol has no value keeps its drawn coordinate or cable length.
     pub fn commands_from(&self, by_symbol: &std::collections::BTreeMap<String, f64>) -> Vec<f64> {
@@ -236,6 +260,7 @@ impl Structure {
                 by_symbol.get(&a.symbol).copied().unwrap_or(match a.target {
                     ActuatorTarget::Joint(j) => self.joints[j].initial_coordinate,
                     ActuatorTarget::CableLength(c) => self.cables[c].length_m,
+                    ActuatorTarget::FixedNode { .. } => 0.0,
                 })
             })
             .collect()
@@ -379,7 +404,38 @@ impl Structure {
         Ok(())
     }
 
-    /// Actuators drive an existing revolute or prismatic joint without a torsion spring, or an existing cable.
+    /// A moved node lies on a fixed body that no joint holds (a joint to it is anchored in the
+    /// ground), along a unit direction.
+    fn validate_fixed_node(&self, symbol: &str, node: usize, direction: Vec3) -> Result<(), StructureError> {
+        let n = self.nodes.get(node).ok_or_else(|| StructureError::DanglingReference {
+            what: "actuator",
+            name: symbol.to_string(),
+            kind: "node",
+            index: node,
+        })?;
+        if self.bodies[n.body].kind != BodyKind::Fixed {
+            return Err(invalid(
+                "actuator",
+                symbol,
+                "a moved node must lie on a fixed body (free nodes follow the dynamics)",
+            ));
+        }
+        if self.joints.iter().any(|j| j.parent == n.body || j.child == n.body) {
+            return Err(invalid(
+                "actuator",
+                symbol,
+                "a moved node's body must carry no joint (put the node on a fixed body of its own)",
+            ));
+        }
+        let norm = direction.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if !((norm - 1.0).abs() <= 1e-12) {
+            return Err(invalid("actuator", symbol, "the direction of a moved node must be a unit vector"));
+        }
+        Ok(())
+    }
+
+    /// Actuators drive an existing revolute or prismatic joint without a torsion spring, an
+    /// existing cable, or a node of a fixed body.
     fn validate_actuators(&self) -> Result<(), StructureError> {
         for a in &self.actuators {
             match a.target {
@@ -414,6 +470,9 @@ impl Structure {
                             index: c,
                         });
                     }
+                }
+                ActuatorTarget::FixedNode { node, direction } => {
+                    self.validate_fixed_node(&a.symbol, node, direction)?
                 }
             }
         }

@@ -530,6 +530,13 @@ impl Writer<'_> {
                         ctrl.push(command);
                     }
                 }
+                ActuatorTarget::FixedNode { node, direction } => {
+                    let _ = writeln!(
+                        rows,
+                        "  <!-- {name} = {command:?}: node {} (fixed) displaced by it along {direction:?} (exported in place) -->",
+                        esc(&s.nodes[node].name)
+                    );
+                }
                 ActuatorTarget::CableLength(c) => {
                     let cable = &s.cables[c];
                     match cable.law {

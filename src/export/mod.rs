@@ -37,8 +37,11 @@ pub fn first_structure(sc: &Scenario) -> Result<(Structure, Vec<f64>), String> {
         Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
     };
     let mech = sc.mechanism();
-    let s = mech.build(&sc.params, &first_inputs, &sc.start).map_err(|e| e.to_string())?;
+    let params = sc.params_at(&first_inputs);
+    let mut s = mech.build(&params, &first_inputs, &sc.start).map_err(|e| e.to_string())?;
     s.validate().map_err(|e| format!("the structure is not valid: {e}"))?;
-    let commands = s.commands_from(&mech.commands(&sc.params, &first_inputs));
+    let commands = s.commands_from(&mech.commands(&params, &first_inputs));
+    // Moved nodes are exported where their commands place them (MJCF has no such actuator).
+    s.displace_fixed_nodes(&commands);
     Ok((s, commands))
 }

@@ -100,6 +100,7 @@ impl Table {
             let target = match a.target {
                 ActuatorTarget::Joint(j) => &s.joints[j].name,
                 ActuatorTarget::CableLength(c) => &s.cables[c].name,
+                ActuatorTarget::FixedNode { node, .. } => &s.nodes[node].name,
             };
             format!("actuator:{}@{target}.force", a.symbol)
         }));

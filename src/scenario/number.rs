@@ -216,6 +216,11 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
     for j in &mut s.joints {
         resolve_joint(j, &mut resolve)?;
     }
+    for a in &mut s.actuators {
+        if let Some(d) = &mut a.direction {
+            resolve_xyz(d, "direction", &mut resolve)?;
+        }
+    }
     Ok(())
 }
 

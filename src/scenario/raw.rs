@@ -218,6 +218,9 @@ pub(super) struct RawActuator {
     pub(super) symbol: Spanned<String>,
     pub(super) joint: Option<Spanned<String>>,
     pub(super) cable: Option<Spanned<String>>,
+    /// A node of a fixed body, moved along `direction` by the command [m].
+    pub(super) node: Option<Spanned<String>>,
+    pub(super) direction: Option<Xyz>,
 }
 
 #[derive(Debug, Deserialize)]

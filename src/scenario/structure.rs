@@ -325,20 +325,34 @@ fn axis(ctx: &Ctx, j: &RawJoint, v: &Option<Xyz>, what: &str) -> Result<[f64; 3]
 
 /// An actuator driving exactly one declared joint or cable.
 fn actuator(ctx: &Ctx, s: &Structure, a: &RawActuator) -> Result<Actuator, ScenarioError> {
-    let target = match (&a.joint, &a.cable) {
-        (Some(j), None) => ActuatorTarget::Joint(
-            s.joints
-                .iter()
-                .position(|x| &x.name == j.get_ref())
-                .ok_or_else(|| ctx.err(j, format!("unknown joint '{}'", j.get_ref())))?,
-        ),
-        (None, Some(c)) => ActuatorTarget::CableLength(
-            s.cables
-                .iter()
-                .position(|x| &x.name == c.get_ref())
-                .ok_or_else(|| ctx.err(c, format!("unknown cable '{}'", c.get_ref())))?,
-        ),
-        _ => return Err(ctx.err(&a.symbol, "an actuator drives exactly one of: joint = \"name\", cable = \"name\"")),
+    let find = |name: &Spanned<String>, list: Vec<&String>, what: &str| {
+        list.iter()
+            .position(|x| *x == name.get_ref())
+            .ok_or_else(|| ctx.err(name, format!("unknown {what} '{}'", name.get_ref())))
+    };
+    if let (Some(d), None) = (&a.direction, &a.node) {
+        return Err(ctx.err(d, "direction goes with node = \"name\" (a moved node)"));
+    }
+    let target = match (&a.joint, &a.cable, &a.node) {
+        (Some(j), None, None) => ActuatorTarget::Joint(find(j, s.joints.iter().map(|x| &x.name).collect(), "joint")?),
+        (None, Some(c), None) => {
+            ActuatorTarget::CableLength(find(c, s.cables.iter().map(|x| &x.name).collect(), "cable")?)
+        }
+        (None, None, Some(n)) => {
+            let d = a.direction.as_ref().ok_or_else(|| {
+                ctx.err(n, "a moved node needs direction = [x, y, z] (the command moves it along it, m)")
+            })?;
+            let v = xyz(ctx, d, "direction")?;
+            let norm = crate::structure::norm(v);
+            if norm == 0.0 {
+                return Err(ctx.err(d, "direction must not be zero"));
+            }
+            ActuatorTarget::FixedNode { node: node(ctx, s, n)?, direction: v.map(|x| x / norm) }
+        }
+        _ => return Err(ctx.err(
+            &a.symbol,
+            "an actuator drives exactly one of: joint = \"name\", cable = \"name\", node = \"name\" (with direction)",
+        )),
     };
     Ok(Actuator { symbol: a.symbol.get_ref().clone(), target })
 }

@@ -327,6 +327,8 @@ impl Simulation {
             .iter()
             .map(|a| match a.target {
                 ActuatorTarget::CableLength(c) => out.cable_tension_n[c],
+                // The force that holds the moved body against its members, along the direction.
+                ActuatorTarget::FixedNode { node, direction } => -wrench[s.nodes[node].body].0.dot(v(direction)),
                 ActuatorTarget::Joint(j) if self.model.joint_impulse[j].is_some() => {
                     let (f, m) = closure_reaction[j];
                     along(&s.joints[j], f, m)

@@ -177,6 +177,26 @@ impl Simulation {
             }
         }
         self.apply_joint_commands();
+        self.move_fixed_nodes();
+    }
+
+    /// Places every fixed body that carries a moved node at the sum of its actuators'
+    /// displacements (bodies are built at the identity: their drawn place).
+    fn move_fixed_nodes(&mut self) {
+        let s = &self.model.structure;
+        let mut offsets: Vec<Option<Vector>> = vec![None; s.bodies.len()];
+        for (a, command) in s.actuators.iter().zip(&self.commands) {
+            if let ActuatorTarget::FixedNode { node, direction } = a.target {
+                let d = Vector::new(direction[0], direction[1], direction[2]) * *command;
+                let o = offsets[s.nodes[node].body].get_or_insert(Vector::ZERO);
+                *o += d;
+            }
+        }
+        for (b, offset) in offsets.into_iter().enumerate() {
+            if let Some(o) = offset {
+                self.bodies[self.model.handles[b]].set_position(Pose::from_translation(o), true);
+            }
+        }
     }
 
     /// Applies a constant external wrench (world frame, about the centre of mass) to a body
