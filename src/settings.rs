@@ -154,11 +154,51 @@ pub struct Check {
     pub tolerance: f64,
 }
 
-/// The stiffness probe (`[probe]`).
+/// The stiffness probe (`[probe]`): the mechanism's own, or one on a named joint.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Probe {
+    /// The load applied as +load and -load: a torque [N m] (the mechanism's probe, a
+    /// revolute joint) or a force [N] (a prismatic joint).
     pub torque_nm: f64,
+    /// A probe on a named joint of the structure, with its predicted stiffness.
+    pub joint: Option<JointProbe>,
     pub tolerance: f64,
+}
+
+/// A stiffness probe on a named revolute or prismatic joint: equal and opposite loads on its
+/// child and parent about (along) its axis, the joint's coordinate measured, the stiffness
+/// dload/dq compared with a closed form of the parameters and inputs.
+#[derive(Clone, Debug)]
+pub struct JointProbe {
+    /// The joint's name and index in the structure.
+    pub joint: String,
+    pub index: usize,
+    /// Prismatic (a force along the axis, N/m) rather than revolute (a torque, N m/rad).
+    pub prismatic: bool,
+    /// The predicted stiffness, compiled against `symbols`.
+    pub expected: crate::model::expr::Expr,
+    /// The symbols `expected` may use: the parameters, then the inputs.
+    pub symbols: Vec<String>,
+}
+
+impl PartialEq for JointProbe {
+    fn eq(&self, other: &Self) -> bool {
+        self.joint == other.joint && self.expected.text() == other.expected.text()
+    }
+}
+
+impl JointProbe {
+    /// The quantity the probe reports: `JOINT.stiffness`.
+    pub fn quantity(&self) -> String {
+        format!("{}.stiffness", self.joint)
+    }
+
+    /// The predicted stiffness with the point's parameters and inputs.
+    pub fn predicted(&self, params: &crate::mechanisms::Values, inputs: &crate::mechanisms::Values) -> f64 {
+        let values: Vec<f64> =
+            self.symbols.iter().map(|s| inputs.get(s).or_else(|| params.get(s)).copied().unwrap_or(f64::NAN)).collect();
+        self.expected.eval(&values)
+    }
 }
 
 /// One part of a run's verdict that failed.

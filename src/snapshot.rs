@@ -2,6 +2,19 @@
 //! equilibrium residual, as plain data. Mechanisms and observers read these; they never see
 //! the simulator's rapier sets.
 
+use crate::structure::{JointKind, Structure};
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
+
+/// The unit vector along `a` (zero stays zero).
+pub fn unit(a: [f64; 3]) -> [f64; 3] {
+    let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    if n > 0.0 {
+        a.map(|x| x / n)
+    } else {
+        a
+    }
+}
+
 /// Pose of a body as translation and rotation (unit quaternion `[x, y, z, w]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BodyPose {
@@ -31,6 +44,58 @@ impl Snapshot {
             Some(i) => self.forces.spring_force_n.get(i).copied(),
             None => self.forces.cable_tension_n.get(s.cable_id(name)?).copied(),
         }
+    }
+
+    /// A body's pose since the build (bodies are built at the identity).
+    fn pose(&self, body: usize) -> Option<Isometry3<f64>> {
+        let p = self.body_poses.get(body)?;
+        let [x, y, z, w] = p.rotation_xyzw;
+        let r = UnitQuaternion::new_normalize(Quaternion::new(w, x, y, z));
+        Some(Isometry3::from_parts(Translation3::from(Vector3::from(p.translation)), r))
+    }
+
+    /// The rotation of `child` relative to `parent` about the unit `axis` (parent frame) since
+    /// the build [rad], as the simulator counts a torsion spring's angle.
+    pub fn joint_angle(&self, parent: usize, child: usize, axis: [f64; 3]) -> Option<f64> {
+        let rel = self.pose(parent)?.rotation.inverse() * self.pose(child)?.rotation;
+        let s = rel.i * axis[0] + rel.j * axis[1] + rel.k * axis[2];
+        Some(2.0 * s.atan2(rel.w))
+    }
+
+    /// The displacement of `child` relative to `parent` at `anchor` (its place at the build),
+    /// along the unit `axis` (parent frame) since the build [m].
+    pub fn joint_slide(&self, parent: usize, child: usize, anchor: [f64; 3], axis: [f64; 3]) -> Option<f64> {
+        let (p, c) = (self.pose(parent)?, self.pose(child)?);
+        let a = Point3::from(anchor);
+        let d = p.inverse_transform_vector(&(c.transform_point(&a) - p.transform_point(&a)));
+        Some(d.dot(&Vector3::from(axis)))
+    }
+
+    /// The coordinate of joint `j` of `s`: a revolute joint's angle [rad] or a prismatic
+    /// joint's slide [m], counted from its initial coordinate; None for other kinds.
+    pub fn joint_coordinate(&self, s: &Structure, j: usize) -> Option<f64> {
+        let joint = s.joints.get(j)?;
+        let q = match joint.kind {
+            JointKind::Revolute { axis } => self.joint_angle(joint.parent, joint.child, unit(axis))?,
+            JointKind::Prismatic { axis } => {
+                let anchor = s.nodes.get(joint.anchor)?.position;
+                self.joint_slide(joint.parent, joint.child, anchor, unit(axis))?
+            }
+            _ => return None,
+        };
+        Some(joint.initial_coordinate + q)
+    }
+
+    /// The axis of a revolute or prismatic joint `j` of `s` in the world (turned with its
+    /// parent), a unit vector.
+    pub fn joint_axis_world(&self, s: &Structure, j: usize) -> Option<[f64; 3]> {
+        let joint = s.joints.get(j)?;
+        let axis = match joint.kind {
+            JointKind::Revolute { axis } | JointKind::Prismatic { axis } => unit(axis),
+            _ => return None,
+        };
+        let w = self.pose(joint.parent)?.rotation * Vector3::from(axis);
+        Some([w.x, w.y, w.z])
     }
 
     /// The force or torque of the actuator driven by `symbol` along its axis [N or N m].

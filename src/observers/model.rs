@@ -7,9 +7,8 @@ use crate::mechanisms::Values;
 use crate::model::energy::Kind;
 use crate::model::spec::{ModelSpec, Source};
 use crate::report::{EnergyPointReport, ModelCheckReport, PointReport, ScenarioReport, StationaryReport};
-use crate::snapshot::Snapshot;
+use crate::snapshot::{unit, Snapshot};
 use crate::structure::{JointKind, Structure};
-use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 /// How a state symbol is read from a snapshot of the run's structure.
 #[derive(Clone, Debug)]
@@ -43,24 +42,6 @@ enum Bind {
     },
 }
 
-/// The unit vector along `a` (zero stays zero).
-fn unit(a: [f64; 3]) -> [f64; 3] {
-    let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-    if n > 0.0 {
-        a.map(|x| x / n)
-    } else {
-        a
-    }
-}
-
-/// A body's pose since the build (bodies are built at the identity).
-fn pose(snap: &Snapshot, body: usize) -> Option<Isometry3<f64>> {
-    let p = snap.body_poses.get(body)?;
-    let [x, y, z, w] = p.rotation_xyzw;
-    let r = UnitQuaternion::new_normalize(Quaternion::new(w, x, y, z));
-    Some(Isometry3::from_parts(Translation3::from(Vector3::from(p.translation)), r))
-}
-
 /// A joint's coordinate symbol, if its kind has one coordinate.
 fn joint_bind(s: &Structure, name: &str, angle: bool) -> Option<Bind> {
     let j = s.joints.iter().find(|j| j.name == name)?;
@@ -73,23 +54,6 @@ fn joint_bind(s: &Structure, name: &str, angle: bool) -> Option<Bind> {
         }
         _ => None,
     }
-}
-
-/// The rotation of `child` relative to `parent` about `axis` (parent frame) [rad], as the
-/// simulator counts a torsion spring's angle.
-fn joint_angle(snap: &Snapshot, parent: usize, child: usize, axis: [f64; 3]) -> Option<f64> {
-    let rel = pose(snap, parent)?.rotation.inverse() * pose(snap, child)?.rotation;
-    let s = rel.i * axis[0] + rel.j * axis[1] + rel.k * axis[2];
-    Some(2.0 * s.atan2(rel.w))
-}
-
-/// The displacement of `child` relative to `parent` at the anchor, along `axis` (parent
-/// frame) [m].
-fn joint_slide(snap: &Snapshot, parent: usize, child: usize, anchor: [f64; 3], axis: [f64; 3]) -> Option<f64> {
-    let (p, c) = (pose(snap, parent)?, pose(snap, child)?);
-    let a = Point3::from(anchor);
-    let d = p.inverse_transform_vector(&(c.transform_point(&a) - p.transform_point(&a)));
-    Some(d.dot(&Vector3::from(axis)))
 }
 
 impl Bind {
@@ -127,10 +91,10 @@ impl Bind {
             },
             Bind::Observed(q) => observed.get(q).copied().unwrap_or(f64::NAN),
             Bind::JointAngle { parent, child, axis, initial } => {
-                joint_angle(snap, *parent, *child, *axis).map_or(f64::NAN, |q| initial + q)
+                snap.joint_angle(*parent, *child, *axis).map_or(f64::NAN, |q| initial + q)
             }
             Bind::JointSlide { parent, child, anchor, axis, initial } => {
-                joint_slide(snap, *parent, *child, *anchor, *axis).map_or(f64::NAN, |q| initial + q)
+                snap.joint_slide(*parent, *child, *anchor, *axis).map_or(f64::NAN, |q| initial + q)
             }
         }
     }

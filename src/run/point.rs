@@ -9,6 +9,7 @@ use crate::observers::compare;
 use crate::observers::SettlePoint;
 use crate::report::{PointReport, ScenarioReport};
 use crate::scenario::Scenario;
+use crate::settings::Probe;
 use crate::snapshot::Snapshot;
 
 impl Runner<'_> {
@@ -39,34 +40,67 @@ impl Runner<'_> {
         Ok(back)
     }
 
-    /// Stiffness by the probe: +tau and -tau on the probe body, K = 2 tau / (q+ - q-); with the
-    /// analytic quantity it is compared with.
-    fn probe(&mut self, inputs: &Values, prediction: &Prediction, torque: f64) -> Result<Option<(String, f64)>, Stop> {
-        let Some(spec) = self.mech.stiffness_probe() else {
-            return Ok(None);
+    /// Stiffness by the probe: +load and -load, K = 2 load / (q+ - q-); with the name of
+    /// the quantity it is reported as. The mechanism's probe: a torque on its probe body; a
+    /// joint probe: equal and opposite torques (forces) on the joint's child and parent about
+    /// (along) its axis, q the joint's coordinate.
+    fn probe(&mut self, inputs: &Values, prediction: &Prediction, p: &Probe) -> Result<Option<(String, f64)>, Stop> {
+        let (quantity, loads, read): (String, Vec<(usize, [f64; 3], bool)>, Reading) = match &p.joint {
+            Some(j) => {
+                let s = self.sim.structure();
+                let joint = &s.joints[j.index];
+                let axis = self.sim.snapshot_with(false).joint_axis_world(&s, j.index).ok_or_else(|| {
+                    Stop::Model(ModelError::no_solution(format!("probe joint '{}' has no axis", j.joint)))
+                })?;
+                let mut loads = vec![(joint.child, axis, j.prismatic)];
+                if s.bodies[joint.parent].kind == crate::structure::BodyKind::Free {
+                    loads.push((joint.parent, axis.map(|a| -a), j.prismatic));
+                }
+                (j.quantity(), loads, Reading::Joint(j.index, j.prismatic))
+            }
+            None => {
+                let Some(spec) = self.mech.stiffness_probe() else {
+                    return Ok(None);
+                };
+                let body = self.sim.structure().body_id(&spec.body).ok_or_else(|| {
+                    Stop::Model(ModelError::no_solution(format!("probe body '{}' not found", spec.body)))
+                })?;
+                (spec.analytic, vec![(body, spec.torque_axis, false)], Reading::Quantity(spec.coordinate))
+            }
         };
-        let body = self
-            .sim
-            .structure()
-            .body_id(&spec.body)
-            .ok_or_else(|| Stop::Model(ModelError::no_solution(format!("probe body '{}' not found", spec.body))))?;
-        let axis = spec.torque_axis;
         let mut q = [0.0; 2];
         for (i, sign) in [1.0, -1.0].iter().enumerate() {
-            let t = [axis[0] * torque * sign, axis[1] * torque * sign, axis[2] * torque * sign];
-            self.sim.set_probe_load(body, [0.0; 3], t);
-            self.emit(format_args!("stiffness probe: torque {:+e} N m", torque * sign));
+            for &(body, axis, force) in &loads {
+                let l = axis.map(|a| a * p.torque_nm * sign);
+                let (f, t) = if force { (l, [0.0; 3]) } else { ([0.0; 3], l) };
+                self.sim.set_probe_load(body, f, t);
+            }
+            self.emit(format_args!("stiffness probe: load {:+e}", p.torque_nm * sign));
             let s = self.settle(inputs, prediction)?;
             if !s.settled {
-                self.sim.set_probe_load(body, [0.0; 3], [0.0; 3]);
+                loads.iter().for_each(|&(b, ..)| self.sim.set_probe_load(b, [0.0; 3], [0.0; 3]));
                 return Ok(None);
             }
-            q[i] = s.simulated[&spec.coordinate];
+            q[i] = match &read {
+                Reading::Quantity(c) => s.simulated[c],
+                Reading::Joint(j, _) => s.snapshot.joint_coordinate(&self.sim.structure(), *j).unwrap_or(f64::NAN),
+            };
         }
-        self.sim.set_probe_load(body, [0.0; 3], [0.0; 3]);
+        loads.iter().for_each(|&(b, ..)| self.sim.set_probe_load(b, [0.0; 3], [0.0; 3]));
         self.settle(inputs, prediction)?;
-        Ok(Some((spec.analytic, 2.0 * torque / mechanisms::wrap_angle(q[0] - q[1]))))
+        let dq = match read {
+            Reading::Joint(_, true) => q[0] - q[1],
+            _ => mechanisms::wrap_angle(q[0] - q[1]),
+        };
+        Ok(Some((quantity, 2.0 * p.torque_nm / dq)))
     }
+}
+
+/// How a probe reads its coordinate: a quantity the mechanism observes, or a joint's
+/// coordinate (prismatic: a slide, not wrapped).
+enum Reading {
+    Quantity(String),
+    Joint(usize, bool),
 }
 
 /// A perturbed equilibrium counts as returned when every node is back within this fraction of
@@ -139,7 +173,7 @@ pub(super) fn settle_point(
     let (branch, analytic_stable) = branch_of(runner.mech.as_ref(), &runner.params, &prediction, &simulated);
     // The settled state is compared with the branch it landed on; landing on an analytically
     // unstable branch is a failure unless the scenario deliberately starts there.
-    let landed = prediction
+    let mut landed = prediction
         .branches
         .iter()
         .find(|b| b.label == branch)
@@ -158,7 +192,10 @@ pub(super) fn settle_point(
         runner.emit(format_args!("point {index}: equilibrium is {}", if st { "stable" } else { "unstable" }));
     }
     if let (Some(p), true) = (&sc.probe, s.settled) {
-        if let Some((quantity, k)) = runner.probe(inputs, &prediction, p.torque_nm)? {
+        if let Some((quantity, k)) = runner.probe(inputs, &prediction, p)? {
+            if let Some(j) = &p.joint {
+                landed.insert(quantity.clone(), j.predicted(&runner.params, inputs));
+            }
             if let Some(ka) = landed.get(&quantity) {
                 probe_errors.push(((k - ka) / ka).abs());
             }

@@ -1,10 +1,14 @@
 //! What the run is judged on: `[[checks]]`, `[stability]`, `[probe]` and `[workspace]`.
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
+use super::number::expr_error;
 use super::raw::{RawCheck, RawExpectedStability, RawProbe, RawStability, RawWorkspace};
 use super::Actuation;
-use crate::mechanisms::Mechanism;
-use crate::settings::{Check, Probe};
+use crate::mechanisms::{Mechanism, Values};
+use crate::model::expr::Expr;
+use crate::settings::{Check, JointProbe, Probe};
+use crate::structure::{ActuatorTarget, JointKind, Structure};
+use toml::Spanned;
 
 /// `[[checks]]`: each a quantity of the mechanism, with a tolerance > 0; a quantity that only
 /// the stiffness probe measures needs `[probe]` (`has_probe`).
@@ -81,18 +85,91 @@ pub(super) fn expected_stability(
     }
 }
 
-/// `[probe]`: a torque > 0 N m and a tolerance > 0, for a mechanism that has a stiffness probe.
-pub(super) fn probe(ctx: &Ctx, m: &dyn Mechanism, raw: &Option<RawProbe>) -> Result<Option<Probe>, ScenarioError> {
+/// `[probe]`: a load > 0 (a torque in N m, or a force in N for a prismatic joint) and a
+/// tolerance > 0; on a named joint of `first` (the structure at the first point) with its
+/// predicted stiffness, or the mechanism's own stiffness probe.
+pub(super) fn probe(
+    ctx: &Ctx,
+    m: &dyn Mechanism,
+    raw: &Option<RawProbe>,
+    first: &Structure,
+    params: &Values,
+) -> Result<Option<Probe>, ScenarioError> {
     let Some(p) = raw else { return Ok(None) };
-    if m.stiffness_probe().is_none() {
-        return Err(ctx.err(&p.torque, format!("{} has no stiffness probe", m.name())));
-    }
-    let t = finite(ctx, &p.torque, "probe.torque")?;
-    if t <= 0.0 {
-        return Err(ctx.err(&p.torque, format!("probe.torque must be > 0 N m, got {t}")));
-    }
     let tol = positive_value(ctx, &p.tolerance, "probe.tolerance")?;
-    Ok(Some(Probe { torque_nm: t, tolerance: tol }))
+    let Some(name) = &p.joint else {
+        if let Some(e) = &p.expected {
+            return Err(
+                ctx.err(e, "expected goes with joint = \"name\" (the mechanism's probe compares with its model)")
+            );
+        }
+        let torque = p.torque.as_ref().ok_or_else(|| ctx.err(&p.tolerance, "[probe] needs torque = N m"))?;
+        if m.stiffness_probe().is_none() {
+            return Err(ctx.err(
+                torque,
+                format!(
+                    "{} has no stiffness probe of its own: probe a joint (joint = \"name\", expected = \"...\")",
+                    m.name()
+                ),
+            ));
+        }
+        return Ok(Some(Probe { torque_nm: load(ctx, torque, "torque", "N m")?, joint: None, tolerance: tol }));
+    };
+    let joint = joint_probe(ctx, m, p, name, first, params)?;
+    let (given, what, unit) = match (joint.prismatic, &p.torque, &p.force) {
+        (false, Some(t), None) => (t, "torque", "N m"),
+        (true, None, Some(f)) => (f, "force", "N"),
+        (false, ..) => return Err(ctx.err(name, "a revolute joint is probed with torque = N m (and no force)")),
+        (true, ..) => return Err(ctx.err(name, "a prismatic joint is probed with force = N (and no torque)")),
+    };
+    Ok(Some(Probe { torque_nm: load(ctx, given, what, unit)?, joint: Some(joint), tolerance: tol }))
+}
+
+/// A probe load: finite and > 0.
+fn load(ctx: &Ctx, v: &Spanned<f64>, what: &str, unit: &str) -> Result<f64, ScenarioError> {
+    let x = finite(ctx, v, &format!("probe.{what}"))?;
+    if x <= 0.0 {
+        return Err(ctx.err(v, format!("probe.{what} must be > 0 {unit}, got {x}")));
+    }
+    Ok(x)
+}
+
+/// The probed joint (revolute or prismatic, not driven by an actuator) and its predicted
+/// stiffness, compiled against the parameters and inputs.
+fn joint_probe(
+    ctx: &Ctx,
+    m: &dyn Mechanism,
+    p: &RawProbe,
+    name: &Spanned<String>,
+    s: &Structure,
+    params: &Values,
+) -> Result<JointProbe, ScenarioError> {
+    let index = s.joints.iter().position(|j| &j.name == name.get_ref()).ok_or_else(|| {
+        let names: Vec<&str> = s.joints.iter().map(|j| j.name.as_str()).collect();
+        ctx.err(name, format!("unknown joint '{}' (the structure's joints: {})", name.get_ref(), names.join(", ")))
+    })?;
+    let prismatic = match s.joints[index].kind {
+        JointKind::Revolute { .. } => false,
+        JointKind::Prismatic { .. } => true,
+        _ => return Err(ctx.err(name, "only a revolute or prismatic joint can be probed (one coordinate)")),
+    };
+    if s.actuators.iter().any(|a| a.target == ActuatorTarget::Joint(index)) {
+        return Err(
+            ctx.err(name, "an actuated joint is held by its command: probe a joint the structure is free to turn")
+        );
+    }
+    let expected = p.expected.as_ref().ok_or_else(|| {
+        ctx.err(
+            name,
+            "a joint probe needs expected = \"...\": the stiffness it is compared with (parameters and inputs)",
+        )
+    })?;
+    let mut symbols: Vec<String> = params.keys().cloned().collect();
+    symbols.extend(m.inputs().iter().map(|i| i.symbol.to_string()));
+    let names: Vec<&str> = symbols.iter().map(String::as_str).collect();
+    let expr = Expr::compile(expected.get_ref(), &names)
+        .map_err(|e| expr_error(ctx, expected.span().start, &e, "probe.expected (parameters and inputs)"))?;
+    Ok(JointProbe { joint: name.get_ref().clone(), index, prismatic, expected: expr, symbols })
 }
 
 /// `[workspace]`: the agreement percentage a workspace sweep passes on, in [0, 100].

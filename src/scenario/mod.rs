@@ -166,7 +166,6 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     }
     let stability_perturbation = checks::stability(ctx, &raw.stability)?;
     let expected_stability = checks::expected_stability(ctx, &raw.stability, &actuation)?;
-    let probe = checks::probe(ctx, m, &raw.probe)?;
     let record = record::record(ctx, &raw.record)?;
     let min_agreement_percent = checks::workspace(ctx, &raw.workspace)?;
     // Every set of parameters the points ask for (a sweep over parameters): the custom
@@ -186,6 +185,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         physical::physical(ctx, &raw, m, &s, &sim)?;
     }
     let interference = interference::interference(ctx, &raw.interference, m, &first_params, &first)?;
+    let probe = checks::probe(ctx, m, &raw.probe, &first, &params)?;
     let expect = match &raw.expect {
         None => None,
         Some(e) => {

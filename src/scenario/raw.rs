@@ -334,8 +334,15 @@ pub(super) enum RawExpectedStability {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawProbe {
-    /// Probe torque [N m] (applied as +torque and -torque).
-    pub(super) torque: Spanned<f64>,
+    /// A named revolute or prismatic joint to probe (default: the mechanism's own probe).
+    pub(super) joint: Option<Spanned<String>>,
+    /// Probe torque [N m] (applied as +torque and -torque): the mechanism's probe or a
+    /// revolute joint.
+    pub(super) torque: Option<Spanned<f64>>,
+    /// Probe force [N]: a prismatic joint.
+    pub(super) force: Option<Spanned<f64>>,
+    /// The joint probe's predicted stiffness: an expression of the parameters and inputs.
+    pub(super) expected: Option<Spanned<String>>,
     /// Tolerance on the relative stiffness error.
     pub(super) tolerance: Spanned<f64>,
 }
