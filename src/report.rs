@@ -580,6 +580,17 @@ impl ScenarioReport {
             .iter()
             .filter(|p| p.stable.is_some() && p.analytic_stable.is_some() && p.stable != p.analytic_stable)
             .count();
+        let expected = self.points.iter().filter(|p| p.stable.is_some() && p.expected_stable.is_some()).count();
+        let unexpected = self
+            .points
+            .iter()
+            .filter(|p| p.stable.is_some() && p.expected_stable.is_some() && p.stable != p.expected_stable)
+            .count();
+        if expected > 0 {
+            out.push_str(&format!(
+                "   stability expected at {expected} point(s) (the file or its energy model): {unexpected} disagree\n"
+            ));
+        }
         if tested > 0 {
             out.push_str(&format!(
                 "   stability: {tested} point(s) perturbed, {unstable} unstable, {disagree} disagree with the analytic sign of K\n"

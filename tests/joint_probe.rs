@@ -67,3 +67,39 @@ fn bad_joint_probes_are_located() {
         assert!(err.message.contains(msg), "{err}");
     }
 }
+
+/// `[stability] expect = "energy"`: each settled point must be as stable as the energy model
+/// classifies the stationary point the dynamics landed on. The bar's minima agree with the
+/// perturbation test; with the potential's sign turned the landed point is the energy's
+/// maximum, so the perturbation (which finds it stable) disagrees and the run fails on
+/// `stability` (and on `energy`: the dynamics is not on a minimum).
+#[test]
+fn stability_is_expected_from_the_energy_model() {
+    let text = std::fs::read_to_string(FILE).unwrap().replace("count = 9", "count = 2");
+    let sc = scenario::parse(Path::new("energy.toml"), &text).unwrap();
+    let r = run(&sc, &RunOptions::default());
+    assert!(r.passed, "{:?}", r.failures);
+    for p in &r.points {
+        assert_eq!((p.expected_stable, p.stable), (Some(true), Some(true)), "{:?}", p.inputs);
+    }
+    let flipped = text.replace("\"-k1*a*L*sin(qe) - k2*b*L*cos(qe)\"", "\"k1*a*L*sin(qe) + k2*b*L*cos(qe)\"");
+    let sc = scenario::parse(Path::new("flipped.toml"), &flipped).unwrap();
+    let r = run(&sc, &RunOptions::default());
+    let mut failures = r.failures.clone();
+    failures.sort();
+    assert_eq!(failures, vec![Failure::Stability, Failure::Energy]);
+    assert!(r.points.iter().all(|p| p.expected_stable == Some(false) && p.stable == Some(true)));
+}
+
+/// `expect = "energy"` without an `[energy]` section is an error at the word.
+#[test]
+fn stability_from_energy_needs_an_energy_model() {
+    let text = std::fs::read_to_string(FILE).unwrap();
+    let at = text.find("[energy]\n").unwrap();
+    let variant = text[..at].to_string();
+    let err = scenario::parse(Path::new("v.toml"), &variant).expect_err("no [energy]");
+    assert!(err.message.contains("needs an [energy] section"), "{err}");
+    let offset = variant.find("\"energy\"").unwrap();
+    let line = variant[..offset].matches('\n').count() + 1;
+    assert_eq!(err.line, line, "{err}");
+}

@@ -5,6 +5,7 @@
 use super::runner::Runner;
 use super::Stop;
 use crate::mechanisms::{self, Mechanism, ModelError, Prediction, Values};
+use crate::model::energy::Kind;
 use crate::observers::compare;
 use crate::observers::SettlePoint;
 use crate::report::{PointReport, ScenarioReport};
@@ -257,9 +258,23 @@ pub(super) fn settle_point(
     for o in runner.observers.iter_mut() {
         o.settle_point(&seen, &mut point, &mut runner.notes);
     }
+    if sc.expected_stability == crate::scenario::ExpectedStability::FromEnergy {
+        point.expected_stable = energy_stability(&point);
+    }
     runner.hand_out_notes();
     report.points.push(point);
     Ok(())
+}
+
+/// The stability the energy model gives the stationary point the dynamics landed on: a
+/// minimum is stable, a maximum or a saddle unstable, a degenerate point undecided.
+fn energy_stability(point: &PointReport) -> Option<bool> {
+    let e = point.energy.as_ref()?;
+    match e.stationary.get(e.landed?)?.kind.as_str() {
+        k if k == Kind::Minimum.name() => Some(true),
+        k if k == Kind::Maximum.name() || k == Kind::Saddle.name() => Some(false),
+        _ => None,
+    }
 }
 
 /// The cables slack in `snap`, by name.

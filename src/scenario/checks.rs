@@ -3,7 +3,7 @@
 use super::error::{finite, positive_value, Ctx, ScenarioError};
 use super::number::expr_error;
 use super::raw::{RawCheck, RawExpectedStability, RawProbe, RawStability, RawWorkspace};
-use super::Actuation;
+use super::{Actuation, ExpectedStability};
 use crate::mechanisms::{Mechanism, Values};
 use crate::model::expr::Expr;
 use crate::settings::{Check, JointProbe, Probe};
@@ -60,15 +60,24 @@ pub(super) fn expected_stability(
     ctx: &Ctx,
     raw: &Option<RawStability>,
     actuation: &Actuation,
-) -> Result<Vec<bool>, ScenarioError> {
-    let Some(e) = raw.as_ref().and_then(|s| s.expect.as_ref()) else { return Ok(Vec::new()) };
+    has_energy: bool,
+) -> Result<ExpectedStability, ScenarioError> {
+    let Some(e) = raw.as_ref().and_then(|s| s.expect.as_ref()) else { return Ok(ExpectedStability::Unsaid) };
     let word = |w: &String| match w.as_str() {
         "stable" => Ok(true),
         "unstable" => Ok(false),
-        other => Err(ctx.err(e, format!("stability.expect must be \"stable\" or \"unstable\", got \"{other}\""))),
+        other => Err(ctx.err(
+            e,
+            format!("stability.expect must be \"stable\", \"unstable\" or \"energy\" (or a list), got \"{other}\""),
+        )),
     };
     match e.get_ref() {
-        RawExpectedStability::All(w) => Ok(vec![word(w)?]),
+        RawExpectedStability::All(w) if w == "energy" => match has_energy {
+            true => Ok(ExpectedStability::FromEnergy),
+            false => Err(ctx
+                .err(e, "stability.expect = \"energy\" needs an [energy] section (its minima are the stable points)")),
+        },
+        RawExpectedStability::All(w) => Ok(ExpectedStability::Listed(vec![word(w)?])),
         RawExpectedStability::PerPoint(list) => {
             let points = match actuation {
                 Actuation::Points { points, .. } => points.len(),
@@ -80,7 +89,7 @@ pub(super) fn expected_stability(
                     format!("stability.expect lists {} stabilities for {points} settle point(s): give one per point, or one word for all", list.len()),
                 ));
             }
-            list.iter().map(word).collect()
+            Ok(ExpectedStability::Listed(list.iter().map(word).collect::<Result<_, _>>()?))
         }
     }
 }

@@ -52,9 +52,8 @@ pub struct Scenario {
     pub actuation: Actuation,
     pub checks: Vec<Check>,
     pub stability_perturbation: Option<f64>,
-    /// `[stability] expect`: empty, one stability for every settle point, or one per point
-    /// (true: stable); see [`Scenario::expected_stable`].
-    pub expected_stability: Vec<bool>,
+    /// `[stability] expect`; see [`Scenario::expected_stable`].
+    pub expected_stability: ExpectedStability,
     pub probe: Option<Probe>,
     pub record: Option<PathBuf>,
     pub interference: crate::settings::InterferenceSettings,
@@ -71,12 +70,15 @@ pub struct Scenario {
 }
 
 impl Scenario {
-    /// The stability the scenario expects at settle point `index` (None: it does not say).
+    /// The stability the scenario states for settle point `index` (None: it does not say,
+    /// or leaves it to the energy model, which decides at the settled state).
     pub fn expected_stable(&self, index: usize) -> Option<bool> {
-        match self.expected_stability.as_slice() {
-            [] => None,
-            [all] => Some(*all),
-            list => list.get(index).copied(),
+        match &self.expected_stability {
+            ExpectedStability::Listed(list) => match list.as_slice() {
+                [all] => Some(*all),
+                list => list.get(index).copied(),
+            },
+            _ => None,
         }
     }
 
@@ -93,6 +95,18 @@ impl Scenario {
             None => mechanisms::find(&self.mechanism).expect("validated mechanism"),
         }
     }
+}
+
+/// `[stability] expect`: what the perturbation test must find at each settle point.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExpectedStability {
+    /// The scenario does not say.
+    Unsaid,
+    /// One stability for every point, or one per point (true: stable).
+    Listed(Vec<bool>),
+    /// What the `[energy]` model says of the stationary point the dynamics landed on: a
+    /// minimum is stable, a maximum or a saddle unstable (a degenerate point says nothing).
+    FromEnergy,
 }
 
 /// What drives the mechanism: points settled one by one, or waypoints followed in time.
@@ -165,7 +179,8 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
             .err_at(0, "the scenario checks nothing: add at least one [[checks]] entry (quantity, tolerance)".into()));
     }
     let stability_perturbation = checks::stability(ctx, &raw.stability)?;
-    let expected_stability = checks::expected_stability(ctx, &raw.stability, &actuation)?;
+    let has_energy = model.as_ref().is_some_and(|m| m.energy.is_some());
+    let expected_stability = checks::expected_stability(ctx, &raw.stability, &actuation, has_energy)?;
     let record = record::record(ctx, &raw.record)?;
     let min_agreement_percent = checks::workspace(ctx, &raw.workspace)?;
     // Every set of parameters the points ask for (a sweep over parameters): the custom
