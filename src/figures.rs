@@ -12,6 +12,7 @@ mod furet2018;
 mod ji2014;
 mod manriquez2019;
 mod mohr2011;
+pub mod sweep;
 
 /// The figures this command draws: (name, what it shows).
 pub const FIGURES: &[(&str, &str)] = &[

@@ -68,6 +68,13 @@ enum Command {
         /// Run the K-th of N interleaved slices of the grid (for job arrays), as K/N.
         #[arg(long)]
         shard: Option<String>,
+        /// A figure of the sweep (FILE.png or FILE.svg): each compared quantity, analytic and
+        /// settled, against one axis, and the errors.
+        #[arg(long)]
+        figure: Option<PathBuf>,
+        /// The figure's axis: an input or a swept parameter (default: the one with most values).
+        #[arg(long)]
+        x: Option<String>,
     },
     /// Draw one of the papers' figures (analytic, with the dynamics' verdict) as PNG and SVG.
     Figure {
@@ -290,8 +297,10 @@ fn dispatch(cli: Cli) -> i32 {
         },
         Command::List { scenario: None } => cmd_list(),
         Command::List { scenario: Some(file) } => cmd_list_file(&file),
-        Command::Sweep { scenario, out, json, jobs, shard } => {
-            cmd_sweep(&scenario, out.as_deref(), json.as_deref(), jobs, shard.as_deref())
+        Command::Sweep { scenario, out, json, jobs, shard, figure, x } => {
+            let outputs =
+                SweepOutputs { csv: out.as_deref(), json: json.as_deref(), figure: figure.as_deref(), x: x.as_deref() };
+            cmd_sweep(&scenario, &outputs, jobs, shard.as_deref())
         }
         Command::Merge { csvs, out, partial } => cmd_merge(&csvs, &out, partial),
         Command::Figure { name, out, list } => cmd_figure(name.as_deref(), &out, list),
@@ -449,12 +458,25 @@ fn cmd_run(
     }
 }
 
-fn cmd_sweep(path: &Path, out: Option<&Path>, json: Option<&Path>, jobs: usize, shard: Option<&str>) -> i32 {
+/// What a sweep writes: its CSV, its JSON summary, its figure (against axis `x`).
+struct SweepOutputs<'a> {
+    csv: Option<&'a Path>,
+    json: Option<&'a Path>,
+    figure: Option<&'a Path>,
+    x: Option<&'a str>,
+}
+
+fn cmd_sweep(path: &Path, o: &SweepOutputs, jobs: usize, shard: Option<&str>) -> i32 {
+    let (out, json) = (o.csv, o.json);
     let sc = match load_all(&[path.to_path_buf()]) {
         Ok(mut s) => s.remove(0),
         Err(code) => return code,
     };
-    let outputs = [("--out", out), ("--json", json)]
+    if let Some(f) = o.figure.filter(|f| !matches!(f.extension().and_then(|e| e.to_str()), Some("png" | "svg"))) {
+        eprintln!("error: --figure {}: give a .png or .svg file", f.display());
+        return EXIT_BAD_INPUT;
+    }
+    let outputs = [("--out", out), ("--json", json), ("--figure", o.figure)]
         .into_iter()
         .filter_map(|(what, p)| p.map(|p| (what.to_string(), p.to_path_buf())))
         .collect();
@@ -505,11 +527,19 @@ fn cmd_sweep(path: &Path, out: Option<&Path>, json: Option<&Path>, jobs: usize, 
     for e in &summary.errors {
         println!("stopped: {e}");
     }
+    let mech = sc.mechanism();
+    let is_angle = |q: &str| {
+        mech.quantities().iter().any(|s| s.symbol == q && s.kind == mechanisms::QuantityKind::Angle)
+            || sc.model.as_ref().is_some_and(|m| m.is_angle(q))
+    };
     if let Some(o) = out {
-        let mech = sc.mechanism();
-        let is_angle =
-            |q: &str| mech.quantities().iter().any(|s| s.symbol == q && s.kind == mechanisms::QuantityKind::Angle);
         if let Err(e) = write_atomic(o, &tensegrity_testbed::sweep::to_csv(&rows, &is_angle)) {
+            eprintln!("error: {e}");
+            return EXIT_FAIL;
+        }
+    }
+    if let Some(f) = o.figure {
+        if let Err(e) = tensegrity_testbed::figures::sweep::draw(&rows, &summary.scenario, o.x, &is_angle, f) {
             eprintln!("error: {e}");
             return EXIT_FAIL;
         }

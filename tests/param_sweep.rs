@@ -2,6 +2,8 @@
 //! custom structure (rebuilt at each value, its derived parameters following) and for a
 //! built-in mechanism (its analytic model and its structure both at the point's parameters).
 
+mod common;
+
 use std::path::Path;
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
@@ -92,4 +94,29 @@ fn bad_parameter_sweeps_are_located() {
     let err = scenario::parse(Path::new("v.toml"), &variant).expect_err("K1 in a waypoint");
     assert_eq!((err.line, err.col), line_col(&variant, at), "{err}");
     assert!(err.message.contains("cannot follow waypoints"), "{err}");
+}
+
+/// `sweep --figure` draws the sweep against its axis: an SVG naming each compared quantity
+/// (q and the probed pin.stiffness) and the axis k1; a figure that is neither .png nor .svg is
+/// refused before anything runs (exit 2), an axis the sweep does not have after (exit 1, the
+/// axes named).
+#[test]
+fn a_sweep_draws_its_figure() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-sweep-figure-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("bar.svg");
+    let (code, out, err) = common::tensegrity(&["sweep", BAR, "--figure", svg.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    for word in ["pin.stiffness", "q: analytic", "k1", "log10"] {
+        assert!(text.contains(word), "{word} in the figure");
+    }
+    let pdf = dir.join("bar.pdf");
+    let (code, _, err) = common::tensegrity(&["sweep", BAR, "--figure", pdf.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("give a .png or .svg file"), "{err}");
+    let (code, _, err) = common::tensegrity(&["sweep", BAR, "--figure", svg.to_str().unwrap(), "--x", "k9"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("not an axis of this sweep (its inputs and swept parameters: k1)"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

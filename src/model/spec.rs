@@ -135,6 +135,11 @@ impl ModelSpec {
         self.symbols.iter().map(|s| s.name.as_str()).collect()
     }
 
+    /// Whether `name` is compared by an angle prediction (its error wrapped).
+    pub fn is_angle(&self, name: &str) -> bool {
+        self.predictions.iter().any(|p| p.class == ErrorClass::Angle && self.symbols[p.symbol].name == name)
+    }
+
     /// Whether symbol `i` is a closed form of the parameters and inputs.
     pub fn is_closed_form(&self, i: usize) -> bool {
         match self.symbols[i].source {
