@@ -2,6 +2,8 @@
 //! opposite loads about the joint's axis, its coordinate measured, dload/dq compared with the
 //! file's closed form.
 
+mod common;
+
 use std::path::Path;
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
@@ -57,14 +59,7 @@ fn bad_joint_probes_are_located() {
         ("\"L*hypot(k1*a, k2*b)\"", "\"L*hypot(k1*a, k3*b)\"", "k3*b", "unknown symbol 'k3'"),
     ];
     for (from, to, at, msg) in cases {
-        let variant = text.replacen(from, to, 1);
-        let err = scenario::parse(Path::new("v.toml"), &variant).expect_err(to);
-        let offset = variant.find(at).unwrap();
-        let before = &variant[..offset];
-        let line = before.matches('\n').count() + 1;
-        let col = before.rsplit('\n').next().unwrap().chars().count() + 1;
-        assert_eq!((err.line, err.col), (line, col), "{err}");
-        assert!(err.message.contains(msg), "{err}");
+        common::error_at(&text.replacen(from, to, 1), at, 0, msg);
     }
 }
 
@@ -97,9 +92,5 @@ fn stability_from_energy_needs_an_energy_model() {
     let text = std::fs::read_to_string(FILE).unwrap();
     let at = text.find("[energy]\n").unwrap();
     let variant = text[..at].to_string();
-    let err = scenario::parse(Path::new("v.toml"), &variant).expect_err("no [energy]");
-    assert!(err.message.contains("needs an [energy] section"), "{err}");
-    let offset = variant.find("\"energy\"").unwrap();
-    let line = variant[..offset].matches('\n').count() + 1;
-    assert_eq!(err.line, line, "{err}");
+    common::error_at(&variant, "\"energy\"", 0, "needs an [energy] section");
 }

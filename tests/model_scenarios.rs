@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{run_file, tensegrity};
+use common::{error_at, run_file, tensegrity};
 use std::path::Path;
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
@@ -14,23 +14,6 @@ const PRISM: &str = "scenarios/custom/prism3_model.toml";
 
 fn prism_text() -> String {
     std::fs::read_to_string(PRISM).unwrap()
-}
-
-/// Line and column (from 1) of byte `offset` of `text`.
-fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset];
-    (before.matches('\n').count() + 1, before.rsplit('\n').next().unwrap().chars().count() + 1)
-}
-
-/// Parses `text` (a variant of a file) and returns its error, which must be located at the
-/// `nth` occurrence of `at` in the text plus `shift` bytes.
-fn error_at(text: &str, at: &str, shift: usize, msg: &str) {
-    let err = scenario::parse(Path::new("variant.toml"), text).expect_err(msg);
-    let offset = text.find(at).unwrap_or_else(|| panic!("'{at}' in the variant")) + shift;
-    let (line, col) = line_col(text, offset);
-    assert_eq!((err.line, err.col), (line, col), "{msg}: {err}");
-    assert!(err.message.contains(msg), "{err}");
-    assert!(err.to_string().starts_with(&format!("variant.toml:{line}:{col}: ")), "{err}");
 }
 
 /// The structure's numbers are the parameters' expressions evaluated: node T2 of the prism lies

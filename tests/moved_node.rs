@@ -61,13 +61,6 @@ fn bad_moved_nodes_are_located() {
         ("node = \"U\"\n", "joint = \"pin\"\n", "[0, 1, 0]\n\n[[quantities", "direction goes with node"),
     ];
     for (from, to, at, msg) in cases {
-        let variant = text.replacen(from, to, 1);
-        let err = scenario::parse(Path::new("v.toml"), &variant).expect_err(to);
-        let offset = variant.find(at).unwrap();
-        let before = &variant[..offset];
-        let line = before.matches('\n').count() + 1;
-        let col = before.rsplit('\n').next().unwrap().chars().count() + 1;
-        assert_eq!((err.line, err.col), (line, col), "{err}");
-        assert!(err.message.contains(msg), "{err}");
+        common::error_at(&text.replacen(from, to, 1), at, 0, msg);
     }
 }

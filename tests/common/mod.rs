@@ -87,3 +87,22 @@ pub fn cross(a: P3, b: P3) -> P3 {
 pub fn norm(a: P3) -> f64 {
     dot(a, a).sqrt()
 }
+
+/// Line and column (from 1) of byte `offset` of `text`.
+#[allow(dead_code)]
+pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset];
+    (before.matches('\n').count() + 1, before.rsplit('\n').next().unwrap().chars().count() + 1)
+}
+
+/// Parses `text` (a variant of a scenario file) and asserts that it fails with a message
+/// containing `msg`, located at the first occurrence of `at` in the text plus `shift` bytes.
+#[allow(dead_code)]
+pub fn error_at(text: &str, at: &str, shift: usize, msg: &str) {
+    let err = tensegrity_testbed::scenario::parse(std::path::Path::new("variant.toml"), text).expect_err(msg);
+    let offset = text.find(at).unwrap_or_else(|| panic!("'{at}' in the variant")) + shift;
+    let (line, col) = line_col(text, offset);
+    assert_eq!((err.line, err.col), (line, col), "{msg}: {err}");
+    assert!(err.message.contains(msg), "{err}");
+    assert!(err.to_string().starts_with(&format!("variant.toml:{line}:{col}: ")), "{err}");
+}
