@@ -43,20 +43,25 @@ fn leak(s: String) -> &'static str {
 
 impl Custom {
     pub fn new(structure: Structure, expected: Values) -> Self {
-        let mut symbols: Vec<String> = Vec::new();
+        let mut inputs: Vec<InputSpec> = Vec::new();
         for a in &structure.actuators {
-            if !symbols.contains(&a.symbol) {
-                symbols.push(a.symbol.clone());
+            if inputs.iter().any(|i| i.symbol == a.symbol) {
+                continue;
             }
+            let (unit, description) = match a.target {
+                ActuatorTarget::Joint(j) => match structure.joints[j].kind {
+                    crate::structure::JointKind::Revolute { .. } => {
+                        ("rad", "joint angle command from the structure file")
+                    }
+                    _ => ("m", "joint slide command from the structure file"),
+                },
+                ActuatorTarget::CableLength(_) => ("m", "winch: the cable's rest length, from the structure file"),
+                ActuatorTarget::FixedNode { .. } => {
+                    ("m", "moved node: its displacement along its direction, from the structure file")
+                }
+            };
+            inputs.push(InputSpec { symbol: leak(a.symbol.clone()), unit, description });
         }
-        let inputs: Vec<InputSpec> = symbols
-            .into_iter()
-            .map(|s| InputSpec {
-                symbol: leak(s),
-                unit: "m or rad",
-                description: "actuator command from the structure file",
-            })
-            .collect();
         let mut quantities = Vec::new();
         for n in &structure.nodes {
             for c in ["x", "y", "z"] {
