@@ -164,3 +164,21 @@ fn a_relaxation_that_is_not_a_boolean_is_located() {
     let err = scenario::parse(Path::new("prism3.toml"), &text).unwrap_err().to_string();
     assert!(err.contains(&format!("prism3.toml:{line}:")), "{err}");
 }
+
+/// Struts of the large prism: the "a structure of 1000 struts".
+const LARGE_PRISM_STRUTS: usize = 1000;
+/// Steps of the large prism to settle, at most (measured 15: 5 relaxation steps and the
+/// 10-step quiet window; body damping alone does not settle a 64-strut prism in 40000).
+const LARGE_PRISM_MAX_STEPS: u64 = 50;
+
+/// A 1000-strut prism (`tensegrity bench --scale`'s family: strut 1 held, started 1/18 of the
+/// polygon angle short of the twist) settles through the sparse step in at most 50 steps, at
+/// the closed-form twist pi/2 + pi/n within 1e-9 rad, with a residual below 1e-9 N.
+#[test]
+fn a_prism_of_a_thousand_struts_settles_at_the_closed_form_twist() {
+    let case = tensegrity_testbed::bench::scale::settle_prism(LARGE_PRISM_STRUTS, true).unwrap();
+    assert!(case.settled, "not settled in {} steps", case.steps);
+    assert!(case.steps <= LARGE_PRISM_MAX_STEPS, "{} steps", case.steps);
+    assert!(case.twist_error_rad <= 1e-9, "twist error {} rad", case.twist_error_rad);
+    assert!(case.residual_force_n <= 1e-9, "residual {} N", case.residual_force_n);
+}

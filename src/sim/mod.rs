@@ -105,6 +105,9 @@ pub struct Simulation {
     relaxing: bool,
     /// The relaxation's current shift, a fraction of the stiffest mode (`relaxation.rs`).
     relaxation_shift: f64,
+    /// The largest generalized force component at the relaxation's last step, for its test of
+    /// a round-off stall (`relaxation/mod.rs`).
+    relaxation_last_force: f64,
 }
 
 impl Simulation {
