@@ -52,6 +52,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         tick: 0,
         relaxing: false,
         relaxation_shift: 0.0,
+        relaxation_last_force: f64::INFINITY,
     };
     sim.model.tree = sim.link_tree();
     sim.model.internal_closures = sim.find_internal_closures();

@@ -12,7 +12,9 @@
 //! laws (springs, elastic cables, gravity and external loads on the bodies it carries, its own
 //! torsion spring; every other coordinate held), and where k > 0 it quenches the joint's
 //! velocity (kinetic damping, as in dynamic relaxation) and sets the damping that makes the
-//! step Newton's. Where k <= 0 (near an unstable equilibrium) the joint keeps the structure's
+//! step Newton's; where the bodies are too heavy for that (dt^2 k < I, no damping reaches
+//! Newton's point from rest), it sets instead the velocity from which the undamped step does,
+//! if that step is at most 0.5 rad (0.25 of the structure's size). Where k <= 0 (near an unstable equilibrium) the joint keeps the structure's
 //! damping and its momentum: it moves away as the dynamics say. Velocity and damping are zero
 //! at rest, so the equilibrium is the same as with any fixed damping; only the path to it
 //! changes.
@@ -26,6 +28,26 @@ use rapier3d_f64::prelude::*;
 /// (dt^2 k < I), 0.
 fn newton_damping(dt: f64, stiffness: f64, inertia: f64) -> f64 {
     (dt * stiffness - inertia / dt).max(0.0)
+}
+
+/// Largest Newton step taken by a start velocity (below), revolute [rad].
+const MAX_NEWTON_TURN_RAD: f64 = 0.5;
+/// Largest Newton step taken by a start velocity, prismatic, as a fraction of the structure's
+/// size.
+const MAX_NEWTON_SLIDE_FRACTION: f64 = 0.25;
+
+/// The joint velocity [rad/s or m/s] from which rapier's undamped implicit step reaches
+/// Newton's point tau / k when damping cannot (dt^2 k < I: from rest the step would fall short,
+/// by dt^2 k / I of the way, and creep): dq = dt v + dt^2 tau / I = tau / k. 0 (rest, the
+/// damping does what it can) where damping can, or where tau / k is longer than `max_step`
+/// (a nearly flat stiffness, whose Newton point the linear model does not reach: on ji2014's
+/// grid a start velocity there diverged, measured).
+fn newton_velocity(dt: f64, force: f64, stiffness: f64, inertia: f64, max_step: f64) -> f64 {
+    if dt * dt * stiffness >= inertia || (force / stiffness).abs() > max_step {
+        0.0
+    } else {
+        force / (stiffness * dt) - dt * force / inertia
+    }
 }
 
 /// One joint's load for the coming step.
@@ -186,8 +208,13 @@ impl Simulation {
             let mut damping = self.model.structure.joints[j].damping;
             if load.stiffness > 0.0 && load.inertia > 0.0 {
                 damping = newton_damping(dt, load.stiffness, load.inertia);
+                let max_step = match self.model.structure.joints[j].kind {
+                    JointKind::Revolute { .. } => MAX_NEWTON_TURN_RAD,
+                    _ => MAX_NEWTON_SLIDE_FRACTION * self.model.length_scale_m,
+                };
+                let velocity = newton_velocity(dt, load.force, load.stiffness, load.inertia, max_step);
                 if let Some(mb) = self.multibody_joints.get_multibody_mut(mb_index) {
-                    mb.generalized_velocity_mut()[dof] = 0.0;
+                    mb.generalized_velocity_mut()[dof] = velocity;
                 }
             }
             if let Some(link) = self.model.joint_links[j] {
@@ -223,6 +250,22 @@ mod tests {
         // With dt^2 k / I < 1 an undamped step from rest falls short of tau / k.
         let (dt, k, inertia) = (0.01, 200.0, 2.0 / 3.0);
         assert_eq!(newton_damping(dt, k, inertia), 0.0);
+    }
+
+    /// Where damping cannot make the step Newton's (dt^2 k < I), the velocity set before the
+    /// undamped step does: the step lands on tau / k to round-off; where damping can, or the
+    /// step is beyond the limit, the joint starts from rest.
+    #[test]
+    fn a_short_step_starts_with_the_velocity_that_reaches_newtons_point() {
+        let (dt, k, inertia) = (0.005, 100.0, 0.37);
+        for tau in [-3.0, 2.5e-9, 12.0] {
+            let v = newton_velocity(dt, tau, k, inertia, MAX_NEWTON_TURN_RAD);
+            let dq = step(dt, newton_damping(dt, k, inertia), inertia, v, tau);
+            assert!((dq - tau / k).abs() <= 1e-15 * (tau / k).abs(), "tau {tau}: step {dq} against {}", tau / k);
+        }
+        assert_eq!(newton_velocity(0.15, 4.0, 200.0, 2.0 / 3.0, MAX_NEWTON_TURN_RAD), 0.0);
+        // A Newton step longer than the limit (200 rad here) is not taken.
+        assert_eq!(newton_velocity(dt, 2e4, k, inertia, MAX_NEWTON_TURN_RAD), 0.0);
     }
 
     /// A pendulum of mass m at radius r under gravity: tau = -m g r sin q about the pivot, so

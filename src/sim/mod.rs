@@ -73,7 +73,7 @@ pub struct Model {
     external_loads: Vec<[f64; 3]>,
     /// Characteristic length of the structure [m], for speeds and tolerances.
     pub length_scale_m: f64,
-    /// Whether the static relaxation applies to this structure (`relaxation.rs`).
+    /// Whether the static relaxation applies to this structure (`relaxation/`).
     relaxation_applies: bool,
 }
 
@@ -103,8 +103,11 @@ pub struct Simulation {
     /// Whether the static relaxation runs before each step (the settings' choice where it
     /// applies; the settle loop turns it off for its quiet window).
     relaxing: bool,
-    /// The relaxation's current shift, a fraction of the stiffest mode (`relaxation.rs`).
+    /// The relaxation's current shift, a fraction of the stiffest mode (`relaxation/`).
     relaxation_shift: f64,
+    /// The largest generalized force component at the relaxation's last step, for its test of
+    /// a round-off stall (`relaxation/mod.rs`).
+    relaxation_last_force: f64,
 }
 
 impl Simulation {

@@ -1,0 +1,200 @@
+//! The relaxation's linear system: the free bodies' coordinates, the generalized force
+//! f = -grad E and the Hessian H of the potential energy as 6x6 blocks (one per pair of
+//! coupled bodies), assembled from the force laws.
+
+use super::super::Simulation;
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix3x6, Matrix6, Vector3};
+use rapier3d_f64::prelude::*;
+use std::ops::AddAssign;
+
+pub(super) fn v3(v: Vector) -> Vector3<f64> {
+    Vector3::new(v.x, v.y, v.z)
+}
+
+pub(super) fn cross_matrix(r: Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -r.z, r.y, r.z, 0.0, -r.x, -r.y, r.x, 0.0)
+}
+
+/// The free bodies' coordinates: for each structure body its block index, if free.
+pub(super) struct Dofs {
+    pub(super) index: Vec<Option<usize>>,
+    /// Centre of mass of each free body, in block order [m].
+    pub(super) com: Vec<Vector>,
+    /// Mass [kg] and mean principal moment of inertia [kg m^2] of each free body.
+    pub(super) scale: Vec<(f64, f64)>,
+}
+
+impl Dofs {
+    /// Number of free bodies (blocks of six coordinates).
+    pub(super) fn blocks(&self) -> usize {
+        self.com.len()
+    }
+
+    /// 1 / sqrt(mass or inertia) of each coordinate (the mass weighting).
+    pub(super) fn weight(&self) -> DVector<f64> {
+        DVector::from_fn(6 * self.blocks(), |r, _| {
+            let (mass, inertia) = self.scale[r / 6];
+            1.0 / if r % 6 < 3 { mass } else { inertia }.sqrt()
+        })
+    }
+
+    /// Pairs of (structure body, block) of the free bodies.
+    pub(super) fn free(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.index.iter().enumerate().filter_map(|(b, i)| i.map(|i| (b, i)))
+    }
+}
+
+/// The generalized force and the Hessian's blocks (row block, column block, 6x6; repeated
+/// pairs add up, and both (i, k) and (k, i) are listed).
+pub(super) struct System {
+    pub(super) force: DVector<f64>,
+    pub(super) blocks: Vec<(usize, usize, Matrix6<f64>)>,
+}
+
+impl System {
+    /// The Hessian as a dense matrix, symmetrized.
+    pub(super) fn dense(&self) -> DMatrix<f64> {
+        let n = self.force.len();
+        let mut h = DMatrix::zeros(n, n);
+        for (i, k, block) in &self.blocks {
+            h.fixed_view_mut::<6, 6>(6 * i, 6 * k).add_assign(block);
+        }
+        0.5 * (&h + h.transpose())
+    }
+}
+
+impl Simulation {
+    pub(super) fn relaxation_dofs(&self) -> Dofs {
+        let s = &self.model.structure;
+        let mut dofs = Dofs { index: vec![None; s.bodies.len()], com: Vec::new(), scale: Vec::new() };
+        for b in (0..s.bodies.len()).filter(|b| self.is_free(*b)) {
+            let inertia = s.bodies[b].inertia.expect("free bodies have inertia");
+            dofs.index[b] = Some(dofs.com.len());
+            dofs.com.push(self.world_com(b));
+            let p = inertia.principal_kg_m2;
+            dofs.scale.push((inertia.mass_kg, ((p[0] + p[1] + p[2]) / 3.0).max(f64::MIN_POSITIVE)));
+        }
+        dofs
+    }
+
+    /// Constant loads on body `b` (gravity, external and probe loads): force [N], torque [N m].
+    pub(super) fn constant_load(&self, b: usize) -> (Vector3<f64>, Vector3<f64>) {
+        let s = &self.model.structure;
+        let g = Vector3::from(s.gravity);
+        let mass = s.bodies[b].inertia.map_or(0.0, |i| i.mass_kg);
+        let (probe_f, probe_t) = self.probe_loads[b];
+        let f = g * mass + Vector3::from(probe_f) + Vector3::from(self.model.external_loads[b]);
+        (f, Vector3::from(probe_t))
+    }
+
+    /// Node Jacobian J = [1, -[rho]x] of the node's block, if its body is free.
+    fn node_jacobian(&self, dofs: &Dofs, node: usize, p: Vector3<f64>) -> Option<(usize, Matrix3x6<f64>)> {
+        let i = dofs.index[self.model.structure.nodes[node].body]?;
+        let rho = p - v3(dofs.com[i]);
+        let mut j = Matrix3x6::zeros();
+        j.fixed_view_mut::<3, 3>(0, 0).copy_from(&Matrix3::identity());
+        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-cross_matrix(rho)));
+        Some((i, j))
+    }
+
+    /// The generalized force f = -grad E and the Hessian H of the energy, six coordinates per
+    /// free body (translation, then rotation): per member J^T K_m J with
+    /// K_m = k e e^T + (t / l)(1 - e e^T), plus the rotations' geometric term
+    /// (F . rho) 1 - sym(F rho^T) of a node force F at the arm rho.
+    pub(super) fn relaxation_system(&self, dofs: &Dofs) -> System {
+        let s = &self.model.structure;
+        let mut f = DVector::zeros(6 * dofs.blocks());
+        let mut blocks = Vec::new();
+        for m in (0..s.springs.len() + s.cables.len()).filter_map(|i| self.elastic_member(i)) {
+            let (pa, pb) = (Vector3::from(self.node_position(m.a)), Vector3::from(self.node_position(m.b)));
+            let d = pb - pa;
+            let l = d.norm();
+            if l <= 0.0 || !m.engaged(l) {
+                continue;
+            }
+            let (t, e) = (m.tension_n(l), d / l);
+            let km = e * e.transpose() * m.stiffness_n_per_m + (Matrix3::identity() - e * e.transpose()) * (t / l);
+            let ends =
+                [(self.node_jacobian(dofs, m.a, pa), pa, e * t), (self.node_jacobian(dofs, m.b, pb), pb, -e * t)];
+            for (x, (jx, px, fx)) in ends.iter().enumerate() {
+                let Some((i, ji)) = jx else { continue };
+                let rho = px - v3(dofs.com[*i]);
+                f.fixed_rows_mut::<6>(6 * i).add_assign(&(ji.transpose() * fx));
+                let mut geo = Matrix6::zeros();
+                geo.fixed_view_mut::<3, 3>(3, 3).copy_from(
+                    &(Matrix3::identity() * fx.dot(&rho) - (fx * rho.transpose() + rho * fx.transpose()) * 0.5),
+                );
+                blocks.push((*i, *i, geo));
+                for (y, (jy, _, _)) in ends.iter().enumerate() {
+                    let Some((k, jk)) = jy else { continue };
+                    let sign = if x == y { 1.0 } else { -1.0 };
+                    blocks.push((*i, *k, ji.transpose() * km * jk * sign));
+                }
+            }
+        }
+        for (b, i) in dofs.free() {
+            let (force, torque) = self.constant_load(b);
+            f.fixed_rows_mut::<3>(6 * i).add_assign(&force);
+            f.fixed_rows_mut::<3>(6 * i + 3).add_assign(&torque);
+        }
+        System { force: f, blocks }
+    }
+
+    /// Every free body alone, with its own nodes that members hold and its centre of mass as
+    /// anchors [m] (a turn about a line off the centre of mass is not free in these
+    /// coordinates: it moves the nodes at second order, and the loads at first); then the
+    /// groups of free bodies joined by members (slack or not), each with its anchors: the
+    /// nodes on bodies that are not free with a member to the group. A group moves rigidly at no cost in energy
+    /// wherever that motion keeps its anchors in place (six motions without anchors, the turns
+    /// about a single anchor, the turn about a line of anchors, as a prism's held strut, or a
+    /// strut's spin about its axis). Blocks and anchors, per group.
+    pub(super) fn rigid_groups(&self, dofs: &Dofs) -> Vec<(Vec<usize>, Vec<Vector3<f64>>)> {
+        let s = &self.model.structure;
+        let n = dofs.blocks();
+        let mut parent: Vec<usize> = (0..n).collect();
+        fn root(parent: &mut [usize], mut i: usize) -> usize {
+            while parent[i] != i {
+                parent[i] = parent[parent[i]];
+                i = parent[i];
+            }
+            i
+        }
+        let mut anchors_of = vec![Vec::new(); n];
+        let mut own_nodes = vec![Vec::new(); n];
+        let ends = s.springs.iter().map(|m| (m.a, m.b)).chain(s.cables.iter().map(|c| (c.a, c.b)));
+        for (a, b) in ends {
+            for node in [a, b] {
+                if let Some(i) = dofs.index[s.nodes[node].body] {
+                    own_nodes[i].push(node);
+                }
+            }
+            match (dofs.index[s.nodes[a].body], dofs.index[s.nodes[b].body]) {
+                (Some(i), Some(k)) => {
+                    let (ri, rk) = (root(&mut parent, i), root(&mut parent, k));
+                    parent[ri] = rk;
+                }
+                (Some(i), None) => anchors_of[i].push(b),
+                (None, Some(k)) => anchors_of[k].push(a),
+                (None, None) => {}
+            }
+        }
+        let mut groups: std::collections::BTreeMap<usize, (Vec<usize>, Vec<usize>)> = Default::default();
+        for (i, anchors) in anchors_of.into_iter().enumerate() {
+            let group = groups.entry(root(&mut parent, i)).or_default();
+            group.0.push(i);
+            group.1.extend(anchors);
+        }
+        let place = |mut nodes: Vec<usize>| {
+            nodes.sort_unstable();
+            nodes.dedup();
+            nodes.into_iter().map(|a| Vector3::from(self.node_position(a))).collect::<Vec<_>>()
+        };
+        let bodies = own_nodes.into_iter().enumerate().map(|(i, nodes)| {
+            let mut anchors = place(nodes);
+            anchors.push(v3(dofs.com[i]));
+            (vec![i], anchors)
+        });
+        let groups: Vec<_> = groups.into_values().map(|(blocks, anchors)| (blocks, place(anchors))).collect();
+        bodies.chain(groups).collect()
+    }
+}
