@@ -1009,17 +1009,22 @@ fn cmd_bench_scale_peer(
     let dir = std::env::temp_dir().join(format!("tensegrity-bench-scale-peer-{}", std::process::id()));
     let out = peer::compare(families, max_struts, caps, command, &dir);
     let _ = std::fs::remove_dir_all(&dir);
-    let rows = match out {
-        Ok(rows) => rows,
+    let (reports, rows) = match out {
+        Ok(r) => r,
         Err(e) => {
             eprintln!("error: {e}");
             return EXIT_BAD_INPUT;
         }
     };
     if json {
-        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "scale_peer": rows })).unwrap());
+        let v = serde_json::json!({ "scale": reports, "scale_peer": rows });
+        println!("{}", serde_json::to_string_pretty(&v).unwrap());
         return EXIT_PASS;
     }
+    reports.iter().for_each(print_scale_family);
+    println!(
+        "\nMuJoCo side by side (cases/s = 1 / wall per case; rate x = testbed / MuJoCo cases/s; error x = testbed / MuJoCo error)"
+    );
     println!(
         "{:<12} {:>5} {:>6} | {:>9} {:>7} {:>10} {:>9} | {:>9} {:>7} {:>10} {:>9} | {:>9} {:>9}",
         "family",

@@ -10,7 +10,7 @@
 //! same process run; rates are 1 / (wall time per case), building the model included on both
 //! sides.
 
-use super::{cases, criteria, run_case, Caps, Case, Measure};
+use super::{cases, criteria, growth_exponent, run_case, Caps, Case, FamilyReport, Measure, ScaleCase};
 use crate::export::mjcf::{to_mjcf, ActuatorMode, MjcfOptions};
 use crate::structure::{ActuatorTarget, BodyKind, JointKind};
 use serde::Serialize;
@@ -143,14 +143,15 @@ fn run_peer(command: &[String], file: &Path) -> Result<serde_json::Value, String
         .map_err(|e| format!("the peer '{}' printed no JSON object: {e}", command.join(" ")))
 }
 
-/// Every case of `families` up to `max_struts`, settled by the testbed and then by the peer.
+/// Every case of `families` up to `max_struts`, settled by the testbed and then by the peer:
+/// the testbed's family tables and the side-by-side rows.
 pub fn compare(
     families: &[&'static str],
     max_struts: usize,
     caps: &Caps,
     command: &[String],
     dir: &Path,
-) -> Result<Vec<PeerRow>, String> {
+) -> Result<(Vec<FamilyReport>, Vec<PeerRow>), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     let (mut ours, mut theirs) = (Vec::new(), Vec::new());
     for family in families {
@@ -174,7 +175,7 @@ pub fn compare(
         "simulator": v.get("simulator"), "mujoco_version": v.get("mujoco_version"), "settings": v.get("settings"),
     });
     let num = |c: &serde_json::Value, k: &str| c.get(k).and_then(|x| x.as_f64()).unwrap_or(f64::NAN);
-    Ok(ours
+    let rows = ours
         .iter()
         .zip(peer_cases)
         .zip(&theirs)
@@ -206,5 +207,13 @@ pub fn compare(
                 peer: about.clone(),
             }
         })
-        .collect())
+        .collect();
+    let reports = families
+        .iter()
+        .map(|f| {
+            let cases: Vec<ScaleCase> = ours.iter().filter(|c| c.family == *f).cloned().collect();
+            FamilyReport { family: f, growth_exponent: growth_exponent(&cases), cases }
+        })
+        .collect();
+    Ok((reports, rows))
 }
