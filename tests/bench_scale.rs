@@ -160,3 +160,55 @@ fn the_aligned_distance_ignores_rigid_motions() {
     let d = scale::aligned_distance(&bent, &pts);
     assert!(d > 0.0 && d < 1e-3, "{d}");
 }
+
+mod common;
+
+/// The Python that has MuJoCo: `TENSEGRITY_PYTHON` if set, else `python3`; None (the test
+/// then says it skipped) when `import mujoco` fails.
+fn python_with_mujoco() -> Option<String> {
+    let py = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
+    let ok = std::process::Command::new(&py).args(["-c", "import mujoco"]).output().is_ok_and(|o| o.status.success());
+    ok.then_some(py)
+}
+
+/// Every family's members up to 6 struts go through MuJoCo in the same run
+/// (`benches/peers/mujoco/scale_peer.py` on the testbed's MJCF export): MuJoCo settles every
+/// one, with no export warning, within 1e-5 of the closed form (measured 4e-14 rad to 7e-7 m),
+/// and the testbed's error is below a tenth of MuJoCo's on each (measured 1e-2 to 5e-10).
+#[test]
+fn mujoco_settles_the_small_members_side_by_side() {
+    let Some(py) = python_with_mujoco() else {
+        eprintln!("skipped: no Python with `import mujoco` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt)");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("tensegrity-test-scale-peer-{}", std::process::id()));
+    let command = [py, "benches/peers/mujoco/scale_peer.py".to_string()];
+    let out = scale::peer::compare(&scale::FAMILIES, 6, &DEFAULT_CAPS, &command, &dir);
+    let _ = std::fs::remove_dir_all(&dir);
+    let (reports, rows) = out.unwrap();
+    assert_eq!(reports.len(), 4);
+    assert_eq!(rows.len(), 6, "prisms 3, 4, 6, the icosahedron, a 1-stage tower, a 1-module chain");
+    for r in &rows {
+        let what = format!("{} {}", r.family, r.size);
+        assert!(r.testbed_settled && r.peer_settled, "{what}: settled {} / {}", r.testbed_settled, r.peer_settled);
+        assert!(r.peer_notes.is_empty(), "{what}: {:?}", r.peer_notes);
+        assert!(r.peer_error <= 1e-5, "{what}: MuJoCo error {:e} {}", r.peer_error, r.error_unit);
+        assert!(r.ratio_error <= 0.1, "{what}: testbed / MuJoCo error {:e}", r.ratio_error);
+    }
+}
+
+/// The command line: an unknown family is bad input (exit 2, named in the message), and
+/// `--json` lists each family's cases up to `--max-struts`.
+#[test]
+fn bench_scale_cli_selects_families_and_sizes() {
+    let (code, _, err) = common::tensegrity(&["bench", "--scale", "--family", "cube"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("no scale family 'cube'"), "{err}");
+    let (code, out, _) = common::tensegrity(&["bench", "--scale", "--family", "prism", "--max-struts", "4", "--json"]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let cases = v["scale"][0]["cases"].as_array().unwrap();
+    let struts: Vec<u64> = cases.iter().map(|c| c["struts"].as_u64().unwrap()).collect();
+    assert_eq!(struts, [3, 4]);
+    assert!(cases.iter().all(|c| c["settled"] == true && c["error_unit"] == "rad"));
+}
