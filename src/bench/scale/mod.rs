@@ -285,7 +285,8 @@ pub fn cases(family: &str, max_struts: usize) -> Result<Vec<Case>, String> {
         "prism" => Ok(prism::SIZES.iter().filter(|&&n| n <= max_struts).map(|&n| prism::case(n)).collect()),
         "icosahedron" => Ok(if max_struts >= 6 { vec![icosahedron::case()] } else { vec![] }),
         "tower" => tower::STAGES.iter().filter(|&&m| tower::N * m <= max_struts).map(|&m| tower::case(m)).collect(),
-        "furet" => Ok(furet::MODULES.iter().filter(|&&n| 3 * n + 1 <= max_struts).map(|&n| furet::case(n)).collect()),
+        // n modules: 3 n struts and the base bar.
+        "furet" => Ok(furet::MODULES.iter().filter(|&&n| 3 * n < max_struts).map(|&n| furet::case(n)).collect()),
         _ => Err(format!("no scale family '{family}' (families: {})", FAMILIES.join(", "))),
     }
 }

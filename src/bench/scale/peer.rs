@@ -143,6 +143,36 @@ fn run_peer(command: &[String], file: &Path) -> Result<serde_json::Value, String
         .map_err(|e| format!("the peer '{}' printed no JSON object: {e}", command.join(" ")))
 }
 
+/// One case of both sides: the testbed's `t`, the peer's JSON `p` for the case `pc` it got.
+fn row(t: &ScaleCase, p: &serde_json::Value, pc: &PeerCase, about: &serde_json::Value) -> PeerRow {
+    let num = |k: &str| p.get(k).and_then(|x| x.as_f64()).unwrap_or(f64::NAN);
+    let (peer_wall_s, peer_error) = (num("wall_s"), num("error"));
+    let mut notes = pc.warnings.clone();
+    if let Some(n) = p.get("note").and_then(|n| n.as_str()) {
+        notes.push(n.to_string());
+    }
+    PeerRow {
+        family: t.family,
+        size: t.size,
+        struts: t.struts,
+        testbed_settled: t.settled,
+        testbed_steps: t.steps,
+        testbed_wall_s: t.wall_s,
+        testbed_cases_per_s: 1.0 / t.wall_s,
+        testbed_error: t.error,
+        error_unit: t.error_unit,
+        peer_settled: p.get("settled").and_then(|x| x.as_bool()).unwrap_or(false),
+        peer_steps: p.get("steps").and_then(|x| x.as_u64()).unwrap_or(0),
+        peer_wall_s,
+        peer_cases_per_s: 1.0 / peer_wall_s,
+        peer_error,
+        ratio_cases_per_s: peer_wall_s / t.wall_s,
+        ratio_error: t.error / peer_error,
+        peer_notes: notes,
+        peer: about.clone(),
+    }
+}
+
 /// Every case of `families` up to `max_struts`, settled by the testbed and then by the peer:
 /// the testbed's family tables and the side-by-side rows.
 pub fn compare(
@@ -174,40 +204,7 @@ pub fn compare(
     let about = serde_json::json!({
         "simulator": v.get("simulator"), "mujoco_version": v.get("mujoco_version"), "settings": v.get("settings"),
     });
-    let num = |c: &serde_json::Value, k: &str| c.get(k).and_then(|x| x.as_f64()).unwrap_or(f64::NAN);
-    let rows = ours
-        .iter()
-        .zip(peer_cases)
-        .zip(&theirs)
-        .map(|((t, p), pc)| {
-            let peer_wall_s = num(p, "wall_s");
-            let peer_error = num(p, "error");
-            let mut notes = pc.warnings.clone();
-            if let Some(n) = p.get("note").and_then(|n| n.as_str()) {
-                notes.push(n.to_string());
-            }
-            PeerRow {
-                family: t.family,
-                size: t.size,
-                struts: t.struts,
-                testbed_settled: t.settled,
-                testbed_steps: t.steps,
-                testbed_wall_s: t.wall_s,
-                testbed_cases_per_s: 1.0 / t.wall_s,
-                testbed_error: t.error,
-                error_unit: t.error_unit,
-                peer_settled: p.get("settled").and_then(|x| x.as_bool()).unwrap_or(false),
-                peer_steps: p.get("steps").and_then(|x| x.as_u64()).unwrap_or(0),
-                peer_wall_s,
-                peer_cases_per_s: 1.0 / peer_wall_s,
-                peer_error,
-                ratio_cases_per_s: peer_wall_s / t.wall_s,
-                ratio_error: t.error / peer_error,
-                peer_notes: notes,
-                peer: about.clone(),
-            }
-        })
-        .collect();
+    let rows = ours.iter().zip(peer_cases).zip(&theirs).map(|((t, p), pc)| row(t, p, pc, &about)).collect();
     let reports = families
         .iter()
         .map(|f| {

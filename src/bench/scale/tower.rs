@@ -270,7 +270,8 @@ const PROJECTION_PASSES: usize = 3;
 
 /// A A^T + shift, factored, for the members' columns.
 fn normal_matrix(cols: &[Vec<(usize, Vec3)>], n: usize) -> Result<Band, String> {
-    let w = 3 * cols.iter().filter_map(|c| (c.len() == 2).then(|| c[0].0.abs_diff(c[1].0))).max().unwrap_or(0) + 2;
+    let span = cols.iter().filter(|c| c.len() == 2).map(|c| c[0].0.abs_diff(c[1].0)).max().unwrap_or(0);
+    let w = 3 * span + 2;
     let mut aat = Band::new(3 * n, w);
     for c in cols {
         for (i, u) in c {
