@@ -9,12 +9,6 @@ use tensegrity_testbed::report::{Report, EXIT_BAD_INPUT, EXIT_FAIL, EXIT_PASS};
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario::{self, Scenario};
 
-/// Counts heap bytes while `bench --scale` measures a case (one relaxed load per allocation
-/// otherwise; `src/bench/scale/memory.rs`).
-#[global_allocator]
-static ALLOCATOR: tensegrity_testbed::bench::scale::memory::CountingAllocator =
-    tensegrity_testbed::bench::scale::memory::CountingAllocator;
-
 #[derive(Parser)]
 #[command(
     name = "tensegrity",
@@ -964,7 +958,7 @@ fn cmd_bench_scale(json: bool, max_struts: usize, only: &[String], max_wall_s: f
 
 fn print_scale_family(r: &tensegrity_testbed::bench::scale::FamilyReport) {
     println!(
-        "\n{:<12} {:>5} {:>6} {:>6} {:>7} {:>7} {:>9} {:>10} {:>9} {:>9} {:>9} {:>10} {:>10}",
+        "\n{:<12} {:>5} {:>6} {:>6} {:>7} {:>7} {:>9} {:>10} {:>9} {:>9} {:>10} {:>10}",
         "family",
         "size",
         "struts",
@@ -975,14 +969,13 @@ fn print_scale_family(r: &tensegrity_testbed::bench::scale::FamilyReport) {
         "wall s",
         "rss MiB",
         "peak MiB",
-        "heap MiB",
         "error",
         "residual"
     );
     let mib = |k: Option<u64>| k.map_or(f64::NAN, |k| k as f64 / 1024.0);
     for c in &r.cases {
         println!(
-            "{:<12} {:>5} {:>6} {:>6} {:>7} {:>7} {:>9} {:>10.4} {:>9.1} {:>9.1} {:>9.2} {:>7.2e} {:<3} {:>9.2e}{}",
+            "{:<12} {:>5} {:>6} {:>6} {:>7} {:>7} {:>9} {:>10.4} {:>9.1} {:>9.1} {:>7.2e} {:<3} {:>9.2e}{}",
             c.family,
             c.size,
             c.struts,
@@ -993,7 +986,6 @@ fn print_scale_family(r: &tensegrity_testbed::bench::scale::FamilyReport) {
             c.wall_s,
             mib(c.rss_before_kib),
             mib(c.peak_rss_kib),
-            c.peak_heap_bytes.map_or(f64::NAN, |b| b as f64 / (1024.0 * 1024.0)),
             c.error,
             c.error_unit,
             c.residual,

@@ -9,16 +9,14 @@
 //! - [`furet`]: furet2018's Snelson X modules in series (n = 1 .. 20), end point against the
 //!   direct kinematics of Eq. 2.
 //!
-//! Each case reports steps, wall time, memory (the peak heap it needed, counted by
-//! [`memory::CountingAllocator`] in the binary, and the process's resident set: `VmRSS` before
-//! the case and its peak `VmHWM` during it, reset before the case through
-//! `/proc/self/clear_refs`),
+//! Each case reports steps, wall time, memory (the process's resident set: `VmRSS` before the
+//! case and its peak `VmHWM` during it, after freed heap has been handed back to the system
+//! and the peak reset, [`reset_memory`]),
 //! the error against the closed form and the force residual; each family the growth exponent
 //! of its cost ([`growth_exponent`]). [`peer`] runs the same structures through MuJoCo.
 
 pub mod furet;
 pub mod icosahedron;
-pub mod memory;
 pub mod peer;
 pub mod prism;
 pub mod tower;
@@ -52,9 +50,6 @@ pub struct ScaleCase {
     pub rss_before_kib: Option<u64>,
     /// Peak resident set during the case (`VmHWM`, reset before it) [KiB].
     pub peak_rss_kib: Option<u64>,
-    /// Peak heap the case needed beyond what was live before it (allocated minus freed
-    /// bytes, [`memory`]; None where the counting allocator is not installed) [B].
-    pub peak_heap_bytes: Option<u64>,
     /// Error against the closed form, in [`ScaleCase::error_unit`]: see [`Measure`].
     pub error: f64,
     pub error_unit: &'static str,
@@ -159,8 +154,16 @@ fn proc_status_kib(field: &str) -> Option<u64> {
     line.split_whitespace().nth(1)?.parse().ok()
 }
 
-/// Resets the peak resident set (`VmHWM`) to the current one (Linux `clear_refs` value 5).
-fn reset_peak_rss() {
+/// Hands the heap that earlier cases freed back to the system (glibc `malloc_trim`: without it
+/// the allocator keeps it and the resident set hides a case's own growth; a counting global
+/// allocator was measured instead and cost ji2014's bench about 8 % of its cases per second),
+/// then resets the peak resident set (`VmHWM`) to the current one (Linux `clear_refs` 5).
+fn reset_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only returns free memory of the allocator's own arenas.
+    unsafe {
+        libc::malloc_trim(0);
+    }
     let _ = std::fs::write("/proc/self/clear_refs", "5");
 }
 
@@ -207,12 +210,9 @@ pub const MIN_CASE_WALL_S: f64 = 0.2;
 
 /// Settles `case` and measures it (the memory of the first settle).
 pub fn run_case(case: &Case, caps: &Caps) -> Result<ScaleCase, String> {
-    reset_peak_rss();
+    reset_memory();
     let rss_before_kib = proc_status_kib("VmRSS:");
-    let heap = memory::Measurement::start();
-    let settled = settle(&case.start, &case.settings, &case.commands, caps);
-    let peak_heap_bytes = heap.stop();
-    let mut out = settled?;
+    let mut out = settle(&case.start, &case.settings, &case.commands, caps)?;
     let peak_rss_kib = proc_status_kib("VmHWM:");
     let mut walls = vec![out.wall_s];
     while walls.iter().sum::<f64>() < MIN_CASE_WALL_S {
@@ -236,7 +236,6 @@ pub fn run_case(case: &Case, caps: &Caps) -> Result<ScaleCase, String> {
         wall_s: out.wall_s,
         rss_before_kib,
         peak_rss_kib,
-        peak_heap_bytes,
         error,
         error_unit: case.measure.unit(),
         residual: out.residual,
