@@ -129,10 +129,22 @@ enum Command {
         /// (default: the MuJoCo peer, `python3 benches/peers/mujoco/peer.py`).
         #[arg(long, value_name = "CMD", num_args = 0..=1, default_missing_value = DEFAULT_PEER)]
         peer: Option<String>,
-        /// Settle regular n-strut prisms (n = 3 .. 128) from a twisted start instead: steps,
-        /// wall time and the twist error against the closed form pi/2 + pi/n.
+        /// Settle the scale families instead (n-strut prisms, the icosahedron, force-density
+        /// towers, furet2018 X chains) from perturbed starts: steps, wall time, memory, error
+        /// against the closed form, growth exponent. With --peer: the same structures in MuJoCo
+        /// too (default `benches/peers/mujoco/scale_peer.py`).
         #[arg(long)]
         scale: bool,
+        /// With --scale: largest structure, in struts.
+        #[arg(long, value_name = "N", default_value_t = 1000)]
+        max_struts: usize,
+        /// With --scale: only this family (prism, icosahedron, tower, furet; repeatable).
+        #[arg(long = "family", value_name = "NAME")]
+        families: Vec<String>,
+        /// With --scale: a case still moving after this wall time is reported as not settled
+        /// (checked between steps) [s].
+        #[arg(long, value_name = "S", default_value_t = 120.0)]
+        max_case_wall_s: f64,
     },
     /// Write a scenario's structure in another simulator's format.
     Export {
@@ -323,7 +335,9 @@ fn dispatch(cli: Cli) -> i32 {
         Command::Export { format: ExportFormat::Mjcf { scenario, out, actuators, kp, cable_damping } } => {
             cmd_export_mjcf(&scenario, out.as_deref(), &actuators, kp, cable_damping)
         }
-        Command::Bench { scale: true, json, .. } => cmd_bench_scale(json),
+        Command::Bench { scale: true, json, max_struts, families, max_case_wall_s, peer, .. } => {
+            cmd_bench_scale(json, max_struts, &families, max_case_wall_s, peer.as_deref())
+        }
         Command::Bench { export_cases: Some(dir), .. } => cmd_export_cases(&dir),
         Command::Bench { rounds, json, export_cases: None, mechanisms, peer: Some(peer), .. } => {
             cmd_bench_peer(rounds, json, &mechanisms, &peer)
@@ -928,41 +942,166 @@ fn cmd_export_cases(dir: &Path) -> i32 {
 /// The MuJoCo peer of `benches/peers/mujoco/`.
 const DEFAULT_PEER: &str = "python3 benches/peers/mujoco/peer.py";
 
-/// The built-in case sets that `--mechanism` selects (all when none is named).
-/// Strut counts of `tensegrity bench --scale`.
-const SCALE_BENCH_STRUTS: [usize; 10] = [3, 4, 6, 8, 12, 16, 24, 32, 64, 128];
+/// The MuJoCo peer of `tensegrity bench --scale --peer` (run with `$TENSEGRITY_PYTHON`, else
+/// python3).
+const DEFAULT_SCALE_PEER: &str = "benches/peers/mujoco/scale_peer.py";
 
-fn cmd_bench_scale(json: bool) -> i32 {
-    let mut cases = Vec::new();
-    if !json {
-        println!(
-            "{:>6} {:>7} {:>8} {:>7} {:>10} {:>14} {:>12}",
-            "struts", "cables", "settled", "steps", "wall s", "twist err rad", "residual N"
-        );
+fn cmd_bench_scale(json: bool, max_struts: usize, only: &[String], max_wall_s: f64, peer: Option<&str>) -> i32 {
+    use tensegrity_testbed::bench::scale;
+    let families: Vec<&'static str> =
+        scale::FAMILIES.iter().copied().filter(|f| only.is_empty() || only.iter().any(|o| o == f)).collect();
+    if let Some(bad) = only.iter().find(|o| !scale::FAMILIES.contains(&o.as_str())) {
+        eprintln!("error: no scale family '{bad}' (families: {})", scale::FAMILIES.join(", "));
+        return EXIT_BAD_INPUT;
     }
-    for n in SCALE_BENCH_STRUTS {
-        match tensegrity_testbed::bench::scale::settle_prism(n, true) {
-            Ok(c) => {
+    let caps = scale::Caps { max_wall_s, ..scale::DEFAULT_CAPS };
+    if let Some(peer) = peer {
+        let command: Vec<String> = if peer == DEFAULT_PEER {
+            let python = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
+            vec![python, DEFAULT_SCALE_PEER.into()]
+        } else {
+            peer.split_whitespace().map(str::to_string).collect()
+        };
+        return cmd_bench_scale_peer(json, max_struts, &families, &caps, &command);
+    }
+    let mut reports = Vec::new();
+    for family in families {
+        eprintln!("{family}: settling up to {max_struts} struts ...");
+        match scale::run_family(family, max_struts, &caps) {
+            Ok(r) => {
                 if !json {
-                    println!(
-                        "{:>6} {:>7} {:>8} {:>7} {:>10.4} {:>14.2e} {:>12.2e}",
-                        c.struts, c.cables, c.settled, c.steps, c.wall_s, c.twist_error_rad, c.residual_force_n
-                    );
+                    print_scale_family(&r);
                 }
-                cases.push(c);
+                reports.push(r);
             }
             Err(e) => {
-                eprintln!("error: {n}-strut prism: {e}");
+                eprintln!("error: {family}: {e}");
                 return 1;
             }
         }
     }
     if json {
-        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "scale": cases })).unwrap());
+        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "scale": reports })).unwrap());
     }
-    0
+    EXIT_PASS
 }
 
+fn print_scale_family(r: &tensegrity_testbed::bench::scale::FamilyReport) {
+    println!(
+        "\n{:<12} {:>5} {:>6} {:>6} {:>7} {:>7} {:>9} {:>10} {:>9} {:>9} {:>10} {:>10}",
+        "family",
+        "size",
+        "struts",
+        "cables",
+        "springs",
+        "settled",
+        "steps",
+        "wall s",
+        "rss MiB",
+        "peak MiB",
+        "error",
+        "residual"
+    );
+    let mib = |k: Option<u64>| k.map_or(f64::NAN, |k| k as f64 / 1024.0);
+    for c in &r.cases {
+        println!(
+            "{:<12} {:>5} {:>6} {:>6} {:>7} {:>7} {:>9} {:>10.4} {:>9.1} {:>9.1} {:>7.2e} {:<3} {:>9.2e}{}",
+            c.family,
+            c.size,
+            c.struts,
+            c.cables,
+            c.springs,
+            c.settled,
+            c.steps,
+            c.wall_s,
+            mib(c.rss_before_kib),
+            mib(c.peak_rss_kib),
+            c.error,
+            c.error_unit,
+            c.residual,
+            c.note.as_ref().map_or(String::new(), |n| format!("  ({n})"))
+        );
+    }
+    match r.growth_exponent {
+        Some(e) => println!("{}: wall ~ struts^{e:.2} over the largest settled sizes", r.family),
+        None => println!("{}: growth exponent: fewer than two settled sizes", r.family),
+    }
+}
+
+fn cmd_bench_scale_peer(
+    json: bool,
+    max_struts: usize,
+    families: &[&'static str],
+    caps: &tensegrity_testbed::bench::scale::Caps,
+    command: &[String],
+) -> i32 {
+    use tensegrity_testbed::bench::scale::peer;
+    let dir = std::env::temp_dir().join(format!("tensegrity-bench-scale-peer-{}", std::process::id()));
+    let out = peer::compare(families, max_struts, caps, command, &dir);
+    let _ = std::fs::remove_dir_all(&dir);
+    let (reports, rows) = match out {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    if json {
+        let v = serde_json::json!({ "scale": reports, "scale_peer": rows });
+        println!("{}", serde_json::to_string_pretty(&v).unwrap());
+        return EXIT_PASS;
+    }
+    reports.iter().for_each(print_scale_family);
+    println!(
+        "\nMuJoCo side by side (cases/s = 1 / wall per case; rate x = testbed / MuJoCo cases/s; error x = testbed / MuJoCo error)"
+    );
+    println!(
+        "{:<12} {:>5} {:>6} | {:>9} {:>7} {:>10} {:>9} | {:>9} {:>7} {:>10} {:>9} | {:>9} {:>9}",
+        "family",
+        "size",
+        "struts",
+        "tb cases/s",
+        "steps",
+        "error",
+        "settled",
+        "mj cases/s",
+        "steps",
+        "error",
+        "settled",
+        "rate x",
+        "error x"
+    );
+    for r in &rows {
+        println!(
+            "{:<12} {:>5} {:>6} | {:>9.2} {:>7} {:>10.2e} {:>9} | {:>9.2} {:>7} {:>10.2e} {:>9} | {:>9.2} {:>9.2e}{}",
+            r.family,
+            r.size,
+            r.struts,
+            r.testbed_cases_per_s,
+            r.testbed_steps,
+            r.testbed_error,
+            r.testbed_settled,
+            r.peer_cases_per_s,
+            r.peer_steps,
+            r.peer_error,
+            r.peer_settled,
+            r.ratio_cases_per_s,
+            r.ratio_error,
+            format!(
+                " {}{}",
+                r.error_unit,
+                if r.peer_notes.is_empty() {
+                    String::new()
+                } else {
+                    format!("  (MuJoCo: {})", r.peer_notes.join("; "))
+                }
+            )
+        );
+    }
+    EXIT_PASS
+}
+
+/// The built-in case sets that `--mechanism` selects (all when none is named).
 fn selected_case_sets(only: &[String]) -> Result<Vec<(&'static str, &'static str)>, i32> {
     if let Some(bad) = only.iter().find(|m| !tensegrity_testbed::bench::CASE_SETS.iter().any(|(n, _)| n == m)) {
         eprintln!("error: no bench case set for mechanism '{bad}'");

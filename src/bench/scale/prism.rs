@@ -1,4 +1,4 @@
-//! `tensegrity bench --scale`: regular n-strut tensegrity prisms, settled from a twisted start,
+//! The prism family of `tensegrity bench --scale`: regular n-strut tensegrity prisms, settled from a twisted start,
 //! against their closed-form twist.
 //!
 //! A regular prism with struts from bottom node i to top node i, side cables from bottom node
@@ -12,11 +12,9 @@
 //! default settling (the static relaxation) and reports steps, wall time and the largest
 //! twist error over the n struts.
 
-use crate::run::SettleDetector;
-use crate::settings::{SettleCriteria, SimSettings};
-use crate::sim::Simulation;
+use super::{run_case, Caps, Case, Measure, ScaleCase};
+use crate::settings::SimSettings;
 use crate::structure::{BodyKind, Cable, CableLaw, Inertia, Structure, Strut, Vec3};
-use serde::Serialize;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Radius of the drawn polygons [m].
@@ -38,19 +36,6 @@ const DT_S: f64 = 0.005;
 const BODY_DAMPING_PER_S: f64 = 2.0;
 /// Steps after which a case counts as not settled.
 const MAX_STEPS: u64 = 20_000;
-
-/// One prism's settle.
-#[derive(Clone, Debug, Serialize)]
-pub struct ScaleCase {
-    pub struts: usize,
-    pub cables: usize,
-    pub settled: bool,
-    pub steps: u64,
-    pub wall_s: f64,
-    /// Largest |twist - (pi/2 + pi/n)| over the struts [rad].
-    pub twist_error_rad: f64,
-    pub residual_force_n: f64,
-}
 
 fn polar(angle: f64, z: f64) -> Vec3 {
     [RADIUS_M * angle.cos(), RADIUS_M * angle.sin(), z]
@@ -104,7 +89,7 @@ pub fn prism(n: usize, twist: f64) -> Structure {
 
 /// Largest |twist - (pi/2 + pi/n)| over the struts of settled node positions (bottom node i
 /// at 2 i, top node i at 2 i + 1) [rad], about the axis through the polygons' centroids.
-fn twist_error(nodes: &[Vec3], n: usize) -> f64 {
+pub fn twist_error(nodes: &[Vec3], n: usize) -> f64 {
     let centroid = |k: usize| {
         let mut c = [0.0; 3];
         for i in 0..n {
@@ -128,46 +113,38 @@ fn twist_error(nodes: &[Vec3], n: usize) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Strut counts of the family.
+pub const SIZES: [usize; 13] = [3, 4, 6, 8, 12, 16, 24, 32, 64, 128, 256, 512, 1000];
+
+/// The n-strut prism's case: drawn [`START_TWIST_OFFSET_FRACTION`] of the polygons' angle short
+/// of the closed-form twist, strut 1 held; compared by its twist.
+pub fn case(n: usize) -> Case {
+    case_with(n, true)
+}
+
+/// The case with the relaxation on or off (`false`: the plain dynamics, body damping alone).
+pub fn case_with(n: usize, relaxation: bool) -> Case {
+    let closed = FRAC_PI_2 + PI / n as f64;
+    let start = prism(n, closed - START_TWIST_OFFSET_FRACTION * 2.0 * PI / n as f64);
+    let design = prism(n, closed);
+    Case {
+        family: "prism",
+        size: n,
+        settings: SimSettings { dt_s: DT_S, body_damping_per_s: BODY_DAMPING_PER_S, relaxation, ..Default::default() },
+        commands: Vec::new(),
+        target: design.nodes.iter().enumerate().map(|(i, p)| (i, p.position)).collect(),
+        measure: Measure::Twist,
+        start,
+    }
+}
+
 /// Settles the n-strut prism from its twisted start, as the settle loop does: stepping until
-/// the speed stays below 1e-12 m/s for 10 steps (the relaxation off once it is) and the
-/// residual is below 1e-9 N and N m.
+/// the speed stays below 1e-11 m/s per metre of size for 10 steps (the relaxation off once it is) and the
+/// residual is below 1e-9 N and N m, at most [`MAX_STEPS`] steps.
 /// `relaxation = false`: the plain dynamics (body damping alone), for comparison.
 pub fn settle_prism(n: usize, relaxation: bool) -> Result<ScaleCase, String> {
-    let s = prism(n, FRAC_PI_2 + PI / n as f64 - START_TWIST_OFFSET_FRACTION * 2.0 * PI / n as f64);
-    let settings = SimSettings { dt_s: DT_S, body_damping_per_s: BODY_DAMPING_PER_S, relaxation, ..Default::default() };
-    let criteria = SettleCriteria {
-        speed_tol_m_per_s: 1e-12,
-        window_steps: 10,
-        residual_force_tol_n: 1e-9,
-        residual_torque_tol_nm: 1e-9,
-        max_time_s: MAX_STEPS as f64 * DT_S,
-    };
-    let start = std::time::Instant::now();
-    let mut sim = Simulation::new(&s, &settings).map_err(|e| e.to_string())?;
-    let mut detector = SettleDetector::new();
-    let (mut settled, mut steps, mut residual) = (false, 0, f64::NAN);
-    while steps < MAX_STEPS && !settled {
-        sim.step().map_err(|e| e.to_string())?;
-        steps += 1;
-        let quiet = detector.update(&sim.snapshot_with(false), DT_S, &criteria);
-        sim.set_relaxation(relaxation && detector.last_speed > criteria.speed_tol_m_per_s);
-        if quiet {
-            let snap = sim.snapshot();
-            residual = snap.forces.residual.as_ref().map_or(f64::NAN, |r| r.max_force_n.max(r.max_torque_nm));
-            settled = SettleDetector::residual_ok(&snap, &criteria);
-        }
-    }
-    let wall_s = start.elapsed().as_secs_f64();
-    let nodes: Vec<Vec3> = (0..2 * n).map(|k| sim.node_position(k)).collect();
-    Ok(ScaleCase {
-        struts: n,
-        cables: s.cables.len(),
-        settled,
-        steps,
-        wall_s,
-        twist_error_rad: twist_error(&nodes, n),
-        residual_force_n: residual,
-    })
+    let caps = Caps { max_steps: MAX_STEPS, ..super::DEFAULT_CAPS };
+    run_case(&case_with(n, relaxation), &caps)
 }
 
 #[cfg(test)]
@@ -194,8 +171,9 @@ mod tests {
             let plain = settle_prism(n, false).unwrap();
             assert!(fast.settled && plain.settled, "n = {n}");
             assert!(fast.steps <= 30 && plain.steps > 1000, "n = {n}: {} and {} steps", fast.steps, plain.steps);
-            assert!(fast.twist_error_rad <= 1e-12, "n = {n}: {} rad", fast.twist_error_rad);
-            assert!(plain.twist_error_rad <= 1e-9, "n = {n}: {} rad plain", plain.twist_error_rad);
+            let (fast_err, plain_err) = (fast.error, plain.error);
+            assert!(fast_err <= 1e-12, "n = {n}: {fast_err} rad");
+            assert!(plain_err <= 1e-9, "n = {n}: {plain_err} rad plain");
         }
     }
 }

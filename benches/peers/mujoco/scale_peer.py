@@ -1,0 +1,200 @@
+#!/usr/bin/env python3
+"""MuJoCo peer of the testbed's scale benchmark (`tensegrity bench --scale --peer`, issue #21).
+
+    python3 scale_peer.py CASES.json [--set NAME=VALUE ...]
+
+CASES.json is written by the testbed (`src/bench/scale/peer.rs`): a list of cases, each with
+the MJCF file the testbed exported for the case's perturbed start (`tensegrity export mjcf`'s
+writer), the time step, the testbed's settle criterion (node speed below `speed_tol_m_per_s`
+for `window_steps` steps), its caps (`max_steps`, `max_wall_s`), the sites to score and their
+closed-form positions (`nodes`, `target`), the error measure (`measure`: "aligned" = largest
+site distance after the best rigid alignment, Kabsch; "absolute"; "twist" = the n-strut prism's
+largest |twist - (pi/2 + pi/n)| with bottom node i at 2 i and top node i at 2 i + 1) and the
+mocap bodies to turn to their actuator command (`mocap`: body, axis, angle_rad about the
+body's frame origin, the joint's anchor; MJCF draws them at the start pose).
+
+Settings (MuJoCo's, as the mechanism peer's `tuned` variant, README.md): the MJCF as
+exported: `implicitfast` integrator, solver tolerance 1e-10, free joints damped at the
+testbed's body damping times the body's mass (zero at rest), elastic cables as tendons with
+the dead band `springlength="0 L"`, springs as tendons, loop closures and actuated joints on
+moving parents as soft equalities at MuJoCo's stiffest impedance (solimp 0.9999) and
+timeconst 2 dt; the time step per family in TUNED. `--set timestep_s=...` /
+`--set damping_scale=...` override the time step / scale every joint damping (for tuning).
+
+Each case is timed from loading the XML (model compile) to the settled state, as the testbed
+times building its simulation and settling it; a case faster than 0.2 s is run again until
+the runs add up to 0.2 s and its median is reported (as the testbed does). One JSON object goes to stdout:
+{"simulator", "mujoco_version", "settings", "cases": [{"family", "size", "steps", "settled",
+"wall_s", "compile_s", "error", "note"}]}.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+import sys
+import time
+
+import mujoco
+import numpy as np
+
+
+#: Tuned per family (measured on prisms 3-16, the icosahedron and towers of 1-4 stages, steps
+#: to settle by the testbed's criterion): implicitfast damps the free bodies implicitly, so a
+#: longer step settles in fewer steps: dt 0.005 -> 0.01 -> 0.02 -> 0.04 s took prism 8 from
+#: 4031 to 2026, 1024 and 545 steps (icosahedron from 2971 at 0.002 s to 180); dt 0.08 s
+#: diverged on every case. Damping x0.5 or x3 at dt 0.04 or 0.005 s took as many steps or
+#: more. furet keeps the testbed's dt 0.005 s: its loop closures are soft constraints of
+#: timeconst 2 dt, whose offset grows with dt (error 7e-7 m at 1 module already).
+TUNED = {
+    "prism": {"timestep_s": 0.04},
+    "icosahedron": {"timestep_s": 0.04},
+    "tower": {"timestep_s": 0.04},
+    "furet": {},
+}
+
+
+#: A case faster than this is run again until the runs add up to it; its wall time is the
+#: median (the testbed's MIN_CASE_WALL_S).
+MIN_CASE_WALL_S = 0.2
+
+
+def turn_mocap(model: mujoco.MjModel, data: mujoco.MjData, turns: list[dict]) -> None:
+    """Turns each listed mocap body by its angle about its axis (through its frame origin)."""
+    for t in turns:
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, t["body"])
+        mocap = model.body_mocapid[body]
+        if body < 0 or mocap < 0:
+            raise SystemExit(f"{t['body']} is not a mocap body")
+        axis = np.asarray(t["axis"], dtype=float)
+        axis /= np.linalg.norm(axis)
+        half = 0.5 * t["angle_rad"]
+        turn = np.concatenate([[math.cos(half)], math.sin(half) * axis])
+        out = np.empty(4)
+        mujoco.mju_mulQuat(out, turn, data.mocap_quat[mocap])
+        data.mocap_quat[mocap] = out
+
+
+def settle(model, data, sites, case) -> tuple[int, bool, str | None]:
+    """Steps until every scored site and every other site moved less than speed_tol * dt per
+    step for `window_steps` steps (the testbed's criterion; `site_xpos` after `mj_step` is the
+    state the step started from, one step late), or a cap is reached."""
+    dt = model.opt.timestep
+    limit_m2 = (case["speed_tol_m_per_s"] * dt) ** 2
+    start = time.perf_counter()
+    mujoco.mj_step(model, data)
+    previous = data.site_xpos.copy()
+    quiet = 0
+    for k in range(2, case["max_steps"] + 1):
+        mujoco.mj_step(model, data)
+        moved = data.site_xpos - previous
+        np.copyto(previous, data.site_xpos)
+        if float(np.max(np.einsum("ij,ij->i", moved, moved))) <= limit_m2:
+            quiet += 1
+            if quiet >= case["window_steps"]:
+                return k, True, None
+        else:
+            quiet = 0
+        if k % 100 == 0 and time.perf_counter() - start > case["max_wall_s"]:
+            return k, False, f"wall cap {case['max_wall_s']} s reached"
+        if not np.all(np.isfinite(data.qpos)):
+            return k, False, "diverged (non-finite state)"
+    return case["max_steps"], False, f"step cap {case['max_steps']} reached"
+
+
+def aligned_distance(a: np.ndarray, b: np.ndarray) -> float:
+    ca, cb = a.mean(axis=0), b.mean(axis=0)
+    h = (a - ca).T @ (b - cb)
+    u, _, vt = np.linalg.svd(h)
+    d = np.sign(np.linalg.det(vt.T @ u.T))
+    r = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    return float(np.max(np.linalg.norm((a - ca) @ r.T + cb - b, axis=1)))
+
+
+def twist_error(p: np.ndarray) -> float:
+    n = len(p) // 2
+    bottom, top = p[0::2], p[1::2]
+    cb, ct = bottom.mean(axis=0), top.mean(axis=0)
+    axis = (ct - cb) / np.linalg.norm(ct - cb)
+    flat = lambda v: v - np.outer(v @ axis, axis)  # noqa: E731
+    u, w = flat(bottom - cb), flat(top - ct)
+    twist = np.arctan2(np.cross(u, w) @ axis, np.einsum("ij,ij->i", u, w))
+    return float(np.max(np.abs(twist - (math.pi / 2 + math.pi / n))))
+
+
+def error(measure: str, settled: np.ndarray, target: np.ndarray) -> float:
+    if measure == "aligned":
+        return aligned_distance(settled, target)
+    if measure == "absolute":
+        return float(np.max(np.linalg.norm(settled - target, axis=1)))
+    if measure == "twist":
+        return twist_error(settled)
+    raise ValueError(f"unknown measure {measure!r}")
+
+
+def run_case(case: dict, overrides: dict) -> dict:
+    overrides = {**TUNED.get(case["family"], {}), **overrides}
+    t0 = time.perf_counter()
+    model = mujoco.MjModel.from_xml_path(case["mjcf"])
+    if "timestep_s" in overrides:
+        model.opt.timestep = overrides["timestep_s"]
+    if "damping_scale" in overrides:
+        model.dof_damping[:] *= overrides["damping_scale"]
+    data = mujoco.MjData(model)
+    turn_mocap(model, data, case.get("mocap", []))
+    compile_s = time.perf_counter() - t0
+    sites = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, n) for n in case["nodes"]]
+    steps, settled, note = settle(model, data, sites, case)
+    mujoco.mj_kinematics(model, data)  # the final state's own site positions
+    wall_s = time.perf_counter() - t0
+    err = error(case["measure"], data.site_xpos[sites].copy(), np.asarray(case["target"], dtype=float))
+    return {
+        "family": case["family"],
+        "size": case["size"],
+        "steps": steps,
+        "settled": settled,
+        "wall_s": wall_s,
+        "compile_s": compile_s,
+        "timestep_s": model.opt.timestep,
+        "error": err if math.isfinite(err) else None,
+        "note": note,
+    }
+
+
+def parse_override(text: str) -> tuple[str, float]:
+    name, value = text.split("=", 1)
+    return name, float(value)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("cases", help="case list JSON written by `tensegrity bench --scale --peer`")
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="timestep_s or damping_scale")
+    args = ap.parse_args()
+    with open(args.cases) as f:
+        cases = json.load(f)["cases"]
+    overrides = dict(parse_override(s) for s in args.set)
+    out = []
+    for case in cases:
+        print(f"{case['family']} {case['size']}: mujoco ...", file=sys.stderr)
+        first = run_case(case, overrides)
+        walls = [first["wall_s"]]
+        while sum(walls) < MIN_CASE_WALL_S:
+            walls.append(run_case(case, overrides)["wall_s"])
+        first["wall_s"] = statistics.median(walls)
+        out.append(first)
+    settings = {
+        "integrator": "implicitfast",
+        "timestep_s": overrides.get("timestep_s", {f: t.get("timestep_s", "the testbed's") for f, t in TUNED.items()}),
+        "damping": f"the testbed's body damping x mass x {overrides.get('damping_scale', 1.0)}",
+        "tolerance": 1e-10,
+        "equality": "solref 2 dt 1, solimp 0.9999 0.9999 0.001 0.5 2",
+    }
+    json.dump({"simulator": "mujoco", "mujoco_version": mujoco.__version__, "settings": settings, "cases": out}, sys.stdout, indent=1)
+    sys.stdout.write("\n")
+
+
+if __name__ == "__main__":
+    main()
