@@ -17,8 +17,10 @@ const K1: f64 = 50.0;
 const K2: f64 = 30.0;
 
 /// At the last waypoint (u = 0.1 m) the anchor sits at (0, a + u) to round-off and the bar at
-/// q = atan2(k1 (a + u), k2 b) within 1e-9 rad; along the way the quasi-static prediction is
-/// followed within 5e-3 rad at every tick (the lag of the damped bar behind the moving anchor).
+/// q = atan2(k1 (a + u), k2 b) within 1e-9 rad; along the way (800 ticks) the quasi-static
+/// prediction is followed within 1e-9 rad at every tick under the Newton damping schedule (a
+/// custom structure's default), and within 5e-3 rad (but not 1e-4: the damped bar lags the
+/// moving anchor) by the plain dynamics.
 #[test]
 fn the_moved_anchor_carries_the_equilibrium_along() {
     let r = run_file(FILE);
@@ -29,8 +31,14 @@ fn the_moved_anchor_carries_the_equilibrium_along() {
     let want = (K1 * (A_M + 0.1)).atan2(K2 * B_M);
     assert!((p[1].atan2(p[0]) - want).abs() <= 1e-9, "q = {}, want {want}", p[1].atan2(p[0]));
     let q = r.model_checks.iter().find(|c| c.name == "q").unwrap();
-    assert!(q.ticks_compared > 1000, "{q:?}");
-    assert!(q.transient_max_error <= 5e-3, "transient {}", q.transient_max_error);
+    assert!(q.ticks_compared >= 800, "{q:?}");
+    assert!(q.transient_max_error <= 1e-9, "transient {}", q.transient_max_error);
+    let text =
+        std::fs::read_to_string(FILE).unwrap().replacen("[settle]", "[sim]\nnewton_damping = false\n\n[settle]", 1);
+    let sc = scenario::parse(Path::new("plain.toml"), &text).unwrap();
+    let plain = tensegrity_testbed::run::run(&sc, &Default::default());
+    let q = plain.model_checks.iter().find(|c| c.name == "q").unwrap();
+    assert!(plain.passed && q.transient_max_error <= 5e-3 && q.transient_max_error > 1e-4, "{q:?}");
 }
 
 /// The moved node's actuator force is what holds its body against the members, along the

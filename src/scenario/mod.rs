@@ -166,7 +166,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let m = mech.as_ref();
     let params = params::params(ctx, m, &raw.params)?;
     let param_table = number::param_table(ctx, &raw.params)?;
-    let sim = sim::sim(ctx, &raw.sim)?;
+    let mut sim = sim::sim(ctx, &raw.sim)?;
     let settle = sim::settle(ctx, &raw.settle)?;
     let start = params::start(ctx, m, &raw.start)?;
     let (actuation, skipped_points) = actuation::actuation(ctx, m, &param_table, &params, &raw.actuation)?;
@@ -195,6 +195,9 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let first_params = params::params_at(&param_table, &params, actuation.first_inputs());
     let first = physical::first_structure(ctx, &raw, m, &first_params, &start, actuation.first_inputs())?;
     physical::physical(ctx, &raw, m, &first, &sim)?;
+    if raw.sim.newton_damping.is_none() {
+        sim.newton_damping = sim::default_newton_damping(custom.is_some(), &first);
+    }
     for set in parameter_sets.iter().skip(1) {
         let s = physical::first_structure(ctx, &raw, m, set, &start, actuation.first_inputs())?;
         physical::physical(ctx, &raw, m, &s, &sim)?;

@@ -67,3 +67,31 @@ pub(super) fn settle(ctx: &Ctx, raw: &RawSettle) -> Result<SettleCriteria, Scena
         max_time_s: positive(ctx, &raw.max_time, "settle.max_time (s)", d.max_time_s)?,
     })
 }
+
+/// The Newton damping schedule's default: on for a custom structure whose joints form no loop
+/// (a tree hung from the ground, where each joint's stiffness with the others held is the
+/// step's), off for the built-in mechanisms (their files say what their baselines use) and
+/// for closed loops (there the projection closes the loop and settles it).
+pub(super) fn default_newton_damping(custom: bool, s: &crate::structure::Structure) -> bool {
+    custom && !s.joints.is_empty() && !joints_close_a_loop(s)
+}
+
+/// Whether the joints of `s` close a loop (fixed bodies count as one ground).
+fn joints_close_a_loop(s: &crate::structure::Structure) -> bool {
+    use crate::structure::BodyKind;
+    let ground = s.bodies.len();
+    let node = |b: usize| if s.bodies[b].kind == BodyKind::Fixed { ground } else { b };
+    let mut parent: Vec<usize> = (0..=ground).collect();
+    fn root(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    s.joints.iter().any(|j| {
+        let (a, b) = (root(&mut parent, node(j.parent)), root(&mut parent, node(j.child)));
+        parent[a] = b;
+        a == b
+    })
+}
