@@ -163,15 +163,14 @@ pub struct PeerComparison {
     pub ratio_max_error: f64,
 }
 
-/// One round of a peer simulator: `command` is run with the case-set file, `--rounds 1` and
-/// `--min-round-wall-s` (the testbed's [`MIN_ROUND_WALL_S`]) appended and must print one JSON
-/// object (see `benches/peers/mujoco/README.md`).
-fn peer_round(command: &[String], cases_file: &Path) -> Result<(Round, String), String> {
+/// Runs the peer `command` with `file` and `extra` arguments appended; returns the one JSON
+/// object it must print (the peers' protocol, `benches/peers/mujoco/README.md`).
+pub(crate) fn run_peer(command: &[String], file: &Path, extra: &[&str]) -> Result<serde_json::Value, String> {
     let (program, args) = command.split_first().ok_or("empty peer command")?;
     let out = std::process::Command::new(program)
         .args(args)
-        .arg(cases_file)
-        .args(["--rounds", "1", "--min-round-wall-s", &MIN_ROUND_WALL_S.to_string()])
+        .arg(file)
+        .args(extra)
         .output()
         .map_err(|e| format!("cannot run the peer '{}': {e}", command.join(" ")))?;
     if !out.status.success() {
@@ -182,8 +181,16 @@ fn peer_round(command: &[String], cases_file: &Path) -> Result<(Round, String), 
             String::from_utf8_lossy(&out.stderr).trim()
         ));
     }
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout)
-        .map_err(|e| format!("the peer '{}' printed no JSON object: {e}", command.join(" ")))?;
+    serde_json::from_slice(&out.stdout)
+        .map_err(|e| format!("the peer '{}' printed no JSON object: {e}", command.join(" ")))
+}
+
+/// One round of a peer simulator: `command` is run with the case-set file, `--rounds 1` and
+/// `--min-round-wall-s` (the testbed's [`MIN_ROUND_WALL_S`]) appended and must print one JSON
+/// object (see `benches/peers/mujoco/README.md`).
+fn peer_round(command: &[String], cases_file: &Path) -> Result<(Round, String), String> {
+    let min_wall = MIN_ROUND_WALL_S.to_string();
+    let v = run_peer(command, cases_file, &["--rounds", "1", "--min-round-wall-s", &min_wall])?;
     let num = |key: &str| {
         v.get(key).and_then(serde_json::Value::as_f64).ok_or_else(|| format!("the peer's JSON has no number '{key}'"))
     };

@@ -123,26 +123,6 @@ fn peer_case(case: &Case, caps: &Caps, dir: &Path) -> Result<PeerCase, String> {
     })
 }
 
-/// Runs the peer `command` on the case list; returns its JSON object.
-fn run_peer(command: &[String], file: &Path) -> Result<serde_json::Value, String> {
-    let (program, args) = command.split_first().ok_or("empty peer command")?;
-    let out = std::process::Command::new(program)
-        .args(args)
-        .arg(file)
-        .output()
-        .map_err(|e| format!("cannot run the peer '{}': {e}", command.join(" ")))?;
-    if !out.status.success() {
-        return Err(format!(
-            "the peer '{}' failed ({}): {}",
-            command.join(" "),
-            out.status,
-            String::from_utf8_lossy(&out.stderr).trim()
-        ));
-    }
-    serde_json::from_slice(&out.stdout)
-        .map_err(|e| format!("the peer '{}' printed no JSON object: {e}", command.join(" ")))
-}
-
 /// One case of both sides: the testbed's `t`, the peer's JSON `p` for the case `pc` it got.
 fn row(t: &ScaleCase, p: &serde_json::Value, pc: &PeerCase, about: &serde_json::Value) -> PeerRow {
     let num = |k: &str| p.get(k).and_then(|x| x.as_f64()).unwrap_or(f64::NAN);
@@ -196,7 +176,7 @@ pub fn compare(
     std::fs::write(&file, serde_json::to_string_pretty(&list).expect("case list serialises"))
         .map_err(|e| format!("cannot write {}: {e}", file.display()))?;
     eprintln!("{} cases: peer ...", theirs.len());
-    let v = run_peer(command, &file)?;
+    let v = crate::bench::run_peer(command, &file, &[])?;
     let peer_cases = v.get("cases").and_then(|c| c.as_array()).ok_or("the peer's JSON has no 'cases' list")?;
     if peer_cases.len() != ours.len() {
         return Err(format!("the peer settled {} cases of {}", peer_cases.len(), ours.len()));

@@ -42,71 +42,91 @@ fn at(v: Vector2<f64>, z: f64) -> Vec3 {
 
 /// The structure with the mechanism assembled at (theta1, theta2).
 pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64) -> Structure {
-    let xs = analytic::x_nodes(p, theta1, theta2);
-    let mut s = Structure { name: "furet2018".into(), gravity: [0.0; 3], ..Default::default() };
+    build_chain("furet2018", p, m, &analytic::x_nodes(p, theta1, theta2)).0
+}
+
+/// A chain of X modules drawn as `xs` (X(i + 1) standing on X(i)'s top bar; the paper's Fig. 1
+/// bird neck for many), named `name`; also each module's top-midpoint node.
+pub fn build_chain(name: &str, p: &Params, m: &ModelChoices, xs: &[analytic::XGeometry]) -> (Structure, Vec<usize>) {
+    let mut s = Structure { name: name.into(), gravity: [0.0; 3], ..Default::default() };
+    let base = s.add_body("base", BodyKind::Fixed, None);
+    let mut below = base; // the body carrying this X's base bar
+    let mut below_nodes =
+        (s.add_node("A1", base, at(xs[0].base_left, 0.0)), s.add_node("B1", base, at(xs[0].base_right, 0.0)));
+    s.struts.push(Strut { name: "base A1B1".into(), a: below_nodes.0, b: below_nodes.1, radius_m: m.strut_radius_m });
+    let mut ends = Vec::with_capacity(xs.len());
+    for (i, x) in xs.iter().enumerate() {
+        let (top, nodes, end) = add_module(&mut s, p, m, x, i + 1, below, below_nodes);
+        (below, below_nodes) = (top, nodes);
+        ends.push(end);
+    }
+    (s, ends)
+}
+
+/// A revolute joint about z.
+fn revolute(name: String, parent: usize, child: usize, anchor: usize, q0: f64, damping: f64) -> Joint {
+    Joint {
+        name,
+        kind: JointKind::Revolute { axis: [0.0, 0.0, 1.0] },
+        parent,
+        child,
+        anchor,
+        initial_coordinate: q0,
+        torsion_spring: None,
+        damping,
+    }
+}
+
+/// Adds X module `k` (from 1) drawn as `x`, standing on body `below` at its nodes (A, B);
+/// returns its top body, its top nodes (D, C) and its top-midpoint node.
+fn add_module(
+    s: &mut Structure,
+    p: &Params,
+    m: &ModelChoices,
+    x: &analytic::XGeometry,
+    k: usize,
+    below: usize,
+    (a, b): (usize, usize),
+) -> (usize, (usize, usize), usize) {
     let bar = |mid: Vector2<f64>, len: f64| Inertia {
         mass_kg: m.bar_mass_kg,
         com: at(mid, 0.0),
         // A slender bar about its midpoint: m len^2 / 12 (isotropic: the motion is planar).
         principal_kg_m2: [m.bar_mass_kg * len * len / 12.0; 3],
     };
-    let base = s.add_body("base", BodyKind::Fixed, None);
-    let dz = m.plane_offset_m;
-    let r = m.strut_radius_m;
-    let z = [0.0, 0.0, 1.0];
-    let mut below = base; // the body carrying this X's base bar
-    let mut below_nodes =
-        (s.add_node("A1", base, at(xs[0].base_left, 0.0)), s.add_node("B1", base, at(xs[0].base_right, 0.0)));
-    s.struts.push(Strut { name: "base A1B1".into(), a: below_nodes.0, b: below_nodes.1, radius_m: r });
-    for (i, x) in xs.iter().enumerate() {
-        let k = i + 1;
-        let ac = s.add_body(&format!("X{k}_bar_AC"), BodyKind::Free, Some(bar((x.base_left + x.top_right) / 2.0, p.l)));
-        let bd = s.add_body(&format!("X{k}_bar_BD"), BodyKind::Free, Some(bar((x.base_right + x.top_left) / 2.0, p.l)));
-        let top = s.add_body(&format!("X{k}_top"), BodyKind::Free, Some(bar(x.top_mid, p.b)));
-        let (a, b) = below_nodes;
-        // Strut ends in the bars' planes; joint anchors in the plane z = 0.
-        let ac_a = s.add_node(&format!("X{k}_AC_A"), ac, at(x.base_left, dz));
-        let ac_c = s.add_node(&format!("X{k}_AC_C"), ac, at(x.top_right, dz));
-        let bd_b = s.add_node(&format!("X{k}_BD_B"), bd, at(x.base_right, -dz));
-        let bd_d = s.add_node(&format!("X{k}_BD_D"), bd, at(x.top_left, -dz));
-        let c = s.add_node(&format!("C{k}"), top, at(x.top_right, 0.0));
-        let d = s.add_node(&format!("D{k}"), top, at(x.top_left, 0.0));
-        let mid = s.add_node(&format!("P{k}"), top, at(x.top_mid, 0.0));
-        let _ = mid;
-        s.struts.push(Strut { name: format!("X{k} crossed bar AC"), a: ac_a, b: ac_c, radius_m: r });
-        s.struts.push(Strut { name: format!("X{k} crossed bar BD"), a: bd_b, b: bd_d, radius_m: r });
-        s.struts.push(Strut { name: format!("X{k} top bar DC"), a: d, b: c, radius_m: r });
-        for (name, na, nb) in [(format!("X{k} spring AD"), a, d), (format!("X{k} spring BC"), b, c)] {
-            s.springs.push(Spring {
-                name,
-                a: na,
-                b: nb,
-                stiffness_n_per_m: m.spring_stiffness_n_per_m,
-                rest_length_m: m.spring_rest_length_m,
-                radius_m: DEFAULT_TENDON_RADIUS_M,
-            });
-        }
-        let joint = |name: String, parent, child, anchor, q0: f64, damping: f64| Joint {
+    let (dz, r) = (m.plane_offset_m, m.strut_radius_m);
+    let ac = s.add_body(&format!("X{k}_bar_AC"), BodyKind::Free, Some(bar((x.base_left + x.top_right) / 2.0, p.l)));
+    let bd = s.add_body(&format!("X{k}_bar_BD"), BodyKind::Free, Some(bar((x.base_right + x.top_left) / 2.0, p.l)));
+    let top = s.add_body(&format!("X{k}_top"), BodyKind::Free, Some(bar(x.top_mid, p.b)));
+    // Strut ends in the bars' planes; joint anchors in the plane z = 0.
+    let ac_a = s.add_node(&format!("X{k}_AC_A"), ac, at(x.base_left, dz));
+    let ac_c = s.add_node(&format!("X{k}_AC_C"), ac, at(x.top_right, dz));
+    let bd_b = s.add_node(&format!("X{k}_BD_B"), bd, at(x.base_right, -dz));
+    let bd_d = s.add_node(&format!("X{k}_BD_D"), bd, at(x.top_left, -dz));
+    let c = s.add_node(&format!("C{k}"), top, at(x.top_right, 0.0));
+    let d = s.add_node(&format!("D{k}"), top, at(x.top_left, 0.0));
+    let end = s.add_node(&format!("P{k}"), top, at(x.top_mid, 0.0));
+    s.struts.push(Strut { name: format!("X{k} crossed bar AC"), a: ac_a, b: ac_c, radius_m: r });
+    s.struts.push(Strut { name: format!("X{k} crossed bar BD"), a: bd_b, b: bd_d, radius_m: r });
+    s.struts.push(Strut { name: format!("X{k} top bar DC"), a: d, b: c, radius_m: r });
+    for (name, na, nb) in [(format!("X{k} spring AD"), a, d), (format!("X{k} spring BC"), b, c)] {
+        s.springs.push(Spring {
             name,
-            kind: JointKind::Revolute { axis: z },
-            parent,
-            child,
-            anchor,
-            initial_coordinate: q0,
-            torsion_spring: None,
-            damping,
-        };
-        let actuated = s.joints.len();
-        s.joints.push(joint(format!("X{k} A (actuated, phi{k})"), below, ac, a, x.joint_angle_a, 0.0));
-        s.joints.push(joint(format!("X{k} C"), ac, top, c, 0.0, m.joint_damping));
-        s.joints.push(joint(format!("X{k} B"), below, bd, b, x.joint_angle_b, m.joint_damping));
-        // The loop closes at D with a planar pin: the other three joints already hold the
-        // loop in the plane, so a full revolute joint would over-constrain it.
-        s.joints
-            .push(Joint { kind: JointKind::PlanarPin { axis: z }, ..joint(format!("X{k} D"), bd, top, d, 0.0, 0.0) });
-        s.actuators.push(Actuator { symbol: format!("phi{k}"), target: ActuatorTarget::Joint(actuated) });
-        below = top;
-        below_nodes = (d, c);
+            a: na,
+            b: nb,
+            stiffness_n_per_m: m.spring_stiffness_n_per_m,
+            rest_length_m: m.spring_rest_length_m,
+            radius_m: DEFAULT_TENDON_RADIUS_M,
+        });
     }
-    s
+    let actuated = s.joints.len();
+    s.joints.push(revolute(format!("X{k} A (actuated, phi{k})"), below, ac, a, x.joint_angle_a, 0.0));
+    s.joints.push(revolute(format!("X{k} C"), ac, top, c, 0.0, m.joint_damping));
+    s.joints.push(revolute(format!("X{k} B"), below, bd, b, x.joint_angle_b, m.joint_damping));
+    // The loop closes at D with a planar pin: the other three joints already hold the loop in
+    // the plane, so a full revolute joint would over-constrain it.
+    let pin = JointKind::PlanarPin { axis: [0.0, 0.0, 1.0] };
+    s.joints.push(Joint { kind: pin, ..revolute(format!("X{k} D"), bd, top, d, 0.0, 0.0) });
+    s.actuators.push(Actuator { symbol: format!("phi{k}"), target: ActuatorTarget::Joint(actuated) });
+    (top, (d, c), end)
 }
