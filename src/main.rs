@@ -126,7 +126,7 @@ enum Command {
         mechanisms: Vec<String>,
         /// Also run each case set through a peer simulator, alternating rounds with the
         /// testbed, and print the ratios. CMD gets the case-set file and `--rounds 1` appended
-        /// (default: the MuJoCo peer, `python3 benches/peers/mujoco/peer.py`).
+        /// (default: the MuJoCo peer, `benches/peers/mujoco/peer.py` run by `$TENSEGRITY_PYTHON`, else python3).
         #[arg(long, value_name = "CMD", num_args = 0..=1, default_missing_value = DEFAULT_PEER)]
         peer: Option<String>,
         /// Settle the scale families instead (n-strut prisms, the icosahedron, force-density
@@ -942,9 +942,19 @@ fn cmd_export_cases(dir: &Path) -> i32 {
 /// The MuJoCo peer of `benches/peers/mujoco/`.
 const DEFAULT_PEER: &str = "python3 benches/peers/mujoco/peer.py";
 
-/// The MuJoCo peer of `tensegrity bench --scale --peer` (run with `$TENSEGRITY_PYTHON`, else
-/// python3).
+/// The MuJoCo peer of `tensegrity bench --scale --peer`.
 const DEFAULT_SCALE_PEER: &str = "benches/peers/mujoco/scale_peer.py";
+
+/// The peer command `peer` as given, or the default peer's `script` (`DEFAULT_PEER` names the
+/// default) run with `$TENSEGRITY_PYTHON` (the Python that has MuJoCo), else python3.
+fn peer_command(peer: &str, script: &str) -> Vec<String> {
+    if peer == DEFAULT_PEER {
+        let python = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
+        vec![python, script.into()]
+    } else {
+        peer.split_whitespace().map(str::to_string).collect()
+    }
+}
 
 fn cmd_bench_scale(json: bool, max_struts: usize, only: &[String], max_wall_s: f64, peer: Option<&str>) -> i32 {
     use tensegrity_testbed::bench::scale;
@@ -956,12 +966,7 @@ fn cmd_bench_scale(json: bool, max_struts: usize, only: &[String], max_wall_s: f
     }
     let caps = scale::Caps { max_wall_s, ..scale::DEFAULT_CAPS };
     if let Some(peer) = peer {
-        let command: Vec<String> = if peer == DEFAULT_PEER {
-            let python = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
-            vec![python, DEFAULT_SCALE_PEER.into()]
-        } else {
-            peer.split_whitespace().map(str::to_string).collect()
-        };
+        let command = peer_command(peer, DEFAULT_SCALE_PEER);
         return cmd_bench_scale_peer(json, max_struts, &families, &caps, &command);
     }
     let mut reports = Vec::new();
@@ -1119,7 +1124,7 @@ fn cmd_bench_peer(rounds: usize, json: bool, only: &[String], peer: &str) -> i32
         Ok(s) => s,
         Err(code) => return code,
     };
-    let command: Vec<String> = peer.split_whitespace().map(str::to_string).collect();
+    let command = peer_command(peer, "benches/peers/mujoco/peer.py");
     let dir = std::env::temp_dir().join(format!("tensegrity-bench-peer-{}", std::process::id()));
     let mut out = Vec::new();
     for (m, file) in sets {
