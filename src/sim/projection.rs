@@ -4,8 +4,8 @@
 //! by an impulse joint (a planar pin). rapier holds such a joint only at the velocity level: its
 //! anchors drift apart by an offset that grows with the time step and with every jump of an
 //! actuator (3.7e-5 m measured on furet2018, FINDINGS.md). After each step this module moves
-//! the multibody's free coordinates q (Gauss-Newton on the closure gap g(q), Jacobian by finite
-//! differences of the multibody's own forward kinematics) until every such loop is closed to
+//! the multibody's free coordinates q (Gauss-Newton on the closure gap g(q), its Jacobian from
+//! the links' columns of rapier's body Jacobians, as for the projected groups below) until every such loop is closed to
 //! round-off, then removes the velocity component that would open it again
 //! (qdot -= J^+ J qdot). The joints that are cut between multibodies keep rapier's treatment.
 
@@ -18,9 +18,6 @@ const MAX_ITERATIONS: usize = 20;
 
 /// The projection stops when the largest gap is below this fraction of the structure's size.
 const GAP_TOLERANCE_FRACTION: f64 = 1e-14;
-
-/// Finite-difference step of a free coordinate (rad or m).
-const FD_STEP: f64 = 1e-7;
 
 /// Singular values of the closure Jacobian below this fraction of the largest are treated as
 /// zero (redundant closure rows).
@@ -60,23 +57,6 @@ fn close_rows(
     }
     let left = largest(&rows(sim));
     (jac, left)
-}
-
-/// The Jacobian of `rows` by forward differences: `probe(sim, k, h)` evaluates the rows with
-/// coordinate k moved by h and puts the state back.
-fn forward_difference_jacobian(
-    sim: &mut Simulation,
-    ndof: usize,
-    g0: &[f64],
-    probe: &dyn Fn(&mut Simulation, usize, f64) -> Vec<f64>,
-) -> nalgebra::DMatrix<f64> {
-    let mut jac = nalgebra::DMatrix::<f64>::zeros(g0.len(), ndof);
-    for k in 0..ndof {
-        for (row, (gi, g0i)) in probe(sim, k, FD_STEP).iter().zip(g0).enumerate() {
-            jac[(row, k)] = (gi - g0i) / FD_STEP;
-        }
-    }
-    jac
 }
 
 /// A body's first-order motion per unit of one coordinate: velocity `v` of the point `at`
@@ -120,14 +100,6 @@ impl Simulation {
         out
     }
 
-    fn closure_gaps(&self, closures: &[InternalClosure], multibody: MultibodyIndex) -> Vec<f64> {
-        let mut rows = Vec::new();
-        for c in closures.iter().filter(|c| c.multibody == multibody) {
-            self.joint_rows(c.joint, &mut rows);
-        }
-        rows
-    }
-
     /// The free coordinates of a multibody: every degree of freedom of a link that no actuator
     /// sets.
     fn free_dofs(&self, multibody: MultibodyIndex) -> Vec<usize> {
@@ -160,50 +132,13 @@ impl Simulation {
             }
         }
         for &mb_index in &multibodies {
-            let Some(mb) = self.multibody_joints.get_multibody(mb_index) else { continue };
-            let ndofs = mb.ndofs();
-            let free = self.free_dofs(mb_index);
-            if free.is_empty() {
+            if self.free_dofs(mb_index).is_empty() {
                 continue;
             }
-            // Coordinates of the projection: the free degrees of freedom, in order.
-            let displace_free = |sim: &mut Simulation, dq: &[f64]| {
-                let mut disp = vec![0.0; ndofs];
-                for (d, &dof) in dq.iter().zip(&free) {
-                    disp[dof] = *d;
-                }
-                sim.displace(mb_index, &disp);
-            };
-            let gaps = |sim: &Simulation| sim.closure_gaps(&closures, mb_index);
-            // A probe moves one free coordinate and back.
-            let probe = |sim: &mut Simulation, k: usize, h: f64| {
-                let mut dq = vec![0.0; free.len()];
-                dq[k] = h;
-                displace_free(sim, &dq);
-                let g = gaps(sim);
-                dq[k] = -h;
-                displace_free(sim, &dq);
-                g
-            };
-            let jacobian = |sim: &mut Simulation, g0: &[f64]| forward_difference_jacobian(sim, free.len(), g0, &probe);
-            let (jac, left) = close_rows(self, &gaps, &jacobian, &displace_free);
-            largest = largest.max(left);
-            // Velocities: remove the part that opens the loops, qdot -= J^+ (J qdot).
-            if jac.nrows() > 0 {
-                if let Some(mb) = self.multibody_joints.get_multibody_mut(mb_index) {
-                    let v = nalgebra::DVector::from_iterator(
-                        free.len(),
-                        free.iter().map(|&d| mb.generalized_velocity()[d]),
-                    );
-                    let jv = &jac * &v;
-                    if let Some(dv) = min_norm_solve(&jac, &jv) {
-                        let mut gv = mb.generalized_velocity_mut();
-                        for (col, &dof) in free.iter().enumerate() {
-                            gv[dof] -= dv[col];
-                        }
-                    }
-                }
-            }
+            // The loops of one multibody: a group of its free coordinates alone.
+            let joints = closures.iter().filter(|c| c.multibody == mb_index).map(|c| c.joint).collect();
+            let g = ProjectedGroup { bodies: Vec::new(), multibodies: vec![mb_index], joints, cables: Vec::new() };
+            largest = largest.max(self.project_group(&g, &[]));
         }
         self.model.internal_closures = closures;
         largest
@@ -503,25 +438,32 @@ impl Simulation {
         let mut largest = 0.0_f64;
         for g in &groups {
             let Some(taut) = self.projected_taut_cables(g) else { continue };
-            let coords = GroupCoordinates::of(self, g);
-            // The body Jacobians at the current coordinates (the Jacobian below reads them).
-            for &m in &g.multibodies {
-                if let Some(mb) = self.multibody_joints.get_multibody_mut(m) {
-                    mb.forward_kinematics(&self.bodies, false);
-                }
+            largest = largest.max(self.project_group(g, &taut));
+        }
+        self.model.projected_groups = groups;
+        largest
+    }
+
+    /// Closes the group's joints and its `taut` cables to round-off (Gauss-Newton in its
+    /// coordinates, the Jacobian from the bodies' twists) and removes the velocities that would
+    /// open them. Returns the largest row left [m].
+    fn project_group(&mut self, g: &ProjectedGroup, taut: &[usize]) -> f64 {
+        let coords = GroupCoordinates::of(self, g);
+        // The body Jacobians at the current coordinates (the Jacobian below reads them).
+        for &m in &g.multibodies {
+            if let Some(mb) = self.multibody_joints.get_multibody_mut(m) {
+                mb.forward_kinematics(&self.bodies, false);
             }
-            let rows = |sim: &Simulation| {
-                let mut out = Vec::new();
-                sim.group_rows(g, &taut, &mut out);
-                out
-            };
-            let jacobian = |sim: &mut Simulation, g0: &[f64]| coords.jacobian(sim, g, &taut, g0.len());
-            let displace = |sim: &mut Simulation, dq: &[f64]| coords.displace(sim, g, dq);
-            let (jac, left) = close_rows(self, &rows, &jacobian, &displace);
-            largest = largest.max(left);
-            if jac.nrows() == 0 {
-                continue;
-            }
+        }
+        let rows = |sim: &Simulation| {
+            let mut out = Vec::new();
+            sim.group_rows(g, taut, &mut out);
+            out
+        };
+        let jacobian = |sim: &mut Simulation, g0: &[f64]| coords.jacobian(sim, g, taut, g0.len());
+        let displace = |sim: &mut Simulation, dq: &[f64]| coords.displace(sim, g, dq);
+        let (jac, left) = close_rows(self, &rows, &jacobian, &displace);
+        if jac.nrows() > 0 {
             // Remove J^+ (J u) from the velocities u over every row, taut cables included (they
             // were just held at their length: a cable goes slack when rapier's rope stops
             // pulling, and is then no longer taut here).
@@ -530,8 +472,7 @@ impl Simulation {
                 coords.remove_velocities(self, g, &du);
             }
         }
-        self.model.projected_groups = groups;
-        largest
+        left
     }
 }
 
