@@ -13,7 +13,8 @@
 
 use super::{Case, Measure};
 use crate::mechanisms::furet2018::analytic::{self, Params};
-use crate::mechanisms::furet2018::build::{build_chain, ModelChoices};
+use crate::mechanisms::furet2018::build::build_chain;
+use crate::mechanisms::furet2018::default_model_choices;
 use crate::settings::SimSettings;
 use crate::structure::Structure;
 
@@ -23,34 +24,16 @@ pub const MODULES: [usize; 7] = [1, 2, 3, 5, 10, 15, 20];
 pub const THETA_RAD: f64 = 0.1;
 /// The start's theta past the commanded one [rad].
 pub const START_OFFSET_RAD: f64 = 0.05;
-/// The mechanism's default model choices (`furet2018` parameters m_bar, k_spring, l0_spring,
-/// c_joint, dz, r_strut).
-const BAR_MASS_KG: f64 = 0.1;
-const SPRING_STIFFNESS_N_PER_M: f64 = 100.0;
-const SPRING_REST_LENGTH_M: f64 = 0.5;
-const JOINT_DAMPING_NMS_PER_RAD: f64 = 0.5;
-const PLANE_OFFSET_M: f64 = 0.03;
-const STRUT_RADIUS_M: f64 = 0.01;
 /// Time step [s] and PGS iterations (the furet2018 scenarios'; the rest of the settings are the
 /// defaults).
 const DT_S: f64 = 0.005;
 const PGS_ITERATIONS: usize = 64;
 
-/// The mechanism's default model choices.
-const MODEL: ModelChoices = ModelChoices {
-    bar_mass_kg: BAR_MASS_KG,
-    spring_stiffness_n_per_m: SPRING_STIFFNESS_N_PER_M,
-    spring_rest_length_m: SPRING_REST_LENGTH_M,
-    joint_damping: JOINT_DAMPING_NMS_PER_RAD,
-    plane_offset_m: PLANE_OFFSET_M,
-    strut_radius_m: STRUT_RADIUS_M,
-};
-
 /// n X modules drawn at `thetas` (one per module), as the built-in mechanism builds its two;
 /// returns the structure and each module's top-midpoint node.
 pub fn chain(p: &Params, thetas: &[f64]) -> (Structure, Vec<usize>) {
     let name = format!("furet2018 x{}", thetas.len());
-    build_chain(&name, p, &MODEL, &analytic::chain_nodes(p, thetas))
+    build_chain(&name, p, &default_model_choices(), &analytic::chain_nodes(p, thetas))
 }
 
 /// The n-module case: drawn at theta + [`START_OFFSET_RAD`], commanded to [`THETA_RAD`]; the

@@ -93,6 +93,11 @@ pub fn params_of(v: &Values) -> Params {
     Params { l: v["L"], b: v["b"] }
 }
 
+/// The mechanism's default model choices (its parameters' defaults).
+pub fn default_model_choices() -> build::ModelChoices {
+    model_of(&crate::mechanisms::with_defaults(&Furet2018, &Values::new()))
+}
+
 fn model_of(v: &Values) -> build::ModelChoices {
     build::ModelChoices {
         bar_mass_kg: v["m_bar"],
