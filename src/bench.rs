@@ -268,6 +268,31 @@ pub struct InterferenceBench {
     pub median_us_per_tick: f64,
 }
 
+/// Unit vectors uniform on the sphere from a fixed linear congruential sequence: the same
+/// directions every run for a given seed (benchmark structures, not statistics).
+pub(crate) struct FixedDirections {
+    state: u64,
+}
+
+impl FixedDirections {
+    pub(crate) fn new(seed: u64) -> Self {
+        FixedDirections { state: seed }
+    }
+
+    /// The next number of the sequence, uniform in [0, 1).
+    fn uniform(&mut self) -> f64 {
+        self.state = self.state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (self.state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The next direction: z uniform in [-1, 1), the azimuth uniform in [0, 2 pi).
+    pub(crate) fn next_unit(&mut self) -> [f64; 3] {
+        let (u, v) = (self.uniform() * 2.0 - 1.0, self.uniform() * std::f64::consts::TAU);
+        let s = (1.0 - u * u).sqrt();
+        [s * v.cos(), s * v.sin(), u]
+    }
+}
+
 /// Struts for the interference benchmark: `n` capsules of radius 0.01 m, length 0.5 m, in
 /// pseudo-random directions, centred on a jittered cubic lattice of spacing 0.5 m, so that each
 /// strut has a bounded number of neighbours (a structure, not a bundle).
@@ -276,19 +301,12 @@ pub fn interference_capsules(n: usize) -> Vec<crate::observers::interference::Ca
     const HALF_LENGTH_M: f64 = 0.25;
     const RADIUS_M: f64 = 0.01;
     let side = (n as f64).cbrt().ceil() as usize;
-    // A fixed linear congruential sequence: the same struts every run.
-    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
-    let mut next = move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut directions = FixedDirections::new(0x2545_f491_4f6c_dd1d);
     (0..n)
         .map(|k| {
             let (i, j, l) = (k % side, (k / side) % side, k / (side * side));
             let c = [i as f64 * SPACING_M, j as f64 * SPACING_M, l as f64 * SPACING_M];
-            let (u, v) = (next() * 2.0 - 1.0, next() * std::f64::consts::TAU);
-            let s = (1.0 - u * u).sqrt();
-            let d = [s * v.cos() * HALF_LENGTH_M, s * v.sin() * HALF_LENGTH_M, u * HALF_LENGTH_M];
+            let d = directions.next_unit().map(|x| x * HALF_LENGTH_M);
             ([c[0] - d[0], c[1] - d[1], c[2] - d[2]], [c[0] + d[0], c[1] + d[1], c[2] + d[2]], RADIUS_M)
         })
         .collect()

@@ -329,20 +329,10 @@ pub fn design(stages: usize) -> Result<Design, String> {
     Ok(d)
 }
 
-/// A fixed pseudo-random unit vector per strut (a linear congruential sequence).
+/// A fixed pseudo-random unit vector per strut.
 fn directions(count: usize) -> Vec<Vec3> {
-    let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
-    let mut next = move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
-    (0..count)
-        .map(|_| {
-            let (u, v) = (next() * 2.0 - 1.0, next() * 2.0 * PI);
-            let s = (1.0 - u * u).sqrt();
-            [s * v.cos(), s * v.sin(), u]
-        })
-        .collect()
+    let mut d = crate::bench::FixedDirections::new(0x9e37_79b9_7f4a_7c15);
+    (0..count).map(|_| d.next_unit()).collect()
 }
 
 /// The tower as a structure, every free strut moved by `perturbation_m`; rest lengths from
