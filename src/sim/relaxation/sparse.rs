@@ -141,7 +141,7 @@ fn rigid_motions(
             if anchors.is_empty() { blocks.iter().map(|&i| v3(dofs.com[i])).collect() } else { anchors.clone() };
         let centre = points.iter().sum::<Vector3<f64>>() / points.len() as f64;
         // Entries of the group's blocks: factor row -> place in the local vector.
-        let local: std::collections::HashMap<usize, usize> = blocks
+        let local: std::collections::BTreeMap<usize, usize> = blocks
             .iter()
             .enumerate()
             .flat_map(|(k, &i)| (0..6).map(move |r| (6 * position[i] + r, 6 * k + r)))
