@@ -5,12 +5,12 @@
 //! [`sim`]ulation -> [`observers`] -> [`report`].
 
 pub mod bench;
-pub mod custom;
+pub mod cli;
 pub mod export;
 pub mod figures;
+pub mod file_model;
 pub mod import;
 pub mod mechanisms;
-pub mod model;
 pub mod observers;
 pub mod output;
 pub mod report;

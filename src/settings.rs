@@ -4,7 +4,6 @@
 
 use crate::mechanisms::QuantityKind;
 use crate::structure::Structure;
-use std::fmt;
 
 /// Numerical settings of the integrator, all from the scenario file.
 #[derive(Clone, Debug, PartialEq)]
@@ -176,7 +175,7 @@ pub struct JointProbe {
     /// Prismatic (a force along the axis, N/m) rather than revolute (a torque, N m/rad).
     pub prismatic: bool,
     /// The predicted stiffness, compiled against `symbols`.
-    pub expected: crate::model::expr::Expr,
+    pub expected: crate::file_model::expr::Expr,
     /// The symbols `expected` may use: the parameters, then the inputs.
     pub symbols: Vec<String>,
 }
@@ -198,120 +197,5 @@ impl JointProbe {
         let values: Vec<f64> =
             self.symbols.iter().map(|s| inputs.get(s).or_else(|| params.get(s)).copied().unwrap_or(f64::NAN)).collect();
         self.expected.eval(&values)
-    }
-}
-
-/// One part of a run's verdict that failed.
-#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Failure {
-    /// The run stopped early (divergence, interruption, a model error, a panic, a recording
-    /// that could not be written): `error`.
-    Error,
-    /// A settle point did not settle within `settle.max_time`: `settle`.
-    Settle,
-    /// A `[[checks]]` quantity exceeded its tolerance: `check:QUANTITY`.
-    Check(String),
-    /// The stiffness probe disagreed with the analytic stiffness: `probe`.
-    Probe,
-    /// The perturbation test disagreed with the analytic stability: `stability`.
-    Stability,
-    /// The slack cables differ from the analytic model's: `slack`.
-    Slack,
-    /// Two members came closer than the interference threshold: `interference`.
-    Interference,
-    /// A workspace sweep's agreement fell below `workspace.min_agreement_percent`: `workspace`.
-    Workspace,
-    /// A `[[predictions]]` entry of the file's model exceeded its tolerance: `prediction:NAME`.
-    Prediction(String),
-    /// A `[[equations]]` residual exceeded its tolerance: `equation:NAME`.
-    Equation(String),
-    /// The dynamics settled away from the `[energy]` model's minima: `energy`.
-    Energy,
-}
-
-/// The names a scenario may give in `[expect] failing` (a check is `check:QUANTITY`).
-pub const FAILURE_NAMES: &[&str] = &[
-    "error",
-    "settle",
-    "check:QUANTITY",
-    "probe",
-    "stability",
-    "slack",
-    "interference",
-    "workspace",
-    "prediction:NAME",
-    "equation:NAME",
-    "energy",
-];
-
-impl fmt::Display for Failure {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Failure::Error => f.write_str("error"),
-            Failure::Settle => f.write_str("settle"),
-            Failure::Check(q) => write!(f, "check:{q}"),
-            Failure::Probe => f.write_str("probe"),
-            Failure::Stability => f.write_str("stability"),
-            Failure::Slack => f.write_str("slack"),
-            Failure::Interference => f.write_str("interference"),
-            Failure::Workspace => f.write_str("workspace"),
-            Failure::Prediction(n) => write!(f, "prediction:{n}"),
-            Failure::Equation(n) => write!(f, "equation:{n}"),
-            Failure::Energy => f.write_str("energy"),
-        }
-    }
-}
-
-impl std::str::FromStr for Failure {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Ok(match s {
-            "error" => Failure::Error,
-            "settle" => Failure::Settle,
-            "probe" => Failure::Probe,
-            "stability" => Failure::Stability,
-            "slack" => Failure::Slack,
-            "interference" => Failure::Interference,
-            "workspace" => Failure::Workspace,
-            "energy" => Failure::Energy,
-            _ if s.strip_prefix("prediction:").is_some_and(|n| !n.is_empty()) => {
-                Failure::Prediction(s["prediction:".len()..].to_string())
-            }
-            _ if s.strip_prefix("equation:").is_some_and(|n| !n.is_empty()) => {
-                Failure::Equation(s["equation:".len()..].to_string())
-            }
-            _ => match s.strip_prefix("check:") {
-                Some(q) if !q.is_empty() => Failure::Check(q.to_string()),
-                _ => return Err(format!("unknown failure '{s}' (expected one of: {})", FAILURE_NAMES.join(", "))),
-            },
-        })
-    }
-}
-
-impl serde::Serialize for Failure {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.collect_str(self)
-    }
-}
-
-/// What a scenario declares it must do: pass, or fail in exactly these parts.
-#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
-pub struct Expectation {
-    /// Empty: the run must pass. Otherwise the run must fail in these parts and no other.
-    pub failing: Vec<Failure>,
-}
-
-impl Expectation {
-    pub const PASS: Expectation = Expectation { failing: Vec::new() };
-
-    /// Whether a run that failed in `failures` did what was declared (the order is free).
-    pub fn met_by(&self, failures: &[Failure]) -> bool {
-        let mut want = self.failing.clone();
-        want.sort();
-        want.dedup();
-        let mut got = failures.to_vec();
-        got.sort();
-        got.dedup();
-        want == got
     }
 }

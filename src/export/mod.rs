@@ -5,6 +5,18 @@
 
 pub mod mjcf;
 
+/// Every option of an MJCF export in its range, or the first that is not, named by its flag:
+/// the position servos' gain `joint_kp` [N/m or N m/rad] and the cables' damping [N s/m].
+pub fn validate_mjcf_options(joint_kp: f64, cable_damping_n_s_per_m: f64) -> Result<(), String> {
+    if !(joint_kp > 0.0 && joint_kp.is_finite()) {
+        return Err(format!("--kp must be a finite number > 0, got {joint_kp}"));
+    }
+    if !(cable_damping_n_s_per_m >= 0.0 && cable_damping_n_s_per_m.is_finite()) {
+        return Err(format!("--cable-damping must be a finite number >= 0, got {cable_damping_n_s_per_m}"));
+    }
+    Ok(())
+}
+
 /// The MJCF of a scenario's first structure, with the scenario's time step and body damping.
 pub fn scenario_mjcf(
     sc: &Scenario,

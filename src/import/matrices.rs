@@ -26,6 +26,24 @@ pub struct MatrixOptions {
     pub string_tension_n: f64,
 }
 
+impl MatrixOptions {
+    /// Every option in its range, or the first that is not, named by its flag.
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = [
+            ("--bar-mass", self.bar_mass_kg),
+            ("--bar-radius", self.bar_radius_m),
+            ("--string-stiffness", self.string_stiffness_n_per_m),
+        ];
+        if let Some((flag, x)) = positive.iter().find(|(_, x)| !(*x > 0.0 && x.is_finite())) {
+            return Err(format!("{flag} must be a finite number > 0, got {x}"));
+        }
+        if !(self.string_tension_n >= 0.0 && self.string_tension_n.is_finite()) {
+            return Err(format!("--string-tension must be a finite number >= 0, got {}", self.string_tension_n));
+        }
+        Ok(())
+    }
+}
+
 /// A row of a matrix file: its line in the file (from 1) and its values.
 type Row = (usize, Vec<f64>);
 

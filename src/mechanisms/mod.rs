@@ -4,6 +4,7 @@
 //! [`Mechanism`] trait that the rest of the testbed uses.
 
 mod angle;
+pub mod custom;
 mod error;
 mod finding;
 pub mod furet2018;

@@ -8,8 +8,8 @@
 //! [`observers`].
 
 pub mod compare;
+pub mod file_model;
 pub mod interference;
-pub mod model;
 pub mod record;
 pub mod slack;
 pub mod table;
@@ -86,7 +86,7 @@ pub struct Setup<'a> {
     pub length_scale_m: f64,
     pub interference: &'a InterferenceSettings,
     /// The scenario file's own model (`[[quantities]]`, `[[predictions]]`, `[[equations]]`).
-    pub model: Option<&'a crate::model::spec::ModelSpec>,
+    pub model: Option<&'a crate::file_model::spec::ModelSpec>,
     /// A recording, when the run writes one (made last: nothing is written when another
     /// observer cannot start).
     pub recording: Option<record::Recording<'a>>,
@@ -100,7 +100,7 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
         vec![Box::new(compare::Compare::new(setup.checks, setup.length_scale_m)), Box::new(slack::SlackTracker::new())];
     list.push(Box::new(interference::Interference::new(setup.structure, setup.interference)?));
     if let Some(spec) = setup.model {
-        list.push(Box::new(model::ModelObserver::new(spec, setup.structure, setup.recording.is_some())));
+        list.push(Box::new(file_model::ModelObserver::new(spec, setup.structure, setup.recording.is_some())));
     }
     if let Some(path) = &setup.table {
         list.push(Box::new(table::Table::start(path)?));

@@ -2,12 +2,11 @@
 //!
 //! `runner.rs` holds the running state and the one step every phase goes through,
 //! `settle.rs` the settle loop, `point.rs` one settle point (branch, stability, probe,
-//! read-out) and `verdict.rs` the pass policy.
+//! read-out) (the pass policy is `report::verdict`).
 
 mod point;
 mod runner;
 mod settle;
-pub mod verdict;
 
 use crate::mechanisms::{Mechanism, ModelError, Values};
 use crate::observers::record::{RecordTarget, Recording};
@@ -58,7 +57,7 @@ pub fn panicked(sc: &Scenario, payload: &(dyn std::any::Any + Send)) -> Scenario
         .or_else(|| payload.downcast_ref::<String>().cloned())
         .unwrap_or_else(|| "unknown panic".into());
     let mut report = ScenarioReport { error: Some(format!("panicked: {msg}")), ..empty_report(sc) };
-    verdict::conclude(&mut report, sc);
+    conclude(&mut report, sc);
     report
 }
 
@@ -146,7 +145,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
             Ok(f) => report.findings = f.into_iter().map(Into::into).collect(),
             Err(halted) => {
                 report.error = Some(format!("{halted} while checking the paper's equations (findings)"));
-                verdict::conclude(&mut report, sc);
+                conclude(&mut report, sc);
                 return report;
             }
         }
@@ -157,7 +156,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         Ok(r) => r,
         Err(e) => {
             report.error = Some(e);
-            verdict::conclude(&mut report, sc);
+            conclude(&mut report, sc);
             return report;
         }
     };
@@ -226,7 +225,7 @@ fn finish(runner: &mut Runner, report: &mut ScenarioReport, probe_errors: &[f64]
             passed: complete && max <= p.tolerance,
         });
     }
-    verdict::conclude(report, sc);
+    conclude(report, sc);
     let tick = runner.sim.tick();
     let mut failed = None;
     for o in &mut runner.observers {
@@ -236,7 +235,7 @@ fn finish(runner: &mut Runner, report: &mut ScenarioReport, probe_errors: &[f64]
     }
     if let Some(e) = failed {
         report.error.get_or_insert(e);
-        verdict::conclude(report, sc);
+        conclude(report, sc);
     }
 }
 
@@ -319,4 +318,12 @@ pub fn interpolate(waypoints: &[(f64, Values)], t: f64) -> Values {
         }
     }
     waypoints.last().unwrap().1.clone()
+}
+
+/// The verdict of a finished report: its failures (the one pass policy, `report::verdict::failures`),
+/// whether it passed, and whether that is what the scenario declares.
+fn conclude(report: &mut ScenarioReport, sc: &Scenario) {
+    report.failures = crate::report::verdict::failures(report, sc.min_agreement_percent);
+    report.passed = report.failures.is_empty();
+    report.as_expected = sc.expect.as_ref().map(|e| e.met_by(&report.failures));
 }

@@ -4,8 +4,8 @@
 
 use super::runner::Runner;
 use super::Stop;
+use crate::file_model::energy_model::Kind;
 use crate::mechanisms::{self, Mechanism, ModelError, Prediction, Values};
-use crate::model::energy::Kind;
 use crate::observers::compare;
 use crate::observers::SettlePoint;
 use crate::report::{PointReport, ScenarioReport};

@@ -7,8 +7,8 @@ use super::error::{finite, value_at, values, Ctx, ScenarioError};
 use super::params::params_at;
 use super::raw::{RawActuation, RawRange, SpannedMap};
 use super::{Actuation, MAX_POINTS};
+use crate::file_model::params::ParamTable;
 use crate::mechanisms::{Mechanism, ModelError, Values};
-use crate::model::params::ParamTable;
 use std::collections::BTreeMap;
 use toml::Spanned;
 

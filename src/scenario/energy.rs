@@ -4,9 +4,9 @@
 use super::error::{finite, positive_value, Ctx, ScenarioError};
 use super::number::expr_error;
 use super::raw::{RawCoordinate, RawEnergy, RawRange};
-use crate::model::energy::{Coordinate, EnergySpec};
-use crate::model::expr::Expr;
-use crate::model::spec::{ErrorClass, ModelSpec};
+use crate::file_model::energy_model::{Coordinate, EnergySpec};
+use crate::file_model::expr::Expr;
+use crate::file_model::spec::{ErrorClass, ModelSpec};
 use toml::Spanned;
 
 /// Largest number of Newton starts a coordinate's scan may ask for.

@@ -2,7 +2,7 @@
 
 use super::error::{Ctx, ScenarioError};
 use super::raw::RawExpect;
-use crate::model::spec::ModelSpec;
+use crate::file_model::spec::ModelSpec;
 use crate::settings::Check;
 use toml::Spanned;
 
@@ -23,8 +23,8 @@ fn listed(names: Vec<&str>) -> String {
 }
 
 /// Whether the scenario has the part `failure` names; else the message saying what it has.
-fn has_part(parts: &Parts, failure: &crate::settings::Failure) -> Result<(), String> {
-    use crate::settings::Failure;
+fn has_part(parts: &Parts, failure: &crate::report::verdict::Failure) -> Result<(), String> {
+    use crate::report::verdict::Failure;
     let model = parts.model;
     match failure {
         Failure::Check(q) if !parts.checks.iter().any(|c| &c.quantity == q) => Err(format!(
@@ -54,8 +54,8 @@ pub(super) fn expectation(
     ctx: &Ctx,
     raw: &Spanned<RawExpect>,
     parts: &Parts,
-) -> Result<crate::settings::Expectation, ScenarioError> {
-    use crate::settings::{Expectation, Failure};
+) -> Result<crate::report::verdict::Expectation, ScenarioError> {
+    use crate::report::verdict::{Expectation, Failure};
     let e = raw.get_ref();
     let mut failing = Vec::new();
     for f in &e.failing {

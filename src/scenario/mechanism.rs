@@ -6,9 +6,9 @@ use super::params::params_at;
 use super::raw::RawScenario;
 use super::structure::structure_from_file;
 use super::Actuation;
-use crate::custom::{Custom, FileParam};
+use crate::file_model::params::ParamTable;
+use crate::mechanisms::custom::{Custom, FileParam};
 use crate::mechanisms::{self, Mechanism, Values};
-use crate::model::params::ParamTable;
 
 /// `mechanism = "custom"`: the mechanism built from the `[structure]` table, with each check's
 /// expected value (required: there is no analytic model). A built-in mechanism: `None`, and

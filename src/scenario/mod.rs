@@ -14,9 +14,9 @@ mod checks;
 mod energy;
 mod error;
 mod expect;
+mod file_model;
 mod interference;
 mod mechanism;
-mod model;
 mod number;
 mod params;
 mod physical;
@@ -45,7 +45,7 @@ pub struct Scenario {
     /// Every parameter's value (the mechanism's defaults where the file gives none).
     pub params: Values,
     /// The file's `[params]`, to evaluate again at a point that sets some ([`Scenario::params_at`]).
-    pub param_table: crate::model::params::ParamTable,
+    pub param_table: crate::file_model::params::ParamTable,
     pub sim: SimSettings,
     pub settle: SettleCriteria,
     pub start: Values,
@@ -62,11 +62,11 @@ pub struct Scenario {
     /// Grid points dropped by `skip_outside`, with the reason.
     pub skipped_points: Vec<(Values, String)>,
     /// `mechanism = "custom"`: the mechanism built from the file.
-    pub custom: Option<crate::custom::Custom>,
+    pub custom: Option<crate::mechanisms::custom::Custom>,
     /// `[expect]`: what the run must do, if the file declares it.
-    pub expect: Option<crate::settings::Expectation>,
+    pub expect: Option<crate::report::verdict::Expectation>,
     /// `[[quantities]]`, `[[predictions]]`, `[[equations]]`: the file's own model, if any.
-    pub model: Option<crate::model::spec::ModelSpec>,
+    pub model: Option<crate::file_model::spec::ModelSpec>,
 }
 
 impl Scenario {
@@ -94,6 +94,14 @@ impl Scenario {
             Some(c) => Box::new(c.clone()),
             None => mechanisms::find(&self.mechanism).expect("validated mechanism"),
         }
+    }
+
+    /// Whether a compared quantity is an angle (its errors are wrapped to (-pi, pi]): one of
+    /// the mechanism's angle quantities, or a prediction of the file's model of class angle.
+    pub fn is_angle(&self, quantity: &str) -> bool {
+        let mechanism = self.mechanism();
+        mechanism.quantities().iter().any(|q| q.symbol == quantity && q.kind == mechanisms::QuantityKind::Angle)
+            || self.model.as_ref().is_some_and(|m| m.is_angle(quantity))
     }
 }
 
@@ -172,7 +180,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let (actuation, skipped_points) = actuation::actuation(ctx, m, &param_table, &params, &raw.actuation)?;
     bounds::bounds(ctx, &raw, &sim, &settle, &actuation)?;
     let checks = checks::checks(ctx, m, &raw.checks, raw.probe.is_some())?;
-    let model = model::model(ctx, &raw, m, &params, &start, &actuation)?;
+    let model = file_model::model(ctx, &raw, m, &params, &start, &actuation)?;
     // A custom structure is checked by its settling and force balance even without [[checks]].
     if checks.is_empty() && raw.probe.is_none() && custom.is_none() && model.is_none() {
         return Err(ctx

@@ -9,9 +9,9 @@
 
 use super::error::{Ctx, ScenarioError};
 use super::raw::{RawBody, RawJoint, RawStructure, Xyz};
+use crate::file_model::expr::{Expr, ExprError};
+use crate::file_model::params::{Cycle, ParamTable};
 use crate::mechanisms::Values;
-use crate::model::expr::{Expr, ExprError};
-use crate::model::params::{Cycle, ParamTable};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::Deserialize;
 use std::collections::BTreeMap;

@@ -3,8 +3,8 @@
 use super::error::{known_keys, value_at, values, Ctx, ScenarioError};
 use super::number::{param_values, ParamMap};
 use super::raw::SpannedMap;
+use crate::file_model::params::ParamTable;
 use crate::mechanisms::{self, Mechanism, Values};
-use crate::model::params::ParamTable;
 
 /// Parameters: known symbols, each a finite number or an expression of the others, in the
 /// mechanism's unit where the file names one, then the mechanism's own ranges; the result

@@ -119,7 +119,7 @@ pub(super) struct RawExpect {
     /// "pass" or "fail".
     pub(super) verdict: Spanned<String>,
     /// With "fail": every part of the verdict that must fail, and no other
-    /// (see [`crate::settings::FAILURE_NAMES`]).
+    /// (see [`crate::report::verdict::FAILURE_NAMES`]).
     #[serde(default)]
     pub(super) failing: Vec<Spanned<String>>,
 }

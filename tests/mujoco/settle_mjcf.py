@@ -2,7 +2,7 @@
 
     python3 tests/mujoco/settle_mjcf.py MODEL.xml --max-time S --speed-tol M_PER_S --window N
 
-Used by tests/export_mjcf.rs on the files `tensegrity export mjcf` writes: starts from the
+Used by tests/it/export_mjcf.rs on the files `tensegrity export mjcf` writes: starts from the
 keyframe `first_point` when the model has one (the exported point's actuator commands),
 applies the constant loads of `<custom><numeric name="load:BODY:i">` at their bodies' centres
 of mass, and steps until every site has moved less than speed_tol * dt per step for `window`

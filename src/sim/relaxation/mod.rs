@@ -31,7 +31,7 @@
 
 mod assemble;
 mod dense;
-mod energy;
+mod line_search;
 mod ordering;
 mod sparse;
 

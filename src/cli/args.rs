@@ -1,0 +1,223 @@
+//! The command line's grammar: every subcommand and flag (clap derive), parsed and nothing
+//! else. What each command does is in its own file beside this one.
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+
+/// The MuJoCo peer of `benches/peers/mujoco/` (`bench --peer` without a command).
+pub const DEFAULT_PEER: &str = "python3 benches/peers/mujoco/peer.py";
+
+#[derive(Parser)]
+#[command(
+    name = "tensegrity",
+    version,
+    about = "Check published tensegrity mechanism models against rigid-body dynamics"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Run scenario files headless and compare the simulation with the analytic model.
+    Run {
+        #[arg(required = true)]
+        scenarios: Vec<PathBuf>,
+        /// Write the JSON report {"scenarios": [...]} to this file.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Record to this .rrd file (with several scenarios: one file each, named FILE-<scenario>.rrd).
+        #[arg(long)]
+        record: Option<PathBuf>,
+        /// Stream live to a running rerun viewer or server instead (default: rerun's own address,
+        /// rerun+http://127.0.0.1:9876/proxy).
+        #[arg(long, num_args = 0..=1, default_missing_value = "", value_name = "ADDR")]
+        connect: Option<String>,
+        /// Record every N-th tick only (thins long runs).
+        #[arg(long, default_value_t = 1, value_name = "N")]
+        record_every: u64,
+        /// Write every tick as a row of this CSV table at full f64 precision (with several
+        /// scenarios: one file each, named FILE-<scenario>.csv).
+        #[arg(long, value_name = "FILE.csv")]
+        table: Option<PathBuf>,
+    },
+    /// Validate scenario files without running them.
+    Check {
+        #[arg(required = true)]
+        scenarios: Vec<PathBuf>,
+    },
+    /// List the mechanisms, their parameters (units, defaults) and their queries; with a
+    /// scenario file, that file's mechanism (a custom file's own parameters with their values)
+    /// and the symbols its model's expressions may use.
+    List { scenario: Option<PathBuf> },
+    /// Settle every point of a scenario's grid in parallel; write a CSV and a JSON summary.
+    Sweep {
+        scenario: PathBuf,
+        /// The CSV (one row per point); default: print the summary only.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// The JSON summary.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Worker threads (at most the machine's threads; more is lowered, and said).
+        #[arg(long, default_value_t = 2)]
+        jobs: usize,
+        /// Run the K-th of N interleaved slices of the grid (for job arrays), as K/N.
+        #[arg(long)]
+        shard: Option<String>,
+        /// A figure of the sweep (FILE.png or FILE.svg): each compared quantity, analytic and
+        /// settled, against one axis, and the errors.
+        #[arg(long)]
+        figure: Option<PathBuf>,
+        /// The figure's axis: an input or a swept parameter (default: the one with most values).
+        #[arg(long)]
+        x: Option<String>,
+    },
+    /// Draw one of the papers' figures (analytic, with the dynamics' verdict) as PNG and SVG.
+    Figure {
+        /// The figure's name (`tensegrity figure --list`).
+        name: Option<String>,
+        /// Directory for NAME.png and NAME.svg.
+        #[arg(long, default_value = "assets/figures")]
+        out: PathBuf,
+        /// List the figures.
+        #[arg(long)]
+        list: bool,
+    },
+    /// Join the CSVs of a sharded sweep into one, rows in grid order.
+    Merge {
+        #[arg(required = true)]
+        csvs: Vec<PathBuf>,
+        #[arg(long)]
+        out: PathBuf,
+        /// Merge what is there even when points of the grid are missing (a shard left out).
+        #[arg(long)]
+        partial: bool,
+    },
+    /// The analytic model alone: print every result of a query.
+    Solve {
+        mechanism: String,
+        query: String,
+        /// NAME=VALUE for a parameter or an input (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Measure settling speed and accuracy on the built-in case sets (medians over rounds).
+    Bench {
+        /// Rounds per case set.
+        #[arg(long, default_value_t = 5)]
+        rounds: usize,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Write each case set as DIR/MECHANISM.json for a peer simulator (parameters, time
+        /// step, settle criterion, inputs, analytic values, start and analytic node positions)
+        /// and stop.
+        #[arg(long, value_name = "DIR")]
+        export_cases: Option<PathBuf>,
+        /// Only this mechanism's case set (repeatable; default: all).
+        #[arg(long = "mechanism", value_name = "NAME")]
+        mechanisms: Vec<String>,
+        /// Also run each case set through a peer simulator, alternating rounds with the
+        /// testbed, and print the ratios. CMD gets the case-set file and `--rounds 1` appended
+        /// (default: the MuJoCo peer, `benches/peers/mujoco/peer.py` run by `$TENSEGRITY_PYTHON`, else python3).
+        #[arg(long, value_name = "CMD", num_args = 0..=1, default_missing_value = DEFAULT_PEER)]
+        peer: Option<String>,
+        /// Settle the scale families instead (n-strut prisms, the icosahedron, force-density
+        /// towers, furet2018 X chains) from perturbed starts: steps, wall time, memory, error
+        /// against the closed form, growth exponent. With --peer: the same structures in MuJoCo
+        /// too (default `benches/peers/mujoco/scale_peer.py`).
+        #[arg(long)]
+        scale: bool,
+        /// With --scale: largest structure, in struts.
+        #[arg(long, value_name = "N", default_value_t = 1000)]
+        max_struts: usize,
+        /// With --scale: only this family (prism, icosahedron, tower, furet; repeatable).
+        #[arg(long = "family", value_name = "NAME")]
+        families: Vec<String>,
+        /// With --scale: a case still moving after this wall time is reported as not settled
+        /// (checked between steps) [s].
+        #[arg(long, value_name = "S", default_value_t = 120.0)]
+        max_case_wall_s: f64,
+    },
+    /// Write a scenario's structure in another simulator's format.
+    Export {
+        #[command(subcommand)]
+        format: ExportFormat,
+    },
+    /// Read a structure from another tool's format and write it as a scenario file.
+    Import {
+        #[command(subcommand)]
+        format: ImportFormat,
+    },
+    /// Check every printed equation of a mechanism's paper against the testbed's derivation.
+    Findings {
+        mechanism: String,
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Subcommand)]
+pub enum ExportFormat {
+    /// MuJoCo MJCF XML of the structure at the scenario's first actuation point.
+    Mjcf {
+        scenario: PathBuf,
+        /// The XML file (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// How the testbed's ideal actuators are written: `mocap` (bodies placed by actuated
+        /// joints are mocap bodies: exact) or `position` (position servos of gain --kp).
+        #[arg(long, default_value = "mocap", value_parser = ["mocap", "position"])]
+        actuators: String,
+        /// Gain of the position actuators on joints [N/m or N m/rad].
+        #[arg(long, default_value_t = 1e6)]
+        kp: f64,
+        /// Viscous damping along every cable [N s/m] (tendon damping, winch kv): zero at rest,
+        /// it only helps MuJoCo settle (the testbed's cables have none).
+        #[arg(long, default_value_t = 0.0)]
+        cable_damping: f64,
+    },
+}
+
+#[derive(Subcommand)]
+pub enum ImportFormat {
+    /// An NTRT YAML model (nodes, pair_groups, builders, substructures, bond_groups).
+    Ntrt {
+        file: PathBuf,
+        /// The scenario file (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Keep NTRT's axes (y up) instead of mapping its y to the testbed's z.
+        #[arg(long)]
+        keep_axes: bool,
+    },
+    /// A node matrix N (3 x n) and connectivity matrices C_b (bars x n) and C_s (strings x n),
+    /// as CSV (Skelton and de Oliveira's notation, TsgFEM, MOTES).
+    Matrices {
+        n: PathBuf,
+        cb: PathBuf,
+        cs: PathBuf,
+        /// The scenario file (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Mass of each bar [kg].
+        #[arg(long, default_value_t = 1.0)]
+        bar_mass: f64,
+        /// Radius of each bar [m].
+        #[arg(long, default_value_t = 0.01)]
+        bar_radius: f64,
+        /// Stiffness of each string [N/m].
+        #[arg(long, default_value_t = 1000.0)]
+        string_stiffness: f64,
+        /// Tension of each string at its drawn length [N] (sets its rest length).
+        #[arg(long, default_value_t = 10.0)]
+        string_tension: f64,
+    },
+}

@@ -1,0 +1,24 @@
+//! `tensegrity figure`: one of the papers' figures as PNG and SVG, or the list of them.
+
+use super::{CliError, Outcome};
+use std::path::Path;
+
+pub fn figure(name: Option<&str>, out: &Path, list: bool) -> Result<Outcome, CliError> {
+    let name = match (name, list) {
+        (Some(n), false) => n,
+        _ => {
+            for (n, what) in crate::figures::FIGURES {
+                println!("{n}: {what}");
+            }
+            return if list {
+                Ok(Outcome::Pass)
+            } else {
+                Err(super::bad_input("name one of the figures listed above"))
+            };
+        }
+    };
+    for f in crate::figures::draw(name, out).map_err(super::bad_input)? {
+        println!("wrote {}", f.display());
+    }
+    Ok(Outcome::Pass)
+}

@@ -1,0 +1,159 @@
+//! The `tensegrity` command line, a thin shell over the library (after ripgrep's `flags`):
+//! `args.rs` the grammar, one file per command, `signals.rs` the signals and the command's
+//! thread, and here the one place that prints errors and maps outcomes to exit codes.
+//!
+//! Adding a subcommand: a variant in `args.rs`, its file here (a function returning
+//! `Result<Outcome, CliError>`), and one line in [`dispatch`].
+
+mod args;
+mod bench;
+mod check;
+mod export;
+mod figure;
+mod findings;
+mod import;
+mod list;
+mod merge;
+mod run;
+mod signals;
+mod solve;
+mod sweep;
+
+use crate::report::{EXIT_BAD_INPUT, EXIT_FAIL, EXIT_PASS};
+use crate::scenario::{self, Scenario};
+use args::{Cli, Command};
+use clap::Parser;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Exit code of a command that panicked (Rust's own for a panic in main).
+const EXIT_INTERNAL_ERROR: u8 = 101;
+
+/// How a command ended when it ran to its end.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Every check passed (exit 0).
+    Pass,
+    /// A check failed, a settle timed out, a run diverged or was interrupted (exit 1).
+    Fail,
+}
+
+impl Outcome {
+    /// Pass when `passed`, else Fail.
+    pub fn from_passed(passed: bool) -> Outcome {
+        if passed {
+            Outcome::Pass
+        } else {
+            Outcome::Fail
+        }
+    }
+}
+
+/// Why a command stopped before its end.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// Bad input: a malformed scenario or flag, an unknown name, an output that would destroy
+    /// an input (exit 2). One message per problem found.
+    #[error("{}", .0.join("\nerror: "))]
+    BadInput(Vec<String>),
+    /// The work failed: an output could not be written (exit 1).
+    #[error("{0}")]
+    Failed(String),
+}
+
+/// Bad input with one message.
+pub fn bad_input(message: impl std::fmt::Display) -> CliError {
+    CliError::BadInput(vec![message.to_string()])
+}
+
+/// A failure with one message.
+pub fn failed(message: impl std::fmt::Display) -> CliError {
+    CliError::Failed(message.to_string())
+}
+
+/// The binary's `main`: parse the arguments, run the command on its own thread, print its
+/// error (the only place that does) and exit with its code.
+pub fn main() -> ExitCode {
+    signals::install_handlers();
+    let cli = Cli::parse();
+    ExitCode::from(signals::run_stoppable(move || exit_code(dispatch(cli))))
+}
+
+/// The exit code of a command's result, printing its error.
+fn exit_code(result: Result<Outcome, CliError>) -> u8 {
+    let code = match result {
+        Ok(Outcome::Pass) => EXIT_PASS,
+        Ok(Outcome::Fail) => EXIT_FAIL,
+        Err(e) => {
+            eprintln!("error: {e}");
+            match e {
+                CliError::BadInput(_) => EXIT_BAD_INPUT,
+                CliError::Failed(_) => EXIT_FAIL,
+            }
+        }
+    };
+    code as u8
+}
+
+/// Runs the command.
+fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
+    match cli.command {
+        Command::Run { scenarios, json, record, connect, record_every, table } => {
+            run::run(&scenarios, &run::Outputs { json, record, connect, record_every, table })
+        }
+        Command::Check { scenarios } => check::check(&scenarios),
+        Command::List { scenario } => list::list(scenario.as_deref()),
+        Command::Sweep { scenario, out, json, jobs, shard, figure, x } => {
+            sweep::sweep(&scenario, &sweep::Outputs { csv: out, json, figure, x }, jobs, shard.as_deref())
+        }
+        Command::Merge { csvs, out, partial } => merge::merge(&csvs, &out, partial),
+        Command::Figure { name, out, list } => figure::figure(name.as_deref(), &out, list),
+        Command::Solve { mechanism, query, set, json } => solve::solve(&mechanism, &query, &set, json),
+        Command::Findings { mechanism, set, json } => findings::findings(&mechanism, &set, json),
+        Command::Import { format } => import::import(format),
+        Command::Export { format } => export::export(format),
+        bench @ Command::Bench { .. } => bench::bench(bench),
+    }
+}
+
+/// Loads and validates every scenario: all of them, or every error found.
+fn load_all(paths: &[PathBuf]) -> Result<Vec<Scenario>, CliError> {
+    let (mut list, mut errors) = (Vec::new(), Vec::new());
+    for p in paths {
+        match scenario::load(p) {
+            Ok(s) => list.push(s),
+            Err(e) => errors.push(e.to_string()),
+        }
+    }
+    if errors.is_empty() {
+        Ok(list)
+    } else {
+        Err(CliError::BadInput(errors))
+    }
+}
+
+/// Loads and validates one scenario.
+fn load_one(path: &Path) -> Result<Scenario, CliError> {
+    scenario::load(path).map_err(bad_input)
+}
+
+/// Refuses outputs that would destroy data (`output::check_outputs`), before anything runs.
+fn check_outputs(inputs: &[PathBuf], outputs: &[(String, PathBuf)]) -> Result<(), CliError> {
+    crate::output::check_outputs(inputs, outputs).map_err(bad_input)
+}
+
+/// Writes `text` to `path` through a unique temporary file and a rename (`output`).
+fn write_atomic(path: &Path, text: &str) -> Result<(), CliError> {
+    crate::output::write_atomic(path, text.as_bytes()).map_err(failed)
+}
+
+/// Writes `text` to `out` (never over an input), or to stdout without `out`.
+fn write_output(out: Option<&Path>, inputs: &[PathBuf], text: &str) -> Result<Outcome, CliError> {
+    let Some(o) = out else {
+        print!("{text}");
+        return Ok(Outcome::Pass);
+    };
+    check_outputs(inputs, &[("--out".into(), o.to_path_buf())])?;
+    write_atomic(o, text)?;
+    Ok(Outcome::Pass)
+}

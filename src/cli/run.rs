@@ -1,0 +1,92 @@
+//! `tensegrity run`: scenario files headless, with their report, recordings and tables.
+
+use super::{check_outputs, load_all, signals, write_atomic, CliError, Outcome};
+use crate::report::Report;
+use crate::run::{run as run_scenario, RunOptions};
+use crate::scenario::Scenario;
+use std::path::{Path, PathBuf};
+
+/// What a run writes besides its table on stdout.
+pub struct Outputs {
+    pub json: Option<PathBuf>,
+    pub record: Option<PathBuf>,
+    pub connect: Option<String>,
+    pub record_every: u64,
+    pub table: Option<PathBuf>,
+}
+
+/// The file of one scenario's output: `base` itself, or with several scenarios
+/// `base-<scenario>.EXT` (the scenario's name with every character but `[A-Za-z0-9_-]` as `_`).
+fn per_scenario(base: &Path, name: &str, several: bool, extension: &str) -> PathBuf {
+    if !several {
+        return base.to_path_buf();
+    }
+    let stem = base.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "run".into());
+    let safe: String =
+        name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+    base.with_file_name(format!("{stem}-{safe}.{extension}"))
+}
+
+impl Outputs {
+    fn record_path(&self, sc: &Scenario, several: bool) -> Option<PathBuf> {
+        self.record.as_deref().map(|r| per_scenario(r, &sc.name, several, "rrd"))
+    }
+
+    fn table_path(&self, sc: &Scenario, several: bool) -> Option<PathBuf> {
+        self.table.as_deref().map(|t| per_scenario(t, &sc.name, several, "csv"))
+    }
+
+    /// Every file the run will write, named for the error that refuses it.
+    fn files(&self, scenarios: &[Scenario]) -> Vec<(String, PathBuf)> {
+        let several = scenarios.len() > 1;
+        let mut out: Vec<(String, PathBuf)> = self.json.iter().map(|j| ("--json".to_string(), j.clone())).collect();
+        if self.connect.is_none() {
+            for sc in scenarios {
+                if let Some(r) = self.record_path(sc, several).or_else(|| sc.record.clone()) {
+                    out.push((format!("the recording of scenario '{}' ({})", sc.name, sc.file.display()), r));
+                }
+            }
+        }
+        for sc in scenarios {
+            if let Some(t) = self.table_path(sc, several) {
+                out.push((format!("the table of scenario '{}' ({})", sc.name, sc.file.display()), t));
+            }
+        }
+        out
+    }
+}
+
+pub fn run(paths: &[PathBuf], o: &Outputs) -> Result<Outcome, CliError> {
+    let scenarios = load_all(paths)?;
+    if let Some(r) = o.record.as_deref().filter(|r| r.extension().and_then(|e| e.to_str()) != Some("rrd")) {
+        return Err(super::bad_input(format!("--record {} must end in .rrd", r.display())));
+    }
+    check_outputs(paths, &o.files(&scenarios))?;
+    // From here on each run stops at its next tick on a signal and the reports are written.
+    signals::stops_itself_from_now();
+    let several = scenarios.len() > 1;
+    let mut report = Report { scenarios: vec![] };
+    for sc in &scenarios {
+        if signals::cancelled() {
+            eprintln!("interrupted: {} scenario(s) not run", scenarios.len() - report.scenarios.len());
+            break;
+        }
+        let opts = RunOptions {
+            record: o.record_path(sc, several),
+            cancel: Some(&signals::CANCEL),
+            connect: o.connect.clone(),
+            record_every: o.record_every,
+            skip_findings: false,
+            table: o.table_path(sc, several),
+        };
+        // A panic inside one scenario fails that scenario, with its message; the batch goes on.
+        let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_scenario(sc, &opts)))
+            .unwrap_or_else(|payload| crate::run::panicked(sc, payload.as_ref()));
+        report.scenarios.push(r);
+    }
+    print!("{}", report.to_table());
+    if let Some(j) = &o.json {
+        write_atomic(j, &report.to_json()).map_err(|e| super::failed(format!("the JSON report: {e}")))?;
+    }
+    Ok(Outcome::from_passed(report.passed() && !signals::cancelled()))
+}

@@ -1,0 +1,82 @@
+//! `tensegrity solve`: the analytic model alone, every branch or solution of a query.
+
+use super::{bad_input, CliError, Outcome};
+use crate::mechanisms::{self, Mechanism, Solution, Values};
+
+/// Splits `--set NAME=VALUE` flags into the mechanism's parameters (with their defaults,
+/// validated) and the inputs in `allowed_inputs`.
+pub(super) fn parse_sets(
+    m: &dyn Mechanism,
+    sets: &[String],
+    allowed_inputs: &[&str],
+) -> Result<(Values, Values), CliError> {
+    let mut params = Values::new();
+    let mut inputs = Values::new();
+    for s in sets {
+        let (k, v) = s.split_once('=').ok_or_else(|| bad_input(format!("--set {s}: expected NAME=VALUE")))?;
+        let x: f64 = v.trim().parse().map_err(|_| bad_input(format!("--set {s}: '{v}' is not a number")))?;
+        if !x.is_finite() {
+            return Err(bad_input(format!("--set {s}: the value must be finite")));
+        }
+        if m.params().iter().any(|p| p.symbol == k) {
+            params.insert(k.into(), x);
+        } else if allowed_inputs.contains(&k) {
+            inputs.insert(k.into(), x);
+        } else {
+            let known: Vec<&str> = m.params().iter().map(|p| p.symbol).chain(allowed_inputs.iter().copied()).collect();
+            return Err(bad_input(format!("--set {s}: unknown name '{k}' (expected one of: {})", known.join(", "))));
+        }
+    }
+    let params = mechanisms::with_defaults(m, &params);
+    m.validate_params(&params).map_err(bad_input)?;
+    Ok((params, inputs))
+}
+
+/// The built-in mechanism called `name`.
+pub(super) fn find_mechanism(name: &str) -> Result<Box<dyn Mechanism>, CliError> {
+    mechanisms::find(name).ok_or_else(|| {
+        let known: Vec<_> = mechanisms::registry().iter().map(|m| m.name()).collect();
+        bad_input(format!("unknown mechanism '{name}' (expected one of: {})", known.join(", ")))
+    })
+}
+
+pub fn solve(mechanism: &str, query: &str, sets: &[String], json: bool) -> Result<Outcome, CliError> {
+    let m = find_mechanism(mechanism)?;
+    let Some(q) = m.queries().iter().find(|q| q.name == query) else {
+        let known: Vec<_> = m.queries().iter().map(|q| q.name).collect();
+        return Err(bad_input(format!(
+            "unknown query '{query}' for {mechanism} (expected one of: {})",
+            known.join(", ")
+        )));
+    };
+    let (params, inputs) = parse_sets(m.as_ref(), sets, q.inputs)?;
+    if let Some(i) = q.inputs.iter().find(|i| !inputs.contains_key(**i)) {
+        return Err(bad_input(format!("query '{query}' needs --set {i}=VALUE (inputs: {})", q.inputs.join(" "))));
+    }
+    let sols = m.solve(query, &params, &inputs).map_err(bad_input)?;
+    if json {
+        let v = serde_json::json!({
+            "mechanism": mechanism, "query": query, "params": params, "inputs": inputs,
+            "solutions": sols.iter().map(|s| serde_json::json!({"label": s.label, "values": s.values, "stable": s.stable})).collect::<Vec<_>>(),
+        });
+        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+    } else {
+        print_solutions(mechanism, query, &sols);
+    }
+    Ok(Outcome::Pass)
+}
+
+fn print_solutions(mechanism: &str, query: &str, sols: &[Solution]) {
+    println!("{mechanism} {query}: {} result(s)", sols.len());
+    for s in sols {
+        let st = match s.stable {
+            Some(true) => ", stable",
+            Some(false) => ", unstable",
+            None => "",
+        };
+        println!("  {}{st}:", s.label);
+        for (k, v) in &s.values {
+            println!("    {k:<12} = {v:.12}");
+        }
+    }
+}

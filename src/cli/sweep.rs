@@ -1,0 +1,92 @@
+//! `tensegrity sweep`: every grid point settled in parallel, its CSV, summary and figure.
+
+use super::{check_outputs, load_one, signals, write_atomic, CliError, Outcome};
+use crate::sweep::SweepSummary;
+use std::path::{Path, PathBuf};
+
+/// What a sweep writes: its CSV, its JSON summary, its figure (against axis `x`).
+pub struct Outputs {
+    pub csv: Option<PathBuf>,
+    pub json: Option<PathBuf>,
+    pub figure: Option<PathBuf>,
+    pub x: Option<String>,
+}
+
+pub fn sweep(path: &Path, o: &Outputs, jobs: usize, shard: Option<&str>) -> Result<Outcome, CliError> {
+    let sc = load_one(path)?;
+    if let Some(f) =
+        o.figure.as_deref().filter(|f| !matches!(f.extension().and_then(|e| e.to_str()), Some("png" | "svg")))
+    {
+        return Err(super::bad_input(format!("--figure {}: give a .png or .svg file", f.display())));
+    }
+    let outputs: Vec<(String, PathBuf)> = [("--out", &o.csv), ("--json", &o.json), ("--figure", &o.figure)]
+        .into_iter()
+        .filter_map(|(what, p)| p.clone().map(|p| (what.to_string(), p)))
+        .collect();
+    check_outputs(&[path.to_path_buf()], &outputs)?;
+    let jobs = capped_jobs(jobs);
+    // From here on every block stops at its next tick on a signal and the outputs are written.
+    signals::stops_itself_from_now();
+    let shard = shard.map(crate::sweep::parse_shard).transpose().map_err(super::bad_input)?;
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} points, {per_sec}, {eta} left")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let progress = |done: usize, total: usize| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    };
+    let result = crate::sweep::sweep(&sc, jobs, shard, Some(&signals::CANCEL), &progress);
+    bar.finish_and_clear();
+    let (rows, summary) = result.map_err(super::bad_input)?;
+    print_summary(&summary);
+    let is_angle = |q: &str| sc.is_angle(q);
+    if let Some(csv) = &o.csv {
+        write_atomic(csv, &crate::sweep::to_csv(&rows, &is_angle))?;
+    }
+    if let Some(f) = &o.figure {
+        crate::figures::sweep::draw(&rows, &summary.scenario, o.x.as_deref(), &is_angle, f).map_err(super::failed)?;
+    }
+    if let Some(j) = &o.json {
+        write_atomic(j, &serde_json::to_string_pretty(&summary).unwrap_or_default())?;
+    }
+    if let Some(min) = summary.min_agreement_percent {
+        println!("required agreement {min:.2} %");
+    }
+    if !summary.disagreements.is_empty() {
+        println!("{} point(s) did not settle or are out of tolerance", summary.disagreements.len());
+    }
+    let passed = summary.passed && !signals::cancelled();
+    println!("{}", if passed { "PASS" } else { "FAIL" });
+    Ok(Outcome::from_passed(passed))
+}
+
+/// The summary's lines: points, settled, within tolerance, wall time; agreement; stops.
+fn print_summary(summary: &SweepSummary) {
+    println!(
+        "{}: {} point(s), {} settled, {} within tolerance, {:.2} s wall on {} job(s){}",
+        summary.scenario,
+        summary.points,
+        summary.settled,
+        summary.within_tolerance,
+        summary.wall_s,
+        summary.jobs,
+        summary.shard.as_ref().map(|s| format!(", shard {s}")).unwrap_or_default()
+    );
+    if let Some(w) = &summary.workspace {
+        println!("workspace agreement {:.2} % ({} of {} points)", w.agreement_percent, w.agree, w.points);
+    }
+    for e in &summary.errors {
+        println!("stopped: {e}");
+    }
+}
+
+/// `--jobs`, at least 1 and at most the machine's threads (lowered with a note on stderr).
+fn capped_jobs(jobs: usize) -> usize {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if jobs > threads {
+        eprintln!("note: --jobs {jobs} lowered to {threads}, the threads of this machine");
+    }
+    jobs.clamp(1, threads)
+}

@@ -1,0 +1,313 @@
+//! A mechanism described in a scenario file (`mechanism = "custom"` and a `[structure]`
+//! table): no analytic model, only what the dynamics can check on their own (settling, the
+//! force balance, cable slackness, member forces, stability, interference), plus optional
+//! expected values given in the file (`[[checks]]` with `value`) and the file's own model
+//! (`[params]`, `[[quantities]]`, `[[predictions]]`, `[[equations]]`, `[energy]`: see
+//! the `file_model` module, which this one does not import).
+
+use crate::mechanisms::{
+    Finding, InputSpec, Mechanism, MechanismSpec, ModelError, Origin, ParamSpec, Prediction, QuantityKind,
+    QuantitySpec, Solution, Values,
+};
+use crate::snapshot::Snapshot;
+use crate::structure::{ActuatorTarget, Structure};
+
+/// The mechanism built from a file's `[structure]`.
+#[derive(Clone, Debug)]
+pub struct Custom {
+    pub structure: Structure,
+    /// Name, title and the symbols of the file's actuators and checks.
+    spec: MechanismSpec,
+    /// Expected values from the file's checks, by quantity.
+    pub expected: Values,
+    /// The parameters `structure` was resolved with.
+    params: Values,
+    /// The structure at the other sets of parameters a sweep over them settles at.
+    variants: Vec<(Values, Structure)>,
+}
+
+/// A parameter a custom file declares in `[params]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FileParam {
+    pub symbol: String,
+    /// Its value in the file (an expression's value once evaluated).
+    pub value: f64,
+    pub unit: String,
+    pub description: String,
+}
+
+/// Leaks a string for the `'static` specs of a file-described mechanism (one per file).
+fn leak(s: String) -> &'static str {
+    Box::leak(s.into_boxed_str())
+}
+
+impl Custom {
+    pub fn new(structure: Structure, expected: Values) -> Self {
+        let mut inputs: Vec<InputSpec> = Vec::new();
+        for a in &structure.actuators {
+            if inputs.iter().any(|i| i.symbol == a.symbol) {
+                continue;
+            }
+            let (unit, description) = match a.target {
+                ActuatorTarget::Joint(j) => match structure.joints[j].kind {
+                    crate::structure::JointKind::Revolute { .. } => {
+                        ("rad", "joint angle command from the structure file")
+                    }
+                    _ => ("m", "joint slide command from the structure file"),
+                },
+                ActuatorTarget::CableLength(_) => ("m", "winch: the cable's rest length, from the structure file"),
+                ActuatorTarget::FixedNode { .. } => {
+                    ("m", "moved node: its displacement along its direction, from the structure file")
+                }
+            };
+            inputs.push(InputSpec { symbol: leak(a.symbol.clone()), unit, description });
+        }
+        let mut quantities = Vec::new();
+        for n in &structure.nodes {
+            for c in ["x", "y", "z"] {
+                quantities.push(QuantitySpec {
+                    symbol: leak(format!("{}.{c}", n.name)),
+                    unit: "m",
+                    kind: QuantityKind::Length,
+                    description: "node coordinate",
+                });
+            }
+        }
+        let members = structure
+            .springs
+            .iter()
+            .map(|m| &m.name)
+            .chain(structure.cables.iter().map(|m| &m.name))
+            .chain(structure.struts.iter().filter(|t| strut_reading(&structure, t).is_some()).map(|m| &m.name));
+        for name in members {
+            quantities.push(QuantitySpec {
+                symbol: leak(format!("{name}.force")),
+                unit: "N",
+                kind: QuantityKind::Magnitude,
+                description: "member force, tension positive (struts: from the balance of an end node without a joint; none for a strut on a fixed body or jointed at both ends)",
+            });
+        }
+        Custom {
+            structure,
+            spec: MechanismSpec {
+                name: "custom",
+                title: "a structure described in the scenario file (its model, if any, stated there too)",
+                params: &[],
+                inputs: Box::leak(inputs.into_boxed_slice()),
+                quantities: Box::leak(quantities.into_boxed_slice()),
+                queries: &[],
+                start_keys: &[],
+                alternative_inputs: &[],
+            },
+            expected,
+            params: Values::new(),
+            variants: Vec::new(),
+        }
+    }
+
+    /// The mechanism with its structure at other sets of parameters (a sweep over them).
+    pub fn with_variants(mut self, variants: Vec<(Values, Structure)>) -> Self {
+        self.variants = variants;
+        self
+    }
+
+    /// The structure resolved with `params`: the file's own, or one of its variants.
+    fn structure_at(&self, params: &Values) -> Result<&Structure, ModelError> {
+        if params == &self.params || params.is_empty() {
+            return Ok(&self.structure);
+        }
+        self.variants.iter().find(|(p, _)| p == params).map(|(_, s)| s).ok_or_else(|| {
+            ModelError::no_solution(format!("the file's structure was not resolved with the parameters {params:?}"))
+        })
+    }
+
+    /// The mechanism with the parameters its file declares (their values are the defaults).
+    pub fn with_params(mut self, params: Vec<FileParam>) -> Self {
+        self.params = params.iter().map(|p| (p.symbol.clone(), p.value)).collect();
+        let specs: Vec<ParamSpec> = params
+            .into_iter()
+            .map(|p| ParamSpec {
+                symbol: leak(p.symbol),
+                unit: leak(p.unit),
+                default: p.value,
+                description: leak(p.description),
+                origin: Origin::Paper,
+            })
+            .collect();
+        self.spec.params = Box::leak(specs.into_boxed_slice());
+        self
+    }
+
+    /// Axial force of each strut whose force can be read ([`strut_reading`]), tension positive
+    /// [N]: minus the member forces on an end node along the strut, so that it balances them.
+    fn strut_forces(&self, snap: &Snapshot) -> Vec<(usize, f64)> {
+        let s = &self.structure;
+        let node_force = |node: usize| -> [f64; 3] {
+            let mut f = [0.0; 3];
+            let mut add = |a: usize, b: usize, t: f64| {
+                let (pa, pb) = (snap.nodes[a], snap.nodes[b]);
+                let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+                let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                if l > 0.0 {
+                    for k in 0..3 {
+                        f[k] += t * d[k] / l;
+                    }
+                }
+            };
+            for (i, m) in s.springs.iter().enumerate() {
+                if m.a == node {
+                    add(m.a, m.b, snap.forces.spring_force_n[i]);
+                } else if m.b == node {
+                    add(m.b, m.a, snap.forces.spring_force_n[i]);
+                }
+            }
+            for (i, m) in s.cables.iter().enumerate() {
+                if m.a == node {
+                    add(m.a, m.b, snap.forces.cable_tension_n[i]);
+                } else if m.b == node {
+                    add(m.b, m.a, snap.forces.cable_tension_n[i]);
+                }
+            }
+            f
+        };
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        s.struts
+            .iter()
+            .enumerate()
+            .filter_map(|(k, st)| {
+                let reading = strut_reading(s, st)?;
+                let (pa, pb) = (snap.nodes[st.a], snap.nodes[st.b]);
+                let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+                let l = dot(d, d).sqrt().max(f64::MIN_POSITIVE);
+                let u = [d[0] / l, d[1] / l, d[2] / l];
+                // Strut tension t pulls a towards b: t u + fa = 0 at a, -t u + fb = 0 at b.
+                let ta = || -dot(node_force(st.a), u);
+                let tb = || dot(node_force(st.b), u);
+                Some((
+                    k,
+                    match reading {
+                        StrutReading::BothEnds => 0.5 * (ta() + tb()),
+                        StrutReading::EndA => ta(),
+                        StrutReading::EndB => tb(),
+                    },
+                ))
+            })
+            .collect()
+    }
+}
+
+/// Which end nodes carry a strut's axial force alone: an end with a joint also takes the
+/// joint's reaction, which the member forces do not show.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum StrutReading {
+    BothEnds,
+    EndA,
+    EndB,
+}
+
+/// How the axial force of `st` is read, or None when it cannot be: a strut on a fixed body
+/// (its force goes into the ground) or with a joint at both ends (the joints' reactions share
+/// the axial force in a way the body's balance does not determine).
+fn strut_reading(s: &Structure, st: &crate::structure::Strut) -> Option<StrutReading> {
+    let fixed = |n: usize| s.bodies[s.nodes[n].body].kind == crate::structure::BodyKind::Fixed;
+    if fixed(st.a) || fixed(st.b) {
+        return None;
+    }
+    let size = crate::structure::structure_size(s);
+    let jointed = |n: usize| {
+        let node = &s.nodes[n];
+        s.joints.iter().any(|j| {
+            (j.parent == node.body || j.child == node.body)
+                && crate::structure::distance(s.nodes[j.anchor].position, node.position)
+                    <= JOINT_AT_NODE_FRACTION * size
+        })
+    };
+    match (jointed(st.a), jointed(st.b)) {
+        (false, false) => Some(StrutReading::BothEnds),
+        (true, false) => Some(StrutReading::EndB),
+        (false, true) => Some(StrutReading::EndA),
+        (true, true) => None,
+    }
+}
+
+/// A joint anchored closer than this fraction of the structure's size to a strut's end node
+/// acts at that end.
+const JOINT_AT_NODE_FRACTION: f64 = 1e-9;
+
+impl Mechanism for Custom {
+    fn spec(&self) -> &MechanismSpec {
+        &self.spec
+    }
+    fn validate_params(&self, _params: &Values) -> Result<(), ModelError> {
+        Ok(())
+    }
+    fn validate_inputs(&self, _params: &Values, inputs: &Values) -> Result<(), ModelError> {
+        for i in self.spec.inputs {
+            let x = inputs
+                .get(i.symbol)
+                .copied()
+                .ok_or(ModelError::value(i.symbol, format!("missing input {}", i.symbol)))?;
+            if !x.is_finite() {
+                return Err(ModelError::value(i.symbol, format!("{} must be finite, got {x}", i.symbol)));
+            }
+        }
+        for a in &self.structure.actuators {
+            if let ActuatorTarget::CableLength(_) = a.target {
+                if inputs.get(&a.symbol).is_some_and(|l| *l <= 0.0) {
+                    return Err(ModelError::value(
+                        a.symbol.clone(),
+                        format!("cable length {} must be > 0 m", a.symbol),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+    fn solve(&self, query: &str, _params: &Values, _inputs: &Values) -> Result<Vec<Solution>, ModelError> {
+        Err(ModelError::no_solution(format!("a custom structure has no analytic model (no query '{query}')")))
+    }
+    fn build(&self, params: &Values, inputs: &Values, _start: &Values) -> Result<Structure, ModelError> {
+        let mut s = self.structure_at(params)?.clone();
+        for a in &s.actuators {
+            if let (ActuatorTarget::CableLength(c), Some(l)) = (&a.target, inputs.get(&a.symbol)) {
+                s.cables[*c].length_m = *l;
+            }
+        }
+        Ok(s)
+    }
+    fn predict(&self, _params: &Values, _inputs: &Values) -> Result<Prediction, ModelError> {
+        Ok(Prediction {
+            expected: self.expected.clone(),
+            branches: vec![Solution {
+                label: "expected values from the file".into(),
+                values: self.expected.clone(),
+                stable: None,
+            }],
+            expected_slack: None,
+        })
+    }
+    fn observe(&self, _params: &Values, s: &Structure, snap: &Snapshot) -> Values {
+        let mut v = Values::new();
+        for (i, n) in s.nodes.iter().enumerate() {
+            for (k, c) in ["x", "y", "z"].iter().enumerate() {
+                v.insert(format!("{}.{c}", n.name), snap.nodes[i][k]);
+            }
+        }
+        for (i, m) in s.springs.iter().enumerate() {
+            v.insert(format!("{}.force", m.name), snap.forces.spring_force_n[i]);
+        }
+        for (i, m) in s.cables.iter().enumerate() {
+            v.insert(format!("{}.force", m.name), snap.forces.cable_tension_n[i]);
+        }
+        for (k, f) in self.strut_forces(snap) {
+            v.insert(format!("{}.force", s.struts[k].name), f);
+        }
+        v
+    }
+    fn length_scale(&self, params: &Values) -> f64 {
+        crate::structure::structure_size(self.structure_at(params).unwrap_or(&self.structure))
+    }
+    fn findings(&self, _params: &Values) -> Vec<Finding> {
+        Vec::new()
+    }
+}

@@ -1,0 +1,331 @@
+//! The file's own model against the dynamics: every `[[predictions]]` entry compared with its
+//! quantity, and every `[[equations]]` residual, at each settle point (which decides the
+//! verdict) and at each tick (reported as transient errors, as the checks are).
+
+use super::{Note, Observer, SettlePoint, Tick};
+use crate::file_model::energy_model::Kind;
+use crate::file_model::spec::{ModelSpec, Source};
+use crate::mechanisms::Values;
+use crate::report::{EnergyPointReport, ModelCheckReport, PointReport, ScenarioReport, StationaryReport};
+use crate::snapshot::{unit, Snapshot};
+use crate::structure::{JointKind, Structure};
+
+/// How a state symbol is read from a snapshot of the run's structure.
+#[derive(Clone, Debug)]
+enum Bind {
+    /// Not used by any expression (or not in this structure): NaN.
+    Unused,
+    Time,
+    Node(usize, usize),
+    SpringForce(usize),
+    SpringLength(usize),
+    CableForce(usize),
+    CableLength(usize),
+    /// Distance between a strut's end nodes.
+    StrutLength(usize, usize),
+    Observed(String),
+    /// A revolute joint: parent and child bodies, unit axis, initial coordinate.
+    JointAngle {
+        parent: usize,
+        child: usize,
+        axis: [f64; 3],
+        initial: f64,
+    },
+    /// A prismatic joint: parent and child bodies, the anchor at the build, unit axis,
+    /// initial coordinate.
+    JointSlide {
+        parent: usize,
+        child: usize,
+        anchor: [f64; 3],
+        axis: [f64; 3],
+        initial: f64,
+    },
+}
+
+/// A joint's coordinate symbol, if its kind has one coordinate.
+fn joint_bind(s: &Structure, name: &str, angle: bool) -> Option<Bind> {
+    let j = s.joints.iter().find(|j| j.name == name)?;
+    let (parent, child, initial) = (j.parent, j.child, j.initial_coordinate);
+    match (&j.kind, angle) {
+        (JointKind::Revolute { axis }, true) => Some(Bind::JointAngle { parent, child, axis: unit(*axis), initial }),
+        (JointKind::Prismatic { axis }, false) => {
+            let anchor = s.nodes.get(j.anchor)?.position;
+            Some(Bind::JointSlide { parent, child, anchor, axis: unit(*axis), initial })
+        }
+        _ => None,
+    }
+}
+
+impl Bind {
+    fn new(source: &Source, s: &Structure) -> Bind {
+        let member = |name: &str, spring: fn(usize) -> Bind, cable: fn(usize) -> Bind| {
+            s.spring_id(name).map(spring).or_else(|| s.cable_id(name).map(cable))
+        };
+        let bound = match source {
+            Source::Time => Some(Bind::Time),
+            Source::Node(n, axis) => s.node_id(n).map(|i| Bind::Node(i, *axis)),
+            Source::MemberForce(m) => member(m, Bind::SpringForce, Bind::CableForce),
+            Source::MemberLength(m) => member(m, Bind::SpringLength, Bind::CableLength)
+                .or_else(|| s.struts.iter().find(|t| &t.name == m).map(|t| Bind::StrutLength(t.a, t.b))),
+            Source::Observed(q) => Some(Bind::Observed(q.clone())),
+            Source::JointAngle(j) => joint_bind(s, j, true),
+            Source::JointSlide(j) => joint_bind(s, j, false),
+            Source::Param(_) | Source::Input(_) | Source::Quantity(_) => None,
+        };
+        bound.unwrap_or(Bind::Unused)
+    }
+
+    fn read(&self, snap: &Snapshot, observed: &Values) -> f64 {
+        let at = |v: &Vec<f64>, i: usize| v.get(i).copied().unwrap_or(f64::NAN);
+        match self {
+            Bind::Unused => f64::NAN,
+            Bind::Time => snap.time_s,
+            Bind::Node(i, axis) => snap.nodes.get(*i).map_or(f64::NAN, |p| p[*axis]),
+            Bind::SpringForce(i) => at(&snap.forces.spring_force_n, *i),
+            Bind::SpringLength(i) => at(&snap.forces.spring_length_m, *i),
+            Bind::CableForce(i) => at(&snap.forces.cable_tension_n, *i),
+            Bind::CableLength(i) => at(&snap.forces.cable_length_m, *i),
+            Bind::StrutLength(a, b) => match (snap.nodes.get(*a), snap.nodes.get(*b)) {
+                (Some(pa), Some(pb)) => crate::structure::distance(*pa, *pb),
+                _ => f64::NAN,
+            },
+            Bind::Observed(q) => observed.get(q).copied().unwrap_or(f64::NAN),
+            Bind::JointAngle { parent, child, axis, initial } => {
+                snap.joint_angle(*parent, *child, *axis).map_or(f64::NAN, |q| initial + q)
+            }
+            Bind::JointSlide { parent, child, anchor, axis, initial } => {
+                snap.joint_slide(*parent, *child, *anchor, *axis).map_or(f64::NAN, |q| initial + q)
+            }
+        }
+    }
+}
+
+/// The recording's series of the model's errors, one per prediction and equation (named once
+/// per recorded run: the recorder takes static names).
+fn series_names(spec: &ModelSpec) -> Vec<&'static str> {
+    let names = spec.predictions.iter().map(|p| &p.name).chain(spec.equations.iter().map(|e| &e.name));
+    names.map(|n| &*Box::leak(format!("model/{n}").into_boxed_str())).collect()
+}
+
+/// Errors gathered for one prediction or equation.
+#[derive(Clone, Debug, Default)]
+struct Acc {
+    settled_max: f64,
+    points: usize,
+    transient_max: f64,
+    transient_sum_sq: f64,
+    ticks: u64,
+}
+
+impl Acc {
+    /// A settle point's error (a NaN or an unsettled point counts as infinite).
+    fn point(&mut self, e: f64, settled: bool) {
+        let e = if settled && e.is_finite() { e } else { f64::INFINITY };
+        self.settled_max = self.settled_max.max(e);
+        self.points += 1;
+    }
+
+    fn tick(&mut self, e: f64) {
+        if e.is_finite() {
+            self.transient_max = self.transient_max.max(e);
+            self.transient_sum_sq += e * e;
+            self.ticks += 1;
+        }
+    }
+}
+
+/// The model observer.
+pub struct ModelObserver {
+    spec: ModelSpec,
+    bind: Vec<Bind>,
+    /// One per prediction, then one per equation.
+    acc: Vec<Acc>,
+    /// The energy model's: the distance to the stationary point landed on.
+    energy: Acc,
+    /// When the run is recorded: the series of each prediction's and equation's error per
+    /// tick (`model/NAME`), in the order of `acc`.
+    series: Option<Vec<&'static str>>,
+}
+
+impl ModelObserver {
+    /// The observer of `spec` on the run's `structure`; `recorded`: the run is recorded (each
+    /// error per tick then goes to the recording).
+    pub fn new(spec: &ModelSpec, structure: &Structure, recorded: bool) -> Self {
+        let mut used = vec![false; spec.symbols.len()];
+        let exprs = spec
+            .quantities
+            .iter()
+            .map(|q| &q.expr)
+            .chain(spec.predictions.iter().map(|p| &p.formula))
+            .chain(spec.equations.iter().map(|e| &e.residual));
+        for u in exprs.flat_map(|e| e.uses().iter()) {
+            used[*u] = true;
+        }
+        spec.predictions.iter().for_each(|p| used[p.symbol] = true);
+        if let Some(e) = &spec.energy {
+            let exprs = e.coordinates.iter().map(|c| &c.measured).chain([&e.potential]).chain(&e.hessian);
+            let n = used.len();
+            for u in exprs.flat_map(|x| x.uses().iter()).filter(|u| **u < n) {
+                used[*u] = true;
+            }
+        }
+        let bind = spec
+            .symbols
+            .iter()
+            .zip(&used)
+            .map(|(s, u)| if *u { Bind::new(&s.source, structure) } else { Bind::Unused })
+            .collect();
+        ModelObserver {
+            spec: spec.clone(),
+            bind,
+            acc: vec![Acc::default(); spec.predictions.len() + spec.equations.len()],
+            energy: Acc::default(),
+            series: recorded.then(|| series_names(spec)),
+        }
+    }
+
+    /// Every symbol's value in this state.
+    fn values(&self, snap: &Snapshot, inputs: &Values, params: &Values, observed: &Values) -> Vec<f64> {
+        self.spec.values(inputs, params, |i| self.bind[i].read(snap, observed))
+    }
+
+    /// Each prediction's (predicted, simulated, error), then each equation's (0, residual,
+    /// |residual|), in the order of `acc`.
+    fn errors(&self, v: &[f64]) -> Vec<(f64, f64, f64)> {
+        let predictions = self.spec.predictions.iter().map(|p| {
+            let (predicted, simulated) = (p.formula.eval(v), v[p.symbol]);
+            (predicted, simulated, p.class.error(predicted, simulated))
+        });
+        let equations = self.spec.equations.iter().map(|e| {
+            let r = e.residual.eval(v);
+            (0.0, r, r.abs())
+        });
+        predictions.chain(equations).collect()
+    }
+
+    fn tolerances(&self) -> impl Iterator<Item = (&str, f64)> {
+        let p = self.spec.predictions.iter().map(|p| (p.name.as_str(), p.tolerance));
+        p.chain(self.spec.equations.iter().map(|e| (e.name.as_str(), e.tolerance)))
+    }
+
+    /// The energy model at a settle point: its stationary points, the one nearest the settled
+    /// state, and the error counted (the distance to it; infinite when it is no minimum).
+    fn energy_point(&self, v: &[f64]) -> Option<(EnergyPointReport, f64)> {
+        let e = self.spec.energy.as_ref()?;
+        let measured = e.measured(v);
+        let mut values = v.to_vec();
+        values.resize(e.first_coordinate + e.coordinates.len(), 0.0);
+        let stationary = e.stationary_points(&mut values, &measured);
+        let landed = (0..stationary.len()).min_by(|a, b| {
+            e.distance(&stationary[*a].coordinates, &measured)
+                .total_cmp(&e.distance(&stationary[*b].coordinates, &measured))
+        });
+        let distance = landed.map_or(f64::INFINITY, |i| e.distance(&stationary[i].coordinates, &measured));
+        let error = match landed {
+            Some(i) if stationary[i].kind == Kind::Minimum => distance,
+            _ => f64::INFINITY,
+        };
+        let named = |x: &[f64]| e.coordinates.iter().zip(x).map(|(c, v)| (c.name.clone(), *v)).collect::<Values>();
+        let stationary = stationary
+            .iter()
+            .map(|s| StationaryReport {
+                coordinates: named(&s.coordinates),
+                energy: s.energy,
+                eigenvalues: s.eigenvalues.clone(),
+                kind: s.kind.name().into(),
+            })
+            .collect();
+        Some((EnergyPointReport { measured: named(&measured), stationary, landed, distance }, error))
+    }
+
+    pub fn reports(&self) -> Vec<ModelCheckReport> {
+        let kinds = self.spec.predictions.iter().map(|p| ("prediction", p.class.name()));
+        let kinds = kinds.chain(self.spec.equations.iter().map(|_| ("equation", "residual")));
+        kinds
+            .zip(self.tolerances())
+            .zip(&self.acc)
+            .map(|(((kind, class), (name, tolerance)), a)| ModelCheckReport {
+                kind: kind.into(),
+                name: name.into(),
+                class: class.into(),
+                max_error: a.settled_max,
+                tolerance,
+                passed: a.points > 0 && a.settled_max <= tolerance,
+                points_compared: a.points,
+                transient_max_error: a.transient_max,
+                transient_rms_error: if a.ticks > 0 { (a.transient_sum_sq / a.ticks as f64).sqrt() } else { 0.0 },
+                ticks_compared: a.ticks,
+            })
+            .chain(self.spec.energy.as_ref().map(|e| ModelCheckReport {
+                kind: "energy".into(),
+                name: "energy".into(),
+                class: "coordinates".into(),
+                max_error: self.energy.settled_max,
+                tolerance: e.tolerance,
+                passed: self.energy.points > 0 && self.energy.settled_max <= e.tolerance,
+                points_compared: self.energy.points,
+                transient_max_error: 0.0,
+                transient_rms_error: 0.0,
+                ticks_compared: 0,
+            }))
+            .collect()
+    }
+}
+
+impl Observer for ModelObserver {
+    fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>) {
+        let v = self.values(t.snapshot, t.inputs, t.params, t.simulated);
+        let errors = self.errors(&v);
+        for (a, (_, _, e)) in self.acc.iter_mut().zip(&errors) {
+            a.tick(*e);
+        }
+        if let Some(series) = &self.series {
+            notes.extend(series.iter().zip(&errors).map(|(s, (_, _, e))| Note::Scalar(s, *e)));
+        }
+    }
+
+    /// Compares at the point (outside the analytic model's validity: not compared), and adds
+    /// the quantities to the point's simulated values and the predictions to its analytic ones.
+    fn settle_point(&mut self, p: &SettlePoint, point: &mut PointReport, notes: &mut Vec<Note>) {
+        if p.outside_model {
+            return;
+        }
+        let v = self.values(p.snapshot, &point.inputs, p.params, &point.simulated);
+        let errors = self.errors(&v);
+        let tolerances: Vec<(String, f64)> = self.tolerances().map(|(n, t)| (n.to_string(), t)).collect();
+        for ((a, (_, _, e)), (name, tol)) in self.acc.iter_mut().zip(&errors).zip(&tolerances) {
+            a.point(*e, point.settled);
+            if point.settled && !(*e <= *tol) {
+                notes.push(Note::Event(format!(
+                    "point {}: {name} failed: error {e:.3e} > tolerance {tol:.1e}",
+                    point.index
+                )));
+                point.within_tolerance = false;
+            }
+        }
+        for (i, s) in self.spec.symbols.iter().enumerate() {
+            if let Source::Quantity(_) = s.source {
+                point.simulated.entry(s.name.clone()).or_insert(v[i]);
+            }
+        }
+        for (pr, (predicted, _, _)) in self.spec.predictions.iter().zip(&errors) {
+            point.analytic.entry(self.spec.symbols[pr.symbol].name.clone()).or_insert(*predicted);
+        }
+        if let Some((report, error)) = self.energy_point(&v) {
+            self.energy.point(error, point.settled);
+            let tol = self.spec.energy.as_ref().map_or(0.0, |e| e.tolerance);
+            if point.settled && !(error <= tol) {
+                notes.push(Note::Event(format!(
+                    "point {}: energy: settled {:.3e} from a minimum (tolerance {tol:.1e})",
+                    point.index, error
+                )));
+                point.within_tolerance = false;
+            }
+            point.energy = Some(report);
+        }
+    }
+
+    fn finish(&mut self, report: &mut ScenarioReport) {
+        report.model_checks = self.reports();
+    }
+}

@@ -1,0 +1,691 @@
+//! Reports: a readable table on stdout, one JSON document for machines, and the exit code
+//! (0 every check passed, 1 a check failed, 2 bad input).
+
+pub mod verdict;
+
+use crate::mechanisms::{Finding, Values};
+use serde::Serialize;
+
+pub const EXIT_PASS: i32 = 0;
+pub const EXIT_FAIL: i32 = 1;
+pub const EXIT_BAD_INPUT: i32 = 2;
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Report {
+    pub scenarios: Vec<ScenarioReport>,
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ScenarioReport {
+    pub name: String,
+    pub file: String,
+    pub mechanism: String,
+    pub passed: bool,
+    /// The parts of the verdict that failed (empty when `passed`), named as `[expect] failing`
+    /// names them.
+    pub failures: Vec<crate::report::verdict::Failure>,
+    /// What the scenario declares it must do (`[expect]`), if it declares it.
+    pub expect: Option<crate::report::verdict::Expectation>,
+    /// Whether the run did what `[expect]` declares (absent without `[expect]`).
+    pub as_expected: Option<bool>,
+    pub params: Values,
+    pub settle: SettleSummary,
+    pub checks: Vec<CheckReport>,
+    pub points: Vec<PointReport>,
+    pub stiffness_probe: Option<ProbeReport>,
+    /// Every interval of ticks in which a cable was slack.
+    pub slack_intervals: Vec<SlackInterval>,
+    /// Analytic against dynamic workspace classification (mechanisms with cables).
+    pub workspace: Option<WorkspaceAgreement>,
+    /// Grid points dropped as outside the mechanism's domain (`actuation.skip_outside`).
+    pub skipped_points: usize,
+    /// The interference checks (on unless the scenario turns them off; absent only when the
+    /// run stopped before its observers started).
+    pub interference: Option<InterferenceReport>,
+    pub findings: Vec<FindingReport>,
+    /// Along a scheduled trajectory: the range of every simulated quantity over its ticks
+    /// (for example the smallest |det J| on a path that must avoid singularities).
+    pub trajectory_ranges: std::collections::BTreeMap<String, QuantityRange>,
+    /// Why the run stopped early (divergence, interruption), if it did.
+    pub error: Option<String>,
+    /// The file's own model: its `[[predictions]]` and `[[equations]]`, judged (absent from the
+    /// JSON when the file states none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub model_checks: Vec<ModelCheckReport>,
+}
+
+/// A `[[predictions]]` or `[[equations]]` entry of the scenario file's model, judged at every
+/// settle point (the verdict) and at every tick (transient errors, reported only).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ModelCheckReport {
+    /// "prediction", "equation" or "energy".
+    pub kind: String,
+    pub name: String,
+    /// A prediction's error class (length [m], angle [rad, wrapped], relative); "residual" for
+    /// an equation (|residual|); "coordinates" for the energy model (the largest coordinate
+    /// difference from the settled state to the stationary point it landed on, infinite when
+    /// that point is not a minimum).
+    pub class: String,
+    /// Largest error over the settle points (infinite at a point that did not settle).
+    pub max_error: f64,
+    pub tolerance: f64,
+    pub passed: bool,
+    pub points_compared: usize,
+    pub transient_max_error: f64,
+    pub transient_rms_error: f64,
+    pub ticks_compared: u64,
+}
+
+impl ModelCheckReport {
+    /// The failure this entry is when it does not pass (`prediction:NAME`, `equation:NAME`).
+    pub fn failure(&self) -> crate::report::verdict::Failure {
+        use crate::report::verdict::Failure;
+        match self.kind.as_str() {
+            "equation" => Failure::Equation(self.name.clone()),
+            "energy" => Failure::Energy,
+            _ => Failure::Prediction(self.name.clone()),
+        }
+    }
+}
+
+/// Smallest, largest and smallest absolute value of a quantity over the ticks of a trajectory.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+pub struct QuantityRange {
+    pub min: f64,
+    pub max: f64,
+    pub min_abs: f64,
+}
+
+impl QuantityRange {
+    pub fn of(v: f64) -> Self {
+        QuantityRange { min: v, max: v, min_abs: v.abs() }
+    }
+
+    pub fn include(&mut self, v: f64) {
+        self.min = self.min.min(v);
+        self.max = self.max.max(v);
+        self.min_abs = self.min_abs.min(v.abs());
+    }
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq, Default)]
+pub struct SettleSummary {
+    /// Every settle point settled (velocity window and residual check both met).
+    pub settled: bool,
+    pub steps: u64,
+    pub sim_time_s: f64,
+    pub wall_s: f64,
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct CheckReport {
+    pub quantity: String,
+    pub unit: String,
+    /// Largest error at the settle points, in the quantity's unit.
+    pub max_abs_error: f64,
+    /// Largest normalised error at the settle points (lengths / L, angles in rad, other
+    /// quantities / |analytic|): what the tolerance applies to.
+    pub max_rel_error: f64,
+    pub tolerance: f64,
+    pub passed: bool,
+    /// Every tick, including transients (reported, not checked).
+    pub transient_max_abs_error: f64,
+    pub transient_rms_abs_error: f64,
+    pub ticks_compared: u64,
+    /// Settle points compared (points outside the analytic model's validity are not).
+    pub points_compared: usize,
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq, Default)]
+pub struct PointReport {
+    pub index: usize,
+    pub inputs: Values,
+    pub analytic: Values,
+    pub simulated: Values,
+    pub settled: bool,
+    pub steps: u64,
+    pub residual_force_n: f64,
+    pub residual_torque_nm: f64,
+    /// Speed at the last tick of the settle [m/s].
+    pub final_speed_m_per_s: f64,
+    /// Kinetic energy left at the last tick of the settle [J] (what an unsettled point still had).
+    pub final_kinetic_energy_j: f64,
+    /// The analytic branch the dynamics landed on.
+    pub branch: String,
+    /// Stability from the perturbation test (None when not tested).
+    pub stable: Option<bool>,
+    /// Stability from the analytic model (sign of the stiffness) for the branch landed on.
+    pub analytic_stable: Option<bool>,
+    /// The stability the scenario expects here (`[stability] expect`), if it says.
+    pub expected_stable: Option<bool>,
+    pub slack_cables: Vec<String>,
+    /// Cables the analytic statics says are slack (mechanisms with cables only).
+    pub expected_slack: Option<Vec<String>>,
+    /// Whether the simulated slack set equals the analytic one.
+    pub slack_agrees: Option<bool>,
+    /// Outside the analytic model's validity (some cable slack): the distance of the settled
+    /// state from the analytic point, over the length quantities [m].
+    pub distance_from_analytic_m: Option<f64>,
+    /// Settled, and every check within its tolerance at this point.
+    pub within_tolerance: bool,
+    /// Smallest strut clearance at the settled state [m] (with an `[interference]` section;
+    /// None when no pair came within the margin).
+    pub min_clearance_m: Option<f64>,
+    /// No strut pair below the interference threshold at the settled state.
+    pub interference_free: Option<bool>,
+    /// The paper's printed values at this point, where it prints any (never checked).
+    pub paper: Option<PaperValues>,
+    /// The file's `[energy]` model at this point: its stationary points and which one the
+    /// dynamics landed on (absent without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub energy: Option<EnergyPointReport>,
+}
+
+/// The stationary points of a file's energy model at one settle point.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct EnergyPointReport {
+    /// The coordinates read off the settled state.
+    pub measured: Values,
+    /// Every stationary point found (from the settled state and the scan), in that order.
+    pub stationary: Vec<StationaryReport>,
+    /// The index in `stationary` of the one nearest the settled state.
+    pub landed: Option<usize>,
+    /// Largest coordinate difference (angles wrapped) from the settled state to it.
+    pub distance: f64,
+}
+
+/// One stationary point of an energy model.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct StationaryReport {
+    pub coordinates: Values,
+    /// Potential energy there.
+    pub energy: f64,
+    /// The Hessian's eigenvalues, ascending: the stiffnesses along its eigenvectors.
+    pub eigenvalues: Vec<f64>,
+    /// minimum, maximum, saddle or degenerate.
+    pub kind: String,
+}
+
+/// A paper's own printed values at a point: its source (table, column) and the values.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PaperValues {
+    pub source: String,
+    pub values: Values,
+}
+
+/// Workspace classification, analytic against dynamic, over the points of a run whose
+/// mechanism predicts slack cables: a point is in the static workspace analytically when no
+/// cable is predicted slack, and by the dynamics when it settled with every cable taut and
+/// every check within tolerance.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct WorkspaceAgreement {
+    pub points: usize,
+    pub analytic_inside: usize,
+    pub simulated_inside: usize,
+    pub agree: usize,
+    pub agreement_percent: f64,
+    /// Indices of the points where the two classifications differ.
+    pub disagreements: Vec<usize>,
+    /// The scenario's pass threshold, if it is a workspace sweep.
+    pub min_agreement_percent: Option<f64>,
+    /// With an `[interference]` section: the points inside by the dynamics whose struts are
+    /// clear of each other, and their share of the inside points.
+    pub inside_interference_free: Option<usize>,
+    pub interference_free_percent_of_inside: Option<f64>,
+}
+
+impl WorkspaceAgreement {
+    pub fn from_points(points: &[PointReport]) -> Option<Self> {
+        let classified: Vec<&PointReport> = points.iter().filter(|p| p.expected_slack.is_some()).collect();
+        if classified.is_empty() {
+            return None;
+        }
+        let analytic = |p: &PointReport| p.expected_slack.as_ref().is_some_and(|e| e.is_empty());
+        let simulated = |p: &PointReport| p.settled && p.slack_cables.is_empty() && p.within_tolerance;
+        let disagreements: Vec<usize> =
+            classified.iter().filter(|p| analytic(p) != simulated(p)).map(|p| p.index).collect();
+        let n = classified.len();
+        let inside: Vec<&&PointReport> = classified.iter().filter(|p| simulated(p)).collect();
+        let free = inside.iter().filter(|p| p.interference_free == Some(true)).count();
+        let checked = inside.iter().any(|p| p.interference_free.is_some());
+        Some(WorkspaceAgreement {
+            points: n,
+            analytic_inside: classified.iter().filter(|p| analytic(p)).count(),
+            simulated_inside: classified.iter().filter(|p| simulated(p)).count(),
+            agree: n - disagreements.len(),
+            agreement_percent: 100.0 * (n - disagreements.len()) as f64 / n as f64,
+            disagreements,
+            min_agreement_percent: None,
+            inside_interference_free: checked.then_some(free),
+            interference_free_percent_of_inside: (checked && !inside.is_empty())
+                .then(|| 100.0 * free as f64 / inside.len() as f64),
+        })
+    }
+}
+
+/// Member interference over the run (parry capsule distances).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct InterferenceReport {
+    /// False when the scenario turned the checks off (`[interference] enabled = false`): then
+    /// nothing was measured.
+    pub enabled: bool,
+    /// Cables and springs were checked too.
+    pub tendons: bool,
+    /// Members checked (struts, then cables and springs).
+    pub members_checked: usize,
+    /// Smallest clearance seen over the run [m] (None: no pair ever came within the margin).
+    #[serde(rename = "min_clearance")]
+    pub min_clearance_m: Option<f64>,
+    pub closest_pair: Option<[String; 2]>,
+    pub closest_points: Option<[[f64; 3]; 2]>,
+    pub tick_of_min: Option<u64>,
+    /// Member pairs checked every tick (all pairs minus those attached by construction or excluded).
+    pub pairs_checked: usize,
+    pub ticks_checked: u64,
+    pub threshold_m: f64,
+    pub margin_m: f64,
+    /// Violations are reported without failing the run.
+    pub informative: bool,
+    pub passed: bool,
+    pub violations: Vec<InterferenceViolation>,
+    /// Every pair that came within the margin: its smallest clearance over the run.
+    pub pairs: Vec<PairClearanceReport>,
+}
+
+/// The smallest clearance of one strut pair over the run.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PairClearanceReport {
+    pub pair: [String; 2],
+    /// "strut", "cable" or "spring", for each of the pair.
+    pub kinds: [String; 2],
+    #[serde(rename = "min_clearance")]
+    pub min_clearance_m: f64,
+    pub tick_of_min: u64,
+    pub closest_points: [[f64; 3]; 2],
+}
+
+/// One interval of ticks in which a pair's clearance stayed below the threshold.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct InterferenceViolation {
+    pub pair: [String; 2],
+    /// "strut", "cable" or "spring", for each of the pair.
+    pub kinds: [String; 2],
+    pub first_tick: u64,
+    pub last_tick: u64,
+    #[serde(rename = "min_clearance")]
+    pub min_clearance_m: f64,
+    pub tick_of_min: u64,
+    /// Closest points on the two member axes at the minimum [m].
+    pub closest_points: [[f64; 3]; 2],
+}
+
+/// Ticks during which one cable was slack.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct SlackInterval {
+    pub cable: String,
+    pub first_tick: u64,
+    pub last_tick: u64,
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ProbeReport {
+    pub torque_nm: f64,
+    pub tolerance: f64,
+    pub max_rel_error: f64,
+    pub passed: bool,
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct FindingReport {
+    pub equation: String,
+    pub claim: String,
+    pub measured: String,
+    pub holds: bool,
+}
+
+impl From<Finding> for FindingReport {
+    fn from(f: Finding) -> Self {
+        FindingReport { equation: f.equation, claim: f.claim, measured: f.measured, holds: f.holds }
+    }
+}
+
+impl ScenarioReport {
+    /// "PASS", or "FAIL (what failed)", with whether that is what the scenario declares.
+    pub fn verdict_line(&self) -> String {
+        let names =
+            |f: &[crate::report::verdict::Failure]| f.iter().map(|f| f.to_string()).collect::<Vec<_>>().join(", ");
+        let mut line = if self.passed { "PASS".to_string() } else { format!("FAIL ({})", names(&self.failures)) };
+        match (&self.expect, self.as_expected) {
+            (Some(_), Some(true)) if !self.passed => line.push_str(", as the scenario expects"),
+            (Some(e), Some(false)) if e.failing.is_empty() => line.push_str(", NOT as expected (expect: pass)"),
+            (Some(e), Some(false)) => {
+                line.push_str(&format!(", NOT as expected (expect: fail in {})", names(&e.failing)))
+            }
+            _ => {}
+        }
+        line
+    }
+}
+
+impl Report {
+    pub fn passed(&self) -> bool {
+        self.scenarios.iter().all(|s| s.passed)
+    }
+
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("report serialises")
+    }
+
+    /// The human-readable table.
+    pub fn to_table(&self) -> String {
+        let mut out = String::new();
+        for s in &self.scenarios {
+            s.write_table(&mut out);
+        }
+        out
+    }
+}
+
+impl ScenarioReport {
+    /// This scenario's part of the table.
+    fn write_table(&self, out: &mut String) {
+        self.table_header(out);
+        self.table_checks(out);
+        self.table_model(out);
+        self.table_probe(out);
+        self.table_slack(out);
+        self.table_workspace(out);
+        self.table_intervals(out);
+        self.table_interference(out);
+        self.table_stability(out);
+        self.table_points(out);
+        self.table_findings(out);
+    }
+
+    /// The verdict line, the settle summary and why the run stopped, if it did.
+    fn table_header(&self, out: &mut String) {
+        out.push_str(&format!("== {} ({}) [{}]: {}\n", self.name, self.mechanism, self.file, self.verdict_line()));
+        out.push_str(&format!(
+            "   settle: {} point(s), all settled: {}, {} steps, {:.3} s simulated, {:.3} s wall\n",
+            self.points.len(),
+            self.settle.settled,
+            self.settle.steps,
+            self.settle.sim_time_s,
+            self.settle.wall_s
+        ));
+        if let Some(e) = &self.error {
+            out.push_str(&format!("   stopped: {e}\n"));
+        }
+    }
+
+    /// One row per check: errors at the settle points, transient errors, verdict.
+    fn table_checks(&self, out: &mut String) {
+        out.push_str(&format!(
+            "   {:<10} {:>12} {:>12} {:>10} {:>12} {:>12}  {}\n",
+            "quantity", "max |err|", "max rel err", "tolerance", "transient", "rms trans.", "verdict"
+        ));
+        for c in &self.checks {
+            out.push_str(&format!(
+                "   {:<10} {:>12.3e} {:>12.3e} {:>10.1e} {:>12.3e} {:>12.3e}  {}\n",
+                c.quantity,
+                c.max_abs_error,
+                c.max_rel_error,
+                c.tolerance,
+                c.transient_max_abs_error,
+                c.transient_rms_abs_error,
+                if c.passed { "pass" } else { "FAIL" }
+            ));
+        }
+    }
+
+    /// One row per prediction and equation of the file's model.
+    fn table_model(&self, out: &mut String) {
+        if self.model_checks.is_empty() {
+            return;
+        }
+        let w = self.model_checks.iter().map(|c| c.name.len()).max().unwrap_or(0).max("model".len());
+        out.push_str(&format!(
+            "   {:<w$} {:>12} {:>10} {:>12} {:>12}  {}\n",
+            "model", "max err", "tolerance", "transient", "rms trans.", "verdict"
+        ));
+        for c in &self.model_checks {
+            out.push_str(&format!(
+                "   {:<w$} {:>12.3e} {:>10.1e} {:>12.3e} {:>12.3e}  {} ({} {})\n",
+                c.name,
+                c.max_error,
+                c.tolerance,
+                c.transient_max_error,
+                c.transient_rms_error,
+                if c.passed { "pass" } else { "FAIL" },
+                c.kind,
+                c.class
+            ));
+        }
+    }
+
+    /// The stiffness probe, if any.
+    fn table_probe(&self, out: &mut String) {
+        if let Some(p) = &self.stiffness_probe {
+            out.push_str(&format!(
+                "   stiffness probe (+-{} N m): max rel err {:.3e} (tolerance {:.1e}) {}\n",
+                p.torque_nm,
+                p.max_rel_error,
+                p.tolerance,
+                if p.passed { "pass" } else { "FAIL" }
+            ));
+        }
+    }
+
+    /// Where the slack cables agree with the analytic ones, and the points where any is slack.
+    fn table_slack(&self, out: &mut String) {
+        let slack_checked: Vec<_> = self.points.iter().filter(|p| p.slack_agrees.is_some()).collect();
+        if !slack_checked.is_empty() {
+            let agree = slack_checked.iter().filter(|p| p.slack_agrees == Some(true)).count();
+            out.push_str(&format!(
+                "   slack cables: simulated set equals the analytic one at {agree} of {} point(s)\n",
+                slack_checked.len()
+            ));
+            for p in slack_checked
+                .iter()
+                .filter(|p| p.expected_slack.as_ref().is_some_and(|e| !e.is_empty()) || p.slack_agrees == Some(false))
+            {
+                out.push_str(&format!(
+                    "     point {:>4}: analytic slack [{}], simulated slack [{}]{}{}\n",
+                    p.index,
+                    p.expected_slack.as_deref().unwrap_or(&[]).join(", "),
+                    p.slack_cables.join(", "),
+                    p.distance_from_analytic_m
+                        .map(|d| format!(", {d:.3e} m from the analytic point"))
+                        .unwrap_or_default(),
+                    if p.slack_agrees == Some(false) { "  DISAGREE" } else { "" }
+                ));
+            }
+        }
+    }
+
+    /// The workspace classifications and their agreement.
+    fn table_workspace(&self, out: &mut String) {
+        if let Some(w) = &self.workspace {
+            out.push_str(&format!(
+                "   workspace: {} point(s), {} inside analytically, {} inside by the dynamics; agreement {:.2} %{}\n",
+                w.points,
+                w.analytic_inside,
+                w.simulated_inside,
+                w.agreement_percent,
+                if w.disagreements.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (disagree at points {:?})", w.disagreements)
+                }
+            ));
+            if let (Some(f), Some(pc)) = (w.inside_interference_free, w.interference_free_percent_of_inside) {
+                out.push_str(&format!(
+                    "   interference-free: {f} of the {} point(s) inside ({pc:.2} %)\n",
+                    w.simulated_inside
+                ));
+            }
+        }
+    }
+
+    /// Skipped grid points and the slack intervals.
+    fn table_intervals(&self, out: &mut String) {
+        if self.skipped_points > 0 {
+            out.push_str(&format!(
+                "   skipped: {} grid point(s) outside the mechanism's domain\n",
+                self.skipped_points
+            ));
+        }
+        if !self.slack_intervals.is_empty() {
+            out.push_str(&format!("   slack intervals ({}):", self.slack_intervals.len()));
+            for iv in self.slack_intervals.iter().take(MAX_POINTS_IN_TABLE) {
+                out.push_str(&format!(" {} ticks {}-{};", iv.cable, iv.first_tick, iv.last_tick));
+            }
+            out.push('\n');
+        }
+    }
+
+    /// Member interference: the closest pair and every violation, or that it was off.
+    fn table_interference(&self, out: &mut String) {
+        if self.interference.as_ref().is_some_and(|i| !i.enabled) {
+            out.push_str("   interference: OFF (the scenario sets [interference] enabled = false)\n");
+        } else if let Some(i) = &self.interference {
+            out.push_str(&format!(
+                "   interference: {} member(s){}, {} pair(s) checked over {} tick(s); min clearance {}; {} violation(s) below {:.3e} m{}\n",
+                i.members_checked,
+                if i.tendons { " incl. cables and springs" } else { ", struts only" },
+                i.pairs_checked,
+                i.ticks_checked,
+                match (&i.min_clearance_m, &i.closest_pair) {
+                    (Some(c), Some([a, b])) => format!("{c:.6e} m ({a} / {b}, tick {})", i.tick_of_min.unwrap_or(0)),
+                    _ => format!("> {:.3e} m (no pair within the margin)", i.margin_m),
+                },
+                i.violations.len(),
+                i.threshold_m,
+                if i.informative { " (informative)" } else if i.passed { "" } else { "  FAIL" }
+            ));
+            for v in i.violations.iter().take(MAX_POINTS_IN_TABLE) {
+                let [p, q] = v.closest_points;
+                out.push_str(&format!(
+                    "     {} '{}' / {} '{}': ticks {}-{}, min clearance {:.6e} m at tick {}, closest points ({:.6}, {:.6}, {:.6}) ({:.6}, {:.6}, {:.6})\n",
+                    v.kinds[0], v.pair[0], v.kinds[1], v.pair[1], v.first_tick, v.last_tick, v.min_clearance_m, v.tick_of_min,
+                    p[0], p[1], p[2], q[0], q[1], q[2]
+                ));
+            }
+        }
+    }
+
+    /// Stability verdicts, the branches landed on, the ranges along a trajectory.
+    fn table_stability(&self, out: &mut String) {
+        let unstable = self.points.iter().filter(|p| p.stable == Some(false)).count();
+        let tested = self.points.iter().filter(|p| p.stable.is_some()).count();
+        let disagree = self
+            .points
+            .iter()
+            .filter(|p| p.stable.is_some() && p.analytic_stable.is_some() && p.stable != p.analytic_stable)
+            .count();
+        let expected = self.points.iter().filter(|p| p.stable.is_some() && p.expected_stable.is_some()).count();
+        let unexpected = self
+            .points
+            .iter()
+            .filter(|p| p.stable.is_some() && p.expected_stable.is_some() && p.stable != p.expected_stable)
+            .count();
+        if expected > 0 {
+            out.push_str(&format!(
+                "   stability expected at {expected} point(s) (the file or its energy model): {unexpected} disagree\n"
+            ));
+        }
+        if tested > 0 {
+            out.push_str(&format!(
+                "   stability: {tested} point(s) perturbed, {unstable} unstable, {disagree} disagree with the analytic sign of K\n"
+            ));
+        }
+        let mut branches: std::collections::BTreeMap<&str, usize> = std::collections::BTreeMap::new();
+        for p in &self.points {
+            *branches.entry(p.branch.as_str()).or_default() += 1;
+        }
+        for (b, n) in &branches {
+            out.push_str(&format!("   landed on: {b}: {n} point(s)\n"));
+        }
+        for (q, r) in &self.trajectory_ranges {
+            out.push_str(&format!(
+                "   along the trajectory: {q} from {:.6e} to {:.6e}, smallest |{q}| {:.6e}\n",
+                r.min, r.max, r.min_abs
+            ));
+        }
+    }
+
+    /// The first settle points, with the paper's values where it prints them.
+    fn table_points(&self, out: &mut String) {
+        let shown = self.points.len().min(MAX_POINTS_IN_TABLE);
+        for p in &self.points[..shown] {
+            out.push_str(&format!(
+                "   point {:>4}: {}  -> {}  [{}{}]\n",
+                p.index,
+                fmt_values(&p.inputs),
+                fmt_errors(&p.analytic, &p.simulated),
+                p.branch,
+                if p.settled {
+                    String::new()
+                } else {
+                    format!(", NOT SETTLED: kinetic energy {:.3e} J left", p.final_kinetic_energy_j)
+                }
+            ));
+            if let Some(paper) = &p.paper {
+                // The paper's value beside the testbed's analytic one, with their relative
+                // difference.
+                let beside: Vec<String> = paper
+                    .values
+                    .iter()
+                    .map(|(q, v)| match p.analytic.get(q.trim_start_matches("ansys_")) {
+                        Some(a) if *a != 0.0 => format!("{q}={v:.6} ({:+.1e})", (v - a) / a.abs()),
+                        _ => format!("{q}={v:.6}"),
+                    })
+                    .collect();
+                out.push_str(&format!(
+                    "              paper, {}: {}  (relative difference from the testbed's analytic value)\n",
+                    paper.source,
+                    beside.join(" ")
+                ));
+            }
+        }
+        if self.points.len() > shown {
+            out.push_str(&format!("   ... {} more point(s) in the JSON report\n", self.points.len() - shown));
+        }
+    }
+
+    /// The printed equations that do not hold.
+    fn table_findings(&self, out: &mut String) {
+        let wrong: Vec<_> = self.findings.iter().filter(|f| !f.holds).collect();
+        if !self.findings.is_empty() {
+            out.push_str(&format!(
+                "   findings: {} printed equation(s) checked, {} do not hold as printed:\n",
+                self.findings.len(),
+                wrong.len()
+            ));
+            for f in wrong {
+                out.push_str(&format!("     - {}: {} ({})\n", f.equation, f.claim, f.measured));
+            }
+        }
+    }
+}
+
+/// Points listed in the table; the JSON has them all.
+const MAX_POINTS_IN_TABLE: usize = 12;
+
+fn fmt_values(v: &Values) -> String {
+    v.iter().map(|(k, x)| format!("{k}={x:.6}")).collect::<Vec<_>>().join(" ")
+}
+
+fn fmt_errors(analytic: &Values, simulated: &Values) -> String {
+    simulated
+        .iter()
+        .filter_map(|(k, s)| {
+            analytic.get(k).map(|a| {
+                // Angles (the papers' theta symbols) are compared modulo 2 pi.
+                let e = if k.starts_with("theta") { crate::mechanisms::wrap_angle(s - a) } else { s - a };
+                format!("{k}={s:.9} (err {:.1e})", e.abs())
+            })
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}

@@ -1,0 +1,165 @@
+//! The verdict, in one place: its parts ([`Failure`]), what a scenario declares of them
+//! ([`Expectation`]), and the pass policy: which parts of a run's verdict failed ([`failures`]), whether
+//! it passed, and whether that is what the scenario's `[expect]` declares.
+//!
+//! A run passes when [`failures`] is empty. Each failure is named the way a scenario file
+//! names it in `[expect] failing`, so a deliberate demonstration of a failure (two struts
+//! through each other, a model that does not hold) declares exactly which part must fail.
+
+use super::{PointReport, ScenarioReport};
+use std::fmt;
+
+/// Which parts of the verdict failed. A workspace sweep (`[workspace] min_agreement_percent`,
+/// given here) passes on the agreement of the analytic and dynamic classifications instead of
+/// on every point: settling and checks are what the classification is made of, reported per
+/// point.
+pub fn failures(report: &ScenarioReport, min_agreement_percent: Option<f64>) -> Vec<Failure> {
+    let mut out = Vec::new();
+    if report.error.is_some() {
+        out.push(Failure::Error);
+    }
+    if let (Some(min), Some(w)) = (min_agreement_percent, &report.workspace) {
+        if !(w.agreement_percent >= min) {
+            out.push(Failure::Workspace);
+        }
+    } else {
+        if !report.settle.settled {
+            out.push(Failure::Settle);
+        }
+        out.extend(report.checks.iter().filter(|c| !c.passed).map(|c| Failure::Check(c.quantity.clone())));
+        out.extend(report.model_checks.iter().filter(|c| !c.passed).map(|c| c.failure()));
+        if report.stiffness_probe.as_ref().is_some_and(|p| !p.passed) {
+            out.push(Failure::Probe);
+        }
+        // The perturbation test must agree with the analytic stability and with the stability
+        // the scenario expects (a point that did not settle fails on `settle` instead).
+        let agrees = |p: &PointReport, want: Option<bool>| p.stable.is_none() || want.is_none() || p.stable == want;
+        let stability_agrees =
+            report.points.iter().all(|p| agrees(p, p.analytic_stable) && (!p.settled || agrees(p, p.expected_stable)));
+        if !stability_agrees {
+            out.push(Failure::Stability);
+        }
+        if report.points.iter().any(|p| p.slack_agrees == Some(false)) {
+            out.push(Failure::Slack);
+        }
+    }
+    if report.interference.as_ref().is_some_and(|i| !i.passed) {
+        out.push(Failure::Interference);
+    }
+    out
+}
+
+/// One part of a run's verdict that failed.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Failure {
+    /// The run stopped early (divergence, interruption, a model error, a panic, a recording
+    /// that could not be written): `error`.
+    Error,
+    /// A settle point did not settle within `settle.max_time`: `settle`.
+    Settle,
+    /// A `[[checks]]` quantity exceeded its tolerance: `check:QUANTITY`.
+    Check(String),
+    /// The stiffness probe disagreed with the analytic stiffness: `probe`.
+    Probe,
+    /// The perturbation test disagreed with the analytic stability: `stability`.
+    Stability,
+    /// The slack cables differ from the analytic model's: `slack`.
+    Slack,
+    /// Two members came closer than the interference threshold: `interference`.
+    Interference,
+    /// A workspace sweep's agreement fell below `workspace.min_agreement_percent`: `workspace`.
+    Workspace,
+    /// A `[[predictions]]` entry of the file's model exceeded its tolerance: `prediction:NAME`.
+    Prediction(String),
+    /// A `[[equations]]` residual exceeded its tolerance: `equation:NAME`.
+    Equation(String),
+    /// The dynamics settled away from the `[energy]` model's minima: `energy`.
+    Energy,
+}
+
+/// The names a scenario may give in `[expect] failing` (a check is `check:QUANTITY`).
+pub const FAILURE_NAMES: &[&str] = &[
+    "error",
+    "settle",
+    "check:QUANTITY",
+    "probe",
+    "stability",
+    "slack",
+    "interference",
+    "workspace",
+    "prediction:NAME",
+    "equation:NAME",
+    "energy",
+];
+
+impl fmt::Display for Failure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Failure::Error => f.write_str("error"),
+            Failure::Settle => f.write_str("settle"),
+            Failure::Check(q) => write!(f, "check:{q}"),
+            Failure::Probe => f.write_str("probe"),
+            Failure::Stability => f.write_str("stability"),
+            Failure::Slack => f.write_str("slack"),
+            Failure::Interference => f.write_str("interference"),
+            Failure::Workspace => f.write_str("workspace"),
+            Failure::Prediction(n) => write!(f, "prediction:{n}"),
+            Failure::Equation(n) => write!(f, "equation:{n}"),
+            Failure::Energy => f.write_str("energy"),
+        }
+    }
+}
+
+impl std::str::FromStr for Failure {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Ok(match s {
+            "error" => Failure::Error,
+            "settle" => Failure::Settle,
+            "probe" => Failure::Probe,
+            "stability" => Failure::Stability,
+            "slack" => Failure::Slack,
+            "interference" => Failure::Interference,
+            "workspace" => Failure::Workspace,
+            "energy" => Failure::Energy,
+            _ if s.strip_prefix("prediction:").is_some_and(|n| !n.is_empty()) => {
+                Failure::Prediction(s["prediction:".len()..].to_string())
+            }
+            _ if s.strip_prefix("equation:").is_some_and(|n| !n.is_empty()) => {
+                Failure::Equation(s["equation:".len()..].to_string())
+            }
+            _ => match s.strip_prefix("check:") {
+                Some(q) if !q.is_empty() => Failure::Check(q.to_string()),
+                _ => return Err(format!("unknown failure '{s}' (expected one of: {})", FAILURE_NAMES.join(", "))),
+            },
+        })
+    }
+}
+
+impl serde::Serialize for Failure {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+/// What a scenario declares it must do: pass, or fail in exactly these parts.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct Expectation {
+    /// Empty: the run must pass. Otherwise the run must fail in these parts and no other.
+    pub failing: Vec<Failure>,
+}
+
+impl Expectation {
+    pub const PASS: Expectation = Expectation { failing: Vec::new() };
+
+    /// Whether a run that failed in `failures` did what was declared (the order is free).
+    pub fn met_by(&self, failures: &[Failure]) -> bool {
+        let mut want = self.failing.clone();
+        want.sort();
+        want.dedup();
+        let mut got = failures.to_vec();
+        got.sort();
+        got.dedup();
+        want == got
+    }
+}

@@ -1,0 +1,175 @@
+//! `[[quantities]]`, `[[predictions]]` and `[[equations]]`: the file's own model, compiled into
+//! a [`ModelSpec`] against the symbols of the mechanism's structure (node coordinates, member
+//! forces and lengths, revolute joints' angles and prismatic joints' slides), its observed
+//! quantities, inputs and parameters, and time `t`. An error
+//! inside an expression names its `file:LINE:COL` inside the string and the symbols there.
+
+use super::error::{positive_value, Ctx, ScenarioError};
+use super::number::expr_error;
+use super::raw::{RawEquation, RawPrediction, RawQuantity, RawScenario};
+use super::Actuation;
+use crate::file_model::expr::Expr;
+use crate::file_model::spec::{Equation, ErrorClass, ModelSpec, Prediction, Quantity, Source, Symbol};
+use crate::mechanisms::{Mechanism, Values};
+use crate::structure::JointKind;
+use toml::Spanned;
+
+/// The compiled model section, or None when the file states none.
+pub(super) fn model(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    m: &dyn Mechanism,
+    params: &Values,
+    start: &Values,
+    actuation: &Actuation,
+) -> Result<Option<ModelSpec>, ScenarioError> {
+    let Some(first) = first_entry(raw) else { return Ok(None) };
+    let inputs = match actuation {
+        Actuation::Points { points, .. } => &points[0],
+        Actuation::Schedule { waypoints } => &waypoints[0].1,
+    };
+    let structure = m
+        .build(params, inputs, start)
+        .map_err(|e| ctx.err_at(first, format!("cannot list the structure's symbols: {e}")))?;
+    let mut spec = ModelSpec { symbols: state_symbols(&structure, m, params), ..Default::default() };
+    for q in &raw.quantities {
+        quantity(ctx, &mut spec, q)?;
+    }
+    for p in &raw.predictions {
+        prediction(ctx, &mut spec, p)?;
+    }
+    for e in &raw.equations {
+        equation(ctx, &mut spec, e)?;
+    }
+    if let Some(e) = &raw.energy {
+        spec.energy = Some(super::energy::energy(ctx, &spec, e)?);
+    }
+    Ok(Some(spec))
+}
+
+/// Where the first model entry starts, if there is one.
+fn first_entry(raw: &RawScenario) -> Option<usize> {
+    let q = raw.quantities.first().map(|q| q.name.span().start);
+    let p = raw.predictions.first().map(|p| p.quantity.span().start);
+    let e = raw.equations.first().map(|e| e.name.span().start);
+    let u = raw.energy.as_ref().map(|u| u.potential.span().start);
+    [q, p, e, u].into_iter().flatten().min()
+}
+
+/// The symbols of the state: nodes, members, observed quantities, inputs, parameters and `t`
+/// (a name given twice keeps its first meaning).
+fn state_symbols(s: &crate::structure::Structure, m: &dyn Mechanism, params: &Values) -> Vec<Symbol> {
+    let mut out: Vec<Symbol> = Vec::new();
+    let mut add = |name: String, source: Source| {
+        if !out.iter().any(|x| x.name == name) {
+            out.push(Symbol { name, source });
+        }
+    };
+    for n in &s.nodes {
+        for (axis, c) in ["x", "y", "z"].iter().enumerate() {
+            add(format!("{}.{c}", n.name), Source::Node(n.name.clone(), axis));
+        }
+    }
+    let members = s.springs.iter().map(|m| &m.name).chain(s.cables.iter().map(|m| &m.name));
+    for name in members {
+        add(format!("{name}.force"), Source::MemberForce(name.clone()));
+        add(format!("{name}.length"), Source::MemberLength(name.clone()));
+    }
+    for st in &s.struts {
+        add(format!("{}.length", st.name), Source::MemberLength(st.name.clone()));
+    }
+    for j in &s.joints {
+        match j.kind {
+            JointKind::Revolute { .. } => add(format!("{}.angle", j.name), Source::JointAngle(j.name.clone())),
+            JointKind::Prismatic { .. } => add(format!("{}.slide", j.name), Source::JointSlide(j.name.clone())),
+            _ => {}
+        }
+    }
+    for q in m.quantities() {
+        add(q.symbol.to_string(), Source::Observed(q.symbol.to_string()));
+    }
+    for i in m.inputs() {
+        add(i.symbol.to_string(), Source::Input(i.symbol.to_string()));
+    }
+    for (k, v) in params {
+        add(k.clone(), Source::Param(*v));
+    }
+    add("t".into(), Source::Time);
+    out
+}
+
+/// A name not yet taken by a symbol.
+fn new_name(ctx: &Ctx, spec: &ModelSpec, name: &Spanned<String>, what: &str) -> Result<String, ScenarioError> {
+    let n = name.get_ref();
+    if n.trim().is_empty() {
+        return Err(ctx.err(name, format!("a {what} needs a name")));
+    }
+    if spec.symbols.iter().any(|s| &s.name == n) {
+        return Err(ctx.err(name, format!("{what} name '{n}' is already a symbol of this scenario")));
+    }
+    Ok(n.clone())
+}
+
+/// An expression compiled against `symbols`, its errors located inside its string.
+fn compile(ctx: &Ctx, text: &Spanned<String>, symbols: &[&str], what: &str) -> Result<Expr, ScenarioError> {
+    Expr::compile(text.get_ref(), symbols).map_err(|e| expr_error(ctx, text.span().start, &e, what))
+}
+
+fn quantity(ctx: &Ctx, spec: &mut ModelSpec, q: &RawQuantity) -> Result<(), ScenarioError> {
+    let name = new_name(ctx, spec, &q.name, "quantity")?;
+    let expr = compile(ctx, &q.expr, &spec.names(), &format!("quantity '{name}'"))?;
+    let closed_form = expr.uses().iter().all(|&u| spec.is_closed_form(u));
+    spec.symbols.push(Symbol { name: name.clone(), source: Source::Quantity(spec.quantities.len()) });
+    let unit = q.unit.clone().unwrap_or_else(|| "-".into());
+    spec.quantities.push(Quantity { name, unit, expr, closed_form });
+    Ok(())
+}
+
+/// A prediction: its compared symbol, its formula (parameters and inputs only), class and
+/// tolerance; its name unique among the predictions.
+fn prediction(ctx: &Ctx, spec: &mut ModelSpec, p: &RawPrediction) -> Result<(), ScenarioError> {
+    let q = p.quantity.get_ref();
+    let symbol = spec.symbols.iter().position(|s| &s.name == q).ok_or_else(|| {
+        let quantities: Vec<_> = spec.quantities.iter().map(|q| q.name.as_str()).collect();
+        ctx.err(
+            &p.quantity,
+            format!(
+                "unknown quantity '{q}' (the [[quantities]] here: {}; or a node coordinate NODE.x, a member's \
+                 NAME.force or NAME.length, or a quantity of the mechanism)",
+                if quantities.is_empty() { "none".into() } else { quantities.join(", ") }
+            ),
+        )
+    })?;
+    let name = p.name.as_ref().map_or(q.clone(), |n| n.get_ref().clone());
+    if spec.predictions.iter().any(|x| x.name == name) {
+        let at = p.name.as_ref().unwrap_or(&p.quantity);
+        return Err(ctx.err(at, format!("two predictions named '{name}': give each a distinct name = \"...\"")));
+    }
+    // The formula may use parameters, inputs and quantities of those only: every other symbol
+    // is hidden from it.
+    let closed_form: Vec<&str> = (0..spec.symbols.len())
+        .map(|i| if spec.is_closed_form(i) { spec.symbols[i].name.as_str() } else { "" })
+        .collect();
+    let what = format!("prediction '{name}' (parameters, inputs and their quantities only)");
+    let formula = compile(ctx, &p.formula, &closed_form, &what)?;
+    let class = ErrorClass::parse(p.class.get_ref()).ok_or_else(|| {
+        ctx.err(
+            &p.class,
+            format!("unknown class '{}' (expected one of: {})", p.class.get_ref(), ErrorClass::NAMES.join(", ")),
+        )
+    })?;
+    let tolerance = positive_value(ctx, &p.tolerance, "tolerance")?;
+    spec.predictions.push(Prediction { name, symbol, formula, class, tolerance });
+    Ok(())
+}
+
+fn equation(ctx: &Ctx, spec: &mut ModelSpec, e: &RawEquation) -> Result<(), ScenarioError> {
+    let name = e.name.get_ref().clone();
+    if name.trim().is_empty() || spec.equations.iter().any(|x| x.name == name) {
+        return Err(ctx.err(&e.name, format!("an equation needs a name of its own, got '{name}'")));
+    }
+    let residual = compile(ctx, &e.residual, &spec.names(), &format!("equation '{name}'"))?;
+    let tolerance = positive_value(ctx, &e.tolerance, "tolerance")?;
+    spec.equations.push(Equation { name, residual, tolerance });
+    Ok(())
+}

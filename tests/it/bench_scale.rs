@@ -1,0 +1,217 @@
+//! The scale families of `tensegrity bench --scale` (src/bench/scale/): each family's closed
+//! form is an equilibrium of the testbed's force laws, and small members of each family settle
+//! to it from their perturbed starts.
+
+use tensegrity_testbed::bench::scale::{self, furet, icosahedron, prism, tower, Case, ScaleCase, DEFAULT_CAPS};
+use tensegrity_testbed::mechanisms::furet2018::analytic::{self, Params};
+use tensegrity_testbed::settings::SimSettings;
+use tensegrity_testbed::sim::Simulation;
+use tensegrity_testbed::structure::Structure;
+
+/// Largest residual force or torque [N, N m] of `s` as drawn, its actuators at `commands`.
+fn residual_as_drawn(s: &Structure, settings: &SimSettings, commands: &[f64]) -> f64 {
+    let mut sim = Simulation::new(s, settings).expect("the structure builds");
+    if !commands.is_empty() {
+        sim.set_commands(commands);
+    }
+    let r = sim.snapshot().forces.residual.expect("a residual is computed");
+    r.max_force_n.max(r.max_torque_nm)
+}
+
+/// The case's structure redrawn at its closed form: its residual as drawn.
+fn assert_equilibrium(name: &str, s: &Structure, case: &Case) {
+    let r = residual_as_drawn(s, &case.settings, &case.commands);
+    assert!(r <= 1e-9, "{name}: residual {r:e} as drawn at the closed form");
+}
+
+/// Prisms of 3, 4 and 7 struts drawn at the twist pi/2 + pi/n with the rest lengths of the
+/// force densities side : polygon = 1 : 1 / (2 sin(pi/n)) carry no residual force above 1e-9 N.
+#[test]
+fn a_prism_drawn_at_its_closed_form_twist_is_an_equilibrium() {
+    for n in [3, 4, 7] {
+        let s = prism(n, std::f64::consts::FRAC_PI_2 + std::f64::consts::PI / n as f64);
+        assert_equilibrium(&format!("prism {n}"), &s, &prism::case(n));
+    }
+}
+
+/// The icosahedron drawn as the expanded octahedron (pairs L/2 apart, cables sqrt(6)/4 L)
+/// carries no residual above 1e-9 N, and its drawn cable / strut length ratio is sqrt(6)/4
+/// within 1e-15.
+#[test]
+fn the_expanded_octahedron_is_the_icosahedrons_equilibrium() {
+    let s = icosahedron::icosahedron(0.5 * icosahedron::STRUT_LENGTH_M);
+    assert_equilibrium("icosahedron", &s, &icosahedron::case());
+    for c in &s.cables {
+        let l = tensegrity_testbed::structure::distance(s.nodes[c.a].position, s.nodes[c.b].position);
+        let ratio = l / icosahedron::STRUT_LENGTH_M;
+        assert!((ratio - icosahedron::cable_to_strut_ratio()).abs() <= 1e-15, "{}: {ratio}", c.name);
+    }
+}
+
+/// The force density design of towers of 1 to 5 stages: sum q (x_j - x_i) vanishes at every
+/// free node within 1e-9 N, every stage cable is in tension and every strut in compression,
+/// and the stage-to-stage members carry no force (|q| below 1e-12 of the largest).
+#[test]
+fn the_tower_force_densities_balance_every_free_node() {
+    for m in 1..=5 {
+        let d = tower::design(m).unwrap();
+        let r = tower::node_residual(&d, &d.q);
+        assert!(r <= 1e-9, "{m} stages: node residual {r:e} N");
+        let largest = d.q.iter().fold(0.0f64, |a, q| a.max(q.abs()));
+        for ((kind, a, b), q) in d.members.iter().zip(&d.q) {
+            match kind {
+                tower::Kind::Strut => assert!(*q < 0.0, "{m} stages: strut {a}-{b} q = {q}"),
+                k if k.is_cable() => assert!(*q > 0.0, "{m} stages: cable {a}-{b} q = {q}"),
+                _ => assert!(q.abs() <= 1e-12 * largest, "{m} stages: link {a}-{b} q = {q}"),
+            }
+        }
+    }
+}
+
+/// Towers of 1 to 3 stages, drawn as designed with the rest lengths from the force densities,
+/// carry no residual above 1e-9 N in the testbed's force laws.
+#[test]
+fn a_tower_drawn_as_designed_is_an_equilibrium() {
+    for m in 1..=3 {
+        let d = tower::design(m).unwrap();
+        assert_equilibrium(&format!("tower {m}"), &tower::structure(&d, 0.0), &tower::case(m).unwrap());
+    }
+}
+
+/// Chains of 1 to 3 furet2018 X modules drawn at the commanded theta carry no residual above
+/// 1e-9 N, and their drawn end point is Eq. 2's within 1e-12 m.
+#[test]
+fn a_furet_chain_drawn_at_its_commands_is_an_equilibrium_at_eq2() {
+    let p = Params::PAPER;
+    for n in 1..=3 {
+        let thetas = vec![furet::THETA_RAD; n];
+        let (s, ends) = furet::chain(&p, &thetas);
+        assert_equilibrium(&format!("furet {n}"), &s, &furet::case(n));
+        let (x, y) = analytic::direct_kinematics_n(&p, &thetas);
+        let e = s.nodes[ends[n - 1]].position;
+        assert!((e[0] - x).hypot(e[1] - y) <= 1e-12, "furet {n}: drawn end point {e:?}, Eq. 2 ({x}, {y})");
+    }
+}
+
+fn assert_settles(c: &ScaleCase, tolerance: f64) {
+    let what = format!("{} {}", c.family, c.size);
+    assert!(c.settled, "{what}: not settled ({:?})", c.note);
+    assert!(c.steps <= 50, "{what}: {} steps", c.steps);
+    assert!(c.error <= tolerance, "{what}: error {:e} {}", c.error, c.error_unit);
+    assert!(c.residual <= 1e-9, "{what}: residual {:e}", c.residual);
+}
+
+/// Small members of every family settle from their perturbed starts in at most 50 steps
+/// (measured 11 to 19) to the closed form within 1e-9 (m, or rad for the prisms' twist;
+/// measured 1e-16 to 1e-14).
+#[test]
+fn small_members_of_every_family_settle_to_their_closed_form() {
+    for (family, max_struts) in [("prism", 4), ("icosahedron", 6), ("tower", 8), ("furet", 10)] {
+        let cases = scale::cases(family, max_struts).unwrap();
+        assert!(!cases.is_empty(), "{family}: no case up to {max_struts} struts");
+        for case in cases {
+            assert_settles(&scale::run_case(&case, &DEFAULT_CAPS).unwrap(), 1e-9);
+        }
+    }
+}
+
+/// The growth exponent is the slope of ln(wall) against ln(struts): wall = 1e-6 struts^2.5
+/// gives 2.5 within 1e-12.
+#[test]
+fn the_growth_exponent_is_the_log_log_slope() {
+    let case = |struts: usize| ScaleCase {
+        family: "synthetic",
+        size: struts,
+        struts,
+        cables: 0,
+        springs: 0,
+        joints: 0,
+        settled: true,
+        steps: 1,
+        wall_s: 1e-6 * (struts as f64).powf(2.5),
+        rss_before_kib: None,
+        peak_rss_kib: None,
+        error: 0.0,
+        error_unit: "m",
+        residual: 0.0,
+        note: None,
+        settled_nodes: Vec::new(),
+    };
+    let cases: Vec<ScaleCase> = [3, 10, 100, 300, 1000].into_iter().map(case).collect();
+    let e = scale::growth_exponent(&cases).unwrap();
+    assert!((e - 2.5).abs() <= 1e-12, "exponent {e}");
+}
+
+/// The aligned distance ignores a rigid motion: a set turned by 0.7 rad about (1, 2, 3) and
+/// moved by (4, -5, 6) m is 0 m (within 1e-12) from the original, and a node moved by 1e-3 m
+/// reads below 1e-3 m and above 0.
+#[test]
+fn the_aligned_distance_ignores_rigid_motions() {
+    let pts = icosahedron::icosahedron(0.5).nodes.iter().map(|n| n.position).collect::<Vec<_>>();
+    let r = nalgebra::Rotation3::from_axis_angle(
+        &nalgebra::Unit::new_normalize(nalgebra::Vector3::new(1.0, 2.0, 3.0)),
+        0.7,
+    );
+    let moved: Vec<[f64; 3]> =
+        pts.iter().map(|p| (r * nalgebra::Vector3::from(*p) + nalgebra::Vector3::new(4.0, -5.0, 6.0)).into()).collect();
+    assert!(scale::aligned_distance(&moved, &pts) <= 1e-12);
+    let mut bent = pts.clone();
+    bent[3][0] += 1e-3;
+    let d = scale::aligned_distance(&bent, &pts);
+    assert!(d > 0.0 && d < 1e-3, "{d}");
+}
+
+use crate::common;
+
+/// The Python that has MuJoCo: `TENSEGRITY_PYTHON` if set, else `python3`; None (the test
+/// then says it skipped) when `import mujoco` fails.
+fn python_with_mujoco() -> Option<String> {
+    let py = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
+    let ok = std::process::Command::new(&py).args(["-c", "import mujoco"]).output().is_ok_and(|o| o.status.success());
+    ok.then_some(py)
+}
+
+/// Every family's members up to 6 struts go through MuJoCo in the same run
+/// (`benches/peers/mujoco/scale_peer.py` on the testbed's MJCF export): MuJoCo settles every
+/// one, with no export warning, within 1e-5 of the closed form (measured 4e-14 rad to 7e-7 m),
+/// and the testbed's error is below a tenth of MuJoCo's on each (measured 1e-2 to 5e-10).
+#[test]
+fn mujoco_settles_the_small_members_side_by_side() {
+    let Some(py) = python_with_mujoco() else {
+        eprintln!("skipped: no Python with `import mujoco` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt)");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("tensegrity-test-scale-peer-{}", std::process::id()));
+    let command = [py, "benches/peers/mujoco/scale_peer.py".to_string()];
+    let out = scale::peer::compare(&scale::FAMILIES, 6, &DEFAULT_CAPS, &command, &dir);
+    let _ = std::fs::remove_dir_all(&dir);
+    let (reports, rows) = out.unwrap();
+    assert_eq!(reports.len(), 4);
+    assert_eq!(rows.len(), 6, "prisms 3, 4, 6, the icosahedron, a 1-stage tower, a 1-module chain");
+    for r in &rows {
+        let what = format!("{} {}", r.family, r.size);
+        assert!(r.testbed_settled && r.peer_settled, "{what}: settled {} / {}", r.testbed_settled, r.peer_settled);
+        assert!(r.peer_notes.is_empty(), "{what}: {:?}", r.peer_notes);
+        assert!(r.peer_error <= 1e-5, "{what}: MuJoCo error {:e} {}", r.peer_error, r.error_unit);
+        assert!(r.ratio_error <= 0.1, "{what}: testbed / MuJoCo error {:e}", r.ratio_error);
+    }
+}
+
+/// The command line: an unknown family is bad input (exit 2, named in the message), and
+/// `--json` lists each family's cases up to `--max-struts`.
+#[test]
+fn bench_scale_cli_selects_families_and_sizes() {
+    let (code, _, err) = common::tensegrity(&["bench", "--scale", "--family", "cube"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("no scale family 'cube'"), "{err}");
+    let (code, out, _) = common::tensegrity(&["bench", "--scale", "--family", "prism", "--max-struts", "4", "--json"]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let cases = v["scale"][0]["cases"].as_array().unwrap();
+    let struts: Vec<u64> = cases.iter().map(|c| c["struts"].as_u64().unwrap()).collect();
+    assert_eq!(struts, [3, 4]);
+    assert!(cases.iter().all(|c| c["settled"] == true && c["error_unit"] == "rad"));
+    // Memory: the peak resident set of a case is at least the one before it.
+    let kib = |c: &serde_json::Value, k: &str| c[k].as_u64().unwrap();
+    assert!(cases.iter().all(|c| kib(c, "peak_rss_kib") >= kib(c, "rss_before_kib")), "{out}");
+}

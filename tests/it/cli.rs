@@ -1,0 +1,292 @@
+//! The command line: exit codes 0 / 1 / 2, file:line:col errors, solve, list, record.
+
+use crate::common;
+
+use common::tensegrity;
+
+fn temp_file(name: &str, text: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("tensegrity-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const VALID: &str = r#"name = "t"
+mechanism = "ji2014"
+[params]
+L = 1.0
+[actuation]
+points = [ { L3 = 1.0, theta1 = 0.5 } ]
+[[checks]]
+quantity = "theta2"
+tolerance = 1e-9
+"#;
+
+#[test]
+fn run_passes_with_exit_0_and_writes_the_json_report() {
+    let json = std::env::temp_dir().join(format!("tensegrity-report-{}.json", std::process::id()));
+    let (code, out, err) = tensegrity(&["run", "scenarios/ji2014/quick.toml", "--json", json.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("PASS"));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let s = &v["scenarios"][0];
+    assert_eq!(s["mechanism"], "ji2014");
+    assert_eq!(s["passed"], true);
+    assert_eq!(s["settle"]["settled"], true);
+    assert!(s["points"][0]["inputs"]["L3"].is_number());
+    assert!(s["points"][0]["simulated"]["theta2"].is_number());
+    assert!(s["points"][0]["stable"].is_boolean());
+    assert!(s["checks"][0]["max_rel_error"].as_f64().unwrap() <= 1e-9);
+}
+
+#[test]
+fn a_check_that_fails_gives_exit_1() {
+    // A tolerance below what f64 can resolve cannot pass.
+    let p = temp_file("tight.toml", &VALID.replace("tolerance = 1e-9", "tolerance = 1e-300"));
+    let (code, out, _) = tensegrity(&["run", p.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("FAIL"));
+}
+
+/// Each malformed scenario gives exit 2 from check and run, with file:line:col in the message.
+#[test]
+fn bad_scenarios_give_exit_2_with_file_line_and_column() {
+    let cases: &[(&str, String, &str)] = &[
+        ("syntax", VALID.replace("L = 1.0", "L = = 1.0"), ":4:"),
+        ("unknown key", VALID.replace("[params]", "colour = 3\n[params]"), ":3:1"),
+        ("wrong type", VALID.replace("L = 1.0", "L = \"one\""), ":4:"),
+        ("negative length", VALID.replace("L = 1.0", "L = -1.0"), ":4:5"),
+        ("unknown param", VALID.replace("L = 1.0", "Q = 1.0"), ":4:1"),
+        ("theta1 out of range", VALID.replace("theta1 = 0.5", "theta1 = 4.0"), ":6:"),
+        ("missing input", VALID.replace(", theta1 = 0.5", ""), ":6:"),
+        ("unknown mechanism", VALID.replace("\"ji2014\"", "\"ji2015\""), ":2:13"),
+        ("zero dt", VALID.replace("[actuation]", "[sim]\ndt = 0.0\n[actuation]"), ":6:6"),
+        ("unknown start key", VALID.replace("[actuation]", "[start]\ntheta9 = 1.0\n[actuation]"), ":6:1"),
+        ("nan", VALID.replace("L = 1.0", "L = nan"), ":4:5"),
+        ("unknown quantity", VALID.replace("quantity = \"theta2\"", "quantity = \"zeta\""), ":8:12"),
+        ("empty points", VALID.replace("points = [ { L3 = 1.0, theta1 = 0.5 } ]", "points = []"), ":5:1"),
+        (
+            "unsorted waypoints",
+            VALID.replace(
+                "points = [ { L3 = 1.0, theta1 = 0.5 } ]",
+                "waypoints = [ { t = 1.0, L3 = 1.0, theta1 = 0.5 }, { t = 0.5, L3 = 1.0, theta1 = 0.5 } ]",
+            ),
+            ":6:",
+        ),
+    ];
+    for (what, text, loc) in cases {
+        let p = temp_file(&format!("{}.toml", what.replace(' ', "_")), text);
+        for cmd in ["check", "run"] {
+            let (code, out, err) = tensegrity(&[cmd, p.to_str().unwrap()]);
+            assert_eq!(code, 2, "{what} ({cmd}): exit {code}\n{out}{err}");
+            let file = p.to_str().unwrap();
+            assert!(err.contains(&format!("{file}{loc}")), "{what} ({cmd}): expected '{file}{loc}' in: {err}");
+            assert!(!err.contains("panicked"), "{what}: {err}");
+        }
+    }
+}
+
+#[test]
+fn a_missing_file_gives_exit_2() {
+    let (code, _, err) = tensegrity(&["check", "no/such/file.toml"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("no/such/file.toml:1:1"), "{err}");
+}
+
+#[test]
+fn every_shipped_scenario_is_valid() {
+    let mut checked = 0;
+    for dir in std::fs::read_dir("scenarios").unwrap() {
+        let dir = dir.unwrap().path();
+        if !dir.is_dir() {
+            continue;
+        }
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let p = entry.unwrap().path();
+            if p.extension().is_some_and(|e| e == "toml") {
+                let (code, out, err) = tensegrity(&["check", p.to_str().unwrap()]);
+                assert_eq!(code, 0, "{}: {out}{err}", p.display());
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 20, "{checked} scenario files checked");
+}
+
+#[test]
+fn solve_fk_prints_both_equilibria_with_their_stability() {
+    let (code, out, err) = tensegrity(&[
+        "solve",
+        "ji2014",
+        "fk",
+        "--set",
+        "L3=6",
+        "--set",
+        "theta1=0.3141592653589793",
+        "--set",
+        "K1=100",
+        "--set",
+        "K2=10",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let sols = v["solutions"].as_array().unwrap();
+    assert_eq!(sols.len(), 2);
+    assert_eq!(sols[0]["stable"], true);
+    assert!((sols[0]["values"]["theta2"].as_f64().unwrap() - 2.656091).abs() < 1e-6);
+    assert_eq!(sols[1]["stable"], false);
+}
+
+#[test]
+fn solve_ik_solutions_reproduce_the_target_through_fk() {
+    let (code, out, err) = tensegrity(&["solve", "ji2014", "ik", "--set", "x=-0.5", "--set", "y=0.8", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let sols = v["solutions"].as_array().unwrap();
+    assert!(!sols.is_empty());
+    for s in sols {
+        let (l3, th1, th2) = (
+            s["values"]["L3"].as_f64().unwrap(),
+            s["values"]["theta1"].as_f64().unwrap(),
+            s["values"]["theta2"].as_f64().unwrap(),
+        );
+        let x = l3 * th1.cos() + th2.cos();
+        let y = l3 * th1.sin() + th2.sin();
+        assert!((x + 0.5).abs() < 1e-10 && (y - 0.8).abs() < 1e-10, "({x}, {y})");
+    }
+}
+
+#[test]
+fn solve_rejects_unknown_names_and_unreachable_targets_with_exit_2() {
+    assert_eq!(tensegrity(&["solve", "ji2014", "fk", "--set", "L3=1"]).0, 2);
+    assert_eq!(tensegrity(&["solve", "ji2014", "fk", "--set", "L3=1", "--set", "theta1=0.5", "--set", "Z=1"]).0, 2);
+    assert_eq!(tensegrity(&["solve", "ji2014", "ik", "--set", "x=0", "--set", "y=-5"]).0, 2);
+    assert_eq!(tensegrity(&["solve", "nope", "fk"]).0, 2);
+    assert_eq!(tensegrity(&["solve", "ji2014", "fk", "--set", "L3=1", "--set", "theta1=0.5", "--set", "K1=-3"]).0, 2);
+}
+
+#[test]
+fn list_names_parameters_with_units_and_queries() {
+    let (code, out, _) = tensegrity(&["list"]);
+    assert_eq!(code, 0);
+    for s in ["ji2014", "K1", "[N/m]", "L3", "theta1", "fk", "ik"] {
+        assert!(out.contains(s), "missing {s} in list output");
+    }
+}
+
+#[test]
+fn record_writes_an_rrd_file_and_no_partial_file() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-rec-{}", std::process::id()));
+    let path = dir.join("quick.rrd");
+    let (code, out, err) = tensegrity(&["run", "scenarios/ji2014/quick.toml", "--record", path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    let len = std::fs::metadata(&path).expect("recording exists").len();
+    assert!(len > 10_000, "recording is only {len} bytes");
+    assert!(no_partial_files(&dir), "a temporary file was left in {}", dir.display());
+}
+
+/// No file in `dir` is a temporary one (`.NAME.PID.SEQ.partial.EXT`).
+fn no_partial_files(dir: &std::path::Path) -> bool {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .all(|e| !e.file_name().to_string_lossy().contains(".partial"))
+}
+
+/// A settle that runs out of time is a failure (exit 1), never a pass.
+#[test]
+fn a_settle_that_never_comes_fails_with_exit_1() {
+    let text = VALID.replace("[actuation]", "[settle]\nmax_time = 0.05\n[actuation]");
+    let p = temp_file("timeout.toml", &text);
+    let json = p.with_extension("json");
+    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap(), "--json", json.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("NOT SETTLED: kinetic energy"), "{out}");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["scenarios"][0]["settle"]["settled"], false);
+    assert_eq!(v["scenarios"][0]["passed"], false);
+    assert!(v["scenarios"][0]["points"][0]["final_kinetic_energy_j"].as_f64().unwrap() > 0.0);
+}
+
+/// A time step far too large for stiff springs diverges: the run stops, says what diverged and
+/// when, fails (exit 1), and still writes the report and the recording up to that tick.
+#[test]
+fn an_absurd_time_step_diverges_and_still_writes_report_and_recording() {
+    let text = VALID
+        .replace("L = 1.0", "L = 1.0\nK1 = 1e9\nK2 = 1e9\nc_D1 = 0.0")
+        .replace("[actuation]", "[sim]\ndt = 0.5\n[settle]\nmax_time = 50.0\n[actuation]");
+    let p = temp_file("diverge.toml", &text);
+    let json = p.with_extension("json");
+    let rrd = p.with_extension("rrd");
+    let (code, out, err) =
+        tensegrity(&["run", p.to_str().unwrap(), "--json", json.to_str().unwrap(), "--record", rrd.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let s = &v["scenarios"][0];
+    assert_eq!(s["passed"], false);
+    let e = s["error"].as_str().expect("the divergence is reported");
+    assert!(e.contains("diverged at tick"), "{e}");
+    assert!(std::fs::metadata(&rrd).map(|m| m.len() > 0).unwrap_or(false), "recording written");
+    assert!(no_partial_files(rrd.parent().unwrap()));
+    assert!(!err.contains("panicked"));
+}
+
+/// `--jobs` above the machine's threads is lowered, and said; the sweep runs.
+#[test]
+fn too_many_jobs_are_lowered_and_said() {
+    let (code, out, err) = tensegrity(&["sweep", "scenarios/ji2014/quick.toml", "--jobs", "100000"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(err.contains("--jobs 100000 lowered to"), "{err}");
+}
+
+/// A reader that closes the pipe early (`tensegrity list | head -1`) ends the command quietly:
+/// no panic message, killed by SIGPIPE like any Unix filter.
+#[test]
+fn a_closed_pipe_ends_the_command_quietly() {
+    use std::io::BufRead;
+    for args in [vec!["list"], vec!["findings", "ji2014"], vec!["solve", "furet2018", "workspace", "--set", "b=0.9"]] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+            .args(&args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        std::io::BufReader::new(child.stdout.take().unwrap()).read_line(&mut first).unwrap();
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{args:?}: {err}");
+        assert_ne!(out.status.code(), Some(101), "{args:?}");
+    }
+}
+
+/// Extreme parameter values are errors or findings, never a hang or a panic: a furet2018 target
+/// at 1e100 m (its quartic's companion matrix never converged) and mohr2011 with l_o = 1e6 l_b
+/// (a point that did not assemble panicked).
+#[test]
+fn extreme_values_give_answers_not_hangs_or_panics() {
+    let start = std::time::Instant::now();
+    let (code, _, err) = tensegrity(&["solve", "furet2018", "ik", "--set", "x=1e100", "--set", "y=1"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("outside the workspace"), "{err}");
+    let (code, out, err) = tensegrity(&["findings", "mohr2011", "--set", "lo=1e6", "--set", "lb=1"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("Eq. 12-14") && !err.contains("panicked"), "{out}{err}");
+    assert!(start.elapsed() < std::time::Duration::from_secs(30), "{:?}", start.elapsed());
+}
+
+/// `solve manriquez2019 fk` prints the cable ends P_M1 and P_M2 (Eq. 8-9) beside M, G and the
+/// cable lengths, each cable length equal to the distance from its base point to its end.
+#[test]
+fn manriquez2019_fk_prints_the_cable_ends_of_eq8_9() {
+    let (code, out, err) =
+        tensegrity(&["solve", "manriquez2019", "fk", "--set", "theta1=0.0941", "--set", "theta2=0.0332", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let values = &v["solutions"][0]["values"];
+    for k in ["x_M1", "y_M1", "z_M1", "x_M2", "y_M2", "z_M2", "L1", "L2"] {
+        assert!(values[k].is_number(), "{k} in {values}");
+    }
+}

@@ -1,0 +1,97 @@
+//! Mechanisms described in a scenario file: the 3-strut prism and a Snelson X, with no Rust.
+
+use crate::common;
+use common::{cross, dot, node, norm, run_file, sub, P3};
+use std::path::Path;
+use std::process::Command;
+use tensegrity_testbed::mechanisms::furet2018::analytic as furet;
+use tensegrity_testbed::run::{run, RunOptions};
+use tensegrity_testbed::scenario;
+
+/// The prism settles with the top triangle turned by pi/2 + pi/3 = 150 degrees from the bottom
+/// (within 1e-8 rad), force densities side : strut : polygon = 1 : -1 : 1/sqrt(3) (within 1e-8),
+/// and a node force residual below 1e-9 of the largest member force.
+#[test]
+fn prism3_settles_at_150_degrees_with_the_self_stress_ratios() {
+    let r = run_file("scenarios/custom/prism3.toml");
+    assert!(r.passed, "{:?}", r.error);
+    let b: Vec<P3> = (1..=3).map(|i| node(&r, &format!("B{i}"))).collect();
+    let t: Vec<P3> = (1..=3).map(|i| node(&r, &format!("T{i}"))).collect();
+    let centroid = |v: &[P3]| [0, 1, 2].map(|k| v.iter().map(|p| p[k]).sum::<f64>() / 3.0);
+    let (cb, ct) = (centroid(&b), centroid(&t));
+    let axis = sub(ct, cb);
+    let axis = axis.map(|x| x / norm(axis));
+    let proj = |v: P3| {
+        let d = dot(v, axis);
+        [v[0] - d * axis[0], v[1] - d * axis[1], v[2] - d * axis[2]]
+    };
+    let (u, w) = (proj(sub(b[0], cb)), proj(sub(t[0], ct)));
+    let twist = dot(cross(u, w), axis).atan2(dot(u, w));
+    let expected = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI / 3.0;
+    assert!((twist - expected).abs() <= 1e-8, "twist {twist} rad, expected {expected}");
+    let s = &r.points[0].simulated;
+    let q = |member: &str, a: P3, c: P3| s[&format!("{member}.force")] / norm(sub(a, c));
+    let q_side = q("side1", b[0], t[2]);
+    assert!(q_side > 0.0);
+    let q_strut = q("strut2", b[1], t[1]) / q_side;
+    let q_poly = q("top23", t[1], t[2]) / q_side;
+    assert!((q_strut + 1.0).abs() <= 1e-8, "strut : side = {q_strut}");
+    assert!((q_poly - 1.0 / 3f64.sqrt()).abs() <= 1e-8, "polygon : side = {q_poly}");
+    let largest = s.iter().filter(|(k, _)| k.ends_with(".force")).map(|(_, v)| v.abs()).fold(0.0, f64::max);
+    let p = &r.points[0];
+    assert!(p.residual_force_n <= 1e-9 * largest, "residual {} N of {largest} N", p.residual_force_n);
+}
+
+/// A Snelson X built from the file alone agrees with the built-in furet2018 module (Eq. 1-2 for
+/// one X at theta = 0.3) within 1e-10.
+#[test]
+fn snelson_x_from_a_file_agrees_with_the_furet2018_module() {
+    let r = run_file("scenarios/custom/snelson-x.toml");
+    assert!(r.passed, "{:?}", r.error);
+    let x = furet::chain_nodes(&furet::Params { l: 1.0, b: 2.0 / 3.0 }, &[0.3])[0];
+    let p = node(&r, "P");
+    assert!((p[0] - x.top_mid.x).abs() <= 1e-10 && (p[1] - x.top_mid.y).abs() <= 1e-10, "{p:?} vs {:?}", x.top_mid);
+    for (n, want) in [("C", x.top_right), ("D", x.top_left)] {
+        let got = node(&r, n);
+        assert!((got[0] - want.x).abs() <= 1e-10 && (got[1] - want.y).abs() <= 1e-10, "{n}: {got:?}");
+    }
+}
+
+/// Bad references, zero-length members and massless bodies are errors at their place.
+#[test]
+fn structure_errors_name_file_line_and_column() {
+    let good = std::fs::read_to_string("scenarios/custom/snelson-x.toml").unwrap();
+    let cases = [
+        ("unknown node", good.replacen("a = \"D\"\nb = \"C\"", "a = \"Q\"\nb = \"C\"", 1), "unknown node 'Q'"),
+        ("unknown body", good.replacen("parent = \"bar_AC\"", "parent = \"bar_XX\"", 1), "unknown body 'bar_XX'"),
+        ("massless body", good.replacen("name = \"top\"\nmass = 0.1", "name = \"top\"", 1), "needs a mass"),
+        ("zero-length member", good.replacen("a = \"A\"\nb = \"D\"", "a = \"A\"\nb = \"A\"", 1), "zero length"),
+        ("unknown joint kind", good.replacen("kind = \"planar_pin\"", "kind = \"hinge\"", 1), "unknown joint kind"),
+        ("check without value", good.replacen("value = ", "# value = ", 1), "give the expected value"),
+    ];
+    let dir = std::env::temp_dir().join(format!("tensegrity-custom-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (what, text, msg) in cases {
+        assert_ne!(text, good, "{what}: the replacement must change the file");
+        let p = dir.join(format!("{}.toml", what.replace(' ', "_")));
+        std::fs::write(&p, &text).unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_tensegrity")).args(["check", p.to_str().unwrap()]).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{what}: {err}");
+        let prefix = format!("{}:", p.display());
+        assert!(err.contains(&prefix) && err.contains(msg), "{what}: {err}");
+        let after = &err[err.find(&prefix).unwrap() + prefix.len()..];
+        assert!(after.chars().next().unwrap().is_ascii_digit(), "{what}: no line:col in {err}");
+    }
+}
+
+/// The README's example of a custom structure is a complete scenario that passes.
+#[test]
+fn the_readme_example_runs_and_passes() {
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let start = readme.find("name = \"Snelson X module\"\nmechanism = \"custom\"").expect("example in README");
+    let text = &readme[start..start + readme[start..].find("```").unwrap()];
+    let sc = scenario::parse(Path::new("README.md"), text).expect("the example parses");
+    let r = run(&sc, &RunOptions::default());
+    assert!(r.passed, "{:?}", r.error);
+}

@@ -1,0 +1,110 @@
+//! Sweeps over parameters: a grid or a point may set parameters besides the inputs, for a
+//! custom structure (rebuilt at each value, its derived parameters following) and for a
+//! built-in mechanism (its analytic model and its structure both at the point's parameters).
+
+use crate::common;
+
+use std::path::Path;
+use tensegrity_testbed::run::{run, RunOptions};
+use tensegrity_testbed::scenario;
+
+const BAR: &str = "scenarios/custom/pinned_bar_sweep.toml";
+const JI_QUICK: &str = "scenarios/ji2014/quick.toml";
+
+/// Each k1 of the custom sweep settles on its own energy minimum q = atan2(k1 a, k2 b)
+/// (a = 0.8 m, b = 0.6 m, k2 = 30 N/m) within 1e-9 rad, read off the settled nodes.
+#[test]
+fn a_custom_structure_is_rebuilt_at_each_swept_stiffness() {
+    let sc = scenario::load(Path::new(BAR)).unwrap();
+    let r = run(&sc, &RunOptions::default());
+    assert!(r.passed, "{:?}", r.failures);
+    assert_eq!(r.points.len(), 9);
+    for p in &r.points {
+        let k1 = p.inputs["k1"];
+        let q = (p.simulated["P.y"] - p.simulated["A.y"]).atan2(p.simulated["P.x"] - p.simulated["A.x"]);
+        let want = (k1 * 0.8).atan2(30.0 * 0.6);
+        assert!((q - want).abs() <= 1e-9, "k1 = {k1}: q = {q}, atan2 = {want}");
+    }
+    let first = r.points[0].simulated["P.x"];
+    let last = r.points[8].simulated["P.x"];
+    assert!((first - last).abs() > 0.3, "the sweep moved the bar: P.x {first} -> {last}");
+}
+
+/// The prediction's derived parameter ratio = k1/k2 follows the swept k1: the model check
+/// passes at every point within 1e-9 rad (with ratio frozen at 50/30 it would be off by up to
+/// 0.73 rad).
+#[test]
+fn a_derived_parameter_follows_the_swept_one_in_the_model() {
+    let sc = scenario::load(Path::new(BAR)).unwrap();
+    let r = run(&sc, &RunOptions::default());
+    let q = r.model_checks.iter().find(|c| c.name == "q").expect("the prediction of q");
+    assert!(q.max_error <= 1e-9, "{q:?}");
+}
+
+/// ji2014 swept over K1 (50, 225, 400 N/m) at two inputs: each point's theta2 is its own
+/// K1's energy minimum (the built-in model at the point's parameters) within 1e-9 rad, and the
+/// minima differ between K1 values by more than 0.3 rad.
+#[test]
+fn a_builtin_mechanism_is_swept_over_a_parameter() {
+    let text = std::fs::read_to_string(JI_QUICK).unwrap();
+    let start = text.find("points = [").unwrap();
+    let end = start + text[start..].find("]\n").unwrap() + 2;
+    let grid = "grid = { K1 = { from = 50.0, to = 400.0, count = 3 }, L3 = { from = 1.0, to = 1.0, count = 1 }, theta1 = { from = 0.5, to = 1.5, count = 2 } }\n";
+    let text = format!("{}{grid}{}", &text[..start], &text[end..]);
+    let sc = scenario::parse(Path::new("ji_k1.toml"), &text).unwrap();
+    let r = run(&sc, &RunOptions { skip_findings: true, ..RunOptions::default() });
+    assert!(r.passed, "{:?}", r.failures);
+    assert_eq!(r.points.len(), 6);
+    // The parameters vary slowest: K1 = 50 for the first two points.
+    assert_eq!(r.points[0].inputs["K1"], 50.0);
+    assert_eq!(r.points[5].inputs["K1"], 400.0);
+    for p in &r.points {
+        assert!((p.simulated["theta2"] - p.analytic["theta2"]).abs() <= 1e-9, "{:?}", p.inputs);
+    }
+    let d = (r.points[0].simulated["theta2"] - r.points[4].simulated["theta2"]).abs();
+    assert!(d > 0.3, "K1 moved the equilibrium: {d} rad");
+}
+
+/// Bad sweeps are errors at the key or value at fault: a parameter in a waypoint, a swept
+/// value the mechanism rejects (K1 <= 0), a grid key that is neither an input nor a parameter
+/// (the message lists the parameters).
+#[test]
+fn bad_parameter_sweeps_are_located() {
+    let text = std::fs::read_to_string(JI_QUICK).unwrap();
+    let cases = [
+        ("{ L3 = 1.0, theta1 = 0.5 }", "{ L3 = 1.0, theta1 = 0.5, K1 = -5.0 }", "-5.0", "K1"),
+        ("{ L3 = 1.0, theta1 = 0.5 }", "{ L3 = 1.0, theta1 = 0.5, k9 = 1.0 }", "k9", "any parameter: K1, K2, L"),
+    ];
+    for (from, to, at, msg) in cases {
+        common::error_at(&text.replacen(from, to, 1), at, 0, msg);
+    }
+    let traj = std::fs::read_to_string("scenarios/ji2014/trajectory.toml").unwrap();
+    let at = traj.find("{ t = 0.0, ").expect("a waypoint") + "{ t = 0.0, ".len();
+    let variant = format!("{}K1 = 150.0, {}", &traj[..at], &traj[at..]);
+    common::error_at(&variant, "K1 = 150.0", 0, "cannot follow waypoints");
+}
+
+/// `sweep --figure` draws the sweep against its axis: an SVG naming each compared quantity
+/// (q and the probed pin.stiffness) and the axis k1; a figure that is neither .png nor .svg is
+/// refused before anything runs (exit 2), an axis the sweep does not have after (exit 1, the
+/// axes named).
+#[test]
+fn a_sweep_draws_its_figure() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-sweep-figure-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("bar.svg");
+    let (code, out, err) = common::tensegrity(&["sweep", BAR, "--figure", svg.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    for word in ["pin.stiffness", "q: analytic", "k1", "log10"] {
+        assert!(text.contains(word), "{word} in the figure");
+    }
+    let pdf = dir.join("bar.pdf");
+    let (code, _, err) = common::tensegrity(&["sweep", BAR, "--figure", pdf.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("give a .png or .svg file"), "{err}");
+    let (code, _, err) = common::tensegrity(&["sweep", BAR, "--figure", svg.to_str().unwrap(), "--x", "k9"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("not an axis of this sweep (its inputs and swept parameters: k1)"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

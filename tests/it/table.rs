@@ -1,0 +1,158 @@
+//! `run --table FILE`: every tick a CSV row at full f64 precision, readable without the rerun
+//! SDK; the settled values read back from it equal the JSON report's bit for bit.
+
+use crate::common;
+use common::tensegrity;
+use std::path::Path;
+use std::process::Command;
+use tensegrity_testbed::run::{run, RunOptions};
+use tensegrity_testbed::scenario;
+
+/// The table's header and rows as text fields.
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(str::to_string).collect();
+    (header, lines.map(|l| l.split(',').map(str::to_string).collect()).collect())
+}
+
+/// mohr2011's trajectory: one row per step of the run (1239), a column per node coordinate,
+/// cable tension, actuator force, input and model quantity; the row of the settled tick holds
+/// the report's settled simulated values exactly (same f64 bits).
+#[test]
+fn the_trajectory_table_holds_the_settled_values_bit_for_bit() {
+    let dir = std::env::temp_dir().join(format!("table-{}", std::process::id()));
+    let path = dir.join("trajectory.csv");
+    let sc = scenario::load(Path::new("scenarios/mohr2011/trajectory.toml")).unwrap();
+    let r = run(&sc, &RunOptions { table: Some(path.clone()), ..RunOptions::default() });
+    assert!(r.passed, "{:?}", r.error);
+    assert!(std::fs::read_dir(&dir).unwrap().all(|e| !e.unwrap().file_name().to_string_lossy().contains(".partial")));
+    let (header, rows) = read_csv(&path);
+    assert_eq!(rows.len() as u64, r.settle.steps);
+    assert!(rows.iter().all(|row| row.len() == header.len()));
+    for c in [
+        "tick",
+        "time_s",
+        "input:rho1",
+        "node:B1.z",
+        "cable:A2B3.tension_n",
+        "actuator:rho1@A3B2.force",
+        "sim:z",
+        "analytic:z",
+    ] {
+        assert!(header.iter().any(|h| h == c), "no column {c}: {header:?}");
+    }
+    let settled = &r.points[0].simulated;
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let matching: Vec<&Vec<String>> = rows
+        .iter()
+        .filter(|row| {
+            settled.iter().all(|(q, v)| row[col(&format!("sim:{q}"))].parse::<f64>().unwrap().to_bits() == v.to_bits())
+        })
+        .collect();
+    assert!(!matching.is_empty(), "no row holds the settled values {settled:?}");
+    let tick: u64 = matching[0][0].parse().unwrap();
+
+    // pandas, where a Python with it is at hand (TENSEGRITY_PYTHON or python3): the JSON
+    // report and the table read in Python (both parsers exact), the settled row compared.
+    let json = dir.join("report.json");
+    std::fs::write(&json, tensegrity_testbed::report::Report { scenarios: vec![r.clone()] }.to_json()).unwrap();
+    let py = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
+    let script = format!(
+        "import json, pandas\n\
+         settled = json.load(open({json:?}))['scenarios'][0]['points'][0]['simulated']\n\
+         t = pandas.read_csv({path:?})\n\
+         row = t[t['tick'] == {tick}].iloc[0]\n\
+         print(all(float(row['sim:' + q]) == v for q, v in settled.items()))",
+        json = json.display().to_string(),
+        path = path.display().to_string()
+    );
+    match Command::new(&py).args(["-c", &script]).output() {
+        Ok(o) if o.status.success() => {
+            assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "True", "pandas read other values");
+            eprintln!("pandas read the settled row (tick {tick}) as the JSON report has it, bit for bit");
+        }
+        _ => eprintln!("skipped the pandas read: no Python with pandas (set TENSEGRITY_PYTHON)"),
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The command line writes one table per scenario when it runs several.
+#[test]
+fn several_scenarios_get_one_table_each() {
+    let dir = std::env::temp_dir().join(format!("table-cli-{}", std::process::id()));
+    let base = dir.join("t.csv");
+    let (code, out, err) = tensegrity(&[
+        "run",
+        "scenarios/custom/prism3.toml",
+        "scenarios/custom/icosahedron6.toml",
+        "--table",
+        base.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
+    for name in ["t-3-strut_tensegrity_prism.csv", "t-6-strut_tensegrity_icosahedron.csv"] {
+        let (header, rows) = read_csv(&dir.join(name));
+        assert!(header.iter().any(|h| h.starts_with("node:")) && !rows.is_empty(), "{name}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The same table as an Arrow IPC file (`--table FILE.arrow`): as many rows, `tick` UInt64 and
+/// every other column Float64 with the CSV's exact values (read back with arrow's own reader);
+/// pandas (with pyarrow) reads the settled row as the JSON report has it, bit for bit.
+#[test]
+fn the_trajectory_table_as_arrow_holds_the_csv_values() {
+    use arrow_array::{Array, Float64Array, UInt64Array};
+    let dir = std::env::temp_dir().join(format!("table-arrow-{}", std::process::id()));
+    let (csv, arrow) = (dir.join("t.csv"), dir.join("t.arrow"));
+    let sc = scenario::load(Path::new("scenarios/mohr2011/trajectory.toml")).unwrap();
+    let r = run(&sc, &RunOptions { table: Some(csv.clone()), ..RunOptions::default() });
+    let r2 = run(&sc, &RunOptions { table: Some(arrow.clone()), ..RunOptions::default() });
+    assert_eq!(r.settle.steps, r2.settle.steps);
+    let (header, rows) = read_csv(&csv);
+    let reader = arrow_ipc::reader::FileReader::try_new(std::fs::File::open(&arrow).unwrap(), None).unwrap();
+    let schema = reader.schema();
+    let names: Vec<&str> = schema.fields().iter().map(|f| f.name().as_str()).collect();
+    assert_eq!(names, header.iter().map(String::as_str).collect::<Vec<_>>());
+    let mut row = 0;
+    for batch in reader {
+        let batch = batch.unwrap();
+        let ticks = batch.column(0).as_any().downcast_ref::<UInt64Array>().expect("tick is UInt64");
+        for k in 0..batch.num_rows() {
+            assert_eq!(ticks.value(k).to_string(), rows[row + k][0]);
+            for c in 1..batch.num_columns() {
+                let col = batch.column(c).as_any().downcast_ref::<Float64Array>().expect("Float64");
+                let cell = &rows[row + k][c];
+                if cell.is_empty() {
+                    assert!(col.is_null(k), "{} at row {}", header[c], row + k);
+                } else {
+                    assert_eq!(col.value(k).to_bits(), cell.parse::<f64>().unwrap().to_bits(), "{}", header[c]);
+                }
+            }
+        }
+        row += batch.num_rows();
+    }
+    assert_eq!(row, rows.len());
+    // pandas with pyarrow, where at hand.
+    let settled = &r2.points[0].simulated;
+    let json = dir.join("report.json");
+    std::fs::write(&json, tensegrity_testbed::report::Report { scenarios: vec![r2.clone()] }.to_json()).unwrap();
+    let py = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
+    let script = format!(
+        "import json, pandas\n\
+         settled = json.load(open({json:?}))['scenarios'][0]['points'][0]['simulated']\n\
+         t = pandas.read_feather({path:?})\n\
+         rows = [r for _, r in t.iterrows() if all(float(r['sim:' + q]) == v for q, v in settled.items())]\n\
+         print(len(rows) > 0)",
+        json = json.display().to_string(),
+        path = arrow.display().to_string()
+    );
+    match Command::new(&py).args(["-c", &script]).output() {
+        Ok(o) if o.status.success() => {
+            assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "True", "pandas read other values: {settled:?}");
+            eprintln!("pandas read the Arrow table's settled row as the JSON report has it, bit for bit");
+        }
+        _ => eprintln!("skipped the pandas read: no Python with pandas and pyarrow (set TENSEGRITY_PYTHON)"),
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
