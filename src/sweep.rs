@@ -102,30 +102,13 @@ pub fn sweep(
         .num_threads(jobs.max(1))
         .build()
         .map_err(|e| SweepError::Io(format!("cannot start {jobs} threads: {e}")))?;
-    let results: Vec<(Vec<Row>, Option<String>)> = pool.install(|| {
-        blocks
-            .par_iter()
-            .map(|block| {
-                let mut sub = sc.clone();
-                sub.actuation =
-                    Actuation::Points { points: block.iter().map(|(_, v)| v.clone()).collect(), continuation };
-                sub.record = None;
-                let r = run(&sub, &RunOptions { cancel, skip_findings: true, ..RunOptions::default() });
-                let rows = r
-                    .points
-                    .into_iter()
-                    .zip(block.iter())
-                    .map(|(mut p, (i, _))| {
-                        p.index = *i;
-                        Row { index: *i, grid_points, point: p }
-                    })
-                    .collect();
-                let n = done.fetch_add(block.len(), std::sync::atomic::Ordering::SeqCst) + block.len();
-                progress(n, total);
-                (rows, r.error)
-            })
-            .collect()
-    });
+    let settle_block = |block: &&[(usize, Values)]| {
+        let r = settle_block(sc, block, continuation, grid_points, cancel);
+        let n = done.fetch_add(block.len(), std::sync::atomic::Ordering::SeqCst) + block.len();
+        progress(n, total);
+        r
+    };
+    let results: Vec<(Vec<Row>, Option<String>)> = pool.install(|| blocks.par_iter().map(settle_block).collect());
     let mut rows = Vec::new();
     let mut errors = Vec::new();
     for (r, e) in results {
@@ -133,6 +116,44 @@ pub fn sweep(
         errors.extend(e);
     }
     rows.sort_by_key(|r| r.index);
+    let summary = summarise(sc, &rows, errors, shard, jobs, start.elapsed().as_secs_f64());
+    Ok((rows, summary))
+}
+
+/// One block of points settled as one run (with continuation where the scenario asks): its
+/// rows, each with its index in the whole grid, and the run's error if it stopped.
+fn settle_block(
+    sc: &Scenario,
+    block: &[(usize, Values)],
+    continuation: bool,
+    grid_points: usize,
+    cancel: Option<&AtomicBool>,
+) -> (Vec<Row>, Option<String>) {
+    let mut sub = sc.clone();
+    sub.actuation = Actuation::Points { points: block.iter().map(|(_, v)| v.clone()).collect(), continuation };
+    sub.record = None;
+    let r = run(&sub, &RunOptions { cancel, skip_findings: true, ..RunOptions::default() });
+    let rows = r
+        .points
+        .into_iter()
+        .zip(block.iter())
+        .map(|(mut p, (i, _))| {
+            p.index = *i;
+            Row { index: *i, grid_points, point: p }
+        })
+        .collect();
+    (rows, r.error)
+}
+
+/// The sweep's summary of its rows (in grid order) and the blocks' errors, and its verdict.
+fn summarise(
+    sc: &Scenario,
+    rows: &[Row],
+    errors: Vec<String>,
+    shard: Option<(usize, usize)>,
+    jobs: usize,
+    wall_s: f64,
+) -> SweepSummary {
     let reports: Vec<PointReport> = rows.iter().map(|r| r.point.clone()).collect();
     let mut summary = SweepSummary {
         scenario: sc.name.clone(),
@@ -142,7 +163,7 @@ pub fn sweep(
         within_tolerance: rows.iter().filter(|r| r.point.within_tolerance).count(),
         shard: shard.map(|(k, n)| format!("{k}/{n}")),
         jobs: jobs.max(1),
-        wall_s: start.elapsed().as_secs_f64(),
+        wall_s,
         workspace: WorkspaceAgreement::from_points(&reports),
         min_agreement_percent: sc.min_agreement_percent,
         disagreements: rows
@@ -161,7 +182,7 @@ pub fn sweep(
             (Some(min), Some(w)) => w.agreement_percent >= min,
             _ => summary.disagreements.is_empty() && summary.settled == summary.points,
         };
-    Ok((rows, summary))
+    summary
 }
 
 /// Formats a number so that it reads back bit for bit.

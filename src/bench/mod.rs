@@ -10,7 +10,41 @@ pub mod table;
 use crate::run::{run, RunOptions};
 use crate::scenario::{self, Actuation};
 use serde::Serialize;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// Why a bench could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// A case set or scale family that a bench cannot run: its scenario, model or structure.
+    #[error("{0}")]
+    Case(String),
+    /// The peer simulator could not be run, or answered outside its protocol.
+    #[error("{0}")]
+    Peer(String),
+    /// A file the bench writes for its peer.
+    #[error("cannot write {}: {message}", path.display())]
+    Write { path: PathBuf, message: String },
+    /// The simulation could not be built, or diverged.
+    #[error(transparent)]
+    Sim(#[from] crate::sim::SimError),
+}
+
+impl From<scenario::ScenarioError> for BenchError {
+    fn from(e: scenario::ScenarioError) -> Self {
+        BenchError::Case(e.to_string())
+    }
+}
+
+impl From<crate::mechanisms::ModelError> for BenchError {
+    fn from(e: crate::mechanisms::ModelError) -> Self {
+        BenchError::Case(e.to_string())
+    }
+}
+
+/// A write error at `path`.
+pub(crate) fn write_error(path: &Path) -> impl FnOnce(std::io::Error) -> BenchError + '_ {
+    move |e| BenchError::Write { path: path.to_path_buf(), message: e.to_string() }
+}
 
 #[derive(Clone, Debug, Serialize)]
 pub struct BenchResult {
@@ -51,8 +85,8 @@ fn median(v: &mut [f64]) -> f64 {
 /// no stability test, no stiffness probe, no recording, no interference checks (the peer's
 /// tendons cannot collide, so it does none: the rates compare the same work; the checks' own
 /// cost is the bench's interference table and BENCHMARKS.md's).
-pub fn bench_scenario(file: &Path) -> Result<scenario::Scenario, String> {
-    let mut sc = scenario::load(file).map_err(|e| e.to_string())?;
+pub fn bench_scenario(file: &Path) -> Result<scenario::Scenario, BenchError> {
+    let mut sc = scenario::load(file)?;
     sc.stability_perturbation = None;
     sc.probe = None;
     sc.record = None;
@@ -139,7 +173,7 @@ fn summarize(mechanism: &str, scenario: &str, mut rounds: Vec<Round>) -> BenchRe
 }
 
 /// Runs one case set `rounds` times.
-pub fn bench_case_set(mechanism: &str, file: &Path, rounds: usize) -> Result<BenchResult, String> {
+pub fn bench_case_set(mechanism: &str, file: &Path, rounds: usize) -> Result<BenchResult, BenchError> {
     let sc = bench_scenario(file)?;
     let rounds = (0..rounds.max(1)).map(|_| testbed_round(mechanism, &sc)).collect();
     Ok(summarize(mechanism, &file.display().to_string(), rounds))
@@ -166,36 +200,36 @@ pub struct PeerComparison {
 
 /// Runs the peer `command` with `file` and `extra` arguments appended; returns the one JSON
 /// object it must print (the peers' protocol, `benches/peers/mujoco/README.md`).
-pub(crate) fn run_peer(command: &[String], file: &Path, extra: &[&str]) -> Result<serde_json::Value, String> {
-    let (program, args) = command.split_first().ok_or("empty peer command")?;
+pub(crate) fn run_peer(command: &[String], file: &Path, extra: &[&str]) -> Result<serde_json::Value, BenchError> {
+    let (program, args) = command.split_first().ok_or_else(|| BenchError::Peer("empty peer command".into()))?;
     let out = std::process::Command::new(program)
         .args(args)
         .arg(file)
         .args(extra)
         .output()
-        .map_err(|e| format!("cannot run the peer '{}': {e}", command.join(" ")))?;
+        .map_err(|e| BenchError::Peer(format!("cannot run the peer '{}': {e}", command.join(" "))))?;
     if !out.status.success() {
-        return Err(format!(
+        return Err(BenchError::Peer(format!(
             "the peer '{}' failed ({}): {}",
             command.join(" "),
             out.status,
             String::from_utf8_lossy(&out.stderr).trim()
-        ));
+        )));
     }
     serde_json::from_slice(&out.stdout)
-        .map_err(|e| format!("the peer '{}' printed no JSON object: {e}", command.join(" ")))
+        .map_err(|e| BenchError::Peer(format!("the peer '{}' printed no JSON object: {e}", command.join(" "))))
 }
 
 /// One round of a peer simulator: `command` is run with the case-set file, `--rounds 1` and
 /// `--min-round-wall-s` (the testbed's [`MIN_ROUND_WALL_S`]) appended and must print one JSON
 /// object (see `benches/peers/mujoco/README.md`).
-fn peer_round(command: &[String], cases_file: &Path) -> Result<(Round, String), String> {
+fn peer_round(command: &[String], cases_file: &Path) -> Result<(Round, String), BenchError> {
+    let protocol = |what: &str| BenchError::Peer(format!("the peer's JSON has no {what}"));
     let min_wall = MIN_ROUND_WALL_S.to_string();
     let v = run_peer(command, cases_file, &["--rounds", "1", "--min-round-wall-s", &min_wall])?;
-    let num = |key: &str| {
-        v.get(key).and_then(serde_json::Value::as_f64).ok_or_else(|| format!("the peer's JSON has no number '{key}'"))
-    };
-    let cases = v.get("cases").and_then(|c| c.as_array()).ok_or("the peer's JSON has no 'cases' list")?;
+    let num =
+        |key: &str| v.get(key).and_then(serde_json::Value::as_f64).ok_or_else(|| protocol(&format!("number '{key}'")));
+    let cases = v.get("cases").and_then(|c| c.as_array()).ok_or_else(|| protocol("'cases' list"))?;
     let mut round = Round {
         cases: cases.len(),
         cases_per_s: num("median_cases_per_s")?,
@@ -204,7 +238,7 @@ fn peer_round(command: &[String], cases_file: &Path) -> Result<(Round, String), 
         ..Default::default()
     };
     for c in cases {
-        round.steps.push(c.get("steps").and_then(|s| s.as_f64()).ok_or("a peer case has no 'steps'")?);
+        round.steps.push(c.get("steps").and_then(|s| s.as_f64()).ok_or_else(|| protocol("'steps' in a case"))?);
         round.all_settled &= c.get("settled").and_then(|s| s.as_bool()).unwrap_or(false);
         if let Some(errs) = c.get("errors").and_then(|e| e.as_object()) {
             round.errors.extend(errs.values().filter_map(|e| e.as_f64()));
@@ -226,13 +260,13 @@ pub fn bench_against_peer(
     rounds: usize,
     peer: &[String],
     dir: &Path,
-) -> Result<PeerComparison, String> {
+) -> Result<PeerComparison, BenchError> {
     let sc = bench_scenario(file)?;
     let set = peer_case_set(mechanism, &sc)?;
     let cases_file = dir.join(format!("{mechanism}.json"));
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(write_error(dir))?;
     std::fs::write(&cases_file, serde_json::to_string_pretty(&set).expect("case set serialises"))
-        .map_err(|e| format!("cannot write {}: {e}", cases_file.display()))?;
+        .map_err(write_error(&cases_file))?;
     let mut ours = Vec::new();
     let mut theirs = Vec::new();
     let mut peer_name = String::new();
@@ -240,7 +274,7 @@ pub fn bench_against_peer(
         ours.push(testbed_round(mechanism, &sc));
         let (round, name) = peer_round(peer, &cases_file)?;
         if round.cases != set.cases.len() {
-            return Err(format!("the peer settled {} cases of {}", round.cases, set.cases.len()));
+            return Err(BenchError::Peer(format!("the peer settled {} cases of {}", round.cases, set.cases.len())));
         }
         theirs.push(round);
         peer_name = name;
@@ -372,20 +406,23 @@ pub struct PeerCase {
 }
 
 /// The case set of scenario `sc` for a peer simulator.
-pub fn peer_case_set(mechanism: &str, sc: &scenario::Scenario) -> Result<PeerCaseSet, String> {
+pub fn peer_case_set(mechanism: &str, sc: &scenario::Scenario) -> Result<PeerCaseSet, BenchError> {
     use crate::mechanisms::QuantityKind;
     let file = &sc.file;
     let m = sc.mechanism();
     let params = crate::mechanisms::with_defaults(m.as_ref(), &sc.params);
     let Actuation::Points { points, .. } = &sc.actuation else {
-        return Err(format!("{}: a bench case set needs [actuation] points or a grid", file.display()));
+        return Err(BenchError::Case(format!(
+            "{}: a bench case set needs [actuation] points or a grid",
+            file.display()
+        )));
     };
     let mut cases = Vec::new();
     for p in points {
         // The scenario's loader already turned alternative inputs into the mechanism's inputs.
         let inputs = p.clone();
-        let prediction = m.predict(&params, &inputs).map_err(|e| e.to_string())?;
-        let start = m.build(&params, &inputs, &sc.start).map_err(|e| e.to_string())?;
+        let prediction = m.predict(&params, &inputs)?;
+        let start = m.build(&params, &inputs, &sc.start)?;
         let name = |i: usize| start.nodes[i].name.clone();
         let start_nodes = start.nodes.iter().enumerate().map(|(i, n)| (name(i), n.position)).collect();
         let analytic_nodes = m

@@ -112,6 +112,9 @@ fn members(path: &Path, c: &[Row], n: usize) -> Result<Vec<(usize, usize, usize)
     Ok(out)
 }
 
+/// A member as read from a connectivity row: its two nodes (from 0) and the row's line.
+type Member = (usize, usize, usize);
+
 /// Imports N, C_b and C_s.
 pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) -> Result<Imported, ImportError> {
     let n = read_matrix(n_path)?;
@@ -127,7 +130,37 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
     let nodes: Vec<Vec3> = (0..count).map(|k| [n[0].1[k], n[1].1[k], n[2].1[k]]).collect();
     let bars = members(cb_path, &read_matrix(cb_path)?, count)?;
     let strings = members(cs_path, &read_matrix(cs_path)?, count)?;
-    let name = |k: usize| format!("n{}", k + 1);
+    let on_bar = bar_of_each_node(cb_path, &bars, count)?;
+    let ground: Vec<usize> = (0..count).filter(|&k| on_bar[k].is_none()).collect();
+    let mut draft = Draft {
+        name: format!(
+            "{} (from N, C_b, C_s)",
+            n_path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default()
+        ),
+        ..Default::default()
+    };
+    if !ground.is_empty() {
+        draft.bodies.push(DraftBody {
+            name: "ground".into(),
+            fixed: true,
+            mass_kg: 0.0,
+            inertia_kg_m2: None,
+            nodes: ground.iter().map(|&k| (node_name(k), nodes[k])).collect(),
+        });
+    }
+    add_bars(&mut draft, &nodes, &bars, ground.is_empty(), o);
+    add_strings(&mut draft, &nodes, &strings, cs_path, o)?;
+    draft.description = description([n_path, cb_path, cs_path], o, ground.len());
+    Ok(Imported { toml: draft.to_toml(), skipped: Vec::new() })
+}
+
+/// Node k (from 0) is n<k+1>, column k+1 of N.
+fn node_name(k: usize) -> String {
+    format!("n{}", k + 1)
+}
+
+/// The bar each node is on, if any; a node on two bars is an error (class 1 only).
+fn bar_of_each_node(cb_path: &Path, bars: &[Member], count: usize) -> Result<Vec<Option<usize>>, ImportError> {
     let mut on_bar: Vec<Option<usize>> = vec![None; count];
     for (i, &(a, b, line)) in bars.iter().enumerate() {
         for k in [a, b] {
@@ -147,40 +180,40 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
             on_bar[k] = Some(i);
         }
     }
-    let ground: Vec<usize> = (0..count).filter(|&k| on_bar[k].is_none()).collect();
-    let mut draft = Draft {
-        name: format!(
-            "{} (from N, C_b, C_s)",
-            n_path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default()
-        ),
-        ..Default::default()
-    };
-    if !ground.is_empty() {
-        draft.bodies.push(DraftBody {
-            name: "ground".into(),
-            fixed: true,
-            mass_kg: 0.0,
-            inertia_kg_m2: None,
-            nodes: ground.iter().map(|&k| (name(k), nodes[k])).collect(),
-        });
-    }
+    Ok(on_bar)
+}
+
+/// Each bar a strut on its own body (a uniform cylinder's inertia about its centre, taken
+/// as the same about every axis); the first held fixed when `fix_first` (no ground).
+fn add_bars(draft: &mut Draft, nodes: &[Vec3], bars: &[Member], fix_first: bool, o: &MatrixOptions) {
     for (i, &(a, b, _)) in bars.iter().enumerate() {
         let l = distance(nodes[a], nodes[b]);
         let inertia = o.bar_mass_kg * (3.0 * o.bar_radius_m * o.bar_radius_m + l * l) / 12.0;
         draft.bodies.push(DraftBody {
             name: format!("bar{}", i + 1),
-            fixed: ground.is_empty() && i == 0,
+            fixed: fix_first && i == 0,
             mass_kg: o.bar_mass_kg,
             inertia_kg_m2: Some([inertia; 3]),
-            nodes: vec![(name(a), nodes[a]), (name(b), nodes[b])],
+            nodes: vec![(node_name(a), nodes[a]), (node_name(b), nodes[b])],
         });
         draft.struts.push(DraftStrut {
             name: format!("bar{}", i + 1),
-            a: name(a),
-            b: name(b),
+            a: node_name(a),
+            b: node_name(b),
             radius_m: o.bar_radius_m,
         });
     }
+}
+
+/// Each string an elastic tension-only cable whose rest length is the drawn length less the
+/// tension over the stiffness; no rest length left is an error at the string's row.
+fn add_strings(
+    draft: &mut Draft,
+    nodes: &[Vec3],
+    strings: &[Member],
+    cs_path: &Path,
+    o: &MatrixOptions,
+) -> Result<(), ImportError> {
     for (i, &(a, b, line)) in strings.iter().enumerate() {
         let l = distance(nodes[a], nodes[b]);
         let rest = l - o.string_tension_n / o.string_stiffness_n_per_m;
@@ -199,13 +232,18 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
         }
         draft.cables.push(DraftCable {
             name: format!("string{}", i + 1),
-            a: name(a),
-            b: name(b),
+            a: node_name(a),
+            b: node_name(b),
             stiffness_n_per_m: Some(o.string_stiffness_n_per_m),
             length_m: rest,
         });
     }
-    draft.description = format!(
+    Ok(())
+}
+
+/// What the scenario file says of where it came from and what was chosen.
+fn description([n_path, cb_path, cs_path]: [&Path; 3], o: &MatrixOptions, grounded: usize) -> String {
+    format!(
         "Imported from N = {}, C_b = {}, C_s = {} (Skelton and de Oliveira's notation) by `tensegrity import matrices`.\n\
          Node k is n<k> (column k of N); bar i is strut bar<i> on its own body of {} kg, radius {} m; string i is the elastic tension-only cable string<i> of {} N/m at {} N when drawn (rest length = drawn - tension / stiffness).\n{}",
         n_path.display(),
@@ -215,7 +253,6 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
         o.bar_radius_m,
         o.string_stiffness_n_per_m,
         o.string_tension_n,
-        if ground.is_empty() { "No node is off the bars: bar1 is held fixed to remove the rigid motion.".to_string() } else { format!("{} node(s) on no bar are fixed points (body 'ground').", ground.len()) }
-    );
-    Ok(Imported { toml: draft.to_toml(), skipped: Vec::new() })
+        if grounded == 0 { "No node is off the bars: bar1 is held fixed to remove the rigid motion.".to_string() } else { format!("{grounded} node(s) on no bar are fixed points (body 'ground').") }
+    )
 }

@@ -634,44 +634,14 @@ impl Reader {
                     if noted.insert(index) {
                         self.note_unmodelled(&tag, &builder, &["radius", "density"]);
                     }
-                    let r = self.param(&builder, "radius", DEFAULT_ROD_RADIUS)?;
-                    let rho = self.param(&builder, "density", DEFAULT_ROD_DENSITY)?;
-                    // tgRodInfo::getMass: volume pi r^2 L times density.
-                    let mass = rho * std::f64::consts::PI * r * r * l;
-                    if !(mass > 0.0) {
-                        return Err(err(
-                            &pair.file,
-                            pair.at,
-                            format!(
-                                "rod {}-{} has no mass (density {rho}, radius {r})",
-                                nodes[a].1.name, nodes[b].1.name
-                            ),
-                        ));
-                    }
+                    let (r, mass) = self.rod(pair, &builder, l, (&nodes[a].1.name, &nodes[b].1.name))?;
                     rods.push((a, b, r, mass));
                 }
                 Kind::String => {
                     if noted.insert(index) {
                         self.note_unmodelled(&tag, &builder, &["stiffness", "pretension"]);
                     }
-                    let k = self.param(&builder, "stiffness", DEFAULT_STRING_STIFFNESS)?;
-                    let p = self.param(&builder, "pretension", DEFAULT_STRING_PRETENSION)?;
-                    let at = builder.params.get("stiffness").map_or(pair.at, |(_, at)| *at);
-                    if !(k > 0.0) {
-                        return Err(err(&builder.file, at, format!("builder '{tag}': stiffness must be > 0, got {k}")));
-                    }
-                    // tgSpringCable.cpp: rest length = drawn length - pretension / stiffness.
-                    let rest = l - p / k;
-                    if !(rest > 0.0) {
-                        return Err(err(
-                            &pair.file,
-                            pair.at,
-                            format!(
-                                "string {}-{}: pretension {p} at stiffness {k} leaves no rest length (drawn {l})",
-                                nodes[a].1.name, nodes[b].1.name
-                            ),
-                        ));
-                    }
+                    let (k, rest) = self.string(pair, (&tag, &builder), l, (&nodes[a].1.name, &nodes[b].1.name))?;
                     strings.push((a, b, tag, k, rest));
                 }
                 Kind::Box | Kind::Sphere => self.skipped.push(format!(
@@ -680,17 +650,63 @@ impl Reader {
                 )),
             }
         }
+        let names: Vec<String> = nodes.iter().map(|(_, n)| n.name.clone()).collect();
+        self.note_spheres(&names);
+        let positions: Vec<Vec3> = (0..nodes.len()).map(pos).collect();
+        self.assemble(path, axes, &names, &positions, &rods, &strings)
+    }
+
+    /// A rod builder's radius [m] and mass [kg] for a pair of drawn length `l` [m] between
+    /// the nodes named `ends`.
+    fn rod(&self, pair: &Pair, builder: &Builder, l: f64, ends: (&str, &str)) -> Result<(f64, f64), ImportError> {
+        let r = self.param(builder, "radius", DEFAULT_ROD_RADIUS)?;
+        let rho = self.param(builder, "density", DEFAULT_ROD_DENSITY)?;
+        // tgRodInfo::getMass: volume pi r^2 L times density.
+        let mass = rho * std::f64::consts::PI * r * r * l;
+        if !(mass > 0.0) {
+            let message = format!("rod {}-{} has no mass (density {rho}, radius {r})", ends.0, ends.1);
+            return Err(err(&pair.file, pair.at, message));
+        }
+        Ok((r, mass))
+    }
+
+    /// A string builder's stiffness [N/m] and rest length [m] for a pair of drawn length `l`
+    /// [m] between the nodes named `ends`.
+    fn string(
+        &self,
+        pair: &Pair,
+        (tag, builder): (&str, &Builder),
+        l: f64,
+        ends: (&str, &str),
+    ) -> Result<(f64, f64), ImportError> {
+        let k = self.param(builder, "stiffness", DEFAULT_STRING_STIFFNESS)?;
+        let p = self.param(builder, "pretension", DEFAULT_STRING_PRETENSION)?;
+        let at = builder.params.get("stiffness").map_or(pair.at, |(_, at)| *at);
+        if !(k > 0.0) {
+            return Err(err(&builder.file, at, format!("builder '{tag}': stiffness must be > 0, got {k}")));
+        }
+        // tgSpringCable.cpp: rest length = drawn length - pretension / stiffness.
+        let rest = l - p / k;
+        if !(rest > 0.0) {
+            let message = format!(
+                "string {}-{}: pretension {p} at stiffness {k} leaves no rest length (drawn {l})",
+                ends.0, ends.1
+            );
+            return Err(err(&pair.file, pair.at, message));
+        }
+        Ok((k, rest))
+    }
+
+    /// Sphere builders whose tag names a node: said skipped.
+    fn note_spheres(&mut self, names: &[String]) {
         for (tag, b) in &self.builders {
             if b.kind == Kind::Sphere
                 && b.file != "(default)"
-                && nodes.iter().any(|(_, n)| n.name.rsplit('.').next() == Some(tag.as_str()))
+                && names.iter().any(|n| n.rsplit('.').next() == Some(tag.as_str()))
             {
                 self.skipped.push(format!("sphere node '{tag}' ({}): not modelled by the testbed", b.class));
             }
         }
-        let names: Vec<String> = nodes.iter().map(|(_, n)| n.name.clone()).collect();
-        let positions: Vec<Vec3> = (0..nodes.len()).map(pos).collect();
-        self.assemble(path, axes, &names, &positions, &rods, &strings)
     }
 
     /// Bodies (rods sharing nodes joined, the first held fixed), struts and cables.
@@ -748,36 +764,7 @@ impl Reader {
                 radius_m: r,
             });
         }
-        let mut used = std::collections::BTreeSet::new();
-        for (a, b, tag, k, rest) in strings {
-            for n in [*a, *b] {
-                if body_of[n].is_none() {
-                    return Err(ImportError {
-                        file: file.clone(),
-                        line: 0,
-                        col: 0,
-                        message: format!(
-                            "string end '{}' is on no rod: NTRT anchors strings to rigid bodies",
-                            names[n]
-                        ),
-                    });
-                }
-            }
-            let mut name = format!("{tag} {}-{}", names[*a], names[*b]);
-            let base = name.clone();
-            let mut i = 2;
-            while !used.insert(name.clone()) {
-                name = format!("{base} ~{i}");
-                i += 1;
-            }
-            draft.cables.push(DraftCable {
-                name,
-                a: names[*a].clone(),
-                b: names[*b].clone(),
-                stiffness_n_per_m: Some(*k),
-                length_m: *rest,
-            });
-        }
+        add_string_cables(&mut draft, &file, names, &body_of, strings)?;
         for (n, name) in names.iter().enumerate() {
             if body_of[n].is_none() && !strings.iter().any(|s| s.0 == n || s.1 == n) {
                 self.skipped.push(format!("node '{name}': on no rod and no string"));
@@ -853,4 +840,43 @@ fn rod_inertia(rods: impl Iterator<Item = (Vec3, Vec3, f64, f64)> + Clone) -> (f
         })
         .sum();
     (mass, inertia)
+}
+
+/// Each string an elastic cable between two rods' nodes, named `TAG A-B` (with ` ~2`, ` ~3`
+/// after a name already taken); a string end on no rod is an error.
+fn add_string_cables(
+    draft: &mut Draft,
+    file: &str,
+    names: &[String],
+    body_of: &[Option<usize>],
+    strings: &[(usize, usize, String, f64, f64)],
+) -> Result<(), ImportError> {
+    let mut used = std::collections::BTreeSet::new();
+    for (a, b, tag, k, rest) in strings {
+        for n in [*a, *b] {
+            if body_of[n].is_none() {
+                return Err(ImportError {
+                    file: file.to_string(),
+                    line: 0,
+                    col: 0,
+                    message: format!("string end '{}' is on no rod: NTRT anchors strings to rigid bodies", names[n]),
+                });
+            }
+        }
+        let mut name = format!("{tag} {}-{}", names[*a], names[*b]);
+        let base = name.clone();
+        let mut i = 2;
+        while !used.insert(name.clone()) {
+            name = format!("{base} ~{i}");
+            i += 1;
+        }
+        draft.cables.push(DraftCable {
+            name,
+            a: names[*a].clone(),
+            b: names[*b].clone(),
+            stiffness_n_per_m: Some(*k),
+            length_m: *rest,
+        });
+    }
+    Ok(())
 }

@@ -298,40 +298,14 @@ fn plan_forest(
     actuated: &[bool],
     banned: &[bool],
 ) -> Result<(Vec<bool>, Vec<usize>), SimError> {
-    let n = s.bodies.len();
-    let mut parent_joint: Vec<Option<usize>> = vec![None; n];
-    let mut is_link = vec![false; s.joints.len()];
-    let root = |pj: &Vec<Option<usize>>, is_link: &Vec<bool>, mut b: usize| -> usize {
-        while let Some(j) = pj[b] {
-            if !is_link[j] {
-                break;
-            }
-            b = s.joints[j].parent;
-        }
-        b
-    };
-    for (j, joint) in s.joints.iter().enumerate() {
-        let free = s.bodies[joint.child].kind == BodyKind::Free
-            && !roped[joint.child]
-            && !banned[j]
-            && !matches!(joint.kind, JointKind::PlanarPin { .. });
-        let parent_root = root(&parent_joint, &is_link, joint.parent);
-        if free
-            && parent_joint[joint.child].is_none()
-            && s.bodies[parent_root].kind == BodyKind::Fixed
-            && parent_root != root(&parent_joint, &is_link, joint.child)
-        {
-            parent_joint[joint.child] = Some(j);
-            is_link[j] = true;
-        }
-    }
+    let (parent_joint, mut is_link) = link_forest(s, roped, banned);
     let mut cuts = Vec::new();
     for (j, joint) in s.joints.iter().enumerate() {
         if is_link[j] {
             continue;
         }
         let (u, v) = (joint.parent, joint.child);
-        if root(&parent_joint, &is_link, u) != root(&parent_joint, &is_link, v) {
+        if forest_root(s, &parent_joint, &is_link, u) != forest_root(s, &parent_joint, &is_link, v) {
             continue;
         }
         // A planar pin closes a planar loop inside its multibody: cutting there would leave the
@@ -339,35 +313,7 @@ fn plan_forest(
         if matches!(joint.kind, JointKind::PlanarPin { .. }) {
             continue;
         }
-        // Ancestors of u (bodies), to find where v's path meets u's.
-        let mut above_u = vec![u];
-        let mut b = u;
-        while let Some(pj) = parent_joint[b].filter(|pj| is_link[*pj]) {
-            b = s.joints[pj].parent;
-            above_u.push(b);
-        }
-        let mut cut = None;
-        let mut b = v;
-        while !above_u.contains(&b) {
-            let Some(pj) = parent_joint[b].filter(|pj| is_link[*pj]) else { break };
-            if !actuated[pj] {
-                cut = Some(pj);
-                break;
-            }
-            b = s.joints[pj].parent;
-        }
-        if cut.is_none() {
-            // Try u's side of the loop.
-            let mut b = u;
-            while let Some(pj) = parent_joint[b].filter(|pj| is_link[*pj]) {
-                if !actuated[pj] {
-                    cut = Some(pj);
-                    break;
-                }
-                b = s.joints[pj].parent;
-            }
-        }
-        match cut {
+        match loop_cut(s, &parent_joint, &is_link, actuated, (u, v)) {
             Some(pj) => {
                 is_link[pj] = false;
                 cuts.push(pj);
@@ -381,6 +327,77 @@ fn plan_forest(
         }
     }
     Ok((is_link, cuts))
+}
+
+/// The body at the root of `b`'s branch of the forest (following link joints to parents).
+fn forest_root(s: &Structure, parent_joint: &[Option<usize>], is_link: &[bool], mut b: usize) -> usize {
+    while let Some(j) = parent_joint[b] {
+        if !is_link[j] {
+            break;
+        }
+        b = s.joints[j].parent;
+    }
+    b
+}
+
+/// The forest of links: each free body (not roped) hangs by at most one joint (not banned,
+/// not a planar pin) from a branch rooted in a fixed body. Each body's parent joint, and which
+/// joints are links.
+fn link_forest(s: &Structure, roped: &[bool], banned: &[bool]) -> (Vec<Option<usize>>, Vec<bool>) {
+    let mut parent_joint: Vec<Option<usize>> = vec![None; s.bodies.len()];
+    let mut is_link = vec![false; s.joints.len()];
+    for (j, joint) in s.joints.iter().enumerate() {
+        let free = s.bodies[joint.child].kind == BodyKind::Free
+            && !roped[joint.child]
+            && !banned[j]
+            && !matches!(joint.kind, JointKind::PlanarPin { .. });
+        let parent_root = forest_root(s, &parent_joint, &is_link, joint.parent);
+        if free
+            && parent_joint[joint.child].is_none()
+            && s.bodies[parent_root].kind == BodyKind::Fixed
+            && parent_root != forest_root(s, &parent_joint, &is_link, joint.child)
+        {
+            parent_joint[joint.child] = Some(j);
+            is_link[j] = true;
+        }
+    }
+    (parent_joint, is_link)
+}
+
+/// The link to cut where a joint from body `u` to body `v` closes a loop in the forest: the
+/// first unactuated link on `v`'s path up to where it meets `u`'s, else on `u`'s path; None
+/// when the loop is made only of actuated joints.
+fn loop_cut(
+    s: &Structure,
+    parent_joint: &[Option<usize>],
+    is_link: &[bool],
+    actuated: &[bool],
+    (u, v): (usize, usize),
+) -> Option<usize> {
+    // Ancestors of u (bodies), to find where v's path meets u's.
+    let mut above_u = vec![u];
+    let mut b = u;
+    while let Some(pj) = parent_joint[b].filter(|pj| is_link[*pj]) {
+        b = s.joints[pj].parent;
+        above_u.push(b);
+    }
+    let mut b = v;
+    while !above_u.contains(&b) {
+        let Some(pj) = parent_joint[b].filter(|pj| is_link[*pj]) else { break };
+        if !actuated[pj] {
+            return Some(pj);
+        }
+        b = s.joints[pj].parent;
+    }
+    // Try u's side of the loop.
+    let mut b = u;
+    while let Some(pj) = parent_joint[b].filter(|pj| is_link[*pj]) {
+        if !actuated[pj] {
+            return Some(pj);
+        }
+        b = s.joints[pj].parent;
+    }
+    None
 }
 
 /// The free axis of a revolute or prismatic joint in rapier's joint frame.

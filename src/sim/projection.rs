@@ -215,45 +215,12 @@ impl Simulation {
     /// loop inside (closed by [`Self::project_internal_closures`]) is left to rapier alone.
     pub(super) fn find_projected_groups(&self) -> Vec<ProjectedGroup> {
         let s = &self.model.structure;
-        let n = s.bodies.len();
-        let multibody_of = |b: usize| self.multibody_joints.rigid_body_link(self.model.handles[b]).map(|l| l.multibody);
+        let multibody_of = |b: usize| self.multibody_of(b);
         let looped: Vec<MultibodyIndex> = self.model.internal_closures.iter().map(|c| c.multibody).collect();
         let plain = |b: usize| self.is_free(b) && multibody_of(b).is_none();
-        let fixed = |b: usize| s.bodies[b].kind == crate::structure::BodyKind::Fixed;
-        // Union-find over bodies joined by a constraint.
-        let mut parent: Vec<usize> = (0..n).collect();
-        fn find(p: &mut [usize], mut x: usize) -> usize {
-            while p[x] != x {
-                p[x] = p[p[x]];
-                x = p[x];
-            }
-            x
-        }
-        let mut edges: Vec<(usize, usize)> = Vec::new();
-        for (j, joint) in s.joints.iter().enumerate() {
-            if self.model.joint_impulse[j].is_some() {
-                edges.push((joint.parent, joint.child));
-            }
-        }
-        for (c, cable) in s.cables.iter().enumerate() {
-            if self.model.cable_ropes[c].is_some() {
-                edges.push((s.nodes[cable.a].body, s.nodes[cable.b].body));
-            }
-        }
-        // The links of one multibody move together: one group.
-        for a in 0..n {
-            for b in a + 1..n {
-                if multibody_of(a).is_some() && multibody_of(a) == multibody_of(b) {
-                    edges.push((a, b));
-                }
-            }
-        }
-        for &(a, b) in &edges {
-            if !fixed(a) && !fixed(b) {
-                let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-                parent[ra] = rb;
-            }
-        }
+        let fixed = |b: usize| self.is_fixed_body(b);
+        let mut parent = self.constrained_together();
+        let find = find_root;
         let mut groups: Vec<(usize, ProjectedGroup, bool)> = Vec::new();
         let group_of = |root: usize, groups: &mut Vec<(usize, ProjectedGroup, bool)>| -> usize {
             if let Some(i) = groups.iter().position(|g| g.0 == root) {
@@ -314,6 +281,49 @@ impl Simulation {
             .filter(|(_, g, ok)| *ok && !(g.bodies.is_empty() && g.multibodies.is_empty()))
             .map(|(_, g, _)| g)
             .collect()
+    }
+
+    /// The multibody that body `b` is a link of, if any.
+    fn multibody_of(&self, b: usize) -> Option<MultibodyIndex> {
+        self.multibody_joints.rigid_body_link(self.model.handles[b]).map(|l| l.multibody)
+    }
+
+    fn is_fixed_body(&self, b: usize) -> bool {
+        self.model.structure.bodies[b].kind == crate::structure::BodyKind::Fixed
+    }
+
+    /// A union-find forest (each body's parent, [`find_root`]) over the bodies joined by an
+    /// impulse joint, a rope cable or a common multibody; fixed bodies join nothing.
+    fn constrained_together(&self) -> Vec<usize> {
+        let s = &self.model.structure;
+        let n = s.bodies.len();
+        let mut edges: Vec<(usize, usize)> = Vec::new();
+        for (j, joint) in s.joints.iter().enumerate() {
+            if self.model.joint_impulse[j].is_some() {
+                edges.push((joint.parent, joint.child));
+            }
+        }
+        for (c, cable) in s.cables.iter().enumerate() {
+            if self.model.cable_ropes[c].is_some() {
+                edges.push((s.nodes[cable.a].body, s.nodes[cable.b].body));
+            }
+        }
+        // The links of one multibody move together: one group.
+        for a in 0..n {
+            for b in a + 1..n {
+                if self.multibody_of(a).is_some() && self.multibody_of(a) == self.multibody_of(b) {
+                    edges.push((a, b));
+                }
+            }
+        }
+        let mut parent: Vec<usize> = (0..n).collect();
+        for &(a, b) in &edges {
+            if !self.is_fixed_body(a) && !self.is_fixed_body(b) {
+                let (ra, rb) = (find_root(&mut parent, a), find_root(&mut parent, b));
+                parent[ra] = rb;
+            }
+        }
+        parent
     }
 
     /// The constraint rows of one joint: its anchor gap (for a planar pin only the two
@@ -608,4 +618,13 @@ impl GroupCoordinates {
             }
         }
     }
+}
+
+/// The root of `x` in the union-find forest `p`, halving the path on the way.
+fn find_root(p: &mut [usize], mut x: usize) -> usize {
+    while p[x] != x {
+        p[x] = p[p[x]];
+        x = p[x];
+    }
+    x
 }

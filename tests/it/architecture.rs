@@ -80,3 +80,53 @@ fn parsing_observing_and_the_models_stay_apart() {
         assert!(!uses(a, b), "{a} imports {b}: {:?}", graph[a]);
     }
 }
+
+/// The README's Architecture section, up to its "How to add" list, as bullets of text.
+fn readme_architecture_bullets() -> Vec<String> {
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let start = readme.find("## Architecture\n").expect("README has an Architecture section");
+    let section = &readme[start..];
+    let end = section.find("How to add").expect("the Architecture section has a How to add list");
+    section[..end].split("\n- ").skip(1).map(str::to_string).collect()
+}
+
+/// Every `.rs` file under `dir`, as paths relative to the crate root.
+fn source_files(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(source_files(&p));
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// Whether `bullet` names `file`: a file at the root as `src/NAME.rs`; a file in a folder by
+/// the folder (`src/DIR/`) and its own name (`NAME.rs`, or for a sub-folder's `mod.rs` the
+/// sub-folder `SUB/`).
+fn names_file(bullet: &str, file: &Path) -> bool {
+    let parts: Vec<String> = file.components().skip(1).map(|c| c.as_os_str().to_string_lossy().into_owned()).collect();
+    match parts.as_slice() {
+        [single] => bullet.contains(&format!("src/{single}")),
+        [dir, .., last] => {
+            let own =
+                if last == "mod.rs" && parts.len() > 2 { format!("{}/", parts[parts.len() - 2]) } else { last.clone() };
+            bullet.contains(&format!("src/{dir}/")) && (last == "mod.rs" || bullet.contains(&own))
+        }
+        [] => false,
+    }
+}
+
+#[test]
+fn the_readme_architecture_names_every_source_file() {
+    let bullets = readme_architecture_bullets();
+    assert!(bullets.len() >= 10, "read only {} bullets", bullets.len());
+    let files = source_files(Path::new("src"));
+    assert!(files.len() >= 50, "read only {} files", files.len());
+    let missing: Vec<String> =
+        files.iter().filter(|f| !bullets.iter().any(|b| names_file(b, f))).map(|f| f.display().to_string()).collect();
+    assert!(missing.is_empty(), "files of src/ the README's Architecture does not name: {missing:?}");
+}

@@ -5,7 +5,7 @@
 //! `CASE_TIME_LIMIT_S` (no hang in parsing, validation or the analytic checks it runs).
 //!
 //! The test suite runs a few hundred cases. The long run (documented in the README):
-//! `PROPTEST_CASES=1000000 cargo test --release --test fuzz_scenarios` (stop it after 10
+//! `PROPTEST_CASES=1000000 cargo test --release --test it fuzz_scenarios` (stop it after 10
 //! minutes or more; any failing input is saved under `proptest-regressions/`).
 
 use proptest::prelude::*;

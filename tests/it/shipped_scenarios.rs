@@ -7,7 +7,7 @@
 //! commit; the diff of `tests/baselines/` shows what moved):
 //!
 //! ```text
-//! TENSEGRITY_BLESS=1 cargo test --release --test shipped_scenarios
+//! TENSEGRITY_BLESS=1 cargo test --release --test it shipped_scenarios
 //! ```
 
 use rayon::prelude::*;
@@ -162,7 +162,7 @@ fn check(file: &Path, bless: bool) -> Vec<String> {
         Ok(text) => serde_json::from_str(&text).expect("baseline is JSON"),
         Err(_) => {
             problems.push(format!(
-                "{name}: no baseline {} (run {BLESS_VAR}=1 cargo test --release --test shipped_scenarios)",
+                "{name}: no baseline {} (run {BLESS_VAR}=1 cargo test --release --test it shipped_scenarios)",
                 path.display()
             ));
             return problems;

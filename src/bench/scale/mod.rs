@@ -23,6 +23,7 @@ pub mod tower;
 
 pub use prism::{prism, settle_prism};
 
+use super::BenchError;
 use crate::run::SettleDetector;
 use crate::settings::{SettleCriteria, SimSettings};
 use crate::sim::Simulation;
@@ -169,10 +170,10 @@ fn reset_memory() {
 
 /// Steps `s` as the settle loop does, the relaxation off once the motion has stopped, until
 /// settled (speed and residual) or a cap is reached.
-pub fn settle(s: &Structure, settings: &SimSettings, commands: &[f64], caps: &Caps) -> Result<Settled, String> {
+pub fn settle(s: &Structure, settings: &SimSettings, commands: &[f64], caps: &Caps) -> Result<Settled, BenchError> {
     let criteria = criteria(s, settings.dt_s, caps);
     let start = Instant::now();
-    let mut sim = Simulation::new(s, settings).map_err(|e| e.to_string())?;
+    let mut sim = Simulation::new(s, settings)?;
     if !commands.is_empty() {
         sim.set_commands(commands);
     }
@@ -190,7 +191,7 @@ pub fn settle(s: &Structure, settings: &SimSettings, commands: &[f64], caps: &Ca
             ));
             break;
         }
-        sim.step().map_err(|e| e.to_string())?;
+        sim.step()?;
         steps += 1;
         let quiet = detector.update(&sim.snapshot_with(false), settings.dt_s, &criteria);
         sim.set_relaxation(settings.relaxation && detector.last_speed > criteria.speed_tol_m_per_s);
@@ -209,7 +210,7 @@ pub fn settle(s: &Structure, settings: &SimSettings, commands: &[f64], caps: &Ca
 pub const MIN_CASE_WALL_S: f64 = 0.2;
 
 /// Settles `case` and measures it (the memory of the first settle).
-pub fn run_case(case: &Case, caps: &Caps) -> Result<ScaleCase, String> {
+pub fn run_case(case: &Case, caps: &Caps) -> Result<ScaleCase, BenchError> {
     reset_memory();
     let rss_before_kib = proc_status_kib("VmRSS:");
     let mut out = settle(&case.start, &case.settings, &case.commands, caps)?;
@@ -289,14 +290,18 @@ pub fn growth_exponent(cases: &[ScaleCase]) -> Option<f64> {
 pub const FAMILIES: [&str; 4] = ["prism", "icosahedron", "tower", "furet"];
 
 /// Every family's cases up to `max_struts` struts (furet: up to its 20 modules).
-pub fn cases(family: &str, max_struts: usize) -> Result<Vec<Case>, String> {
+pub fn cases(family: &str, max_struts: usize) -> Result<Vec<Case>, BenchError> {
     match family {
         "prism" => Ok(prism::SIZES.iter().filter(|&&n| n <= max_struts).map(|&n| prism::case(n)).collect()),
         "icosahedron" => Ok(if max_struts >= 6 { vec![icosahedron::case()] } else { vec![] }),
-        "tower" => tower::STAGES.iter().filter(|&&m| tower::N * m <= max_struts).map(|&m| tower::case(m)).collect(),
+        "tower" => tower::STAGES
+            .iter()
+            .filter(|&&m| tower::N * m <= max_struts)
+            .map(|&m| tower::case(m).map_err(BenchError::Case))
+            .collect(),
         // n modules: 3 n struts and the base bar.
         "furet" => Ok(furet::MODULES.iter().filter(|&&n| 3 * n < max_struts).map(|&n| furet::case(n)).collect()),
-        _ => Err(format!("no scale family '{family}' (families: {})", FAMILIES.join(", "))),
+        _ => Err(BenchError::Case(format!("no scale family '{family}' (families: {})", FAMILIES.join(", ")))),
     }
 }
 
@@ -310,7 +315,7 @@ pub struct FamilyReport {
 }
 
 /// Settles every case of `family`.
-pub fn run_family(family: &'static str, max_struts: usize, caps: &Caps) -> Result<FamilyReport, String> {
+pub fn run_family(family: &'static str, max_struts: usize, caps: &Caps) -> Result<FamilyReport, BenchError> {
     let mut out = Vec::new();
     for case in cases(family, max_struts)? {
         out.push(run_case(&case, caps)?);

@@ -11,6 +11,7 @@
 //! sides.
 
 use super::{cases, criteria, growth_exponent, run_case, Caps, Case, FamilyReport, Measure, ScaleCase};
+use crate::bench::{write_error, BenchError};
 use crate::export::mjcf::{to_mjcf, ActuatorMode, MjcfOptions};
 use crate::structure::{ActuatorTarget, BodyKind, JointKind};
 use serde::Serialize;
@@ -91,7 +92,7 @@ fn mocap_turns(case: &Case) -> Vec<MocapTurn> {
 }
 
 /// The case for the peer, its MJCF written to `dir`.
-fn peer_case(case: &Case, caps: &Caps, dir: &Path) -> Result<PeerCase, String> {
+fn peer_case(case: &Case, caps: &Caps, dir: &Path) -> Result<PeerCase, BenchError> {
     let s = &case.start;
     let o = MjcfOptions {
         model_name: s.name.clone(),
@@ -104,7 +105,7 @@ fn peer_case(case: &Case, caps: &Caps, dir: &Path) -> Result<PeerCase, String> {
     };
     let m = to_mjcf(s, &o);
     let path = dir.join(format!("{}-{}.xml", case.family, case.size));
-    std::fs::write(&path, &m.xml).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    std::fs::write(&path, &m.xml).map_err(write_error(&path))?;
     let c = criteria(s, case.settings.dt_s, caps);
     Ok(PeerCase {
         family: case.family,
@@ -161,8 +162,8 @@ pub fn compare(
     caps: &Caps,
     command: &[String],
     dir: &Path,
-) -> Result<(Vec<FamilyReport>, Vec<PeerRow>), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+) -> Result<(Vec<FamilyReport>, Vec<PeerRow>), BenchError> {
+    std::fs::create_dir_all(dir).map_err(write_error(dir))?;
     let (mut ours, mut theirs) = (Vec::new(), Vec::new());
     for family in families {
         for case in cases(family, max_struts)? {
@@ -174,12 +175,15 @@ pub fn compare(
     let file = dir.join("scale_cases.json");
     let list = serde_json::json!({ "cases": theirs });
     std::fs::write(&file, serde_json::to_string_pretty(&list).expect("case list serialises"))
-        .map_err(|e| format!("cannot write {}: {e}", file.display()))?;
+        .map_err(write_error(&file))?;
     eprintln!("{} cases: peer ...", theirs.len());
     let v = crate::bench::run_peer(command, &file, &[])?;
-    let peer_cases = v.get("cases").and_then(|c| c.as_array()).ok_or("the peer's JSON has no 'cases' list")?;
+    let peer_cases = v
+        .get("cases")
+        .and_then(|c| c.as_array())
+        .ok_or_else(|| BenchError::Peer("the peer's JSON has no 'cases' list".into()))?;
     if peer_cases.len() != ours.len() {
-        return Err(format!("the peer settled {} cases of {}", peer_cases.len(), ours.len()));
+        return Err(BenchError::Peer(format!("the peer settled {} cases of {}", peer_cases.len(), ours.len())));
     }
     let about = serde_json::json!({
         "simulator": v.get("simulator"), "mujoco_version": v.get("mujoco_version"), "settings": v.get("settings"),

@@ -142,7 +142,7 @@ pub fn case_with(n: usize, relaxation: bool) -> Case {
 /// the speed stays below 1e-11 m/s per metre of size for 10 steps (the relaxation off once it is) and the
 /// residual is below 1e-9 N and N m, at most [`MAX_STEPS`] steps.
 /// `relaxation = false`: the plain dynamics (body damping alone), for comparison.
-pub fn settle_prism(n: usize, relaxation: bool) -> Result<ScaleCase, String> {
+pub fn settle_prism(n: usize, relaxation: bool) -> Result<ScaleCase, crate::bench::BenchError> {
     let caps = Caps { max_steps: MAX_STEPS, ..super::DEFAULT_CAPS };
     run_case(&case_with(n, relaxation), &caps)
 }

@@ -67,54 +67,74 @@ pub fn build(p: &Params, m: &ModelChoices, l3: f64, theta1: f64, theta2: f64) ->
     if l3 > 0.0 {
         s.struts.push(Strut { name: "C1D1 (actuator L3)".into(), a: c1, b: tip, radius_m: r });
     }
-    s.springs.push(Spring {
-        name: "K1".into(),
-        a: d2,
-        b: c2,
-        stiffness_n_per_m: p.k1,
-        rest_length_m: 0.0,
-        radius_m: DEFAULT_TENDON_RADIUS_M,
-    });
-    s.springs.push(Spring {
-        name: "K2".into(),
-        a: d3,
-        b: c3,
-        stiffness_n_per_m: p.k2,
-        rest_length_m: 0.0,
-        radius_m: DEFAULT_TENDON_RADIUS_M,
-    });
-    let z = [0.0, 0.0, 1.0];
-    s.joints.push(Joint {
-        name: "theta1".into(),
-        kind: JointKind::Revolute { axis: z },
-        parent: ground,
-        child: housing,
-        anchor: c1,
-        initial_coordinate: theta1,
-        torsion_spring: None,
-        damping: 0.0,
-    });
-    s.joints.push(Joint {
-        name: "L3".into(),
-        kind: JointKind::Prismatic { axis: [theta1.cos(), theta1.sin(), 0.0] },
-        parent: housing,
-        child: rod,
-        anchor: c1,
-        initial_coordinate: l3,
-        torsion_spring: None,
-        damping: 0.0,
-    });
-    s.joints.push(Joint {
-        name: "D1".into(),
-        kind: JointKind::Revolute { axis: z },
-        parent: rod,
-        child: platform,
-        anchor: d1,
-        initial_coordinate: theta2,
-        torsion_spring: None,
-        damping: m.pivot_damping,
-    });
+    s.springs.extend(zero_free_length_springs(p, (d2, c2), (d3, c3)));
+    s.joints.extend(joints(m, [ground, housing, rod, platform], (c1, d1), (theta1, l3, theta2)));
     s.actuators.push(Actuator { symbol: "L3".into(), target: ActuatorTarget::Joint(1) });
     s.actuators.push(Actuator { symbol: "theta1".into(), target: ActuatorTarget::Joint(0) });
     s
+}
+
+/// K1 (D2-C2) and K2 (D3-C3): zero-free-length springs of the paper's stiffnesses.
+fn zero_free_length_springs(p: &Params, (d2, c2): (usize, usize), (d3, c3): (usize, usize)) -> [Spring; 2] {
+    [
+        Spring {
+            name: "K1".into(),
+            a: d2,
+            b: c2,
+            stiffness_n_per_m: p.k1,
+            rest_length_m: 0.0,
+            radius_m: DEFAULT_TENDON_RADIUS_M,
+        },
+        Spring {
+            name: "K2".into(),
+            a: d3,
+            b: c3,
+            stiffness_n_per_m: p.k2,
+            rest_length_m: 0.0,
+            radius_m: DEFAULT_TENDON_RADIUS_M,
+        },
+    ]
+}
+
+/// theta1 (the housing about C1, z), L3 (the rod along theta1 from C1) and the platform's
+/// pivot D1 (about z, damped by the model's pivot damping).
+fn joints(
+    m: &ModelChoices,
+    [ground, housing, rod, platform]: [usize; 4],
+    (c1, d1): (usize, usize),
+    (theta1, l3, theta2): (f64, f64, f64),
+) -> [Joint; 3] {
+    let z = [0.0, 0.0, 1.0];
+    [
+        Joint {
+            name: "theta1".into(),
+            kind: JointKind::Revolute { axis: z },
+            parent: ground,
+            child: housing,
+            anchor: c1,
+            initial_coordinate: theta1,
+            torsion_spring: None,
+            damping: 0.0,
+        },
+        Joint {
+            name: "L3".into(),
+            kind: JointKind::Prismatic { axis: [theta1.cos(), theta1.sin(), 0.0] },
+            parent: housing,
+            child: rod,
+            anchor: c1,
+            initial_coordinate: l3,
+            torsion_spring: None,
+            damping: 0.0,
+        },
+        Joint {
+            name: "D1".into(),
+            kind: JointKind::Revolute { axis: z },
+            parent: rod,
+            child: platform,
+            anchor: d1,
+            initial_coordinate: theta2,
+            torsion_spring: None,
+            damping: m.pivot_damping,
+        },
+    ]
 }

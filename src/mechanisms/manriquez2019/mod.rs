@@ -237,32 +237,7 @@ impl Mechanism for Manriquez2019 {
     fn solve(&self, query: &str, params: &Values, inputs: &Values) -> Result<Vec<Solution>, ModelError> {
         let p = params_of(params);
         match query {
-            "fk" => {
-                let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
-                let q = analytic::points(&p, t1, t2);
-                let l = analytic::cable_lengths(&p, t1, t2);
-                let [m1, m2] = q.cable_platform;
-                Ok(vec![Solution {
-                    label: "Eq. 8-9 (cable ends P_M1, P_M2 through the DH chain), Eq. 15 (lengths in m)".into(),
-                    values: Values::from([
-                        ("x_m".into(), q.m.x),
-                        ("y_m".into(), q.m.y),
-                        ("z_m".into(), q.m.z),
-                        ("x_G".into(), q.g.x),
-                        ("y_G".into(), q.g.y),
-                        ("z_G".into(), q.g.z),
-                        ("x_M1".into(), m1.x),
-                        ("y_M1".into(), m1.y),
-                        ("z_M1".into(), m1.z),
-                        ("x_M2".into(), m2.x),
-                        ("y_M2".into(), m2.y),
-                        ("z_M2".into(), m2.z),
-                        ("L1".into(), l[0]),
-                        ("L2".into(), l[1]),
-                    ]),
-                    stable: None,
-                }])
-            }
+            "fk" => fk_solution(&p, inputs),
             "ik" => {
                 let m = Vector3::new(input(inputs, "x_m")?, input(inputs, "y_m")?, input(inputs, "z_m")?);
                 let (t1, t2) = analytic::ik_position(&p, &m).map_err(ModelError::NoSolution)?;
@@ -272,32 +247,7 @@ impl Mechanism for Manriquez2019 {
                     stable: None,
                 }])
             }
-            "statics" => {
-                let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
-                let st = analytic::statics(&p, t1, t2);
-                let mut v = statics_values(&p, t1, t2);
-                v.insert("equilibrium".into(), f64::from(u8::from(st.equilibrium)));
-                v.insert(
-                    "stable_fixed_cables".into(),
-                    f64::from(u8::from(analytic::stable_with_fixed_cables(&p, t1, t2))),
-                );
-                let mut out = vec![Solution {
-                    label: "statics (SI; m_joint in N m)".into(),
-                    values: v,
-                    stable: Some(st.equilibrium),
-                }];
-                if let Some(k) = analytic::table3_experiment(t1, t2) {
-                    let t = analytic::TABLE5_ANALYTICAL[k];
-                    let mut values: Values = TABLE5_FORCES.iter().zip(t).map(|(q, f)| (q.to_string(), f)).collect();
-                    values.insert("m_joint_Nmm".into(), t[5]);
-                    out.push(Solution {
-                        label: format!("Table 5, experiment {} (analytical column; m_joint in N mm)", k + 1),
-                        values,
-                        stable: None,
-                    });
-                }
-                Ok(out)
-            }
+            "statics" => statics_solutions(&p, inputs),
             "form_finding" => {
                 let grid = analytic::paper_grid();
                 let n_eq = analytic::classify(&p, &grid).iter().filter(|e| **e).count();
@@ -406,4 +356,55 @@ impl Mechanism for Manriquez2019 {
     fn findings(&self, params: &Values) -> Vec<Finding> {
         findings::findings(&params_of(params))
     }
+}
+
+/// `fk`: the cable ends and the platform points through the DH chain, and the cable lengths.
+fn fk_solution(p: &analytic::Params, inputs: &Values) -> Result<Vec<Solution>, ModelError> {
+    let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
+    let q = analytic::points(p, t1, t2);
+    let l = analytic::cable_lengths(p, t1, t2);
+    let [m1, m2] = q.cable_platform;
+    Ok(vec![Solution {
+        label: "Eq. 8-9 (cable ends P_M1, P_M2 through the DH chain), Eq. 15 (lengths in m)".into(),
+        values: Values::from([
+            ("x_m".into(), q.m.x),
+            ("y_m".into(), q.m.y),
+            ("z_m".into(), q.m.z),
+            ("x_G".into(), q.g.x),
+            ("y_G".into(), q.g.y),
+            ("z_G".into(), q.g.z),
+            ("x_M1".into(), m1.x),
+            ("y_M1".into(), m1.y),
+            ("z_M1".into(), m1.z),
+            ("x_M2".into(), m2.x),
+            ("y_M2".into(), m2.y),
+            ("z_M2".into(), m2.z),
+            ("L1".into(), l[0]),
+            ("L2".into(), l[1]),
+        ]),
+        stable: None,
+    }])
+}
+
+/// `statics`: the statics at the joint angles, and Table 5's analytical column where the
+/// angles are one of Table 3's experiments.
+fn statics_solutions(p: &analytic::Params, inputs: &Values) -> Result<Vec<Solution>, ModelError> {
+    let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
+    let st = analytic::statics(p, t1, t2);
+    let mut v = statics_values(p, t1, t2);
+    v.insert("equilibrium".into(), f64::from(u8::from(st.equilibrium)));
+    v.insert("stable_fixed_cables".into(), f64::from(u8::from(analytic::stable_with_fixed_cables(p, t1, t2))));
+    let mut out =
+        vec![Solution { label: "statics (SI; m_joint in N m)".into(), values: v, stable: Some(st.equilibrium) }];
+    if let Some(k) = analytic::table3_experiment(t1, t2) {
+        let t = analytic::TABLE5_ANALYTICAL[k];
+        let mut values: Values = TABLE5_FORCES.iter().zip(t).map(|(q, f)| (q.to_string(), f)).collect();
+        values.insert("m_joint_Nmm".into(), t[5]);
+        out.push(Solution {
+            label: format!("Table 5, experiment {} (analytical column; m_joint in N mm)", k + 1),
+            values,
+            stable: None,
+        });
+    }
+    Ok(out)
 }
