@@ -592,8 +592,8 @@ fn cmd_figure(name: Option<&str>, out: &Path, list: bool) -> i32 {
     let name = match (name, list) {
         (Some(n), false) => n,
         _ => {
-            for (n, what) in tensegrity_testbed::figures::FIGURES {
-                println!("{n}: {what}");
+            for f in tensegrity_testbed::figures::all() {
+                println!("{}: {}", f.name, f.description);
             }
             return if list { EXIT_PASS } else { EXIT_BAD_INPUT };
         }
