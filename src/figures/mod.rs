@@ -58,3 +58,29 @@ pub fn draw(name: &str, out_dir: &Path) -> Result<Vec<PathBuf>, FigureError> {
     kit::write(&files, figure.size, figure.draw)?;
     Ok(files.into_iter().map(|(path, _)| path).collect())
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    /// `find` and the files NAME.png, NAME.svg need every figure to have its own name.
+    #[test]
+    fn every_figure_has_its_own_name() {
+        let mut names: Vec<&str> = super::all().map(|f| f.name).collect();
+        let count = names.len();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), count, "{names:?}");
+        assert!(super::all().all(|f| super::find(f.name).is_some_and(|g| std::ptr::eq(f, g))));
+    }
+
+    /// An unknown name is refused before anything is written, naming the figures there are.
+    #[test]
+    fn an_unknown_figure_is_refused_with_the_known_names() {
+        let dir = Path::new("/nonexistent/tensegrity-figures");
+        let e = super::draw("no-such-figure", dir).unwrap_err();
+        assert!(matches!(e, super::FigureError::Unknown { .. }));
+        assert!(e.to_string().starts_with("unknown figure 'no-such-figure' (expected one of: ji2014-fig2, "), "{e}");
+        assert!(!dir.exists());
+    }
+}
