@@ -7,8 +7,8 @@ pub fn figure(name: Option<&str>, out: &Path, list: bool) -> Result<Outcome, Cli
     let name = match (name, list) {
         (Some(n), false) => n,
         _ => {
-            for (n, what) in crate::figures::FIGURES {
-                println!("{n}: {what}");
+            for f in crate::figures::all() {
+                println!("{}: {}", f.name, f.description);
             }
             return if list {
                 Ok(Outcome::Pass)

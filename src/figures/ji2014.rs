@@ -1,15 +1,54 @@
-//! ji2014's workspace figures, redrawn from the derived model with the dynamics on top: Fig. 2-3
+//! ji2014's figures, redrawn from the derived model with the dynamics on top: Fig. 2-3
 //! (actuator and Cartesian workspaces with the singular curves of Section 4.2 and 5.2, and the
-//! points of `scenarios/ji2014/grid.toml`), Fig. 7-8 (the stiffness over both workspaces, and the
-//! torque probe of `scenarios/ji2014/stiffness_grid.toml`).
+//! points of `scenarios/ji2014/grid.toml`), Fig. 4-6 (energy, torque and stiffness against
+//! theta2, with the equilibrium of `scenarios/ji2014/fig4.toml`), Fig. 7-8 (the stiffness over
+//! both workspaces, and the torque probe of `scenarios/ji2014/stiffness_grid.toml`).
 
-use super::{cell_runs, colour_at, colour_bar, legend_panel, zero_contour, Glyph, LIGHT_BLUES, VIRIDIS};
+use super::kit::{
+    cell_runs, colour_at, colour_bar, legend_box, legend_panel, map_chart, range, rimmed_dot, run_scenario,
+    titled_page, zero_contour, Chart, FigureError, Glyph, Plot, LIGHT_BLUES, VIRIDIS,
+};
+use super::Figure;
 use crate::mechanisms::ji2014::analytic as ji;
 use crate::mechanisms::ji2014::PAPER_ROOT_MARK;
 use plotters::coord::Shift;
+use plotters::element::ComposedElement;
 use plotters::prelude::*;
 use std::f64::consts::PI;
-use std::path::Path;
+
+/// ji2014's figures.
+pub(super) const FIGURES: &[Figure] = &[
+    Figure {
+        name: "ji2014-fig2",
+        description: "ji2014 Fig. 2: actuator workspace (theta1, L3) with det J and the singular curves i-vi of Section 4.2 as derived (which printed ones are not singular), with the 110 points of grid.toml settled by the dynamics",
+        size: SIZE,
+        draw: |canvas| canvas.draw(&fig2_data()?),
+    },
+    Figure {
+        name: "ji2014-fig3",
+        description: "ji2014 Fig. 3: Cartesian workspace of D3 (how many stable inputs reach each point) with the images of the curves and the printed Eq. 34-37, with the settled D3 of grid.toml",
+        size: SIZE,
+        draw: |canvas| canvas.draw(&fig3_data()?),
+    },
+    Figure {
+        name: "ji2014-fig4",
+        description: "ji2014 Fig. 4-6: energy U, torque tau and stiffness K against theta2 (L3 = 6, K1 = 100, K2 = 10, theta1 = pi/10), with the equilibrium the dynamics settled on",
+        size: FIG4_SIZE,
+        draw: |canvas| canvas.draw(&fig4_data()?),
+    },
+    Figure {
+        name: "ji2014-fig7",
+        description: "ji2014 Fig. 7: stiffness K at the stable equilibrium over the actuator workspace (colour map, contours, symmetry line), with the dynamics' torque probe at 16 points (stiffness_grid.toml)",
+        size: SIZE,
+        draw: |canvas| canvas.draw(&fig7_data()?),
+    },
+    Figure {
+        name: "ji2014-fig8",
+        description: "ji2014 Fig. 8: stiffness K at the stable equilibrium over the Cartesian workspace of D3 (colour map, contours, the paper's symmetry line x = 0), with the dynamics' torque probe at the settled D3 of stiffness_grid.toml",
+        size: SIZE,
+        draw: |canvas| canvas.draw(&fig8_data()?),
+    },
+];
 
 /// Size of an actuator- or Cartesian-workspace figure in pixels.
 const SIZE: (u32, u32) = (1000, 1080);
@@ -42,8 +81,8 @@ struct GridPoint {
     d3_error_m: f64,
 }
 
-fn grid_points() -> Result<(ji::Params, Vec<GridPoint>), String> {
-    let (sc, report) = super::run_scenario("scenarios/ji2014/grid.toml")?;
+fn grid_points() -> Result<(ji::Params, Vec<GridPoint>), FigureError> {
+    let (sc, report) = run_scenario("scenarios/ji2014/grid.toml")?;
     let p = ji::Params { l: sc.params["L"], k1: sc.params["K1"], k2: sc.params["K2"] };
     let points = report
         .points
@@ -67,7 +106,7 @@ fn det_j_stable(p: &ji::Params, l3: f64, theta1: f64) -> f64 {
     ji::det_jacobian_closed_form(p, l3, theta1, e.theta2)
 }
 
-pub(super) struct Fig2 {
+struct Fig2 {
     p: ji::Params,
     l3_max: f64,
     /// (theta1, L3, det J) at cell centres.
@@ -91,7 +130,7 @@ pub(super) struct Fig2 {
     points: Vec<GridPoint>,
 }
 
-pub(super) fn fig2_data() -> Result<Fig2, String> {
+fn fig2_data() -> Result<Fig2, FigureError> {
     let (p, points) = grid_points()?;
     let l3_max = ji::PAPER_L3_MAX_OVER_L * p.l;
     let cell = (PI / CELLS as f64, l3_max / CELLS as f64);
@@ -174,103 +213,126 @@ const DISAGREE: RGBColor = RGBColor(230, 0, 0);
 /// A diamond marker's corners [px].
 const DIAMOND_PX: [(i32, i32); 4] = [(0, -8), (8, 0), (0, 8), (-8, 0)];
 
-pub(super) fn fig2_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig2) -> Result<(), String> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    let agree = d.points.iter().filter(|q| q.agrees).count();
-    let n = d.points.len();
-    let root = super::titled_page(
-        root,
-        &format!(
-            "ji2014 Fig. 2: actuator workspace and singular curves (L = {} m, K1 = {} N/m, K2 = {} N/m)",
-            d.p.l, d.p.k1, d.p.k2
-        ),
-        20,
-    )?;
-    let (top, legend) = root.split_vertically(SIZE.1 - LEGEND_PX - 30);
-    let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
-    let mut chart = super::map_chart(&plot, &format!(
-                "colour: det J at the stable equilibrium (Eq. 23, corrected Eq. 24); dynamics (grid.toml): {agree} of {n} points agree ({:.1} %)",
-                100.0 * agree as f64 / n as f64
-            ), -MAP_PAD_RAD..PI + MAP_PAD_RAD, -MAP_PAD_M..d.l3_max + MAP_PAD_M, ("theta1 [rad]", "L3 [m]"))?;
-    let colours = d.cells.iter().map(|(t1, l3, det)| (*t1, *l3, colour_at(LIGHT_BLUES, det / d.det_max)));
-    chart.draw_series(cell_runs(colours, d.cell)).map_err(err)?;
-    // Curve vi (Eq. 31) and ii (Eq. 27): the edges of the range, ii dashed (not singular).
-    chart.draw_series(LineSeries::new([(0.0, d.l3_max), (PI, d.l3_max)], CURVE_VI.stroke_width(3))).map_err(err)?;
-    for t1 in [0.0, PI] {
-        chart
-            .draw_series(DashedLineSeries::new([(t1, 0.0), (t1, d.l3_max)], 10, 6, CURVE_II.stroke_width(4).into()))
-            .map_err(err)?;
-    }
-    chart
-        .draw_series(DashedLineSeries::new(d.curve_iii.iter().copied(), 10, 6, CURVE_III.stroke_width(3).into()))
-        .map_err(err)?;
-    chart
-        .draw_series(DashedLineSeries::new(d.curve_iv.iter().copied(), 10, 6, CURVE_IV.stroke_width(3).into()))
-        .map_err(err)?;
-    for line in &d.curve_v {
-        chart.draw_series(LineSeries::new(line.iter().copied(), CURVE_V.stroke_width(3))).map_err(err)?;
-    }
-    for line in &d.curve_v_printed {
-        chart
-            .draw_series(DashedLineSeries::new(line.iter().copied(), 6, 4, CURVE_V.stroke_width(2).into()))
-            .map_err(err)?;
-    }
-    // Curve i (Eq. 26), the one singular curve: drawn last among the curves.
-    chart.draw_series(LineSeries::new([(0.0, 0.0), (PI, 0.0)], CURVE_I.stroke_width(4))).map_err(err)?;
-    // The dynamics.
-    chart
-        .draw_series(d.points.iter().filter(|q| q.agrees && !q.paper_root).map(|q| {
-            EmptyElement::at((q.theta1, q.l3))
-                + Circle::new((0, 0), 5, AGREE.filled())
-                + Circle::new((0, 0), 5, BLACK.stroke_width(1))
-        }))
-        .map_err(err)?;
-    chart
-        .draw_series(d.points.iter().filter(|q| q.agrees && q.paper_root).map(|q| {
-            EmptyElement::at((q.theta1, q.l3))
-                + Polygon::new(DIAMOND_PX.to_vec(), AGREE_PAPER_ROOT.filled())
-                + PathElement::new([&DIAMOND_PX[..], &DIAMOND_PX[..1]].concat(), BLACK.stroke_width(1))
-        }))
-        .map_err(err)?;
-    chart
-        .draw_series(
-            d.points.iter().filter(|q| !q.agrees).map(|q| Cross::new((q.theta1, q.l3), 7, DISAGREE.stroke_width(3))),
-        )
-        .map_err(err)?;
-    colour_bar(&bar, LIGHT_BLUES, 0.0, d.det_max, "det J [m/rad]").map_err(err)?;
-    let paper_roots = d.points.iter().filter(|q| q.paper_root).count();
-    let v_entry = if d.curve_v.is_empty() && d.curve_v_printed.is_empty() {
-        (
-            Glyph::Note,
-            format!(
-                "v: Phi1 = 0 (Eq. 30): |eta| = L (K1+2K2), a circle of radius {:.3} m about D1* = ({:.3}, {:.3}) m, below the X axis: not in this workspace (printed Eq. 24 neither)",
-                d.v_radius_m, d.neutral.0, d.neutral.1
+impl Plot for Fig2 {
+    fn plot<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), FigureError> {
+        let d = self;
+        let (agree, n) = (d.points.iter().filter(|q| q.agrees).count(), d.points.len());
+        let root = titled_page(
+            root,
+            &format!(
+                "ji2014 Fig. 2: actuator workspace and singular curves (L = {} m, K1 = {} N/m, K2 = {} N/m)",
+                d.p.l, d.p.k1, d.p.k2
             ),
-        )
-    } else {
-        (Glyph::Line(CURVE_V, 3), "v: Phi1 = 0 (Eq. 30; dashed: Eq. 24 as printed)".to_string())
-    };
-    let entries = vec![
-        (Glyph::Line(CURVE_I, 4), format!("i: L3 = 0 (Eq. 26): det J = 0, singular; but not free: K = {:.1} N m/rad", d.k_at_l3_zero)),
-        (Glyph::Dashed(CURVE_II, 4), format!("ii: sin theta1 = 0 (Eq. 27): NOT singular, det J >= {:.3} m/rad for L3 >= {DET_SCAN_L3_MIN_M} m; only the edge of the range", d.det_min_ii)),
-        (Glyph::Dashed(CURVE_III, 3), format!("iii: eta1 = 0 (Eq. 28): NOT singular, |det J| <= {:.2} m/rad (finite); Eq. 5's [0, pi] root jumps by pi here", d.det_max_iii)),
-        (Glyph::Dashed(CURVE_IV, 3), format!("iv: theta1 = theta2 (Eq. 33): NOT singular, det J >= {:.3} m/rad for L3 >= {DET_SCAN_L3_MIN_M} m", d.det_min_iv)),
-        v_entry,
-        (Glyph::Line(CURVE_VI, 3), "vi: L3 = 2L (Eq. 31): the actuator's limit, not a singularity".to_string()),
-        (Glyph::Dot(AGREE), "dynamics: settled on the energy minimum within 1e-9, stable by perturbation, as K > 0 says".to_string()),
-        (Glyph::Diamond(AGREE_PAPER_ROOT), format!("the same, and the minimum is the root Eq. 5 picks in [0, pi] ({paper_roots} of {n} points)")),
-        (Glyph::Cross(DISAGREE), "dynamics and analytic stability disagree, or not settled".to_string()),
-        (Glyph::Note, format!("Dashed: printed singular curves that prove not singular. Elsewhere Eq. 5's [0, pi] root is the energy maximum ({} of {n} points).", n - paper_roots)),
-    ];
-    legend_panel(&legend.margin(0, 8, 10, 10), &entries, 1, 13).map_err(err)?;
-    root.present().map_err(err)?;
+            20,
+        )?;
+        let (top, legend) = root.split_vertically(SIZE.1 - LEGEND_PX - 30);
+        let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
+        let mut chart = map_chart(&plot, &format!(
+                    "colour: det J at the stable equilibrium (Eq. 23, corrected Eq. 24); dynamics (grid.toml): {agree} of {n} points agree ({:.1} %)",
+                    100.0 * agree as f64 / n as f64
+                ), -MAP_PAD_RAD..PI + MAP_PAD_RAD, -MAP_PAD_M..d.l3_max + MAP_PAD_M, ("theta1 [rad]", "L3 [m]"))?;
+        let colours = d.cells.iter().map(|(t1, l3, det)| (*t1, *l3, colour_at(LIGHT_BLUES, det / d.det_max)));
+        chart.draw_series(cell_runs(colours, d.cell))?;
+        d.draw_curves(&mut chart)?;
+        draw_grid_points(&mut chart, &d.points, &|q| (q.theta1, q.l3), 5, true)?;
+        colour_bar(&bar, LIGHT_BLUES, 0.0, d.det_max, "det J [m/rad]")?;
+        legend_panel(&legend.margin(0, 8, 10, 10), &d.legend(), 1, 13)?;
+        Ok(())
+    }
+}
+
+impl Fig2 {
+    /// The curves i-vi of Section 4.2 in the actuator workspace.
+    fn draw_curves<DB: DrawingBackend>(&self, chart: &mut Chart<'_, DB>) -> Result<(), FigureError> {
+        let d = self;
+        // Curve vi (Eq. 31) and ii (Eq. 27): the edges of the range, ii dashed (not singular).
+        chart.draw_series(LineSeries::new([(0.0, d.l3_max), (PI, d.l3_max)], CURVE_VI.stroke_width(3)))?;
+        for t1 in [0.0, PI] {
+            chart.draw_series(DashedLineSeries::new(
+                [(t1, 0.0), (t1, d.l3_max)],
+                10,
+                6,
+                CURVE_II.stroke_width(4).into(),
+            ))?;
+        }
+        chart.draw_series(DashedLineSeries::new(
+            d.curve_iii.iter().copied(),
+            10,
+            6,
+            CURVE_III.stroke_width(3).into(),
+        ))?;
+        chart.draw_series(DashedLineSeries::new(d.curve_iv.iter().copied(), 10, 6, CURVE_IV.stroke_width(3).into()))?;
+        for line in &d.curve_v {
+            chart.draw_series(LineSeries::new(line.iter().copied(), CURVE_V.stroke_width(3)))?;
+        }
+        for line in &d.curve_v_printed {
+            chart.draw_series(DashedLineSeries::new(line.iter().copied(), 6, 4, CURVE_V.stroke_width(2).into()))?;
+        }
+        // Curve i (Eq. 26), the one singular curve: drawn last among the curves.
+        chart.draw_series(LineSeries::new([(0.0, 0.0), (PI, 0.0)], CURVE_I.stroke_width(4)))?;
+        Ok(())
+    }
+
+    /// Fig. 2's legend: the curves and the dynamics' markers.
+    fn legend(&self) -> Vec<(Glyph, String)> {
+        let d = self;
+        let n = d.points.len();
+        let paper_roots = d.points.iter().filter(|q| q.paper_root).count();
+        let v_entry = if d.curve_v.is_empty() && d.curve_v_printed.is_empty() {
+            (
+                Glyph::Note,
+                format!(
+                    "v: Phi1 = 0 (Eq. 30): |eta| = L (K1+2K2), a circle of radius {:.3} m about D1* = ({:.3}, {:.3}) m, below the X axis: not in this workspace (printed Eq. 24 neither)",
+                    d.v_radius_m, d.neutral.0, d.neutral.1
+                ),
+            )
+        } else {
+            (Glyph::Line(CURVE_V, 3), "v: Phi1 = 0 (Eq. 30; dashed: Eq. 24 as printed)".to_string())
+        };
+        vec![
+            (Glyph::Line(CURVE_I, 4), format!("i: L3 = 0 (Eq. 26): det J = 0, singular; but not free: K = {:.1} N m/rad", d.k_at_l3_zero)),
+            (Glyph::Dashed(CURVE_II, 4), format!("ii: sin theta1 = 0 (Eq. 27): NOT singular, det J >= {:.3} m/rad for L3 >= {DET_SCAN_L3_MIN_M} m; only the edge of the range", d.det_min_ii)),
+            (Glyph::Dashed(CURVE_III, 3), format!("iii: eta1 = 0 (Eq. 28): NOT singular, |det J| <= {:.2} m/rad (finite); Eq. 5's [0, pi] root jumps by pi here", d.det_max_iii)),
+            (Glyph::Dashed(CURVE_IV, 3), format!("iv: theta1 = theta2 (Eq. 33): NOT singular, det J >= {:.3} m/rad for L3 >= {DET_SCAN_L3_MIN_M} m", d.det_min_iv)),
+            v_entry,
+            (Glyph::Line(CURVE_VI, 3), "vi: L3 = 2L (Eq. 31): the actuator's limit, not a singularity".to_string()),
+            (Glyph::Dot(AGREE), "dynamics: settled on the energy minimum within 1e-9, stable by perturbation, as K > 0 says".to_string()),
+            (Glyph::Diamond(AGREE_PAPER_ROOT), format!("the same, and the minimum is the root Eq. 5 picks in [0, pi] ({paper_roots} of {n} points)")),
+            (Glyph::Cross(DISAGREE), "dynamics and analytic stability disagree, or not settled".to_string()),
+            (Glyph::Note, format!("Dashed: printed singular curves that prove not singular. Elsewhere Eq. 5's [0, pi] root is the energy maximum ({} of {n} points).", n - paper_roots)),
+        ]
+    }
+}
+
+/// The dynamics' verdict on the points of grid.toml, placed by `at`: a white dot of `radius`
+/// where it agrees (where moreover the minimum is the root Eq. 5 picks, a yellow diamond if
+/// `mark_paper_root`), a red cross where it does not.
+fn draw_grid_points<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    points: &[GridPoint],
+    at: &dyn Fn(&GridPoint) -> (f64, f64),
+    radius: i32,
+    mark_paper_root: bool,
+) -> Result<(), FigureError> {
+    let dot = |q: &&GridPoint| q.agrees && !(mark_paper_root && q.paper_root);
+    chart.draw_series(points.iter().filter(dot).map(|q| rimmed_dot(at(q), radius, AGREE, 1)))?;
+    if mark_paper_root {
+        let diamond = |q: &&GridPoint| q.agrees && q.paper_root;
+        chart.draw_series(points.iter().filter(diamond).map(|q| rimmed_diamond(at(q), AGREE_PAPER_ROOT, 1)))?;
+    }
+    chart.draw_series(points.iter().filter(|q| !q.agrees).map(|q| Cross::new(at(q), 7, DISAGREE.stroke_width(3))))?;
     Ok(())
 }
 
-pub(super) fn draw_fig2(png: &Path, svg: &Path) -> Result<(), String> {
-    let d = fig2_data()?;
-    fig2_plot(BitMapBackend::new(png, SIZE).into_drawing_area(), &d)?;
-    fig2_plot(SVGBackend::new(svg, SIZE).into_drawing_area(), &d)
+/// A diamond marker at `at`, filled with `fill`, with a black rim `rim_px` wide.
+fn rimmed_diamond<DB: DrawingBackend>(
+    at: (f64, f64),
+    fill: RGBColor,
+    rim_px: u32,
+) -> ComposedElement<(f64, f64), DB, Polygon<(i32, i32)>, PathElement<(i32, i32)>> {
+    EmptyElement::at(at)
+        + Polygon::new(DIAMOND_PX.to_vec(), fill.filled())
+        + PathElement::new([&DIAMOND_PX[..], &DIAMOND_PX[..1]].concat(), BLACK.stroke_width(rim_px))
 }
 
 /// Which equilibria of the actuator workspace reach a point of the plane.
@@ -306,7 +368,7 @@ fn d3_stable(p: &ji::Params, l3: f64, theta1: f64) -> (f64, f64) {
 const FIG3_X_M: (f64, f64) = (-3.2, 3.2);
 const FIG3_Y_M: (f64, f64) = (-1.6, 3.2);
 
-pub(super) struct Fig3 {
+struct Fig3 {
     p: ji::Params,
     /// (x, y, reach) at cell centres.
     cells: Vec<(f64, f64, Reach)>,
@@ -330,7 +392,7 @@ pub(super) struct Fig3 {
     max_d3_error: f64,
 }
 
-pub(super) fn fig3_data() -> Result<Fig3, String> {
+fn fig3_data() -> Result<Fig3, FigureError> {
     let (p, grid) = grid_points()?;
     let l3_max = ji::PAPER_L3_MAX_OVER_L * p.l;
     let cell = ((FIG3_X_M.1 - FIG3_X_M.0) / CELLS as f64, (FIG3_Y_M.1 - FIG3_Y_M.0) / CELLS as f64);
@@ -396,120 +458,232 @@ fn circle(r: f64) -> Vec<(f64, f64)> {
         .collect()
 }
 
-pub(super) fn fig3_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig3) -> Result<(), String> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    let agree = d.points.iter().filter(|q| q.agrees).count();
-    let n = d.points.len();
-    let root = super::titled_page(
-        root,
-        &format!(
-            "ji2014 Fig. 3: Cartesian workspace of D3 and the images of the curves (L = {} m, K1 = {} N/m, K2 = {} N/m)",
-            d.p.l, d.p.k1, d.p.k2
-        ),
-        19,
-    )?;
-    let (plot, legend) = root.split_vertically(SIZE.1 - FIG3_LEGEND_PX - 30);
-    let mut chart = super::map_chart(
-        &plot,
-        &format!(
-            "dynamics (grid.toml): {agree} of {n} settled D3 agree, largest distance from the analytic D3 {:.1e} L",
-            d.max_d3_error
-        ),
-        FIG3_X_M.0..FIG3_X_M.1,
-        FIG3_Y_M.0..FIG3_Y_M.1,
-        ("x [m]", "y [m]"),
-    )?;
-    let colours = d.cells.iter().map(|(x, y, r)| {
-        let c = match r {
-            Reach::StableOnce => REACH_ONCE,
-            Reach::StableTwice => REACH_TWICE,
-            Reach::OnlyUnstable => REACH_UNSTABLE,
-        };
-        (*x, *y, c)
-    });
-    chart.draw_series(cell_runs(colours, d.cell)).map_err(err)?;
-    // The printed Cartesian curves (Eq. 34, 36, 37), thin dashed.
-    let dashed = |pts: Vec<(f64, f64)>, c: RGBColor| DashedLineSeries::new(pts, 8, 5, c.stroke_width(2).into());
-    chart.draw_series(dashed(circle(d.p.l), CURVE_I)).map_err(err)?;
-    chart.draw_series(dashed(circle(3.0 * d.p.l), CURVE_IV)).map_err(err)?;
-    // Eq. 36 as printed is a line: y = (2 sqrt3 K1 x + 2 sqrt3 L (K2 - K1)) / (K1 + 2 K2).
-    let eq36 = |x: f64| {
-        (2.0 * ji::SQRT_3 * d.p.k1 * x + 2.0 * ji::SQRT_3 * d.p.l * (d.p.k2 - d.p.k1)) / (d.p.k1 + 2.0 * d.p.k2)
-    };
-    let eq36_line: Vec<(f64, f64)> = (0..=CURVE_SAMPLES)
-        .map(|k| FIG3_X_M.0 + (FIG3_X_M.1 - FIG3_X_M.0) * k as f64 / CURVE_SAMPLES as f64)
-        .map(|x| (x, eq36(x)))
-        .filter(|(_, y)| (FIG3_Y_M.0..=FIG3_Y_M.1).contains(y))
-        .collect();
-    chart.draw_series(dashed(eq36_line, CURVE_III)).map_err(err)?;
-    // The images of the actuator-space curves through the stable equilibrium, solid.
-    for line in &d.image_ii {
-        chart.draw_series(LineSeries::new(line.iter().copied(), CURVE_II.stroke_width(3))).map_err(err)?;
+impl Plot for Fig3 {
+    fn plot<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), FigureError> {
+        let d = self;
+        let (agree, n) = (d.points.iter().filter(|q| q.agrees).count(), d.points.len());
+        let root = titled_page(
+            root,
+            &format!(
+                "ji2014 Fig. 3: Cartesian workspace of D3 and the images of the curves (L = {} m, K1 = {} N/m, K2 = {} N/m)",
+                d.p.l, d.p.k1, d.p.k2
+            ),
+            19,
+        )?;
+        let (plot, legend) = root.split_vertically(SIZE.1 - FIG3_LEGEND_PX - 30);
+        let mut chart = map_chart(
+            &plot,
+            &format!(
+                "dynamics (grid.toml): {agree} of {n} settled D3 agree, largest distance from the analytic D3 {:.1e} L",
+                d.max_d3_error
+            ),
+            FIG3_X_M.0..FIG3_X_M.1,
+            FIG3_Y_M.0..FIG3_Y_M.1,
+            ("x [m]", "y [m]"),
+        )?;
+        let colours = d.cells.iter().map(|(x, y, r)| {
+            let c = match r {
+                Reach::StableOnce => REACH_ONCE,
+                Reach::StableTwice => REACH_TWICE,
+                Reach::OnlyUnstable => REACH_UNSTABLE,
+            };
+            (*x, *y, c)
+        });
+        chart.draw_series(cell_runs(colours, d.cell))?;
+        d.draw_curves(&mut chart)?;
+        draw_grid_points(&mut chart, &d.points, &|q| (q.x, q.y), 4, false)?;
+        legend_panel(&legend.margin(0, 8, 10, 10), &d.legend(), 1, 13)?;
+        Ok(())
     }
-    chart.draw_series(LineSeries::new(d.image_iii.iter().copied(), CURVE_III.stroke_width(4))).map_err(err)?;
-    chart.draw_series(LineSeries::new(d.image_iv.iter().copied(), CURVE_IV.stroke_width(3))).map_err(err)?;
-    chart.draw_series(LineSeries::new(d.image_vi.iter().copied(), CURVE_VI.stroke_width(3))).map_err(err)?;
-    chart.draw_series(std::iter::once(TriangleMarker::new(d.image_i, 9, CURVE_I.filled()))).map_err(err)?;
-    chart
-        .draw_series(d.points.iter().filter(|q| q.agrees).map(|q| {
-            EmptyElement::at((q.x, q.y))
-                + Circle::new((0, 0), 4, AGREE.filled())
-                + Circle::new((0, 0), 4, BLACK.stroke_width(1))
-        }))
-        .map_err(err)?;
-    chart
-        .draw_series(d.points.iter().filter(|q| !q.agrees).map(|q| Cross::new((q.x, q.y), 7, DISAGREE.stroke_width(3))))
-        .map_err(err)?;
-    let entries = vec![
-        (Glyph::Fill(REACH_ONCE), format!("stable equilibrium of one input (L3, theta1): {:.2} m^2", d.areas_m2[0])),
-        (Glyph::Fill(REACH_TWICE), format!("stable equilibrium of two inputs: {:.2} m^2", d.areas_m2[1])),
-        (
-            Glyph::Fill(REACH_UNSTABLE),
-            format!("only an energy maximum (most of the paper's Eq. 5 roots): {:.2} m^2", d.areas_m2[2]),
-        ),
-        (Glyph::Triangle(CURVE_I), format!("i: L3 = 0 maps to ONE point ({:.3}, {:.3}) m", d.image_i.0, d.image_i.1)),
-        (
-            Glyph::Dashed(CURVE_I, 2),
-            "Eq. 34 as printed (x^2 + y^2 = L^2): |D3 - D1| = L, not the image of i".to_string(),
-        ),
-        (
-            Glyph::Line(CURVE_II, 3),
-            "ii: images of theta1 = 0 and theta1 = pi (curves, not the region Sec. 5.2 says)".to_string(),
-        ),
-        (Glyph::Line(CURVE_III, 4), "iii: image of eta1 = 0, on the line of theta2 = pi".to_string()),
-        (
-            Glyph::Dashed(CURVE_III, 2),
-            format!("Eq. 36 as printed (assumes theta2 = 0): off by up to {:.2} K1 L on the image", d.eq36_residual),
-        ),
-        (
-            Glyph::Line(CURVE_IV, 3),
-            format!("iv: image of Eq. 33, |D3| = L - L3 from {:.3} to {:.3} L", d.iv_radius.0, d.iv_radius.1),
-        ),
-        (
-            Glyph::Dashed(CURVE_IV, 2),
-            "Eq. 37 as printed (x^2 + y^2 = 9 L^2): only the reach circle of the maximum".to_string(),
-        ),
-        (
-            Glyph::Line(CURVE_VI, 3),
-            "vi: image of L3 = 2L; v (Phi1 = 0) has no image: it lies outside the actuator workspace".to_string(),
-        ),
-        (Glyph::Dot(AGREE), "dynamics: settled D3 on the stable analytic D3 within 1e-9 L, stable".to_string()),
-        (Glyph::Cross(DISAGREE), "dynamics: disagrees with the analytic stability, or not settled".to_string()),
-    ];
-    legend_panel(&legend.margin(0, 8, 10, 10), &entries, 1, 13).map_err(err)?;
-    root.present().map_err(err)?;
-    Ok(())
+}
+
+impl Fig3 {
+    /// The printed Cartesian curves and the images of the actuator-space curves.
+    fn draw_curves<DB: DrawingBackend>(&self, chart: &mut Chart<'_, DB>) -> Result<(), FigureError> {
+        let d = self;
+        // The printed Cartesian curves (Eq. 34, 36, 37), thin dashed.
+        let dashed = |pts: Vec<(f64, f64)>, c: RGBColor| DashedLineSeries::new(pts, 8, 5, c.stroke_width(2).into());
+        chart.draw_series(dashed(circle(d.p.l), CURVE_I))?;
+        chart.draw_series(dashed(circle(3.0 * d.p.l), CURVE_IV))?;
+        // Eq. 36 as printed is a line: y = (2 sqrt3 K1 x + 2 sqrt3 L (K2 - K1)) / (K1 + 2 K2).
+        let eq36 = |x: f64| {
+            (2.0 * ji::SQRT_3 * d.p.k1 * x + 2.0 * ji::SQRT_3 * d.p.l * (d.p.k2 - d.p.k1)) / (d.p.k1 + 2.0 * d.p.k2)
+        };
+        let eq36_line: Vec<(f64, f64)> = (0..=CURVE_SAMPLES)
+            .map(|k| FIG3_X_M.0 + (FIG3_X_M.1 - FIG3_X_M.0) * k as f64 / CURVE_SAMPLES as f64)
+            .map(|x| (x, eq36(x)))
+            .filter(|(_, y)| (FIG3_Y_M.0..=FIG3_Y_M.1).contains(y))
+            .collect();
+        chart.draw_series(dashed(eq36_line, CURVE_III))?;
+        // The images of the actuator-space curves through the stable equilibrium, solid.
+        for line in &d.image_ii {
+            chart.draw_series(LineSeries::new(line.iter().copied(), CURVE_II.stroke_width(3)))?;
+        }
+        chart.draw_series(LineSeries::new(d.image_iii.iter().copied(), CURVE_III.stroke_width(4)))?;
+        chart.draw_series(LineSeries::new(d.image_iv.iter().copied(), CURVE_IV.stroke_width(3)))?;
+        chart.draw_series(LineSeries::new(d.image_vi.iter().copied(), CURVE_VI.stroke_width(3)))?;
+        chart.draw_series(std::iter::once(TriangleMarker::new(d.image_i, 9, CURVE_I.filled())))?;
+        Ok(())
+    }
+
+    /// Fig. 3's legend: the reach classes, the curves and the dynamics' markers.
+    fn legend(&self) -> Vec<(Glyph, String)> {
+        let d = self;
+        vec![
+            (
+                Glyph::Fill(REACH_ONCE),
+                format!("stable equilibrium of one input (L3, theta1): {:.2} m^2", d.areas_m2[0]),
+            ),
+            (Glyph::Fill(REACH_TWICE), format!("stable equilibrium of two inputs: {:.2} m^2", d.areas_m2[1])),
+            (
+                Glyph::Fill(REACH_UNSTABLE),
+                format!("only an energy maximum (most of the paper's Eq. 5 roots): {:.2} m^2", d.areas_m2[2]),
+            ),
+            (
+                Glyph::Triangle(CURVE_I),
+                format!("i: L3 = 0 maps to ONE point ({:.3}, {:.3}) m", d.image_i.0, d.image_i.1),
+            ),
+            (
+                Glyph::Dashed(CURVE_I, 2),
+                "Eq. 34 as printed (x^2 + y^2 = L^2): |D3 - D1| = L, not the image of i".to_string(),
+            ),
+            (
+                Glyph::Line(CURVE_II, 3),
+                "ii: images of theta1 = 0 and theta1 = pi (curves, not the region Sec. 5.2 says)".to_string(),
+            ),
+            (Glyph::Line(CURVE_III, 4), "iii: image of eta1 = 0, on the line of theta2 = pi".to_string()),
+            (
+                Glyph::Dashed(CURVE_III, 2),
+                format!(
+                    "Eq. 36 as printed (assumes theta2 = 0): off by up to {:.2} K1 L on the image",
+                    d.eq36_residual
+                ),
+            ),
+            (
+                Glyph::Line(CURVE_IV, 3),
+                format!("iv: image of Eq. 33, |D3| = L - L3 from {:.3} to {:.3} L", d.iv_radius.0, d.iv_radius.1),
+            ),
+            (
+                Glyph::Dashed(CURVE_IV, 2),
+                "Eq. 37 as printed (x^2 + y^2 = 9 L^2): only the reach circle of the maximum".to_string(),
+            ),
+            (
+                Glyph::Line(CURVE_VI, 3),
+                "vi: image of L3 = 2L; v (Phi1 = 0) has no image: it lies outside the actuator workspace".to_string(),
+            ),
+            (Glyph::Dot(AGREE), "dynamics: settled D3 on the stable analytic D3 within 1e-9 L, stable".to_string()),
+            (Glyph::Cross(DISAGREE), "dynamics: disagrees with the analytic stability, or not settled".to_string()),
+        ]
+    }
 }
 
 /// Height of Fig. 3's legend panel [px].
 const FIG3_LEGEND_PX: u32 = 310;
 
-pub(super) fn draw_fig3(png: &Path, svg: &Path) -> Result<(), String> {
-    let d = fig3_data()?;
-    fig3_plot(BitMapBackend::new(png, SIZE).into_drawing_area(), &d)?;
-    fig3_plot(SVGBackend::new(svg, SIZE).into_drawing_area(), &d)
+// ---------------------------------------------------------------------------
+// Fig. 4-6: energy, torque and stiffness against theta2 at one input.
+// ---------------------------------------------------------------------------
+
+/// Samples of a curve against theta2.
+const FIG4_SAMPLES: usize = 721;
+/// Size of Fig. 4-6 in pixels.
+const FIG4_SIZE: (u32, u32) = (900, 1100);
+
+struct Fig4 {
+    theta2: Vec<f64>,
+    u: Vec<f64>,
+    tau: Vec<f64>,
+    k: Vec<f64>,
+    /// Analytic equilibria: (theta2, stable).
+    equilibria: Vec<(f64, bool)>,
+    /// Where the dynamics settled (theta2), from `scenarios/ji2014/fig4.toml`.
+    simulated: f64,
+    params: ji::Params,
+    l3: f64,
+    theta1: f64,
 }
 
+fn fig4_data() -> Result<Fig4, FigureError> {
+    let (sc, report) = run_scenario("scenarios/ji2014/fig4.toml")?;
+    let point = report.points.first().ok_or_else(|| FigureError::Data("the fig4 scenario settled no point".into()))?;
+    if !point.settled {
+        return Err(FigureError::Data("the fig4 scenario did not settle".into()));
+    }
+    let params = ji::Params { l: sc.params["L"], k1: sc.params["K1"], k2: sc.params["K2"] };
+    let (l3, theta1) = (point.inputs["L3"], point.inputs["theta1"]);
+    let theta2: Vec<f64> = (0..FIG4_SAMPLES)
+        .map(|i| -std::f64::consts::PI + std::f64::consts::TAU * i as f64 / (FIG4_SAMPLES - 1) as f64)
+        .collect();
+    Ok(Fig4 {
+        u: theta2.iter().map(|t| ji::potential_energy(&params, l3, theta1, *t)).collect(),
+        tau: theta2.iter().map(|t| ji::torque(&params, l3, theta1, *t)).collect(),
+        k: theta2.iter().map(|t| ji::stiffness(&params, l3, theta1, *t)).collect(),
+        equilibria: ji::equilibria(&params, l3, theta1).iter().map(|e| (e.theta2, e.stable)).collect(),
+        simulated: point.simulated["theta2"],
+        theta2,
+        params,
+        l3,
+        theta1,
+    })
+}
+
+impl Plot for Fig4 {
+    fn plot<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), FigureError> {
+        let d = self;
+        let root = titled_page(
+            root,
+            &format!(
+                "ji2014, L3 = {} m, theta1 = {:.4} rad, K1 = {} N/m, K2 = {} N/m",
+                d.l3, d.theta1, d.params.k1, d.params.k2
+            ),
+            22,
+        )?;
+        let panels = root.split_evenly((3, 1));
+        let curves: [(&str, &str, &Vec<f64>, RGBColor, SeriesLabelPosition); 3] = [
+            ("U [J] (Eq. 4)", "energy", &d.u, BLUE, SeriesLabelPosition::UpperRight),
+            ("tau [N m] (Eq. 41)", "torque", &d.tau, GREEN, SeriesLabelPosition::UpperRight),
+            ("K [N m/rad] (Eq. 42)", "stiffness", &d.k, MAGENTA, SeriesLabelPosition::LowerRight),
+        ];
+        for (panel, (ylabel, what, ys, colour, legend_at)) in panels.iter().zip(curves) {
+            let mut chart = ChartBuilder::on(panel)
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(70)
+                .caption(format!("{what} against theta2"), ("sans-serif", 18))
+                .build_cartesian_2d(-std::f64::consts::PI..std::f64::consts::PI, range(ys))?;
+            chart.configure_mesh().x_desc("theta2 [rad]").y_desc(ylabel).draw()?;
+            chart
+                .draw_series(LineSeries::new(d.theta2.iter().copied().zip(ys.iter().copied()), colour.stroke_width(2)))?
+                .label(format!("analytic {what}"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+            let value_at = |t: f64| -> f64 {
+                match what {
+                    "energy" => ji::potential_energy(&d.params, d.l3, d.theta1, t),
+                    "torque" => ji::torque(&d.params, d.l3, d.theta1, t),
+                    _ => ji::stiffness(&d.params, d.l3, d.theta1, t),
+                }
+            };
+            for (t, stable) in &d.equilibria {
+                let (label, style) = if *stable {
+                    ("analytic energy minimum", BLACK.filled())
+                } else {
+                    ("analytic energy maximum", BLACK.stroke_width(2))
+                };
+                chart
+                    .draw_series(std::iter::once(Circle::new((*t, value_at(*t)), 7, style)))?
+                    .label(label)
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 5, style));
+            }
+            let sim = d.simulated;
+            chart
+                .draw_series(std::iter::once(TriangleMarker::new((sim, value_at(sim)), 9, RED.filled())))?
+                .label(format!("dynamics settled at theta2 = {sim:.9} rad"))
+                .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, RED.filled()));
+            legend_box(&mut chart, legend_at, 13)?;
+        }
+        Ok(())
+    }
+}
 // ---------------------------------------------------------------------------
 // Fig. 7-8: the stiffness at the stable equilibrium, with the dynamics' probe.
 // ---------------------------------------------------------------------------
@@ -525,8 +699,8 @@ struct Probe {
     rel_error: f64,
 }
 
-fn probe_points() -> Result<(ji::Params, Vec<Probe>, f64), String> {
-    let (sc, report) = super::run_scenario("scenarios/ji2014/stiffness_grid.toml")?;
+fn probe_points() -> Result<(ji::Params, Vec<Probe>, f64), FigureError> {
+    let (sc, report) = run_scenario("scenarios/ji2014/stiffness_grid.toml")?;
     let p = ji::Params { l: sc.params["L"], k1: sc.params["K1"], k2: sc.params["K2"] };
     let probes = report
         .points
@@ -554,23 +728,15 @@ const K_CONTOUR_STEP: f64 = 100.0;
 
 /// Draws the probe markers, one series per error class (white circle, white diamond, red cross).
 fn draw_probes<DB: DrawingBackend>(
-    chart: &mut ChartContext<
-        '_,
-        DB,
-        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
-    >,
+    chart: &mut Chart<'_, DB>,
     probes: &[Probe],
     at: &dyn Fn(&Probe) -> (f64, f64),
-) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+) -> Result<(), FigureError> {
     let [lo, hi] = PROBE_ERROR_BOUNDS;
-    chart.draw_series(probes.iter().filter(|q| q.rel_error < lo).map(|q| {
-        EmptyElement::at(at(q)) + Circle::new((0, 0), 7, AGREE.filled()) + Circle::new((0, 0), 7, BLACK.stroke_width(2))
-    }))?;
-    chart.draw_series(probes.iter().filter(|q| (lo..hi).contains(&q.rel_error)).map(|q| {
-        EmptyElement::at(at(q))
-            + Polygon::new(DIAMOND_PX.to_vec(), AGREE.filled())
-            + PathElement::new([&DIAMOND_PX[..], &DIAMOND_PX[..1]].concat(), BLACK.stroke_width(2))
-    }))?;
+    chart.draw_series(probes.iter().filter(|q| q.rel_error < lo).map(|q| rimmed_dot(at(q), 7, AGREE, 2)))?;
+    chart.draw_series(
+        probes.iter().filter(|q| (lo..hi).contains(&q.rel_error)).map(|q| rimmed_diamond(at(q), AGREE, 2)),
+    )?;
     chart.draw_series(
         probes.iter().filter(|q| q.rel_error >= hi).map(|q| Cross::new(at(q), 8, DISAGREE.stroke_width(3))),
     )?;
@@ -600,7 +766,7 @@ fn probe_entries(probes: &[Probe], tolerance: f64) -> Vec<(Glyph, String)> {
     ]
 }
 
-pub(super) struct Fig7 {
+struct Fig7 {
     p: ji::Params,
     l3_max: f64,
     /// (theta1, L3, K) at cell centres.
@@ -630,7 +796,7 @@ fn k_stable(p: &ji::Params, l3: f64, theta1: f64) -> f64 {
     ji::equilibria(p, l3, theta1)[0].stiffness
 }
 
-pub(super) fn fig7_data() -> Result<Fig7, String> {
+fn fig7_data() -> Result<Fig7, FigureError> {
     let (p, probes, tolerance) = probe_points()?;
     let l3_max = ji::PAPER_L3_MAX_OVER_L * p.l;
     let cell = (PI / CELLS as f64, l3_max / CELLS as f64);
@@ -729,90 +895,86 @@ struct StiffnessMap<'a> {
     legend: Vec<(Glyph, String)>,
 }
 
-fn stiffness_map_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, m: StiffnessMap) -> Result<(), String> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    let root = super::titled_page(root, &m.title, 20)?;
-    let (top, legend) = root.split_vertically(SIZE.1 - FIG7_LEGEND_PX - 30);
-    let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
-    let mut chart = super::map_chart(&plot, &m.caption, m.x, m.y, (m.x_desc, m.y_desc))?;
-    let colours = m.cells.iter().map(|(x, y, k)| (*x, *y, colour_at(VIRIDIS, (k - m.k_min) / (m.k_max - m.k_min))));
-    chart.draw_series(cell_runs(colours, m.cell)).map_err(err)?;
-    for line in m.contours {
-        chart.draw_series(LineSeries::new(line.iter().copied(), K_LINES.mix(0.6).stroke_width(1))).map_err(err)?;
-    }
-    for l in &m.lines {
-        let style = l.colour.stroke_width(l.width);
-        if l.dashed {
-            chart.draw_series(DashedLineSeries::new(l.points.iter().copied(), 10, 6, style.into())).map_err(err)?;
-        } else {
-            chart.draw_series(LineSeries::new(l.points.iter().copied(), style)).map_err(err)?;
+impl Plot for StiffnessMap<'_> {
+    fn plot<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), FigureError> {
+        let m = self;
+        let root = titled_page(root, &m.title, 20)?;
+        let (top, legend) = root.split_vertically(SIZE.1 - FIG7_LEGEND_PX - 30);
+        let (plot, bar) = top.split_horizontally(SIZE.0 - COLOUR_BAR_PX);
+        let mut chart = map_chart(&plot, &m.caption, m.x.clone(), m.y.clone(), (m.x_desc, m.y_desc))?;
+        let colours = m.cells.iter().map(|(x, y, k)| (*x, *y, colour_at(VIRIDIS, (k - m.k_min) / (m.k_max - m.k_min))));
+        chart.draw_series(cell_runs(colours, m.cell))?;
+        for line in m.contours {
+            chart.draw_series(LineSeries::new(line.iter().copied(), K_LINES.mix(0.6).stroke_width(1)))?;
         }
+        for l in &m.lines {
+            let style = l.colour.stroke_width(l.width);
+            if l.dashed {
+                chart.draw_series(DashedLineSeries::new(l.points.iter().copied(), 10, 6, style.into()))?;
+            } else {
+                chart.draw_series(LineSeries::new(l.points.iter().copied(), style))?;
+            }
+        }
+        draw_probes(&mut chart, m.probes, m.probe_at)?;
+        colour_bar(&bar, VIRIDIS, m.k_min, m.k_max, "K [N m/rad]")?;
+        let mut entries = m.legend.clone();
+        entries.extend(probe_entries(m.probes, m.tolerance));
+        legend_panel(&legend.margin(0, 8, 10, 10), &entries, 1, 13)?;
+        Ok(())
     }
-    draw_probes(&mut chart, m.probes, m.probe_at).map_err(err)?;
-    colour_bar(&bar, VIRIDIS, m.k_min, m.k_max, "K [N m/rad]").map_err(err)?;
-    let mut entries = m.legend;
-    entries.extend(probe_entries(m.probes, m.tolerance));
-    legend_panel(&legend.margin(0, 8, 10, 10), &entries, 1, 13).map_err(err)?;
-    root.present().map_err(err)?;
-    Ok(())
 }
 
-pub(super) fn fig7_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig7) -> Result<(), String> {
-    let max_err = d.probes.iter().map(|q| q.rel_error).fold(0.0, f64::max);
-    stiffness_map_plot(
-        root,
+impl Plot for Fig7 {
+    fn plot<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), FigureError> {
+        let d = self;
+        let max_err = d.probes.iter().map(|q| q.rel_error).fold(0.0, f64::max);
         StiffnessMap {
-            title: format!(
-                "ji2014 Fig. 7: stiffness K over the actuator workspace (L = {} m, K1 = {} N/m, K2 = {} N/m)",
-                d.p.l, d.p.k1, d.p.k2
-            ),
-            caption: format!(
-                "colour: K = (L/2)|eta| at the stable equilibrium (Eq. 42); probe (stiffness_grid.toml): max relative error {max_err:.1e}"
-            ),
-            x: -MAP_PAD_RAD..PI + MAP_PAD_RAD,
-            y: -MAP_PAD_M..d.l3_max + MAP_PAD_M,
-            x_desc: "theta1 [rad]",
-            y_desc: "L3 [m]",
-            cells: &d.cells,
-            cell: d.cell,
-            k_min: d.k_min,
-            k_max: d.k_max,
-            contours: &d.contours,
-            lines: vec![
-                MapLine {
-                    points: vec![(d.symmetry_theta1, 0.0), (d.symmetry_theta1, d.l3_max)],
-                    colour: K_LINES,
-                    width: 3,
-                    dashed: false,
-                },
-                MapLine {
-                    points: vec![(PAPER_FIG7_SYMMETRY_THETA1, 0.0), (PAPER_FIG7_SYMMETRY_THETA1, d.l3_max)],
-                    colour: PAPER_LINE,
-                    width: 3,
-                    dashed: true,
-                },
-                MapLine { points: d.curve_iii.clone(), colour: CURVE_III, width: 3, dashed: true },
-            ],
-            probes: &d.probes,
-            probe_at: &|q| (q.theta1, q.l3),
-            tolerance: d.tolerance,
-            legend: vec![
-                (Glyph::Line(LEGEND_WHITE_LINE, 1), format!(
-                    "contour lines of K every {K_CONTOUR_STEP} N m/rad. The paper: K grows with L3. It does in {} of {CELLS} columns; for theta1 > {:.2} rad it falls first, up to L3 = {:.2} m",
-                    CELLS - d.columns_not_growing, d.falls_from_theta1, d.falls_up_to_l3
-                )),
-                (Glyph::Line(LEGEND_WHITE_LINE, 3), format!("theta1 = {:.4} rad: K is exactly symmetric about it (the direction opposite D1*)", d.symmetry_theta1)),
-                (Glyph::Dashed(PAPER_LINE, 3), format!("theta1 = {PAPER_FIG7_SYMMETRY_THETA1} rad: the symmetry line Section 6.2 reads off Fig. 7 (wrong)")),
-                (Glyph::Dashed(CURVE_III, 3), format!("eta1 = 0 (to its right Eq. 47 as printed is NEGATIVE, -K, as the paper's root is the maximum): {:.1} % of the map", 100.0 * d.eq47_negative)),
-            ],
-        },
-    )
-}
-
-pub(super) fn draw_fig7(png: &Path, svg: &Path) -> Result<(), String> {
-    let d = fig7_data()?;
-    fig7_plot(BitMapBackend::new(png, SIZE).into_drawing_area(), &d)?;
-    fig7_plot(SVGBackend::new(svg, SIZE).into_drawing_area(), &d)
+                title: format!(
+                    "ji2014 Fig. 7: stiffness K over the actuator workspace (L = {} m, K1 = {} N/m, K2 = {} N/m)",
+                    d.p.l, d.p.k1, d.p.k2
+                ),
+                caption: format!(
+                    "colour: K = (L/2)|eta| at the stable equilibrium (Eq. 42); probe (stiffness_grid.toml): max relative error {max_err:.1e}"
+                ),
+                x: -MAP_PAD_RAD..PI + MAP_PAD_RAD,
+                y: -MAP_PAD_M..d.l3_max + MAP_PAD_M,
+                x_desc: "theta1 [rad]",
+                y_desc: "L3 [m]",
+                cells: &d.cells,
+                cell: d.cell,
+                k_min: d.k_min,
+                k_max: d.k_max,
+                contours: &d.contours,
+                lines: vec![
+                    MapLine {
+                        points: vec![(d.symmetry_theta1, 0.0), (d.symmetry_theta1, d.l3_max)],
+                        colour: K_LINES,
+                        width: 3,
+                        dashed: false,
+                    },
+                    MapLine {
+                        points: vec![(PAPER_FIG7_SYMMETRY_THETA1, 0.0), (PAPER_FIG7_SYMMETRY_THETA1, d.l3_max)],
+                        colour: PAPER_LINE,
+                        width: 3,
+                        dashed: true,
+                    },
+                    MapLine { points: d.curve_iii.clone(), colour: CURVE_III, width: 3, dashed: true },
+                ],
+                probes: &d.probes,
+                probe_at: &|q| (q.theta1, q.l3),
+                tolerance: d.tolerance,
+                legend: vec![
+                    (Glyph::Line(LEGEND_WHITE_LINE, 1), format!(
+                        "contour lines of K every {K_CONTOUR_STEP} N m/rad. The paper: K grows with L3. It does in {} of {CELLS} columns; for theta1 > {:.2} rad it falls first, up to L3 = {:.2} m",
+                        CELLS - d.columns_not_growing, d.falls_from_theta1, d.falls_up_to_l3
+                    )),
+                    (Glyph::Line(LEGEND_WHITE_LINE, 3), format!("theta1 = {:.4} rad: K is exactly symmetric about it (the direction opposite D1*)", d.symmetry_theta1)),
+                    (Glyph::Dashed(PAPER_LINE, 3), format!("theta1 = {PAPER_FIG7_SYMMETRY_THETA1} rad: the symmetry line Section 6.2 reads off Fig. 7 (wrong)")),
+                    (Glyph::Dashed(CURVE_III, 3), format!("eta1 = 0 (to its right Eq. 47 as printed is NEGATIVE, -K, as the paper's root is the maximum): {:.1} % of the map", 100.0 * d.eq47_negative)),
+                ],
+            }
+            .plot(root)
+    }
 }
 
 /// Cartesian window of Fig. 8 [m]: the stable part of Fig. 3's workspace.
@@ -827,7 +989,7 @@ fn k_at_d3(p: &ji::Params, l3_max: f64, x: f64, y: f64) -> Option<f64> {
     ji::inverse_kinematics(p, x, y).into_iter().find(|s| s.stable && s.l3 <= l3_max).map(|s| s.stiffness)
 }
 
-pub(super) struct Fig8 {
+struct Fig8 {
     p: ji::Params,
     /// (x, y, K) at the cell centres inside the stable workspace.
     cells: Vec<(f64, f64, f64)>,
@@ -846,7 +1008,7 @@ pub(super) struct Fig8 {
     tolerance: f64,
 }
 
-pub(super) fn fig8_data() -> Result<Fig8, String> {
+fn fig8_data() -> Result<Fig8, FigureError> {
     let (p, probes, tolerance) = probe_points()?;
     let l3_max = ji::PAPER_L3_MAX_OVER_L * p.l;
     let cell = ((FIG8_X_M.1 - FIG8_X_M.0) / CELLS as f64, (FIG8_Y_M.1 - FIG8_Y_M.0) / CELLS as f64);
@@ -897,57 +1059,52 @@ pub(super) fn fig8_data() -> Result<Fig8, String> {
     })
 }
 
-pub(super) fn fig8_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig8) -> Result<(), String> {
-    let max_err = d.probes.iter().map(|q| q.rel_error).fold(0.0, f64::max);
-    stiffness_map_plot(
-        root,
+impl Plot for Fig8 {
+    fn plot<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), FigureError> {
+        let d = self;
+        let max_err = d.probes.iter().map(|q| q.rel_error).fold(0.0, f64::max);
         StiffnessMap {
-            title: format!(
-                "ji2014 Fig. 8: stiffness K over the Cartesian workspace (L = {} m, K1 = {} N/m, K2 = {} N/m)",
-                d.p.l, d.p.k1, d.p.k2
-            ),
-            caption: format!("colour: K at the stable equilibrium with D3 = (x, y) (Eq. 42, IK by Eq. 48); probe: max relative error {max_err:.1e}"),
-            x: FIG8_X_M.0..FIG8_X_M.1,
-            y: FIG8_Y_M.0..FIG8_Y_M.1,
-            x_desc: "x [m]",
-            y_desc: "y [m]",
-            cells: &d.cells,
-            cell: d.cell,
-            k_min: d.k_min,
-            k_max: d.k_max,
-            contours: &d.contours,
-            lines: vec![MapLine {
-                points: vec![(PAPER_FIG8_SYMMETRY_X_M, FIG8_Y_M.0), (PAPER_FIG8_SYMMETRY_X_M, FIG8_Y_M.1)],
-                colour: PAPER_LINE,
-                width: 3,
-                dashed: true,
-            }],
-            probes: &d.probes,
-            probe_at: &|q| (q.x, q.y),
-            tolerance: d.tolerance,
-            legend: vec![
-                (
-                    Glyph::Line(LEGEND_WHITE_LINE, 1),
-                    format!(
-                        "contour lines of K every {K_CONTOUR_STEP} N m/rad. The paper: for a given x, K grows with y. It does in {} of {} columns",
-                        d.columns_growing_with_y, d.columns
-                    ),
+                title: format!(
+                    "ji2014 Fig. 8: stiffness K over the Cartesian workspace (L = {} m, K1 = {} N/m, K2 = {} N/m)",
+                    d.p.l, d.p.k1, d.p.k2
                 ),
-                (
-                    Glyph::Dashed(PAPER_LINE, 3),
-                    format!(
-                        "x = 0: the paper's symmetry line; K(x, y) and K(-x, y) differ by up to {:.0} % ({} cells with both inside)",
-                        100.0 * d.mirror_asymmetry,
-                        d.mirrored_cells
+                caption: format!("colour: K at the stable equilibrium with D3 = (x, y) (Eq. 42, IK by Eq. 48); probe: max relative error {max_err:.1e}"),
+                x: FIG8_X_M.0..FIG8_X_M.1,
+                y: FIG8_Y_M.0..FIG8_Y_M.1,
+                x_desc: "x [m]",
+                y_desc: "y [m]",
+                cells: &d.cells,
+                cell: d.cell,
+                k_min: d.k_min,
+                k_max: d.k_max,
+                contours: &d.contours,
+                lines: vec![MapLine {
+                    points: vec![(PAPER_FIG8_SYMMETRY_X_M, FIG8_Y_M.0), (PAPER_FIG8_SYMMETRY_X_M, FIG8_Y_M.1)],
+                    colour: PAPER_LINE,
+                    width: 3,
+                    dashed: true,
+                }],
+                probes: &d.probes,
+                probe_at: &|q| (q.x, q.y),
+                tolerance: d.tolerance,
+                legend: vec![
+                    (
+                        Glyph::Line(LEGEND_WHITE_LINE, 1),
+                        format!(
+                            "contour lines of K every {K_CONTOUR_STEP} N m/rad. The paper: for a given x, K grows with y. It does in {} of {} columns",
+                            d.columns_growing_with_y, d.columns
+                        ),
                     ),
-                ),
-            ],
-        },
-    )
-}
-
-pub(super) fn draw_fig8(png: &Path, svg: &Path) -> Result<(), String> {
-    let d = fig8_data()?;
-    fig8_plot(BitMapBackend::new(png, SIZE).into_drawing_area(), &d)?;
-    fig8_plot(SVGBackend::new(svg, SIZE).into_drawing_area(), &d)
+                    (
+                        Glyph::Dashed(PAPER_LINE, 3),
+                        format!(
+                            "x = 0: the paper's symmetry line; K(x, y) and K(-x, y) differ by up to {:.0} % ({} cells with both inside)",
+                            100.0 * d.mirror_asymmetry,
+                            d.mirrored_cells
+                        ),
+                    ),
+                ],
+            }
+            .plot(root)
+    }
 }

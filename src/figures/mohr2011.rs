@@ -1,15 +1,42 @@
 //! mohr2011's workspace figures: Fig. 4 (horizontal slices of the kinematic workspace, Eq.
-//! 17-18, at several heights) and Fig. 6 (the paper's 3D view of the static workspace, Eq.
-//! 29-31, drawn as two vertical slices), each with small dynamics grids from
+//! 17-18, at several heights), Fig. 5 (the slice z = 3 m of the static and kinematic
+//! workspaces) and Fig. 6 (the paper's 3D view of the static workspace, Eq. 29-31, drawn as two
+//! vertical slices), each with small dynamics grids from
 //! `scenarios/mohr2011/workspace_grid_small.toml`.
 
-use super::{cell_runs, legend_panel, zero_contour, Glyph};
+use super::kit::{
+    cell_runs, legend_box, legend_panel, read_scenario, rimmed_dot, swatch, titled_page, zero_contour, Chart,
+    FigureError, Glyph, Plot,
+};
+use super::Figure;
 use crate::mechanisms::mohr2011::analytic::{self as mohr, Region};
-use crate::scenario;
+use crate::scenario::{self, Scenario};
 use nalgebra::Vector3;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
+
+/// mohr2011's figures.
+pub(super) const FIGURES: &[Figure] = &[
+    Figure {
+        name: "mohr2011-fig4",
+        description: "mohr2011 Fig. 4: horizontal slices z = 1-5 m of the kinematic workspace (l_b = 2, l_o = 3 l_b) with the static boundary and the base triangle, with 9 x 9 points per slice settled by the dynamics",
+        size: FIG4_SIZE,
+        draw: |canvas| canvas.draw(&fig4_data()?),
+    },
+    Figure {
+        name: "mohr2011-fig5",
+        description: "mohr2011 Fig. 5: the horizontal slice z = 3 m of the static and kinematic workspaces (l_b = 2, l_o = 3 l_b), with a 9 x 9 grid classified by the dynamics",
+        size: FIG5_SIZE,
+        draw: |canvas| canvas.draw(&fig5_data()?),
+    },
+    Figure {
+        name: "mohr2011-fig6",
+        description: "mohr2011 Fig. 6: the static workspace (l_b = 2, l_o = 3 l_b) in the vertical slices x = 0 and y = 0, with 9 x 9 points per slice settled by the dynamics",
+        size: FIG6_SIZE,
+        draw: |canvas| canvas.draw(&fig6_data()?),
+    },
+];
 
 /// The paper's parameters of Figs. 4-6: l_b = 2 m, l_o = l_max = 3 l_b, l_min = 0.
 fn paper_params() -> mohr::Params {
@@ -50,27 +77,45 @@ struct Grid {
 }
 
 impl Grid {
-    fn agreement_percent(&self) -> f64 {
-        let agree = self.points.iter().filter(|q| q.analytic_static == q.dynamics_static).count();
-        100.0 * agree as f64 / self.points.len().max(1) as f64
+    /// The points where the dynamics and the analytic model classify alike.
+    fn agreeing(&self) -> usize {
+        self.points.iter().filter(|q| q.analytic_static == q.dynamics_static).count()
     }
+
+    fn agreement_percent(&self) -> f64 {
+        100.0 * self.agreeing() as f64 / self.points.len().max(1) as f64
+    }
+}
+
+/// The points of `grids` that agree, and all their (assembled) points.
+fn tally<'a>(grids: impl Iterator<Item = &'a Grid>) -> (usize, usize) {
+    grids.fold((0, 0), |(agree, points), g| (agree + g.agreeing(), points + g.points.len()))
+}
+
+/// `workspace_grid_small.toml` with the lines that start with the keys replaced (key, line).
+fn small_grid_scenario(edits: &[(&str, String)]) -> Result<Scenario, FigureError> {
+    let path = Path::new("scenarios/mohr2011/workspace_grid_small.toml");
+    let mut text = read_scenario(path)?;
+    for (key, line) in edits {
+        text = replace_line(&text, key, line)?;
+    }
+    Ok(scenario::parse(path, &text)?)
 }
 
 /// Runs `workspace_grid_small.toml` with its grid replaced by `grid` (a TOML inline table of
 /// x, y, z ranges).
-fn dynamics_grid(grid: &str) -> Result<Grid, String> {
-    let path = Path::new("scenarios/mohr2011/workspace_grid_small.toml");
-    let src = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let text = replace_line(&src, "grid = {", &format!("grid = {grid}"))?;
-    let text = replace_line(&text, "max_time = ", &format!("max_time = {SETTLE_MAX_TIME_S:?}"))?;
-    let sc = scenario::parse(path, &text).map_err(|e| e.to_string())?;
+fn dynamics_grid(grid: &str) -> Result<Grid, FigureError> {
+    let sc = small_grid_scenario(&[
+        ("grid = {", format!("grid = {grid}")),
+        ("max_time = ", format!("max_time = {SETTLE_MAX_TIME_S:?}")),
+    ])?;
     let centroid = |v: &crate::mechanisms::Values| Vector3::new(v["x"], v["y"], v["z"]);
     // The grid's centroids are converted to the cable lengths rho (Eq. 15) before the check
     // that drops them; the direct kinematics (Eq. 12-14) gives them back.
     let p = paper_params();
     let not_assembled =
         sc.skipped_points.iter().filter_map(|(v, _)| mohr::dkp(&p, &[v["rho1"], v["rho2"], v["rho3"]])).collect();
-    let (rows, _) = crate::sweep::sweep(&sc, SWEEP_JOBS, None, None, &|_, _| {}).map_err(|e| e.to_string())?;
+    let (rows, _) = crate::sweep::sweep(&sc, SWEEP_JOBS, None, None, &|_, _| {})?;
     let points = rows
         .iter()
         .map(|r| {
@@ -86,8 +131,11 @@ fn dynamics_grid(grid: &str) -> Result<Grid, String> {
 }
 
 /// `src` with the line that starts with `key` replaced by `line`.
-fn replace_line(src: &str, key: &str, line: &str) -> Result<String, String> {
-    let start = src.find(&format!("\n{key}")).ok_or(format!("workspace_grid_small.toml has no '{key}'"))? + 1;
+fn replace_line(src: &str, key: &str, line: &str) -> Result<String, FigureError> {
+    let start = src
+        .find(&format!("\n{key}"))
+        .ok_or_else(|| FigureError::Data(format!("workspace_grid_small.toml has no '{key}'")))?
+        + 1;
     let end = start + src[start..].find('\n').unwrap_or(src.len() - start);
     Ok(format!("{}{line}{}", &src[..start], &src[end..]))
 }
@@ -138,13 +186,13 @@ struct Slice {
     grid: Grid,
 }
 
-pub(super) struct Fig4 {
+struct Fig4 {
     p: mohr::Params,
     cell: f64,
     slices: Vec<Slice>,
 }
 
-fn fig4_data() -> Result<Fig4, String> {
+fn fig4_data() -> Result<Fig4, FigureError> {
     let p = paper_params();
     let cell = 2.0 * HALF_WIDTH_M / CELLS as f64;
     let g = GRID_HALF_WIDTH_M;
@@ -190,84 +238,76 @@ fn base_triangle(p: &mohr::Params) -> Vec<(f64, f64)> {
     vec![(a[0].x, a[0].y), (a[1].x, a[1].y), (a[2].x, a[2].y), (a[0].x, a[0].y)]
 }
 
-fn fig4_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig4) -> Result<(), String> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    let points: usize = d.slices.iter().map(|s| s.grid.points.len()).sum();
-    let agree: usize =
-        d.slices.iter().flat_map(|s| &s.grid.points).filter(|q| q.analytic_static == q.dynamics_static).count();
-    let root = super::titled_page(
-        root,
-        &format!(
-            "mohr2011 Fig. 4: horizontal slices of the kinematic workspace (l_b = {} m, l_min = 0, l_max = l_o = {} m)",
-            d.p.lb, d.p.lo
-        ),
-        20,
-    )?;
-    let areas = root.split_evenly((2, 3));
-    let h = HALF_WIDTH_M;
-    for (area, s) in areas.iter().zip(&d.slices) {
-        let mut chart = ChartBuilder::on(area)
-            .margin(8)
-            .x_label_area_size(35)
-            .y_label_area_size(45)
-            .caption(
-                format!(
-                    "z = {} m: kinematic {:.1} m^2 (static {:.1} m^2); dynamics agree {:.0} %",
-                    s.z,
-                    s.areas_m2.0,
-                    s.areas_m2.1,
-                    s.grid.agreement_percent()
-                ),
-                ("sans-serif", 14),
-            )
-            .build_cartesian_2d(-h..h, -h..h)
-            .map_err(err)?;
-        chart.configure_mesh().disable_mesh().x_desc("x [m]").y_desc("y [m]").draw().map_err(err)?;
-        chart
-            .draw_series(cell_runs(s.cells.iter().map(|(x, y)| (*x, *y, KINEMATIC)), (d.cell, d.cell)))
-            .map_err(err)?;
-        for line in &s.static_boundary {
-            chart
-                .draw_series(DashedLineSeries::new(line.iter().copied(), 6, 4, STATIC_LINE.stroke_width(2).into()))
-                .map_err(err)?;
+impl Plot for Fig4 {
+    fn plot<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), FigureError> {
+        let d = self;
+        let (agree, points) = tally(d.slices.iter().map(|s| &s.grid));
+        let root = titled_page(
+            root,
+            &format!(
+                "mohr2011 Fig. 4: horizontal slices of the kinematic workspace (l_b = {} m, l_min = 0, l_max = l_o = {} m)",
+                d.p.lb, d.p.lo
+            ),
+            20,
+        )?;
+        let areas = root.split_evenly((2, 3));
+        let h = HALF_WIDTH_M;
+        for (area, s) in areas.iter().zip(&d.slices) {
+            let mut chart = ChartBuilder::on(area)
+                .margin(8)
+                .x_label_area_size(35)
+                .y_label_area_size(45)
+                .caption(
+                    format!(
+                        "z = {} m: kinematic {:.1} m^2 (static {:.1} m^2); dynamics agree {:.0} %",
+                        s.z,
+                        s.areas_m2.0,
+                        s.areas_m2.1,
+                        s.grid.agreement_percent()
+                    ),
+                    ("sans-serif", 14),
+                )
+                .build_cartesian_2d(-h..h, -h..h)?;
+            chart.configure_mesh().disable_mesh().x_desc("x [m]").y_desc("y [m]").draw()?;
+            chart.draw_series(cell_runs(s.cells.iter().map(|(x, y)| (*x, *y, KINEMATIC)), (d.cell, d.cell)))?;
+            for line in &s.static_boundary {
+                chart.draw_series(DashedLineSeries::new(
+                    line.iter().copied(),
+                    6,
+                    4,
+                    STATIC_LINE.stroke_width(2).into(),
+                ))?;
+            }
+            chart.draw_series(LineSeries::new(base_triangle(&d.p), BASE.stroke_width(2)))?;
+            draw_grid(&mut chart, &s.grid, &|c| (c.x, c.y))?;
         }
-        chart.draw_series(LineSeries::new(base_triangle(&d.p), BASE.stroke_width(2))).map_err(err)?;
-        draw_grid(&mut chart, &s.grid, &|c| (c.x, c.y)).map_err(err)?;
+        let entries = vec![
+            (Glyph::Fill(KINEMATIC), "kinematic workspace (Eq. 17-18, z > 0)".to_string()),
+            (Glyph::Dashed(STATIC_LINE, 2), "boundary of the static workspace (Eq. 29-31; Fig. 5)".to_string()),
+            (Glyph::Line(BASE, 2), "base triangle A1A2A3 (Eq. 1)".to_string()),
+            (Glyph::Dot(HELD), "dynamics: held there, every cable taut, within 1e-9".to_string()),
+            (Glyph::Cross(NOT_HELD), "dynamics: assembled, but a cable pair went slack".to_string()),
+            (Glyph::Ring(DISAGREE), format!("differs from the analytic class: not at rest in {SETTLE_MAX_TIME_S} s")),
+            (Glyph::Dot(NOT_ASSEMBLED), "cannot be assembled: a spring longer than l_o".to_string()),
+            (Glyph::Note, format!("9 x 9 points per slice: {agree} of {points} assembled points agree")),
+            (Glyph::Note, "with the analytic static classification (the others lie on".to_string()),
+            (Glyph::Note, "a boundary). Every assembled point lies in the kinematic".to_string()),
+            (Glyph::Note, "workspace, and none outside.".to_string()),
+        ];
+        let legend_area = &areas[FIG4_HEIGHTS_M.len()];
+        legend_panel(&legend_area.margin(40, 40, 10, 0), &entries, 1, 14)?;
+        Ok(())
     }
-    let entries = vec![
-        (Glyph::Fill(KINEMATIC), "kinematic workspace (Eq. 17-18, z > 0)".to_string()),
-        (Glyph::Dashed(STATIC_LINE, 2), "boundary of the static workspace (Eq. 29-31; Fig. 5)".to_string()),
-        (Glyph::Line(BASE, 2), "base triangle A1A2A3 (Eq. 1)".to_string()),
-        (Glyph::Dot(HELD), "dynamics: held there, every cable taut, within 1e-9".to_string()),
-        (Glyph::Cross(NOT_HELD), "dynamics: assembled, but a cable pair went slack".to_string()),
-        (Glyph::Ring(DISAGREE), format!("differs from the analytic class: not at rest in {SETTLE_MAX_TIME_S} s")),
-        (Glyph::Dot(NOT_ASSEMBLED), "cannot be assembled: a spring longer than l_o".to_string()),
-        (Glyph::Note, format!("9 x 9 points per slice: {agree} of {points} assembled points agree")),
-        (Glyph::Note, "with the analytic static classification (the others lie on".to_string()),
-        (Glyph::Note, "a boundary). Every assembled point lies in the kinematic".to_string()),
-        (Glyph::Note, "workspace, and none outside.".to_string()),
-    ];
-    let legend_area = &areas[FIG4_HEIGHTS_M.len()];
-    legend_panel(&legend_area.margin(40, 40, 10, 0), &entries, 1, 14).map_err(err)?;
-    root.present().map_err(err)?;
-    Ok(())
 }
-
-type Chart<'a, DB> =
-    ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
 
 /// The dynamics' markers of `grid`, placed by `at`.
 fn draw_grid<'a, DB: DrawingBackend + 'a>(
     chart: &mut Chart<'a, DB>,
     grid: &Grid,
     at: &dyn Fn(&Vector3<f64>) -> (f64, f64),
-) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+) -> Result<(), FigureError> {
     chart.draw_series(grid.not_assembled.iter().map(|c| Circle::new(at(c), 3, NOT_ASSEMBLED.filled())))?;
-    chart.draw_series(grid.points.iter().filter(|q| q.dynamics_static).map(|q| {
-        EmptyElement::at(at(&q.at))
-            + Circle::new((0, 0), 5, HELD.filled())
-            + Circle::new((0, 0), 5, BLACK.stroke_width(1))
-    }))?;
+    chart.draw_series(grid.points.iter().filter(|q| q.dynamics_static).map(|q| rimmed_dot(at(&q.at), 5, HELD, 1)))?;
     chart.draw_series(
         grid.points.iter().filter(|q| !q.dynamics_static).map(|q| Cross::new(at(&q.at), 5, NOT_HELD.stroke_width(2))),
     )?;
@@ -280,10 +320,101 @@ fn draw_grid<'a, DB: DrawingBackend + 'a>(
     Ok(())
 }
 
-pub(super) fn draw_fig4(png: &Path, svg: &Path) -> Result<(), String> {
-    let d = fig4_data()?;
-    fig4_plot(BitMapBackend::new(png, FIG4_SIZE).into_drawing_area(), &d)?;
-    fig4_plot(SVGBackend::new(svg, FIG4_SIZE).into_drawing_area(), &d)
+// ---------------------------------------------------------------------------
+// Fig. 5: the horizontal slice z = 3 m of the static and kinematic workspaces.
+// ---------------------------------------------------------------------------
+
+/// Size of Fig. 5 in pixels.
+const FIG5_SIZE: (u32, u32) = (900, 820);
+/// Height of the slice [m].
+const FIG5_Z_M: f64 = 3.0;
+/// Cells per side of the slice.
+const FIG5_CELLS: usize = 120;
+
+struct Fig5 {
+    /// Analytic class per cell centre: (x, y, region).
+    cells: Vec<(f64, f64, Region)>,
+    cell: f64,
+    /// Dynamics: (x, y, inside the static workspace by the dynamics).
+    points: Vec<(f64, f64, bool)>,
+    agreement: f64,
+}
+
+fn fig5_data() -> Result<Fig5, FigureError> {
+    let p = mohr::Params { lb: 2.0, lo: 6.0, kappa: 10.0, l_min: 0.0 };
+    let cell = 2.0 * HALF_WIDTH_M / FIG5_CELLS as f64;
+    let mut cells = Vec::new();
+    for i in 0..FIG5_CELLS {
+        for j in 0..FIG5_CELLS {
+            let (x, y) = (-HALF_WIDTH_M + (i as f64 + 0.5) * cell, -HALF_WIDTH_M + (j as f64 + 0.5) * cell);
+            cells.push((x, y, mohr::classify(&p, &Vector3::new(x, y, FIG5_Z_M)).region));
+        }
+    }
+    // The dynamics: the small workspace grid scenario, at this slice, 9 x 9 points.
+    let g = GRID_HALF_WIDTH_M;
+    let (across, at_z) = (range_toml(-g, g, GRID_COUNT), range_toml(FIG5_Z_M, FIG5_Z_M, 1));
+    let sc = small_grid_scenario(&[("grid = {", format!("grid = {{ x = {across}, y = {across}, z = {at_z} }}"))])?;
+    let (rows, summary) = crate::sweep::sweep(&sc, SWEEP_JOBS, None, None, &|_, _| {})?;
+    let points = rows
+        .iter()
+        .map(|r| {
+            let q = &r.point;
+            (q.analytic["x"], q.analytic["y"], q.settled && q.slack_cables.is_empty() && q.within_tolerance)
+        })
+        .collect();
+    Ok(Fig5 { cells, cell, points, agreement: summary.workspace.map_or(f64::NAN, |w| w.agreement_percent) })
+}
+
+impl Plot for Fig5 {
+    fn plot<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), FigureError> {
+        let d = self;
+        root.fill(&WHITE)?;
+        let h = HALF_WIDTH_M;
+        let mut chart = ChartBuilder::on(root)
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(55)
+            .caption(
+                format!(
+                    "mohr2011, slice z = {FIG5_Z_M} m (l_b = 2, l_o = 6): analytic classes, dynamics' verdict (agreement {:.1} %)",
+                    d.agreement
+                ),
+                ("sans-serif", 17),
+            )
+            .build_cartesian_2d(-h..h, -h..h)?;
+        chart.configure_mesh().x_desc("x [m]").y_desc("y [m]").draw()?;
+        let static_c = RGBColor(170, 215, 255);
+        let kin_c = RGBColor(235, 235, 235);
+        let colours = d
+            .cells
+            .iter()
+            .filter(|(_, _, r)| *r != Region::OutsideKinematic)
+            .map(|(x, y, r)| (*x, *y, if *r == Region::Static { static_c } else { kin_c }));
+        chart.draw_series(cell_runs(colours, (d.cell, d.cell)))?;
+        // Legend entries for the background classes.
+        swatch(&mut chart, "static workspace (Eq. 29-31)", static_c)?;
+        swatch(&mut chart, "kinematic only (a cable pair slack)", kin_c)?;
+        chart
+            .draw_series(
+                d.points
+                    .iter()
+                    .filter(|(_, _, inside)| *inside)
+                    .map(|(x, y, _)| Circle::new((*x, *y), 6, GREEN.filled())),
+            )?
+            .label("dynamics: settled, every cable taut, within 1e-9")
+            .legend(|(x, y)| Circle::new((x + 8, y), 5, GREEN.filled()));
+        chart
+            .draw_series(
+                d.points
+                    .iter()
+                    .filter(|(_, _, inside)| !*inside)
+                    .map(|(x, y, _)| Cross::new((*x, *y), 6, RED.stroke_width(2))),
+            )?
+            .label("dynamics: a cable slack or not settled")
+            .legend(|(x, y)| Cross::new((x + 8, y), 5, RED.stroke_width(2)));
+        legend_box(&mut chart, SeriesLabelPosition::LowerRight, 13)?;
+        Ok(())
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -346,12 +477,12 @@ struct VerticalSlice {
     grid: Grid,
 }
 
-pub(super) struct Fig6 {
+struct Fig6 {
     p: mohr::Params,
     slices: Vec<VerticalSlice>,
 }
 
-fn fig6_data() -> Result<Fig6, String> {
+fn fig6_data() -> Result<Fig6, FigureError> {
     let p = paper_params();
     let cell = (2.0 * HALF_WIDTH_M / CELLS as f64, FIG6_Z_MAX_M / CELLS as f64);
     let g = GRID_HALF_WIDTH_M;
@@ -396,69 +527,59 @@ fn fig6_data() -> Result<Fig6, String> {
 const STATIC: RGBColor = RGBColor(170, 215, 255);
 const KINEMATIC_ONLY: RGBColor = RGBColor(225, 225, 225);
 
-fn fig6_plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Fig6) -> Result<(), String> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    let root = super::titled_page(
-        root,
-        &format!(
-            "mohr2011 Fig. 6: the static workspace in two vertical slices (l_b = {} m, l_o = {} m)",
-            d.p.lb, d.p.lo
-        ),
-        20,
-    )?;
-    let (top, legend) = root.split_vertically(FIG6_SIZE.1 - FIG6_LEGEND_PX - 30);
-    let h = HALF_WIDTH_M;
-    for (area, s) in top.split_evenly((1, 2)).iter().zip(&d.slices) {
-        let mut chart = ChartBuilder::on(area)
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(50)
-            .caption(
-                format!(
-                    "{}: static {:.1} m^2 of kinematic {:.1} m^2, up to z = {:.2} m; dynamics agree {:.0} %",
-                    s.plane.name(),
-                    s.areas_m2.1,
-                    s.areas_m2.0,
-                    s.static_top_m,
-                    s.grid.agreement_percent()
-                ),
-                ("sans-serif", 15),
-            )
-            .build_cartesian_2d(-h..h, 0.0..FIG6_Z_MAX_M)
-            .map_err(err)?;
-        chart.configure_mesh().disable_mesh().x_desc(s.plane.axis()).y_desc("z [m]").draw().map_err(err)?;
-        let colours =
-            s.cells.iter().map(|(x, z, r)| (*x, *z, if *r == Region::Static { STATIC } else { KINEMATIC_ONLY }));
-        chart.draw_series(cell_runs(colours, s.cell)).map_err(err)?;
-        // The base A1A2A3 seen edge-on: its extent in this plane.
-        let base: Vec<f64> = mohr::base_nodes(&d.p).iter().map(|a| s.plane.horizontal(a)).collect();
-        let (lo, hi) = base.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
-        chart.draw_series(LineSeries::new([(lo, 0.0), (hi, 0.0)], BASE.stroke_width(5))).map_err(err)?;
-        let plane = s.plane;
-        draw_grid(&mut chart, &s.grid, &move |c| (plane.horizontal(c), c.z)).map_err(err)?;
+impl Plot for Fig6 {
+    fn plot<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), FigureError> {
+        let d = self;
+        let root = titled_page(
+            root,
+            &format!(
+                "mohr2011 Fig. 6: the static workspace in two vertical slices (l_b = {} m, l_o = {} m)",
+                d.p.lb, d.p.lo
+            ),
+            20,
+        )?;
+        let (top, legend) = root.split_vertically(FIG6_SIZE.1 - FIG6_LEGEND_PX - 30);
+        let h = HALF_WIDTH_M;
+        for (area, s) in top.split_evenly((1, 2)).iter().zip(&d.slices) {
+            let mut chart = ChartBuilder::on(area)
+                .margin(10)
+                .x_label_area_size(40)
+                .y_label_area_size(50)
+                .caption(
+                    format!(
+                        "{}: static {:.1} m^2 of kinematic {:.1} m^2, up to z = {:.2} m; dynamics agree {:.0} %",
+                        s.plane.name(),
+                        s.areas_m2.1,
+                        s.areas_m2.0,
+                        s.static_top_m,
+                        s.grid.agreement_percent()
+                    ),
+                    ("sans-serif", 15),
+                )
+                .build_cartesian_2d(-h..h, 0.0..FIG6_Z_MAX_M)?;
+            chart.configure_mesh().disable_mesh().x_desc(s.plane.axis()).y_desc("z [m]").draw()?;
+            let colours =
+                s.cells.iter().map(|(x, z, r)| (*x, *z, if *r == Region::Static { STATIC } else { KINEMATIC_ONLY }));
+            chart.draw_series(cell_runs(colours, s.cell))?;
+            // The base A1A2A3 seen edge-on: its extent in this plane.
+            let base: Vec<f64> = mohr::base_nodes(&d.p).iter().map(|a| s.plane.horizontal(a)).collect();
+            let (lo, hi) = base.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+            chart.draw_series(LineSeries::new([(lo, 0.0), (hi, 0.0)], BASE.stroke_width(5)))?;
+            let plane = s.plane;
+            draw_grid(&mut chart, &s.grid, &move |c| (plane.horizontal(c), c.z))?;
+        }
+        let (agree, points) = tally(d.slices.iter().map(|s| &s.grid));
+        let entries = vec![
+            (Glyph::Fill(STATIC), "static workspace (Eq. 17-18 and 29-31)".to_string()),
+            (Glyph::Fill(KINEMATIC_ONLY), "kinematic only: a cable pair would be slack".to_string()),
+            (Glyph::Line(BASE, 5), "the base triangle A1A2A3, edge-on (z = 0)".to_string()),
+            (Glyph::Note, format!("9 x 9 points per slice: {agree} of {points} assembled points agree")),
+            (Glyph::Dot(HELD), "dynamics: held there, every cable taut, within 1e-9".to_string()),
+            (Glyph::Cross(NOT_HELD), "dynamics: assembled, but a cable pair went slack".to_string()),
+            (Glyph::Ring(DISAGREE), format!("differs from the analytic class: not at rest in {SETTLE_MAX_TIME_S} s")),
+            (Glyph::Dot(NOT_ASSEMBLED), "cannot be assembled: a spring longer than l_o".to_string()),
+        ];
+        legend_panel(&legend.margin(0, 8, 10, 10), &entries, 2, 14)?;
+        Ok(())
     }
-    let (points, agree) = d
-        .slices
-        .iter()
-        .flat_map(|s| &s.grid.points)
-        .fold((0, 0), |(n, a), q| (n + 1, a + usize::from(q.analytic_static == q.dynamics_static)));
-    let entries = vec![
-        (Glyph::Fill(STATIC), "static workspace (Eq. 17-18 and 29-31)".to_string()),
-        (Glyph::Fill(KINEMATIC_ONLY), "kinematic only: a cable pair would be slack".to_string()),
-        (Glyph::Line(BASE, 5), "the base triangle A1A2A3, edge-on (z = 0)".to_string()),
-        (Glyph::Note, format!("9 x 9 points per slice: {agree} of {points} assembled points agree")),
-        (Glyph::Dot(HELD), "dynamics: held there, every cable taut, within 1e-9".to_string()),
-        (Glyph::Cross(NOT_HELD), "dynamics: assembled, but a cable pair went slack".to_string()),
-        (Glyph::Ring(DISAGREE), format!("differs from the analytic class: not at rest in {SETTLE_MAX_TIME_S} s")),
-        (Glyph::Dot(NOT_ASSEMBLED), "cannot be assembled: a spring longer than l_o".to_string()),
-    ];
-    legend_panel(&legend.margin(0, 8, 10, 10), &entries, 2, 14).map_err(err)?;
-    root.present().map_err(err)?;
-    Ok(())
-}
-
-pub(super) fn draw_fig6(png: &Path, svg: &Path) -> Result<(), String> {
-    let d = fig6_data()?;
-    fig6_plot(BitMapBackend::new(png, FIG6_SIZE).into_drawing_area(), &d)?;
-    fig6_plot(SVGBackend::new(svg, FIG6_SIZE).into_drawing_area(), &d)
 }

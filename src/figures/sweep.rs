@@ -3,7 +3,7 @@
 //! stiffness) the analytic values as lines and the settled ones as dots, one series per value
 //! of the other axes; below, log10 of every quantity's error.
 
-use super::{range, register_font, titled_page};
+use super::kit::{self, range, titled_page, FigureError, Format, Plot};
 use crate::sweep::Row;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -31,15 +31,15 @@ struct SweepPlot {
 
 /// The axis to draw against: `x` if given (a column of the points), else the one with the
 /// most distinct values.
-fn x_axis(rows: &[Row], x: Option<&str>) -> Result<String, String> {
+fn x_axis(rows: &[Row], x: Option<&str>) -> Result<String, FigureError> {
     let keys: Vec<&String> = rows.first().map(|r| r.point.inputs.keys().collect()).unwrap_or_default();
     if let Some(x) = x {
         return match keys.iter().any(|k| *k == x) {
             true => Ok(x.to_string()),
-            false => Err(format!(
-                "--x {x}: not an axis of this sweep (its inputs and swept parameters: {})",
-                keys.iter().map(|k| k.as_str()).collect::<Vec<_>>().join(", ")
-            )),
+            false => Err(FigureError::NotAnAxis {
+                x: x.to_string(),
+                axes: keys.iter().map(|k| k.as_str()).collect::<Vec<_>>().join(", "),
+            }),
         };
     }
     let distinct = |k: &str| {
@@ -48,10 +48,13 @@ fn x_axis(rows: &[Row], x: Option<&str>) -> Result<String, String> {
         v.dedup();
         v.len()
     };
-    keys.iter().max_by_key(|k| distinct(k)).map(|k| k.to_string()).ok_or_else(|| "the sweep has no axis".into())
+    keys.iter()
+        .max_by_key(|k| distinct(k))
+        .map(|k| k.to_string())
+        .ok_or_else(|| FigureError::Data("the sweep has no axis".into()))
 }
 
-fn data(rows: &[Row], title: &str, x: Option<&str>, is_angle: &dyn Fn(&str) -> bool) -> Result<SweepPlot, String> {
+fn data(rows: &[Row], title: &str, x: Option<&str>, is_angle: &dyn Fn(&str) -> bool) -> Result<SweepPlot, FigureError> {
     let x = x_axis(rows, x)?;
     let mut quantities: Vec<String> = Vec::new();
     for r in rows {
@@ -62,7 +65,9 @@ fn data(rows: &[Row], title: &str, x: Option<&str>, is_angle: &dyn Fn(&str) -> b
         }
     }
     if quantities.is_empty() {
-        return Err("the sweep compares no quantity (no check, prediction or probe): nothing to draw".into());
+        return Err(FigureError::Data(
+            "the sweep compares no quantity (no check, prediction or probe): nothing to draw".into(),
+        ));
     }
     let mut series: Vec<(String, Vec<Vec<(f64, f64, f64, f64)>>)> = Vec::new();
     for r in rows.iter().filter(|r| r.point.settled) {
@@ -91,68 +96,66 @@ fn data(rows: &[Row], title: &str, x: Option<&str>, is_angle: &dyn Fn(&str) -> b
     Ok(SweepPlot { title: title.to_string(), x, quantities, series })
 }
 
-fn plot<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &SweepPlot) -> Result<(), String> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing failed: {e:?}");
-    let root = titled_page(root, &d.title, 20)?;
-    let shown = d.quantities.len().min(MAX_PANELS);
-    let panels = root.split_evenly((shown + 1, 1));
-    let all = |f: fn(&(f64, f64, f64, f64)) -> f64, i: Option<usize>| -> Vec<f64> {
-        d.series
-            .iter()
-            .flat_map(|(_, per_q)| per_q.iter().enumerate().filter(|(j, _)| i.is_none_or(|i| *j == i)))
-            .flat_map(|(_, v)| v.iter().map(f))
-            .collect()
-    };
-    let xs = range(&all(|p| p.0, None));
-    for (i, q) in d.quantities.iter().take(shown).enumerate() {
-        let mut ys = all(|p| p.1, Some(i));
-        ys.extend(all(|p| p.2, Some(i)));
-        let mut chart = ChartBuilder::on(&panels[i])
+impl Plot for SweepPlot {
+    fn plot<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), FigureError> {
+        let d = self;
+        let root = titled_page(root, &d.title, 20)?;
+        let shown = d.quantities.len().min(MAX_PANELS);
+        let panels = root.split_evenly((shown + 1, 1));
+        let all = |f: fn(&(f64, f64, f64, f64)) -> f64, i: Option<usize>| -> Vec<f64> {
+            d.series
+                .iter()
+                .flat_map(|(_, per_q)| per_q.iter().enumerate().filter(|(j, _)| i.is_none_or(|i| *j == i)))
+                .flat_map(|(_, v)| v.iter().map(f))
+                .collect()
+        };
+        let xs = range(&all(|p| p.0, None));
+        for (i, q) in d.quantities.iter().take(shown).enumerate() {
+            let mut ys = all(|p| p.1, Some(i));
+            ys.extend(all(|p| p.2, Some(i)));
+            let mut chart = ChartBuilder::on(&panels[i])
+                .margin(10)
+                .x_label_area_size(35)
+                .y_label_area_size(80)
+                .caption(format!("{q}: analytic (line), settled (dots)"), ("sans-serif", 16))
+                .build_cartesian_2d(xs.clone(), range(&ys))?;
+            chart.configure_mesh().x_desc(d.x.as_str()).y_desc(q.as_str()).draw()?;
+            for (k, (label, per_q)) in d.series.iter().enumerate() {
+                let c = PALETTE[k % PALETTE.len()];
+                let v = &per_q[i];
+                chart
+                    .draw_series(LineSeries::new(v.iter().map(|p| (p.0, p.1)), c.stroke_width(2)))?
+                    .label(label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+                chart.draw_series(v.iter().map(|p| Circle::new((p.0, p.2), 4, c.filled())))?;
+            }
+            if d.series.len() > 1 {
+                chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw()?;
+            }
+        }
+        let logs: Vec<f64> = all(|p| p.3.max(ERROR_FLOOR).log10(), None);
+        let mut chart = ChartBuilder::on(&panels[shown])
             .margin(10)
             .x_label_area_size(35)
             .y_label_area_size(80)
-            .caption(format!("{q}: analytic (line), settled (dots)"), ("sans-serif", 16))
-            .build_cartesian_2d(xs.clone(), range(&ys))
-            .map_err(err)?;
-        chart.configure_mesh().x_desc(d.x.as_str()).y_desc(q.as_str()).draw().map_err(err)?;
-        for (k, (label, per_q)) in d.series.iter().enumerate() {
-            let c = PALETTE[k % PALETTE.len()];
-            let v = &per_q[i];
+            .caption("log10 |settled - analytic| (angles wrapped)", ("sans-serif", 16))
+            .build_cartesian_2d(xs, range(&logs))?;
+        chart.configure_mesh().x_desc(d.x.as_str()).y_desc("log10 |error|").draw()?;
+        for (i, q) in d.quantities.iter().enumerate() {
+            let c = PALETTE[i % PALETTE.len()];
+            let points: Vec<(f64, f64)> = d
+                .series
+                .iter()
+                .flat_map(|(_, per_q)| per_q[i].iter().map(|p| (p.0, p.3.max(ERROR_FLOOR).log10())))
+                .collect();
             chart
-                .draw_series(LineSeries::new(v.iter().map(|p| (p.0, p.1)), c.stroke_width(2)))
-                .map_err(err)?
-                .label(label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
-            chart.draw_series(v.iter().map(|p| Circle::new((p.0, p.2), 4, c.filled()))).map_err(err)?;
+                .draw_series(points.iter().map(|p| Cross::new(*p, 5, c.stroke_width(2))))?
+                .label(q.clone())
+                .legend(move |(x, y)| Cross::new((x + 10, y), 5, c.stroke_width(2)));
         }
-        if d.series.len() > 1 {
-            chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
-        }
+        chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw()?;
+        Ok(())
     }
-    let logs: Vec<f64> = all(|p| p.3.max(ERROR_FLOOR).log10(), None);
-    let mut chart = ChartBuilder::on(&panels[shown])
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(80)
-        .caption("log10 |settled - analytic| (angles wrapped)", ("sans-serif", 16))
-        .build_cartesian_2d(xs, range(&logs))
-        .map_err(err)?;
-    chart.configure_mesh().x_desc(d.x.as_str()).y_desc("log10 |error|").draw().map_err(err)?;
-    for (i, q) in d.quantities.iter().enumerate() {
-        let c = PALETTE[i % PALETTE.len()];
-        let points: Vec<(f64, f64)> = d
-            .series
-            .iter()
-            .flat_map(|(_, per_q)| per_q[i].iter().map(|p| (p.0, p.3.max(ERROR_FLOOR).log10())))
-            .collect();
-        chart
-            .draw_series(points.iter().map(|p| Cross::new(*p, 5, c.stroke_width(2))))
-            .map_err(err)?
-            .label(q.clone())
-            .legend(move |(x, y)| Cross::new((x + 10, y), 5, c.stroke_width(2)));
-    }
-    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
-    root.present().map_err(err)
 }
 
 /// Draws the sweep `rows` of scenario `title` against axis `x` (default: the axis with the
@@ -164,21 +167,9 @@ pub fn draw(
     x: Option<&str>,
     is_angle: &dyn Fn(&str) -> bool,
     out: &Path,
-) -> Result<(), String> {
-    register_font()?;
+) -> Result<(), FigureError> {
     let d = data(rows, title, x, is_angle)?;
+    let format = Format::of(out).ok_or_else(|| FigureError::Extension(out.to_path_buf()))?;
     let size = (WIDTH_PX, PANEL_PX * (d.quantities.len().min(MAX_PANELS) as u32 + 1) + 40);
-    let partial = crate::output::partial_path(out);
-    let drawn = match out.extension().and_then(|e| e.to_str()) {
-        Some("svg") => plot(SVGBackend::new(&partial, size).into_drawing_area(), &d),
-        Some("png") => plot(BitMapBackend::new(&partial, size).into_drawing_area(), &d),
-        _ => Err(format!("--figure {}: give a .png or .svg file", out.display())),
-    };
-    match drawn {
-        Ok(()) => crate::output::commit(&partial, out),
-        Err(e) => {
-            crate::output::discard(&partial);
-            Err(e)
-        }
-    }
+    kit::write(&[(out.to_path_buf(), format)], size, |canvas| canvas.draw(&d))
 }
