@@ -5,7 +5,7 @@
 
 mod angle;
 mod error;
-mod finding;
+pub mod finding;
 pub mod furet2018;
 pub mod ji2014;
 pub mod manriquez2019;
