@@ -6,7 +6,7 @@
 mod angle;
 pub mod custom;
 mod error;
-mod finding;
+pub mod finding;
 pub mod furet2018;
 pub mod ji2014;
 pub mod manriquez2019;
