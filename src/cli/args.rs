@@ -22,9 +22,11 @@ pub struct Cli {
 pub enum Command {
     /// Run scenario files headless and compare the simulation with the analytic model.
     Run {
+        /// Scenario files (`-`: one from standard input).
         #[arg(required = true)]
         scenarios: Vec<PathBuf>,
-        /// Write the JSON report {"scenarios": [...]} to this file.
+        /// Write the JSON report {"scenarios": [...]} to this file (`-`: standard output, the
+        /// table then going to standard error).
         #[arg(long)]
         json: Option<PathBuf>,
         /// Record to this .rrd file (with several scenarios: one file each, named FILE-<scenario>.rrd).
@@ -41,16 +43,34 @@ pub enum Command {
         /// scenarios: one file each, named FILE-<scenario>.csv).
         #[arg(long, value_name = "FILE.csv")]
         table: Option<PathBuf>,
+        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
+        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+        /// Exit 1 when a scenario fails a check even where it declares that failure in
+        /// `[expect]` (the exit code before: the physics' verdict instead of the declared one).
+        #[arg(long)]
+        fail_on_declared: bool,
     },
     /// Validate scenario files without running them.
     Check {
         #[arg(required = true)]
         scenarios: Vec<PathBuf>,
+        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
+        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
     },
     /// List the mechanisms, their parameters (units, defaults) and their queries; with a
     /// scenario file, that file's mechanism (a custom file's own parameters with their values)
     /// and the symbols its model's expressions may use.
-    List { scenario: Option<PathBuf> },
+    List {
+        scenario: Option<PathBuf>,
+        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
+        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+    },
     /// Settle every point of a scenario's grid in parallel; write a CSV and a JSON summary.
     Sweep {
         scenario: PathBuf,
@@ -73,6 +93,10 @@ pub enum Command {
         /// The figure's axis: an input or a swept parameter (default: the one with most values).
         #[arg(long)]
         x: Option<String>,
+        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
+        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
     },
     /// Draw one of the papers' figures (analytic, with the dynamics' verdict) as PNG and SVG.
     Figure {
@@ -183,6 +207,10 @@ pub enum ExportFormat {
         /// it only helps MuJoCo settle (the testbed's cables have none).
         #[arg(long, default_value_t = 0.0)]
         cable_damping: f64,
+        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
+        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
     },
 }
 

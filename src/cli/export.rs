@@ -5,8 +5,8 @@ use super::{bad_input, load_one, write_output, CliError, Outcome};
 use crate::export::{mjcf::ActuatorMode, scenario_mjcf, validate_mjcf_options};
 
 pub fn export(format: ExportFormat) -> Result<Outcome, CliError> {
-    let ExportFormat::Mjcf { scenario, out, actuators, kp, cable_damping } = format;
-    let sc = load_one(&scenario)?;
+    let ExportFormat::Mjcf { scenario, out, actuators, kp, cable_damping, set } = format;
+    let sc = load_one(&scenario, &super::overrides(&set)?)?;
     validate_mjcf_options(kp, cable_damping).map_err(bad_input)?;
     let mode = if actuators == "position" { ActuatorMode::Position } else { ActuatorMode::Mocap };
     let mjcf =

@@ -2,21 +2,23 @@
 
 use super::{load_one, CliError, Outcome};
 use crate::mechanisms::{self, Origin};
+use crate::scenario::Override;
 use std::path::Path;
 
 /// Every mechanism, or with a scenario file that file's mechanism and model symbols.
-pub fn list(scenario: Option<&Path>) -> Result<Outcome, CliError> {
+pub fn list(scenario: Option<&Path>, overrides: &[Override]) -> Result<Outcome, CliError> {
     match scenario {
+        None if !overrides.is_empty() => return Err(super::bad_input("--set needs a scenario file to set values of")),
         None => mechanisms::registry().iter().for_each(|m| print_mechanism(m.as_ref())),
-        Some(file) => list_file(file)?,
+        Some(file) => list_file(file, overrides)?,
     }
     Ok(Outcome::Pass)
 }
 
 /// `list FILE`: the file's mechanism with the parameter values the file gives, then the
 /// symbols of its model section, if it has one.
-fn list_file(file: &Path) -> Result<(), CliError> {
-    let sc = load_one(file)?;
+fn list_file(file: &Path, overrides: &[Override]) -> Result<(), CliError> {
+    let sc = load_one(file, overrides)?;
     let m = sc.mechanism();
     print_mechanism(m.as_ref());
     println!("  parameter values in {}:", file.display());

@@ -20,7 +20,7 @@ mod solve;
 mod sweep;
 
 use crate::report::{EXIT_BAD_INPUT, EXIT_FAIL, EXIT_PASS};
-use crate::scenario::{self, Scenario};
+use crate::scenario::{self, Override, Scenario};
 use args::{Cli, Command};
 use clap::Parser;
 use std::path::{Path, PathBuf};
@@ -98,13 +98,15 @@ fn exit_code(result: Result<Outcome, CliError>) -> u8 {
 /// Runs the command.
 fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
     match cli.command {
-        Command::Run { scenarios, json, record, connect, record_every, table } => {
-            run::run(&scenarios, &run::Outputs { json, record, connect, record_every, table })
+        Command::Run { scenarios, json, record, connect, record_every, table, set, fail_on_declared } => {
+            let outputs = run::Outputs { json, record, connect, record_every, table };
+            run::run(&scenarios, &overrides(&set)?, &outputs, fail_on_declared)
         }
-        Command::Check { scenarios } => check::check(&scenarios),
-        Command::List { scenario } => list::list(scenario.as_deref()),
-        Command::Sweep { scenario, out, json, jobs, shard, figure, x } => {
-            sweep::sweep(&scenario, &sweep::Outputs { csv: out, json, figure, x }, jobs, shard.as_deref())
+        Command::Check { scenarios, set } => check::check(&scenarios, &overrides(&set)?),
+        Command::List { scenario, set } => list::list(scenario.as_deref(), &overrides(&set)?),
+        Command::Sweep { scenario, out, json, jobs, shard, figure, x, set } => {
+            let outputs = sweep::Outputs { csv: out, json, figure, x };
+            sweep::sweep(&scenario, &overrides(&set)?, &outputs, jobs, shard.as_deref())
         }
         Command::Merge { csvs, out, partial } => merge::merge(&csvs, &out, partial),
         Command::Figure { name, out, list } => figure::figure(name.as_deref(), &out, list),
@@ -116,11 +118,20 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
     }
 }
 
-/// Loads and validates every scenario: all of them, or every error found.
-fn load_all(paths: &[PathBuf]) -> Result<Vec<Scenario>, CliError> {
+/// The `--set NAME=VALUE` flags of a scenario command.
+fn overrides(flags: &[String]) -> Result<Vec<Override>, CliError> {
+    flags.iter().map(|f| Override::parse(f).map_err(bad_input)).collect()
+}
+
+/// Loads and validates every scenario (`-`: standard input, once) with the overrides: all of
+/// them, or every error found.
+fn load_all(paths: &[PathBuf], overrides: &[Override]) -> Result<Vec<Scenario>, CliError> {
+    if paths.iter().filter(|p| is_stdio(p)).count() > 1 {
+        return Err(bad_input("standard input (-) can be read once: name it as one scenario"));
+    }
     let (mut list, mut errors) = (Vec::new(), Vec::new());
     for p in paths {
-        match scenario::load(p) {
+        match scenario::load_with(p, overrides) {
             Ok(s) => list.push(s),
             Err(e) => errors.push(e.to_string()),
         }
@@ -132,24 +143,37 @@ fn load_all(paths: &[PathBuf]) -> Result<Vec<Scenario>, CliError> {
     }
 }
 
-/// Loads and validates one scenario.
-fn load_one(path: &Path) -> Result<Scenario, CliError> {
-    scenario::load(path).map_err(bad_input)
+/// Loads and validates one scenario (`-`: standard input) with the overrides.
+fn load_one(path: &Path, overrides: &[Override]) -> Result<Scenario, CliError> {
+    scenario::load_with(path, overrides).map_err(bad_input)
 }
 
-/// Refuses outputs that would destroy data (`output::check_outputs`), before anything runs.
+/// Whether a path is `-`: standard input as a scenario, standard output as an output.
+fn is_stdio(path: &Path) -> bool {
+    path == Path::new(scenario::STDIN)
+}
+
+/// Refuses outputs that would destroy data (`output::check_outputs`), before anything runs;
+/// standard input and output destroy nothing.
 fn check_outputs(inputs: &[PathBuf], outputs: &[(String, PathBuf)]) -> Result<(), CliError> {
-    crate::output::check_outputs(inputs, outputs).map_err(bad_input)
+    let inputs: Vec<PathBuf> = inputs.iter().filter(|p| !is_stdio(p)).cloned().collect();
+    let outputs: Vec<(String, PathBuf)> = outputs.iter().filter(|(_, p)| !is_stdio(p)).cloned().collect();
+    crate::output::check_outputs(&inputs, &outputs).map_err(bad_input)
 }
 
-/// Writes `text` to `path` through a unique temporary file and a rename (`output`).
+/// Writes `text` to `path` through a unique temporary file and a rename (`output`), or to
+/// standard output for `-`.
 fn write_atomic(path: &Path, text: &str) -> Result<(), CliError> {
+    if is_stdio(path) {
+        print!("{text}");
+        return Ok(());
+    }
     crate::output::write_atomic(path, text.as_bytes()).map_err(failed)
 }
 
 /// Writes `text` to `out` (never over an input), or to stdout without `out`.
 fn write_output(out: Option<&Path>, inputs: &[PathBuf], text: &str) -> Result<Outcome, CliError> {
-    let Some(o) = out else {
+    let Some(o) = out.filter(|o| !is_stdio(o)) else {
         print!("{text}");
         return Ok(Outcome::Pass);
     };

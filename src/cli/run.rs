@@ -3,7 +3,7 @@
 use super::{check_outputs, load_all, signals, write_atomic, CliError, Outcome};
 use crate::report::Report;
 use crate::run::{run as run_scenario, RunOptions};
-use crate::scenario::Scenario;
+use crate::scenario::{Override, Scenario};
 use std::path::{Path, PathBuf};
 
 /// What a run writes besides its table on stdout.
@@ -56,10 +56,21 @@ impl Outputs {
     }
 }
 
-pub fn run(paths: &[PathBuf], o: &Outputs) -> Result<Outcome, CliError> {
-    let scenarios = load_all(paths)?;
+/// Runs the scenarios. The exit code says whether every scenario ended as it declares (a
+/// declared failure that happened passes), or with `fail_on_declared` whether every check
+/// passed.
+pub fn run(
+    paths: &[PathBuf],
+    overrides: &[Override],
+    o: &Outputs,
+    fail_on_declared: bool,
+) -> Result<Outcome, CliError> {
+    let scenarios = load_all(paths, overrides)?;
     if let Some(r) = o.record.as_deref().filter(|r| r.extension().and_then(|e| e.to_str()) != Some("rrd")) {
         return Err(super::bad_input(format!("--record {} must end in .rrd", r.display())));
+    }
+    if o.table.as_deref().is_some_and(super::is_stdio) {
+        return Err(super::bad_input("--table -: a table is written to a file (.csv, or .arrow for Arrow IPC)"));
     }
     check_outputs(paths, &o.files(&scenarios))?;
     // From here on each run stops at its next tick on a signal and the reports are written.
@@ -84,9 +95,14 @@ pub fn run(paths: &[PathBuf], o: &Outputs) -> Result<Outcome, CliError> {
             .unwrap_or_else(|payload| crate::run::panicked(sc, payload.as_ref()));
         report.scenarios.push(r);
     }
-    print!("{}", report.to_table());
+    // With the JSON report on standard output the table goes to standard error.
+    match o.json.as_deref().filter(|j| super::is_stdio(j)) {
+        Some(_) => eprint!("{}", report.to_table()),
+        None => print!("{}", report.to_table()),
+    }
     if let Some(j) = &o.json {
         write_atomic(j, &report.to_json()).map_err(|e| super::failed(format!("the JSON report: {e}")))?;
     }
-    Ok(Outcome::from_passed(report.passed() && !signals::cancelled()))
+    let ended_well = if fail_on_declared { report.passed() } else { report.as_declared() };
+    Ok(Outcome::from_passed(ended_well && !signals::cancelled()))
 }

@@ -1,6 +1,7 @@
 //! `tensegrity sweep`: every grid point settled in parallel, its CSV, summary and figure.
 
 use super::{check_outputs, load_one, signals, write_atomic, CliError, Outcome};
+use crate::scenario::Override;
 use crate::sweep::SweepSummary;
 use std::path::{Path, PathBuf};
 
@@ -12,8 +13,14 @@ pub struct Outputs {
     pub x: Option<String>,
 }
 
-pub fn sweep(path: &Path, o: &Outputs, jobs: usize, shard: Option<&str>) -> Result<Outcome, CliError> {
-    let sc = load_one(path)?;
+pub fn sweep(
+    path: &Path,
+    overrides: &[Override],
+    o: &Outputs,
+    jobs: usize,
+    shard: Option<&str>,
+) -> Result<Outcome, CliError> {
+    let sc = load_one(path, overrides)?;
     if let Some(f) =
         o.figure.as_deref().filter(|f| !matches!(f.extension().and_then(|e| e.to_str()), Some("png" | "svg")))
     {
@@ -40,7 +47,10 @@ pub fn sweep(path: &Path, o: &Outputs, jobs: usize, shard: Option<&str>) -> Resu
     let result = crate::sweep::sweep(&sc, jobs, shard, Some(&signals::CANCEL), &progress);
     bar.finish_and_clear();
     let (rows, summary) = result.map_err(super::bad_input)?;
-    print_summary(&summary);
+    // With the CSV or the summary on standard output, the human lines go to standard error.
+    let on_stdout = [&o.csv, &o.json].into_iter().flatten().any(|p| super::is_stdio(p));
+    let say: fn(&str) = if on_stdout { |line| eprintln!("{line}") } else { |line| println!("{line}") };
+    print_summary(&summary, say);
     let is_angle = |q: &str| sc.is_angle(q);
     if let Some(csv) = &o.csv {
         write_atomic(csv, &crate::sweep::to_csv(&rows, &is_angle))?;
@@ -52,19 +62,19 @@ pub fn sweep(path: &Path, o: &Outputs, jobs: usize, shard: Option<&str>) -> Resu
         write_atomic(j, &serde_json::to_string_pretty(&summary).unwrap_or_default())?;
     }
     if let Some(min) = summary.min_agreement_percent {
-        println!("required agreement {min:.2} %");
+        say(&format!("required agreement {min:.2} %"));
     }
     if !summary.disagreements.is_empty() {
-        println!("{} point(s) did not settle or are out of tolerance", summary.disagreements.len());
+        say(&format!("{} point(s) did not settle or are out of tolerance", summary.disagreements.len()));
     }
     let passed = summary.passed && !signals::cancelled();
-    println!("{}", if passed { "PASS" } else { "FAIL" });
+    say(if passed { "PASS" } else { "FAIL" });
     Ok(Outcome::from_passed(passed))
 }
 
 /// The summary's lines: points, settled, within tolerance, wall time; agreement; stops.
-fn print_summary(summary: &SweepSummary) {
-    println!(
+fn print_summary(summary: &SweepSummary, say: fn(&str)) {
+    say(&format!(
         "{}: {} point(s), {} settled, {} within tolerance, {:.2} s wall on {} job(s){}",
         summary.scenario,
         summary.points,
@@ -73,12 +83,12 @@ fn print_summary(summary: &SweepSummary) {
         summary.wall_s,
         summary.jobs,
         summary.shard.as_ref().map(|s| format!(", shard {s}")).unwrap_or_default()
-    );
+    ));
     if let Some(w) = &summary.workspace {
-        println!("workspace agreement {:.2} % ({} of {} points)", w.agreement_percent, w.agree, w.points);
+        say(&format!("workspace agreement {:.2} % ({} of {} points)", w.agreement_percent, w.agree, w.points));
     }
     for e in &summary.errors {
-        println!("stopped: {e}");
+        say(&format!("stopped: {e}"));
     }
 }
 

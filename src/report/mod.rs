@@ -368,8 +368,16 @@ impl ScenarioReport {
 }
 
 impl Report {
+    /// Whether every scenario passed every check (the physics' verdict).
     pub fn passed(&self) -> bool {
         self.scenarios.iter().all(|s| s.passed)
+    }
+
+    /// Whether every scenario ended as it declares in `[expect]`: passed where it declares a
+    /// pass (or declares nothing), failed in exactly the declared parts where it declares a
+    /// failure.
+    pub fn as_declared(&self) -> bool {
+        self.scenarios.iter().all(|s| s.as_expected.unwrap_or(s.passed))
     }
 
     pub fn to_json(&self) -> String {

@@ -18,6 +18,7 @@ mod file_model;
 mod interference;
 mod mechanism;
 mod number;
+mod overrides;
 mod params;
 mod physical;
 mod raw;
@@ -33,6 +34,7 @@ use std::path::{Path, PathBuf};
 
 pub use bounds::{MAX_STEPS_PER_RUN, MAX_STEPS_PER_SETTLE};
 pub use error::ScenarioError;
+pub use overrides::Override;
 
 /// A validated scenario, ready to run.
 #[derive(Clone, Debug)]
@@ -136,15 +138,35 @@ impl Actuation {
 
 /// Reads and validates a scenario file.
 pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
+    load_with(path, &[])
+}
+
+/// Reads a scenario file (`-`: standard input) and validates it with `overrides` applied.
+pub fn load_with(path: &Path, overrides: &[Override]) -> Result<Scenario, ScenarioError> {
+    let source = read_source(path)?;
+    parse_with(path, &source, overrides)
+}
+
+/// The path that stands for standard input.
+pub const STDIN: &str = "-";
+
+/// A scenario's text, from its file or standard input, at most [`MAX_SCENARIO_BYTES`].
+fn read_source(path: &Path) -> Result<String, ScenarioError> {
+    use std::io::Read;
     let at_start = |message: String| ScenarioError { file: path.display().to_string(), line: 1, col: 1, message };
-    let bytes = std::fs::metadata(path).map_err(|e| at_start(format!("cannot read the scenario file: {e}")))?.len();
-    if bytes > MAX_SCENARIO_BYTES {
+    let mut bytes = Vec::new();
+    let read = if path == Path::new(STDIN) {
+        std::io::stdin().lock().take(MAX_SCENARIO_BYTES + 1).read_to_end(&mut bytes)
+    } else {
+        std::fs::File::open(path).and_then(|f| f.take(MAX_SCENARIO_BYTES + 1).read_to_end(&mut bytes))
+    };
+    read.map_err(|e| at_start(format!("cannot read the scenario file: {e}")))?;
+    if bytes.len() as u64 > MAX_SCENARIO_BYTES {
         return Err(at_start(format!(
-            "the file is {bytes} bytes; a scenario is at most {MAX_SCENARIO_BYTES} (its parse takes about 75 times its size in memory: a grid describes up to a million points in one line)"
+            "the file is larger than a scenario may be: at most {MAX_SCENARIO_BYTES} bytes (its parse takes about 75 times its size in memory: a grid describes up to a million points in one line)"
         )));
     }
-    let source = std::fs::read_to_string(path).map_err(|e| at_start(format!("cannot read the scenario file: {e}")))?;
-    parse(path, &source)
+    String::from_utf8(bytes).map_err(|e| at_start(format!("cannot read the scenario file: {e}")))
 }
 
 /// Largest scenario file read [bytes]: 16 MiB. A list of 1,000,001 points (28 MB) took 2.1 GB
@@ -153,12 +175,23 @@ pub const MAX_SCENARIO_BYTES: u64 = 16 << 20;
 
 /// Parses and validates scenario text (`path` names it in errors).
 pub fn parse(path: &Path, source: &str) -> Result<Scenario, ScenarioError> {
-    let ctx = Ctx { file: path.display().to_string(), source };
-    let raw: RawScenario = toml::from_str(source).map_err(|e| {
+    parse_with(path, source, &[])
+}
+
+/// Parses scenario text and validates it with `overrides` applied (`--set`; an error in one
+/// is reported at its flag).
+pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<Scenario, ScenarioError> {
+    let (extended, file_lines) = overrides::extended_source(source, overrides);
+    let ctx = Ctx { file: path.display().to_string(), source: &extended };
+    let mut raw: RawScenario = toml::from_str(source).map_err(|e| {
         let start = e.span().map(|s| s.start).unwrap_or(0);
         ctx.err_at(start, e.message().trim().to_string())
     })?;
-    validate(&ctx, path, raw)
+    let located = |e| overrides::at_flag(e, overrides, file_lines);
+    overrides::apply(&ctx, &mut raw, overrides, file_lines).map_err(located)?;
+    let mut sc = validate(&ctx, path, raw).map_err(located)?;
+    sc.source = source.to_string();
+    Ok(sc)
 }
 
 /// Largest number of settle points a scenario may ask for.

@@ -30,6 +30,7 @@ mod param_sweep;
 mod recording;
 mod relaxation;
 mod restart;
+mod scripting;
 mod shipped_scenarios;
 mod sim_divergence;
 mod sweep;
