@@ -37,7 +37,7 @@ pub enum Command {
         #[arg(long, num_args = 0..=1, default_missing_value = "", value_name = "ADDR")]
         connect: Option<String>,
         /// Record every N-th tick only (thins long runs).
-        #[arg(long, default_value_t = 1, value_name = "N")]
+        #[arg(long, default_value_t = 1, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
         record_every: u64,
         /// Write every tick as a row of this CSV table at full f64 precision (with several
         /// scenarios: one file each, named FILE-<scenario>.csv).
@@ -81,7 +81,7 @@ pub enum Command {
         #[arg(long)]
         json: Option<PathBuf>,
         /// Worker threads (at most the machine's threads; more is lowered, and said).
-        #[arg(long, default_value_t = 2)]
+        #[arg(long, default_value_t = 2, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
         jobs: usize,
         /// Run the K-th of N interleaved slices of the grid (for job arrays), as K/N.
         #[arg(long)]

@@ -69,8 +69,11 @@ pub fn run(
     if let Some(r) = o.record.as_deref().filter(|r| r.extension().and_then(|e| e.to_str()) != Some("rrd")) {
         return Err(super::bad_input(format!("--record {} must end in .rrd", r.display())));
     }
-    if o.table.as_deref().is_some_and(super::is_stdio) {
-        return Err(super::bad_input("--table -: a table is written to a file (.csv, or .arrow for Arrow IPC)"));
+    if let Some(t) = o.table.as_deref().filter(|t| !crate::observers::table::is_table_file(t)) {
+        return Err(super::bad_input(format!(
+            "--table {}: give a file ending in .csv, or .arrow, .feather or .ipc for Arrow IPC",
+            t.display()
+        )));
     }
     check_outputs(paths, &o.files(&scenarios))?;
     // From here on each run stops at its next tick on a signal and the reports are written.

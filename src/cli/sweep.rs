@@ -31,6 +31,7 @@ pub fn sweep(
         .filter_map(|(what, p)| p.clone().map(|p| (what.to_string(), p)))
         .collect();
     check_outputs(&[path.to_path_buf()], &outputs)?;
+    check_axis(&sc, o.x.as_deref())?;
     let jobs = capped_jobs(jobs);
     // From here on every block stops at its next tick on a signal and the outputs are written.
     signals::stops_itself_from_now();
@@ -90,6 +91,17 @@ fn print_summary(summary: &SweepSummary, say: fn(&str)) {
     for e in &summary.errors {
         say(&format!("stopped: {e}"));
     }
+}
+
+/// `--x`, before any point is settled: an input or a swept parameter of the scenario's points.
+fn check_axis(sc: &crate::scenario::Scenario, x: Option<&str>) -> Result<(), CliError> {
+    let Some(x) = x else { return Ok(()) };
+    let axes: Vec<&String> = sc.actuation.first_inputs().keys().collect();
+    if axes.iter().any(|a| *a == x) {
+        return Ok(());
+    }
+    let axes = axes.iter().map(|a| a.as_str()).collect::<Vec<_>>().join(", ");
+    Err(super::bad_input(format!("--x {x}: not an axis of this sweep (its inputs and swept parameters: {axes})")))
 }
 
 /// `--jobs`, at least 1 and at most the machine's threads (lowered with a note on stderr).

@@ -29,6 +29,11 @@ pub const ARROW_BATCH_ROWS: usize = 8192;
 /// The file endings that select the Arrow IPC format.
 const ARROW_ENDINGS: &[&str] = &["arrow", "feather", "ipc"];
 
+/// Whether `path` names a table file: `.csv`, or one of [`ARROW_ENDINGS`].
+pub fn is_table_file(path: &std::path::Path) -> bool {
+    path.extension().and_then(|e| e.to_str()).is_some_and(|e| e == "csv" || ARROW_ENDINGS.contains(&e))
+}
+
 /// Input, simulated and analytic keys, fixed at the first tick.
 type Keys = (Vec<String>, Vec<String>, Vec<String>);
 

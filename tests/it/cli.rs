@@ -290,3 +290,21 @@ fn manriquez2019_fk_prints_the_cable_ends_of_eq8_9() {
         assert!(values[k].is_number(), "{k} in {values}");
     }
 }
+
+#[test]
+fn meaningless_flags_are_refused_with_exit_2_before_any_work() {
+    let sweep = "scenarios/custom/pinned_bar_sweep.toml";
+    for (args, said) in [
+        (vec!["sweep", sweep, "--jobs", "0"], "--jobs"),
+        (vec!["run", "scenarios/ji2014/quick.toml", "--record-every", "0"], "--record-every"),
+        (vec!["run", "scenarios/ji2014/quick.toml", "--table", "out.txt"], "--table out.txt"),
+        (vec!["sweep", sweep, "--figure", "f.png", "--x", "nope"], "--x nope: not an axis"),
+    ] {
+        let start = std::time::Instant::now();
+        let (code, _, err) = tensegrity(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(said), "{args:?}: {err}");
+        // Refused from the flags and the file alone: nothing settled (a sweep takes seconds).
+        assert!(start.elapsed() < std::time::Duration::from_secs(1), "{args:?} took {:?}", start.elapsed());
+    }
+}
