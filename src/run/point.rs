@@ -159,32 +159,9 @@ pub(super) fn settle_point(
     let prediction = runner.mech.predict(&runner.params, inputs).map_err(Stop::Model)?;
     let s = runner.settle(inputs, &prediction)?;
     let final_energy = runner.sim.kinetic_energy_j();
-    if s.settled {
-        runner.emit(format_args!("point {index} settled after {} steps", s.steps));
-    } else {
-        runner.emit(format_args!(
-            "point {index} did NOT settle in {} s (kinetic energy {final_energy:.3e} J, speed {:.3e} m/s, residual {:.3e} N, {:.3e} N m)",
-            sc.settle.max_time_s,
-            s.final_speed,
-            s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_force_n),
-            s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_torque_nm)
-        ));
-    }
+    say_settled(runner, sc, index, &s, final_energy);
     let mut simulated = s.simulated.clone();
-    let (branch, analytic_stable) = branch_of(runner.mech.as_ref(), &runner.params, &prediction, &simulated);
-    // The settled state is compared with the branch it landed on; landing on an analytically
-    // unstable branch is a failure unless the scenario deliberately starts there.
-    let mut landed = prediction
-        .branches
-        .iter()
-        .find(|b| b.label == branch)
-        .map(|b| b.values.clone())
-        .unwrap_or_else(|| prediction.expected.clone());
-    let wanted_unstable = runner.mech.starts_on_unstable_branch(&sc.start);
-    if analytic_stable == Some(false) && !wanted_unstable {
-        runner.emit(format_args!("point {index}: landed on the analytically unstable branch '{branch}'"));
-        report.error.get_or_insert(format!("point {index} settled on the analytically unstable branch '{branch}'"));
-    }
+    let (branch, analytic_stable, mut landed) = landed_branch(runner, sc, index, &prediction, &simulated, report);
     let stable = match sc.stability_perturbation {
         Some(d) if s.settled => Some(runner.classify(inputs, &prediction, &s.snapshot, d)?),
         _ => None,
@@ -193,30 +170,10 @@ pub(super) fn settle_point(
         runner.emit(format_args!("point {index}: equilibrium is {}", if st { "stable" } else { "unstable" }));
     }
     if let (Some(p), true) = (&sc.probe, s.settled) {
-        if let Some((quantity, k)) = runner.probe(inputs, &prediction, p)? {
-            if let Some(j) = &p.joint {
-                landed.insert(quantity.clone(), j.predicted(&runner.params, inputs));
-            }
-            if let Some(ka) = landed.get(&quantity) {
-                probe_errors.push(((k - ka) / ka).abs());
-            }
-            simulated.insert(quantity, k);
-        }
+        probe_point(runner, inputs, &prediction, p, (&mut landed, &mut simulated), probe_errors)?;
     }
     let slack_cables = slack_cables(runner, &s.snapshot);
-    let slack_agrees = prediction.expected_slack.as_ref().map(|e| {
-        let mut e = e.clone();
-        e.sort();
-        let mut got = slack_cables.clone();
-        got.sort();
-        e == got
-    });
-    if slack_agrees == Some(false) {
-        runner.emit(format_args!(
-            "point {index}: slack cables {slack_cables:?} differ from the analytic {:?}",
-            prediction.expected_slack
-        ));
-    }
+    let slack_agrees = slack_agreement(runner, index, &prediction, &slack_cables);
     let outside = prediction.expected_slack.as_ref().is_some_and(|e| !e.is_empty());
     let mut point = PointReport {
         index,
@@ -264,6 +221,94 @@ pub(super) fn settle_point(
     runner.hand_out_notes();
     report.points.push(point);
     Ok(())
+}
+
+/// The analytic branch the settled state landed on: its label, its stability and its values
+/// (the settled state is compared with them). Landing on an analytically unstable branch is
+/// a failure unless the scenario deliberately starts there.
+fn landed_branch(
+    runner: &mut Runner,
+    sc: &Scenario,
+    index: usize,
+    prediction: &Prediction,
+    simulated: &Values,
+    report: &mut ScenarioReport,
+) -> (String, Option<bool>, Values) {
+    let (branch, analytic_stable) = branch_of(runner.mech.as_ref(), &runner.params, prediction, simulated);
+    let landed = prediction
+        .branches
+        .iter()
+        .find(|b| b.label == branch)
+        .map(|b| b.values.clone())
+        .unwrap_or_else(|| prediction.expected.clone());
+    let wanted_unstable = runner.mech.starts_on_unstable_branch(&sc.start);
+    if analytic_stable == Some(false) && !wanted_unstable {
+        runner.emit(format_args!("point {index}: landed on the analytically unstable branch '{branch}'"));
+        report.error.get_or_insert(format!("point {index} settled on the analytically unstable branch '{branch}'"));
+    }
+    (branch, analytic_stable, landed)
+}
+
+/// The event of a settle: settled after so many steps, or not, with what was left moving.
+fn say_settled(runner: &mut Runner, sc: &Scenario, index: usize, s: &super::settle::Settled, final_energy: f64) {
+    if s.settled {
+        runner.emit(format_args!("point {index} settled after {} steps", s.steps));
+    } else {
+        runner.emit(format_args!(
+            "point {index} did NOT settle in {} s (kinetic energy {final_energy:.3e} J, speed {:.3e} m/s, residual {:.3e} N, {:.3e} N m)",
+            sc.settle.max_time_s,
+            s.final_speed,
+            s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_force_n),
+            s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_torque_nm)
+        ));
+    }
+}
+
+/// The stiffness probe at a settled point: the measured stiffness among the simulated values,
+/// a joint probe's prediction among the analytic ones, and the relative error in
+/// `probe_errors`.
+fn probe_point(
+    runner: &mut Runner,
+    inputs: &Values,
+    prediction: &Prediction,
+    p: &Probe,
+    (landed, simulated): (&mut Values, &mut Values),
+    probe_errors: &mut Vec<f64>,
+) -> Result<(), Stop> {
+    if let Some((quantity, k)) = runner.probe(inputs, prediction, p)? {
+        if let Some(j) = &p.joint {
+            landed.insert(quantity.clone(), j.predicted(&runner.params, inputs));
+        }
+        if let Some(ka) = landed.get(&quantity) {
+            probe_errors.push(((k - ka) / ka).abs());
+        }
+        simulated.insert(quantity, k);
+    }
+    Ok(())
+}
+
+/// Whether the slack cables are the analytic model's (None where it says nothing), said when
+/// they are not.
+fn slack_agreement(
+    runner: &mut Runner,
+    index: usize,
+    prediction: &Prediction,
+    slack_cables: &[String],
+) -> Option<bool> {
+    let agrees = prediction.expected_slack.as_ref().map(|e| {
+        let mut e = e.clone();
+        e.sort();
+        let mut got = slack_cables.to_vec();
+        got.sort();
+        e == got
+    });
+    if agrees == Some(false) {
+        runner.emit(format_args!(
+            "point {index}: slack cables {slack_cables:?} differ from the analytic {:?}",
+            prediction.expected_slack
+        ));
+    }
+    agrees
 }
 
 /// The stability the energy model gives the stationary point the dynamics landed on: a
