@@ -5,6 +5,7 @@
 //! [`sim`]ulation -> [`observers`] -> [`report`].
 
 pub mod bench;
+pub mod eigen;
 pub mod cli;
 pub mod export;
 pub mod figures;

@@ -12,6 +12,7 @@ mod actuation;
 mod bounds;
 mod checks;
 mod energy;
+mod kinetic;
 mod error;
 mod expect;
 mod file_model;
