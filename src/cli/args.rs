@@ -42,6 +42,14 @@ pub enum Command {
         #[arg(long, value_name = "FILE.csv")]
         table: Option<PathBuf>,
     },
+    /// Natural frequencies and mode shapes of a scenario's structure at its settled state (its
+    /// first point, settled as `run` settles it): free bodies held by springs and elastic cables.
+    Modes {
+        scenario: PathBuf,
+        /// Write the JSON report to this file.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// Validate scenario files without running them.
     Check {
         #[arg(required = true)]

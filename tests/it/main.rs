@@ -9,6 +9,7 @@ mod cli;
 mod common;
 mod compact_members;
 mod custom_structure;
+mod dynamic_model;
 mod export_mjcf;
 mod figures;
 mod furet2018_dynamics;
