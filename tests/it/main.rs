@@ -24,6 +24,7 @@ mod joint_settling;
 mod manriquez2019_dynamics;
 mod model_expressions;
 mod model_scenarios;
+mod modes;
 mod mohr2011_dynamics;
 mod moved_node;
 mod outputs;
