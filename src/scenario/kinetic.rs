@@ -64,10 +64,16 @@ pub(super) fn dynamics(
     Ok(Some(Dynamics { kinetic, mass, kinetic_gradient, mixed, first_rate, frequencies }))
 }
 
-/// An error at the first place `name` appears in the expression `text` (else at its start).
+/// An error at the first place `name` appears as a whole symbol in the expression `text` (not
+/// inside a longer name; else at the string's start).
 fn located(ctx: &Ctx, text: &Spanned<String>, name: &str, message: String) -> ScenarioError {
     let quote = 1;
-    match text.get_ref().find(name) {
+    let t = text.get_ref();
+    let symbol_char = |c: Option<char>| c.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == '.');
+    let whole = t.match_indices(name).map(|(i, _)| i).find(|&i| {
+        !symbol_char(t[..i].chars().next_back()) && !symbol_char(t[i + name.len()..].chars().next())
+    });
+    match whole {
         Some(i) => ctx.err_at(text.span().start + quote + i, message),
         None => ctx.err(text, message),
     }
