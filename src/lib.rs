@@ -5,8 +5,8 @@
 //! [`sim`]ulation -> [`observers`] -> [`report`].
 
 pub mod bench;
-pub mod eigen;
 pub mod cli;
+pub mod eigen;
 pub mod export;
 pub mod figures;
 pub mod file_model;

@@ -51,7 +51,11 @@ fn rows(analysis: &StructureModes, nodes: &[crate::structure::Node]) -> Vec<Mode
             omega_rad_per_s: m.omega(),
             frequency_hz: m.omega() / std::f64::consts::TAU,
             rigid: m.rigid,
-            largest_moving: m.largest_moving(NODES_LISTED).into_iter().map(|(n, d)| (nodes[n].name.clone(), d)).collect(),
+            largest_moving: m
+                .largest_moving(NODES_LISTED)
+                .into_iter()
+                .map(|(n, d)| (nodes[n].name.clone(), d))
+                .collect(),
         })
         .collect()
 }

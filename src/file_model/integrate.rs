@@ -34,15 +34,8 @@ const A: [[f64; 6]; 7] = [
 /// Fifth-order weights (the last row of A; the seventh stage is the next step's first).
 const B5: [f64; 7] = [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0, 0.0];
 /// Fifth-order minus fourth-order weights (the error estimate).
-const E: [f64; 7] = [
-    71.0 / 57600.0,
-    0.0,
-    -71.0 / 16695.0,
-    71.0 / 1920.0,
-    -17253.0 / 339200.0,
-    22.0 / 525.0,
-    -1.0 / 40.0,
-];
+const E: [f64; 7] =
+    [71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0];
 
 /// The integrator's error control and limits.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -181,7 +174,8 @@ impl Stepper {
     /// two stages), at most the whole span.
     fn initial_step(&self, y: &[f64], span: f64) -> f64 {
         let n = y.len().max(1) as f64;
-        let norm = |v: &[f64]| (v.iter().zip(y).map(|(x, yi)| (x / self.scale(*yi, *yi)).powi(2)).sum::<f64>() / n).sqrt();
+        let norm =
+            |v: &[f64]| (v.iter().zip(y).map(|(x, yi)| (x / self.scale(*yi, *yi)).powi(2)).sum::<f64>() / n).sqrt();
         let (d0, d1) = (norm(y), norm(&self.k[0]));
         let h = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
         if span > 0.0 {
@@ -223,7 +217,18 @@ mod tests {
     fn exponential_decay_is_followed_within_the_tolerance() {
         let times: Vec<f64> = (1..=10).map(|i| i as f64 * 0.5).collect();
         let tol = Tolerance { rtol: 1e-12, atol: 1e-14, ..Tolerance::default() };
-        let (ys, stats) = dopri5(|_, y, dy| { dy[0] = -y[0]; true }, 0.0, &[1.0], &times, &tol, None).unwrap();
+        let (ys, stats) = dopri5(
+            |_, y, dy| {
+                dy[0] = -y[0];
+                true
+            },
+            0.0,
+            &[1.0],
+            &times,
+            &tol,
+            None,
+        )
+        .unwrap();
         for (t, y) in times.iter().zip(&ys) {
             assert!((y[0] - (-t).exp()).abs() < 1e-11, "t {t}: {} vs {}", y[0], (-t).exp());
         }
@@ -236,7 +241,19 @@ mod tests {
         let err = |n: usize| {
             let times: Vec<f64> = (1..=n).map(|i| i as f64 / n as f64).collect();
             let tol = Tolerance { rtol: 1.0, atol: 1.0, ..Tolerance::default() };
-            let (ys, _) = dopri5(|_, y, dy| { dy[0] = y[1]; dy[1] = -y[0]; true }, 0.0, &[1.0, 0.0], &times, &tol, None).unwrap();
+            let (ys, _) = dopri5(
+                |_, y, dy| {
+                    dy[0] = y[1];
+                    dy[1] = -y[0];
+                    true
+                },
+                0.0,
+                &[1.0, 0.0],
+                &times,
+                &tol,
+                None,
+            )
+            .unwrap();
             (ys[n - 1][0] - 1f64.cos()).abs()
         };
         let order = (err(10) / err(20)).log2();

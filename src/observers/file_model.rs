@@ -178,8 +178,10 @@ impl ModelObserver {
         }
         spec.predictions.iter().for_each(|p| used[p.symbol] = true);
         if let Some(e) = &spec.energy {
-            let dynamics = e.dynamics.iter().flat_map(|d| d.mass.iter().chain(d.frequencies.iter().map(|f| &f.formula)));
-            let exprs = e.coordinates.iter().map(|c| &c.measured).chain([&e.potential]).chain(&e.hessian).chain(dynamics);
+            let dynamics =
+                e.dynamics.iter().flat_map(|d| d.mass.iter().chain(d.frequencies.iter().map(|f| &f.formula)));
+            let exprs =
+                e.coordinates.iter().map(|c| &c.measured).chain([&e.potential]).chain(&e.hessian).chain(dynamics);
             let n = used.len();
             for u in exprs.flat_map(|x| x.uses().iter()).filter(|u| **u < n) {
                 used[*u] = true;

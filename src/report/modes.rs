@@ -52,7 +52,10 @@ impl ModesReport {
             self.zero_mode_ratio,
             if self.settled { String::new() } else { ", NOT SETTLED".into() }
         );
-        out.push_str(&format!("   {:>4} {:>16} {:>14}  {}\n", "mode", "omega [rad/s]", "f [Hz]", "largest-moving nodes"));
+        out.push_str(&format!(
+            "   {:>4} {:>16} {:>14}  {}\n",
+            "mode", "omega [rad/s]", "f [Hz]", "largest-moving nodes"
+        ));
         for m in &self.modes {
             let nodes: Vec<String> = m.largest_moving.iter().map(|(n, d)| format!("{n} {d:.2}")).collect();
             out.push_str(&format!(

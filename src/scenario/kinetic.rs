@@ -70,9 +70,10 @@ fn located(ctx: &Ctx, text: &Spanned<String>, name: &str, message: String) -> Sc
     let quote = 1;
     let t = text.get_ref();
     let symbol_char = |c: Option<char>| c.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == '.');
-    let whole = t.match_indices(name).map(|(i, _)| i).find(|&i| {
-        !symbol_char(t[..i].chars().next_back()) && !symbol_char(t[i + name.len()..].chars().next())
-    });
+    let whole = t
+        .match_indices(name)
+        .map(|(i, _)| i)
+        .find(|&i| !symbol_char(t[..i].chars().next_back()) && !symbol_char(t[i + name.len()..].chars().next()));
     match whole {
         Some(i) => ctx.err_at(text.span().start + quote + i, message),
         None => ctx.err(text, message),
@@ -184,12 +185,4 @@ fn frequencies(
         out.push(FrequencyPrediction { name, formula, mode: mode as usize - 1, tolerance });
     }
     Ok(out)
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn rate_suffix_is_dot() {
-        assert_eq!(crate::file_model::dynamics::RATE_SUFFIX, "_dot");
-    }
 }

@@ -115,7 +115,8 @@ impl Simulation {
             let inertia = self.model.structure.bodies[b].inertia.expect("free bodies have inertia");
             let q = self.body_pose(b).rotation_xyzw;
             let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2])).to_rotation_matrix();
-            let world = r.matrix() * Matrix3::from_diagonal(&Vector3::from(inertia.principal_kg_m2)) * r.matrix().transpose();
+            let world =
+                r.matrix() * Matrix3::from_diagonal(&Vector3::from(inertia.principal_kg_m2)) * r.matrix().transpose();
             m.view_mut((6 * i, 6 * i), (3, 3)).copy_from(&(Matrix3::identity() * inertia.mass_kg));
             m.view_mut((6 * i + 3, 6 * i + 3), (3, 3)).copy_from(&(0.5 * (world + world.transpose())));
         }
