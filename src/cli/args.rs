@@ -49,6 +49,9 @@ pub enum Command {
         /// Write the JSON report to this file.
         #[arg(long)]
         json: Option<PathBuf>,
+        /// Record each mode animated at its frequency to this .rrd file (rerun).
+        #[arg(long, value_name = "FILE.rrd")]
+        record: Option<PathBuf>,
     },
     /// Validate scenario files without running them.
     Check {

@@ -113,7 +113,7 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         Command::Findings { mechanism, set, json } => findings::findings(&mechanism, &set, json),
         Command::Import { format } => import::import(format),
         Command::Export { format } => export::export(format),
-        Command::Modes { scenario, json } => modes::modes(&scenario, json.as_deref()),
+        Command::Modes { scenario, json, record } => modes::modes(&scenario, json.as_deref(), record.as_deref()),
         bench @ Command::Bench { .. } => bench::bench(bench),
     }
 }

@@ -168,3 +168,33 @@ fn prism3_and_the_icosahedron_agree_with_mujoco() {
         assert!(worst < 1e-7, "{path}: {worst:e}");
     }
 }
+
+/// `--record FILE.rrd` writes one entity group per non-rigid mode (prism3: 9), each with its
+/// nodes, struts and cables, decoded back from the file.
+#[test]
+fn the_recording_animates_every_mode() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-modes-rec-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rrd = dir.join("prism3-modes.rrd");
+    let (code, _, err) =
+        common::tensegrity(&["modes", "scenarios/custom/prism3.toml", "--record", rrd.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let file = std::io::BufReader::new(std::fs::File::open(&rrd).expect("recording exists"));
+    let mut entities = std::collections::BTreeSet::new();
+    for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
+        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.expect("decodes") {
+            entities.insert(re_chunk::Chunk::from_arrow_msg(&arrow).expect("a chunk").entity_path().to_string());
+        }
+    }
+    let modes: std::collections::BTreeSet<String> = entities
+        .iter()
+        .filter_map(|e| e.strip_prefix("/modes/").map(|r| r.split('/').next().unwrap().to_string()))
+        .collect();
+    assert_eq!(modes.len(), 9, "{entities:?}");
+    assert!(
+        entities.iter().any(|e| e.ends_with("/struts")) && entities.iter().any(|e| e.ends_with("/cables")),
+        "{entities:?}"
+    );
+    let (code, _, err) = common::tensegrity(&["modes", "scenarios/custom/prism3.toml", "--record", "x.txt"]);
+    assert_eq!(code, 2, "{err}");
+}
