@@ -6,6 +6,7 @@
 
 pub mod bench;
 pub mod cli;
+pub mod eigen;
 pub mod export;
 pub mod figures;
 pub mod file_model;

@@ -52,6 +52,17 @@ pub enum Command {
         #[arg(long)]
         fail_on_declared: bool,
     },
+    /// Natural frequencies and mode shapes of a scenario's structure at its settled state (its
+    /// first point, settled as `run` settles it): free bodies held by springs and elastic cables.
+    Modes {
+        scenario: PathBuf,
+        /// Write the JSON report to this file.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Record each mode animated at its frequency to this .rrd file (rerun).
+        #[arg(long, value_name = "FILE.rrd")]
+        record: Option<PathBuf>,
+    },
     /// Validate scenario files without running them.
     Check {
         #[arg(required = true)]

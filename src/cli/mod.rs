@@ -14,6 +14,7 @@ mod findings;
 mod import;
 mod list;
 mod merge;
+mod modes;
 mod run;
 mod signals;
 mod solve;
@@ -114,6 +115,7 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         Command::Findings { mechanism, set, json } => findings::findings(&mechanism, &set, json),
         Command::Import { format } => import::import(format),
         Command::Export { format } => export::export(format),
+        Command::Modes { scenario, json, record } => modes::modes(&scenario, json.as_deref(), record.as_deref()),
         bench @ Command::Bench { .. } => bench::bench(bench),
     }
 }

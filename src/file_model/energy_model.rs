@@ -43,6 +43,8 @@ pub struct EnergySpec {
     pub first_coordinate: usize,
     /// On the distance from the settled coordinates to the stationary point they landed on.
     pub tolerance: f64,
+    /// The kinetic energy and what it gives (`[energy] kinetic`), if the file states one.
+    pub dynamics: Option<super::dynamics::Dynamics>,
 }
 
 /// How a stationary point is classified by the Hessian's eigenvalues.

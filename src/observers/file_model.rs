@@ -6,7 +6,9 @@ use super::{Note, Observer, SettlePoint, Tick};
 use crate::file_model::energy_model::Kind;
 use crate::file_model::spec::{ModelSpec, Source};
 use crate::mechanisms::Values;
-use crate::report::{EnergyPointReport, ModelCheckReport, PointReport, ScenarioReport, StationaryReport};
+use crate::report::{
+    EnergyPointReport, ModelCheckReport, ModelModeReport, PointReport, ScenarioReport, StationaryReport,
+};
 use crate::snapshot::{unit, Snapshot};
 use crate::structure::{JointKind, Structure};
 
@@ -107,6 +109,17 @@ fn series_names(spec: &ModelSpec) -> Vec<&'static str> {
     names.map(|n| &*Box::leak(format!("model/{n}").into_boxed_str())).collect()
 }
 
+/// The number of `[[energy.frequencies]]` entries.
+fn frequency_count(spec: &ModelSpec) -> usize {
+    spec.energy.as_ref().and_then(|e| e.dynamics.as_ref()).map_or(0, |d| d.frequencies.len())
+}
+
+/// The dynamic model's modes at a settle point and its frequency predictions' errors.
+struct ModesAt {
+    reports: Vec<ModelModeReport>,
+    errors: Vec<f64>,
+}
+
 /// Errors gathered for one prediction or equation.
 #[derive(Clone, Debug, Default)]
 struct Acc {
@@ -142,6 +155,8 @@ pub struct ModelObserver {
     acc: Vec<Acc>,
     /// The energy model's: the distance to the stationary point landed on.
     energy: Acc,
+    /// One per `[[energy.frequencies]]` entry: the relative error of its prediction.
+    frequencies: Vec<Acc>,
     /// When the run is recorded: the series of each prediction's and equation's error per
     /// tick (`model/NAME`), in the order of `acc`.
     series: Option<Vec<&'static str>>,
@@ -163,7 +178,10 @@ impl ModelObserver {
         }
         spec.predictions.iter().for_each(|p| used[p.symbol] = true);
         if let Some(e) = &spec.energy {
-            let exprs = e.coordinates.iter().map(|c| &c.measured).chain([&e.potential]).chain(&e.hessian);
+            let dynamics =
+                e.dynamics.iter().flat_map(|d| d.mass.iter().chain(d.frequencies.iter().map(|f| &f.formula)));
+            let exprs =
+                e.coordinates.iter().map(|c| &c.measured).chain([&e.potential]).chain(&e.hessian).chain(dynamics);
             let n = used.len();
             for u in exprs.flat_map(|x| x.uses().iter()).filter(|u| **u < n) {
                 used[*u] = true;
@@ -180,6 +198,7 @@ impl ModelObserver {
             bind,
             acc: vec![Acc::default(); spec.predictions.len() + spec.equations.len()],
             energy: Acc::default(),
+            frequencies: vec![Acc::default(); frequency_count(spec)],
             series: recorded.then(|| series_names(spec)),
         }
     }
@@ -214,7 +233,7 @@ impl ModelObserver {
         let e = self.spec.energy.as_ref()?;
         let measured = e.measured(v);
         let mut values = v.to_vec();
-        values.resize(e.first_coordinate + e.coordinates.len(), 0.0);
+        values.resize(e.values_len(), 0.0);
         let stationary = e.stationary_points(&mut values, &measured);
         let landed = (0..stationary.len()).min_by(|a, b| {
             e.distance(&stationary[*a].coordinates, &measured)
@@ -235,7 +254,94 @@ impl ModelObserver {
                 kind: s.kind.name().into(),
             })
             .collect();
-        Some((EnergyPointReport { measured: named(&measured), stationary, landed, distance }, error))
+        Some((EnergyPointReport { measured: named(&measured), stationary, landed, distance, modes: None }, error))
+    }
+
+    /// The dynamic model's modes at the stationary point landed on, and each frequency
+    /// prediction's relative error there (infinite where there are no modes: no point landed
+    /// on, or a mass matrix that is not positive definite, which is `Err` with the message).
+    fn model_modes(&self, v: &[f64], report: &EnergyPointReport) -> Option<Result<ModesAt, String>> {
+        let e = self.spec.energy.as_ref()?;
+        let d = e.dynamics.as_ref()?;
+        let landed = report.landed.map(|i| &report.stationary[i]);
+        let Some(point) = landed else { return Some(Err("no stationary point landed on".into())) };
+        let q: Vec<f64> = e.coordinates.iter().map(|c| point.coordinates[&c.name]).collect();
+        let mut values = v.to_vec();
+        values.resize(e.values_len(), 0.0);
+        let modes = match e.modes_at(&mut values, &q)? {
+            Ok(m) => m,
+            Err(err) => return Some(Err(format!("energy kinetic at {q:?}: {err}"))),
+        };
+        let errors = d
+            .frequencies
+            .iter()
+            .map(|f| {
+                let predicted = f.formula.eval(v);
+                crate::file_model::spec::ErrorClass::Relative.error(predicted, modes[f.mode].omega())
+            })
+            .collect();
+        let reports = modes
+            .iter()
+            .map(|m| {
+                let scale = m.shape.iter().copied().fold(0.0f64, |a, x| if x.abs() > a.abs() { x } else { a });
+                let scale = if scale == 0.0 { 1.0 } else { scale };
+                let shape = e.coordinates.iter().zip(m.shape.iter()).map(|(c, x)| (c.name.clone(), x / scale));
+                ModelModeReport {
+                    omega_squared: m.omega_squared,
+                    omega_rad_per_s: m.omega(),
+                    frequency_hz: m.omega() / std::f64::consts::TAU,
+                    shape: shape.collect(),
+                }
+            })
+            .collect();
+        Some(Ok(ModesAt { reports, errors }))
+    }
+
+    /// Judges the frequency predictions at a settle point (and puts the modes in its report).
+    fn frequency_point(&mut self, v: &[f64], point: &mut PointReport, notes: &mut Vec<Note>) {
+        let Some(report) = point.energy.as_mut() else { return };
+        let Some(result) = self.model_modes(v, report) else { return };
+        let errors = match result {
+            Ok(m) => {
+                report.modes = Some(m.reports);
+                m.errors
+            }
+            Err(message) => {
+                notes.push(Note::Event(format!("point {}: dynamic model: {message}", point.index)));
+                vec![f64::INFINITY; self.frequencies.len()]
+            }
+        };
+        let predictions = self.spec.energy.iter().flat_map(|e| e.dynamics.iter()).flat_map(|d| &d.frequencies);
+        for ((a, e), f) in self.frequencies.iter_mut().zip(&errors).zip(predictions) {
+            a.point(*e, point.settled);
+            if point.settled && !(*e <= f.tolerance) {
+                notes.push(Note::Event(format!(
+                    "point {}: frequency {} failed: relative error {e:.3e} > tolerance {:.1e}",
+                    point.index, f.name, f.tolerance
+                )));
+                point.within_tolerance = false;
+            }
+        }
+    }
+
+    /// The frequency predictions, judged.
+    fn frequency_reports(&self) -> Vec<ModelCheckReport> {
+        let predictions = self.spec.energy.iter().flat_map(|e| e.dynamics.iter()).flat_map(|d| &d.frequencies);
+        predictions
+            .zip(&self.frequencies)
+            .map(|(f, a)| ModelCheckReport {
+                kind: "frequency".into(),
+                name: f.name.clone(),
+                class: "relative".into(),
+                max_error: a.settled_max,
+                tolerance: f.tolerance,
+                passed: a.points > 0 && a.settled_max <= f.tolerance,
+                points_compared: a.points,
+                transient_max_error: 0.0,
+                transient_rms_error: 0.0,
+                ticks_compared: 0,
+            })
+            .collect()
     }
 
     pub fn reports(&self) -> Vec<ModelCheckReport> {
@@ -256,6 +362,7 @@ impl ModelObserver {
                 transient_rms_error: if a.ticks > 0 { (a.transient_sum_sq / a.ticks as f64).sqrt() } else { 0.0 },
                 ticks_compared: a.ticks,
             })
+            .chain(self.frequency_reports())
             .chain(self.spec.energy.as_ref().map(|e| ModelCheckReport {
                 kind: "energy".into(),
                 name: "energy".into(),
@@ -322,6 +429,7 @@ impl Observer for ModelObserver {
                 point.within_tolerance = false;
             }
             point.energy = Some(report);
+            self.frequency_point(&v, point, notes);
         }
     }
 

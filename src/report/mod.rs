@@ -1,6 +1,7 @@
 //! Reports: a readable table on stdout, one JSON document for machines, and the exit code
 //! (0 every check passed, 1 a check failed, 2 bad input).
 
+pub mod modes;
 pub mod verdict;
 
 use crate::mechanisms::{Finding, Values};
@@ -58,13 +59,13 @@ pub struct ScenarioReport {
 /// settle point (the verdict) and at every tick (transient errors, reported only).
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct ModelCheckReport {
-    /// "prediction", "equation" or "energy".
+    /// "prediction", "equation", "energy" or "frequency".
     pub kind: String,
     pub name: String,
     /// A prediction's error class (length [m], angle [rad, wrapped], relative); "residual" for
     /// an equation (|residual|); "coordinates" for the energy model (the largest coordinate
     /// difference from the settled state to the stationary point it landed on, infinite when
-    /// that point is not a minimum).
+    /// that point is not a minimum); "relative" for a frequency of the dynamic model.
     pub class: String,
     /// Largest error over the settle points (infinite at a point that did not settle).
     pub max_error: f64,
@@ -83,6 +84,7 @@ impl ModelCheckReport {
         match self.kind.as_str() {
             "equation" => Failure::Equation(self.name.clone()),
             "energy" => Failure::Energy,
+            "frequency" => Failure::Frequency(self.name.clone()),
             _ => Failure::Prediction(self.name.clone()),
         }
     }
@@ -192,6 +194,23 @@ pub struct EnergyPointReport {
     pub landed: Option<usize>,
     /// Largest coordinate difference (angles wrapped) from the settled state to it.
     pub distance: f64,
+    /// With a kinetic energy: the linearised modes of the file's dynamic model at the
+    /// stationary point landed on (K v = omega^2 M v), omega ascending.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub modes: Option<Vec<ModelModeReport>>,
+}
+
+/// One linearised mode of the file's dynamic model.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ModelModeReport {
+    /// Eigenvalue of K v = omega^2 M v [rad^2/s^2] (negative: an unstable direction).
+    pub omega_squared: f64,
+    /// sqrt(omega_squared) [rad/s] (minus sqrt(-omega_squared) where it is negative).
+    pub omega_rad_per_s: f64,
+    /// omega / (2 pi) [Hz].
+    pub frequency_hz: f64,
+    /// The shape in the coordinates, scaled so that its largest component is +1.
+    pub shape: Values,
 }
 
 /// One stationary point of an energy model.
@@ -638,6 +657,13 @@ impl ScenarioReport {
                     format!(", NOT SETTLED: kinetic energy {:.3e} J left", p.final_kinetic_energy_j)
                 }
             ));
+            if let Some(modes) = p.energy.as_ref().and_then(|e| e.modes.as_ref()) {
+                let listed: Vec<String> = modes
+                    .iter()
+                    .map(|m| format!("{:.9} rad/s ({:.6} Hz)", m.omega_rad_per_s, m.frequency_hz))
+                    .collect();
+                out.push_str(&format!("              model's natural frequencies: {}\n", listed.join(", ")));
+            }
             if let Some(paper) = &p.paper {
                 // The paper's value beside the testbed's analytic one, with their relative
                 // difference.

@@ -75,6 +75,9 @@ pub enum Failure {
     Equation(String),
     /// The dynamics settled away from the `[energy]` model's minima: `energy`.
     Energy,
+    /// A `[[energy.frequencies]]` prediction differs from the dynamic model's natural
+    /// frequency beyond its tolerance: `frequency:NAME`.
+    Frequency(String),
 }
 
 /// The names a scenario may give in `[expect] failing` (a check is `check:QUANTITY`).
@@ -90,6 +93,7 @@ pub const FAILURE_NAMES: &[&str] = &[
     "prediction:NAME",
     "equation:NAME",
     "energy",
+    "frequency:NAME",
 ];
 
 impl fmt::Display for Failure {
@@ -106,6 +110,7 @@ impl fmt::Display for Failure {
             Failure::Prediction(n) => write!(f, "prediction:{n}"),
             Failure::Equation(n) => write!(f, "equation:{n}"),
             Failure::Energy => f.write_str("energy"),
+            Failure::Frequency(n) => write!(f, "frequency:{n}"),
         }
     }
 }
@@ -124,6 +129,9 @@ impl std::str::FromStr for Failure {
             "energy" => Failure::Energy,
             _ if s.strip_prefix("prediction:").is_some_and(|n| !n.is_empty()) => {
                 Failure::Prediction(s["prediction:".len()..].to_string())
+            }
+            _ if s.strip_prefix("frequency:").is_some_and(|n| !n.is_empty()) => {
+                Failure::Frequency(s["frequency:".len()..].to_string())
             }
             _ if s.strip_prefix("equation:").is_some_and(|n| !n.is_empty()) => {
                 Failure::Equation(s["equation:".len()..].to_string())

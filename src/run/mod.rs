@@ -7,6 +7,7 @@
 mod point;
 mod runner;
 mod settle;
+mod settled;
 
 use crate::mechanisms::{Mechanism, ModelError, Values};
 use crate::observers::record::{RecordTarget, Recording};
@@ -21,6 +22,7 @@ use std::time::Instant;
 
 pub use point::NO_BRANCH;
 pub use settle::SettleDetector;
+pub use settled::{settle_first_point, SettledState};
 
 /// How a run is observed beyond the comparison.
 #[derive(Default)]

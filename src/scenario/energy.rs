@@ -1,5 +1,6 @@
 //! `[energy]`: a potential in named coordinates, compiled with its symbolic gradient and
-//! Hessian into an [`EnergySpec`]; each coordinate with how it is read off the settled state.
+//! Hessian into an [`EnergySpec`]; each coordinate with how it is read off the settled state;
+//! its kinetic energy and frequency predictions in `kinetic.rs`.
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
 use super::number::expr_error;
@@ -44,7 +45,8 @@ pub(super) fn energy(ctx: &Ctx, spec: &ModelSpec, raw: &RawEnergy) -> Result<Ene
         }
     }
     let tolerance = positive_value(ctx, &raw.tolerance, "energy.tolerance")?;
-    Ok(EnergySpec { potential, gradient, hessian, coordinates, first_coordinate: first, tolerance })
+    let dynamics = super::kinetic::dynamics(ctx, spec, raw, &coordinates)?;
+    Ok(EnergySpec { potential, gradient, hessian, coordinates, first_coordinate: first, tolerance, dynamics })
 }
 
 /// One coordinate: a new name, its measured expression of the state, its class and scan.

@@ -22,6 +22,12 @@ fn listed(names: Vec<&str>) -> String {
     }
 }
 
+/// The names of the `[[energy.frequencies]]` predictions.
+fn frequency_names(model: Option<&ModelSpec>) -> Vec<&str> {
+    let dynamics = model.and_then(|m| m.energy.as_ref()).and_then(|e| e.dynamics.as_ref());
+    dynamics.map_or(vec![], |d| d.frequencies.iter().map(|f| f.name.as_str()).collect())
+}
+
 /// Whether the scenario has the part `failure` names; else the message saying what it has.
 fn has_part(parts: &Parts, failure: &crate::report::verdict::Failure) -> Result<(), String> {
     use crate::report::verdict::Failure;
@@ -38,6 +44,10 @@ fn has_part(parts: &Parts, failure: &crate::report::verdict::Failure) -> Result<
         Failure::Equation(q) if !model.is_some_and(|m| m.equations.iter().any(|x| &x.name == q)) => Err(format!(
             "'{q}' is not among this scenario's [[equations]] ({})",
             listed(model.map_or(vec![], |m| m.equations.iter().map(|x| x.name.as_str()).collect()))
+        )),
+        Failure::Frequency(q) if !frequency_names(model).contains(&q.as_str()) => Err(format!(
+            "'{q}' is not among this scenario's [[energy.frequencies]] ({})",
+            listed(frequency_names(model))
         )),
         Failure::Energy if !model.is_some_and(|m| m.energy.is_some()) => {
             Err("'energy' needs an [energy] section in this scenario".into())

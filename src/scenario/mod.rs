@@ -16,6 +16,7 @@ mod error;
 mod expect;
 mod file_model;
 mod interference;
+mod kinetic;
 mod mechanism;
 mod number;
 mod overrides;

@@ -66,6 +66,25 @@ pub(super) struct RawEnergy {
     /// On the largest coordinate difference from the settled state to its stationary point.
     pub(super) tolerance: Spanned<f64>,
     pub(super) coordinates: Vec<RawCoordinate>,
+    /// A kinetic energy [J]: an expression of the coordinates, their rates (`NAME_dot`),
+    /// parameters, inputs and their quantities, quadratic in the rates.
+    #[serde(default)]
+    pub(super) kinetic: Option<Spanned<String>>,
+    /// Natural frequencies of the dynamic model predicted by closed forms.
+    #[serde(default)]
+    pub(super) frequencies: Vec<RawFrequency>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawFrequency {
+    pub(super) name: Spanned<String>,
+    /// A closed form of the parameters and inputs [rad/s].
+    pub(super) formula: Spanned<String>,
+    /// The mode, from 1 (the lowest frequency).
+    pub(super) mode: Spanned<i64>,
+    /// On the relative error.
+    pub(super) tolerance: Spanned<f64>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -19,6 +19,7 @@ mod build;
 mod damping;
 mod forces;
 mod least_squares;
+pub mod modes;
 mod projection;
 mod relaxation;
 mod restart;

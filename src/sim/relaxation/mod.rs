@@ -100,7 +100,28 @@ fn raised(shift: f64) -> f64 {
     }
 }
 
+/// The tangent stiffness of the free bodies at the current state (`sim::modes` reads it):
+/// for each block of six coordinates (translation of the centre of mass, then a small rotation
+/// about it, world frame) its structure body and centre of mass [m], and the dense, symmetrized
+/// Hessian of the potential energy (N/m, N, N m/rad).
+pub(super) struct Tangent {
+    pub(super) bodies: Vec<usize>,
+    pub(super) com: Vec<nalgebra::Vector3<f64>>,
+    pub(super) hessian: nalgebra::DMatrix<f64>,
+}
+
 impl Simulation {
+    /// The Hessian the relaxation assembles, at the current state.
+    pub(super) fn tangent_stiffness(&self) -> Tangent {
+        let dofs = self.relaxation_dofs();
+        let hessian = self.relaxation_system(&dofs).dense();
+        let mut bodies = vec![0; dofs.blocks()];
+        for (b, i) in dofs.free() {
+            bodies[i] = b;
+        }
+        Tangent { bodies, com: dofs.com.iter().map(|c| assemble::v3(*c)).collect(), hessian }
+    }
+
     /// The step solver for the structure's size: dense up to [`DENSE_MAX_BODIES`] free
     /// bodies, sparse above.
     fn relaxation_solver(&self, dofs: &assemble::Dofs, system: &assemble::System) -> Box<dyn StepSolver> {

@@ -1,0 +1,184 @@
+//! The file's dynamic model: a kinetic energy T(q, q') in the `[energy]` coordinates q and
+//! their rates q' (`NAME_dot`) beside the potential V(q). From its symbolic derivatives:
+//! - the mass matrix M(q) = d2T/dq'2 (T must be a quadratic form in the rates, so M does not
+//!   depend on them);
+//! - the linearised natural frequencies and mode shapes at a stationary point q*: the
+//!   generalized symmetric eigenproblem K v = omega^2 M v, K = d2V/dq2 at q*;
+//! - the Lagrangian equations of motion d/dt(dT/dq') - dT/dq + dV/dq = 0, that is
+//!   M q'' = dT/dq - (d2T/dq' dq) q' - dV/dq  (1)
+//!   (d/dt (dT/dq') = M q'' + (d2T/dq' dq) q', the term written (dM/dt) q' in the issue),
+//!   integrated by Dormand-Prince 5(4) ([`super::integrate`]).
+
+use super::energy_model::EnergySpec;
+use super::expr::Expr;
+use super::integrate::{dopri5, IntegrateError, Stats, Tolerance};
+use super::spec::ModelSpec;
+use crate::eigen::{modes, EigenError, Mode};
+use crate::mechanisms::Values;
+use nalgebra::{DMatrix, DVector};
+use std::sync::atomic::AtomicBool;
+
+/// The suffix naming a coordinate's rate (`q` -> `q_dot`).
+pub const RATE_SUFFIX: &str = "_dot";
+
+/// A `[[energy.frequencies]]` entry: a closed form of the parameters and inputs predicting the
+/// natural frequency of one mode of the file's dynamic model [rad/s].
+#[derive(Clone, Debug)]
+pub struct FrequencyPrediction {
+    pub name: String,
+    pub formula: Expr,
+    /// The mode, counted from 0 in ascending omega (the file counts from 1).
+    pub mode: usize,
+    /// On |omega - predicted| / |predicted|.
+    pub tolerance: f64,
+}
+
+/// The compiled kinetic energy and its derivatives. Compiled against the model's symbols,
+/// then the coordinates (at `EnergySpec::first_coordinate`), then the rates (at `first_rate`).
+#[derive(Clone, Debug)]
+pub struct Dynamics {
+    pub kinetic: Expr,
+    /// d2T/dq'_i dq'_j, row-major n x n.
+    pub mass: Vec<Expr>,
+    /// dT/dq_i.
+    pub kinetic_gradient: Vec<Expr>,
+    /// d2T/dq'_i dq_j, row-major n x n.
+    pub mixed: Vec<Expr>,
+    pub first_rate: usize,
+    pub frequencies: Vec<FrequencyPrediction>,
+}
+
+/// The coordinates and rates of a trajectory at its sample times.
+#[derive(Clone, Debug, Default)]
+pub struct Trajectory {
+    /// The sample times [s].
+    pub times: Vec<f64>,
+    /// q at each sample, in the order of `[[energy.coordinates]]` (m or rad).
+    pub coordinates: Vec<Vec<f64>>,
+    /// q' at each sample (m/s or rad/s).
+    pub rates: Vec<Vec<f64>>,
+    pub stats: Stats,
+}
+
+/// Why the model cannot be integrated.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DynamicsError {
+    #[error("the file states no kinetic energy ([energy] kinetic)")]
+    NoKinetic,
+    #[error("expected {0} initial coordinates and rates, got {1} and {2}")]
+    Size(usize, usize, usize),
+    #[error("the kinetic energy's mass matrix is not positive definite at q = {0:?}")]
+    MassNotPositiveDefinite(Vec<f64>),
+    #[error(transparent)]
+    Integrate(#[from] IntegrateError),
+}
+
+impl EnergySpec {
+    /// The slice length the dynamic model's expressions are evaluated with.
+    pub fn values_len(&self) -> usize {
+        self.first_coordinate + 2 * self.coordinates.len()
+    }
+
+    fn matrix(&self, exprs: &[Expr], values: &[f64]) -> DMatrix<f64> {
+        let n = self.coordinates.len();
+        DMatrix::from_fn(n, n, |i, j| exprs[i * n + j].eval(values))
+    }
+
+    /// `values` with the coordinates set to `q` and the rates to `v`.
+    pub fn set_state(&self, values: &mut [f64], q: &[f64], v: &[f64]) {
+        let (f, n) = (self.first_coordinate, self.coordinates.len());
+        values[f..f + n].copy_from_slice(q);
+        values[f + n..f + 2 * n].copy_from_slice(v);
+    }
+
+    /// The mass matrix M(q) at the coordinates in `values` (None without a kinetic energy).
+    pub fn mass_at(&self, values: &[f64]) -> Option<DMatrix<f64>> {
+        Some(self.matrix(&self.dynamics.as_ref()?.mass, values))
+    }
+
+    /// The linearised modes at the coordinates `q` (a stationary point): K v = omega^2 M v,
+    /// omega ascending, shapes mass-normalised (None without a kinetic energy).
+    pub fn modes_at(&self, values: &mut [f64], q: &[f64]) -> Option<Result<Vec<Mode>, EigenError>> {
+        self.dynamics.as_ref()?;
+        let zero = vec![0.0; q.len()];
+        self.set_state(values, q, &zero);
+        let k = self.matrix(&self.hessian, values);
+        Some(modes(&k, &self.mass_at(values)?))
+    }
+
+    /// q'' from Eq. (1) at the state in `values` (None where M is singular).
+    pub fn acceleration(&self, values: &[f64]) -> Option<DVector<f64>> {
+        let d = self.dynamics.as_ref()?;
+        let n = self.coordinates.len();
+        let rates = DVector::from_fn(n, |i, _| values[d.first_rate + i]);
+        let dt_dq = DVector::from_fn(n, |i, _| d.kinetic_gradient[i].eval(values));
+        let dv_dq = DVector::from_fn(n, |i, _| self.gradient[i].eval(values));
+        let rhs = dt_dq - self.matrix(&d.mixed, values) * rates - dv_dq;
+        self.matrix(&d.mass, values).cholesky().map(|c| c.solve(&rhs))
+    }
+
+    /// The trajectory from (q0, v0) at t = 0, sampled at `times` (s, non-decreasing, from 0),
+    /// with the closed forms (parameters, inputs) in `values` (at least the model's symbols).
+    pub fn integrate(
+        &self,
+        values: &[f64],
+        q0: &[f64],
+        v0: &[f64],
+        times: &[f64],
+        tol: &Tolerance,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Trajectory, DynamicsError> {
+        self.dynamics.as_ref().ok_or(DynamicsError::NoKinetic)?;
+        let n = self.coordinates.len();
+        if q0.len() != n || v0.len() != n {
+            return Err(DynamicsError::Size(n, q0.len(), v0.len()));
+        }
+        let mut work = values.to_vec();
+        work.resize(self.values_len(), 0.0);
+        self.set_state(&mut work, q0, v0);
+        if !self.mass_at(&work).is_some_and(|m| crate::eigen::is_positive_definite(&m)) {
+            return Err(DynamicsError::MassNotPositiveDefinite(q0.to_vec()));
+        }
+        let y0: Vec<f64> = q0.iter().chain(v0).copied().collect();
+        let rhs = |_t: f64, y: &[f64], dy: &mut [f64]| {
+            self.set_state(&mut work, &y[..n], &y[n..]);
+            let Some(a) = self.acceleration(&work) else { return false };
+            dy[..n].copy_from_slice(&y[n..]);
+            dy[n..].copy_from_slice(a.as_slice());
+            true
+        };
+        let (ys, stats) = dopri5(rhs, 0.0, &y0, times, tol, cancel)?;
+        Ok(Trajectory {
+            times: times.to_vec(),
+            coordinates: ys.iter().map(|y| y[..n].to_vec()).collect(),
+            rates: ys.iter().map(|y| y[n..].to_vec()).collect(),
+            stats,
+        })
+    }
+}
+
+/// Where a trajectory starts (t = 0), in the order of `[[energy.coordinates]]`.
+#[derive(Clone, Copy, Debug)]
+pub struct InitialState<'a> {
+    /// q(0) [m or rad].
+    pub coordinates: &'a [f64],
+    /// q'(0) [m/s or rad/s].
+    pub rates: &'a [f64],
+}
+
+/// The file's dynamic model integrated from `start` at t = 0 and sampled at `times` [s]: the
+/// parameters (`params`, a swept set; one absent keeps the scenario's value) and inputs held
+/// at their values. The comparison with a simulated motion calls this.
+pub fn integrate(
+    spec: &ModelSpec,
+    inputs: &Values,
+    params: &Values,
+    start: InitialState,
+    times: &[f64],
+    tol: &Tolerance,
+    cancel: Option<&AtomicBool>,
+) -> Result<Trajectory, DynamicsError> {
+    let energy = spec.energy.as_ref().ok_or(DynamicsError::NoKinetic)?;
+    let values = spec.values(inputs, params, |_| f64::NAN);
+    energy.integrate(&values, start.coordinates, start.rates, times, tol, cancel)
+}

@@ -1,0 +1,140 @@
+//! The structure's own modal analysis at its current (settled) state: the generalized
+//! symmetric eigenproblem H v = omega^2 M v of the tangent stiffness H that the static
+//! relaxation assembles (the exact Hessian of the potential energy over six coordinates per
+//! free body: translation of the centre of mass, small rotation about it, world frame;
+//! `relaxation/assemble.rs`) and the mass matrix M = diag(m 1, R I R^T) per body (the
+//! kinetic energy m v^2 / 2 + w^T I_world w / 2, I_world the principal moments turned by the
+//! body's current rotation R). Structures of free bodies held by springs and elastic cables
+//! (no joints, no inextensible cables: the relaxation's own domain); others are refused, by
+//! name. Modes with |omega^2| below [`ZERO_MODE_RATIO`] of the largest are rigid-body modes
+//! (a free turn or translation, a strut's spin about its axis): reported as ~0 and counted.
+
+use super::Simulation;
+use crate::eigen::EigenError;
+use crate::structure::{BodyKind, CableLaw};
+use nalgebra::{DMatrix, Matrix3, Quaternion, UnitQuaternion, Vector3};
+
+/// A mode whose |omega^2| is below this fraction of the largest is a rigid-body (zero) mode.
+pub const ZERO_MODE_RATIO: f64 = 1e-9;
+/// Nodes listed per mode as the largest-moving.
+pub const NODES_LISTED: usize = 3;
+
+/// One natural mode of the structure.
+#[derive(Clone, Debug)]
+pub struct StructureMode {
+    /// Eigenvalue of H v = omega^2 M v [rad^2/s^2] (negative: an unstable direction).
+    pub omega_squared: f64,
+    /// A rigid-body mode (|omega^2| below [`ZERO_MODE_RATIO`] of the largest).
+    pub rigid: bool,
+    /// Six coordinates per free body (m, rad), mass-normalised (v^T M v = 1).
+    pub shape: Vec<f64>,
+    /// Every node's displacement in this mode, in structure node order [m per unit of the
+    /// mass-normalised amplitude]; zero on fixed bodies.
+    pub node_motion: Vec<[f64; 3]>,
+}
+
+impl StructureMode {
+    /// omega [rad/s] (minus sqrt(-omega^2) where omega^2 < 0).
+    pub fn omega(&self) -> f64 {
+        self.omega_squared.signum() * self.omega_squared.abs().sqrt()
+    }
+
+    /// The nodes that move most in this mode: (node index, |displacement| relative to the
+    /// largest), at most `n`, largest first.
+    pub fn largest_moving(&self, n: usize) -> Vec<(usize, f64)> {
+        let norm = |d: &[f64; 3]| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let mut by: Vec<(usize, f64)> = self.node_motion.iter().map(norm).enumerate().collect();
+        by.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+        let top = by.first().map_or(0.0, |x| x.1);
+        by.into_iter().take(n).map(|(i, d)| (i, if top > 0.0 { d / top } else { 0.0 })).collect()
+    }
+}
+
+/// The modal analysis of a structure at one state.
+#[derive(Clone, Debug)]
+pub struct StructureModes {
+    /// The structure body of each block of six coordinates.
+    pub bodies: Vec<usize>,
+    /// Ascending omega^2.
+    pub modes: Vec<StructureMode>,
+    /// How many are rigid-body modes.
+    pub rigid: usize,
+}
+
+/// Why a structure's modes are not computed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ModesError {
+    #[error(
+        "joint '{0}': modes are computed for free bodies held by springs and elastic cables only (a reduction \
+         to the joints' coordinates is not implemented)"
+    )]
+    Joint(String),
+    #[error("inextensible cable '{0}': modes are computed for springs and elastic cables only")]
+    InextensibleCable(String),
+    #[error("no free body: nothing moves")]
+    NoFreeBody,
+    #[error(transparent)]
+    Eigen(#[from] EigenError),
+}
+
+impl Simulation {
+    /// The structure's natural modes at its current state.
+    pub fn modes(&self) -> Result<StructureModes, ModesError> {
+        let s = &self.model.structure;
+        if let Some(j) = s.joints.first() {
+            return Err(ModesError::Joint(j.name.clone()));
+        }
+        if let Some(c) = s.cables.iter().find(|c| !matches!(c.law, CableLaw::Elastic { .. })) {
+            return Err(ModesError::InextensibleCable(c.name.clone()));
+        }
+        if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
+            return Err(ModesError::NoFreeBody);
+        }
+        let tangent = self.tangent_stiffness();
+        let mass = self.mass_matrix(&tangent.bodies);
+        let eigen = crate::eigen::modes(&tangent.hessian, &mass)?;
+        let largest = eigen.iter().fold(0.0f64, |m, e| m.max(e.omega_squared.abs()));
+        let modes: Vec<StructureMode> = eigen
+            .into_iter()
+            .map(|e| StructureMode {
+                omega_squared: e.omega_squared,
+                rigid: e.omega_squared.abs() <= ZERO_MODE_RATIO * largest,
+                node_motion: self.node_motion(&tangent.bodies, &tangent.com, e.shape.as_slice()),
+                shape: e.shape.iter().copied().collect(),
+            })
+            .collect();
+        let rigid = modes.iter().filter(|m| m.rigid).count();
+        Ok(StructureModes { bodies: tangent.bodies, modes, rigid })
+    }
+
+    /// The mass matrix of the free bodies' blocks: m 1 for the translation, R diag(I) R^T for
+    /// the rotation (the principal moments about the centre of mass, turned with the body).
+    fn mass_matrix(&self, bodies: &[usize]) -> DMatrix<f64> {
+        let mut m = DMatrix::zeros(6 * bodies.len(), 6 * bodies.len());
+        for (i, &b) in bodies.iter().enumerate() {
+            let inertia = self.model.structure.bodies[b].inertia.expect("free bodies have inertia");
+            let q = self.body_pose(b).rotation_xyzw;
+            let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2])).to_rotation_matrix();
+            let world =
+                r.matrix() * Matrix3::from_diagonal(&Vector3::from(inertia.principal_kg_m2)) * r.matrix().transpose();
+            m.view_mut((6 * i, 6 * i), (3, 3)).copy_from(&(Matrix3::identity() * inertia.mass_kg));
+            m.view_mut((6 * i + 3, 6 * i + 3), (3, 3)).copy_from(&(0.5 * (world + world.transpose())));
+        }
+        m
+    }
+
+    /// Each node's displacement for the coordinates `shape`: dx + dtheta x rho.
+    fn node_motion(&self, bodies: &[usize], com: &[Vector3<f64>], shape: &[f64]) -> Vec<[f64; 3]> {
+        let s = &self.model.structure;
+        (0..s.nodes.len())
+            .map(|n| {
+                let Some(i) = bodies.iter().position(|&b| b == s.nodes[n].body) else { return [0.0; 3] };
+                let rho = Vector3::from(self.node_position(n)) - com[i];
+                let dx = Vector3::from_column_slice(&shape[6 * i..6 * i + 3]);
+                let dtheta = Vector3::from_column_slice(&shape[6 * i + 3..6 * i + 6]);
+                let d = dx + dtheta.cross(&rho);
+                [d.x, d.y, d.z]
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,200 @@
+//! `tensegrity modes`: a structure's natural frequencies at its settled state, from the
+//! relaxation's tangent stiffness and the bodies' mass matrix, against a closed form and
+//! against MuJoCo's linearisation of the MJCF export (`mjd_transitionFD`).
+
+use crate::common;
+
+use std::path::Path;
+use std::process::Command;
+use tensegrity_testbed::run::settle_first_point;
+use tensegrity_testbed::scenario;
+use tensegrity_testbed::sim::modes::StructureModes;
+
+/// A free body (2.5 kg, nodes C at the origin and D 0.1 m above it: centre of mass 0.05 m
+/// above C) held at C by six zero-free-length springs (k = 40 N/m each, to anchors 1 m away on
+/// the axes): each spring's tangent stiffness is k e e^T + (t / l)(1 - e e^T) = k 1 (t = k l),
+/// so C sits in an isotropic 6 k spring: the stiffness has rank 3 (one point held), so the three
+/// turns about C are free; the translation along z (the line through C and the centre of mass)
+/// moves C alone: omega^2 = 6 k / m = 96 rad^2/s^2.
+const BODY_ON_SIX_SPRINGS: &str = r#"name = "body on six springs"
+mechanism = "custom"
+[actuation]
+points = [ {} ]
+[structure]
+[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { XP = [1, 0, 0], XM = [-1, 0, 0], YP = [0, 1, 0], YM = [0, -1, 0], ZP = [0, 0, 1], ZM = [0, 0, -1] }
+[[structure.bodies]]
+name = "bob"
+mass = 2.5
+inertia = [0.1, 0.2, 0.3]
+nodes = { C = [0, 0, 0], D = [0, 0, 0.1] }
+[[structure.springs]]
+name = "sxp"
+a = "C"
+b = "XP"
+stiffness = 40.0
+length = 0.0
+[[structure.springs]]
+name = "sxm"
+a = "C"
+b = "XM"
+stiffness = 40.0
+length = 0.0
+[[structure.springs]]
+name = "syp"
+a = "C"
+b = "YP"
+stiffness = 40.0
+length = 0.0
+[[structure.springs]]
+name = "sym"
+a = "C"
+b = "YM"
+stiffness = 40.0
+length = 0.0
+[[structure.springs]]
+name = "szp"
+a = "C"
+b = "ZP"
+stiffness = 40.0
+length = 0.0
+[[structure.springs]]
+name = "szm"
+a = "C"
+b = "ZM"
+stiffness = 40.0
+length = 0.0
+"#;
+
+fn modes_of(path: &str, text: Option<&str>) -> StructureModes {
+    let sc = match text {
+        Some(t) => scenario::parse(Path::new(path), t).unwrap(),
+        None => scenario::load(Path::new(path)).unwrap(),
+    };
+    let state = settle_first_point(&sc, None).unwrap();
+    assert!(state.settled, "{path} settles");
+    state.sim.modes().unwrap()
+}
+
+/// Three rigid-body modes (the turns about C), and the vertical mode at omega^2 = 6 k / m within
+/// 1e-9 relative (the other two couple the horizontal translations with turns about C).
+#[test]
+fn a_body_on_six_springs_vibrates_at_the_closed_form_frequency() {
+    let m = modes_of("six.toml", Some(BODY_ON_SIX_SPRINGS));
+    assert_eq!(m.rigid, 3, "{:?}", m.modes.iter().map(|x| x.omega()).collect::<Vec<_>>());
+    let want = 6.0 * 40.0 / 2.5;
+    let close = m.modes.iter().filter(|x| ((x.omega_squared - want) / want).abs() < 1e-9).count();
+    assert!(close >= 1, "{:?}", m.modes.iter().map(|x| x.omega_squared).collect::<Vec<_>>());
+}
+
+/// The prism's lowest frequencies are MuJoCo's (from the notes, mujoco 4.0 at dt = 1e-4):
+/// 7.856, 9.092, 12.675 and 16.40 rad/s, within half a unit of their last printed digit;
+/// three rigid-body modes
+/// (the two free struts' spins about their axes, and the turn of the whole about the held
+/// strut's line).
+#[test]
+fn prism3_has_the_frequencies_mujoco_reports() {
+    let m = modes_of("scenarios/custom/prism3.toml", None);
+    assert_eq!((m.modes.len(), m.rigid), (12, 3));
+    let omega: Vec<f64> = m.modes.iter().filter(|x| !x.rigid).map(|x| x.omega()).collect();
+    for (got, (want, half_digit)) in omega.iter().zip([(7.856, 5e-4), (9.092, 5e-4), (12.675, 5e-4), (16.40, 5e-3)]) {
+        assert!((got - want).abs() <= half_digit, "{got} vs {want}");
+    }
+}
+
+/// A structure with joints is refused, by name, with exit 2.
+#[test]
+fn joints_are_refused_by_name() {
+    let (code, _, err) = common::tensegrity(&["modes", "scenarios/custom/pinned_bar_modes.toml"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("joint 'pin'"), "{err}");
+}
+
+/// The Python that has MuJoCo (`TENSEGRITY_PYTHON`, else `python3`), or None.
+fn python_with_mujoco() -> Option<String> {
+    let py = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
+    let ok = Command::new(&py).args(["-c", "import mujoco"]).output().is_ok_and(|o| o.status.success());
+    ok.then_some(py)
+}
+
+/// MuJoCo's frequencies (dispersion-corrected) of the export of `path`, settled there.
+fn mujoco_modes(py: &str, path: &str) -> Vec<f64> {
+    let dir = std::env::temp_dir().join(format!("tensegrity-modes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let xml = dir.join(format!("{}.xml", Path::new(path).file_stem().unwrap().to_string_lossy()));
+    let (code, _, err) = common::tensegrity(&["export", "mjcf", path, "--out", xml.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let sc = scenario::load(Path::new(path)).unwrap();
+    let out = Command::new(py)
+        .arg("tests/mujoco/modes_mjcf.py")
+        .arg(&xml)
+        .args(["--max-time", &sc.settle.max_time_s.to_string()])
+        .args(["--speed-tol", &sc.settle.speed_tol_m_per_s.to_string()])
+        .args(["--window", &sc.settle.window_steps.to_string()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["settled"], true, "{v}");
+    v["omega"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+/// Every mode of prism3 and of the icosahedron agrees with MuJoCo's linearisation of the MJCF
+/// export within 1e-7 relative (measured: at most 4.2e-8), the rigid-body modes counted alike
+/// (MuJoCo's below 1e-3 rad/s). The tolerance: MuJoCo's transition matrix is a centred finite
+/// difference (eps 1e-6) of its step map at dt = 1e-4 s, its frequencies corrected exactly for
+/// the semi-implicit step's dispersion ((w dt)^2 / 24 uncorrected: up to 1.3e-6 here), and the
+/// two settle to states 1e-10 m apart; these structures use no soft constraint (springs and
+/// elastic cables only), so MuJoCo adds no stiffness of its own.
+#[test]
+fn prism3_and_the_icosahedron_agree_with_mujoco() {
+    let Some(py) = python_with_mujoco() else {
+        eprintln!("skipped: no Python with `import mujoco` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt)");
+        return;
+    };
+    const RIGID_RAD_PER_S: f64 = 1e-3;
+    for path in ["scenarios/custom/prism3.toml", "scenarios/custom/icosahedron6.toml"] {
+        let ours = modes_of(path, None);
+        let theirs = mujoco_modes(&py, path);
+        assert_eq!(theirs.len(), ours.modes.len(), "{path}");
+        assert_eq!(theirs.iter().filter(|w| **w < RIGID_RAD_PER_S).count(), ours.rigid, "{path}: {theirs:?}");
+        let mut worst = 0.0f64;
+        for (m, w) in ours.modes.iter().zip(&theirs).filter(|(m, _)| !m.rigid) {
+            worst = worst.max(((m.omega() - w) / w).abs());
+        }
+        eprintln!("{path}: largest relative difference from MuJoCo {worst:.2e}");
+        assert!(worst < 1e-7, "{path}: {worst:e}");
+    }
+}
+
+/// `--record FILE.rrd` writes one entity group per non-rigid mode (prism3: 9), each with its
+/// nodes, struts and cables, decoded back from the file.
+#[test]
+fn the_recording_animates_every_mode() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-modes-rec-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rrd = dir.join("prism3-modes.rrd");
+    let (code, _, err) =
+        common::tensegrity(&["modes", "scenarios/custom/prism3.toml", "--record", rrd.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let file = std::io::BufReader::new(std::fs::File::open(&rrd).expect("recording exists"));
+    let mut entities = std::collections::BTreeSet::new();
+    for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
+        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.expect("decodes") {
+            entities.insert(re_chunk::Chunk::from_arrow_msg(&arrow).expect("a chunk").entity_path().to_string());
+        }
+    }
+    let modes: std::collections::BTreeSet<String> = entities
+        .iter()
+        .filter_map(|e| e.strip_prefix("/modes/").map(|r| r.split('/').next().unwrap().to_string()))
+        .collect();
+    assert_eq!(modes.len(), 9, "{entities:?}");
+    assert!(
+        entities.iter().any(|e| e.ends_with("/struts")) && entities.iter().any(|e| e.ends_with("/cables")),
+        "{entities:?}"
+    );
+    let (code, _, err) = common::tensegrity(&["modes", "scenarios/custom/prism3.toml", "--record", "x.txt"]);
+    assert_eq!(code, 2, "{err}");
+}
