@@ -23,8 +23,14 @@ pub fn failures(report: &ScenarioReport, min_agreement_percent: Option<f64>) -> 
             out.push(Failure::Workspace);
         }
     } else {
-        if !report.settle.settled {
+        // A motion run needs no settle: only one that starts from the settled state fails
+        // when that settle does.
+        let needs_settle = report.motion.as_ref().is_none_or(|m| m.start == crate::settings::MotionStart::Settled);
+        if needs_settle && !report.settle.settled {
             out.push(Failure::Settle);
+        }
+        if let Some(m) = &report.motion {
+            out.extend(m.frequencies.iter().filter(|f| !f.passed).map(|f| Failure::Frequency(f.name.clone())));
         }
         out.extend(report.checks.iter().filter(|c| !c.passed).map(|c| Failure::Check(c.quantity.clone())));
         out.extend(report.model_checks.iter().filter(|c| !c.passed).map(|c| c.failure()));
@@ -75,6 +81,9 @@ pub enum Failure {
     Equation(String),
     /// The dynamics settled away from the `[energy]` model's minima: `energy`.
     Energy,
+    /// A natural frequency measured from a motion run disagreed with its prediction:
+    /// `frequency:NAME`.
+    Frequency(String),
 }
 
 /// The names a scenario may give in `[expect] failing` (a check is `check:QUANTITY`).
@@ -90,6 +99,7 @@ pub const FAILURE_NAMES: &[&str] = &[
     "prediction:NAME",
     "equation:NAME",
     "energy",
+    "frequency:NAME",
 ];
 
 impl fmt::Display for Failure {
@@ -106,6 +116,7 @@ impl fmt::Display for Failure {
             Failure::Prediction(n) => write!(f, "prediction:{n}"),
             Failure::Equation(n) => write!(f, "equation:{n}"),
             Failure::Energy => f.write_str("energy"),
+            Failure::Frequency(n) => write!(f, "frequency:{n}"),
         }
     }
 }
@@ -124,6 +135,9 @@ impl std::str::FromStr for Failure {
             "energy" => Failure::Energy,
             _ if s.strip_prefix("prediction:").is_some_and(|n| !n.is_empty()) => {
                 Failure::Prediction(s["prediction:".len()..].to_string())
+            }
+            _ if s.strip_prefix("frequency:").is_some_and(|n| !n.is_empty()) => {
+                Failure::Frequency(s["frequency:".len()..].to_string())
             }
             _ if s.strip_prefix("equation:").is_some_and(|n| !n.is_empty()) => {
                 Failure::Equation(s["equation:".len()..].to_string())

@@ -11,6 +11,7 @@ pub(super) struct Parts<'a> {
     pub checks: &'a [Check],
     pub model: Option<&'a ModelSpec>,
     pub probe: bool,
+    pub motion: Option<&'a crate::settings::Motion>,
 }
 
 /// Names in a message: `none` for an empty list.
@@ -43,6 +44,10 @@ fn has_part(parts: &Parts, failure: &crate::report::verdict::Failure) -> Result<
             Err("'energy' needs an [energy] section in this scenario".into())
         }
         Failure::Probe if !parts.probe => Err("'probe' needs a [probe] section in this scenario".into()),
+        Failure::Frequency(f) if !parts.motion.is_some_and(|m| m.frequencies.iter().any(|x| &x.name == f)) => Err(format!(
+            "'{f}' is not among this scenario's [[motion.frequencies]] ({})",
+            listed(parts.motion.map_or(vec![], |m| m.frequencies.iter().map(|x| x.name.as_str()).collect()))
+        )),
         _ => Ok(()),
     }
 }

@@ -17,6 +17,7 @@ mod expect;
 mod file_model;
 mod interference;
 mod mechanism;
+mod motion;
 mod number;
 mod params;
 mod physical;
@@ -33,6 +34,7 @@ use std::path::{Path, PathBuf};
 
 pub use bounds::{MAX_STEPS_PER_RUN, MAX_STEPS_PER_SETTLE};
 pub use error::ScenarioError;
+
 
 /// A validated scenario, ready to run.
 #[derive(Clone, Debug)]
@@ -67,6 +69,8 @@ pub struct Scenario {
     pub expect: Option<crate::report::verdict::Expectation>,
     /// `[[quantities]]`, `[[predictions]]`, `[[equations]]`: the file's own model, if any.
     pub model: Option<crate::file_model::spec::ModelSpec>,
+    /// `[motion]`: a motion run (the physical dynamics for a stated time), if the file asks.
+    pub motion: Option<crate::settings::Motion>,
 }
 
 impl Scenario {
@@ -182,7 +186,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let checks = checks::checks(ctx, m, &raw.checks, raw.probe.is_some())?;
     let model = file_model::model(ctx, &raw, m, &params, &start, &actuation)?;
     // A custom structure is checked by its settling and force balance even without [[checks]].
-    if checks.is_empty() && raw.probe.is_none() && custom.is_none() && model.is_none() {
+    if checks.is_empty() && raw.probe.is_none() && custom.is_none() && model.is_none() && raw.motion.is_none() {
         return Err(ctx
             .err_at(0, "the scenario checks nothing: add at least one [[checks]] entry (quantity, tolerance)".into()));
     }
@@ -212,10 +216,12 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     }
     let interference = interference::interference(ctx, &raw.interference, m, &first_params, &first)?;
     let probe = checks::probe(ctx, m, &raw.probe, &first, &params)?;
+    let motion = motion::motion(ctx, &raw, sim.dt_s, &first, &first_params, &actuation)?;
     let expect = match &raw.expect {
         None => None,
         Some(e) => {
-            let parts = expect::Parts { checks: &checks, model: model.as_ref(), probe: probe.is_some() };
+            let parts =
+                expect::Parts { checks: &checks, model: model.as_ref(), probe: probe.is_some(), motion: motion.as_ref() };
             Some(expect::expectation(ctx, e, &parts)?)
         }
     };
@@ -242,5 +248,6 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         custom,
         expect,
         model,
+        motion,
     })
 }
