@@ -24,6 +24,7 @@ mod manriquez2019_dynamics;
 mod model_expressions;
 mod model_scenarios;
 mod mohr2011_dynamics;
+mod motion;
 mod moved_node;
 mod outputs;
 mod param_sweep;
