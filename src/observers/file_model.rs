@@ -210,13 +210,13 @@ impl ModelObserver {
     }
 
     /// Every symbol's value in this state, at the model's time `time_s`.
-    fn values(&self, snap: &Snapshot, inputs: &Values, params: &Values, observed: &Values, time_s: f64) -> Vec<f64> {
+    pub(super) fn values(&self, snap: &Snapshot, inputs: &Values, params: &Values, observed: &Values, time_s: f64) -> Vec<f64> {
         self.spec.values(inputs, params, |i| self.bind[i].read(snap, observed, time_s))
     }
 
     /// Each prediction's (predicted, simulated, error), then each equation's (0, residual,
     /// |residual|), in the order of `acc`.
-    fn errors(&self, v: &[f64]) -> Vec<(f64, f64, f64)> {
+    pub(super) fn errors(&self, v: &[f64]) -> Vec<(f64, f64, f64)> {
         let predictions = self.spec.predictions.iter().map(|p| {
             let (predicted, simulated) = (p.formula.eval(v), v[p.symbol]);
             (predicted, simulated, p.class.error(predicted, simulated))
@@ -261,6 +261,28 @@ impl ModelObserver {
             })
             .collect();
         Some((EnergyPointReport { measured: named(&measured), stationary, landed, distance }, error))
+    }
+
+    /// The table's columns of the model: each quantity (`model:NAME`), each prediction's
+    /// predicted value and error (`predicted:NAME`, `error:NAME`), each equation's residual
+    /// (`equation:NAME`).
+    pub(super) fn table_columns(&self) -> Vec<String> {
+        let q = self.spec.quantities.iter().map(|q| format!("model:{}", q.name));
+        let p = self.spec.predictions.iter().flat_map(|p| [format!("predicted:{}", p.name), format!("error:{}", p.name)]);
+        q.chain(p).chain(self.spec.equations.iter().map(|e| format!("equation:{}", e.name))).collect()
+    }
+
+    /// This tick's values of [`ModelObserver::table_columns`].
+    pub(super) fn table_values(&self, t: &Tick) -> Vec<Option<f64>> {
+        let time_s = t.motion_time_s.unwrap_or(t.snapshot.time_s);
+        let v = self.values(t.snapshot, t.inputs, t.params, t.simulated, time_s);
+        let errors = self.errors(&v);
+        let quantities = self.spec.symbols.iter().enumerate().filter(|(_, s)| matches!(s.source, Source::Quantity(_)));
+        let mut out: Vec<Option<f64>> = quantities.map(|(i, _)| Some(v[i])).collect();
+        let n = self.spec.predictions.len();
+        out.extend(errors[..n].iter().flat_map(|(p, _, e)| [Some(*p), Some(*e)]));
+        out.extend(errors[n..].iter().map(|(_, r, _)| Some(*r)));
+        out
     }
 
     pub fn reports(&self) -> Vec<ModelCheckReport> {

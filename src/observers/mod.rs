@@ -116,7 +116,9 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
         list.push(Box::new(motion::MotionObserver::new(m)));
     }
     if let Some(path) = &setup.table {
-        list.push(Box::new(table::Table::start(path)?));
+        let motion = setup.motion.is_some();
+        let model = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, motion));
+        list.push(Box::new(table::Table::start(path, model)?));
     }
     if let Some(r) = &setup.recording {
         if let Some(recorder) = record::Recorder::start(r)? {
