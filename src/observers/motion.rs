@@ -226,7 +226,7 @@ mod tests {
     /// cos theta = 1 - (w dt)^2 / 2: the correction gives w back to round-off.
     #[test]
     fn the_dispersion_correction_inverts_the_step_maps_rotation() {
-        let (w, dt) = (18.8, 1e-3);
+        let (w, dt): (f64, f64) = (18.8, 1e-3);
         let theta = (1.0 - (w * dt) * (w * dt) / 2.0).acos();
         let corrected = corrected_for_symplectic_euler(theta / dt, dt);
         assert!((corrected - w).abs() <= 1e-12 * w, "{corrected}");

@@ -154,7 +154,11 @@ fn prediction(ctx: &Ctx, spec: &mut ModelSpec, p: &RawPrediction, motion: bool) 
     let closed_form: Vec<&str> = (0..spec.symbols.len())
         .map(|i| if spec.is_closed_form(i) || is_time(i) { spec.symbols[i].name.as_str() } else { "" })
         .collect();
-    let what = format!("prediction '{name}' (parameters, inputs, their quantities{})", if motion { " and t" } else { "" });
+    let what = if motion {
+        format!("prediction '{name}' (parameters, inputs, their quantities and t)")
+    } else {
+        format!("prediction '{name}' (parameters, inputs and their quantities only)")
+    };
     let formula = compile(ctx, &p.formula, &closed_form, &what)?;
     if !motion && formula.uses().iter().any(|&u| is_time(u)) {
         let at = word_offset(p.formula.get_ref(), "t").unwrap_or(0);
