@@ -199,3 +199,63 @@ impl JointProbe {
         self.expected.eval(&values)
     }
 }
+
+/// `[motion]`: a motion run, the physical dynamics for a stated time (`scenario/motion.rs`).
+/// Where a motion run starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MotionStart {
+    /// The structure as drawn (at rest): no step before the motion.
+    Drawn,
+    /// Settled first, with the scenario's settle accelerators, which are then switched off.
+    Settled,
+}
+
+/// A joint coordinate named by a motion run: the joint's name, its index in the structure and
+/// whether it slides (prismatic, m) or turns (revolute, rad).
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointCoordinate {
+    pub joint: String,
+    pub index: usize,
+    pub prismatic: bool,
+}
+
+/// A natural frequency predicted in closed form and measured from the motion.
+#[derive(Clone, Debug)]
+pub struct FrequencyPrediction {
+    pub name: String,
+    pub coordinate: JointCoordinate,
+    /// Compiled against [`FrequencyPrediction::symbols`].
+    pub formula: crate::file_model::expr::Expr,
+    /// The parameters, then the inputs.
+    pub symbols: Vec<String>,
+    /// Relative.
+    pub tolerance: f64,
+}
+
+impl PartialEq for FrequencyPrediction {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name && self.formula.text() == other.formula.text() && self.tolerance == other.tolerance
+    }
+}
+
+impl FrequencyPrediction {
+    /// The predicted angular frequency [rad/s] with these parameters and inputs.
+    pub fn predicted(&self, params: &crate::mechanisms::Values, inputs: &crate::mechanisms::Values) -> f64 {
+        let values: Vec<f64> =
+            self.symbols.iter().map(|s| inputs.get(s).or_else(|| params.get(s)).copied().unwrap_or(f64::NAN)).collect();
+        self.formula.eval(&values)
+    }
+}
+
+/// A validated `[motion]` section.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Motion {
+    pub duration_s: f64,
+    /// Whole time steps of the motion: duration / dt, rounded.
+    pub steps: u64,
+    pub start: MotionStart,
+    /// The displaced coordinate, with its displacement and start rate.
+    pub coordinate: Option<(JointCoordinate, f64, f64)>,
+    pub frequencies: Vec<FrequencyPrediction>,
+}

@@ -62,6 +62,10 @@ pub enum Command {
         /// Record each mode animated at its frequency to this .rrd file (rerun).
         #[arg(long, value_name = "FILE.rrd")]
         record: Option<PathBuf>,
+        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
+        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
     },
     /// Validate scenario files without running them.
     Check {

@@ -115,7 +115,9 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         Command::Findings { mechanism, set, json } => findings::findings(&mechanism, &set, json),
         Command::Import { format } => import::import(format),
         Command::Export { format } => export::export(format),
-        Command::Modes { scenario, json, record } => modes::modes(&scenario, json.as_deref(), record.as_deref()),
+        Command::Modes { scenario, json, record, set } => {
+            modes::modes(&scenario, &overrides(&set)?, json.as_deref(), record.as_deref())
+        }
         bench @ Command::Bench { .. } => bench::bench(bench),
     }
 }

@@ -8,8 +8,13 @@ use crate::sim::modes::{ModesError, StructureModes, NODES_LISTED, ZERO_MODE_RATI
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-pub fn modes(scenario: &Path, json: Option<&Path>, record: Option<&Path>) -> Result<Outcome, CliError> {
-    let sc = load_one(scenario)?;
+pub fn modes(
+    scenario: &Path,
+    overrides: &[crate::scenario::Override],
+    json: Option<&Path>,
+    record: Option<&Path>,
+) -> Result<Outcome, CliError> {
+    let sc = load_one(scenario, overrides)?;
     if let Some(r) = record.filter(|r| r.extension().and_then(|e| e.to_str()) != Some("rrd")) {
         return Err(bad_input(format!("--record {} must end in .rrd", r.display())));
     }

@@ -101,7 +101,11 @@ pub struct Prediction {
     pub symbol: usize,
     pub formula: Expr,
     pub class: ErrorClass,
+    /// On the error at each settle point, or in a motion run on the largest error over its
+    /// ticks.
     pub tolerance: f64,
+    /// A motion run only: on the rms error over its ticks.
+    pub rms_tolerance: Option<f64>,
 }
 
 /// A `[[equations]]` entry: a residual that must vanish at every settled state.

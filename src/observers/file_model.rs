@@ -77,11 +77,12 @@ impl Bind {
         bound.unwrap_or(Bind::Unused)
     }
 
-    fn read(&self, snap: &Snapshot, observed: &Values) -> f64 {
+    /// The symbol's value in `snap`; `time_s` is the model's time `t` there.
+    fn read(&self, snap: &Snapshot, observed: &Values, time_s: f64) -> f64 {
         let at = |v: &Vec<f64>, i: usize| v.get(i).copied().unwrap_or(f64::NAN);
         match self {
             Bind::Unused => f64::NAN,
-            Bind::Time => snap.time_s,
+            Bind::Time => time_s,
             Bind::Node(i, axis) => snap.nodes.get(*i).map_or(f64::NAN, |p| p[*axis]),
             Bind::SpringForce(i) => at(&snap.forces.spring_force_n, *i),
             Bind::SpringLength(i) => at(&snap.forces.spring_length_m, *i),
@@ -128,6 +129,10 @@ struct Acc {
     transient_max: f64,
     transient_sum_sq: f64,
     ticks: u64,
+    /// Over a motion's ticks (a motion run's predictions are judged there).
+    motion_max: f64,
+    motion_sum_sq: f64,
+    motion_ticks: u64,
 }
 
 impl Acc {
@@ -136,6 +141,22 @@ impl Acc {
         let e = if settled && e.is_finite() { e } else { f64::INFINITY };
         self.settled_max = self.settled_max.max(e);
         self.points += 1;
+    }
+
+    /// A motion tick's error (NaN counts as infinite: the prediction failed there).
+    fn motion_tick(&mut self, e: f64) {
+        let e = if e.is_nan() { f64::INFINITY } else { e };
+        self.motion_max = self.motion_max.max(e);
+        self.motion_sum_sq += e * e;
+        self.motion_ticks += 1;
+    }
+
+    fn motion_rms(&self) -> f64 {
+        if self.motion_ticks > 0 {
+            (self.motion_sum_sq / self.motion_ticks as f64).sqrt()
+        } else {
+            f64::INFINITY
+        }
     }
 
     fn tick(&mut self, e: f64) {
@@ -160,12 +181,15 @@ pub struct ModelObserver {
     /// When the run is recorded: the series of each prediction's and equation's error per
     /// tick (`model/NAME`), in the order of `acc`.
     series: Option<Vec<&'static str>>,
+    /// A motion run: the predictions are judged over the motion's ticks, not at settle points.
+    motion: bool,
 }
 
 impl ModelObserver {
     /// The observer of `spec` on the run's `structure`; `recorded`: the run is recorded (each
     /// error per tick then goes to the recording).
-    pub fn new(spec: &ModelSpec, structure: &Structure, recorded: bool) -> Self {
+    /// `motion`: the run is a motion run.
+    pub fn new(spec: &ModelSpec, structure: &Structure, recorded: bool, motion: bool) -> Self {
         let mut used = vec![false; spec.symbols.len()];
         let exprs = spec
             .quantities
@@ -200,17 +224,25 @@ impl ModelObserver {
             energy: Acc::default(),
             frequencies: vec![Acc::default(); frequency_count(spec)],
             series: recorded.then(|| series_names(spec)),
+            motion,
         }
     }
 
-    /// Every symbol's value in this state.
-    fn values(&self, snap: &Snapshot, inputs: &Values, params: &Values, observed: &Values) -> Vec<f64> {
-        self.spec.values(inputs, params, |i| self.bind[i].read(snap, observed))
+    /// Every symbol's value in this state, at the model's time `time_s`.
+    pub(super) fn values(
+        &self,
+        snap: &Snapshot,
+        inputs: &Values,
+        params: &Values,
+        observed: &Values,
+        time_s: f64,
+    ) -> Vec<f64> {
+        self.spec.values(inputs, params, |i| self.bind[i].read(snap, observed, time_s))
     }
 
     /// Each prediction's (predicted, simulated, error), then each equation's (0, residual,
     /// |residual|), in the order of `acc`.
-    fn errors(&self, v: &[f64]) -> Vec<(f64, f64, f64)> {
+    pub(super) fn errors(&self, v: &[f64]) -> Vec<(f64, f64, f64)> {
         let predictions = self.spec.predictions.iter().map(|p| {
             let (predicted, simulated) = (p.formula.eval(v), v[p.symbol]);
             (predicted, simulated, p.class.error(predicted, simulated))
@@ -340,27 +372,70 @@ impl ModelObserver {
                 transient_max_error: 0.0,
                 transient_rms_error: 0.0,
                 ticks_compared: 0,
+                rms_error: None,
+                rms_tolerance: None,
+                motion_ticks: None,
             })
             .collect()
+    }
+
+    /// The table's columns of the model: each quantity (`model:NAME`), each prediction's
+    /// predicted value and error (`predicted:NAME`, `error:NAME`), each equation's residual
+    /// (`equation:NAME`).
+    pub(super) fn table_columns(&self) -> Vec<String> {
+        let q = self.spec.quantities.iter().map(|q| format!("model:{}", q.name));
+        let p =
+            self.spec.predictions.iter().flat_map(|p| [format!("predicted:{}", p.name), format!("error:{}", p.name)]);
+        q.chain(p).chain(self.spec.equations.iter().map(|e| format!("equation:{}", e.name))).collect()
+    }
+
+    /// This tick's values of [`ModelObserver::table_columns`].
+    pub(super) fn table_values(&self, t: &Tick) -> Vec<Option<f64>> {
+        let time_s = t.motion_time_s.unwrap_or(t.snapshot.time_s);
+        let v = self.values(t.snapshot, t.inputs, t.params, t.simulated, time_s);
+        let errors = self.errors(&v);
+        let quantities = self.spec.symbols.iter().enumerate().filter(|(_, s)| matches!(s.source, Source::Quantity(_)));
+        let mut out: Vec<Option<f64>> = quantities.map(|(i, _)| Some(v[i])).collect();
+        let n = self.spec.predictions.len();
+        out.extend(errors[..n].iter().flat_map(|(p, _, e)| [Some(*p), Some(*e)]));
+        out.extend(errors[n..].iter().map(|(_, r, _)| Some(*r)));
+        out
     }
 
     pub fn reports(&self) -> Vec<ModelCheckReport> {
         let kinds = self.spec.predictions.iter().map(|p| ("prediction", p.class.name()));
         let kinds = kinds.chain(self.spec.equations.iter().map(|_| ("equation", "residual")));
+        let rms_tolerances = self.spec.predictions.iter().map(|p| p.rms_tolerance);
+        let rms_tolerances = rms_tolerances.chain(self.spec.equations.iter().map(|_| None));
         kinds
             .zip(self.tolerances())
             .zip(&self.acc)
-            .map(|(((kind, class), (name, tolerance)), a)| ModelCheckReport {
-                kind: kind.into(),
-                name: name.into(),
-                class: class.into(),
-                max_error: a.settled_max,
-                tolerance,
-                passed: a.points > 0 && a.settled_max <= tolerance,
-                points_compared: a.points,
-                transient_max_error: a.transient_max,
-                transient_rms_error: if a.ticks > 0 { (a.transient_sum_sq / a.ticks as f64).sqrt() } else { 0.0 },
-                ticks_compared: a.ticks,
+            .zip(rms_tolerances)
+            .map(|((((kind, class), (name, tolerance)), a), rms_tolerance)| {
+                let mut r = ModelCheckReport {
+                    kind: kind.into(),
+                    name: name.into(),
+                    class: class.into(),
+                    max_error: a.settled_max,
+                    tolerance,
+                    passed: a.points > 0 && a.settled_max <= tolerance,
+                    points_compared: a.points,
+                    transient_max_error: a.transient_max,
+                    transient_rms_error: if a.ticks > 0 { (a.transient_sum_sq / a.ticks as f64).sqrt() } else { 0.0 },
+                    ticks_compared: a.ticks,
+                    rms_error: None,
+                    rms_tolerance: None,
+                    motion_ticks: None,
+                };
+                if self.motion && kind == "prediction" {
+                    let rms = a.motion_rms();
+                    r.max_error = if a.motion_ticks > 0 { a.motion_max } else { f64::INFINITY };
+                    r.passed = a.motion_ticks > 0 && r.max_error <= tolerance && rms_tolerance.is_none_or(|t| rms <= t);
+                    r.rms_error = Some(rms);
+                    r.rms_tolerance = rms_tolerance;
+                    r.motion_ticks = Some(a.motion_ticks);
+                }
+                r
             })
             .chain(self.frequency_reports())
             .chain(self.spec.energy.as_ref().map(|e| ModelCheckReport {
@@ -374,6 +449,9 @@ impl ModelObserver {
                 transient_max_error: 0.0,
                 transient_rms_error: 0.0,
                 ticks_compared: 0,
+                rms_error: None,
+                rms_tolerance: None,
+                motion_ticks: None,
             }))
             .collect()
     }
@@ -381,10 +459,17 @@ impl ModelObserver {
 
 impl Observer for ModelObserver {
     fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>) {
-        let v = self.values(t.snapshot, t.inputs, t.params, t.simulated);
+        let time_s = t.motion_time_s.unwrap_or(t.snapshot.time_s);
+        let v = self.values(t.snapshot, t.inputs, t.params, t.simulated, time_s);
         let errors = self.errors(&v);
         for (a, (_, _, e)) in self.acc.iter_mut().zip(&errors) {
             a.tick(*e);
+        }
+        if t.motion_time_s.is_some() {
+            let predictions = self.spec.predictions.len();
+            for (a, (_, _, e)) in self.acc.iter_mut().zip(&errors).take(predictions) {
+                a.motion_tick(*e);
+            }
         }
         if let Some(series) = &self.series {
             notes.extend(series.iter().zip(&errors).map(|(s, (_, _, e))| Note::Scalar(s, *e)));
@@ -397,10 +482,12 @@ impl Observer for ModelObserver {
         if p.outside_model {
             return;
         }
-        let v = self.values(p.snapshot, &point.inputs, p.params, &point.simulated);
+        let v = self.values(p.snapshot, &point.inputs, p.params, &point.simulated, p.snapshot.time_s);
         let errors = self.errors(&v);
         let tolerances: Vec<(String, f64)> = self.tolerances().map(|(n, t)| (n.to_string(), t)).collect();
-        for ((a, (_, _, e)), (name, tol)) in self.acc.iter_mut().zip(&errors).zip(&tolerances) {
+        // A motion run judges its predictions over the motion, not at its start point.
+        let skip = if self.motion { self.spec.predictions.len() } else { 0 };
+        for ((a, (_, _, e)), (name, tol)) in self.acc.iter_mut().zip(&errors).zip(&tolerances).skip(skip) {
             a.point(*e, point.settled);
             if point.settled && !(*e <= *tol) {
                 notes.push(Note::Event(format!(
@@ -415,7 +502,7 @@ impl Observer for ModelObserver {
                 point.simulated.entry(s.name.clone()).or_insert(v[i]);
             }
         }
-        for (pr, (predicted, _, _)) in self.spec.predictions.iter().zip(&errors) {
+        for (pr, (predicted, _, _)) in self.spec.predictions.iter().zip(&errors).filter(|_| !self.motion) {
             point.analytic.entry(self.spec.symbols[pr.symbol].name.clone()).or_insert(*predicted);
         }
         if let Some((report, error)) = self.energy_point(&v) {

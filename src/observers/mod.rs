@@ -11,6 +11,7 @@ pub mod compare;
 pub mod file_model;
 pub mod interference;
 pub mod modes_record;
+pub mod motion;
 pub mod record;
 pub mod slack;
 pub mod table;
@@ -32,6 +33,12 @@ pub struct Tick<'a> {
     pub simulated: &'a Values,
     /// Analytic node positions for the ghost overlay (only for observers that record).
     pub ghost_nodes: Option<&'a [[f64; 3]]>,
+    /// In a motion run's motion: the time since the motion started [s] (the model's `t`
+    /// there). None before it (a settle to its start) and in every other run.
+    pub motion_time_s: Option<f64>,
+    /// The step to this tick took a settle accelerator (the static relaxation or the Newton
+    /// damping schedule): it is no part of a physical path.
+    pub accelerated: bool,
 }
 
 /// What the observers see of a settle point besides its report (which holds the inputs, the
@@ -93,6 +100,8 @@ pub struct Setup<'a> {
     pub recording: Option<record::Recording<'a>>,
     /// A per-tick f64 table (CSV) to write, if the run writes one.
     pub table: Option<std::path::PathBuf>,
+    /// A motion run's `[motion]`: its frequencies are measured from its ticks.
+    pub motion: Option<&'a crate::settings::Motion>,
 }
 
 /// Every observer of a run, in the order they see each tick.
@@ -101,10 +110,16 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
         vec![Box::new(compare::Compare::new(setup.checks, setup.length_scale_m)), Box::new(slack::SlackTracker::new())];
     list.push(Box::new(interference::Interference::new(setup.structure, setup.interference)?));
     if let Some(spec) = setup.model {
-        list.push(Box::new(file_model::ModelObserver::new(spec, setup.structure, setup.recording.is_some())));
+        let recorded = setup.recording.is_some();
+        list.push(Box::new(file_model::ModelObserver::new(spec, setup.structure, recorded, setup.motion.is_some())));
+    }
+    if let Some(m) = setup.motion {
+        list.push(Box::new(motion::MotionObserver::new(m)));
     }
     if let Some(path) = &setup.table {
-        list.push(Box::new(table::Table::start(path)?));
+        let motion = setup.motion.is_some();
+        let model = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, motion));
+        list.push(Box::new(table::Table::start(path, model)?));
     }
     if let Some(r) = &setup.recording {
         if let Some(recorder) = record::Recorder::start(r)? {

@@ -9,7 +9,12 @@
 //! force and every cable's tension (`spring:NAME.force_n`, `cable:NAME.tension_n`), every
 //! actuator's force (`actuator:SYMBOL@JOINT_OR_CABLE.force`, N or N m), and the mechanism's quantities,
 //! simulated (`sim:QUANTITY`) and analytic (`analytic:QUANTITY`, empty where the model has no
-//! value). Numbers are written in Rust's shortest round-trip form, so reading them back gives
+//! value), then `path_accelerated` (1 when the step to the tick took a settle accelerator, 0 on
+//! a physical path), `motion_time_s` (a motion run's time since its start, the model's `t`;
+//! empty elsewhere), every revolute joint's angle and prismatic joint's slide
+//! (`joint:NAME.angle` rad, `joint:NAME.slide` m) and the file's model: each quantity
+//! (`model:NAME`), each prediction's predicted value and error (`predicted:NAME`,
+//! `error:NAME`), each equation's residual (`equation:NAME`). Numbers are written in Rust's shortest round-trip form, so reading them back gives
 //! the same f64 bit for bit. The file is written to a temporary file (`output::partial_path`) and renamed when the run
 //! is over.
 
@@ -57,6 +62,18 @@ pub struct Table {
     keys: Option<Keys>,
     /// The first write error, reported when the run closes.
     error: Option<String>,
+    /// The file's model, evaluated for its columns (quantities, predictions, errors).
+    model: Option<super::file_model::ModelObserver>,
+}
+
+/// Every joint with one coordinate: its index and column (`joint:NAME.angle` [rad] for a
+/// revolute, `joint:NAME.slide` [m] for a prismatic).
+fn coordinates(s: &crate::structure::Structure) -> impl Iterator<Item = (usize, String)> + '_ {
+    s.joints.iter().enumerate().filter_map(|(j, joint)| match joint.kind {
+        crate::structure::JointKind::Revolute { .. } => Some((j, format!("joint:{}.angle", joint.name))),
+        crate::structure::JointKind::Prismatic { .. } => Some((j, format!("joint:{}.slide", joint.name))),
+        _ => None,
+    })
 }
 
 /// A CSV field: quoted when it holds a comma, a quote or a line break.
@@ -71,7 +88,8 @@ fn field(s: &str) -> String {
 impl Table {
     /// Starts the table at `path` (its directory is made if needed); Arrow IPC for the endings
     /// in [`ARROW_ENDINGS`], CSV otherwise.
-    pub fn start(path: &Path) -> Result<Self, String> {
+    /// `model`: the file's model, whose quantities, predictions and errors get columns.
+    pub fn start(path: &Path, model: Option<super::file_model::ModelObserver>) -> Result<Self, String> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
         }
@@ -87,11 +105,11 @@ impl Table {
         } else {
             Sink::Csv(std::io::BufWriter::new(file))
         };
-        Ok(Table { path: path.to_path_buf(), partial, sink, keys: None, error: None })
+        Ok(Table { path: path.to_path_buf(), partial, sink, keys: None, error: None, model })
     }
 
     /// The column names after `tick`.
-    fn columns(t: &Tick, keys: &Keys) -> Vec<String> {
+    fn columns(&self, t: &Tick, keys: &Keys) -> Vec<String> {
         let s = t.structure;
         let mut cols: Vec<String> = vec!["time_s".into(), "kinetic_energy_j".into()];
         cols.extend(keys.0.iter().map(|k| format!("input:{k}")));
@@ -111,11 +129,14 @@ impl Table {
         }));
         cols.extend(keys.1.iter().map(|k| format!("sim:{k}")));
         cols.extend(keys.2.iter().map(|k| format!("analytic:{k}")));
+        cols.extend(["path_accelerated".to_string(), "motion_time_s".to_string()]);
+        cols.extend(coordinates(s).map(|(_, name)| name));
+        cols.extend(self.model.iter().flat_map(|m| m.table_columns()));
         cols
     }
 
     /// The values of one tick, in the order of [`Table::columns`] (None: no value there).
-    fn values(t: &Tick, keys: &Keys) -> Vec<Option<f64>> {
+    fn values(&self, t: &Tick, keys: &Keys) -> Vec<Option<f64>> {
         let snap = t.snapshot;
         let mut v = vec![Some(snap.time_s), Some(snap.kinetic_energy_j)];
         v.extend(keys.0.iter().map(|k| t.inputs.get(k).copied()));
@@ -124,6 +145,10 @@ impl Table {
         v.extend(f.spring_force_n.iter().chain(&f.cable_tension_n).chain(&f.actuator_force).map(|x| Some(*x)));
         v.extend(keys.1.iter().map(|k| t.simulated.get(k).copied()));
         v.extend(keys.2.iter().map(|k| t.prediction.expected.get(k).copied()));
+        v.push(Some(if t.accelerated { 1.0 } else { 0.0 }));
+        v.push(t.motion_time_s);
+        v.extend(coordinates(t.structure).map(|(j, _)| snap.joint_coordinate(t.structure, j)));
+        v.extend(self.model.iter().flat_map(|m| m.table_values(t)));
         v
     }
 
@@ -217,12 +242,12 @@ impl Observer for Table {
                     t.simulated.keys().cloned().collect(),
                     t.prediction.expected.keys().cloned().collect(),
                 );
-                let h = Self::columns(t, &keys);
+                let h = self.columns(t, &keys);
                 self.keys = Some(keys);
                 Some(h)
             }
         };
-        let values = Self::values(t, self.keys.as_ref().expect("set above"));
+        let values = self.values(t, self.keys.as_ref().expect("set above"));
         if let Err(e) = self.write(t.snapshot.tick, header, values) {
             self.error = Some(e);
         }

@@ -53,6 +53,84 @@ pub struct ScenarioReport {
     /// JSON when the file states none).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub model_checks: Vec<ModelCheckReport>,
+    /// Which kind of path the run took: "physical" (no step took a settle accelerator; in a
+    /// motion run, no step of its motion) or "accelerated" (the static relaxation or the
+    /// Newton damping schedule acted: a quasi-static or accelerated settle, whose path is not
+    /// the dynamics').
+    pub path: PathKind,
+    /// Steps of the whole run that took a settle accelerator (a motion run's settle to its
+    /// start included).
+    pub accelerated_steps: u64,
+    /// A motion run (`[motion]`): what ran, and the frequencies measured from it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub motion: Option<MotionReport>,
+}
+
+/// Which kind of path a run took (see [`ScenarioReport::path`]).
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum PathKind {
+    /// Only the physical dynamics: the path is a trajectory of the structure.
+    Physical,
+    /// A settle accelerator acted: the path reaches equilibria but is not a trajectory.
+    #[default]
+    Accelerated,
+}
+
+impl PathKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            PathKind::Physical => "physical",
+            PathKind::Accelerated => "accelerated",
+        }
+    }
+}
+
+/// A motion run: the physical dynamics for a stated time.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct MotionReport {
+    /// "drawn" or "settled".
+    pub start: crate::settings::MotionStart,
+    pub duration_s: f64,
+    pub dt_s: f64,
+    /// Steps the motion asks for, and the steps it took (fewer when it stopped early).
+    pub steps: u64,
+    pub steps_taken: u64,
+    /// The tick the motion started after (its time origin: the model's t = 0).
+    pub start_tick: u64,
+    /// The displaced joint, its displacement [rad or m] and start rate [rad/s or m/s].
+    pub coordinate: Option<String>,
+    pub displacement: f64,
+    pub rate: f64,
+    /// Steps of the motion that took a settle accelerator (0: the motion is physical).
+    pub accelerated_steps: u64,
+    pub frequencies: Vec<FrequencyReport>,
+}
+
+/// A natural frequency measured from a motion run's free vibration and its prediction.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct FrequencyReport {
+    pub name: String,
+    /// The joint whose coordinate was fitted.
+    pub coordinate: String,
+    pub predicted_rad_per_s: f64,
+    /// The fitted angular frequency of the simulated samples, w_d [rad/s].
+    pub measured_rad_per_s: f64,
+    /// Corrected for symplectic Euler's dispersion: w = (2 / dt) sin(w_d dt / 2) [rad/s].
+    pub corrected_rad_per_s: f64,
+    /// |corrected - predicted| / predicted: what the tolerance applies to.
+    pub error: f64,
+    /// |measured - predicted| / predicted: the error without the correction.
+    pub uncorrected_error: f64,
+    pub tolerance: f64,
+    pub passed: bool,
+    /// The fit: offset c, amplitude A and the rms of its residual [rad or m], samples fitted.
+    pub fit_offset: f64,
+    pub fit_amplitude: f64,
+    pub fit_rms_residual: f64,
+    pub samples: usize,
+    /// How it was measured.
+    pub method: String,
 }
 
 /// A `[[predictions]]` or `[[equations]]` entry of the scenario file's model, judged at every
@@ -75,6 +153,14 @@ pub struct ModelCheckReport {
     pub transient_max_error: f64,
     pub transient_rms_error: f64,
     pub ticks_compared: u64,
+    /// A prediction in a motion run, judged over the motion's ticks: its rms error there (the
+    /// largest is `max_error`), the rms tolerance if the file gives one, and the ticks.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rms_error: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rms_tolerance: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub motion_ticks: Option<u64>,
 }
 
 impl ModelCheckReport {
@@ -419,6 +505,7 @@ impl ScenarioReport {
         self.table_header(out);
         self.table_checks(out);
         self.table_model(out);
+        self.table_motion(out);
         self.table_probe(out);
         self.table_slack(out);
         self.table_workspace(out);
@@ -440,8 +527,40 @@ impl ScenarioReport {
             self.settle.sim_time_s,
             self.settle.wall_s
         ));
+        out.push_str(&format!("   path: {} ({} accelerated step(s))\n", self.path.name(), self.accelerated_steps));
         if let Some(e) = &self.error {
             out.push_str(&format!("   stopped: {e}\n"));
+        }
+    }
+
+    /// A motion run: what ran, and each measured frequency against its prediction.
+    fn table_motion(&self, out: &mut String) {
+        let Some(m) = &self.motion else { return };
+        out.push_str(&format!(
+            "   motion from the {} state: {} of {} steps of {} s ({} s), {} accelerated; {}\n",
+            if m.start == crate::settings::MotionStart::Drawn { "drawn" } else { "settled" },
+            m.steps_taken,
+            m.steps,
+            m.dt_s,
+            m.duration_s,
+            m.accelerated_steps,
+            match &m.coordinate {
+                Some(c) => format!("{c} displaced by {:e}, rate {:e}", m.displacement, m.rate),
+                None => "no displacement".into(),
+            }
+        ));
+        for f in &m.frequencies {
+            out.push_str(&format!(
+                "   frequency {}: predicted {:.9} rad/s, measured {:.9}, corrected {:.9}: error {:.3e} (uncorrected {:.3e}), tolerance {:.1e}  {}\n",
+                f.name,
+                f.predicted_rad_per_s,
+                f.measured_rad_per_s,
+                f.corrected_rad_per_s,
+                f.error,
+                f.uncorrected_error,
+                f.tolerance,
+                if f.passed { "pass" } else { "FAIL" }
+            ));
         }
     }
 

@@ -23,8 +23,14 @@ pub fn failures(report: &ScenarioReport, min_agreement_percent: Option<f64>) -> 
             out.push(Failure::Workspace);
         }
     } else {
-        if !report.settle.settled {
+        // A motion run needs no settle: only one that starts from the settled state fails
+        // when that settle does.
+        let needs_settle = report.motion.as_ref().is_none_or(|m| m.start == crate::settings::MotionStart::Settled);
+        if needs_settle && !report.settle.settled {
             out.push(Failure::Settle);
+        }
+        if let Some(m) = &report.motion {
+            out.extend(m.frequencies.iter().filter(|f| !f.passed).map(|f| Failure::Frequency(f.name.clone())));
         }
         out.extend(report.checks.iter().filter(|c| !c.passed).map(|c| Failure::Check(c.quantity.clone())));
         out.extend(report.model_checks.iter().filter(|c| !c.passed).map(|c| c.failure()));
@@ -75,8 +81,9 @@ pub enum Failure {
     Equation(String),
     /// The dynamics settled away from the `[energy]` model's minima: `energy`.
     Energy,
-    /// A `[[energy.frequencies]]` prediction differs from the dynamic model's natural
-    /// frequency beyond its tolerance: `frequency:NAME`.
+    /// A frequency prediction failed: a `[[energy.frequencies]]` one against the dynamic
+    /// model's natural frequency, or a `[[motion.frequencies]]` one against the frequency
+    /// measured from a motion run: `frequency:NAME`.
     Frequency(String),
 }
 

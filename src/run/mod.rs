@@ -4,6 +4,7 @@
 //! `settle.rs` the settle loop, `point.rs` one settle point (branch, stability, probe,
 //! read-out) (the pass policy is `report::verdict`).
 
+mod motion;
 mod point;
 mod runner;
 mod settle;
@@ -86,6 +87,9 @@ fn empty_report(sc: &Scenario) -> ScenarioReport {
         trajectory_ranges: Default::default(),
         error: None,
         model_checks: vec![],
+        path: crate::report::PathKind::Accelerated,
+        accelerated_steps: 0,
+        motion: None,
     }
 }
 
@@ -163,7 +167,12 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         }
     };
     let mut probe_errors: Vec<f64> = Vec::new();
-    if let Err(e) = run_actuation(&mut runner, sc, &mut report, &mut probe_errors) {
+    report.motion = sc.motion.as_ref().map(|m| motion::planned(m, sc.sim.dt_s));
+    let ran = match &sc.motion {
+        Some(m) => motion::run_motion(&mut runner, sc, m, &mut report, &mut probe_errors),
+        None => run_actuation(&mut runner, sc, &mut report, &mut probe_errors),
+    };
+    if let Err(e) = ran {
         report.error = Some(e.to_string());
         runner.emit(format_args!("run stopped: {e}"));
     }
@@ -193,6 +202,7 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         model: sc.model.as_ref(),
         recording: target.map(|target| Recording { target, every: opts.record_every.max(1), scenario: &sc.source }),
         table: opts.table.clone(),
+        motion: sc.motion.as_ref(),
     })?;
     let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel, params);
     // The first point's commands (a no-op where the build already placed them).
@@ -211,6 +221,13 @@ fn finish(runner: &mut Runner, report: &mut ScenarioReport, probe_errors: &[f64]
         w.min_agreement_percent = sc.min_agreement_percent;
         w
     });
+    report.accelerated_steps = runner.accelerated_steps;
+    // A motion run's path is its motion's; any other run's is every step's.
+    let physical = match &report.motion {
+        Some(m) => m.steps_taken > 0 && m.accelerated_steps == 0,
+        None => runner.steps > 0 && runner.accelerated_steps == 0,
+    };
+    report.path = if physical { crate::report::PathKind::Physical } else { crate::report::PathKind::Accelerated };
     report.settle = SettleSummary {
         settled: !report.points.is_empty() && report.points.iter().all(|p| p.settled),
         steps: runner.steps,

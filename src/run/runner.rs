@@ -9,6 +9,10 @@ use crate::sim::Simulation;
 use crate::snapshot::Snapshot;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+/// The recording's series that says, per tick, whether the step took a settle accelerator
+/// (1) or was physical (0).
+pub const ACCELERATED_SERIES: &str = "path/accelerated";
+
 pub(super) struct Runner<'a> {
     pub mech: Box<dyn Mechanism>,
     pub sc: &'a Scenario,
@@ -25,6 +29,12 @@ pub(super) struct Runner<'a> {
     pub steps: u64,
     /// The analytic ghost nodes for the last inputs (recordings only).
     ghost: Option<(Values, Option<Vec<[f64; 3]>>)>,
+    /// The tick a motion run's motion started at (its time origin), once it has.
+    pub motion_start_tick: Option<u64>,
+    /// Whether the step before the last one was accelerated (the recording notes each change).
+    was_accelerated: Option<bool>,
+    /// Steps over the whole run that took a settle accelerator.
+    pub accelerated_steps: u64,
 }
 
 impl<'a> Runner<'a> {
@@ -37,7 +47,21 @@ impl<'a> Runner<'a> {
         params: Values,
     ) -> Self {
         let recording = observers.iter().any(|o| o.records());
-        Runner { mech, sc, params, sim, observers, recording, notes: Vec::new(), cancel, steps: 0, ghost: None }
+        Runner {
+            mech,
+            sc,
+            params,
+            sim,
+            observers,
+            recording,
+            notes: Vec::new(),
+            cancel,
+            steps: 0,
+            ghost: None,
+            motion_start_tick: None,
+            was_accelerated: None,
+            accelerated_steps: 0,
+        }
     }
 
     /// Commands every actuator for `inputs` (by its symbol).
@@ -104,7 +128,21 @@ impl<'a> Runner<'a> {
         if self.recording && self.ghost.as_ref().is_none_or(|(i, _)| i != inputs) {
             self.ghost = Some((inputs.clone(), self.mech.analytic_nodes(&self.params, inputs)));
         }
+        let accelerated = self.sim.last_step_accelerated();
+        if self.recording {
+            self.notes.push(Note::Scalar(ACCELERATED_SERIES, f64::from(u8::from(accelerated))));
+            if self.was_accelerated != Some(accelerated) {
+                let kind = if accelerated { "accelerated (a settle accelerator acts)" } else { "physical" };
+                self.notes.push(Note::Event(format!("path from here: {kind}")));
+            }
+        }
+        self.was_accelerated = Some(accelerated);
+        self.accelerated_steps += u64::from(accelerated);
+        let dt = self.sc.sim.dt_s;
+        let motion_time_s = self.motion_start_tick.map(|t0| snap.tick.saturating_sub(t0) as f64 * dt);
         let tick = Tick {
+            motion_time_s,
+            accelerated,
             structure: &self.sim.structure(),
             snapshot: &snap,
             inputs,

@@ -11,6 +11,7 @@ pub(super) struct Parts<'a> {
     pub checks: &'a [Check],
     pub model: Option<&'a ModelSpec>,
     pub probe: bool,
+    pub motion: Option<&'a crate::settings::Motion>,
 }
 
 /// Names in a message: `none` for an empty list.
@@ -22,10 +23,13 @@ fn listed(names: Vec<&str>) -> String {
     }
 }
 
-/// The names of the `[[energy.frequencies]]` predictions.
-fn frequency_names(model: Option<&ModelSpec>) -> Vec<&str> {
-    let dynamics = model.and_then(|m| m.energy.as_ref()).and_then(|e| e.dynamics.as_ref());
-    dynamics.map_or(vec![], |d| d.frequencies.iter().map(|f| f.name.as_str()).collect())
+/// The names of the frequency predictions: `[[energy.frequencies]]` and
+/// `[[motion.frequencies]]`.
+fn frequency_names<'a>(parts: &Parts<'a>) -> Vec<&'a str> {
+    let dynamics = parts.model.and_then(|m| m.energy.as_ref()).and_then(|e| e.dynamics.as_ref());
+    let model = dynamics.into_iter().flat_map(|d| d.frequencies.iter().map(|f| f.name.as_str()));
+    let motion = parts.motion.into_iter().flat_map(|m| m.frequencies.iter().map(|f| f.name.as_str()));
+    model.chain(motion).collect()
 }
 
 /// Whether the scenario has the part `failure` names; else the message saying what it has.
@@ -45,9 +49,9 @@ fn has_part(parts: &Parts, failure: &crate::report::verdict::Failure) -> Result<
             "'{q}' is not among this scenario's [[equations]] ({})",
             listed(model.map_or(vec![], |m| m.equations.iter().map(|x| x.name.as_str()).collect()))
         )),
-        Failure::Frequency(q) if !frequency_names(model).contains(&q.as_str()) => Err(format!(
-            "'{q}' is not among this scenario's [[energy.frequencies]] ({})",
-            listed(frequency_names(model))
+        Failure::Frequency(q) if !frequency_names(parts).contains(&q.as_str()) => Err(format!(
+            "'{q}' is not among this scenario's [[energy.frequencies]] and [[motion.frequencies]] ({})",
+            listed(frequency_names(parts))
         )),
         Failure::Energy if !model.is_some_and(|m| m.energy.is_some()) => {
             Err("'energy' needs an [energy] section in this scenario".into())

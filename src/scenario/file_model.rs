@@ -36,7 +36,7 @@ pub(super) fn model(
         quantity(ctx, &mut spec, q)?;
     }
     for p in &raw.predictions {
-        prediction(ctx, &mut spec, p)?;
+        prediction(ctx, &mut spec, p, raw.motion.is_some())?;
     }
     for e in &raw.equations {
         equation(ctx, &mut spec, e)?;
@@ -125,9 +125,10 @@ fn quantity(ctx: &Ctx, spec: &mut ModelSpec, q: &RawQuantity) -> Result<(), Scen
     Ok(())
 }
 
-/// A prediction: its compared symbol, its formula (parameters and inputs only), class and
-/// tolerance; its name unique among the predictions.
-fn prediction(ctx: &Ctx, spec: &mut ModelSpec, p: &RawPrediction) -> Result<(), ScenarioError> {
+/// A prediction: its compared symbol, its formula (parameters and inputs only; in a motion run
+/// time `t` too, counted from the motion's start), class and tolerance (in a motion run also
+/// an optional `rms_tolerance`); its name unique among the predictions.
+fn prediction(ctx: &Ctx, spec: &mut ModelSpec, p: &RawPrediction, motion: bool) -> Result<(), ScenarioError> {
     let q = p.quantity.get_ref();
     let symbol = spec.symbols.iter().position(|s| &s.name == q).ok_or_else(|| {
         let quantities: Vec<_> = spec.quantities.iter().map(|q| q.name.as_str()).collect();
@@ -147,11 +148,36 @@ fn prediction(ctx: &Ctx, spec: &mut ModelSpec, p: &RawPrediction) -> Result<(), 
     }
     // The formula may use parameters, inputs and quantities of those only: every other symbol
     // is hidden from it.
+    // Time is offered to every formula so that its misuse outside a motion run gets its own
+    // message.
+    let is_time = |i: usize| spec.symbols[i].source == Source::Time;
     let closed_form: Vec<&str> = (0..spec.symbols.len())
-        .map(|i| if spec.is_closed_form(i) { spec.symbols[i].name.as_str() } else { "" })
+        .map(|i| if spec.is_closed_form(i) || is_time(i) { spec.symbols[i].name.as_str() } else { "" })
         .collect();
-    let what = format!("prediction '{name}' (parameters, inputs and their quantities only)");
+    let what = if motion {
+        format!("prediction '{name}' (parameters, inputs, their quantities and t)")
+    } else {
+        format!("prediction '{name}' (parameters, inputs and their quantities only)")
+    };
     let formula = compile(ctx, &p.formula, &closed_form, &what)?;
+    if !motion && formula.uses().iter().any(|&u| is_time(u)) {
+        let at = word_offset(p.formula.get_ref(), "t").unwrap_or(0);
+        return Err(ctx.err_at(
+            p.formula.span().start + 1 + at,
+            format!(
+                "prediction '{name}' uses t, which means nothing at a settle point: time enters a prediction only in a motion run ([motion], t counted from its start)"
+            ),
+        ));
+    }
+    let rms_tolerance = match &p.rms_tolerance {
+        Some(r) if !motion => {
+            return Err(
+                ctx.err(r, "rms_tolerance judges a prediction over a motion's ticks: it needs a [motion] section")
+            )
+        }
+        Some(r) => Some(positive_value(ctx, r, "rms_tolerance")?),
+        None => None,
+    };
     let class = ErrorClass::parse(p.class.get_ref()).ok_or_else(|| {
         ctx.err(
             &p.class,
@@ -159,7 +185,7 @@ fn prediction(ctx: &Ctx, spec: &mut ModelSpec, p: &RawPrediction) -> Result<(), 
         )
     })?;
     let tolerance = positive_value(ctx, &p.tolerance, "tolerance")?;
-    spec.predictions.push(Prediction { name, symbol, formula, class, tolerance });
+    spec.predictions.push(Prediction { name, symbol, formula, class, tolerance, rms_tolerance });
     Ok(())
 }
 
@@ -172,4 +198,14 @@ fn equation(ctx: &Ctx, spec: &mut ModelSpec, e: &RawEquation) -> Result<(), Scen
     let tolerance = positive_value(ctx, &e.tolerance, "tolerance")?;
     spec.equations.push(Equation { name, residual, tolerance });
     Ok(())
+}
+
+/// The byte offset of `word` standing alone in `text` (not inside a longer name), if it does.
+fn word_offset(text: &str, word: &str) -> Option<usize> {
+    let name_char = |c: char| c.is_alphanumeric() || c == '_' || c == '.';
+    text.match_indices(word).map(|(i, _)| i).find(|&i| {
+        let before = text[..i].chars().next_back().is_none_or(|c| !name_char(c));
+        let after = text[i + word.len()..].chars().next().is_none_or(|c| !name_char(c));
+        before && after
+    })
 }

@@ -18,6 +18,7 @@ mod file_model;
 mod interference;
 mod kinetic;
 mod mechanism;
+mod motion;
 mod number;
 mod overrides;
 mod params;
@@ -70,6 +71,8 @@ pub struct Scenario {
     pub expect: Option<crate::report::verdict::Expectation>,
     /// `[[quantities]]`, `[[predictions]]`, `[[equations]]`: the file's own model, if any.
     pub model: Option<crate::file_model::spec::ModelSpec>,
+    /// `[motion]`: a motion run (the physical dynamics for a stated time), if the file asks.
+    pub motion: Option<crate::settings::Motion>,
 }
 
 impl Scenario {
@@ -216,7 +219,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let checks = checks::checks(ctx, m, &raw.checks, raw.probe.is_some())?;
     let model = file_model::model(ctx, &raw, m, &params, &start, &actuation)?;
     // A custom structure is checked by its settling and force balance even without [[checks]].
-    if checks.is_empty() && raw.probe.is_none() && custom.is_none() && model.is_none() {
+    if checks.is_empty() && raw.probe.is_none() && custom.is_none() && model.is_none() && raw.motion.is_none() {
         return Err(ctx
             .err_at(0, "the scenario checks nothing: add at least one [[checks]] entry (quantity, tolerance)".into()));
     }
@@ -246,10 +249,16 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     }
     let interference = interference::interference(ctx, &raw.interference, m, &first_params, &first)?;
     let probe = checks::probe(ctx, m, &raw.probe, &first, &params)?;
+    let motion = motion::motion(ctx, &raw, sim.dt_s, &first, &first_params, &actuation)?;
     let expect = match &raw.expect {
         None => None,
         Some(e) => {
-            let parts = expect::Parts { checks: &checks, model: model.as_ref(), probe: probe.is_some() };
+            let parts = expect::Parts {
+                checks: &checks,
+                model: model.as_ref(),
+                probe: probe.is_some(),
+                motion: motion.as_ref(),
+            };
             Some(expect::expectation(ctx, e, &parts)?)
         }
     };
@@ -276,5 +285,6 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         custom,
         expect,
         model,
+        motion,
     })
 }

@@ -56,6 +56,9 @@ pub(super) struct RawScenario {
     /// dynamics landed on.
     #[serde(default)]
     pub(super) energy: Option<RawEnergy>,
+    /// A motion run: the physical dynamics for a stated time (`motion.rs`).
+    #[serde(default)]
+    pub(super) motion: Option<Spanned<super::motion::RawMotion>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -121,6 +124,9 @@ pub(super) struct RawPrediction {
     /// length (m), angle (rad, wrapped) or relative.
     pub(super) class: Spanned<String>,
     pub(super) tolerance: Spanned<f64>,
+    /// A motion run only: on the rms error over the motion's ticks (`tolerance` is then on
+    /// their maximum).
+    pub(super) rms_tolerance: Option<Spanned<f64>>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -53,6 +53,9 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         relaxing: false,
         relaxation_shift: 0.0,
         relaxation_last_force: f64::INFINITY,
+        physical: false,
+        last_step_accelerated: false,
+        accelerated_steps: 0,
     };
     sim.model.tree = sim.link_tree();
     sim.model.internal_closures = sim.find_internal_closures();

@@ -109,7 +109,7 @@ impl JointMotion {
 
 impl Simulation {
     /// The joints the schedule drives: damped, free, revolute or prismatic multibody links.
-    fn scheduled(&self, j: usize) -> bool {
+    pub(super) fn scheduled(&self, j: usize) -> bool {
         let joint = &self.model.structure.joints[j];
         self.model.joint_links[j].is_some()
             && !self.model.actuated[j]
@@ -196,9 +196,11 @@ impl Simulation {
     }
 
     /// Sets every scheduled joint's velocity and damping for the coming step (after the loads
-    /// are applied).
-    pub(super) fn schedule_damping(&mut self) {
+    /// are applied). Whether it set any (a joint with k > 0: its velocity quenched or set, its
+    /// damping not the structure's; the step is then no part of a physical path).
+    pub(super) fn schedule_damping(&mut self) -> bool {
         let dt = self.model.settings.dt_s;
+        let mut acted = false;
         for j in 0..self.model.structure.joints.len() {
             if !self.scheduled(j) {
                 continue;
@@ -207,6 +209,7 @@ impl Simulation {
             let load = self.joint_load(j);
             let mut damping = self.model.structure.joints[j].damping;
             if load.stiffness > 0.0 && load.inertia > 0.0 {
+                acted = true;
                 damping = newton_damping(dt, load.stiffness, load.inertia);
                 let max_step = match self.model.structure.joints[j].kind {
                     JointKind::Revolute { .. } => MAX_NEWTON_TURN_RAD,
@@ -221,6 +224,7 @@ impl Simulation {
                 super::build::set_link_damping(&mut self.multibody_joints, link.multibody_joint, damping);
             }
         }
+        acted
     }
 }
 

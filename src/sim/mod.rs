@@ -109,6 +109,13 @@ pub struct Simulation {
     /// The largest generalized force component at the relaxation's last step, for its test of
     /// a round-off stall (`relaxation/mod.rs`).
     relaxation_last_force: f64,
+    /// Only the physical dynamics from now on ([`Simulation::end_acceleration`]): no static
+    /// relaxation, no Newton damping schedule, every joint's damping as stated.
+    physical: bool,
+    /// Whether the last step took a settle accelerator (the relaxation or the Newton schedule).
+    last_step_accelerated: bool,
+    /// Steps taken with a settle accelerator.
+    accelerated_steps: u64,
 }
 
 impl Simulation {
@@ -140,7 +147,7 @@ impl Simulation {
 
     /// Turns the static relaxation on (where the settings ask for it and it applies) or off.
     pub fn set_relaxation(&mut self, on: bool) {
-        self.relaxing = on && self.model.settings.relaxation && self.model.relaxation_applies;
+        self.relaxing = on && !self.physical && self.model.settings.relaxation && self.model.relaxation_applies;
     }
 
     /// Whether the static relaxation runs before each step.
@@ -150,6 +157,61 @@ impl Simulation {
 
     pub fn tick(&self) -> u64 {
         self.tick
+    }
+
+    /// From now on only the physical dynamics: the static relaxation and the Newton damping
+    /// schedule off for good, every scheduled joint's damping back to the structure's value.
+    /// Velocities are left as they are (a motion run starts from them).
+    pub fn end_acceleration(&mut self) {
+        self.physical = true;
+        self.relaxing = false;
+        for j in 0..self.model.structure.joints.len() {
+            if let (Some(link), true) = (self.model.joint_links[j], self.scheduled(j)) {
+                let damping = self.model.structure.joints[j].damping;
+                build::set_link_damping(&mut self.multibody_joints, link.multibody_joint, damping);
+            }
+        }
+    }
+
+    /// Whether the last step took a settle accelerator (the static relaxation, or the Newton
+    /// schedule quenching a joint's velocity and setting its damping): the step was no part of
+    /// a physical path.
+    pub fn last_step_accelerated(&self) -> bool {
+        self.last_step_accelerated
+    }
+
+    /// Steps taken with a settle accelerator so far (a rebuilt simulation starts at 0).
+    pub fn accelerated_steps(&self) -> u64 {
+        self.accelerated_steps
+    }
+
+    /// Moves the coordinate of joint `j` (a revolute's angle [rad], a prismatic's slide [m])
+    /// by `displacement` and sets its rate to `rate` [rad/s or m/s], the bodies beyond it
+    /// carried along; the other coordinates and rates stay. Only a joint that is a free
+    /// (not actuated) link of a multibody has such a coordinate here.
+    pub fn set_joint_motion(&mut self, j: usize, displacement: f64, rate: f64) -> Result<(), String> {
+        let name = &self.model.structure.joints[j].name;
+        let link = match (self.model.joint_links[j], self.model.actuated[j]) {
+            (Some(link), false) => link,
+            (_, true) => return Err(format!("joint '{name}' is actuated: its coordinate is commanded")),
+            (None, _) => return Err(format!("joint '{name}' closes a loop: it has no coordinate of its own")),
+        };
+        let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) else {
+            return Err(format!("joint '{name}' has no multibody link"));
+        };
+        // Forward kinematics settles the multibody's root (fixed or free), and with it the
+        // degree-of-freedom indices read next.
+        mb.forward_kinematics(&self.bodies, true);
+        let Some(start) = mb.link(link_id).map(|l| l.assembly_id()).filter(|s| *s < mb.ndofs()) else {
+            return Err(format!("joint '{name}' has no degree of freedom of its own in its multibody"));
+        };
+        let mut disp = vec![0.0; mb.ndofs()];
+        disp[start] = displacement;
+        mb.apply_displacements(&disp);
+        mb.forward_kinematics(&self.bodies, true);
+        mb.update_rigid_bodies(&mut self.bodies, true);
+        mb.generalized_velocity_mut()[start] = rate;
+        Ok(())
     }
 
     /// Continues the tick count of a previous simulation (after a rebuild between points).
@@ -211,13 +273,17 @@ impl Simulation {
 
     /// Advances one time step. Fails if the state is no longer finite or leaves the box.
     pub fn step(&mut self) -> Result<(), SimError> {
+        let mut accelerated = false;
         if self.relaxing {
             self.relax();
+            accelerated = true;
         }
         self.apply_member_forces();
-        if self.model.settings.newton_damping {
-            self.schedule_damping();
+        if self.model.settings.newton_damping && !self.physical {
+            accelerated |= self.schedule_damping();
         }
+        self.last_step_accelerated = accelerated;
+        self.accelerated_steps += u64::from(accelerated);
         let gravity = Vector::new(
             self.model.structure.gravity[0],
             self.model.structure.gravity[1],

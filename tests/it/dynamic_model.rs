@@ -168,6 +168,6 @@ fn bad_kinetic_energies_are_located() {
         &variant("verdict = \"pass\"", "verdict = \"fail\"\nfailing = [\"frequency:nu\"]"),
         "\"frequency:nu\"",
         0,
-        "'nu' is not among this scenario's [[energy.frequencies]] (omega)",
+        "'nu' is not among this scenario's [[energy.frequencies]] and [[motion.frequencies]] (omega)",
     );
 }

@@ -26,6 +26,7 @@ mod model_expressions;
 mod model_scenarios;
 mod modes;
 mod mohr2011_dynamics;
+mod motion;
 mod moved_node;
 mod outputs;
 mod param_sweep;

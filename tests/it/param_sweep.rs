@@ -103,8 +103,9 @@ fn a_sweep_draws_its_figure() {
     let (code, _, err) = common::tensegrity(&["sweep", BAR, "--figure", pdf.to_str().unwrap()]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("give a .png or .svg file"), "{err}");
+    // An axis the sweep does not have is bad input, refused before any point settles.
     let (code, _, err) = common::tensegrity(&["sweep", BAR, "--figure", svg.to_str().unwrap(), "--x", "k9"]);
-    assert_eq!(code, 1, "{err}");
+    assert_eq!(code, 2, "{err}");
     assert!(err.contains("not an axis of this sweep (its inputs and swept parameters: k1)"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

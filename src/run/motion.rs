@@ -1,0 +1,123 @@
+//! A motion run (`[motion]`): its start state (the drawn one, read out as it is, or the
+//! settled one, reached with the scenario's settle accelerators), then every accelerator off
+//! for good, the named coordinate displaced and given its rate, and the physical dynamics for
+//! the stated time. The observers judge it tick by tick; nothing here settles it.
+
+use super::runner::Runner;
+use super::settle::SettleDetector;
+use super::{point, Stop};
+use crate::mechanisms::{ModelError, Values};
+use crate::observers::SettlePoint;
+use crate::report::{MotionReport, PointReport, ScenarioReport};
+use crate::scenario::Scenario;
+use crate::settings::{Motion, MotionStart};
+
+/// What the report says of a motion before it runs.
+pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
+    MotionReport {
+        start: m.start,
+        duration_s: m.duration_s,
+        dt_s,
+        steps: m.steps,
+        steps_taken: 0,
+        start_tick: 0,
+        coordinate: m.coordinate.as_ref().map(|(c, ..)| c.joint.clone()),
+        displacement: m.coordinate.as_ref().map_or(0.0, |(_, d, _)| *d),
+        rate: m.coordinate.as_ref().map_or(0.0, |(.., r)| *r),
+        accelerated_steps: 0,
+        frequencies: vec![],
+    }
+}
+
+/// Runs the motion of `m`: the start point, then the physical dynamics for its steps.
+pub(super) fn run_motion(
+    runner: &mut Runner,
+    sc: &Scenario,
+    m: &Motion,
+    report: &mut ScenarioReport,
+    probe_errors: &mut Vec<f64>,
+) -> Result<(), Stop> {
+    let inputs = sc.actuation.first_inputs().clone();
+    match m.start {
+        MotionStart::Settled => point::settle_point(runner, sc, 0, &inputs, report, probe_errors)?,
+        MotionStart::Drawn => start_point(runner, sc, &inputs, report)?,
+    }
+    if m.start == MotionStart::Settled && !report.points.last().is_some_and(|p| p.settled) {
+        runner.emit("the start did not settle: no motion");
+        return Ok(());
+    }
+    runner.sim.end_acceleration();
+    if let Some((c, displacement, rate)) = &m.coordinate {
+        runner
+            .sim
+            .set_joint_motion(c.index, *displacement, *rate)
+            .map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
+    }
+    let start_tick = runner.sim.tick();
+    runner.motion_start_tick = Some(start_tick);
+    let accelerated_before = runner.accelerated_steps;
+    if let Some(r) = report.motion.as_mut() {
+        r.start_tick = start_tick;
+    }
+    runner.emit(format_args!("motion: {} steps of physical dynamics, every settle accelerator off", m.steps));
+    let prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
+    let mut result = Ok(());
+    for _ in 0..m.steps {
+        result = runner.step(&inputs, &prediction).map(|_| ());
+        if result.is_err() {
+            break;
+        }
+        if let Some(r) = report.motion.as_mut() {
+            r.steps_taken += 1;
+        }
+    }
+    if let Some(r) = report.motion.as_mut() {
+        r.accelerated_steps = runner.accelerated_steps - accelerated_before;
+    }
+    result
+}
+
+/// The drawn state as the motion's start point (no step taken): at rest, so an equilibrium
+/// exactly when its residual meets the settle tolerances (then `settled`); the settle-point
+/// judgments of the file (checks, equations, energy) are made there.
+fn start_point(runner: &mut Runner, sc: &Scenario, inputs: &Values, report: &mut ScenarioReport) -> Result<(), Stop> {
+    let prediction = runner.mech.predict(&runner.params, inputs).map_err(Stop::Model)?;
+    let snapshot = runner.sim.snapshot();
+    let simulated = runner.observe(&snapshot);
+    let settled = SettleDetector::residual_ok(&snapshot, &sc.settle);
+    let residual = snapshot.forces.residual;
+    let slack_cables = {
+        let cables = &runner.sim.structure().cables;
+        cables.iter().zip(&snapshot.forces.cable_slack).filter(|(_, s)| **s).map(|(c, _)| c.name.clone()).collect()
+    };
+    let mut point = PointReport {
+        index: 0,
+        inputs: inputs.clone(),
+        analytic: prediction.expected.clone(),
+        simulated,
+        settled,
+        residual_force_n: residual.map_or(f64::NAN, |r| r.max_force_n),
+        residual_torque_nm: residual.map_or(f64::NAN, |r| r.max_torque_nm),
+        final_kinetic_energy_j: runner.sim.kinetic_energy_j(),
+        branch: "the drawn state".into(),
+        slack_cables,
+        ..PointReport::default()
+    };
+    let seen = SettlePoint {
+        structure: &runner.sim.structure(),
+        snapshot: &snapshot,
+        params: &runner.params,
+        outside_model: false,
+    };
+    for o in runner.observers.iter_mut() {
+        o.settle_point(&seen, &mut point, &mut runner.notes);
+    }
+    runner.emit(format_args!(
+        "start: the drawn state, {} (residual {:.3e} N, {:.3e} N m)",
+        if settled { "an equilibrium" } else { "not an equilibrium" },
+        point.residual_force_n,
+        point.residual_torque_nm
+    ));
+    report.points.push(point);
+    Ok(())
+}

@@ -1,0 +1,250 @@
+//! `[motion]`: a motion run. The physical dynamics for a stated time, with no settle
+//! accelerator (no static relaxation, no Newton damping schedule, no kinetic damping; joint
+//! damping exactly as the structure states it), from the drawn state or from the settled one
+//! (settled with the usual accelerators, which are then switched off for good), optionally
+//! displaced along a named joint coordinate and given a rate of it. Its verdict comes from its
+//! checks: the `[[predictions]]` judged over every tick of the motion (maximum and rms error),
+//! and the natural frequencies measured from it (`[[motion.frequencies]]`).
+//!
+//! ```toml
+//! [motion]
+//! duration_s = 2.0        # simulated time of the motion [s]
+//! start = "drawn"         # or "settled"
+//! coordinate = "pin"      # a revolute (angle, rad) or prismatic (slide, m) joint, not actuated
+//! displacement = "A"      # added to its coordinate at the start (a number or an expression of the params)
+//! rate = 0.0              # its rate at the start [rad/s or m/s]
+//!
+//! [[motion.frequencies]]  # a natural frequency measured from the motion and predicted
+//! name = "omega"
+//! coordinate = "pin"      # the joint whose free vibration is fitted
+//! formula = "sqrt(L*hypot(k1*a, k2*b)/I_pivot)"  # [rad/s], parameters and inputs
+//! tolerance = 1e-6        # relative, on the frequency corrected for the integrator
+//! ```
+
+use super::error::{finite, positive_value, Ctx, ScenarioError};
+use super::number::{expr_error, Num};
+use super::raw::RawScenario;
+use super::Actuation;
+use crate::file_model::expr::Expr;
+use crate::mechanisms::Values;
+use crate::settings::{FrequencyPrediction, JointCoordinate, Motion, MotionStart};
+use crate::structure::{JointKind, Structure};
+use serde::Deserialize;
+use toml::Spanned;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawMotion {
+    /// Simulated time of the motion [s].
+    pub(super) duration_s: Spanned<f64>,
+    /// "drawn" or "settled".
+    pub(super) start: Spanned<String>,
+    /// A joint whose coordinate is displaced or given a rate at the start.
+    pub(super) coordinate: Option<Spanned<String>>,
+    /// [rad or m]: a number or an expression of the parameters.
+    pub(super) displacement: Option<Spanned<Num>>,
+    /// [rad/s or m/s]: a number or an expression of the parameters.
+    pub(super) rate: Option<Spanned<Num>>,
+    #[serde(default)]
+    pub(super) frequencies: Vec<RawFrequency>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawFrequency {
+    pub(super) name: Spanned<String>,
+    /// The joint whose coordinate's free vibration is fitted.
+    pub(super) coordinate: Spanned<String>,
+    /// The predicted angular frequency [rad/s]: a closed form of the parameters and inputs.
+    pub(super) formula: Spanned<String>,
+    /// Relative, on the corrected measured frequency.
+    pub(super) tolerance: Spanned<f64>,
+}
+
+/// The validated `[motion]` section, or None without one. `first` is the structure at the first
+/// point; a motion run holds its single point's inputs.
+pub(super) fn motion(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    dt_s: f64,
+    first: &Structure,
+    params: &Values,
+    actuation: &Actuation,
+) -> Result<Option<Motion>, ScenarioError> {
+    let Some(m) = &raw.motion else { return Ok(None) };
+    let section = m.get_ref();
+    single_point(ctx, raw, actuation)?;
+    settle_only_sections(ctx, raw)?;
+    let duration_s = positive_value(ctx, &section.duration_s, "motion.duration_s")?;
+    let steps = (duration_s / dt_s).round();
+    if !(steps <= super::MAX_STEPS_PER_SETTLE) {
+        return Err(ctx.err(
+            &section.duration_s,
+            format!(
+                "motion.duration_s / sim.dt = {duration_s} / {dt_s} s is {steps:e} time steps; at most {:e} (a shorter motion or a longer dt)",
+                super::MAX_STEPS_PER_SETTLE
+            ),
+        ));
+    }
+    if steps < 1.0 {
+        return Err(ctx.err(&section.duration_s, format!("motion.duration_s must be at least sim.dt = {dt_s} s")));
+    }
+    let start = match section.start.get_ref().as_str() {
+        "drawn" => MotionStart::Drawn,
+        "settled" => MotionStart::Settled,
+        other => {
+            return Err(
+                ctx.err(&section.start, format!("motion.start must be \"drawn\" or \"settled\", got \"{other}\""))
+            )
+        }
+    };
+    let coordinate = displaced(ctx, m, first, params)?;
+    let inputs = actuation.first_inputs();
+    let frequencies =
+        section.frequencies.iter().map(|f| frequency(ctx, f, first, params, inputs)).collect::<Result<_, _>>()?;
+    Ok(Some(Motion { duration_s, steps: steps as u64, start, coordinate, frequencies }))
+}
+
+/// A motion run holds one set of inputs: `points` with one point.
+fn single_point(ctx: &Ctx, raw: &RawScenario, actuation: &Actuation) -> Result<(), ScenarioError> {
+    match actuation {
+        Actuation::Points { points, .. } if points.len() == 1 => Ok(()),
+        _ => Err(ctx.err(
+            &raw.actuation,
+            "a motion run ([motion]) holds one set of inputs: [actuation] points = [ { ... } ] with one point",
+        )),
+    }
+}
+
+/// Sections that judge settle points by perturbing or probing them, or a sweep's agreement:
+/// they have no meaning in a motion run.
+fn settle_only_sections(ctx: &Ctx, raw: &RawScenario) -> Result<(), ScenarioError> {
+    let motion = raw.motion.as_ref().expect("a motion run");
+    let at = |what: &str| {
+        ctx.err(
+            motion,
+            format!("[{what}] perturbs, probes or sweeps settled states; a motion run ([motion]) does not: remove one of them"),
+        )
+    };
+    if raw.stability.is_some() {
+        return Err(at("stability"));
+    }
+    if raw.probe.is_some() {
+        return Err(at("probe"));
+    }
+    if raw.workspace.is_some() {
+        return Err(at("workspace"));
+    }
+    Ok(())
+}
+
+/// The displaced coordinate of `[motion]`, with its displacement and rate.
+fn displaced(
+    ctx: &Ctx,
+    m: &Spanned<RawMotion>,
+    s: &Structure,
+    params: &Values,
+) -> Result<Option<(JointCoordinate, f64, f64)>, ScenarioError> {
+    let section = m.get_ref();
+    let Some(name) = &section.coordinate else {
+        if let Some(v) = section.displacement.as_ref().or(section.rate.as_ref()) {
+            return Err(
+                ctx.err(v, "a displacement or a rate needs coordinate = \"JOINT\" (a revolute or prismatic joint)")
+            );
+        }
+        return Ok(None);
+    };
+    if section.displacement.is_none() && section.rate.is_none() {
+        return Err(ctx.err(name, "coordinate needs a displacement (rad or m) or a rate (rad/s or m/s), or both"));
+    }
+    let joint = joint_coordinate(ctx, name, s)?;
+    let number = |v: &Option<Spanned<Num>>, what: &str| match v {
+        None => Ok(0.0),
+        Some(v) => param_number(ctx, v, params, what),
+    };
+    let displacement = number(&section.displacement, "motion.displacement")?;
+    let rate = number(&section.rate, "motion.rate")?;
+    Ok(Some((joint, displacement, rate)))
+}
+
+/// A revolute or prismatic joint of `s`, not driven by an actuator, by name.
+fn joint_coordinate(ctx: &Ctx, name: &Spanned<String>, s: &Structure) -> Result<JointCoordinate, ScenarioError> {
+    let index = s.joints.iter().position(|j| &j.name == name.get_ref()).ok_or_else(|| {
+        let names: Vec<&str> = s
+            .joints
+            .iter()
+            .filter(|j| matches!(j.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. }))
+            .map(|j| j.name.as_str())
+            .collect();
+        ctx.err(
+            name,
+            format!(
+                "unknown coordinate '{}': a motion coordinate is a revolute or prismatic joint's (the structure's: {})",
+                name.get_ref(),
+                if names.is_empty() { "none".into() } else { names.join(", ") }
+            ),
+        )
+    })?;
+    let prismatic = match s.joints[index].kind {
+        JointKind::Revolute { .. } => false,
+        JointKind::Prismatic { .. } => true,
+        _ => {
+            return Err(ctx.err(
+                name,
+                format!("joint '{}' has no single coordinate: a revolute or prismatic joint is needed", name.get_ref()),
+            ))
+        }
+    };
+    if s.actuators.iter().any(|a| a.target == crate::structure::ActuatorTarget::Joint(index)) {
+        return Err(
+            ctx.err(name, format!("joint '{}' is actuated: its coordinate is commanded, not free", name.get_ref()))
+        );
+    }
+    Ok(JointCoordinate { joint: name.get_ref().clone(), index, prismatic })
+}
+
+/// A number, or an expression of the parameters evaluated with their values; finite.
+fn param_number(ctx: &Ctx, v: &Spanned<Num>, params: &Values, what: &str) -> Result<f64, ScenarioError> {
+    match v.get_ref() {
+        Num::Value(_) => finite(ctx, v, what),
+        Num::Expr(text) => {
+            let names: Vec<&str> = params.keys().map(String::as_str).collect();
+            let e = Expr::compile(text, &names).map_err(|e| expr_error(ctx, v.span().start, &e, what))?;
+            let x = e.eval(&params.values().copied().collect::<Vec<_>>());
+            if x.is_finite() {
+                Ok(x)
+            } else {
+                Err(ctx.err(v, format!("{what} = \"{text}\" is {x}, not a finite number")))
+            }
+        }
+    }
+}
+
+/// A `[[motion.frequencies]]` entry: its joint, its formula of the parameters and inputs.
+fn frequency(
+    ctx: &Ctx,
+    f: &RawFrequency,
+    s: &Structure,
+    params: &Values,
+    inputs: &Values,
+) -> Result<FrequencyPrediction, ScenarioError> {
+    let name = f.name.get_ref().clone();
+    if name.trim().is_empty() {
+        return Err(ctx.err(&f.name, "a frequency needs a name"));
+    }
+    let coordinate = joint_coordinate(ctx, &f.coordinate, s)?;
+    let symbols: Vec<String> = params.keys().chain(inputs.keys()).cloned().collect();
+    let names: Vec<&str> = symbols.iter().map(String::as_str).collect();
+    let what = format!("frequency '{name}' (parameters and inputs only)");
+    let formula =
+        Expr::compile(f.formula.get_ref(), &names).map_err(|e| expr_error(ctx, f.formula.span().start, &e, &what))?;
+    let tolerance = positive_value(ctx, &f.tolerance, "tolerance")?;
+    let p = FrequencyPrediction { name, coordinate, formula, symbols, tolerance };
+    let w = p.predicted(params, inputs);
+    if !(w.is_finite() && w > 0.0) {
+        return Err(
+            ctx.err(&f.formula, format!("frequency '{}' is {w} rad/s here; a frequency is finite and > 0", p.name))
+        );
+    }
+    Ok(p)
+}

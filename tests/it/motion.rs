@@ -1,0 +1,261 @@
+//! Motion runs (`[motion]`): the physical dynamics for a stated time, judged by its checks.
+//! The structure is the shipped pinned bar between two zero-free-length springs
+//! (`scenarios/custom/pinned_bar_vibration.toml`): a pendulum, V(q) = -K cos(q - q*) + const,
+//! K = 43.86 N m/rad, I = m L^2 / 3 = 1/6 kg m^2 about the pin, omega = 16.22 rad/s.
+
+use super::common::error_at;
+use std::path::Path;
+use tensegrity_testbed::report::{PathKind, ScenarioReport};
+use tensegrity_testbed::run::{self, RunOptions};
+use tensegrity_testbed::scenario;
+
+const SHIPPED: &str = "scenarios/custom/pinned_bar_vibration.toml";
+
+/// The shipped file's text with each (from, to) replaced once (each `from` must be there).
+fn variant(edits: &[(&str, &str)]) -> String {
+    let mut text = std::fs::read_to_string(SHIPPED).expect("the shipped scenario");
+    for (from, to) in edits {
+        assert!(text.contains(from), "'{from}' in {SHIPPED}");
+        text = text.replacen(from, to, 1);
+    }
+    text
+}
+
+fn run_text(text: &str, opts: &RunOptions) -> ScenarioReport {
+    let sc = scenario::parse(Path::new("variant.toml"), text).expect("the variant is valid");
+    run::run(&sc, opts)
+}
+
+/// The pendulum's numbers (the shipped file's parameters).
+const K1: f64 = 50.0;
+const K2: f64 = 30.0;
+const ANCHOR_U: [f64; 2] = [0.0, 0.8];
+const ANCHOR_V: [f64; 2] = [0.6, 0.0];
+const INERTIA_KG_M2: f64 = 0.5 / 3.0;
+
+fn omega() -> f64 {
+    (f64::hypot(K1 * 0.8, K2 * 0.6) / INERTIA_KG_M2).sqrt()
+}
+
+/// The springs' energy with the bar's end at (x, y) [J].
+fn spring_energy(x: f64, y: f64) -> f64 {
+    let d2 = |a: [f64; 2]| (x - a[0]).powi(2) + (y - a[1]).powi(2);
+    0.5 * K1 * d2(ANCHOR_U) + 0.5 * K2 * d2(ANCHOR_V)
+}
+
+/// Runs `text` writing its per-tick table; the named columns, one vector per column.
+fn table_columns(text: &str, name: &str, columns: &[&str]) -> (ScenarioReport, Vec<Vec<f64>>) {
+    let path = std::env::temp_dir().join(format!("tensegrity-motion-{}-{name}.csv", std::process::id()));
+    let _ = std::fs::remove_file(&path);
+    let report = run_text(text, &RunOptions { table: Some(path.clone()), ..Default::default() });
+    let csv = std::fs::read_to_string(&path).expect("the table");
+    let _ = std::fs::remove_file(&path);
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let index: Vec<usize> =
+        columns.iter().map(|c| header.iter().position(|h| h == c).unwrap_or_else(|| panic!("column {c}"))).collect();
+    let mut out = vec![Vec::new(); columns.len()];
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        for (o, i) in out.iter_mut().zip(&index) {
+            o.push(cells[*i].parse::<f64>().unwrap_or(f64::NAN));
+        }
+    }
+    (report, out)
+}
+
+/// The shipped free vibration passes: the frequency measured from the motion and corrected for
+/// symplectic Euler's dispersion is within 1e-6 of sqrt(V''/I) (measured 6.25e-8: the
+/// pendulum's own shift A^2/16 at A = 1e-3), uncorrected 1.09e-5 = (omega dt)^2/24; its path is
+/// physical, its closed-form trajectory met within 1.5e-5 rad at every tick.
+#[test]
+fn the_shipped_free_vibration_meets_the_linear_frequency_within_1e_6_once_corrected() {
+    let report = super::common::run_file(SHIPPED);
+    assert!(report.passed, "{}", report.verdict_line());
+    assert_eq!(report.path, PathKind::Physical);
+    let m = report.motion.as_ref().expect("a motion report");
+    assert_eq!((m.steps_taken, m.accelerated_steps), (4000, 0));
+    let f = &m.frequencies[0];
+    assert!(f.error <= 1e-6, "corrected error {:e}", f.error);
+    let dispersion = (omega() * 1e-3).powi(2) / 24.0;
+    assert!((f.uncorrected_error - dispersion).abs() <= 0.02 * dispersion, "uncorrected {:e}", f.uncorrected_error);
+    let amplitude_shift = 1e-6 / 16.0;
+    assert!((f.error - amplitude_shift).abs() <= 0.05 * amplitude_shift, "corrected {:e}", f.error);
+    let p = report.model_checks.iter().find(|c| c.name == "small oscillation").unwrap();
+    assert!(p.passed && p.max_error <= 1.5e-5 && p.motion_ticks == Some(4000), "{p:?}");
+}
+
+/// A motion from the settled state of a damped pin: the settle takes the Newton damping
+/// schedule (accelerated steps), then every accelerator is off, so the motion itself has none
+/// and the run is labelled physical; the same structure settled without a motion run is
+/// labelled accelerated.
+#[test]
+fn a_motion_run_is_labelled_physical_and_an_accelerated_settle_accelerated() {
+    let damped = [("axis = [0, 0, 1]\n", "axis = [0, 0, 1]\ndamping = 0.5\n")];
+    let settled = variant(&[damped[0], ("start = \"drawn\"", "start = \"settled\"")]);
+    let report = run_text(&settled, &RunOptions::default());
+    let m = report.motion.as_ref().unwrap();
+    assert!(report.accelerated_steps > 0, "the settle took the Newton schedule");
+    assert_eq!(m.accelerated_steps, 0);
+    assert_eq!(report.path, PathKind::Physical);
+    assert_eq!(serde_json::to_value(&report).unwrap()["path"], "physical");
+    // Without [motion] (and without the predictions of t), the same file is a settle.
+    let start = settled.find("[motion]").unwrap();
+    let end = settled.find("[[quantities]]").unwrap();
+    let mut settle = format!("{}{}", &settled[..start], &settled[end..]);
+    let p = settle.find("[[predictions]]").unwrap();
+    let e = settle.find("[energy]").unwrap();
+    settle.replace_range(p..e, "");
+    let report = run_text(&settle, &RunOptions::default());
+    assert!(report.passed, "{}", report.verdict_line());
+    assert_eq!(report.path, PathKind::Accelerated);
+    assert!(report.accelerated_steps > 0);
+}
+
+/// Undamped free vibration over 100 periods: symplectic Euler keeps a modified energy, so the
+/// true energy oscillates but does not drift. For a linear oscillator the step map keeps
+/// H - (dt/2) w^2 q v, so H(q_n, v_n) oscillates with relative amplitude (omega dt) / 2. The
+/// energy read from the table pairs the positions after a step with the bodies' velocities
+/// before it (the velocity a multibody link's body reports lags its joint's by one step: the
+/// map with that pairing gives 3 (omega dt) / 2 = 2.43e-2, as measured here to 0.2 %), so the
+/// bound on the table's energy is 3 (omega dt) / 2; the mean over the last period is within
+/// 1e-6 of the mean over the first (measured: 1.4e-7, the
+/// windows' own rounding to whole steps).
+#[test]
+fn undamped_free_vibration_keeps_its_energy_within_the_integrators_bound_over_100_periods() {
+    let period_s = 2.0 * std::f64::consts::PI / omega();
+    let duration = format!("duration_s = {}", 100.0 * period_s);
+    let text = variant(&[("duration_s = 4.0", &duration)]);
+    let (report, cols) = table_columns(&text, "energy", &["kinetic_energy_j", "node:P.x", "node:P.y"]);
+    assert!(report.passed, "{}", report.verdict_line());
+    let q_star = f64::atan2(K1 * 0.8, K2 * 0.6);
+    let v_min = spring_energy(q_star.cos(), q_star.sin());
+    let energy: Vec<f64> =
+        (0..cols[0].len()).map(|i| cols[0][i] + spring_energy(cols[1][i], cols[2][i]) - v_min).collect();
+    let mean = energy.iter().sum::<f64>() / energy.len() as f64;
+    let deviation = energy.iter().map(|e| (e - mean).abs()).fold(0.0, f64::max) / mean;
+    let bound = 1.01 * 3.0 * omega() * 1e-3 / 2.0;
+    assert!(deviation <= bound, "relative energy oscillation {deviation:e} above 3 (omega dt)/2 = {bound:e}");
+    assert!(
+        deviation >= 0.9 * bound,
+        "relative energy oscillation {deviation:e}, the bound {bound:e} is the amplitude"
+    );
+    let per_period = (period_s / 1e-3).round() as usize;
+    let period_mean = |s: &[f64]| s.iter().sum::<f64>() / s.len() as f64;
+    let (first, last) = (period_mean(&energy[..per_period]), period_mean(&energy[energy.len() - per_period..]));
+    eprintln!("energy over 100 periods: relative oscillation {deviation:e}, drift {:e}", (last - first) / first);
+    assert!((last - first).abs() <= 1e-6 * first, "drift over 100 periods {:e}", (last - first) / first);
+}
+
+/// Joint damping c on the pin: the amplitude decays as exp(-c t / (2 I)). The peaks of the
+/// simulated angle over 4 s give that rate within 1e-3 relative.
+#[test]
+fn damped_free_vibration_decays_at_the_rate_the_damping_predicts() {
+    let c = 0.02;
+    let damping = format!("axis = [0, 0, 1]\ndamping = {c}\n");
+    let text = variant(&[
+        ("axis = [0, 0, 1]\n", &damping),
+        ("tolerance = 1.5e-5", "tolerance = 1.0"),
+        ("rms_tolerance = 1e-5", "rms_tolerance = 1.0"),
+        ("tolerance = 1e-6", "tolerance = 1.0"),
+    ]);
+    let (report, cols) = table_columns(&text, "decay", &["time_s", "node:P.x", "node:P.y"]);
+    assert!(report.passed, "{}", report.verdict_line());
+    let q_star = f64::atan2(K1 * 0.8, K2 * 0.6);
+    let q: Vec<f64> = cols[1].iter().zip(&cols[2]).map(|(x, y)| y.atan2(*x) - q_star).collect();
+    // Peaks of q (local maxima), and a least-squares line through (t, ln peak).
+    let peaks: Vec<(f64, f64)> =
+        (1..q.len() - 1).filter(|&i| q[i] > q[i - 1] && q[i] >= q[i + 1]).map(|i| (cols[0][i], q[i].ln())).collect();
+    assert!(peaks.len() >= 8, "{} peaks", peaks.len());
+    let n = peaks.len() as f64;
+    let (mt, my) = (peaks.iter().map(|p| p.0).sum::<f64>() / n, peaks.iter().map(|p| p.1).sum::<f64>() / n);
+    let slope = peaks.iter().map(|p| (p.0 - mt) * (p.1 - my)).sum::<f64>()
+        / peaks.iter().map(|p| (p.0 - mt).powi(2)).sum::<f64>();
+    let predicted = -c / (2.0 * INERTIA_KG_M2);
+    assert!(((slope - predicted) / predicted).abs() <= 1e-3, "decay rate {slope} against {predicted}");
+}
+
+/// Trajectory error against the exact linear solution q* + A cos(omega t) at three time steps,
+/// with the fitted order of log(error) against log(dt): symplectic Euler's samples lead the
+/// exact motion by half a step, a first-order error (measured: 3.8e-5, 1.8e-5, 8.4e-6 rad at
+/// dt = 4, 2, 1 ms, order 1.08; about A omega dt / 2); against the exact solution at t + dt/2
+/// the error is second order (5.3e-6, 1.3e-6, 3.3e-7 rad, order 2.00).
+#[test]
+fn trajectory_error_against_the_exact_solution_falls_as_dt_and_as_dt_squared_half_a_step_on() {
+    let mut lag = Vec::new();
+    let mut shifted = Vec::new();
+    let steps = [4e-3, 2e-3, 1e-3];
+    for dt in steps {
+        let text = variant(&[
+            ("[sim]\ndt = 1e-3", &format!("[sim]\ndt = {dt}")),
+            ("A = { value = 1e-3", &format!("dt = {dt}\nA = {{ value = 1e-3")),
+            ("duration_s = 4.0", "duration_s = 2.0"),
+            ("tolerance = 1.5e-5", "tolerance = 1.0"),
+            ("rms_tolerance = 1e-5", "rms_tolerance = 1.0"),
+            (
+                "[energy]",
+                "[[predictions]]\nname = \"half a step on\"\nquantity = \"q\"\nformula = \"q_star + A*cos(omega*(t + dt/2))\"\nclass = \"angle\"\ntolerance = 1.0\n\n[energy]",
+            ),
+        ]);
+        let report = run_text(&text, &RunOptions::default());
+        let err = |name: &str| report.model_checks.iter().find(|c| c.name == name).unwrap().max_error;
+        lag.push(err("small oscillation"));
+        shifted.push(err("half a step on"));
+    }
+    let order = |errors: &[f64]| {
+        let x: Vec<f64> = steps.iter().map(|d: &f64| d.ln()).collect();
+        let y: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
+        let (mx, my) = (x.iter().sum::<f64>() / 3.0, y.iter().sum::<f64>() / 3.0);
+        x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum::<f64>()
+            / x.iter().map(|a| (a - mx).powi(2)).sum::<f64>()
+    };
+    let (p1, p2) = (order(&lag), order(&shifted));
+    eprintln!(
+        "trajectory errors at dt {steps:?}: {lag:?} (order {p1:.3}); half a step on: {shifted:?} (order {p2:.3})"
+    );
+    assert!((p1 - 1.0).abs() <= 0.15, "order at the samples' times {p1}: {lag:?}");
+    assert!((p2 - 2.0).abs() <= 0.1, "order half a step on {p2}: {shifted:?}");
+}
+
+/// `[expect]` works for motion runs: a frequency claimed 0.1 % high fails by name
+/// (`frequency:omega`) and the run does what it declares.
+#[test]
+fn a_motion_run_can_declare_its_failure() {
+    let text = variant(&[
+        ("formula = \"sqrt(K/I_pivot)\"", "formula = \"1.001*sqrt(K/I_pivot)\""),
+        ("verdict = \"pass\"", "verdict = \"fail\"\nfailing = [\"frequency:omega\"]"),
+    ]);
+    let report = run_text(&text, &RunOptions::default());
+    assert!(!report.passed);
+    assert_eq!(report.failures.iter().map(|f| f.to_string()).collect::<Vec<_>>(), ["frequency:omega"]);
+    assert_eq!(report.as_expected, Some(true), "{}", report.verdict_line());
+    let f = &report.motion.as_ref().unwrap().frequencies[0];
+    assert!((f.error - 1e-3 / 1.001).abs() <= 1e-6, "{f:?}");
+}
+
+/// Bad input in a motion run gets located errors.
+#[test]
+fn bad_motion_input_is_located() {
+    let text = variant(&[("duration_s = 4.0", "duration_s = 1e5")]);
+    error_at(&text, "1e5", 0, "time steps; at most");
+    let text = variant(&[("coordinate = \"pin\"\ndisplacement", "coordinate = \"hinge\"\ndisplacement")]);
+    error_at(&text, "\"hinge\"", 0, "unknown coordinate 'hinge'");
+    let text = variant(&[("start = \"drawn\"", "start = \"sideways\"")]);
+    error_at(&text, "\"sideways\"", 0, "motion.start must be");
+    let text = variant(&[(
+        "[motion]",
+        "[probe]\njoint = \"pin\"\ntorque = 1e-3\ntolerance = 1e-6\nexpected = \"K\"\n\n[motion]",
+    )]);
+    error_at(&text, "[motion]", 0, "a motion run ([motion]) does not");
+    // Without [motion], t means nothing in a prediction, and rms_tolerance nothing at all.
+    let settle = variant(&[("[motion]", "[unused]"), ("[[motion.frequencies]]", "[[unused.f]]")]);
+    let settle = settle
+        .replace("[unused]\nduration_s = 4.0\nstart = \"drawn\"\ncoordinate = \"pin\"\ndisplacement = \"A\"\n", "");
+    let settle = settle.replace(
+        "[[unused.f]]\nname = \"omega\"\ncoordinate = \"pin\"\nformula = \"sqrt(K/I_pivot)\"\ntolerance = 1e-6\n",
+        "",
+    );
+    error_at(&settle, "omega*t", 6, "uses t, which means nothing at a settle point");
+    let settle = settle.replace("omega*t", "omega");
+    error_at(&settle, "1e-5     # on their rms", 0, "rms_tolerance judges a prediction over a motion's ticks");
+}
