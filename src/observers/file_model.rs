@@ -361,20 +361,15 @@ impl ModelObserver {
         let predictions = self.spec.energy.iter().flat_map(|e| e.dynamics.iter()).flat_map(|d| &d.frequencies);
         predictions
             .zip(&self.frequencies)
-            .map(|(f, a)| ModelCheckReport {
-                kind: "frequency".into(),
-                name: f.name.clone(),
-                class: "relative".into(),
-                max_error: a.settled_max,
-                tolerance: f.tolerance,
-                passed: a.points > 0 && a.settled_max <= f.tolerance,
-                points_compared: a.points,
-                transient_max_error: 0.0,
-                transient_rms_error: 0.0,
-                ticks_compared: 0,
-                rms_error: None,
-                rms_tolerance: None,
-                motion_ticks: None,
+            .map(|(f, a)| {
+                ModelCheckReport::at_settle_points(
+                    "frequency",
+                    &f.name,
+                    "relative",
+                    a.settled_max,
+                    f.tolerance,
+                    a.points,
+                )
             })
             .collect()
     }
@@ -438,20 +433,9 @@ impl ModelObserver {
                 r
             })
             .chain(self.frequency_reports())
-            .chain(self.spec.energy.as_ref().map(|e| ModelCheckReport {
-                kind: "energy".into(),
-                name: "energy".into(),
-                class: "coordinates".into(),
-                max_error: self.energy.settled_max,
-                tolerance: e.tolerance,
-                passed: self.energy.points > 0 && self.energy.settled_max <= e.tolerance,
-                points_compared: self.energy.points,
-                transient_max_error: 0.0,
-                transient_rms_error: 0.0,
-                ticks_compared: 0,
-                rms_error: None,
-                rms_tolerance: None,
-                motion_ticks: None,
+            .chain(self.spec.energy.as_ref().map(|e| {
+                let (max, points) = (self.energy.settled_max, self.energy.points);
+                ModelCheckReport::at_settle_points("energy", "energy", "coordinates", max, e.tolerance, points)
             }))
             .collect()
     }

@@ -164,6 +164,33 @@ pub struct ModelCheckReport {
 }
 
 impl ModelCheckReport {
+    /// A check judged at settle points only (no per-tick errors): its largest error over the
+    /// `points` compared against `tolerance`; it passes when at least one point was compared.
+    pub fn at_settle_points(
+        kind: &str,
+        name: &str,
+        class: &str,
+        max_error: f64,
+        tolerance: f64,
+        points: usize,
+    ) -> Self {
+        ModelCheckReport {
+            kind: kind.into(),
+            name: name.into(),
+            class: class.into(),
+            max_error,
+            tolerance,
+            passed: points > 0 && max_error <= tolerance,
+            points_compared: points,
+            transient_max_error: 0.0,
+            transient_rms_error: 0.0,
+            ticks_compared: 0,
+            rms_error: None,
+            rms_tolerance: None,
+            motion_ticks: None,
+        }
+    }
+
     /// The failure this entry is when it does not pass (`prediction:NAME`, `equation:NAME`).
     pub fn failure(&self) -> crate::report::verdict::Failure {
         use crate::report::verdict::Failure;
