@@ -591,8 +591,12 @@ impl ScenarioReport {
         }
     }
 
-    /// One row per check: errors at the settle points, transient errors, verdict.
+    /// One row per check: errors at the settle points, transient errors, verdict (nothing,
+    /// not even the header, without checks).
     fn table_checks(&self, out: &mut String) {
+        if self.checks.is_empty() {
+            return;
+        }
         out.push_str(&format!(
             "   {:<10} {:>12} {:>12} {:>10} {:>12} {:>12}  {}\n",
             "quantity", "max |err|", "max rel err", "tolerance", "transient", "rms trans.", "verdict"
