@@ -280,7 +280,9 @@ fn probe_point(
             landed.insert(quantity.clone(), j.predicted(&runner.params, inputs));
         }
         if let Some(ka) = landed.get(&quantity) {
-            probe_errors.push(((k - ka) / ka).abs());
+            // A prediction that is not a number (NaN) cannot pass: its error is infinite.
+            let e = ((k - ka) / ka).abs();
+            probe_errors.push(if e.is_nan() { f64::INFINITY } else { e });
         }
         simulated.insert(quantity, k);
     }

@@ -41,6 +41,18 @@ fn a_wrong_stiffness_fails_the_probe() {
     assert!((e - 0.5).abs() <= 1e-6, "relative error {e}");
 }
 
+/// An expected stiffness that is not a number (here sqrt(-1)) cannot pass: the probe fails
+/// with an infinite error instead of comparing NaN as within the tolerance.
+#[test]
+fn a_stiffness_that_is_not_a_number_fails_the_probe() {
+    let text = std::fs::read_to_string(FILE).unwrap().replace("\"L*hypot(k1*a, k2*b)\"", "\"sqrt(-1)\"");
+    let text = text.replace("count = 9", "count = 2");
+    let sc = scenario::parse(Path::new("nan.toml"), &text).unwrap();
+    let r = run(&sc, &RunOptions::default());
+    assert_eq!(r.failures, vec![Failure::Probe]);
+    assert_eq!(r.stiffness_probe.unwrap().max_rel_error, f64::INFINITY);
+}
+
 /// Bad joint probes are errors at the key at fault: an unknown joint (the joints are listed),
 /// a force on a revolute joint, an expected value for the mechanism's own probe, an
 /// expression with an unknown symbol.
