@@ -22,7 +22,16 @@ pub(super) fn interference(
     let Some(i) = raw else { return Ok(InterferenceSettings::default_on(default_margin)) };
     let threshold = match &i.get_ref().threshold {
         None => 0.0,
-        Some(t) => finite(ctx, t, "interference.threshold")?,
+        Some(t) => {
+            let x = finite(ctx, t, "interference.threshold")?;
+            // A negative threshold would let members pass through each other by that much
+            // unseen: every overlap shallower than it would pass.
+            if x < 0.0 {
+                let message = format!("interference.threshold must be >= 0 m (a clearance below it violates), got {x}");
+                return Err(ctx.err(t, message));
+            }
+            x
+        }
     };
     let margin = match &i.get_ref().margin {
         None => default_margin,

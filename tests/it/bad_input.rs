@@ -186,6 +186,7 @@ fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
         ("stability expect misspelt", JI.replace("[actuation]", "[stability]\nperturbation = 1e-3\nexpect = \"stabel\"\n[actuation]"), 12, "stable"),
         ("stability expect per point of the wrong length", JI.replace("[actuation]", "[stability]\nperturbation = 1e-3\nexpect = [\"stable\", \"stable\"]\n[actuation]"), 12, "one per point"),
         ("interference exclusion of an unknown member", PIN.replace("[actuation]", "[interference]\nexclude = [[\"bar\", \"nope\"]]\n[actuation]"), 4, "'nope'"),
+        ("negative interference threshold", PIN.replace("[actuation]", "[interference]\nthreshold = -1.0\n[actuation]"), 4, ">= 0 m"),
         (
             "force of a strut on a fixed body",
             PIN.replace("[structure]", "[[checks]]\nquantity = \"post.force\"\nvalue = 1.0\ntolerance = 1e-9\n[structure]")
