@@ -24,27 +24,7 @@ import json
 import mujoco
 import numpy as np
 
-from settle_mjcf import apply_loads
-
-
-def settle(model: mujoco.MjModel, data: mujoco.MjData, max_time: float, speed_tol: float, window: int):
-    dt = model.opt.timestep
-    max_steps = int(np.ceil(max_time / dt))
-    mujoco.mj_kinematics(model, data)
-    last = data.site_xpos.copy()
-    quiet, steps = 0, 0
-    limit_sq = (speed_tol * dt) ** 2
-    while steps < max_steps:
-        mujoco.mj_step(model, data)
-        steps += 1
-        mujoco.mj_kinematics(model, data)
-        now = data.site_xpos
-        moved_sq = float(np.max(np.sum((now - last) ** 2, axis=1))) if model.nsite else 0.0
-        last = now.copy()
-        quiet = quiet + 1 if moved_sq <= limit_sq else 0
-        if quiet >= window:
-            return True, steps
-    return False, steps
+from settle_mjcf import apply_loads, settle
 
 
 def main() -> None:

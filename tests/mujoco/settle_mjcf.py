@@ -30,6 +30,28 @@ def apply_loads(model: mujoco.MjModel, data: mujoco.MjData) -> None:
         data.xfrc_applied[body, :3] += model.numeric_data[adr : adr + 3]
 
 
+def settle(model: mujoco.MjModel, data: mujoco.MjData, max_time: float, speed_tol: float, window: int):
+    """Steps until every site moves less than speed_tol * dt per step for `window` steps, or
+    `max_time` runs out: (settled, steps)."""
+    dt = model.opt.timestep
+    max_steps = int(np.ceil(max_time / dt))
+    mujoco.mj_kinematics(model, data)
+    last = data.site_xpos.copy()
+    quiet, steps = 0, 0
+    limit_sq = (speed_tol * dt) ** 2
+    while steps < max_steps:
+        mujoco.mj_step(model, data)
+        steps += 1
+        mujoco.mj_kinematics(model, data)
+        now = data.site_xpos
+        moved_sq = float(np.max(np.sum((now - last) ** 2, axis=1))) if model.nsite else 0.0
+        last = now.copy()
+        quiet = quiet + 1 if moved_sq <= limit_sq else 0
+        if quiet >= window:
+            return True, steps
+    return False, steps
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("xml")
@@ -43,23 +65,7 @@ def main() -> None:
     if key >= 0:
         mujoco.mj_resetDataKeyframe(model, data, key)
     apply_loads(model, data)
-    dt = model.opt.timestep
-    max_steps = int(np.ceil(a.max_time / dt))
-    mujoco.mj_kinematics(model, data)
-    last = data.site_xpos.copy()
-    quiet, steps, settled = 0, 0, False
-    limit_sq = (a.speed_tol * dt) ** 2
-    while steps < max_steps:
-        mujoco.mj_step(model, data)
-        steps += 1
-        mujoco.mj_kinematics(model, data)
-        now = data.site_xpos
-        moved_sq = float(np.max(np.sum((now - last) ** 2, axis=1))) if model.nsite else 0.0
-        last = now.copy()
-        quiet = quiet + 1 if moved_sq <= limit_sq else 0
-        if quiet >= a.window:
-            settled = True
-            break
+    settled, steps = settle(model, data, a.max_time, a.speed_tol, a.window)
     sites = {
         mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, i): data.site_xpos[i].tolist() for i in range(model.nsite)
     }
