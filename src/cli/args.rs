@@ -43,10 +43,8 @@ pub enum Command {
         /// scenarios: one file each, named FILE-<scenario>.csv).
         #[arg(long, value_name = "FILE.csv")]
         table: Option<PathBuf>,
-        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
-        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
+        #[command(flatten)]
+        set: SetArgs,
         /// Exit 1 when a scenario fails a check even where it declares that failure in
         /// `[expect]` (the exit code before: the physics' verdict instead of the declared one).
         #[arg(long)]
@@ -62,29 +60,23 @@ pub enum Command {
         /// Record each mode animated at its frequency to this .rrd file (rerun).
         #[arg(long, value_name = "FILE.rrd")]
         record: Option<PathBuf>,
-        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
-        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
+        #[command(flatten)]
+        set: SetArgs,
     },
     /// Validate scenario files without running them.
     Check {
         #[arg(required = true)]
         scenarios: Vec<PathBuf>,
-        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
-        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
+        #[command(flatten)]
+        set: SetArgs,
     },
     /// List the mechanisms, their parameters (units, defaults) and their queries; with a
     /// scenario file, that file's mechanism (a custom file's own parameters with their values)
     /// and the symbols its model's expressions may use.
     List {
         scenario: Option<PathBuf>,
-        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
-        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
+        #[command(flatten)]
+        set: SetArgs,
     },
     /// Settle every point of a scenario's grid in parallel; write a CSV and a JSON summary.
     Sweep {
@@ -108,10 +100,8 @@ pub enum Command {
         /// The figure's axis: an input or a swept parameter (default: the one with most values).
         #[arg(long)]
         x: Option<String>,
-        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
-        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
+        #[command(flatten)]
+        set: SetArgs,
     },
     /// Draw one of the papers' figures (analytic, with the dynamics' verdict) as PNG and SVG.
     Figure {
@@ -222,10 +212,8 @@ pub enum ExportFormat {
         /// it only helps MuJoCo settle (the testbed's cables have none).
         #[arg(long, default_value_t = 0.0)]
         cable_damping: f64,
-        /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
-        /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
+        #[command(flatten)]
+        set: SetArgs,
     },
 }
 
@@ -263,4 +251,13 @@ pub enum ImportFormat {
         #[arg(long, default_value_t = 10.0)]
         string_tension: f64,
     },
+}
+
+/// `--set NAME=VALUE` on a command that reads a scenario.
+#[derive(clap::Args)]
+pub struct SetArgs {
+    /// Override a parameter (NAME=VALUE, a number or an expression) or a setting
+    /// (sim.KEY=VALUE, settle.KEY=VALUE) of the scenario (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
 }

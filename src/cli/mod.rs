@@ -123,8 +123,16 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
 }
 
 /// The `--set NAME=VALUE` flags of a scenario command.
-fn overrides(flags: &[String]) -> Result<Vec<Override>, CliError> {
-    flags.iter().map(|f| Override::parse(f).map_err(bad_input)).collect()
+fn overrides(flags: &args::SetArgs) -> Result<Vec<Override>, CliError> {
+    flags.set.iter().map(|f| Override::parse(f).map_err(bad_input)).collect()
+}
+
+/// A recording's file must end in `.rrd` (rerun's format).
+fn check_recording_path(record: Option<&Path>) -> Result<(), CliError> {
+    match record.filter(|r| r.extension().and_then(|e| e.to_str()) != Some("rrd")) {
+        Some(r) => Err(bad_input(format!("--record {} must end in .rrd", r.display()))),
+        None => Ok(()),
+    }
 }
 
 /// Loads and validates every scenario (`-`: standard input, once) with the overrides: all of

@@ -15,9 +15,7 @@ pub fn modes(
     record: Option<&Path>,
 ) -> Result<Outcome, CliError> {
     let sc = load_one(scenario, overrides)?;
-    if let Some(r) = record.filter(|r| r.extension().and_then(|e| e.to_str()) != Some("rrd")) {
-        return Err(bad_input(format!("--record {} must end in .rrd", r.display())));
-    }
+    super::check_recording_path(record)?;
     let outputs: Vec<(String, PathBuf)> = [("--json", json), ("--record", record)]
         .into_iter()
         .filter_map(|(flag, p)| p.map(|p| (flag.to_string(), p.to_path_buf())))

@@ -66,9 +66,7 @@ pub fn run(
     fail_on_declared: bool,
 ) -> Result<Outcome, CliError> {
     let scenarios = load_all(paths, overrides)?;
-    if let Some(r) = o.record.as_deref().filter(|r| r.extension().and_then(|e| e.to_str()) != Some("rrd")) {
-        return Err(super::bad_input(format!("--record {} must end in .rrd", r.display())));
-    }
+    super::check_recording_path(o.record.as_deref())?;
     if let Some(t) = o.table.as_deref().filter(|t| !crate::observers::table::is_table_file(t)) {
         return Err(super::bad_input(format!(
             "--table {}: give a file ending in .csv, or .arrow, .feather or .ipc for Arrow IPC",
