@@ -46,6 +46,17 @@ pub struct Dynamics {
     pub mixed: Vec<Expr>,
     pub first_rate: usize,
     pub frequencies: Vec<FrequencyPrediction>,
+    /// `[energy.trajectory]`: a motion run compared with the Lagrangian equations, tick by tick.
+    pub trajectory: Option<TrajectoryCheck>,
+}
+
+/// The tolerances of a motion against the Lagrangian model, per coordinate and in its class.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrajectoryCheck {
+    /// On the largest error over the motion's ticks [m or rad].
+    pub tolerance: f64,
+    /// On the rms error over them, if given.
+    pub rms_tolerance: Option<f64>,
 }
 
 /// The coordinates and rates of a trajectory at its sample times.

@@ -1,8 +1,12 @@
 //! The file's own model against the dynamics: every `[[predictions]]` entry compared with its
 //! quantity, and every `[[equations]]` residual, at each settle point (which decides the
-//! verdict) and at each tick (reported as transient errors, as the checks are).
+//! verdict) and at each tick (reported as transient errors, as the checks are). In a motion
+//! run with `[energy.trajectory]` it gathers the energy coordinates at every tick for the
+//! comparison with the Lagrangian model (`lagrangian.rs`).
 
+use super::lagrangian::{self, Samples};
 use super::{Note, Observer, SettlePoint, Tick};
+use crate::file_model::dynamics::TrajectoryCheck;
 use crate::file_model::energy_model::Kind;
 use crate::file_model::spec::{ModelSpec, Source};
 use crate::mechanisms::Values;
@@ -168,6 +172,11 @@ impl Acc {
     }
 }
 
+/// The file's `[energy.trajectory]`, if it has one.
+fn trajectory_check(spec: &ModelSpec) -> Option<TrajectoryCheck> {
+    spec.energy.as_ref()?.dynamics.as_ref()?.trajectory
+}
+
 /// The model observer.
 pub struct ModelObserver {
     spec: ModelSpec,
@@ -183,6 +192,9 @@ pub struct ModelObserver {
     series: Option<Vec<&'static str>>,
     /// A motion run: the predictions are judged over the motion's ticks, not at settle points.
     motion: bool,
+    /// With `[energy.trajectory]` in a motion run: the energy coordinates at every tick of the
+    /// motion, and every symbol's value at its first tick (the parameters and inputs).
+    trajectory: Option<(Samples, Vec<f64>)>,
 }
 
 impl ModelObserver {
@@ -225,6 +237,7 @@ impl ModelObserver {
             frequencies: vec![Acc::default(); frequency_count(spec)],
             series: recorded.then(|| series_names(spec)),
             motion,
+            trajectory: trajectory_check(spec).filter(|_| motion).map(|_| (Samples::default(), Vec::new())),
         }
     }
 
@@ -449,10 +462,17 @@ impl Observer for ModelObserver {
         for (a, (_, _, e)) in self.acc.iter_mut().zip(&errors) {
             a.tick(*e);
         }
-        if t.motion_time_s.is_some() {
+        if let Some(time_s) = t.motion_time_s {
             let predictions = self.spec.predictions.len();
             for (a, (_, _, e)) in self.acc.iter_mut().zip(&errors).take(predictions) {
                 a.motion_tick(*e);
+            }
+            if let (Some((samples, first)), Some(e)) = (self.trajectory.as_mut(), self.spec.energy.as_ref()) {
+                if first.is_empty() {
+                    *first = v.clone();
+                }
+                samples.times.push(time_s);
+                samples.coordinates.push(e.measured(&v));
             }
         }
         if let Some(series) = &self.series {
@@ -506,5 +526,17 @@ impl Observer for ModelObserver {
 
     fn finish(&mut self, report: &mut ScenarioReport) {
         report.model_checks = self.reports();
+        let (Some((samples, values)), Some(e), Some(check)) =
+            (&self.trajectory, &self.spec.energy, trajectory_check(&self.spec))
+        else {
+            return;
+        };
+        if let Some(m) = report.motion.as_mut() {
+            let tolerances = (check.tolerance, check.rms_tolerance);
+            m.lagrangian = Some(
+                lagrangian::compare(e, values, samples, tolerances)
+                    .unwrap_or_else(|why| lagrangian::not_compared(e, why, tolerances)),
+            );
+        }
     }
 }

@@ -10,6 +10,7 @@
 pub mod compare;
 pub mod file_model;
 pub mod interference;
+pub mod lagrangian;
 pub mod modes_record;
 pub mod motion;
 pub mod record;

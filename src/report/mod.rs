@@ -105,6 +105,47 @@ pub struct MotionReport {
     /// Steps of the motion that took a settle accelerator (0: the motion is physical).
     pub accelerated_steps: u64,
     pub frequencies: Vec<FrequencyReport>,
+    /// The file's Lagrangian model integrated beside the motion (`[energy.trajectory]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lagrangian: Option<LagrangianReport>,
+}
+
+/// A motion against the file's Lagrangian model, compared tick by tick
+/// (`observers::lagrangian`).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct LagrangianReport {
+    /// The integrator, its error control and how its start is read from the motion.
+    pub method: String,
+    /// The model's start: the motion's time [s], the coordinates [m or rad] and rates there.
+    pub start_time_s: f64,
+    pub start_coordinates: Vec<f64>,
+    pub start_rates: Vec<f64>,
+    /// Accepted steps of the integrator.
+    pub integrator_steps: usize,
+    /// Why the model could not be compared (every coordinate then fails, its error infinite).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    pub coordinates: Vec<LagrangianCoordinateReport>,
+}
+
+/// One `[energy]` coordinate of the simulated motion against the Lagrangian model.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct LagrangianCoordinateReport {
+    pub name: String,
+    /// "length" [m], "angle" [rad, wrapped] or "relative".
+    pub class: String,
+    /// The largest and the rms error over the ticks compared, in the class.
+    pub max_error: f64,
+    pub rms_error: f64,
+    pub tolerance: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rms_tolerance: Option<f64>,
+    pub passed: bool,
+    pub ticks_compared: usize,
+    /// The frequency fitted to the model's trajectory, and to the simulated one (corrected for
+    /// symplectic Euler's dispersion) [rad/s]; NaN where the motion is no oscillation.
+    pub model_omega_rad_per_s: f64,
+    pub simulated_omega_rad_per_s: f64,
 }
 
 /// A natural frequency measured from a motion run's free vibration and its prediction.
@@ -131,6 +172,30 @@ pub struct FrequencyReport {
     pub samples: usize,
     /// How it was measured.
     pub method: String,
+}
+
+/// The motion against the Lagrangian model: one line per coordinate.
+fn table_lagrangian(l: &LagrangianReport, out: &mut String) {
+    out.push_str(&format!(
+        "   lagrangian model from t = {:.6} s ({} integrator steps){}\n",
+        l.start_time_s,
+        l.integrator_steps,
+        l.error.as_ref().map_or(String::new(), |e| format!(": {e}"))
+    ));
+    for c in &l.coordinates {
+        out.push_str(&format!(
+            "   trajectory {}: max error {:.3e} (tolerance {:.1e}), rms {:.3e}{} over {} ticks; omega model {:.9}, simulated {:.9} rad/s  {}\n",
+            c.name,
+            c.max_error,
+            c.tolerance,
+            c.rms_error,
+            c.rms_tolerance.map_or(String::new(), |t| format!(" (tolerance {t:.1e})")),
+            c.ticks_compared,
+            c.model_omega_rad_per_s,
+            c.simulated_omega_rad_per_s,
+            if c.passed { "pass" } else { "FAIL" }
+        ));
+    }
 }
 
 /// A `[[predictions]]` or `[[equations]]` entry of the scenario file's model, judged at every
@@ -588,6 +653,9 @@ impl ScenarioReport {
                 f.tolerance,
                 if f.passed { "pass" } else { "FAIL" }
             ));
+        }
+        if let Some(l) = &m.lagrangian {
+            table_lagrangian(l, out);
         }
     }
 

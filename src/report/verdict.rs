@@ -31,6 +31,8 @@ pub fn failures(report: &ScenarioReport, min_agreement_percent: Option<f64>) -> 
         }
         if let Some(m) = &report.motion {
             out.extend(m.frequencies.iter().filter(|f| !f.passed).map(|f| Failure::Frequency(f.name.clone())));
+            let lagrangian = m.lagrangian.iter().flat_map(|l| &l.coordinates);
+            out.extend(lagrangian.filter(|c| !c.passed).map(|c| Failure::Trajectory(c.name.clone())));
         }
         out.extend(report.checks.iter().filter(|c| !c.passed).map(|c| Failure::Check(c.quantity.clone())));
         out.extend(report.model_checks.iter().filter(|c| !c.passed).map(|c| c.failure()));
@@ -85,6 +87,9 @@ pub enum Failure {
     /// model's natural frequency, or a `[[motion.frequencies]]` one against the frequency
     /// measured from a motion run: `frequency:NAME`.
     Frequency(String),
+    /// A coordinate of the `[energy]` model strayed from its Lagrangian trajectory
+    /// (`[energy.trajectory]`) in a motion run: `trajectory:COORDINATE`.
+    Trajectory(String),
 }
 
 /// The names a scenario may give in `[expect] failing` (a check is `check:QUANTITY`).
@@ -101,6 +106,7 @@ pub const FAILURE_NAMES: &[&str] = &[
     "equation:NAME",
     "energy",
     "frequency:NAME",
+    "trajectory:COORDINATE",
 ];
 
 impl fmt::Display for Failure {
@@ -118,6 +124,7 @@ impl fmt::Display for Failure {
             Failure::Equation(n) => write!(f, "equation:{n}"),
             Failure::Energy => f.write_str("energy"),
             Failure::Frequency(n) => write!(f, "frequency:{n}"),
+            Failure::Trajectory(n) => write!(f, "trajectory:{n}"),
         }
     }
 }
@@ -139,6 +146,9 @@ impl std::str::FromStr for Failure {
             }
             _ if s.strip_prefix("frequency:").is_some_and(|n| !n.is_empty()) => {
                 Failure::Frequency(s["frequency:".len()..].to_string())
+            }
+            _ if s.strip_prefix("trajectory:").is_some_and(|n| !n.is_empty()) => {
+                Failure::Trajectory(s["trajectory:".len()..].to_string())
             }
             _ if s.strip_prefix("equation:").is_some_and(|n| !n.is_empty()) => {
                 Failure::Equation(s["equation:".len()..].to_string())

@@ -26,6 +26,7 @@ pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
         rate: m.coordinate.as_ref().map_or(0.0, |(.., r)| *r),
         accelerated_steps: 0,
         frequencies: vec![],
+        lagrangian: None,
     }
 }
 

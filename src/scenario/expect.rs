@@ -32,6 +32,13 @@ fn frequency_names<'a>(parts: &Parts<'a>) -> Vec<&'a str> {
     model.chain(motion).collect()
 }
 
+/// The `[energy]` coordinates a motion is compared by with the Lagrangian model.
+fn trajectory_coordinates<'a>(parts: &Parts<'a>) -> Vec<&'a str> {
+    let energy = parts.model.and_then(|m| m.energy.as_ref());
+    let compared = energy.filter(|e| e.dynamics.as_ref().is_some_and(|d| d.trajectory.is_some()));
+    compared.into_iter().flat_map(|e| e.coordinates.iter().map(|c| c.name.as_str())).collect()
+}
+
 /// Whether the scenario has the part `failure` names; else the message saying what it has.
 fn has_part(parts: &Parts, failure: &crate::report::verdict::Failure) -> Result<(), String> {
     use crate::report::verdict::Failure;
@@ -52,6 +59,10 @@ fn has_part(parts: &Parts, failure: &crate::report::verdict::Failure) -> Result<
         Failure::Frequency(q) if !frequency_names(parts).contains(&q.as_str()) => Err(format!(
             "'{q}' is not among this scenario's [[energy.frequencies]] and [[motion.frequencies]] ({})",
             listed(frequency_names(parts))
+        )),
+        Failure::Trajectory(q) if !trajectory_coordinates(parts).contains(&q.as_str()) => Err(format!(
+            "'{q}' is not among the coordinates compared by [energy.trajectory] ({})",
+            listed(trajectory_coordinates(parts))
         )),
         Failure::Energy if !model.is_some_and(|m| m.energy.is_some()) => {
             Err("'energy' needs an [energy] section in this scenario".into())

@@ -6,8 +6,8 @@
 
 use super::error::{positive_value, Ctx, ScenarioError};
 use super::number::expr_error;
-use super::raw::{RawEnergy, RawFrequency};
-use crate::file_model::dynamics::{Dynamics, FrequencyPrediction, RATE_SUFFIX};
+use super::raw::{RawEnergy, RawFrequency, RawTrajectory};
+use crate::file_model::dynamics::{Dynamics, FrequencyPrediction, TrajectoryCheck, RATE_SUFFIX};
 use crate::file_model::energy_model::Coordinate;
 use crate::file_model::expr::Expr;
 use crate::file_model::spec::ModelSpec;
@@ -23,6 +23,9 @@ pub(super) fn dynamics(
     let Some(text) = &raw.kinetic else {
         if let Some(f) = raw.frequencies.first() {
             return Err(ctx.err(&f.name, "[[energy.frequencies]] needs a kinetic energy: [energy] kinetic = \"...\""));
+        }
+        if let Some(t) = &raw.trajectory {
+            return Err(ctx.err(t, "[energy.trajectory] needs a kinetic energy: [energy] kinetic = \"...\""));
         }
         return Ok(None);
     };
@@ -61,7 +64,16 @@ pub(super) fn dynamics(
     mass_checks(ctx, spec, text, &mass, n)?;
     let kinetic_gradient = (0..n).map(|j| d(&kinetic, first + j)).collect::<Result<_, _>>()?;
     let frequencies = frequencies(ctx, spec, &raw.frequencies, n)?;
-    Ok(Some(Dynamics { kinetic, mass, kinetic_gradient, mixed, first_rate, frequencies }))
+    let trajectory = raw.trajectory.as_ref().map(|t| trajectory(ctx, t.get_ref())).transpose()?;
+    Ok(Some(Dynamics { kinetic, mass, kinetic_gradient, mixed, first_rate, frequencies, trajectory }))
+}
+
+/// `[energy.trajectory]`: its tolerances, positive.
+fn trajectory(ctx: &Ctx, raw: &RawTrajectory) -> Result<TrajectoryCheck, ScenarioError> {
+    let tolerance = positive_value(ctx, &raw.tolerance, "energy.trajectory.tolerance")?;
+    let rms_tolerance =
+        raw.rms_tolerance.as_ref().map(|t| positive_value(ctx, t, "energy.trajectory.rms_tolerance")).transpose()?;
+    Ok(TrajectoryCheck { tolerance, rms_tolerance })
 }
 
 /// An error at the first place `name` appears as a whole symbol in the expression `text` (not

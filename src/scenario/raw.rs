@@ -76,6 +76,19 @@ pub(super) struct RawEnergy {
     /// Natural frequencies of the dynamic model predicted by closed forms.
     #[serde(default)]
     pub(super) frequencies: Vec<RawFrequency>,
+    /// A motion run compared with the Lagrangian equations of the kinetic and potential energy.
+    #[serde(default)]
+    pub(super) trajectory: Option<Spanned<RawTrajectory>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawTrajectory {
+    /// On the largest error of each coordinate over the motion, in its class [m or rad].
+    pub(super) tolerance: Spanned<f64>,
+    /// On the rms error of each coordinate over the motion.
+    #[serde(default)]
+    pub(super) rms_tolerance: Option<Spanned<f64>>,
 }
 
 #[derive(Debug, Deserialize)]
