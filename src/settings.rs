@@ -227,7 +227,7 @@ pub struct FrequencyPrediction {
     pub coordinate: JointCoordinate,
     /// Compiled against [`FrequencyPrediction::symbols`].
     pub formula: crate::file_model::expr::Expr,
-    /// The parameters, then the inputs.
+    /// The parameters, then the inputs, then the mechanism's analytic quantities.
     pub symbols: Vec<String>,
     /// Relative.
     pub tolerance: f64,
@@ -240,10 +240,16 @@ impl PartialEq for FrequencyPrediction {
 }
 
 impl FrequencyPrediction {
-    /// The predicted angular frequency [rad/s] with these parameters and inputs.
-    pub fn predicted(&self, params: &crate::mechanisms::Values, inputs: &crate::mechanisms::Values) -> f64 {
-        let values: Vec<f64> =
-            self.symbols.iter().map(|s| inputs.get(s).or_else(|| params.get(s)).copied().unwrap_or(f64::NAN)).collect();
+    /// The predicted angular frequency [rad/s] with these parameters, inputs and analytic
+    /// quantities.
+    pub fn predicted(
+        &self,
+        params: &crate::mechanisms::Values,
+        inputs: &crate::mechanisms::Values,
+        analytic: &crate::mechanisms::Values,
+    ) -> f64 {
+        let value = |s: &String| inputs.get(s).or_else(|| params.get(s)).or_else(|| analytic.get(s));
+        let values: Vec<f64> = self.symbols.iter().map(|s| value(s).copied().unwrap_or(f64::NAN)).collect();
         self.formula.eval(&values)
     }
 }
@@ -258,4 +264,7 @@ pub struct Motion {
     /// The displaced coordinate, with its displacement and start rate.
     pub coordinate: Option<(JointCoordinate, f64, f64)>,
     pub frequencies: Vec<FrequencyPrediction>,
+    /// Every joint's damping released (set to zero) for the motion; the settle to a settled
+    /// start keeps the damping the structure states.
+    pub undamped: bool,
 }

@@ -146,8 +146,8 @@ pub struct MotionObserver {
     frequencies: Vec<FrequencyPrediction>,
     /// Per frequency: the motion's times and the joint's coordinate there.
     samples: Vec<(Vec<f64>, Vec<f64>)>,
-    /// The parameters and inputs of the motion (for the predictions).
-    at: Option<(Values, Values)>,
+    /// The parameters, inputs and analytic quantities of the motion (for the predictions).
+    at: Option<(Values, Values, Values)>,
 }
 
 impl MotionObserver {
@@ -160,7 +160,7 @@ impl MotionObserver {
     }
 
     fn report(&self, f: &FrequencyPrediction, (t, q): &(Vec<f64>, Vec<f64>), dt_s: f64) -> FrequencyReport {
-        let predicted = self.at.as_ref().map_or(f64::NAN, |(p, i)| f.predicted(p, i));
+        let predicted = self.at.as_ref().map_or(f64::NAN, |(p, i, a)| f.predicted(p, i, a));
         let fit = fit_cosine(t, q);
         let measured = fit.map_or(f64::NAN, |x| x.omega_rad_per_s);
         let corrected = corrected_for_symplectic_euler(measured, dt_s);
@@ -188,7 +188,7 @@ impl Observer for MotionObserver {
     fn tick(&mut self, t: &Tick, _notes: &mut Vec<Note>) {
         let Some(time_s) = t.motion_time_s else { return };
         if self.at.is_none() {
-            self.at = Some((t.params.clone(), t.inputs.clone()));
+            self.at = Some((t.params.clone(), t.inputs.clone(), t.prediction.expected.clone()));
         }
         for (f, (ts, qs)) in self.frequencies.iter().zip(&mut self.samples) {
             let q = t.snapshot.joint_coordinate(t.structure, f.coordinate.index).unwrap_or(f64::NAN);

@@ -104,6 +104,8 @@ pub struct MotionReport {
     pub rate: f64,
     /// Steps of the motion that took a settle accelerator (0: the motion is physical).
     pub accelerated_steps: u64,
+    /// Every joint's damping was released for the motion (`[motion] undamped`).
+    pub undamped: bool,
     pub frequencies: Vec<FrequencyReport>,
     /// The file's Lagrangian model integrated beside the motion (`[energy.trajectory]`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -629,13 +631,14 @@ impl ScenarioReport {
     fn table_motion(&self, out: &mut String) {
         let Some(m) = &self.motion else { return };
         out.push_str(&format!(
-            "   motion from the {} state: {} of {} steps of {} s ({} s), {} accelerated; {}\n",
+            "   motion from the {} state: {} of {} steps of {} s ({} s), {} accelerated{}; {}\n",
             if m.start == crate::settings::MotionStart::Drawn { "drawn" } else { "settled" },
             m.steps_taken,
             m.steps,
             m.dt_s,
             m.duration_s,
             m.accelerated_steps,
+            if m.undamped { ", joint damping released" } else { "" },
             match &m.coordinate {
                 Some(c) => format!("{c} displaced by {:e}, rate {:e}", m.displacement, m.rate),
                 None => "no displacement".into(),

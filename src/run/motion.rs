@@ -25,6 +25,7 @@ pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
         displacement: m.coordinate.as_ref().map_or(0.0, |(_, d, _)| *d),
         rate: m.coordinate.as_ref().map_or(0.0, |(.., r)| *r),
         accelerated_steps: 0,
+        undamped: m.undamped,
         frequencies: vec![],
         lagrangian: None,
     }
@@ -48,6 +49,9 @@ pub(super) fn run_motion(
         return Ok(());
     }
     runner.sim.end_acceleration();
+    if m.undamped {
+        runner.sim.release_joint_damping();
+    }
     if let Some((c, displacement, rate)) = &m.coordinate {
         runner
             .sim

@@ -249,7 +249,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     }
     let interference = interference::interference(ctx, &raw.interference, m, &first_params, &first)?;
     let probe = checks::probe(ctx, m, &raw.probe, &first, &params)?;
-    let motion = motion::motion(ctx, &raw, sim.dt_s, &first, &first_params, &actuation)?;
+    let motion = motion::motion(ctx, &raw, sim.dt_s, (m, &first), &first_params, &actuation)?;
     let expect = match &raw.expect {
         None => None,
         Some(e) => {

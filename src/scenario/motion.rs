@@ -13,11 +13,14 @@
 //! coordinate = "pin"      # a revolute (angle, rad) or prismatic (slide, m) joint, not actuated
 //! displacement = "A"      # added to its coordinate at the start (a number or an expression of the params)
 //! rate = 0.0              # its rate at the start [rad/s or m/s]
+//! undamped = false        # true: every joint's damping released for the motion (a settle to
+//!                         # the start keeps it: damped to equilibrium, then free vibration)
 //!
 //! [[motion.frequencies]]  # a natural frequency measured from the motion and predicted
 //! name = "omega"
 //! coordinate = "pin"      # the joint whose free vibration is fitted
-//! formula = "sqrt(L*hypot(k1*a, k2*b)/I_pivot)"  # [rad/s], parameters and inputs
+//! formula = "sqrt(L*hypot(k1*a, k2*b)/I_pivot)"  # [rad/s]: parameters, inputs and the
+//!                         # mechanism's analytic quantities (ji2014's K of Eq. 42, say)
 //! tolerance = 1e-6        # relative, on the frequency corrected for the integrator
 //! ```
 
@@ -26,7 +29,7 @@ use super::number::{expr_error, Num};
 use super::raw::RawScenario;
 use super::Actuation;
 use crate::file_model::expr::Expr;
-use crate::mechanisms::Values;
+use crate::mechanisms::{Mechanism, Values};
 use crate::settings::{FrequencyPrediction, JointCoordinate, Motion, MotionStart};
 use crate::structure::{JointKind, Structure};
 use serde::Deserialize;
@@ -47,6 +50,9 @@ pub(super) struct RawMotion {
     pub(super) rate: Option<Spanned<Num>>,
     #[serde(default)]
     pub(super) frequencies: Vec<RawFrequency>,
+    /// Release every joint's damping for the motion (the settle to its start keeps it).
+    #[serde(default)]
+    pub(super) undamped: bool,
 }
 
 #[derive(Debug, Deserialize)]
@@ -67,7 +73,7 @@ pub(super) fn motion(
     ctx: &Ctx,
     raw: &RawScenario,
     dt_s: f64,
-    first: &Structure,
+    (mech, first): (&dyn Mechanism, &Structure),
     params: &Values,
     actuation: &Actuation,
 ) -> Result<Option<Motion>, ScenarioError> {
@@ -100,9 +106,13 @@ pub(super) fn motion(
     };
     let coordinate = displaced(ctx, m, first, params)?;
     let inputs = actuation.first_inputs();
-    let frequencies =
-        section.frequencies.iter().map(|f| frequency(ctx, f, first, params, inputs)).collect::<Result<_, _>>()?;
-    Ok(Some(Motion { duration_s, steps: steps as u64, start, coordinate, frequencies }))
+    let frequencies = section
+        .frequencies
+        .iter()
+        .map(|f| frequency(ctx, f, (mech, first), params, inputs))
+        .collect::<Result<_, _>>()?;
+    let undamped = section.undamped;
+    Ok(Some(Motion { duration_s, steps: steps as u64, start, coordinate, frequencies, undamped }))
 }
 
 /// A motion run holds one set of inputs: `points` with one point.
@@ -220,11 +230,13 @@ fn param_number(ctx: &Ctx, v: &Spanned<Num>, params: &Values, what: &str) -> Res
     }
 }
 
-/// A `[[motion.frequencies]]` entry: its joint, its formula of the parameters and inputs.
+/// A `[[motion.frequencies]]` entry: its joint, its formula of the parameters, the inputs and
+/// the mechanism's analytic quantities (checked finite and positive where the mechanism
+/// predicts them at the first point).
 fn frequency(
     ctx: &Ctx,
     f: &RawFrequency,
-    s: &Structure,
+    (mech, s): (&dyn Mechanism, &Structure),
     params: &Values,
     inputs: &Values,
 ) -> Result<FrequencyPrediction, ScenarioError> {
@@ -233,14 +245,20 @@ fn frequency(
         return Err(ctx.err(&f.name, "a frequency needs a name"));
     }
     let coordinate = joint_coordinate(ctx, &f.coordinate, s)?;
-    let symbols: Vec<String> = params.keys().chain(inputs.keys()).cloned().collect();
+    let mut symbols: Vec<String> = params.keys().chain(inputs.keys()).cloned().collect();
+    for q in mech.quantities() {
+        if !symbols.iter().any(|s| s == q.symbol) {
+            symbols.push(q.symbol.to_string());
+        }
+    }
     let names: Vec<&str> = symbols.iter().map(String::as_str).collect();
-    let what = format!("frequency '{name}' (parameters and inputs only)");
+    let what = format!("frequency '{name}' (parameters, inputs and the mechanism's quantities)");
     let formula =
         Expr::compile(f.formula.get_ref(), &names).map_err(|e| expr_error(ctx, f.formula.span().start, &e, &what))?;
     let tolerance = positive_value(ctx, &f.tolerance, "tolerance")?;
     let p = FrequencyPrediction { name, coordinate, formula, symbols, tolerance };
-    let w = p.predicted(params, inputs);
+    let Ok(prediction) = mech.predict(params, inputs) else { return Ok(p) };
+    let w = p.predicted(params, inputs, &prediction.expected);
     if !(w.is_finite() && w > 0.0) {
         return Err(
             ctx.err(&f.formula, format!("frequency '{}' is {w} rad/s here; a frequency is finite and > 0", p.name))

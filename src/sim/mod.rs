@@ -173,6 +173,14 @@ impl Simulation {
         }
     }
 
+    /// Releases every joint's damping (sets it to zero) from now on: a free vibration of the
+    /// undamped structure after a settle that used its damping.
+    pub fn release_joint_damping(&mut self) {
+        for link in self.model.joint_links.iter().flatten() {
+            build::set_link_damping(&mut self.multibody_joints, link.multibody_joint, 0.0);
+        }
+    }
+
     /// Whether the last step took a settle accelerator (the static relaxation, or the Newton
     /// schedule quenching a joint's velocity and setting its damping): the step was no part of
     /// a physical path.
