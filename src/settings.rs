@@ -220,13 +220,35 @@ pub struct JointCoordinate {
     pub prismatic: bool,
 }
 
-/// A natural frequency predicted in closed form and measured from the motion.
+/// What a measured frequency is fitted to.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FrequencySignal {
+    /// A revolute or prismatic joint's coordinate.
+    Joint(JointCoordinate),
+    /// The coordinate of one of the structure's own modes (from 0, ascending, rigid-body modes
+    /// counted) at the motion's start (`sim::modes::ModalProjector`).
+    Mode(usize),
+}
+
+impl FrequencySignal {
+    /// As the report names it: the joint's name, or "mode N" (from 1).
+    pub fn label(&self) -> String {
+        match self {
+            FrequencySignal::Joint(c) => c.joint.clone(),
+            FrequencySignal::Mode(i) => format!("mode {}", i + 1),
+        }
+    }
+}
+
+/// A natural frequency predicted (in closed form, or by the structure's own modal analysis)
+/// and measured from the motion.
 #[derive(Clone, Debug)]
 pub struct FrequencyPrediction {
     pub name: String,
-    pub coordinate: JointCoordinate,
-    /// Compiled against [`FrequencyPrediction::symbols`].
-    pub formula: crate::file_model::expr::Expr,
+    pub signal: FrequencySignal,
+    /// Compiled against [`FrequencyPrediction::symbols`]; None: the modal analysis's frequency
+    /// of the mode fitted.
+    pub formula: Option<crate::file_model::expr::Expr>,
     /// The parameters, then the inputs, then the mechanism's analytic quantities.
     pub symbols: Vec<String>,
     /// Relative.
@@ -235,22 +257,24 @@ pub struct FrequencyPrediction {
 
 impl PartialEq for FrequencyPrediction {
     fn eq(&self, other: &Self) -> bool {
-        self.name == other.name && self.formula.text() == other.formula.text() && self.tolerance == other.tolerance
+        self.name == other.name
+            && self.formula.as_ref().map(|f| f.text()) == other.formula.as_ref().map(|f| f.text())
+            && self.tolerance == other.tolerance
     }
 }
 
 impl FrequencyPrediction {
     /// The predicted angular frequency [rad/s] with these parameters, inputs and analytic
-    /// quantities.
+    /// quantities (None without a formula).
     pub fn predicted(
         &self,
         params: &crate::mechanisms::Values,
         inputs: &crate::mechanisms::Values,
         analytic: &crate::mechanisms::Values,
-    ) -> f64 {
+    ) -> Option<f64> {
         let value = |s: &String| inputs.get(s).or_else(|| params.get(s)).or_else(|| analytic.get(s));
         let values: Vec<f64> = self.symbols.iter().map(|s| value(s).copied().unwrap_or(f64::NAN)).collect();
-        self.formula.eval(&values)
+        Some(self.formula.as_ref()?.eval(&values))
     }
 }
 
@@ -263,6 +287,9 @@ pub struct Motion {
     pub start: MotionStart,
     /// The displaced coordinate, with its displacement and start rate.
     pub coordinate: Option<(JointCoordinate, f64, f64)>,
+    /// A displacement along one of the structure's own modes at the start: the mode (from 0,
+    /// rigid-body modes counted) and the largest node displacement [m].
+    pub mode: Option<(usize, f64)>,
     pub frequencies: Vec<FrequencyPrediction>,
     /// Every joint's damping released (set to zero) for the motion; the settle to a settled
     /// start keeps the damping the structure states.

@@ -63,6 +63,17 @@ pub enum Note {
     Scalar(&'static str, f64),
 }
 
+/// One of the structure's own modes at a motion run's start (`sim::modes`), for the
+/// frequencies fitted to it.
+#[derive(Clone, Debug)]
+pub struct ModeAtStart {
+    /// The mode, from 0 (ascending, rigid-body modes counted).
+    pub index: usize,
+    pub omega_rad_per_s: f64,
+    /// Reads the mode's coordinate off a snapshot.
+    pub projector: crate::sim::modes::ModalProjector,
+}
+
 /// Something that watches a run.
 pub trait Observer {
     /// After every step; what the observer has to tell the others goes into `notes`.
@@ -77,6 +88,9 @@ pub trait Observer {
     /// The equilibrium residual computed after `tick` (the settle loop computes it only once
     /// the motion has stopped).
     fn residual(&mut self, _tick: u64, _r: &Residual) {}
+    /// A motion run's motion starts (after its start point, before its first step), with the
+    /// structure's own modes there that its frequencies are fitted to.
+    fn motion_start(&mut self, _modes: &[ModeAtStart]) {}
     /// A settle point: fill in what this observer measures there (`point` has the rest).
     fn settle_point(&mut self, _p: &SettlePoint, _point: &mut PointReport, _notes: &mut Vec<Note>) {}
     /// The run is over: put what was gathered into the report.

@@ -12,10 +12,10 @@
 //! system's own nonlinearity (a frequency shift growing with the amplitude squared) and any
 //! damping.
 
-use super::{Note, Observer, Tick};
+use super::{ModeAtStart, Note, Observer, Tick};
 use crate::mechanisms::Values;
 use crate::report::{FrequencyReport, ScenarioReport};
-use crate::settings::{FrequencyPrediction, Motion};
+use crate::settings::{FrequencyPrediction, FrequencySignal, Motion};
 
 /// How the frequencies are measured, as the report states it.
 pub const METHOD: &str = "least-squares fit of c + A cos(w t + p) over every tick of the motion, \
@@ -148,6 +148,8 @@ pub struct MotionObserver {
     samples: Vec<(Vec<f64>, Vec<f64>)>,
     /// The parameters, inputs and analytic quantities of the motion (for the predictions).
     at: Option<(Values, Values, Values)>,
+    /// The structure's own modes at the motion's start that frequencies are fitted to.
+    modes: Vec<ModeAtStart>,
 }
 
 impl MotionObserver {
@@ -156,18 +158,33 @@ impl MotionObserver {
             frequencies: m.frequencies.clone(),
             samples: vec![(Vec::new(), Vec::new()); m.frequencies.len()],
             at: None,
+            modes: Vec::new(),
         }
     }
 
+    fn mode(&self, index: usize) -> Option<&ModeAtStart> {
+        self.modes.iter().find(|m| m.index == index)
+    }
+
+    /// The prediction of `f`: its formula, or the modal analysis's frequency of its mode.
+    fn predicted(&self, f: &FrequencyPrediction) -> f64 {
+        let formula = self.at.as_ref().and_then(|(p, i, a)| f.predicted(p, i, a));
+        let modal = || match f.signal {
+            FrequencySignal::Mode(i) => self.mode(i).map(|m| m.omega_rad_per_s),
+            FrequencySignal::Joint(_) => None,
+        };
+        formula.or_else(modal).unwrap_or(f64::NAN)
+    }
+
     fn report(&self, f: &FrequencyPrediction, (t, q): &(Vec<f64>, Vec<f64>), dt_s: f64) -> FrequencyReport {
-        let predicted = self.at.as_ref().map_or(f64::NAN, |(p, i, a)| f.predicted(p, i, a));
+        let predicted = self.predicted(f);
         let fit = fit_cosine(t, q);
         let measured = fit.map_or(f64::NAN, |x| x.omega_rad_per_s);
         let corrected = corrected_for_symplectic_euler(measured, dt_s);
         let error = (corrected - predicted).abs() / predicted.abs();
         FrequencyReport {
             name: f.name.clone(),
-            coordinate: f.coordinate.joint.clone(),
+            coordinate: f.signal.label(),
             predicted_rad_per_s: predicted,
             measured_rad_per_s: measured,
             corrected_rad_per_s: corrected,
@@ -191,10 +208,18 @@ impl Observer for MotionObserver {
             self.at = Some((t.params.clone(), t.inputs.clone(), t.prediction.expected.clone()));
         }
         for (f, (ts, qs)) in self.frequencies.iter().zip(&mut self.samples) {
-            let q = t.snapshot.joint_coordinate(t.structure, f.coordinate.index).unwrap_or(f64::NAN);
+            let q = match f.signal {
+                FrequencySignal::Joint(ref c) => t.snapshot.joint_coordinate(t.structure, c.index),
+                FrequencySignal::Mode(i) => self.modes.iter().find(|m| m.index == i).map(|m| m.projector.coordinate(t.snapshot)),
+            };
+            let q = q.unwrap_or(f64::NAN);
             ts.push(time_s);
             qs.push(q);
         }
+    }
+
+    fn motion_start(&mut self, modes: &[ModeAtStart]) {
+        self.modes = modes.to_vec();
     }
 
     fn finish(&mut self, report: &mut ScenarioReport) {

@@ -638,7 +638,7 @@ impl ScenarioReport {
             m.dt_s,
             m.duration_s,
             m.accelerated_steps,
-            if m.undamped { ", joint damping released" } else { "" },
+            if m.undamped { ", damping released" } else { "" },
             match &m.coordinate {
                 Some(c) => format!("{c} displaced by {:e}, rate {:e}", m.displacement, m.rate),
                 None => "no displacement".into(),

@@ -7,10 +7,11 @@ use super::runner::Runner;
 use super::settle::SettleDetector;
 use super::{point, Stop};
 use crate::mechanisms::{ModelError, Values};
-use crate::observers::SettlePoint;
+use crate::observers::{ModeAtStart, SettlePoint};
 use crate::report::{MotionReport, PointReport, ScenarioReport};
 use crate::scenario::Scenario;
-use crate::settings::{Motion, MotionStart};
+use crate::settings::{FrequencySignal, Motion, MotionStart};
+use crate::sim::modes::ModalProjector;
 
 /// What the report says of a motion before it runs.
 pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
@@ -21,8 +22,8 @@ pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
         steps: m.steps,
         steps_taken: 0,
         start_tick: 0,
-        coordinate: m.coordinate.as_ref().map(|(c, ..)| c.joint.clone()),
-        displacement: m.coordinate.as_ref().map_or(0.0, |(_, d, _)| *d),
+        coordinate: m.coordinate.as_ref().map(|(c, ..)| c.joint.clone()).or(m.mode.map(|(i, _)| format!("mode {}", i + 1))),
+        displacement: m.coordinate.as_ref().map(|(_, d, _)| *d).or(m.mode.map(|(_, a)| a)).unwrap_or(0.0),
         rate: m.coordinate.as_ref().map_or(0.0, |(.., r)| *r),
         accelerated_steps: 0,
         undamped: m.undamped,
@@ -50,13 +51,17 @@ pub(super) fn run_motion(
     }
     runner.sim.end_acceleration();
     if m.undamped {
-        runner.sim.release_joint_damping();
+        runner.sim.release_damping();
     }
     if let Some((c, displacement, rate)) = &m.coordinate {
         runner
             .sim
             .set_joint_motion(c.index, *displacement, *rate)
             .map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
+    }
+    let modes = start_modes(runner, m)?;
+    for o in runner.observers.iter_mut() {
+        o.motion_start(&modes);
     }
     let start_tick = runner.sim.tick();
     runner.motion_start_tick = Some(start_tick);
@@ -80,6 +85,39 @@ pub(super) fn run_motion(
         r.accelerated_steps = runner.accelerated_steps - accelerated_before;
     }
     result
+}
+
+/// The structure's own modes at the start that the motion needs (its displacement along one,
+/// the frequencies fitted to them), analysed before the displacement, which follows.
+fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, Stop> {
+    let fitted = m.frequencies.iter().filter_map(|f| match f.signal {
+        FrequencySignal::Mode(i) => Some(i),
+        FrequencySignal::Joint(_) => None,
+    });
+    let mut wanted: Vec<usize> = fitted.chain(m.mode.map(|(i, _)| i)).collect();
+    wanted.sort_unstable();
+    wanted.dedup();
+    if wanted.is_empty() {
+        return Ok(vec![]);
+    }
+    let analysis = runner.sim.modes().map_err(|e| Stop::Model(ModelError::no_solution(e.to_string())))?;
+    let modes: Vec<ModeAtStart> = wanted
+        .iter()
+        .map(|&index| ModeAtStart {
+            index,
+            omega_rad_per_s: analysis.modes[index].omega(),
+            projector: ModalProjector::new(&runner.sim, &analysis, index),
+        })
+        .collect();
+    if let Some((index, amplitude_m)) = m.mode {
+        let eta = runner.sim.displace_along_mode(&analysis, index, amplitude_m);
+        runner.emit(format_args!(
+            "start displaced along mode {} (omega {:.9} rad/s): largest node displacement {amplitude_m:e} m, modal coordinate {eta:.6e}",
+            index + 1,
+            analysis.modes[index].omega()
+        ));
+    }
+    Ok(modes)
 }
 
 /// The drawn state as the motion's start point (no step taken): at rest, so an equilibrium

@@ -13,12 +13,16 @@
 //! coordinate = "pin"      # a revolute (angle, rad) or prismatic (slide, m) joint, not actuated
 //! displacement = "A"      # added to its coordinate at the start (a number or an expression of the params)
 //! rate = 0.0              # its rate at the start [rad/s or m/s]
+//! # mode = 4, amplitude = 1e-4  # instead: along the structure's own mode 4 (as `tensegrity
+//! #                             # modes` lists them), largest node displacement 1e-4 m
 //! undamped = false        # true: every joint's damping released for the motion (a settle to
 //!                         # the start keeps it: damped to equilibrium, then free vibration)
 //!
 //! [[motion.frequencies]]  # a natural frequency measured from the motion and predicted
 //! name = "omega"
-//! coordinate = "pin"      # the joint whose free vibration is fitted
+//! coordinate = "pin"      # the joint whose free vibration is fitted (or mode = N: the
+//!                         # coordinate of the structure's own mode N; formula then optional,
+//!                         # the modal analysis's frequency by default)
 //! formula = "sqrt(L*hypot(k1*a, k2*b)/I_pivot)"  # [rad/s]: parameters, inputs and the
 //!                         # mechanism's analytic quantities (ji2014's K of Eq. 42, say)
 //! tolerance = 1e-6        # relative, on the frequency corrected for the integrator
@@ -30,7 +34,7 @@ use super::raw::RawScenario;
 use super::Actuation;
 use crate::file_model::expr::Expr;
 use crate::mechanisms::{Mechanism, Values};
-use crate::settings::{FrequencyPrediction, JointCoordinate, Motion, MotionStart};
+use crate::settings::{FrequencyPrediction, FrequencySignal, JointCoordinate, Motion, MotionStart};
 use crate::structure::{JointKind, Structure};
 use serde::Deserialize;
 use toml::Spanned;
@@ -48,6 +52,11 @@ pub(super) struct RawMotion {
     pub(super) displacement: Option<Spanned<Num>>,
     /// [rad/s or m/s]: a number or an expression of the parameters.
     pub(super) rate: Option<Spanned<Num>>,
+    /// One of the structure's own modes (from 1, as `tensegrity modes` lists them) to displace
+    /// the start along, instead of a coordinate.
+    pub(super) mode: Option<Spanned<i64>>,
+    /// The largest node displacement of the displacement along `mode` [m].
+    pub(super) amplitude: Option<Spanned<Num>>,
     #[serde(default)]
     pub(super) frequencies: Vec<RawFrequency>,
     /// Release every joint's damping for the motion (the settle to its start keeps it).
@@ -60,9 +69,12 @@ pub(super) struct RawMotion {
 pub(super) struct RawFrequency {
     pub(super) name: Spanned<String>,
     /// The joint whose coordinate's free vibration is fitted.
-    pub(super) coordinate: Spanned<String>,
-    /// The predicted angular frequency [rad/s]: a closed form of the parameters and inputs.
-    pub(super) formula: Spanned<String>,
+    pub(super) coordinate: Option<Spanned<String>>,
+    /// Or the structure's own mode (from 1) whose coordinate is fitted.
+    pub(super) mode: Option<Spanned<i64>>,
+    /// The predicted angular frequency [rad/s]: a closed form of the parameters, inputs and
+    /// analytic quantities; optional with `mode` (then the modal analysis's frequency).
+    pub(super) formula: Option<Spanned<String>>,
     /// Relative, on the corrected measured frequency.
     pub(super) tolerance: Spanned<f64>,
 }
@@ -104,6 +116,7 @@ pub(super) fn motion(
             )
         }
     };
+    let mode = displaced_mode(ctx, m, first, params)?;
     let coordinate = displaced(ctx, m, first, params)?;
     let inputs = actuation.first_inputs();
     let frequencies = section
@@ -112,7 +125,7 @@ pub(super) fn motion(
         .map(|f| frequency(ctx, f, (mech, first), params, inputs))
         .collect::<Result<_, _>>()?;
     let undamped = section.undamped;
-    Ok(Some(Motion { duration_s, steps: steps as u64, start, coordinate, frequencies, undamped }))
+    Ok(Some(Motion { duration_s, steps: steps as u64, start, coordinate, mode, frequencies, undamped }))
 }
 
 /// A motion run holds one set of inputs: `points` with one point.
@@ -177,6 +190,47 @@ fn displaced(
     Ok(Some((joint, displacement, rate)))
 }
 
+/// The structure's own mode `[motion] mode` (from 1) to displace the start along, and the
+/// largest node displacement `amplitude` [m]; not with `coordinate`.
+fn displaced_mode(
+    ctx: &Ctx,
+    m: &Spanned<RawMotion>,
+    s: &Structure,
+    params: &Values,
+) -> Result<Option<(usize, f64)>, ScenarioError> {
+    let section = m.get_ref();
+    let (mode, amplitude) = match (&section.mode, &section.amplitude) {
+        (None, None) => return Ok(None),
+        (Some(mode), Some(amplitude)) => (mode, amplitude),
+        (Some(mode), None) => return Err(ctx.err(mode, "mode needs an amplitude: the largest node displacement [m]")),
+        (None, Some(a)) => return Err(ctx.err(a, "amplitude is the largest node displacement along a mode: it needs mode = N")),
+    };
+    if let Some(c) = &section.coordinate {
+        return Err(ctx.err(c, "a motion starts displaced along a coordinate or along a mode, not both"));
+    }
+    let index = mode_index(ctx, mode, s)?;
+    let amplitude = param_number(ctx, amplitude, params, "motion.amplitude")?;
+    Ok(Some((index, amplitude)))
+}
+
+/// A mode of the structure's own modal analysis (from 1 in the file, from 0 here): only for
+/// structures it analyses (free bodies, springs and elastic cables) and at most six per free
+/// body.
+fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, ScenarioError> {
+    if let Some(j) = s.joints.first() {
+        return Err(ctx.err(
+            mode,
+            format!("the structure's modes are computed for free bodies only, and joint '{}' is a joint", j.name),
+        ));
+    }
+    let count = 6 * s.bodies.iter().filter(|b| b.kind == crate::structure::BodyKind::Free).count() as i64;
+    let m = *mode.get_ref();
+    if !(1..=count).contains(&m) {
+        return Err(ctx.err(mode, format!("mode {m} does not exist: the structure has {count} (from 1)")));
+    }
+    Ok(m as usize - 1)
+}
+
 /// A revolute or prismatic joint of `s`, not driven by an actuator, by name.
 fn joint_coordinate(ctx: &Ctx, name: &Spanned<String>, s: &Structure) -> Result<JointCoordinate, ScenarioError> {
     let index = s.joints.iter().position(|j| &j.name == name.get_ref()).ok_or_else(|| {
@@ -230,9 +284,9 @@ fn param_number(ctx: &Ctx, v: &Spanned<Num>, params: &Values, what: &str) -> Res
     }
 }
 
-/// A `[[motion.frequencies]]` entry: its joint, its formula of the parameters, the inputs and
-/// the mechanism's analytic quantities (checked finite and positive where the mechanism
-/// predicts them at the first point).
+/// A `[[motion.frequencies]]` entry: its joint or mode, its formula of the parameters, the
+/// inputs and the mechanism's analytic quantities (checked finite and positive where the
+/// mechanism predicts them at the first point; optional for a mode).
 fn frequency(
     ctx: &Ctx,
     f: &RawFrequency,
@@ -244,25 +298,32 @@ fn frequency(
     if name.trim().is_empty() {
         return Err(ctx.err(&f.name, "a frequency needs a name"));
     }
-    let coordinate = joint_coordinate(ctx, &f.coordinate, s)?;
+    let signal = match (&f.coordinate, &f.mode) {
+        (Some(c), None) => FrequencySignal::Joint(joint_coordinate(ctx, c, s)?),
+        (None, Some(m)) => FrequencySignal::Mode(mode_index(ctx, m, s)?),
+        _ => return Err(ctx.err(&f.name, format!("frequency '{name}' is fitted to a coordinate = \"JOINT\" or to a mode = N: one of them"))),
+    };
     let mut symbols: Vec<String> = params.keys().chain(inputs.keys()).cloned().collect();
     for q in mech.quantities() {
         if !symbols.iter().any(|s| s == q.symbol) {
             symbols.push(q.symbol.to_string());
         }
     }
+    let tolerance = positive_value(ctx, &f.tolerance, "tolerance")?;
+    let Some(text) = &f.formula else {
+        if let FrequencySignal::Joint(_) = signal {
+            return Err(ctx.err(&f.name, format!("frequency '{name}' of a joint needs a formula [rad/s]")));
+        }
+        return Ok(FrequencyPrediction { name, signal, formula: None, symbols, tolerance });
+    };
     let names: Vec<&str> = symbols.iter().map(String::as_str).collect();
     let what = format!("frequency '{name}' (parameters, inputs and the mechanism's quantities)");
-    let formula =
-        Expr::compile(f.formula.get_ref(), &names).map_err(|e| expr_error(ctx, f.formula.span().start, &e, &what))?;
-    let tolerance = positive_value(ctx, &f.tolerance, "tolerance")?;
-    let p = FrequencyPrediction { name, coordinate, formula, symbols, tolerance };
+    let formula = Expr::compile(text.get_ref(), &names).map_err(|e| expr_error(ctx, text.span().start, &e, &what))?;
+    let p = FrequencyPrediction { name, signal, formula: Some(formula), symbols, tolerance };
     let Ok(prediction) = mech.predict(params, inputs) else { return Ok(p) };
-    let w = p.predicted(params, inputs, &prediction.expected);
+    let w = p.predicted(params, inputs, &prediction.expected).unwrap_or(f64::NAN);
     if !(w.is_finite() && w > 0.0) {
-        return Err(
-            ctx.err(&f.formula, format!("frequency '{}' is {w} rad/s here; a frequency is finite and > 0", p.name))
-        );
+        return Err(ctx.err(text, format!("frequency '{}' is {w} rad/s here; a frequency is finite and > 0", p.name)));
     }
     Ok(p)
 }

@@ -173,11 +173,16 @@ impl Simulation {
         }
     }
 
-    /// Releases every joint's damping (sets it to zero) from now on: a free vibration of the
-    /// undamped structure after a settle that used its damping.
-    pub fn release_joint_damping(&mut self) {
+    /// Releases every joint's and body's damping (sets it to zero) from now on: a free
+    /// vibration of the undamped structure after a settle that used its damping.
+    pub fn release_damping(&mut self) {
         for link in self.model.joint_links.iter().flatten() {
             build::set_link_damping(&mut self.multibody_joints, link.multibody_joint, 0.0);
+        }
+        for h in &self.model.handles {
+            let body = &mut self.bodies[*h];
+            body.set_linear_damping(0.0);
+            body.set_angular_damping(0.0);
         }
     }
 

@@ -11,8 +11,9 @@
 
 use super::Simulation;
 use crate::eigen::EigenError;
+use crate::snapshot::{BodyPose, Snapshot};
 use crate::structure::{BodyKind, CableLaw};
-use nalgebra::{DMatrix, Matrix3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 /// A mode whose |omega^2| is below this fraction of the largest is a rigid-body (zero) mode.
 pub const ZERO_MODE_RATIO: f64 = 1e-9;
@@ -55,6 +56,10 @@ impl StructureMode {
 pub struct StructureModes {
     /// The structure body of each block of six coordinates.
     pub bodies: Vec<usize>,
+    /// Each free body's pose at the state analysed.
+    pub poses: Vec<BodyPose>,
+    /// The mass matrix there (six coordinates per free body).
+    pub mass: DMatrix<f64>,
     /// Ascending omega^2.
     pub modes: Vec<StructureMode>,
     /// How many are rigid-body modes.
@@ -104,7 +109,20 @@ impl Simulation {
             })
             .collect();
         let rigid = modes.iter().filter(|m| m.rigid).count();
-        Ok(StructureModes { bodies: tangent.bodies, modes, rigid })
+        let poses = tangent.bodies.iter().map(|b| self.body_pose(*b)).collect();
+        Ok(StructureModes { bodies: tangent.bodies, poses, mass, modes, rigid })
+    }
+
+    /// Displaces the structure along mode `index` (from 0) of `analysis` (made at the current
+    /// state) so that its largest node displacement is `amplitude_m`; returns the modal
+    /// coordinate reached (the mass-normalised amplitude). Linear in the shape: a rotation of
+    /// dtheta about each centre of mass, exact for a rigid body.
+    pub fn displace_along_mode(&mut self, analysis: &StructureModes, index: usize, amplitude_m: f64) -> f64 {
+        let mode = &analysis.modes[index];
+        let largest = mode.node_motion.iter().map(|d| Vector3::from(*d).norm()).fold(0.0, f64::max);
+        let eta = if largest > 0.0 { amplitude_m / largest } else { 0.0 };
+        self.displace_free_bodies(&(DVector::from_column_slice(&mode.shape) * eta));
+        eta
     }
 
     /// The mass matrix of the free bodies' blocks: m 1 for the translation, R diag(I) R^T for
@@ -136,5 +154,60 @@ impl Simulation {
                 [d.x, d.y, d.z]
             })
             .collect()
+    }
+}
+
+/// Reads one mode's coordinate off a snapshot: eta = v^T M (x - x0), v the mass-normalised
+/// shape, M the mass matrix and x0 the poses at the analysed state, x - x0 per free body the
+/// displacement of its centre of mass and the rotation vector of R R0^T. Exact for a motion
+/// along the mode at small amplitude; the other modes, M-orthogonal to it, do not enter.
+#[derive(Clone, Debug)]
+pub struct ModalProjector {
+    bodies: Vec<usize>,
+    start: Vec<BodyPose>,
+    /// Each body's centre of mass in its own frame [m].
+    com_local: Vec<Vector3<f64>>,
+    /// M v: six per free body.
+    weights: Vec<f64>,
+}
+
+fn rotation(p: &BodyPose) -> UnitQuaternion<f64> {
+    let q = p.rotation_xyzw;
+    UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]))
+}
+
+fn com_world(p: &BodyPose, local: &Vector3<f64>) -> Vector3<f64> {
+    Vector3::from(p.translation) + rotation(p) * local
+}
+
+impl ModalProjector {
+    /// The coordinate of mode `index` (from 0) of `analysis`.
+    pub fn new(sim: &Simulation, analysis: &StructureModes, index: usize) -> Self {
+        let s = sim.structure();
+        let com_local = analysis
+            .bodies
+            .iter()
+            .map(|b| Vector3::from(s.bodies[*b].inertia.map_or([0.0; 3], |i| i.com)))
+            .collect();
+        let weights = &analysis.mass * DVector::from_column_slice(&analysis.modes[index].shape);
+        ModalProjector {
+            bodies: analysis.bodies.clone(),
+            start: analysis.poses.clone(),
+            com_local,
+            weights: weights.iter().copied().collect(),
+        }
+    }
+
+    /// The modal coordinate in the state `snap`.
+    pub fn coordinate(&self, snap: &Snapshot) -> f64 {
+        let mut eta = 0.0;
+        for (i, b) in self.bodies.iter().enumerate() {
+            let (now, start) = (&snap.body_poses[*b], &self.start[i]);
+            let du = com_world(now, &self.com_local[i]) - com_world(start, &self.com_local[i]);
+            let dtheta = (rotation(now) * rotation(start).inverse()).scaled_axis();
+            let w = &self.weights[6 * i..6 * i + 6];
+            eta += w[0] * du.x + w[1] * du.y + w[2] * du.z + w[3] * dtheta.x + w[4] * dtheta.y + w[5] * dtheta.z;
+        }
+        eta
     }
 }

@@ -122,6 +122,14 @@ impl Simulation {
         Tangent { bodies, com: dofs.com.iter().map(|c| assemble::v3(*c)).collect(), hessian }
     }
 
+    /// Moves every free body by `step` (six coordinates per body, in the order of
+    /// [`Simulation::tangent_stiffness`]'s blocks: translation of the centre of mass, then a
+    /// rotation about it).
+    pub(super) fn displace_free_bodies(&mut self, step: &nalgebra::DVector<f64>) {
+        let dofs = self.relaxation_dofs();
+        self.move_bodies(&dofs, step, 1.0);
+    }
+
     /// The step solver for the structure's size: dense up to [`DENSE_MAX_BODIES`] free
     /// bodies, sparse above.
     fn relaxation_solver(&self, dofs: &assemble::Dofs, system: &assemble::System) -> Box<dyn StepSolver> {
