@@ -226,7 +226,7 @@ pub enum FrequencySignal {
     /// A revolute or prismatic joint's coordinate.
     Joint(JointCoordinate),
     /// The coordinate of one of the structure's own modes (from 0, ascending, rigid-body modes
-    /// counted) at the motion's start (`sim::modes::ModalProjector`).
+    /// counted) at the motion's start (`snapshot::ModalProjector`).
     Mode(usize),
 }
 

@@ -134,3 +134,44 @@ pub struct Residual {
     /// Largest residual torque on a rotational coordinate [N m].
     pub max_torque_nm: f64,
 }
+
+/// Reads one mode's coordinate off a snapshot: eta = v^T M (x - x0), v the mass-normalised
+/// shape, M the mass matrix and x0 the poses at the analysed state, x - x0 per free body the
+/// displacement of its centre of mass and the rotation vector of R R0^T. Exact for a motion
+/// along the mode at small amplitude; the other modes, M-orthogonal to it, do not enter. Made
+/// by `sim::modes::modal_projector`.
+#[derive(Clone, Debug)]
+pub struct ModalProjector {
+    /// The free bodies, by structure index.
+    pub bodies: Vec<usize>,
+    /// Their poses at the analysed state.
+    pub start: Vec<BodyPose>,
+    /// Each body's centre of mass in its own frame [m].
+    pub com_local: Vec<[f64; 3]>,
+    /// M v: six per free body (translation, rotation).
+    pub weights: Vec<f64>,
+}
+
+fn pose_rotation(p: &BodyPose) -> UnitQuaternion<f64> {
+    let q = p.rotation_xyzw;
+    UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]))
+}
+
+fn pose_com(p: &BodyPose, local: &[f64; 3]) -> Vector3<f64> {
+    Vector3::from(p.translation) + pose_rotation(p) * Vector3::from(*local)
+}
+
+impl ModalProjector {
+    /// The modal coordinate in the state `snap`.
+    pub fn coordinate(&self, snap: &Snapshot) -> f64 {
+        let mut eta = 0.0;
+        for (i, b) in self.bodies.iter().enumerate() {
+            let (now, start) = (&snap.body_poses[*b], &self.start[i]);
+            let du = pose_com(now, &self.com_local[i]) - pose_com(start, &self.com_local[i]);
+            let dtheta = (pose_rotation(now) * pose_rotation(start).inverse()).scaled_axis();
+            let w = &self.weights[6 * i..6 * i + 6];
+            eta += w[0] * du.x + w[1] * du.y + w[2] * du.z + w[3] * dtheta.x + w[4] * dtheta.y + w[5] * dtheta.z;
+        }
+        eta
+    }
+}

@@ -21,7 +21,7 @@ pub fn modes(
         .filter_map(|(flag, p)| p.map(|p| (flag.to_string(), p.to_path_buf())))
         .collect();
     check_outputs(&[scenario.to_path_buf()], &outputs)?;
-    let state = crate::run::settle_first_point(&sc, Some(&signals::CANCEL))
+    let mut state = crate::run::settle_first_point(&sc, Some(&signals::CANCEL))
         .map_err(|e| failed(format!("{}: {e}", scenario.display())))?;
     let wall = Instant::now();
     let analysis = state.sim.modes().map_err(|e| match e {
@@ -34,7 +34,8 @@ pub fn modes(
         settled: state.settled,
         settle_steps: state.steps,
         free_bodies: analysis.bodies.len(),
-        coordinates: 6 * analysis.bodies.len(),
+        coordinates: if analysis.joints.is_empty() { 6 * analysis.bodies.len() } else { analysis.joints.len() },
+        joint_coordinates: analysis.joints.iter().map(|j| state.sim.structure().joints[*j].name.clone()).collect(),
         rigid_modes: analysis.rigid,
         zero_mode_ratio: ZERO_MODE_RATIO,
         modes: rows(&analysis, &state.sim.structure().nodes),

@@ -63,7 +63,7 @@ pub enum Note {
     Scalar(&'static str, f64),
 }
 
-/// One of the structure's own modes at a motion run's start (`sim::modes`), for the
+/// One of the structure's own modes at a motion run's start (the simulation's modal analysis), for the
 /// frequencies fitted to it.
 #[derive(Clone, Debug)]
 pub struct ModeAtStart {
@@ -71,7 +71,7 @@ pub struct ModeAtStart {
     pub index: usize,
     pub omega_rad_per_s: f64,
     /// Reads the mode's coordinate off a snapshot.
-    pub projector: crate::sim::modes::ModalProjector,
+    pub projector: crate::snapshot::ModalProjector,
 }
 
 /// Something that watches a run.

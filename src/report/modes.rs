@@ -12,8 +12,10 @@ pub struct ModesReport {
     pub settled: bool,
     pub settle_steps: u64,
     pub free_bodies: usize,
-    /// Six per free body.
+    /// Six per free body, or one per free joint of a jointed structure.
     pub coordinates: usize,
+    /// A jointed structure's coordinates: its free joints, by name (empty for free bodies).
+    pub joint_coordinates: Vec<String>,
     /// Modes with |omega^2| below `zero_mode_ratio` of the largest (free rigid motions).
     pub rigid_modes: usize,
     pub zero_mode_ratio: f64,
@@ -43,11 +45,16 @@ impl ModesReport {
     /// The table: a header, then one row per mode.
     pub fn to_table(&self) -> String {
         let mut out = format!(
-            "== {} [{}]: {} free bodies, {} coordinates, {} rigid-body mode(s) (|omega^2| < {:.0e} of the largest){}\n",
+            "== {} [{}]: {} free bodies, {} coordinates{}, {} rigid-body mode(s) (|omega^2| < {:.0e} of the largest){}\n",
             self.name,
             self.file,
             self.free_bodies,
             self.coordinates,
+            if self.joint_coordinates.is_empty() {
+                String::new()
+            } else {
+                format!(" (joints {})", self.joint_coordinates.join(", "))
+            },
             self.rigid_modes,
             self.zero_mode_ratio,
             if self.settled { String::new() } else { ", NOT SETTLED".into() }

@@ -11,7 +11,7 @@ use crate::observers::{ModeAtStart, SettlePoint};
 use crate::report::{MotionReport, PointReport, ScenarioReport};
 use crate::scenario::Scenario;
 use crate::settings::{FrequencySignal, Motion, MotionStart};
-use crate::sim::modes::ModalProjector;
+use crate::sim::modes::modal_projector;
 
 /// What the report says of a motion before it runs.
 pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
@@ -106,7 +106,7 @@ fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, Stop
         .map(|&index| ModeAtStart {
             index,
             omega_rad_per_s: analysis.modes[index].omega(),
-            projector: ModalProjector::new(&runner.sim, &analysis, index),
+            projector: modal_projector(&runner.sim, &analysis, index),
         })
         .collect();
     if let Some((index, amplitude_m)) = m.mode {

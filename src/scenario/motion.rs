@@ -213,17 +213,15 @@ fn displaced_mode(
     Ok(Some((index, amplitude)))
 }
 
-/// A mode of the structure's own modal analysis (from 1 in the file, from 0 here): only for
-/// structures it analyses (free bodies, springs and elastic cables) and at most six per free
-/// body.
+/// A mode of the structure's own modal analysis (from 1 in the file, from 0 here): at most six
+/// per free body, or one per free (not actuated) joint of a jointed structure.
 fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, ScenarioError> {
-    if let Some(j) = s.joints.first() {
-        return Err(ctx.err(
-            mode,
-            format!("the structure's modes are computed for free bodies only, and joint '{}' is a joint", j.name),
-        ));
-    }
-    let count = 6 * s.bodies.iter().filter(|b| b.kind == crate::structure::BodyKind::Free).count() as i64;
+    let count = if s.joints.is_empty() {
+        6 * s.bodies.iter().filter(|b| b.kind == crate::structure::BodyKind::Free).count() as i64
+    } else {
+        let actuated = |j: usize| s.actuators.iter().any(|a| a.target == crate::structure::ActuatorTarget::Joint(j));
+        (0..s.joints.len()).filter(|j| !actuated(*j)).count() as i64
+    };
     let m = *mode.get_ref();
     if !(1..=count).contains(&m) {
         return Err(ctx.err(mode, format!("mode {m} does not exist: the structure has {count} (from 1)")));

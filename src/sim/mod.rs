@@ -18,6 +18,7 @@
 mod build;
 mod damping;
 mod forces;
+mod joint_modes;
 mod least_squares;
 pub mod modes;
 mod projection;

@@ -5,13 +5,13 @@
 //! `relaxation/assemble.rs`) and the mass matrix M = diag(m 1, R I R^T) per body (the
 //! kinetic energy m v^2 / 2 + w^T I_world w / 2, I_world the principal moments turned by the
 //! body's current rotation R). Structures of free bodies held by springs and elastic cables
-//! (no joints, no inextensible cables: the relaxation's own domain); others are refused, by
-//! name. Modes with |omega^2| below [`ZERO_MODE_RATIO`] of the largest are rigid-body modes
+//! (no inextensible cables: the relaxation's own domain); jointed ones are reduced to their
+//! joints' coordinates (`joint_modes.rs`); others are refused, by name. Modes with |omega^2| below [`ZERO_MODE_RATIO`] of the largest are rigid-body modes
 //! (a free turn or translation, a strut's spin about its axis): reported as ~0 and counted.
 
 use super::Simulation;
 use crate::eigen::EigenError;
-use crate::snapshot::{BodyPose, Snapshot};
+use crate::snapshot::{BodyPose, ModalProjector};
 use crate::structure::{BodyKind, CableLaw};
 use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
 
@@ -32,6 +32,9 @@ pub struct StructureMode {
     /// Every node's displacement in this mode, in structure node order [m per unit of the
     /// mass-normalised amplitude]; zero on fixed bodies.
     pub node_motion: Vec<[f64; 3]>,
+    /// A jointed structure's mode in its joints' coordinates (rad or m, mass-normalised; in
+    /// the order of [`StructureModes::joints`]); empty for free bodies.
+    pub joint_shape: Vec<f64>,
 }
 
 impl StructureMode {
@@ -56,6 +59,9 @@ impl StructureMode {
 pub struct StructureModes {
     /// The structure body of each block of six coordinates.
     pub bodies: Vec<usize>,
+    /// A jointed structure's coordinates: its free joints (`joint_modes.rs`); empty for free
+    /// bodies, whose coordinates are the bodies' six each.
+    pub joints: Vec<usize>,
     /// Each free body's pose at the state analysed.
     pub poses: Vec<BodyPose>,
     /// The mass matrix there (six coordinates per free body).
@@ -69,11 +75,12 @@ pub struct StructureModes {
 /// Why a structure's modes are not computed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ModesError {
-    #[error(
-        "joint '{0}': modes are computed for free bodies held by springs and elastic cables only (a reduction \
-         to the joints' coordinates is not implemented)"
-    )]
-    Joint(String),
+    #[error("joint '{0}' closes a loop: modes are reduced to the coordinates of joint trees only")]
+    Loop(String),
+    #[error("free body '{0}' hangs on no joint: a structure of free bodies and joints together is not analysed")]
+    Unjointed(String),
+    #[error("joint '{0}' has more than one coordinate: modes are reduced to revolute and prismatic joints")]
+    JointKind(String),
     #[error("inextensible cable '{0}': modes are computed for springs and elastic cables only")]
     InextensibleCable(String),
     #[error("no free body: nothing moves")]
@@ -83,17 +90,18 @@ pub enum ModesError {
 }
 
 impl Simulation {
-    /// The structure's natural modes at its current state.
-    pub fn modes(&self) -> Result<StructureModes, ModesError> {
+    /// The structure's natural modes at its current state: over six coordinates per free body,
+    /// or reduced to the joints' coordinates where there are joints (`joint_modes.rs`).
+    pub fn modes(&mut self) -> Result<StructureModes, ModesError> {
         let s = &self.model.structure;
-        if let Some(j) = s.joints.first() {
-            return Err(ModesError::Joint(j.name.clone()));
-        }
         if let Some(c) = s.cables.iter().find(|c| !matches!(c.law, CableLaw::Elastic { .. })) {
             return Err(ModesError::InextensibleCable(c.name.clone()));
         }
         if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
             return Err(ModesError::NoFreeBody);
+        }
+        if !s.joints.is_empty() {
+            return self.joint_modes();
         }
         let tangent = self.tangent_stiffness();
         let mass = self.mass_matrix(&tangent.bodies);
@@ -106,11 +114,12 @@ impl Simulation {
                 rigid: e.omega_squared.abs() <= ZERO_MODE_RATIO * largest,
                 node_motion: self.node_motion(&tangent.bodies, &tangent.com, e.shape.as_slice()),
                 shape: e.shape.iter().copied().collect(),
+                joint_shape: vec![],
             })
             .collect();
         let rigid = modes.iter().filter(|m| m.rigid).count();
         let poses = tangent.bodies.iter().map(|b| self.body_pose(*b)).collect();
-        Ok(StructureModes { bodies: tangent.bodies, poses, mass, modes, rigid })
+        Ok(StructureModes { bodies: tangent.bodies, joints: vec![], poses, mass, modes, rigid })
     }
 
     /// Displaces the structure along mode `index` (from 0) of `analysis` (made at the current
@@ -121,13 +130,19 @@ impl Simulation {
         let mode = &analysis.modes[index];
         let largest = mode.node_motion.iter().map(|d| Vector3::from(*d).norm()).fold(0.0, f64::max);
         let eta = if largest > 0.0 { amplitude_m / largest } else { 0.0 };
-        self.displace_free_bodies(&(DVector::from_column_slice(&mode.shape) * eta));
+        if analysis.joints.is_empty() {
+            self.displace_free_bodies(&(DVector::from_column_slice(&mode.shape) * eta));
+        } else {
+            for (&j, v) in analysis.joints.iter().zip(&mode.joint_shape) {
+                self.displace_joint(j, eta * v);
+            }
+        }
         eta
     }
 
     /// The mass matrix of the free bodies' blocks: m 1 for the translation, R diag(I) R^T for
     /// the rotation (the principal moments about the centre of mass, turned with the body).
-    fn mass_matrix(&self, bodies: &[usize]) -> DMatrix<f64> {
+    pub(super) fn mass_matrix(&self, bodies: &[usize]) -> DMatrix<f64> {
         let mut m = DMatrix::zeros(6 * bodies.len(), 6 * bodies.len());
         for (i, &b) in bodies.iter().enumerate() {
             let inertia = self.model.structure.bodies[b].inertia.expect("free bodies have inertia");
@@ -142,7 +157,7 @@ impl Simulation {
     }
 
     /// Each node's displacement for the coordinates `shape`: dx + dtheta x rho.
-    fn node_motion(&self, bodies: &[usize], com: &[Vector3<f64>], shape: &[f64]) -> Vec<[f64; 3]> {
+    pub(super) fn node_motion(&self, bodies: &[usize], com: &[Vector3<f64>], shape: &[f64]) -> Vec<[f64; 3]> {
         let s = &self.model.structure;
         (0..s.nodes.len())
             .map(|n| {
@@ -157,57 +172,17 @@ impl Simulation {
     }
 }
 
-/// Reads one mode's coordinate off a snapshot: eta = v^T M (x - x0), v the mass-normalised
-/// shape, M the mass matrix and x0 the poses at the analysed state, x - x0 per free body the
-/// displacement of its centre of mass and the rotation vector of R R0^T. Exact for a motion
-/// along the mode at small amplitude; the other modes, M-orthogonal to it, do not enter.
-#[derive(Clone, Debug)]
-pub struct ModalProjector {
-    bodies: Vec<usize>,
-    start: Vec<BodyPose>,
-    /// Each body's centre of mass in its own frame [m].
-    com_local: Vec<Vector3<f64>>,
-    /// M v: six per free body.
-    weights: Vec<f64>,
-}
-
-fn rotation(p: &BodyPose) -> UnitQuaternion<f64> {
-    let q = p.rotation_xyzw;
-    UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]))
-}
-
-fn com_world(p: &BodyPose, local: &Vector3<f64>) -> Vector3<f64> {
-    Vector3::from(p.translation) + rotation(p) * local
-}
-
-impl ModalProjector {
-    /// The coordinate of mode `index` (from 0) of `analysis`.
-    pub fn new(sim: &Simulation, analysis: &StructureModes, index: usize) -> Self {
-        let s = sim.structure();
-        let com_local = analysis
-            .bodies
-            .iter()
-            .map(|b| Vector3::from(s.bodies[*b].inertia.map_or([0.0; 3], |i| i.com)))
-            .collect();
-        let weights = &analysis.mass * DVector::from_column_slice(&analysis.modes[index].shape);
-        ModalProjector {
-            bodies: analysis.bodies.clone(),
-            start: analysis.poses.clone(),
-            com_local,
-            weights: weights.iter().copied().collect(),
-        }
-    }
-
-    /// The modal coordinate in the state `snap`.
-    pub fn coordinate(&self, snap: &Snapshot) -> f64 {
-        let mut eta = 0.0;
-        for (i, b) in self.bodies.iter().enumerate() {
-            let (now, start) = (&snap.body_poses[*b], &self.start[i]);
-            let du = com_world(now, &self.com_local[i]) - com_world(start, &self.com_local[i]);
-            let dtheta = (rotation(now) * rotation(start).inverse()).scaled_axis();
-            let w = &self.weights[6 * i..6 * i + 6];
-            eta += w[0] * du.x + w[1] * du.y + w[2] * du.z + w[3] * dtheta.x + w[4] * dtheta.y + w[5] * dtheta.z;
-        }
-        eta
+/// The reader of mode `index` (from 0) of `analysis`'s coordinate off a snapshot (plain data,
+/// `snapshot::ModalProjector`).
+pub fn modal_projector(sim: &Simulation, analysis: &StructureModes, index: usize) -> ModalProjector {
+    let s = sim.structure();
+    let com_local =
+        analysis.bodies.iter().map(|b| s.bodies[*b].inertia.map_or([0.0; 3], |i| i.com)).collect();
+    let weights = &analysis.mass * DVector::from_column_slice(&analysis.modes[index].shape);
+    ModalProjector {
+        bodies: analysis.bodies.clone(),
+        start: analysis.poses.clone(),
+        com_local,
+        weights: weights.iter().copied().collect(),
     }
 }

@@ -73,7 +73,7 @@ fn modes_of(path: &str, text: Option<&str>) -> StructureModes {
         Some(t) => scenario::parse(Path::new(path), t).unwrap(),
         None => scenario::load(Path::new(path)).unwrap(),
     };
-    let state = settle_first_point(&sc, None).unwrap();
+    let mut state = settle_first_point(&sc, None).unwrap();
     assert!(state.settled, "{path} settles");
     state.sim.modes().unwrap()
 }
@@ -104,12 +104,29 @@ fn prism3_has_the_frequencies_mujoco_reports() {
     }
 }
 
-/// A structure with joints is refused, by name, with exit 2.
+/// A jointed structure's modes are reduced to its free joints' coordinates: the pinned bar's
+/// one mode is the pendulum's sqrt(V''(q*) / I) = 16.2228403 rad/s, and ji2014's platform about
+/// D1 (the actuators held) has sqrt(K / I_D1) with K of Eq. 42, each within 1e-7 (measured
+/// 1.5e-8 and 5.1e-9: the finite differences' round-off).
 #[test]
-fn joints_are_refused_by_name() {
-    let (code, _, err) = common::tensegrity(&["modes", "scenarios/custom/pinned_bar_modes.toml"]);
+fn a_jointed_structure_is_reduced_to_its_joints_coordinates() {
+    let bar = modes_of("scenarios/custom/pinned_bar_vibration.toml", None);
+    assert_eq!((bar.joints.len(), bar.modes.len(), bar.rigid), (1, 1, 0));
+    let k = 1.0 * f64::hypot(50.0 * 0.8, 30.0 * 0.6);
+    let omega = (k / (0.5 / 3.0)).sqrt();
+    assert!((bar.modes[0].omega() - omega).abs() <= 1e-7 * omega, "{} against {omega}", bar.modes[0].omega());
+    let ji = modes_of("scenarios/ji2014/free_vibration.toml", None);
+    assert_eq!(ji.joints.len(), 1, "D1 alone: L3 and theta1 are held");
+    let eq42 = 29.258228902; // sqrt(K / (2 m L^2 / 3)) at L3 = 1, theta1 = 0.5 (the motion run's)
+    assert!((ji.modes[0].omega() - eq42).abs() <= 1e-7 * eq42, "{}", ji.modes[0].omega());
+}
+
+/// A structure whose joints close a loop is refused, naming the closing joint, with exit 2.
+#[test]
+fn loops_are_refused_by_name() {
+    let (code, _, err) = common::tensegrity(&["modes", "scenarios/custom/snelson-x.toml"]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("joint 'pin'"), "{err}");
+    assert!(err.contains("joint 'D' closes a loop"), "{err}");
 }
 
 /// The Python that has MuJoCo (`TENSEGRITY_PYTHON`, else `python3`), or None.

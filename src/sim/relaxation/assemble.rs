@@ -78,7 +78,7 @@ impl Simulation {
     }
 
     /// Constant loads on body `b` (gravity, external and probe loads): force [N], torque [N m].
-    pub(super) fn constant_load(&self, b: usize) -> (Vector3<f64>, Vector3<f64>) {
+    pub(in crate::sim) fn constant_load(&self, b: usize) -> (Vector3<f64>, Vector3<f64>) {
         let s = &self.model.structure;
         let g = Vector3::from(s.gravity);
         let mass = s.bodies[b].inertia.map_or(0.0, |i| i.mass_kg);
