@@ -1,0 +1,127 @@
+"""Check published tensegrity models against f64 rigid-body dynamics, from Python.
+
+The testbed's own API (the same code as the ``tensegrity`` command, built with PyO3): load and
+check a scenario from a path or from TOML text with ``NAME=VALUE`` overrides, run it (the GIL
+released; Ctrl-C stops it at the next tick), and read the result as the JSON report (a dict),
+one row per settle point (a pandas DataFrame) and every tick (a pyarrow Table). Units are SI:
+m, rad, N, N m, s.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any, Mapping, Optional, Sequence, Union
+
+from . import _tensegrity
+
+__all__ = ["ScenarioError", "Result", "check", "run"]
+
+Scenario = Union[str, "os.PathLike[str]"]
+
+
+class ScenarioError(ValueError):
+    """A scenario the testbed refuses, located: ``file``, ``line``, ``col`` (from 1), ``message``."""
+
+    def __init__(self, file: str, line: int, col: int, message: str) -> None:
+        super().__init__(f"{file}:{line}:{col}: {message}")
+        self.file, self.line, self.col, self.message = file, line, col, message
+
+
+def _source(scenario: Scenario, name: str) -> tuple[str, Optional[str]]:
+    """(path, None) for a file, (name, text) for TOML text (anything with a newline)."""
+    if isinstance(scenario, os.PathLike) or "\n" not in str(scenario):
+        return os.fspath(scenario), None
+    return name, str(scenario)
+
+
+def _sets(set: Optional[Mapping[str, Any]]) -> list[str]:
+    """``{"k1": 60.0, "sim.dt": 1e-3}`` as the CLI's ``--set NAME=VALUE`` flags."""
+    return [f"{k}={v!r}" if isinstance(v, float) else f"{k}={v}" for k, v in (set or {}).items()]
+
+
+def _call(f, *args, **kwargs):
+    try:
+        return f(*args, **kwargs)
+    except _tensegrity.TestbedError as e:
+        raise ScenarioError(*e.args) from None
+
+
+def check(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml") -> str:
+    """Checks a scenario (a path, or TOML text named ``name``); returns its name.
+
+    Raises ScenarioError at the file, line and column of what is wrong.
+    """
+    path, text = _source(scenario, name)
+    return _call(_tensegrity.check, path, text, _sets(set))
+
+
+class Result:
+    """A finished run: ``report`` (the JSON report of ``tensegrity run --json``, one scenario,
+    as a dict), ``passed`` (the physics' verdict), ``as_expected`` (whether that is what the
+    scenario declares), ``failures`` (``"settle"``, ``"prediction:NAME"``, ...), ``points`` and
+    ``table``."""
+
+    def __init__(self, report: dict, table_path: Optional[Path]) -> None:
+        self.report = report
+        self.passed: bool = report["passed"]
+        self.as_expected: Optional[bool] = report.get("as_expected")
+        self.failures: list[str] = list(report["failures"])
+        self._table_path = table_path
+        self._table = None
+
+    @property
+    def points(self):
+        """One row per settle point (pandas DataFrame): ``index``, ``settled``, ``steps``,
+        ``branch``, ``stable``, residuals, and the columns ``input:NAME``, ``param:NAME``,
+        ``analytic:NAME`` and ``simulated:NAME`` (the report's values, bit for bit)."""
+        import pandas as pd
+
+        scalars = ("index", "settled", "steps", "branch", "stable", "residual_force_n", "residual_torque_nm")
+        rows = []
+        for p in self.report["points"]:
+            row = {k: p.get(k) for k in scalars}
+            row.update({f"input:{k}": v for k, v in p["inputs"].items()})
+            row.update({f"param:{k}": v for k, v in self.report["params"].items()})
+            row.update({f"analytic:{k}": v for k, v in p["analytic"].items()})
+            row.update({f"simulated:{k}": v for k, v in p["simulated"].items()})
+            rows.append(row)
+        return pd.DataFrame(rows)
+
+    @property
+    def table(self):
+        """Every tick (pyarrow Table, the columns of ``tensegrity run --table``); None unless the
+        run was asked for it (``run(..., table=True)``)."""
+        if self._table is None and self._table_path is not None:
+            import pyarrow.ipc
+
+            with pyarrow.ipc.open_file(str(self._table_path)) as f:
+                self._table = f.read_all()
+            self._table_path.unlink(missing_ok=True)
+            self._table_path = None
+        return self._table
+
+    def __repr__(self) -> str:
+        verdict = "PASS" if self.passed else f"FAIL ({', '.join(self.failures)})"
+        return f"<Result {self.report['name']!r}: {verdict}, as expected: {self.as_expected}>"
+
+
+def run(
+    scenario: Scenario,
+    set: Optional[Mapping[str, Any]] = None,
+    table: bool = False,
+    name: str = "<string>.toml",
+) -> Result:
+    """Runs a scenario (a path, or TOML text named ``name``) with overrides ``set``
+    (``{"k1": 60.0, "sim.dt": 1e-3}``, as ``--set``). ``table``: keep every tick as a pyarrow
+    Table (``Result.table``). Raises ScenarioError on bad input, KeyboardInterrupt on Ctrl-C."""
+    path, text = _source(scenario, name)
+    table_path = None
+    if table:
+        fd, tmp = tempfile.mkstemp(suffix=".arrow", prefix="tensegrity-")
+        os.close(fd)
+        table_path = Path(tmp)
+    report = json.loads(_call(_tensegrity.run_json, path, text, _sets(set), str(table_path) if table_path else None))
+    return Result(report, table_path)
