@@ -7,8 +7,11 @@ use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
+use tensegrity_testbed::file_model::spec::ErrorClass;
+use tensegrity_testbed::observers::external::{External, ExternalModel, ExternalPrediction};
 use tensegrity_testbed::run::{self, RunOptions};
 use tensegrity_testbed::scenario::{self, Override, Scenario, ScenarioError};
 
@@ -40,17 +43,88 @@ fn check(path: &str, text: Option<&str>, set: Vec<String>) -> PyResult<String> {
     Ok(load(path, text, &set)?.name)
 }
 
+/// A Python callable `f(params, inputs, t) -> {name: value}` as the testbed's external model:
+/// called with the GIL from the run's thread; its first failure (an exception, a prediction
+/// left out, a value that is not a finite float) is kept and raised after the run.
+struct PyModel {
+    function: Py<PyAny>,
+    names: Vec<String>,
+    failure: Mutex<Option<PyErr>>,
+}
+
+impl PyModel {
+    fn call(&self, py: Python<'_>, params: &BTreeMap<String, f64>, inputs: &BTreeMap<String, f64>, t: Option<f64>) -> PyResult<BTreeMap<String, f64>> {
+        let out: BTreeMap<String, f64> = self.function.call1(py, (params.clone(), inputs.clone(), t))?.extract(py)?;
+        for n in &self.names {
+            match out.get(n) {
+                Some(v) if v.is_finite() => {}
+                Some(v) => return Err(PyValueError::new_err(format!("the model's prediction '{n}' is {v}, not a finite number"))),
+                None => {
+                    let got: Vec<&String> = out.keys().collect();
+                    return Err(PyValueError::new_err(format!("the model returned no prediction '{n}' (it returned {got:?})")));
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+impl ExternalModel for PyModel {
+    fn predict(&self, params: &BTreeMap<String, f64>, inputs: &BTreeMap<String, f64>, time_s: Option<f64>) -> Result<BTreeMap<String, f64>, String> {
+        Python::attach(|py| {
+            self.call(py, params, inputs, time_s).map_err(|e| {
+                let message = e.to_string();
+                let mut failure = self.failure.lock().expect("one lock holder at a time");
+                failure.get_or_insert(e);
+                message
+            })
+        })
+    }
+}
+
+/// (name, quantity, class, tolerance, rms tolerance) as the testbed's predictions.
+type PredictionTuple = (String, String, String, f64, Option<f64>);
+
+fn predictions(raw: Vec<PredictionTuple>) -> PyResult<Vec<ExternalPrediction>> {
+    raw.into_iter()
+        .map(|(name, quantity, class, tolerance, rms_tolerance)| {
+            let class = ErrorClass::parse(&class).ok_or_else(|| {
+                PyValueError::new_err(format!("prediction '{name}': class '{class}' (expected one of {:?})", ErrorClass::NAMES))
+            })?;
+            let positive = |t: f64| t.is_finite() && t > 0.0;
+            if !positive(tolerance) || rms_tolerance.is_some_and(|t| !positive(t)) {
+                return Err(PyValueError::new_err(format!("prediction '{name}': tolerances are finite and > 0")));
+            }
+            Ok(ExternalPrediction { name, quantity, class, tolerance, rms_tolerance })
+        })
+        .collect()
+}
+
 /// Runs a scenario; the report as JSON. `table`: also write every tick to this file (`.arrow`
-/// or `.csv`). The run happens on a thread of its own, without the GIL; Ctrl-C stops it at the
-/// next tick and raises KeyboardInterrupt.
+/// or `.csv`). `model` and `predictions`: a Python callable compared as the file's predictions
+/// are. The run happens on a thread of its own, without the GIL; Ctrl-C stops it at the next
+/// tick and raises KeyboardInterrupt.
 #[pyfunction]
-#[pyo3(signature = (path, text=None, set=Vec::new(), table=None))]
-fn run_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>, table: Option<PathBuf>) -> PyResult<String> {
+#[pyo3(signature = (path, text=None, set=Vec::new(), table=None, model=None, predictions=Vec::new()))]
+#[allow(clippy::too_many_arguments)]
+fn run_json(
+    py: Python<'_>,
+    path: &str,
+    text: Option<&str>,
+    set: Vec<String>,
+    table: Option<PathBuf>,
+    model: Option<Py<PyAny>>,
+    predictions: Vec<PredictionTuple>,
+) -> PyResult<String> {
     let sc = load(path, text, &set)?;
+    let predictions = self::predictions(predictions)?;
+    let names = predictions.iter().map(|p| p.name.clone()).collect();
+    let model = model.map(|function| Arc::new(PyModel { function, names, failure: Mutex::new(None) }));
+    let external = model.clone().map(|m| External { model: m as Arc<dyn ExternalModel>, predictions });
     let cancel = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&cancel);
     let worker = std::thread::spawn(move || {
-        let opts = RunOptions { cancel: Some(&flag), table, ..Default::default() };
+        let opts = RunOptions { cancel: Some(&flag), table, external, ..Default::default() };
         serde_json::to_string(&run::run(&sc, &opts)).expect("a report serialises")
     });
     while !worker.is_finished() {
@@ -61,7 +135,11 @@ fn run_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>, ta
             return Err(e);
         }
     }
-    py.detach(|| worker.join()).map_err(|_| PyException::new_err("the run panicked"))
+    let json = py.detach(|| worker.join()).map_err(|_| PyException::new_err("the run panicked"))?;
+    if let Some(e) = model.and_then(|m| m.failure.lock().expect("the run is over").take()) {
+        return Err(e);
+    }
+    Ok(json)
 }
 
 #[pymodule]

@@ -13,11 +13,11 @@ import json
 import os
 import tempfile
 from pathlib import Path
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Mapping, NamedTuple, Optional, Sequence, Union
 
 from . import _tensegrity
 
-__all__ = ["ScenarioError", "Result", "check", "run"]
+__all__ = ["ScenarioError", "Prediction", "Result", "check", "run"]
 
 Scenario = Union[str, "os.PathLike[str]"]
 
@@ -40,6 +40,20 @@ def _source(scenario: Scenario, name: str) -> tuple[str, Optional[str]]:
 def _sets(set: Optional[Mapping[str, Any]]) -> list[str]:
     """``{"k1": 60.0, "sim.dt": 1e-3}`` as the CLI's ``--set NAME=VALUE`` flags."""
     return [f"{k}={v!r}" if isinstance(v, float) else f"{k}={v}" for k, v in (set or {}).items()]
+
+
+class Prediction(NamedTuple):
+    """What a Python model predicts, judged as a file's ``[[predictions]]`` entry: the model's
+    output ``name`` against the simulated ``quantity`` (the mechanism's or the file's), in the
+    error ``cls`` ("length" [m], "angle" [rad, wrapped] or "relative"), within ``tolerance`` at
+    every settle point (over the motion's ticks in a motion run, with ``rms_tolerance``); it
+    fails as ``prediction:NAME``."""
+
+    name: str
+    quantity: str
+    cls: str
+    tolerance: float
+    rms_tolerance: Optional[float] = None
 
 
 def _call(f, *args, **kwargs):
@@ -108,20 +122,40 @@ class Result:
         return f"<Result {self.report['name']!r}: {verdict}, as expected: {self.as_expected}>"
 
 
+Model = Callable[[dict, dict, Optional[float]], Mapping[str, float]]
+
+
 def run(
     scenario: Scenario,
     set: Optional[Mapping[str, Any]] = None,
     table: bool = False,
     name: str = "<string>.toml",
+    model: Optional[Model] = None,
+    predictions: Sequence[Prediction] = (),
 ) -> Result:
     """Runs a scenario (a path, or TOML text named ``name``) with overrides ``set``
     (``{"k1": 60.0, "sim.dt": 1e-3}``, as ``--set``). ``table``: keep every tick as a pyarrow
-    Table (``Result.table``). Raises ScenarioError on bad input, KeyboardInterrupt on Ctrl-C."""
+    Table (``Result.table``).
+
+    ``model``: a Python model, ``model(params, inputs, t) -> {name: value}`` (dicts of floats in
+    SI units; ``t`` the time since a motion started [s], None outside a motion), called at every
+    settle point and tick, each of ``predictions`` compared as a file's ``[[predictions]]``
+    entry (report rows of kind "prediction", failures ``prediction:NAME``). An exception in the
+    model, or a prediction it leaves out or makes non-finite, is raised after the run.
+
+    Raises ScenarioError on bad input, KeyboardInterrupt on Ctrl-C."""
+    if model is not None and not callable(model):
+        raise TypeError(f"model must be callable, got {type(model).__name__}")
+    if predictions and model is None:
+        raise ValueError("predictions need a model")
+    preds = [tuple(Prediction(*p)) for p in predictions]
     path, text = _source(scenario, name)
     table_path = None
     if table:
         fd, tmp = tempfile.mkstemp(suffix=".arrow", prefix="tensegrity-")
         os.close(fd)
         table_path = Path(tmp)
-    report = json.loads(_call(_tensegrity.run_json, path, text, _sets(set), str(table_path) if table_path else None))
+    report = json.loads(
+        _call(_tensegrity.run_json, path, text, _sets(set), str(table_path) if table_path else None, model, preds)
+    )
     return Result(report, table_path)

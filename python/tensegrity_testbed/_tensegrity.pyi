@@ -1,9 +1,18 @@
-from typing import Optional, Sequence
+from typing import Callable, Mapping, Optional, Sequence, Tuple
 
 class TestbedError(Exception): ...
 
 def check(path: str, text: Optional[str] = None, set: Sequence[str] = ...) -> str:
     """The scenario's name; TestbedError(file, line, col, message) when it is refused."""
 
-def run_json(path: str, text: Optional[str] = None, set: Sequence[str] = ..., table: Optional[str] = None) -> str:
-    """The run's report (one scenario) as JSON; `table`: every tick written to this file."""
+def run_json(
+    path: str,
+    text: Optional[str] = None,
+    set: Sequence[str] = ...,
+    table: Optional[str] = None,
+    model: Optional[Callable[[dict, dict, Optional[float]], Mapping[str, float]]] = None,
+    predictions: Sequence[Tuple[str, str, str, float, Optional[float]]] = ...,
+) -> str:
+    """The run's report (one scenario) as JSON; `table`: every tick written to this file;
+    `model` and `predictions` (name, quantity, class, tolerance, rms tolerance): a Python model
+    compared as the file's predictions are."""

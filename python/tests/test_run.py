@@ -86,3 +86,44 @@ def test_ctrl_c_stops_a_run():
     child.send_signal(signal.SIGINT)
     out, _ = child.communicate(timeout=60)  # a guard against a hang, not a speed target
     assert child.returncode == 3 and "interrupted" in out
+
+
+SWEEP = ROOT / "scenarios" / "custom" / "pinned_bar_sweep.toml"
+
+
+def bar_model(params, inputs, t):
+    """The pinned bar's equilibrium q = atan2(k1 a, k2 b) [rad]."""
+    import math
+
+    return {"q_py": math.atan2(params["k1"] * params["a"], params["k2"] * params["b"])}
+
+
+def test_a_python_model_is_judged_as_the_files_prediction():
+    """Over the nine k1 of the sweep the callable's errors are the file's prediction's to 1e-15."""
+    result = tt.run(SWEEP, model=bar_model, predictions=[tt.Prediction("q_py", "q", "angle", 1e-9)])
+    checks = {c["name"]: c for c in result.report["model_checks"]}
+    file_row, py_row = checks["q"], checks["q_py"]
+    assert py_row["kind"] == "prediction" and py_row["points_compared"] == file_row["points_compared"] == 9
+    assert abs(py_row["max_error"] - file_row["max_error"]) <= 1e-15
+    assert abs(py_row["transient_max_error"] - file_row["transient_max_error"]) <= 1e-15
+    assert py_row["passed"] and result.as_expected
+
+
+def test_a_wrong_python_model_fails_by_name():
+    wrong = lambda p, i, t: {"q_py": bar_model(p, i, t)["q_py"] + 1e-3}
+    result = tt.run(SWEEP, model=wrong, predictions=[tt.Prediction("q_py", "q", "angle", 1e-9)])
+    assert "prediction:q_py" in result.failures
+    row = next(c for c in result.report["model_checks"] if c["name"] == "q_py")
+    assert abs(row["max_error"] - 1e-3) <= 1e-9
+
+
+def test_a_model_that_raises_or_returns_other_names_raises():
+    def raises(p, i, t):
+        raise RuntimeError("no branch here")
+
+    with pytest.raises(RuntimeError, match="no branch here"):
+        tt.run(SWEEP, model=raises, predictions=[tt.Prediction("q_py", "q", "angle", 1e-9)])
+    with pytest.raises(ValueError, match="no prediction 'q_py'"):
+        tt.run(SWEEP, model=lambda p, i, t: {"other": 0.0}, predictions=[tt.Prediction("q_py", "q", "angle", 1e-9)])
+    with pytest.raises(ValueError, match="class"):
+        tt.run(SWEEP, model=bar_model, predictions=[tt.Prediction("q_py", "q", "degrees", 1e-9)])

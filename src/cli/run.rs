@@ -90,6 +90,7 @@ pub fn run(
             record_every: o.record_every,
             skip_findings: false,
             table: o.table_path(sc, several),
+            external: None,
         };
         // A panic inside one scenario fails that scenario, with its message; the batch goes on.
         let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_scenario(sc, &opts)))

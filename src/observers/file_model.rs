@@ -127,7 +127,7 @@ struct ModesAt {
 
 /// Errors gathered for one prediction or equation.
 #[derive(Clone, Debug, Default)]
-struct Acc {
+pub(super) struct Acc {
     settled_max: f64,
     points: usize,
     transient_max: f64,
@@ -141,14 +141,14 @@ struct Acc {
 
 impl Acc {
     /// A settle point's error (a NaN or an unsettled point counts as infinite).
-    fn point(&mut self, e: f64, settled: bool) {
+    pub(super) fn point(&mut self, e: f64, settled: bool) {
         let e = if settled && e.is_finite() { e } else { f64::INFINITY };
         self.settled_max = self.settled_max.max(e);
         self.points += 1;
     }
 
     /// A motion tick's error (NaN counts as infinite: the prediction failed there).
-    fn motion_tick(&mut self, e: f64) {
+    pub(super) fn motion_tick(&mut self, e: f64) {
         let e = if e.is_nan() { f64::INFINITY } else { e };
         self.motion_max = self.motion_max.max(e);
         self.motion_sum_sq += e * e;
@@ -163,13 +163,51 @@ impl Acc {
         }
     }
 
-    fn tick(&mut self, e: f64) {
+    pub(super) fn tick(&mut self, e: f64) {
         if e.is_finite() {
             self.transient_max = self.transient_max.max(e);
             self.transient_sum_sq += e * e;
             self.ticks += 1;
         }
     }
+}
+
+/// What a compared entry is judged by.
+pub(super) struct Judged<'a> {
+    pub(super) kind: &'a str,
+    pub(super) name: &'a str,
+    pub(super) class: &'a str,
+    pub(super) tolerance: f64,
+    pub(super) rms_tolerance: Option<f64>,
+}
+
+/// The report of one compared entry from its errors `a`: judged at the settle points, or over a
+/// motion's ticks (`over_motion`: the largest error and, if given, the rms one).
+pub(super) fn check_report(j: &Judged, a: &Acc, over_motion: bool) -> ModelCheckReport {
+    let mut r = ModelCheckReport {
+        kind: j.kind.into(),
+        name: j.name.into(),
+        class: j.class.into(),
+        max_error: a.settled_max,
+        tolerance: j.tolerance,
+        passed: a.points > 0 && a.settled_max <= j.tolerance,
+        points_compared: a.points,
+        transient_max_error: a.transient_max,
+        transient_rms_error: if a.ticks > 0 { (a.transient_sum_sq / a.ticks as f64).sqrt() } else { 0.0 },
+        ticks_compared: a.ticks,
+        rms_error: None,
+        rms_tolerance: None,
+        motion_ticks: None,
+    };
+    if over_motion {
+        let rms = a.motion_rms();
+        r.max_error = if a.motion_ticks > 0 { a.motion_max } else { f64::INFINITY };
+        r.passed = a.motion_ticks > 0 && r.max_error <= j.tolerance && j.rms_tolerance.is_none_or(|t| rms <= t);
+        r.rms_error = Some(rms);
+        r.rms_tolerance = j.rms_tolerance;
+        r.motion_ticks = Some(a.motion_ticks);
+    }
+    r
 }
 
 /// The file's `[energy.trajectory]`, if it has one.
@@ -390,6 +428,14 @@ impl ModelObserver {
     /// The table's columns of the model: each quantity (`model:NAME`), each prediction's
     /// predicted value and error (`predicted:NAME`, `error:NAME`), each equation's residual
     /// (`equation:NAME`).
+    /// The file's quantities in this tick's state, by name.
+    pub(super) fn quantities(&self, snap: &Snapshot, t: &Tick) -> Values {
+        let time_s = t.motion_time_s.unwrap_or(snap.time_s);
+        let v = self.values(snap, t.inputs, t.params, t.simulated, time_s);
+        let quantities = self.spec.symbols.iter().enumerate().filter(|(_, s)| matches!(s.source, Source::Quantity(_)));
+        quantities.map(|(i, s)| (s.name.clone(), v[i])).collect()
+    }
+
     pub(super) fn table_columns(&self) -> Vec<String> {
         let q = self.spec.quantities.iter().map(|q| format!("model:{}", q.name));
         let p =
@@ -420,30 +466,8 @@ impl ModelObserver {
             .zip(&self.acc)
             .zip(rms_tolerances)
             .map(|((((kind, class), (name, tolerance)), a), rms_tolerance)| {
-                let mut r = ModelCheckReport {
-                    kind: kind.into(),
-                    name: name.into(),
-                    class: class.into(),
-                    max_error: a.settled_max,
-                    tolerance,
-                    passed: a.points > 0 && a.settled_max <= tolerance,
-                    points_compared: a.points,
-                    transient_max_error: a.transient_max,
-                    transient_rms_error: if a.ticks > 0 { (a.transient_sum_sq / a.ticks as f64).sqrt() } else { 0.0 },
-                    ticks_compared: a.ticks,
-                    rms_error: None,
-                    rms_tolerance: None,
-                    motion_ticks: None,
-                };
-                if self.motion && kind == "prediction" {
-                    let rms = a.motion_rms();
-                    r.max_error = if a.motion_ticks > 0 { a.motion_max } else { f64::INFINITY };
-                    r.passed = a.motion_ticks > 0 && r.max_error <= tolerance && rms_tolerance.is_none_or(|t| rms <= t);
-                    r.rms_error = Some(rms);
-                    r.rms_tolerance = rms_tolerance;
-                    r.motion_ticks = Some(a.motion_ticks);
-                }
-                r
+                let judged = Judged { kind, name, class, tolerance, rms_tolerance };
+                check_report(&judged, a, self.motion && kind == "prediction")
             })
             .chain(self.frequency_reports())
             .chain(self.spec.energy.as_ref().map(|e| {

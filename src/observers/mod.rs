@@ -8,6 +8,7 @@
 //! [`observers`].
 
 pub mod compare;
+pub mod external;
 pub mod file_model;
 pub mod interference;
 pub mod lagrangian;
@@ -117,6 +118,8 @@ pub struct Setup<'a> {
     pub table: Option<std::path::PathBuf>,
     /// A motion run's `[motion]`: its frequencies are measured from its ticks.
     pub motion: Option<&'a crate::settings::Motion>,
+    /// A model outside the file (a Python callable), compared as its predictions are.
+    pub external: Option<external::External>,
 }
 
 /// Every observer of a run, in the order they see each tick.
@@ -130,6 +133,11 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
     }
     if let Some(m) = setup.motion {
         list.push(Box::new(motion::MotionObserver::new(m)));
+    }
+    if let Some(x) = setup.external {
+        let motion = setup.motion.is_some();
+        let file = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, motion));
+        list.push(Box::new(external::ExternalObserver::new(x, file, motion)));
     }
     if let Some(path) = &setup.table {
         let motion = setup.motion.is_some();

@@ -40,6 +40,9 @@ pub struct RunOptions<'a> {
     pub skip_findings: bool,
     /// Write every tick as a row of this CSV table (`observers::table`).
     pub table: Option<PathBuf>,
+    /// A model outside the file (the Python package's callables), compared as the file's
+    /// predictions are (`observers::external`).
+    pub external: Option<crate::observers::external::External>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -203,6 +206,7 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         recording: target.map(|target| Recording { target, every: opts.record_every.max(1), scenario: &sc.source }),
         table: opts.table.clone(),
         motion: sc.motion.as_ref(),
+        external: opts.external.clone(),
     })?;
     let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel, params);
     // The first point's commands (a no-op where the build already placed them).
