@@ -43,6 +43,39 @@ fn check(path: &str, text: Option<&str>, set: Vec<String>) -> PyResult<String> {
     Ok(load(path, text, &set)?.name)
 }
 
+/// Runs `work` on a thread of its own without the GIL, polling for Ctrl-C every
+/// [`SIGNAL_POLL_S`]: on one it raises the flag `work` watches (the run stops at its next
+/// tick), waits for it and raises KeyboardInterrupt.
+fn on_own_thread<T: Send + 'static>(py: Python<'_>, work: impl FnOnce(&AtomicBool) -> T + Send + 'static) -> PyResult<T> {
+    let cancel = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&cancel);
+    let worker = std::thread::spawn(move || work(&flag));
+    while !worker.is_finished() {
+        py.detach(|| std::thread::sleep(Duration::from_secs_f64(SIGNAL_POLL_S)));
+        if let Err(e) = py.check_signals() {
+            cancel.store(true, Ordering::SeqCst);
+            let _ = py.detach(|| worker.join());
+            return Err(e);
+        }
+    }
+    py.detach(|| worker.join()).map_err(|_| PyException::new_err("the run panicked"))
+}
+
+/// Sweeps a scenario's grid (or points) in parallel on `jobs` threads (0: every core): the
+/// CSV of `tensegrity sweep --out` and the JSON summary of `--json`.
+#[pyfunction]
+#[pyo3(signature = (path, text=None, set=Vec::new(), jobs=0))]
+fn sweep_csv(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>, jobs: usize) -> PyResult<(String, String)> {
+    let sc = load(path, text, &set)?;
+    let jobs = if jobs == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { jobs };
+    let result = on_own_thread(py, move |cancel| {
+        let (rows, summary) = tensegrity_testbed::sweep::sweep(&sc, jobs, None, Some(cancel), &|_, _| {})?;
+        let csv = tensegrity_testbed::sweep::to_csv(&rows, &|q: &str| sc.is_angle(q));
+        Ok::<_, tensegrity_testbed::sweep::SweepError>((csv, serde_json::to_string(&summary).expect("a summary serialises")))
+    })?;
+    result.map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
 /// A Python callable `f(params, inputs, t) -> {name: value}` as the testbed's external model:
 /// called with the GIL from the run's thread; its first failure (an exception, a prediction
 /// left out, a value that is not a finite float) is kept and raised after the run.
@@ -121,21 +154,10 @@ fn run_json(
     let names = predictions.iter().map(|p| p.name.clone()).collect();
     let model = model.map(|function| Arc::new(PyModel { function, names, failure: Mutex::new(None) }));
     let external = model.clone().map(|m| External { model: m as Arc<dyn ExternalModel>, predictions });
-    let cancel = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&cancel);
-    let worker = std::thread::spawn(move || {
-        let opts = RunOptions { cancel: Some(&flag), table, external, ..Default::default() };
+    let json = on_own_thread(py, move |cancel| {
+        let opts = RunOptions { cancel: Some(cancel), table, external, ..Default::default() };
         serde_json::to_string(&run::run(&sc, &opts)).expect("a report serialises")
-    });
-    while !worker.is_finished() {
-        py.detach(|| std::thread::sleep(Duration::from_secs_f64(SIGNAL_POLL_S)));
-        if let Err(e) = py.check_signals() {
-            cancel.store(true, Ordering::SeqCst);
-            let _ = py.detach(|| worker.join());
-            return Err(e);
-        }
-    }
-    let json = py.detach(|| worker.join()).map_err(|_| PyException::new_err("the run panicked"))?;
+    })?;
     if let Some(e) = model.and_then(|m| m.failure.lock().expect("the run is over").take()) {
         return Err(e);
     }
@@ -146,6 +168,7 @@ fn run_json(
 fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(run_json, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_csv, m)?)?;
     m.add("TestbedError", m.py().get_type::<TestbedError>())?;
     Ok(())
 }

@@ -17,7 +17,7 @@ from typing import Any, Callable, Mapping, NamedTuple, Optional, Sequence, Union
 
 from . import _tensegrity
 
-__all__ = ["ScenarioError", "Prediction", "Result", "check", "run"]
+__all__ = ["ScenarioError", "Prediction", "Result", "check", "run", "sweep"]
 
 Scenario = Union[str, "os.PathLike[str]"]
 
@@ -159,3 +159,23 @@ def run(
         _call(_tensegrity.run_json, path, text, _sets(set), str(table_path) if table_path else None, model, preds)
     )
     return Result(report, table_path)
+
+
+def sweep(
+    scenario: Scenario,
+    set: Optional[Mapping[str, Any]] = None,
+    jobs: int = 0,
+    name: str = "<string>.toml",
+):
+    """Settles every point of a scenario's grid (or points) in parallel on ``jobs`` threads
+    (0: every core). Returns (DataFrame, summary): the DataFrame has the columns of
+    ``tensegrity sweep --out`` (one row per point, values as the CSV writes them: shortest
+    round-trip decimals, so bit for bit), the summary is the dict of ``--json``. Raises
+    ScenarioError on bad input, KeyboardInterrupt on Ctrl-C."""
+    import io
+
+    import pandas as pd
+
+    path, text = _source(scenario, name)
+    csv, summary = _call(_tensegrity.sweep_csv, path, text, _sets(set), jobs)
+    return pd.read_csv(io.StringIO(csv)), json.loads(summary)

@@ -16,3 +16,6 @@ def run_json(
     """The run's report (one scenario) as JSON; `table`: every tick written to this file;
     `model` and `predictions` (name, quantity, class, tolerance, rms tolerance): a Python model
     compared as the file's predictions are."""
+
+def sweep_csv(path: str, text: Optional[str] = None, set: Sequence[str] = ..., jobs: int = 0) -> Tuple[str, str]:
+    """(the CSV of `tensegrity sweep --out`, the JSON summary of `--json`)."""

@@ -127,3 +127,21 @@ def test_a_model_that_raises_or_returns_other_names_raises():
         tt.run(SWEEP, model=lambda p, i, t: {"other": 0.0}, predictions=[tt.Prediction("q_py", "q", "angle", 1e-9)])
     with pytest.raises(ValueError, match="class"):
         tt.run(SWEEP, model=bar_model, predictions=[tt.Prediction("q_py", "q", "degrees", 1e-9)])
+
+
+def test_a_sweep_from_python_has_the_clis_csv():
+    """The same nine points and values as `tensegrity sweep --out -`."""
+    import io
+
+    import pandas as pd
+
+    frame, summary = tt.sweep(SWEEP, jobs=2)
+    target = os.environ.get("CARGO_TARGET_DIR", str(ROOT / "target"))
+    out = subprocess.run(
+        [os.path.join(target, "release", "tensegrity"), "sweep", str(SWEEP), "--out", "-"],
+        capture_output=True, text=True, cwd=ROOT,
+    )
+    cli = pd.read_csv(io.StringIO(out.stdout))
+    assert len(frame) == 9 and summary["passed"]
+    assert list(frame.columns) == list(cli.columns)
+    pd.testing.assert_frame_equal(frame, cli, check_exact=True)
