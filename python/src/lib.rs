@@ -49,16 +49,31 @@ fn check(path: &str, text: Option<&str>, set: Vec<String>) -> PyResult<String> {
 fn on_own_thread<T: Send + 'static>(py: Python<'_>, work: impl FnOnce(&AtomicBool) -> T + Send + 'static) -> PyResult<T> {
     let cancel = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&cancel);
-    let worker = std::thread::spawn(move || work(&flag));
-    while !worker.is_finished() {
-        py.detach(|| std::thread::sleep(Duration::from_secs_f64(SIGNAL_POLL_S)));
+    let (done, result) = std::sync::mpsc::channel();
+    let worker = std::thread::spawn(move || {
+        // The receiver is gone only after an interruption: nothing is waiting for the result.
+        let _ = done.send(work(&flag));
+    });
+    let poll = Duration::from_secs_f64(SIGNAL_POLL_S);
+    // Waited on without the GIL, which needs a Sync receiver.
+    let result = Mutex::new(result);
+    loop {
+        match py.detach(|| result.lock().expect("one waiter").recv_timeout(poll)) {
+            Ok(value) => {
+                let _ = py.detach(|| worker.join());
+                return Ok(value);
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(PyException::new_err("the run panicked"));
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+        }
         if let Err(e) = py.check_signals() {
             cancel.store(true, Ordering::SeqCst);
             let _ = py.detach(|| worker.join());
             return Err(e);
         }
     }
-    py.detach(|| worker.join()).map_err(|_| PyException::new_err("the run panicked"))
 }
 
 /// Sweeps a scenario's grid (or points) in parallel on `jobs` threads (0: every core): the
