@@ -179,11 +179,23 @@ fn run_json(
     Ok(json)
 }
 
+/// A scenario (TOML text) from the node matrix and the connectivity matrices in files (the
+/// importer of `tensegrity import matrices`); errors at file, line and column.
+#[pyfunction]
+fn import_matrices(n: PathBuf, cb: PathBuf, cs: PathBuf, bar_mass_kg: f64, bar_radius_m: f64, string_stiffness_n_per_m: f64, string_tension_n: f64) -> PyResult<String> {
+    use tensegrity_testbed::import::matrices::{import, MatrixOptions};
+    let o = MatrixOptions { bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n };
+    o.validate().map_err(PyValueError::new_err)?;
+    let imported = import(&n, &cb, &cs, &o).map_err(|e| TestbedError::new_err((e.file.clone(), e.line, e.col, e.message.clone())))?;
+    Ok(imported.toml)
+}
+
 #[pymodule]
 fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(run_json, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(import_matrices, m)?)?;
     m.add("TestbedError", m.py().get_type::<TestbedError>())?;
     Ok(())
 }

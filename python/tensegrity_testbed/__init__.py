@@ -17,7 +17,7 @@ from typing import Any, Callable, Mapping, NamedTuple, Optional, Sequence, Union
 
 from . import _tensegrity
 
-__all__ = ["ScenarioError", "Prediction", "Result", "check", "run", "sweep"]
+__all__ = ["ScenarioError", "Prediction", "Result", "check", "from_matrices", "run", "sweep"]
 
 Scenario = Union[str, "os.PathLike[str]"]
 
@@ -179,3 +179,48 @@ def sweep(
     path, text = _source(scenario, name)
     csv, summary = _call(_tensegrity.sweep_csv, path, text, _sets(set), jobs)
     return pd.read_csv(io.StringIO(csv)), json.loads(summary)
+
+
+def _matrix(name: str, a, rows: Optional[int] = None, cols: Optional[int] = None):
+    """``a`` as a finite 2-D float array, or ValueError naming the matrix and what is wrong."""
+    import numpy as np
+
+    m = np.asarray(a, dtype=float)
+    if m.ndim != 2 or (rows is not None and m.shape[0] != rows) or (cols is not None and m.shape[1] != cols):
+        want = f"({rows if rows is not None else 'k'}, {cols if cols is not None else 'n'})"
+        raise ValueError(f"{name} has shape {m.shape}: expected {want}")
+    bad = np.argwhere(~np.isfinite(m))
+    if len(bad):
+        r, c = bad[0]
+        raise ValueError(f"{name}[{r}, {c}] is {m[r, c]}, not a finite number")
+    return m
+
+
+def from_matrices(
+    N,
+    Cb,
+    Cs,
+    bar_mass_kg: float = 1.0,
+    bar_radius_m: float = 0.01,
+    string_stiffness_n_per_m: float = 100.0,
+    string_tension_n: float = 0.0,
+) -> str:
+    """A scenario (TOML text, for ``run``, ``check`` or a file) from numpy arrays in the
+    notation of Skelton and de Oliveira: N (3 x n node coordinates [m]), Cb and Cs (one row per
+    bar or string: -1 at its first node, 1 at its second). The importer of ``tensegrity import
+    matrices``: each bar a strut on its own body of ``bar_mass_kg``, nodes on no bar fixed,
+    strings elastic of ``string_stiffness_n_per_m`` at ``string_tension_n`` when drawn. Member
+    properties are scalars. Raises ValueError on a wrong shape or a non-finite value."""
+    import numpy as np
+
+    n = _matrix("N", N, rows=3)
+    cb = _matrix("Cb", Cb, cols=n.shape[1])
+    cs = _matrix("Cs", Cs, cols=n.shape[1])
+    with tempfile.TemporaryDirectory(prefix="tensegrity-") as d:
+        paths = [Path(d) / f"{k}.csv" for k in ("N", "Cb", "Cs")]
+        for p, m in zip(paths, (n, cb, cs)):
+            np.savetxt(p, m, delimiter=",", fmt="%.17g")
+        return _call(
+            _tensegrity.import_matrices, *map(str, paths),
+            bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n,
+        )

@@ -19,3 +19,8 @@ def run_json(
 
 def sweep_csv(path: str, text: Optional[str] = None, set: Sequence[str] = ..., jobs: int = 0) -> Tuple[str, str]:
     """(the CSV of `tensegrity sweep --out`, the JSON summary of `--json`)."""
+
+def import_matrices(
+    n: str, cb: str, cs: str, bar_mass_kg: float, bar_radius_m: float, string_stiffness_n_per_m: float, string_tension_n: float
+) -> str:
+    """A scenario's TOML from N, Cb and Cs in CSV files (`tensegrity import matrices`)."""

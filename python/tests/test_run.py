@@ -145,3 +145,61 @@ def test_a_sweep_from_python_has_the_clis_csv():
     assert len(frame) == 9 and summary["passed"]
     assert list(frame.columns) == list(cli.columns)
     pd.testing.assert_frame_equal(frame, cli, check_exact=True)
+
+
+def prism_arrays():
+    """A 3-strut prism drawn untwisted (radius 1 m, height 1.5 m): N, Cb (bars 1-5, 2-6, 3-4),
+    Cs (bottom, top, verticals i to i+3), nodes counted from 1 as in the notation."""
+    import numpy as np
+
+    k = np.arange(6)
+    angle = 2 * np.pi * k / 3
+    N = np.vstack([np.cos(angle), np.sin(angle), np.where(k < 3, 0.0, 1.5)])
+
+    def rows(pairs):
+        C = np.zeros((len(pairs), 6))
+        for r, (a, b) in enumerate(pairs):
+            C[r, a - 1], C[r, b - 1] = -1.0, 1.0
+        return C
+
+    Cb = rows([(1, 5), (2, 6), (3, 4)])
+    Cs = rows([(1, 2), (2, 3), (3, 1), (4, 5), (5, 6), (6, 4), (1, 4), (2, 5), (3, 6)])
+    return N, Cb, Cs
+
+
+def test_a_prism_from_numpy_arrays_settles_to_the_closed_form_twist():
+    """From N, Cb, Cs as arrays, the prism settles with its bars turned by pi/2 + pi/3 (1e-8)."""
+    import numpy as np
+
+    N, Cb, Cs = prism_arrays()
+    text = tt.from_matrices(N, Cb, Cs, bar_radius_m=0.02, string_tension_n=20.0)
+    result = tt.run(text, name="prism.toml")
+    assert result.passed, result.failures
+    sim = result.report["points"][0]["simulated"]
+    p = lambda k: np.array([sim[f"n{k}.{c}"] for c in "xyz"])
+    bottom, top = np.mean([p(k) for k in (1, 2, 3)], axis=0), np.mean([p(k) for k in (4, 5, 6)], axis=0)
+    axis = (top - bottom) / np.linalg.norm(top - bottom)
+    flat = lambda v, c: (v - c) - np.dot(v - c, axis) * axis
+    twists = []
+    for a, b in [(1, 5), (2, 6), (3, 4)]:
+        u, w = flat(p(a), bottom), flat(p(b), top)
+        twists.append(abs(np.arctan2(np.dot(np.cross(u, w), axis), np.dot(u, w))))
+    assert max(abs(t - (np.pi / 2 + np.pi / 3)) for t in twists) <= 1e-8
+
+
+def test_bad_arrays_are_value_errors():
+    import numpy as np
+
+    N, Cb, Cs = prism_arrays()
+    with pytest.raises(ValueError, match=r"N has shape \(2, 6\)"):
+        tt.from_matrices(N[:2], Cb, Cs)
+    bad = N.copy()
+    bad[1, 4] = np.nan
+    with pytest.raises(ValueError, match=r"N\[1, 4\] is nan"):
+        tt.from_matrices(bad, Cb, Cs)
+    with pytest.raises(ValueError, match=r"Cs has shape \(9, 5\)"):
+        tt.from_matrices(N, Cb, Cs[:, :5])
+    with pytest.raises(tt.ScenarioError, match="one -1, one 1"):
+        tt.from_matrices(N, Cb * 2, Cs)
+    with pytest.raises(ValueError, match="bar-mass"):
+        tt.from_matrices(N, Cb, Cs, bar_mass_kg=-1.0)
