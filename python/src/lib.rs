@@ -190,12 +190,83 @@ fn import_matrices(n: PathBuf, cb: PathBuf, cs: PathBuf, bar_mass_kg: f64, bar_r
     Ok(imported.toml)
 }
 
+/// The MJCF export of a scenario's first structure (`tensegrity export mjcf`): (the XML, what
+/// was not exported). `actuators`: "mocap" or "position" (servos of gain `kp`).
+#[pyfunction]
+#[pyo3(signature = (path, text=None, set=Vec::new(), actuators="mocap", kp=1e6, cable_damping=0.0))]
+fn export_mjcf(path: &str, text: Option<&str>, set: Vec<String>, actuators: &str, kp: f64, cable_damping: f64) -> PyResult<(String, Vec<String>)> {
+    use tensegrity_testbed::export::{mjcf::ActuatorMode, scenario_mjcf, validate_mjcf_options};
+    let sc = load(path, text, &set)?;
+    validate_mjcf_options(kp, cable_damping).map_err(PyValueError::new_err)?;
+    let mode = match actuators {
+        "mocap" => ActuatorMode::Mocap,
+        "position" => ActuatorMode::Position,
+        other => return Err(PyValueError::new_err(format!("actuators '{other}': \"mocap\" or \"position\""))),
+    };
+    let mjcf = scenario_mjcf(&sc, mode, kp, cable_damping).map_err(PyValueError::new_err)?;
+    Ok((mjcf.xml, mjcf.warnings))
+}
+
+/// A built-in mechanism by name, its parameters (defaults for those not given, validated) and
+/// the remaining values as inputs.
+fn mechanism_values(
+    name: &str,
+    values: BTreeMap<String, f64>,
+) -> PyResult<(Box<dyn tensegrity_testbed::mechanisms::Mechanism>, BTreeMap<String, f64>, BTreeMap<String, f64>)> {
+    use tensegrity_testbed::mechanisms;
+    let m = mechanisms::find(name).ok_or_else(|| {
+        let known: Vec<_> = mechanisms::registry().iter().map(|m| m.name()).collect();
+        PyValueError::new_err(format!("unknown mechanism '{name}' (expected one of: {})", known.join(", ")))
+    })?;
+    let (params, inputs): (BTreeMap<_, _>, BTreeMap<_, _>) =
+        values.into_iter().partition(|(k, _)| m.params().iter().any(|p| p.symbol == k));
+    if let Some((k, v)) = params.iter().chain(&inputs).find(|(_, v)| !v.is_finite()) {
+        return Err(PyValueError::new_err(format!("{k} = {v}: values are finite")));
+    }
+    let params = mechanisms::with_defaults(m.as_ref(), &params);
+    m.validate_params(&params).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok((m, params, inputs))
+}
+
+/// The analytic model alone (`tensegrity solve`): every solution of `query` as (label, values,
+/// stable).
+#[pyfunction]
+fn solve(mechanism: &str, query: &str, values: BTreeMap<String, f64>) -> PyResult<Vec<(String, BTreeMap<String, f64>, Option<bool>)>> {
+    let (m, params, inputs) = mechanism_values(mechanism, values)?;
+    let Some(q) = m.queries().iter().find(|q| q.name == query) else {
+        let known: Vec<_> = m.queries().iter().map(|q| q.name).collect();
+        return Err(PyValueError::new_err(format!("unknown query '{query}' for {mechanism} (expected one of: {})", known.join(", "))));
+    };
+    if let Some(k) = inputs.keys().find(|k| !q.inputs.contains(&k.as_str())) {
+        return Err(PyValueError::new_err(format!("'{k}' is neither a parameter of {mechanism} nor an input of '{query}' ({})", q.inputs.join(", "))));
+    }
+    if let Some(i) = q.inputs.iter().find(|i| !inputs.contains_key(**i)) {
+        return Err(PyValueError::new_err(format!("query '{query}' needs {i} (inputs: {})", q.inputs.join(", "))));
+    }
+    let sols = m.solve(query, &params, &inputs).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(sols.into_iter().map(|s| (s.label, s.values, s.stable)).collect())
+}
+
+/// Every printed equation of a built-in mechanism's paper checked (`tensegrity findings`):
+/// (equation, claim, measured, holds).
+#[pyfunction]
+fn findings(mechanism: &str, params: BTreeMap<String, f64>) -> PyResult<Vec<(String, String, String, bool)>> {
+    let (m, params, inputs) = mechanism_values(mechanism, params)?;
+    if let Some(k) = inputs.keys().next() {
+        return Err(PyValueError::new_err(format!("'{k}' is not a parameter of {mechanism}")));
+    }
+    Ok(m.findings(&params).into_iter().map(|f| (f.equation.to_string(), f.claim.to_string(), f.measured, f.holds)).collect())
+}
+
 #[pymodule]
 fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(run_json, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_csv, m)?)?;
     m.add_function(wrap_pyfunction!(import_matrices, m)?)?;
+    m.add_function(wrap_pyfunction!(export_mjcf, m)?)?;
+    m.add_function(wrap_pyfunction!(solve, m)?)?;
+    m.add_function(wrap_pyfunction!(findings, m)?)?;
     m.add("TestbedError", m.py().get_type::<TestbedError>())?;
     Ok(())
 }

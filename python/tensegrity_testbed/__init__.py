@@ -17,7 +17,10 @@ from typing import Any, Callable, Mapping, NamedTuple, Optional, Sequence, Union
 
 from . import _tensegrity
 
-__all__ = ["ScenarioError", "Prediction", "Result", "check", "from_matrices", "run", "sweep"]
+__all__ = [
+    "ScenarioError", "Prediction", "Result", "Solution", "Finding",
+    "check", "export_mjcf", "findings", "from_matrices", "run", "solve", "sweep",
+]
 
 Scenario = Union[str, "os.PathLike[str]"]
 
@@ -224,3 +227,49 @@ def from_matrices(
             _tensegrity.import_matrices, *map(str, paths),
             bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n,
         )
+
+
+class Solution(NamedTuple):
+    """One solution of an analytic query: its ``label``, its ``values`` by symbol (SI units),
+    and whether it is ``stable`` (None where the query does not say)."""
+
+    label: str
+    values: dict
+    stable: Optional[bool]
+
+
+class Finding(NamedTuple):
+    """One printed equation checked against the derivation: does it ``hold``?"""
+
+    equation: str
+    claim: str
+    measured: str
+    holds: bool
+
+
+def solve(mechanism: str, query: str, **values: float) -> list:
+    """The analytic model of a built-in mechanism alone (``tensegrity solve``): every solution of
+    ``query`` ("fk", "ik", ...) at these parameters (defaults for the others) and inputs, e.g.
+    ``solve("ji2014", "fk", L3=1.0, theta1=0.5)``. Raises ValueError on unknown names."""
+    return [Solution(*s) for s in _tensegrity.solve(mechanism, query, {k: float(v) for k, v in values.items()})]
+
+
+def findings(mechanism: str, **params: float) -> list:
+    """Every printed equation of a built-in mechanism's paper checked (``tensegrity findings``)."""
+    return [Finding(*f) for f in _tensegrity.findings(mechanism, {k: float(v) for k, v in params.items()})]
+
+
+def export_mjcf(
+    scenario: Scenario,
+    set: Optional[Mapping[str, Any]] = None,
+    actuators: str = "mocap",
+    kp: float = 1e6,
+    cable_damping: float = 0.0,
+    name: str = "<string>.toml",
+) -> tuple:
+    """The MuJoCo MJCF of a scenario's first structure (``tensegrity export mjcf``): (XML text,
+    list of what was not exported). ``actuators``: "mocap" (exact) or "position" (servos of gain
+    ``kp`` [N/m or N m/rad]); ``cable_damping`` [N s/m]."""
+    path, text = _source(scenario, name)
+    xml, warnings = _call(_tensegrity.export_mjcf, path, text, _sets(set), actuators, kp, cable_damping)
+    return xml, list(warnings)

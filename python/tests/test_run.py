@@ -245,3 +245,23 @@ def test_a_furet2018_ik_branch_from_numpy_roots_is_compared_tick_by_tick():
     assert row["points_compared"] == 8 and row["passed"], row
     assert row["ticks_compared"] >= 40 and row["transient_max_error"] <= 1e-7, row
     assert result.as_expected
+
+
+def test_solve_findings_and_export_are_the_clis():
+    sols = tt.solve("ji2014", "fk", L3=1.0, theta1=0.5)
+    cli = json.loads(subprocess.run(
+        [os.path.join(os.environ.get("CARGO_TARGET_DIR", str(ROOT / "target")), "release", "tensegrity"),
+         "solve", "ji2014", "fk", "--set", "L3=1.0", "--set", "theta1=0.5", "--json"],
+        capture_output=True, text=True, cwd=ROOT).stdout)
+    assert [s.values for s in sols] == [s["values"] for s in cli["solutions"]]
+    assert [s.stable for s in sols] == [s["stable"] for s in cli["solutions"]]
+    found = tt.findings("ji2014")
+    assert len(found) == 33 and sum(not f.holds for f in found) == 15
+    xml, skipped = tt.export_mjcf(ROOT / "scenarios" / "custom" / "prism3.toml")
+    assert xml.lstrip().startswith("<mujoco") and "tendon" in xml
+    with pytest.raises(ValueError, match="unknown mechanism"):
+        tt.solve("ji2015", "fk")
+    with pytest.raises(ValueError, match="needs theta1"):
+        tt.solve("ji2014", "fk", L3=1.0)
+    with pytest.raises(ValueError, match="actuators"):
+        tt.export_mjcf(QUICK, actuators="torque")
