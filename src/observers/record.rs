@@ -1,6 +1,6 @@
 //! Recording a run to a rerun `.rrd` file, headless.
 //!
-//! Entities: `structure/{nodes,struts,springs,cables}` (springs and cables coloured by force),
+//! Entities: `structure/{nodes,struts,springs,cables}` (every member coloured by its force),
 //! `analytic/{nodes,struts}` (the analytic prediction as a ghost overlay), and time series with
 //! one named series per quantity or member: `errors` (simulated - analytic), `errors_log10`
 //! (log10 of their magnitude: rerun 0.36 plots have no log axis), `forces/{springs,cables,actuators}`,
@@ -41,6 +41,9 @@ pub struct Recording<'a> {
     pub every: u64,
     /// The scenario file's text, stored as a document.
     pub scenario: &'a str,
+    /// The scenario has a model of its own (`[[predictions]]`, `[[equations]]`): the viewer
+    /// opens on its errors (`model/NAME`).
+    pub file_model: bool,
 }
 
 /// The application name recordings carry.
@@ -298,6 +301,38 @@ fn f32x3(p: [f64; 3]) -> [f32; 3] {
     [p[0] as f32, p[1] as f32, p[2] as f32]
 }
 
+/// Each strut's axial force [N], tension positive, from the springs and cables pulling at its
+/// first node: sum of their forces there along the strut, from the other end outwards
+/// (compression when they pull the end away from the strut). Loads at the node other than
+/// members (gravity, actuators, joints) are not counted: a colour, not a measurement.
+fn strut_forces(s: &crate::structure::Structure, snap: &crate::snapshot::Snapshot) -> Vec<f64> {
+    let f = &snap.forces;
+    let pulls = s
+        .springs
+        .iter()
+        .map(|m| (m.a, m.b))
+        .zip(f.spring_force_n.iter())
+        .chain(s.cables.iter().map(|m| (m.a, m.b)).zip(f.cable_tension_n.iter()));
+    let pulls: Vec<((usize, usize), f64)> = pulls.map(|(ends, t)| (ends, *t)).collect();
+    let p = |n: usize| nalgebra::Vector3::from(snap.nodes[n]);
+    s.struts
+        .iter()
+        .map(|strut| {
+            let out = (p(strut.a) - p(strut.b)).normalize();
+            let pull_at_a: f64 = pulls
+                .iter()
+                .filter_map(|((a, b), t)| {
+                    let other = if *a == strut.a { *b } else if *b == strut.a { *a } else { return None };
+                    let d = p(other) - p(strut.a);
+                    let len = d.norm();
+                    (len > 0.0).then(|| t * d.dot(&out) / len)
+                })
+                .sum();
+            -pull_at_a
+        })
+        .collect()
+}
+
 /// Colour of a member by its force: blue in compression, red in tension, grey when slack.
 fn force_colour(force: f64, max_abs: f64) -> [u8; 4] {
     if force == 0.0 {
@@ -317,8 +352,8 @@ impl Recorder {
     /// nobody runs).
     pub fn start(r: &Recording) -> Result<Option<Self>, String> {
         let recorder = match &r.target {
-            RecordTarget::File(path) => Recorder::create(path, APP, r.every).map(Some),
-            RecordTarget::Live(url) => Recorder::connect(url, APP, r.every),
+            RecordTarget::File(path) => Recorder::create(path, APP, r.every, r.file_model).map(Some),
+            RecordTarget::Live(url) => Recorder::connect(url, APP, r.every, r.file_model),
         };
         let mut recorder = recorder.map_err(|e| e.to_string())?;
         if let Some(rec) = recorder.as_mut() {
@@ -328,7 +363,7 @@ impl Recorder {
     }
 
     /// Starts a recording that will be renamed to `path` by [`Recorder::finish`].
-    pub fn create(path: &Path, app: &'static str, every: u64) -> Result<Self, RecordError> {
+    pub fn create(path: &Path, app: &'static str, every: u64, file_model: bool) -> Result<Self, RecordError> {
         let io = |e: String| RecordError::Io { path: path.display().to_string(), message: e };
         if let Some(dir) = path.parent() {
             if !dir.as_os_str().is_empty() {
@@ -338,7 +373,7 @@ impl Recorder {
         crate::output::check_replaceable(path).map_err(io)?;
         let partial = crate::output::partial_path(path);
         let rec = rerun::RecordingStreamBuilder::new(app)
-            .with_blueprint(blueprint())
+            .with_blueprint(blueprint(file_model))
             .save(&partial)
             .map_err(|e| io(e.to_string()))?;
         Ok(Recorder::new(rec, Target::File { partial, path: path.to_path_buf() }, every))
@@ -361,7 +396,7 @@ impl Recorder {
 
     /// Streams the same data live to a rerun viewer or server at `url` (rerun's default when
     /// empty). A run never fails or waits because nobody listens: the end of the run says so once.
-    pub fn connect(url: &str, app: &'static str, every: u64) -> Result<Option<Self>, RecordError> {
+    pub fn connect(url: &str, app: &'static str, every: u64, file_model: bool) -> Result<Option<Self>, RecordError> {
         let url = if url.is_empty() { DEFAULT_CONNECT_URL.to_string() } else { url.to_string() };
         // rerun's gRPC sink blocks the logging calls while nobody listens (measured: a run
         // stalled for good): check that a viewer or server answers first.
@@ -370,7 +405,7 @@ impl Recorder {
             return Ok(None);
         }
         let rec = rerun::RecordingStreamBuilder::new(app)
-            .with_blueprint(blueprint())
+            .with_blueprint(blueprint(file_model))
             .connect_grpc_opts(url.clone())
             .map_err(|e| RecordError::Io { path: url.clone(), message: e.to_string() })?;
         Ok(Some(Recorder::new(rec, Target::Live { url }, every)))
@@ -425,7 +460,6 @@ impl Recorder {
             "structure/struts",
             &rerun::LineStrips3D::update_fields()
                 .with_radii(s.struts.iter().map(|m| m.radius_m as f32).collect::<Vec<_>>())
-                .with_colors([[200u8, 200, 200, 255]])
                 .with_labels(names(s.struts.iter().map(|m| &m.name).collect())),
         );
         let _ = rec.log_static(
@@ -517,7 +551,9 @@ impl Observer for Recorder {
         c.nodes.push_points(tick, time, nodes.iter().copied());
         c.struts.push_segments(tick, time, nodes, s.struts.iter().map(|m| (m.a, m.b)));
         let f = &snap.forces;
-        let max_f = f.spring_force_n.iter().chain(&f.cable_tension_n).fold(0.0f64, |m, x| m.max(x.abs()));
+        let struts = strut_forces(s, snap);
+        let max_f = f.spring_force_n.iter().chain(&f.cable_tension_n).chain(&struts).fold(0.0f64, |m, x| m.max(x.abs()));
+        c.struts.colors.extend(struts.iter().map(|x| force_colour(*x, max_f)));
         if !s.springs.is_empty() {
             c.springs.push_segments(tick, time, nodes, s.springs.iter().map(|m| (m.a, m.b)));
             c.springs.colors.extend(f.spring_force_n.iter().map(|x| force_colour(*x, max_f)));
@@ -591,8 +627,10 @@ impl Observer for Recorder {
 /// The viewer layout stored in every recording: the structure in 3D with the analytic ghost
 /// (left, over tabs of events and the two documents), and on the right the errors (log10 of
 /// their magnitude, and signed), the member forces, and the kinetic energy with the other
-/// series in tabs. The time cursor follows the end of the recording: the settled state.
-pub fn blueprint() -> rerun::blueprint::Blueprint {
+/// series in tabs; with a model in the file (`file_model`) its errors (`model/NAME`) are the
+/// first tab of the errors, the one the viewer shows. The time cursor follows the end of the
+/// recording: the settled state.
+pub fn blueprint(file_model: bool) -> rerun::blueprint::Blueprint {
     use rerun::blueprint::components::{PanelState, PlayState};
     use rerun::blueprint::{
         Blueprint, BlueprintPanel, Horizontal, SelectionPanel, Spatial3DView, Tabs, TextDocumentView, TextLogView,
@@ -609,10 +647,14 @@ pub fn blueprint() -> rerun::blueprint::Blueprint {
         TextDocumentView::new("report").with_contents(["/report"]).into(),
     ]);
     let left = Vertical::new([structure.into(), documents.into()]).with_row_shares([0.68, 0.32]);
-    let errors = Tabs::new([
+    let mut error_tabs = vec![
         series("log10 |simulated - analytic|", &["/errors_log10"]).into(),
         series("simulated - analytic", &["/errors"]).into(),
-    ]);
+    ];
+    if file_model {
+        error_tabs.insert(0, series("the file's model: |error| per prediction and equation", &["/model/**"]).into());
+    }
+    let errors = Tabs::new(error_tabs);
     let forces = series("member forces [N] (cables: tension)", &["/forces/springs", "/forces/cables"]);
     let others = Tabs::new([
         series("kinetic energy [J]", &["/energy/**"]).into(),
@@ -631,4 +673,35 @@ pub fn blueprint() -> rerun::blueprint::Blueprint {
                 .with_timeline("tick")
                 .with_play_state(PlayState::Following),
         )
+}
+
+#[cfg(test)]
+mod strut_force_tests {
+    use super::strut_forces;
+    use crate::snapshot::{MemberForces, Snapshot};
+    use crate::structure::{BodyKind, Cable, CableLaw, Strut, Structure};
+
+    /// A strut from A (0, 0, 0) to B (1, 0, 0) with a cable of 10 N from A to C (-1, 1, 0):
+    /// the cable pulls A away from B with 10 / sqrt(2) N along the strut, a compression.
+    #[test]
+    fn a_cable_pulling_a_struts_end_outwards_compresses_it() {
+        let mut s = Structure::default();
+        let bar = s.add_body("bar", BodyKind::Free, None);
+        let ground = s.add_body("ground", BodyKind::Fixed, None);
+        let (a, b) = (s.add_node("A", bar, [0.0; 3]), s.add_node("B", bar, [1.0, 0.0, 0.0]));
+        let c = s.add_node("C", ground, [-1.0, 1.0, 0.0]);
+        s.struts.push(Strut { name: "AB".into(), a, b, radius_m: 0.01 });
+        s.cables.push(Cable { name: "AC".into(), a, b: c, law: CableLaw::Inextensible, length_m: 1.0, radius_m: 0.001 });
+        let snap = Snapshot {
+            tick: 0,
+            time_s: 0.0,
+            nodes: s.nodes.iter().map(|n| n.position).collect(),
+            body_poses: vec![],
+            forces: MemberForces { cable_tension_n: vec![10.0], ..Default::default() },
+            actuator_values: vec![],
+            kinetic_energy_j: 0.0,
+        };
+        let f = strut_forces(&s, &snap)[0];
+        assert!((f + 10.0 / 2f64.sqrt()).abs() <= 1e-12, "{f}");
+    }
 }

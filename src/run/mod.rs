@@ -203,7 +203,12 @@ fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) 
         length_scale_m: mech.length_scale(&params),
         interference: &sc.interference,
         model: sc.model.as_ref(),
-        recording: target.map(|target| Recording { target, every: opts.record_every.max(1), scenario: &sc.source }),
+        recording: target.map(|target| Recording {
+            target,
+            every: opts.record_every.max(1),
+            scenario: &sc.source,
+            file_model: sc.model.is_some(),
+        }),
         table: opts.table.clone(),
         motion: sc.motion.as_ref(),
         external: opts.external.clone(),
