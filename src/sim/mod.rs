@@ -490,29 +490,7 @@ impl Simulation {
     /// followed by the closure projection, so that the loops follow the actuators continuously
     /// and stay on their assembly mode.
     fn apply_joint_commands(&mut self) {
-        // (joint, total displacement) of every actuated link; (joint, from, to) of every
-        // actuated joint locked off the tree.
-        let mut moves: Vec<(usize, f64)> = Vec::new();
-        let mut locks: Vec<(usize, f64, f64)> = Vec::new();
-        for j in 0..self.model.structure.joints.len() {
-            if !self.model.actuated[j] {
-                continue;
-            }
-            if let Some(h) = self.model.joint_impulse[j] {
-                let target = self.joint_command(j) - self.model.structure.joints[j].initial_coordinate;
-                let axis = build::free_axis_of(&self.model.structure.joints[j].kind);
-                let from = self.impulse_joints.get(h).and_then(|joint| joint.data.limits(axis)).map_or(target, |l| l.min);
-                locks.push((j, from, target));
-                continue;
-            }
-            let Some(link) = self.model.joint_links[j] else { continue };
-            let target = self.joint_command(j) - self.model.structure.joints[j].initial_coordinate;
-            let Some((mb, link_id)) = self.multibody_joints.get(link.multibody_joint) else { continue };
-            let Some(current) = mb.link(link_id).map(|l| l.joint().coords()[joint_free_axis(&l.joint().data)]) else {
-                continue;
-            };
-            moves.push((j, target - current));
-        }
+        let (moves, locks) = self.actuator_moves();
         // The moves that loops must follow: the links' where loops close inside a multibody,
         // the locked joints' where the projection closes their groups.
         let locks_projected = !self.model.projected_groups.is_empty() && !locks.is_empty();
@@ -581,6 +559,34 @@ impl Simulation {
                 self.project_groups();
             }
         }
+    }
+
+    /// (joint, displacement to its command) of every actuated multibody link, and (joint,
+    /// locked coordinate now, command) of every actuated joint locked off the tree.
+    #[allow(clippy::type_complexity)]
+    fn actuator_moves(&self) -> (Vec<(usize, f64)>, Vec<(usize, f64, f64)>) {
+        let mut moves: Vec<(usize, f64)> = Vec::new();
+        let mut locks: Vec<(usize, f64, f64)> = Vec::new();
+        for j in 0..self.model.structure.joints.len() {
+            if !self.model.actuated[j] {
+                continue;
+            }
+            if let Some(h) = self.model.joint_impulse[j] {
+                let target = self.joint_command(j) - self.model.structure.joints[j].initial_coordinate;
+                let axis = build::free_axis_of(&self.model.structure.joints[j].kind);
+                let from = self.impulse_joints.get(h).and_then(|joint| joint.data.limits(axis)).map_or(target, |l| l.min);
+                locks.push((j, from, target));
+                continue;
+            }
+            let Some(link) = self.model.joint_links[j] else { continue };
+            let target = self.joint_command(j) - self.model.structure.joints[j].initial_coordinate;
+            let Some((mb, link_id)) = self.multibody_joints.get(link.multibody_joint) else { continue };
+            let Some(current) = mb.link(link_id).map(|l| l.joint().coords()[joint_free_axis(&l.joint().data)]) else {
+                continue;
+            };
+            moves.push((j, target - current));
+        }
+        (moves, locks)
     }
 
     /// Joint `j`'s first degree of freedom in its multibody: (multibody, index), if a link.
