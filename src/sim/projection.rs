@@ -8,6 +8,11 @@
 //! the links' columns of rapier's body Jacobians, as for the projected groups below) until every such loop is closed to
 //! round-off, then removes the velocity component that would open it again
 //! (qdot -= J^+ J qdot). The joints that are cut between multibodies keep rapier's treatment.
+//!
+//! Groups of plain bodies with many coordinates (a long chain of X modules cut into plain
+//! bodies, `build::LOOPED_MULTIBODY_MAX_LINKS`) take a sparse Jacobian, assembled member by
+//! member, and a band Cholesky of J J^T kept across the iterations (`least_squares.rs`): the
+//! cost of a step grows with the members, not with their cube.
 
 use super::Simulation;
 use crate::structure::JointKind;
@@ -293,7 +298,8 @@ impl Simulation {
     }
 
     /// Groups of free bodies whose every constraint the projection handles. A group that
-    /// touches an actuated joint, a joint kind without projection rows, or a multibody with a
+    /// touches an actuated joint other than a revolute (which the projection holds at its
+    /// command), a joint kind without projection rows, or a multibody with a
     /// loop inside (closed by [`Self::project_internal_closures`]) is left to rapier alone.
     pub(super) fn find_projected_groups(&self) -> Vec<ProjectedGroup> {
         let s = &self.model.structure;
