@@ -42,15 +42,15 @@ pub(super) fn min_norm_solve(a: &DMatrix<f64>, b: &DVector<f64>, svd_relative_to
 
 /// A sparse matrix by rows: each row's (column, value) entries.
 #[derive(Clone, Debug)]
-pub(super) struct SparseRows {
-    pub ncols: usize,
-    pub rows: Vec<Vec<(usize, f64)>>,
+pub(crate) struct SparseRows {
+    pub(crate) ncols: usize,
+    pub(crate) rows: Vec<Vec<(usize, f64)>>,
 }
 
 impl SparseRows {
     /// The matrix of `nrows` x `ncols` with these (row, column, value) entries; entries at the
     /// same place add up.
-    pub(super) fn new(nrows: usize, ncols: usize, entries: &[(usize, usize, f64)]) -> Self {
+    pub(crate) fn new(nrows: usize, ncols: usize, entries: &[(usize, usize, f64)]) -> Self {
         let mut rows = vec![Vec::new(); nrows];
         for &(r, c, x) in entries {
             rows[r].push((c, x));
@@ -68,12 +68,12 @@ impl SparseRows {
         SparseRows { ncols, rows }
     }
 
-    pub(super) fn nrows(&self) -> usize {
+    pub(crate) fn nrows(&self) -> usize {
         self.rows.len()
     }
 
     /// A x.
-    pub(super) fn mul(&self, x: &DVector<f64>) -> DVector<f64> {
+    pub(crate) fn mul(&self, x: &DVector<f64>) -> DVector<f64> {
         DVector::from_iterator(self.nrows(), self.rows.iter().map(|row| row.iter().map(|&(c, v)| v * x[c]).sum()))
     }
 
@@ -120,8 +120,9 @@ struct BandCholesky {
 }
 
 impl BandCholesky {
-    /// None when M M^T is not positive definite (a redundant row of M).
-    fn of_gram(m: &SparseRows) -> Option<Self> {
+    /// The factor of M M^T + shift x its largest diagonal entry; None when that is not
+    /// positive definite (a redundant row of M, unshifted).
+    fn of_gram(m: &SparseRows, shift: f64) -> Option<Self> {
         let n = m.nrows();
         let mut by_column: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m.ncols];
         for (r, row) in m.rows.iter().enumerate() {
@@ -140,6 +141,9 @@ impl BandCholesky {
             }
         }
         let largest = (0..n).map(|i| l[i * w]).fold(0.0_f64, f64::max);
+        for i in 0..n {
+            l[i * w] += shift * largest;
+        }
         for j in 0..n {
             let lo = j.saturating_sub(band);
             let d = l[j * w] - (lo..j).map(|k| l[j * w + (j - k)].powi(2)).sum::<f64>();
@@ -190,7 +194,7 @@ const REFINEMENT_ROUNDS: usize = 2;
 /// A sparse `a` ready to give minimum-norm least-squares solutions of `a x = b` at full rank:
 /// the band Cholesky factor of its normal matrix (a a^T when `a` has fewer rows than columns,
 /// x = a^T y; a^T a otherwise), each solve followed by [`REFINEMENT_ROUNDS`] of refinement.
-pub(super) struct SparseLeastSquares {
+pub(crate) struct SparseLeastSquares {
     a: SparseRows,
     /// a^T when `a` is tall (its normal matrix a^T a is the Gram matrix of a^T).
     at: Option<SparseRows>,
@@ -200,15 +204,26 @@ pub(super) struct SparseLeastSquares {
 impl SparseLeastSquares {
     /// `a` back when the normal matrix is not positive definite (a redundant row or column):
     /// the caller then takes the dense [`min_norm_solve`], which drops it.
-    pub(super) fn new(a: SparseRows) -> Result<Self, SparseRows> {
+    pub(crate) fn new(a: SparseRows) -> Result<Self, SparseRows> {
         let at = (a.nrows() > a.ncols).then(|| a.transpose());
-        match BandCholesky::of_gram(at.as_ref().unwrap_or(&a)) {
+        match BandCholesky::of_gram(at.as_ref().unwrap_or(&a), 0.0) {
             Some(factor) => Ok(SparseLeastSquares { a, at, factor }),
             None => Err(a),
         }
     }
 
-    pub(super) fn matrix(&self) -> &SparseRows {
+    /// The regularised minimum-norm solutions x = a^T (a a^T + shift d I)^-1 b of any `a`, d
+    /// the largest diagonal entry of a a^T: where `a` has dependent rows (a null space of
+    /// a^T), the shift keeps the factorization positive definite and leaves out what no x
+    /// reaches. `a` back when even the shifted matrix is not positive definite.
+    pub(crate) fn regularised(a: SparseRows, shift: f64) -> Result<Self, SparseRows> {
+        match BandCholesky::of_gram(&a, shift) {
+            Some(factor) => Ok(SparseLeastSquares { a, at: None, factor }),
+            None => Err(a),
+        }
+    }
+
+    pub(crate) fn matrix(&self) -> &SparseRows {
         &self.a
     }
 
@@ -220,13 +235,13 @@ impl SparseLeastSquares {
     }
 
     /// The solution, refined.
-    pub(super) fn solve(&self, b: &DVector<f64>) -> Option<DVector<f64>> {
+    pub(crate) fn solve(&self, b: &DVector<f64>) -> Option<DVector<f64>> {
         self.solve_refined(b, REFINEMENT_ROUNDS)
     }
 
     /// The solution with `rounds` of refinement (none for a step of an iteration that
     /// corrects itself, such as the projection's Gauss-Newton steps).
-    pub(super) fn solve_refined(&self, b: &DVector<f64>, rounds: usize) -> Option<DVector<f64>> {
+    pub(crate) fn solve_refined(&self, b: &DVector<f64>, rounds: usize) -> Option<DVector<f64>> {
         let mut x = self.solve_once(b);
         for _ in 0..rounds {
             let r = b - self.a.mul(&x);

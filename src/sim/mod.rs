@@ -18,7 +18,7 @@
 mod build;
 mod damping;
 mod forces;
-mod least_squares;
+pub(crate) mod least_squares;
 pub mod modes;
 mod projection;
 mod relaxation;
