@@ -104,15 +104,21 @@ impl SettleDetector {
 
     /// Feeds one tick; returns true when the speed has been below the threshold for the window.
     pub fn update(&mut self, snap: &Snapshot, dt_s: f64, criteria: &SettleCriteria) -> bool {
+        self.update_nodes(&snap.nodes, dt_s, criteria)
+    }
+
+    /// [`Self::update`] from the node positions alone (the scale bench reads no forces while
+    /// the motion runs).
+    pub fn update_nodes(&mut self, nodes: &[[f64; 3]], dt_s: f64, criteria: &SettleCriteria) -> bool {
         let speed = match &self.previous {
             Some(prev) => {
-                prev.iter().zip(&snap.nodes).map(|(a, b)| crate::structure::distance(*a, *b) / dt_s).fold(0.0, f64::max)
+                prev.iter().zip(nodes).map(|(a, b)| crate::structure::distance(*a, *b) / dt_s).fold(0.0, f64::max)
             }
             None => f64::INFINITY,
         };
         match &mut self.previous {
-            Some(prev) => prev.clone_from(&snap.nodes),
-            None => self.previous = Some(snap.nodes.clone()),
+            Some(prev) => prev.copy_from_slice(nodes),
+            None => self.previous = Some(nodes.to_vec()),
         }
         self.last_speed = speed;
         if speed <= criteria.speed_tol_m_per_s {

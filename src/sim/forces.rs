@@ -250,30 +250,16 @@ impl Simulation {
     /// least squares, adds them to `wrench` and `out`, and returns each closing joint's
     /// reaction on its child (force, moment about the anchor).
     fn fit_closure_reactions(&self, held: &[bool], wrench: &mut [Wrench], out: &mut MemberForces) -> Vec<Wrench> {
-        let tree = &self.model.tree;
-        let scale = self.model.length_scale_m;
-        let base = self.coordinate_forces(tree, wrench, true);
         let mut closure_loads = self.closure_unit_loads();
         closure_loads.extend(self.projected_cable_unit_loads(held));
         let mut closure_reaction = vec![(Vector::ZERO, Vector::ZERO); self.model.structure.joints.len()];
-        if closure_loads.is_empty() || base.is_empty() {
-            return closure_reaction;
-        }
-        let scaled = |c: &CoordinateForce| if c.is_torque { c.value / scale } else { c.value };
-        let mut g = nalgebra::DMatrix::<f64>::zeros(base.len(), closure_loads.len());
-        for (k, load) in closure_loads.iter().enumerate() {
-            for (r, c) in self.coordinate_forces(tree, &load.loads, false).iter().enumerate() {
-                g[(r, k)] = scaled(c);
-            }
-        }
-        let r0 = nalgebra::DVector::<f64>::from_iterator(base.len(), base.iter().map(scaled));
-        let Some(lambda) = super::least_squares::min_norm_solve(&g, &(-r0), CLOSURE_SVD_RELATIVE_TOLERANCE) else {
+        let Some(lambda) = self.closure_magnitudes(&closure_loads, wrench) else {
             return closure_reaction;
         };
         for (k, load) in closure_loads.iter().enumerate() {
-            for (w, l) in wrench.iter_mut().zip(&load.loads) {
-                w.0 += l.0 * lambda[k];
-                w.1 += l.1 * lambda[k];
+            for &(b, l) in &load.loads {
+                wrench[b].0 += l.0 * lambda[k];
+                wrench[b].1 += l.1 * lambda[k];
             }
             match load.member {
                 ClosureMember::Joint(j) => {
@@ -287,6 +273,69 @@ impl Simulation {
             }
         }
         closure_reaction
+    }
+
+    /// The magnitudes of the unit closure loads that best balance every free coordinate
+    /// against `wrench` (least squares, minimum norm; torques divided by the structure's size);
+    /// None when there is nothing to fit. Without multibody links each load moves only the
+    /// coordinates of its own two bodies, and large fits take the sparse solve.
+    fn closure_magnitudes(&self, closure_loads: &[ClosureComponent], wrench: &[Wrench]) -> Option<nalgebra::DVector<f64>> {
+        let tree = &self.model.tree;
+        let scale = self.model.length_scale_m;
+        let base = self.coordinate_forces(tree, wrench, true);
+        if closure_loads.is_empty() || base.is_empty() {
+            return None;
+        }
+        let scaled = |c: &CoordinateForce| if c.is_torque { c.value / scale } else { c.value };
+        let r0 = nalgebra::DVector::<f64>::from_iterator(base.len(), base.iter().map(scaled));
+        let no_links = self.model.joint_links.iter().all(Option::is_none);
+        if no_links && closure_loads.len() >= SPARSE_MIN_CLOSURE_LOADS {
+            let g = self.plain_closure_matrix(closure_loads, base.len());
+            if let Some(lambda) = super::least_squares::sparse_min_norm_solve(g, &(-&r0)) {
+                return Some(lambda);
+            }
+        }
+        let nb = self.model.structure.bodies.len();
+        let mut g = nalgebra::DMatrix::<f64>::zeros(base.len(), closure_loads.len());
+        for (k, load) in closure_loads.iter().enumerate() {
+            let mut loads = vec![(Vector::ZERO, Vector::ZERO); nb];
+            for &(b, l) in &load.loads {
+                loads[b].0 += l.0;
+                loads[b].1 += l.1;
+            }
+            for (r, c) in self.coordinate_forces(tree, &loads, false).iter().enumerate() {
+                g[(r, k)] = scaled(c);
+            }
+        }
+        super::least_squares::min_norm_solve(&g, &(-r0), CLOSURE_SVD_RELATIVE_TOLERANCE)
+    }
+
+    /// The closure loads' generalized forces as a sparse matrix (coordinates x loads) where every
+    /// free body is a plain body: six coordinates per free body in body order, as
+    /// [`Self::coordinate_forces`] lists them (force, then moment about the centre of mass
+    /// divided by the structure's size).
+    fn plain_closure_matrix(&self, closure_loads: &[ClosureComponent], rows: usize) -> super::least_squares::SparseRows {
+        let s = &self.model.structure;
+        let mut first_row = vec![None; s.bodies.len()];
+        let mut next = 0;
+        for (b, r) in first_row.iter_mut().enumerate() {
+            if self.is_free(b) {
+                *r = Some(next);
+                next += 6;
+            }
+        }
+        let coms: Vec<Vector> = (0..s.bodies.len()).map(|b| self.world_com(b)).collect();
+        let mut entries = Vec::new();
+        for (k, load) in closure_loads.iter().enumerate() {
+            for &(b, (f, m)) in &load.loads {
+                let Some(r) = first_row[b] else { continue };
+                let m = (m - coms[b].cross(f)) / self.model.length_scale_m;
+                for (i, x) in [f.x, f.y, f.z, m.x, m.y, m.z].into_iter().enumerate() {
+                    entries.push((r + i, k, x));
+                }
+            }
+        }
+        super::least_squares::SparseRows::new(rows, closure_loads.len(), &entries)
     }
 
     /// The largest generalized force left on a free coordinate once every load is on the
@@ -314,6 +363,7 @@ impl Simulation {
     /// tree.
     fn actuator_forces(&self, wrench: &[Wrench], closure_reaction: &[Wrench], out: &MemberForces) -> Vec<f64> {
         let s = &self.model.structure;
+        let subtree = self.model.tree.subtree_wrenches(s, wrench);
         let about = |w: Wrench, p: Vector| -> Vector { w.1 - p.cross(w.0) };
         let along = |joint: &crate::structure::Joint, force: Vector, moment: Vector| {
             let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
@@ -335,7 +385,7 @@ impl Simulation {
                 }
                 ActuatorTarget::Joint(j) => {
                     let joint = &s.joints[j];
-                    let w = self.model.tree.subtree_wrench(s, wrench, joint.child);
+                    let w = subtree[joint.child];
                     let anchor = v(self.node_position(joint.anchor));
                     -along(joint, w.0, about(w, anchor))
                 }
@@ -352,6 +402,11 @@ pub(crate) fn relative_angle(parent: Rotation, child: Rotation, axis: Vector) ->
     let s = Vector::new(rel.x, rel.y, rel.z).dot(axis);
     2.0 * s.atan2(rel.w)
 }
+
+/// Fits of at least this many closure loads, on structures without multibody links, take the
+/// sparse solve (`least_squares::sparse_min_norm_solve`): a dense one grows as the cube of the
+/// loads (a chain of 20 furet2018 X modules cut into plain bodies has 340).
+const SPARSE_MIN_CLOSURE_LOADS: usize = 48;
 
 /// Singular values below this fraction of the largest are treated as zero when fitting the
 /// reactions of loop-closing joints (redundant closures).
@@ -371,7 +426,8 @@ struct ClosureComponent {
     member: ClosureMember,
     force: Vector,
     moment: Vector,
-    loads: Vec<Wrench>,
+    /// The bodies it loads and their wrenches (force, moment about the world origin).
+    loads: Vec<(usize, Wrench)>,
 }
 
 /// One free coordinate's generalized force: a force [N] or a torque [N m].
@@ -412,16 +468,21 @@ impl Tree {
         depth
     }
 
-    /// Sum of the wrenches of `root` and every body hanging from it.
-    fn subtree_wrench(&self, s: &crate::structure::Structure, wrench: &[Wrench], root: usize) -> Wrench {
-        let mut w = (Vector::ZERO, Vector::ZERO);
-        for (b, wb) in wrench.iter().enumerate() {
-            if self.descends_from(s, b, root) {
-                w.0 += wb.0;
-                w.1 += wb.1;
+    /// For every body, the sum of the wrenches of it and of every body hanging from it: each
+    /// body's sum handed to its parent, deepest bodies first (one pass, where a search of every
+    /// body's descendants for each joint grew with the cube of a chain's length).
+    fn subtree_wrenches(&self, s: &crate::structure::Structure, wrench: &[Wrench]) -> Vec<Wrench> {
+        let mut order: Vec<(usize, usize)> = (0..wrench.len()).map(|b| (self.depth(s, b), b)).collect();
+        order.sort_unstable_by(|a, b| b.cmp(a));
+        let mut sums = wrench.to_vec();
+        for (_, b) in order {
+            if let Some(j) = self.parent_joint[b] {
+                let (w, p) = (sums[b], s.joints[j].parent);
+                sums[p].0 += w.0;
+                sums[p].1 += w.1;
             }
         }
-        w
+        sums
     }
 }
 
@@ -445,13 +506,14 @@ impl Simulation {
         let about = |w: Wrench, p: Vector| -> Vector { w.1 - p.cross(w.0) };
         let force = |value: f64| CoordinateForce { value, is_torque: false };
         let torque = |value: f64| CoordinateForce { value, is_torque: true };
+        let subtree = tree.subtree_wrenches(s, wrench);
         let mut out = Vec::new();
         for (j, joint) in s.joints.iter().enumerate() {
             // Only the free coordinates: an actuated joint's coordinate is set, not balanced.
             if self.model.joint_links[j].is_none() || self.model.actuated[j] {
                 continue;
             }
-            let w = tree.subtree_wrench(s, wrench, joint.child);
+            let w = subtree[joint.child];
             let anchor = v(self.node_position(joint.anchor));
             let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
             let child_rot = self.bodies[self.model.handles[joint.child]].position().rotation;
@@ -479,7 +541,7 @@ impl Simulation {
         // Free bodies with no parent joint: all six coordinates.
         for b in 0..s.bodies.len() {
             if self.is_free(b) && tree.parent_joint[b].is_none() {
-                let w = tree.subtree_wrench(s, wrench, b);
+                let w = subtree[b];
                 let m = about(w, self.world_com(b));
                 out.extend([force(w.0.x), force(w.0.y), force(w.0.z), torque(m.x), torque(m.y), torque(m.z)]);
             }
@@ -491,7 +553,6 @@ impl Simulation {
     /// unit tension (pulling its two nodes together).
     fn projected_cable_unit_loads(&self, held: &[bool]) -> Vec<ClosureComponent> {
         let s = &self.model.structure;
-        let nb = s.bodies.len();
         let mut out = Vec::new();
         for (c, cable) in s.cables.iter().enumerate() {
             if !held[c] {
@@ -499,12 +560,8 @@ impl Simulation {
             }
             let (pa, pb) = (v(self.node_position(cable.a)), v(self.node_position(cable.b)));
             let d = (pb - pa).normalize();
-            let mut w = vec![(Vector::ZERO, Vector::ZERO); nb];
             let (ba, bb) = (s.nodes[cable.a].body, s.nodes[cable.b].body);
-            w[ba].0 += d;
-            w[ba].1 += pa.cross(d);
-            w[bb].0 -= d;
-            w[bb].1 -= pb.cross(d);
+            let w = vec![(ba, (d, pa.cross(d))), (bb, (-d, -pb.cross(d)))];
             out.push(ClosureComponent { member: ClosureMember::Cable(c), force: d, moment: Vector::ZERO, loads: w });
         }
         out
@@ -514,7 +571,6 @@ impl Simulation {
     /// reaction (child +, parent -), world frame.
     fn closure_unit_loads(&self) -> Vec<ClosureComponent> {
         let s = &self.model.structure;
-        let nb = s.bodies.len();
         let axes = [Vector::X, Vector::Y, Vector::Z];
         let mut out = Vec::new();
         for (j, joint) in s.joints.iter().enumerate() {
@@ -550,9 +606,7 @@ impl Simulation {
                 }
             };
             for f in forces {
-                let mut w = vec![(Vector::ZERO, Vector::ZERO); nb];
-                w[joint.child] = (f, anchor.cross(f));
-                w[joint.parent] = (-f, -anchor.cross(f));
+                let w = vec![(joint.child, (f, anchor.cross(f))), (joint.parent, (-f, -anchor.cross(f)))];
                 out.push(ClosureComponent {
                     member: ClosureMember::Joint(j),
                     force: f,
@@ -561,9 +615,7 @@ impl Simulation {
                 });
             }
             for m in moments {
-                let mut w = vec![(Vector::ZERO, Vector::ZERO); nb];
-                w[joint.child] = (Vector::ZERO, m);
-                w[joint.parent] = (Vector::ZERO, -m);
+                let w = vec![(joint.child, (Vector::ZERO, m)), (joint.parent, (Vector::ZERO, -m))];
                 out.push(ClosureComponent {
                     member: ClosureMember::Joint(j),
                     force: Vector::ZERO,

@@ -19,7 +19,7 @@ mod build;
 mod damping;
 mod forces;
 mod joint_modes;
-mod least_squares;
+pub(crate) mod least_squares;
 pub mod modes;
 mod projection;
 mod relaxation;
@@ -397,6 +397,11 @@ impl Simulation {
         [p.x, p.y, p.z]
     }
 
+    /// World position of every node [m].
+    pub fn node_positions(&self) -> Vec<[f64; 3]> {
+        (0..self.model.structure.nodes.len()).map(|i| self.node_position(i)).collect()
+    }
+
     pub fn body_pose(&self, body: usize) -> BodyPose {
         let pose = self.bodies[self.model.handles[body]].position();
         let q = pose.rotation;
@@ -422,7 +427,7 @@ impl Simulation {
         Snapshot {
             tick: self.tick,
             time_s: self.time_s(),
-            nodes: (0..self.model.structure.nodes.len()).map(|i| self.node_position(i)).collect(),
+            nodes: self.node_positions(),
             body_poses: (0..self.model.structure.bodies.len()).map(|b| self.body_pose(b)).collect(),
             forces: self.member_forces_with(with_residual),
             actuator_values: self.commands.clone(),
@@ -499,34 +504,18 @@ impl Simulation {
     /// followed by the closure projection, so that the loops follow the actuators continuously
     /// and stay on their assembly mode.
     fn apply_joint_commands(&mut self) {
-        // (joint, total displacement) of every actuated link.
-        let mut moves: Vec<(usize, f64)> = Vec::new();
-        for j in 0..self.model.structure.joints.len() {
-            if !self.model.actuated[j] {
-                continue;
-            }
-            if let Some(h) = self.model.joint_impulse[j] {
-                let target = self.joint_command(j) - self.model.structure.joints[j].initial_coordinate;
-                let axis = build::free_axis_of(&self.model.structure.joints[j].kind);
-                if let Some(joint) = self.impulse_joints.get_mut(h, true) {
-                    joint.data.set_limits(axis, [target, target]);
-                }
-                continue;
-            }
-            let Some(link) = self.model.joint_links[j] else { continue };
-            let target = self.joint_command(j) - self.model.structure.joints[j].initial_coordinate;
-            let Some((mb, link_id)) = self.multibody_joints.get(link.multibody_joint) else { continue };
-            let Some(current) = mb.link(link_id).map(|l| l.joint().coords()[joint_free_axis(&l.joint().data)]) else {
-                continue;
-            };
-            moves.push((j, target - current));
+        let (moves, locks) = self.actuator_moves();
+        // The moves that loops must follow: the links' where loops close inside a multibody,
+        // the locked joints' where the projection closes their groups.
+        let locks_projected = !self.model.projected_groups.is_empty() && !locks.is_empty();
+        let mut largest = 0.0_f64;
+        if !self.model.internal_closures.is_empty() {
+            largest = moves.iter().fold(largest, |m, (_, d)| m.max(d.abs()));
         }
-        let largest = moves.iter().fold(0.0_f64, |m, (_, d)| m.max(d.abs()));
-        let increments = if self.model.internal_closures.is_empty() {
-            1
-        } else {
-            ((largest / MAX_CLOSED_LOOP_INCREMENT).ceil() as usize).max(1)
-        };
+        if locks_projected {
+            largest = locks.iter().fold(largest, |m, (_, from, to)| m.max((to - from).abs()));
+        }
+        let increments = ((largest / MAX_CLOSED_LOOP_INCREMENT).ceil() as usize).max(1);
         // The multibodies moved. Forward kinematics settles each one's root (and so its
         // degree-of-freedom indices, read below) before the first move.
         let mut multibodies: Vec<MultibodyIndex> = Vec::new();
@@ -556,7 +545,16 @@ impl Simulation {
                 (m, dofs)
             })
             .collect();
-        for _ in 0..increments {
+        for i in 1..=increments {
+            let part = i as f64 / increments as f64;
+            for &(j, from, to) in &locks {
+                let axis = build::free_axis_of(&self.model.structure.joints[j].kind);
+                let Some(h) = self.model.joint_impulse[j] else { continue };
+                if let Some(joint) = self.impulse_joints.get_mut(h, true) {
+                    let q = from + (to - from) * part;
+                    joint.data.set_limits(axis, [q, q]);
+                }
+            }
             for (m, dofs) in &steps {
                 let Some(mb) = self.multibody_joints.get_multibody_mut(*m) else { continue };
                 let mut disp = vec![0.0; mb.ndofs()];
@@ -571,7 +569,38 @@ impl Simulation {
                 mb.update_rigid_bodies(&mut self.bodies, true);
             }
             self.project_internal_closures();
+            if locks_projected {
+                self.project_groups();
+            }
         }
+    }
+
+    /// (joint, displacement to its command) of every actuated multibody link, and (joint,
+    /// locked coordinate now, command) of every actuated joint locked off the tree.
+    #[allow(clippy::type_complexity)]
+    fn actuator_moves(&self) -> (Vec<(usize, f64)>, Vec<(usize, f64, f64)>) {
+        let mut moves: Vec<(usize, f64)> = Vec::new();
+        let mut locks: Vec<(usize, f64, f64)> = Vec::new();
+        for j in 0..self.model.structure.joints.len() {
+            if !self.model.actuated[j] {
+                continue;
+            }
+            if let Some(h) = self.model.joint_impulse[j] {
+                let target = self.joint_command(j) - self.model.structure.joints[j].initial_coordinate;
+                let axis = build::free_axis_of(&self.model.structure.joints[j].kind);
+                let from = self.impulse_joints.get(h).and_then(|joint| joint.data.limits(axis)).map_or(target, |l| l.min);
+                locks.push((j, from, target));
+                continue;
+            }
+            let Some(link) = self.model.joint_links[j] else { continue };
+            let target = self.joint_command(j) - self.model.structure.joints[j].initial_coordinate;
+            let Some((mb, link_id)) = self.multibody_joints.get(link.multibody_joint) else { continue };
+            let Some(current) = mb.link(link_id).map(|l| l.joint().coords()[joint_free_axis(&l.joint().data)]) else {
+                continue;
+            };
+            moves.push((j, target - current));
+        }
+        (moves, locks)
     }
 
     /// Joint `j`'s first degree of freedom in its multibody: (multibody, index), if a link.

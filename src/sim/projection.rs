@@ -8,10 +8,19 @@
 //! the links' columns of rapier's body Jacobians, as for the projected groups below) until every such loop is closed to
 //! round-off, then removes the velocity component that would open it again
 //! (qdot -= J^+ J qdot). The joints that are cut between multibodies keep rapier's treatment.
+//!
+//! Groups of plain bodies with many coordinates (a long chain of X modules cut into plain
+//! bodies, `build::LOOPED_MULTIBODY_MAX_LINKS`) take a sparse Jacobian, assembled member by
+//! member, and a band Cholesky of J J^T kept across the iterations (`least_squares.rs`): the
+//! cost of a step grows with the members, not with their cube.
 
 use super::Simulation;
 use crate::structure::JointKind;
 use rapier3d_f64::prelude::*;
+
+/// The chord method keeps its Jacobian while each iteration shrinks the largest gap at least
+/// by this factor.
+const CHORD_CONTRACTION: f64 = 0.1;
 
 /// Gauss-Newton iterations at most per step.
 const MAX_ITERATIONS: usize = 20;
@@ -29,6 +38,61 @@ fn min_norm_solve(a: &nalgebra::DMatrix<f64>, b: &nalgebra::DVector<f64>) -> Opt
     super::least_squares::min_norm_solve(a, b, SVD_RELATIVE_TOLERANCE)
 }
 
+/// A group's closure Jacobian (rows x coordinates): dense for small groups and groups with
+/// multibodies, sparse for large groups of plain bodies ([`SPARSE_MIN_COORDINATES`]).
+enum Jacobian {
+    Dense(nalgebra::DMatrix<f64>),
+    /// With its factorization, which the Gauss-Newton step and the velocity projection share.
+    Sparse(Box<super::least_squares::SparseLeastSquares>),
+}
+
+/// Groups of plain bodies with at least this many coordinates take the sparse Jacobian and
+/// factorization: a dense solve grows as the cube of the coordinates (a chain of 20
+/// furet2018 X modules has 360), the sparse one as the coordinates times the band squared.
+const SPARSE_MIN_COORDINATES: usize = 48;
+
+impl Jacobian {
+    fn nrows(&self) -> usize {
+        match self {
+            Jacobian::Dense(j) => j.nrows(),
+            Jacobian::Sparse(j) => j.matrix().nrows(),
+        }
+    }
+
+    fn mul(&self, u: &nalgebra::DVector<f64>) -> nalgebra::DVector<f64> {
+        match self {
+            Jacobian::Dense(j) => j * u,
+            Jacobian::Sparse(j) => j.matrix().mul(u),
+        }
+    }
+
+    /// A sparse Jacobian factorized; one with redundant rows becomes dense (whose solve drops
+    /// them).
+    fn sparse(j: super::least_squares::SparseRows) -> Self {
+        match super::least_squares::SparseLeastSquares::new(j) {
+            Ok(f) => Jacobian::Sparse(Box::new(f)),
+            Err(j) => Jacobian::Dense(j.to_dense()),
+        }
+    }
+
+    /// The minimum-norm least-squares solution of `J x = b`.
+    fn solve(&self, b: &nalgebra::DVector<f64>) -> Option<nalgebra::DVector<f64>> {
+        match self {
+            Jacobian::Dense(j) => min_norm_solve(j, b),
+            Jacobian::Sparse(j) => j.solve(b),
+        }
+    }
+
+    /// A Gauss-Newton step: [`Self::solve`], without the sparse solve's refinement (the next
+    /// iteration corrects what the step leaves).
+    fn step(&self, b: &nalgebra::DVector<f64>) -> Option<nalgebra::DVector<f64>> {
+        match self {
+            Jacobian::Dense(j) => min_norm_solve(j, b),
+            Jacobian::Sparse(j) => j.solve_refined(b, 0),
+        }
+    }
+}
+
 /// Gauss-Newton onto a constraint manifold of `ndof` coordinates: `rows` evaluates the
 /// constraint rows [m]; `jacobian(sim, rows)` their derivatives by the coordinates at the
 /// current state (rows x ndof); `displace` moves every coordinate by a step. Iterates until
@@ -37,22 +101,45 @@ fn min_norm_solve(a: &nalgebra::DMatrix<f64>, b: &nalgebra::DVector<f64>) -> Opt
 fn close_rows(
     sim: &mut Simulation,
     rows: &dyn Fn(&Simulation) -> Vec<f64>,
-    jacobian: &dyn Fn(&mut Simulation, &[f64]) -> nalgebra::DMatrix<f64>,
+    jacobian: &dyn Fn(&mut Simulation, &[f64]) -> Jacobian,
     displace: &dyn Fn(&mut Simulation, &[f64]),
-) -> (nalgebra::DMatrix<f64>, f64) {
+) -> (Option<Jacobian>, f64) {
     let largest = |g: &[f64]| g.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     let tol = GAP_TOLERANCE_FRACTION * sim.model.length_scale_m;
-    let mut jac = nalgebra::DMatrix::<f64>::zeros(0, 0);
+    let mut jac: Option<Jacobian> = None;
+    let (mut previous, mut polished) = (f64::INFINITY, false);
     for _ in 0..MAX_ITERATIONS {
         let g0 = rows(sim);
         if g0.is_empty() {
             break;
         }
-        jac = jacobian(sim, &g0);
-        if largest(&g0) <= tol {
+        let gap = largest(&g0);
+        // A sparse group takes one step more once within the tolerance: along a chain of a
+        // hundred links the gaps left at the tolerance move its far end by 5e-12 m from step to
+        // step, ten times the settle's speed threshold; one step more leaves round-off.
+        let sparse = matches!(jac, Some(Jacobian::Sparse(_)));
+        if sparse && gap <= tol && polished {
             break;
         }
-        let Some(dq) = min_norm_solve(&jac, &-nalgebra::DVector::from_vec(g0)) else { break };
+        // A sparse Jacobian and its factorization are kept while they shrink the gap by at
+        // least [`CHORD_CONTRACTION`] per iteration (the chord method: after a step each
+        // iteration shrinks the gap by about the gap over the structure's size, 1e-4 to 1e-6,
+        // in as many iterations as Newton's method with one factorization instead of three
+        // or four); a dense one is evaluated at every iterate.
+        if !sparse || (gap > tol && gap > CHORD_CONTRACTION * previous) {
+            jac = Some(jacobian(sim, &g0));
+        }
+        previous = gap;
+        let Some(j) = jac.as_ref() else { break };
+        if gap <= tol {
+            if !matches!(j, Jacobian::Sparse(_)) {
+                break;
+            }
+            polished = true;
+        }
+        // The polishing step refined: it leaves the round-off of the gap, not of the solve.
+        let b = -nalgebra::DVector::from_vec(g0);
+        let Some(dq) = (if polished { j.solve(&b) } else { j.step(&b) }) else { break };
         displace(sim, dq.as_slice());
     }
     let left = largest(&rows(sim));
@@ -211,7 +298,8 @@ impl Simulation {
     }
 
     /// Groups of free bodies whose every constraint the projection handles. A group that
-    /// touches an actuated joint, a joint kind without projection rows, or a multibody with a
+    /// touches an actuated joint other than a revolute (which the projection holds at its
+    /// command), a joint kind without projection rows, or a multibody with a
     /// loop inside (closed by [`Self::project_internal_closures`]) is left to rapier alone.
     pub(super) fn find_projected_groups(&self) -> Vec<ProjectedGroup> {
         let s = &self.model.structure;
@@ -246,7 +334,9 @@ impl Simulation {
                     | JointKind::Universal { .. }
                     | JointKind::PlanarPin { .. }
             );
-            groups[g].2 &= supported && !self.model.actuated[j];
+            // An actuated revolute off the tree is locked at its command: one row more.
+            let actuated_ok = !self.model.actuated[j] || matches!(joint.kind, JointKind::Revolute { .. });
+            groups[g].2 &= supported && actuated_ok;
         }
         for (c, cable) in s.cables.iter().enumerate() {
             if self.model.cable_ropes[c].is_none() {
@@ -352,6 +442,11 @@ impl Simulation {
                 for t in super::forces::orthogonal_pair(ap) {
                     out.push(ac.dot(t) * scale);
                 }
+                // An actuated joint locked off the tree: its angle at the command.
+                if let Some(target) = self.locked_angle(j) {
+                    let off = super::forces::relative_angle(pp.rotation, pc.rotation, vec3(axis)) - target;
+                    out.push(off.sin().atan2(off.cos()) * scale);
+                }
             }
             JointKind::Universal { axis1, axis2 } => {
                 out.extend([gap.x, gap.y, gap.z]);
@@ -380,52 +475,77 @@ impl Simulation {
     /// The rates of [`Self::group_rows`] (same order and scaling) when each body moves with
     /// its twist (`None`: the body stays). Exact to first order at a closed joint; the terms
     /// that multiply a gap are dropped (the gap is round-off once projected).
-    fn group_row_rates(&self, g: &ProjectedGroup, taut: &[usize], twists: &[Option<Twist>], out: &mut Vec<f64>) {
+    fn group_row_rates(&self, g: &ProjectedGroup, taut: &[usize], twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
+        for &j in &g.joints {
+            self.joint_row_rates(j, twist, out);
+        }
+        for &c in taut {
+            self.cable_row_rate(c, twist, out);
+        }
+    }
+
+    /// The rates of [`Self::joint_rows`] of joint `j` for the bodies' twists.
+    fn joint_row_rates(&self, j: usize, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
         let s = &self.model.structure;
         let scale = self.model.length_scale_m;
         let pose = |b: usize| *self.bodies[self.model.handles[b]].position();
         let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
-        let point_rate = |b: usize, p: Vector| twists[b].map_or(Vector::ZERO, |t| t.of_point(p));
-        let spin = |b: usize| twists[b].map_or(Vector::ZERO, |t| t.w);
-        for &j in &g.joints {
-            let joint = &s.joints[j];
-            let (pp, pc) = (pose(joint.parent), pose(joint.child));
-            let a = vec3(s.nodes[joint.anchor].position);
-            let gap_rate =
-                point_rate(joint.child, pc.transform_point(a)) - point_rate(joint.parent, pp.transform_point(a));
-            let (wp, wc) = (spin(joint.parent), spin(joint.child));
-            match joint.kind {
-                JointKind::PlanarPin { axis } => {
-                    let n = (pp.rotation * vec3(axis)).normalize();
-                    for t in super::forces::orthogonal_pair(n) {
-                        out.push(gap_rate.dot(t));
-                    }
+        let point_rate = |b: usize, p: Vector| twist(b).map_or(Vector::ZERO, |t| t.of_point(p));
+        let spin = |b: usize| twist(b).map_or(Vector::ZERO, |t| t.w);
+        let joint = &s.joints[j];
+        let (pp, pc) = (pose(joint.parent), pose(joint.child));
+        let a = vec3(s.nodes[joint.anchor].position);
+        let gap_rate = point_rate(joint.child, pc.transform_point(a)) - point_rate(joint.parent, pp.transform_point(a));
+        let (wp, wc) = (spin(joint.parent), spin(joint.child));
+        match joint.kind {
+            JointKind::PlanarPin { axis } => {
+                let n = (pp.rotation * vec3(axis)).normalize();
+                for t in super::forces::orthogonal_pair(n) {
+                    out.push(gap_rate.dot(t));
                 }
-                JointKind::Revolute { axis } => {
-                    out.extend([gap_rate.x, gap_rate.y, gap_rate.z]);
-                    let ap = (pp.rotation * vec3(axis)).normalize();
-                    let ac = (pc.rotation * vec3(axis)).normalize();
-                    for t in super::forces::orthogonal_pair(ap) {
-                        out.push((wc.cross(ac).dot(t) + ac.dot(wp.cross(t))) * scale);
-                    }
-                }
-                JointKind::Universal { axis1, axis2 } => {
-                    out.extend([gap_rate.x, gap_rate.y, gap_rate.z]);
-                    let a1 = pp.rotation * vec3(axis1).normalize();
-                    let a2 = pc.rotation * vec3(axis2).normalize();
-                    out.push((wp.cross(a1).dot(a2) + a1.dot(wc.cross(a2))) * scale);
-                }
-                _ => out.extend([gap_rate.x, gap_rate.y, gap_rate.z]),
             }
+            JointKind::Revolute { axis } => {
+                out.extend([gap_rate.x, gap_rate.y, gap_rate.z]);
+                let ap = (pp.rotation * vec3(axis)).normalize();
+                let ac = (pc.rotation * vec3(axis)).normalize();
+                for t in super::forces::orthogonal_pair(ap) {
+                    out.push((wc.cross(ac).dot(t) + ac.dot(wp.cross(t))) * scale);
+                }
+                if self.locked_angle(j).is_some() {
+                    out.push((wc - wp).dot(ap) * scale);
+                }
+            }
+            JointKind::Universal { axis1, axis2 } => {
+                out.extend([gap_rate.x, gap_rate.y, gap_rate.z]);
+                let a1 = pp.rotation * vec3(axis1).normalize();
+                let a2 = pc.rotation * vec3(axis2).normalize();
+                out.push((wp.cross(a1).dot(a2) + a1.dot(wc.cross(a2))) * scale);
+            }
+            _ => out.extend([gap_rate.x, gap_rate.y, gap_rate.z]),
         }
-        for &c in taut {
-            let cable = &s.cables[c];
-            let (pa, pb) = (vec3(self.node_position(cable.a)), vec3(self.node_position(cable.b)));
-            let d = pb - pa;
-            let l = d.length();
-            let rate = point_rate(s.nodes[cable.b].body, pb) - point_rate(s.nodes[cable.a].body, pa);
-            out.push(if l > 0.0 { rate.dot(d / l) } else { 0.0 });
+    }
+
+    /// The rate of a taut cable's stretch for the bodies' twists.
+    fn cable_row_rate(&self, c: usize, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
+        let s = &self.model.structure;
+        let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
+        let point_rate = |b: usize, p: Vector| twist(b).map_or(Vector::ZERO, |t| t.of_point(p));
+        let cable = &s.cables[c];
+        let (pa, pb) = (vec3(self.node_position(cable.a)), vec3(self.node_position(cable.b)));
+        let d = pb - pa;
+        let l = d.length();
+        let rate = point_rate(s.nodes[cable.b].body, pb) - point_rate(s.nodes[cable.a].body, pa);
+        out.push(if l > 0.0 { rate.dot(d / l) } else { 0.0 });
+    }
+
+    /// The commanded angle of an actuated revolute joint off the tree, locked there by equal
+    /// limits (relative to the drawn pose) [rad]; None for any other joint.
+    fn locked_angle(&self, j: usize) -> Option<f64> {
+        if !self.model.actuated[j] || !matches!(self.model.structure.joints[j].kind, JointKind::Revolute { .. }) {
+            return None;
         }
+        let joint = self.impulse_joints.get(self.model.joint_impulse[j]?)?;
+        joint.data.limits(JointAxis::AngX).map(|l| l.min)
     }
 
     /// Moves body `b` by a translation `t` [m] and a rotation `r` [rad, rotation vector] about
@@ -473,12 +593,12 @@ impl Simulation {
         let jacobian = |sim: &mut Simulation, g0: &[f64]| coords.jacobian(sim, g, taut, g0.len());
         let displace = |sim: &mut Simulation, dq: &[f64]| coords.displace(sim, g, dq);
         let (jac, left) = close_rows(self, &rows, &jacobian, &displace);
-        if jac.nrows() > 0 {
+        if let Some(jac) = jac.filter(|j| j.nrows() > 0) {
             // Remove J^+ (J u) from the velocities u over every row, taut cables included (they
             // were just held at their length: a cable goes slack when rapier's rope stops
             // pulling, and is then no longer taut here).
             let u = coords.velocities(self, g);
-            if let Some(du) = min_norm_solve(&jac, &(&jac * &u)) {
+            if let Some(du) = jac.solve(&jac.mul(&u)) {
                 coords.remove_velocities(self, g, &du);
             }
         }
@@ -547,7 +667,10 @@ impl GroupCoordinates {
     /// moves: a plain body's unit translation or rotation about its centre of mass, a
     /// multibody link's column of rapier's body Jacobian (centre-of-mass velocity and angular
     /// velocity).
-    fn jacobian(&self, sim: &Simulation, g: &ProjectedGroup, taut: &[usize], rows: usize) -> nalgebra::DMatrix<f64> {
+    fn jacobian(&self, sim: &Simulation, g: &ProjectedGroup, taut: &[usize], rows: usize) -> Jacobian {
+        if self.multibodies.is_empty() && self.n_plain >= SPARSE_MIN_COORDINATES {
+            return Jacobian::sparse(self.sparse_jacobian(sim, g, taut, rows));
+        }
         let ndof = self.count();
         let mut jac = nalgebra::DMatrix::<f64>::zeros(rows, ndof);
         let mut twists: Vec<Option<Twist>> = vec![None; sim.model.structure.bodies.len()];
@@ -555,9 +678,7 @@ impl GroupCoordinates {
             twists.iter_mut().for_each(|t| *t = None);
             if k < self.n_plain {
                 let b = g.bodies[k / 6];
-                let mut q = [Vector::ZERO; 2];
-                q[(k % 6) / 3][k % 3] = 1.0;
-                twists[b] = Some(Twist { v: q[0], w: q[1] / self.scale, at: sim.world_com(b) });
+                twists[b] = Some(self.unit_twist(sim, b, k % 6));
             } else {
                 let (m, dof) = self.multibody_dof(k);
                 let Some(mb) = sim.multibody_joints.get_multibody(m) else { continue };
@@ -575,12 +696,57 @@ impl GroupCoordinates {
                 }
             }
             let mut column = Vec::with_capacity(rows);
-            sim.group_row_rates(g, taut, &twists, &mut column);
+            sim.group_row_rates(g, taut, &|b| twists[b], &mut column);
             for (r, x) in column.into_iter().enumerate() {
                 jac[(r, k)] = x;
             }
         }
-        jac
+        Jacobian::Dense(jac)
+    }
+
+    /// Plain body `b`'s motion per unit of its coordinate `k` (0..3 translation [m], 3..6
+    /// rotation times the structure's size [m]) about its centre of mass.
+    fn unit_twist(&self, sim: &Simulation, b: usize, k: usize) -> Twist {
+        let mut q = [Vector::ZERO; 2];
+        q[k / 3][k % 3] = 1.0;
+        Twist { v: q[0], w: q[1] / self.scale, at: sim.world_com(b) }
+    }
+
+    /// The Jacobian of a group of plain bodies, member by member: each joint's or cable's rows
+    /// depend only on the coordinates of its two bodies (twelve columns at most), so it costs
+    /// in proportion to the members where the dense one costs rows times coordinates.
+    fn sparse_jacobian(
+        &self,
+        sim: &Simulation,
+        g: &ProjectedGroup,
+        taut: &[usize],
+        rows: usize,
+    ) -> super::least_squares::SparseRows {
+        let s = &sim.model.structure;
+        let mut position = vec![None; s.bodies.len()];
+        for (i, &b) in g.bodies.iter().enumerate() {
+            position[b] = Some(i);
+        }
+        // Each member's rows for a twist of one body: a joint's or a cable's.
+        let joints = g.joints.iter().map(|&j| (Member::Joint(j), [s.joints[j].parent, s.joints[j].child]));
+        let cables =
+            taut.iter().map(|&c| (Member::Cable(c), [s.nodes[s.cables[c].a].body, s.nodes[s.cables[c].b].body]));
+        let (mut entries, mut first_row, mut block) = (Vec::new(), 0, Vec::new());
+        for (member, bodies) in joints.chain(cables) {
+            let mut count = 0;
+            for (b, i) in bodies.into_iter().filter_map(|b| position[b].map(|i| (b, i))) {
+                for k in 0..6 {
+                    let t = self.unit_twist(sim, b, k);
+                    block.clear();
+                    member.row_rates(sim, &|x| (x == b).then_some(t), &mut block);
+                    entries.extend(block.iter().enumerate().map(|(r, &x)| (first_row + r, 6 * i + k, x)));
+                    count = block.len();
+                }
+            }
+            first_row += count;
+        }
+        debug_assert_eq!(first_row, rows, "one block of rows per member");
+        super::least_squares::SparseRows::new(rows, self.n_plain, &entries)
     }
 
     /// The velocities in these coordinates: u = [v, w L] per plain body, then the
@@ -616,6 +782,22 @@ impl GroupCoordinates {
             if let Some(mb) = sim.multibody_joints.get_multibody_mut(m) {
                 mb.generalized_velocity_mut()[dof] -= du[k];
             }
+        }
+    }
+}
+
+/// A member whose rows a projected group closes: a joint or a taut cable.
+#[derive(Clone, Copy, Debug)]
+enum Member {
+    Joint(usize),
+    Cable(usize),
+}
+
+impl Member {
+    fn row_rates(self, sim: &Simulation, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
+        match self {
+            Member::Joint(j) => sim.joint_row_rates(j, twist, out),
+            Member::Cable(c) => sim.cable_row_rate(c, twist, out),
         }
     }
 }

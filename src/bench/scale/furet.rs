@@ -1,5 +1,5 @@
 //! The furet2018 family of `tensegrity bench --scale`: n Snelson X modules in series (the bird
-//! neck of the paper's Fig. 1), n = 1 .. 20, each X as the built-in mechanism builds its two
+//! neck of the paper's Fig. 1), n = 1 .. 100, each X as the built-in mechanism builds its two
 //! (`mechanisms/furet2018/build.rs`: crossed bars A-C and B-D in planes [`PLANE_OFFSET_M`]
 //! apart, top bar D-C, revolute joints about z at A (actuated), B and C, the loop closed at D
 //! by a planar pin, lateral springs A-D and B-C), X(i + 1) standing on X(i)'s top bar.
@@ -19,7 +19,7 @@ use crate::settings::SimSettings;
 use crate::structure::Structure;
 
 /// Module counts of the family.
-pub const MODULES: [usize; 7] = [1, 2, 3, 5, 10, 15, 20];
+pub const MODULES: [usize; 10] = [1, 2, 3, 5, 10, 15, 20, 30, 50, 100];
 /// The commanded theta of every X [rad].
 pub const THETA_RAD: f64 = 0.1;
 /// The start's theta past the commanded one [rad].

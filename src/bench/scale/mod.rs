@@ -6,8 +6,10 @@
 //! - [`icosahedron`]: the 6-strut icosahedron (the expanded octahedron, cable / strut length
 //!   sqrt(6)/4);
 //! - [`tower`]: stacked towers of 4-strut prisms designed by the force density method;
-//! - [`furet`]: furet2018's Snelson X modules in series (n = 1 .. 20), end point against the
-//!   direct kinematics of Eq. 2.
+//! - [`furet`]: furet2018's Snelson X modules in series (n = 1 .. 100), end point against the
+//!   direct kinematics of Eq. 2;
+//! - [`spine`]: tensegrity spines of stacked tetrahedral vertebrae joined by saddle cables and
+//!   vertical springs, whose design is an equilibrium by its symmetry.
 //!
 //! Each case reports steps, wall time, memory (the process's resident set: `VmRSS` before the
 //! case and its peak `VmHWM` during it, after freed heap has been handed back to the system
@@ -19,6 +21,7 @@ pub mod furet;
 pub mod icosahedron;
 pub mod peer;
 pub mod prism;
+pub mod spine;
 pub mod tower;
 
 pub use prism::{prism, settle_prism};
@@ -37,7 +40,7 @@ use std::time::Instant;
 pub struct ScaleCase {
     pub family: &'static str,
     /// The family's size parameter: struts (prism, icosahedron), stages (tower), X modules
-    /// (furet).
+    /// (furet), free vertebrae (spine).
     pub size: usize,
     pub struts: usize,
     pub cables: usize,
@@ -193,7 +196,7 @@ pub fn settle(s: &Structure, settings: &SimSettings, commands: &[f64], caps: &Ca
         }
         sim.step()?;
         steps += 1;
-        let quiet = detector.update(&sim.snapshot_with(false), settings.dt_s, &criteria);
+        let quiet = detector.update_nodes(&sim.node_positions(), settings.dt_s, &criteria);
         sim.set_relaxation(settings.relaxation && detector.last_speed > criteria.speed_tol_m_per_s);
         if quiet {
             let snap = sim.snapshot();
@@ -287,9 +290,9 @@ pub fn growth_exponent(cases: &[ScaleCase]) -> Option<f64> {
 }
 
 /// The families, in table order.
-pub const FAMILIES: [&str; 4] = ["prism", "icosahedron", "tower", "furet"];
+pub const FAMILIES: [&str; 5] = ["prism", "icosahedron", "tower", "furet", "spine"];
 
-/// Every family's cases up to `max_struts` struts (furet: up to its 20 modules).
+/// Every family's cases up to `max_struts` struts (furet: up to its 100 modules).
 pub fn cases(family: &str, max_struts: usize) -> Result<Vec<Case>, BenchError> {
     match family {
         "prism" => Ok(prism::SIZES.iter().filter(|&&n| n <= max_struts).map(|&n| prism::case(n)).collect()),
@@ -301,6 +304,8 @@ pub fn cases(family: &str, max_struts: usize) -> Result<Vec<Case>, BenchError> {
             .collect(),
         // n modules: 3 n struts and the base bar.
         "furet" => Ok(furet::MODULES.iter().filter(|&&n| 3 * n < max_struts).map(|&n| furet::case(n)).collect()),
+        // m free vertebrae and the held one: four legs each.
+        "spine" => Ok(spine::VERTEBRAE.iter().filter(|&&m| 4 * (m + 1) <= max_struts).map(|&m| spine::case(m)).collect()),
         _ => Err(BenchError::Case(format!("no scale family '{family}' (families: {})", FAMILIES.join(", ")))),
     }
 }

@@ -29,6 +29,7 @@
 
 use super::{Case, Measure};
 use crate::settings::SimSettings;
+use crate::sim::least_squares::{SparseLeastSquares, SparseRows};
 use crate::structure::{BodyKind, Cable, CableLaw, Inertia, Spring, Structure, Strut, Vec3, DEFAULT_TENDON_RADIUS_M};
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -198,69 +199,6 @@ pub fn node_residual(d: &Design, q: &[f64]) -> f64 {
     f.iter().map(|v| crate::structure::norm(*v)).fold(0.0, f64::max)
 }
 
-/// A symmetric positive definite band matrix (half bandwidth `w`), rows stored from column
-/// i - w, factored in place by Cholesky.
-struct Band {
-    w: usize,
-    rows: Vec<Vec<f64>>,
-}
-
-impl Band {
-    fn new(n: usize, w: usize) -> Self {
-        Band { w, rows: vec![vec![0.0; w + 1]; n] }
-    }
-
-    fn add(&mut self, i: usize, j: usize, v: f64) {
-        if j <= i {
-            self.rows[i][j + self.w - i] += v;
-        }
-    }
-
-    fn get(&self, i: usize, j: usize) -> f64 {
-        self.rows[i][j + self.w - i]
-    }
-
-    /// Cholesky L L^T in place; Err if not positive definite.
-    fn factor(&mut self) -> Result<(), String> {
-        for i in 0..self.rows.len() {
-            for j in i.saturating_sub(self.w)..=i {
-                let mut s = self.get(i, j);
-                for k in i.saturating_sub(self.w).max(j.saturating_sub(self.w))..j {
-                    s -= self.get(i, k) * self.get(j, k);
-                }
-                let v = if i == j {
-                    if s <= 0.0 {
-                        return Err(format!("A A^T is singular at row {i}: the tower has too few members"));
-                    }
-                    s.sqrt()
-                } else {
-                    s / self.get(j, j)
-                };
-                self.rows[i][j + self.w - i] = v;
-            }
-        }
-        Ok(())
-    }
-
-    /// Solves L L^T y = b after [`Band::factor`].
-    fn solve(&self, mut b: Vec<f64>) -> Vec<f64> {
-        let n = b.len();
-        for i in 0..n {
-            for k in i.saturating_sub(self.w)..i {
-                b[i] -= self.get(i, k) * b[k];
-            }
-            b[i] /= self.get(i, i);
-        }
-        for i in (0..n).rev() {
-            b[i] /= self.get(i, i);
-            for k in i.saturating_sub(self.w)..i {
-                b[k] -= self.get(i, k) * b[i];
-            }
-        }
-        b
-    }
-}
-
 /// Regularisation of A A^T, relative to its largest diagonal entry: A has a null row space
 /// (the rotation about the held strut's axis stretches no member), along which A q has no
 /// component; the shift keeps the factorization positive definite.
@@ -268,28 +206,17 @@ const REGULARISATION: f64 = 1e-12;
 /// Passes of the projection (each removes the residual A q that the last one left).
 const PROJECTION_PASSES: usize = 3;
 
-/// A A^T + shift, factored, for the members' columns.
-fn normal_matrix(cols: &[Vec<(usize, Vec3)>], n: usize) -> Result<Band, String> {
-    let span = cols.iter().filter(|c| c.len() == 2).map(|c| c[0].0.abs_diff(c[1].0)).max().unwrap_or(0);
-    let w = 3 * span + 2;
-    let mut aat = Band::new(3 * n, w);
-    for c in cols {
+/// A (free node coordinates x members) from the members' columns, with A A^T + shift factored
+/// (`sim::least_squares`: a band Cholesky, the nodes numbered stage by stage).
+fn normal_matrix(cols: &[Vec<(usize, Vec3)>], n: usize) -> Result<SparseLeastSquares, String> {
+    let mut entries = Vec::new();
+    for (m, c) in cols.iter().enumerate() {
         for (i, u) in c {
-            for (j, v) in c {
-                for (k, uk) in u.iter().enumerate() {
-                    for (l, vl) in v.iter().enumerate() {
-                        aat.add(3 * i + k, 3 * j + l, uk * vl);
-                    }
-                }
-            }
+            entries.extend((0..3).map(|k| (3 * i + k, m, u[k])));
         }
     }
-    let largest = (0..3 * n).map(|i| aat.get(i, i)).fold(0.0, f64::max);
-    for i in 0..3 * n {
-        aat.add(i, i, REGULARISATION * largest);
-    }
-    aat.factor()?;
-    Ok(aat)
+    SparseLeastSquares::regularised(SparseRows::new(3 * n, cols.len(), &entries), REGULARISATION)
+        .map_err(|_| "A A^T is singular: the tower has too few members".to_string())
 }
 
 /// The force densities nearest the target pattern that make the drawn shape an equilibrium,
@@ -297,21 +224,13 @@ fn normal_matrix(cols: &[Vec<(usize, Vec3)>], n: usize) -> Result<Band, String> 
 pub fn force_densities(d: &Design) -> Result<Vec<f64>, String> {
     let (idx, n) = free_index(d);
     let cols: Vec<Vec<(usize, Vec3)>> = d.members.iter().map(|(_, a, b)| column(d, *a, *b, &idx)).collect();
-    let aat = normal_matrix(&cols, n)?;
-    let mut q = target_q(d);
+    let a = normal_matrix(&cols, n)?;
+    let mut q = nalgebra::DVector::from_vec(target_q(d));
+    // Each pass takes off A^T (A A^T + shift)^-1 A q: the part of q that A q sees.
     for _ in 0..PROJECTION_PASSES {
-        let mut aq = vec![0.0; 3 * n];
-        for (c, qm) in cols.iter().zip(&q) {
-            for (i, u) in c {
-                for k in 0..3 {
-                    aq[3 * i + k] += qm * u[k];
-                }
-            }
-        }
-        let y = aat.solve(aq);
-        for (c, qm) in cols.iter().zip(q.iter_mut()) {
-            *qm -= c.iter().map(|(i, u)| (0..3).map(|k| u[k] * y[3 * i + k]).sum::<f64>()).sum::<f64>();
-        }
+        let aq = a.matrix().mul(&q);
+        let off = a.solve_refined(&aq, 0).ok_or_else(|| "the force density projection is not finite".to_string())?;
+        q -= off;
     }
     let cable_q = d.members.iter().zip(&q).filter(|((k, _, _), _)| k.is_cable()).map(|(_, q)| *q);
     let (lo, hi) = cable_q.fold((f64::INFINITY, 0.0f64), |(lo, hi), q| (lo.min(q), hi.max(q)));
