@@ -252,7 +252,8 @@ pub fn import(path: &Path, axes: Axes) -> Result<Imported, ImportError> {
     let mut r = Reader { builders: default_builders(), skipped: Vec::new() };
     let top = r.load(path, "", 0)?;
     let draft = r.draft(path, &top, axes)?;
-    Ok(Imported { toml: draft.to_toml(), skipped: r.skipped })
+    let toml = draft.to_toml().map_err(|message| ImportError::whole(path, message))?;
+    Ok(Imported { toml, skipped: r.skipped })
 }
 
 fn default_builders() -> Vec<(String, Builder)> {

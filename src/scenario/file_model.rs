@@ -98,12 +98,10 @@ fn state_symbols(s: &crate::structure::Structure, m: &dyn Mechanism, params: &Va
     out
 }
 
-/// A name not yet taken by a symbol.
+/// A name not yet taken by a symbol of the structure or the mechanism (the file's own names
+/// are checked against each other in `names.rs`).
 fn new_name(ctx: &Ctx, spec: &ModelSpec, name: &Spanned<String>, what: &str) -> Result<String, ScenarioError> {
     let n = name.get_ref();
-    if n.trim().is_empty() {
-        return Err(ctx.err(name, format!("a {what} needs a name")));
-    }
     if spec.symbols.iter().any(|s| &s.name == n) {
         return Err(ctx.err(name, format!("{what} name '{n}' is already a symbol of this scenario")));
     }

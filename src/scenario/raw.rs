@@ -350,7 +350,7 @@ pub(super) struct RawStability {
 }
 
 #[derive(Debug, Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "\"stable\", \"unstable\", \"energy\", or a list of \"stable\" and \"unstable\"")]
 pub(super) enum RawExpectedStability {
     All(String),
     PerPoint(Vec<String>),
