@@ -139,7 +139,7 @@ impl Expr {
     /// The symbolic partial derivative with respect to symbol `symbol` of the list (zero when
     /// the expression does not use it). atan2, abs, min and max have no derivative here.
     pub fn derivative(&self, symbol: usize) -> Result<Expr, ExprError> {
-        let size = self.flat.unparse().len();
+        let size = self.size();
         if size > MAX_DIFFERENTIATED_BYTES {
             return Err(err(
                 0,
@@ -160,6 +160,12 @@ impl Expr {
         };
         let text = if self.text.starts_with(DERIVATIVE_OF) { format!("{}'", self.text) } else { format!("{DERIVATIVE_OF}{}", self.text) };
         Ok(Expr { text, order: order_of(&flat), flat })
+    }
+
+    /// The size of the expression as the engine holds it [bytes of its text]: what its
+    /// evaluation and its derivative cost grow with.
+    pub fn size(&self) -> usize {
+        self.flat.unparse().len()
     }
 
     /// The expression for a message: its text, or its start when long.

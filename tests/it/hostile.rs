@@ -169,6 +169,12 @@ fn work_before_validation() {
     refused_at(&d, "listed_sets", &listed, "[actuation]", 0, "asks for more than 10000 sets of parameters");
     let scans = s.replace("count = 4 }", "count = 4 }\n[[energy.coordinates]]\nname = \"q2\"\nmeasured = \"q\"\nclass = \"angle\"\nscan = { from = -3.0, to = 3.0, count = 5000 }");
     refused_at(&d, "scans", &scans, "count = 5000", 8, "the scans ask for 20000 Newton starts together");
+    let terms: Vec<String> = (1..12).map(|i| format!("sin(qe*{i})^2")).collect();
+    let heavy = s
+        .replacen("count = 4 }", "count = 10000 }", 1)
+        .replacen("potential = \"", &format!("potential = \"{}+", terms.join("+")), 1);
+    refused_at(&d, "scan_work", &heavy, "\"sin(qe*1)", 0, "Newton starts times the");
+    assert!(heavy.contains("count = 10000 }"));
     let (code, _, err) = tensegrity(&["sweep", SWEEP_FILE, "--figure", d.join("f.png").to_str().unwrap(), "--x", "nope"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("--x nope: not an axis of this sweep"), "{err}");
