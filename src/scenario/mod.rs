@@ -189,7 +189,7 @@ pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<S
     let ctx = Ctx { file: path.display().to_string(), source: &extended };
     let mut raw: RawScenario = toml::from_str(source).map_err(|e| {
         let start = e.span().map(|s| s.start).unwrap_or(0);
-        ctx.err_at(start, e.message().trim().to_string())
+        ctx.err_at(start, error::in_file_words(e.message().trim()))
     })?;
     let located = |e| overrides::at_flag(e, overrides, file_lines);
     overrides::apply(&ctx, &mut raw, overrides, file_lines).map_err(located)?;

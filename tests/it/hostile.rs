@@ -287,5 +287,16 @@ fn flags() {
     let p = d.join("stability_number.toml");
     let (_, _, err) = tensegrity(&["check", p.to_str().unwrap()]);
     assert!(!err.contains("untagged") && !err.contains("Raw"), "{err}");
+    for (name, section, at, words) in [
+        ("dt_text", "[sim]\ndt = \"a\"", "\"a\"", "invalid type: string \"a\", expected a number"),
+        ("substeps_fraction", "[sim]\nsubsteps = 1.5", "1.5", "expected a whole number"),
+        ("points_number", "", "3\n", "expected a list [...]"),
+    ] {
+        let text = PINNED_STRUT.replace("[actuation]", &format!("{section}\n[actuation]"));
+        let text = if section.is_empty() { text.replace("points = [ {} ]", "points = 3\n") } else { text };
+        refused_at(&d, name, &text, at, 0, words);
+        let (_, _, err) = tensegrity(&["check", d.join(format!("{name}.toml")).to_str().unwrap()]);
+        assert!(!err.contains("f64") && !err.contains("i64") && !err.contains("sequence"), "{err}");
+    }
     std::fs::remove_dir_all(&d).ok();
 }
