@@ -289,7 +289,7 @@ impl Reader {
             });
         }
         let text = super::read_text(path)?;
-        let root = yaml::parse(&text).map_err(|e| err(&file, e.at, format!("YAML syntax: {}", e.message)))?;
+        let root = yaml::parse(&text).map_err(|e| err(&file, e.at, e.message))?;
         only_keys(&file, &root, ROOT_KEYS, "an NTRT model file")?;
         let mut sub = Sub { name: name.into(), ..Default::default() };
         if let Some(c) = root.get("substructures") {

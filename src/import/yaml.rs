@@ -46,7 +46,7 @@ impl Yaml {
     }
 }
 
-/// A YAML syntax error at a place.
+/// A YAML document refused at a place: its syntax, or a bound.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SyntaxError {
     pub at: At,
@@ -65,7 +65,9 @@ pub const MAX_YAML_DEPTH: usize = 256;
 pub fn parse(text: &str) -> Result<Yaml, SyntaxError> {
     let mut b = Builder::default();
     let mut parser = Parser::new_from_str(text);
-    parser.load(&mut b, true).map_err(|e| SyntaxError { at: at(e.marker()), message: e.info().to_string() })?;
+    parser
+        .load(&mut b, true)
+        .map_err(|e| SyntaxError { at: at(e.marker()), message: format!("YAML syntax: {}", e.info()) })?;
     if let Some(e) = b.error {
         return Err(e);
     }

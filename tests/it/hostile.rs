@@ -214,12 +214,12 @@ fn unbounded_resources() {
     std::fs::write(&yaml, &laughs).unwrap();
     let (code, _, err) = import(&yaml);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("laughs.yaml:6:") && err.contains("expands to more than 1000000 nodes"), "{err}");
+    assert!(err.contains("laughs.yaml:6:45: the document expands to more than 1000000 nodes"), "{err}");
     let two = d.join("two.yaml");
     std::fs::write(&two, "nodes:\n  a: [0, 0, 0]\n---\nnodes:\n  b: [1, 0, 0]\n").unwrap();
     let (code, _, err) = import(&two);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("two.yaml:3:1: ") && err.contains("a second YAML document"), "{err}");
+    assert!(err.contains("two.yaml:3:1: a second YAML document"), "{err}");
 
     let fifo = d.join("fifo.yaml");
     assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
