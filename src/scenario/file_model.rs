@@ -198,6 +198,40 @@ fn equation(ctx: &Ctx, spec: &mut ModelSpec, e: &RawEquation) -> Result<(), Scen
     Ok(())
 }
 
+/// Every closed form of the model at every settle point of `actuation` (its parameters from
+/// `at_point`): a prediction is a finite number (a NaN or an infinity could never be within
+/// or outside its tolerance), a frequency finite and > 0. A motion run's predictions depend on
+/// t and are judged on its ticks. The error is at the formula, naming the point.
+pub(super) fn closed_forms_at_points(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    spec: &ModelSpec,
+    at_point: &dyn Fn(&Values) -> Values,
+    actuation: &Actuation,
+) -> Result<(), ScenarioError> {
+    let predictions = if raw.motion.is_some() { &[][..] } else { &spec.predictions[..] };
+    let frequencies = spec.energy.iter().flat_map(|e| e.dynamics.iter()).flat_map(|d| &d.frequencies);
+    let raw_frequencies = raw.energy.iter().flat_map(|e| &e.frequencies);
+    for p in actuation.all_inputs() {
+        let values = spec.values(p, &at_point(p), |_| f64::NAN);
+        for (pr, r) in predictions.iter().zip(&raw.predictions) {
+            let x = pr.formula.eval(&values);
+            if !x.is_finite() {
+                let what = format!("prediction '{}' is {x} at the point {p:?}: a predicted value is a finite number", pr.name);
+                return Err(ctx.err(&r.formula, what));
+            }
+        }
+        for (f, r) in frequencies.clone().zip(raw_frequencies.clone()) {
+            let w = f.formula.eval(&values);
+            if !(w.is_finite() && w > 0.0) {
+                let what = format!("frequency '{}' is {w} rad/s at the point {p:?}: a frequency is finite and > 0", f.name);
+                return Err(ctx.err(&r.formula, what));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The byte offset of `word` standing alone in `text` (not inside a longer name), if it does.
 fn word_offset(text: &str, word: &str) -> Option<usize> {
     let name_char = |c: char| c.is_alphanumeric() || c == '_' || c == '.';

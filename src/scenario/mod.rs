@@ -252,6 +252,9 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let probe = checks::probe(ctx, m, &raw.probe, &first, &params)?;
     let at_point = |p: &Values| params::params_at(&param_table, &params, p);
     checks::probe_expected(ctx, &raw.probe, &probe, &at_point, &actuation)?;
+    if let Some(spec) = &model {
+        file_model::closed_forms_at_points(ctx, &raw, spec, &at_point, &actuation)?;
+    }
     let motion = motion::motion(ctx, &raw, sim.dt_s, &first, &first_params, &actuation)?;
     let expect = match &raw.expect {
         None => None,

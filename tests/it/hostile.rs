@@ -51,6 +51,13 @@ fn checks_that_cannot_fail() {
         let text = s.replace("\"L*hypot(k1*a, k2*b)\"", &format!("\"{expected}\""));
         refused_at(&d, name, &text, &format!("\"{expected}\""), 0, words);
     }
+    let prediction = s.replace("\"atan2(ratio*a, b)\"", "\"sqrt(30-k1)\"");
+    let words = "prediction 'q' is NaN at the point {\"k1\": 40.0}: a predicted value is a finite number";
+    refused_at(&d, "prediction_nan", &prediction, "\"sqrt(30-k1)\"", 0, words);
+    let modes = std::fs::read_to_string("scenarios/custom/pinned_bar_modes.toml").unwrap();
+    let frequency = modes.replace("\"sqrt(L*hypot(k1*a, k2*b)/I)\"", "\"50-k1\"");
+    let words = "frequency 'omega' is 0 rad/s at the point {\"k1\": 50.0}: a frequency is finite and > 0";
+    refused_at(&d, "frequency_zero", &frequency, "\"50-k1\"", 0, words);
     let nan_tolerance = s.replacen("tolerance = 1e-9", "tolerance = nan", 1);
     refused_at(&d, "tolerance_nan", &nan_tolerance, "nan\n", 0, "must be a finite number, got NaN");
     let negative = s.replacen("tolerance = 1e-9", "tolerance = -1e-9", 1);
