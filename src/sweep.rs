@@ -338,7 +338,10 @@ pub fn merge_csv(texts: &[(String, String)], partial: bool) -> Result<String, Sw
             let id = line.rsplit(',').next().unwrap_or_default();
             let (first_id, first_file) = *sweep.get_or_insert((id, name));
             if id != first_id {
-                return Err(bad(format!("{at}: a row of another sweep than {first_file}'s: {}", differing(first_id, id))));
+                return Err(bad(format!(
+                    "{at}: a row of another sweep than {first_file}'s: {}",
+                    differing(first_id, id)
+                )));
             }
             let mut cells = line.split(',');
             let mut number = |col: usize| {

@@ -98,7 +98,10 @@ impl Expr {
             return Err(err(0, format!("at most {MAX_SYMBOLS} symbols, got {}", symbols.len())));
         }
         if text.len() > MAX_EXPRESSION_BYTES {
-            return Err(err(0, format!("an expression has at most {MAX_EXPRESSION_BYTES} bytes, this one {}", text.len())));
+            return Err(err(
+                0,
+                format!("an expression has at most {MAX_EXPRESSION_BYTES} bytes, this one {}", text.len()),
+            ));
         }
         let tokens = tokenize(text)?;
         if tokens.is_empty() {
@@ -158,7 +161,11 @@ impl Expr {
                 .map_err(|e| err(0, format!("no symbolic derivative of {} ({})", self.shown(), e.msg())))?,
             None => FlatEx::<f64>::parse("0").map_err(|e| err(0, e.msg().to_string()))?,
         };
-        let text = if self.text.starts_with(DERIVATIVE_OF) { format!("{}'", self.text) } else { format!("{DERIVATIVE_OF}{}", self.text) };
+        let text = if self.text.starts_with(DERIVATIVE_OF) {
+            format!("{}'", self.text)
+        } else {
+            format!("{DERIVATIVE_OF}{}", self.text)
+        };
         Ok(Expr { text, order: order_of(&flat), flat })
     }
 

@@ -118,7 +118,10 @@ impl Builder {
     fn count(&mut self, size: usize, a: At) -> bool {
         self.nodes += size;
         if self.nodes > MAX_YAML_NODES {
-            self.stop(a, format!("the document expands to more than {MAX_YAML_NODES} nodes (aliases counted at every use)"));
+            self.stop(
+                a,
+                format!("the document expands to more than {MAX_YAML_NODES} nodes (aliases counted at every use)"),
+            );
         }
         self.error.is_none()
     }

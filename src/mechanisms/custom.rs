@@ -77,12 +77,10 @@ impl Custom {
             }
         }
         let size = crate::structure::structure_size(&structure);
-        let members = structure
-            .springs
-            .iter()
-            .map(|m| &m.name)
-            .chain(structure.cables.iter().map(|m| &m.name))
-            .chain(structure.struts.iter().filter(|t| strut_reading(&structure, t, size).is_some()).map(|m| &m.name));
+        let members =
+            structure.springs.iter().map(|m| &m.name).chain(structure.cables.iter().map(|m| &m.name)).chain(
+                structure.struts.iter().filter(|t| strut_reading(&structure, t, size).is_some()).map(|m| &m.name),
+            );
         for name in members {
             quantities.push(QuantitySpec {
                 symbol: leak(format!("{name}.force")),

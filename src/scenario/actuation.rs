@@ -4,9 +4,9 @@
 //! those parameters beside the inputs, and every parameter that depends on them follows.
 
 use super::error::{finite, value_at, values, Ctx, ScenarioError};
+use super::mechanism::{too_many_sets, MAX_PARAMETER_SETS};
 use super::params::params_at;
 use super::raw::{RawActuation, RawRange, SpannedMap};
-use super::mechanism::{too_many_sets, MAX_PARAMETER_SETS};
 use super::{Actuation, MAX_POINTS};
 use crate::file_model::params::ParamTable;
 use crate::mechanisms::{Mechanism, ModelError, Values};

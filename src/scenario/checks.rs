@@ -187,11 +187,11 @@ fn joint_probe(
 pub(super) fn probe_expected(
     ctx: &Ctx,
     raw: &Option<RawProbe>,
-    probe: &Option<Probe>,
+    probe: Option<&Probe>,
     at_point: &dyn Fn(&Values) -> Values,
     actuation: &Actuation,
 ) -> Result<(), ScenarioError> {
-    let (Some(j), Some(e)) = (probe.as_ref().and_then(|p| p.joint.as_ref()), raw.as_ref().and_then(|r| r.expected.as_ref()))
+    let (Some(j), Some(e)) = (probe.and_then(|p| p.joint.as_ref()), raw.as_ref().and_then(|r| r.expected.as_ref()))
     else {
         return Ok(());
     };

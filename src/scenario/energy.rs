@@ -99,11 +99,7 @@ fn scan_work(
 
 /// One coordinate: a name new among the state's symbols (and the file's names: `names.rs`),
 /// its measured expression of the state, its class and scan.
-fn coordinate(
-    ctx: &Ctx,
-    state: &[&str],
-    c: &RawCoordinate,
-) -> Result<Coordinate, ScenarioError> {
+fn coordinate(ctx: &Ctx, state: &[&str], c: &RawCoordinate) -> Result<Coordinate, ScenarioError> {
     let name = c.name.get_ref().clone();
     if state.contains(&name.as_str()) {
         return Err(ctx.err(&c.name, format!("coordinate name '{name}' is already a symbol of this scenario")));

@@ -217,14 +217,16 @@ pub(super) fn closed_forms_at_points(
         for (pr, r) in predictions.iter().zip(&raw.predictions) {
             let x = pr.formula.eval(&values);
             if !x.is_finite() {
-                let what = format!("prediction '{}' is {x} at the point {p:?}: a predicted value is a finite number", pr.name);
+                let what =
+                    format!("prediction '{}' is {x} at the point {p:?}: a predicted value is a finite number", pr.name);
                 return Err(ctx.err(&r.formula, what));
             }
         }
         for (f, r) in frequencies.clone().zip(raw_frequencies.clone()) {
             let w = f.formula.eval(&values);
             if !(w.is_finite() && w > 0.0) {
-                let what = format!("frequency '{}' is {w} rad/s at the point {p:?}: a frequency is finite and > 0", f.name);
+                let what =
+                    format!("frequency '{}' is {w} rad/s at the point {p:?}: a frequency is finite and > 0", f.name);
                 return Err(ctx.err(&r.formula, what));
             }
         }

@@ -4,12 +4,12 @@ use super::error::{finite, Ctx, ScenarioError};
 use super::number::{param_start, param_values, resolve_structure, ParamMap};
 use super::params::params_at;
 use super::raw::{RawActuation, RawScenario};
-use toml::Spanned;
 use super::structure::structure_from_file;
 use super::Actuation;
 use crate::file_model::params::ParamTable;
 use crate::mechanisms::custom::{Custom, FileParam};
 use crate::mechanisms::{self, Mechanism, Values};
+use toml::Spanned;
 
 /// `mechanism = "custom"`: the mechanism built from the `[structure]` table, with each check's
 /// expected value (required: there is no analytic model). A built-in mechanism: `None`, and
@@ -69,8 +69,14 @@ pub(super) fn parameter_sets(
     for p in points {
         let set = params_at(table, params, p);
         if let Some((k, x)) = set.iter().find(|(_, x)| !x.is_finite()) {
-            let at = raw.params.iter().find(|(n, _)| n.get_ref() == k).map_or(raw.actuation.span().start, |(_, d)| param_start(d));
-            return Err(ctx.err_at(at, format!("parameter '{k}' is {x} at the point {p:?}: a parameter is a finite number")));
+            let at = raw
+                .params
+                .iter()
+                .find(|(n, _)| n.get_ref() == k)
+                .map_or(raw.actuation.span().start, |(_, d)| param_start(d));
+            return Err(
+                ctx.err_at(at, format!("parameter '{k}' is {x} at the point {p:?}: a parameter is a finite number"))
+            );
         }
         if seen.insert(bits(&set)) {
             if sets.len() == MAX_PARAMETER_SETS {

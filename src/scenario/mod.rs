@@ -201,6 +201,26 @@ pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<S
 /// Largest number of settle points a scenario may ask for.
 pub const MAX_POINTS: usize = 1_000_000;
 
+/// Every expected value that is an expression of the parameters and inputs (a joint probe's
+/// stiffness, the model's predictions and frequencies), evaluated at every settle point: a
+/// comparison with a value that is not a number could not fail.
+fn closed_forms(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    probe: Option<&Probe>,
+    model: Option<&crate::file_model::spec::ModelSpec>,
+    table: &crate::file_model::params::ParamTable,
+    params: &Values,
+    actuation: &Actuation,
+) -> Result<(), ScenarioError> {
+    let at_point = |p: &Values| params::params_at(table, params, p);
+    checks::probe_expected(ctx, &raw.probe, probe, &at_point, actuation)?;
+    match model {
+        Some(spec) => file_model::closed_forms_at_points(ctx, raw, spec, &at_point, actuation),
+        None => Ok(()),
+    }
+}
+
 /// The values of a scenario whose shape serde has read, section by section.
 fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, ScenarioError> {
     if raw.name.get_ref().trim().is_empty() {
@@ -250,11 +270,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     }
     let interference = interference::interference(ctx, &raw.interference, m, &first_params, &first)?;
     let probe = checks::probe(ctx, m, &raw.probe, &first, &params)?;
-    let at_point = |p: &Values| params::params_at(&param_table, &params, p);
-    checks::probe_expected(ctx, &raw.probe, &probe, &at_point, &actuation)?;
-    if let Some(spec) = &model {
-        file_model::closed_forms_at_points(ctx, &raw, spec, &at_point, &actuation)?;
-    }
+    closed_forms(ctx, &raw, probe.as_ref(), model.as_ref(), &param_table, &params, &actuation)?;
     let motion = motion::motion(ctx, &raw, sim.dt_s, &first, &first_params, &actuation)?;
     let expect = match &raw.expect {
         None => None,

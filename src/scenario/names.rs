@@ -49,10 +49,9 @@ impl Names<'_> {
         let mut chars = n.chars();
         let first_ok = chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
         if !n.is_empty() && !(first_ok && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')) {
-            return Err(self.ctx.err(
-                name,
-                format!("{what} '{n}' must be an identifier (letters, digits and _, not first a digit)"),
-            ));
+            return Err(self
+                .ctx
+                .err(name, format!("{what} '{n}' must be an identifier (letters, digits and _, not first a digit)")));
         }
         self.define(name, what)
     }

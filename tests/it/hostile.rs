@@ -62,8 +62,8 @@ fn checks_that_cannot_fail() {
     refused_at(&d, "tolerance_nan", &nan_tolerance, "nan\n", 0, "must be a finite number, got NaN");
     let negative = s.replacen("tolerance = 1e-9", "tolerance = -1e-9", 1);
     refused_at(&d, "tolerance_negative", &negative, "-1e-9", 0, "must be > 0, got -0.000000001");
-    let inf_value =
-        PINNED_STRUT.replace("[structure]", "[[checks]]\nquantity = \"k.force\"\nvalue = inf\ntolerance = 1e-6\n[structure]");
+    let inf_value = PINNED_STRUT
+        .replace("[structure]", "[[checks]]\nquantity = \"k.force\"\nvalue = inf\ntolerance = 1e-6\n[structure]");
     refused_at(&d, "value_inf", &inf_value, "inf\n", 0, "value must be a finite number, got inf");
     std::fs::remove_dir_all(&d).ok();
 }
@@ -87,10 +87,8 @@ fn names_that_mean_something_else() {
         refused_at(&d, name, &text, param, 0, words);
     }
     // An actuator's symbol equal to a parameter's: the second place, naming the first.
-    let actuated = with_params("q = 0.5").replace(
-        "damping = 0.5\n",
-        "damping = 0.5\n[[structure.actuators]]\nsymbol = \"q\"\njoint = \"pin\"\n",
-    );
+    let actuated = with_params("q = 0.5")
+        .replace("damping = 0.5\n", "damping = 0.5\n[[structure.actuators]]\nsymbol = \"q\"\njoint = \"pin\"\n");
     let (line, col) = line_col(&actuated, actuated.find("q = 0.5").unwrap());
     let words = format!("duplicate name 'q': this actuator symbol and the parameter at {line}:{col}");
     refused_at(&d, "actuator_is_param", &actuated, "\"q\"\njoint", 0, &words);
@@ -141,9 +139,17 @@ fn outputs_that_lie() {
     };
     sweep("1/2", "k2=30", &a);
     sweep("2/2", "k2=35", &b);
-    let (code, _, err) = tensegrity(&["merge", a.to_str().unwrap(), b.to_str().unwrap(), "--out", merged.to_str().unwrap()]);
+    let (code, _, err) =
+        tensegrity(&["merge", a.to_str().unwrap(), b.to_str().unwrap(), "--out", merged.to_str().unwrap()]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains(&format!("{}:2: a row of another sweep than {}'s: its parameters differ", b.display(), a.display())), "{err}");
+    assert!(
+        err.contains(&format!(
+            "{}:2: a row of another sweep than {}'s: its parameters differ",
+            b.display(),
+            a.display()
+        )),
+        "{err}"
+    );
     assert!(!merged.exists(), "nothing written");
 
     let yaml = d.join("huge.yaml");
@@ -177,12 +183,15 @@ fn work_before_validation() {
     let scans = s.replace("count = 4 }", "count = 4 }\n[[energy.coordinates]]\nname = \"q2\"\nmeasured = \"q\"\nclass = \"angle\"\nscan = { from = -3.0, to = 3.0, count = 5000 }");
     refused_at(&d, "scans", &scans, "count = 5000", 8, "the scans ask for 20000 Newton starts together");
     let terms: Vec<String> = (1..12).map(|i| format!("sin(qe*{i})^2")).collect();
-    let heavy = s
-        .replacen("count = 4 }", "count = 10000 }", 1)
-        .replacen("potential = \"", &format!("potential = \"{}+", terms.join("+")), 1);
+    let heavy = s.replacen("count = 4 }", "count = 10000 }", 1).replacen(
+        "potential = \"",
+        &format!("potential = \"{}+", terms.join("+")),
+        1,
+    );
     refused_at(&d, "scan_work", &heavy, "\"sin(qe*1)", 0, "Newton starts times the");
     assert!(heavy.contains("count = 10000 }"));
-    let (code, _, err) = tensegrity(&["sweep", SWEEP_FILE, "--figure", d.join("f.png").to_str().unwrap(), "--x", "nope"]);
+    let (code, _, err) =
+        tensegrity(&["sweep", SWEEP_FILE, "--figure", d.join("f.png").to_str().unwrap(), "--x", "nope"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("--x nope: not an axis of this sweep"), "{err}");
     assert!(!d.join("f.png").exists());

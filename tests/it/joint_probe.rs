@@ -46,7 +46,8 @@ fn a_wrong_stiffness_fails_the_probe() {
 #[test]
 fn a_stiffness_that_is_not_a_number_is_refused_at_read() {
     for (expected, value) in [("sqrt(-1)", "NaN"), ("0*k1", "0"), ("1/(k1-10)", "inf")] {
-        let text = std::fs::read_to_string(FILE).unwrap().replace("\"L*hypot(k1*a, k2*b)\"", &format!("\"{expected}\""));
+        let text =
+            std::fs::read_to_string(FILE).unwrap().replace("\"L*hypot(k1*a, k2*b)\"", &format!("\"{expected}\""));
         let text = text.replace("count = 9", "count = 2");
         let e = scenario::parse(Path::new("nan.toml"), &text).unwrap_err();
         let at = text.find(&format!("\"{expected}\"")).unwrap();
