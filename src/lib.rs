@@ -11,6 +11,7 @@ pub mod export;
 pub mod figures;
 pub mod file_model;
 pub mod import;
+pub mod input;
 pub mod mechanisms;
 pub mod observers;
 pub mod output;

@@ -102,8 +102,19 @@ pub fn sweep(
         .num_threads(jobs.max(1))
         .build()
         .map_err(|e| SweepError::Io(format!("cannot start {jobs} threads: {e}")))?;
+    // What every block's run shares, without the grid's points and the file's text (cloned
+    // once here, not once per block: a million points had made a signal take 29 s to stop).
+    let mut template = sc.clone();
+    template.actuation = Actuation::Points { points: Vec::new(), continuation };
+    template.skipped_points.clear();
+    template.source.clear();
+    template.record = None;
+    let cancelled = || cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::SeqCst));
     let settle_block = |block: &&[(usize, Values)]| {
-        let r = settle_block(sc, block, continuation, grid_points, cancel);
+        if cancelled() {
+            return (Vec::new(), None);
+        }
+        let r = settle_block(&template, block, continuation, grid_points, cancel);
         let n = done.fetch_add(block.len(), std::sync::atomic::Ordering::SeqCst) + block.len();
         progress(n, total);
         r
@@ -123,15 +134,14 @@ pub fn sweep(
 /// One block of points settled as one run (with continuation where the scenario asks): its
 /// rows, each with its index in the whole grid, and the run's error if it stopped.
 fn settle_block(
-    sc: &Scenario,
+    template: &Scenario,
     block: &[(usize, Values)],
     continuation: bool,
     grid_points: usize,
     cancel: Option<&AtomicBool>,
 ) -> (Vec<Row>, Option<String>) {
-    let mut sub = sc.clone();
+    let mut sub = template.clone();
     sub.actuation = Actuation::Points { points: block.iter().map(|(_, v)| v.clone()).collect(), continuation };
-    sub.record = None;
     let r = run(&sub, &RunOptions { cancel, skip_findings: true, ..RunOptions::default() });
     let rows = r
         .points
@@ -190,9 +200,54 @@ fn num(x: f64) -> String {
     format!("{x:?}")
 }
 
-/// The CSV of a sweep: one row per point, the full grid's index and size first. `is_angle`
-/// names the quantities whose error is wrapped into (-pi, pi].
-pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool) -> String {
+/// The parts of a sweep's identity, in the order [`fingerprint`] writes them.
+const FINGERPRINT_PARTS: [&str; 3] = ["scenario (its text and settings)", "parameters", "grid"];
+
+/// What makes a sweep the one it is, as three 64-bit FNV-1a hashes `scenario/parameters/grid`
+/// in hex: the file's text with its settings, every parameter's value, every grid point. Each
+/// CSV row carries it (column `sweep`), so that `merge` refuses shards of different sweeps and
+/// names the part that differs.
+pub fn fingerprint(sc: &Scenario) -> String {
+    let mut scenario = Fnv::default();
+    scenario.write(sc.source.as_bytes());
+    scenario.write(format!("{:?}{:?}{}", sc.sim, sc.settle, sc.mechanism).as_bytes());
+    let mut params = Fnv::default();
+    for (k, v) in &sc.params {
+        params.write(k.as_bytes());
+        params.write(&v.to_bits().to_le_bytes());
+    }
+    let mut grid = Fnv::default();
+    for p in sc.actuation.all_inputs() {
+        for (k, v) in p {
+            grid.write(k.as_bytes());
+            grid.write(&v.to_bits().to_le_bytes());
+        }
+    }
+    format!("{:016x}/{:016x}/{:016x}", scenario.0, params.0, grid.0)
+}
+
+/// The 64-bit FNV-1a hash (stable across Rust versions and machines, unlike the standard
+/// library's hasher).
+struct Fnv(u64);
+
+impl Default for Fnv {
+    fn default() -> Self {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv {
+    fn write(&mut self, bytes: &[u8]) {
+        const PRIME: u64 = 0x0100_0000_01b3;
+        for b in bytes {
+            self.0 = (self.0 ^ u64::from(*b)).wrapping_mul(PRIME);
+        }
+    }
+}
+
+/// The CSV of a sweep: one row per point, the full grid's index and size first, the sweep's
+/// [`fingerprint`] last. `is_angle` names the quantities whose error is wrapped into (-pi, pi].
+pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool, sweep: &str) -> String {
     let mut inputs: Vec<String> = Vec::new();
     let mut quantities: Vec<String> = Vec::new();
     for r in rows {
@@ -225,6 +280,7 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool) -> String {
             "slack_cables",
             "expected_slack",
             "min_clearance_m",
+            "sweep",
         ]
         .map(String::from),
     );
@@ -250,6 +306,7 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool) -> String {
         cells.push(p.slack_cables.join(";"));
         cells.push(p.expected_slack.as_ref().map(|e| e.join(";")).unwrap_or_default());
         cells.push(opt(p.min_clearance_m));
+        cells.push(sweep.to_string());
         out.push_str(&cells.join(","));
         out.push('\n');
     }
@@ -257,55 +314,59 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool) -> String {
 }
 
 /// Joins shard CSVs (same header) into one, rows ordered by grid index; a point present twice
-/// is an error, and so is a point missing from the grid (a shard left out) unless `partial`.
+/// is an error, and so is a point missing from the grid (a shard left out) unless `partial`,
+/// and a row of another sweep (its `sweep` fingerprint differs: the part that differs is named).
 pub fn merge_csv(texts: &[(String, String)], partial: bool) -> Result<String, SweepError> {
+    let bad = |m: String| SweepError::BadInput(m);
     let mut header: Option<&str> = None;
     let mut rows: Vec<(usize, &str)> = Vec::new();
     let mut grid_points: Option<usize> = None;
+    let mut sweep: Option<(&str, &str)> = None;
     for (name, text) in texts {
         let mut lines = text.lines();
-        let h = lines.next().ok_or_else(|| SweepError::BadInput(format!("{name}: empty CSV")))?;
+        let h = lines.next().ok_or_else(|| bad(format!("{name}: empty CSV")))?;
+        if !h.starts_with("index,grid_points,") || !h.ends_with(",sweep") {
+            return Err(bad(format!("{name}:1:1: expected a sweep CSV (index,grid_points,...,sweep)")));
+        }
         match header {
             None => header = Some(h),
-            Some(first) if first != h => {
-                return Err(SweepError::BadInput(format!("{name}: its header differs from the first file's")))
-            }
+            Some(first) if first != h => return Err(bad(format!("{name}: its header differs from the first file's"))),
             _ => {}
         }
-        if !h.starts_with("index,grid_points,") {
-            return Err(SweepError::BadInput(format!("{name}:1:1: expected a sweep CSV (index,grid_points,...)")));
-        }
-        for (k, line) in lines.enumerate() {
-            if line.is_empty() {
-                continue;
+        for (k, line) in lines.enumerate().filter(|(_, l)| !l.is_empty()) {
+            let at = format!("{name}:{}", k + 2);
+            let id = line.rsplit(',').next().unwrap_or_default();
+            let (first_id, first_file) = *sweep.get_or_insert((id, name));
+            if id != first_id {
+                return Err(bad(format!(
+                    "{at}: a row of another sweep than {first_file}'s: {}",
+                    differing(first_id, id)
+                )));
             }
             let mut cells = line.split(',');
             let mut number = |col: usize| {
                 cells
                     .next()
                     .and_then(|s| s.parse::<usize>().ok())
-                    .ok_or_else(|| SweepError::BadInput(format!("{name}:{}:{col}: expected a whole number", k + 2)))
+                    .ok_or_else(|| bad(format!("{at}:{col}: expected a whole number")))
             };
             let (idx, n) = (number(1)?, number(2)?);
             if *grid_points.get_or_insert(n) != n || idx >= n {
-                return Err(SweepError::BadInput(format!(
-                    "{name}:{}: point {idx} of a {n}-point grid does not fit the other files' grid",
-                    k + 2
-                )));
+                return Err(bad(format!("{at}: point {idx} of a {n}-point grid does not fit the other files' grid")));
             }
             rows.push((idx, line));
         }
     }
     rows.sort_by_key(|(i, _)| *i);
     if let Some(w) = rows.windows(2).find(|w| w[0].0 == w[1].0) {
-        return Err(SweepError::BadInput(format!("grid point {} appears in more than one file", w[0].0)));
+        return Err(bad(format!("grid point {} appears in more than one file", w[0].0)));
     }
     let total = grid_points.unwrap_or(0);
     if !partial && rows.len() != total {
         let present: std::collections::BTreeSet<usize> = rows.iter().map(|(i, _)| *i).collect();
         let missing: Vec<String> =
             (0..total).filter(|i| !present.contains(i)).take(10).map(|i| i.to_string()).collect();
-        return Err(SweepError::BadInput(format!(
+        return Err(bad(format!(
             "{} of the grid's {total} points are missing (first: {}): a shard left out? (--partial merges what is there)",
             total - rows.len(),
             missing.join(", ")
@@ -318,6 +379,22 @@ pub fn merge_csv(texts: &[(String, String)], partial: bool) -> Result<String, Sw
         out.push('\n');
     }
     Ok(out)
+}
+
+/// Which parts of two sweep fingerprints differ, in words.
+fn differing(a: &str, b: &str) -> String {
+    let parts: Vec<&str> = a
+        .split('/')
+        .zip(b.split('/'))
+        .zip(FINGERPRINT_PARTS)
+        .filter(|((x, y), _)| x != y)
+        .map(|(_, what)| what)
+        .collect();
+    if parts.is_empty() {
+        format!("its fingerprint {b} is not {a}")
+    } else {
+        format!("its {} differ", parts.join(" and "))
+    }
 }
 
 #[cfg(test)]
@@ -334,7 +411,7 @@ mod tests {
             simulated: Values::from([("theta2".into(), pi), ("x".into(), 1.25)]),
             ..PointReport::default()
         };
-        let csv = to_csv(&[Row { index: 0, grid_points: 1, point }], &|q| q == "theta2");
+        let csv = to_csv(&[Row { index: 0, grid_points: 1, point }], &|q| q == "theta2", "0/0/0");
         let mut lines = csv.lines();
         let header: Vec<&str> = lines.next().unwrap().split(',').collect();
         let row: Vec<&str> = lines.next().unwrap().split(',').collect();

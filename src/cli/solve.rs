@@ -54,6 +54,14 @@ pub fn solve(mechanism: &str, query: &str, sets: &[String], json: bool) -> Resul
         return Err(bad_input(format!("query '{query}' needs --set {i}=VALUE (inputs: {})", q.inputs.join(" "))));
     }
     let sols = m.solve(query, &params, &inputs).map_err(bad_input)?;
+    let non_finite = sols.iter().find_map(|s| s.values.iter().find(|(_, v)| !v.is_finite()).map(|kv| (s, kv)));
+    if let Some((s, (k, v))) = non_finite {
+        return Err(bad_input(format!(
+            "{mechanism} {query}: {} gives {k} = {v} with these values: outside the range where the model is a \
+             number (nothing printed)",
+            s.label
+        )));
+    }
     if json {
         let v = serde_json::json!({
             "mechanism": mechanism, "query": query, "params": params, "inputs": inputs,

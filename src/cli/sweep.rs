@@ -26,10 +26,13 @@ pub fn sweep(
     {
         return Err(super::bad_input(format!("--figure {}: give a .png or .svg file", f.display())));
     }
-    let outputs: Vec<(String, PathBuf)> = [("--out", &o.csv), ("--json", &o.json), ("--figure", &o.figure)]
+    let mut outputs: Vec<(String, PathBuf)> = [("--out", &o.csv), ("--json", &o.json), ("--figure", &o.figure)]
         .into_iter()
         .filter_map(|(what, p)| p.clone().map(|p| (what.to_string(), p)))
         .collect();
+    if let Some(csv) = o.csv.as_deref().filter(|p| !super::is_stdio(p)) {
+        outputs.push(("the CSV of an interrupted sweep".into(), partial_path(csv)));
+    }
     check_outputs(&[path.to_path_buf()], &outputs)?;
     check_axis(&sc, o.x.as_deref())?;
     let jobs = capped_jobs(jobs);
@@ -53,8 +56,12 @@ pub fn sweep(
     let say: fn(&str) = if on_stdout { |line| eprintln!("{line}") } else { |line| println!("{line}") };
     print_summary(&summary, say);
     let is_angle = |q: &str| sc.is_angle(q);
+    let csv_text = || crate::sweep::to_csv(&rows, &is_angle, &crate::sweep::fingerprint(&sc));
+    if signals::cancelled() {
+        return interrupted(o.csv.as_deref(), rows.len(), &csv_text(), say);
+    }
     if let Some(csv) = &o.csv {
-        write_atomic(csv, &crate::sweep::to_csv(&rows, &is_angle))?;
+        write_atomic(csv, &csv_text())?;
     }
     if let Some(f) = &o.figure {
         crate::figures::sweep::draw(&rows, &summary.scenario, o.x.as_deref(), &is_angle, f).map_err(super::failed)?;
@@ -71,6 +78,32 @@ pub fn sweep(
     let passed = summary.passed && !signals::cancelled();
     say(if passed { "PASS" } else { "FAIL" });
     Ok(Outcome::from_passed(passed))
+}
+
+/// An interrupted sweep: the rows that ran go beside `--out`, to a file named as partial (for
+/// `merge --partial` or a later run), never over an earlier complete CSV; the summary and the
+/// figure are not written. Exit 1.
+fn interrupted(csv: Option<&Path>, rows: usize, text: &str, say: fn(&str)) -> Result<Outcome, CliError> {
+    match csv.filter(|p| !super::is_stdio(p)) {
+        Some(p) => {
+            let partial = partial_path(p);
+            write_atomic(&partial, text)?;
+            say(&format!(
+                "interrupted: the {rows} point(s) that ran are in {} (merge --partial reads it); {} was not written",
+                partial.display(),
+                p.display()
+            ));
+        }
+        None => say("interrupted: no CSV written"),
+    }
+    Ok(Outcome::from_passed(false))
+}
+
+/// `out/s.csv` -> `out/s.partial.csv`.
+pub fn partial_path(p: &Path) -> PathBuf {
+    let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let ext = p.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
+    p.with_file_name(format!("{stem}.partial{ext}"))
 }
 
 /// The summary's lines: points, settled, within tolerance, wall time; agreement; stops.

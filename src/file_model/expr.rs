@@ -29,6 +29,23 @@ pub const FUNCTIONS: &[(&str, usize)] = &[
     ("ln", 1),
 ];
 
+/// The symbol of time in every expression that may use it.
+pub const TIME: &str = "t";
+
+/// What `name` already means in an expression (a built-in constant or function, or time), if
+/// anything: a name a file defines may not be one of these.
+pub fn reserved_meaning(name: &str) -> Option<&'static str> {
+    if CONSTANTS.iter().any(|(c, _)| *c == name) {
+        Some("a built-in constant of the expressions")
+    } else if FUNCTIONS.iter().any(|(f, _)| *f == name) {
+        Some("a built-in function of the expressions")
+    } else if name == TIME {
+        Some("the time symbol of the expressions")
+    } else {
+        None
+    }
+}
+
 /// The constants an expression may name, with the engine's spelling.
 const CONSTANTS: &[(&str, &str)] = &[("pi", "PI"), ("e", "E")];
 
@@ -36,6 +53,21 @@ const CONSTANTS: &[(&str, &str)] = &[("pi", "PI"), ("e", "E")];
 /// names are `v` and this many digits, so that they sort in the list's order).
 const SYMBOL_DIGITS: usize = 5;
 const MAX_SYMBOLS: usize = 99_999;
+
+/// Longest expression compiled [bytes of its text]. The shipped scenarios' longest is 151; a
+/// longer text is refused before it is read, so that reading it stays linear in its size.
+pub const MAX_EXPRESSION_BYTES: usize = 10_000;
+
+/// Deepest nesting of an expression: parentheses, function calls, signs (`--x`) and powers
+/// (`a^b^c`) each add a level. Refused before the engine parses it (deep nesting overflowed
+/// the stack).
+pub const MAX_EXPRESSION_DEPTH: usize = 64;
+
+/// Largest expression differentiated symbolically [bytes of the engine's text]: the engine's
+/// derivative costs time and memory that grow with the square of its input and more (a sum of
+/// 400 terms took 8 s and 3 GB, one of 800 overflowed the stack), and each order multiplies
+/// the size, so a larger one is refused before the work.
+pub const MAX_DIFFERENTIATED_BYTES: usize = 1_000;
 
 /// Why an expression does not compile or differentiate, at byte `offset` of its text.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -64,6 +96,12 @@ impl Expr {
     pub fn compile(text: &str, symbols: &[&str]) -> Result<Expr, ExprError> {
         if symbols.len() > MAX_SYMBOLS {
             return Err(err(0, format!("at most {MAX_SYMBOLS} symbols, got {}", symbols.len())));
+        }
+        if text.len() > MAX_EXPRESSION_BYTES {
+            return Err(err(
+                0,
+                format!("an expression has at most {MAX_EXPRESSION_BYTES} bytes, this one {}", text.len()),
+            ));
         }
         let tokens = tokenize(text)?;
         if tokens.is_empty() {
@@ -104,17 +142,52 @@ impl Expr {
     /// The symbolic partial derivative with respect to symbol `symbol` of the list (zero when
     /// the expression does not use it). atan2, abs, min and max have no derivative here.
     pub fn derivative(&self, symbol: usize) -> Result<Expr, ExprError> {
+        let size = self.size();
+        if size > MAX_DIFFERENTIATED_BYTES {
+            return Err(err(
+                0,
+                format!(
+                    "{} has {size} bytes, too large to differentiate symbolically (at most {MAX_DIFFERENTIATED_BYTES}): \
+                     write it with fewer terms or nested functions",
+                    self.shown()
+                ),
+            ));
+        }
         let flat = match self.order.iter().position(|&s| s == symbol) {
             Some(var) => self
                 .flat
                 .clone()
                 .partial(var)
-                .map_err(|e| err(0, format!("no symbolic derivative of '{}' ({})", self.text, e.msg())))?,
+                .map_err(|e| err(0, format!("no symbolic derivative of {} ({})", self.shown(), e.msg())))?,
             None => FlatEx::<f64>::parse("0").map_err(|e| err(0, e.msg().to_string()))?,
         };
-        Ok(Expr { text: format!("d({})/d[{symbol}]", self.text), order: order_of(&flat), flat })
+        let text = if self.text.starts_with(DERIVATIVE_OF) {
+            format!("{}'", self.text)
+        } else {
+            format!("{DERIVATIVE_OF}{}", self.text)
+        };
+        Ok(Expr { text, order: order_of(&flat), flat })
+    }
+
+    /// The size of the expression as the engine holds it [bytes of its text]: what its
+    /// evaluation and its derivative cost grow with.
+    pub fn size(&self) -> usize {
+        self.flat.unparse().len()
+    }
+
+    /// The expression for a message: its text, or its start when long.
+    fn shown(&self) -> String {
+        const SHOWN_CHARS: usize = 60;
+        let mut t: String = self.text.chars().take(SHOWN_CHARS).collect();
+        if t.len() < self.text.len() {
+            t.push_str("...");
+        }
+        format!("'{t}'")
     }
 }
+
+/// How a derivative's text starts (`the derivative of V`, a second one `the derivative of V'`).
+const DERIVATIVE_OF: &str = "the derivative of ";
 
 /// The symbol index of each of the engine's variables (`v00003` -> 3).
 fn order_of(flat: &FlatEx<f64>) -> Vec<usize> {
@@ -233,11 +306,13 @@ struct Translator<'a> {
     symbols: &'a [&'a str],
     tokens: &'a [Token],
     at: usize,
+    /// How deeply the cursor is nested now (see [`MAX_EXPRESSION_DEPTH`]).
+    depth: usize,
 }
 
 impl<'a> Translator<'a> {
     fn new(text: &'a str, symbols: &'a [&'a str], tokens: &'a [Token]) -> Self {
-        Translator { text, symbols, tokens, at: 0 }
+        Translator { text, symbols, tokens, at: 0, depth: 0 }
     }
 
     /// The whole expression.
@@ -267,25 +342,54 @@ impl<'a> Translator<'a> {
         self.tokens.get(self.at).map_or(self.text.len(), |t| t.start)
     }
 
+    /// Terms joined by `+ -` (written flat: the engine groups them left to right).
     fn sum(&mut self) -> Result<String, ExprError> {
-        let mut out = self.product()?;
-        while let Some(op) = self.op(&["+", "-"]) {
-            self.at += 1;
-            out = format!("({out}{op}{})", self.product()?);
-        }
-        Ok(out)
+        self.chain(&["+", "-"], Self::product)
     }
 
+    /// Factors joined by `* /` (written flat, as a sum is).
     fn product(&mut self) -> Result<String, ExprError> {
-        let mut out = self.unary()?;
-        while let Some(op) = self.op(&["*", "/"]) {
-            self.at += 1;
-            out = format!("({out}{op}{})", self.unary()?);
+        self.chain(&["*", "/"], Self::unary)
+    }
+
+    /// Operands read by `operand`, joined by the left-associative operators `ops` of one
+    /// precedence, in one pair of parentheses (one level for the engine however long the chain).
+    fn chain(
+        &mut self,
+        ops: &[&str],
+        operand: fn(&mut Self) -> Result<String, ExprError>,
+    ) -> Result<String, ExprError> {
+        let first = operand(self)?;
+        if self.op(ops).is_none() {
+            return Ok(first);
         }
+        let mut out = format!("({first}");
+        while let Some(op) = self.op(ops) {
+            self.at += 1;
+            out.push_str(op);
+            out.push_str(&operand(self)?);
+        }
+        out.push(')');
         Ok(out)
     }
 
+    /// A signed operand, one level deeper than the operator before it.
     fn unary(&mut self) -> Result<String, ExprError> {
+        self.depth += 1;
+        if self.depth > MAX_EXPRESSION_DEPTH {
+            return Err(err(
+                self.here(),
+                format!(
+                    "nested deeper than {MAX_EXPRESSION_DEPTH} levels (parentheses, function calls, signs and powers)"
+                ),
+            ));
+        }
+        let out = self.signed();
+        self.depth -= 1;
+        out
+    }
+
+    fn signed(&mut self) -> Result<String, ExprError> {
         match self.op(&["-", "+"]) {
             Some(op) => {
                 self.at += 1;

@@ -82,8 +82,18 @@ fn multiline(s: &str) -> String {
     s.replace('\\', "\\\\").replace("\"\"\"", "\"\"\\\"")
 }
 
-fn xyz(v: Vec3) -> String {
-    format!("[{:?}, {:?}, {:?}]", v[0], v[1], v[2])
+/// A number as TOML writes it back exactly, or an error naming `what` when it is not finite (TOML's
+/// inf and nan would make a scenario that means nothing).
+fn num(x: f64, what: &str) -> Result<String, String> {
+    if x.is_finite() {
+        Ok(format!("{x:?}"))
+    } else {
+        Err(format!("{what} would be {x}: the model's numbers are too large (or not numbers) to write"))
+    }
+}
+
+fn xyz(v: Vec3, what: &str) -> Result<String, String> {
+    Ok(format!("[{}, {}, {}]", num(v[0], what)?, num(v[1], what)?, num(v[2], what)?))
 }
 
 impl Draft {
@@ -117,7 +127,7 @@ impl Draft {
 
     /// The `[sim]` and `[settle]` tables: a step and a damping from the fastest body, a time
     /// limit from the slowest.
-    fn settings(&self) -> String {
+    fn settings(&self) -> Result<String, String> {
         let rates: Vec<f64> = self.body_rates().iter().filter(|(_, k)| *k > 0.0).map(|(m, k)| (k / m).sqrt()).collect();
         // Nothing elastic moves (all held, or no cable on a free body): the rate of a 1 s period.
         let fastest = rates.iter().copied().fold(f64::NAN, f64::max);
@@ -126,50 +136,53 @@ impl Draft {
         let size = self.size_m();
         let k_max = self.cables.iter().filter_map(|c| c.stiffness_n_per_m).fold(0.0, f64::max).max(1.0);
         let residual = RESIDUAL_FRACTION * k_max * size;
-        format!(
-            "[sim]\ndt = {:?}\nbody_damping = {:?}\n\n[settle]\nspeed_tol = {:?}\nwindow = 10\nresidual_force_tol = {residual:?}\nresidual_torque_tol = {:?}\nmax_time = {:?}\n",
-            DT_FRACTION / fastest,
-            DAMPING_FRACTION * fastest,
-            SPEED_TOL_PER_M * size,
-            residual * size,
-            (MAX_TIME_PERIODS / slowest).ceil()
-        )
+        Ok(format!(
+            "[sim]\ndt = {}\nbody_damping = {}\n\n[settle]\nspeed_tol = {}\nwindow = 10\nresidual_force_tol = {}\nresidual_torque_tol = {}\nmax_time = {}\n",
+            num(DT_FRACTION / fastest, "sim.dt")?,
+            num(DAMPING_FRACTION * fastest, "sim.body_damping")?,
+            num(SPEED_TOL_PER_M * size, "settle.speed_tol")?,
+            num(residual, "settle.residual_force_tol")?,
+            num(residual * size, "settle.residual_torque_tol")?,
+            num((MAX_TIME_PERIODS / slowest).ceil(), "settle.max_time")?
+        ))
     }
 
-    /// The scenario file: name, description, settings, one point, the structure.
-    pub fn to_toml(&self) -> String {
+    /// The scenario file: name, description, settings, one point, the structure; an error when
+    /// a number of it would not be finite.
+    pub fn to_toml(&self) -> Result<String, String> {
         let mut t = String::new();
         let _ = writeln!(t, "name = {}", quote(&self.name));
         let _ = writeln!(t, "description = \"\"\"\n{}\n\"\"\"", multiline(&self.description));
         t.push_str("mechanism = \"custom\"\n\n");
-        t.push_str(&self.settings());
+        t.push_str(&self.settings()?);
         t.push_str("\n[actuation]\npoints = [ {} ]\n\n[structure]\n");
         for b in &self.bodies {
             let _ = writeln!(t, "\n[[structure.bodies]]\nname = {}", quote(&b.name));
             if b.fixed {
                 t.push_str("fixed = true\n");
             } else {
-                let _ = writeln!(t, "mass = {:?}", b.mass_kg);
+                let _ = writeln!(t, "mass = {}", num(b.mass_kg, &format!("the mass of body {}", b.name))?);
                 if let Some(i) = b.inertia_kg_m2 {
-                    let _ = writeln!(t, "inertia = {}", xyz(i));
+                    let _ = writeln!(t, "inertia = {}", xyz(i, &format!("the inertia of body {}", b.name))?);
                 }
             }
-            let nodes: Vec<String> = b.nodes.iter().map(|(n, p)| format!("{} = {}", quote(n), xyz(*p))).collect();
+            let node = |(n, p): &(String, Vec3)| Ok(format!("{} = {}", quote(n), xyz(*p, &format!("node {n}"))?));
+            let nodes: Vec<String> = b.nodes.iter().map(node).collect::<Result<_, String>>()?;
             let _ = writeln!(t, "nodes = {{ {} }}", nodes.join(", "));
         }
         for s in &self.struts {
             let _ = writeln!(
                 t,
-                "\n[[structure.struts]]\nname = {}\na = {}\nb = {}\nradius = {:?}",
+                "\n[[structure.struts]]\nname = {}\na = {}\nb = {}\nradius = {}",
                 quote(&s.name),
                 quote(&s.a),
                 quote(&s.b),
-                s.radius_m
+                num(s.radius_m, &format!("the radius of strut {}", s.name))?
             );
         }
         for c in &self.cables {
             let drawn = match (self.position(&c.a), self.position(&c.b)) {
-                (Some(a), Some(b)) => format!("  # drawn {:?} m", distance(a, b)),
+                (Some(a), Some(b)) => format!("  # drawn {} m", num(distance(a, b), &format!("cable {}", c.name))?),
                 _ => String::new(),
             };
             let _ = writeln!(
@@ -180,10 +193,10 @@ impl Draft {
                 quote(&c.b)
             );
             if let Some(k) = c.stiffness_n_per_m {
-                let _ = writeln!(t, "stiffness = {k:?}");
+                let _ = writeln!(t, "stiffness = {}", num(k, &format!("the stiffness of cable {}", c.name))?);
             }
-            let _ = writeln!(t, "length = {:?}{drawn}", c.length_m);
+            let _ = writeln!(t, "length = {}{drawn}", num(c.length_m, &format!("the length of cable {}", c.name))?);
         }
-        t
+        Ok(t)
     }
 }

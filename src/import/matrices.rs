@@ -151,7 +151,8 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
     add_bars(&mut draft, &nodes, &bars, ground.is_empty(), o);
     add_strings(&mut draft, &nodes, &strings, cs_path, o)?;
     draft.description = description([n_path, cb_path, cs_path], o, ground.len());
-    Ok(Imported { toml: draft.to_toml(), skipped: Vec::new() })
+    let toml = draft.to_toml().map_err(|message| ImportError::whole(n_path, message))?;
+    Ok(Imported { toml, skipped: Vec::new() })
 }
 
 /// Node k (from 0) is n<k+1>, column k+1 of N.

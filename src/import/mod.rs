@@ -20,14 +20,13 @@ pub struct ImportError {
     pub message: String,
 }
 
-/// The text of an input file, or an error naming it.
+/// Largest input file an import reads [bytes] (as a scenario file: 16 MiB).
+pub const MAX_IMPORT_BYTES: u64 = 16 << 20;
+
+/// The text of an input file (a regular file, at most [`MAX_IMPORT_BYTES`]), or an error
+/// naming it.
 pub(crate) fn read_text(path: &std::path::Path) -> Result<String, ImportError> {
-    std::fs::read_to_string(path).map_err(|e| ImportError {
-        file: path.display().to_string(),
-        line: 0,
-        col: 0,
-        message: format!("cannot read: {e}"),
-    })
+    crate::input::read_text(path, MAX_IMPORT_BYTES, false).map_err(|message| ImportError::whole(path, message))
 }
 
 impl std::fmt::Display for ImportError {
@@ -43,6 +42,11 @@ impl std::fmt::Display for ImportError {
 impl std::error::Error for ImportError {}
 
 impl ImportError {
+    /// An error about the file `path` as a whole.
+    pub fn whole(path: &std::path::Path, message: String) -> Self {
+        ImportError { file: path.display().to_string(), line: 0, col: 0, message }
+    }
+
     pub fn at(file: &str, at: yaml::At, message: impl Into<String>) -> Self {
         ImportError { file: file.into(), line: at.line, col: at.col, message: message.into() }
     }

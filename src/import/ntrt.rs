@@ -252,7 +252,8 @@ pub fn import(path: &Path, axes: Axes) -> Result<Imported, ImportError> {
     let mut r = Reader { builders: default_builders(), skipped: Vec::new() };
     let top = r.load(path, "", 0)?;
     let draft = r.draft(path, &top, axes)?;
-    Ok(Imported { toml: draft.to_toml(), skipped: r.skipped })
+    let toml = draft.to_toml().map_err(|message| ImportError::whole(path, message))?;
+    Ok(Imported { toml, skipped: r.skipped })
 }
 
 fn default_builders() -> Vec<(String, Builder)> {
@@ -288,7 +289,7 @@ impl Reader {
             });
         }
         let text = super::read_text(path)?;
-        let root = yaml::parse(&text).map_err(|e| err(&file, e.at, format!("YAML syntax: {}", e.message)))?;
+        let root = yaml::parse(&text).map_err(|e| err(&file, e.at, e.message))?;
         only_keys(&file, &root, ROOT_KEYS, "an NTRT model file")?;
         let mut sub = Sub { name: name.into(), ..Default::default() };
         if let Some(c) = root.get("substructures") {

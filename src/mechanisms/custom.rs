@@ -24,6 +24,9 @@ pub struct Custom {
     params: Values,
     /// The structure at the other sets of parameters a sweep over them settles at.
     variants: Vec<(Values, Structure)>,
+    /// `structure`'s size [m] ([`crate::structure::structure_size`], quadratic in the nodes:
+    /// computed once).
+    size_m: f64,
 }
 
 /// A parameter a custom file declares in `[params]`.
@@ -73,12 +76,11 @@ impl Custom {
                 });
             }
         }
-        let members = structure
-            .springs
-            .iter()
-            .map(|m| &m.name)
-            .chain(structure.cables.iter().map(|m| &m.name))
-            .chain(structure.struts.iter().filter(|t| strut_reading(&structure, t).is_some()).map(|m| &m.name));
+        let size = crate::structure::structure_size(&structure);
+        let members =
+            structure.springs.iter().map(|m| &m.name).chain(structure.cables.iter().map(|m| &m.name)).chain(
+                structure.struts.iter().filter(|t| strut_reading(&structure, t, size).is_some()).map(|m| &m.name),
+            );
         for name in members {
             quantities.push(QuantitySpec {
                 symbol: leak(format!("{name}.force")),
@@ -89,6 +91,7 @@ impl Custom {
         }
         Custom {
             structure,
+            size_m: size,
             spec: MechanismSpec {
                 name: "custom",
                 title: "a structure described in the scenario file (its model, if any, stated there too)",
@@ -175,7 +178,7 @@ impl Custom {
             .iter()
             .enumerate()
             .filter_map(|(k, st)| {
-                let reading = strut_reading(s, st)?;
+                let reading = strut_reading(s, st, self.size_m)?;
                 let (pa, pb) = (snap.nodes[st.a], snap.nodes[st.b]);
                 let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
                 let l = dot(d, d).sqrt().max(f64::MIN_POSITIVE);
@@ -207,13 +210,14 @@ enum StrutReading {
 
 /// How the axial force of `st` is read, or None when it cannot be: a strut on a fixed body
 /// (its force goes into the ground) or with a joint at both ends (the joints' reactions share
-/// the axial force in a way the body's balance does not determine).
-fn strut_reading(s: &Structure, st: &crate::structure::Strut) -> Option<StrutReading> {
+/// the axial force in a way the body's balance does not determine). `size`: the structure's
+/// ([`crate::structure::structure_size`], computed once by the caller: it is quadratic in the
+/// nodes, and computing it per strut had made checking a 1000-rod model take 10.9 s).
+fn strut_reading(s: &Structure, st: &crate::structure::Strut, size: f64) -> Option<StrutReading> {
     let fixed = |n: usize| s.bodies[s.nodes[n].body].kind == crate::structure::BodyKind::Fixed;
     if fixed(st.a) || fixed(st.b) {
         return None;
     }
-    let size = crate::structure::structure_size(s);
     let jointed = |n: usize| {
         let node = &s.nodes[n];
         s.joints.iter().any(|j| {

@@ -4,6 +4,7 @@
 //! those parameters beside the inputs, and every parameter that depends on them follows.
 
 use super::error::{finite, value_at, values, Ctx, ScenarioError};
+use super::mechanism::{too_many_sets, MAX_PARAMETER_SETS};
 use super::params::params_at;
 use super::raw::{RawActuation, RawRange, SpannedMap};
 use super::{Actuation, MAX_POINTS};
@@ -181,6 +182,10 @@ fn grid(
     let mut axes: Vec<(String, Vec<f64>)> = Vec::new();
     for (k, r) in grid.iter().filter(|(k, _)| inputs.is_param(k.get_ref())) {
         axes.push((k.get_ref().clone(), axis(ctx, r.get_ref())?));
+    }
+    let sets: usize = axes.iter().map(|(_, v)| v.len()).product();
+    if sets > MAX_PARAMETER_SETS {
+        return Err(too_many_sets(ctx, whole, &sets.to_string()));
     }
     for s in &input_syms {
         let (_, r) = grid

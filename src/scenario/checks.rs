@@ -181,6 +181,30 @@ fn joint_probe(
     Ok(JointProbe { joint: name.get_ref().clone(), index, prismatic, expected: expr, symbols })
 }
 
+/// A joint probe's expected stiffness at every settle point of `actuation`: a finite number,
+/// not zero (the relative error against NaN, an infinity or zero cannot pass or fail). An
+/// error at `expected` naming the point.
+pub(super) fn probe_expected(
+    ctx: &Ctx,
+    raw: &Option<RawProbe>,
+    probe: Option<&Probe>,
+    at_point: &dyn Fn(&Values) -> Values,
+    actuation: &Actuation,
+) -> Result<(), ScenarioError> {
+    let (Some(j), Some(e)) = (probe.and_then(|p| p.joint.as_ref()), raw.as_ref().and_then(|r| r.expected.as_ref()))
+    else {
+        return Ok(());
+    };
+    let points = actuation.all_inputs();
+    for p in points {
+        let k = j.predicted(&at_point(p), p);
+        if !k.is_finite() || k == 0.0 {
+            return Err(ctx.err(e, format!("probe.expected is {k} at the point {p:?}: a stiffness compared by its relative error is finite and not zero")));
+        }
+    }
+    Ok(())
+}
+
 /// `[workspace]`: the agreement percentage a workspace sweep passes on, in [0, 100].
 pub(super) fn workspace(ctx: &Ctx, raw: &Option<RawWorkspace>) -> Result<Option<f64>, ScenarioError> {
     let Some(w) = raw else { return Ok(None) };

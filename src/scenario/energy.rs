@@ -10,8 +10,13 @@ use crate::file_model::expr::Expr;
 use crate::file_model::spec::{ErrorClass, ModelSpec};
 use toml::Spanned;
 
-/// Largest number of Newton starts a coordinate's scan may ask for.
+/// Largest number of Newton starts the scans may ask for together (the product of their
+/// counts across coordinates: two scans of 10,000 had taken 3.4 GB).
 const MAX_SCAN: i64 = 10_000;
+
+/// Largest number of coordinates of a potential: its Hessian has their square of symbolic
+/// derivatives, each evaluated at every Newton step of every start.
+const MAX_COORDINATES: usize = 20;
 
 /// The compiled `[energy]` section of a model whose other sections are in `spec`.
 pub(super) fn energy(ctx: &Ctx, spec: &ModelSpec, raw: &RawEnergy) -> Result<EnergySpec, ScenarioError> {
@@ -20,10 +25,23 @@ pub(super) fn energy(ctx: &Ctx, spec: &ModelSpec, raw: &RawEnergy) -> Result<Ene
             ctx.err(&raw.potential, "[energy] needs at least one [[energy.coordinates]] (name, measured, class)")
         );
     }
+    if let Some(c) = raw.coordinates.get(MAX_COORDINATES) {
+        return Err(ctx.err(&c.name, format!("[energy] has at most {MAX_COORDINATES} coordinates")));
+    }
     let state = spec.names();
     let mut coordinates = Vec::new();
+    let mut starts: i64 = 1;
     for c in &raw.coordinates {
-        coordinates.push(coordinate(ctx, &state, &coordinates, c)?);
+        coordinates.push(coordinate(ctx, &state, c)?);
+        if let Some(s) = &c.scan {
+            starts = starts.saturating_mul(*s.get_ref().count.get_ref());
+            if starts > MAX_SCAN {
+                return Err(ctx.err(
+                    &s.get_ref().count,
+                    format!("the scans ask for {starts} Newton starts together (the product of their counts); at most {MAX_SCAN}"),
+                ));
+            }
+        }
     }
     // The potential sees the closed forms (parameters, inputs, their quantities) and the
     // coordinates.
@@ -44,24 +62,47 @@ pub(super) fn energy(ctx: &Ctx, spec: &ModelSpec, raw: &RawEnergy) -> Result<Ene
             hessian.push(derivative(g, j)?);
         }
     }
+    scan_work(ctx, raw, &coordinates, &gradient, &hessian)?;
     let tolerance = positive_value(ctx, &raw.tolerance, "energy.tolerance")?;
     let dynamics = super::kinetic::dynamics(ctx, spec, raw, &coordinates)?;
     Ok(EnergySpec { potential, gradient, hessian, coordinates, first_coordinate: first, tolerance, dynamics })
 }
 
-/// One coordinate: a new name, its measured expression of the state, its class and scan.
-fn coordinate(
+/// Largest work of the scans at one settle point: the Newton starts times the bytes of the
+/// gradient and Hessian that each Newton step evaluates. Measured: 10,000 starts of a
+/// two-coordinate potential of 11 squared sines (8,437 bytes: 84 million) took 4.5 s a settle
+/// point, which a signal had to wait for; at the bound a point's scans take about 0.5 s.
+const MAX_SCAN_WORK: usize = 10_000_000;
+
+/// The scans' work ([`MAX_SCAN_WORK`]), an error at the potential when it is larger.
+fn scan_work(
     ctx: &Ctx,
-    state: &[&str],
-    before: &[Coordinate],
-    c: &RawCoordinate,
-) -> Result<Coordinate, ScenarioError> {
-    let name = c.name.get_ref().clone();
-    if name.trim().is_empty() || state.contains(&name.as_str()) || before.iter().any(|b| b.name == name) {
+    raw: &RawEnergy,
+    coordinates: &[Coordinate],
+    gradient: &[Expr],
+    hessian: &[Expr],
+) -> Result<(), ScenarioError> {
+    let starts: usize = coordinates.iter().filter_map(|c| c.scan.map(|(_, _, n)| n)).product();
+    let bytes: usize = gradient.iter().chain(hessian).map(Expr::size).sum();
+    if coordinates.iter().any(|c| c.scan.is_some()) && starts.saturating_mul(bytes) > MAX_SCAN_WORK {
         return Err(ctx.err(
-            &c.name,
-            format!("coordinate name '{name}' must be new (not empty, not a symbol of this scenario, not twice)"),
+            &raw.potential,
+            format!(
+                "the scans' {starts} Newton starts times the {bytes} bytes of the potential's gradient and Hessian \
+                 make {} evaluations' worth a settle point; at most {MAX_SCAN_WORK}: scan fewer starts",
+                starts * bytes
+            ),
         ));
+    }
+    Ok(())
+}
+
+/// One coordinate: a name new among the state's symbols (and the file's names: `names.rs`),
+/// its measured expression of the state, its class and scan.
+fn coordinate(ctx: &Ctx, state: &[&str], c: &RawCoordinate) -> Result<Coordinate, ScenarioError> {
+    let name = c.name.get_ref().clone();
+    if state.contains(&name.as_str()) {
+        return Err(ctx.err(&c.name, format!("coordinate name '{name}' is already a symbol of this scenario")));
     }
     let measured = Expr::compile(c.measured.get_ref(), state)
         .map_err(|e| expr_error(ctx, c.measured.span().start, &e, &format!("coordinate '{name}' measured")))?;

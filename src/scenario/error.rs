@@ -38,6 +38,24 @@ impl Ctx<'_> {
     }
 }
 
+/// The parser's words for the kinds of value, as the file says them (a message never names a
+/// Rust type).
+const FILE_WORDS: [(&str, &str); 8] = [
+    ("expected f64", "expected a number"),
+    ("expected f32", "expected a number"),
+    ("expected i64", "expected a whole number"),
+    ("expected u64", "expected a whole number >= 0"),
+    ("expected usize", "expected a whole number >= 0"),
+    ("expected u32", "expected a whole number >= 0"),
+    ("expected a sequence", "expected a list [...]"),
+    ("expected a map", "expected a table"),
+];
+
+/// A parser's message in the file's words ([`FILE_WORDS`]).
+pub(super) fn in_file_words(message: &str) -> String {
+    FILE_WORDS.iter().fold(message.to_string(), |m, (parser, file)| m.replace(parser, file))
+}
+
 /// A number read from the file: a plain one, or an expression's value.
 pub(super) trait Numeric {
     fn number(&self) -> f64;

@@ -101,12 +101,10 @@ fn state_symbols(s: &crate::structure::Structure, m: &dyn Mechanism, params: &Va
     out
 }
 
-/// A name not yet taken by a symbol.
+/// A name not yet taken by a symbol of the structure or the mechanism (the file's own names
+/// are checked against each other in `names.rs`).
 fn new_name(ctx: &Ctx, spec: &ModelSpec, name: &Spanned<String>, what: &str) -> Result<String, ScenarioError> {
     let n = name.get_ref();
-    if n.trim().is_empty() {
-        return Err(ctx.err(name, format!("a {what} needs a name")));
-    }
     if spec.symbols.iter().any(|s| &s.name == n) {
         return Err(ctx.err(name, format!("{what} name '{n}' is already a symbol of this scenario")));
     }
@@ -200,6 +198,42 @@ fn equation(ctx: &Ctx, spec: &mut ModelSpec, e: &RawEquation) -> Result<(), Scen
     let residual = compile(ctx, &e.residual, &spec.names(), &format!("equation '{name}'"))?;
     let tolerance = positive_value(ctx, &e.tolerance, "tolerance")?;
     spec.equations.push(Equation { name, residual, tolerance });
+    Ok(())
+}
+
+/// Every closed form of the model at every settle point of `actuation` (its parameters from
+/// `at_point`): a prediction is a finite number (a NaN or an infinity could never be within
+/// or outside its tolerance), a frequency finite and > 0. A motion run's predictions depend on
+/// t and are judged on its ticks. The error is at the formula, naming the point.
+pub(super) fn closed_forms_at_points(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    spec: &ModelSpec,
+    at_point: &dyn Fn(&Values) -> Values,
+    actuation: &Actuation,
+) -> Result<(), ScenarioError> {
+    let predictions = if raw.motion.is_some() { &[][..] } else { &spec.predictions[..] };
+    let frequencies = spec.energy.iter().flat_map(|e| e.dynamics.iter()).flat_map(|d| &d.frequencies);
+    let raw_frequencies = raw.energy.iter().flat_map(|e| &e.frequencies);
+    for p in actuation.all_inputs() {
+        let values = spec.values(p, &at_point(p), |_| f64::NAN);
+        for (pr, r) in predictions.iter().zip(&raw.predictions) {
+            let x = pr.formula.eval(&values);
+            if !x.is_finite() {
+                let what =
+                    format!("prediction '{}' is {x} at the point {p:?}: a predicted value is a finite number", pr.name);
+                return Err(ctx.err(&r.formula, what));
+            }
+        }
+        for (f, r) in frequencies.clone().zip(raw_frequencies.clone()) {
+            let w = f.formula.eval(&values);
+            if !(w.is_finite() && w > 0.0) {
+                let what =
+                    format!("frequency '{}' is {w} rad/s at the point {p:?}: a frequency is finite and > 0", f.name);
+                return Err(ctx.err(&r.formula, what));
+            }
+        }
+    }
     Ok(())
 }
 

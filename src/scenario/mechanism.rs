@@ -1,14 +1,15 @@
 //! `mechanism` and `[structure]`: a built-in mechanism by name, or the file's own structure.
 
 use super::error::{finite, Ctx, ScenarioError};
-use super::number::{param_values, resolve_structure, ParamMap};
+use super::number::{param_start, param_values, resolve_structure, ParamMap};
 use super::params::params_at;
-use super::raw::RawScenario;
+use super::raw::{RawActuation, RawScenario};
 use super::structure::structure_from_file;
 use super::Actuation;
 use crate::file_model::params::ParamTable;
 use crate::mechanisms::custom::{Custom, FileParam};
 use crate::mechanisms::{self, Mechanism, Values};
+use toml::Spanned;
 
 /// `mechanism = "custom"`: the mechanism built from the `[structure]` table, with each check's
 /// expected value (required: there is no analytic model). A built-in mechanism: `None`, and
@@ -52,20 +53,47 @@ pub(super) fn custom(ctx: &Ctx, raw: &RawScenario) -> Result<Option<Custom>, Sce
 pub const MAX_PARAMETER_SETS: usize = 10_000;
 
 /// The distinct sets of parameters the actuation's points ask for, in their order (the
-/// scenario's own set when no point sets a parameter).
-pub(super) fn parameter_sets(table: &ParamTable, params: &Values, actuation: &Actuation) -> Vec<Values> {
-    let points: Vec<&Values> = match actuation {
-        Actuation::Points { points, .. } => points.iter().collect(),
-        Actuation::Schedule { waypoints } => waypoints.iter().map(|(_, v)| v).collect(),
-    };
-    let mut sets: Vec<Values> = Vec::new();
+/// scenario's own set when no point sets a parameter); more than [`MAX_PARAMETER_SETS`] is an
+/// error at `[actuation]`, found as the sets are gathered (each set is looked up in a hash of
+/// its bits, so a million points take one pass).
+pub(super) fn parameter_sets(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    table: &ParamTable,
+    params: &Values,
+    actuation: &Actuation,
+) -> Result<Vec<Values>, ScenarioError> {
+    let points = actuation.all_inputs();
+    let bits = |set: &Values| set.values().map(|x| x.to_bits()).collect::<Vec<u64>>();
+    let (mut sets, mut seen) = (Vec::new(), std::collections::HashSet::new());
     for p in points {
         let set = params_at(table, params, p);
-        if sets.last() != Some(&set) && !sets.contains(&set) {
+        if let Some((k, x)) = set.iter().find(|(_, x)| !x.is_finite()) {
+            let at = raw
+                .params
+                .iter()
+                .find(|(n, _)| n.get_ref() == k)
+                .map_or(raw.actuation.span().start, |(_, d)| param_start(d));
+            return Err(
+                ctx.err_at(at, format!("parameter '{k}' is {x} at the point {p:?}: a parameter is a finite number"))
+            );
+        }
+        if seen.insert(bits(&set)) {
+            if sets.len() == MAX_PARAMETER_SETS {
+                return Err(too_many_sets(ctx, &raw.actuation, &format!("more than {MAX_PARAMETER_SETS}")));
+            }
             sets.push(set);
         }
     }
-    sets
+    Ok(sets)
+}
+
+/// The error for more than [`MAX_PARAMETER_SETS`] sets of parameters (`count`: how many).
+pub(super) fn too_many_sets(ctx: &Ctx, actuation: &Spanned<RawActuation>, count: &str) -> ScenarioError {
+    ctx.err(
+        actuation,
+        format!("the actuation asks for {count} sets of parameters; at most {MAX_PARAMETER_SETS} (each is a structure built and checked at read)"),
+    )
 }
 
 /// The custom structure at every set of parameters in `sets` besides the file's own, each
@@ -78,12 +106,6 @@ pub(super) fn with_variants(
     sets: &[Values],
 ) -> Result<Custom, ScenarioError> {
     let Some(st) = &raw.structure else { return Ok(custom) };
-    if sets.len() > MAX_PARAMETER_SETS {
-        return Err(ctx.err(
-            &raw.actuation,
-            format!("the actuation asks for {} sets of parameters; at most {MAX_PARAMETER_SETS}", sets.len()),
-        ));
-    }
     let mut variants = Vec::new();
     for set in sets.iter().filter(|set| *set != params) {
         let mut st = st.clone();

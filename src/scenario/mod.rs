@@ -19,6 +19,7 @@ mod interference;
 mod kinetic;
 mod mechanism;
 mod motion;
+mod names;
 mod number;
 mod overrides;
 mod params;
@@ -138,6 +139,14 @@ impl Actuation {
             Actuation::Schedule { waypoints } => &waypoints[0].1,
         }
     }
+
+    /// The inputs of every point or waypoint, in order.
+    pub fn all_inputs(&self) -> Vec<&Values> {
+        match self {
+            Actuation::Points { points, .. } => points.iter().collect(),
+            Actuation::Schedule { waypoints } => waypoints.iter().map(|(_, v)| v).collect(),
+        }
+    }
 }
 
 /// Reads and validates a scenario file.
@@ -152,25 +161,16 @@ pub fn load_with(path: &Path, overrides: &[Override]) -> Result<Scenario, Scenar
 }
 
 /// The path that stands for standard input.
-pub const STDIN: &str = "-";
+pub const STDIN: &str = crate::input::STDIN;
 
 /// A scenario's text, from its file or standard input, at most [`MAX_SCENARIO_BYTES`].
 fn read_source(path: &Path) -> Result<String, ScenarioError> {
-    use std::io::Read;
-    let at_start = |message: String| ScenarioError { file: path.display().to_string(), line: 1, col: 1, message };
-    let mut bytes = Vec::new();
-    let read = if path == Path::new(STDIN) {
-        std::io::stdin().lock().take(MAX_SCENARIO_BYTES + 1).read_to_end(&mut bytes)
-    } else {
-        std::fs::File::open(path).and_then(|f| f.take(MAX_SCENARIO_BYTES + 1).read_to_end(&mut bytes))
-    };
-    read.map_err(|e| at_start(format!("cannot read the scenario file: {e}")))?;
-    if bytes.len() as u64 > MAX_SCENARIO_BYTES {
-        return Err(at_start(format!(
-            "the file is larger than a scenario may be: at most {MAX_SCENARIO_BYTES} bytes (its parse takes about 75 times its size in memory: a grid describes up to a million points in one line)"
-        )));
-    }
-    String::from_utf8(bytes).map_err(|e| at_start(format!("cannot read the scenario file: {e}")))
+    crate::input::read_text(path, MAX_SCENARIO_BYTES, true).map_err(|e| ScenarioError {
+        file: path.display().to_string(),
+        line: 1,
+        col: 1,
+        message: format!("the scenario file: {e}"),
+    })
 }
 
 /// Largest scenario file read [bytes]: 16 MiB. A list of 1,000,001 points (28 MB) took 2.1 GB
@@ -189,7 +189,7 @@ pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<S
     let ctx = Ctx { file: path.display().to_string(), source: &extended };
     let mut raw: RawScenario = toml::from_str(source).map_err(|e| {
         let start = e.span().map(|s| s.start).unwrap_or(0);
-        ctx.err_at(start, e.message().trim().to_string())
+        ctx.err_at(start, error::in_file_words(e.message().trim()))
     })?;
     let located = |e| overrides::at_flag(e, overrides, file_lines);
     overrides::apply(&ctx, &mut raw, overrides, file_lines).map_err(located)?;
@@ -201,11 +201,32 @@ pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<S
 /// Largest number of settle points a scenario may ask for.
 pub const MAX_POINTS: usize = 1_000_000;
 
+/// Every expected value that is an expression of the parameters and inputs (a joint probe's
+/// stiffness, the model's predictions and frequencies), evaluated at every settle point: a
+/// comparison with a value that is not a number could not fail.
+fn closed_forms(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    probe: Option<&Probe>,
+    model: Option<&crate::file_model::spec::ModelSpec>,
+    table: &crate::file_model::params::ParamTable,
+    params: &Values,
+    actuation: &Actuation,
+) -> Result<(), ScenarioError> {
+    let at_point = |p: &Values| params::params_at(table, params, p);
+    checks::probe_expected(ctx, &raw.probe, probe, &at_point, actuation)?;
+    match model {
+        Some(spec) => file_model::closed_forms_at_points(ctx, raw, spec, &at_point, actuation),
+        None => Ok(()),
+    }
+}
+
 /// The values of a scenario whose shape serde has read, section by section.
 fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, ScenarioError> {
     if raw.name.get_ref().trim().is_empty() {
         return Err(ctx.err(&raw.name, "name must not be empty"));
     }
+    names::names(ctx, &raw)?;
     let custom = mechanism::custom(ctx, &raw)?;
     let mech = mechanism::mechanism(ctx, &raw, custom.as_ref())?;
     let m = mech.as_ref();
@@ -230,7 +251,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let min_agreement_percent = checks::workspace(ctx, &raw.workspace)?;
     // Every set of parameters the points ask for (a sweep over parameters): the custom
     // structure resolved with each, and each structure checked as the first point's is.
-    let parameter_sets = mechanism::parameter_sets(&param_table, &params, &actuation);
+    let parameter_sets = mechanism::parameter_sets(ctx, &raw, &param_table, &params, &actuation)?;
     let custom = match custom {
         Some(c) => Some(mechanism::with_variants(ctx, &raw, c, &params, &parameter_sets)?),
         None => None,
@@ -249,6 +270,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     }
     let interference = interference::interference(ctx, &raw.interference, m, &first_params, &first)?;
     let probe = checks::probe(ctx, m, &raw.probe, &first, &params)?;
+    closed_forms(ctx, &raw, probe.as_ref(), model.as_ref(), &param_table, &params, &actuation)?;
     let motion = motion::motion(ctx, &raw, sim.dt_s, (m, &first), &first_params, &actuation)?;
     let expect = match &raw.expect {
         None => None,

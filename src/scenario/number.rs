@@ -144,7 +144,7 @@ pub(super) fn expr_error(ctx: &Ctx, value_start: usize, e: &ExprError, what: &st
 }
 
 /// Where a parameter's value starts in the file.
-fn param_start(p: &Spanned<RawParam>) -> usize {
+pub(super) fn param_start(p: &Spanned<RawParam>) -> usize {
     p.get_ref().value_span.as_ref().map_or(p.span().start, |s| s.start)
 }
 

@@ -363,7 +363,10 @@ pub(super) struct RawStability {
 }
 
 #[derive(Debug, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "stability.expect must be \"stable\", \"unstable\", \"energy\", or a list of \"stable\" and \"unstable\""
+)]
 pub(super) enum RawExpectedStability {
     All(String),
     PerPoint(Vec<String>),

@@ -16,21 +16,6 @@ const MIN_BODY_SIZE_M: f64 = 1e-3;
 /// Strut radius when the file gives none [m].
 const DEFAULT_STRUT_RADIUS_M: f64 = 0.01;
 
-/// An error at the second use of a name among `names` (a check or a report would read only one).
-fn unique_names<'a>(
-    ctx: &Ctx,
-    what: &str,
-    names: impl Iterator<Item = &'a Spanned<String>>,
-) -> Result<(), ScenarioError> {
-    let mut seen = std::collections::BTreeSet::new();
-    for n in names {
-        if !seen.insert(n.get_ref().as_str()) {
-            return Err(ctx.err(n, format!("duplicate {what} name '{}'", n.get_ref())));
-        }
-    }
-    Ok(())
-}
-
 /// Builds the structure of a `[structure]` table; every bad reference, zero-length member or
 /// massless free body is an error at its place in the file.
 pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Result<Structure, ScenarioError> {
@@ -50,13 +35,8 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
         body_names.push(b.name.get_ref().clone());
         add_body(ctx, &mut s, b)?;
     }
-    unique_names(
-        ctx,
-        "member (strut, spring or cable)",
-        r.struts.iter().chain(&r.springs).chain(&r.cables).map(|m| &m.name),
-    )?;
-    unique_names(ctx, "joint", r.joints.iter().map(|j| &j.name))?;
-    unique_names(ctx, "actuator symbol", r.actuators.iter().map(|a| &a.symbol))?;
+    // Names of members, joints and actuator symbols: unique, checked with every other name
+    // of the file (`names.rs`).
     // Each part refers only to the parts built before it.
     s.struts = r.struts.iter().map(|m| strut(ctx, &s, m)).collect::<Result<_, _>>()?;
     s.springs = r.springs.iter().map(|m| spring(ctx, &s, m)).collect::<Result<_, _>>()?;
@@ -363,21 +343,18 @@ fn actuator(ctx: &Ctx, s: &Structure, a: &RawActuator) -> Result<Actuator, Scena
 fn add_member_groups(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(), ScenarioError> {
     for g in &r.strut_groups {
         for m in group_members(ctx, g)? {
-            unique_member(ctx, &m, s.struts.iter().map(|x| &x.name), "strut")?;
             let st = strut(ctx, s, &m)?;
             s.struts.push(st);
         }
     }
     for g in &r.spring_groups {
         for m in group_members(ctx, g)? {
-            unique_member(ctx, &m, s.springs.iter().map(|x| &x.name), "spring")?;
             let sp = spring(ctx, s, &m)?;
             s.springs.push(sp);
         }
     }
     for g in &r.cable_groups {
         for m in group_members(ctx, g)? {
-            unique_member(ctx, &m, s.cables.iter().map(|x| &x.name), "cable")?;
             let c = cable(ctx, s, &m)?;
             s.cables.push(c);
         }
@@ -387,7 +364,7 @@ fn add_member_groups(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(
 
 /// A group's members as if each had its own table: the name (given, or "<group>:<a>-<b>")
 /// located at its pair.
-fn group_members(ctx: &Ctx, g: &RawMemberGroup) -> Result<Vec<RawMember>, ScenarioError> {
+pub(super) fn group_members(ctx: &Ctx, g: &RawMemberGroup) -> Result<Vec<RawMember>, ScenarioError> {
     if g.name.get_ref().trim().is_empty() {
         return Err(ctx.err(&g.name, "a member group's name must not be empty"));
     }
@@ -428,17 +405,4 @@ fn group_members(ctx: &Ctx, g: &RawMemberGroup) -> Result<Vec<RawMember>, Scenar
         });
     }
     Ok(out)
-}
-
-/// A group's member name must not repeat a member of the same kind.
-fn unique_member<'a>(
-    ctx: &Ctx,
-    m: &RawMember,
-    mut existing: impl Iterator<Item = &'a String>,
-    what: &str,
-) -> Result<(), ScenarioError> {
-    if existing.any(|n| n == m.name.get_ref()) {
-        return Err(ctx.err(&m.name, format!("duplicate {what} name '{}'", m.name.get_ref())));
-    }
-    Ok(())
 }

@@ -144,7 +144,14 @@ fn a_repeated_pair_is_a_duplicate_name_at_the_second_pair() {
     let second = text.match_indices(r#"["T1", "T2"]"#).nth(1).unwrap().0;
     let line = text[..second].matches('\n').count() + 1;
     assert!(e.starts_with(&format!("compact.toml:{line}:")), "{e}");
-    assert!(e.contains("duplicate cable name 'top:T1-T2'"), "{e}");
+    let first =
+        line_col(&text, r#"["T1", "T2"]"#).trim_start_matches("compact.toml:").trim_end_matches(':').to_string();
+    assert!(
+        e.contains(&format!(
+            "duplicate name 'top:T1-T2': this cable of group 'top' and the cable of group 'top' at {first}"
+        )),
+        "{e}"
+    );
 }
 
 #[test]

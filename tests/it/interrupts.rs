@@ -74,14 +74,15 @@ fn a_panic_fails_its_scenario_and_the_batch_goes_on() {
     assert_eq!(s[1]["passed"], true, "the batch went on");
 }
 
-/// A sweep killed with SIGINT writes the rows it has (a complete CSV, never a truncated one)
-/// and exits 1.
+/// A sweep killed with SIGINT writes the rows it has beside `--out`, to `NAME.partial.csv` (a
+/// complete CSV, never a truncated one), leaves the earlier `--out` as it was, says where, and
+/// exits 1.
 #[test]
 fn an_interrupted_sweep_writes_the_rows_it_has() {
     let dir = out_dir("sweep");
     let csv = dir.join("sweep.csv");
     std::fs::write(&csv, "previous").unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+    let child = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
         .args(["sweep", "scenarios/mohr2011/workspace_sweep.toml", "--jobs", "2", "--out"])
         .arg(&csv)
         .stdout(Stdio::piped())
@@ -90,11 +91,15 @@ fn an_interrupted_sweep_writes_the_rows_it_has() {
         .expect("binary runs");
     std::thread::sleep(Duration::from_millis(2500));
     assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
-    let status = child.wait().unwrap();
-    assert_eq!(status.code(), Some(1));
-    let text = std::fs::read_to_string(&csv).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), "previous", "the earlier CSV stays");
+    let partial = dir.join("sweep.partial.csv");
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(said.contains(&format!("are in {} (merge --partial reads it)", partial.display())), "{said}");
+    let text = std::fs::read_to_string(&partial).unwrap();
     let mut lines = text.lines();
-    assert!(lines.next().unwrap().starts_with("index,"), "a CSV replaced the old file");
+    assert!(lines.next().unwrap().starts_with("index,"), "a sweep CSV");
     let rows: Vec<&str> = lines.collect();
     assert!(!rows.is_empty() && rows.len() < 474, "{} rows", rows.len());
     assert!(rows.iter().all(|r| r.split(',').count() > 10), "no truncated row");

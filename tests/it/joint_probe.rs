@@ -41,16 +41,19 @@ fn a_wrong_stiffness_fails_the_probe() {
     assert!((e - 0.5).abs() <= 1e-6, "relative error {e}");
 }
 
-/// An expected stiffness that is not a number (here sqrt(-1)) cannot pass: the probe fails
-/// with an infinite error instead of comparing NaN as within the tolerance.
+/// An expected stiffness that is not a number (here sqrt(-1)) or zero cannot pass or fail: it
+/// is bad input at `expected`, found at read for every settle point.
 #[test]
-fn a_stiffness_that_is_not_a_number_fails_the_probe() {
-    let text = std::fs::read_to_string(FILE).unwrap().replace("\"L*hypot(k1*a, k2*b)\"", "\"sqrt(-1)\"");
-    let text = text.replace("count = 9", "count = 2");
-    let sc = scenario::parse(Path::new("nan.toml"), &text).unwrap();
-    let r = run(&sc, &RunOptions::default());
-    assert_eq!(r.failures, vec![Failure::Probe]);
-    assert_eq!(r.stiffness_probe.unwrap().max_rel_error, f64::INFINITY);
+fn a_stiffness_that_is_not_a_number_is_refused_at_read() {
+    for (expected, value) in [("sqrt(-1)", "NaN"), ("0*k1", "0"), ("1/(k1-10)", "inf")] {
+        let text =
+            std::fs::read_to_string(FILE).unwrap().replace("\"L*hypot(k1*a, k2*b)\"", &format!("\"{expected}\""));
+        let text = text.replace("count = 9", "count = 2");
+        let e = scenario::parse(Path::new("nan.toml"), &text).unwrap_err();
+        let at = text.find(&format!("\"{expected}\"")).unwrap();
+        assert_eq!((e.line, e.col), common::line_col(&text, at), "{e}");
+        assert!(e.message.starts_with(&format!("probe.expected is {value} at the point")), "{e}");
+    }
 }
 
 /// Bad joint probes are errors at the key at fault: an unknown joint (the joints are listed),

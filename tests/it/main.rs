@@ -14,6 +14,7 @@ mod export_mjcf;
 mod figures;
 mod furet2018_dynamics;
 mod fuzz_scenarios;
+mod hostile;
 mod import_matrices;
 mod import_ntrt;
 mod interference;

@@ -95,7 +95,7 @@ fn model_errors_are_located_inside_the_string() {
     let eq = good.replacen("abs(top12.force - top23.force)", "abs(top12.force - top24.force)", 1);
     error_at(&eq, "top24.force", 0, "equation 'equal_top_tensions': unknown symbol 'top24.force'");
     let clash = good.replacen("name = \"q_side\"", "name = \"k\"", 1);
-    error_at(&clash, "\"k\"\nexpr", 0, "quantity name 'k' is already a symbol");
+    error_at(&clash, "\"k\"\nexpr", 0, "duplicate name 'k': this quantity and the parameter at");
 }
 
 /// The prism settles on the closed form stated in its file: twist pi/2 + pi/n, force densities
@@ -248,7 +248,7 @@ fn energy_errors_are_located() {
     let d = good.replacen("\"u0 + a*cos(th) + b*sin(th)\"", "\"u0 + abs(a*cos(th)) + b*sin(th)\"", 1);
     error_at(&d, "\"u0 + abs", 1, "no symbolic derivative");
     let n = good.replacen("name = \"th\"", "name = \"theta2\"", 1);
-    error_at(&n, "\"theta2\"\nmeasured", 0, "coordinate name 'theta2' must be new");
+    error_at(&n, "\"theta2\"\nmeasured", 0, "coordinate name 'theta2' is already a symbol of this scenario");
     let m = good.replacen("measured = \"theta2\"", "measured = \"theta3\"", 1);
     error_at(&m, "theta3", 0, "coordinate 'th' measured: unknown symbol 'theta3'");
 }

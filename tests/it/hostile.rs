@@ -1,0 +1,318 @@
+//! The hostile suite, one test per class of input that used to misbehave (issue 30): checks
+//! that cannot fail, names that mean something else, values that invert a meaning, outputs
+//! that lie, work before validation, unbounded resources, signals and flags. Every input is
+//! written here; every refusal is asserted as exit 2 with its `file:LINE:COL` and its words,
+//! every bounded behaviour by what it refuses or leaves behind (never by wall time).
+
+use crate::common::{line_col, tensegrity, PINNED_STRUT};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+/// The bar of `scenarios/custom/pinned_bar_sweep.toml`: parameters, a grid over k1, a joint
+/// probe, an energy model.
+const SWEEP_FILE: &str = "scenarios/custom/pinned_bar_sweep.toml";
+
+fn dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tensegrity-hostile-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn sweep_text() -> String {
+    std::fs::read_to_string(SWEEP_FILE).unwrap()
+}
+
+/// Writes `text` as `d/NAME.toml`, runs `tensegrity check` on it and asserts exit 2 with the
+/// error at the first occurrence of `at` (plus `shift` bytes) and `msg` in its message.
+fn refused_at(d: &Path, name: &str, text: &str, at: &str, shift: usize, msg: &str) {
+    let p = d.join(format!("{name}.toml"));
+    std::fs::write(&p, text).unwrap();
+    let (code, _, err) = tensegrity(&["check", p.to_str().unwrap()]);
+    let offset = text.find(at).unwrap_or_else(|| panic!("{name}: '{at}' in the input")) + shift;
+    let (line, col) = line_col(text, offset);
+    assert_eq!(code, 2, "{name}: {err}");
+    assert!(err.contains(&format!("{name}.toml:{line}:{col}: ")), "{name}: expected at {line}:{col}: {err}");
+    assert!(err.contains(msg), "{name}: expected '{msg}': {err}");
+}
+
+/// A value or a tolerance that would make a comparison that cannot fail (NaN, an infinity,
+/// zero against a relative error, a negative tolerance) is bad input where it is written.
+#[test]
+fn checks_that_cannot_fail() {
+    let d = dir("cannot-fail");
+    let s = sweep_text();
+    for (name, expected, words) in [
+        ("probe_nan", "sqrt(-1)", "probe.expected is NaN at the point"),
+        ("probe_zero", "0*k1", "probe.expected is 0 at the point"),
+        ("probe_inf", "1/(k1-10)", "probe.expected is inf at the point"),
+        ("probe_minus_inf", "-1/(k1-10)", "probe.expected is -inf at the point"),
+    ] {
+        let text = s.replace("\"L*hypot(k1*a, k2*b)\"", &format!("\"{expected}\""));
+        refused_at(&d, name, &text, &format!("\"{expected}\""), 0, words);
+    }
+    let prediction = s.replace("\"atan2(ratio*a, b)\"", "\"sqrt(30-k1)\"");
+    let words = "prediction 'q' is NaN at the point {\"k1\": 40.0}: a predicted value is a finite number";
+    refused_at(&d, "prediction_nan", &prediction, "\"sqrt(30-k1)\"", 0, words);
+    let modes = std::fs::read_to_string("scenarios/custom/pinned_bar_modes.toml").unwrap();
+    let frequency = modes.replace("\"sqrt(L*hypot(k1*a, k2*b)/I)\"", "\"50-k1\"");
+    let words = "frequency 'omega' is 0 rad/s at the point {\"k1\": 50.0}: a frequency is finite and > 0";
+    refused_at(&d, "frequency_zero", &frequency, "\"50-k1\"", 0, words);
+    let nan_tolerance = s.replacen("tolerance = 1e-9", "tolerance = nan", 1);
+    refused_at(&d, "tolerance_nan", &nan_tolerance, "nan\n", 0, "must be a finite number, got NaN");
+    let negative = s.replacen("tolerance = 1e-9", "tolerance = -1e-9", 1);
+    refused_at(&d, "tolerance_negative", &negative, "-1e-9", 0, "must be > 0, got -0.000000001");
+    let inf_value = PINNED_STRUT
+        .replace("[structure]", "[[checks]]\nquantity = \"k.force\"\nvalue = inf\ntolerance = 1e-6\n[structure]");
+    refused_at(&d, "value_inf", &inf_value, "inf\n", 0, "value must be a finite number, got inf");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// A name that the expressions already read otherwise, an empty name, a name that spells
+/// another symbol, and a name defined twice (the error names both places).
+#[test]
+fn names_that_mean_something_else() {
+    let d = dir("names");
+    let with_params = |params: &str| PINNED_STRUT.replace("[actuation]", &format!("[params]\n{params}\n[actuation]"));
+    for (name, param, words) in [
+        ("param_pi", "pi = 3.0", "parameter 'pi' is a built-in constant of the expressions"),
+        ("param_e", "e = 2.0", "parameter 'e' is a built-in constant of the expressions"),
+        ("param_sin", "sin = 1.0", "parameter 'sin' is a built-in function of the expressions"),
+        ("param_t", "t = 1.0", "parameter 't' is the time symbol of the expressions"),
+        ("param_empty", "\"\" = 1.0", "a parameter needs a name, got ''"),
+        ("param_coordinate", "\"Q.x\" = 1.0", "parameter 'Q.x' must be an identifier"),
+        ("param_force", "\"k.force\" = 1.0", "parameter 'k.force' must be an identifier"),
+    ] {
+        let text = with_params(param);
+        refused_at(&d, name, &text, param, 0, words);
+    }
+    // An actuator's symbol equal to a parameter's: the second place, naming the first.
+    let actuated = with_params("q = 0.5")
+        .replace("damping = 0.5\n", "damping = 0.5\n[[structure.actuators]]\nsymbol = \"q\"\njoint = \"pin\"\n");
+    let (line, col) = line_col(&actuated, actuated.find("q = 0.5").unwrap());
+    let words = format!("duplicate name 'q': this actuator symbol and the parameter at {line}:{col}");
+    refused_at(&d, "actuator_is_param", &actuated, "\"q\"\njoint", 0, &words);
+    // A group's generated name equal to a cable of the member table.
+    let grouped = PINNED_STRUT.to_string()
+        + "[[structure.cables]]\nname = \"g:Q-S\"\na = \"Q\"\nb = \"S\"\n[[structure.cable_groups]]\nname = \"g\"\npairs = [[\"Q\", \"S\"]]\n";
+    let (line, col) = line_col(&grouped, grouped.find("\"g:Q-S\"").unwrap());
+    let words = format!("duplicate name 'g:Q-S': this cable of group 'g' and the cable at {line}:{col}");
+    refused_at(&d, "group_name_twice", &grouped, "[\"Q\", \"S\"]]", 0, &words);
+    // A quantity of the file's model named like a constant.
+    let quantity = PINNED_STRUT.to_string() + "[[quantities]]\nname = \"e\"\nexpr = \"Q.x\"\n";
+    refused_at(&d, "quantity_e", &quantity, "\"e\"", 0, "quantity 'e' is a built-in constant");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// Values that would turn a meaning around: a parameter that follows a swept one to an
+/// infinity, a negative interference threshold, an analytic solve that overflows.
+#[test]
+fn values_that_invert_a_meaning() {
+    let d = dir("invert");
+    let s = sweep_text();
+    let text = s.replace("ratio = { value = \"k1/k2\"", "ratio = { value = \"k2/(k1-10)\"");
+    refused_at(&d, "derived_inf", &text, "\"k2/(k1-10)\"", 0, "parameter 'ratio' is inf at the point");
+    let text = PINNED_STRUT.replace("[actuation]", "[interference]\nthreshold = -0.5\n[actuation]");
+    refused_at(&d, "threshold_negative", &text, "-0.5", 0, ">= 0 m");
+    for (query, words) in [
+        (vec!["ji2014", "fk", "--set", "L3=1e300", "--set", "theta1=0.3"], "gives F_K1 = inf"),
+        (vec!["mohr2011", "statics", "--set", "x=1e300", "--set", "y=0.8", "--set", "z=1.5"], "gives f1 = NaN"),
+    ] {
+        let (code, out, err) = tensegrity(&[&["solve"], &query[..]].concat());
+        assert_eq!(code, 2, "{query:?}: {out}{err}");
+        assert!(err.contains(words) && err.contains("outside the range where the model is a number"), "{err}");
+        assert!(out.is_empty(), "nothing printed: {out}");
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// Outputs that would lie: shards of two different sweeps merged into one, an import that
+/// would write an infinity, an interrupted sweep over an earlier complete CSV.
+#[test]
+fn outputs_that_lie() {
+    let d = dir("lie");
+    let (a, b, merged) = (d.join("a.csv"), d.join("b.csv"), d.join("merged.csv"));
+    let sweep = |shard: &str, set: &str, out: &Path| {
+        let args = ["sweep", SWEEP_FILE, "--shard", shard, "--set", set, "--jobs", "1", "--out", out.to_str().unwrap()];
+        let (code, _, err) = tensegrity(&args);
+        assert_eq!(code, 0, "{err}");
+    };
+    sweep("1/2", "k2=30", &a);
+    sweep("2/2", "k2=35", &b);
+    let (code, _, err) =
+        tensegrity(&["merge", a.to_str().unwrap(), b.to_str().unwrap(), "--out", merged.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(&format!(
+            "{}:2: a row of another sweep than {}'s: its parameters differ",
+            b.display(),
+            a.display()
+        )),
+        "{err}"
+    );
+    assert!(!merged.exists(), "nothing written");
+
+    let yaml = d.join("huge.yaml");
+    std::fs::write(&yaml, "nodes:\n  a: [0, 0, 0]\n  b: [1e308, -1e308, 1e308]\npair_groups:\n  rod:\n    - [a, b]\nbuilders:\n  rod:\n    class: tgRodInfo\n    parameters:\n      density: 1.0\n      radius: 0.01\n").unwrap();
+    let toml = d.join("huge.toml");
+    let (code, _, err) = tensegrity(&["import", "ntrt", yaml.to_str().unwrap(), "--out", toml.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("too large (or not numbers) to write"), "{err}");
+    assert!(!toml.exists(), "no scenario with inf or NaN written");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// Work that used to run before the input was known to be valid: a grid of 40,000 sets of
+/// parameters (refused from its counts), energy scans whose product passes the bound, a
+/// sweep's unknown `--x` axis.
+#[test]
+fn work_before_validation() {
+    let d = dir("before");
+    let s = sweep_text();
+    let grid = s.replace(
+        "grid = { k1 = { from = 10.0, to = 90.0, count = 9 } }",
+        "grid = { k1 = { from = 10.0, to = 90.0, count = 200 }, k2 = { from = 10.0, to = 90.0, count = 200 } }",
+    );
+    refused_at(&d, "sets", &grid, "[actuation]", 0, "the actuation asks for 40000 sets of parameters; at most 10000");
+    let points: Vec<String> = (0..10_001).map(|i| format!("{{ k1 = {} }}", 10.0 + i as f64 * 1e-3)).collect();
+    let listed = s.replace(
+        "grid = { k1 = { from = 10.0, to = 90.0, count = 9 } }",
+        &format!("points = [ {} ]", points.join(", ")),
+    );
+    refused_at(&d, "listed_sets", &listed, "[actuation]", 0, "asks for more than 10000 sets of parameters");
+    let scans = s.replace("count = 4 }", "count = 4 }\n[[energy.coordinates]]\nname = \"q2\"\nmeasured = \"q\"\nclass = \"angle\"\nscan = { from = -3.0, to = 3.0, count = 5000 }");
+    refused_at(&d, "scans", &scans, "count = 5000", 8, "the scans ask for 20000 Newton starts together");
+    let terms: Vec<String> = (1..12).map(|i| format!("sin(qe*{i})^2")).collect();
+    let heavy = s.replacen("count = 4 }", "count = 10000 }", 1).replacen(
+        "potential = \"",
+        &format!("potential = \"{}+", terms.join("+")),
+        1,
+    );
+    refused_at(&d, "scan_work", &heavy, "\"sin(qe*1)", 0, "Newton starts times the");
+    assert!(heavy.contains("count = 10000 }"));
+    let (code, _, err) =
+        tensegrity(&["sweep", SWEEP_FILE, "--figure", d.join("f.png").to_str().unwrap(), "--x", "nope"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--x nope: not an axis of this sweep"), "{err}");
+    assert!(!d.join("f.png").exists());
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// Inputs whose cost had no bound: long and deep expressions, derivatives that grow, YAML
+/// aliases, a second YAML document, endless or blocking files.
+#[test]
+fn unbounded_resources() {
+    let d = dir("unbounded");
+    let param = |expr: &str| PINNED_STRUT.replace("[actuation]", &format!("[params]\na = \"{expr}\"\n[actuation]"));
+    let long = vec!["1"; 20_000].join("+");
+    refused_at(&d, "long", &param(&long), "a = ", 5, "an expression has at most 10000 bytes, this one 39999");
+    let deep = format!("{}1{}", "(".repeat(4000), ")".repeat(4000));
+    refused_at(&d, "deep", &param(&deep), "a = ", 4 + 1 + 64, "nested deeper than 64 levels");
+    let signs = format!("{}1", "-".repeat(5000));
+    refused_at(&d, "signs", &param(&signs), "a = ", 4 + 1 + 64, "nested deeper than 64 levels");
+    let powers = vec!["2"; 1000].join("^");
+    refused_at(&d, "powers", &param(&powers), "a = ", 4 + 1 + 64 * 2, "nested deeper than 64 levels");
+    let modes = std::fs::read_to_string("scenarios/custom/pinned_bar_modes.toml").unwrap();
+    let product: Vec<String> = (0..50).map(|i| format!("sin(qe+{i})")).collect();
+    let text = modes.replace("\"-k1*a*L*sin(qe) - k2*b*L*cos(qe)\"", &format!("\"{}\"", product.join("*")));
+    refused_at(&d, "derivative", &text, "\"sin(qe+0)", 1, "too large to differentiate symbolically (at most 1000)");
+    let sum: Vec<String> = (0..800).map(|i| format!("sin(qe+{i})")).collect();
+    let text = modes.replace("\"-k1*a*L*sin(qe) - k2*b*L*cos(qe)\"", &format!("\"{}\"", sum.join("+")));
+    refused_at(&d, "sum800", &text, "\"sin(qe+0)", 1, "too large to differentiate symbolically");
+
+    let import = |file: &Path| tensegrity(&["import", "ntrt", file.to_str().unwrap()]);
+    let mut laughs = String::from("a0: &a0 [x, x, x, x, x, x, x, x, x, x]\n");
+    for i in 1..12 {
+        let refs = vec![format!("*a{}", i - 1); 10].join(", ");
+        laughs.push_str(&format!("a{i}: &a{i} [{refs}]\n"));
+    }
+    let yaml = d.join("laughs.yaml");
+    std::fs::write(&yaml, &laughs).unwrap();
+    let (code, _, err) = import(&yaml);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("laughs.yaml:6:45: the document expands to more than 1000000 nodes"), "{err}");
+    let two = d.join("two.yaml");
+    std::fs::write(&two, "nodes:\n  a: [0, 0, 0]\n---\nnodes:\n  b: [1, 0, 0]\n").unwrap();
+    let (code, _, err) = import(&two);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("two.yaml:3:1: a second YAML document"), "{err}");
+
+    let fifo = d.join("fifo.yaml");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let (code, _, err) = import(&fifo);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("a pipe, socket or device, not a regular file"), "{err}");
+    let (code, _, err) = tensegrity(&["check", fifo.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("fifo.yaml:1:1: the scenario file: cannot read: a pipe"), "{err}");
+    let (code, _, err) = tensegrity(&["check", "/dev/zero"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("not a regular file"), "{err}");
+    let big = d.join("big.yaml");
+    std::fs::write(&big, "#".repeat((16 << 20) + 1)).unwrap();
+    let (code, _, err) = import(&big);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("at most 16777216 bytes"), "{err}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// One SIGTERM stops a sweep: exit 1, the earlier complete CSV unchanged, the rows that ran in
+/// the partial file (each row whole), no temporary file left.
+#[test]
+fn signals() {
+    let d = dir("signals");
+    let csv = d.join("grid.csv");
+    std::fs::write(&csv, "earlier complete CSV\n").unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+        .args(["sweep", "scenarios/mohr2011/workspace_sweep.toml", "--jobs", "2", "--out"])
+        .arg(&csv)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    std::thread::sleep(Duration::from_millis(2000));
+    assert!(Command::new("kill").args(["-TERM", &child.id().to_string()]).status().unwrap().success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), "earlier complete CSV\n");
+    let partial = std::fs::read_to_string(d.join("grid.partial.csv")).unwrap();
+    let header_cells = partial.lines().next().unwrap().split(',').count();
+    assert!(partial.lines().skip(1).all(|r| r.split(',').count() >= header_cells), "whole rows");
+    let left: Vec<_> = std::fs::read_dir(&d).unwrap().flatten().map(|e| e.file_name()).collect();
+    assert_eq!(left.len(), 2, "only the CSV and its partial: {left:?}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// Flags and shapes that meant nothing: zero jobs, a zero recording interval, a table of an
+/// unknown kind, a stability of the wrong shape (in the file's words, not a parser's).
+#[test]
+fn flags() {
+    let d = dir("flags");
+    let quick = "scenarios/ji2014/quick.toml";
+    for (args, words) in [
+        (vec!["sweep", SWEEP_FILE, "--jobs", "0"], "--jobs"),
+        (vec!["run", quick, "--record-every", "0"], "--record-every"),
+        (vec!["run", quick, "--table", "/tmp/x.txt"], "--table"),
+    ] {
+        let (code, _, err) = tensegrity(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(words), "{args:?}: {err}");
+    }
+    let text = PINNED_STRUT.replace("[actuation]", "[stability]\nperturbation = 0.01\nexpect = 3\n[actuation]");
+    refused_at(&d, "stability_number", &text, "3\n[actuation]", 0, "\"stable\", \"unstable\", \"energy\", or a list");
+    let p = d.join("stability_number.toml");
+    let (_, _, err) = tensegrity(&["check", p.to_str().unwrap()]);
+    assert!(!err.contains("untagged") && !err.contains("Raw"), "{err}");
+    for (name, section, at, words) in [
+        ("dt_text", "[sim]\ndt = \"a\"", "\"a\"", "invalid type: string \"a\", expected a number"),
+        ("substeps_fraction", "[sim]\nsubsteps = 1.5", "1.5", "expected a whole number"),
+        ("points_number", "", "3\n", "expected a list [...]"),
+    ] {
+        let text = PINNED_STRUT.replace("[actuation]", &format!("{section}\n[actuation]"));
+        let text = if section.is_empty() { text.replace("points = [ {} ]", "points = 3\n") } else { text };
+        refused_at(&d, name, &text, at, 0, words);
+        let (_, _, err) = tensegrity(&["check", d.join(format!("{name}.toml")).to_str().unwrap()]);
+        assert!(!err.contains("f64") && !err.contains("i64") && !err.contains("sequence"), "{err}");
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
