@@ -85,7 +85,8 @@ fn sweep_csv(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>, j
     let jobs = if jobs == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { jobs };
     let result = on_own_thread(py, move |cancel| {
         let (rows, summary) = tensegrity_testbed::sweep::sweep(&sc, jobs, None, Some(cancel), &|_, _| {})?;
-        let csv = tensegrity_testbed::sweep::to_csv(&rows, &|q: &str| sc.is_angle(q));
+        let fingerprint = tensegrity_testbed::sweep::fingerprint(&sc);
+        let csv = tensegrity_testbed::sweep::to_csv(&rows, &|q: &str| sc.is_angle(q), &fingerprint);
         Ok::<_, tensegrity_testbed::sweep::SweepError>((csv, serde_json::to_string(&summary).expect("a summary serialises")))
     })?;
     result.map_err(|e| PyValueError::new_err(e.to_string()))
