@@ -46,6 +46,12 @@ pub(crate) fn write_error(path: &Path) -> impl FnOnce(std::io::Error) -> BenchEr
     move |e| BenchError::Write { path: path.to_path_buf(), message: e.to_string() }
 }
 
+/// Writes `text` to `path` whole or not at all (`output::write_atomic`).
+pub(crate) fn write_whole(path: &Path, text: &str) -> Result<(), BenchError> {
+    crate::output::write_atomic(path, text.as_bytes())
+        .map_err(|message| BenchError::Write { path: path.to_path_buf(), message })
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct BenchResult {
     pub mechanism: String,
@@ -265,8 +271,7 @@ pub fn bench_against_peer(
     let set = peer_case_set(mechanism, &sc)?;
     let cases_file = dir.join(format!("{mechanism}.json"));
     std::fs::create_dir_all(dir).map_err(write_error(dir))?;
-    std::fs::write(&cases_file, serde_json::to_string_pretty(&set).expect("case set serialises"))
-        .map_err(write_error(&cases_file))?;
+    write_whole(&cases_file, &serde_json::to_string_pretty(&set).expect("case set serialises"))?;
     let mut ours = Vec::new();
     let mut theirs = Vec::new();
     let mut peer_name = String::new();

@@ -6,8 +6,7 @@
 
 use crate::common::{line_col, tensegrity, PINNED_STRUT};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::Duration;
+use std::process::Command;
 
 /// The bar of `scenarios/custom/pinned_bar_sweep.toml`: parameters, a grid over k1, a joint
 /// probe, an energy model.
@@ -256,32 +255,8 @@ fn unbounded_resources() {
     std::fs::remove_dir_all(&d).ok();
 }
 
-/// One SIGTERM stops a sweep: exit 1, the earlier complete CSV unchanged, the rows that ran in
-/// the partial file (each row whole), no temporary file left.
-#[test]
-fn signals() {
-    let d = dir("signals");
-    let csv = d.join("grid.csv");
-    std::fs::write(&csv, "earlier complete CSV\n").unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
-        .args(["sweep", "scenarios/mohr2011/workspace_sweep.toml", "--jobs", "2", "--out"])
-        .arg(&csv)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("binary runs");
-    std::thread::sleep(Duration::from_millis(2000));
-    assert!(Command::new("kill").args(["-TERM", &child.id().to_string()]).status().unwrap().success());
-    let out = child.wait_with_output().unwrap();
-    assert_eq!(out.status.code(), Some(1));
-    assert_eq!(std::fs::read_to_string(&csv).unwrap(), "earlier complete CSV\n");
-    let partial = std::fs::read_to_string(d.join("grid.partial.csv")).unwrap();
-    let header_cells = partial.lines().next().unwrap().split(',').count();
-    assert!(partial.lines().skip(1).all(|r| r.split(',').count() >= header_cells), "whole rows");
-    let left: Vec<_> = std::fs::read_dir(&d).unwrap().flatten().map(|e| e.file_name()).collect();
-    assert_eq!(left.len(), 2, "only the CSV and its partial: {left:?}");
-    std::fs::remove_dir_all(&d).ok();
-}
+// Signals: SIGINT and SIGTERM to a sweep (the earlier CSV kept, the partial one whole) are
+// `interrupts::an_interrupted_sweep_writes_the_rows_it_has`, one test for both.
 
 /// Flags and shapes that meant nothing: zero jobs, a zero recording interval, a table of an
 /// unknown kind, a stability of the wrong shape (in the file's words, not a parser's).

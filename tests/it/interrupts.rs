@@ -74,12 +74,18 @@ fn a_panic_fails_its_scenario_and_the_batch_goes_on() {
     assert_eq!(s[1]["passed"], true, "the batch went on");
 }
 
-/// A sweep killed with SIGINT writes the rows it has beside `--out`, to `NAME.partial.csv` (a
-/// complete CSV, never a truncated one), leaves the earlier `--out` as it was, says where, and
-/// exits 1.
+/// A sweep stopped by SIGINT or SIGTERM writes the rows it has beside `--out`, to
+/// `NAME.partial.csv` (a complete CSV, never a truncated one), leaves the earlier `--out` as it
+/// was, says where, and exits 1 (issue 30's signals class too).
 #[test]
 fn an_interrupted_sweep_writes_the_rows_it_has() {
-    let dir = out_dir("sweep");
+    for signal in ["-INT", "-TERM"] {
+        interrupted_sweep(signal);
+    }
+}
+
+fn interrupted_sweep(signal: &str) {
+    let dir = out_dir(&format!("sweep{signal}"));
     let csv = dir.join("sweep.csv");
     std::fs::write(&csv, "previous").unwrap();
     let child = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
@@ -90,7 +96,7 @@ fn an_interrupted_sweep_writes_the_rows_it_has() {
         .spawn()
         .expect("binary runs");
     std::thread::sleep(Duration::from_millis(2500));
-    assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
+    assert!(Command::new("kill").args([signal, &child.id().to_string()]).status().unwrap().success());
     let out = child.wait_with_output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(std::fs::read_to_string(&csv).unwrap(), "previous", "the earlier CSV stays");

@@ -105,7 +105,7 @@ fn peer_case(case: &Case, caps: &Caps, dir: &Path) -> Result<PeerCase, BenchErro
     };
     let m = to_mjcf(s, &o);
     let path = dir.join(format!("{}-{}.xml", case.family, case.size));
-    std::fs::write(&path, &m.xml).map_err(write_error(&path))?;
+    crate::bench::write_whole(&path, &m.xml)?;
     let c = criteria(s, case.settings.dt_s, caps);
     Ok(PeerCase {
         family: case.family,
@@ -174,8 +174,7 @@ pub fn compare(
     }
     let file = dir.join("scale_cases.json");
     let list = serde_json::json!({ "cases": theirs });
-    std::fs::write(&file, serde_json::to_string_pretty(&list).expect("case list serialises"))
-        .map_err(write_error(&file))?;
+    crate::bench::write_whole(&file, &serde_json::to_string_pretty(&list).expect("case list serialises"))?;
     eprintln!("{} cases: peer ...", theirs.len());
     let v = crate::bench::run_peer(command, &file, &[])?;
     let peer_cases = v
