@@ -221,6 +221,40 @@ fn closed_forms(
     }
 }
 
+/// The structures a scenario builds: at its first point, and at every other set of parameters
+/// its points ask for.
+struct Structures<'a> {
+    sets: &'a [Values],
+    first: &'a Values,
+    start: &'a Values,
+    actuation: &'a Actuation,
+}
+
+impl Structures<'_> {
+    /// Builds and checks each structure (`physical`); the first one, whose joints also decide
+    /// the default Newton damping schedule where `[sim]` does not.
+    fn check(
+        &self,
+        ctx: &Ctx,
+        raw: &RawScenario,
+        m: &dyn Mechanism,
+        sim: &mut SimSettings,
+        custom: bool,
+    ) -> Result<crate::structure::Structure, ScenarioError> {
+        let inputs = self.actuation.first_inputs();
+        let first = physical::first_structure(ctx, raw, m, self.first, self.start, inputs)?;
+        physical::physical(ctx, raw, m, &first, sim)?;
+        if raw.sim.newton_damping.is_none() {
+            sim.newton_damping = sim::default_newton_damping(custom, &first);
+        }
+        for set in self.sets.iter().skip(1) {
+            let s = physical::first_structure(ctx, raw, m, set, self.start, inputs)?;
+            physical::physical(ctx, raw, m, &s, sim)?;
+        }
+        Ok(first)
+    }
+}
+
 /// The values of a scenario whose shape serde has read, section by section.
 fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, ScenarioError> {
     if raw.name.get_ref().trim().is_empty() {
@@ -259,31 +293,14 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let mech = mechanism::mechanism(ctx, &raw, custom.as_ref())?;
     let m = mech.as_ref();
     let first_params = params::params_at(&param_table, &params, actuation.first_inputs());
-    let first = physical::first_structure(ctx, &raw, m, &first_params, &start, actuation.first_inputs())?;
-    physical::physical(ctx, &raw, m, &first, &sim)?;
-    if raw.sim.newton_damping.is_none() {
-        sim.newton_damping = sim::default_newton_damping(custom.is_some(), &first);
-    }
-    for set in parameter_sets.iter().skip(1) {
-        let s = physical::first_structure(ctx, &raw, m, set, &start, actuation.first_inputs())?;
-        physical::physical(ctx, &raw, m, &s, &sim)?;
-    }
+    let structures = Structures { sets: &parameter_sets, first: &first_params, start: &start, actuation: &actuation };
+    let first = structures.check(ctx, &raw, m, &mut sim, custom.is_some())?;
     let interference = interference::interference(ctx, &raw.interference, m, &first_params, &first)?;
     let probe = checks::probe(ctx, m, &raw.probe, &first, &params)?;
     closed_forms(ctx, &raw, probe.as_ref(), model.as_ref(), &param_table, &params, &actuation)?;
     let motion = motion::motion(ctx, &raw, sim.dt_s, (m, &first), &first_params, &actuation)?;
-    let expect = match &raw.expect {
-        None => None,
-        Some(e) => {
-            let parts = expect::Parts {
-                checks: &checks,
-                model: model.as_ref(),
-                probe: probe.is_some(),
-                motion: motion.as_ref(),
-            };
-            Some(expect::expectation(ctx, e, &parts)?)
-        }
-    };
+    let parts = expect::Parts { checks: &checks, model: model.as_ref(), probe: probe.is_some(), motion: motion.as_ref() };
+    let expect = raw.expect.as_ref().map(|e| expect::expectation(ctx, e, &parts)).transpose()?;
     Ok(Scenario {
         file: path.to_path_buf(),
         source: ctx.source.to_string(),
