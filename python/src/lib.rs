@@ -5,9 +5,9 @@
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use tensegrity_testbed::file_model::spec::ErrorClass;
@@ -15,7 +15,12 @@ use tensegrity_testbed::observers::external::{External, ExternalModel, ExternalP
 use tensegrity_testbed::run::{self, RunOptions};
 use tensegrity_testbed::scenario::{self, Override, Scenario, ScenarioError};
 
-create_exception!(_tensegrity, TestbedError, PyException, "A scenario the testbed refuses (args: file, line, col, message).");
+create_exception!(
+    _tensegrity,
+    TestbedError,
+    PyException,
+    "A scenario the testbed refuses (args: file, line, col, message)."
+);
 
 /// How often a run's waiting thread looks for Ctrl-C [s].
 const SIGNAL_POLL_S: f64 = 0.05;
@@ -46,7 +51,10 @@ fn check(path: &str, text: Option<&str>, set: Vec<String>) -> PyResult<String> {
 /// Runs `work` on a thread of its own without the GIL, polling for Ctrl-C every
 /// [`SIGNAL_POLL_S`]: on one it raises the flag `work` watches (the run stops at its next
 /// tick), waits for it and raises KeyboardInterrupt.
-fn on_own_thread<T: Send + 'static>(py: Python<'_>, work: impl FnOnce(&AtomicBool) -> T + Send + 'static) -> PyResult<T> {
+fn on_own_thread<T: Send + 'static>(
+    py: Python<'_>,
+    work: impl FnOnce(&AtomicBool) -> T + Send + 'static,
+) -> PyResult<T> {
     let cancel = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&cancel);
     let (done, result) = std::sync::mpsc::channel();
@@ -80,14 +88,23 @@ fn on_own_thread<T: Send + 'static>(py: Python<'_>, work: impl FnOnce(&AtomicBoo
 /// CSV of `tensegrity sweep --out` and the JSON summary of `--json`.
 #[pyfunction]
 #[pyo3(signature = (path, text=None, set=Vec::new(), jobs=0))]
-fn sweep_csv(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>, jobs: usize) -> PyResult<(String, String)> {
+fn sweep_csv(
+    py: Python<'_>,
+    path: &str,
+    text: Option<&str>,
+    set: Vec<String>,
+    jobs: usize,
+) -> PyResult<(String, String)> {
     let sc = load(path, text, &set)?;
     let jobs = if jobs == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { jobs };
     let result = on_own_thread(py, move |cancel| {
         let (rows, summary) = tensegrity_testbed::sweep::sweep(&sc, jobs, None, Some(cancel), &|_, _| {})?;
         let fingerprint = tensegrity_testbed::sweep::fingerprint(&sc);
         let csv = tensegrity_testbed::sweep::to_csv(&rows, &|q: &str| sc.is_angle(q), &fingerprint);
-        Ok::<_, tensegrity_testbed::sweep::SweepError>((csv, serde_json::to_string(&summary).expect("a summary serialises")))
+        Ok::<_, tensegrity_testbed::sweep::SweepError>((
+            csv,
+            serde_json::to_string(&summary).expect("a summary serialises"),
+        ))
     })?;
     result.map_err(|e| PyValueError::new_err(e.to_string()))
 }
@@ -102,15 +119,27 @@ struct PyModel {
 }
 
 impl PyModel {
-    fn call(&self, py: Python<'_>, params: &BTreeMap<String, f64>, inputs: &BTreeMap<String, f64>, t: Option<f64>) -> PyResult<BTreeMap<String, f64>> {
+    fn call(
+        &self,
+        py: Python<'_>,
+        params: &BTreeMap<String, f64>,
+        inputs: &BTreeMap<String, f64>,
+        t: Option<f64>,
+    ) -> PyResult<BTreeMap<String, f64>> {
         let out: BTreeMap<String, f64> = self.function.call1(py, (params.clone(), inputs.clone(), t))?.extract(py)?;
         for n in &self.names {
             match out.get(n) {
                 Some(v) if v.is_finite() => {}
-                Some(v) => return Err(PyValueError::new_err(format!("the model's prediction '{n}' is {v}, not a finite number"))),
+                Some(v) => {
+                    return Err(PyValueError::new_err(format!(
+                        "the model's prediction '{n}' is {v}, not a finite number"
+                    )))
+                }
                 None => {
                     let got: Vec<&String> = out.keys().collect();
-                    return Err(PyValueError::new_err(format!("the model returned no prediction '{n}' (it returned {got:?})")));
+                    return Err(PyValueError::new_err(format!(
+                        "the model returned no prediction '{n}' (it returned {got:?})"
+                    )));
                 }
             }
         }
@@ -119,7 +148,12 @@ impl PyModel {
 }
 
 impl ExternalModel for PyModel {
-    fn predict(&self, params: &BTreeMap<String, f64>, inputs: &BTreeMap<String, f64>, time_s: Option<f64>) -> Result<BTreeMap<String, f64>, String> {
+    fn predict(
+        &self,
+        params: &BTreeMap<String, f64>,
+        inputs: &BTreeMap<String, f64>,
+        time_s: Option<f64>,
+    ) -> Result<BTreeMap<String, f64>, String> {
         Python::attach(|py| {
             self.call(py, params, inputs, time_s).map_err(|e| {
                 let message = e.to_string();
@@ -138,7 +172,10 @@ fn predictions(raw: Vec<PredictionTuple>) -> PyResult<Vec<ExternalPrediction>> {
     raw.into_iter()
         .map(|(name, quantity, class, tolerance, rms_tolerance)| {
             let class = ErrorClass::parse(&class).ok_or_else(|| {
-                PyValueError::new_err(format!("prediction '{name}': class '{class}' (expected one of {:?})", ErrorClass::NAMES))
+                PyValueError::new_err(format!(
+                    "prediction '{name}': class '{class}' (expected one of {:?})",
+                    ErrorClass::NAMES
+                ))
             })?;
             let positive = |t: f64| t.is_finite() && t > 0.0;
             if !positive(tolerance) || rms_tolerance.is_some_and(|t| !positive(t)) {
@@ -183,11 +220,20 @@ fn run_json(
 /// A scenario (TOML text) from the node matrix and the connectivity matrices in files (the
 /// importer of `tensegrity import matrices`); errors at file, line and column.
 #[pyfunction]
-fn import_matrices(n: PathBuf, cb: PathBuf, cs: PathBuf, bar_mass_kg: f64, bar_radius_m: f64, string_stiffness_n_per_m: f64, string_tension_n: f64) -> PyResult<String> {
+fn import_matrices(
+    n: PathBuf,
+    cb: PathBuf,
+    cs: PathBuf,
+    bar_mass_kg: f64,
+    bar_radius_m: f64,
+    string_stiffness_n_per_m: f64,
+    string_tension_n: f64,
+) -> PyResult<String> {
     use tensegrity_testbed::import::matrices::{import, MatrixOptions};
     let o = MatrixOptions { bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n };
     o.validate().map_err(PyValueError::new_err)?;
-    let imported = import(&n, &cb, &cs, &o).map_err(|e| TestbedError::new_err((e.file.clone(), e.line, e.col, e.message.clone())))?;
+    let imported = import(&n, &cb, &cs, &o)
+        .map_err(|e| TestbedError::new_err((e.file.clone(), e.line, e.col, e.message.clone())))?;
     Ok(imported.toml)
 }
 
@@ -195,7 +241,14 @@ fn import_matrices(n: PathBuf, cb: PathBuf, cs: PathBuf, bar_mass_kg: f64, bar_r
 /// was not exported). `actuators`: "mocap" or "position" (servos of gain `kp`).
 #[pyfunction]
 #[pyo3(signature = (path, text=None, set=Vec::new(), actuators="mocap", kp=1e6, cable_damping=0.0))]
-fn export_mjcf(path: &str, text: Option<&str>, set: Vec<String>, actuators: &str, kp: f64, cable_damping: f64) -> PyResult<(String, Vec<String>)> {
+fn export_mjcf(
+    path: &str,
+    text: Option<&str>,
+    set: Vec<String>,
+    actuators: &str,
+    kp: f64,
+    cable_damping: f64,
+) -> PyResult<(String, Vec<String>)> {
     use tensegrity_testbed::export::{mjcf::ActuatorMode, scenario_mjcf, validate_mjcf_options};
     let sc = load(path, text, &set)?;
     validate_mjcf_options(kp, cable_damping).map_err(PyValueError::new_err)?;
@@ -232,14 +285,24 @@ fn mechanism_values(
 /// The analytic model alone (`tensegrity solve`): every solution of `query` as (label, values,
 /// stable).
 #[pyfunction]
-fn solve(mechanism: &str, query: &str, values: BTreeMap<String, f64>) -> PyResult<Vec<(String, BTreeMap<String, f64>, Option<bool>)>> {
+fn solve(
+    mechanism: &str,
+    query: &str,
+    values: BTreeMap<String, f64>,
+) -> PyResult<Vec<(String, BTreeMap<String, f64>, Option<bool>)>> {
     let (m, params, inputs) = mechanism_values(mechanism, values)?;
     let Some(q) = m.queries().iter().find(|q| q.name == query) else {
         let known: Vec<_> = m.queries().iter().map(|q| q.name).collect();
-        return Err(PyValueError::new_err(format!("unknown query '{query}' for {mechanism} (expected one of: {})", known.join(", "))));
+        return Err(PyValueError::new_err(format!(
+            "unknown query '{query}' for {mechanism} (expected one of: {})",
+            known.join(", ")
+        )));
     };
     if let Some(k) = inputs.keys().find(|k| !q.inputs.contains(&k.as_str())) {
-        return Err(PyValueError::new_err(format!("'{k}' is neither a parameter of {mechanism} nor an input of '{query}' ({})", q.inputs.join(", "))));
+        return Err(PyValueError::new_err(format!(
+            "'{k}' is neither a parameter of {mechanism} nor an input of '{query}' ({})",
+            q.inputs.join(", ")
+        )));
     }
     if let Some(i) = q.inputs.iter().find(|i| !inputs.contains_key(**i)) {
         return Err(PyValueError::new_err(format!("query '{query}' needs {i} (inputs: {})", q.inputs.join(", "))));
@@ -256,7 +319,10 @@ fn findings(mechanism: &str, params: BTreeMap<String, f64>) -> PyResult<Vec<(Str
     if let Some(k) = inputs.keys().next() {
         return Err(PyValueError::new_err(format!("'{k}' is not a parameter of {mechanism}")));
     }
-    Ok(m.findings(&params).into_iter().map(|f| (f.equation.to_string(), f.claim.to_string(), f.measured, f.holds)).collect())
+    Ok(m.findings(&params)
+        .into_iter()
+        .map(|f| (f.equation.to_string(), f.claim.to_string(), f.measured, f.holds))
+        .collect())
 }
 
 #[pymodule]

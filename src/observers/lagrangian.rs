@@ -137,7 +137,11 @@ fn coordinate_report(
 }
 
 /// The report of a comparison that could not be made (`why`): every coordinate fails.
-pub fn not_compared(energy: &EnergySpec, why: String, (tolerance, rms_tolerance): (f64, Option<f64>)) -> LagrangianReport {
+pub fn not_compared(
+    energy: &EnergySpec,
+    why: String,
+    (tolerance, rms_tolerance): (f64, Option<f64>),
+) -> LagrangianReport {
     let coordinates = energy
         .coordinates
         .iter()

@@ -210,7 +210,9 @@ impl Observer for MotionObserver {
         for (f, (ts, qs)) in self.frequencies.iter().zip(&mut self.samples) {
             let q = match f.signal {
                 FrequencySignal::Joint(ref c) => t.snapshot.joint_coordinate(t.structure, c.index),
-                FrequencySignal::Mode(i) => self.modes.iter().find(|m| m.index == i).map(|m| m.projector.coordinate(t.snapshot)),
+                FrequencySignal::Mode(i) => {
+                    self.modes.iter().find(|m| m.index == i).map(|m| m.projector.coordinate(t.snapshot))
+                }
             };
             let q = q.unwrap_or(f64::NAN);
             ts.push(time_s);

@@ -322,7 +322,13 @@ fn strut_forces(s: &crate::structure::Structure, snap: &crate::snapshot::Snapsho
             let pull_at_a: f64 = pulls
                 .iter()
                 .filter_map(|((a, b), t)| {
-                    let other = if *a == strut.a { *b } else if *b == strut.a { *a } else { return None };
+                    let other = if *a == strut.a {
+                        *b
+                    } else if *b == strut.a {
+                        *a
+                    } else {
+                        return None;
+                    };
                     let d = p(other) - p(strut.a);
                     let len = d.norm();
                     (len > 0.0).then(|| t * d.dot(&out) / len)
@@ -552,7 +558,8 @@ impl Observer for Recorder {
         c.struts.push_segments(tick, time, nodes, s.struts.iter().map(|m| (m.a, m.b)));
         let f = &snap.forces;
         let struts = strut_forces(s, snap);
-        let max_f = f.spring_force_n.iter().chain(&f.cable_tension_n).chain(&struts).fold(0.0f64, |m, x| m.max(x.abs()));
+        let max_f =
+            f.spring_force_n.iter().chain(&f.cable_tension_n).chain(&struts).fold(0.0f64, |m, x| m.max(x.abs()));
         c.struts.colors.extend(struts.iter().map(|x| force_colour(*x, max_f)));
         if !s.springs.is_empty() {
             c.springs.push_segments(tick, time, nodes, s.springs.iter().map(|m| (m.a, m.b)));
@@ -679,7 +686,7 @@ pub fn blueprint(file_model: bool) -> rerun::blueprint::Blueprint {
 mod strut_force_tests {
     use super::strut_forces;
     use crate::snapshot::{MemberForces, Snapshot};
-    use crate::structure::{BodyKind, Cable, CableLaw, Strut, Structure};
+    use crate::structure::{BodyKind, Cable, CableLaw, Structure, Strut};
 
     /// A strut from A (0, 0, 0) to B (1, 0, 0) with a cable of 10 N from A to C (-1, 1, 0):
     /// the cable pulls A away from B with 10 / sqrt(2) N along the strut, a compression.
@@ -691,7 +698,14 @@ mod strut_force_tests {
         let (a, b) = (s.add_node("A", bar, [0.0; 3]), s.add_node("B", bar, [1.0, 0.0, 0.0]));
         let c = s.add_node("C", ground, [-1.0, 1.0, 0.0]);
         s.struts.push(Strut { name: "AB".into(), a, b, radius_m: 0.01 });
-        s.cables.push(Cable { name: "AC".into(), a, b: c, law: CableLaw::Inextensible, length_m: 1.0, radius_m: 0.001 });
+        s.cables.push(Cable {
+            name: "AC".into(),
+            a,
+            b: c,
+            law: CableLaw::Inextensible,
+            length_m: 1.0,
+            radius_m: 0.001,
+        });
         let snap = Snapshot {
             tick: 0,
             time_s: 0.0,

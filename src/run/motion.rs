@@ -22,7 +22,11 @@ pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
         steps: m.steps,
         steps_taken: 0,
         start_tick: 0,
-        coordinate: m.coordinate.as_ref().map(|(c, ..)| c.joint.clone()).or(m.mode.map(|(i, _)| format!("mode {}", i + 1))),
+        coordinate: m
+            .coordinate
+            .as_ref()
+            .map(|(c, ..)| c.joint.clone())
+            .or(m.mode.map(|(i, _)| format!("mode {}", i + 1))),
         displacement: m.coordinate.as_ref().map(|(_, d, _)| *d).or(m.mode.map(|(_, a)| a)).unwrap_or(0.0),
         rate: m.coordinate.as_ref().map_or(0.0, |(.., r)| *r),
         accelerated_steps: 0,

@@ -44,7 +44,9 @@ pub(super) fn model(
     if let Some(e) = &raw.energy {
         spec.energy = Some(super::energy::energy(ctx, &spec, e)?);
         if let (Some(t), None) = (&e.trajectory, &raw.motion) {
-            return Err(ctx.err(t, "[energy.trajectory] compares a motion with the Lagrangian model: it needs [motion]"));
+            return Err(
+                ctx.err(t, "[energy.trajectory] compares a motion with the Lagrangian model: it needs [motion]")
+            );
         }
     }
     Ok(Some(spec))

@@ -203,7 +203,9 @@ fn displaced_mode(
         (None, None) => return Ok(None),
         (Some(mode), Some(amplitude)) => (mode, amplitude),
         (Some(mode), None) => return Err(ctx.err(mode, "mode needs an amplitude: the largest node displacement [m]")),
-        (None, Some(a)) => return Err(ctx.err(a, "amplitude is the largest node displacement along a mode: it needs mode = N")),
+        (None, Some(a)) => {
+            return Err(ctx.err(a, "amplitude is the largest node displacement along a mode: it needs mode = N"))
+        }
     };
     if let Some(c) = &section.coordinate {
         return Err(ctx.err(c, "a motion starts displaced along a coordinate or along a mode, not both"));
@@ -299,7 +301,12 @@ fn frequency(
     let signal = match (&f.coordinate, &f.mode) {
         (Some(c), None) => FrequencySignal::Joint(joint_coordinate(ctx, c, s)?),
         (None, Some(m)) => FrequencySignal::Mode(mode_index(ctx, m, s)?),
-        _ => return Err(ctx.err(&f.name, format!("frequency '{name}' is fitted to a coordinate = \"JOINT\" or to a mode = N: one of them"))),
+        _ => {
+            return Err(ctx.err(
+                &f.name,
+                format!("frequency '{name}' is fitted to a coordinate = \"JOINT\" or to a mode = N: one of them"),
+            ))
+        }
     };
     let mut symbols: Vec<String> = params.keys().chain(inputs.keys()).cloned().collect();
     for q in mech.quantities() {

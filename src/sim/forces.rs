@@ -279,7 +279,11 @@ impl Simulation {
     /// against `wrench` (least squares, minimum norm; torques divided by the structure's size);
     /// None when there is nothing to fit. Without multibody links each load moves only the
     /// coordinates of its own two bodies, and large fits take the sparse solve.
-    fn closure_magnitudes(&self, closure_loads: &[ClosureComponent], wrench: &[Wrench]) -> Option<nalgebra::DVector<f64>> {
+    fn closure_magnitudes(
+        &self,
+        closure_loads: &[ClosureComponent],
+        wrench: &[Wrench],
+    ) -> Option<nalgebra::DVector<f64>> {
         let tree = &self.model.tree;
         let scale = self.model.length_scale_m;
         let base = self.coordinate_forces(tree, wrench, true);
@@ -314,7 +318,11 @@ impl Simulation {
     /// free body is a plain body: six coordinates per free body in body order, as
     /// [`Self::coordinate_forces`] lists them (force, then moment about the centre of mass
     /// divided by the structure's size).
-    fn plain_closure_matrix(&self, closure_loads: &[ClosureComponent], rows: usize) -> super::least_squares::SparseRows {
+    fn plain_closure_matrix(
+        &self,
+        closure_loads: &[ClosureComponent],
+        rows: usize,
+    ) -> super::least_squares::SparseRows {
         let s = &self.model.structure;
         let mut first_row = vec![None; s.bodies.len()];
         let mut next = 0;

@@ -38,7 +38,10 @@ impl Simulation {
             return Err(ModesError::Unjointed(b.1.name.clone()));
         }
         let free: Vec<usize> = (0..s.joints.len()).filter(|j| !self.model.actuated[*j]).collect();
-        if let Some(&j) = free.iter().find(|&&j| !matches!(s.joints[j].kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. })) {
+        if let Some(&j) = free
+            .iter()
+            .find(|&&j| !matches!(s.joints[j].kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. }))
+        {
             return Err(ModesError::JointKind(s.joints[j].name.clone()));
         }
         Ok(free)
@@ -127,7 +130,10 @@ impl Simulation {
             .map(|&b| {
                 let q = self.body_pose(b).rotation_xyzw;
                 let com = self.world_com(b);
-                (Vector3::new(com.x, com.y, com.z), UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2])))
+                (
+                    Vector3::new(com.x, com.y, com.z),
+                    UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2])),
+                )
             })
             .collect()
     }
@@ -165,7 +171,8 @@ impl Simulation {
         let jac = self.body_jacobian(&joints, &bodies);
         let body_mass = self.mass_matrix(&bodies);
         let mass = jac.transpose() * &body_mass * &jac;
-        let eigen = crate::eigen::modes(&(0.5 * (&stiffness + stiffness.transpose())), &(0.5 * (&mass + mass.transpose())))?;
+        let eigen =
+            crate::eigen::modes(&(0.5 * (&stiffness + stiffness.transpose())), &(0.5 * (&mass + mass.transpose())))?;
         let largest = eigen.iter().fold(0.0f64, |m, e| m.max(e.omega_squared.abs()));
         let com: Vec<_> = self.body_states(&bodies).iter().map(|(c, _)| *c).collect();
         let modes: Vec<StructureMode> = eigen

@@ -285,8 +285,10 @@ mod tests {
         let wide = tall.transpose();
         for m in [a, tall, wide] {
             let b = DVector::from_fn(m.nrows(), |i, _| 1.0 - 0.7 * i as f64);
-            let entries: Vec<_> =
-                (0..m.nrows()).flat_map(|r| (0..m.ncols()).map(move |c| (r, c))).map(|(r, c)| (r, c, m[(r, c)])).collect();
+            let entries: Vec<_> = (0..m.nrows())
+                .flat_map(|r| (0..m.ncols()).map(move |c| (r, c)))
+                .map(|(r, c)| (r, c, m[(r, c)]))
+                .collect();
             let x = sparse_min_norm_solve(SparseRows::new(m.nrows(), m.ncols(), &entries), &b).expect("full rank");
             let dense = min_norm_solve(&m, &b, 1e-12).expect("full rank");
             assert!((&x - &dense).amax() < 1e-13, "sparse {x} against dense {dense}");

@@ -588,7 +588,8 @@ impl Simulation {
             if let Some(h) = self.model.joint_impulse[j] {
                 let target = self.joint_command(j) - self.model.structure.joints[j].initial_coordinate;
                 let axis = build::free_axis_of(&self.model.structure.joints[j].kind);
-                let from = self.impulse_joints.get(h).and_then(|joint| joint.data.limits(axis)).map_or(target, |l| l.min);
+                let from =
+                    self.impulse_joints.get(h).and_then(|joint| joint.data.limits(axis)).map_or(target, |l| l.min);
                 locks.push((j, from, target));
                 continue;
             }

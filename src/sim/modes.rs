@@ -176,8 +176,7 @@ impl Simulation {
 /// `snapshot::ModalProjector`).
 pub fn modal_projector(sim: &Simulation, analysis: &StructureModes, index: usize) -> ModalProjector {
     let s = sim.structure();
-    let com_local =
-        analysis.bodies.iter().map(|b| s.bodies[*b].inertia.map_or([0.0; 3], |i| i.com)).collect();
+    let com_local = analysis.bodies.iter().map(|b| s.bodies[*b].inertia.map_or([0.0; 3], |i| i.com)).collect();
     let weights = &analysis.mass * DVector::from_column_slice(&analysis.modes[index].shape);
     ModalProjector {
         bodies: analysis.bodies.clone(),

@@ -475,7 +475,13 @@ impl Simulation {
     /// The rates of [`Self::group_rows`] (same order and scaling) when each body moves with
     /// its twist (`None`: the body stays). Exact to first order at a closed joint; the terms
     /// that multiply a gap are dropped (the gap is round-off once projected).
-    fn group_row_rates(&self, g: &ProjectedGroup, taut: &[usize], twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
+    fn group_row_rates(
+        &self,
+        g: &ProjectedGroup,
+        taut: &[usize],
+        twist: &dyn Fn(usize) -> Option<Twist>,
+        out: &mut Vec<f64>,
+    ) {
         for &j in &g.joints {
             self.joint_row_rates(j, twist, out);
         }

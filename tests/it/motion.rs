@@ -266,9 +266,11 @@ const LARGE: &str = "scenarios/custom/pinned_bar_large_amplitude.toml";
 /// Lagrangian comparison of qe.
 fn lagrangian_at(dt_s: f64, amplitude_rad: f64) -> tensegrity_testbed::report::LagrangianCoordinateReport {
     let text = std::fs::read_to_string(LARGE).expect("the shipped scenario");
-    let text = text
-        .replacen("[sim]\ndt = 1e-3", &format!("[sim]\ndt = {dt_s}"), 1)
-        .replacen("A = { value = 0.5,", &format!("A = {{ value = {amplitude_rad},"), 1);
+    let text = text.replacen("[sim]\ndt = 1e-3", &format!("[sim]\ndt = {dt_s}"), 1).replacen(
+        "A = { value = 0.5,",
+        &format!("A = {{ value = {amplitude_rad},"),
+        1,
+    );
     let report = run_text(&text, &RunOptions::default());
     let l = report.motion.and_then(|m| m.lagrangian).expect("a Lagrangian comparison");
     assert_eq!(l.error, None);
@@ -330,7 +332,11 @@ fn a_trajectory_check_without_its_parts_is_located() {
     error_at(&negative, "-5e-4", 0, "energy.trajectory.tolerance");
     let start = text.find("[motion]").expect("[motion]");
     let end = text.find("[[quantities]]").expect("[[quantities]]");
-    let settle = format!("{}{}", &text[..start], &text[end..]).replacen("verdict = \"fail\"\nfailing = [\"frequency:linear\"]", "verdict = \"pass\"", 1);
+    let settle = format!("{}{}", &text[..start], &text[end..]).replacen(
+        "verdict = \"fail\"\nfailing = [\"frequency:linear\"]",
+        "verdict = \"pass\"",
+        1,
+    );
     error_at(&settle, "\n[energy.trajectory]", 1, "it needs [motion]");
 }
 
@@ -368,14 +374,19 @@ fn the_lowest_modes_of_the_prism_and_the_icosahedron_are_the_simulated_free_vibr
     {
         let shipped = std::fs::read_to_string(path).expect("the shipped scenario");
         for mode in lowest..lowest + 3 {
-            let text = shipped
-                .replace(&format!("mode = {lowest}  "), &format!("mode = {mode}  "))
-                .replacen("tolerance = 1e-8", "tolerance = 1e-9", 1);
+            let text = shipped.replace(&format!("mode = {lowest}  "), &format!("mode = {mode}  ")).replacen(
+                "tolerance = 1e-8",
+                "tolerance = 1e-9",
+                1,
+            );
             let report = run_text(&text, &RunOptions::default());
             let m = report.motion.as_ref().expect("a motion");
             assert_eq!(m.coordinate.as_deref(), Some(format!("mode {mode}").as_str()));
             let f = &m.frequencies[0];
-            eprintln!("{path} mode {mode}: {} rad/s, error {:.3e} (uncorrected {:.3e})", f.predicted_rad_per_s, f.error, f.uncorrected_error);
+            eprintln!(
+                "{path} mode {mode}: {} rad/s, error {:.3e} (uncorrected {:.3e})",
+                f.predicted_rad_per_s, f.error, f.uncorrected_error
+            );
             assert_eq!(f.coordinate, format!("mode {mode}"));
             assert!(f.passed && report.passed, "{path} mode {mode}: {f:?}");
         }
@@ -389,8 +400,18 @@ fn the_lowest_modes_of_the_prism_and_the_icosahedron_are_the_simulated_free_vibr
 fn bad_mode_input_is_located() {
     let prism = std::fs::read_to_string("scenarios/custom/prism3_free_vibration.toml").expect("shipped");
     let motion_mode = "mode = 4              # displaced";
-    error_at(&prism.replacen(motion_mode, "mode = 13             # displaced", 1), "mode = 13", 7, "mode 13 does not exist: the structure has 12");
-    error_at(&prism.replacen(motion_mode, "mode = 0              # displaced", 1), "mode = 0", 7, "mode 0 does not exist");
+    error_at(
+        &prism.replacen(motion_mode, "mode = 13             # displaced", 1),
+        "mode = 13",
+        7,
+        "mode 13 does not exist: the structure has 12",
+    );
+    error_at(
+        &prism.replacen(motion_mode, "mode = 0              # displaced", 1),
+        "mode = 0",
+        7,
+        "mode 0 does not exist",
+    );
     let no_amplitude = prism.replacen("amplitude = 1e-5", "", 1);
     error_at(&no_amplitude, motion_mode, 7, "mode needs an amplitude");
     let both = prism.replacen("amplitude = 1e-5", "amplitude = 1e-5\ncoordinate = \"x\"\nrate = 1.0", 1);

@@ -305,7 +305,9 @@ pub fn cases(family: &str, max_struts: usize) -> Result<Vec<Case>, BenchError> {
         // n modules: 3 n struts and the base bar.
         "furet" => Ok(furet::MODULES.iter().filter(|&&n| 3 * n < max_struts).map(|&n| furet::case(n)).collect()),
         // m free vertebrae and the held one: four legs each.
-        "spine" => Ok(spine::VERTEBRAE.iter().filter(|&&m| 4 * (m + 1) <= max_struts).map(|&m| spine::case(m)).collect()),
+        "spine" => {
+            Ok(spine::VERTEBRAE.iter().filter(|&&m| 4 * (m + 1) <= max_struts).map(|&m| spine::case(m)).collect())
+        }
         _ => Err(BenchError::Case(format!("no scale family '{family}' (families: {})", FAMILIES.join(", ")))),
     }
 }

@@ -21,9 +21,7 @@
 
 use super::{Case, Measure};
 use crate::settings::SimSettings;
-use crate::structure::{
-    BodyKind, Cable, CableLaw, Inertia, Spring, Structure, Strut, Vec3, DEFAULT_TENDON_RADIUS_M,
-};
+use crate::structure::{BodyKind, Cable, CableLaw, Inertia, Spring, Structure, Strut, Vec3, DEFAULT_TENDON_RADIUS_M};
 
 /// Free vertebrae of the family. 249 (1000 struts) was measured too and did not settle within
 /// 20000 steps: its residual stayed at 1.2e-9 N against the 1e-9 N criterion, its error at
