@@ -88,7 +88,7 @@ impl Observer for ExternalObserver {
         if p.outside_model || self.motion {
             return;
         }
-        let errors = self.errors(p.params, &point.inputs.clone(), None, &point.simulated.clone());
+        let errors = self.errors(p.params, &point.inputs, None, &point.simulated);
         for ((a, e), pr) in self.acc.iter_mut().zip(errors).zip(&self.external.predictions) {
             a.point(e, point.settled);
             if point.settled && !(e <= pr.tolerance) {

@@ -306,37 +306,21 @@ fn f32x3(p: [f64; 3]) -> [f32; 3] {
 /// (compression when they pull the end away from the strut). Loads at the node other than
 /// members (gravity, actuators, joints) are not counted: a colour, not a measurement.
 fn strut_forces(s: &crate::structure::Structure, snap: &crate::snapshot::Snapshot) -> Vec<f64> {
+    use nalgebra::Vector3;
     let f = &snap.forces;
-    let pulls = s
-        .springs
-        .iter()
-        .map(|m| (m.a, m.b))
-        .zip(f.spring_force_n.iter())
-        .chain(s.cables.iter().map(|m| (m.a, m.b)).zip(f.cable_tension_n.iter()));
-    let pulls: Vec<((usize, usize), f64)> = pulls.map(|(ends, t)| (ends, *t)).collect();
-    let p = |n: usize| nalgebra::Vector3::from(snap.nodes[n]);
-    s.struts
-        .iter()
-        .map(|strut| {
-            let out = (p(strut.a) - p(strut.b)).normalize();
-            let pull_at_a: f64 = pulls
-                .iter()
-                .filter_map(|((a, b), t)| {
-                    let other = if *a == strut.a {
-                        *b
-                    } else if *b == strut.a {
-                        *a
-                    } else {
-                        return None;
-                    };
-                    let d = p(other) - p(strut.a);
-                    let len = d.norm();
-                    (len > 0.0).then(|| t * d.dot(&out) / len)
-                })
-                .sum();
-            -pull_at_a
-        })
-        .collect()
+    let p = |n: usize| Vector3::from(snap.nodes[n]);
+    // The springs' and cables' pull at every node, summed once: one pass over the members.
+    let mut pull = vec![Vector3::zeros(); snap.nodes.len()];
+    let members = s.springs.iter().map(|m| (m.a, m.b)).zip(&f.spring_force_n);
+    for ((a, b), t) in members.chain(s.cables.iter().map(|m| (m.a, m.b)).zip(&f.cable_tension_n)) {
+        let d = p(b) - p(a);
+        let len = d.norm();
+        if len > 0.0 {
+            pull[a] += d * (t / len);
+            pull[b] -= d * (t / len);
+        }
+    }
+    s.struts.iter().map(|strut| -pull[strut.a].dot(&(p(strut.a) - p(strut.b)).normalize())).collect()
 }
 
 /// Colour of a member by its force: blue in compression, red in tension, grey when slack.
