@@ -268,10 +268,7 @@ fn mechanism_values(
     values: BTreeMap<String, f64>,
 ) -> PyResult<(Box<dyn tensegrity_testbed::mechanisms::Mechanism>, BTreeMap<String, f64>, BTreeMap<String, f64>)> {
     use tensegrity_testbed::mechanisms;
-    let m = mechanisms::find(name).ok_or_else(|| {
-        let known: Vec<_> = mechanisms::registry().iter().map(|m| m.name()).collect();
-        PyValueError::new_err(format!("unknown mechanism '{name}' (expected one of: {})", known.join(", ")))
-    })?;
+    let m = mechanisms::find_named(name).map_err(PyValueError::new_err)?;
     let (params, inputs): (BTreeMap<_, _>, BTreeMap<_, _>) =
         values.into_iter().partition(|(k, _)| m.params().iter().any(|p| p.symbol == k));
     if let Some((k, v)) = params.iter().chain(&inputs).find(|(_, v)| !v.is_finite()) {
@@ -291,13 +288,7 @@ fn solve(
     values: BTreeMap<String, f64>,
 ) -> PyResult<Vec<(String, BTreeMap<String, f64>, Option<bool>)>> {
     let (m, params, inputs) = mechanism_values(mechanism, values)?;
-    let Some(q) = m.queries().iter().find(|q| q.name == query) else {
-        let known: Vec<_> = m.queries().iter().map(|q| q.name).collect();
-        return Err(PyValueError::new_err(format!(
-            "unknown query '{query}' for {mechanism} (expected one of: {})",
-            known.join(", ")
-        )));
-    };
+    let q = tensegrity_testbed::mechanisms::query_named(m.as_ref(), query).map_err(PyValueError::new_err)?;
     if let Some(k) = inputs.keys().find(|k| !q.inputs.contains(&k.as_str())) {
         return Err(PyValueError::new_err(format!(
             "'{k}' is neither a parameter of {mechanism} nor an input of '{query}' ({})",

@@ -34,21 +34,12 @@ pub(super) fn parse_sets(
 
 /// The built-in mechanism called `name`.
 pub(super) fn find_mechanism(name: &str) -> Result<Box<dyn Mechanism>, CliError> {
-    mechanisms::find(name).ok_or_else(|| {
-        let known: Vec<_> = mechanisms::registry().iter().map(|m| m.name()).collect();
-        bad_input(format!("unknown mechanism '{name}' (expected one of: {})", known.join(", ")))
-    })
+    mechanisms::find_named(name).map_err(bad_input)
 }
 
 pub fn solve(mechanism: &str, query: &str, sets: &[String], json: bool) -> Result<Outcome, CliError> {
     let m = find_mechanism(mechanism)?;
-    let Some(q) = m.queries().iter().find(|q| q.name == query) else {
-        let known: Vec<_> = m.queries().iter().map(|q| q.name).collect();
-        return Err(bad_input(format!(
-            "unknown query '{query}' for {mechanism} (expected one of: {})",
-            known.join(", ")
-        )));
-    };
+    let q = mechanisms::query_named(m.as_ref(), query).map_err(bad_input)?;
     let (params, inputs) = parse_sets(m.as_ref(), sets, q.inputs)?;
     if let Some(i) = q.inputs.iter().find(|i| !inputs.contains_key(**i)) {
         return Err(bad_input(format!("query '{query}' needs --set {i}=VALUE (inputs: {})", q.inputs.join(" "))));

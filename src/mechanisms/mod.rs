@@ -215,6 +215,22 @@ pub fn find(name: &str) -> Option<Box<dyn Mechanism>> {
     registry().into_iter().find(|m| m.name() == name)
 }
 
+/// The built-in mechanism called `name`, or the message that lists the known ones.
+pub fn find_named(name: &str) -> Result<Box<dyn Mechanism>, String> {
+    find(name).ok_or_else(|| {
+        let known: Vec<_> = registry().iter().map(|m| m.name()).collect();
+        format!("unknown mechanism '{name}' (expected one of: {})", known.join(", "))
+    })
+}
+
+/// The analytic query `query` of `m`, or the message that lists its queries.
+pub fn query_named(m: &dyn Mechanism, query: &str) -> Result<&'static QuerySpec, String> {
+    m.queries().iter().find(|q| q.name == query).ok_or_else(|| {
+        let known: Vec<_> = m.queries().iter().map(|q| q.name).collect();
+        format!("unknown query '{query}' for {} (expected one of: {})", m.name(), known.join(", "))
+    })
+}
+
 /// The parameter values: the defaults overridden by `given`.
 pub fn with_defaults(m: &dyn Mechanism, given: &Values) -> Values {
     let mut out: Values = m.params().iter().map(|p| (p.symbol.to_string(), p.default)).collect();
