@@ -56,16 +56,10 @@ impl Simulation {
     }
 
     /// Moves joint `j`'s coordinate by `d` (rad or m), the bodies beyond it along.
+    /// [`Simulation::modal_joints`] admits only joints that are links of a multibody, so the
+    /// move cannot fail here.
     pub(super) fn displace_joint(&mut self, j: usize, d: f64) {
-        let Some(link) = self.model.joint_links[j] else { return };
-        let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) else { return };
-        mb.forward_kinematics(&self.bodies, true);
-        let Some(start) = mb.link(link_id).map(|l| l.assembly_id()).filter(|s| *s < mb.ndofs()) else { return };
-        let mut disp = vec![0.0; mb.ndofs()];
-        disp[start] = d;
-        mb.apply_displacements(&disp);
-        mb.forward_kinematics(&self.bodies, true);
-        mb.update_rigid_bodies(&mut self.bodies, true);
+        let _ = self.move_joint(j, d, None);
     }
 
     /// The potential energy now [J]: elastic members (engaged), torsion springs, and the work

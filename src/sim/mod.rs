@@ -204,11 +204,20 @@ impl Simulation {
     /// carried along; the other coordinates and rates stay. Only a joint that is a free
     /// (not actuated) link of a multibody has such a coordinate here.
     pub fn set_joint_motion(&mut self, j: usize, displacement: f64, rate: f64) -> Result<(), String> {
+        if self.model.actuated[j] {
+            let name = &self.model.structure.joints[j].name;
+            return Err(format!("joint '{name}' is actuated: its coordinate is commanded"));
+        }
+        self.move_joint(j, displacement, Some(rate))
+    }
+
+    /// Moves joint `j`'s coordinate by `displacement` (rad or m), the bodies beyond it along,
+    /// and sets its rate (rad/s or m/s) where one is given; Err where the joint has no degree of
+    /// freedom of its own in a multibody (a loop's closing joint).
+    pub(super) fn move_joint(&mut self, j: usize, displacement: f64, rate: Option<f64>) -> Result<(), String> {
         let name = &self.model.structure.joints[j].name;
-        let link = match (self.model.joint_links[j], self.model.actuated[j]) {
-            (Some(link), false) => link,
-            (_, true) => return Err(format!("joint '{name}' is actuated: its coordinate is commanded")),
-            (None, _) => return Err(format!("joint '{name}' closes a loop: it has no coordinate of its own")),
+        let Some(link) = self.model.joint_links[j] else {
+            return Err(format!("joint '{name}' closes a loop: it has no coordinate of its own"));
         };
         let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) else {
             return Err(format!("joint '{name}' has no multibody link"));
@@ -224,7 +233,9 @@ impl Simulation {
         mb.apply_displacements(&disp);
         mb.forward_kinematics(&self.bodies, true);
         mb.update_rigid_bodies(&mut self.bodies, true);
-        mb.generalized_velocity_mut()[start] = rate;
+        if let Some(rate) = rate {
+            mb.generalized_velocity_mut()[start] = rate;
+        }
         Ok(())
     }
 
