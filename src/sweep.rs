@@ -82,6 +82,9 @@ pub fn sweep(
     cancel: Option<&AtomicBool>,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(Vec<Row>, SweepSummary), SweepError> {
+    if !sc.topologies.is_empty() {
+        return sweep_topologies(sc, jobs, shard, cancel, progress);
+    }
     let (points, continuation) = match &sc.actuation {
         Actuation::Points { points, continuation } => (points.clone(), *continuation),
         Actuation::Schedule { .. } => {
@@ -127,6 +130,34 @@ pub fn sweep(
         errors.extend(e);
     }
     rows.sort_by_key(|r| r.index);
+    let summary = summarise(sc, &rows, errors, shard, jobs, start.elapsed().as_secs_f64());
+    Ok((rows, summary))
+}
+
+/// A sweep over a topology parameter: each topology's points swept with its own structure,
+/// the rows numbered in the whole grid's order.
+fn sweep_topologies(
+    sc: &Scenario,
+    jobs: usize,
+    shard: Option<(usize, usize)>,
+    cancel: Option<&AtomicBool>,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(Vec<Row>, SweepSummary), SweepError> {
+    let start = std::time::Instant::now();
+    let grid_points = sc.actuation.all_inputs().len();
+    let (mut rows, mut errors, mut offset) = (Vec::new(), Vec::new(), 0);
+    for variant in &sc.topologies {
+        let (variant_rows, summary) = sweep(variant, jobs, shard, cancel, progress)?;
+        let note = crate::run::rebuilt(sc, variant);
+        errors.extend(summary.errors.into_iter().map(|e| format!("{note}: {e}")));
+        rows.extend(variant_rows.into_iter().map(|mut r| {
+            r.index += offset;
+            r.point.index = r.index;
+            r.grid_points = grid_points;
+            r
+        }));
+        offset += variant.actuation.all_inputs().len();
+    }
     let summary = summarise(sc, &rows, errors, shard, jobs, start.elapsed().as_secs_f64());
     Ok((rows, summary))
 }

@@ -479,7 +479,9 @@ impl<'a> Translator<'a> {
         Ok(match name {
             "pow" => format!("({}^{})", a[0], a[1]),
             "hypot" => format!("sqrt({}^2+{}^2)", a[0], a[1]),
-            _ if arity == 2 => format!("{name}({}, {})", a[0], a[1]),
+            // Infix, as the engine also reads them: its call form fails on a call of two
+            // arguments in the second argument (`atan2(a, min(b, c))`, measured).
+            _ if arity == 2 => format!("(({}) {name} ({}))", a[0], a[1]),
             _ => format!("{name}({})", a[0]),
         })
     }

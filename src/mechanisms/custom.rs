@@ -114,6 +114,20 @@ impl Custom {
         self
     }
 
+    /// The parameters of `swept` that change nothing in the structure: at every other value of
+    /// the swept ones, each value gives the same structure (a sweep that only the formulas see).
+    pub fn unseen(&self, swept: &[String]) -> Vec<String> {
+        let all: Vec<(&Values, &Structure)> =
+            std::iter::once((&self.params, &self.structure)).chain(self.variants.iter().map(|(p, s)| (p, s))).collect();
+        let value = |p: &Values, k: &str| p.get(k).copied().unwrap_or(f64::NAN).to_bits();
+        let unseen = |k: &String| {
+            let others = |p: &Values| swept.iter().filter(|o| *o != k).map(|o| value(p, o)).collect::<Vec<u64>>();
+            let varies = all.iter().any(|(p, _)| value(p, k) != value(all[0].0, k));
+            varies && all.iter().all(|(p, s)| all.iter().filter(|(q, _)| others(q) == others(p)).all(|(_, t)| t == s))
+        };
+        swept.iter().filter(|k| unseen(k)).cloned().collect()
+    }
+
     /// The structure resolved with `params`: the file's own, or one of its variants.
     fn structure_at(&self, params: &Values) -> Result<&Structure, ModelError> {
         if params == &self.params || params.is_empty() {

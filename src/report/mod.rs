@@ -64,6 +64,14 @@ pub struct ScenarioReport {
     /// A motion run (`[motion]`): what ran, and the frequencies measured from it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub motion: Option<MotionReport>,
+    /// A sweep over a topology parameter: each structure the run rebuilt, with the parameter
+    /// values and the structure's size (absent when one structure served every point).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub topologies: Vec<String>,
+    /// Swept parameters that change nothing in the file's structure: only its formulas see
+    /// them (a structure drawn for one value, swept over others).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub unseen_params: Vec<String>,
 }
 
 /// Which kind of path a run took (see [`ScenarioReport::path`]).
@@ -622,6 +630,14 @@ impl ScenarioReport {
             self.settle.wall_s
         ));
         out.push_str(&format!("   path: {} ({} accelerated step(s))\n", self.path.name(), self.accelerated_steps));
+        for t in &self.topologies {
+            out.push_str(&format!("   topology: {t}\n"));
+        }
+        for p in &self.unseen_params {
+            out.push_str(&format!(
+                "   note: parameter '{p}' is swept but the structure does not change with it (only formulas see it)\n"
+            ));
+        }
         if let Some(e) = &self.error {
             out.push_str(&format!("   stopped: {e}\n"));
         }

@@ -9,6 +9,7 @@ mod point;
 mod runner;
 mod settle;
 mod settled;
+mod topologies;
 
 use crate::mechanisms::{Mechanism, ModelError, Values};
 use crate::observers::record::{RecordTarget, Recording};
@@ -24,6 +25,7 @@ use std::time::Instant;
 pub use point::NO_BRANCH;
 pub use settle::SettleDetector;
 pub use settled::{settle_first_point, SettledState};
+pub use topologies::rebuilt;
 
 /// How a run is observed beyond the comparison.
 #[derive(Default)]
@@ -93,6 +95,8 @@ fn empty_report(sc: &Scenario) -> ScenarioReport {
         path: crate::report::PathKind::Accelerated,
         accelerated_steps: 0,
         motion: None,
+        topologies: vec![],
+        unseen_params: sc.unseen_params.clone(),
     }
 }
 
@@ -145,6 +149,9 @@ pub const INJECT_PANIC_VAR: &str = "TENSEGRITY_INJECT_PANIC";
 pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
     if std::env::var(INJECT_PANIC_VAR).is_ok_and(|n| n == sc.name) {
         panic!("injected by {INJECT_PANIC_VAR} (test hook)");
+    }
+    if !sc.topologies.is_empty() {
+        return topologies::run_topologies(sc, opts);
     }
     let mech = sc.mechanism();
     let mut report = empty_report(sc);

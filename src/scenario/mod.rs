@@ -15,6 +15,7 @@ mod energy;
 mod error;
 mod expect;
 mod file_model;
+mod for_each;
 mod interference;
 mod kinetic;
 mod mechanism;
@@ -23,9 +24,11 @@ mod names;
 mod number;
 mod overrides;
 mod params;
+mod pattern;
 mod physical;
 mod raw;
 mod record;
+mod repeat;
 mod sim;
 mod structure;
 
@@ -74,6 +77,14 @@ pub struct Scenario {
     pub model: Option<crate::file_model::spec::ModelSpec>,
     /// `[motion]`: a motion run (the physical dynamics for a stated time), if the file asks.
     pub motion: Option<crate::settings::Motion>,
+    /// A sweep over a parameter that changes the structure's topology (a pattern's range):
+    /// the scenario validated again for each value, with that value's points, run one after
+    /// the other (empty: one structure for every point).
+    pub topologies: Vec<Scenario>,
+    /// The parameters the patterns' ranges and templates read (`pattern.rs`).
+    pub topology_params: Vec<String>,
+    /// Swept parameters that change nothing in a custom structure (only formulas see them).
+    pub unseen_params: Vec<String>,
 }
 
 impl Scenario {
@@ -193,9 +204,103 @@ pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<S
     })?;
     let located = |e| overrides::at_flag(e, overrides, file_lines);
     overrides::apply(&ctx, &mut raw, overrides, file_lines).map_err(located)?;
-    let mut sc = validate(&ctx, path, raw).map_err(located)?;
+    let mut sc = match validate(&ctx, path, raw, None).map_err(located)? {
+        Validated::One(sc) => *sc,
+        Validated::Split(topologies) => {
+            let mut variants = Vec::new();
+            for t in &topologies {
+                let mut raw: RawScenario = toml::from_str(source).expect("read once already");
+                overrides::apply(&ctx, &mut raw, overrides, file_lines).map_err(located)?;
+                match validate(&ctx, path, raw, Some(t)).map_err(located)? {
+                    Validated::One(v) => variants.push(*v),
+                    Validated::Split(_) => unreachable!("a topology's scenario is not split again"),
+                }
+            }
+            pattern_sweep(variants)
+        }
+    };
     sc.source = source.to_string();
     Ok(sc)
+}
+
+/// The scenario of a sweep over a topology parameter: the first topology's, with every
+/// topology's points, and the topologies to run.
+fn pattern_sweep(mut variants: Vec<Scenario>) -> Scenario {
+    let mut sc = variants[0].clone();
+    let continuation = matches!(sc.actuation, Actuation::Points { continuation: true, .. });
+    let points = variants
+        .iter()
+        .flat_map(|v| match &v.actuation {
+            Actuation::Points { points, .. } => points.clone(),
+            Actuation::Schedule { .. } => Vec::new(),
+        })
+        .collect();
+    sc.actuation = Actuation::Points { points, continuation };
+    sc.skipped_points = variants.iter_mut().flat_map(|v| std::mem::take(&mut v.skipped_points)).collect();
+    sc.topologies = variants;
+    sc
+}
+
+/// A validated scenario, or the topologies a sweep over a pattern's parameter asks for.
+enum Validated {
+    One(Box<Scenario>),
+    Split(Vec<Topology>),
+}
+
+/// One structure of a sweep over a topology parameter: the parameters its patterns are
+/// expanded with, and the points settled with it.
+#[derive(Clone, Debug)]
+struct Topology {
+    params: Values,
+    points: Vec<Values>,
+    /// The topology parameters, each set to its value here as `--set` would.
+    used: Vec<String>,
+}
+
+/// The points grouped by the values of the topology parameters `used` (in grid order; one
+/// group when the sweep leaves them alone).
+fn topologies(
+    table: &crate::file_model::params::ParamTable,
+    params: &Values,
+    actuation: &Actuation,
+    used: &[String],
+) -> Vec<Topology> {
+    let mut groups: Vec<(Vec<u64>, Topology)> = Vec::new();
+    for p in actuation.all_inputs() {
+        let set = params::params_at(table, params, p);
+        let key: Vec<u64> = used.iter().map(|k| set.get(k).copied().unwrap_or(f64::NAN).to_bits()).collect();
+        match groups.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, t)) => t.points.push(p.clone()),
+            None => groups.push((key, Topology { params: set, points: vec![p.clone()], used: used.to_vec() })),
+        }
+    }
+    groups.into_iter().map(|(_, t)| t).collect()
+}
+
+/// Expands the file's patterns (`repeat.rs`, `for_each.rs`) with the parameters of
+/// `topology`, or the file's own; returns the parameters their ranges and templates read.
+fn expand_patterns(
+    ctx: &Ctx,
+    raw: &mut RawScenario,
+    topology: Option<&Topology>,
+) -> Result<Vec<String>, ScenarioError> {
+    // A parameter error is reported where the parameters are validated; templates then see none.
+    let params = match topology {
+        Some(t) => {
+            for (k, p) in raw.params.iter_mut().filter(|(k, _)| t.used.contains(k.get_ref())) {
+                p.get_mut().value = number::Num::Value(t.params[k.get_ref()]);
+            }
+            t.params.clone()
+        }
+        None => number::param_values(ctx, &raw.params).unwrap_or_default(),
+    };
+    let env = pattern::Env::new(&params);
+    if let Some(s) = &mut raw.structure {
+        repeat::expand(ctx, s.get_mut(), &env)?;
+    }
+    for_each::expand_model(ctx, raw, &env)?;
+    let used = env.used.borrow().iter().cloned().collect();
+    Ok(used)
 }
 
 /// Largest number of settle points a scenario may ask for.
@@ -256,10 +361,16 @@ impl Structures<'_> {
 }
 
 /// The values of a scenario whose shape serde has read, section by section.
-fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, ScenarioError> {
+fn validate(
+    ctx: &Ctx,
+    path: &Path,
+    mut raw: RawScenario,
+    topology: Option<&Topology>,
+) -> Result<Validated, ScenarioError> {
     if raw.name.get_ref().trim().is_empty() {
         return Err(ctx.err(&raw.name, "name must not be empty"));
     }
+    let topology_params = expand_patterns(ctx, &mut raw, topology)?;
     names::names(ctx, &raw)?;
     let custom = mechanism::custom(ctx, &raw)?;
     let mech = mechanism::mechanism(ctx, &raw, custom.as_ref())?;
@@ -269,7 +380,19 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let mut sim = sim::sim(ctx, &raw.sim)?;
     let settle = sim::settle(ctx, &raw.settle)?;
     let start = params::start(ctx, m, &raw.start)?;
-    let (actuation, skipped_points) = actuation::actuation(ctx, m, &param_table, &params, &raw.actuation)?;
+    let (mut actuation, skipped_points) = actuation::actuation(ctx, m, &param_table, &params, &raw.actuation)?;
+    match topology {
+        Some(t) => {
+            let continuation = matches!(actuation, Actuation::Points { continuation: true, .. });
+            actuation = Actuation::Points { points: t.points.clone(), continuation };
+        }
+        None => {
+            let split = topologies(&param_table, &params, &actuation, &topology_params);
+            if split.len() > 1 {
+                return Ok(Validated::Split(split));
+            }
+        }
+    }
     bounds::bounds(ctx, &raw, &sim, &settle, &actuation)?;
     let checks = checks::checks(ctx, m, &raw.checks, raw.probe.is_some())?;
     let model = file_model::model(ctx, &raw, m, &params, &start, &actuation)?;
@@ -290,6 +413,13 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         Some(c) => Some(mechanism::with_variants(ctx, &raw, c, &params, &parameter_sets)?),
         None => None,
     };
+    let mut swept: Vec<String> = Vec::new();
+    for k in actuation.all_inputs().into_iter().flat_map(|p| p.keys()) {
+        if params.contains_key(k) && !swept.contains(k) {
+            swept.push(k.clone());
+        }
+    }
+    let unseen_params = custom.as_ref().map(|c| c.unseen(&swept)).unwrap_or_default();
     let mech = mechanism::mechanism(ctx, &raw, custom.as_ref())?;
     let m = mech.as_ref();
     let first_params = params::params_at(&param_table, &params, actuation.first_inputs());
@@ -302,7 +432,7 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let parts =
         expect::Parts { checks: &checks, model: model.as_ref(), probe: probe.is_some(), motion: motion.as_ref() };
     let expect = raw.expect.as_ref().map(|e| expect::expectation(ctx, e, &parts)).transpose()?;
-    Ok(Scenario {
+    Ok(Validated::One(Box::new(Scenario {
         file: path.to_path_buf(),
         source: ctx.source.to_string(),
         name: raw.name.into_inner(),
@@ -326,5 +456,8 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         expect,
         model,
         motion,
-    })
+        topologies: Vec::new(),
+        topology_params,
+        unseen_params,
+    })))
 }

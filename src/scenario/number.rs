@@ -8,7 +8,7 @@
 //! names its `file:LINE:COL` inside the string.
 
 use super::error::{Ctx, ScenarioError};
-use super::raw::{RawBody, RawJoint, RawStructure, Xyz};
+use super::raw::{Placement, RawBody, RawJoint, RawStructure, Xyz};
 use crate::file_model::expr::{Expr, ExprError};
 use crate::file_model::params::{Cycle, ParamTable};
 use crate::mechanisms::Values;
@@ -219,9 +219,46 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
     for a in &mut s.actuators {
         if let Some(d) = &mut a.direction {
             resolve_xyz(d, "direction", &mut resolve)?;
+            if let Some(pl) = &mut a.placement {
+                let (turn, _) = resolve_placement(pl, &mut resolve)?;
+                place(d, turn, [0.0; 3]);
+            }
         }
     }
     Ok(())
+}
+
+/// A rotation (unit axis, angle [rad]) and an offset [m].
+type Turn = Option<([f64; 3], f64)>;
+
+/// A generated copy's rotation and offset, evaluated.
+fn resolve_placement(pl: &mut Placement, resolve: &mut Resolve) -> Result<(Turn, [f64; 3]), ScenarioError> {
+    let mut turn = None;
+    if let Some(r) = &mut pl.rotate {
+        resolve_xyz(&mut r.axis, "rotate.axis", resolve)?;
+        resolve(&mut r.angle, "rotate.angle")?;
+        turn = Some((values(&r.axis), r.angle.get_ref().value()));
+    }
+    let mut offset = [0.0; 3];
+    if let Some(o) = &mut pl.offset {
+        resolve_xyz(o, "offset", resolve)?;
+        offset = values(o);
+    }
+    Ok((turn, offset))
+}
+
+/// The three numbers of a resolved triple (NaN where one is missing, which the checks refuse).
+fn values(v: &Xyz) -> [f64; 3] {
+    std::array::from_fn(|i| v.get_ref().get(i).map_or(f64::NAN, |c| c.get_ref().value()))
+}
+
+/// A resolved point or vector turned and then offset.
+fn place(v: &mut Xyz, turn: Turn, offset: [f64; 3]) {
+    let p = values(v);
+    let p = turn.map_or(p, |(axis, angle)| super::repeat::rotated(p, axis, angle));
+    for (c, x) in v.get_mut().iter_mut().zip(p.iter().zip(offset).map(|(a, b)| a + b)) {
+        *c = Spanned::new(c.span(), Num::Value(x));
+    }
 }
 
 type Resolve<'a> = dyn FnMut(&mut Spanned<Num>, &str) -> Result<(), ScenarioError> + 'a;
@@ -239,6 +276,10 @@ fn resolve_body(b: &mut RawBody, resolve: &mut Resolve) -> Result<(), ScenarioEr
     }
     for (name, p) in &mut b.nodes {
         resolve_xyz(p, &format!("a coordinate of node '{}'", name.get_ref()), resolve)?;
+    }
+    if let Some(pl) = &mut b.placement {
+        let (turn, offset) = resolve_placement(pl, resolve)?;
+        b.nodes.values_mut().for_each(|p| place(p, turn, offset));
     }
     Ok(())
 }
@@ -259,9 +300,14 @@ fn resolve_member(
 }
 
 fn resolve_joint(j: &mut RawJoint, resolve: &mut Resolve) -> Result<(), ScenarioError> {
+    let turn = match &mut j.placement {
+        Some(pl) => resolve_placement(pl, resolve)?.0,
+        None => None,
+    };
     for (v, what) in [(&mut j.axis, "axis"), (&mut j.axis2, "axis2")] {
         if let Some(v) = v {
             resolve_xyz(v, what, resolve)?;
+            place(v, turn, [0.0; 3]);
         }
     }
     let fields = [

@@ -11,6 +11,25 @@ fn eval(text: &str, symbols: &[&str], values: &[f64]) -> f64 {
     Expr::compile(text, symbols).unwrap_or_else(|e| panic!("{text}: {e}")).eval(values)
 }
 
+/// A call of two arguments inside the second argument of another (the engine's own call form
+/// failed on `atan2(a, min(b, c))` with "parentheses mismatch"; the expansion of `min(c in
+/// cables, ...)` nests that way).
+#[test]
+fn two_argument_calls_nest_in_either_argument() {
+    let (a, b, c): (f64, f64, f64) = (1.0, 2.0, 3.0);
+    let s = ["a", "b", "c"];
+    let cases: &[(&str, f64)] = &[
+        ("atan2(a, atan2(b, c))", a.atan2(b.atan2(c))),
+        ("min(a, min(b, c))", a.min(b.min(c))),
+        ("max(min(a, b), max(b, hypot(a, c)))", a.min(b).max(b.max(a.hypot(c)))),
+        ("pow(a + 1, min(b, c)) * 2", (a + 1.0).powf(b.min(c)) * 2.0),
+    ];
+    for (text, expected) in cases {
+        let got = eval(text, &s, &[a, b, c]);
+        assert!((got - expected).abs() <= EVAL_TOL, "{text}: {got} against {expected}");
+    }
+}
+
 /// Every function and constant of the grammar evaluates as its Rust counterpart, with the
 /// usual precedence (`-x^2` is `-(x^2)`, `^` groups to the right, `-` and `/` to the left).
 #[test]

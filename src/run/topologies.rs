@@ -1,0 +1,129 @@
+//! A sweep over a parameter that changes the structure's topology (a pattern's range, an
+//! n-strut prism for n = 3..12): each topology's scenario runs on its own, with its own
+//! structure, and the reports join into one. Checks and predictions of the same name join by
+//! their worst error; each point keeps its own values.
+
+use super::{conclude, run, RunOptions};
+use crate::report::{CheckReport, ModelCheckReport, ScenarioReport};
+use crate::scenario::Scenario;
+use std::path::{Path, PathBuf};
+
+/// Runs every topology of `sc` and joins the reports.
+pub(super) fn run_topologies(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
+    let mut joined: Option<ScenarioReport> = None;
+    let mut rebuilt_at = Vec::new();
+    for (k, variant) in sc.topologies.iter().enumerate() {
+        let record = opts.record.clone().or_else(|| sc.record.clone()).map(|p| numbered(&p, k));
+        let options = RunOptions {
+            record,
+            cancel: opts.cancel,
+            connect: opts.connect.clone(),
+            record_every: opts.record_every,
+            skip_findings: opts.skip_findings || k > 0,
+            table: opts.table.as_deref().map(|p| numbered(p, k)),
+            external: opts.external.clone(),
+        };
+        let mut r = run(variant, &options);
+        let note = rebuilt(sc, variant);
+        rebuilt_at.push(format!("{note} ({} point(s))", variant.actuation.all_inputs().len()));
+        r.error = r.error.map(|e| format!("{note}: {e}"));
+        let stop = r.error.is_some();
+        joined = Some(match joined {
+            None => r,
+            Some(mut j) => {
+                join(&mut j, r);
+                j
+            }
+        });
+        if stop {
+            break;
+        }
+    }
+    let mut report = joined.expect("a topology sweep has at least two topologies");
+    report.params = sc.params.clone();
+    report.topologies = rebuilt_at;
+    conclude(&mut report, sc);
+    report
+}
+
+/// What a topology's run says of itself: the parameters that rebuilt the structure.
+pub fn rebuilt(sc: &Scenario, variant: &Scenario) -> String {
+    let first = variant.actuation.first_inputs();
+    let params = variant.params_at(first);
+    let values: Vec<String> =
+        sc.topology_params.iter().map(|k| format!("{k} = {}", params.get(k).copied().unwrap_or(f64::NAN))).collect();
+    let size = match &variant.custom {
+        Some(c) => {
+            let s = &c.structure;
+            format!(
+                ": {} bodies, {} nodes, {} struts, {} cables, {} springs, {} joints",
+                s.bodies.len(),
+                s.nodes.len(),
+                s.struts.len(),
+                s.cables.len(),
+                s.springs.len(),
+                s.joints.len()
+            )
+        }
+        None => String::new(),
+    };
+    format!("structure rebuilt at {}{size}", values.join(", "))
+}
+
+/// `path` with the topology's number before its extension (`run.rrd` -> `run.topology2.rrd`).
+fn numbered(path: &Path, k: usize) -> PathBuf {
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = match path.extension() {
+        Some(ext) => format!("{stem}.topology{k}.{}", ext.to_string_lossy()),
+        None => format!("{stem}.topology{k}"),
+    };
+    path.with_file_name(name)
+}
+
+/// Adds a later topology's report to the joined one.
+fn join(j: &mut ScenarioReport, r: ScenarioReport) {
+    let offset = j.points.len();
+    j.points.extend(r.points.into_iter().map(|mut p| {
+        p.index += offset;
+        p
+    }));
+    for c in r.checks {
+        match j.checks.iter_mut().find(|x| x.quantity == c.quantity) {
+            Some(x) => join_check(x, &c),
+            None => j.checks.push(c),
+        }
+    }
+    for m in r.model_checks {
+        match j.model_checks.iter_mut().find(|x| x.kind == m.kind && x.name == m.name) {
+            Some(x) => join_model_check(x, &m),
+            None => j.model_checks.push(m),
+        }
+    }
+    j.slack_intervals.extend(r.slack_intervals);
+    j.skipped_points += r.skipped_points;
+    j.accelerated_steps += r.accelerated_steps;
+    j.settle.settled &= r.settle.settled;
+    j.settle.steps += r.settle.steps;
+    j.settle.sim_time_s += r.settle.sim_time_s;
+    j.settle.wall_s += r.settle.wall_s;
+    j.error = j.error.take().or(r.error);
+}
+
+fn join_check(x: &mut CheckReport, c: &CheckReport) {
+    x.max_abs_error = x.max_abs_error.max(c.max_abs_error);
+    x.max_rel_error = x.max_rel_error.max(c.max_rel_error);
+    x.passed &= c.passed;
+    x.transient_max_abs_error = x.transient_max_abs_error.max(c.transient_max_abs_error);
+    x.transient_rms_abs_error = x.transient_rms_abs_error.max(c.transient_rms_abs_error);
+    x.ticks_compared += c.ticks_compared;
+    x.points_compared += c.points_compared;
+}
+
+fn join_model_check(x: &mut ModelCheckReport, c: &ModelCheckReport) {
+    x.max_error = x.max_error.max(c.max_error);
+    x.passed &= c.passed;
+    x.points_compared += c.points_compared;
+    x.transient_max_error = x.transient_max_error.max(c.transient_max_error);
+    x.transient_rms_error = x.transient_rms_error.max(c.transient_rms_error);
+    x.ticks_compared += c.ticks_compared;
+}
