@@ -282,10 +282,13 @@ def from_matrices(
     cb = _matrix("Cb", Cb, cols=n.shape[1])
     cs = _matrix("Cs", Cs, cols=n.shape[1])
     bars, strings = cb.shape[0], cs.shape[0]
-    if string_tension_n is not None and string_rest_length_m is not None:
+    if string_rest_length_m is None:
+        tension = _per_member("string_tension_n", 0.0 if string_tension_n is None else string_tension_n, strings, "string")
+        rest = None
+    elif string_tension_n is None:
+        tension, rest = None, _per_member("string_rest_length_m", string_rest_length_m, strings, "string")
+    else:
         raise ValueError("give string_tension_n or string_rest_length_m, not both")
-    tension = None if string_tension_n is None and string_rest_length_m is not None else (
-        0.0 if string_tension_n is None else string_tension_n)
     pin_list = []
     for node, axis in (pins or {}).items():
         if axis is not None:
@@ -298,8 +301,8 @@ def from_matrices(
         _per_member("bar_mass_kg", bar_mass_kg, bars, "bar"),
         _per_member("bar_radius_m", bar_radius_m, bars, "bar"),
         _per_member("string_stiffness_n_per_m", string_stiffness_n_per_m, strings, "string"),
-        None if tension is None else _per_member("string_tension_n", tension, strings, "string"),
-        None if string_rest_length_m is None else _per_member("string_rest_length_m", string_rest_length_m, strings, "string"),
+        tension,
+        rest,
         _per_member("tension_only", tension_only, strings, "string", dtype=bool),
         pin_list,
         [(str(k), str(v)) for k, v in (quantities or {}).items()],

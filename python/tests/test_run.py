@@ -499,3 +499,29 @@ def test_the_table_is_the_clis_arrow_table_bit_for_bit(tmp_path):
             assert (ours == cli.column(name).to_numpy().view("u8")).all(), name
     assert pa.table(result.arrow).equals(table)  # any PyCapsule consumer, and again
     assert tt.run(SWEEP).table is None and tt.run(SWEEP).arrow is None
+
+
+def test_bad_models_on_a_structure_from_arrays_raise_not_crash():
+    """On a structure built from arrays: a callable that raises, returns another name, NaN or
+    not a dict raises after the run; a pin axis of the wrong shape and non-numeric properties
+    are ValueErrors. The interpreter lives on (the next run passes)."""
+    import numpy as np
+
+    bar = pinned_bar(50.0)
+    pred = [tt.Prediction("q_py", "q", "angle", 1e-9)]
+    with pytest.raises(ZeroDivisionError):
+        tt.run(bar, model=lambda p, i, t: {"q_py": 1 / 0}, predictions=pred)
+    with pytest.raises(ValueError, match="no prediction 'q_py'"):
+        tt.run(bar, model=lambda p, i, t: {"q": 0.5}, predictions=pred)
+    with pytest.raises(ValueError, match="'q_py' is NaN, not a finite number"):
+        tt.run(bar, model=lambda p, i, t: {"q_py": float("nan")}, predictions=pred)
+    with pytest.raises(TypeError):
+        tt.run(bar, model=lambda p, i, t: 0.5, predictions=pred)
+    N, Cb, Cs = prism_arrays()
+    with pytest.raises(ValueError, match=r"pins\['n1'\] has shape \(1, 2\)"):
+        tt.from_matrices(N, Cb, Cs, pins={"n1": (0.0, 1.0)})
+    with pytest.raises(ValueError, match="bar_mass_kg must be a number or one per bar"):
+        tt.from_matrices(N, Cb, Cs, bar_mass_kg="heavy")
+    with pytest.raises(ValueError, match=r"Cb has shape \(6,\): expected \(k, 6\)"):
+        tt.from_matrices(N, Cb[0], Cs)
+    assert tt.run(bar, model=lambda p, i, t: {"q_py": math.atan2(50.0 * 0.8, 30.0 * 0.6)}, predictions=pred).passed
