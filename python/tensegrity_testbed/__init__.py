@@ -274,6 +274,7 @@ def from_matrices(
     ``{"n1": (0, 0, 1)}`` a revolute joint ``pin_n1`` about that axis, ``{"n1": None}`` a
     spherical one. ``quantities``: ``{"q": "atan2(n2.y - n1.y, n2.x - n1.x)"}``, the
     scenario's ``[[quantities]]`` (expressions of the state), for predictions to compare with.
+    ``name``: the file name its errors carry (the scenario is named by its stem).
 
     Raises ValueError on a wrong shape or length (naming the argument and the expected length),
     a value that is not finite or out of range, a malformed connectivity row (``Cb[2]: ...``)
@@ -290,13 +291,13 @@ def from_matrices(
     else:
         raise ValueError("give string_tension_n or string_rest_length_m, not both")
     pin_list = []
-    for node, axis in (pins or {}).items():
+    for node, axis in dict(pins or {}).items():
         if axis is not None:
             a = _matrix(f"pins[{node!r}]", [axis], rows=1, cols=3)[0]
             axis = a.tolist()
         pin_list.append((str(node), axis))
     text = _tensegrity.structure_from_arrays(
-        name,
+        Path(name).stem,
         n.tolist(), cb.tolist(), cs.tolist(),
         _per_member("bar_mass_kg", bar_mass_kg, bars, "bar"),
         _per_member("bar_radius_m", bar_radius_m, bars, "bar"),
