@@ -1,10 +1,17 @@
 //! The testbed's own API for Python (`tensegrity_testbed._tensegrity`; the package's
 //! `__init__.py` wraps it): a scenario checked and run by the same code as the CLI, the report
-//! handed over as its JSON. Runs release the GIL and stop at the next tick on Ctrl-C.
+//! handed over as its JSON, the per-tick table as Arrow record batches in memory
+//! ([`ArrowTable`], the Arrow PyCapsule interface). Runs release the GIL and stop at the next
+//! tick on Ctrl-C.
 
+use arrow_array::ffi_stream::FFI_ArrowArrayStream;
+use arrow_array::{RecordBatch, RecordBatchIterator};
+use arrow_schema::ffi::FFI_ArrowSchema;
+use arrow_schema::{ArrowError, SchemaRef};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyCapsule;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -12,6 +19,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use tensegrity_testbed::file_model::spec::ErrorClass;
 use tensegrity_testbed::observers::external::{External, ExternalModel, ExternalPrediction};
+use tensegrity_testbed::observers::table::{MemoryTable, TableTarget};
 use tensegrity_testbed::run::{self, RunOptions};
 use tensegrity_testbed::scenario::{self, Override, Scenario, ScenarioError};
 
@@ -186,55 +194,169 @@ fn predictions(raw: Vec<PredictionTuple>) -> PyResult<Vec<ExternalPrediction>> {
         .collect()
 }
 
-/// Runs a scenario; the report as JSON. `table`: also write every tick to this file (`.arrow`
-/// or `.csv`). `model` and `predictions`: a Python callable compared as the file's predictions
-/// are. The run happens on a thread of its own, without the GIL; Ctrl-C stops it at the next
-/// tick and raises KeyboardInterrupt.
+/// Every tick of a run as Arrow record batches in memory (the columns of `tensegrity run
+/// --table FILE.arrow`), exported through the Arrow PyCapsule interface: `pyarrow.table(t)`
+/// (or any consumer of `__arrow_c_stream__`) takes the batches without copying them. Can be
+/// read any number of times.
+#[pyclass(frozen, module = "tensegrity_testbed._tensegrity")]
+struct ArrowTable {
+    schema: SchemaRef,
+    batches: Vec<RecordBatch>,
+}
+
+#[pymethods]
+impl ArrowTable {
+    /// The table as an Arrow C stream (a PyCapsule named "arrow_array_stream"); the
+    /// `requested_schema` is not applied (the table has one schema: UInt64 `tick`, Float64
+    /// else).
+    #[pyo3(signature = (requested_schema=None))]
+    fn __arrow_c_stream__<'py>(
+        &self,
+        py: Python<'py>,
+        requested_schema: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyCapsule>> {
+        let _ = requested_schema;
+        let batches: Vec<Result<RecordBatch, ArrowError>> = self.batches.iter().cloned().map(Ok).collect();
+        let reader = RecordBatchIterator::new(batches, self.schema.clone());
+        PyCapsule::new(py, FFI_ArrowArrayStream::new(Box::new(reader)), Some(c"arrow_array_stream".to_owned()))
+    }
+
+    /// The table's schema as an Arrow C schema (a PyCapsule named "arrow_schema").
+    fn __arrow_c_schema__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyCapsule>> {
+        let schema =
+            FFI_ArrowSchema::try_from(self.schema.as_ref()).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        PyCapsule::new(py, schema, Some(c"arrow_schema".to_owned()))
+    }
+
+    /// The number of rows (ticks).
+    #[getter]
+    fn num_rows(&self) -> usize {
+        self.batches.iter().map(RecordBatch::num_rows).sum()
+    }
+
+    /// The column names: `tick`, then those of `tensegrity run --table`.
+    #[getter]
+    fn column_names(&self) -> Vec<String> {
+        self.schema.fields().iter().map(|f| f.name().clone()).collect()
+    }
+
+    fn __len__(&self) -> usize {
+        self.num_rows()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<ArrowTable: {} rows, {} columns>", self.num_rows(), self.schema.fields().len())
+    }
+}
+
+/// Runs a scenario: the report as JSON and, with `table`, every tick as an [`ArrowTable`]
+/// (None when no tick ran). `model` and `predictions`: a Python callable compared as the file's
+/// predictions are. The run happens on a thread of its own, without the GIL; Ctrl-C stops it at
+/// the next tick and raises KeyboardInterrupt.
 #[pyfunction]
-#[pyo3(signature = (path, text=None, set=Vec::new(), table=None, model=None, predictions=Vec::new()))]
+#[pyo3(signature = (path, text=None, set=Vec::new(), table=false, model=None, predictions=Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 fn run_json(
     py: Python<'_>,
     path: &str,
     text: Option<&str>,
     set: Vec<String>,
-    table: Option<PathBuf>,
+    table: bool,
     model: Option<Py<PyAny>>,
     predictions: Vec<PredictionTuple>,
-) -> PyResult<String> {
+) -> PyResult<(String, Option<ArrowTable>)> {
     let sc = load(path, text, &set)?;
     let predictions = self::predictions(predictions)?;
     let names = predictions.iter().map(|p| p.name.clone()).collect();
     let model = model.map(|function| Arc::new(PyModel { function, names, failure: Mutex::new(None) }));
     let external = model.clone().map(|m| External { model: m as Arc<dyn ExternalModel>, predictions });
+    let kept = table.then(MemoryTable::default);
+    let target = kept.clone().map(TableTarget::Memory);
     let json = on_own_thread(py, move |cancel| {
-        let opts = RunOptions { cancel: Some(cancel), table, external, ..Default::default() };
+        let opts = RunOptions { cancel: Some(cancel), table: target, external, ..Default::default() };
         serde_json::to_string(&run::run(&sc, &opts)).expect("a report serialises")
     })?;
     if let Some(e) = model.and_then(|m| m.failure.lock().expect("the run is over").take()) {
         return Err(e);
     }
-    Ok(json)
+    let table = kept.and_then(|k| k.take()).map(|(schema, batches)| ArrowTable { schema, batches });
+    Ok((json, table))
 }
 
-/// A scenario (TOML text) from the node matrix and the connectivity matrices in files (the
-/// importer of `tensegrity import matrices`); errors at file, line and column.
+/// An import's error as a ValueError: `FILE[ROW]: message` for the arrays of `from_matrices`
+/// (`N`, `Cb`, `Cs`, rows from 0), `FILE: message` for the whole of one, the message alone
+/// for the member properties.
+fn array_error(e: tensegrity_testbed::import::ImportError) -> PyErr {
+    match e.line {
+        0 if e.file.is_empty() => PyValueError::new_err(e.message),
+        0 => PyValueError::new_err(format!("{}: {}", e.file, e.message)),
+        line => PyValueError::new_err(format!("{}[{}]: {}", e.file, line - 1, e.message)),
+    }
+}
+
+/// A scenario (TOML text) named `name` from N (3 rows), C_b and C_s as rows of numbers and one
+/// property per member (`import::matrices::from_arrays`): ValueError on what is wrong.
 #[pyfunction]
-fn import_matrices(
-    n: PathBuf,
-    cb: PathBuf,
-    cs: PathBuf,
-    bar_mass_kg: f64,
-    bar_radius_m: f64,
-    string_stiffness_n_per_m: f64,
-    string_tension_n: f64,
+#[pyo3(signature = (name, n, cb, cs, bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n, string_rest_length_m, tension_only, pins, quantities))]
+#[allow(clippy::too_many_arguments)]
+fn structure_from_arrays(
+    name: &str,
+    n: Vec<Vec<f64>>,
+    cb: Vec<Vec<f64>>,
+    cs: Vec<Vec<f64>>,
+    bar_mass_kg: Vec<f64>,
+    bar_radius_m: Vec<f64>,
+    string_stiffness_n_per_m: Vec<f64>,
+    string_tension_n: Option<Vec<f64>>,
+    string_rest_length_m: Option<Vec<f64>>,
+    tension_only: Vec<bool>,
+    pins: Vec<(String, Option<[f64; 3]>)>,
+    quantities: Vec<(String, String)>,
 ) -> PyResult<String> {
-    use tensegrity_testbed::import::matrices::{import, MatrixOptions};
-    let o = MatrixOptions { bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n };
-    o.validate().map_err(PyValueError::new_err)?;
-    let imported = import(&n, &cb, &cs, &o)
-        .map_err(|e| TestbedError::new_err((e.file.clone(), e.line, e.col, e.message.clone())))?;
-    Ok(imported.toml)
+    use tensegrity_testbed::import::matrices::{from_arrays, MemberProperties, StringRest};
+    let string_rest = match (string_tension_n, string_rest_length_m) {
+        (Some(_), Some(_)) => {
+            return Err(PyValueError::new_err("give string_tension_n or string_rest_length_m, not both"))
+        }
+        (Some(t), None) => StringRest::TensionN(t),
+        (None, Some(l)) => StringRest::LengthM(l),
+        (None, None) => StringRest::TensionN(vec![0.0; cs.len()]),
+    };
+    let p = MemberProperties {
+        bar_mass_kg,
+        bar_radius_m,
+        string_stiffness_n_per_m,
+        string_rest,
+        tension_only,
+        pins,
+        quantities,
+    };
+    Ok(from_arrays(name, &n, &cb, &cs, &p).map_err(array_error)?.toml)
+}
+
+/// A scenario (TOML text) from an NTRT YAML model (`tensegrity import ntrt`), read from `path`
+/// or given as `text` named `path` (substructures relative to its directory): (the TOML, what
+/// was skipped). Errors at file, line and column.
+#[pyfunction]
+#[pyo3(signature = (path, text=None, keep_axes=false))]
+fn import_ntrt(path: PathBuf, text: Option<&str>, keep_axes: bool) -> PyResult<(String, Vec<String>)> {
+    use tensegrity_testbed::import::ntrt::{import, import_text, Axes};
+    let axes = if keep_axes { Axes::Keep } else { Axes::ZUp };
+    let imported = match text {
+        Some(t) => import_text(&path, t, axes),
+        None => import(&path, axes),
+    }
+    .map_err(|e| TestbedError::new_err((e.file.clone(), e.line, e.col, e.message.clone())))?;
+    Ok((imported.toml, imported.skipped))
+}
+
+/// Writes a scenario's text to `path` as the CLI writes its outputs (`output`): never over one
+/// of `inputs` or over anything but a regular file, through a temporary file and a rename.
+#[pyfunction]
+fn write_scenario(path: PathBuf, text: &str, inputs: Vec<PathBuf>) -> PyResult<()> {
+    use tensegrity_testbed::output;
+    output::check_outputs(&inputs, &[("the scenario".into(), path.clone())]).map_err(PyValueError::new_err)?;
+    output::write_atomic(&path, text.as_bytes()).map_err(pyo3::exceptions::PyOSError::new_err)
 }
 
 /// The MJCF export of a scenario's first structure (`tensegrity export mjcf`): (the XML, what
@@ -321,10 +443,13 @@ fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(run_json, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_csv, m)?)?;
-    m.add_function(wrap_pyfunction!(import_matrices, m)?)?;
+    m.add_function(wrap_pyfunction!(structure_from_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(import_ntrt, m)?)?;
+    m.add_function(wrap_pyfunction!(write_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(export_mjcf, m)?)?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(findings, m)?)?;
+    m.add_class::<ArrowTable>()?;
     m.add("TestbedError", m.py().get_type::<TestbedError>())?;
     Ok(())
 }

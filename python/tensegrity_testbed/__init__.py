@@ -11,18 +11,17 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from pathlib import Path
 from typing import Any, Callable, Mapping, NamedTuple, Optional, Sequence, Union
 
 from . import _tensegrity
 
 __all__ = [
-    "ScenarioError", "Prediction", "Result", "Solution", "Finding",
-    "check", "export_mjcf", "findings", "from_matrices", "run", "solve", "sweep",
+    "ScenarioError", "Prediction", "Result", "Solution", "Finding", "Structure",
+    "check", "export_mjcf", "findings", "from_matrices", "from_ntrt", "from_toml", "run", "solve", "sweep",
 ]
 
-Scenario = Union[str, "os.PathLike[str]"]
+Scenario = Union[str, "os.PathLike[str]", "Structure"]
 
 
 class ScenarioError(ValueError):
@@ -34,7 +33,10 @@ class ScenarioError(ValueError):
 
 
 def _source(scenario: Scenario, name: str) -> tuple[str, Optional[str]]:
-    """(path, None) for a file, (name, text) for TOML text (anything with a newline)."""
+    """(path, None) for a file, (name, text) for TOML text (anything with a newline) and for a
+    Structure (its own name)."""
+    if isinstance(scenario, Structure):
+        return scenario.name, scenario.toml
     if isinstance(scenario, os.PathLike) or "\n" not in str(scenario):
         return os.fspath(scenario), None
     return name, str(scenario)
@@ -79,14 +81,14 @@ class Result:
     """A finished run: ``report`` (the JSON report of ``tensegrity run --json``, one scenario,
     as a dict), ``passed`` (the physics' verdict), ``as_expected`` (whether that is what the
     scenario declares), ``failures`` (``"settle"``, ``"prediction:NAME"``, ...), ``points`` and
-    ``table``."""
+    ``table`` (pyarrow) and ``arrow`` (the same ticks for any Arrow PyCapsule consumer)."""
 
-    def __init__(self, report: dict, table_path: Optional[Path]) -> None:
+    def __init__(self, report: dict, arrow: Optional["_tensegrity.ArrowTable"]) -> None:
         self.report = report
         self.passed: bool = report["passed"]
         self.as_expected: Optional[bool] = report.get("as_expected")
         self.failures: list[str] = list(report["failures"])
-        self._table_path = table_path
+        self.arrow = arrow
         self._table = None
 
     @property
@@ -109,15 +111,14 @@ class Result:
 
     @property
     def table(self):
-        """Every tick (pyarrow Table, the columns of ``tensegrity run --table``); None unless the
-        run was asked for it (``run(..., table=True)``)."""
-        if self._table is None and self._table_path is not None:
-            import pyarrow.ipc
+        """Every tick (pyarrow Table, the columns of ``tensegrity run --table FILE.arrow``: ``tick``
+        UInt64, the others Float64 in SI units, null where the CSV leaves a cell empty); None
+        unless the run was asked for it (``run(..., table=True)``). Handed over in memory through
+        the Arrow PyCapsule interface, without a copy (``pyarrow.table(result.arrow)``)."""
+        if self._table is None and self.arrow is not None:
+            import pyarrow
 
-            with pyarrow.ipc.open_file(str(self._table_path)) as f:
-                self._table = f.read_all()
-            self._table_path.unlink(missing_ok=True)
-            self._table_path = None
+            self._table = pyarrow.table(self.arrow)
         return self._table
 
     def __repr__(self) -> str:
@@ -136,9 +137,9 @@ def run(
     model: Optional[Model] = None,
     predictions: Sequence[Prediction] = (),
 ) -> Result:
-    """Runs a scenario (a path, or TOML text named ``name``) with overrides ``set``
-    (``{"k1": 60.0, "sim.dt": 1e-3}``, as ``--set``). ``table``: keep every tick as a pyarrow
-    Table (``Result.table``).
+    """Runs a scenario (a path, TOML text named ``name``, or a ``Structure``) with overrides
+    ``set`` (``{"k1": 60.0, "sim.dt": 1e-3}``, as ``--set``). ``table``: keep every tick in
+    memory as Arrow (``Result.table``, a pyarrow Table; ``Result.arrow`` for other consumers).
 
     ``model``: a Python model, ``model(params, inputs, t) -> {name: value}`` (dicts of floats in
     SI units; ``t`` the time since a motion started [s], None outside a motion), called at every
@@ -153,15 +154,8 @@ def run(
         raise ValueError("predictions need a model")
     preds = [tuple(Prediction(*p)) for p in predictions]
     path, text = _source(scenario, name)
-    table_path = None
-    if table:
-        fd, tmp = tempfile.mkstemp(suffix=".arrow", prefix="tensegrity-")
-        os.close(fd)
-        table_path = Path(tmp)
-    report = json.loads(
-        _call(_tensegrity.run_json, path, text, _sets(set), str(table_path) if table_path else None, model, preds)
-    )
-    return Result(report, table_path)
+    report, arrow = _call(_tensegrity.run_json, path, text, _sets(set), bool(table), model, preds)
+    return Result(json.loads(report), arrow)
 
 
 def sweep(
@@ -184,6 +178,37 @@ def sweep(
     return pd.read_csv(io.StringIO(csv)), json.loads(summary)
 
 
+class Structure:
+    """A structure made in Python (``from_matrices``, ``from_ntrt``, ``from_toml``) as the
+    scenario file it is, checked when made: ``toml`` (the text), ``name`` (the file name its
+    errors carry), ``skipped`` (what an import left out), ``sources`` (the files it was read
+    from). ``run``, ``check``, ``sweep`` and ``export_mjcf`` take it as they take a path."""
+
+    def __init__(self, toml: str, name: str = "structure.toml", skipped: Sequence[str] = (),
+                 sources: Sequence[Union[str, "os.PathLike[str]"]] = ()) -> None:
+        self.toml, self.name = str(toml), str(name)
+        self.skipped = list(skipped)
+        self.sources = [os.fspath(p) for p in sources]
+        self.scenario_name = _call(_tensegrity.check, self.name, self.toml, [])
+
+    def to_toml(self) -> str:
+        """The scenario file's text."""
+        return self.toml
+
+    def write(self, path: Union[str, "os.PathLike[str]"]) -> Path:
+        """Writes the scenario file to ``path`` as the CLI writes its outputs: through a
+        temporary file and a rename (never half-written), never over one of ``sources`` (nor
+        over anything but a regular file: ValueError). Returns the path."""
+        _tensegrity.write_scenario(os.fspath(path), self.toml, self.sources)
+        return Path(path)
+
+    def __str__(self) -> str:
+        return self.toml
+
+    def __repr__(self) -> str:
+        return f"<Structure {self.scenario_name!r} ({self.name})>"
+
+
 def _matrix(name: str, a, rows: Optional[int] = None, cols: Optional[int] = None):
     """``a`` as a finite 2-D float array, or ValueError naming the matrix and what is wrong."""
     import numpy as np
@@ -199,34 +224,112 @@ def _matrix(name: str, a, rows: Optional[int] = None, cols: Optional[int] = None
     return m
 
 
+def _per_member(name: str, value, count: int, what: str, dtype=float) -> list:
+    """A scalar or one value per member as a list of ``count`` values, or ValueError naming the
+    argument: a wrong length, or a value that is not a finite number."""
+    import numpy as np
+
+    try:
+        a = np.asarray(value, dtype=dtype)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number or one per {what}, got {value!r}") from None
+    if a.ndim == 0:
+        a = np.full(count, a[()], dtype=dtype)
+    if a.ndim != 1 or len(a) != count:
+        raise ValueError(f"{name} has shape {a.shape}: expected one number or {count} (one per {what})")
+    if dtype is float:
+        bad = np.flatnonzero(~np.isfinite(a))
+        if len(bad):
+            raise ValueError(f"{name}[{bad[0]}] is {a[bad[0]]}, not a finite number")
+    return a.tolist()
+
+
 def from_matrices(
     N,
     Cb,
     Cs,
-    bar_mass_kg: float = 1.0,
-    bar_radius_m: float = 0.01,
-    string_stiffness_n_per_m: float = 100.0,
-    string_tension_n: float = 0.0,
-) -> str:
-    """A scenario (TOML text, for ``run``, ``check`` or a file) from numpy arrays in the
-    notation of Skelton and de Oliveira: N (3 x n node coordinates [m]), Cb and Cs (one row per
-    bar or string: -1 at its first node, 1 at its second). The importer of ``tensegrity import
-    matrices``: each bar a strut on its own body of ``bar_mass_kg``, nodes on no bar fixed,
-    strings elastic of ``string_stiffness_n_per_m`` at ``string_tension_n`` when drawn. Member
-    properties are scalars. Raises ValueError on a wrong shape or a non-finite value."""
-    import numpy as np
+    bar_mass_kg=1.0,
+    bar_radius_m=0.01,
+    string_stiffness_n_per_m=100.0,
+    string_tension_n=None,
+    *,
+    string_rest_length_m=None,
+    tension_only=True,
+    pins: Optional[Mapping[str, Optional[Sequence[float]]]] = None,
+    quantities: Optional[Mapping[str, str]] = None,
+    name: str = "from_matrices.toml",
+) -> Structure:
+    """A structure from numpy arrays in the notation of Skelton and de Oliveira: N (3 x n node
+    coordinates [m]), Cb and Cs (one row per bar or string: -1 at its first node, 1 at its
+    second). As ``tensegrity import matrices`` makes it: node k (column k, from 1) is ``n<k>``,
+    bar i (row i of Cb, from 1) the strut ``bar<i>`` on its own body, string i ``string<i>``;
+    nodes on no bar are fixed (body "ground"), else bar1 is held.
 
+    Member properties, each one number or an array of one per member (rows of Cb or Cs):
+    ``bar_mass_kg`` [kg], ``bar_radius_m`` [m], ``string_stiffness_n_per_m`` [N/m], and the
+    strings' rest lengths, from ``string_tension_n`` [N] at the drawn length (rest = drawn -
+    tension / stiffness; default 0 N) or given as ``string_rest_length_m`` [m].
+    ``tension_only``: True (default) for cables, False (one or per string) for linear springs
+    that push as well (zero rest length allowed). ``pins``: bar nodes joined to the ground,
+    ``{"n1": (0, 0, 1)}`` a revolute joint ``pin_n1`` about that axis, ``{"n1": None}`` a
+    spherical one. ``quantities``: ``{"q": "atan2(n2.y - n1.y, n2.x - n1.x)"}``, the
+    scenario's ``[[quantities]]`` (expressions of the state), for predictions to compare with.
+    ``name``: the file name its errors carry (the scenario is named by its stem).
+
+    Raises ValueError on a wrong shape or length (naming the argument and the expected length),
+    a value that is not finite or out of range, a malformed connectivity row (``Cb[2]: ...``)
+    or a bad pin; ScenarioError on a bad quantity expression."""
     n = _matrix("N", N, rows=3)
     cb = _matrix("Cb", Cb, cols=n.shape[1])
     cs = _matrix("Cs", Cs, cols=n.shape[1])
-    with tempfile.TemporaryDirectory(prefix="tensegrity-") as d:
-        paths = [Path(d) / f"{k}.csv" for k in ("N", "Cb", "Cs")]
-        for p, m in zip(paths, (n, cb, cs)):
-            np.savetxt(p, m, delimiter=",", fmt="%.17g")
-        return _call(
-            _tensegrity.import_matrices, *map(str, paths),
-            bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n,
-        )
+    bars, strings = cb.shape[0], cs.shape[0]
+    if string_rest_length_m is None:
+        tension = _per_member("string_tension_n", 0.0 if string_tension_n is None else string_tension_n, strings, "string")
+        rest = None
+    elif string_tension_n is None:
+        tension, rest = None, _per_member("string_rest_length_m", string_rest_length_m, strings, "string")
+    else:
+        raise ValueError("give string_tension_n or string_rest_length_m, not both")
+    pin_list = []
+    for node, axis in dict(pins or {}).items():
+        if axis is not None:
+            a = _matrix(f"pins[{node!r}]", [axis], rows=1, cols=3)[0]
+            axis = a.tolist()
+        pin_list.append((str(node), axis))
+    text = _tensegrity.structure_from_arrays(
+        Path(name).stem,
+        n.tolist(), cb.tolist(), cs.tolist(),
+        _per_member("bar_mass_kg", bar_mass_kg, bars, "bar"),
+        _per_member("bar_radius_m", bar_radius_m, bars, "bar"),
+        _per_member("string_stiffness_n_per_m", string_stiffness_n_per_m, strings, "string"),
+        tension,
+        rest,
+        _per_member("tension_only", tension_only, strings, "string", dtype=bool),
+        pin_list,
+        [(str(k), str(v)) for k, v in (quantities or {}).items()],
+    )
+    return Structure(text, name=name)
+
+
+def from_ntrt(source: Union[str, "os.PathLike[str]"], keep_axes: bool = False, name: str = "<string>.yaml") -> Structure:
+    """A structure from an NTRT YAML model (``tensegrity import ntrt``): a path, or the YAML
+    text itself named ``name`` (its substructures' paths then relative to the working
+    directory). NTRT's y (up) becomes z unless ``keep_axes``; rods become struts on rigid
+    bodies, strings elastic tension-only cables (numbers taken as SI). What the testbed does not
+    model is listed in ``Structure.skipped``. Raises ScenarioError at ``file:line:col``."""
+    path, text = _source(source, name)
+    toml, skipped = _call(_tensegrity.import_ntrt, path, text, keep_axes)
+    stem = Path(path).stem or "ntrt"
+    return Structure(toml, name=f"{stem}.toml", skipped=skipped, sources=[path] if text is None else [])
+
+
+def from_toml(source: Union[str, "os.PathLike[str]"], name: str = "<string>.toml") -> Structure:
+    """A scenario from a path or from TOML text named ``name``, checked (ScenarioError at its
+    file, line and column), to run or to write back (``Structure.write``)."""
+    path, text = _source(source, name)
+    if text is None:
+        return Structure(Path(path).read_text(), name=path, sources=[path])
+    return Structure(text, name=path)
 
 
 class Solution(NamedTuple):

@@ -1,6 +1,22 @@
-from typing import Callable, Dict, List, Mapping, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 
 class TestbedError(Exception): ...
+
+class ArrowTable:
+    """Every tick of a run as Arrow record batches in memory: `tick` (UInt64), the other columns
+    of `tensegrity run --table FILE.arrow` (Float64, SI units: m, rad, N, N m, s, J; null where
+    the CSV leaves a cell empty). An Arrow PyCapsule producer: `pyarrow.table(t)` takes the
+    batches without copying; can be read any number of times."""
+
+    def __arrow_c_stream__(self, requested_schema: Optional[Any] = None) -> Any:
+        """A PyCapsule "arrow_array_stream" (`requested_schema` is not applied)."""
+    def __arrow_c_schema__(self) -> Any:
+        """A PyCapsule "arrow_schema"."""
+    @property
+    def num_rows(self) -> int: ...
+    @property
+    def column_names(self) -> List[str]: ...
+    def __len__(self) -> int: ...
 
 def check(path: str, text: Optional[str] = None, set: Sequence[str] = ...) -> str:
     """The scenario's name; TestbedError(file, line, col, message) when it is refused."""
@@ -9,21 +25,39 @@ def run_json(
     path: str,
     text: Optional[str] = None,
     set: Sequence[str] = ...,
-    table: Optional[str] = None,
+    table: bool = False,
     model: Optional[Callable[[dict, dict, Optional[float]], Mapping[str, float]]] = None,
     predictions: Sequence[Tuple[str, str, str, float, Optional[float]]] = ...,
-) -> str:
-    """The run's report (one scenario) as JSON; `table`: every tick written to this file;
-    `model` and `predictions` (name, quantity, class, tolerance, rms tolerance): a Python model
-    compared as the file's predictions are."""
+) -> Tuple[str, Optional[ArrowTable]]:
+    """The run's report (one scenario) as JSON and, with `table`, every tick in memory (None
+    when no tick ran); `model` and `predictions` (name, quantity, class, tolerance [m, rad or
+    relative], rms tolerance): a Python model compared as the file's predictions are."""
 
 def sweep_csv(path: str, text: Optional[str] = None, set: Sequence[str] = ..., jobs: int = 0) -> Tuple[str, str]:
     """(the CSV of `tensegrity sweep --out`, the JSON summary of `--json`)."""
 
-def import_matrices(
-    n: str, cb: str, cs: str, bar_mass_kg: float, bar_radius_m: float, string_stiffness_n_per_m: float, string_tension_n: float
+def structure_from_arrays(
+    name: str,
+    n: Sequence[Sequence[float]],
+    cb: Sequence[Sequence[float]],
+    cs: Sequence[Sequence[float]],
+    bar_mass_kg: Sequence[float],
+    bar_radius_m: Sequence[float],
+    string_stiffness_n_per_m: Sequence[float],
+    string_tension_n: Optional[Sequence[float]],
+    string_rest_length_m: Optional[Sequence[float]],
+    tension_only: Sequence[bool],
+    pins: Sequence[Tuple[str, Optional[Tuple[float, float, float]]]],
+    quantities: Sequence[Tuple[str, str]],
 ) -> str:
-    """A scenario's TOML from N, Cb and Cs in CSV files (`tensegrity import matrices`)."""
+    """A scenario's TOML from N (3 rows, m), Cb and Cs as rows and one property per member (kg,
+    m, N/m, N or m); ValueError (`Cb[2]: ...`, `bar_mass_kg[1] must be ...`) when refused."""
+
+def import_ntrt(path: str, text: Optional[str] = None, keep_axes: bool = False) -> Tuple[str, List[str]]:
+    """(a scenario's TOML, what was skipped) from NTRT YAML at `path` or given as `text`."""
+
+def write_scenario(path: str, text: str, inputs: Sequence[str]) -> None:
+    """Writes `text` to `path` atomically, never over one of `inputs` (ValueError)."""
 
 def export_mjcf(
     path: str, text: Optional[str] = None, set: Sequence[str] = ..., actuators: str = "mocap", kp: float = 1e6, cable_damping: float = 0.0

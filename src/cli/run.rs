@@ -89,7 +89,7 @@ pub fn run(
             connect: o.connect.clone(),
             record_every: o.record_every,
             skip_findings: false,
-            table: o.table_path(sc, several),
+            table: o.table_path(sc, several).map(Into::into),
             external: None,
         };
         // A panic inside one scenario fails that scenario, with its message; the batch goes on.

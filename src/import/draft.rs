@@ -33,6 +33,20 @@ pub struct DraftCable {
     pub stiffness_n_per_m: Option<f64>,
     /// Unstretched length [m].
     pub length_m: f64,
+    /// A tension-only cable (true) or a linear spring that pushes as well (false, written as
+    /// `[[structure.springs]]`; needs a stiffness).
+    pub tension_only: bool,
+}
+
+/// A joint from a fixed body to a node of a body: revolute about `axis`, or spherical (None);
+/// damped so that it settles ([`Draft::joint_damping`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DraftJoint {
+    pub name: String,
+    pub parent: String,
+    pub child: String,
+    pub at: String,
+    pub axis: Option<Vec3>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -42,6 +56,9 @@ pub struct Draft {
     pub bodies: Vec<DraftBody>,
     pub struts: Vec<DraftStrut>,
     pub cables: Vec<DraftCable>,
+    pub joints: Vec<DraftJoint>,
+    /// `[[quantities]]`: (name, expression).
+    pub quantities: Vec<(String, String)>,
 }
 
 /// Time step as a fraction of the fastest body's period scale sqrt(m / sum k) (the prism of
@@ -125,14 +142,32 @@ impl Draft {
             .collect()
     }
 
-    /// The `[sim]` and `[settle]` tables: a step and a damping from the fastest body, a time
-    /// limit from the slowest.
-    fn settings(&self) -> Result<String, String> {
+    /// The free bodies' rates sqrt(sum k / m) [1/s]: (fastest, slowest).
+    fn rates(&self) -> (f64, f64) {
         let rates: Vec<f64> = self.body_rates().iter().filter(|(_, k)| *k > 0.0).map(|(m, k)| (k / m).sqrt()).collect();
         // Nothing elastic moves (all held, or no cable on a free body): the rate of a 1 s period.
         let fastest = rates.iter().copied().fold(f64::NAN, f64::max);
         let fastest = if fastest.is_finite() { fastest } else { FALLBACK_RATE_PER_S };
-        let slowest = rates.iter().copied().fold(f64::INFINITY, f64::min).min(fastest);
+        (fastest, rates.iter().copied().fold(f64::INFINITY, f64::min).min(fastest))
+    }
+
+    /// A joint's damping [N m s/rad]: the bodies' damping rate times the child's moment of
+    /// inertia about the joint (its largest principal moment plus m d^2, d from its nodes'
+    /// centroid). A jointed body is a link of a multibody, which `body_damping` does not damp;
+    /// zero at rest, this only lets it settle.
+    fn joint_damping(&self, j: &DraftJoint) -> f64 {
+        let Some(child) = self.bodies.iter().find(|b| b.name == j.child) else { return 0.0 };
+        let n = child.nodes.len().max(1) as f64;
+        let centroid = [0, 1, 2].map(|c| child.nodes.iter().map(|(_, p)| p[c]).sum::<f64>() / n);
+        let d = self.position(&j.at).map_or(0.0, |p| distance(p, centroid));
+        let moment = child.inertia_kg_m2.map_or(0.0, |i| i.iter().copied().fold(0.0, f64::max));
+        DAMPING_FRACTION * self.rates().0 * (moment + child.mass_kg * d * d)
+    }
+
+    /// The `[sim]` and `[settle]` tables: a step and a damping from the fastest body, a time
+    /// limit from the slowest.
+    fn settings(&self) -> Result<String, String> {
+        let (fastest, slowest) = self.rates();
         let size = self.size_m();
         let k_max = self.cables.iter().filter_map(|c| c.stiffness_n_per_m).fold(0.0, f64::max).max(1.0);
         let residual = RESIDUAL_FRACTION * k_max * size;
@@ -185,9 +220,10 @@ impl Draft {
                 (Some(a), Some(b)) => format!("  # drawn {} m", num(distance(a, b), &format!("cable {}", c.name))?),
                 _ => String::new(),
             };
+            let table = if c.tension_only { "cables" } else { "springs" };
             let _ = writeln!(
                 t,
-                "\n[[structure.cables]]\nname = {}\na = {}\nb = {}",
+                "\n[[structure.{table}]]\nname = {}\na = {}\nb = {}",
                 quote(&c.name),
                 quote(&c.a),
                 quote(&c.b)
@@ -196,6 +232,25 @@ impl Draft {
                 let _ = writeln!(t, "stiffness = {}", num(k, &format!("the stiffness of cable {}", c.name))?);
             }
             let _ = writeln!(t, "length = {}{drawn}", num(c.length_m, &format!("the length of cable {}", c.name))?);
+        }
+        for j in &self.joints {
+            let kind = if j.axis.is_some() { "revolute" } else { "spherical" };
+            let _ = writeln!(
+                t,
+                "\n[[structure.joints]]\nname = {}\nkind = \"{kind}\"\nparent = {}\nchild = {}\nat = {}",
+                quote(&j.name),
+                quote(&j.parent),
+                quote(&j.child),
+                quote(&j.at)
+            );
+            if let Some(a) = j.axis {
+                let _ = writeln!(t, "axis = {}", xyz(a, &format!("the axis of joint {}", j.name))?);
+            }
+            let _ =
+                writeln!(t, "damping = {}", num(self.joint_damping(j), &format!("the damping of joint {}", j.name))?);
+        }
+        for (name, expr) in &self.quantities {
+            let _ = writeln!(t, "\n[[quantities]]\nname = {}\nexpr = {}", quote(name), quote(expr));
         }
         Ok(t)
     }

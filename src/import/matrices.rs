@@ -7,9 +7,11 @@
 //! bars); nodes on no bar are fixed points (one fixed body "ground"); without such points the
 //! first bar's body is held fixed to remove the rigid motion. Each string an elastic
 //! tension-only cable whose rest length is the drawn length minus its initial tension over its
-//! stiffness. Member properties come from [`MatrixOptions`].
+//! stiffness. Member properties come from [`MatrixOptions`] (the command's, one value for every
+//! bar or string) or [`MemberProperties`] (one value per member, with springs, pins and
+//! quantities: the Python package's `from_matrices`, through [`from_arrays`]).
 
-use super::draft::{Draft, DraftBody, DraftCable, DraftStrut};
+use super::draft::{Draft, DraftBody, DraftCable, DraftJoint, DraftStrut};
 use super::{ImportError, Imported};
 use crate::structure::{distance, Vec3};
 use std::path::Path;
@@ -39,6 +41,83 @@ impl MatrixOptions {
         }
         if !(self.string_tension_n >= 0.0 && self.string_tension_n.is_finite()) {
             return Err(format!("--string-tension must be a finite number >= 0, got {}", self.string_tension_n));
+        }
+        Ok(())
+    }
+
+    /// These options for each of `bars` bars and `strings` strings.
+    pub fn per_member(&self, bars: usize, strings: usize) -> MemberProperties {
+        MemberProperties {
+            bar_mass_kg: vec![self.bar_mass_kg; bars],
+            bar_radius_m: vec![self.bar_radius_m; bars],
+            string_stiffness_n_per_m: vec![self.string_stiffness_n_per_m; strings],
+            string_rest: StringRest::TensionN(vec![self.string_tension_n; strings]),
+            tension_only: vec![true; strings],
+            pins: Vec::new(),
+            quantities: Vec::new(),
+        }
+    }
+}
+
+/// Each string's rest length: from its tension at its drawn length [N] (rest = drawn -
+/// tension / stiffness), or given [m].
+#[derive(Clone, Debug)]
+pub enum StringRest {
+    TensionN(Vec<f64>),
+    LengthM(Vec<f64>),
+}
+
+/// One value per member, in the order of the rows of C_b (bars) and C_s (strings).
+#[derive(Clone, Debug)]
+pub struct MemberProperties {
+    /// Mass [kg] of each bar.
+    pub bar_mass_kg: Vec<f64>,
+    /// Radius [m] of each bar.
+    pub bar_radius_m: Vec<f64>,
+    /// Stiffness [N/m] of each string.
+    pub string_stiffness_n_per_m: Vec<f64>,
+    pub string_rest: StringRest,
+    /// Whether each string is a tension-only cable (true) or a linear spring that pushes as
+    /// well as pulls (false; a rest length of zero allowed: a zero-free-length spring).
+    pub tension_only: Vec<bool>,
+    /// Bar nodes pinned to the fixed body "ground" (node name `n<k>`, the axis of a revolute
+    /// joint, or None for a spherical joint), each joint named `pin_n<k>`.
+    pub pins: Vec<(String, Option<Vec3>)>,
+    /// `[[quantities]]` of the scenario: (name, expression of the state).
+    pub quantities: Vec<(String, String)>,
+}
+
+impl MemberProperties {
+    /// One value per member, each in its range: errors name the Python argument (and the
+    /// member's index from 0 when there are several).
+    pub fn validate(&self, bars: usize, strings: usize) -> Result<(), String> {
+        let (rest_name, rest) = match &self.string_rest {
+            StringRest::TensionN(t) => ("string_tension_n", t),
+            StringRest::LengthM(l) => ("string_rest_length_m", l),
+        };
+        let counts = [
+            ("bar_mass_kg", self.bar_mass_kg.len(), bars, "bar"),
+            ("bar_radius_m", self.bar_radius_m.len(), bars, "bar"),
+            ("string_stiffness_n_per_m", self.string_stiffness_n_per_m.len(), strings, "string"),
+            (rest_name, rest.len(), strings, "string"),
+            ("tension_only", self.tension_only.len(), strings, "string"),
+        ];
+        if let Some((name, got, want, what)) = counts.iter().find(|(_, got, want, _)| got != want) {
+            return Err(format!("{name} has {got} values: expected {want} (one per {what}) or one number"));
+        }
+        let ranges: [(&str, &[f64], bool); 4] = [
+            ("bar_mass_kg", &self.bar_mass_kg, true),
+            ("bar_radius_m", &self.bar_radius_m, true),
+            ("string_stiffness_n_per_m", &self.string_stiffness_n_per_m, true),
+            (rest_name, rest, false),
+        ];
+        for (name, values, positive) in ranges {
+            let bad = |x: f64| !x.is_finite() || x < 0.0 || (positive && x == 0.0);
+            if let Some((i, x)) = values.iter().enumerate().find(|(_, x)| bad(**x)) {
+                let at = if values.len() > 1 { format!("{name}[{i}]") } else { name.to_string() };
+                let range = if positive { "> 0" } else { ">= 0" };
+                return Err(format!("{at} must be a finite number {range}, got {x}"));
+            }
         }
         Ok(())
     }
@@ -115,9 +194,58 @@ fn members(path: &Path, c: &[Row], n: usize) -> Result<Vec<(usize, usize, usize)
 /// A member as read from a connectivity row: its two nodes (from 0) and the row's line.
 type Member = (usize, usize, usize);
 
-/// Imports N, C_b and C_s.
+/// Imports N, C_b and C_s from files.
 pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) -> Result<Imported, ImportError> {
     let n = read_matrix(n_path)?;
+    let nodes = node_columns(n_path, &n)?;
+    let bars = members(cb_path, &read_matrix(cb_path)?, nodes.len())?;
+    let strings = members(cs_path, &read_matrix(cs_path)?, nodes.len())?;
+    let p = o.per_member(bars.len(), strings.len());
+    let (mut draft, grounded) = build([n_path, cb_path, cs_path], &nodes, &bars, &strings, &p)?;
+    draft.name = format!(
+        "{} (from N, C_b, C_s)",
+        n_path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default()
+    );
+    draft.description = description(
+        &format!("N = {}, C_b = {}, C_s = {}", n_path.display(), cb_path.display(), cs_path.display()),
+        "`tensegrity import matrices`",
+        &p,
+        grounded,
+    );
+    let toml = draft.to_toml().map_err(|message| ImportError::whole(n_path, message))?;
+    Ok(Imported { toml, skipped: Vec::new() })
+}
+
+/// Builds the scenario `name` from N (3 rows of n values), C_b and C_s given as rows of numbers
+/// (numpy arrays): errors at `N`, `Cb` or `Cs`, the row as its line counted from 1 (an error
+/// of the properties or the pins at no file: "" or `pins`).
+pub fn from_arrays(
+    name: &str,
+    n: &[Vec<f64>],
+    cb: &[Vec<f64>],
+    cs: &[Vec<f64>],
+    p: &MemberProperties,
+) -> Result<Imported, ImportError> {
+    let paths = [Path::new("N"), Path::new("Cb"), Path::new("Cs")];
+    let rows = |m: &[Vec<f64>]| -> Vec<Row> { m.iter().enumerate().map(|(i, r)| (i + 1, r.clone())).collect() };
+    let n_rows = rows(n);
+    if let Some((line, r)) = n_rows.iter().find(|(_, r)| r.len() != n_rows[0].1.len()) {
+        let message = format!("{} values where the first row has {}", r.len(), n_rows[0].1.len());
+        return Err(ImportError { file: "N".into(), line: *line, col: 1, message });
+    }
+    let nodes = node_columns(paths[0], &n_rows)?;
+    let bars = members(paths[1], &rows(cb), nodes.len())?;
+    let strings = members(paths[2], &rows(cs), nodes.len())?;
+    p.validate(bars.len(), strings.len()).map_err(|message| ImportError::whole(Path::new(""), message))?;
+    let (mut draft, grounded) = build(paths, &nodes, &bars, &strings, p)?;
+    draft.name = name.to_string();
+    draft.description = description("numpy arrays N, C_b, C_s", "tensegrity_testbed.from_matrices", p, grounded);
+    let toml = draft.to_toml().map_err(|message| ImportError::whole(Path::new(""), message))?;
+    Ok(Imported { toml, skipped: Vec::new() })
+}
+
+/// The nodes, one per column of N's three rows (x, y, z).
+fn node_columns(n_path: &Path, n: &[Row]) -> Result<Vec<Vec3>, ImportError> {
     if n.len() != 3 {
         return Err(ImportError {
             file: n_path.display().to_string(),
@@ -126,33 +254,76 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
             message: format!("N must have 3 rows (x, y, z of each node), got {}", n.len()),
         });
     }
-    let count = n[0].1.len();
-    let nodes: Vec<Vec3> = (0..count).map(|k| [n[0].1[k], n[1].1[k], n[2].1[k]]).collect();
-    let bars = members(cb_path, &read_matrix(cb_path)?, count)?;
-    let strings = members(cs_path, &read_matrix(cs_path)?, count)?;
-    let on_bar = bar_of_each_node(cb_path, &bars, count)?;
+    Ok((0..n[0].1.len()).map(|k| [n[0].1[k], n[1].1[k], n[2].1[k]]).collect())
+}
+
+/// The structure: a fixed body "ground" with the nodes on no bar (and a node `ground_n<k>` at
+/// each pin whose ground has none), the bars, the pins, the strings and the quantities; and
+/// the number of nodes on no bar.
+fn build(
+    [_, cb_path, cs_path]: [&Path; 3],
+    nodes: &[Vec3],
+    bars: &[Member],
+    strings: &[Member],
+    p: &MemberProperties,
+) -> Result<(Draft, usize), ImportError> {
+    let count = nodes.len();
+    let on_bar = bar_of_each_node(cb_path, bars, count)?;
     let ground: Vec<usize> = (0..count).filter(|&k| on_bar[k].is_none()).collect();
-    let mut draft = Draft {
-        name: format!(
-            "{} (from N, C_b, C_s)",
-            n_path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default()
-        ),
-        ..Default::default()
-    };
-    if !ground.is_empty() {
+    let mut draft = Draft::default();
+    let mut ground_nodes: Vec<(String, Vec3)> = ground.iter().map(|&k| (node_name(k), nodes[k])).collect();
+    let pins = pins(&p.pins, &on_bar)?;
+    if ground_nodes.is_empty() {
+        ground_nodes.extend(pins.iter().take(1).map(|&(k, _)| (format!("ground_{}", node_name(k)), nodes[k])));
+    }
+    if !ground_nodes.is_empty() {
         draft.bodies.push(DraftBody {
             name: "ground".into(),
             fixed: true,
             mass_kg: 0.0,
             inertia_kg_m2: None,
-            nodes: ground.iter().map(|&k| (node_name(k), nodes[k])).collect(),
+            nodes: ground_nodes,
         });
     }
-    add_bars(&mut draft, &nodes, &bars, ground.is_empty(), o);
-    add_strings(&mut draft, &nodes, &strings, cs_path, o)?;
-    draft.description = description([n_path, cb_path, cs_path], o, ground.len());
-    let toml = draft.to_toml().map_err(|message| ImportError::whole(n_path, message))?;
-    Ok(Imported { toml, skipped: Vec::new() })
+    let fix_first = draft.bodies.is_empty();
+    add_bars(&mut draft, nodes, bars, fix_first, p);
+    for &(k, axis) in &pins {
+        draft.joints.push(DraftJoint {
+            name: format!("pin_{}", node_name(k)),
+            parent: "ground".into(),
+            child: format!("bar{}", on_bar[k].expect("pins are on bars") + 1),
+            at: node_name(k),
+            axis,
+        });
+    }
+    add_strings(&mut draft, nodes, strings, cs_path, p)?;
+    draft.quantities = p.quantities.clone();
+    Ok((draft, ground.len()))
+}
+
+/// Each pin's node (from 0) and axis: a node of N on a bar, pinned once, its axis finite and
+/// not zero.
+fn pins(pins: &[(String, Option<Vec3>)], on_bar: &[Option<usize>]) -> Result<Vec<(usize, Option<Vec3>)>, ImportError> {
+    let e = |message: String| ImportError::whole(Path::new("pins"), message);
+    let mut out: Vec<(usize, Option<Vec3>)> = Vec::new();
+    for (name, axis) in pins {
+        let k = (0..on_bar.len()).find(|&k| node_name(k) == *name).ok_or_else(|| {
+            e(format!("no node '{name}' (the nodes are n1 to n{}, one per column of N)", on_bar.len()))
+        })?;
+        if on_bar[k].is_none() {
+            return Err(e(format!(
+                "node '{name}' is on no bar (nodes on no bar are fixed already; a pin joins a bar to them)"
+            )));
+        }
+        if out.iter().any(|(j, _)| *j == k) {
+            return Err(e(format!("node '{name}' is pinned twice")));
+        }
+        if let Some(a) = (*axis).filter(|a| !a.iter().all(|x| x.is_finite()) || a.iter().all(|x| *x == 0.0)) {
+            return Err(e(format!("the axis of the pin at '{name}' is {a:?}: three finite numbers, not all zero")));
+        }
+        out.push((k, *axis));
+    }
+    Ok(out)
 }
 
 /// Node k (from 0) is n<k+1>, column k+1 of N.
@@ -185,75 +356,110 @@ fn bar_of_each_node(cb_path: &Path, bars: &[Member], count: usize) -> Result<Vec
 }
 
 /// Each bar a strut on its own body (a uniform cylinder's inertia about its centre, taken
-/// as the same about every axis); the first held fixed when `fix_first` (no ground).
-fn add_bars(draft: &mut Draft, nodes: &[Vec3], bars: &[Member], fix_first: bool, o: &MatrixOptions) {
+/// as the same about every axis); the first held fixed when `fix_first` (nothing else fixed).
+fn add_bars(draft: &mut Draft, nodes: &[Vec3], bars: &[Member], fix_first: bool, p: &MemberProperties) {
     for (i, &(a, b, _)) in bars.iter().enumerate() {
+        let (m, r) = (p.bar_mass_kg[i], p.bar_radius_m[i]);
         let l = distance(nodes[a], nodes[b]);
-        let inertia = o.bar_mass_kg * (3.0 * o.bar_radius_m * o.bar_radius_m + l * l) / 12.0;
+        let inertia = m * (3.0 * r * r + l * l) / 12.0;
         draft.bodies.push(DraftBody {
             name: format!("bar{}", i + 1),
             fixed: fix_first && i == 0,
-            mass_kg: o.bar_mass_kg,
+            mass_kg: m,
             inertia_kg_m2: Some([inertia; 3]),
             nodes: vec![(node_name(a), nodes[a]), (node_name(b), nodes[b])],
         });
-        draft.struts.push(DraftStrut {
-            name: format!("bar{}", i + 1),
-            a: node_name(a),
-            b: node_name(b),
-            radius_m: o.bar_radius_m,
-        });
+        draft.struts.push(DraftStrut { name: format!("bar{}", i + 1), a: node_name(a), b: node_name(b), radius_m: r });
     }
 }
 
-/// Each string an elastic tension-only cable whose rest length is the drawn length less the
-/// tension over the stiffness; no rest length left is an error at the string's row.
+/// Each string an elastic tension-only cable (or a spring) whose rest length is given or the
+/// drawn length less the tension over the stiffness; no rest length left for a cable (a
+/// negative one for a spring) is an error at the string's row.
 fn add_strings(
     draft: &mut Draft,
     nodes: &[Vec3],
     strings: &[Member],
     cs_path: &Path,
-    o: &MatrixOptions,
+    p: &MemberProperties,
 ) -> Result<(), ImportError> {
     for (i, &(a, b, line)) in strings.iter().enumerate() {
+        let (k, tension_only) = (p.string_stiffness_n_per_m[i], p.tension_only[i]);
         let l = distance(nodes[a], nodes[b]);
-        let rest = l - o.string_tension_n / o.string_stiffness_n_per_m;
-        if !(rest > 0.0) {
+        let (rest, given) = match &p.string_rest {
+            StringRest::TensionN(t) => (l - t[i] / k, format!("tension {} N at {k} N/m", t[i])),
+            StringRest::LengthM(r) => (r[i], format!("rest length {} m", r[i])),
+        };
+        let name = format!("string{}", i + 1);
+        if !(rest > 0.0 || (!tension_only && rest >= 0.0)) {
+            let what = if tension_only {
+                "no rest length (a tension-only cable needs one > 0)"
+            } else {
+                "a negative rest length"
+            };
             return Err(ImportError {
                 file: cs_path.display().to_string(),
                 line,
                 col: 1,
-                message: format!(
-                    "string {}: tension {} N at {} N/m leaves no rest length (drawn {l} m)",
-                    i + 1,
-                    o.string_tension_n,
-                    o.string_stiffness_n_per_m
-                ),
+                message: format!("{name}: {given} leaves {what} (drawn {l} m)"),
             });
         }
         draft.cables.push(DraftCable {
-            name: format!("string{}", i + 1),
+            name,
             a: node_name(a),
             b: node_name(b),
-            stiffness_n_per_m: Some(o.string_stiffness_n_per_m),
+            stiffness_n_per_m: Some(k),
             length_m: rest,
+            tension_only,
         });
     }
     Ok(())
 }
 
+/// `v` as the description says it: the value when every member has it, else its range.
+fn said(v: &[f64]) -> String {
+    let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(*x), hi.max(*x)));
+    if v.is_empty() || lo == hi {
+        v.first().map_or("-".into(), |x| x.to_string())
+    } else {
+        format!("{lo} to {hi} (one per member)")
+    }
+}
+
 /// What the scenario file says of where it came from and what was chosen.
-fn description([n_path, cb_path, cs_path]: [&Path; 3], o: &MatrixOptions, grounded: usize) -> String {
+fn description(source: &str, by: &str, p: &MemberProperties, grounded: usize) -> String {
+    let rest = match &p.string_rest {
+        StringRest::TensionN(t) => {
+            format!("at {} N when drawn (rest length = drawn - tension / stiffness)", said(t))
+        }
+        StringRest::LengthM(l) => format!("of rest length {} m", said(l)),
+    };
+    let kind = match (p.tension_only.iter().all(|t| *t), p.tension_only.iter().any(|t| *t)) {
+        (true, _) => "elastic tension-only cable",
+        (false, false) => "linear spring (pushes as well as pulls)",
+        (false, true) => "elastic tension-only cable (or spring, where tension_only is false)",
+    };
+    let held = if grounded > 0 {
+        format!("{grounded} node(s) on no bar are fixed points (body 'ground').")
+    } else if p.pins.is_empty() {
+        "No node is off the bars: bar1 is held fixed to remove the rigid motion.".to_string()
+    } else {
+        String::new()
+    };
+    let pins = if p.pins.is_empty() {
+        String::new()
+    } else {
+        let at: Vec<&str> = p.pins.iter().map(|(n, _)| n.as_str()).collect();
+        format!(
+            "\nPinned to the ground (joints pin_<node>, revolute about the given axis or spherical): {}.",
+            at.join(", ")
+        )
+    };
     format!(
-        "Imported from N = {}, C_b = {}, C_s = {} (Skelton and de Oliveira's notation) by `tensegrity import matrices`.\n\
-         Node k is n<k> (column k of N); bar i is strut bar<i> on its own body of {} kg, radius {} m; string i is the elastic tension-only cable string<i> of {} N/m at {} N when drawn (rest length = drawn - tension / stiffness).\n{}",
-        n_path.display(),
-        cb_path.display(),
-        cs_path.display(),
-        o.bar_mass_kg,
-        o.bar_radius_m,
-        o.string_stiffness_n_per_m,
-        o.string_tension_n,
-        if grounded == 0 { "No node is off the bars: bar1 is held fixed to remove the rigid motion.".to_string() } else { format!("{grounded} node(s) on no bar are fixed points (body 'ground').") }
+        "Imported from {source} (Skelton and de Oliveira's notation) by {by}.\n\
+         Node k is n<k> (column k of N); bar i is strut bar<i> on its own body of {} kg, radius {} m; string i is the {kind} string<i> of {} N/m {rest}.\n{held}{pins}",
+        said(&p.bar_mass_kg),
+        said(&p.bar_radius_m),
+        said(&p.string_stiffness_n_per_m),
     )
 }

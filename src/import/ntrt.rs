@@ -249,8 +249,14 @@ fn only_keys(file: &str, y: &Yaml, allowed: &[&str], what: &str) -> Result<(), I
 
 /// Imports an NTRT YAML file as a scenario; `name` names it.
 pub fn import(path: &Path, axes: Axes) -> Result<Imported, ImportError> {
+    import_text(path, &super::read_text(path)?, axes)
+}
+
+/// Imports NTRT YAML text as a scenario, as if read from `path` (which names it in errors and
+/// the scenario; substructures' paths are relative to its directory).
+pub fn import_text(path: &Path, text: &str, axes: Axes) -> Result<Imported, ImportError> {
     let mut r = Reader { builders: default_builders(), skipped: Vec::new() };
-    let top = r.load(path, "", 0)?;
+    let top = r.load(path, text, "", 0)?;
     let draft = r.draft(path, &top, axes)?;
     let toml = draft.to_toml().map_err(|message| ImportError::whole(path, message))?;
     Ok(Imported { toml, skipped: r.skipped })
@@ -278,7 +284,7 @@ impl Kind {
 impl Reader {
     /// One file and its substructures, in NTRT's order: substructures, builders, nodes, pair
     /// groups, bond groups.
-    fn load(&mut self, path: &Path, name: &str, depth: usize) -> Result<Sub, ImportError> {
+    fn load(&mut self, path: &Path, text: &str, name: &str, depth: usize) -> Result<Sub, ImportError> {
         let file = path.display().to_string();
         if depth > MAX_DEPTH {
             return Err(ImportError {
@@ -288,8 +294,7 @@ impl Reader {
                 message: format!("substructures nest deeper than {MAX_DEPTH} levels (does a file include itself?)"),
             });
         }
-        let text = super::read_text(path)?;
-        let root = yaml::parse(&text).map_err(|e| err(&file, e.at, e.message))?;
+        let root = yaml::parse(text).map_err(|e| err(&file, e.at, e.message))?;
         only_keys(&file, &root, ROOT_KEYS, "an NTRT model file")?;
         let mut sub = Sub { name: name.into(), ..Default::default() };
         if let Some(c) = root.get("substructures") {
@@ -340,13 +345,15 @@ impl Reader {
                     return Err(err(file, k.at(), format!("duplicate substructure '{name}'")));
                 }
                 // A child file that cannot be read is an error at the parent's key.
-                let child = self.load(&child_path, name, depth + 1).map_err(|e| {
-                    if e.line == 0 && e.file == child_path.display().to_string() {
-                        err(file, k.at(), format!("substructure '{name}' ({}): {}", e.file, e.message))
-                    } else {
-                        e
-                    }
-                })?;
+                let child = super::read_text(&child_path)
+                    .and_then(|text| self.load(&child_path, &text, name, depth + 1))
+                    .map_err(|e| {
+                        if e.line == 0 && e.file == child_path.display().to_string() {
+                            err(file, k.at(), format!("substructure '{name}' ({}): {}", e.file, e.message))
+                        } else {
+                            e
+                        }
+                    })?;
                 sub.children.push(child);
             }
         }
@@ -877,6 +884,7 @@ fn add_string_cables(
             b: names[*b].clone(),
             stiffness_n_per_m: Some(*k),
             length_m: *rest,
+            tension_only: true,
         });
     }
     Ok(())

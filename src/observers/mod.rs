@@ -114,8 +114,8 @@ pub struct Setup<'a> {
     /// A recording, when the run writes one (made last: nothing is written when another
     /// observer cannot start).
     pub recording: Option<record::Recording<'a>>,
-    /// A per-tick f64 table (CSV) to write, if the run writes one.
-    pub table: Option<std::path::PathBuf>,
+    /// A per-tick f64 table to write (CSV or Arrow IPC) or keep in memory, if the run makes one.
+    pub table: Option<table::TableTarget>,
     /// A motion run's `[motion]`: its frequencies are measured from its ticks.
     pub motion: Option<&'a crate::settings::Motion>,
     /// A model outside the file (a Python callable), compared as its predictions are.
@@ -139,10 +139,13 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
         let file = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, motion));
         list.push(Box::new(external::ExternalObserver::new(x, file, motion)));
     }
-    if let Some(path) = &setup.table {
+    if let Some(target) = &setup.table {
         let motion = setup.motion.is_some();
         let model = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, motion));
-        list.push(Box::new(table::Table::start(path, model)?));
+        list.push(Box::new(match target {
+            table::TableTarget::File(path) => table::Table::start(path, model)?,
+            table::TableTarget::Memory(to) => table::Table::in_memory(to.clone(), model),
+        }));
     }
     if let Some(r) = &setup.recording {
         if let Some(recorder) = record::Recorder::start(r)? {

@@ -2,7 +2,8 @@
 //! spreadsheet without the rerun SDK (whose recordings store positions as f32): CSV, or an Arrow
 //! IPC file when the name ends in `.arrow`, `.feather` or `.ipc` (`tick` a UInt64 column, every
 //! other column Float64, nulls where the CSV leaves a cell empty; written in record batches of
-//! [`ARROW_BATCH_ROWS`] rows).
+//! [`ARROW_BATCH_ROWS`] rows), or the same record batches kept in memory ([`MemoryTable`]: the
+//! Python package hands them to pyarrow without a file).
 //!
 //! Columns, fixed at the first tick: `tick`, `time_s`, `kinetic_energy_j`, the inputs
 //! (`input:SYMBOL`), every node's coordinates (`node:NAME.x`, `.y`, `.z`, m), every spring's
@@ -22,11 +23,11 @@ use super::{Observer, Tick};
 use crate::report::ScenarioReport;
 use crate::structure::ActuatorTarget;
 use arrow_array::{ArrayRef, Float64Array, RecordBatch, UInt64Array};
-use arrow_schema::{DataType, Field, Schema};
+use arrow_schema::{DataType, Field, Schema, SchemaRef};
 use std::fmt::Write as _;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// Rows buffered before an Arrow record batch is written.
 pub const ARROW_BATCH_ROWS: usize = 8192;
@@ -39,25 +40,60 @@ pub fn is_table_file(path: &std::path::Path) -> bool {
     path.extension().and_then(|e| e.to_str()).is_some_and(|e| e == "csv" || ARROW_ENDINGS.contains(&e))
 }
 
+/// Where a run's table goes: a file (CSV or Arrow IPC, by its ending) or memory.
+#[derive(Clone)]
+pub enum TableTarget {
+    File(PathBuf),
+    Memory(MemoryTable),
+}
+
+impl From<PathBuf> for TableTarget {
+    fn from(path: PathBuf) -> Self {
+        TableTarget::File(path)
+    }
+}
+
+/// A table kept in memory: the run's record batches and their schema, handed over when the
+/// run closes (None before, and when no tick ran).
+#[derive(Clone, Default)]
+pub struct MemoryTable(Arc<Mutex<Option<(SchemaRef, Vec<RecordBatch>)>>>);
+
+impl MemoryTable {
+    /// The schema and the record batches of the finished run (once; None when no tick ran).
+    pub fn take(&self) -> Option<(SchemaRef, Vec<RecordBatch>)> {
+        self.0.lock().ok().and_then(|mut t| t.take())
+    }
+}
+
 /// Input, simulated and analytic keys, fixed at the first tick.
 type Keys = (Vec<String>, Vec<String>, Vec<String>);
+
+/// Where the record batches go.
+enum Batches {
+    /// The file until the first tick gives the schema, then its writer.
+    File { file: Option<std::fs::File>, writer: Option<arrow_ipc::writer::FileWriter<std::fs::File>> },
+    /// Kept, then handed to the [`MemoryTable`] when the run closes.
+    Memory { kept: Vec<RecordBatch>, to: MemoryTable },
+}
 
 /// Where the rows go.
 enum Sink {
     Csv(std::io::BufWriter<std::fs::File>),
-    /// The file until the first tick gives the schema, then its writer; the rows not yet written
-    /// as a batch (tick, then every other column).
+    /// Record batches; the schema from the first tick, and the rows not yet made a batch
+    /// (tick, then every other column).
     Arrow {
-        file: Option<std::fs::File>,
-        writer: Option<arrow_ipc::writer::FileWriter<std::fs::File>>,
+        out: Batches,
+        schema: Option<SchemaRef>,
         ticks: Vec<u64>,
         columns: Vec<Vec<Option<f64>>>,
     },
 }
 
 pub struct Table {
+    /// The file, or "(memory)" for a table kept in memory (for messages).
     path: PathBuf,
-    partial: PathBuf,
+    /// The temporary file written until the run closes (None in memory).
+    partial: Option<PathBuf>,
     sink: Sink,
     keys: Option<Keys>,
     /// The first write error, reported when the run closes.
@@ -101,11 +137,21 @@ impl Table {
         })?;
         let arrow = path.extension().and_then(|e| e.to_str()).is_some_and(|e| ARROW_ENDINGS.contains(&e));
         let sink = if arrow {
-            Sink::Arrow { file: Some(file), writer: None, ticks: Vec::new(), columns: Vec::new() }
+            Self::arrow(Batches::File { file: Some(file), writer: None })
         } else {
             Sink::Csv(std::io::BufWriter::new(file))
         };
-        Ok(Table { path: path.to_path_buf(), partial, sink, keys: None, error: None, model })
+        Ok(Table { path: path.to_path_buf(), partial: Some(partial), sink, keys: None, error: None, model })
+    }
+
+    /// Starts a table kept in memory, handed to `to` when the run closes.
+    pub fn in_memory(to: MemoryTable, model: Option<super::file_model::ModelObserver>) -> Self {
+        let sink = Self::arrow(Batches::Memory { kept: Vec::new(), to });
+        Table { path: PathBuf::from("(memory)"), partial: None, sink, keys: None, error: None, model }
+    }
+
+    fn arrow(out: Batches) -> Sink {
+        Sink::Arrow { out, schema: None, ticks: Vec::new(), columns: Vec::new() }
     }
 
     /// The column names after `tick`.
@@ -173,13 +219,16 @@ impl Table {
                 text.push('\n');
                 out.write_all(text.as_bytes()).map_err(|e| fail(&e))
             }
-            Sink::Arrow { file, writer, ticks, columns } => {
+            Sink::Arrow { out, schema, ticks, columns } => {
                 if let Some(h) = header {
                     let mut fields = vec![Field::new("tick", DataType::UInt64, false)];
                     fields.extend(h.iter().map(|c| Field::new(c, DataType::Float64, true)));
-                    let f = file.take().ok_or_else(|| fail(&"the file is gone"))?;
-                    *writer =
-                        Some(arrow_ipc::writer::FileWriter::try_new(f, &Schema::new(fields)).map_err(|e| fail(&e))?);
+                    let s = Arc::new(Schema::new(fields));
+                    if let Batches::File { file, writer } = out {
+                        let f = file.take().ok_or_else(|| fail(&"the file is gone"))?;
+                        *writer = Some(arrow_ipc::writer::FileWriter::try_new(f, &s).map_err(|e| fail(&e))?);
+                    }
+                    *schema = Some(s);
                     *columns = vec![Vec::with_capacity(ARROW_BATCH_ROWS); h.len()];
                 }
                 ticks.push(tick);
@@ -187,26 +236,35 @@ impl Table {
                     c.push(x);
                 }
                 if ticks.len() >= ARROW_BATCH_ROWS {
-                    Self::flush_batch(writer, ticks, columns).map_err(|e| fail(&e))?;
+                    Self::flush_batch(out, schema, ticks, columns).map_err(|e| fail(&e))?;
                 }
                 Ok(())
             }
         }
     }
 
-    /// Writes the buffered rows as one record batch.
+    /// Writes (or keeps) the buffered rows as one record batch.
     fn flush_batch(
-        writer: &mut Option<arrow_ipc::writer::FileWriter<std::fs::File>>,
+        out: &mut Batches,
+        schema: &Option<SchemaRef>,
         ticks: &mut Vec<u64>,
         columns: &mut [Vec<Option<f64>>],
     ) -> Result<(), arrow_schema::ArrowError> {
-        let Some(w) = writer.as_mut() else { return Ok(()) };
+        let Some(schema) = schema else { return Ok(()) };
         if ticks.is_empty() {
             return Ok(());
         }
         let mut arrays: Vec<ArrayRef> = vec![Arc::new(UInt64Array::from(std::mem::take(ticks)))];
         arrays.extend(columns.iter_mut().map(|c| Arc::new(Float64Array::from(std::mem::take(c))) as ArrayRef));
-        w.write(&RecordBatch::try_new(w.schema().clone(), arrays)?)
+        let batch = RecordBatch::try_new(schema.clone(), arrays)?;
+        match out {
+            Batches::File { writer: Some(w), .. } => w.write(&batch),
+            Batches::File { writer: None, .. } => Ok(()),
+            Batches::Memory { kept, .. } => {
+                kept.push(batch);
+                Ok(())
+            }
+        }
     }
 
     /// Finishes the file (the last batch and the Arrow footer, or the CSV buffer) and syncs it.
@@ -214,15 +272,23 @@ impl Table {
         let fail = |e: &dyn std::fmt::Display| format!("cannot write the table {}: {e}", self.path.display());
         match &mut self.sink {
             Sink::Csv(out) => out.flush().and_then(|_| out.get_ref().sync_all()).map_err(|e| fail(&e)),
-            Sink::Arrow { file, writer, ticks, columns } => {
-                Self::flush_batch(writer, ticks, columns).map_err(|e| fail(&e))?;
-                match (writer.take(), file.take()) {
-                    (Some(mut w), _) => {
-                        w.finish().map_err(|e| fail(&e))?;
-                        w.into_inner().and_then(|f| f.sync_all().map_err(Into::into)).map_err(|e| fail(&e))
+            Sink::Arrow { out, schema, ticks, columns } => {
+                Self::flush_batch(out, schema, ticks, columns).map_err(|e| fail(&e))?;
+                match out {
+                    Batches::File { writer, file } => match (writer.take(), file.take()) {
+                        (Some(mut w), _) => {
+                            w.finish().map_err(|e| fail(&e))?;
+                            w.into_inner().and_then(|f| f.sync_all().map_err(Into::into)).map_err(|e| fail(&e))
+                        }
+                        (None, Some(f)) => f.sync_all().map_err(|e| fail(&e)),
+                        (None, None) => Ok(()),
+                    },
+                    Batches::Memory { kept, to } => {
+                        if let (Some(s), Ok(mut handed)) = (schema.clone(), to.0.lock()) {
+                            *handed = Some((s, std::mem::take(kept)));
+                        }
+                        Ok(())
                     }
-                    (None, Some(f)) => f.sync_all().map_err(|e| fail(&e)),
-                    (None, None) => Ok(()),
                 }
             }
         }
@@ -258,10 +324,11 @@ impl Observer for Table {
             Some(e) => Err(e),
             None => self.finish_file(),
         };
+        let Some(partial) = &self.partial else { return written };
         match written {
-            Ok(()) => crate::output::commit(&self.partial, &self.path),
+            Ok(()) => crate::output::commit(partial, &self.path),
             Err(e) => {
-                crate::output::discard(&self.partial);
+                crate::output::discard(partial);
                 Err(e)
             }
         }

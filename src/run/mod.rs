@@ -40,8 +40,9 @@ pub struct RunOptions<'a> {
     pub record_every: u64,
     /// Leave the findings out of the report (a sweep's blocks: the summary has none).
     pub skip_findings: bool,
-    /// Write every tick as a row of this CSV table (`observers::table`).
-    pub table: Option<PathBuf>,
+    /// Every tick as a row of a table: a CSV or Arrow IPC file, or kept in memory
+    /// (`observers::table`).
+    pub table: Option<crate::observers::table::TableTarget>,
     /// A model outside the file (the Python package's callables), compared as the file's
     /// predictions are (`observers::external`).
     pub external: Option<crate::observers::external::External>,

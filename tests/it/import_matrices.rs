@@ -150,3 +150,35 @@ fn the_matrices_command_writes_a_scenario_that_checks() {
     assert_eq!(code, 2);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The README tutorial's pinned bar from arrays (`from_arrays`, the Python package's
+/// `from_matrices`): one stiffness per string, zero-free-length springs, a damped revolute pin
+/// and a quantity; it settles at q = atan2(k1 a, k2 b) within 1e-15 rad. A property with one
+/// value too few is an error naming it.
+#[test]
+fn the_pinned_bar_from_arrays_settles_at_the_closed_form() {
+    use tensegrity_testbed::import::matrices::{from_arrays, MemberProperties, StringRest};
+    let (k1, k2, a, b, q0) = (50.0, 30.0, 0.8, 0.6, std::f64::consts::PI / 10.0);
+    let n = [vec![0.0, q0.cos(), 0.0, b], vec![0.0, q0.sin(), a, 0.0], vec![0.0; 4]];
+    let cb = [vec![-1.0, 1.0, 0.0, 0.0]];
+    let cs = [vec![0.0, -1.0, 1.0, 0.0], vec![0.0, -1.0, 0.0, 1.0]];
+    let mut p = MemberProperties {
+        bar_mass_kg: vec![0.5],
+        bar_radius_m: vec![0.01],
+        string_stiffness_n_per_m: vec![k1, k2],
+        string_rest: StringRest::LengthM(vec![0.0, 0.0]),
+        tension_only: vec![false, false],
+        pins: vec![("n1".into(), Some([0.0, 0.0, 1.0]))],
+        quantities: vec![("q".into(), "atan2(n2.y - n1.y, n2.x - n1.x)".into())],
+    };
+    let toml = from_arrays("pinned bar", &n, &cb, &cs, &p).unwrap().toml;
+    assert!(toml.contains("[[structure.springs]]") && toml.contains("kind = \"revolute\""), "{toml}");
+    let sc = scenario::parse(Path::new("bar.toml"), &toml).unwrap_or_else(|e| panic!("{e}\n{toml}"));
+    let r = run(&sc, &RunOptions::default());
+    assert!(r.passed, "{:?} {:?}", r.failures, r.error);
+    let q = r.points[0].simulated["q"];
+    assert!((q - (k1 * a).atan2(k2 * b)).abs() <= 1e-15, "{q}");
+    p.string_stiffness_n_per_m.pop();
+    let e = from_arrays("pinned bar", &n, &cb, &cs, &p).unwrap_err();
+    assert!(e.message.contains("string_stiffness_n_per_m has 1 values: expected 2"), "{e}");
+}

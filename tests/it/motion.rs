@@ -47,7 +47,7 @@ fn spring_energy(x: f64, y: f64) -> f64 {
 fn table_columns(text: &str, name: &str, columns: &[&str]) -> (ScenarioReport, Vec<Vec<f64>>) {
     let path = std::env::temp_dir().join(format!("tensegrity-motion-{}-{name}.csv", std::process::id()));
     let _ = std::fs::remove_file(&path);
-    let report = run_text(text, &RunOptions { table: Some(path.clone()), ..Default::default() });
+    let report = run_text(text, &RunOptions { table: Some(path.clone().into()), ..Default::default() });
     let csv = std::fs::read_to_string(&path).expect("the table");
     let _ = std::fs::remove_file(&path);
     let mut lines = csv.lines();

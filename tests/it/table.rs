@@ -24,7 +24,7 @@ fn the_trajectory_table_holds_the_settled_values_bit_for_bit() {
     let dir = std::env::temp_dir().join(format!("table-{}", std::process::id()));
     let path = dir.join("trajectory.csv");
     let sc = scenario::load(Path::new("scenarios/mohr2011/trajectory.toml")).unwrap();
-    let r = run(&sc, &RunOptions { table: Some(path.clone()), ..RunOptions::default() });
+    let r = run(&sc, &RunOptions { table: Some(path.clone().into()), ..RunOptions::default() });
     assert!(r.passed, "{:?}", r.error);
     assert!(std::fs::read_dir(&dir).unwrap().all(|e| !e.unwrap().file_name().to_string_lossy().contains(".partial")));
     let (header, rows) = read_csv(&path);
@@ -106,8 +106,8 @@ fn the_trajectory_table_as_arrow_holds_the_csv_values() {
     let dir = std::env::temp_dir().join(format!("table-arrow-{}", std::process::id()));
     let (csv, arrow) = (dir.join("t.csv"), dir.join("t.arrow"));
     let sc = scenario::load(Path::new("scenarios/mohr2011/trajectory.toml")).unwrap();
-    let r = run(&sc, &RunOptions { table: Some(csv.clone()), ..RunOptions::default() });
-    let r2 = run(&sc, &RunOptions { table: Some(arrow.clone()), ..RunOptions::default() });
+    let r = run(&sc, &RunOptions { table: Some(csv.clone().into()), ..RunOptions::default() });
+    let r2 = run(&sc, &RunOptions { table: Some(arrow.clone().into()), ..RunOptions::default() });
     assert_eq!(r.settle.steps, r2.settle.steps);
     let (header, rows) = read_csv(&csv);
     let reader = arrow_ipc::reader::FileReader::try_new(std::fs::File::open(&arrow).unwrap(), None).unwrap();
@@ -154,5 +154,26 @@ fn the_trajectory_table_as_arrow_holds_the_csv_values() {
         }
         _ => eprintln!("skipped the pandas read: no Python with pandas and pyarrow (set TENSEGRITY_PYTHON)"),
     }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The table kept in memory (`TableTarget::Memory`, the Python package's) is the Arrow file's:
+/// the same schema and the same record batches, value for value.
+#[test]
+fn the_table_in_memory_is_the_arrow_files() {
+    use tensegrity_testbed::observers::table::{MemoryTable, TableTarget};
+    let dir = std::env::temp_dir().join(format!("table-memory-{}", std::process::id()));
+    let arrow = dir.join("t.arrow");
+    let sc = scenario::load(Path::new("scenarios/custom/pinned_bar_sweep.toml")).unwrap();
+    let kept = MemoryTable::default();
+    run(&sc, &RunOptions { table: Some(arrow.clone().into()), ..RunOptions::default() });
+    run(&sc, &RunOptions { table: Some(TableTarget::Memory(kept.clone())), ..RunOptions::default() });
+    let (schema, batches) = kept.take().expect("the run handed its table over");
+    let reader = arrow_ipc::reader::FileReader::try_new(std::fs::File::open(&arrow).unwrap(), None).unwrap();
+    assert_eq!(reader.schema(), schema);
+    let from_file: Vec<_> = reader.map(Result::unwrap).collect();
+    assert!(!batches.is_empty());
+    assert_eq!(from_file, batches);
+    assert!(kept.take().is_none(), "handed over once");
     std::fs::remove_dir_all(&dir).ok();
 }
