@@ -4,6 +4,7 @@
 //! their worst error; each point keeps its own values.
 
 use super::{conclude, run, RunOptions};
+use crate::observers::table::TableTarget;
 use crate::report::{CheckReport, ModelCheckReport, ScenarioReport};
 use crate::scenario::Scenario;
 use std::path::{Path, PathBuf};
@@ -20,7 +21,11 @@ pub(super) fn run_topologies(sc: &Scenario, opts: &RunOptions) -> ScenarioReport
             connect: opts.connect.clone(),
             record_every: opts.record_every,
             skip_findings: opts.skip_findings || k > 0,
-            table: opts.table.as_deref().map(|p| numbered(p, k)),
+            // A file per structure; a table in memory keeps the last structure's ticks.
+            table: opts.table.as_ref().map(|t| match t {
+                TableTarget::File(p) => TableTarget::File(numbered(p, k)),
+                other => other.clone(),
+            }),
             external: opts.external.clone(),
         };
         let mut r = run(variant, &options);
