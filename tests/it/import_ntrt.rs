@@ -109,6 +109,21 @@ fn ntrt_icosahedron_from_substructures_settles_to_the_closed_form() {
     }
 }
 
+/// The imported SuperBall with one added prediction over every cable (`for = { c = "cables"
+/// }`): each of its 24 cables is judged against sqrt(6)/4 of the 2 m strut, within 1e-12 m.
+#[test]
+fn an_imported_superball_checks_every_cable_with_one_added_prediction() {
+    let (toml, _) = imported("ball.yaml");
+    let added = "\n[[predictions]]\nfor = { c = \"cables\" }\nname = \"cable_length\"\nquantity = \"{c}.length\"\n\
+                 formula = \"2*sqrt(6)/4\"\nclass = \"length\"\ntolerance = 1e-12\n";
+    let r = run_text("ball.toml", &format!("{toml}{added}"));
+    let cables: Vec<_> = r.model_checks.iter().filter(|m| m.name.starts_with("cable_length[")).collect();
+    assert_eq!(cables.len(), 24);
+    let worst = cables.iter().map(|m| m.max_error).fold(0.0, f64::max);
+    eprintln!("NTRT SuperBall: every cable within {worst:.1e} m of sqrt(6)/4 of the strut");
+    assert!(cables.iter().all(|m| m.passed) && worst <= 1e-12, "{worst}");
+}
+
 /// Errors name the file, line and column: an unknown node in a pair, an unknown top-level
 /// key, a builder parameter NTRT does not have, a YAML syntax error, a pretension that leaves
 /// no rest length, a missing substructure file (at the parent's key).
