@@ -32,6 +32,7 @@ mod moved_node;
 mod outputs;
 mod param_sweep;
 mod patterns;
+mod readme;
 mod recording;
 mod relaxation;
 mod restart;

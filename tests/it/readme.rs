@@ -1,0 +1,90 @@
+//! Every command the README shows in a code block runs, and exits 0: `tensegrity ...` and
+//! `cargo run --release -- ...` lines (the latter through the built binary), in a scratch
+//! directory that sees the repository's `scenarios/` and `tests/` (so outputs such as
+//! `out/report.json` never land in the repository). A line with `${SLURM_ARRAY_TASK_ID}` runs
+//! once for every task of its `--shard K/N`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The command lines of the README's code blocks, with their line numbers.
+fn commands(readme: &str) -> Vec<(usize, String)> {
+    let mut inside = false;
+    let mut out = Vec::new();
+    for (k, line) in readme.lines().enumerate() {
+        if line.starts_with("```") {
+            inside = !inside;
+            continue;
+        }
+        let line = line.trim_start_matches("$ ");
+        if !inside {
+            continue;
+        }
+        if let Some(rest) = line.strip_prefix("cargo run --release -- ") {
+            out.push((k + 1, format!("tensegrity {rest}")));
+        } else if line.starts_with("tensegrity ") {
+            out.push((k + 1, line.to_string()));
+        }
+    }
+    out
+}
+
+/// The number of shards a Slurm line asks for (`--shard ${SLURM_ARRAY_TASK_ID}/N`).
+fn shards(command: &str) -> usize {
+    command
+        .split("${SLURM_ARRAY_TASK_ID}/")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(1)
+}
+
+fn scratch() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tt-readme-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("out")).expect("scratch directory");
+    let repo = std::env::current_dir().expect("the package root");
+    for d in ["scenarios", "tests"] {
+        let link = dir.join(d);
+        if !link.exists() {
+            std::os::unix::fs::symlink(repo.join(d), &link).expect("link");
+        }
+    }
+    dir
+}
+
+fn run(dir: &Path, command: &str, task: usize) -> (bool, String) {
+    let bin = Path::new(env!("CARGO_BIN_EXE_tensegrity")).parent().expect("bin dir").to_path_buf();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(command)
+        .current_dir(dir)
+        .env("PATH", path)
+        .env("SLURM_ARRAY_TASK_ID", task.to_string())
+        .output()
+        .expect("sh runs");
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    (out.status.success(), text)
+}
+
+#[test]
+fn every_command_the_readme_shows_runs_and_exits_0() {
+    let readme = std::fs::read_to_string("README.md").expect("README.md");
+    let list = commands(&readme);
+    assert!(list.len() >= 10, "the README shows {} commands", list.len());
+    let dir = scratch();
+    let mut failed = Vec::new();
+    for (line, command) in &list {
+        for task in 1..=shards(command) {
+            let (ok, text) = run(&dir, command, task);
+            if !ok {
+                failed.push(format!(
+                    "README.md:{line}: {command} (task {task})\n{}",
+                    text.lines().take(5).collect::<Vec<_>>().join("\n")
+                ));
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(failed.is_empty(), "{} command(s) failed:\n{}", failed.len(), failed.join("\n"));
+}
