@@ -55,15 +55,15 @@ fn expand<T: Looped>(
     env: &Env,
     groups: &Groups,
     entries: Vec<T>,
-    fill: fn(&Ctx, &Env, &Groups, &T, Option<&str>) -> Result<T, ScenarioError>,
+    fill: fn(&Element, &T) -> Result<T, ScenarioError>,
 ) -> Result<Vec<T>, ScenarioError> {
     let mut out = Vec::new();
     for mut e in entries {
         match e.over() {
-            None => out.push(fill(ctx, env, groups, &e, None)?),
+            None => out.push(fill(&Element { ctx, env, groups, tag: None }, &e)?),
             Some(over) => {
                 for (inner, tag) in loop_envs(ctx, env, groups, &over)? {
-                    out.push(fill(ctx, &inner, groups, &e, Some(&tag))?);
+                    out.push(fill(&Element { ctx, env: &inner, groups, tag: Some(&tag) }, &e)?);
                 }
             }
         }
@@ -131,54 +131,51 @@ fn quantity_name(
     }
 }
 
-fn quantity(
-    ctx: &Ctx,
-    env: &Env,
-    g: &Groups,
-    q: &RawQuantity,
-    tag: Option<&str>,
-) -> Result<RawQuantity, ScenarioError> {
+/// What fills one element of a looped entry: the file, the loop's environment, the groups and
+/// the element's tag (None without a loop).
+struct Element<'e, 'a> {
+    ctx: &'e Ctx<'e>,
+    env: &'e Env<'a>,
+    groups: &'e Groups,
+    tag: Option<&'e str>,
+}
+
+impl Element<'_, '_> {
+    fn expr(&self, s: &Spanned<String>) -> Result<Spanned<String>, ScenarioError> {
+        spanned_expr(self.ctx, s, self.env, self.groups)
+    }
+}
+
+fn quantity(e: &Element, q: &RawQuantity) -> Result<RawQuantity, ScenarioError> {
     Ok(RawQuantity {
         over: None,
-        name: quantity_name(ctx, &q.name, env, tag)?,
-        expr: spanned_expr(ctx, &q.expr, env, g)?,
+        name: quantity_name(e.ctx, &q.name, e.env, e.tag)?,
+        expr: e.expr(&q.expr)?,
         unit: q.unit.clone(),
     })
 }
 
-fn prediction(
-    ctx: &Ctx,
-    env: &Env,
-    g: &Groups,
-    p: &RawPrediction,
-    tag: Option<&str>,
-) -> Result<RawPrediction, ScenarioError> {
+fn prediction(e: &Element, p: &RawPrediction) -> Result<RawPrediction, ScenarioError> {
     // A quantity written without a template is the looped quantity of the same tag.
-    let quantity = quantity_name(ctx, &p.quantity, env, tag)?;
-    let name = p.name.as_ref().map(|n| element_name(ctx, n, env, tag)).transpose()?;
+    let quantity = quantity_name(e.ctx, &p.quantity, e.env, e.tag)?;
+    let name = p.name.as_ref().map(|n| element_name(e.ctx, n, e.env, e.tag)).transpose()?;
     Ok(RawPrediction {
         over: None,
         quantity,
         name,
-        formula: spanned_expr(ctx, &p.formula, env, g)?,
+        formula: e.expr(&p.formula)?,
         class: p.class.clone(),
         tolerance: p.tolerance.clone(),
         rms_tolerance: p.rms_tolerance.clone(),
     })
 }
 
-fn equation(
-    ctx: &Ctx,
-    env: &Env,
-    g: &Groups,
-    e: &RawEquation,
-    tag: Option<&str>,
-) -> Result<RawEquation, ScenarioError> {
+fn equation(e: &Element, q: &RawEquation) -> Result<RawEquation, ScenarioError> {
     Ok(RawEquation {
         over: None,
-        name: element_name(ctx, &e.name, env, tag)?,
-        residual: spanned_expr(ctx, &e.residual, env, g)?,
-        tolerance: e.tolerance.clone(),
+        name: element_name(e.ctx, &q.name, e.env, e.tag)?,
+        residual: e.expr(&q.residual)?,
+        tolerance: q.tolerance.clone(),
     })
 }
 
