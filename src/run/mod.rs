@@ -83,6 +83,7 @@ fn empty_report(sc: &Scenario) -> ScenarioReport {
         points: vec![],
         stiffness_probe: None,
         slack_intervals: vec![],
+        prestress: None,
         workspace: None,
         skipped_points: sc.skipped_points.len(),
         interference: None,
@@ -246,13 +247,25 @@ fn finish(runner: &mut Runner, report: &mut ScenarioReport, probe_errors: &[f64]
     if let Some(p) = &sc.probe {
         let max = probe_errors.iter().copied().fold(0.0, f64::max);
         let complete = !probe_errors.is_empty() && probe_errors.len() == report.points.len();
+        let quantity = match &p.joint {
+            Some(j) => j.quantity(),
+            None => runner.mech.stiffness_probe().map(|s| s.analytic).unwrap_or_default(),
+        };
+        let measured = report.points.iter().map(|q| q.simulated.get(&quantity).copied().unwrap_or(f64::NAN)).collect();
+        let max_rel_error = p.tolerance.map(|_| if complete { max } else { f64::INFINITY });
         report.stiffness_probe = Some(ProbeReport {
             torque_nm: p.torque_nm,
             tolerance: p.tolerance,
-            max_rel_error: if complete { max } else { f64::INFINITY },
-            passed: complete && max <= p.tolerance,
+            passed: p.tolerance.is_none_or(|t| max_rel_error.is_some_and(|e| e <= t)),
+            max_rel_error,
+            quantity,
+            measured,
         });
     }
+    report.prestress = sc
+        .prestress
+        .as_ref()
+        .map(|p| crate::report::PrestressReport::of(p, runner.sim.structure().cables.len(), &report.points));
     conclude(report, sc);
     let tick = runner.sim.tick();
     let mut failed = None;

@@ -24,6 +24,7 @@ mod number;
 mod overrides;
 mod params;
 mod physical;
+mod prestress;
 mod raw;
 mod record;
 mod sim;
@@ -74,6 +75,9 @@ pub struct Scenario {
     pub model: Option<crate::file_model::spec::ModelSpec>,
     /// `[motion]`: a motion run (the physical dynamics for a stated time), if the file asks.
     pub motion: Option<crate::settings::Motion>,
+    /// `[prestress]`, or the default of a custom structure with cables: when the structure has
+    /// lost its self-stress and what that does (None: not judged).
+    pub prestress: Option<crate::settings::Prestress>,
 }
 
 impl Scenario {
@@ -104,11 +108,12 @@ impl Scenario {
     }
 
     /// Whether a compared quantity is an angle (its errors are wrapped to (-pi, pi]): one of
-    /// the mechanism's angle quantities, or a prediction of the file's model of class angle.
+    /// the mechanism's angle quantities, a prediction of the file's model of class angle, or
+    /// an `[energy]` coordinate of class angle.
     pub fn is_angle(&self, quantity: &str) -> bool {
         let mechanism = self.mechanism();
         mechanism.quantities().iter().any(|q| q.symbol == quantity && q.kind == mechanisms::QuantityKind::Angle)
-            || self.model.as_ref().is_some_and(|m| m.is_angle(quantity))
+            || self.model.as_ref().is_some_and(|m| m.is_angle(quantity) || m.is_angle_coordinate(quantity))
     }
 }
 
@@ -297,10 +302,16 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
     let first = structures.check(ctx, &raw, m, &mut sim, custom.is_some())?;
     let interference = interference::interference(ctx, &raw.interference, m, &first_params, &first)?;
     let probe = checks::probe(ctx, m, &raw.probe, &first, &params)?;
+    let prestress = prestress::prestress(ctx, &raw.prestress, &first, custom.is_some())?;
     closed_forms(ctx, &raw, probe.as_ref(), model.as_ref(), &param_table, &params, &actuation)?;
     let motion = motion::motion(ctx, &raw, sim.dt_s, (m, &first), &first_params, &actuation)?;
-    let parts =
-        expect::Parts { checks: &checks, model: model.as_ref(), probe: probe.is_some(), motion: motion.as_ref() };
+    let parts = expect::Parts {
+        checks: &checks,
+        model: model.as_ref(),
+        probe: probe.as_ref().is_some_and(|p| p.tolerance.is_some()),
+        motion: motion.as_ref(),
+        prestress: prestress.is_some(),
+    };
     let expect = raw.expect.as_ref().map(|e| expect::expectation(ctx, e, &parts)).transpose()?;
     Ok(Scenario {
         file: path.to_path_buf(),
@@ -326,5 +337,6 @@ fn validate(ctx: &Ctx, path: &Path, raw: RawScenario) -> Result<Scenario, Scenar
         expect,
         model,
         motion,
+        prestress,
     })
 }

@@ -31,6 +31,7 @@ mod motion;
 mod moved_node;
 mod outputs;
 mod param_sweep;
+mod prestress;
 mod recording;
 mod relaxation;
 mod restart;

@@ -96,7 +96,7 @@ fn a_sweep_draws_its_figure() {
     let (code, out, err) = common::tensegrity(&["sweep", BAR, "--figure", svg.to_str().unwrap()]);
     assert_eq!(code, 0, "{out}{err}");
     let text = std::fs::read_to_string(&svg).unwrap();
-    for word in ["pin.stiffness", "q: analytic", "k1", "log10"] {
+    for word in ["pin.stiffness", "q: closed form", "k1", "log10"] {
         assert!(text.contains(word), "{word} in the figure");
     }
     let pdf = dir.join("bar.pdf");
@@ -107,5 +107,69 @@ fn a_sweep_draws_its_figure() {
     let (code, _, err) = common::tensegrity(&["sweep", BAR, "--figure", svg.to_str().unwrap(), "--x", "k9"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("not an axis of this sweep (its inputs and swept parameters: k1)"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The pinned bar with no closed form at all: no prediction, and a probe without `expected`.
+fn bar_without_closed_forms() -> String {
+    let text = std::fs::read_to_string(BAR).unwrap();
+    let text = text.replace("expected = \"L*hypot(k1*a, k2*b)\"\ntolerance = 1e-6\n", "");
+    let prediction =
+        "[[predictions]]\nquantity = \"q\"\nformula = \"atan2(ratio*a, b)\"\nclass = \"angle\"\ntolerance = 1e-9\n";
+    assert!(text.contains(prediction) && !text.contains("expected ="));
+    text.replace(prediction, "")
+}
+
+/// `sweep --figure` of the pinned bar with no closed form given draws the energy model's
+/// equilibrium (its coordinate qe and Hessian eigenvalue at the minimum landed on) and the
+/// probe's measured stiffness against k1, and the CSV has their columns: at each of the nine
+/// k1 the equilibrium is atan2(k1 a, k2 b) within 1e-12 rad, its energy -L hypot(k1 a, k2 b)
+/// and its eigenvalue L hypot(k1 a, k2 b) within 1e-12 relative (the model's Newton), the
+/// settled qe within 1e-9 rad of it, and the measured stiffness within 1e-6 relative of the
+/// eigenvalue (L = 1 m, a = 0.8 m, b = 0.6 m, k2 = 30 N/m).
+#[test]
+fn a_sweep_without_closed_forms_draws_the_energy_equilibrium_and_the_measured_stiffness() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-sweep-measured-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("bar.toml");
+    std::fs::write(&file, bar_without_closed_forms()).unwrap();
+    let (svg, csv) = (dir.join("bar.svg"), dir.join("bar.csv"));
+    let (code, out, err) = common::tensegrity(&[
+        "sweep",
+        file.to_str().unwrap(),
+        "--figure",
+        svg.to_str().unwrap(),
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
+    let figure = std::fs::read_to_string(&svg).unwrap();
+    for caption in [
+        "pin.stiffness: measured (dots), no closed form",
+        "qe: energy model&apos;s equilibrium landed on (line), settled (dots)",
+        "energy model&apos;s Hessian eigenvalue 1 at that equilibrium (line)",
+    ] {
+        assert!(figure.contains(caption) || figure.contains(&caption.replace("&apos;", "'")), "{caption}");
+    }
+    assert!(!figure.contains("closed form (line)"), "no closed form is drawn");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 9);
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("column {name}"));
+    let cell = |r: &Vec<&str>, name: &str| r[col(name)].parse::<f64>().unwrap();
+    for r in &rows {
+        let k1 = cell(r, "k1");
+        let (q, stiffness) = ((k1 * 0.8).atan2(30.0 * 0.6), (k1 * 0.8).hypot(30.0 * 0.6));
+        assert!((cell(r, "equilibrium_qe") - q).abs() <= 1e-12, "k1 = {k1}");
+        assert!((cell(r, "equilibrium_energy") + stiffness).abs() <= 1e-12 * stiffness, "k1 = {k1}");
+        assert!((cell(r, "equilibrium_eigenvalue_1") / stiffness - 1.0).abs() <= 1e-12, "k1 = {k1}");
+        assert_eq!(r[col("equilibrium_kind")], "minimum");
+        assert!((cell(r, "stationary_0_qe") - q).abs() <= 1e-12, "k1 = {k1}");
+        let measured = cell(r, "simulated_pin.stiffness");
+        assert!((measured / stiffness - 1.0).abs() <= 1e-6, "k1 = {k1}: {measured} N m/rad, want {stiffness}");
+        assert_eq!(r[col("analytic_pin.stiffness")], "", "no closed form");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
