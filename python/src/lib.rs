@@ -230,7 +230,8 @@ fn import_matrices(
     string_tension_n: f64,
 ) -> PyResult<String> {
     use tensegrity_testbed::import::matrices::{import, MatrixOptions};
-    let o = MatrixOptions { bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n };
+    let o =
+        MatrixOptions { bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n, uniform_tension: false };
     o.validate().map_err(PyValueError::new_err)?;
     let imported = import(&n, &cb, &cs, &o)
         .map_err(|e| TestbedError::new_err((e.file.clone(), e.line, e.col, e.message.clone())))?;

@@ -206,14 +206,15 @@ def from_matrices(
     bar_mass_kg: float = 1.0,
     bar_radius_m: float = 0.01,
     string_stiffness_n_per_m: float = 100.0,
-    string_tension_n: float = 0.0,
+    string_tension_n: float = 10.0,
 ) -> str:
     """A scenario (TOML text, for ``run``, ``check`` or a file) from numpy arrays in the
     notation of Skelton and de Oliveira: N (3 x n node coordinates [m]), Cb and Cs (one row per
     bar or string: -1 at its first node, 1 at its second). The importer of ``tensegrity import
     matrices``: each bar a strut on its own body of ``bar_mass_kg``, nodes on no bar fixed,
-    strings elastic of ``string_stiffness_n_per_m`` at ``string_tension_n`` when drawn. Member
-    properties are scalars. Raises ValueError on a wrong shape or a non-finite value."""
+    strings elastic of ``string_stiffness_n_per_m``, carrying the drawn structure's self-stress
+    with its least tension ``string_tension_n`` [N] (every string at it where the drawing has
+    no self-stress with every string taut), as the command does. Member properties are scalars. Raises ValueError on a wrong shape or a non-finite value."""
     import numpy as np
 
     n = _matrix("N", N, rows=3)

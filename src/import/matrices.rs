@@ -22,11 +22,24 @@ pub struct MatrixOptions {
     pub bar_radius_m: f64,
     /// Stiffness of each string [N/m].
     pub string_stiffness_n_per_m: f64,
-    /// Tension of each string at its drawn length [N] (sets its rest length).
+    /// The least string tension at the drawn state [N]: the drawn structure's self-stress is
+    /// scaled to it (each string's rest length set by its share); with `uniform_tension`, or
+    /// when the drawing has no self-stress with every string in tension, every string's.
     pub string_tension_n: f64,
+    /// Every string at `string_tension_n`, whatever the self-stress.
+    pub uniform_tension: bool,
 }
 
 impl MatrixOptions {
+    /// The command's defaults.
+    pub const DEFAULT: MatrixOptions = MatrixOptions {
+        bar_mass_kg: 1.0,
+        bar_radius_m: 0.01,
+        string_stiffness_n_per_m: 1000.0,
+        string_tension_n: super::DEFAULT_LEAST_TENSION_N,
+        uniform_tension: false,
+    };
+
     /// Every option in its range, or the first that is not, named by its flag.
     pub fn validate(&self) -> Result<(), String> {
         let positive = [
@@ -150,9 +163,10 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
     }
     add_bars(&mut draft, &nodes, &bars, ground.is_empty(), o);
     add_strings(&mut draft, &nodes, &strings, cs_path, o)?;
-    draft.description = description([n_path, cb_path, cs_path], o, ground.len());
+    let chosen = prestress(&mut draft, o).map_err(|message| ImportError::whole(cs_path, message))?;
+    draft.description = description([n_path, cb_path, cs_path], o, ground.len()) + "\n" + &chosen;
     let toml = draft.to_toml().map_err(|message| ImportError::whole(n_path, message))?;
-    Ok(Imported { toml, skipped: Vec::new() })
+    Ok(Imported { toml, skipped: Vec::new(), chosen: vec![chosen] })
 }
 
 /// Node k (from 0) is n<k+1>, column k+1 of N.
@@ -242,18 +256,38 @@ fn add_strings(
     Ok(())
 }
 
+/// The strings' tensions at the drawn state: the drawn structure's self-stress, its least
+/// string tension `--string-tension`, unless `--uniform-tension` or the drawing has none with
+/// every string in tension (then every string at it, as [`add_strings`] set them); what was
+/// chosen, in a sentence.
+fn prestress(draft: &mut Draft, o: &MatrixOptions) -> Result<String, String> {
+    if o.uniform_tension {
+        return Ok(format!(
+            "prestress: every string at {} N at the drawn state (--uniform-tension).",
+            o.string_tension_n
+        ));
+    }
+    Ok(match super::self_stress::prestress(draft, o.string_tension_n)? {
+        Some(c) => format!("{}.", c.sentence),
+        None => format!(
+            "prestress: the drawn structure has no self-stress with every string in tension, so every string is at {} N \
+             at the drawn state, which is then no equilibrium: the structure moves, and the run fails if it loses its prestress.",
+            o.string_tension_n
+        ),
+    })
+}
+
 /// What the scenario file says of where it came from and what was chosen.
 fn description([n_path, cb_path, cs_path]: [&Path; 3], o: &MatrixOptions, grounded: usize) -> String {
     format!(
         "Imported from N = {}, C_b = {}, C_s = {} (Skelton and de Oliveira's notation) by `tensegrity import matrices`.\n\
-         Node k is n<k> (column k of N); bar i is strut bar<i> on its own body of {} kg, radius {} m; string i is the elastic tension-only cable string<i> of {} N/m at {} N when drawn (rest length = drawn - tension / stiffness).\n{}",
+         Node k is n<k> (column k of N); bar i is strut bar<i> on its own body of {} kg, radius {} m; string i is the elastic tension-only cable string<i> of {} N/m (rest length = drawn - tension / stiffness).\n{}",
         n_path.display(),
         cb_path.display(),
         cs_path.display(),
         o.bar_mass_kg,
         o.bar_radius_m,
         o.string_stiffness_n_per_m,
-        o.string_tension_n,
         if grounded == 0 { "No node is off the bars: bar1 is held fixed to remove the rigid motion.".to_string() } else { format!("{grounded} node(s) on no bar are fixed points (body 'ground').") }
     )
 }
