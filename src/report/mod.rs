@@ -307,6 +307,9 @@ pub struct SettleSummary {
 pub struct CheckReport {
     pub quantity: String,
     pub unit: String,
+    /// How its error is measured, the one convention of `max_rel_error`, the transient
+    /// `_rel_` errors and the table: "length / L", "angle [rad]" or "relative".
+    pub convention: String,
     /// Largest error at the settle points, in the quantity's unit.
     pub max_abs_error: f64,
     /// Largest normalised error at the settle points (lengths / L, angles in rad, other
@@ -317,6 +320,9 @@ pub struct CheckReport {
     /// Every tick, including transients (reported, not checked).
     pub transient_max_abs_error: f64,
     pub transient_rms_abs_error: f64,
+    /// The same, normalised as `max_rel_error` is.
+    pub transient_max_rel_error: f64,
+    pub transient_rms_rel_error: f64,
     pub ticks_compared: u64,
     /// Settle points compared (points outside the analytic model's validity are not).
     pub points_compared: usize,
@@ -373,6 +379,11 @@ pub struct PointReport {
     /// dynamics landed on (absent without one).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub energy: Option<EnergyPointReport>,
+    /// Each judged quantity's error here as its verdict measures it (a check's normalised
+    /// error, a prediction's in its class, the probe's relative): what the table's point lines
+    /// show (the JSON has them per check, prediction and probe).
+    #[serde(skip)]
+    pub errors: Values,
 }
 
 /// The stationary points of a file's energy model at one settle point.
@@ -728,26 +739,28 @@ impl ScenarioReport {
         }
     }
 
-    /// One row per check: errors at the settle points, transient errors, verdict (nothing,
-    /// not even the header, without checks).
+    /// One row per check, every error in the convention its tolerance applies to (named
+    /// last): at the settle points, transient, verdict (nothing, not even the header, without
+    /// checks).
     fn table_checks(&self, out: &mut String) {
         if self.checks.is_empty() {
             return;
         }
+        let w = self.checks.iter().map(|c| c.quantity.len()).max().unwrap_or(0).max("check".len());
         out.push_str(&format!(
-            "   {:<10} {:>12} {:>12} {:>10} {:>12} {:>12}  {}\n",
-            "quantity", "max |err|", "max rel err", "tolerance", "transient", "rms trans.", "verdict"
+            "   {:<w$} {:>12} {:>10} {:>12} {:>12}  {}\n",
+            "check", "max err", "tolerance", "transient", "rms trans.", "verdict"
         ));
         for c in &self.checks {
             out.push_str(&format!(
-                "   {:<10} {:>12.3e} {:>12.3e} {:>10.1e} {:>12.3e} {:>12.3e}  {}\n",
+                "   {:<w$} {:>12.3e} {:>10.1e} {:>12.3e} {:>12.3e}  {} ({})\n",
                 c.quantity,
-                c.max_abs_error,
                 c.max_rel_error,
                 c.tolerance,
-                c.transient_max_abs_error,
-                c.transient_rms_abs_error,
-                if c.passed { "pass" } else { "FAIL" }
+                c.transient_max_rel_error,
+                c.transient_rms_rel_error,
+                if c.passed { "pass" } else { "FAIL" },
+                c.convention
             ));
         }
     }
@@ -964,18 +977,21 @@ impl ScenarioReport {
     fn table_points(&self, out: &mut String) {
         let shown = self.points.len().min(MAX_POINTS_IN_TABLE);
         for p in &self.points[..shown] {
-            out.push_str(&format!(
-                "   point {:>4}: {}  -> {}  [{}{}]\n",
-                p.index,
-                fmt_values(&p.inputs),
-                fmt_errors(&p.analytic, &p.simulated),
-                p.branch,
-                if p.settled {
-                    String::new()
-                } else {
-                    format!(", NOT SETTLED: kinetic energy {:.3e} J left", p.final_kinetic_energy_j)
-                }
-            ));
+            let compared = fmt_errors(p);
+            // A settled point with no inputs and nothing compared would be an empty line.
+            if !(p.inputs.is_empty() && compared.is_empty() && p.settled) {
+                out.push_str(&format!(
+                    "   point {:>4}: {}  -> {compared}  [{}{}]\n",
+                    p.index,
+                    fmt_values(&p.inputs),
+                    p.branch,
+                    if p.settled {
+                        String::new()
+                    } else {
+                        format!(", NOT SETTLED: kinetic energy {:.3e} J left", p.final_kinetic_energy_j)
+                    }
+                ));
+            }
             if let Some(modes) = p.energy.as_ref().and_then(|e| e.modes.as_ref()) {
                 let listed: Vec<String> = modes
                     .iter()
@@ -1029,15 +1045,15 @@ fn fmt_values(v: &Values) -> String {
     v.iter().map(|(k, x)| format!("{k}={x:.6}")).collect::<Vec<_>>().join(" ")
 }
 
-fn fmt_errors(analytic: &Values, simulated: &Values) -> String {
-    simulated
+/// Each simulated quantity with a closed form, and its error as its verdict measures it (the
+/// table's convention for it; none for a quantity nothing judges).
+fn fmt_errors(p: &PointReport) -> String {
+    p.simulated
         .iter()
-        .filter_map(|(k, s)| {
-            analytic.get(k).map(|a| {
-                // Angles (the papers' theta symbols) are compared modulo 2 pi.
-                let e = if k.starts_with("theta") { crate::mechanisms::wrap_angle(s - a) } else { s - a };
-                format!("{k}={s:.9} (err {:.1e})", e.abs())
-            })
+        .filter(|(k, _)| p.analytic.contains_key(*k))
+        .map(|(k, s)| match p.errors.get(k) {
+            Some(e) => format!("{k}={s:.9} (err {e:.1e})"),
+            None => format!("{k}={s:.9}"),
         })
         .collect::<Vec<_>>()
         .join(" ")

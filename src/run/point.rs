@@ -169,8 +169,9 @@ pub(super) fn settle_point(
     if let Some(st) = stable {
         runner.emit(format_args!("point {index}: equilibrium is {}", if st { "stable" } else { "unstable" }));
     }
+    let mut errors = Values::new();
     if let (Some(p), true) = (&sc.probe, s.settled) {
-        probe_point(runner, inputs, &prediction, p, (&mut landed, &mut simulated), probe_errors)?;
+        probe_point(runner, inputs, &prediction, p, (&mut landed, &mut simulated, &mut errors), probe_errors)?;
     }
     let slack_cables = slack_cables(runner, &s.snapshot);
     let slack_agrees = slack_agreement(runner, index, &prediction, &slack_cables);
@@ -204,6 +205,7 @@ pub(super) fn settle_point(
         min_clearance_m: None,
         interference_free: None,
         energy: None,
+        errors,
         paper: runner
             .mech
             .paper_values(&runner.params, inputs)
@@ -270,14 +272,14 @@ fn say_settled(runner: &mut Runner, sc: &Scenario, index: usize, s: &super::sett
 }
 
 /// The stiffness probe at a settled point: the measured stiffness among the simulated values,
-/// a joint probe's prediction among the analytic ones, and the relative error in
-/// `probe_errors`.
+/// a joint probe's prediction among the analytic ones, and the relative error in `errors`
+/// (the point's) and `probe_errors`.
 fn probe_point(
     runner: &mut Runner,
     inputs: &Values,
     prediction: &Prediction,
     p: &Probe,
-    (landed, simulated): (&mut Values, &mut Values),
+    (landed, simulated, errors): (&mut Values, &mut Values, &mut Values),
     probe_errors: &mut Vec<f64>,
 ) -> Result<(), Stop> {
     if let Some((quantity, k)) = runner.probe(inputs, prediction, p)? {
@@ -287,7 +289,9 @@ fn probe_point(
         if let Some(ka) = landed.get(&quantity) {
             // A prediction that is not a number (NaN) cannot pass: its error is infinite.
             let e = ((k - ka) / ka).abs();
-            probe_errors.push(if e.is_nan() { f64::INFINITY } else { e });
+            let e = if e.is_nan() { f64::INFINITY } else { e };
+            probe_errors.push(e);
+            errors.insert(quantity.clone(), e);
         }
         simulated.insert(quantity, k);
     }

@@ -34,6 +34,7 @@ mod param_sweep;
 mod prestress;
 mod recording;
 mod relaxation;
+mod report_table;
 mod restart;
 mod scripting;
 mod shipped_scenarios;
