@@ -173,3 +173,36 @@ fn a_sweep_without_closed_forms_draws_the_energy_equilibrium_and_the_measured_st
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The pinned bar's potential from the anchors' drawn coordinates: the two springs' energy
+/// k/2 |P - anchor|^2 with P = L (cos qe, sin qe), the anchors read as U.x, U.y, V.x, V.y.
+const POTENTIAL_OF_NODES: &str =
+    "0.5*k1*((L*cos(qe) - U.x)^2 + (L*sin(qe) - U.y)^2) + 0.5*k2*((L*cos(qe) - V.x)^2 + (L*sin(qe) - V.y)^2)";
+
+/// The `[energy]` potential may read the nodes of fixed bodies (here the anchors U and V,
+/// not typed again): swept over the anchor height a (0.6 and 1.0 m, the structure drawn again
+/// at each), the model's minimum is atan2(k1 a, k2 b) within 1e-12 rad at both, and the run
+/// passes (the dynamics within 1e-9 rad of it). An unknown node is an error at its name; a
+/// node of the free bar is an error saying so.
+#[test]
+fn the_potential_reads_the_drawn_anchors() {
+    let text = std::fs::read_to_string(BAR).unwrap();
+    let text = text.replace("\"-k1*a*L*sin(qe) - k2*b*L*cos(qe)\"", &format!("\"{POTENTIAL_OF_NODES}\""));
+    let swept = text.replace(
+        "grid = { k1 = { from = 10.0, to = 90.0, count = 9 } }",
+        "grid = { a = { from = 0.6, to = 1.0, count = 2 } }",
+    );
+    let sc = scenario::parse(Path::new("nodes.toml"), &swept).unwrap_or_else(|e| panic!("{e}"));
+    let r = run(&sc, &RunOptions::default());
+    assert!(r.passed, "{:?}", r.failures);
+    for p in &r.points {
+        let e = p.energy.as_ref().unwrap();
+        let landed = &e.stationary[e.landed.unwrap()];
+        let want = (50.0 * p.inputs["a"]).atan2(30.0 * 0.6);
+        assert!((landed.coordinates["qe"] - want).abs() <= 1e-12, "a = {}: {landed:?}", p.inputs["a"]);
+    }
+    let unknown = text.replacen("U.y)^2", "W.y)^2", 1);
+    common::error_at(&unknown, "W.y)^2", 0, "unknown symbol 'W.y'");
+    let free = text.replacen("U.y)^2", "P.y)^2", 1);
+    common::error_at(&free, "P.y)^2", 0, "node 'P' is on the free body 'bar'");
+}
