@@ -96,59 +96,26 @@ fn the_readme_example_runs_and_passes() {
     assert!(r.passed, "{:?}", r.error);
 }
 
-/// The defaults the README's table states, read off a structure that gives none: a 2 m bar of
-/// 3 kg on nodes (1, 0, 0) and (1, 2, 0) gets its centre of mass at the midpoint and the
-/// isotropic moment 3 x 2^2 / 12 = 1 kg m^2 (a uniform thin rod's about its middle) within
-/// 1e-15; a strut radius 0.01 m, a cable's and a spring's 0.001 m, a cable inextensible of the
-/// drawn length, a joint undamped without torsion spring at coordinate 0, no gravity, and the
-/// `[sim]` and `[settle]` defaults; the README's table says each.
+/// The defaults the README's table states, read off the pinned strut of `common.rs` with its
+/// gravity, joint damping and spring length taken out and a cable added: the 1 m bar of 1 kg on
+/// nodes (0, 0, 0) and (1, 0, 0) gets its centre of mass at the midpoint and the isotropic
+/// moment 1 x 1^2 / 12 kg m^2 (a uniform thin rod's about its middle) within 1e-15; a strut
+/// radius 0.01 m, a cable's and a spring's 0.001 m, a cable inextensible of the drawn length
+/// 1 m (the spring's too), a joint undamped without torsion spring at coordinate 0, no
+/// gravity, and the `[sim]` and `[settle]` defaults; the README's table says each.
 #[test]
 fn the_documented_defaults_are_the_structures() {
-    let text = r#"name = "defaults"
-mechanism = "custom"
-[actuation]
-points = [ {} ]
-[structure]
-[[structure.bodies]]
-name = "ground"
-fixed = true
-nodes = { O = [1.0, 0.0, 0.0], S = [3.0, 1.0, 0.0] }
-[[structure.bodies]]
-name = "bar"
-mass = 3.0
-nodes = { P = [1.0, 0.0, 0.0], Q = [1.0, 2.0, 0.0] }
-[[structure.struts]]
-name = "bar"
-a = "P"
-b = "Q"
-[[structure.cables]]
-name = "c"
-a = "Q"
-b = "S"
-[[structure.springs]]
-name = "k"
-a = "Q"
-b = "S"
-stiffness = 10.0
-[[structure.joints]]
-name = "pin"
-kind = "revolute"
-parent = "ground"
-child = "bar"
-at = "P"
-axis = [0.0, 0.0, 1.0]
-"#;
-    let sc = scenario::parse(Path::new("defaults.toml"), text).unwrap_or_else(|e| panic!("{e}"));
+    let text = common::PINNED_STRUT.replace("gravity = [0.0, 0.0, 0.0]\n", "").replace("damping = 0.5\n", "");
+    let text = text.replace("length = 0.5\n", "") + "[[structure.cables]]\nname = \"c\"\na = \"Q\"\nb = \"S\"\n";
+    let sc = scenario::parse(Path::new("defaults.toml"), &text).unwrap_or_else(|e| panic!("{e}"));
     let s = &sc.custom.as_ref().unwrap().structure;
     let i = s.bodies[1].inertia.as_ref().unwrap();
-    assert!(i.com.iter().zip([1.0, 1.0, 0.0]).all(|(a, b)| (a - b).abs() <= 1e-15), "{:?}", i.com);
-    assert!(i.principal_kg_m2.iter().all(|m| (m - 1.0).abs() <= 1e-15), "{:?}", i.principal_kg_m2);
+    assert!(i.com.iter().zip([0.5, 0.0, 0.0]).all(|(a, b)| (a - b).abs() <= 1e-15), "{:?}", i.com);
+    assert!(i.principal_kg_m2.iter().all(|m| (m - 1.0 / 12.0).abs() <= 1e-15), "{:?}", i.principal_kg_m2);
     assert_eq!((s.struts[0].radius_m, s.cables[0].radius_m, s.springs[0].radius_m), (0.01, 0.001, 0.001));
     assert_eq!(s.cables[0].law, tensegrity_testbed::structure::CableLaw::Inextensible);
-    assert!(
-        (s.cables[0].length_m - 5f64.sqrt()).abs() <= 1e-15
-            && (s.springs[0].rest_length_m - 5f64.sqrt()).abs() <= 1e-15
-    );
+    let drawn = 1.0;
+    assert!((s.cables[0].length_m - drawn).abs() <= 1e-15 && (s.springs[0].rest_length_m - drawn).abs() <= 1e-15);
     let j = &s.joints[0];
     assert_eq!((j.damping, j.torsion_spring.is_none(), j.initial_coordinate, s.gravity), (0.0, true, 0.0, [0.0; 3]));
     let (sim, settle) = (&sc.sim, &sc.settle);

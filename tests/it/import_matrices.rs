@@ -27,23 +27,8 @@ fn prism_files(dir: &Path) -> [PathBuf; 3] {
     let angle = |k: f64| 2.0 * std::f64::consts::PI * k / 3.0;
     let cols: Vec<P3> =
         (0..6).map(|i| [angle(i as f64).cos(), angle(i as f64).sin(), if i < 3 { 0.0 } else { 1.5 }]).collect();
-    let n: String =
-        (0..3).map(|r| cols.iter().map(|c| format!("{:?}", c[r])).collect::<Vec<_>>().join(", ") + "\n").collect();
-    let row = |a: usize, b: usize| {
-        (1..=6)
-            .map(|k| {
-                if k == a {
-                    "-1"
-                } else if k == b {
-                    "1"
-                } else {
-                    "0"
-                }
-            })
-            .collect::<Vec<_>>()
-            .join(",")
-            + "\n"
-    };
+    let n = node_matrix(&cols);
+    let row = |a: usize, b: usize| connectivity_row(a - 1, b - 1, 6);
     let cb: String = [(1, 5), (2, 6), (3, 4)].iter().map(|&(a, b)| row(a, b)).collect();
     let cs: String = [(1, 2), (2, 3), (3, 1), (4, 5), (5, 6), (6, 4), (1, 4), (2, 5), (3, 6)]
         .iter()
@@ -55,6 +40,27 @@ fn prism_files(dir: &Path) -> [PathBuf; 3] {
         std::fs::write(f, text).unwrap();
     }
     files
+}
+
+/// N as CSV text: one row per coordinate, one column per node.
+fn node_matrix(cols: &[P3]) -> String {
+    (0..3).map(|r| cols.iter().map(|c| format!("{:?}", c[r])).collect::<Vec<_>>().join(", ") + "\n").collect()
+}
+
+/// A connectivity row of `count` nodes: -1 at node `a`, 1 at node `b` (from 0), zeros.
+fn connectivity_row(a: usize, b: usize, count: usize) -> String {
+    let cells: Vec<&str> = (0..count)
+        .map(|k| {
+            if k == a {
+                "-1"
+            } else if k == b {
+                "1"
+            } else {
+                "0"
+            }
+        })
+        .collect();
+    cells.join(",") + "\n"
 }
 
 fn temp(name: &str) -> PathBuf {
@@ -171,22 +177,8 @@ fn n_prism_files(dir: &Path, n: usize, twist: f64) -> [PathBuf; 3] {
             [a.cos(), a.sin(), if top { 1.5 } else { 0.0 }]
         })
         .collect();
-    let n_text: String =
-        (0..3).map(|r| cols.iter().map(|c| format!("{:?}", c[r])).collect::<Vec<_>>().join(", ") + "\n").collect();
-    let row = |a: usize, b: usize| {
-        let cells: Vec<&str> = (0..2 * n)
-            .map(|k| {
-                if k == a {
-                    "-1"
-                } else if k == b {
-                    "1"
-                } else {
-                    "0"
-                }
-            })
-            .collect();
-        cells.join(",") + "\n"
-    };
+    let n_text = node_matrix(&cols);
+    let row = |a: usize, b: usize| connectivity_row(a, b, 2 * n);
     let cb: String = (0..n).map(|i| row(i, n + i)).collect();
     let mut cs: String = (0..n).map(|i| row(i, (i + 1) % n)).collect();
     cs += &(0..n).map(|i| row(n + i, n + (i + 1) % n)).collect::<String>();
