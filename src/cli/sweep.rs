@@ -80,7 +80,10 @@ pub fn sweep(
         say(&format!("required agreement {min:.2} %"));
     }
     if !summary.disagreements.is_empty() {
-        say(&format!("{} point(s) did not settle or are out of tolerance", summary.disagreements.len()));
+        say(&format!(
+            "{} point(s) did not settle, are out of tolerance or lost their prestress",
+            summary.disagreements.len()
+        ));
     }
     let passed = summary.passed && !signals::cancelled();
     say(if passed { "PASS" } else { "FAIL" });

@@ -97,3 +97,31 @@ fn bad_prestress_sections_are_located() {
     let bar = bar.replace("[expect]", "[prestress]\non_loss = \"warn\"\n\n[expect]");
     common::error_at(&bar, "[prestress]", 0, "this structure has no cables");
 }
+
+/// A sweep counts a point that lost its prestress as disagreeing: the slack prism's sweep
+/// fails (exit 1), its CSV row says `prestress_lost` true and the kept share is empty (no drawn
+/// tension); the shipped prism's row keeps 0.8747 of it (within 1e-4) and passes.
+#[test]
+fn a_sweep_fails_on_a_point_that_lost_its_prestress() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-prestress-sweep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cell = |csv: &str, name: &str| {
+        let mut lines = csv.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let row: Vec<&str> = lines.next().unwrap().split(',').collect();
+        row[header.iter().position(|h| *h == name).unwrap()].to_string()
+    };
+    let (slack, csv) = (dir.join("slack.toml"), dir.join("slack.csv"));
+    std::fs::write(&slack, slack_prism("")).unwrap();
+    let (code, out, err) = common::tensegrity(&["sweep", slack.to_str().unwrap(), "--out", csv.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("1 point(s) did not settle, are out of tolerance or lost their prestress"), "{out}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!((cell(&text, "prestress_lost").as_str(), cell(&text, "prestress_fraction").as_str()), ("true", ""));
+    let (code, out, err) = common::tensegrity(&["sweep", PRISM, "--out", csv.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let kept: f64 = cell(&text, "prestress_fraction").parse().unwrap();
+    assert!((kept - 0.8747).abs() <= 1e-4 && cell(&text, "prestress_lost") == "false", "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
