@@ -153,6 +153,38 @@ pub struct Check {
     pub tolerance: f64,
 }
 
+/// `[prestress]`: when the structure counts as having lost its self-stress, and what that does
+/// to the verdict. Lost at a settle point when every cable is slack there, or (with
+/// `min_fraction`) when the cables' total tension there falls below `min_fraction` of their
+/// total tension at the drawn state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prestress {
+    /// The smallest share of the drawn total cable tension a settled state may keep.
+    pub min_fraction: Option<f64>,
+    /// Whether a loss fails the run (`prestress`) or is reported as a warning.
+    pub on_loss: OnLoss,
+}
+
+/// What a loss of prestress does (`[prestress] on_loss`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OnLoss {
+    Fail,
+    Warn,
+}
+
+impl Prestress {
+    /// What a custom structure with cables gets without a `[prestress]` section: it fails
+    /// when every cable is slack at a settle point.
+    pub const DEFAULT: Prestress = Prestress { min_fraction: None, on_loss: OnLoss::Fail };
+
+    /// Whether a settled state of a structure of `cables` cables, `slack` of them slack,
+    /// keeping `fraction` of the drawn cable tension, has lost its self-stress.
+    pub fn lost(&self, cables: usize, slack: usize, fraction: Option<f64>) -> bool {
+        (cables > 0 && slack == cables) || self.min_fraction.zip(fraction).is_some_and(|(min, f)| !(f >= min))
+    }
+}
+
 /// The stiffness probe (`[probe]`): the mechanism's own, or one on a named joint.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Probe {
@@ -161,7 +193,9 @@ pub struct Probe {
     pub torque_nm: f64,
     /// A probe on a named joint of the structure, with its predicted stiffness.
     pub joint: Option<JointProbe>,
-    pub tolerance: f64,
+    /// On the relative stiffness error; None: a joint probe without a closed form, which
+    /// measures the stiffness and gives no verdict.
+    pub tolerance: Option<f64>,
 }
 
 /// A stiffness probe on a named revolute or prismatic joint: equal and opposite loads on its
@@ -174,15 +208,16 @@ pub struct JointProbe {
     pub index: usize,
     /// Prismatic (a force along the axis, N/m) rather than revolute (a torque, N m/rad).
     pub prismatic: bool,
-    /// The predicted stiffness, compiled against `symbols`.
-    pub expected: crate::file_model::expr::Expr,
+    /// The predicted stiffness, compiled against `symbols` (None: the probe only measures).
+    pub expected: Option<crate::file_model::expr::Expr>,
     /// The symbols `expected` may use: the parameters, then the inputs.
     pub symbols: Vec<String>,
 }
 
 impl PartialEq for JointProbe {
     fn eq(&self, other: &Self) -> bool {
-        self.joint == other.joint && self.expected.text() == other.expected.text()
+        self.joint == other.joint
+            && self.expected.as_ref().map(|e| e.text()) == other.expected.as_ref().map(|e| e.text())
     }
 }
 
@@ -192,11 +227,11 @@ impl JointProbe {
         format!("{}.stiffness", self.joint)
     }
 
-    /// The predicted stiffness with the point's parameters and inputs.
-    pub fn predicted(&self, params: &crate::mechanisms::Values, inputs: &crate::mechanisms::Values) -> f64 {
+    /// The predicted stiffness with the point's parameters and inputs (None: no closed form).
+    pub fn predicted(&self, params: &crate::mechanisms::Values, inputs: &crate::mechanisms::Values) -> Option<f64> {
         let values: Vec<f64> =
             self.symbols.iter().map(|s| inputs.get(s).or_else(|| params.get(s)).copied().unwrap_or(f64::NAN)).collect();
-        self.expected.eval(&values)
+        self.expected.as_ref().map(|e| e.eval(&values))
     }
 }
 

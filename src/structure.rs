@@ -279,6 +279,21 @@ impl Structure {
         self.actuators.iter().position(|a| a.symbol == symbol)
     }
 
+    /// The cables' total tension at the drawn state [N]: each elastic cable's stiffness times
+    /// its stretch past its rest length (an inextensible cable carries none until loaded).
+    pub fn drawn_cable_tension_n(&self) -> f64 {
+        self.cables
+            .iter()
+            .map(|c| match c.law {
+                CableLaw::Elastic { stiffness_n_per_m } => {
+                    let l = distance(self.nodes[c.a].position, self.nodes[c.b].position);
+                    stiffness_n_per_m * (l - c.length_m).max(0.0)
+                }
+                CableLaw::Inextensible => 0.0,
+            })
+            .sum()
+    }
+
     pub fn node_id(&self, name: &str) -> Option<NodeId> {
         self.nodes.iter().position(|n| n.name == name)
     }

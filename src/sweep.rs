@@ -51,7 +51,8 @@ pub struct SweepSummary {
     /// The scenario's `[workspace] min_agreement_percent`: a workspace sweep passes on the
     /// agreement instead of on every point (as `run` judges it).
     pub min_agreement_percent: Option<f64>,
-    /// Points that did not settle or had a check out of tolerance.
+    /// Points that did not settle, had a check out of tolerance or lost the prestress (where
+    /// `[prestress] on_loss` fails).
     pub disagreements: Vec<usize>,
     /// Errors of the blocks that stopped early (divergence, interruption).
     pub errors: Vec<String>,
@@ -211,6 +212,8 @@ fn summarise(
             .iter()
             .filter(|r| {
                 !r.point.settled
+                    || (r.point.prestress_lost == Some(true)
+                        && sc.prestress.as_ref().is_some_and(|p| p.on_loss == crate::settings::OnLoss::Fail))
                     || (!r.point.within_tolerance && r.point.expected_slack.as_ref().is_none_or(|e| e.is_empty()))
             })
             .map(|r| r.index)
@@ -294,6 +297,7 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool, sweep: &str) -> Str
         }
     }
     quantities.sort();
+    let energy = EnergyColumns::of(rows);
     let mut header = vec!["index".to_string(), "grid_points".to_string()];
     header.extend(inputs.iter().cloned());
     for q in &quantities {
@@ -301,6 +305,7 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool, sweep: &str) -> Str
         header.push(format!("simulated_{q}"));
         header.push(format!("error_{q}"));
     }
+    header.extend(energy.header());
     header.extend(
         [
             "settled",
@@ -310,6 +315,8 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool, sweep: &str) -> Str
             "branch",
             "slack_cables",
             "expected_slack",
+            "prestress_fraction",
+            "prestress_lost",
             "min_clearance_m",
             "sweep",
         ]
@@ -329,6 +336,7 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool, sweep: &str) -> Str
             let error = |(a, s): (f64, f64)| if is_angle(q) { crate::mechanisms::wrap_angle(s - a) } else { s - a };
             cells.push(opt(a.zip(s).map(error)));
         }
+        cells.extend(energy.cells(p));
         cells.push(p.settled.to_string());
         cells.push(p.steps.to_string());
         cells.push(p.within_tolerance.to_string());
@@ -336,12 +344,83 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool, sweep: &str) -> Str
         cells.push(format!("\"{}\"", p.branch.replace('"', "'")));
         cells.push(p.slack_cables.join(";"));
         cells.push(p.expected_slack.as_ref().map(|e| e.join(";")).unwrap_or_default());
+        cells.push(opt(p.prestress_fraction));
+        cells.push(p.prestress_lost.map(|b| b.to_string()).unwrap_or_default());
         cells.push(opt(p.min_clearance_m));
         cells.push(sweep.to_string());
         out.push_str(&cells.join(","));
         out.push('\n');
     }
     out
+}
+
+/// The columns of the `[energy]` model's stationary points: the one landed on
+/// (`equilibrium_COORD`, `equilibrium_energy`, `equilibrium_eigenvalue_K`, `equilibrium_kind`,
+/// `equilibrium_index`), then every one found (`stationary_I_...`, I from 0, as many as the
+/// point with the most), each with its coordinates, energy, Hessian eigenvalues (ascending,
+/// K from 1) and kind.
+struct EnergyColumns {
+    coordinates: Vec<String>,
+    /// Hessian eigenvalues per stationary point (the number of coordinates).
+    eigenvalues: usize,
+    /// Stationary points of the point with the most.
+    stationary: usize,
+}
+
+impl EnergyColumns {
+    fn of(rows: &[Row]) -> Self {
+        let reports = || rows.iter().filter_map(|r| r.point.energy.as_ref());
+        let coordinates: Vec<String> =
+            reports().next().map(|e| e.measured.keys().cloned().collect()).unwrap_or_default();
+        let stationary = reports().map(|e| e.stationary.len()).max().unwrap_or(0);
+        EnergyColumns { eigenvalues: coordinates.len(), coordinates, stationary }
+    }
+
+    /// The names of one stationary point's columns, after `prefix`.
+    fn point_header(&self, prefix: &str) -> Vec<String> {
+        let mut h: Vec<String> = self.coordinates.iter().map(|c| format!("{prefix}_{c}")).collect();
+        h.push(format!("{prefix}_energy"));
+        h.extend((1..=self.eigenvalues).map(|k| format!("{prefix}_eigenvalue_{k}")));
+        h.push(format!("{prefix}_kind"));
+        h
+    }
+
+    fn header(&self) -> Vec<String> {
+        if self.coordinates.is_empty() {
+            return Vec::new();
+        }
+        let mut h = self.point_header("equilibrium");
+        h.push("equilibrium_index".into());
+        for i in 0..self.stationary {
+            h.extend(self.point_header(&format!("stationary_{i}")));
+        }
+        h
+    }
+
+    /// One stationary point's cells (empty where there is none).
+    fn point_cells(&self, s: Option<&crate::report::StationaryReport>) -> Vec<String> {
+        let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+        let mut c: Vec<String> =
+            self.coordinates.iter().map(|k| opt(s.and_then(|s| s.coordinates.get(k).copied()))).collect();
+        c.push(opt(s.map(|s| s.energy)));
+        c.extend((0..self.eigenvalues).map(|k| opt(s.and_then(|s| s.eigenvalues.get(k).copied()))));
+        c.push(s.map(|s| s.kind.clone()).unwrap_or_default());
+        c
+    }
+
+    fn cells(&self, p: &PointReport) -> Vec<String> {
+        if self.coordinates.is_empty() {
+            return Vec::new();
+        }
+        let e = p.energy.as_ref();
+        let landed = e.and_then(|e| e.landed);
+        let mut c = self.point_cells(e.zip(landed).and_then(|(e, i)| e.stationary.get(i)));
+        c.push(landed.map(|i| i.to_string()).unwrap_or_default());
+        for i in 0..self.stationary {
+            c.extend(self.point_cells(e.and_then(|e| e.stationary.get(i))));
+        }
+        c
+    }
 }
 
 /// Joins shard CSVs (same header) into one, rows ordered by grid index; a point present twice

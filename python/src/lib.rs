@@ -313,14 +313,20 @@ fn structure_from_arrays(
     pins: Vec<(String, Option<[f64; 3]>)>,
     quantities: Vec<(String, String)>,
 ) -> PyResult<String> {
-    use tensegrity_testbed::import::matrices::{from_arrays, MemberProperties, StringRest};
-    let string_rest = match (string_tension_n, string_rest_length_m) {
+    use tensegrity_testbed::import::matrices::{from_arrays, DrawnTension, MemberProperties, StringRest};
+    use tensegrity_testbed::import::DEFAULT_LEAST_TENSION_N;
+    // Neither given: the drawn structure's self-stress, its least string tension the CLI's
+    // default (as `tensegrity import matrices` chooses).
+    let (string_rest, prestress) = match (string_tension_n, string_rest_length_m) {
         (Some(_), Some(_)) => {
             return Err(PyValueError::new_err("give string_tension_n or string_rest_length_m, not both"))
         }
-        (Some(t), None) => StringRest::TensionN(t),
-        (None, Some(l)) => StringRest::LengthM(l),
-        (None, None) => StringRest::TensionN(vec![0.0; cs.len()]),
+        (Some(t), None) => (StringRest::TensionN(t), DrawnTension::AsGiven),
+        (None, Some(l)) => (StringRest::LengthM(l), DrawnTension::AsGiven),
+        (None, None) => (
+            StringRest::TensionN(vec![DEFAULT_LEAST_TENSION_N; cs.len()]),
+            DrawnTension::SelfStress { least_n: DEFAULT_LEAST_TENSION_N },
+        ),
     };
     let p = MemberProperties {
         bar_mass_kg,
@@ -330,6 +336,7 @@ fn structure_from_arrays(
         tension_only,
         pins,
         quantities,
+        prestress,
     };
     Ok(from_arrays(name, &n, &cb, &cs, &p).map_err(array_error)?.toml)
 }

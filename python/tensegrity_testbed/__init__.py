@@ -268,7 +268,10 @@ def from_matrices(
     Member properties, each one number or an array of one per member (rows of Cb or Cs):
     ``bar_mass_kg`` [kg], ``bar_radius_m`` [m], ``string_stiffness_n_per_m`` [N/m], and the
     strings' rest lengths, from ``string_tension_n`` [N] at the drawn length (rest = drawn -
-    tension / stiffness; default 0 N) or given as ``string_rest_length_m`` [m].
+    tension / stiffness) or given as ``string_rest_length_m`` [m]. Neither given: the drawn
+    structure's own self-stress with its least string tension 10 N (every string at 10 N where
+    the drawing has none with every string taut), as ``tensegrity import matrices`` chooses;
+    the scenario's description says which.
     ``tension_only``: True (default) for cables, False (one or per string) for linear springs
     that push as well (zero rest length allowed). ``pins``: bar nodes joined to the ground,
     ``{"n1": (0, 0, 1)}`` a revolute joint ``pin_n1`` about that axis, ``{"n1": None}`` a
@@ -283,9 +286,10 @@ def from_matrices(
     cb = _matrix("Cb", Cb, cols=n.shape[1])
     cs = _matrix("Cs", Cs, cols=n.shape[1])
     bars, strings = cb.shape[0], cs.shape[0]
-    if string_rest_length_m is None:
-        tension = _per_member("string_tension_n", 0.0 if string_tension_n is None else string_tension_n, strings, "string")
-        rest = None
+    if string_rest_length_m is None and string_tension_n is None:
+        tension, rest = None, None
+    elif string_rest_length_m is None:
+        tension, rest = _per_member("string_tension_n", string_tension_n, strings, "string"), None
     elif string_tension_n is None:
         tension, rest = None, _per_member("string_rest_length_m", string_rest_length_m, strings, "string")
     else:

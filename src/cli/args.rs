@@ -1,6 +1,7 @@
 //! The command line's grammar: every subcommand and flag (clap derive), parsed and nothing
 //! else. What each command does is in its own file beside this one.
 
+use crate::import::matrices::MatrixOptions;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
@@ -239,17 +240,22 @@ pub enum ImportFormat {
         #[arg(long)]
         out: Option<PathBuf>,
         /// Mass of each bar [kg].
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = MatrixOptions::DEFAULT.bar_mass_kg)]
         bar_mass: f64,
         /// Radius of each bar [m].
-        #[arg(long, default_value_t = 0.01)]
+        #[arg(long, default_value_t = MatrixOptions::DEFAULT.bar_radius_m)]
         bar_radius: f64,
         /// Stiffness of each string [N/m].
-        #[arg(long, default_value_t = 1000.0)]
+        #[arg(long, default_value_t = MatrixOptions::DEFAULT.string_stiffness_n_per_m)]
         string_stiffness: f64,
-        /// Tension of each string at its drawn length [N] (sets its rest length).
-        #[arg(long, default_value_t = 10.0)]
+        /// The least string tension at the drawn state [N]: the drawn structure's self-stress
+        /// scaled to it sets each string's rest length (every string at it with
+        /// --uniform-tension, or when the drawing has no self-stress with every string taut).
+        #[arg(long, default_value_t = MatrixOptions::DEFAULT.string_tension_n)]
         string_tension: f64,
+        /// Every string at --string-tension, whatever the drawn structure's self-stress.
+        #[arg(long)]
+        uniform_tension: bool,
     },
 }
 

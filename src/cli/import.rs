@@ -13,17 +13,30 @@ pub fn import(format: ImportFormat) -> Result<Outcome, CliError> {
             for s in &imported.skipped {
                 eprintln!("skipped: {s}");
             }
+            imported.chosen.iter().for_each(|c| eprintln!("chose: {c}"));
             write_output(out.as_deref(), &[file], &imported.toml)
         }
-        ImportFormat::Matrices { n, cb, cs, out, bar_mass, bar_radius, string_stiffness, string_tension } => {
+        ImportFormat::Matrices {
+            n,
+            cb,
+            cs,
+            out,
+            bar_mass,
+            bar_radius,
+            string_stiffness,
+            string_tension,
+            uniform_tension,
+        } => {
             let o = MatrixOptions {
                 bar_mass_kg: bar_mass,
                 bar_radius_m: bar_radius,
                 string_stiffness_n_per_m: string_stiffness,
                 string_tension_n: string_tension,
+                uniform_tension,
             };
             o.validate().map_err(bad_input)?;
             let imported = crate::import::matrices::import(&n, &cb, &cs, &o).map_err(bad_input)?;
+            imported.chosen.iter().for_each(|c| eprintln!("chose: {c}"));
             write_output(out.as_deref(), &[n, cb, cs], &imported.toml)
         }
     }

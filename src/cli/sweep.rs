@@ -64,7 +64,14 @@ pub fn sweep(
         write_atomic(csv, &csv_text())?;
     }
     if let Some(f) = &o.figure {
-        crate::figures::sweep::draw(&rows, &summary.scenario, o.x.as_deref(), &is_angle, f).map_err(super::failed)?;
+        let measured: Vec<String> = sc
+            .probe
+            .iter()
+            .filter(|p| p.tolerance.is_none())
+            .filter_map(|p| p.joint.as_ref().map(|j| j.quantity()))
+            .collect();
+        let titled = (summary.scenario.as_str(), o.x.as_deref());
+        crate::figures::sweep::draw(&rows, titled, &measured, &is_angle, f).map_err(super::failed)?;
     }
     if let Some(j) = &o.json {
         write_atomic(j, &serde_json::to_string_pretty(&summary).unwrap_or_default())?;
@@ -73,7 +80,10 @@ pub fn sweep(
         say(&format!("required agreement {min:.2} %"));
     }
     if !summary.disagreements.is_empty() {
-        say(&format!("{} point(s) did not settle or are out of tolerance", summary.disagreements.len()));
+        say(&format!(
+            "{} point(s) did not settle, are out of tolerance or lost their prestress",
+            summary.disagreements.len()
+        ));
     }
     let passed = summary.passed && !signals::cancelled();
     say(if passed { "PASS" } else { "FAIL" });

@@ -716,7 +716,7 @@ fn probe_points() -> Result<(ji::Params, Vec<Probe>, f64), FigureError> {
             },
         })
         .collect();
-    let tolerance = sc.probe.as_ref().map_or(f64::NAN, |pr| pr.tolerance);
+    let tolerance = sc.probe.as_ref().and_then(|pr| pr.tolerance).unwrap_or(f64::NAN);
     Ok((p, probes, tolerance))
 }
 

@@ -1,7 +1,9 @@
 //! `tensegrity sweep S.toml --figure FILE.png|FILE.svg`: any sweep drawn against one of its
-//! axes (an input or a swept parameter): per compared quantity (checks, predictions, probed
-//! stiffness) the analytic values as lines and the settled ones as dots, one series per value
-//! of the other axes; below, log10 of every quantity's error.
+//! axes (an input or a swept parameter), one series per value of the other axes: per compared
+//! quantity (checks, predictions, probed stiffness) the closed form as a line and the settled
+//! values as dots; a probe's stiffness without a closed form as dots; the `[energy]` model's
+//! equilibrium landed on (a line, the settled coordinates as dots) and its Hessian eigenvalues
+//! there (lines); below, log10 of every error.
 
 use super::kit::{self, range, titled_page, FigureError, Format, Plot};
 use crate::sweep::Row;
@@ -10,7 +12,7 @@ use plotters::prelude::*;
 use std::path::Path;
 
 /// Quantities drawn in panels of their own (the error panel shows them all).
-const MAX_PANELS: usize = 4;
+const MAX_PANELS: usize = 6;
 /// Width and height of a sweep figure [px]: a panel's height per quantity, plus the errors.
 const WIDTH_PX: u32 = 900;
 const PANEL_PX: u32 = 260;
@@ -24,8 +26,10 @@ struct SweepPlot {
     title: String,
     x: String,
     quantities: Vec<String>,
+    /// Each quantity's panel caption: what its line and its dots are.
+    captions: Vec<String>,
     /// Per series (one value of the other axes): its label and its rows' (x, analytic,
-    /// simulated, |error|) per quantity, sorted by x.
+    /// simulated, |error|) per quantity, sorted by x; NaN where a point has no such value.
     series: Vec<(String, Vec<Vec<(f64, f64, f64, f64)>>)>,
 }
 
@@ -54,19 +58,98 @@ fn x_axis(rows: &[Row], x: Option<&str>) -> Result<String, FigureError> {
         .ok_or_else(|| FigureError::Data("the sweep has no axis".into()))
 }
 
-fn data(rows: &[Row], title: &str, x: Option<&str>, is_angle: &dyn Fn(&str) -> bool) -> Result<SweepPlot, FigureError> {
-    let x = x_axis(rows, x)?;
-    let mut quantities: Vec<String> = Vec::new();
+/// Where a panel's values come from.
+#[derive(Clone, Debug, PartialEq)]
+enum Source {
+    /// A quantity with a closed form (a check, a prediction, a probe's `expected`): the closed
+    /// form as a line, the settled values as dots.
+    Compared(String),
+    /// A quantity only measured (a probe without a closed form): the settled values as dots.
+    Measured(String),
+    /// A coordinate of the `[energy]` model: the stationary point landed on as a line, the
+    /// coordinate read off the settled state as dots.
+    Equilibrium(String),
+    /// The Hessian's eigenvalue K (from 0, ascending) at the stationary point landed on.
+    Eigenvalue(usize),
+}
+
+impl Source {
+    fn name(&self) -> String {
+        match self {
+            Source::Compared(q) | Source::Measured(q) => q.clone(),
+            Source::Equilibrium(c) => format!("equilibrium {c}"),
+            Source::Eigenvalue(k) => format!("eigenvalue {}", k + 1),
+        }
+    }
+
+    fn caption(&self) -> String {
+        match self {
+            Source::Compared(q) => format!("{q}: closed form (line), settled (dots)"),
+            Source::Measured(q) => format!("{q}: measured (dots), no closed form"),
+            Source::Equilibrium(c) => format!("{c}: energy model's equilibrium landed on (line), settled (dots)"),
+            Source::Eigenvalue(k) => format!("energy model's Hessian eigenvalue {} at that equilibrium (line)", k + 1),
+        }
+    }
+
+    /// The line's and the dots' value at one point (NaN where there is none).
+    fn values(&self, p: &crate::report::PointReport) -> (f64, f64) {
+        let landed = || p.energy.as_ref().and_then(|e| e.stationary.get(e.landed?));
+        let nan = f64::NAN;
+        match self {
+            Source::Compared(q) => {
+                (p.analytic.get(q).copied().unwrap_or(nan), p.simulated.get(q).copied().unwrap_or(nan))
+            }
+            Source::Measured(q) => (nan, p.simulated.get(q).copied().unwrap_or(nan)),
+            Source::Equilibrium(c) => (
+                landed().and_then(|s| s.coordinates.get(c).copied()).unwrap_or(nan),
+                p.energy.as_ref().and_then(|e| e.measured.get(c).copied()).unwrap_or(nan),
+            ),
+            Source::Eigenvalue(k) => (landed().and_then(|s| s.eigenvalues.get(*k).copied()).unwrap_or(nan), nan),
+        }
+    }
+
+    /// The quantity whose errors are wrapped when it is an angle.
+    fn angle_name(&self) -> Option<&str> {
+        match self {
+            Source::Compared(q) | Source::Equilibrium(q) => Some(q),
+            _ => None,
+        }
+    }
+}
+
+/// The panels of a sweep: the compared quantities, the `measured` ones (a probe without a
+/// closed form), the energy model's equilibrium coordinates and Hessian eigenvalues.
+fn sources(rows: &[Row], measured: &[String]) -> Vec<Source> {
+    let mut out: Vec<Source> = Vec::new();
     for r in rows {
         for q in r.point.analytic.keys().filter(|q| r.point.simulated.contains_key(*q)) {
-            if !quantities.contains(q) {
-                quantities.push(q.clone());
+            if !out.contains(&Source::Compared(q.clone())) {
+                out.push(Source::Compared(q.clone()));
             }
         }
     }
-    if quantities.is_empty() {
+    let seen = |q: &String| rows.iter().any(|r| r.point.simulated.contains_key(q));
+    out.extend(measured.iter().filter(|q| seen(q)).map(|q| Source::Measured(q.clone())));
+    if let Some(e) = rows.iter().find_map(|r| r.point.energy.as_ref()) {
+        out.extend(e.measured.keys().map(|c| Source::Equilibrium(c.clone())));
+        out.extend((0..e.measured.len()).map(Source::Eigenvalue));
+    }
+    out
+}
+
+fn data(
+    rows: &[Row],
+    title: &str,
+    x: Option<&str>,
+    measured: &[String],
+    is_angle: &dyn Fn(&str) -> bool,
+) -> Result<SweepPlot, FigureError> {
+    let x = x_axis(rows, x)?;
+    let sources = sources(rows, measured);
+    if sources.is_empty() {
         return Err(FigureError::Data(
-            "the sweep compares no quantity (no check, prediction or probe): nothing to draw".into(),
+            "the sweep compares or measures no quantity (no check, prediction, probe or energy model): nothing to draw"
+                .into(),
         ));
     }
     let mut series: Vec<(String, Vec<Vec<(f64, f64, f64, f64)>>)> = Vec::new();
@@ -78,22 +161,23 @@ fn data(rows: &[Row], title: &str, x: Option<&str>, is_angle: &dyn Fn(&str) -> b
         let at = match series.iter().position(|(l, _)| *l == label) {
             Some(i) => i,
             None => {
-                series.push((label, vec![Vec::new(); quantities.len()]));
+                series.push((label, vec![Vec::new(); sources.len()]));
                 series.len() - 1
             }
         };
-        for (i, q) in quantities.iter().enumerate() {
-            if let (Some(a), Some(s)) = (p.analytic.get(q), p.simulated.get(q)) {
-                let d = s - a;
-                let e = if is_angle(q) { crate::mechanisms::wrap_angle(d) } else { d };
-                series[at].1[i].push((p.inputs[&x], *a, *s, e.abs()));
-            }
+        for (i, q) in sources.iter().enumerate() {
+            let (a, s) = q.values(p);
+            let d = s - a;
+            let e = if q.angle_name().is_some_and(is_angle) { crate::mechanisms::wrap_angle(d) } else { d };
+            series[at].1[i].push((p.inputs[&x], a, s, e.abs()));
         }
     }
     for (_, per_q) in &mut series {
         per_q.iter_mut().for_each(|v| v.sort_by(|a, b| a.0.total_cmp(&b.0)));
     }
-    Ok(SweepPlot { title: title.to_string(), x, quantities, series })
+    let captions = sources.iter().map(Source::caption).collect();
+    let quantities = sources.iter().map(Source::name).collect();
+    Ok(SweepPlot { title: title.to_string(), x, quantities, captions, series })
 }
 
 impl Plot for SweepPlot {
@@ -113,27 +197,34 @@ impl Plot for SweepPlot {
         for (i, q) in d.quantities.iter().take(shown).enumerate() {
             let mut ys = all(|p| p.1, Some(i));
             ys.extend(all(|p| p.2, Some(i)));
+            ys.retain(|y| y.is_finite());
             let mut chart = ChartBuilder::on(&panels[i])
                 .margin(10)
                 .x_label_area_size(35)
                 .y_label_area_size(80)
-                .caption(format!("{q}: analytic (line), settled (dots)"), ("sans-serif", 16))
+                .caption(d.captions[i].as_str(), ("sans-serif", 16))
                 .build_cartesian_2d(xs.clone(), range(&ys))?;
             chart.configure_mesh().x_desc(d.x.as_str()).y_desc(q.as_str()).draw()?;
             for (k, (label, per_q)) in d.series.iter().enumerate() {
                 let c = PALETTE[k % PALETTE.len()];
                 let v = &per_q[i];
                 chart
-                    .draw_series(LineSeries::new(v.iter().map(|p| (p.0, p.1)), c.stroke_width(2)))?
+                    .draw_series(LineSeries::new(
+                        v.iter().filter(|p| p.1.is_finite()).map(|p| (p.0, p.1)),
+                        c.stroke_width(2),
+                    ))?
                     .label(label.clone())
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
-                chart.draw_series(v.iter().map(|p| Circle::new((p.0, p.2), 4, c.filled())))?;
+                chart.draw_series(
+                    v.iter().filter(|p| p.2.is_finite()).map(|p| Circle::new((p.0, p.2), 4, c.filled())),
+                )?;
             }
             if d.series.len() > 1 {
                 chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw()?;
             }
         }
-        let logs: Vec<f64> = all(|p| p.3.max(ERROR_FLOOR).log10(), None);
+        let mut logs: Vec<f64> = all(|p| p.3.max(ERROR_FLOOR).log10(), None);
+        logs.retain(|y| y.is_finite());
         let mut chart = ChartBuilder::on(&panels[shown])
             .margin(10)
             .x_label_area_size(35)
@@ -146,7 +237,8 @@ impl Plot for SweepPlot {
             let points: Vec<(f64, f64)> = d
                 .series
                 .iter()
-                .flat_map(|(_, per_q)| per_q[i].iter().map(|p| (p.0, p.3.max(ERROR_FLOOR).log10())))
+                .flat_map(|(_, per_q)| per_q[i].iter().filter(|p| p.3.is_finite()))
+                .map(|p| (p.0, p.3.max(ERROR_FLOOR).log10()))
                 .collect();
             chart
                 .draw_series(points.iter().map(|p| Cross::new(*p, 5, c.stroke_width(2))))?
@@ -160,15 +252,16 @@ impl Plot for SweepPlot {
 
 /// Draws the sweep `rows` of scenario `title` against axis `x` (default: the axis with the
 /// most values) to `out`, PNG or SVG by its extension (written to a temporary file and
-/// renamed when complete).
+/// renamed when complete); `measured` names the quantities only measured (a probe without a
+/// closed form), drawn as dots alone.
 pub fn draw(
     rows: &[Row],
-    title: &str,
-    x: Option<&str>,
+    (title, x): (&str, Option<&str>),
+    measured: &[String],
     is_angle: &dyn Fn(&str) -> bool,
     out: &Path,
 ) -> Result<(), FigureError> {
-    let d = data(rows, title, x, is_angle)?;
+    let d = data(rows, title, x, measured, is_angle)?;
     let format = Format::of(out).ok_or_else(|| FigureError::Extension(out.to_path_buf()))?;
     let size = (WIDTH_PX, PANEL_PX * (d.quantities.len().min(MAX_PANELS) as u32 + 1) + 40);
     kit::write(&[(out.to_path_buf(), format)], size, |canvas| canvas.draw(&d))

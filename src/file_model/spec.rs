@@ -144,6 +144,12 @@ impl ModelSpec {
         self.predictions.iter().any(|p| p.class == ErrorClass::Angle && self.symbols[p.symbol].name == name)
     }
 
+    /// Whether `name` is an `[energy]` coordinate of class angle.
+    pub fn is_angle_coordinate(&self, name: &str) -> bool {
+        let coordinates = self.energy.iter().flat_map(|e| &e.coordinates);
+        coordinates.into_iter().any(|c| c.name == name && c.class == ErrorClass::Angle)
+    }
+
     /// Whether symbol `i` is a closed form of the parameters and inputs.
     pub fn is_closed_form(&self, i: usize) -> bool {
         match self.symbols[i].source {

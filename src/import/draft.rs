@@ -61,6 +61,10 @@ pub struct Draft {
     pub quantities: Vec<(String, String)>,
 }
 
+/// The share of its drawn cable tension an imported structure must keep at its settled
+/// state (`[prestress] min_fraction` written with every import whose cables are drawn taut).
+pub const IMPORTED_MIN_FRACTION: f64 = 0.1;
+
 /// Time step as a fraction of the fastest body's period scale sqrt(m / sum k) (the prism of
 /// `scenarios/custom/prism3.toml`: 0.05 x sqrt(1 kg / 100 N/m) = 0.005 s, its own step).
 const DT_FRACTION: f64 = 0.05;
@@ -116,6 +120,14 @@ fn xyz(v: Vec3, what: &str) -> Result<String, String> {
 impl Draft {
     fn position(&self, node: &str) -> Option<Vec3> {
         self.bodies.iter().flat_map(|b| &b.nodes).find(|(n, _)| n == node).map(|(_, p)| *p)
+    }
+
+    /// Whether an elastic cable is drawn longer than its rest length (in tension when drawn).
+    fn drawn_taut(&self) -> bool {
+        self.cables.iter().any(|c| {
+            let drawn = self.position(&c.a).zip(self.position(&c.b)).map(|(a, b)| distance(a, b));
+            c.stiffness_n_per_m.is_some() && drawn.is_some_and(|l| l > c.length_m)
+        })
     }
 
     /// Size of the structure [m]: the largest distance between two nodes (at least 1e-3).
@@ -251,6 +263,14 @@ impl Draft {
         }
         for (name, expr) in &self.quantities {
             let _ = writeln!(t, "\n[[quantities]]\nname = {}\nexpr = {}", quote(name), quote(expr));
+        }
+        if self.drawn_taut() {
+            let _ = write!(
+                t,
+                "\n# Written by the import: the run fails if the structure loses its self-stress (every cable\n\
+                 # slack, or its cables' total tension below this share of the drawn one).\n\
+                 [prestress]\nmin_fraction = {IMPORTED_MIN_FRACTION:?}\non_loss = \"fail\"\n"
+            );
         }
         Ok(t)
     }

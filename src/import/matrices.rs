@@ -24,11 +24,24 @@ pub struct MatrixOptions {
     pub bar_radius_m: f64,
     /// Stiffness of each string [N/m].
     pub string_stiffness_n_per_m: f64,
-    /// Tension of each string at its drawn length [N] (sets its rest length).
+    /// The least string tension at the drawn state [N]: the drawn structure's self-stress is
+    /// scaled to it (each string's rest length set by its share); with `uniform_tension`, or
+    /// when the drawing has no self-stress with every string in tension, every string's.
     pub string_tension_n: f64,
+    /// Every string at `string_tension_n`, whatever the self-stress.
+    pub uniform_tension: bool,
 }
 
 impl MatrixOptions {
+    /// The command's defaults.
+    pub const DEFAULT: MatrixOptions = MatrixOptions {
+        bar_mass_kg: 1.0,
+        bar_radius_m: 0.01,
+        string_stiffness_n_per_m: 1000.0,
+        string_tension_n: super::DEFAULT_LEAST_TENSION_N,
+        uniform_tension: false,
+    };
+
     /// Every option in its range, or the first that is not, named by its flag.
     pub fn validate(&self) -> Result<(), String> {
         let positive = [
@@ -55,6 +68,11 @@ impl MatrixOptions {
             tension_only: vec![true; strings],
             pins: Vec::new(),
             quantities: Vec::new(),
+            prestress: if self.uniform_tension {
+                DrawnTension::AsGiven
+            } else {
+                DrawnTension::SelfStress { least_n: self.string_tension_n }
+            },
         }
     }
 }
@@ -85,6 +103,18 @@ pub struct MemberProperties {
     pub pins: Vec<(String, Option<Vec3>)>,
     /// `[[quantities]]` of the scenario: (name, expression of the state).
     pub quantities: Vec<(String, String)>,
+    /// How the strings' tensions at the drawn state are chosen.
+    pub prestress: DrawnTension,
+}
+
+/// How the strings' tensions at the drawn state are chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DrawnTension {
+    /// The drawn structure's own self-stress, scaled so that its least string tension is
+    /// `least_n` [N] (each string's rest length then follows from its stiffness).
+    SelfStress { least_n: f64 },
+    /// Each string's tension or rest length as [`MemberProperties::string_rest`] gives it.
+    AsGiven,
 }
 
 impl MemberProperties {
@@ -201,7 +231,7 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
     let bars = members(cb_path, &read_matrix(cb_path)?, nodes.len())?;
     let strings = members(cs_path, &read_matrix(cs_path)?, nodes.len())?;
     let p = o.per_member(bars.len(), strings.len());
-    let (mut draft, grounded) = build([n_path, cb_path, cs_path], &nodes, &bars, &strings, &p)?;
+    let (mut draft, grounded, chosen) = build([n_path, cb_path, cs_path], &nodes, &bars, &strings, &p)?;
     draft.name = format!(
         "{} (from N, C_b, C_s)",
         n_path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default()
@@ -211,9 +241,10 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
         "`tensegrity import matrices`",
         &p,
         grounded,
-    );
+    ) + "\n"
+        + &chosen;
     let toml = draft.to_toml().map_err(|message| ImportError::whole(n_path, message))?;
-    Ok(Imported { toml, skipped: Vec::new() })
+    Ok(Imported { toml, skipped: Vec::new(), chosen: vec![chosen] })
 }
 
 /// Builds the scenario `name` from N (3 rows of n values), C_b and C_s given as rows of numbers
@@ -237,11 +268,12 @@ pub fn from_arrays(
     let bars = members(paths[1], &rows(cb), nodes.len())?;
     let strings = members(paths[2], &rows(cs), nodes.len())?;
     p.validate(bars.len(), strings.len()).map_err(|message| ImportError::whole(Path::new(""), message))?;
-    let (mut draft, grounded) = build(paths, &nodes, &bars, &strings, p)?;
+    let (mut draft, grounded, chosen) = build(paths, &nodes, &bars, &strings, p)?;
     draft.name = name.to_string();
-    draft.description = description("numpy arrays N, C_b, C_s", "tensegrity_testbed.from_matrices", p, grounded);
+    draft.description =
+        description("numpy arrays N, C_b, C_s", "tensegrity_testbed.from_matrices", p, grounded) + "\n" + &chosen;
     let toml = draft.to_toml().map_err(|message| ImportError::whole(Path::new(""), message))?;
-    Ok(Imported { toml, skipped: Vec::new() })
+    Ok(Imported { toml, skipped: Vec::new(), chosen: vec![chosen] })
 }
 
 /// The nodes, one per column of N's three rows (x, y, z).
@@ -266,7 +298,7 @@ fn build(
     bars: &[Member],
     strings: &[Member],
     p: &MemberProperties,
-) -> Result<(Draft, usize), ImportError> {
+) -> Result<(Draft, usize, String), ImportError> {
     let count = nodes.len();
     let on_bar = bar_of_each_node(cb_path, bars, count)?;
     let ground: Vec<usize> = (0..count).filter(|&k| on_bar[k].is_none()).collect();
@@ -297,8 +329,9 @@ fn build(
         });
     }
     add_strings(&mut draft, nodes, strings, cs_path, p)?;
+    let chosen = prestress(&mut draft, p).map_err(|message| ImportError::whole(cs_path, message))?;
     draft.quantities = p.quantities.clone();
-    Ok((draft, ground.len()))
+    Ok((draft, ground.len(), chosen))
 }
 
 /// Each pin's node (from 0) and axis: a node of N on a bar, pinned once, its axis finite and
@@ -424,6 +457,27 @@ fn said(v: &[f64]) -> String {
     } else {
         format!("{lo} to {hi} (one per member)")
     }
+}
+
+/// The strings' tensions at the drawn state: the drawn structure's self-stress with its least
+/// string tension `least_n` ([`DrawnTension::SelfStress`]), unless the strings are as given or
+/// the drawing has no self-stress with every string in tension (then as [`add_strings`] set
+/// them); what was chosen, in a sentence.
+fn prestress(draft: &mut Draft, p: &MemberProperties) -> Result<String, String> {
+    let least_n = match p.prestress {
+        DrawnTension::AsGiven => {
+            return Ok("prestress: every string's tension or rest length as given (not the drawn self-stress).".into())
+        }
+        DrawnTension::SelfStress { least_n } => least_n,
+    };
+    Ok(match super::self_stress::prestress(draft, least_n)? {
+        Some(c) => format!("{}.", c.sentence),
+        None => format!(
+            "prestress: the drawn structure has no self-stress with every string in tension, so every string is at {} N \
+             at the drawn state, which is then no equilibrium: the structure moves, and the run fails if it loses its prestress.",
+            least_n
+        ),
+    })
 }
 
 /// What the scenario file says of where it came from and what was chosen.

@@ -8,6 +8,7 @@
 pub mod draft;
 pub mod matrices;
 pub mod ntrt;
+pub mod self_stress;
 pub mod yaml;
 
 /// A rejected input, at a line and column of a file (both from 1; 0 for the file as a whole,
@@ -58,4 +59,10 @@ impl ImportError {
 pub struct Imported {
     pub toml: String,
     pub skipped: Vec<String>,
+    /// What the import chose where the source says nothing (its prestress), in sentences
+    /// (also in the scenario's description).
+    pub chosen: Vec<String>,
 }
+
+/// The least cable tension an import gives a structure whose source sets none [N].
+pub const DEFAULT_LEAST_TENSION_N: f64 = 10.0;

@@ -198,6 +198,8 @@ struct Reader {
     /// initConnectorInfo search from the end), rigid builders before strings.
     builders: Vec<(String, Builder)>,
     skipped: Vec<String>,
+    /// A string builder that builds a pair gives its pretension.
+    pretension_given: bool,
 }
 
 fn err(file: &str, at: At, message: impl Into<String>) -> ImportError {
@@ -255,11 +257,45 @@ pub fn import(path: &Path, axes: Axes) -> Result<Imported, ImportError> {
 /// Imports NTRT YAML text as a scenario, as if read from `path` (which names it in errors and
 /// the scenario; substructures' paths are relative to its directory).
 pub fn import_text(path: &Path, text: &str, axes: Axes) -> Result<Imported, ImportError> {
-    let mut r = Reader { builders: default_builders(), skipped: Vec::new() };
+    let mut r = Reader { builders: default_builders(), skipped: Vec::new(), pretension_given: false };
     let top = r.load(path, text, "", 0)?;
-    let draft = r.draft(path, &top, axes)?;
+    let mut draft = r.draft(path, &top, axes)?;
+    let chosen = prestress(&mut draft, r.pretension_given).map_err(|message| ImportError::whole(path, message))?;
+    draft.description.push_str(&format!("\n{chosen}"));
     let toml = draft.to_toml().map_err(|message| ImportError::whole(path, message))?;
-    Ok(Imported { toml, skipped: r.skipped })
+    Ok(Imported { toml, skipped: r.skipped, chosen: vec![chosen] })
+}
+
+/// The strings' tensions at the drawn state: the file's pretensions where a builder gives
+/// one; else (NTRT's default pretension 0 would leave every string slack) the drawn
+/// structure's self-stress, its least tension [`super::DEFAULT_LEAST_TENSION_N`], or that
+/// tension on every string when the drawing has no self-stress with every string taut. What
+/// was chosen, in a sentence.
+fn prestress(draft: &mut Draft, pretension_given: bool) -> Result<String, String> {
+    if pretension_given {
+        return Ok("prestress: the file's pretensions (rest length = drawn - pretension / stiffness).".into());
+    }
+    let least = super::DEFAULT_LEAST_TENSION_N;
+    if let Some(c) = super::self_stress::prestress(draft, least)? {
+        return Ok(format!(
+            "{} (the file gives no pretension; NTRT's default 0 leaves every string slack).",
+            c.sentence
+        ));
+    }
+    let positions: Vec<(String, Vec3)> = draft.bodies.iter().flat_map(|b| b.nodes.clone()).collect();
+    let pos = |n: &str| positions.iter().find(|(m, _)| m == n).map(|(_, p)| *p).unwrap_or_default();
+    for c in &mut draft.cables {
+        let (Some(k), drawn) = (c.stiffness_n_per_m, distance(pos(&c.a), pos(&c.b))) else { continue };
+        c.length_m = drawn - least / k;
+        if !(c.length_m > 0.0) {
+            return Err(format!("string {}: {least} N at {k} N/m leaves no rest length (drawn {drawn})", c.name));
+        }
+    }
+    Ok(format!(
+        "prestress: the file gives no pretension and the drawing has no self-stress with every string in tension, so every \
+         string is at {least} N at the drawn state, which is then no equilibrium: the structure moves, and the run fails if \
+         it loses its prestress."
+    ))
 }
 
 fn default_builders() -> Vec<(String, Builder)> {
@@ -646,6 +682,7 @@ impl Reader {
                     rods.push((a, b, r, mass));
                 }
                 Kind::String => {
+                    self.pretension_given |= builder.params.contains_key("pretension");
                     if noted.insert(index) {
                         self.note_unmodelled(&tag, &builder, &["stiffness", "pretension"]);
                     }

@@ -26,6 +26,24 @@ pub fn error(kind: QuantityKind, analytic: f64, simulated: f64, length_scale: f6
     }
 }
 
+/// How a check's error is measured (see [`error`]).
+pub fn convention(kind: QuantityKind) -> &'static str {
+    match kind {
+        QuantityKind::Angle => "angle [rad]",
+        QuantityKind::Length => "length / L",
+        QuantityKind::Magnitude => "relative",
+    }
+}
+
+/// The root mean square of `ticks` values whose squares sum to `sum_sq` (0 without ticks).
+fn rms(sum_sq: f64, ticks: u64) -> f64 {
+    if ticks > 0 {
+        (sum_sq / ticks as f64).sqrt()
+    } else {
+        0.0
+    }
+}
+
 #[derive(Clone, Debug)]
 struct Accumulator {
     check: Check,
@@ -34,6 +52,8 @@ struct Accumulator {
     settled_points: usize,
     transient_max_abs: f64,
     transient_sum_sq: f64,
+    transient_max_rel: f64,
+    transient_sum_sq_rel: f64,
     ticks: u64,
     missing: bool,
     /// Settle points outside the analytic model's validity (not compared).
@@ -58,6 +78,8 @@ impl Compare {
                     settled_points: 0,
                     transient_max_abs: 0.0,
                     transient_sum_sq: 0.0,
+                    transient_max_rel: 0.0,
+                    transient_sum_sq_rel: 0.0,
                     ticks: 0,
                     missing: false,
                     outside_points: 0,
@@ -109,6 +131,7 @@ impl Compare {
             .map(|a| CheckReport {
                 quantity: a.check.quantity.clone(),
                 unit: a.check.unit.clone(),
+                convention: convention(a.check.kind).into(),
                 max_abs_error: a.settled_max_abs,
                 max_rel_error: a.settled_max_rel,
                 tolerance: a.check.tolerance,
@@ -118,7 +141,9 @@ impl Compare {
                     && if a.settled_points > 0 { a.settled_max_rel <= a.check.tolerance } else { a.outside_points > 0 },
                 points_compared: a.settled_points,
                 transient_max_abs_error: a.transient_max_abs,
-                transient_rms_abs_error: if a.ticks > 0 { (a.transient_sum_sq / a.ticks as f64).sqrt() } else { 0.0 },
+                transient_rms_abs_error: rms(a.transient_sum_sq, a.ticks),
+                transient_max_rel_error: a.transient_max_rel,
+                transient_rms_rel_error: rms(a.transient_sum_sq_rel, a.ticks),
                 ticks_compared: a.ticks,
             })
             .collect()
@@ -131,9 +156,11 @@ impl Observer for Compare {
             if let (Some(&x), Some(&y)) =
                 (t.prediction.expected.get(&a.check.quantity), t.simulated.get(&a.check.quantity))
             {
-                let (abs, _) = error(a.check.kind, x, y, self.length_scale);
+                let (abs, rel) = error(a.check.kind, x, y, self.length_scale);
                 a.transient_max_abs = a.transient_max_abs.max(abs);
                 a.transient_sum_sq += abs * abs;
+                a.transient_max_rel = a.transient_max_rel.max(rel);
+                a.transient_sum_sq_rel += rel * rel;
                 a.ticks += 1;
             }
         }
@@ -150,6 +177,7 @@ impl Observer for Compare {
         }
         self.record_point(&point.analytic, &point.simulated, point.settled);
         let errors = self.point_errors(point);
+        point.errors.extend(errors.iter().map(|(c, e)| (c.quantity.clone(), *e)));
         if point.settled {
             for (c, e) in errors.iter().filter(|(c, e)| !(*e <= c.tolerance)) {
                 notes.push(Note::Event(format!(

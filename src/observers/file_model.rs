@@ -530,8 +530,10 @@ impl Observer for ModelObserver {
                 point.simulated.entry(s.name.clone()).or_insert(v[i]);
             }
         }
-        for (pr, (predicted, _, _)) in self.spec.predictions.iter().zip(&errors).filter(|_| !self.motion) {
-            point.analytic.entry(self.spec.symbols[pr.symbol].name.clone()).or_insert(*predicted);
+        for (pr, (predicted, _, e)) in self.spec.predictions.iter().zip(&errors).filter(|_| !self.motion) {
+            let name = &self.spec.symbols[pr.symbol].name;
+            point.analytic.entry(name.clone()).or_insert(*predicted);
+            point.errors.insert(name.clone(), *e);
         }
         if let Some((report, error)) = self.energy_point(&v) {
             self.energy.point(error, point.settled);

@@ -36,6 +36,10 @@ pub struct ScenarioReport {
     pub stiffness_probe: Option<ProbeReport>,
     /// Every interval of ticks in which a cable was slack.
     pub slack_intervals: Vec<SlackInterval>,
+    /// Whether the structure kept its self-stress at the settle points (absent where it is
+    /// not judged: no `[prestress]` and no custom structure with cables).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub prestress: Option<PrestressReport>,
     /// Analytic against dynamic workspace classification (mechanisms with cables).
     pub workspace: Option<WorkspaceAgreement>,
     /// Grid points dropped as outside the mechanism's domain (`actuation.skip_outside`).
@@ -311,6 +315,9 @@ pub struct SettleSummary {
 pub struct CheckReport {
     pub quantity: String,
     pub unit: String,
+    /// How its error is measured, the one convention of `max_rel_error`, the transient
+    /// `_rel_` errors and the table: "length / L", "angle [rad]" or "relative".
+    pub convention: String,
     /// Largest error at the settle points, in the quantity's unit.
     pub max_abs_error: f64,
     /// Largest normalised error at the settle points (lengths / L, angles in rad, other
@@ -321,6 +328,9 @@ pub struct CheckReport {
     /// Every tick, including transients (reported, not checked).
     pub transient_max_abs_error: f64,
     pub transient_rms_abs_error: f64,
+    /// The same, normalised as `max_rel_error` is.
+    pub transient_max_rel_error: f64,
+    pub transient_rms_rel_error: f64,
     pub ticks_compared: u64,
     /// Settle points compared (points outside the analytic model's validity are not).
     pub points_compared: usize,
@@ -353,6 +363,14 @@ pub struct PointReport {
     pub expected_slack: Option<Vec<String>>,
     /// Whether the simulated slack set equals the analytic one.
     pub slack_agrees: Option<bool>,
+    /// The cables' total tension at the settled state over their total tension at the drawn
+    /// state (the share of the self-stress kept); None without cables or without a drawn
+    /// tension.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub prestress_fraction: Option<f64>,
+    /// Whether the structure lost its self-stress here (`[prestress]`; None: not judged).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub prestress_lost: Option<bool>,
     /// Outside the analytic model's validity (some cable slack): the distance of the settled
     /// state from the analytic point, over the length quantities [m].
     pub distance_from_analytic_m: Option<f64>,
@@ -369,6 +387,11 @@ pub struct PointReport {
     /// dynamics landed on (absent without one).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub energy: Option<EnergyPointReport>,
+    /// Each judged quantity's error here as its verdict measures it (a check's normalised
+    /// error, a prediction's in its class, the probe's relative): what the table's point lines
+    /// show (the JSON has them per check, prediction and probe).
+    #[serde(skip)]
+    pub errors: Values,
 }
 
 /// The stationary points of a file's energy model at one settle point.
@@ -526,6 +549,51 @@ pub struct InterferenceViolation {
     pub closest_points: [[f64; 3]; 2],
 }
 
+/// The self-stress over the settle points (`[prestress]`): where it was lost, and the verdict.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PrestressReport {
+    /// What a loss does: "fail" or "warn".
+    pub on_loss: crate::settings::OnLoss,
+    /// The smallest share of the drawn total cable tension a settled state may keep (absent:
+    /// lost only when every cable is slack).
+    pub min_fraction: Option<f64>,
+    /// Cables of the structure.
+    pub cables: usize,
+    /// The smallest share kept over the settle points (absent without a drawn tension).
+    pub least_fraction_kept: Option<f64>,
+    /// Settle points at which the self-stress was lost (every cable slack, or below
+    /// `min_fraction`).
+    pub lost_at: Vec<usize>,
+    /// The cables slack at those points, by name (each once, in the structure's order of
+    /// first appearance).
+    pub slack_cables: Vec<String>,
+    /// No loss, or a loss the scenario lets warn.
+    pub passed: bool,
+}
+
+impl PrestressReport {
+    /// The judgement of `points` under `p` (each point says whether it lost the prestress).
+    pub fn of(p: &crate::settings::Prestress, cables: usize, points: &[PointReport]) -> Self {
+        let lost_points: Vec<&PointReport> = points.iter().filter(|q| q.prestress_lost == Some(true)).collect();
+        let mut slack_cables: Vec<String> = Vec::new();
+        for c in lost_points.iter().flat_map(|q| &q.slack_cables) {
+            if !slack_cables.contains(c) {
+                slack_cables.push(c.clone());
+            }
+        }
+        let least = points.iter().filter_map(|q| q.prestress_fraction).reduce(f64::min);
+        PrestressReport {
+            on_loss: p.on_loss,
+            min_fraction: p.min_fraction,
+            cables,
+            least_fraction_kept: least,
+            lost_at: lost_points.iter().map(|q| q.index).collect(),
+            passed: lost_points.is_empty() || p.on_loss == crate::settings::OnLoss::Warn,
+            slack_cables,
+        }
+    }
+}
+
 /// Ticks during which one cable was slack.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct SlackInterval {
@@ -536,9 +604,17 @@ pub struct SlackInterval {
 
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct ProbeReport {
+    /// The load applied as +load and -load [N m, or N on a prismatic joint].
     pub torque_nm: f64,
-    pub tolerance: f64,
-    pub max_rel_error: f64,
+    /// The quantity the stiffness is reported as (`JOINT.stiffness`, or the mechanism's).
+    pub quantity: String,
+    /// The stiffness measured at each settle point [N m/rad or N/m] (null where it was not).
+    pub measured: Vec<f64>,
+    /// On the relative error; absent for a probe that only measures (no closed form).
+    pub tolerance: Option<f64>,
+    /// Largest relative error against the closed form; absent for a probe that only measures.
+    pub max_rel_error: Option<f64>,
+    /// Within tolerance, or a probe that only measures (no verdict from it).
     pub passed: bool,
 }
 
@@ -610,6 +686,7 @@ impl ScenarioReport {
         self.table_motion(out);
         self.table_probe(out);
         self.table_slack(out);
+        self.table_prestress(out);
         self.table_workspace(out);
         self.table_intervals(out);
         self.table_interference(out);
@@ -678,26 +755,28 @@ impl ScenarioReport {
         }
     }
 
-    /// One row per check: errors at the settle points, transient errors, verdict (nothing,
-    /// not even the header, without checks).
+    /// One row per check, every error in the convention its tolerance applies to (named
+    /// last): at the settle points, transient, verdict (nothing, not even the header, without
+    /// checks).
     fn table_checks(&self, out: &mut String) {
         if self.checks.is_empty() {
             return;
         }
+        let w = self.checks.iter().map(|c| c.quantity.len()).max().unwrap_or(0).max("check".len());
         out.push_str(&format!(
-            "   {:<10} {:>12} {:>12} {:>10} {:>12} {:>12}  {}\n",
-            "quantity", "max |err|", "max rel err", "tolerance", "transient", "rms trans.", "verdict"
+            "   {:<w$} {:>12} {:>10} {:>12} {:>12}  {}\n",
+            "check", "max err", "tolerance", "transient", "rms trans.", "verdict"
         ));
         for c in &self.checks {
             out.push_str(&format!(
-                "   {:<10} {:>12.3e} {:>12.3e} {:>10.1e} {:>12.3e} {:>12.3e}  {}\n",
+                "   {:<w$} {:>12.3e} {:>10.1e} {:>12.3e} {:>12.3e}  {} ({})\n",
                 c.quantity,
-                c.max_abs_error,
                 c.max_rel_error,
                 c.tolerance,
-                c.transient_max_abs_error,
-                c.transient_rms_abs_error,
-                if c.passed { "pass" } else { "FAIL" }
+                c.transient_max_rel_error,
+                c.transient_rms_rel_error,
+                if c.passed { "pass" } else { "FAIL" },
+                c.convention
             ));
         }
     }
@@ -729,14 +808,25 @@ impl ScenarioReport {
 
     /// The stiffness probe, if any.
     fn table_probe(&self, out: &mut String) {
-        if let Some(p) = &self.stiffness_probe {
-            out.push_str(&format!(
-                "   stiffness probe (+-{} N m): max rel err {:.3e} (tolerance {:.1e}) {}\n",
+        let Some(p) = &self.stiffness_probe else { return };
+        match (p.max_rel_error, p.tolerance) {
+            (Some(e), Some(t)) => out.push_str(&format!(
+                "   stiffness probe {} (+-{}): max rel err {e:.3e} (tolerance {t:.1e}) {}\n",
+                p.quantity,
                 p.torque_nm,
-                p.max_rel_error,
-                p.tolerance,
                 if p.passed { "pass" } else { "FAIL" }
-            ));
+            )),
+            _ => {
+                let measured: Vec<String> =
+                    p.measured.iter().take(MAX_POINTS_IN_TABLE).map(|k| format!("{k:.9e}")).collect();
+                out.push_str(&format!(
+                    "   stiffness probe {} (+-{}): measured only (no closed form): {}{}\n",
+                    p.quantity,
+                    p.torque_nm,
+                    measured.join(", "),
+                    if p.measured.len() > MAX_POINTS_IN_TABLE { ", ..." } else { "" }
+                ));
+            }
         }
     }
 
@@ -765,6 +855,27 @@ impl ScenarioReport {
                 ));
             }
         }
+    }
+
+    /// The self-stress kept, or where it was lost and which cables were slack there.
+    fn table_prestress(&self, out: &mut String) {
+        let Some(p) = &self.prestress else { return };
+        let kept = p.least_fraction_kept.map(|f| format!(", least share of the drawn cable tension kept {f:.3}"));
+        let rule = match p.min_fraction {
+            Some(m) => format!("every cable slack or below {m} of the drawn tension"),
+            None => "every cable slack".into(),
+        };
+        if p.lost_at.is_empty() {
+            out.push_str(&format!("   prestress: kept at every settle point{}\n", kept.unwrap_or_default()));
+            return;
+        }
+        let verdict = if p.passed { "WARNING (on_loss = \"warn\")" } else { "FAIL" };
+        out.push_str(&format!(
+            "   prestress: LOST at point(s) {:?} ({rule}){}; slack: {}  {verdict}\n",
+            p.lost_at,
+            kept.unwrap_or_default(),
+            if p.slack_cables.is_empty() { "none".to_string() } else { p.slack_cables.join(", ") },
+        ));
     }
 
     /// The workspace classifications and their agreement.
@@ -882,18 +993,21 @@ impl ScenarioReport {
     fn table_points(&self, out: &mut String) {
         let shown = self.points.len().min(MAX_POINTS_IN_TABLE);
         for p in &self.points[..shown] {
-            out.push_str(&format!(
-                "   point {:>4}: {}  -> {}  [{}{}]\n",
-                p.index,
-                fmt_values(&p.inputs),
-                fmt_errors(&p.analytic, &p.simulated),
-                p.branch,
-                if p.settled {
-                    String::new()
-                } else {
-                    format!(", NOT SETTLED: kinetic energy {:.3e} J left", p.final_kinetic_energy_j)
-                }
-            ));
+            let compared = fmt_errors(p);
+            // A settled point with no inputs and nothing compared would be an empty line.
+            if !(p.inputs.is_empty() && compared.is_empty() && p.settled) {
+                out.push_str(&format!(
+                    "   point {:>4}: {}  -> {compared}  [{}{}]\n",
+                    p.index,
+                    fmt_values(&p.inputs),
+                    p.branch,
+                    if p.settled {
+                        String::new()
+                    } else {
+                        format!(", NOT SETTLED: kinetic energy {:.3e} J left", p.final_kinetic_energy_j)
+                    }
+                ));
+            }
             if let Some(modes) = p.energy.as_ref().and_then(|e| e.modes.as_ref()) {
                 let listed: Vec<String> = modes
                     .iter()
@@ -947,15 +1061,15 @@ fn fmt_values(v: &Values) -> String {
     v.iter().map(|(k, x)| format!("{k}={x:.6}")).collect::<Vec<_>>().join(" ")
 }
 
-fn fmt_errors(analytic: &Values, simulated: &Values) -> String {
-    simulated
+/// Each simulated quantity with a closed form, and its error as its verdict measures it (the
+/// table's convention for it; none for a quantity nothing judges).
+fn fmt_errors(p: &PointReport) -> String {
+    p.simulated
         .iter()
-        .filter_map(|(k, s)| {
-            analytic.get(k).map(|a| {
-                // Angles (the papers' theta symbols) are compared modulo 2 pi.
-                let e = if k.starts_with("theta") { crate::mechanisms::wrap_angle(s - a) } else { s - a };
-                format!("{k}={s:.9} (err {:.1e})", e.abs())
-            })
+        .filter(|(k, _)| p.analytic.contains_key(*k))
+        .map(|(k, s)| match p.errors.get(k) {
+            Some(e) => format!("{k}={s:.9} (err {e:.1e})"),
+            None => format!("{k}={s:.9}"),
         })
         .collect::<Vec<_>>()
         .join(" ")

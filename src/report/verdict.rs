@@ -50,6 +50,9 @@ pub fn failures(report: &ScenarioReport, min_agreement_percent: Option<f64>) -> 
         if report.points.iter().any(|p| p.slack_agrees == Some(false)) {
             out.push(Failure::Slack);
         }
+        if report.prestress.as_ref().is_some_and(|p| !p.passed) {
+            out.push(Failure::Prestress);
+        }
     }
     if report.interference.as_ref().is_some_and(|i| !i.passed) {
         out.push(Failure::Interference);
@@ -73,6 +76,9 @@ pub enum Failure {
     Stability,
     /// The slack cables differ from the analytic model's: `slack`.
     Slack,
+    /// The structure lost its self-stress (every cable slack, or below `[prestress]
+    /// min_fraction` of the drawn tension) where `[prestress] on_loss` fails: `prestress`.
+    Prestress,
     /// Two members came closer than the interference threshold: `interference`.
     Interference,
     /// A workspace sweep's agreement fell below `workspace.min_agreement_percent`: `workspace`.
@@ -100,6 +106,7 @@ pub const FAILURE_NAMES: &[&str] = &[
     "probe",
     "stability",
     "slack",
+    "prestress",
     "interference",
     "workspace",
     "prediction:NAME",
@@ -118,6 +125,7 @@ impl fmt::Display for Failure {
             Failure::Probe => f.write_str("probe"),
             Failure::Stability => f.write_str("stability"),
             Failure::Slack => f.write_str("slack"),
+            Failure::Prestress => f.write_str("prestress"),
             Failure::Interference => f.write_str("interference"),
             Failure::Workspace => f.write_str("workspace"),
             Failure::Prediction(n) => write!(f, "prediction:{n}"),
@@ -138,6 +146,7 @@ impl std::str::FromStr for Failure {
             "probe" => Failure::Probe,
             "stability" => Failure::Stability,
             "slack" => Failure::Slack,
+            "prestress" => Failure::Prestress,
             "interference" => Failure::Interference,
             "workspace" => Failure::Workspace,
             "energy" => Failure::Energy,

@@ -14,7 +14,7 @@ mod topologies;
 use crate::mechanisms::{Mechanism, ModelError, Values};
 use crate::observers::record::{RecordTarget, Recording};
 use crate::observers::{self, Setup};
-use crate::report::{ProbeReport, ScenarioReport, SettleSummary, WorkspaceAgreement};
+use crate::report::{PointReport, ProbeReport, ScenarioReport, SettleSummary, WorkspaceAgreement};
 use crate::scenario::{Actuation, Scenario};
 use crate::sim::{SimError, Simulation};
 use runner::Runner;
@@ -86,6 +86,7 @@ fn empty_report(sc: &Scenario) -> ScenarioReport {
         points: vec![],
         stiffness_probe: None,
         slack_intervals: vec![],
+        prestress: None,
         workspace: None,
         skipped_points: sc.skipped_points.len(),
         interference: None,
@@ -251,16 +252,12 @@ fn finish(runner: &mut Runner, report: &mut ScenarioReport, probe_errors: &[f64]
         sim_time_s: runner.sim.time_s(),
         wall_s: wall.elapsed().as_secs_f64(),
     };
-    if let Some(p) = &sc.probe {
-        let max = probe_errors.iter().copied().fold(0.0, f64::max);
-        let complete = !probe_errors.is_empty() && probe_errors.len() == report.points.len();
-        report.stiffness_probe = Some(ProbeReport {
-            torque_nm: p.torque_nm,
-            tolerance: p.tolerance,
-            max_rel_error: if complete { max } else { f64::INFINITY },
-            passed: complete && max <= p.tolerance,
-        });
-    }
+    report.stiffness_probe =
+        sc.probe.as_ref().map(|p| probe_report(runner.mech.as_ref(), p, &report.points, probe_errors));
+    report.prestress = sc
+        .prestress
+        .as_ref()
+        .map(|p| crate::report::PrestressReport::of(p, runner.sim.structure().cables.len(), &report.points));
     conclude(report, sc);
     let tick = runner.sim.tick();
     let mut failed = None;
@@ -272,6 +269,32 @@ fn finish(runner: &mut Runner, report: &mut ScenarioReport, probe_errors: &[f64]
     if let Some(e) = failed {
         report.error.get_or_insert(e);
         conclude(report, sc);
+    }
+}
+
+/// The probe over the run: the stiffness measured at each point, and with a closed form its
+/// largest relative error (`probe_errors`, one per point) against the tolerance.
+fn probe_report(
+    mech: &dyn Mechanism,
+    p: &crate::settings::Probe,
+    points: &[PointReport],
+    probe_errors: &[f64],
+) -> ProbeReport {
+    let max = probe_errors.iter().copied().fold(0.0, f64::max);
+    let complete = !probe_errors.is_empty() && probe_errors.len() == points.len();
+    let quantity = match &p.joint {
+        Some(j) => j.quantity(),
+        None => mech.stiffness_probe().map(|s| s.analytic).unwrap_or_default(),
+    };
+    let measured = points.iter().map(|q| q.simulated.get(&quantity).copied().unwrap_or(f64::NAN)).collect();
+    let max_rel_error = p.tolerance.map(|_| if complete { max } else { f64::INFINITY });
+    ProbeReport {
+        torque_nm: p.torque_nm,
+        tolerance: p.tolerance,
+        passed: p.tolerance.is_none_or(|t| max_rel_error.is_some_and(|e| e <= t)),
+        max_rel_error,
+        quantity,
+        measured,
     }
 }
 

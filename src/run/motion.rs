@@ -133,10 +133,10 @@ fn start_point(runner: &mut Runner, sc: &Scenario, inputs: &Values, report: &mut
     let simulated = runner.observe(&snapshot);
     let settled = SettleDetector::residual_ok(&snapshot, &sc.settle);
     let residual = snapshot.forces.residual;
-    let slack_cables = {
-        let cables = &runner.sim.structure().cables;
-        cables.iter().zip(&snapshot.forces.cable_slack).filter(|(_, s)| **s).map(|(c, _)| c.name.clone()).collect()
-    };
+    let slack_cables = point::slack_cables(runner, &snapshot);
+    let prestress_fraction = point::prestress_fraction(runner, &snapshot);
+    let cables = runner.sim.structure().cables.len();
+    let prestress_lost = sc.prestress.as_ref().map(|p| p.lost(cables, slack_cables.len(), prestress_fraction));
     let mut point = PointReport {
         index: 0,
         inputs: inputs.clone(),
@@ -148,6 +148,8 @@ fn start_point(runner: &mut Runner, sc: &Scenario, inputs: &Values, report: &mut
         final_kinetic_energy_j: runner.sim.kinetic_energy_j(),
         branch: "the drawn state".into(),
         slack_cables,
+        prestress_fraction,
+        prestress_lost,
         ..PointReport::default()
     };
     let seen = SettlePoint {

@@ -169,12 +169,16 @@ pub(super) fn settle_point(
     if let Some(st) = stable {
         runner.emit(format_args!("point {index}: equilibrium is {}", if st { "stable" } else { "unstable" }));
     }
+    let mut errors = Values::new();
     if let (Some(p), true) = (&sc.probe, s.settled) {
-        probe_point(runner, inputs, &prediction, p, (&mut landed, &mut simulated), probe_errors)?;
+        probe_point(runner, inputs, &prediction, p, (&mut landed, &mut simulated, &mut errors), probe_errors)?;
     }
     let slack_cables = slack_cables(runner, &s.snapshot);
     let slack_agrees = slack_agreement(runner, index, &prediction, &slack_cables);
     let outside = prediction.expected_slack.as_ref().is_some_and(|e| !e.is_empty());
+    let prestress_fraction = prestress_fraction(runner, &s.snapshot);
+    let cables = runner.sim.structure().cables.len();
+    let prestress_lost = sc.prestress.as_ref().map(|p| p.lost(cables, slack_cables.len(), prestress_fraction));
     let mut point = PointReport {
         index,
         inputs: inputs.clone(),
@@ -191,6 +195,8 @@ pub(super) fn settle_point(
         slack_cables,
         expected_slack: prediction.expected_slack.clone(),
         slack_agrees,
+        prestress_fraction,
+        prestress_lost,
         // Outside the analytic model's validity the analytic point is no equilibrium: report
         // the distance from it instead of checking against it.
         distance_from_analytic_m: outside.then(|| distance_m(runner.mech.as_ref(), &landed, &simulated)),
@@ -199,6 +205,7 @@ pub(super) fn settle_point(
         min_clearance_m: None,
         interference_free: None,
         energy: None,
+        errors,
         paper: runner
             .mech
             .paper_values(&runner.params, inputs)
@@ -265,24 +272,26 @@ fn say_settled(runner: &mut Runner, sc: &Scenario, index: usize, s: &super::sett
 }
 
 /// The stiffness probe at a settled point: the measured stiffness among the simulated values,
-/// a joint probe's prediction among the analytic ones, and the relative error in
-/// `probe_errors`.
+/// a joint probe's prediction among the analytic ones, and the relative error in `errors`
+/// (the point's) and `probe_errors`.
 fn probe_point(
     runner: &mut Runner,
     inputs: &Values,
     prediction: &Prediction,
     p: &Probe,
-    (landed, simulated): (&mut Values, &mut Values),
+    (landed, simulated, errors): (&mut Values, &mut Values, &mut Values),
     probe_errors: &mut Vec<f64>,
 ) -> Result<(), Stop> {
     if let Some((quantity, k)) = runner.probe(inputs, prediction, p)? {
-        if let Some(j) = &p.joint {
-            landed.insert(quantity.clone(), j.predicted(&runner.params, inputs));
+        if let Some(k) = p.joint.as_ref().and_then(|j| j.predicted(&runner.params, inputs)) {
+            landed.insert(quantity.clone(), k);
         }
         if let Some(ka) = landed.get(&quantity) {
             // A prediction that is not a number (NaN) cannot pass: its error is infinite.
             let e = ((k - ka) / ka).abs();
-            probe_errors.push(if e.is_nan() { f64::INFINITY } else { e });
+            let e = if e.is_nan() { f64::INFINITY } else { e };
+            probe_errors.push(e);
+            errors.insert(quantity.clone(), e);
         }
         simulated.insert(quantity, k);
     }
@@ -324,8 +333,15 @@ fn energy_stability(point: &PointReport) -> Option<bool> {
     }
 }
 
+/// The cables' total tension in `snap` over their total tension at the drawn state (None
+/// without a drawn tension).
+pub(super) fn prestress_fraction(runner: &Runner, snap: &Snapshot) -> Option<f64> {
+    let drawn = runner.sim.structure().drawn_cable_tension_n();
+    (drawn > 0.0).then(|| snap.forces.cable_tension_n.iter().sum::<f64>() / drawn)
+}
+
 /// The cables slack in `snap`, by name.
-fn slack_cables(runner: &Runner, snap: &Snapshot) -> Vec<String> {
+pub(super) fn slack_cables(runner: &Runner, snap: &Snapshot) -> Vec<String> {
     let cables = &runner.sim.structure().cables;
     cables.iter().zip(&snap.forces.cable_slack).filter(|(_, sl)| **sl).map(|(c, _)| c.name.clone()).collect()
 }

@@ -100,19 +100,22 @@ pub(super) fn expected_stability(
 pub(super) fn probe(
     ctx: &Ctx,
     m: &dyn Mechanism,
-    raw: &Option<RawProbe>,
+    raw: &Option<Spanned<RawProbe>>,
     first: &Structure,
     params: &Values,
 ) -> Result<Option<Probe>, ScenarioError> {
-    let Some(p) = raw else { return Ok(None) };
-    let tol = positive_value(ctx, &p.tolerance, "probe.tolerance")?;
+    let Some(section) = raw else { return Ok(None) };
+    let p = section.get_ref();
+    let tol = p.tolerance.as_ref().map(|t| positive_value(ctx, t, "probe.tolerance")).transpose()?;
     let Some(name) = &p.joint else {
         if let Some(e) = &p.expected {
             return Err(
                 ctx.err(e, "expected goes with joint = \"name\" (the mechanism's probe compares with its model)")
             );
         }
-        let torque = p.torque.as_ref().ok_or_else(|| ctx.err(&p.tolerance, "[probe] needs torque = N m"))?;
+        let Some(torque) = p.torque.as_ref() else {
+            return Err(ctx.err(section, "[probe] needs torque = N m"));
+        };
         if m.stiffness_probe().is_none() {
             return Err(ctx.err(
                 torque,
@@ -122,8 +125,20 @@ pub(super) fn probe(
                 ),
             ));
         }
+        if tol.is_none() {
+            return Err(ctx.err(torque, "the mechanism's probe is compared with its model: give probe.tolerance"));
+        }
         return Ok(Some(Probe { torque_nm: load(ctx, torque, "torque", "N m")?, joint: None, tolerance: tol }));
     };
+    match (&p.expected, &p.tolerance) {
+        (Some(e), None) => return Err(ctx.err(e, "probe.expected needs probe.tolerance (on the relative error)")),
+        (None, Some(t)) => {
+            return Err(
+                ctx.err(t, "probe.tolerance goes with probe.expected: without a closed form the probe only measures")
+            )
+        }
+        _ => {}
+    }
     let joint = joint_probe(ctx, m, p, name, first, params)?;
     let (given, what, unit) = match (joint.prismatic, &p.torque, &p.force) {
         (false, Some(t), None) => (t, "torque", "N m"),
@@ -167,17 +182,17 @@ fn joint_probe(
             ctx.err(name, "an actuated joint is held by its command: probe a joint the structure is free to turn")
         );
     }
-    let expected = p.expected.as_ref().ok_or_else(|| {
-        ctx.err(
-            name,
-            "a joint probe needs expected = \"...\": the stiffness it is compared with (parameters and inputs)",
-        )
-    })?;
     let mut symbols: Vec<String> = params.keys().cloned().collect();
     symbols.extend(m.inputs().iter().map(|i| i.symbol.to_string()));
     let names: Vec<&str> = symbols.iter().map(String::as_str).collect();
-    let expr = Expr::compile(expected.get_ref(), &names)
-        .map_err(|e| expr_error(ctx, expected.span().start, &e, "probe.expected (parameters and inputs)"))?;
+    let expr = p
+        .expected
+        .as_ref()
+        .map(|e| {
+            Expr::compile(e.get_ref(), &names)
+                .map_err(|err| expr_error(ctx, e.span().start, &err, "probe.expected (parameters and inputs)"))
+        })
+        .transpose()?;
     Ok(JointProbe { joint: name.get_ref().clone(), index, prismatic, expected: expr, symbols })
 }
 
@@ -186,18 +201,19 @@ fn joint_probe(
 /// error at `expected` naming the point.
 pub(super) fn probe_expected(
     ctx: &Ctx,
-    raw: &Option<RawProbe>,
+    raw: &Option<Spanned<RawProbe>>,
     probe: Option<&Probe>,
     at_point: &dyn Fn(&Values) -> Values,
     actuation: &Actuation,
 ) -> Result<(), ScenarioError> {
-    let (Some(j), Some(e)) = (probe.and_then(|p| p.joint.as_ref()), raw.as_ref().and_then(|r| r.expected.as_ref()))
+    let (Some(j), Some(e)) =
+        (probe.and_then(|p| p.joint.as_ref()), raw.as_ref().and_then(|r| r.get_ref().expected.as_ref()))
     else {
         return Ok(());
     };
     let points = actuation.all_inputs();
     for p in points {
-        let k = j.predicted(&at_point(p), p);
+        let Some(k) = j.predicted(&at_point(p), p) else { return Ok(()) };
         if !k.is_finite() || k == 0.0 {
             return Err(ctx.err(e, format!("probe.expected is {k} at the point {p:?}: a stiffness compared by its relative error is finite and not zero")));
         }

@@ -6,8 +6,9 @@ use super::error::{finite, positive_value, Ctx, ScenarioError};
 use super::number::expr_error;
 use super::raw::{RawCoordinate, RawEnergy, RawRange};
 use crate::file_model::energy_model::{Coordinate, EnergySpec};
-use crate::file_model::expr::Expr;
-use crate::file_model::spec::{ErrorClass, ModelSpec};
+use crate::file_model::expr::{Expr, ExprError};
+use crate::file_model::spec::{ErrorClass, ModelSpec, Source};
+use crate::structure::BodyKind;
 use toml::Spanned;
 
 /// Largest number of Newton starts the scans may ask for together (the product of their
@@ -18,8 +19,14 @@ const MAX_SCAN: i64 = 10_000;
 /// derivatives, each evaluated at every Newton step of every start.
 const MAX_COORDINATES: usize = 20;
 
-/// The compiled `[energy]` section of a model whose other sections are in `spec`.
-pub(super) fn energy(ctx: &Ctx, spec: &ModelSpec, raw: &RawEnergy) -> Result<EnergySpec, ScenarioError> {
+/// The compiled `[energy]` section of a model whose other sections are in `spec`, of the
+/// structure `s` (drawn at the first point: whose nodes are on fixed bodies).
+pub(super) fn energy(
+    ctx: &Ctx,
+    spec: &ModelSpec,
+    raw: &RawEnergy,
+    s: &crate::structure::Structure,
+) -> Result<EnergySpec, ScenarioError> {
     if raw.coordinates.is_empty() {
         return Err(
             ctx.err(&raw.potential, "[energy] needs at least one [[energy.coordinates]] (name, measured, class)")
@@ -43,13 +50,19 @@ pub(super) fn energy(ctx: &Ctx, spec: &ModelSpec, raw: &RawEnergy) -> Result<Ene
             }
         }
     }
-    // The potential sees the closed forms (parameters, inputs, their quantities) and the
-    // coordinates.
-    let mut names: Vec<&str> = (0..state.len()).map(|i| if spec.is_closed_form(i) { state[i] } else { "" }).collect();
+    // The potential sees the closed forms (parameters, inputs, their quantities), the nodes of
+    // fixed bodies (which stay where they are drawn) and the coordinates.
+    let anchored = |i: usize| match &spec.symbols[i].source {
+        Source::Node(n, _) => s.node_id(n).is_some_and(|k| s.bodies[s.nodes[k].body].kind == BodyKind::Fixed),
+        _ => false,
+    };
+    let mut names: Vec<&str> =
+        (0..state.len()).map(|i| if spec.is_closed_form(i) || anchored(i) { state[i] } else { "" }).collect();
     names.extend(coordinates.iter().map(|c: &Coordinate| c.name.as_str()));
     let at = raw.potential.span().start;
     let potential = Expr::compile(raw.potential.get_ref(), &names).map_err(|e| {
-        expr_error(ctx, at, &e, "energy potential (coordinates, parameters, inputs and their quantities)")
+        let e = on_free_body(e, s);
+        expr_error(ctx, at, &e, "energy potential (coordinates, parameters, inputs, their quantities, fixed nodes)")
     })?;
     let first = state.len();
     let derivative =
@@ -66,6 +79,22 @@ pub(super) fn energy(ctx: &Ctx, spec: &ModelSpec, raw: &RawEnergy) -> Result<Ene
     let tolerance = positive_value(ctx, &raw.tolerance, "energy.tolerance")?;
     let dynamics = super::kinetic::dynamics(ctx, spec, raw, &coordinates)?;
     Ok(EnergySpec { potential, gradient, hessian, coordinates, first_coordinate: first, tolerance, dynamics })
+}
+
+/// An unknown symbol that is a coordinate of a free body's node, said so.
+fn on_free_body(mut e: ExprError, s: &crate::structure::Structure) -> ExprError {
+    let name = e.message.strip_prefix("unknown symbol '").and_then(|m| m.split('\'').next()).unwrap_or("");
+    let node = name.rsplit_once('.').filter(|(_, c)| ["x", "y", "z"].contains(c)).map(|(n, _)| n);
+    if let Some(k) = node.and_then(|n| s.node_id(n)) {
+        if s.bodies[s.nodes[k].body].kind == BodyKind::Free {
+            e.message = format!(
+                "node '{}' is on the free body '{}': the potential reads the nodes of fixed bodies only, where they \
+                 are drawn (a moving node is a coordinate's job)",
+                s.nodes[k].name, s.bodies[s.nodes[k].body].name
+            );
+        }
+    }
+    e
 }
 
 /// Largest work of the scans at one settle point: the Newton starts times the bytes of the

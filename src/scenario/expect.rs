@@ -12,6 +12,8 @@ pub(super) struct Parts<'a> {
     pub model: Option<&'a ModelSpec>,
     pub probe: bool,
     pub motion: Option<&'a crate::settings::Motion>,
+    /// The prestress is judged (`[prestress]`, or a custom structure with cables).
+    pub prestress: bool,
 }
 
 /// Names in a message: `none` for an empty list.
@@ -67,7 +69,13 @@ fn has_part(parts: &Parts, failure: &crate::report::verdict::Failure) -> Result<
         Failure::Energy if !model.is_some_and(|m| m.energy.is_some()) => {
             Err("'energy' needs an [energy] section in this scenario".into())
         }
-        Failure::Probe if !parts.probe => Err("'probe' needs a [probe] section in this scenario".into()),
+        Failure::Probe if !parts.probe => {
+            Err("'probe' needs a [probe] section that compares (expected and tolerance)".into())
+        }
+        Failure::Prestress if !parts.prestress => {
+            Err("'prestress' needs cables whose tension is judged ([prestress], or a custom structure with cables)"
+                .into())
+        }
         _ => Ok(()),
     }
 }

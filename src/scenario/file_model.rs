@@ -42,7 +42,7 @@ pub(super) fn model(
         equation(ctx, &mut spec, e)?;
     }
     if let Some(e) = &raw.energy {
-        spec.energy = Some(super::energy::energy(ctx, &spec, e)?);
+        spec.energy = Some(super::energy::energy(ctx, &spec, e, &structure)?);
         if let (Some(t), None) = (&e.trajectory, &raw.motion) {
             return Err(
                 ctx.err(t, "[energy.trajectory] compares a motion with the Lagrangian model: it needs [motion]")

@@ -26,6 +26,7 @@ mod overrides;
 mod params;
 mod pattern;
 mod physical;
+mod prestress;
 mod raw;
 mod record;
 mod repeat;
@@ -85,6 +86,9 @@ pub struct Scenario {
     pub topology_params: Vec<String>,
     /// Swept parameters that change nothing in a custom structure (only formulas see them).
     pub unseen_params: Vec<String>,
+    /// `[prestress]`, or the default of a custom structure with cables: when the structure has
+    /// lost its self-stress and what that does (None: not judged).
+    pub prestress: Option<crate::settings::Prestress>,
 }
 
 impl Scenario {
@@ -115,11 +119,12 @@ impl Scenario {
     }
 
     /// Whether a compared quantity is an angle (its errors are wrapped to (-pi, pi]): one of
-    /// the mechanism's angle quantities, or a prediction of the file's model of class angle.
+    /// the mechanism's angle quantities, a prediction of the file's model of class angle, or
+    /// an `[energy]` coordinate of class angle.
     pub fn is_angle(&self, quantity: &str) -> bool {
         let mechanism = self.mechanism();
         mechanism.quantities().iter().any(|q| q.symbol == quantity && q.kind == mechanisms::QuantityKind::Angle)
-            || self.model.as_ref().is_some_and(|m| m.is_angle(quantity))
+            || self.model.as_ref().is_some_and(|m| m.is_angle(quantity) || m.is_angle_coordinate(quantity))
     }
 }
 
@@ -427,10 +432,16 @@ fn validate(
     let first = structures.check(ctx, &raw, m, &mut sim, custom.is_some())?;
     let interference = interference::interference(ctx, &raw.interference, m, &first_params, &first)?;
     let probe = checks::probe(ctx, m, &raw.probe, &first, &params)?;
+    let prestress = prestress::prestress(ctx, &raw.prestress, &first, custom.is_some())?;
     closed_forms(ctx, &raw, probe.as_ref(), model.as_ref(), &param_table, &params, &actuation)?;
     let motion = motion::motion(ctx, &raw, sim.dt_s, (m, &first), &first_params, &actuation)?;
-    let parts =
-        expect::Parts { checks: &checks, model: model.as_ref(), probe: probe.is_some(), motion: motion.as_ref() };
+    let parts = expect::Parts {
+        checks: &checks,
+        model: model.as_ref(),
+        probe: probe.as_ref().is_some_and(|p| p.tolerance.is_some()),
+        motion: motion.as_ref(),
+        prestress: prestress.is_some(),
+    };
     let expect = raw.expect.as_ref().map(|e| expect::expectation(ctx, e, &parts)).transpose()?;
     Ok(Validated::One(Box::new(Scenario {
         file: path.to_path_buf(),
@@ -459,5 +470,6 @@ fn validate(
         topologies: Vec::new(),
         topology_params,
         unseen_params,
+        prestress,
     })))
 }

@@ -30,13 +30,16 @@ pub(super) struct RawScenario {
     #[serde(default)]
     pub(super) stability: Option<RawStability>,
     #[serde(default)]
-    pub(super) probe: Option<RawProbe>,
+    pub(super) probe: Option<Spanned<RawProbe>>,
     #[serde(default)]
     pub(super) record: Option<RawRecord>,
     #[serde(default)]
     pub(super) interference: Option<Spanned<RawInterference>>,
     #[serde(default)]
     pub(super) workspace: Option<RawWorkspace>,
+    /// When the structure counts as having lost its self-stress, and what that does.
+    #[serde(default)]
+    pub(super) prestress: Option<Spanned<RawPrestress>>,
     /// `mechanism = "custom"`: the structure itself.
     #[serde(default)]
     pub(super) structure: Option<Spanned<RawStructure>>,
@@ -348,6 +351,15 @@ pub(super) struct RawWorkspace {
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
+pub(super) struct RawPrestress {
+    /// Lost when the settled cables' total tension is below this share of the drawn one.
+    pub(super) min_fraction: Option<Spanned<f64>>,
+    /// "fail" (default) or "warn".
+    pub(super) on_loss: Option<Spanned<String>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub(super) struct RawInterference {
     /// false turns the checks off, which the report says (default true).
     pub(super) enabled: Option<bool>,
@@ -461,8 +473,9 @@ pub(super) struct RawProbe {
     pub(super) force: Option<Spanned<f64>>,
     /// The joint probe's predicted stiffness: an expression of the parameters and inputs.
     pub(super) expected: Option<Spanned<String>>,
-    /// Tolerance on the relative stiffness error.
-    pub(super) tolerance: Spanned<f64>,
+    /// Tolerance on the relative stiffness error (with `expected`, or the mechanism's probe;
+    /// a joint probe without either only measures).
+    pub(super) tolerance: Option<Spanned<f64>>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -95,3 +95,48 @@ fn the_readme_example_runs_and_passes() {
     let r = run(&sc, &RunOptions::default());
     assert!(r.passed, "{:?}", r.error);
 }
+
+/// The defaults the README's table states, read off the pinned strut of `common.rs` with its
+/// gravity, joint damping and spring length taken out and a cable added: the 1 m bar of 1 kg on
+/// nodes (0, 0, 0) and (1, 0, 0) gets its centre of mass at the midpoint and the isotropic
+/// moment 1 x 1^2 / 12 kg m^2 (a uniform thin rod's about its middle) within 1e-15; a strut
+/// radius 0.01 m, a cable's and a spring's 0.001 m, a cable inextensible of the drawn length
+/// 1 m (the spring's too), a joint undamped without torsion spring at coordinate 0, no
+/// gravity, and the `[sim]` and `[settle]` defaults; the README's table says each.
+#[test]
+fn the_documented_defaults_are_the_structures() {
+    let text = common::PINNED_STRUT.replace("gravity = [0.0, 0.0, 0.0]\n", "").replace("damping = 0.5\n", "");
+    let text = text.replace("length = 0.5\n", "") + "[[structure.cables]]\nname = \"c\"\na = \"Q\"\nb = \"S\"\n";
+    let sc = scenario::parse(Path::new("defaults.toml"), &text).unwrap_or_else(|e| panic!("{e}"));
+    let s = &sc.custom.as_ref().unwrap().structure;
+    let i = s.bodies[1].inertia.as_ref().unwrap();
+    assert!(i.com.iter().zip([0.5, 0.0, 0.0]).all(|(a, b)| (a - b).abs() <= 1e-15), "{:?}", i.com);
+    assert!(i.principal_kg_m2.iter().all(|m| (m - 1.0 / 12.0).abs() <= 1e-15), "{:?}", i.principal_kg_m2);
+    assert_eq!((s.struts[0].radius_m, s.cables[0].radius_m, s.springs[0].radius_m), (0.01, 0.001, 0.001));
+    assert_eq!(s.cables[0].law, tensegrity_testbed::structure::CableLaw::Inextensible);
+    let drawn = 1.0;
+    assert!((s.cables[0].length_m - drawn).abs() <= 1e-15 && (s.springs[0].rest_length_m - drawn).abs() <= 1e-15);
+    let j = &s.joints[0];
+    assert_eq!((j.damping, j.torsion_spring.is_none(), j.initial_coordinate, s.gravity), (0.0, true, 0.0, [0.0; 3]));
+    let (sim, settle) = (&sc.sim, &sc.settle);
+    assert_eq!((sim.dt_s, sim.substeps, sim.pgs_iterations, sim.body_damping_per_s), (0.01, 1, 8, 0.0));
+    assert_eq!((sim.relaxation, sim.bounding_box_m, sim.max_kinetic_energy_j), (true, 1000.0, 1e6));
+    assert!(sim.newton_damping, "a custom tree of joints");
+    assert_eq!((settle.speed_tol_m_per_s, settle.window_steps, settle.max_time_s), (1e-10, 10, 60.0));
+    assert_eq!((settle.residual_force_tol_n, settle.residual_torque_tol_nm), (1e-7, 1e-7));
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    for row in [
+        "| 0.01 s, 1, 8, 0 1/s, true, 1000 m, 1e6 J |",
+        "| 1e-10 m/s, 10 steps, 1e-7 N, 1e-7 N m, 60 s |",
+        "| a free body's centre of mass | the mean of its nodes",
+        "| a free body's inertia | isotropic m s^2 / 12",
+        "| strut radius (interference, drawing) | 0.01 m |",
+        "| cable and spring radius | 0.001 m |",
+        "| cable stiffness | none: inextensible |",
+        "| cable and spring length | the drawn distance |",
+        "| joint damping, torsion spring, `torsion_rest`, `initial_coordinate` | 0 N m s/rad (N s/m), none, 0 rad, 0 |",
+        "| gravity | none |",
+    ] {
+        assert!(readme.contains(row), "the README's defaults table lacks: {row}");
+    }
+}

@@ -12,8 +12,13 @@ use tensegrity_testbed::scenario;
 
 type P3 = [f64; 3];
 
-const OPTIONS: MatrixOptions =
-    MatrixOptions { bar_mass_kg: 1.0, bar_radius_m: 0.02, string_stiffness_n_per_m: 100.0, string_tension_n: 20.0 };
+const OPTIONS: MatrixOptions = MatrixOptions {
+    bar_mass_kg: 1.0,
+    bar_radius_m: 0.02,
+    string_stiffness_n_per_m: 100.0,
+    string_tension_n: 20.0,
+    uniform_tension: false,
+};
 
 /// A 3-strut prism drawn untwisted: nodes 1-3 the bottom triangle (radius 1 m), 4-6 the top
 /// one 1.5 m above; bars 1-5, 2-6, 3-4; strings: bottom, top, and verticals i to i+3.
@@ -22,23 +27,8 @@ fn prism_files(dir: &Path) -> [PathBuf; 3] {
     let angle = |k: f64| 2.0 * std::f64::consts::PI * k / 3.0;
     let cols: Vec<P3> =
         (0..6).map(|i| [angle(i as f64).cos(), angle(i as f64).sin(), if i < 3 { 0.0 } else { 1.5 }]).collect();
-    let n: String =
-        (0..3).map(|r| cols.iter().map(|c| format!("{:?}", c[r])).collect::<Vec<_>>().join(", ") + "\n").collect();
-    let row = |a: usize, b: usize| {
-        (1..=6)
-            .map(|k| {
-                if k == a {
-                    "-1"
-                } else if k == b {
-                    "1"
-                } else {
-                    "0"
-                }
-            })
-            .collect::<Vec<_>>()
-            .join(",")
-            + "\n"
-    };
+    let n = node_matrix(&cols);
+    let row = |a: usize, b: usize| connectivity_row(a - 1, b - 1, 6);
     let cb: String = [(1, 5), (2, 6), (3, 4)].iter().map(|&(a, b)| row(a, b)).collect();
     let cs: String = [(1, 2), (2, 3), (3, 1), (4, 5), (5, 6), (6, 4), (1, 4), (2, 5), (3, 6)]
         .iter()
@@ -50,6 +40,27 @@ fn prism_files(dir: &Path) -> [PathBuf; 3] {
         std::fs::write(f, text).unwrap();
     }
     files
+}
+
+/// N as CSV text: one row per coordinate, one column per node.
+fn node_matrix(cols: &[P3]) -> String {
+    (0..3).map(|r| cols.iter().map(|c| format!("{:?}", c[r])).collect::<Vec<_>>().join(", ") + "\n").collect()
+}
+
+/// A connectivity row of `count` nodes: -1 at node `a`, 1 at node `b` (from 0), zeros.
+fn connectivity_row(a: usize, b: usize, count: usize) -> String {
+    let cells: Vec<&str> = (0..count)
+        .map(|k| {
+            if k == a {
+                "-1"
+            } else if k == b {
+                "1"
+            } else {
+                "0"
+            }
+        })
+        .collect();
+    cells.join(",") + "\n"
 }
 
 fn temp(name: &str) -> PathBuf {
@@ -140,6 +151,8 @@ fn the_matrices_command_writes_a_scenario_that_checks() {
     };
     let (code, _, err) = run_with(&["--out", out.to_str().unwrap(), "--string-stiffness", "200"]);
     assert_eq!(code, 0, "{err}");
+    // The prism is drawn untwisted (no self-stress): the command says what it chose.
+    assert!(err.contains("chose: prestress: the drawn structure has no self-stress"), "{err}");
     assert!(std::fs::read_to_string(&out).unwrap().contains("stiffness = 200.0"));
     let (code, stdout, err) = tensegrity(&["check", out.to_str().unwrap()]);
     assert_eq!(code, 0, "{stdout}{err}");
@@ -157,7 +170,7 @@ fn the_matrices_command_writes_a_scenario_that_checks() {
 /// value too few is an error naming it.
 #[test]
 fn the_pinned_bar_from_arrays_settles_at_the_closed_form() {
-    use tensegrity_testbed::import::matrices::{from_arrays, MemberProperties, StringRest};
+    use tensegrity_testbed::import::matrices::{from_arrays, DrawnTension, MemberProperties, StringRest};
     let (k1, k2, a, b, q0) = (50.0, 30.0, 0.8, 0.6, std::f64::consts::PI / 10.0);
     let n = [vec![0.0, q0.cos(), 0.0, b], vec![0.0, q0.sin(), a, 0.0], vec![0.0; 4]];
     let cb = [vec![-1.0, 1.0, 0.0, 0.0]];
@@ -170,6 +183,7 @@ fn the_pinned_bar_from_arrays_settles_at_the_closed_form() {
         tension_only: vec![false, false],
         pins: vec![("n1".into(), Some([0.0, 0.0, 1.0]))],
         quantities: vec![("q".into(), "atan2(n2.y - n1.y, n2.x - n1.x)".into())],
+        prestress: DrawnTension::AsGiven,
     };
     let toml = from_arrays("pinned bar", &n, &cb, &cs, &p).unwrap().toml;
     assert!(toml.contains("[[structure.springs]]") && toml.contains("kind = \"revolute\""), "{toml}");
@@ -181,4 +195,112 @@ fn the_pinned_bar_from_arrays_settles_at_the_closed_form() {
     p.string_stiffness_n_per_m.pop();
     let e = from_arrays("pinned bar", &n, &cb, &cs, &p).unwrap_err();
     assert!(e.message.contains("string_stiffness_n_per_m has 1 values: expected 2"), "{e}");
+}
+
+/// An n-strut prism drawn with its top polygon turned by `twist` [rad] from the bottom one
+/// (radius 1 m, height 1.5 m): bar i joins bottom node i to top node i, the strings run round
+/// the bottom, round the top, and from bottom node i to top node i-1.
+fn n_prism_files(dir: &Path, n: usize, twist: f64) -> [PathBuf; 3] {
+    std::fs::create_dir_all(dir).unwrap();
+    let step = 2.0 * std::f64::consts::PI / n as f64;
+    let cols: Vec<P3> = (0..2 * n)
+        .map(|k| {
+            let (i, top) = (k % n, k >= n);
+            let a = step * i as f64 + if top { twist } else { 0.0 };
+            [a.cos(), a.sin(), if top { 1.5 } else { 0.0 }]
+        })
+        .collect();
+    let n_text = node_matrix(&cols);
+    let row = |a: usize, b: usize| connectivity_row(a, b, 2 * n);
+    let cb: String = (0..n).map(|i| row(i, n + i)).collect();
+    let mut cs: String = (0..n).map(|i| row(i, (i + 1) % n)).collect();
+    cs += &(0..n).map(|i| row(n + i, n + (i + 1) % n)).collect::<String>();
+    cs += &(0..n).map(|i| row(i, n + (i + n - 1) % n)).collect::<String>();
+    let files = [dir.join("N.csv"), dir.join("Cb.csv"), dir.join("Cs.csv")];
+    for (f, text) in files.iter().zip([n_text, cb, cs]) {
+        std::fs::write(f, text).unwrap();
+    }
+    files
+}
+
+/// Largest difference [rad] of the settled twist of an n-prism (each bar's bottom end against
+/// its top end about the axis through the polygons' centroids) from pi/2 + pi/n.
+fn twist_error(r: &tensegrity_testbed::report::ScenarioReport, n: usize) -> f64 {
+    let sim = &r.points[0].simulated;
+    let p = |k: usize| [sim[&format!("n{k}.x")], sim[&format!("n{k}.y")], sim[&format!("n{k}.z")]];
+    let centroid = |ks: Vec<usize>| [0, 1, 2].map(|c| ks.iter().map(|&k| p(k)[c]).sum::<f64>() / n as f64);
+    let (cb, ct) = (centroid((1..=n).collect()), centroid((n + 1..=2 * n).collect()));
+    let axis = common::sub(ct, cb).map(|x| x / common::norm(common::sub(ct, cb)));
+    let flat = |v: P3| {
+        let d = common::dot(v, axis);
+        [v[0] - d * axis[0], v[1] - d * axis[1], v[2] - d * axis[2]]
+    };
+    let expected = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI / n as f64;
+    (1..=n)
+        .map(|i| {
+            let (u, w) = (flat(common::sub(p(i), cb)), flat(common::sub(p(n + i), ct)));
+            (common::dot(common::cross(u, w), axis).atan2(common::dot(u, w)).abs() - expected).abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// With the command's defaults (10 N, 1000 N/m) a 3- and a 5-prism drawn at their twist
+/// pi/2 + pi/n are prestressed by their own self-stress: the import says so, every string's
+/// rest length is shorter than drawn (the least tension 10 N), and the run settles within
+/// 1e-9 rad of pi/2 + pi/n keeping all of its drawn cable tension (within 1e-6).
+#[test]
+fn prisms_imported_with_defaults_are_prestressed_and_settle_at_their_twist() {
+    for n in [3usize, 5] {
+        let dir = temp(&format!("prism{n}"));
+        let twist = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI / n as f64;
+        let [nf, cb, cs] = n_prism_files(&dir, n, twist);
+        let imported = import(&nf, &cb, &cs, &MatrixOptions::DEFAULT).unwrap();
+        assert!(
+            imported.chosen[0].contains("the drawn structure's self-stress, its least cable tension 10 N"),
+            "{:?}",
+            imported.chosen
+        );
+        assert!(imported.toml.contains("[prestress]\nmin_fraction = 0.1\non_loss = \"fail\""), "{}", imported.toml);
+        let sc = scenario::parse(Path::new("prism.toml"), &imported.toml).unwrap();
+        let cables = &sc.custom.as_ref().unwrap().structure.cables;
+        let r = run(&sc, &RunOptions::default());
+        assert!(r.passed, "n = {n}: {:?} {:?}", r.failures, r.prestress);
+        let error = twist_error(&r, n);
+        let kept = r.points[0].prestress_fraction.unwrap();
+        eprintln!("{n}-prism imported with defaults: twist within {error:.1e} rad of pi/2 + pi/{n}, {kept} of the drawn tension kept, {} cables", cables.len());
+        assert!(error <= 1e-9, "n = {n}: twist off by {error} rad");
+        assert!((kept - 1.0).abs() <= 1e-6, "n = {n}: {kept}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
+
+/// A 5-prism drawn 0.3 rad short of its twist has no self-stress: the import says so and puts
+/// every string at 10 N, so the drawn state is no equilibrium. It settles 0.17 rad off the
+/// closed-form twist with its cables' tension gone (measured 1.3e-14 of the drawn one; below
+/// the import's min_fraction 0.1) and seven strings slack: the run fails on `prestress`
+/// alone, the report and the table naming the slack strings; declared `on_loss = "warn"` it
+/// passes with a warning naming them.
+#[test]
+fn a_slack_import_fails_naming_its_slack_strings() {
+    let dir = temp("slack5");
+    let twist = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI / 5.0 - 0.3;
+    let [nf, cb, cs] = n_prism_files(&dir, 5, twist);
+    let imported = import(&nf, &cb, &cs, &MatrixOptions::DEFAULT).unwrap();
+    assert!(imported.chosen[0].contains("no self-stress with every string in tension"), "{:?}", imported.chosen);
+    let sc = scenario::parse(Path::new("off.toml"), &imported.toml).unwrap();
+    let r = run(&sc, &RunOptions::default());
+    assert_eq!(r.failures, vec![tensegrity_testbed::report::verdict::Failure::Prestress]);
+    let p = r.prestress.clone().unwrap();
+    eprintln!("5-prism drawn 0.3 rad off, every string at 10 N: {:?}, twist off by {:.3e} rad", p, twist_error(&r, 5));
+    assert!((twist_error(&r, 5) - 0.17).abs() <= 0.01, "{}", twist_error(&r, 5));
+    assert!(p.least_fraction_kept.unwrap() <= 1e-6, "{p:?}");
+    assert_eq!(p.lost_at, vec![0]);
+    assert_eq!(p.slack_cables.len(), 7, "{p:?}");
+    assert!(p.slack_cables.iter().all(|c| c.starts_with("string")), "{p:?}");
+    let table = tensegrity_testbed::report::Report { scenarios: vec![r] }.to_table();
+    assert!(table.contains(&format!("slack: {}  FAIL", p.slack_cables.join(", "))), "{table}");
+    let warned = imported.toml.replace("on_loss = \"fail\"", "on_loss = \"warn\"");
+    let r = run(&scenario::parse(Path::new("warn.toml"), &warned).unwrap(), &RunOptions::default());
+    assert!(r.passed && r.prestress.as_ref().unwrap().lost_at == vec![0], "{:?}", r.failures);
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -251,3 +251,81 @@ fn a_single_compound_body_imports_with_finite_settings() {
     run_text("triangle.toml", &i.toml);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// An n-strut prism in NTRT's YAML (y up) drawn at its twist pi/2 + pi/n (radius 1, height
+/// 1.5), its string builder giving a stiffness and `pretension` only if given.
+fn ntrt_prism(n: usize, pretension: Option<f64>) -> String {
+    let step = 2.0 * std::f64::consts::PI / n as f64;
+    let twist = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI / n as f64;
+    let mut y = String::from("nodes:\n");
+    for i in 0..n {
+        let (b, t) = (step * i as f64, step * i as f64 + twist);
+        y += &format!("  b{i}: [{:?}, 0.0, {:?}]\n  t{i}: [{:?}, 1.5, {:?}]\n", b.cos(), -b.sin(), t.cos(), -t.sin());
+    }
+    y += "pair_groups:\n  rod:\n";
+    y += &(0..n).map(|i| format!("    - [b{i}, t{i}]\n")).collect::<String>();
+    y += "  string:\n";
+    for i in 0..n {
+        let (j, k) = ((i + 1) % n, (i + n - 1) % n);
+        y += &format!("    - [b{i}, b{j}]\n    - [t{i}, t{j}]\n    - [b{i}, t{k}]\n");
+    }
+    y += "builders:\n  rod:\n    class: tgRodInfo\n    parameters:\n      density: 200.0\n      radius: 0.02\n";
+    y += "  string:\n    class: tgBasicActuatorInfo\n    parameters:\n      stiffness: 100.0\n";
+    if let Some(p) = pretension {
+        y += &format!("      pretension: {p:?}\n");
+    }
+    y
+}
+
+fn import_text(name: &str, yaml: &str) -> tensegrity_testbed::import::Imported {
+    let dir = std::env::temp_dir().join(format!("import-ntrt-prestress-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, yaml).unwrap();
+    import(&path, Axes::ZUp).unwrap()
+}
+
+/// NTRT's default pretension is 0 (every string slack): a 3- and a 5-prism whose file gives
+/// none are prestressed by their drawn self-stress instead (least string tension 10 N), the
+/// import says so, and each settles within 1e-9 rad of its twist pi/2 + pi/n, measured between
+/// each rod's ends about the axis through the polygons' centroids.
+#[test]
+fn ntrt_prisms_without_pretension_are_prestressed_by_their_self_stress() {
+    for n in [3usize, 5] {
+        let imported = import_text(&format!("prism{n}.yaml"), &ntrt_prism(n, None));
+        assert!(imported.chosen[0].contains("self-stress, its least cable tension 10 N"), "{:?}", imported.chosen);
+        let r = run_text("prism.toml", &imported.toml);
+        let b: Vec<P3> = (0..n).map(|i| node(&r, &format!("b{i}"))).collect();
+        let t: Vec<P3> = (0..n).map(|i| node(&r, &format!("t{i}"))).collect();
+        let centroid = |v: &[P3]| [0, 1, 2].map(|k| v.iter().map(|p| p[k]).sum::<f64>() / n as f64);
+        let (cb, ct) = (centroid(&b), centroid(&t));
+        let axis = sub(ct, cb).map(|x| x / norm(sub(ct, cb)));
+        let flat = |v: P3| {
+            let d = dot(v, axis);
+            [v[0] - d * axis[0], v[1] - d * axis[1], v[2] - d * axis[2]]
+        };
+        let expected = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI / n as f64;
+        let worst = (0..n)
+            .map(|i| {
+                let (u, w) = (flat(sub(b[i], cb)), flat(sub(t[i], ct)));
+                (dot(cross(u, w), axis).atan2(dot(u, w)).abs() - expected).abs()
+            })
+            .fold(0.0, f64::max);
+        eprintln!("NTRT {n}-prism without pretension: twist within {worst:.1e} rad of pi/2 + pi/{n}");
+        assert!(worst <= 1e-9, "n = {n}: twist off by {worst} rad");
+    }
+}
+
+/// A pretension the file gives is kept, even 0: then every string is slack at the drawn
+/// state, and the run fails on `prestress` naming every string.
+#[test]
+fn an_ntrt_pretension_of_zero_is_kept_and_the_slack_run_fails() {
+    let imported = import_text("slack.yaml", &ntrt_prism(3, Some(0.0)));
+    assert!(imported.chosen[0].contains("the file's pretensions"), "{:?}", imported.chosen);
+    let sc = scenario::parse(Path::new("slack.toml"), &imported.toml).unwrap();
+    let r = run(&sc, &RunOptions::default());
+    assert_eq!(r.failures, vec![tensegrity_testbed::report::verdict::Failure::Prestress]);
+    let p = r.prestress.unwrap();
+    eprintln!("NTRT prism at pretension 0: {p:?}");
+    assert_eq!(p.slack_cables.len(), 9, "{p:?}");
+}

@@ -20,7 +20,8 @@ fn the_probe_measures_the_joint_stiffness_of_the_energy() {
     let r = run(&sc, &RunOptions::default());
     assert!(r.passed, "{:?}", r.failures);
     let probe = r.stiffness_probe.as_ref().unwrap();
-    assert!(probe.passed && probe.max_rel_error <= 1e-6, "{probe:?}");
+    assert!(probe.passed && probe.max_rel_error.unwrap() <= 1e-6, "{probe:?}");
+    assert_eq!(probe.quantity, "pin.stiffness");
     for p in &r.points {
         let k = p.simulated["pin.stiffness"];
         let want = (p.inputs["k1"] * 0.8).hypot(30.0 * 0.6);
@@ -37,8 +38,44 @@ fn a_wrong_stiffness_fails_the_probe() {
     let sc = scenario::parse(Path::new("wrong.toml"), &text).unwrap();
     let r = run(&sc, &RunOptions::default());
     assert_eq!(r.failures, vec![Failure::Probe]);
-    let e = r.stiffness_probe.unwrap().max_rel_error;
+    let e = r.stiffness_probe.unwrap().max_rel_error.unwrap();
     assert!((e - 0.5).abs() <= 1e-6, "relative error {e}");
+}
+
+/// The pinned bar with no closed form: `[probe]` without `expected` and `tolerance`.
+fn measuring_only(count: usize) -> String {
+    let text = std::fs::read_to_string(FILE).unwrap().replace("count = 9", &format!("count = {count}"));
+    text.replace("expected = \"L*hypot(k1*a, k2*b)\"\ntolerance = 1e-6\n", "")
+}
+
+/// A probe without a closed form only measures: the stiffness about the pin at k1 = 10 and
+/// 90 N/m is reported (in the points and the probe's report, against V''(q) = L hypot(k1 a,
+/// k2 b) within 1e-6 relative), no analytic value, no verdict from it (the run passes, and a
+/// prediction off by a factor 2 would have failed it); the table says "measured only".
+#[test]
+fn a_probe_without_a_closed_form_only_measures() {
+    let text = measuring_only(2);
+    let sc = scenario::parse(Path::new("measure.toml"), &text).unwrap();
+    let r = run(&sc, &RunOptions::default());
+    assert!(r.passed, "{:?}", r.failures);
+    let probe = r.stiffness_probe.as_ref().unwrap();
+    assert_eq!((probe.tolerance, probe.max_rel_error, probe.passed), (None, None, true));
+    assert_eq!(probe.measured.len(), 2);
+    for (p, k) in r.points.iter().zip(&probe.measured) {
+        let want = (p.inputs["k1"] * 0.8).hypot(30.0 * 0.6);
+        assert!(((k - want) / want).abs() <= 1e-6, "k1 = {}: {k} N m/rad, want {want}", p.inputs["k1"]);
+        assert_eq!(p.simulated["pin.stiffness"], *k);
+        assert!(!p.analytic.contains_key("pin.stiffness"));
+    }
+    let table = tensegrity_testbed::report::Report { scenarios: vec![r] }.to_table();
+    assert!(table.contains("stiffness probe pin.stiffness (+-0.001): measured only (no closed form)"), "{table}");
+    // `tolerance` without `expected`, and `expected` without `tolerance`, are located errors.
+    let with_tol = text.replace("torque = 1e-3\n", "torque = 1e-3\ntolerance = 1e-6\n");
+    common::error_at(&with_tol, "1e-6\n\n[[quantities]]", 0, "probe.tolerance goes with probe.expected");
+    let with_expected = text.replace("torque = 1e-3\n", "torque = 1e-3\nexpected = \"k1\"\n");
+    common::error_at(&with_expected, "expected = \"k1\"", 11, "probe.expected needs probe.tolerance");
+    let expect_probe = text.replace("verdict = \"pass\"", "verdict = \"fail\"\nfailing = [\"probe\"]");
+    common::error_at(&expect_probe, "\"probe\"]", 0, "that compares (expected and tolerance)");
 }
 
 /// An expected stiffness that is not a number (here sqrt(-1)) or zero cannot pass or fail: it

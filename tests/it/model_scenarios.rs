@@ -243,7 +243,7 @@ fn energy_errors_are_located() {
         &v,
         "x\"\ntolerance",
         0,
-        "energy potential (coordinates, parameters, inputs and their quantities): unknown symbol 'x'",
+        "energy potential (coordinates, parameters, inputs, their quantities, fixed nodes): unknown symbol 'x'",
     );
     let d = good.replacen("\"u0 + a*cos(th) + b*sin(th)\"", "\"u0 + abs(a*cos(th)) + b*sin(th)\"", 1);
     error_at(&d, "\"u0 + abs", 1, "no symbolic derivative");

@@ -1,0 +1,122 @@
+//! The prestress an import gives a structure: the drawn structure's own self-stress (member
+//! forces in equilibrium at every node with no load: cables in tension, struts in
+//! compression), scaled so that the least cable tension is a stated one, set by each elastic
+//! cable's rest length (drawn length less tension / stiffness). The drawn state is then an
+//! equilibrium and the structure settles where it was drawn, prestressed.
+//!
+//! The self-stress is found in the null space of the equilibrium matrix (one column per
+//! member: its unit vector at its two nodes, one row per coordinate of a node not on a fixed
+//! anchor; a node on a strut counts even when its body is held) as the projection of a uniform
+//! stress (cables +1, struts -1) on it (Pellegrino 1993, "Structural computations with the
+//! singular value decomposition of the equilibrium matrix").
+
+use super::draft::Draft;
+use crate::structure::{distance, Vec3};
+use nalgebra::DMatrix;
+
+/// Singular values of the equilibrium matrix below this share of the largest are its null
+/// space's (a drawing given to 9 digits or more; the decomposition's own error is ~1e-16).
+const NULL_SPACE_FRACTION: f64 = 1e-9;
+/// A cable whose share of the stress is below this fraction of the largest member force
+/// counts as carrying none: no self-stress keeps every cable taut.
+const TAUT_FRACTION: f64 = 1e-6;
+
+/// What an import did to prestress the structure, in a sentence.
+pub struct Chosen {
+    pub sentence: String,
+    /// The least and largest cable tension at the drawn state [N].
+    pub least_n: f64,
+    pub largest_n: f64,
+}
+
+/// The drawn structure's self-stress: one tension per cable [N] in `draft.cables` order, the
+/// least of them 1 (struts in compression), or None when no self-stress keeps every cable in
+/// tension.
+pub fn self_stress(draft: &Draft) -> Option<Vec<f64>> {
+    let nodes: Vec<(&str, Vec3)> =
+        draft.bodies.iter().flat_map(|b| b.nodes.iter().map(|(n, p)| (n.as_str(), *p))).collect();
+    let on_strut = |n: &str| draft.struts.iter().any(|s| s.a == n || s.b == n);
+    let anchored =
+        |n: &str| draft.bodies.iter().any(|b| b.fixed && b.nodes.iter().any(|(m, _)| m == n)) && !on_strut(n);
+    let free: Vec<&(&str, Vec3)> = nodes.iter().filter(|(n, _)| !anchored(n)).collect();
+    let row = |n: &str| free.iter().position(|(m, _)| *m == n);
+    let pos = |n: &str| nodes.iter().find(|(m, _)| *m == n).map(|(_, p)| *p);
+    let members: Vec<(&str, &str)> = draft
+        .cables
+        .iter()
+        .map(|c| (c.a.as_str(), c.b.as_str()))
+        .chain(draft.struts.iter().map(|s| (s.a.as_str(), s.b.as_str())))
+        .collect();
+    let mut a = DMatrix::<f64>::zeros(3 * free.len(), members.len());
+    for (j, (na, nb)) in members.iter().enumerate() {
+        let (pa, pb) = (pos(na)?, pos(nb)?);
+        let l = distance(pa, pb);
+        for (n, sign) in [(na, 1.0), (nb, -1.0)] {
+            if let Some(r) = row(n) {
+                for k in 0..3 {
+                    a[(3 * r + k, j)] += sign * (pb[k] - pa[k]) / l;
+                }
+            }
+        }
+    }
+    let stress = projected_uniform_stress(&a, draft.cables.len())?;
+    let largest = stress.iter().fold(0.0f64, |m, t| m.max(t.abs()));
+    let cables = &stress[..draft.cables.len()];
+    let least = cables.iter().copied().fold(f64::INFINITY, f64::min);
+    if !(least > TAUT_FRACTION * largest) {
+        return None;
+    }
+    Some(cables.iter().map(|t| t / least).collect())
+}
+
+/// The uniform stress (the first `cables` members +1, the rest -1) projected on the null
+/// space of `a` (None: no null space), from its singular value decomposition (zero rows added
+/// so that every right singular vector is computed).
+fn projected_uniform_stress(a: &DMatrix<f64>, cables: usize) -> Option<Vec<f64>> {
+    let m = a.ncols();
+    let mut padded = DMatrix::<f64>::zeros(a.nrows().max(m), m);
+    padded.view_mut((0, 0), (a.nrows(), m)).copy_from(a);
+    let svd = padded.svd(false, true);
+    let v_t = svd.v_t?;
+    let top = svd.singular_values.iter().copied().fold(0.0f64, f64::max).max(f64::MIN_POSITIVE);
+    let uniform: Vec<f64> = (0..m).map(|j| if j < cables { 1.0 } else { -1.0 }).collect();
+    let mut t = vec![0.0; m];
+    let mut found = false;
+    for (i, sigma) in svd.singular_values.iter().enumerate() {
+        if *sigma > NULL_SPACE_FRACTION * top {
+            continue;
+        }
+        found = true;
+        let v = v_t.row(i);
+        let c: f64 = v.iter().zip(&uniform).map(|(x, u)| x * u).sum();
+        t.iter_mut().zip(v.iter()).for_each(|(t, x)| *t += c * x);
+    }
+    found.then_some(t)
+}
+
+/// Prestresses `draft` with its self-stress scaled so that the least cable tension is
+/// `least_n` [N]: each elastic cable's rest length set to its drawn length less its tension
+/// over its stiffness. None when there is no such self-stress (nothing changed); an error
+/// naming the cable when a tension leaves it no rest length.
+pub fn prestress(draft: &mut Draft, least_n: f64) -> Result<Option<Chosen>, String> {
+    let Some(stress) = self_stress(draft) else { return Ok(None) };
+    let positions: Vec<(String, Vec3)> = draft.bodies.iter().flat_map(|b| b.nodes.clone()).collect();
+    let pos = |n: &str| positions.iter().find(|(m, _)| m == n).map(|(_, p)| *p).unwrap_or_default();
+    for (c, t) in draft.cables.iter_mut().zip(&stress) {
+        let Some(k) = c.stiffness_n_per_m else { continue };
+        let (tension, drawn) = (t * least_n, distance(pos(&c.a), pos(&c.b)));
+        c.length_m = drawn - tension / k;
+        if !(c.length_m > 0.0) {
+            return Err(format!(
+                "cable {}: its share of the self-stress, {tension} N at {k} N/m, leaves no rest length (drawn {drawn} m)",
+                c.name
+            ));
+        }
+    }
+    let largest = stress.iter().copied().fold(0.0, f64::max) * least_n;
+    let sentence = format!(
+        "prestress: the drawn structure's self-stress, its least cable tension {least_n} N (largest {largest:.6} N), \
+         set by each cable's rest length (drawn - tension / stiffness): the drawn state is an equilibrium"
+    );
+    Ok(Some(Chosen { sentence, least_n, largest_n: largest }))
+}

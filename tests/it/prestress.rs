@@ -1,0 +1,127 @@
+//! `[prestress]`: a structure that loses its self-stress (every cable slack, or its cables'
+//! total tension below a stated share of the drawn one) fails on `prestress`, or warns where
+//! the scenario says it may, naming the slack cables; a custom structure with cables is judged
+//! so without the section (it fails when every cable is slack).
+
+use crate::common;
+use std::path::Path;
+use tensegrity_testbed::report::verdict::Failure;
+use tensegrity_testbed::report::{Report, ScenarioReport};
+use tensegrity_testbed::run::{run, RunOptions};
+use tensegrity_testbed::scenario;
+
+const PRISM: &str = "scenarios/custom/prism3.toml";
+
+/// The prism's nine cables, as its file names them.
+const CABLES: [&str; 9] = ["bottom12", "bottom23", "bottom31", "top12", "top23", "top31", "side1", "side2", "side3"];
+
+fn run_text(text: &str) -> ScenarioReport {
+    let sc = scenario::parse(Path::new("prestress.toml"), text).unwrap_or_else(|e| panic!("{e}"));
+    run(&sc, &RunOptions::default())
+}
+
+/// The prism with every cable's rest length 5 m, longer than any cable is drawn: slack from
+/// the start, the drawn state an equilibrium of nothing.
+fn slack_prism(extra: &str) -> String {
+    let text = std::fs::read_to_string(PRISM).unwrap();
+    let text = text.replace("length = 1.5\n", "length = 5.0\n").replace("length = 1.2\n", "length = 5.0\n");
+    text.replace("[expect]", &format!("{extra}\n[expect]"))
+}
+
+/// The shipped prism keeps its self-stress without a `[prestress]` section: its settled
+/// cables carry 0.8747 of their drawn total tension (within 1e-6), no cable slack, and it
+/// passes; asked to keep 0.9 of it, it fails on `prestress` at point 0; 0.8 passes.
+#[test]
+fn the_prism_keeps_its_prestress_and_a_stated_fraction_is_judged() {
+    let text = std::fs::read_to_string(PRISM).unwrap();
+    let r = run_text(&text);
+    assert!(r.passed, "{:?}", r.failures);
+    let p = r.prestress.as_ref().expect("a custom structure with cables is judged");
+    let kept = p.least_fraction_kept.unwrap();
+    eprintln!("prism3: share of the drawn cable tension kept {kept}");
+    assert!((kept - 0.8747).abs() <= 1e-4, "{kept}");
+    assert!(p.lost_at.is_empty() && p.slack_cables.is_empty() && p.cables == 9, "{p:?}");
+    let strict = run_text(&text.replace("[expect]", "[prestress]\nmin_fraction = 0.9\n\n[expect]"));
+    assert_eq!(strict.failures, vec![Failure::Prestress]);
+    assert_eq!(strict.prestress.as_ref().unwrap().lost_at, vec![0]);
+    let table = Report { scenarios: vec![strict] }.to_table();
+    assert!(
+        table.contains("prestress: LOST at point(s) [0] (every cable slack or below 0.9 of the drawn tension)"),
+        "{table}"
+    );
+    let loose = run_text(&text.replace("[expect]", "[prestress]\nmin_fraction = 0.8\n\n[expect]"));
+    assert!(loose.passed, "{:?}", loose.failures);
+}
+
+/// Every cable slack: the run fails on `prestress` alone (it settles, as the drawn state is at
+/// rest), and the report and the table name the nine slack cables; with `on_loss = "warn"`
+/// it passes with a warning naming them; `[expect] failing = ["prestress"]` declares it.
+#[test]
+fn a_slack_structure_fails_or_warns_naming_its_slack_cables() {
+    let r = run_text(&slack_prism(""));
+    assert_eq!(r.failures, vec![Failure::Prestress]);
+    let p = r.prestress.as_ref().unwrap();
+    assert_eq!(p.slack_cables, CABLES.map(String::from).to_vec());
+    assert_eq!(p.least_fraction_kept, None, "no drawn tension to keep a share of");
+    let table = Report { scenarios: vec![r] }.to_table();
+    assert!(table.contains(&format!("slack: {}  FAIL", CABLES.join(", "))), "{table}");
+
+    let warned = run_text(&slack_prism("[prestress]\non_loss = \"warn\"\n"));
+    assert!(warned.passed, "{:?}", warned.failures);
+    assert_eq!(warned.prestress.as_ref().unwrap().slack_cables.len(), 9);
+    let table = Report { scenarios: vec![warned] }.to_table();
+    assert!(table.contains("WARNING (on_loss = \"warn\")"), "{table}");
+
+    let declared = slack_prism("").replace("verdict = \"pass\"", "verdict = \"fail\"\nfailing = [\"prestress\"]");
+    let r = run_text(&declared);
+    assert_eq!(r.as_expected, Some(true), "{:?}", r.failures);
+}
+
+/// Bad `[prestress]` sections are errors at the key at fault: a fraction outside (0, 1], an
+/// `on_loss` that is neither word, a fraction of a structure whose cables carry no tension when
+/// drawn, the section on a structure without cables.
+#[test]
+fn bad_prestress_sections_are_located() {
+    let prism = std::fs::read_to_string(PRISM).unwrap();
+    let with = |section: &str| prism.replace("[expect]", &format!("[prestress]\n{section}\n\n[expect]"));
+    common::error_at(
+        &with("min_fraction = 1.5"),
+        "min_fraction = 1.5",
+        15,
+        "prestress.min_fraction must lie in (0, 1], got 1.5",
+    );
+    common::error_at(&with("on_loss = \"maybe\""), "\"maybe\"", 0, "must be \"fail\" or \"warn\", got 'maybe'");
+    let slack = slack_prism("[prestress]\nmin_fraction = 0.5\n");
+    common::error_at(&slack, "min_fraction = 0.5", 15, "they carry none there");
+    let bar = std::fs::read_to_string("scenarios/custom/pinned_bar_sweep.toml").unwrap();
+    let bar = bar.replace("[expect]", "[prestress]\non_loss = \"warn\"\n\n[expect]");
+    common::error_at(&bar, "[prestress]", 0, "this structure has no cables");
+}
+
+/// A sweep counts a point that lost its prestress as disagreeing: the slack prism's sweep
+/// fails (exit 1), its CSV row says `prestress_lost` true and the kept share is empty (no drawn
+/// tension); the shipped prism's row keeps 0.8747 of it (within 1e-4) and passes.
+#[test]
+fn a_sweep_fails_on_a_point_that_lost_its_prestress() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-prestress-sweep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cell = |csv: &str, name: &str| {
+        let mut lines = csv.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let row: Vec<&str> = lines.next().unwrap().split(',').collect();
+        row[header.iter().position(|h| *h == name).unwrap()].to_string()
+    };
+    let (slack, csv) = (dir.join("slack.toml"), dir.join("slack.csv"));
+    std::fs::write(&slack, slack_prism("")).unwrap();
+    let (code, out, err) = common::tensegrity(&["sweep", slack.to_str().unwrap(), "--out", csv.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("1 point(s) did not settle, are out of tolerance or lost their prestress"), "{out}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!((cell(&text, "prestress_lost").as_str(), cell(&text, "prestress_fraction").as_str()), ("true", ""));
+    let (code, out, err) = common::tensegrity(&["sweep", PRISM, "--out", csv.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let kept: f64 = cell(&text, "prestress_fraction").parse().unwrap();
+    assert!((kept - 0.8747).abs() <= 1e-4 && cell(&text, "prestress_lost") == "false", "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
