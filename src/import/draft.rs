@@ -124,7 +124,8 @@ impl Draft {
 
     /// Whether an elastic cable is drawn longer than its rest length (in tension when drawn).
     fn drawn_taut(&self) -> bool {
-        self.cables.iter().any(|c| {
+        // Springs (not tension-only) are no cables: `[prestress]` judges cables only.
+        self.cables.iter().filter(|c| c.tension_only).any(|c| {
             let drawn = self.position(&c.a).zip(self.position(&c.b)).map(|(a, b)| distance(a, b));
             c.stiffness_n_per_m.is_some() && drawn.is_some_and(|l| l > c.length_m)
         })

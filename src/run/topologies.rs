@@ -5,7 +5,7 @@
 
 use super::{conclude, run, RunOptions};
 use crate::observers::table::TableTarget;
-use crate::report::{CheckReport, ModelCheckReport, ScenarioReport};
+use crate::report::{CheckReport, ModelCheckReport, PrestressReport, ScenarioReport};
 use crate::scenario::Scenario;
 use std::path::{Path, PathBuf};
 
@@ -104,6 +104,13 @@ fn join(j: &mut ScenarioReport, r: ScenarioReport) {
             None => j.model_checks.push(m),
         }
     }
+    j.prestress = match (j.prestress.take(), r.prestress) {
+        (Some(mut x), Some(p)) => {
+            join_prestress(&mut x, p, offset);
+            Some(x)
+        }
+        (x, p) => x.or(p),
+    };
     j.slack_intervals.extend(r.slack_intervals);
     j.skipped_points += r.skipped_points;
     j.accelerated_steps += r.accelerated_steps;
@@ -131,4 +138,50 @@ fn join_model_check(x: &mut ModelCheckReport, c: &ModelCheckReport) {
     x.transient_max_error = x.transient_max_error.max(c.transient_max_error);
     x.transient_rms_error = x.transient_rms_error.max(c.transient_rms_error);
     x.ticks_compared += c.ticks_compared;
+}
+
+/// A later structure's prestress judgement added: its lost points numbered after the earlier
+/// structures' points, its slack cables named once.
+fn join_prestress(x: &mut PrestressReport, p: PrestressReport, offset: usize) {
+    x.least_fraction_kept = match (x.least_fraction_kept, p.least_fraction_kept) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    };
+    x.lost_at.extend(p.lost_at.into_iter().map(|i| i + offset));
+    for c in p.slack_cables {
+        if !x.slack_cables.contains(&c) {
+            x.slack_cables.push(c);
+        }
+    }
+    x.cables = x.cables.max(p.cables);
+    x.passed &= p.passed;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn judged(lost_at: Vec<usize>, slack: &[&str], least: f64) -> PrestressReport {
+        PrestressReport {
+            on_loss: crate::settings::OnLoss::Fail,
+            min_fraction: Some(0.1),
+            cables: 9,
+            least_fraction_kept: Some(least),
+            passed: lost_at.is_empty(),
+            lost_at,
+            slack_cables: slack.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    /// A loss in a later structure fails the joined run, at that structure's point numbered
+    /// after the earlier structures' points.
+    #[test]
+    fn a_later_structures_lost_prestress_fails_the_joined_judgement() {
+        let mut first = judged(vec![], &[], 0.87);
+        join_prestress(&mut first, judged(vec![0], &["side3", "top1"], 1e-14), 4);
+        assert!(!first.passed);
+        assert_eq!(first.lost_at, vec![4]);
+        assert_eq!(first.slack_cables, vec!["side3".to_string(), "top1".to_string()]);
+        assert_eq!(first.least_fraction_kept, Some(1e-14));
+    }
 }
