@@ -6,7 +6,7 @@
 
 use super::error::{Ctx, ScenarioError};
 use super::number::expr_error;
-use super::pattern::{bindings, spanned_expr, spanned_name, Binding, Env, Groups};
+use super::pattern::{bindings, spanned_expr, spanned_name, Binding, Env, Groups, MAX_PATTERN_COUNT};
 use super::raw::{For, RawEquation, RawPrediction, RawQuantity, RawScenario, RawStructure};
 use toml::Spanned;
 
@@ -62,7 +62,11 @@ fn expand<T: Looped>(
         match e.over() {
             None => out.push(fill(&Element { ctx, env, groups, tag: None }, &e)?),
             Some(over) => {
-                for (inner, tag) in loop_envs(ctx, env, groups, &over)? {
+                let envs = loop_envs(ctx, env, groups, &over)?;
+                if out.len() + envs.len() > MAX_PATTERN_COUNT as usize {
+                    return Err(ctx.err(&over, format!("the loops make more than {MAX_PATTERN_COUNT} entries in all")));
+                }
+                for (inner, tag) in envs {
                     out.push(fill(&Element { ctx, env: &inner, groups, tag: Some(&tag) }, &e)?);
                 }
             }

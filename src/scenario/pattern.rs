@@ -16,7 +16,7 @@
 //! and a member variable names the member (`{c}.force`).
 
 use super::error::{Ctx, ScenarioError};
-use crate::file_model::expr::ExprError;
+use crate::file_model::expr::{ExprError, MAX_EXPRESSION_BYTES};
 use crate::mechanisms::Values;
 use std::cell::RefCell;
 use std::collections::BTreeSet;
@@ -225,11 +225,16 @@ fn aggregate(
         return Err(at(start, format!("{word} over an empty range {over}")));
     }
     let body = &text[comma + 1..close];
-    let terms = envs
-        .iter()
-        .map(|e| fill(body, e, Mode::Expr, groups).map(|t| t.trim().to_string()))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| shifted(e, comma + 1))?;
+    let (mut terms, mut bytes) = (Vec::new(), 0);
+    for e in &envs {
+        let t = fill(body, e, Mode::Expr, groups).map_err(|e| shifted(e, comma + 1))?;
+        bytes += t.len();
+        // Bounded while it grows: the expansion could otherwise be the range times the body.
+        if bytes > MAX_EXPRESSION_BYTES {
+            return Err(at(start, format!("{word}(...) over {over} expands beyond {MAX_EXPRESSION_BYTES} bytes")));
+        }
+        terms.push(t.trim().to_string());
+    }
     let joined = if word == "sum" {
         format!("({})", terms.iter().map(|t| format!("({t})")).collect::<Vec<_>>().join(" + "))
     } else {

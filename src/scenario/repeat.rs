@@ -6,7 +6,7 @@
 
 use super::error::{Ctx, ScenarioError};
 use super::number::{expr_error, Num};
-use super::pattern::{bindings, spanned_name, Env, Groups};
+use super::pattern::{bindings, spanned_name, Env, Groups, MAX_PATTERN_COUNT};
 use super::raw::{
     Placement, RawActuator, RawBody, RawJoint, RawMember, RawMemberGroup, RawRepeat, RawRotate, RawStructure,
 };
@@ -99,8 +99,14 @@ impl Instantiate for RawBody {
 /// Appends every `[[structure.repeat]]` copy to the structure's lists, with the parameters'
 /// values of `env` (which decide the ranges).
 pub(super) fn expand(ctx: &Ctx, s: &mut RawStructure, env: &Env) -> Result<(), ScenarioError> {
+    let mut total = 0;
     for r in std::mem::take(&mut s.repeat) {
-        for env in copies(ctx, &r, env)? {
+        let envs = copies(ctx, &r, env)?;
+        total += envs.len();
+        if total > MAX_PATTERN_COUNT as usize {
+            return Err(ctx.err(&r.over, format!("the repeats make more than {MAX_PATTERN_COUNT} copies in all")));
+        }
+        for env in envs {
             add_copy(ctx, s, &r, &env)?;
         }
     }

@@ -152,3 +152,21 @@ fn a_swept_parameter_the_structure_does_not_see_is_reported() {
     let sc = load(&text).expect("valid");
     assert_eq!(sc.unseen_params, vec!["unused".to_string()]);
 }
+
+/// Generated work is bounded before it is done: the repeats' copies in all, and an aggregate's
+/// expansion while it grows (a sum over 10,000 indices of a long body).
+#[test]
+fn patterns_are_bounded_before_their_work() {
+    let mut text = ring("4", "");
+    for _ in 0..3 {
+        text.push_str("[[structure.repeat]]\nfor = { i = \"0..4000\" }\n[[structure.repeat.cables]]\nname = \"x{i}\"\na = \"A0\"\nb = \"C\"\n");
+    }
+    let e = load(&text).expect_err("12,004 copies");
+    assert!(e.message.contains("more than 10000 copies"), "{e}");
+    let long = format!("sum(i in 0..9000, {})", "C.x + ".repeat(20) + "C.x");
+    let text = ring("4", &format!("[[quantities]]\nname = \"big\"\nexpr = \"{long}\"\n"));
+    let started = std::time::Instant::now();
+    let e = load(&text).expect_err("too long");
+    assert!(e.message.contains("expands beyond 10000 bytes"), "{e}");
+    assert!(started.elapsed().as_secs_f64() < 5.0);
+}
