@@ -10,7 +10,7 @@ use crate::mechanisms::{ModelError, Values};
 use crate::observers::{ModeAtStart, SettlePoint};
 use crate::report::{MotionReport, PointReport, ScenarioReport};
 use crate::scenario::Scenario;
-use crate::settings::{FrequencySignal, Motion, MotionStart};
+use crate::settings::{Drive, FrequencySignal, Motion, MotionStart};
 use crate::sim::modes::modal_projector;
 
 /// What the report says of a motion before it runs.
@@ -33,6 +33,7 @@ pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
         undamped: m.undamped,
         frequencies: vec![],
         lagrangian: None,
+        driven: m.drive.as_ref().map(|d| driven_text(d)),
     }
 }
 
@@ -74,9 +75,19 @@ pub(super) fn run_motion(
         r.start_tick = start_tick;
     }
     runner.emit(format_args!("motion: {} steps of physical dynamics, every settle accelerator off", m.steps));
-    let prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
+    if m.drive.is_some() {
+        runner.sim.drive_physically().map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
+    }
+    let mut prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
     let mut result = Ok(());
-    for _ in 0..m.steps {
+    let mut inputs = inputs;
+    for k in 1..=m.steps {
+        if let Some(d) = &m.drive {
+            // The commands at the end of this step, t = k dt after the motion's start.
+            inputs = d.inputs_at(&runner.params, k as f64 * sc.sim.dt_s);
+            runner.drive(&inputs);
+            prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
+        }
         result = runner.step(&inputs, &prediction).map(|_| ());
         if result.is_err() {
             break;
@@ -89,6 +100,19 @@ pub(super) fn run_motion(
         r.accelerated_steps = runner.accelerated_steps - accelerated_before;
     }
     result
+}
+
+/// What the report says of a motion's drive.
+fn driven_text(d: &Drive) -> String {
+    let how = match d {
+        Drive::Waypoints(w) => format!("{} waypoints", w.len()),
+        Drive::Functions { functions, .. } => {
+            functions.iter().map(|(n, e)| format!("{n} = {}", e.text())).collect::<Vec<_>>().join(", ")
+        }
+    };
+    format!(
+        "{how}, followed physically: each actuated joint a dynamic degree of freedom held to its command by a rigid velocity motor (rate (q(t + dt) - q) / dt), its reaction on the bodies it carries through the solver"
+    )
 }
 
 /// The structure's own modes at the start that the motion needs (its displacement along one,

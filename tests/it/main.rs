@@ -9,6 +9,7 @@ mod cli;
 mod common;
 mod compact_members;
 mod custom_structure;
+mod driven_motion;
 mod dynamic_model;
 mod export_mjcf;
 mod figures;
