@@ -70,6 +70,16 @@ pub(super) struct RawMotion {
     /// Inputs as closed forms of the parameters and the motion's time `t` [s], followed at
     /// their real speed (the others held at the single point's values).
     pub(super) inputs: Option<Spanned<BTreeMap<Spanned<String>, Spanned<String>>>>,
+    /// A free body without joints started spinning (a torque-free rigid body).
+    pub(super) spin: Option<Spanned<RawSpin>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSpin {
+    pub(super) body: Spanned<String>,
+    /// [rad/s], world frame: numbers or expressions of the parameters.
+    pub(super) angular_velocity: Spanned<Vec<Spanned<Num>>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -133,7 +143,8 @@ pub(super) fn motion(
         .map(|f| frequency(ctx, f, (mech, first), params, inputs))
         .collect::<Result<_, _>>()?;
     let undamped = section.undamped;
-    Ok(Some(Motion { duration_s, steps: steps as u64, start, coordinate, mode, frequencies, undamped, drive }))
+    let spin = section.spin.as_ref().map(|sp| spin(ctx, sp, first, params)).transpose()?;
+    Ok(Some(Motion { duration_s, steps: steps as u64, start, coordinate, mode, frequencies, undamped, drive, spin }))
 }
 
 /// What a motion run's inputs do: held at its single point (`points` with one point), or
@@ -332,6 +343,37 @@ fn joint_coordinate(ctx: &Ctx, name: &Spanned<String>, s: &Structure) -> Result<
         );
     }
     Ok(JointCoordinate { joint: name.get_ref().clone(), index, prismatic })
+}
+
+/// `[motion] spin`: a free body that no joint holds, by name, and its angular velocity
+/// [rad/s] (world frame, three finite numbers).
+fn spin(ctx: &Ctx, sp: &Spanned<RawSpin>, s: &Structure, params: &Values) -> Result<(usize, [f64; 3]), ScenarioError> {
+    let raw = sp.get_ref();
+    let name = raw.body.get_ref();
+    let b = s.bodies.iter().position(|b| &b.name == name).ok_or_else(|| {
+        let names: Vec<&str> = s.bodies.iter().map(|b| b.name.as_str()).collect();
+        ctx.err(&raw.body, format!("unknown body '{name}' (the structure's: {})", names.join(", ")))
+    })?;
+    if s.bodies[b].kind != crate::structure::BodyKind::Free {
+        return Err(ctx.err(&raw.body, format!("body '{name}' is fixed: only a free body can spin")));
+    }
+    if s.joints.iter().any(|j| j.parent == b || j.child == b) {
+        return Err(
+            ctx.err(&raw.body, format!("body '{name}' is held by a joint: a spin starts a body without joints"))
+        );
+    }
+    let w = raw.angular_velocity.get_ref();
+    if w.len() != 3 {
+        return Err(ctx.err(
+            &raw.angular_velocity,
+            format!("angular_velocity is [wx, wy, wz] in rad/s, got {} numbers", w.len()),
+        ));
+    }
+    let mut out = [0.0; 3];
+    for (o, c) in out.iter_mut().zip(w) {
+        *o = param_number(ctx, c, params, "motion.spin.angular_velocity")?;
+    }
+    Ok((b, out))
 }
 
 /// A number, or an expression of the parameters evaluated with their values; finite.

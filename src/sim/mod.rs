@@ -242,6 +242,18 @@ impl Simulation {
         Ok(())
     }
 
+    /// Sets a free body's angular velocity [rad/s] (world frame); Err for a multibody link,
+    /// whose velocity is its joints' rates.
+    pub fn set_body_spin(&mut self, body: usize, angular_velocity: [f64; 3]) -> Result<(), String> {
+        let h = self.model.handles[body];
+        if !self.is_free(body) || self.multibody_joints.rigid_body_link(h).is_some() {
+            return Err(format!("body '{}' is not a free body of its own", self.model.structure.bodies[body].name));
+        }
+        let [x, y, z] = angular_velocity;
+        self.bodies[h].set_angvel(Vector::new(x, y, z), true);
+        Ok(())
+    }
+
     /// Continues the tick count of a previous simulation (after a rebuild between points).
     pub fn set_tick(&mut self, tick: u64) {
         self.tick = tick;

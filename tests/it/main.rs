@@ -13,6 +13,7 @@ mod driven_motion;
 mod dynamic_model;
 mod export_mjcf;
 mod figures;
+mod free_spin;
 mod furet2018_dynamics;
 mod fuzz_scenarios;
 mod hostile;
