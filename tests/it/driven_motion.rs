@@ -20,31 +20,14 @@ const RK4_STEP_S: f64 = 1e-5;
 
 /// The shipped file's text with each (from, to) replaced once (each `from` must be there).
 fn variant(edits: &[(&str, &str)]) -> String {
-    let mut text = std::fs::read_to_string(SHIPPED).expect("the shipped scenario");
-    for (from, to) in edits {
-        assert!(text.contains(from), "'{from}' in {SHIPPED}");
-        text = text.replacen(from, to, 1);
-    }
-    text
+    super::common::edited(SHIPPED, edits)
 }
 
 /// Runs `text` writing its per-tick table: the report and, for every tick of the motion,
 /// (motion time [s], theta [rad]).
 fn swing(text: &str, name: &str) -> (ScenarioReport, Vec<(f64, f64)>) {
-    let path = std::env::temp_dir().join(format!("tensegrity-driven-{}-{name}.csv", std::process::id()));
-    let _ = std::fs::remove_file(&path);
-    let sc = scenario::parse(Path::new("variant.toml"), text).expect("the variant is valid");
-    let report = run::run(&sc, &RunOptions { table: Some(path.clone().into()), ..Default::default() });
-    let csv = std::fs::read_to_string(&path).expect("the table");
-    let _ = std::fs::remove_file(&path);
-    let mut lines = csv.lines();
-    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
-    let col = |c: &str| header.iter().position(|h| *h == c).unwrap_or_else(|| panic!("column {c}"));
-    let (t, q) = (col("motion_time_s"), col("model:theta"));
-    let rows = lines
-        .map(|l| l.split(',').collect::<Vec<_>>())
-        .filter_map(|c| Some((c[t].parse::<f64>().ok()?, c[q].parse::<f64>().ok()?)))
-        .collect();
+    let (report, cols) = super::common::table_columns(text, name, &["motion_time_s", "model:theta"]);
+    let rows = cols[0].iter().zip(&cols[1]).filter(|(t, _)| t.is_finite()).map(|(t, q)| (*t, *q)).collect();
     (report, rows)
 }
 
@@ -77,15 +60,6 @@ fn exact_swing(a: f64, times: &[f64]) -> Vec<f64> {
         out.push(y[0]);
     }
     out
-}
-
-/// Slope of log(error) against log(dt): the fitted order.
-fn order(steps: &[f64], errors: &[f64]) -> f64 {
-    let x: Vec<f64> = steps.iter().map(|d| d.ln()).collect();
-    let y: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
-    let n = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-    x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum::<f64>() / x.iter().map(|a| (a - mx).powi(2)).sum::<f64>()
 }
 
 /// The shipped scenario passes, its path physical, the drive named in the report, the cart
@@ -128,7 +102,7 @@ fn the_driven_swing_matches_the_exact_equation_with_an_error_falling_as_dt_squar
         let e = rows.iter().zip(&exact).map(|(r, q)| (r.1 - q).abs()).fold(0.0, f64::max);
         errors.push(e);
     }
-    let p = order(&steps, &errors);
+    let p = super::common::fitted_order(&steps, &errors);
     eprintln!("driven swing against the exact equation at dt {steps:?}: {errors:?} rad (order {p:.3})");
     assert!((p - 2.0).abs() <= 0.1, "order {p}: {errors:?}");
     assert!(errors[2] <= 1e-3, "{errors:?}");

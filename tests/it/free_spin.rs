@@ -205,11 +205,7 @@ fn a_free_body_spins_torque_free_within_the_measured_error() {
         drifts.push((l_drift, energy_drift));
         sizes.push(l_size);
     }
-    let x: Vec<f64> = steps.iter().map(|d| d.ln()).collect();
-    let y: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
-    let (mx, my) = (x.iter().sum::<f64>() / 3.0, y.iter().sum::<f64>() / 3.0);
-    let p = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum::<f64>()
-        / x.iter().map(|a| (a - mx).powi(2)).sum::<f64>();
+    let p = super::common::fitted_order(&steps, &errors);
     eprintln!("torque-free spin: orientation errors {errors:?} rad at dt {steps:?}, order {p:.3}; drifts (L, energy) {drifts:?}; |L| {sizes:?}");
     assert!((p - 1.43).abs() <= 0.1, "order {p}: {errors:?}");
     assert!(errors[2] <= 0.04, "{errors:?}");
