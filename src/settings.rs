@@ -297,8 +297,9 @@ pub struct Motion {
     /// The inputs followed in time during the motion, at their real speed (`[actuation]
     /// waypoints` or `[motion] inputs`); None: the single point's inputs held.
     pub drive: Option<Drive>,
-    /// A free body without joints started spinning: (body, angular velocity [rad/s], world frame).
-    pub spin: Option<(usize, [f64; 3])>,
+    /// A free body without joints started spinning: (body, its name, angular velocity
+    /// [rad/s], world frame).
+    pub spin: Option<(usize, String, [f64; 3])>,
 }
 
 /// Inputs as functions of the motion's time, followed physically: each actuated joint a

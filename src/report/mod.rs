@@ -659,6 +659,7 @@ impl ScenarioReport {
             m.accelerated_steps,
             if m.undamped { ", damping released" } else { "" },
             match &m.coordinate {
+                Some(c) if m.displacement == 0.0 && m.rate == 0.0 => c.clone(),
                 Some(c) => format!("{c} displaced by {:e}, rate {:e}", m.displacement, m.rate),
                 None => "no displacement".into(),
             }

@@ -27,7 +27,7 @@ pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
             .as_ref()
             .map(|(c, ..)| c.joint.clone())
             .or(m.mode.map(|(i, _)| format!("mode {}", i + 1)))
-            .or(m.spin.map(|(b, w)| format!("body {b} spun at {w:?} rad/s"))),
+            .or(m.spin.as_ref().map(|(_, name, w)| format!("body '{name}' spun at {w:?} rad/s"))),
         displacement: m.coordinate.as_ref().map(|(_, d, _)| *d).or(m.mode.map(|(_, a)| a)).unwrap_or(0.0),
         rate: m.coordinate.as_ref().map_or(0.0, |(.., r)| *r),
         accelerated_steps: 0,
@@ -65,8 +65,8 @@ pub(super) fn run_motion(
             .set_joint_motion(c.index, *displacement, *rate)
             .map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
     }
-    if let Some((body, w)) = m.spin {
-        runner.sim.set_body_spin(body, w).map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
+    if let Some((body, _, w)) = &m.spin {
+        runner.sim.set_body_spin(*body, *w).map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
     }
     let modes = start_modes(runner, m)?;
     for o in runner.observers.iter_mut() {

@@ -347,7 +347,12 @@ fn joint_coordinate(ctx: &Ctx, name: &Spanned<String>, s: &Structure) -> Result<
 
 /// `[motion] spin`: a free body that no joint holds, by name, and its angular velocity
 /// [rad/s] (world frame, three finite numbers).
-fn spin(ctx: &Ctx, sp: &Spanned<RawSpin>, s: &Structure, params: &Values) -> Result<(usize, [f64; 3]), ScenarioError> {
+fn spin(
+    ctx: &Ctx,
+    sp: &Spanned<RawSpin>,
+    s: &Structure,
+    params: &Values,
+) -> Result<(usize, String, [f64; 3]), ScenarioError> {
     let raw = sp.get_ref();
     let name = raw.body.get_ref();
     let b = s.bodies.iter().position(|b| &b.name == name).ok_or_else(|| {
@@ -373,7 +378,7 @@ fn spin(ctx: &Ctx, sp: &Spanned<RawSpin>, s: &Structure, params: &Values) -> Res
     for (o, c) in out.iter_mut().zip(w) {
         *o = param_number(ctx, c, params, "motion.spin.angular_velocity")?;
     }
-    Ok((b, out))
+    Ok((b, name.clone(), out))
 }
 
 /// A number, or an expression of the parameters evaluated with their values; finite.

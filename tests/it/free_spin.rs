@@ -57,6 +57,8 @@ fn spin_table(dt: f64) -> Vec<(f64, M3, f64)> {
     let report = run::run(&sc, &RunOptions { table: Some(path.clone().into()), ..Default::default() });
     assert!(report.error.is_none(), "{:?}", report.error);
     assert_eq!(report.path, PathKind::Physical);
+    let start = report.motion.as_ref().and_then(|m| m.coordinate.clone());
+    assert_eq!(start.as_deref(), Some("body 'top' spun at [0.3, 0.2, 4.0] rad/s"));
     let csv = std::fs::read_to_string(&path).expect("the table");
     let _ = std::fs::remove_file(&path);
     let mut lines = csv.lines();
