@@ -329,4 +329,73 @@ pub struct Motion {
     /// Every joint's damping released (set to zero) for the motion; the settle to a settled
     /// start keeps the damping the structure states.
     pub undamped: bool,
+    /// The inputs followed in time during the motion, at their real speed (`[actuation]
+    /// waypoints` or `[motion] inputs`); None: the single point's inputs held.
+    pub drive: Option<Drive>,
+    /// A free body without joints started spinning: (body, its name, angular velocity
+    /// [rad/s], world frame).
+    pub spin: Option<(usize, String, [f64; 3])>,
+}
+
+/// Inputs as functions of the motion's time, followed physically: each actuated joint a
+/// dynamic degree of freedom held to its commanded path through the solver.
+#[derive(Clone, Debug)]
+pub enum Drive {
+    /// Linearly interpolated in time (s since the motion started), held at the last.
+    Waypoints(Vec<(f64, crate::mechanisms::Values)>),
+    /// Closed forms of the parameters and `t` for some inputs, the others held at the point's.
+    Functions {
+        held: crate::mechanisms::Values,
+        /// (input, its formula compiled against `symbols`).
+        functions: Vec<(String, crate::file_model::expr::Expr)>,
+        /// The parameters, then `t`.
+        symbols: Vec<String>,
+    },
+}
+
+impl PartialEq for Drive {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (Drive::Waypoints(a), Drive::Waypoints(b)) => a == b,
+            (Drive::Functions { functions: a, held: ha, .. }, Drive::Functions { functions: b, held: hb, .. }) => {
+                ha == hb && a.iter().map(|(n, e)| (n, e.text())).eq(b.iter().map(|(n, e)| (n, e.text())))
+            }
+            _ => false,
+        }
+    }
+}
+
+impl Drive {
+    /// The inputs at motion time `t` [s] with these parameters.
+    pub fn inputs_at(&self, params: &crate::mechanisms::Values, t: f64) -> crate::mechanisms::Values {
+        match self {
+            Drive::Waypoints(w) => interpolate(w, t),
+            Drive::Functions { held, functions, symbols } => {
+                let values: Vec<f64> = symbols
+                    .iter()
+                    .map(|s| if s == "t" { t } else { params.get(s).copied().unwrap_or(f64::NAN) })
+                    .collect();
+                let mut inputs = held.clone();
+                for (name, e) in functions {
+                    inputs.insert(name.clone(), e.eval(&values));
+                }
+                inputs
+            }
+        }
+    }
+}
+
+/// Linear interpolation of the waypoints at time `t`, held at the last.
+pub fn interpolate(waypoints: &[(f64, crate::mechanisms::Values)], t: f64) -> crate::mechanisms::Values {
+    if t <= waypoints[0].0 {
+        return waypoints[0].1.clone();
+    }
+    for w in waypoints.windows(2) {
+        let ((t0, a), (t1, b)) = (&w[0], &w[1]);
+        if t <= *t1 {
+            let s = (t - t0) / (t1 - t0);
+            return a.iter().map(|(k, x)| (k.clone(), x + (b[k] - x) * s)).collect();
+        }
+    }
+    waypoints.last().unwrap().1.clone()
 }

@@ -122,6 +122,9 @@ pub struct MotionReport {
     /// The file's Lagrangian model integrated beside the motion (`[energy.trajectory]`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lagrangian: Option<LagrangianReport>,
+    /// The inputs followed in time and how (`[actuation] waypoints` or `[motion] inputs`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub driven: Option<String>,
 }
 
 /// A motion against the file's Lagrangian model, compared tick by tick
@@ -733,10 +736,14 @@ impl ScenarioReport {
             m.accelerated_steps,
             if m.undamped { ", damping released" } else { "" },
             match &m.coordinate {
+                Some(c) if m.displacement == 0.0 && m.rate == 0.0 => c.clone(),
                 Some(c) => format!("{c} displaced by {:e}, rate {:e}", m.displacement, m.rate),
                 None => "no displacement".into(),
             }
         ));
+        if let Some(d) = &m.driven {
+            out.push_str(&format!("   actuation: {d}\n"));
+        }
         for f in &m.frequencies {
             out.push_str(&format!(
                 "   frequency {}: predicted {:.9} rad/s, measured {:.9}, corrected {:.9}: error {:.3e} (uncorrected {:.3e}), tolerance {:.1e}  {}\n",

@@ -11,7 +11,7 @@ mod settle;
 mod settled;
 mod topologies;
 
-use crate::mechanisms::{Mechanism, ModelError, Values};
+use crate::mechanisms::{Mechanism, ModelError};
 use crate::observers::record::{RecordTarget, Recording};
 use crate::observers::{self, Setup};
 use crate::report::{PointReport, ProbeReport, ScenarioReport, SettleSummary, WorkspaceAgreement};
@@ -364,20 +364,7 @@ fn run_actuation(
     Ok(())
 }
 
-/// Linear interpolation of the waypoints at time `t`, held at the last.
-pub fn interpolate(waypoints: &[(f64, Values)], t: f64) -> Values {
-    if t <= waypoints[0].0 {
-        return waypoints[0].1.clone();
-    }
-    for w in waypoints.windows(2) {
-        let ((t0, a), (t1, b)) = (&w[0], &w[1]);
-        if t <= *t1 {
-            let s = (t - t0) / (t1 - t0);
-            return a.iter().map(|(k, x)| (k.clone(), x + (b[k] - x) * s)).collect();
-        }
-    }
-    waypoints.last().unwrap().1.clone()
-}
+pub use crate::settings::interpolate;
 
 /// The verdict of a finished report: its failures (the one pass policy, `report::verdict::failures`),
 /// whether it passed, and whether that is what the scenario declares.

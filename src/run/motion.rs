@@ -10,7 +10,7 @@ use crate::mechanisms::{ModelError, Values};
 use crate::observers::{ModeAtStart, SettlePoint};
 use crate::report::{MotionReport, PointReport, ScenarioReport};
 use crate::scenario::Scenario;
-use crate::settings::{FrequencySignal, Motion, MotionStart};
+use crate::settings::{Drive, FrequencySignal, Motion, MotionStart};
 use crate::sim::modes::modal_projector;
 
 /// What the report says of a motion before it runs.
@@ -26,13 +26,15 @@ pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
             .coordinate
             .as_ref()
             .map(|(c, ..)| c.joint.clone())
-            .or(m.mode.map(|(i, _)| format!("mode {}", i + 1))),
+            .or(m.mode.map(|(i, _)| format!("mode {}", i + 1)))
+            .or(m.spin.as_ref().map(|(_, name, w)| format!("body '{name}' spun at {w:?} rad/s"))),
         displacement: m.coordinate.as_ref().map(|(_, d, _)| *d).or(m.mode.map(|(_, a)| a)).unwrap_or(0.0),
         rate: m.coordinate.as_ref().map_or(0.0, |(.., r)| *r),
         accelerated_steps: 0,
         undamped: m.undamped,
         frequencies: vec![],
         lagrangian: None,
+        driven: m.drive.as_ref().map(|d| driven_text(d)),
     }
 }
 
@@ -63,6 +65,9 @@ pub(super) fn run_motion(
             .set_joint_motion(c.index, *displacement, *rate)
             .map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
     }
+    if let Some((body, _, w)) = &m.spin {
+        runner.sim.set_body_spin(*body, *w).map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
+    }
     let modes = start_modes(runner, m)?;
     for o in runner.observers.iter_mut() {
         o.motion_start(&modes);
@@ -74,9 +79,19 @@ pub(super) fn run_motion(
         r.start_tick = start_tick;
     }
     runner.emit(format_args!("motion: {} steps of physical dynamics, every settle accelerator off", m.steps));
-    let prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
+    if m.drive.is_some() {
+        runner.sim.drive_physically().map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
+    }
+    let mut prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
     let mut result = Ok(());
-    for _ in 0..m.steps {
+    let mut inputs = inputs;
+    for k in 1..=m.steps {
+        if let Some(d) = &m.drive {
+            // The commands at the end of this step, t = k dt after the motion's start.
+            inputs = d.inputs_at(&runner.params, k as f64 * sc.sim.dt_s);
+            runner.drive(&inputs);
+            prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
+        }
         result = runner.step(&inputs, &prediction).map(|_| ());
         if result.is_err() {
             break;
@@ -89,6 +104,19 @@ pub(super) fn run_motion(
         r.accelerated_steps = runner.accelerated_steps - accelerated_before;
     }
     result
+}
+
+/// What the report says of a motion's drive.
+fn driven_text(d: &Drive) -> String {
+    let how = match d {
+        Drive::Waypoints(w) => format!("{} waypoints", w.len()),
+        Drive::Functions { functions, .. } => {
+            functions.iter().map(|(n, e)| format!("{n} = {}", e.text())).collect::<Vec<_>>().join(", ")
+        }
+    };
+    format!(
+        "{how}, followed physically: each actuated joint a dynamic degree of freedom held to its command by a rigid velocity motor (rate (q(t + dt) - q) / dt), its reaction on the bodies it carries through the solver"
+    )
 }
 
 /// The structure's own modes at the start that the motion needs (its displacement along one,

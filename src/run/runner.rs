@@ -71,6 +71,14 @@ impl<'a> Runner<'a> {
         self.sim.set_commands(&commands);
     }
 
+    /// Commands the mechanism's `inputs` for the end of the next step, followed through the
+    /// solver (a motion's drive; `Simulation::drive_commands`).
+    pub fn drive(&mut self, inputs: &Values) {
+        let by_symbol = self.mech.commands(&self.params, inputs);
+        let commands = self.sim.structure().commands_from(&by_symbol);
+        self.sim.drive_commands(&commands);
+    }
+
     /// The mechanism's quantities in a snapshot of this simulation.
     pub fn observe(&self, snap: &Snapshot) -> Values {
         self.mech.observe(&self.params, &self.sim.structure(), snap)

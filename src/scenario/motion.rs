@@ -17,6 +17,9 @@
 //! #                             # modes` lists them), largest node displacement 1e-4 m
 //! undamped = false        # true: every joint's damping released for the motion (a settle to
 //!                         # the start keeps it: damped to equilibrium, then free vibration)
+//! inputs = { x = "A*sin(w*t)" }  # optional: inputs as functions of the parameters and the
+//!                         # motion's time t, followed at their real speed (as [actuation]
+//!                         # waypoints are): each actuated joint driven through the solver
 //!
 //! [[motion.frequencies]]  # a natural frequency measured from the motion and predicted
 //! name = "omega"
@@ -34,9 +37,11 @@ use super::raw::RawScenario;
 use super::Actuation;
 use crate::file_model::expr::Expr;
 use crate::mechanisms::{Mechanism, Values};
-use crate::settings::{FrequencyPrediction, FrequencySignal, JointCoordinate, Motion, MotionStart};
+use crate::settings::{Drive, FrequencyPrediction, FrequencySignal, JointCoordinate, Motion, MotionStart};
+use crate::structure::ActuatorTarget;
 use crate::structure::{JointKind, Structure};
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use toml::Spanned;
 
 #[derive(Debug, Deserialize)]
@@ -62,6 +67,19 @@ pub(super) struct RawMotion {
     /// Release every joint's damping for the motion (the settle to its start keeps it).
     #[serde(default)]
     pub(super) undamped: bool,
+    /// Inputs as closed forms of the parameters and the motion's time `t` [s], followed at
+    /// their real speed (the others held at the single point's values).
+    pub(super) inputs: Option<Spanned<BTreeMap<Spanned<String>, Spanned<String>>>>,
+    /// A free body without joints started spinning (a torque-free rigid body).
+    pub(super) spin: Option<Spanned<RawSpin>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSpin {
+    pub(super) body: Spanned<String>,
+    /// [rad/s], world frame: numbers or expressions of the parameters.
+    pub(super) angular_velocity: Spanned<Vec<Spanned<Num>>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -91,7 +109,7 @@ pub(super) fn motion(
 ) -> Result<Option<Motion>, ScenarioError> {
     let Some(m) = &raw.motion else { return Ok(None) };
     let section = m.get_ref();
-    single_point(ctx, raw, actuation)?;
+    let drive = drive(ctx, raw, actuation, first, params)?;
     settle_only_sections(ctx, raw)?;
     let duration_s = positive_value(ctx, &section.duration_s, "motion.duration_s")?;
     let steps = (duration_s / dt_s).round();
@@ -125,18 +143,78 @@ pub(super) fn motion(
         .map(|f| frequency(ctx, f, (mech, first), params, inputs))
         .collect::<Result<_, _>>()?;
     let undamped = section.undamped;
-    Ok(Some(Motion { duration_s, steps: steps as u64, start, coordinate, mode, frequencies, undamped }))
+    let spin = section.spin.as_ref().map(|sp| spin(ctx, sp, first, params)).transpose()?;
+    Ok(Some(Motion { duration_s, steps: steps as u64, start, coordinate, mode, frequencies, undamped, drive, spin }))
 }
 
-/// A motion run holds one set of inputs: `points` with one point.
-fn single_point(ctx: &Ctx, raw: &RawScenario, actuation: &Actuation) -> Result<(), ScenarioError> {
-    match actuation {
-        Actuation::Points { points, .. } if points.len() == 1 => Ok(()),
-        _ => Err(ctx.err(
-            &raw.actuation,
-            "a motion run ([motion]) holds one set of inputs: [actuation] points = [ { ... } ] with one point",
-        )),
+/// What a motion run's inputs do: held at its single point (`points` with one point), or
+/// followed in time at their real speed (`waypoints`, or the point with `[motion] inputs`).
+fn drive(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    actuation: &Actuation,
+    s: &Structure,
+    params: &Values,
+) -> Result<Option<Drive>, ScenarioError> {
+    let functions = raw.motion.as_ref().and_then(|m| m.get_ref().inputs.as_ref());
+    let drive = match (actuation, functions) {
+        (Actuation::Points { points, .. }, None) if points.len() == 1 => return Ok(None),
+        (Actuation::Points { points, .. }, Some(f)) if points.len() == 1 => input_functions(ctx, f, &points[0], params)?,
+        (Actuation::Schedule { waypoints }, None) => Drive::Waypoints(waypoints.clone()),
+        (Actuation::Schedule { .. }, Some(f)) => {
+            return Err(ctx.err(f, "a motion follows [actuation] waypoints or [motion] inputs, not both"))
+        }
+        _ => {
+            return Err(ctx.err(
+                &raw.actuation,
+                "a motion run ([motion]) holds one set of inputs ([actuation] points = [ { ... } ] with one point) or follows waypoints",
+            ))
+        }
+    };
+    let at = functions.map_or(raw.actuation.span(), |f| f.span());
+    if let Some(a) = s.actuators.iter().find(|a| matches!(a.target, ActuatorTarget::FixedNode { .. })) {
+        return Err(ctx.err_at(
+            at.start,
+            format!(
+                "actuator '{}' moves a fixed node, which a motion cannot follow physically (a fixed body has no velocity to carry its members and joints): drive joints or cable lengths",
+                a.symbol
+            ),
+        ));
     }
+    Ok(Some(drive))
+}
+
+/// `[motion] inputs = { SYMBOL = "formula of the parameters and t" }`: each an input of the
+/// point, compiled and finite at the start.
+fn input_functions(
+    ctx: &Ctx,
+    f: &Spanned<BTreeMap<Spanned<String>, Spanned<String>>>,
+    point: &Values,
+    params: &Values,
+) -> Result<Drive, ScenarioError> {
+    let mut symbols: Vec<String> = params.keys().cloned().collect();
+    symbols.push("t".into());
+    let names: Vec<&str> = symbols.iter().map(String::as_str).collect();
+    let mut functions = Vec::new();
+    for (name, text) in f.get_ref() {
+        if !point.contains_key(name.get_ref()) {
+            let known: Vec<&str> = point.keys().map(String::as_str).collect();
+            return Err(
+                ctx.err(name, format!("unknown input '{}' (the point's inputs: {})", name.get_ref(), known.join(", ")))
+            );
+        }
+        let what = format!("motion input '{}' (parameters and t)", name.get_ref());
+        let e = Expr::compile(text.get_ref(), &names).map_err(|e| expr_error(ctx, text.span().start, &e, &what))?;
+        let at_start = e.eval(&symbols.iter().map(|s| params.get(s).copied().unwrap_or(0.0)).collect::<Vec<_>>());
+        if !at_start.is_finite() {
+            return Err(ctx.err(text, format!("{what} is {at_start} at t = 0, not a finite number")));
+        }
+        functions.push((name.get_ref().clone(), e));
+    }
+    if functions.is_empty() {
+        return Err(ctx.err(f, "motion.inputs names no input: give { SYMBOL = \"formula of t\" } or remove it"));
+    }
+    Ok(Drive::Functions { held: point.clone(), functions, symbols })
 }
 
 /// Sections that judge settle points by perturbing or probing them, or a sweep's agreement:
@@ -265,6 +343,42 @@ fn joint_coordinate(ctx: &Ctx, name: &Spanned<String>, s: &Structure) -> Result<
         );
     }
     Ok(JointCoordinate { joint: name.get_ref().clone(), index, prismatic })
+}
+
+/// `[motion] spin`: a free body that no joint holds, by name, and its angular velocity
+/// [rad/s] (world frame, three finite numbers).
+fn spin(
+    ctx: &Ctx,
+    sp: &Spanned<RawSpin>,
+    s: &Structure,
+    params: &Values,
+) -> Result<(usize, String, [f64; 3]), ScenarioError> {
+    let raw = sp.get_ref();
+    let name = raw.body.get_ref();
+    let b = s.bodies.iter().position(|b| &b.name == name).ok_or_else(|| {
+        let names: Vec<&str> = s.bodies.iter().map(|b| b.name.as_str()).collect();
+        ctx.err(&raw.body, format!("unknown body '{name}' (the structure's: {})", names.join(", ")))
+    })?;
+    if s.bodies[b].kind != crate::structure::BodyKind::Free {
+        return Err(ctx.err(&raw.body, format!("body '{name}' is fixed: only a free body can spin")));
+    }
+    if s.joints.iter().any(|j| j.parent == b || j.child == b) {
+        return Err(
+            ctx.err(&raw.body, format!("body '{name}' is held by a joint: a spin starts a body without joints"))
+        );
+    }
+    let w = raw.angular_velocity.get_ref();
+    if w.len() != 3 {
+        return Err(ctx.err(
+            &raw.angular_velocity,
+            format!("angular_velocity is [wx, wy, wz] in rad/s, got {} numbers", w.len()),
+        ));
+    }
+    let mut out = [0.0; 3];
+    for (o, c) in out.iter_mut().zip(w) {
+        *o = param_number(ctx, c, params, "motion.spin.angular_velocity")?;
+    }
+    Ok((b, name.clone(), out))
 }
 
 /// A number, or an expression of the parameters evaluated with their values; finite.

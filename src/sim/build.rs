@@ -56,6 +56,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         physical: false,
         last_step_accelerated: false,
         accelerated_steps: 0,
+        driven: false,
     };
     sim.model.tree = sim.link_tree();
     sim.model.internal_closures = sim.find_internal_closures();

@@ -17,6 +17,7 @@
 
 mod build;
 mod damping;
+mod drive;
 mod forces;
 mod joint_modes;
 pub(crate) mod least_squares;
@@ -117,6 +118,8 @@ pub struct Simulation {
     last_step_accelerated: bool,
     /// Steps taken with a settle accelerator.
     accelerated_steps: u64,
+    /// Whether the actuated joints are driven through the solver (`drive.rs`) rather than set.
+    driven: bool,
 }
 
 impl Simulation {
@@ -239,6 +242,18 @@ impl Simulation {
         Ok(())
     }
 
+    /// Sets a free body's angular velocity [rad/s] (world frame); Err for a multibody link,
+    /// whose velocity is its joints' rates.
+    pub fn set_body_spin(&mut self, body: usize, angular_velocity: [f64; 3]) -> Result<(), String> {
+        let h = self.model.handles[body];
+        if !self.is_free(body) || self.multibody_joints.rigid_body_link(h).is_some() {
+            return Err(format!("body '{}' is not a free body of its own", self.model.structure.bodies[body].name));
+        }
+        let [x, y, z] = angular_velocity;
+        self.bodies[h].set_angvel(Vector::new(x, y, z), true);
+        Ok(())
+    }
+
     /// Continues the tick count of a previous simulation (after a rebuild between points).
     pub fn set_tick(&mut self, tick: u64) {
         self.tick = tick;
@@ -257,18 +272,24 @@ impl Simulation {
     pub fn set_commands(&mut self, values: &[f64]) {
         assert_eq!(values.len(), self.model.structure.actuators.len(), "one command per actuator");
         self.commands.copy_from_slice(values);
+        self.apply_cable_commands();
+        self.apply_joint_commands();
+        self.move_fixed_nodes();
+    }
+
+    /// Sets every cable-length actuator's cable to its command: an elastic cable's rest length,
+    /// an inextensible one's rope limit.
+    fn apply_cable_commands(&mut self) {
         for (i, a) in self.model.structure.actuators.iter().enumerate() {
             if let ActuatorTarget::CableLength(c) = a.target {
-                self.cable_lengths[c] = values[i];
+                self.cable_lengths[c] = self.commands[i];
                 if let Some(h) = self.model.cable_ropes[c] {
                     if let Some(j) = self.impulse_joints.get_mut(h, true) {
-                        j.data.set_limits(JointAxis::LinX, [0.0, values[i]]);
+                        j.data.set_limits(JointAxis::LinX, [0.0, self.commands[i]]);
                     }
                 }
             }
         }
-        self.apply_joint_commands();
-        self.move_fixed_nodes();
     }
 
     /// Places every fixed body that carries a moved node at the sum of its actuators'

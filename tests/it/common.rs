@@ -12,6 +12,54 @@ pub fn tensegrity(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// The text of the scenario file at `path` with each (from, to) replaced once (each `from`
+/// must be there).
+pub fn edited(path: &str, edits: &[(&str, &str)]) -> String {
+    let mut text = std::fs::read_to_string(path).expect("the scenario file");
+    for (from, to) in edits {
+        assert!(text.contains(from), "'{from}' in {path}");
+        text = text.replacen(from, to, 1);
+    }
+    text
+}
+
+/// Runs the scenario `text` writing its per-tick table: the report, and the named columns,
+/// one vector per column (NaN where a cell is empty).
+pub fn table_columns(
+    text: &str,
+    name: &str,
+    columns: &[&str],
+) -> (tensegrity_testbed::report::ScenarioReport, Vec<Vec<f64>>) {
+    let path = std::env::temp_dir().join(format!("tensegrity-table-{}-{name}.csv", std::process::id()));
+    let _ = std::fs::remove_file(&path);
+    let sc = tensegrity_testbed::scenario::parse(std::path::Path::new("variant.toml"), text).expect("valid");
+    let opts = tensegrity_testbed::run::RunOptions { table: Some(path.clone().into()), ..Default::default() };
+    let report = tensegrity_testbed::run::run(&sc, &opts);
+    let csv = std::fs::read_to_string(&path).expect("the table");
+    let _ = std::fs::remove_file(&path);
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let index: Vec<usize> =
+        columns.iter().map(|c| header.iter().position(|h| h == c).unwrap_or_else(|| panic!("column {c}"))).collect();
+    let mut out = vec![Vec::new(); columns.len()];
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        for (o, i) in out.iter_mut().zip(&index) {
+            o.push(cells[*i].parse::<f64>().unwrap_or(f64::NAN));
+        }
+    }
+    (report, out)
+}
+
+/// The slope of log(error) against log(dt): an error's fitted order in the time step.
+pub fn fitted_order(steps: &[f64], errors: &[f64]) -> f64 {
+    let x: Vec<f64> = steps.iter().map(|d| d.ln()).collect();
+    let y: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum::<f64>() / x.iter().map(|a| (a - mx).powi(2)).sum::<f64>()
+}
+
 /// Loads and runs a scenario file through the library, with the default options.
 pub fn run_file(path: &str) -> tensegrity_testbed::report::ScenarioReport {
     let sc = tensegrity_testbed::scenario::load(std::path::Path::new(path)).expect("scenario is valid");

@@ -13,12 +13,7 @@ const SHIPPED: &str = "scenarios/custom/pinned_bar_vibration.toml";
 
 /// The shipped file's text with each (from, to) replaced once (each `from` must be there).
 fn variant(edits: &[(&str, &str)]) -> String {
-    let mut text = std::fs::read_to_string(SHIPPED).expect("the shipped scenario");
-    for (from, to) in edits {
-        assert!(text.contains(from), "'{from}' in {SHIPPED}");
-        text = text.replacen(from, to, 1);
-    }
-    text
+    super::common::edited(SHIPPED, edits)
 }
 
 fn run_text(text: &str, opts: &RunOptions) -> ScenarioReport {
@@ -45,23 +40,7 @@ fn spring_energy(x: f64, y: f64) -> f64 {
 
 /// Runs `text` writing its per-tick table; the named columns, one vector per column.
 fn table_columns(text: &str, name: &str, columns: &[&str]) -> (ScenarioReport, Vec<Vec<f64>>) {
-    let path = std::env::temp_dir().join(format!("tensegrity-motion-{}-{name}.csv", std::process::id()));
-    let _ = std::fs::remove_file(&path);
-    let report = run_text(text, &RunOptions { table: Some(path.clone().into()), ..Default::default() });
-    let csv = std::fs::read_to_string(&path).expect("the table");
-    let _ = std::fs::remove_file(&path);
-    let mut lines = csv.lines();
-    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
-    let index: Vec<usize> =
-        columns.iter().map(|c| header.iter().position(|h| h == c).unwrap_or_else(|| panic!("column {c}"))).collect();
-    let mut out = vec![Vec::new(); columns.len()];
-    for line in lines {
-        let cells: Vec<&str> = line.split(',').collect();
-        for (o, i) in out.iter_mut().zip(&index) {
-            o.push(cells[*i].parse::<f64>().unwrap_or(f64::NAN));
-        }
-    }
-    (report, out)
+    super::common::table_columns(text, name, columns)
 }
 
 /// The shipped free vibration passes: the frequency measured from the motion and corrected for
@@ -202,13 +181,7 @@ fn trajectory_error_against_the_exact_solution_falls_as_dt_and_as_dt_squared_hal
         lag.push(err("small oscillation"));
         shifted.push(err("half a step on"));
     }
-    let order = |errors: &[f64]| {
-        let x: Vec<f64> = steps.iter().map(|d: &f64| d.ln()).collect();
-        let y: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
-        let (mx, my) = (x.iter().sum::<f64>() / 3.0, y.iter().sum::<f64>() / 3.0);
-        x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum::<f64>()
-            / x.iter().map(|a| (a - mx).powi(2)).sum::<f64>()
-    };
+    let order = |errors: &[f64]| super::common::fitted_order(&steps, errors);
     let (p1, p2) = (order(&lag), order(&shifted));
     eprintln!(
         "trajectory errors at dt {steps:?}: {lag:?} (order {p1:.3}); half a step on: {shifted:?} (order {p2:.3})"
