@@ -9,8 +9,8 @@
 //! (`input:SYMBOL`), every node's coordinates (`node:NAME.x`, `.y`, `.z`, m), every spring's
 //! force and every cable's tension (`spring:NAME.force_n`, `cable:NAME.tension_n`), every
 //! actuator's force (`actuator:SYMBOL@JOINT_OR_CABLE.force`, N or N m), and the mechanism's quantities,
-//! simulated (`sim:QUANTITY`) and analytic (`analytic:QUANTITY`, empty where the model has no
-//! value), then `path_accelerated` (1 when the step to the tick took a settle accelerator, 0 on
+//! simulated (`sim:QUANTITY`, but for the node coordinates and member forces the columns above
+//! hold) and analytic (`analytic:QUANTITY`, empty where the model has no value), then `path_accelerated` (1 when the step to the tick took a settle accelerator, 0 on
 //! a physical path), `motion_time_s` (a motion run's time since its start, the model's `t`;
 //! empty elsewhere), every revolute joint's angle and prismatic joint's slide
 //! (`joint:NAME.angle` rad, `joint:NAME.slide` m) and the file's model: each quantity
@@ -295,6 +295,17 @@ impl Table {
     }
 }
 
+/// Whether a simulated quantity is a node coordinate or a spring's or cable's force, which
+/// the `node:`, `spring:` and `cable:` columns already hold (a `sim:` column would repeat it).
+fn repeats_a_column(s: &crate::structure::Structure, key: &str) -> bool {
+    let Some((name, what)) = key.rsplit_once('.') else { return false };
+    match what {
+        "x" | "y" | "z" => s.nodes.iter().any(|n| n.name == name),
+        "force" => s.springs.iter().map(|m| &m.name).chain(s.cables.iter().map(|m| &m.name)).any(|m| m == name),
+        _ => false,
+    }
+}
+
 impl Observer for Table {
     fn tick(&mut self, t: &Tick, _notes: &mut Vec<super::Note>) {
         if self.error.is_some() {
@@ -305,7 +316,7 @@ impl Observer for Table {
             None => {
                 let keys: Keys = (
                     t.inputs.keys().cloned().collect(),
-                    t.simulated.keys().cloned().collect(),
+                    t.simulated.keys().filter(|k| !repeats_a_column(t.structure, k)).cloned().collect(),
                     t.prediction.expected.keys().cloned().collect(),
                 );
                 let h = self.columns(t, &keys);

@@ -44,11 +44,18 @@ fn the_trajectory_table_holds_the_settled_values_bit_for_bit() {
     }
     let settled = &r.points[0].simulated;
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    // A simulated value's column: its own `sim:` one, or the node or member column that holds
+    // it (a node coordinate or a member force is not written twice).
+    let column_of = |q: &str| {
+        let (name, _) = q.rsplit_once('.').unwrap_or((q, ""));
+        [format!("sim:{q}"), format!("node:{q}"), format!("spring:{name}.force_n"), format!("cable:{name}.tension_n")]
+            .into_iter()
+            .find_map(|c| header.iter().position(|h| *h == c))
+            .unwrap_or_else(|| panic!("no column holds {q}"))
+    };
     let matching: Vec<&Vec<String>> = rows
         .iter()
-        .filter(|row| {
-            settled.iter().all(|(q, v)| row[col(&format!("sim:{q}"))].parse::<f64>().unwrap().to_bits() == v.to_bits())
-        })
+        .filter(|row| settled.iter().all(|(q, v)| row[column_of(q)].parse::<f64>().unwrap().to_bits() == v.to_bits()))
         .collect();
     assert!(!matching.is_empty(), "no row holds the settled values {settled:?}");
     let tick: u64 = matching[0][0].parse().unwrap();
