@@ -205,7 +205,7 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
         resolve_xyz(g, "gravity", &mut resolve)?;
     }
     for b in &mut s.bodies {
-        resolve_body(b, &mut resolve)?;
+        resolve_body(ctx, b, &mut resolve)?;
     }
     for m in s.struts.iter_mut().chain(s.springs.iter_mut()).chain(s.cables.iter_mut()) {
         resolve_member(&mut m.radius, &mut m.stiffness, &mut m.length, &mut resolve)?;
@@ -214,13 +214,13 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
         resolve_member(&mut g.radius, &mut g.stiffness, &mut g.length, &mut resolve)?;
     }
     for j in &mut s.joints {
-        resolve_joint(j, &mut resolve)?;
+        resolve_joint(ctx, j, &mut resolve)?;
     }
     for a in &mut s.actuators {
         if let Some(d) = &mut a.direction {
             resolve_xyz(d, "direction", &mut resolve)?;
             if let Some(pl) = &mut a.placement {
-                let (turn, _) = resolve_placement(pl, &mut resolve)?;
+                let (turn, _) = resolve_placement(ctx, pl, &mut resolve)?;
                 place(d, turn, [0.0; 3]);
             }
         }
@@ -232,12 +232,16 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
 type Turn = Option<([f64; 3], f64)>;
 
 /// A generated copy's rotation and offset, evaluated.
-fn resolve_placement(pl: &mut Placement, resolve: &mut Resolve) -> Result<(Turn, [f64; 3]), ScenarioError> {
+fn resolve_placement(ctx: &Ctx, pl: &mut Placement, resolve: &mut Resolve) -> Result<(Turn, [f64; 3]), ScenarioError> {
     let mut turn = None;
     if let Some(r) = &mut pl.rotate {
         resolve_xyz(&mut r.axis, "rotate.axis", resolve)?;
         resolve(&mut r.angle, "rotate.angle")?;
-        turn = Some((values(&r.axis), r.angle.get_ref().value()));
+        let axis = values(&r.axis);
+        if !(axis.iter().map(|c| c * c).sum::<f64>() > 0.0) {
+            return Err(ctx.err(&r.axis, format!("rotate.axis is {axis:?}: a direction, not zero")));
+        }
+        turn = Some((axis, r.angle.get_ref().value()));
     }
     let mut offset = [0.0; 3];
     if let Some(o) = &mut pl.offset {
@@ -267,7 +271,7 @@ fn resolve_xyz(v: &mut Xyz, what: &str, resolve: &mut Resolve) -> Result<(), Sce
     v.get_mut().iter_mut().try_for_each(|c| resolve(c, what))
 }
 
-fn resolve_body(b: &mut RawBody, resolve: &mut Resolve) -> Result<(), ScenarioError> {
+fn resolve_body(ctx: &Ctx, b: &mut RawBody, resolve: &mut Resolve) -> Result<(), ScenarioError> {
     if let Some(m) = &mut b.mass {
         resolve(m, "mass")?;
     }
@@ -278,7 +282,7 @@ fn resolve_body(b: &mut RawBody, resolve: &mut Resolve) -> Result<(), ScenarioEr
         resolve_xyz(p, &format!("a coordinate of node '{}'", name.get_ref()), resolve)?;
     }
     if let Some(pl) = &mut b.placement {
-        let (turn, offset) = resolve_placement(pl, resolve)?;
+        let (turn, offset) = resolve_placement(ctx, pl, resolve)?;
         b.nodes.values_mut().for_each(|p| place(p, turn, offset));
     }
     Ok(())
@@ -299,9 +303,9 @@ fn resolve_member(
     Ok(())
 }
 
-fn resolve_joint(j: &mut RawJoint, resolve: &mut Resolve) -> Result<(), ScenarioError> {
+fn resolve_joint(ctx: &Ctx, j: &mut RawJoint, resolve: &mut Resolve) -> Result<(), ScenarioError> {
     let turn = match &mut j.placement {
-        Some(pl) => resolve_placement(pl, resolve)?.0,
+        Some(pl) => resolve_placement(ctx, pl, resolve)?.0,
         None => None,
     };
     for (v, what) in [(&mut j.axis, "axis"), (&mut j.axis2, "axis2")] {

@@ -86,6 +86,8 @@ fn a_bad_range_is_an_error_at_its_text() {
         assert!(e.message.contains(words), "{range}: {e}");
         assert_eq!(e.line, 9, "{range}: {e}");
     }
+    let e = load(&ring("4", "").replace("axis = [0, 0, 1]", "axis = [0, 0, 0]")).expect_err("zero axis");
+    assert!(e.message.contains("rotate.axis") && e.line == 10, "{e}");
     let e = load(&ring("2.5", "")).expect_err("n = 2.5");
     assert!(e.message.contains("not a whole number"), "{e}");
 }
