@@ -84,7 +84,10 @@ pub fn sweep(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(Vec<Row>, SweepSummary), SweepError> {
     if !sc.topologies.is_empty() {
-        return sweep_topologies(sc, jobs, shard, cancel, progress);
+        let each = |variant: &Scenario| sweep(variant, jobs, shard, cancel, progress);
+        let (rows, errors, wall_s) = sweep_topologies(sc, &each)?;
+        let summary = summarise(sc, &rows, errors, shard, jobs, wall_s);
+        return Ok((rows, summary));
     }
     let (points, continuation) = match &sc.actuation {
         Actuation::Points { points, continuation } => (points.clone(), *continuation),
@@ -135,20 +138,21 @@ pub fn sweep(
     Ok((rows, summary))
 }
 
-/// A sweep over a topology parameter: each topology's points swept with its own structure,
-/// the rows numbered in the whole grid's order.
+/// The result of sweeping one scenario.
+type Swept = Result<(Vec<Row>, SweepSummary), SweepError>;
+
+/// A sweep over a topology parameter: each topology's points swept with its own structure
+/// (`each`), the rows numbered in the whole grid's order; the rows, the errors and the wall
+/// time [s].
 fn sweep_topologies(
     sc: &Scenario,
-    jobs: usize,
-    shard: Option<(usize, usize)>,
-    cancel: Option<&AtomicBool>,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<(Vec<Row>, SweepSummary), SweepError> {
+    each: &dyn Fn(&Scenario) -> Swept,
+) -> Result<(Vec<Row>, Vec<String>, f64), SweepError> {
     let start = std::time::Instant::now();
     let grid_points = sc.actuation.all_inputs().len();
     let (mut rows, mut errors, mut offset) = (Vec::new(), Vec::new(), 0);
     for variant in &sc.topologies {
-        let (variant_rows, summary) = sweep(variant, jobs, shard, cancel, progress)?;
+        let (variant_rows, summary) = each(variant)?;
         let note = crate::run::rebuilt(sc, variant);
         errors.extend(summary.errors.into_iter().map(|e| format!("{note}: {e}")));
         rows.extend(variant_rows.into_iter().map(|mut r| {
@@ -159,8 +163,7 @@ fn sweep_topologies(
         }));
         offset += variant.actuation.all_inputs().len();
     }
-    let summary = summarise(sc, &rows, errors, shard, jobs, start.elapsed().as_secs_f64());
-    Ok((rows, summary))
+    Ok((rows, errors, start.elapsed().as_secs_f64()))
 }
 
 /// One block of points settled as one run (with continuation where the scenario asks): its

@@ -185,69 +185,61 @@ pub(super) type For = Spanned<BTreeMap<String, Spanned<String>>>;
 /// trailing entries unread).
 pub(super) type Xyz = Spanned<Vec<Spanned<Num>>>;
 
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct RawStructure {
-    /// Gravity [m/s^2] (default none).
-    pub(super) gravity: Option<Xyz>,
-    #[serde(default)]
-    pub(super) bodies: Vec<RawBody>,
-    #[serde(default)]
-    pub(super) struts: Vec<RawMember>,
-    #[serde(default)]
-    pub(super) springs: Vec<RawMember>,
-    #[serde(default)]
-    pub(super) cables: Vec<RawMember>,
-    #[serde(default)]
-    pub(super) joints: Vec<RawJoint>,
-    #[serde(default)]
-    pub(super) actuators: Vec<RawActuator>,
-    /// Compact form: struts, springs and cables sharing their properties, listed by node
-    /// pairs (after the one-table-per-member entries above).
-    #[serde(default)]
-    pub(super) strut_groups: Vec<RawMemberGroup>,
-    #[serde(default)]
-    pub(super) spring_groups: Vec<RawMemberGroup>,
-    #[serde(default)]
-    pub(super) cable_groups: Vec<RawMemberGroup>,
-    /// Sub-structures generated over an index range (`repeat.rs`), appended to the lists
-    /// above.
-    #[serde(default)]
-    pub(super) repeat: Vec<RawRepeat>,
+/// A table that holds the parts of a structure (`[structure]` and `[[structure.repeat]]`):
+/// its own fields, then bodies, members, joints, actuators and the compact member groups
+/// (struts, springs and cables sharing their properties, listed by node pairs, after the
+/// one-table-per-member entries).
+macro_rules! with_parts {
+    ($(#[$doc:meta])* $name:ident { $($(#[$fm:meta])* $f:ident: $t:ty,)* }) => {
+        $(#[$doc])*
+        #[derive(Clone, Debug, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub(super) struct $name {
+            $($(#[$fm])* pub(super) $f: $t,)*
+            #[serde(default)]
+            pub(super) bodies: Vec<RawBody>,
+            #[serde(default)]
+            pub(super) struts: Vec<RawMember>,
+            #[serde(default)]
+            pub(super) springs: Vec<RawMember>,
+            #[serde(default)]
+            pub(super) cables: Vec<RawMember>,
+            #[serde(default)]
+            pub(super) joints: Vec<RawJoint>,
+            #[serde(default)]
+            pub(super) actuators: Vec<RawActuator>,
+            #[serde(default)]
+            pub(super) strut_groups: Vec<RawMemberGroup>,
+            #[serde(default)]
+            pub(super) spring_groups: Vec<RawMemberGroup>,
+            #[serde(default)]
+            pub(super) cable_groups: Vec<RawMemberGroup>,
+        }
+    };
 }
 
-/// `[[structure.repeat]]`: bodies, members, groups, joints and actuators written once with
-/// `{i}` templates and generated for every index of `for`, each copy optionally rotated about
-/// an axis through the origin and then offset.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct RawRepeat {
-    /// `{ i = "0..n" }`: one loop variable over a range whose bounds are integer expressions
-    /// of the parameters (end excluded).
-    #[serde(rename = "for")]
-    pub(super) over: For,
-    pub(super) rotate: Option<RawRotate>,
-    /// [m], added after the rotation; expressions may use the loop variable.
-    pub(super) offset: Option<Xyz>,
+with_parts!(RawStructure {
+    /// Gravity [m/s^2] (default none).
+    gravity: Option<Xyz>,
+    /// Sub-structures generated over an index range (`repeat.rs`), appended to the lists.
     #[serde(default)]
-    pub(super) bodies: Vec<RawBody>,
-    #[serde(default)]
-    pub(super) struts: Vec<RawMember>,
-    #[serde(default)]
-    pub(super) springs: Vec<RawMember>,
-    #[serde(default)]
-    pub(super) cables: Vec<RawMember>,
-    #[serde(default)]
-    pub(super) joints: Vec<RawJoint>,
-    #[serde(default)]
-    pub(super) actuators: Vec<RawActuator>,
-    #[serde(default)]
-    pub(super) strut_groups: Vec<RawMemberGroup>,
-    #[serde(default)]
-    pub(super) spring_groups: Vec<RawMemberGroup>,
-    #[serde(default)]
-    pub(super) cable_groups: Vec<RawMemberGroup>,
-}
+    repeat: Vec<RawRepeat>,
+});
+
+with_parts!(
+    /// `[[structure.repeat]]`: bodies, members, groups, joints and actuators written once with
+    /// `{i}` templates and generated for every index of `for`, each copy optionally rotated
+    /// about an axis through the origin and then offset.
+    RawRepeat {
+        /// `{ i = "0..n" }`: one loop variable over a range whose bounds are integer
+        /// expressions of the parameters (end excluded).
+        #[serde(rename = "for")]
+        over: For,
+        rotate: Option<RawRotate>,
+        /// [m], added after the rotation; expressions may use the loop variable.
+        offset: Option<Xyz>,
+    }
+);
 
 /// A rotation about `axis` (through the origin) by `angle` [rad].
 #[derive(Clone, Debug, Deserialize)]
