@@ -548,6 +548,17 @@ pub fn distance(a: Vec3, b: Vec3) -> f64 {
     norm([a[0] - b[0], a[1] - b[1], a[2] - b[2]])
 }
 
+/// `v` turned by `angle` [rad] about `axis` (through the origin; any length but zero), by
+/// Rodrigues' formula.
+pub fn rotated(v: Vec3, axis: Vec3, angle: f64) -> Vec3 {
+    let n = norm(axis);
+    let k = axis.map(|c| c / n);
+    let (s, c) = angle.sin_cos();
+    let kxv = [k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0]];
+    let kdv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
+    std::array::from_fn(|i| v[i] * c + kxv[i] * s + k[i] * kdv * (1.0 - c))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

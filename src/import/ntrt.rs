@@ -555,22 +555,18 @@ fn rotate(file: &str, rot: &Yaml, c: &mut Sub) -> Result<(), ImportError> {
         return Ok(()); // NTRT ignores a rotation without both
     };
     let axis = vec3(file, axis, "rotation axis")?;
-    let n = crate::structure::norm(axis);
-    if !(n > 0.0) {
+    if !(crate::structure::norm(axis) > 0.0) {
         return Err(err(file, rot.at(), "the rotation axis must not be zero"));
     }
-    let u = axis.map(|x| x / n);
     let theta = number(file, angle, "rotation angle")?.to_radians();
     let reference = match rot.get("reference") {
         Some(r) => vec3(file, r, "rotation reference")?,
         None => c.centroid(),
     };
-    let (s, co) = theta.sin_cos();
     c.for_each_node(&mut |p| {
         let v = [p[0] - reference[0], p[1] - reference[1], p[2] - reference[2]];
-        let d = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-        let x = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
-        *p = [0, 1, 2].map(|k| reference[k] + v[k] * co + x[k] * s + u[k] * d * (1.0 - co));
+        let turned = crate::structure::rotated(v, axis, theta);
+        *p = [0, 1, 2].map(|k| reference[k] + turned[k]);
     });
     Ok(())
 }

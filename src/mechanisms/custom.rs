@@ -120,10 +120,16 @@ impl Custom {
         let all: Vec<(&Values, &Structure)> =
             std::iter::once((&self.params, &self.structure)).chain(self.variants.iter().map(|(p, s)| (p, s))).collect();
         let value = |p: &Values, k: &str| p.get(k).copied().unwrap_or(f64::NAN).to_bits();
+        // Unseen: it varies, and every structure equals the first one found at the same values
+        // of the other swept parameters.
         let unseen = |k: &String| {
-            let others = |p: &Values| swept.iter().filter(|o| *o != k).map(|o| value(p, o)).collect::<Vec<u64>>();
             let varies = all.iter().any(|(p, _)| value(p, k) != value(all[0].0, k));
-            varies && all.iter().all(|(p, s)| all.iter().filter(|(q, _)| others(q) == others(p)).all(|(_, t)| t == s))
+            let mut first: std::collections::HashMap<Vec<u64>, &Structure> = std::collections::HashMap::new();
+            varies
+                && all.iter().all(|(p, s)| {
+                    let others: Vec<u64> = swept.iter().filter(|o| *o != k).map(|o| value(p, o)).collect();
+                    *first.entry(others).or_insert(s) == *s
+                })
         };
         swept.iter().filter(|k| unseen(k)).cloned().collect()
     }

@@ -263,23 +263,30 @@ struct Topology {
 }
 
 /// The points grouped by the values of the topology parameters `used` (in grid order; one
-/// group when the sweep leaves them alone).
+/// group when the sweep leaves them alone, none when no pattern reads a parameter).
 fn topologies(
     table: &crate::file_model::params::ParamTable,
     params: &Values,
     actuation: &Actuation,
     used: &[String],
 ) -> Vec<Topology> {
-    let mut groups: Vec<(Vec<u64>, Topology)> = Vec::new();
+    if used.is_empty() {
+        return Vec::new(); // no pattern reads a parameter: one structure serves every point
+    }
+    let mut groups: Vec<Topology> = Vec::new();
+    let mut index: std::collections::HashMap<Vec<u64>, usize> = std::collections::HashMap::new();
     for p in actuation.all_inputs() {
         let set = params::params_at(table, params, p);
         let key: Vec<u64> = used.iter().map(|k| set.get(k).copied().unwrap_or(f64::NAN).to_bits()).collect();
-        match groups.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, t)) => t.points.push(p.clone()),
-            None => groups.push((key, Topology { params: set, points: vec![p.clone()], used: used.to_vec() })),
+        match index.get(&key) {
+            Some(&g) => groups[g].points.push(p.clone()),
+            None => {
+                index.insert(key, groups.len());
+                groups.push(Topology { params: set, points: vec![p.clone()], used: used.to_vec() });
+            }
         }
     }
-    groups.into_iter().map(|(_, t)| t).collect()
+    groups
 }
 
 /// Expands the file's patterns (`repeat.rs`, `for_each.rs`) with the parameters of

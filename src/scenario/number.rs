@@ -259,7 +259,7 @@ fn values(v: &Xyz) -> [f64; 3] {
 /// A resolved point or vector turned and then offset.
 fn place(v: &mut Xyz, turn: Turn, offset: [f64; 3]) {
     let p = values(v);
-    let p = turn.map_or(p, |(axis, angle)| super::repeat::rotated(p, axis, angle));
+    let p = turn.map_or(p, |(axis, angle)| crate::structure::rotated(p, axis, angle));
     for (c, x) in v.get_mut().iter_mut().zip(p.iter().zip(offset).map(|(a, b)| a + b)) {
         *c = Spanned::new(c.span(), Num::Value(x));
     }

@@ -67,13 +67,12 @@ impl<'a> Env<'a> {
             Some(Binding::Member(_)) => return Err(format!("'{name}' names a member, not a number")),
             None => {}
         }
-        if self.params.contains_key(name) {
-            self.used.borrow_mut().insert(name.to_string());
-        }
-        match self.params.get(name) {
-            Some(x) if (x - x.round()).abs() <= 1e-9 && x.abs() < 1e15 => Ok(Some(x.round() as i64)),
-            Some(x) => Err(format!("parameter '{name}' = {x} is not a whole number")),
-            None => Ok(None),
+        let Some(x) = self.params.get(name) else { return Ok(None) };
+        self.used.borrow_mut().insert(name.to_string());
+        if (x - x.round()).abs() <= 1e-9 && x.abs() < 1e15 {
+            Ok(Some(x.round() as i64))
+        } else {
+            Err(format!("parameter '{name}' = {x} is not a whole number"))
         }
     }
 }
@@ -144,7 +143,7 @@ fn fill(text: &str, env: &Env, mode: Mode, groups: &Groups) -> Result<String, Ex
             let end =
                 i + text[i..].find(|ch: char| !(ch.is_ascii_alphanumeric() || ch == '_')).unwrap_or(text.len() - i);
             let word = &text[i..end];
-            if let Some(next) = aggregate(text, i, end, env, groups).map_err(|e| shifted(e, 0))? {
+            if let Some(next) = aggregate(text, i, end, env, groups)? {
                 out.push_str(&next.0);
                 i = next.1;
                 continue;

@@ -151,13 +151,3 @@ fn add_copy(ctx: &Ctx, s: &mut RawStructure, r: &RawRepeat, env: &Env) -> Result
     s.cable_groups.extend(r.cable_groups.instantiate(ctx, env)?);
     Ok(())
 }
-
-/// A point or vector turned by `angle` [rad] about the unit vector `axis` (Rodrigues).
-pub(super) fn rotated(p: [f64; 3], axis: [f64; 3], angle: f64) -> [f64; 3] {
-    let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
-    let k = axis.map(|c| c / n);
-    let (s, c) = angle.sin_cos();
-    let kxp = [k[1] * p[2] - k[2] * p[1], k[2] * p[0] - k[0] * p[2], k[0] * p[1] - k[1] * p[0]];
-    let kdp = k[0] * p[0] + k[1] * p[1] + k[2] * p[2];
-    std::array::from_fn(|i| p[i] * c + kxp[i] * s + k[i] * kdp * (1.0 - c))
-}
