@@ -57,6 +57,8 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         last_step_accelerated: false,
         accelerated_steps: 0,
         driven: false,
+        locked_coordinates: vec![0.0; s.joints.len()],
+        kept_jacobians: Vec::new(),
     };
     sim.model.tree = sim.link_tree();
     sim.model.internal_closures = sim.find_internal_closures();
@@ -151,12 +153,9 @@ fn insert_joints(
     for (j, joint) in s.joints.iter().enumerate() {
         let (mut h1, h2) = (handles[joint.parent], handles[joint.child]);
         if !tree[j] {
-            // An actuated joint off the tree is locked at its command by equal limits.
-            let mut data = generic_joint(s, joint);
-            if actuated[j] {
-                let q = 0.0; // the initial configuration; commands move the limits
-                data.set_limits(free_axis_of(&joint.kind), [q, q]);
-            }
+            // An actuated joint off the tree is locked at its command (the drawn configuration
+            // until a command moves it).
+            let data = if actuated[j] { locked_joint(s, joint, 0.0) } else { generic_joint(s, joint) };
             out.joint_impulse[j] = Some(out.impulse_joints.insert(h1, h2, data, true));
             continue;
         }
@@ -300,10 +299,10 @@ fn plan_tree(s: &Structure, roped: &[bool], actuated: &[bool]) -> Result<Vec<boo
 /// closed by the position projection with sparse factorizations. rapier's multibody step
 /// assembles and factorizes a dense mass matrix over every link (its cost grows as the cube of
 /// the links); the plain bodies' step and the sparse projection grow linearly. Measured on
-/// furet2018's X chains (three links an X; BENCHMARKS.md, "X chains at scale"): the
-/// multibody settles 10 X in 4.1 ms against 6.8 ms cut, 15 X in 10.3 ms against 10.1 ms and
-/// 20 X in 20.2 ms against 13.6 ms.
-pub(super) const LOOPED_MULTIBODY_MAX_LINKS: usize = 45;
+/// furet2018's X chains (three links an X; BENCHMARKS.md, "X chains at scale"), a settle with
+/// the multibody against cut: 5 X 1.06 against 1.43 ms, 7 X 1.92 against 2.08, 8 X 2.48 against
+/// 2.42, 10 X 3.93 against 3.18, 15 X 9.37 against 5.36.
+pub(super) const LOOPED_MULTIBODY_MAX_LINKS: usize = 24;
 
 /// Turns every link of a multibody (the links hung from one fixed body) into an impulse joint
 /// when a planar pin closes a loop inside it and it has more than
@@ -447,6 +446,25 @@ pub(super) fn free_axis_of(kind: &JointKind) -> JointAxis {
         JointKind::Prismatic { .. } => JointAxis::LinX,
         _ => JointAxis::AngX,
     }
+}
+
+/// An actuated revolute or prismatic joint off the multibody tree, held at coordinate `q`
+/// [rad or m] from its drawn configuration: its free axis locked (an equality in rapier's
+/// solver) and its first frame turned or slid by `q` along that axis. Equal limits [q, q], the
+/// lock used before, are enforced one side at a time: measured on a chain of 10 furet2018 X
+/// modules cut into plain bodies, rapier's step at rest opened the locks by 3e-3 to 3e-2 (rows
+/// scaled to metres), and the projection then took 5 to 7 iterations a step.
+pub(super) fn locked_joint(s: &Structure, joint: &Joint, q: f64) -> GenericJoint {
+    let mut data = generic_joint(s, joint);
+    let axis = free_axis_of(&joint.kind);
+    let offset = match axis {
+        JointAxis::LinX => Pose::from_translation(Vector::X * q),
+        _ => Pose::from_rotation(Rotation::from_scaled_axis(Vector::X * q)),
+    };
+    let frame1 = data.local_frame1;
+    data.set_local_frame1(frame1 * offset);
+    data.lock_axes(axis.into());
+    data
 }
 
 /// Sets the damping of every degree of freedom of a multibody link [N s/m or N m s/rad].

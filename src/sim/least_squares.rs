@@ -144,18 +144,24 @@ impl BandCholesky {
         for i in 0..n {
             l[i * w] += shift * largest;
         }
+        // Row i holds L[i][i - b] at b = 0 ..= band; L[i][j] L[j][k] pairs are (b + off, b)
+        // with off = i - j, b = j - k.
         for j in 0..n {
-            let lo = j.saturating_sub(band);
-            let d = l[j * w] - (lo..j).map(|k| l[j * w + (j - k)].powi(2)).sum::<f64>();
+            let reach = j.min(band);
+            let d = l[j * w] - l[j * w + 1..=j * w + reach].iter().map(|x| x * x).sum::<f64>();
             if !(d > PIVOT_FLOOR * largest) {
                 return None;
             }
             let d = d.sqrt();
             l[j * w] = d;
             for i in j + 1..(j + w).min(n) {
-                let lo = i.saturating_sub(band);
-                let dot: f64 = (lo..j).map(|k| l[i * w + (i - k)] * l[j * w + (j - k)]).sum();
-                l[i * w + (i - j)] = (l[i * w + (i - j)] - dot) / d;
+                let off = i - j;
+                let reach = (i.min(band) - off).min(j);
+                let dot: f64 = {
+                    let (row_i, row_j) = (&l[i * w + off + 1..=i * w + off + reach], &l[j * w + 1..=j * w + reach]);
+                    row_i.iter().zip(row_j).map(|(a, b)| a * b).sum()
+                };
+                l[i * w + off] = (l[i * w + off] - dot) / d;
             }
         }
         Some(BandCholesky { band, l })
@@ -164,17 +170,19 @@ impl BandCholesky {
     /// (M M^T)^-1 b.
     fn solve(&self, b: &DVector<f64>) -> DVector<f64> {
         let (n, w) = (b.len(), self.band + 1);
-        let l = &self.l;
+        let l = &self.l[..n * w];
         let mut y: Vec<f64> = b.iter().copied().collect();
+        // Forward: L y = b, row i's band L[i][i - d] (d = 1 ..= band) against y[i - d].
         for i in 0..n {
-            let lo = i.saturating_sub(self.band);
             let row = &l[i * w..i * w + w];
-            let dot: f64 = (lo..i).map(|k| row[i - k] * y[k]).sum();
+            let reach = i.min(self.band);
+            let dot: f64 = row[1..=reach].iter().zip(y[i - reach..i].iter().rev()).map(|(a, b)| a * b).sum();
             y[i] = (y[i] - dot) / row[0];
         }
+        // Backward: L^T x = y, column i of L below the diagonal is L[i + d][d].
         for i in (0..n).rev() {
-            let hi = (i + w).min(n);
-            let dot: f64 = (i + 1..hi).map(|k| l[k * w + (k - i)] * y[k]).sum();
+            let reach = (n - 1 - i).min(self.band);
+            let dot: f64 = (1..=reach).map(|d| l[(i + d) * w + d] * y[i + d]).sum();
             y[i] = (y[i] - dot) / l[i * w];
         }
         DVector::from_vec(y)

@@ -26,7 +26,7 @@ const CHORD_CONTRACTION: f64 = 0.1;
 const MAX_ITERATIONS: usize = 20;
 
 /// The projection stops when the largest gap is below this fraction of the structure's size.
-const GAP_TOLERANCE_FRACTION: f64 = 1e-14;
+pub(super) const GAP_TOLERANCE_FRACTION: f64 = 1e-14;
 
 /// Singular values of the closure Jacobian below this fraction of the largest are treated as
 /// zero (redundant closure rows).
@@ -95,18 +95,23 @@ impl Jacobian {
 
 /// Gauss-Newton onto a constraint manifold of `ndof` coordinates: `rows` evaluates the
 /// constraint rows [m]; `jacobian(sim, rows)` their derivatives by the coordinates at the
-/// current state (rows x ndof); `displace` moves every coordinate by a step. Iterates until
-/// every row is within [`GAP_TOLERANCE_FRACTION`] of the structure's size (at most
-/// [`MAX_ITERATIONS`]); returns the Jacobian at the last point and the largest row left.
+/// current state (rows x ndof); `displace` moves every coordinate by a step; `start`, a sparse
+/// Jacobian kept from an earlier call, is tried first (the chord test replaces it when it
+/// contracts too little). Iterates until every row is within `tolerance_fraction` of the
+/// structure's size (at most [`MAX_ITERATIONS`]); returns the last Jacobian, whether this call
+/// formed it, and the largest row left.
 fn close_rows(
     sim: &mut Simulation,
     rows: &dyn Fn(&Simulation) -> Vec<f64>,
     jacobian: &dyn Fn(&mut Simulation, &[f64]) -> Jacobian,
     displace: &dyn Fn(&mut Simulation, &[f64]),
-) -> (Option<Jacobian>, f64) {
+    start: Option<Jacobian>,
+    tolerance_fraction: f64,
+) -> (Option<Jacobian>, bool, f64) {
     let largest = |g: &[f64]| g.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    let tol = GAP_TOLERANCE_FRACTION * sim.model.length_scale_m;
-    let mut jac: Option<Jacobian> = None;
+    let tol = tolerance_fraction * sim.model.length_scale_m;
+    let mut jac: Option<Jacobian> = start;
+    let mut formed = false;
     let (mut previous, mut polished) = (f64::INFINITY, false);
     for _ in 0..MAX_ITERATIONS {
         let g0 = rows(sim);
@@ -126,13 +131,15 @@ fn close_rows(
         // iteration shrinks the gap by about the gap over the structure's size, 1e-4 to 1e-6,
         // in as many iterations as Newton's method with one factorization instead of three
         // or four); a dense one is evaluated at every iterate.
-        if !sparse || (gap > tol && gap > CHORD_CONTRACTION * previous) {
+        if jac.is_none() || !sparse || (gap > tol && gap > CHORD_CONTRACTION * previous) {
             jac = Some(jacobian(sim, &g0));
+            formed = true;
         }
         previous = gap;
         let Some(j) = jac.as_ref() else { break };
         if gap <= tol {
-            if !matches!(j, Jacobian::Sparse(_)) {
+            // A loose tolerance is not polished.
+            if !matches!(j, Jacobian::Sparse(_)) || tolerance_fraction > GAP_TOLERANCE_FRACTION {
                 break;
             }
             polished = true;
@@ -143,7 +150,7 @@ fn close_rows(
         displace(sim, dq.as_slice());
     }
     let left = largest(&rows(sim));
-    (jac, left)
+    (jac, formed, left)
 }
 
 /// A body's first-order motion per unit of one coordinate: velocity `v` of the point `at`
@@ -225,7 +232,7 @@ impl Simulation {
             // The loops of one multibody: a group of its free coordinates alone.
             let joints = closures.iter().filter(|c| c.multibody == mb_index).map(|c| c.joint).collect();
             let g = ProjectedGroup { bodies: Vec::new(), multibodies: vec![mb_index], joints, cables: Vec::new() };
-            largest = largest.max(self.project_group(&g, &[]));
+            largest = largest.max(self.project_group(&g, &[], &mut None, GAP_TOLERANCE_FRACTION));
         }
         self.model.internal_closures = closures;
         largest
@@ -544,14 +551,12 @@ impl Simulation {
         out.push(if l > 0.0 { rate.dot(d / l) } else { 0.0 });
     }
 
-    /// The commanded angle of an actuated revolute joint off the tree, locked there by equal
-    /// limits (relative to the drawn pose) [rad]; None for any other joint.
+    /// The commanded angle of an actuated revolute joint off the tree, locked there
+    /// (`build::locked_joint`, relative to the drawn pose) [rad]; None for any other joint.
     fn locked_angle(&self, j: usize) -> Option<f64> {
-        if !self.model.actuated[j] || !matches!(self.model.structure.joints[j].kind, JointKind::Revolute { .. }) {
-            return None;
-        }
-        let joint = self.impulse_joints.get(self.model.joint_impulse[j]?)?;
-        joint.data.limits(JointAxis::AngX).map(|l| l.min)
+        let revolute = matches!(self.model.structure.joints[j].kind, JointKind::Revolute { .. });
+        (self.model.actuated[j] && revolute && self.model.joint_impulse[j].is_some())
+            .then(|| self.locked_coordinates[j])
     }
 
     /// Moves body `b` by a translation `t` [m] and a rotation `r` [rad, rotation vector] about
@@ -570,20 +575,35 @@ impl Simulation {
     /// Closes every projected group's joints and taut cables to round-off and projects the
     /// velocities of its bodies and multibodies. Returns the largest row left [m].
     pub(super) fn project_groups(&mut self) -> f64 {
+        self.project_groups_to(GAP_TOLERANCE_FRACTION)
+    }
+
+    /// [`Self::project_groups`] to rows within `tolerance_fraction` of the structure's size.
+    pub(super) fn project_groups_to(&mut self, tolerance_fraction: f64) -> f64 {
         let groups = std::mem::take(&mut self.model.projected_groups);
+        let mut kept = std::mem::take(&mut self.kept_jacobians);
+        kept.resize_with(groups.len(), || None);
         let mut largest = 0.0_f64;
-        for g in &groups {
+        for (g, kept) in groups.iter().zip(kept.iter_mut()) {
             let Some(taut) = self.projected_taut_cables(g) else { continue };
-            largest = largest.max(self.project_group(g, &taut));
+            largest = largest.max(self.project_group(g, &taut, kept, tolerance_fraction));
         }
         self.model.projected_groups = groups;
+        self.kept_jacobians = kept;
         largest
     }
 
     /// Closes the group's joints and its `taut` cables to round-off (Gauss-Newton in its
     /// coordinates, the Jacobian from the bodies' twists) and removes the velocities that would
-    /// open them. Returns the largest row left [m].
-    fn project_group(&mut self, g: &ProjectedGroup, taut: &[usize]) -> f64 {
+    /// open them. A sparse Jacobian is `kept` for the next call ([`KeptJacobian`]). Returns the
+    /// largest row left [m].
+    fn project_group(
+        &mut self,
+        g: &ProjectedGroup,
+        taut: &[usize],
+        kept: &mut Option<KeptJacobian>,
+        tolerance_fraction: f64,
+    ) -> f64 {
         let coords = GroupCoordinates::of(self, g);
         // The body Jacobians at the current coordinates (the Jacobian below reads them).
         for &m in &g.multibodies {
@@ -596,21 +616,80 @@ impl Simulation {
             sim.group_rows(g, taut, &mut out);
             out
         };
-        let jacobian = |sim: &mut Simulation, g0: &[f64]| coords.jacobian(sim, g, taut, g0.len());
+        // Where the last Jacobian was formed: the poses a kept one is judged by.
+        let formed_at = std::cell::RefCell::new(kept.as_ref().filter(|k| k.taut == taut).map(|k| k.poses.clone()));
+        let jacobian = |sim: &mut Simulation, g0: &[f64]| {
+            *formed_at.borrow_mut() = Some(sim.group_poses(g));
+            coords.jacobian(sim, g, taut, g0.len())
+        };
         let displace = |sim: &mut Simulation, dq: &[f64]| coords.displace(sim, g, dq);
-        let (jac, left) = close_rows(self, &rows, &jacobian, &displace);
+        let start = kept.take().filter(|k| k.taut == taut).map(|k| k.jacobian);
+        let (jac, formed, left) = close_rows(self, &rows, &jacobian, &displace, start, tolerance_fraction);
+        let u = coords.velocities(self, g);
+        let moving = u.iter().any(|&x| x != 0.0);
+        // A Jacobian kept from an earlier call serves the velocities only where the bodies are
+        // back where it was formed (at rest); otherwise they take one formed here.
+        let stale = |sim: &Simulation| {
+            let at = formed_at.borrow();
+            !at.as_ref().is_some_and(|p| sim.poses_within(g, p, KEPT_POSE_TOLERANCE_FRACTION))
+        };
+        let jac = match jac {
+            Some(j) if matches!(j, Jacobian::Sparse(_)) && !formed && moving && stale(self) => {
+                let g0 = rows(self);
+                Some(jacobian(self, &g0))
+            }
+            j => j,
+        };
         if let Some(jac) = jac.filter(|j| j.nrows() > 0) {
             // Remove J^+ (J u) from the velocities u over every row, taut cables included (they
             // were just held at their length: a cable goes slack when rapier's rope stops
             // pulling, and is then no longer taut here).
-            let u = coords.velocities(self, g);
-            if let Some(du) = jac.solve(&jac.mul(&u)) {
-                coords.remove_velocities(self, g, &du);
+            if moving {
+                if let Some(du) = jac.solve(&jac.mul(&u)) {
+                    coords.remove_velocities(self, g, &du);
+                }
+            }
+            if let (Jacobian::Sparse(_), Some(poses)) = (&jac, formed_at.take()) {
+                *kept = Some(KeptJacobian { jacobian: jac, poses, taut: taut.to_vec() });
             }
         }
         left
     }
+
+    /// The poses of the group's plain bodies.
+    fn group_poses(&self, g: &ProjectedGroup) -> Vec<Pose> {
+        g.bodies.iter().map(|&b| *self.bodies[self.model.handles[b]].position()).collect()
+    }
+
+    /// Whether every plain body of the group is within `fraction` of the structure's size of
+    /// its pose in `poses` (rotations times the size).
+    fn poses_within(&self, g: &ProjectedGroup, poses: &[Pose], fraction: f64) -> bool {
+        let (scale, tol) = (self.model.length_scale_m, fraction * self.model.length_scale_m);
+        g.bodies.iter().zip(poses).all(|(&b, p)| {
+            let now = self.bodies[self.model.handles[b]].position();
+            let turn = (now.rotation * p.rotation.inverse()).to_scaled_axis().length();
+            (now.translation - p.translation).length() <= tol && turn * scale <= tol
+        })
+    }
 }
+
+/// A sparse group's Jacobian with its factorization, kept from one projection to the next: at
+/// rest rapier's step opens the joints of a long chain by 1e-5 to 1e-3 of its size, and the
+/// kept factorization closes them again in the chord iterations of [`close_rows`] without a
+/// new one (the factorization was 30 % of a 10-module X chain's settle).
+pub(super) struct KeptJacobian {
+    jacobian: Jacobian,
+    /// The group's plain bodies' poses where it was formed.
+    poses: Vec<Pose>,
+    /// The taut cables whose rows it has.
+    taut: Vec<usize>,
+}
+
+/// A kept Jacobian removes the velocities only while every body is back within this fraction
+/// of the structure's size of where it was formed: the velocities it leaves across the joints
+/// are then this fraction of the velocities themselves (at rest, round-off), where one formed
+/// a step of motion before would leave the step's displacement over the size.
+const KEPT_POSE_TOLERANCE_FRACTION: f64 = 1e-10;
 
 /// The coordinates of a projected group: per plain body a translation [m] and a rotation
 /// vector times the structure's size [m], about the centre of mass; then each multibody's free
