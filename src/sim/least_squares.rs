@@ -199,6 +199,10 @@ const PIVOT_FLOOR: f64 = 1e-14;
 /// the accuracy that forming the normal matrix loses (its condition is the square of a's).
 const REFINEMENT_ROUNDS: usize = 2;
 
+/// Refinement stops once what a solution leaves of `a x = b` is below this fraction of `b`:
+/// the round-off of forming the residual, so a further round changes nothing.
+const REFINED_FRACTION: f64 = 1e-15;
+
 /// A sparse `a` ready to give minimum-norm least-squares solutions of `a x = b` at full rank:
 /// the band Cholesky factor of its normal matrix (a a^T when `a` has fewer rows than columns,
 /// x = a^T y; a^T a otherwise), each solve followed by [`REFINEMENT_ROUNDS`] of refinement.
@@ -251,8 +255,12 @@ impl SparseLeastSquares {
     /// corrects itself, such as the projection's Gauss-Newton steps).
     pub(crate) fn solve_refined(&self, b: &DVector<f64>, rounds: usize) -> Option<DVector<f64>> {
         let mut x = self.solve_once(b);
+        let floor = REFINED_FRACTION * b.amax();
         for _ in 0..rounds {
             let r = b - self.a.mul(&x);
+            if r.amax() <= floor {
+                break;
+            }
             x += self.solve_once(&r);
         }
         x.iter().all(|v| v.is_finite()).then_some(x)

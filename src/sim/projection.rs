@@ -384,8 +384,51 @@ impl Simulation {
         groups
             .into_iter()
             .filter(|(_, g, ok)| *ok && !(g.bodies.is_empty() && g.multibodies.is_empty()))
-            .map(|(_, g, _)| g)
+            .map(|(_, mut g, _)| {
+                if g.multibodies.is_empty() && 6 * g.bodies.len() >= SPARSE_MIN_COORDINATES {
+                    self.order_joints_by_band(&mut g);
+                }
+                g
+            })
             .collect()
+    }
+
+    /// Puts a sparse group's joints in reverse Cuthill-McKee order over the bodies they share,
+    /// so that the rows coupled in J J^T sit close together: the band Cholesky's cost grows as
+    /// the band squared. Measured on a chain of 10 furet2018 X modules cut into plain bodies:
+    /// the band of its 180 rows went from 27 in the structure's order to 17, and a settle from
+    /// 2.7 to 2.4 ms.
+    fn order_joints_by_band(&self, g: &mut ProjectedGroup) {
+        let s = &self.model.structure;
+        let mut members_of_body: Vec<Vec<usize>> = vec![Vec::new(); s.bodies.len()];
+        for (k, &j) in g.joints.iter().enumerate() {
+            for b in [s.joints[j].parent, s.joints[j].child] {
+                if !self.is_fixed_body(b) {
+                    members_of_body[b].push(k);
+                }
+            }
+        }
+        let neighbours: Vec<Vec<usize>> = g
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(k, &j)| {
+                let mut n: Vec<usize> = [s.joints[j].parent, s.joints[j].child]
+                    .iter()
+                    .flat_map(|&b| members_of_body[b].iter().copied())
+                    .filter(|&m| m != k)
+                    .collect();
+                n.sort_unstable();
+                n.dedup();
+                n
+            })
+            .collect();
+        let position = super::relaxation::ordering::reverse_cuthill_mckee(&neighbours);
+        let mut ordered = g.joints.clone();
+        for (k, &j) in g.joints.iter().enumerate() {
+            ordered[position[k]] = j;
+        }
+        g.joints = ordered;
     }
 
     /// The multibody that body `b` is a link of, if any.

@@ -32,7 +32,7 @@
 mod assemble;
 mod dense;
 mod line_search;
-mod ordering;
+pub(super) mod ordering;
 mod sparse;
 
 use super::Simulation;

@@ -24,7 +24,7 @@ fn farthest(neighbours: &[Vec<usize>], start: usize, visited: &[bool]) -> usize 
 
 /// The factor position of each of the blocks coupled as `neighbours` (reverse Cuthill-McKee:
 /// breadth first from a peripheral block, neighbours by increasing degree, then reversed).
-pub(super) fn reverse_cuthill_mckee(neighbours: &[Vec<usize>]) -> Vec<usize> {
+pub(in crate::sim) fn reverse_cuthill_mckee(neighbours: &[Vec<usize>]) -> Vec<usize> {
     let n = neighbours.len();
     let degree = |i: usize| neighbours[i].len();
     let mut visited = vec![false; n];
