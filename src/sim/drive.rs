@@ -7,7 +7,8 @@
 //! full inverse mass matrix: the bodies it carries feel the prescribed acceleration (a cart's
 //! acceleration swings its pendulum). Cable-length commands stay as they are (their forces are
 //! computed from the geometry, so a changing length acts physically); an actuated joint that
-//! closes a loop (locked by limits off the tree) has no such degree of freedom and is refused.
+//! closes a loop (locked off the tree, `build::locked_joint`) has no such degree of freedom and is
+//! refused.
 
 use super::Simulation;
 use crate::structure::ActuatorTarget;
