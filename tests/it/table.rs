@@ -43,7 +43,6 @@ fn the_trajectory_table_holds_the_settled_values_bit_for_bit() {
         assert!(header.iter().any(|h| h == c), "no column {c}: {header:?}");
     }
     let settled = &r.points[0].simulated;
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     // A simulated value's column: its own `sim:` one, or the node or member column that holds
     // it (a node coordinate or a member force is not written twice).
     let column_of = |q: &str| {
@@ -78,6 +77,10 @@ fn the_trajectory_table_holds_the_settled_values_bit_for_bit() {
         Ok(o) if o.status.success() => {
             assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "True", "pandas read other values");
             eprintln!("pandas read the settled row (tick {tick}) as the JSON report has it, bit for bit");
+        }
+        // Only a missing Python or pandas skips; a script that fails otherwise is a failure.
+        Ok(o) if !String::from_utf8_lossy(&o.stderr).contains("No module named") => {
+            panic!("the pandas read failed: {}", String::from_utf8_lossy(&o.stderr))
         }
         _ => eprintln!("skipped the pandas read: no Python with pandas (set TENSEGRITY_PYTHON)"),
     }
@@ -158,6 +161,13 @@ fn the_trajectory_table_as_arrow_holds_the_csv_values() {
         Ok(o) if o.status.success() => {
             assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "True", "pandas read other values: {settled:?}");
             eprintln!("pandas read the Arrow table's settled row as the JSON report has it, bit for bit");
+        }
+        // Only a missing Python, pandas or pyarrow skips; any other failure fails.
+        Ok(o)
+            if !String::from_utf8_lossy(&o.stderr).contains("No module named")
+                && !String::from_utf8_lossy(&o.stderr).contains("pyarrow") =>
+        {
+            panic!("the pandas read failed: {}", String::from_utf8_lossy(&o.stderr))
         }
         _ => eprintln!("skipped the pandas read: no Python with pandas and pyarrow (set TENSEGRITY_PYTHON)"),
     }
