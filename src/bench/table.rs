@@ -182,3 +182,53 @@ pub fn case_sets(results: &[BenchResult], interference: &[InterferenceBench]) ->
     }
     t
 }
+
+/// The motion comparison: per case, each time step's steps per second and error on both
+/// sides, then the cost at equal error.
+pub fn scale_motion(cases: &[crate::bench::scale::motion::MotionCase]) -> String {
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "Physical motion, undamped, {} s; error = largest node distance from MuJoCo's RK4 at {} s [m]",
+        crate::bench::scale::motion::DURATION_S,
+        crate::bench::scale::motion::REFERENCE_DT_S
+    );
+    let _ = writeln!(
+        t,
+        "{:<12} {:>5} {:>6} {:>8} | {:>11} {:>10} | {:>11} {:>10}",
+        "family", "size", "struts", "dt s", "tb steps/s", "tb error", "mj steps/s", "mj error"
+    );
+    for c in cases {
+        for (a, b) in c.testbed.iter().zip(&c.peer) {
+            let _ = writeln!(
+                t,
+                "{:<12} {:>5} {:>6} {:>8.1e} | {:>11.0} {:>10.2e} | {:>11.0} {:>10.2e}",
+                c.family, c.size, c.struts, a.dt_s, a.steps_per_s, a.error_m, b.steps_per_s, b.error_m
+            );
+        }
+    }
+    let _ = writeln!(
+        t,
+        "\nAt equal error (the testbed's at dt = {} s): MuJoCo's step and wall interpolated in log-log; rate x = MuJoCo wall / testbed wall",
+        crate::bench::scale::motion::EQUAL_ERROR_DT_S
+    );
+    let _ = writeln!(
+        t,
+        "{:<12} {:>5} {:>10} {:>12} {:>12} {:>9}",
+        "family", "size", "error", "mj dt s", "mj wall s", "rate x"
+    );
+    let opt = |x: Option<f64>, prec: usize| x.map_or("outside".to_string(), |v| format!("{v:.prec$e}"));
+    for c in cases {
+        let _ = writeln!(
+            t,
+            "{:<12} {:>5} {:>10.2e} {:>12} {:>12} {:>9}",
+            c.family,
+            c.size,
+            c.equal_error_m,
+            opt(c.peer_dt_at_equal_error_s, 2),
+            opt(c.peer_wall_at_equal_error_s, 2),
+            c.ratio_at_equal_error.map_or("-".to_string(), |r| format!("{r:.2}"))
+        );
+    }
+    t
+}

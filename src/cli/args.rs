@@ -173,6 +173,11 @@ pub enum Command {
         /// (checked between steps) [s].
         #[arg(long, value_name = "S", default_value_t = 120.0)]
         max_case_wall_s: f64,
+        /// With --scale --peer: physical motion instead of settling. The free-body families
+        /// move undamped from their perturbed starts at several time steps on both sides,
+        /// scored against MuJoCo's RK4; steps per second and the cost at equal error.
+        #[arg(long, requires = "scale")]
+        motion: bool,
     },
     /// Write a scenario's structure in another simulator's format.
     Export {

@@ -7,8 +7,18 @@ use crate::bench::{self, scale, table};
 use std::path::Path;
 
 pub fn bench(command: Command) -> Result<Outcome, CliError> {
-    let Command::Bench { rounds, json, export_cases, mechanisms, peer, scale, max_struts, families, max_case_wall_s } =
-        command
+    let Command::Bench {
+        rounds,
+        json,
+        export_cases,
+        mechanisms,
+        peer,
+        scale,
+        max_struts,
+        families,
+        max_case_wall_s,
+        motion,
+    } = command
     else {
         unreachable!("dispatch passes bench commands only")
     };
@@ -17,6 +27,13 @@ pub fn bench(command: Command) -> Result<Outcome, CliError> {
     if scale {
         let caps = scale::Caps { max_wall_s: max_case_wall_s, ..scale::DEFAULT_CAPS };
         let families = selected_families(&families)?;
+        if motion {
+            if peer.is_none() {
+                return Err(bad_input("--motion needs --peer: its reference is MuJoCo's RK4"));
+            }
+            let command = bench::peer_command(given_peer, bench::SCALE_PEER_SCRIPT);
+            return scale_motion(json, max_struts, &families, &command);
+        }
         return match peer {
             Some(_) => {
                 let command = bench::peer_command(given_peer, bench::SCALE_PEER_SCRIPT);
@@ -92,6 +109,24 @@ fn scale_peer(
     } else {
         reports.iter().for_each(|r| print!("{}", table::scale_family(r)));
         print!("{}", table::scale_peer(&rows));
+    }
+    Ok(Outcome::Pass)
+}
+
+fn scale_motion(
+    json: bool,
+    max_struts: usize,
+    families: &[&'static str],
+    command: &[String],
+) -> Result<Outcome, CliError> {
+    let dir = std::env::temp_dir().join(format!("tensegrity-bench-scale-motion-{}", std::process::id()));
+    let out = scale::motion::compare(families, max_struts, command, &dir);
+    let _ = std::fs::remove_dir_all(&dir);
+    let cases = out.map_err(bad_input)?;
+    if json {
+        print_json(serde_json::json!({ "scale_motion": cases }));
+    } else {
+        print!("{}", table::scale_motion(&cases));
     }
     Ok(Outcome::Pass)
 }

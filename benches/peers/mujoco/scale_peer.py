@@ -21,6 +21,11 @@ moving parents as soft equalities at MuJoCo's stiffest impedance (solimp 0.9999)
 timeconst 2 dt; the time step per family in TUNED. `--set timestep_s=...` /
 `--set damping_scale=...` override the time step / scale every joint damping (for tuning).
 
+With a "motion" entry in CASES.json (`tensegrity bench --scale --motion --peer`), each case
+is moved instead, undamped, for `duration_s` at each of `dts` and once with RK4 at
+`reference_dt_s` (`motion_case`); the node sites at the end of each run go back with the wall
+time of its steps.
+
 Each case is timed from loading the XML (model compile) to the settled state, as the testbed
 times building its simulation and settling it; a case faster than 0.2 s is run again until
 the runs add up to 0.2 s and its median is reported (as the testbed does). One JSON object goes to stdout:
@@ -163,6 +168,48 @@ def run_case(case: dict, overrides: dict) -> dict:
     }
 
 
+def motion_positions(model, data, sites, steps: int) -> tuple[np.ndarray, float]:
+    """Steps `steps` times from the model's initial state; the sites at the end and the wall
+    time of the steps alone."""
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        mujoco.mj_step(model, data)
+    wall_s = time.perf_counter() - t0
+    mujoco.mj_kinematics(model, data)
+    return data.site_xpos[sites].copy(), wall_s
+
+
+def motion_case(case: dict, motion: dict) -> dict:
+    """The motion protocol (`src/bench/scale/motion.rs`): the undamped export moved for
+    `duration_s` at each of `dts` (the export's integrator, implicitfast) and once with RK4
+    at `reference_dt_s`, the reference; node sites at the end of each run."""
+
+    def load(dt: float, integrator=None):
+        model = mujoco.MjModel.from_xml_path(case["mjcf"])
+        model.opt.timestep = dt
+        model.dof_damping[:] = 0.0
+        if integrator is not None:
+            model.opt.integrator = integrator
+        sites = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, n) for n in case["nodes"]]
+        return model, mujoco.MjData(model), sites
+
+    duration = motion["duration_s"]
+    runs = []
+    for dt in motion["dts"]:
+        steps = round(duration / dt)
+        model, data, sites = load(dt)
+        pos, wall_s = motion_positions(model, data, sites, steps)
+        walls = [wall_s]
+        while sum(walls) < MIN_CASE_WALL_S:
+            model, data, sites = load(dt)
+            walls.append(motion_positions(model, data, sites, steps)[1])
+        runs.append({"dt_s": dt, "steps": steps, "wall_s": statistics.median(walls), "positions": pos.tolist()})
+    ref_dt = motion["reference_dt_s"]
+    model, data, sites = load(ref_dt, mujoco.mjtIntegrator.mjINT_RK4)
+    reference, _ = motion_positions(model, data, sites, round(duration / ref_dt))
+    return {"family": case["family"], "size": case["size"], "reference": reference.tolist(), "runs": runs}
+
+
 def parse_override(text: str) -> tuple[str, float]:
     name, value = text.split("=", 1)
     return name, float(value)
@@ -174,7 +221,17 @@ def main() -> None:
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="timestep_s or damping_scale")
     args = ap.parse_args()
     with open(args.cases) as f:
-        cases = json.load(f)["cases"]
+        listed = json.load(f)
+    cases = listed["cases"]
+    if "motion" in listed:
+        out = []
+        for case in cases:
+            print(f"{case['family']} {case['size']}: mujoco motion ...", file=sys.stderr)
+            out.append(motion_case(case, listed["motion"]))
+        settings = {"integrator": "implicitfast (reference: RK4)", "damping": 0.0}
+        json.dump({"simulator": "mujoco", "mujoco_version": mujoco.__version__, "settings": settings, "cases": out}, sys.stdout)
+        sys.stdout.write("\n")
+        return
     overrides = dict(parse_override(s) for s in args.set)
     out = []
     for case in cases:

@@ -19,6 +19,7 @@
 
 pub mod furet;
 pub mod icosahedron;
+pub mod motion;
 pub mod peer;
 pub mod prism;
 pub mod spine;

@@ -1,0 +1,259 @@
+//! `tensegrity bench --scale --motion --peer`: the cost of physical dynamics on the free-body
+//! scale families, beside MuJoCo's, at equal trajectory error (issue 33).
+//!
+//! Each case's perturbed start moves undamped (body damping 0, no settle accelerator: the
+//! path is the dynamics' own) for [`DURATION_S`] at each time step of [`DT_S`], in the testbed
+//! and in MuJoCo (the case's MJCF export, `implicitfast` as exported). The reference is
+//! MuJoCo's RK4 at [`REFERENCE_DT_S`]: the same equations of motion on both sides (rigid
+//! bodies, springs and tension-only cables as tendons, held bodies; no constraint). The furet
+//! chains are left out: MuJoCo closes their loops with soft equalities, another model. Error:
+//! the largest node distance from the reference at the end [m]. Steps per second: the steps
+//! over the wall time of stepping alone (building excluded on both sides; runs repeated until
+//! they add up to 0.2 s, the median taken; MuJoCo's steps are `mj_step` calls from a Python
+//! loop, as in its other comparisons).
+//!
+//! At equal error: the testbed's error at [`EQUAL_ERROR_DT_S`] is the level; MuJoCo's time
+//! step and wall time at that error are interpolated in log-log between its runs (None when
+//! the level is outside them), and the ratio compares simulated seconds per wall second.
+
+use super::{cases, Case};
+use crate::bench::{write_error, BenchError};
+use crate::export::mjcf::{to_mjcf, ActuatorMode, MjcfOptions};
+use crate::settings::SimSettings;
+use crate::sim::Simulation;
+use crate::structure::Vec3;
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+
+/// The families whose equations of motion are the same in MuJoCo (free bodies only).
+pub const FAMILIES: [&str; 4] = ["prism", "icosahedron", "tower", "spine"];
+/// Simulated time of every run [s].
+pub const DURATION_S: f64 = 0.5;
+/// Time steps of both sides [s].
+pub const DT_S: [f64; 4] = [4e-3, 2e-3, 1e-3, 5e-4];
+/// MuJoCo's RK4 step for the reference [s]: a tenth of the finest step, fourth order.
+pub const REFERENCE_DT_S: f64 = 5e-5;
+/// The testbed's time step whose error sets the level compared [s].
+pub const EQUAL_ERROR_DT_S: f64 = 1e-3;
+
+/// One run of one side at one time step.
+#[derive(Clone, Debug, Serialize)]
+pub struct MotionRun {
+    pub dt_s: f64,
+    pub steps: u64,
+    /// Wall time of the steps alone [s].
+    pub wall_s: f64,
+    pub steps_per_s: f64,
+    /// Largest node distance from the reference at the end [m].
+    pub error_m: f64,
+}
+
+/// One case: both sides' runs and the comparison at the testbed's error at
+/// [`EQUAL_ERROR_DT_S`].
+#[derive(Clone, Debug, Serialize)]
+pub struct MotionCase {
+    pub family: &'static str,
+    pub size: usize,
+    pub struts: usize,
+    pub testbed: Vec<MotionRun>,
+    pub peer: Vec<MotionRun>,
+    /// The error level compared [m].
+    pub equal_error_m: f64,
+    /// MuJoCo's time step and wall time reaching that level (interpolated), if within its runs.
+    pub peer_dt_at_equal_error_s: Option<f64>,
+    pub peer_wall_at_equal_error_s: Option<f64>,
+    /// Testbed / MuJoCo simulated seconds per wall second at that level.
+    pub ratio_at_equal_error: Option<f64>,
+}
+
+/// The testbed's run of `case` at `dt`, repeated until the runs add up to
+/// [`super::MIN_CASE_WALL_S`] (as the settles are): the node positions at the end, steps and
+/// the median wall time.
+fn testbed_run(case: &Case, dt: f64) -> Result<(Vec<Vec3>, u64, f64), BenchError> {
+    let (positions, steps, first) = testbed_run_once(case, dt)?;
+    let mut walls = vec![first];
+    while walls.iter().sum::<f64>() < super::MIN_CASE_WALL_S {
+        walls.push(testbed_run_once(case, dt)?.2);
+    }
+    walls.sort_by(f64::total_cmp);
+    Ok((positions, steps, walls[walls.len() / 2]))
+}
+
+/// One run of `case` at `dt`: the node positions at the end, steps and wall time of the steps.
+fn testbed_run_once(case: &Case, dt: f64) -> Result<(Vec<Vec3>, u64, f64), BenchError> {
+    let settings = SimSettings {
+        dt_s: dt,
+        body_damping_per_s: 0.0,
+        relaxation: false,
+        newton_damping: false,
+        ..case.settings.clone()
+    };
+    let mut sim = Simulation::new(&case.start, &settings)?;
+    sim.end_acceleration();
+    if !case.commands.is_empty() {
+        sim.set_commands(&case.commands);
+    }
+    let steps = (DURATION_S / dt).round() as u64;
+    let start = Instant::now();
+    for _ in 0..steps {
+        sim.step()?;
+    }
+    Ok((sim.node_positions(), steps, start.elapsed().as_secs_f64()))
+}
+
+/// Largest distance between corresponding points [m].
+fn largest_distance(a: &[Vec3], b: &[Vec3]) -> f64 {
+    a.iter().zip(b).map(|(p, q)| crate::structure::distance(*p, *q)).fold(0.0, f64::max)
+}
+
+/// Linear interpolation of `y` at `x` in log-log through points sorted by x; None outside.
+fn log_log_at(points: &[(f64, f64)], x: f64) -> Option<f64> {
+    points.windows(2).find_map(|w| {
+        let ((x0, y0), (x1, y1)) = (w[0], w[1]);
+        let (lo, hi) = (x0.min(x1), x0.max(x1));
+        (x >= lo && x <= hi && x0 != x1).then(|| {
+            let t = (x.ln() - x0.ln()) / (x1.ln() - x0.ln());
+            (y0.ln() + t * (y1.ln() - y0.ln())).exp()
+        })
+    })
+}
+
+/// MuJoCo's time step and wall time at error `level`, interpolated between its runs.
+fn peer_at_error(peer: &[MotionRun], level: f64) -> (Option<f64>, Option<f64>) {
+    let mut by_error: Vec<&MotionRun> = peer.iter().filter(|r| r.error_m > 0.0 && r.error_m.is_finite()).collect();
+    by_error.sort_by(|a, b| a.error_m.total_cmp(&b.error_m));
+    let dt = log_log_at(&by_error.iter().map(|r| (r.error_m, r.dt_s)).collect::<Vec<_>>(), level);
+    let wall = log_log_at(&by_error.iter().map(|r| (r.error_m, r.wall_s)).collect::<Vec<_>>(), level);
+    (dt, wall)
+}
+
+/// The case list for the peer: each case's MJCF (undamped) and its node sites.
+fn peer_case(case: &Case, dir: &Path) -> Result<serde_json::Value, BenchError> {
+    let s = &case.start;
+    let o = MjcfOptions {
+        model_name: s.name.clone(),
+        timestep_s: EQUAL_ERROR_DT_S,
+        body_damping_per_s: 0.0,
+        actuators: ActuatorMode::Mocap,
+        joint_kp: 0.0,
+        commands: case.commands.clone(),
+        cable_damping_n_s_per_m: 0.0,
+    };
+    let path = dir.join(format!("motion-{}-{}.xml", case.family, case.size));
+    crate::bench::write_whole(&path, &to_mjcf(s, &o).xml)?;
+    Ok(serde_json::json!({
+        "family": case.family, "size": case.size, "mjcf": path.display().to_string(),
+        "nodes": s.nodes.iter().map(|n| n.name.clone()).collect::<Vec<_>>(),
+    }))
+}
+
+/// The peer's runs of one case and its reference positions.
+fn peer_runs(p: &serde_json::Value) -> Result<(Vec<Vec3>, Vec<(f64, u64, f64, Vec<Vec3>)>), BenchError> {
+    let bad = || BenchError::Peer("the peer's motion case lacks 'reference' or 'runs'".into());
+    let points = |v: &serde_json::Value| -> Option<Vec<Vec3>> {
+        v.as_array()?.iter().map(|p| serde_json::from_value::<Vec3>(p.clone()).ok()).collect()
+    };
+    let reference = points(p.get("reference").ok_or_else(bad)?).ok_or_else(bad)?;
+    let runs = p.get("runs").and_then(|r| r.as_array()).ok_or_else(bad)?;
+    let runs = runs
+        .iter()
+        .map(|r| {
+            let num = |k: &str| r.get(k).and_then(|x| x.as_f64());
+            Some((num("dt_s")?, r.get("steps")?.as_u64()?, num("wall_s")?, points(r.get("positions")?)?))
+        })
+        .collect::<Option<Vec<_>>>()
+        .ok_or_else(bad)?;
+    Ok((reference, runs))
+}
+
+fn run(dt_s: f64, steps: u64, wall_s: f64, error_m: f64) -> MotionRun {
+    MotionRun { dt_s, steps, wall_s, steps_per_s: steps as f64 / wall_s, error_m }
+}
+
+/// Every case of `families` (free-body ones) up to `max_struts`: the testbed's runs, then the
+/// peer's with its reference, compared.
+pub fn compare(
+    families: &[&'static str],
+    max_struts: usize,
+    command: &[String],
+    dir: &Path,
+) -> Result<Vec<MotionCase>, BenchError> {
+    std::fs::create_dir_all(dir).map_err(write_error(dir))?;
+    let (mut ours, mut listed) = (Vec::new(), Vec::new());
+    for family in families.iter().filter(|f| FAMILIES.contains(f)) {
+        for case in cases(family, max_struts)? {
+            eprintln!("{} {}: testbed motion ...", case.family, case.size);
+            let runs = DT_S.iter().map(|&dt| testbed_run(&case, dt)).collect::<Result<Vec<_>, _>>()?;
+            listed.push(peer_case(&case, dir)?);
+            ours.push((case, runs));
+        }
+    }
+    let file = dir.join("motion_cases.json");
+    let list = serde_json::json!({
+        "motion": { "duration_s": DURATION_S, "dts": DT_S, "reference_dt_s": REFERENCE_DT_S },
+        "cases": listed,
+    });
+    crate::bench::write_whole(&file, &serde_json::to_string_pretty(&list).expect("case list serialises"))?;
+    eprintln!("{} cases: peer motion ...", listed.len());
+    let v = crate::bench::run_peer(command, &file, &[])?;
+    let theirs = v.get("cases").and_then(|c| c.as_array()).filter(|c| c.len() == ours.len());
+    let theirs =
+        theirs.ok_or_else(|| BenchError::Peer(format!("the peer did not return {} motion cases", ours.len())))?;
+    ours.into_iter().zip(theirs).map(|((case, runs), p)| compare_case(&case, runs, p)).collect()
+}
+
+/// One case's comparison against the peer's reference.
+fn compare_case(
+    case: &Case,
+    runs: Vec<(Vec<Vec3>, u64, f64)>,
+    p: &serde_json::Value,
+) -> Result<MotionCase, BenchError> {
+    let (reference, peer) = peer_runs(p)?;
+    let testbed: Vec<MotionRun> = DT_S
+        .iter()
+        .zip(runs)
+        .map(|(&dt, (pos, steps, wall))| run(dt, steps, wall, largest_distance(&pos, &reference)))
+        .collect();
+    let peer: Vec<MotionRun> = peer
+        .into_iter()
+        .map(|(dt, steps, wall, pos)| run(dt, steps, wall, largest_distance(&pos, &reference)))
+        .collect();
+    let ours = testbed.iter().find(|r| r.dt_s == EQUAL_ERROR_DT_S).expect("EQUAL_ERROR_DT_S is one of DT_S");
+    let (dt, wall) = peer_at_error(&peer, ours.error_m);
+    Ok(MotionCase {
+        family: case.family,
+        size: case.size,
+        struts: case.start.struts.len(),
+        equal_error_m: ours.error_m,
+        peer_dt_at_equal_error_s: dt,
+        peer_wall_at_equal_error_s: wall,
+        ratio_at_equal_error: wall.map(|w| w / ours.wall_s),
+        testbed,
+        peer,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Log-log interpolation of y = x^2 between (1, 1) and (4, 16) gives 4 at 2 within 1e-12,
+    /// and nothing outside [1, 4].
+    #[test]
+    fn log_log_interpolation_is_exact_for_a_power_law() {
+        let pts = [(1.0, 1.0), (4.0, 16.0)];
+        assert!((log_log_at(&pts, 2.0).unwrap() - 4.0).abs() <= 1e-12);
+        assert!(log_log_at(&pts, 0.5).is_none() && log_log_at(&pts, 5.0).is_none());
+    }
+
+    /// MuJoCo's wall time at an error between two of its runs is read off the line between
+    /// them: errors 1e-3 and 1e-4 at 1 and 10 ms of wall give 10^-2.5 s at 10^-3.5 m.
+    #[test]
+    fn the_peer_wall_at_a_level_between_its_runs_is_interpolated() {
+        let peer = [run(2e-3, 250, 1e-3, 1e-3), run(2e-4, 2500, 1e-2, 1e-4)];
+        let (dt, wall) = peer_at_error(&peer, 10f64.powf(-3.5));
+        assert!((wall.unwrap() - 10f64.powf(-2.5)).abs() <= 1e-15);
+        assert!((dt.unwrap() - 2e-3 * 10f64.powf(-0.5)).abs() <= 1e-15);
+    }
+}
