@@ -217,7 +217,7 @@ pub fn scale_motion(cases: &[crate::bench::scale::motion::MotionCase]) -> String
         "{:<12} {:>5} {:>10} {:>12} {:>12} {:>9}",
         "family", "size", "error", "mj dt s", "mj wall s", "rate x"
     );
-    let opt = |x: Option<f64>, prec: usize| x.map_or("outside".to_string(), |v| format!("{v:.prec$e}"));
+    let opt = |x: Option<f64>| x.map_or("outside".to_string(), |v| format!("{v:.2e}"));
     for c in cases {
         let _ = writeln!(
             t,
@@ -225,8 +225,8 @@ pub fn scale_motion(cases: &[crate::bench::scale::motion::MotionCase]) -> String
             c.family,
             c.size,
             c.equal_error_m,
-            opt(c.peer_dt_at_equal_error_s, 2),
-            opt(c.peer_wall_at_equal_error_s, 2),
+            opt(c.peer_dt_at_equal_error_s),
+            opt(c.peer_wall_at_equal_error_s),
             c.ratio_at_equal_error.map_or("-".to_string(), |r| format!("{r:.2}"))
         );
     }
