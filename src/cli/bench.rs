@@ -26,10 +26,19 @@ pub fn bench(command: Command) -> Result<Outcome, CliError> {
     let given_peer = peer.as_deref().filter(|p| *p != DEFAULT_PEER);
     if scale {
         let caps = scale::Caps { max_wall_s: max_case_wall_s, ..scale::DEFAULT_CAPS };
-        let families = selected_families(&families)?;
+        let named = families;
+        let families = selected_families(&named)?;
         if motion {
             if peer.is_none() {
                 return Err(bad_input("--motion needs --peer: its reference is MuJoCo's RK4"));
+            }
+            if let Some(f) =
+                families.iter().find(|f| !scale::motion::FAMILIES.contains(f)).filter(|_| !named.is_empty())
+            {
+                return Err(bad_input(format!(
+                    "--motion covers the free-body families ({}); '{f}' has constraints MuJoCo holds softly, another model",
+                    scale::motion::FAMILIES.join(", ")
+                )));
             }
             let command = bench::peer_command(given_peer, bench::SCALE_PEER_SCRIPT);
             return scale_motion(json, max_struts, &families, &command);

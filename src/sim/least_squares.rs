@@ -205,7 +205,8 @@ const REFINED_FRACTION: f64 = 1e-15;
 
 /// A sparse `a` ready to give minimum-norm least-squares solutions of `a x = b` at full rank:
 /// the band Cholesky factor of its normal matrix (a a^T when `a` has fewer rows than columns,
-/// x = a^T y; a^T a otherwise), each solve followed by [`REFINEMENT_ROUNDS`] of refinement.
+/// x = a^T y; a^T a otherwise), each solve followed by at most [`REFINEMENT_ROUNDS`] of
+/// refinement (fewer once the residual is round-off, [`REFINED_FRACTION`]).
 pub(crate) struct SparseLeastSquares {
     a: SparseRows,
     /// a^T when `a` is tall (its normal matrix a^T a is the Gram matrix of a^T).

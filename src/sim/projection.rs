@@ -486,6 +486,7 @@ impl Simulation {
         let (pp, pc) = (pose(joint.parent), pose(joint.child));
         let a = vec3(s.nodes[joint.anchor].position);
         let gap = pc.transform_point(a) - pp.transform_point(a);
+        let before = out.len();
         match joint.kind {
             JointKind::PlanarPin { axis } => {
                 let n = (pp.rotation * vec3(axis)).normalize();
@@ -514,6 +515,7 @@ impl Simulation {
             }
             _ => out.extend([gap.x, gap.y, gap.z]),
         }
+        debug_assert_eq!(out.len() - before, self.joint_row_count(j), "joint_row_count matches joint_rows");
     }
 
     /// The constraint rows of a projected group: each joint's ([`Self::joint_rows`]), then the
@@ -682,14 +684,20 @@ impl Simulation {
             sim.group_rows(g, taut, &mut out);
             out
         };
-        // Where the last Jacobian was formed: the poses a kept one is judged by.
-        let formed_at = std::cell::RefCell::new(kept.as_ref().filter(|k| k.taut == taut).map(|k| k.poses.clone()));
+        let (start, start_poses) = match kept.take().filter(|k| k.taut == taut) {
+            Some(k) => (Some(k.jacobian), Some(k.poses)),
+            None => (None, None),
+        };
+        // Where the last sparse Jacobian was formed: the poses a kept one is judged by.
+        let formed_at = std::cell::RefCell::new(start_poses);
         let jacobian = |sim: &mut Simulation, g0: &[f64]| {
-            *formed_at.borrow_mut() = Some(sim.group_poses(g));
-            coords.jacobian(sim, g, taut, g0.len())
+            let j = coords.jacobian(sim, g, taut, g0.len());
+            if matches!(j, Jacobian::Sparse(_)) {
+                *formed_at.borrow_mut() = Some(sim.group_poses(g));
+            }
+            j
         };
         let displace = |sim: &mut Simulation, dq: &[f64]| coords.displace(sim, g, dq);
-        let start = kept.take().filter(|k| k.taut == taut).map(|k| k.jacobian);
         let (jac, formed, left) = close_rows(self, &rows, &jacobian, &displace, start, tolerance_fraction);
         let u = coords.velocities(self, g);
         let moving = u.iter().any(|&x| x != 0.0);

@@ -240,7 +240,8 @@ fn bench_scale_cli_selects_families_and_sizes() {
     assert!(cases.iter().all(|c| kib(c, "peak_rss_kib") >= kib(c, "rss_before_kib")), "{out}");
 }
 
-/// Physical motion beside MuJoCo (`bench --scale --motion --peer`): the 3- and 4-strut prisms
+/// Physical motion beside MuJoCo (`bench --scale --motion --peer`; without `--peer`, or with a
+/// family that has constraints, it is bad input): the 3- and 4-strut prisms
 /// move undamped for 0.5 s; against MuJoCo's RK4 at 5e-5 s both sides' errors halve with the
 /// time step (first order: each ratio within 1.8-2.2, measured 1.99-2.03), the testbed's
 /// within 5 % of MuJoCo's at every step (both are semi-implicit Euler on the same equations
@@ -251,6 +252,9 @@ fn motion_beside_mujoco_converges_at_first_order_on_both_sides() {
     let (code, _, err) = common::tensegrity(&["bench", "--scale", "--motion", "--family", "prism"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("--motion needs --peer"), "{err}");
+    let (code, _, err) = common::tensegrity(&["bench", "--scale", "--motion", "--peer", "--family", "furet"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--motion covers the free-body families"), "{err}");
     let Some(py) = python_with_mujoco() else {
         eprintln!("skipped the MuJoCo side: no Python with `import mujoco` (set TENSEGRITY_PYTHON)");
         return;

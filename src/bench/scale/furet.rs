@@ -27,9 +27,9 @@ pub const START_OFFSET_RAD: f64 = 0.05;
 /// Time step [s] (the furet2018 scenarios') and PGS iterations (the default; the furet2018
 /// scenarios take 64). The projection closes every joint of the chain after each step, so the
 /// iterations only set how far rapier's step opens them first: measured on 10 X cut into plain
-/// bodies, 64 iterations opened them by 9.1e-4 m and 8 by 7.8e-3 m (rows scaled to metres), at the same 11
-/// steps and errors, and 8 settled in 0.7 of the time. The rest of the settings are the
-/// defaults.
+/// bodies, 64 iterations opened them by 9.1e-4 m and 8 by 7.8e-3 m (rows scaled to metres), at
+/// the same 11 steps and errors, and 8 settled in 0.7 of the time. The rest of the settings are
+/// the defaults.
 const DT_S: f64 = 0.005;
 const PGS_ITERATIONS: usize = 8;
 

@@ -213,18 +213,24 @@ pub fn settle(s: &Structure, settings: &SimSettings, commands: &[f64], caps: &Ca
 /// single timing varied by 10x within a run.
 pub const MIN_CASE_WALL_S: f64 = 0.2;
 
+/// The median wall time of a run that took `first` [s] and of its repeats by `again`, run
+/// until the runs add up to [`MIN_CASE_WALL_S`].
+pub(super) fn median_wall(first: f64, mut again: impl FnMut() -> Result<f64, BenchError>) -> Result<f64, BenchError> {
+    let mut walls = vec![first];
+    while walls.iter().sum::<f64>() < MIN_CASE_WALL_S {
+        walls.push(again()?);
+    }
+    walls.sort_by(f64::total_cmp);
+    Ok(walls[walls.len() / 2])
+}
+
 /// Settles `case` and measures it (the memory of the first settle).
 pub fn run_case(case: &Case, caps: &Caps) -> Result<ScaleCase, BenchError> {
     reset_memory();
     let rss_before_kib = proc_status_kib("VmRSS:");
     let mut out = settle(&case.start, &case.settings, &case.commands, caps)?;
     let peak_rss_kib = proc_status_kib("VmHWM:");
-    let mut walls = vec![out.wall_s];
-    while walls.iter().sum::<f64>() < MIN_CASE_WALL_S {
-        walls.push(settle(&case.start, &case.settings, &case.commands, caps)?.wall_s);
-    }
-    walls.sort_by(f64::total_cmp);
-    out.wall_s = walls[walls.len() / 2];
+    out.wall_s = median_wall(out.wall_s, || Ok(settle(&case.start, &case.settings, &case.commands, caps)?.wall_s))?;
     let settled_nodes: Vec<Vec3> = case.target.iter().map(|(i, _)| out.sim.node_position(*i)).collect();
     let target: Vec<Vec3> = case.target.iter().map(|(_, p)| *p).collect();
     let error = case.measure.error(&settled_nodes, &target);

@@ -18,7 +18,6 @@
 
 use super::{cases, Case};
 use crate::bench::{write_error, BenchError};
-use crate::export::mjcf::{to_mjcf, ActuatorMode, MjcfOptions};
 use crate::settings::SimSettings;
 use crate::sim::Simulation;
 use crate::structure::Vec3;
@@ -72,12 +71,8 @@ pub struct MotionCase {
 /// the median wall time.
 fn testbed_run(case: &Case, dt: f64) -> Result<(Vec<Vec3>, u64, f64), BenchError> {
     let (positions, steps, first) = testbed_run_once(case, dt)?;
-    let mut walls = vec![first];
-    while walls.iter().sum::<f64>() < super::MIN_CASE_WALL_S {
-        walls.push(testbed_run_once(case, dt)?.2);
-    }
-    walls.sort_by(f64::total_cmp);
-    Ok((positions, steps, walls[walls.len() / 2]))
+    let wall = super::median_wall(first, || Ok(testbed_run_once(case, dt)?.2))?;
+    Ok((positions, steps, wall))
 }
 
 /// One run of `case` at `dt`: the node positions at the end, steps and wall time of the steps.
@@ -131,17 +126,8 @@ fn peer_at_error(peer: &[MotionRun], level: f64) -> (Option<f64>, Option<f64>) {
 /// The case list for the peer: each case's MJCF (undamped) and its node sites.
 fn peer_case(case: &Case, dir: &Path) -> Result<serde_json::Value, BenchError> {
     let s = &case.start;
-    let o = MjcfOptions {
-        model_name: s.name.clone(),
-        timestep_s: EQUAL_ERROR_DT_S,
-        body_damping_per_s: 0.0,
-        actuators: ActuatorMode::Mocap,
-        joint_kp: 0.0,
-        commands: case.commands.clone(),
-        cable_damping_n_s_per_m: 0.0,
-    };
     let path = dir.join(format!("motion-{}-{}.xml", case.family, case.size));
-    crate::bench::write_whole(&path, &to_mjcf(s, &o).xml)?;
+    super::peer::write_mjcf(case, EQUAL_ERROR_DT_S, 0.0, &path)?;
     Ok(serde_json::json!({
         "family": case.family, "size": case.size, "mjcf": path.display().to_string(),
         "nodes": s.nodes.iter().map(|n| n.name.clone()).collect::<Vec<_>>(),

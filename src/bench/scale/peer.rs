@@ -94,18 +94,8 @@ fn mocap_turns(case: &Case) -> Vec<MocapTurn> {
 /// The case for the peer, its MJCF written to `dir`.
 fn peer_case(case: &Case, caps: &Caps, dir: &Path) -> Result<PeerCase, BenchError> {
     let s = &case.start;
-    let o = MjcfOptions {
-        model_name: s.name.clone(),
-        timestep_s: case.settings.dt_s,
-        body_damping_per_s: case.settings.body_damping_per_s,
-        actuators: ActuatorMode::Mocap,
-        joint_kp: 0.0,
-        commands: case.commands.clone(),
-        cable_damping_n_s_per_m: 0.0,
-    };
-    let m = to_mjcf(s, &o);
     let path = dir.join(format!("{}-{}.xml", case.family, case.size));
-    crate::bench::write_whole(&path, &m.xml)?;
+    let warnings = write_mjcf(case, case.settings.dt_s, case.settings.body_damping_per_s, &path)?;
     let c = criteria(s, case.settings.dt_s, caps);
     Ok(PeerCase {
         family: case.family,
@@ -120,8 +110,30 @@ fn peer_case(case: &Case, caps: &Caps, dir: &Path) -> Result<PeerCase, BenchErro
         target: case.target.iter().map(|(_, p)| *p).collect(),
         measure: case.measure,
         mocap: mocap_turns(case),
-        warnings: m.warnings,
+        warnings,
     })
+}
+
+/// Writes `case`'s start to `path` as MJCF at this time step and body damping [1/s], its
+/// actuators as mocap bodies; returns what the export could not express.
+pub(super) fn write_mjcf(
+    case: &Case,
+    timestep_s: f64,
+    body_damping_per_s: f64,
+    path: &Path,
+) -> Result<Vec<String>, BenchError> {
+    let o = MjcfOptions {
+        model_name: case.start.name.clone(),
+        timestep_s,
+        body_damping_per_s,
+        actuators: ActuatorMode::Mocap,
+        joint_kp: 0.0,
+        commands: case.commands.clone(),
+        cable_damping_n_s_per_m: 0.0,
+    };
+    let m = to_mjcf(&case.start, &o);
+    crate::bench::write_whole(path, &m.xml)?;
+    Ok(m.warnings)
 }
 
 /// One case of both sides: the testbed's `t`, the peer's JSON `p` for the case `pc` it got.
