@@ -300,9 +300,10 @@ fn plan_tree(s: &Structure, roped: &[bool], actuated: &[bool]) -> Result<Vec<boo
 /// assembles and factorizes a dense mass matrix over every link (its cost grows as the cube of
 /// the links); the plain bodies' step and the sparse projection grow linearly. Measured on
 /// furet2018's X chains (three links an X; BENCHMARKS.md, "X chains at scale"), a settle with
-/// the multibody against cut: 5 X 1.06 against 1.43 ms, 7 X 1.92 against 2.08, 8 X 2.48 against
-/// 2.42, 10 X 3.93 against 3.18, 15 X 9.37 against 5.36.
-pub(super) const LOOPED_MULTIBODY_MAX_LINKS: usize = 24;
+/// the multibody against cut, once a rigid cut chain goes back to its closed configuration at
+/// rest without solves (`projection.rs`): 2 X 0.29 against 1.48 ms (its 36 coordinates take the
+/// dense projection), 3 X 0.44 against 0.37, 4 X 0.67 against 0.51.
+pub(super) const LOOPED_MULTIBODY_MAX_LINKS: usize = 8;
 
 /// Turns every link of a multibody (the links hung from one fixed body) into an impulse joint
 /// when a planar pin closes a loop inside it and it has more than

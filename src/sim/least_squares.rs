@@ -51,7 +51,11 @@ impl SparseRows {
     /// The matrix of `nrows` x `ncols` with these (row, column, value) entries; entries at the
     /// same place add up.
     pub(crate) fn new(nrows: usize, ncols: usize, entries: &[(usize, usize, f64)]) -> Self {
-        let mut rows = vec![Vec::new(); nrows];
+        let mut counts = vec![0_usize; nrows];
+        for &(r, _, _) in entries {
+            counts[r] += 1;
+        }
+        let mut rows: Vec<Vec<(usize, f64)>> = counts.into_iter().map(Vec::with_capacity).collect();
         for &(r, c, x) in entries {
             rows[r].push((c, x));
         }
@@ -124,7 +128,11 @@ impl BandCholesky {
     /// positive definite (a redundant row of M, unshifted).
     fn of_gram(m: &SparseRows, shift: f64) -> Option<Self> {
         let n = m.nrows();
-        let mut by_column: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m.ncols];
+        let mut counts = vec![0_usize; m.ncols];
+        for &(c, _) in m.rows.iter().flatten() {
+            counts[c] += 1;
+        }
+        let mut by_column: Vec<Vec<(usize, f64)>> = counts.into_iter().map(Vec::with_capacity).collect();
         for (r, row) in m.rows.iter().enumerate() {
             for &(c, v) in row {
                 by_column[c].push((r, v));
