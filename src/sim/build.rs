@@ -303,7 +303,7 @@ fn plan_tree(s: &Structure, roped: &[bool], actuated: &[bool]) -> Result<Vec<boo
 /// the multibody against cut, once a rigid cut chain goes back to its closed configuration at
 /// rest without solves (`projection.rs`): 2 X 0.29 against 1.48 ms (its 36 coordinates take the
 /// dense projection), 3 X 0.44 against 0.37, 4 X 0.67 against 0.51.
-pub(super) const LOOPED_MULTIBODY_MAX_LINKS: usize = 8;
+pub const LOOPED_MULTIBODY_MAX_LINKS: usize = 8;
 
 /// Turns every link of a multibody (the links hung from one fixed body) into an impulse joint
 /// when a planar pin closes a loop inside it and it has more than

@@ -26,6 +26,8 @@ mod projection;
 mod relaxation;
 mod restart;
 
+pub use build::LOOPED_MULTIBODY_MAX_LINKS;
+
 use crate::structure::{ActuatorTarget, BodyKind, Structure};
 use rapier3d_f64::prelude::*;
 
