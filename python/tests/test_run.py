@@ -67,12 +67,13 @@ def test_bad_input_is_a_located_exception():
 
 
 def test_ctrl_c_stops_a_run():
-    """SIGINT to a Python running a long motion (100 s simulated) stops it with KeyboardInterrupt."""
+    """SIGINT to a Python running a long motion (1000 s simulated, about 5 s of wall time; at 100 s
+    the run could end before the signal 0.5 s in) stops it with KeyboardInterrupt."""
     import signal
     import sys
     import time
 
-    text = BAR.read_text().replace("duration_s = 4.0", "duration_s = 100.0")
+    text = BAR.read_text().replace("duration_s = 4.0", "duration_s = 1000.0")
     script = (
         "import sys, tensegrity_testbed as tt\n"
         "print('started', flush=True)\n"
