@@ -68,14 +68,17 @@ def test_bad_input_is_a_located_exception():
 
 def test_ctrl_c_stops_a_run():
     """SIGINT to a Python running a long motion (1000 s simulated, about 5 s of wall time; at 100 s
-    the run could end before the signal 0.5 s in) stops it with KeyboardInterrupt."""
+    the run could end before the signal 0.5 s in) stops it with KeyboardInterrupt. The child
+    takes Python's own SIGINT handler: started from a shell's background job it inherits SIGINT
+    ignored, and Python then installs none."""
     import signal
     import sys
     import time
 
     text = BAR.read_text().replace("duration_s = 4.0", "duration_s = 1000.0")
     script = (
-        "import sys, tensegrity_testbed as tt\n"
+        "import signal, sys, tensegrity_testbed as tt\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         "print('started', flush=True)\n"
         "try:\n"
         f"    tt.run({text!r}, name='long.toml')\n"
