@@ -12,7 +12,10 @@
 //! Groups of plain bodies with many coordinates (a long chain of X modules cut into plain
 //! bodies, `build::LOOPED_MULTIBODY_MAX_LINKS`) take a sparse Jacobian, assembled member by
 //! member, and a band Cholesky of J J^T kept across the iterations (`least_squares.rs`): the
-//! cost of a step grows with the members, not with their cube.
+//! cost of a step grows with the members, not with their cube. Such a group that is rigid (its
+//! Jacobian at full column rank, as an X chain at its commands) goes back to where it was last
+//! closed, with no velocity and no solve, while nothing has opened a row there
+//! ([`Jacobian::rigid`]).
 
 use super::Simulation;
 use crate::structure::JointKind;
