@@ -528,12 +528,16 @@ impl Simulation {
     /// Sets every free body's linear and angular velocity to zero (multibody links as well:
     /// their generalized velocities are the caller's).
     fn zero_body_velocities(&mut self) {
-        for (b, &h) in self.model.handles.iter().enumerate() {
-            if self.is_free(b) {
-                let rb = &mut self.bodies[h];
-                rb.set_linvel(Vector::ZERO, true);
-                rb.set_angvel(Vector::ZERO, true);
-            }
+        let free: Vec<usize> = (0..self.model.handles.len()).filter(|&b| self.is_free(b)).collect();
+        self.stop_bodies(&free);
+    }
+
+    /// Sets the linear and angular velocity of each of `bodies` (structure indices) to zero.
+    fn stop_bodies(&mut self, bodies: &[usize]) {
+        for &b in bodies {
+            let rb = &mut self.bodies[self.model.handles[b]];
+            rb.set_linvel(Vector::ZERO, true);
+            rb.set_angvel(Vector::ZERO, true);
         }
     }
 

@@ -125,7 +125,6 @@ fn close_rows(
     start: Option<Jacobian>,
     tolerance_fraction: f64,
 ) -> (Option<Jacobian>, bool, f64) {
-    let largest = |g: &[f64]| g.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     let tol = tolerance_fraction * sim.model.length_scale_m;
     let mut jac: Option<Jacobian> = start;
     let mut formed = false;
@@ -135,7 +134,7 @@ fn close_rows(
         if g0.is_empty() {
             break;
         }
-        let gap = largest(&g0);
+        let gap = largest_abs(&g0);
         // A sparse group takes one step more once within the tolerance: along a chain of a
         // hundred links the gaps left at the tolerance move its far end by 5e-12 m from step to
         // step, ten times the settle's speed threshold; one step more leaves round-off.
@@ -168,8 +167,13 @@ fn close_rows(
         let Some(dq) = (if polished { j.solve(&b) } else { j.step(&b) }) else { break };
         displace(sim, dq.as_slice());
     }
-    let left = largest(&rows(sim));
+    let left = largest_abs(&rows(sim));
     (jac, formed, left)
+}
+
+/// The largest magnitude among `rows` (0 for none).
+fn largest_abs(rows: &[f64]) -> f64 {
+    rows.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
 }
 
 /// A body's first-order motion per unit of one coordinate: velocity `v` of the point `at`
@@ -683,7 +687,7 @@ impl Simulation {
         kept: &mut Option<KeptJacobian>,
         tolerance_fraction: f64,
     ) -> f64 {
-        if let Some(left) = self.back_to_rigid_rest(g, taut, kept.as_ref(), tolerance_fraction) {
+        if let Some(left) = self.back_to_rigid_rest(g, taut, kept.as_ref()) {
             return left;
         }
         let coords = GroupCoordinates::of(self, g);
@@ -733,7 +737,7 @@ impl Simulation {
             // were just held at their length: a cable goes slack when rapier's rope stops
             // pulling, and is then no longer taut here). A rigid group keeps none: J^+ J = I.
             if moving && jac.rigid() {
-                self.stop_group(g);
+                self.stop_bodies(&g.bodies);
             } else if moving {
                 if let Some(du) = jac.solve(&jac.mul(&u)) {
                     coords.remove_velocities(self, g, &du);
@@ -753,15 +757,9 @@ impl Simulation {
     /// structure's size from where it was last closed to round-off goes back there when every
     /// row is still closed there (no command moved it since): the configuration is isolated,
     /// so it is where Gauss-Newton from the stepped poses converges, without its solves; and
-    /// it keeps no velocity. Returns the largest row left, or None (nothing changed) when the
-    /// projection must run.
-    fn back_to_rigid_rest(
-        &mut self,
-        g: &ProjectedGroup,
-        taut: &[usize],
-        kept: Option<&KeptJacobian>,
-        tolerance_fraction: f64,
-    ) -> Option<f64> {
+    /// it keeps no velocity. Closed there means to round-off, whatever the caller's tolerance.
+    /// Returns the largest row left, or None (nothing changed) when the projection must run.
+    fn back_to_rigid_rest(&mut self, g: &ProjectedGroup, taut: &[usize], kept: Option<&KeptJacobian>) -> Option<f64> {
         let rest = kept.filter(|k| k.taut == taut)?.rest.as_ref()?;
         if !self.poses_within(g, rest, RIGID_REST_FRACTION) {
             return None;
@@ -770,27 +768,18 @@ impl Simulation {
         self.set_group_poses(g, rest);
         let mut rows = Vec::new();
         self.group_rows(g, taut, &mut rows);
-        let left = rows.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-        if left > tolerance_fraction.min(GAP_TOLERANCE_FRACTION) * self.model.length_scale_m {
+        let left = largest_abs(&rows);
+        if left > GAP_TOLERANCE_FRACTION * self.model.length_scale_m {
             self.set_group_poses(g, &stepped);
             return None;
         }
-        self.stop_group(g);
+        self.stop_bodies(&g.bodies);
         Some(left)
     }
 
     fn set_group_poses(&mut self, g: &ProjectedGroup, poses: &[Pose]) {
         for (&b, p) in g.bodies.iter().zip(poses) {
             self.bodies[self.model.handles[b]].set_position(*p, true);
-        }
-    }
-
-    /// Zero velocity for the group's plain bodies.
-    fn stop_group(&mut self, g: &ProjectedGroup) {
-        for &b in &g.bodies {
-            let rb = &mut self.bodies[self.model.handles[b]];
-            rb.set_linvel(Vector::ZERO, true);
-            rb.set_angvel(Vector::ZERO, true);
         }
     }
 
