@@ -16,6 +16,7 @@
 //!   (implicit, and zero at rest, so it does not move the equilibrium).
 
 mod build;
+mod continuation;
 mod damping;
 mod drive;
 mod forces;
@@ -559,6 +560,12 @@ impl Simulation {
             largest = locks.iter().fold(largest, |m, (_, from, to)| m.max((to - from).abs()));
         }
         let increments = ((largest / MAX_CLOSED_LOOP_INCREMENT).ceil() as usize).max(1);
+        // Joints locked off the tree alone, in groups of plain bodies: at once where the
+        // projection's convergence allows (`continuation.rs`).
+        let at_once = increments > 1 && moves.is_empty() && self.projected_groups_are_plain();
+        if at_once && locks_projected && self.jump_locked_commands_at_once(&locks) {
+            return;
+        }
         // The multibodies moved. Forward kinematics settles each one's root (and so its
         // degree-of-freedom indices, read below) before the first move.
         let mut multibodies: Vec<MultibodyIndex> = Vec::new();
@@ -610,7 +617,8 @@ impl Simulation {
             if locks_projected {
                 // The increments before the last only keep the loops on their branch.
                 let last = i == increments;
-                self.project_groups_to(if last { projection::GAP_TOLERANCE_FRACTION } else { INCREMENT_GAP_FRACTION });
+                let tolerance = if last { projection::GAP_TOLERANCE_FRACTION } else { INCREMENT_GAP_FRACTION };
+                self.project_groups_to(tolerance, f64::INFINITY);
             }
         }
     }

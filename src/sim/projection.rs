@@ -115,8 +115,8 @@ impl Jacobian {
 /// current state (rows x ndof); `displace` moves every coordinate by a step; `start`, a sparse
 /// Jacobian kept from an earlier call, is tried first (the chord test replaces it when it
 /// contracts too little). Iterates until every row is within `tolerance_fraction` of the
-/// structure's size (at most [`MAX_ITERATIONS`]); returns the last Jacobian, whether this call
-/// formed it, and the largest row left.
+/// structure's size (at most [`MAX_ITERATIONS`]), or gives up when the first step shrinks the
+/// largest row by less than `max_first_contraction`.
 fn close_rows(
     sim: &mut Simulation,
     rows: &dyn Fn(&Simulation) -> Vec<f64>,
@@ -124,17 +124,25 @@ fn close_rows(
     displace: &dyn Fn(&mut Simulation, &[f64]),
     start: Option<Jacobian>,
     tolerance_fraction: f64,
-) -> (Option<Jacobian>, bool, f64) {
+    max_first_contraction: f64,
+) -> Closing {
     let tol = tolerance_fraction * sim.model.length_scale_m;
     let mut jac: Option<Jacobian> = start;
     let mut formed = false;
     let (mut previous, mut polished) = (f64::INFINITY, false);
-    for _ in 0..MAX_ITERATIONS {
+    let mut first_contraction = 0.0;
+    for k in 0..MAX_ITERATIONS {
         let g0 = rows(sim);
         if g0.is_empty() {
             break;
         }
         let gap = largest_abs(&g0);
+        if k == 1 {
+            first_contraction = gap / previous;
+            if first_contraction > max_first_contraction {
+                break;
+            }
+        }
         // A sparse group takes one step more once within the tolerance: along a chain of a
         // hundred links the gaps left at the tolerance move its far end by 5e-12 m from step to
         // step, ten times the settle's speed threshold; one step more leaves round-off.
@@ -168,7 +176,35 @@ fn close_rows(
         displace(sim, dq.as_slice());
     }
     let left = largest_abs(&rows(sim));
-    (jac, formed, left)
+    Closing { jacobian: jac, formed, left, first_contraction }
+}
+
+/// What [`close_rows`] leaves: the last Jacobian, whether that call formed it, the largest row
+/// left [m], and the first contraction: the largest row after the first Gauss-Newton step over
+/// the largest before it (0 when no step was taken). A small first contraction says the start
+/// was well inside the iteration's region of convergence (see `continuation.rs`).
+struct Closing {
+    jacobian: Option<Jacobian>,
+    formed: bool,
+    left: f64,
+    first_contraction: f64,
+}
+
+/// What a projection leaves: the largest row [m] and the largest first contraction over the
+/// groups ([`Closing`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Projected {
+    pub left: f64,
+    pub first_contraction: f64,
+}
+
+impl Projected {
+    fn max(self, other: Projected) -> Projected {
+        Projected {
+            left: self.left.max(other.left),
+            first_contraction: self.first_contraction.max(other.first_contraction),
+        }
+    }
 }
 
 /// The largest magnitude among `rows` (0 for none).
@@ -255,7 +291,7 @@ impl Simulation {
             // The loops of one multibody: a group of its free coordinates alone.
             let joints = closures.iter().filter(|c| c.multibody == mb_index).map(|c| c.joint).collect();
             let g = ProjectedGroup { bodies: Vec::new(), multibodies: vec![mb_index], joints, cables: Vec::new() };
-            largest = largest.max(self.project_group(&g, &[], &mut None, GAP_TOLERANCE_FRACTION));
+            largest = largest.max(self.project_group(&g, &[], &mut None, GAP_TOLERANCE_FRACTION, f64::INFINITY).left);
         }
         self.model.internal_closures = closures;
         largest
@@ -658,18 +694,20 @@ impl Simulation {
     /// Closes every projected group's joints and taut cables to round-off and projects the
     /// velocities of its bodies and multibodies. Returns the largest row left [m].
     pub(super) fn project_groups(&mut self) -> f64 {
-        self.project_groups_to(GAP_TOLERANCE_FRACTION)
+        self.project_groups_to(GAP_TOLERANCE_FRACTION, f64::INFINITY).left
     }
 
-    /// [`Self::project_groups`] to rows within `tolerance_fraction` of the structure's size.
-    pub(super) fn project_groups_to(&mut self, tolerance_fraction: f64) -> f64 {
+    /// [`Self::project_groups`] to rows within `tolerance_fraction` of the structure's size;
+    /// a group gives up once its first Gauss-Newton step shrinks its largest row by less than
+    /// `max_first_contraction` ([`close_rows`]).
+    pub(super) fn project_groups_to(&mut self, tolerance_fraction: f64, max_first_contraction: f64) -> Projected {
         let groups = std::mem::take(&mut self.model.projected_groups);
         let mut kept = std::mem::take(&mut self.kept_jacobians);
         kept.resize_with(groups.len(), || None);
-        let mut largest = 0.0_f64;
+        let mut largest = Projected::default();
         for (g, kept) in groups.iter().zip(kept.iter_mut()) {
             let Some(taut) = self.projected_taut_cables(g) else { continue };
-            largest = largest.max(self.project_group(g, &taut, kept, tolerance_fraction));
+            largest = largest.max(self.project_group(g, &taut, kept, tolerance_fraction, max_first_contraction));
         }
         self.model.projected_groups = groups;
         self.kept_jacobians = kept;
@@ -678,17 +716,17 @@ impl Simulation {
 
     /// Closes the group's joints and its `taut` cables to round-off (Gauss-Newton in its
     /// coordinates, the Jacobian from the bodies' twists) and removes the velocities that would
-    /// open them. A sparse Jacobian is `kept` for the next call ([`KeptJacobian`]). Returns the
-    /// largest row left [m].
+    /// open them. A sparse Jacobian is `kept` for the next call ([`KeptJacobian`]).
     fn project_group(
         &mut self,
         g: &ProjectedGroup,
         taut: &[usize],
         kept: &mut Option<KeptJacobian>,
         tolerance_fraction: f64,
-    ) -> f64 {
+        max_first_contraction: f64,
+    ) -> Projected {
         if let Some(left) = self.back_to_rigid_rest(g, taut, kept.as_ref()) {
-            return left;
+            return Projected { left, first_contraction: 0.0 };
         }
         let coords = GroupCoordinates::of(self, g);
         // The body Jacobians at the current coordinates (the Jacobian below reads them).
@@ -716,7 +754,8 @@ impl Simulation {
             j
         };
         let displace = |sim: &mut Simulation, dq: &[f64]| coords.displace(sim, g, dq);
-        let (jac, formed, left) = close_rows(self, &rows, &jacobian, &displace, start, tolerance_fraction);
+        let Closing { jacobian: jac, formed, left, first_contraction } =
+            close_rows(self, &rows, &jacobian, &displace, start, tolerance_fraction, max_first_contraction);
         let u = coords.velocities(self, g);
         let moving = u.iter().any(|&x| x != 0.0);
         // A Jacobian kept from an earlier call serves the velocities only where the bodies are
@@ -750,7 +789,7 @@ impl Simulation {
                 *kept = Some(KeptJacobian { jacobian: jac, poses, taut: taut.to_vec(), rest });
             }
         }
-        left
+        Projected { left, first_contraction }
     }
 
     /// A rigid group that rapier's step moved by less than [`RIGID_REST_FRACTION`] of the
@@ -775,6 +814,33 @@ impl Simulation {
         }
         self.stop_bodies(&g.bodies);
         Some(left)
+    }
+
+    /// Whether every projected group is of plain bodies alone (no multibody coordinates).
+    pub(super) fn projected_groups_are_plain(&self) -> bool {
+        self.model.projected_groups.iter().all(|g| g.multibodies.is_empty())
+    }
+
+    /// The pose and velocities of every plain body of the projected groups.
+    pub(super) fn projected_states(&self) -> Vec<(usize, Pose, Vector, Vector)> {
+        let bodies = self.model.projected_groups.iter().flat_map(|g| g.bodies.iter().copied());
+        bodies
+            .map(|b| {
+                let rb = &self.bodies[self.model.handles[b]];
+                (b, *rb.position(), rb.linvel(), rb.angvel())
+            })
+            .collect()
+    }
+
+    /// Puts the bodies back as [`Self::projected_states`] read them. A Jacobian kept since is
+    /// kept: formed where they started (or earlier), it is judged by where it was formed.
+    pub(super) fn restore_projected_states(&mut self, states: Vec<(usize, Pose, Vector, Vector)>) {
+        for (b, pose, v, w) in states {
+            let rb = &mut self.bodies[self.model.handles[b]];
+            rb.set_position(pose, true);
+            rb.set_linvel(v, true);
+            rb.set_angvel(w, true);
+        }
     }
 
     fn set_group_poses(&mut self, g: &ProjectedGroup, poses: &[Pose]) {
