@@ -20,6 +20,7 @@ mod continuation;
 mod damping;
 mod drive;
 mod forces;
+mod group_tree;
 mod joint_modes;
 pub(crate) mod least_squares;
 pub mod modes;

@@ -290,7 +290,7 @@ impl Simulation {
             }
             // The loops of one multibody: a group of its free coordinates alone.
             let joints = closures.iter().filter(|c| c.multibody == mb_index).map(|c| c.joint).collect();
-            let g = ProjectedGroup { bodies: Vec::new(), multibodies: vec![mb_index], joints, cables: Vec::new() };
+            let g = ProjectedGroup { multibodies: vec![mb_index], joints, ..Default::default() };
             largest = largest.max(self.project_group(&g, &[], &mut None, GAP_TOLERANCE_FRACTION, f64::INFINITY).left);
         }
         self.model.internal_closures = closures;
@@ -322,6 +322,8 @@ pub(super) struct ProjectedGroup {
     joints: Vec<usize>,
     /// Inextensible cables with a rope joint.
     cables: Vec<usize>,
+    /// A sparse group's spanning tree, along which its Gauss-Newton steps move it.
+    tree: Option<super::group_tree::GroupTree>,
 }
 
 /// A cable within this fraction of the structure's size of its length counts as taut.
@@ -438,6 +440,7 @@ impl Simulation {
             .map(|(_, mut g, _)| {
                 if g.multibodies.is_empty() && 6 * g.bodies.len() >= SPARSE_MIN_COORDINATES {
                     self.order_joints_by_band(&mut g);
+                    g.tree = Some(super::group_tree::GroupTree::of(self, &g.bodies, &g.joints));
                 }
                 g
             })
@@ -684,10 +687,7 @@ impl Simulation {
         let com = self.world_com(b);
         let h = self.model.handles[b];
         let pose = *self.bodies[h].position();
-        let moved = Pose::from_translation(com + t)
-            * Pose::from_rotation(Rotation::from_scaled_axis(r))
-            * Pose::from_translation(-com)
-            * pose;
+        let moved = super::group_tree::turn_about(com, t, r) * pose;
         self.bodies[h].set_position(moved, true);
     }
 
@@ -933,9 +933,13 @@ impl GroupCoordinates {
 
     /// Moves every coordinate by `dq`.
     fn displace(&self, sim: &mut Simulation, g: &ProjectedGroup, dq: &[f64]) {
-        for (i, &b) in g.bodies.iter().enumerate() {
-            let q = &dq[6 * i..6 * i + 6];
-            sim.nudge(b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / self.scale);
+        if let Some(tree) = &g.tree {
+            tree.displace(sim, &g.bodies, &dq[..self.n_plain], self.scale);
+        } else {
+            for (i, &b) in g.bodies.iter().enumerate() {
+                let q = &dq[6 * i..6 * i + 6];
+                sim.nudge(b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / self.scale);
+            }
         }
         let mut k = self.n_plain;
         for (m, dofs) in &self.multibodies {
