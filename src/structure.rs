@@ -634,13 +634,16 @@ mod tests {
     }
 }
 
-/// Largest distance between two nodes of the structure [m] (at least 1e-3 m).
+/// Largest distance between two nodes of the structure [m] (at least 1e-3 m). Each pair is
+/// measured once and the squares are compared: the square root is monotonic and correctly
+/// rounded, so the root of the largest square is the largest of the roots, to the bit.
 pub fn structure_size(s: &Structure) -> f64 {
-    let mut l: f64 = 1e-3;
-    for a in &s.nodes {
-        for b in &s.nodes {
-            l = l.max(distance(a.position, b.position));
+    let mut largest_squared: f64 = 0.0;
+    for (i, a) in s.nodes.iter().enumerate() {
+        for b in &s.nodes[i + 1..] {
+            let d = [a.position[0] - b.position[0], a.position[1] - b.position[1], a.position[2] - b.position[2]];
+            largest_squared = largest_squared.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         }
     }
-    l
+    largest_squared.sqrt().max(1e-3)
 }
