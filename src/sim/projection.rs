@@ -228,6 +228,66 @@ impl Twist {
     }
 }
 
+/// A joint's geometry at the current poses ([`Simulation::joint_frame`]): its rows' rates
+/// are linear in its two bodies' twists, with these as coefficients. The sparse Jacobian forms
+/// it once per joint for its twelve unit twists.
+struct JointFrame {
+    parent: usize,
+    child: usize,
+    /// The anchor as carried by each body [m].
+    anchor_on_parent: Vector,
+    anchor_on_child: Vector,
+    axes: JointAxes,
+    /// The structure's size, which scales angular rows to lengths [m].
+    scale: f64,
+}
+
+/// The axes a joint's angular rows (or, for a planar pin, its in-plane rows) are taken along.
+enum JointAxes {
+    /// The in-plane pair of the plane's normal (parent's frame).
+    PlanarPin { pair: [Vector; 2] },
+    /// The axis as carried by the parent and by the child, the pair across the parent's, and
+    /// whether the angle about it is locked (an actuated joint off the tree).
+    Revolute { ap: Vector, ac: Vector, pair: [Vector; 2], locked: bool },
+    /// The first axis as carried by the parent, the second by the child.
+    Universal { a1: Vector, a2: Vector },
+    /// A point joint: the anchor gap alone.
+    Point,
+}
+
+impl JointFrame {
+    /// The rates of the joint's rows for the bodies' twists (`None`: the body stays). Exact to
+    /// first order at a closed joint; the terms that multiply a gap are dropped.
+    fn row_rates(&self, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
+        let point_rate = |b: usize, p: Vector| twist(b).map_or(Vector::ZERO, |t| t.of_point(p));
+        let spin = |b: usize| twist(b).map_or(Vector::ZERO, |t| t.w);
+        let gap_rate = point_rate(self.child, self.anchor_on_child) - point_rate(self.parent, self.anchor_on_parent);
+        let (wp, wc) = (spin(self.parent), spin(self.child));
+        let scale = self.scale;
+        match &self.axes {
+            JointAxes::PlanarPin { pair } => {
+                for t in pair {
+                    out.push(gap_rate.dot(*t));
+                }
+            }
+            JointAxes::Revolute { ap, ac, pair, locked } => {
+                out.extend([gap_rate.x, gap_rate.y, gap_rate.z]);
+                for t in pair {
+                    out.push((wc.cross(*ac).dot(*t) + ac.dot(wp.cross(*t))) * scale);
+                }
+                if *locked {
+                    out.push((wc - wp).dot(*ap) * scale);
+                }
+            }
+            JointAxes::Universal { a1, a2 } => {
+                out.extend([gap_rate.x, gap_rate.y, gap_rate.z]);
+                out.push((wp.cross(*a1).dot(*a2) + a1.dot(wc.cross(*a2))) * scale);
+            }
+            JointAxes::Point => out.extend([gap_rate.x, gap_rate.y, gap_rate.z]),
+        }
+    }
+}
+
 /// A loop-closing joint inside one multibody: the rows of its gap that the projection zeroes.
 #[derive(Clone, Debug)]
 pub(super) struct InternalClosure {
@@ -622,41 +682,41 @@ impl Simulation {
             out.extend(std::iter::repeat_n(0.0, self.joint_row_count(j)));
             return;
         }
-        let scale = self.model.length_scale_m;
+        self.joint_frame(j).row_rates(twist, out);
+    }
+
+    /// Joint `j`'s geometry at the current poses, which its rows' rates are linear in.
+    fn joint_frame(&self, j: usize) -> JointFrame {
+        let s = &self.model.structure;
         let pose = |b: usize| *self.bodies[self.model.handles[b]].position();
         let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
-        let point_rate = |b: usize, p: Vector| twist(b).map_or(Vector::ZERO, |t| t.of_point(p));
-        let spin = |b: usize| twist(b).map_or(Vector::ZERO, |t| t.w);
         let joint = &s.joints[j];
         let (pp, pc) = (pose(joint.parent), pose(joint.child));
         let a = vec3(s.nodes[joint.anchor].position);
-        let gap_rate = point_rate(joint.child, pc.transform_point(a)) - point_rate(joint.parent, pp.transform_point(a));
-        let (wp, wc) = (spin(joint.parent), spin(joint.child));
-        match joint.kind {
+        let axes = match joint.kind {
             JointKind::PlanarPin { axis } => {
                 let n = (pp.rotation * vec3(axis)).normalize();
-                for t in super::forces::orthogonal_pair(n) {
-                    out.push(gap_rate.dot(t));
-                }
+                JointAxes::PlanarPin { pair: super::forces::orthogonal_pair(n) }
             }
             JointKind::Revolute { axis } => {
-                out.extend([gap_rate.x, gap_rate.y, gap_rate.z]);
                 let ap = (pp.rotation * vec3(axis)).normalize();
                 let ac = (pc.rotation * vec3(axis)).normalize();
-                for t in super::forces::orthogonal_pair(ap) {
-                    out.push((wc.cross(ac).dot(t) + ac.dot(wp.cross(t))) * scale);
-                }
-                if self.locked_angle(j).is_some() {
-                    out.push((wc - wp).dot(ap) * scale);
-                }
+                let pair = super::forces::orthogonal_pair(ap);
+                JointAxes::Revolute { ap, ac, pair, locked: self.locked_angle(j).is_some() }
             }
-            JointKind::Universal { axis1, axis2 } => {
-                out.extend([gap_rate.x, gap_rate.y, gap_rate.z]);
-                let a1 = pp.rotation * vec3(axis1).normalize();
-                let a2 = pc.rotation * vec3(axis2).normalize();
-                out.push((wp.cross(a1).dot(a2) + a1.dot(wc.cross(a2))) * scale);
-            }
-            _ => out.extend([gap_rate.x, gap_rate.y, gap_rate.z]),
+            JointKind::Universal { axis1, axis2 } => JointAxes::Universal {
+                a1: pp.rotation * vec3(axis1).normalize(),
+                a2: pc.rotation * vec3(axis2).normalize(),
+            },
+            _ => JointAxes::Point,
+        };
+        JointFrame {
+            parent: joint.parent,
+            child: joint.child,
+            anchor_on_parent: pp.transform_point(a),
+            anchor_on_child: pc.transform_point(a),
+            axes,
+            scale: self.model.length_scale_m,
         }
     }
 
@@ -1022,7 +1082,8 @@ impl GroupCoordinates {
             position[b] = Some(i);
         }
         // Each member's rows for a twist of one body: a joint's or a cable's.
-        let joints = g.joints.iter().map(|&j| (Member::Joint(j), [s.joints[j].parent, s.joints[j].child]));
+        let joints =
+            g.joints.iter().map(|&j| (Member::Joint(sim.joint_frame(j)), [s.joints[j].parent, s.joints[j].child]));
         let cables =
             taut.iter().map(|&c| (Member::Cable(c), [s.nodes[s.cables[c].a].body, s.nodes[s.cables[c].b].body]));
         // At most two bodies' six twists per row.
@@ -1081,18 +1142,18 @@ impl GroupCoordinates {
     }
 }
 
-/// A member whose rows a projected group closes: a joint or a taut cable.
-#[derive(Clone, Copy, Debug)]
+/// A member whose rows a projected group closes: a joint (its geometry at the current poses)
+/// or a taut cable.
 enum Member {
-    Joint(usize),
+    Joint(JointFrame),
     Cable(usize),
 }
 
 impl Member {
-    fn row_rates(self, sim: &Simulation, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
+    fn row_rates(&self, sim: &Simulation, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
         match self {
-            Member::Joint(j) => sim.joint_row_rates(j, twist, out),
-            Member::Cable(c) => sim.cable_row_rate(c, twist, out),
+            Member::Joint(frame) => frame.row_rates(twist, out),
+            Member::Cable(c) => sim.cable_row_rate(*c, twist, out),
         }
     }
 }
