@@ -434,8 +434,8 @@ struct ClosureComponent {
     member: ClosureMember,
     force: Vector,
     moment: Vector,
-    /// The bodies it loads and their wrenches (force, moment about the world origin).
-    loads: Vec<(usize, Wrench)>,
+    /// The two bodies it loads and their wrenches (force, moment about the world origin).
+    loads: [(usize, Wrench); 2],
 }
 
 /// One free coordinate's generalized force: a force [N] or a torque [N m].
@@ -569,7 +569,7 @@ impl Simulation {
             let (pa, pb) = (v(self.node_position(cable.a)), v(self.node_position(cable.b)));
             let d = (pb - pa).normalize();
             let (ba, bb) = (s.nodes[cable.a].body, s.nodes[cable.b].body);
-            let w = vec![(ba, (d, pa.cross(d))), (bb, (-d, -pb.cross(d)))];
+            let w = [(ba, (d, pa.cross(d))), (bb, (-d, -pb.cross(d)))];
             out.push(ClosureComponent { member: ClosureMember::Cable(c), force: d, moment: Vector::ZERO, loads: w });
         }
         out
@@ -614,7 +614,7 @@ impl Simulation {
                 }
             };
             for f in forces {
-                let w = vec![(joint.child, (f, anchor.cross(f))), (joint.parent, (-f, -anchor.cross(f)))];
+                let w = [(joint.child, (f, anchor.cross(f))), (joint.parent, (-f, -anchor.cross(f)))];
                 out.push(ClosureComponent {
                     member: ClosureMember::Joint(j),
                     force: f,
@@ -623,7 +623,7 @@ impl Simulation {
                 });
             }
             for m in moments {
-                let w = vec![(joint.child, (Vector::ZERO, m)), (joint.parent, (Vector::ZERO, -m))];
+                let w = [(joint.child, (Vector::ZERO, m)), (joint.parent, (Vector::ZERO, -m))];
                 out.push(ClosureComponent {
                     member: ClosureMember::Joint(j),
                     force: Vector::ZERO,
