@@ -129,6 +129,9 @@ pub struct Simulation {
     locked_coordinates: Vec<f64>,
     /// Each projected group's Jacobian kept from its last projection (`projection.rs`).
     kept_jacobians: Vec<Option<projection::KeptJacobian>>,
+    /// Counts the changes of what the projection's rows depend on besides the bodies' poses:
+    /// a locked coordinate, a cable's length, a fixed body's place.
+    constraint_inputs: u64,
 }
 
 impl Simulation {
@@ -292,6 +295,7 @@ impl Simulation {
         for (i, a) in self.model.structure.actuators.iter().enumerate() {
             if let ActuatorTarget::CableLength(c) = a.target {
                 self.cable_lengths[c] = self.commands[i];
+                self.constraint_inputs += 1;
                 if let Some(h) = self.model.cable_ropes[c] {
                     if let Some(j) = self.impulse_joints.get_mut(h, true) {
                         j.data.set_limits(JointAxis::LinX, [0.0, self.commands[i]]);
@@ -316,6 +320,7 @@ impl Simulation {
         for (b, offset) in offsets.into_iter().enumerate() {
             if let Some(o) = offset {
                 self.bodies[self.model.handles[b]].set_position(Pose::from_translation(o), true);
+                self.constraint_inputs += 1;
             }
         }
     }
@@ -658,6 +663,7 @@ impl Simulation {
         if let Some(joint) = self.impulse_joints.get_mut(h, true) {
             joint.data = build::locked_joint(&self.model.structure, &self.model.structure.joints[j], q);
             self.locked_coordinates[j] = q;
+            self.constraint_inputs += 1;
         }
     }
 

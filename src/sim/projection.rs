@@ -845,7 +845,11 @@ impl Simulation {
             if let (Jacobian::Sparse(_), Some(poses)) = (&jac, formed_at.take()) {
                 let closed_to_round_off = tolerance_fraction <= GAP_TOLERANCE_FRACTION
                     && left <= GAP_TOLERANCE_FRACTION * self.model.length_scale_m;
-                let rest = (jac.rigid() && closed_to_round_off).then(|| self.group_poses(g));
+                let rest = (jac.rigid() && closed_to_round_off).then(|| RigidRest {
+                    poses: self.group_poses(g),
+                    left,
+                    generation: self.constraint_inputs,
+                });
                 *kept = Some(KeptJacobian { jacobian: jac, poses, taut: taut.to_vec(), rest });
             }
         }
@@ -856,15 +860,22 @@ impl Simulation {
     /// structure's size from where it was last closed to round-off goes back there when every
     /// row is still closed there (no command moved it since): the configuration is isolated,
     /// so it is where Gauss-Newton from the stepped poses converges, without its solves; and
-    /// it keeps no velocity. Closed there means to round-off, whatever the caller's tolerance.
-    /// Returns the largest row left, or None (nothing changed) when the projection must run.
+    /// it keeps no velocity. Closed there means to round-off, whatever the caller's tolerance;
+    /// the rows are evaluated again only when their other inputs have changed since
+    /// ([`RigidRest`]). Returns the largest row left, or None (nothing changed) when the
+    /// projection must run.
     fn back_to_rigid_rest(&mut self, g: &ProjectedGroup, taut: &[usize], kept: Option<&KeptJacobian>) -> Option<f64> {
         let rest = kept.filter(|k| k.taut == taut)?.rest.as_ref()?;
-        if !self.poses_within(g, rest, RIGID_REST_FRACTION) {
+        if !self.poses_within(g, &rest.poses, RIGID_REST_FRACTION) {
             return None;
         }
+        if rest.generation == self.constraint_inputs {
+            self.set_group_poses(g, &rest.poses);
+            self.stop_bodies(&g.bodies);
+            return Some(rest.left);
+        }
         let stepped = self.group_poses(g);
-        self.set_group_poses(g, rest);
+        self.set_group_poses(g, &rest.poses);
         let mut rows = Vec::new();
         self.group_rows(g, taut, &mut rows);
         let left = largest_abs(&rows);
@@ -937,7 +948,17 @@ pub(super) struct KeptJacobian {
     /// The taut cables whose rows it has.
     taut: Vec<usize>,
     /// A rigid group's poses where it was last closed to round-off ([`Jacobian::rigid`]).
-    rest: Option<Vec<Pose>>,
+    rest: Option<RigidRest>,
+}
+
+/// Where a rigid group was last closed to round-off: its plain bodies' poses, the largest row
+/// left there [m], and the generation of the rows' other inputs then (`constraint_inputs` in
+/// `mod.rs`: locked coordinates, cable lengths, fixed bodies' places). While that generation
+/// holds, the rows at these poses are what they were: a function of the poses and those inputs.
+struct RigidRest {
+    poses: Vec<Pose>,
+    left: f64,
+    generation: u64,
 }
 
 /// A rigid group goes back to where it was last closed only from within this fraction of the
