@@ -45,32 +45,29 @@ impl GroupTree {
         let holds_a_point = |j: usize| {
             matches!(s.joints[j].kind, JointKind::Spherical | JointKind::Revolute { .. } | JointKind::Universal { .. })
         };
-        let edges: Vec<(usize, Option<usize>, Option<usize>)> = joints
-            .iter()
-            .filter(|&&j| holds_a_point(j))
-            .map(|&j| (j, position[s.joints[j].parent], position[s.joints[j].child]))
-            .collect();
-        let mut reached = vec![false; bodies.len()];
+        // Each group body's point-holding joints to other group bodies, with the other body.
+        let mut joints_of: Vec<Vec<(usize, usize)>> = vec![Vec::new(); bodies.len()];
         let mut links: Vec<Link> = Vec::new();
-        // Roots: bodies joined to a fixed one (the other end of the joint is not in the group).
-        for &(joint, p, c) in &edges {
-            if let (Some(b), None) | (None, Some(b)) = (p, c) {
-                if !reached[b] {
-                    reached[b] = true;
-                    links.push(Link { body: b, parent: None, joint });
+        let mut reached = vec![false; bodies.len()];
+        for &j in joints.iter().filter(|&&j| holds_a_point(j)) {
+            match (position[s.joints[j].parent], position[s.joints[j].child]) {
+                (Some(a), Some(b)) => {
+                    joints_of[a].push((j, b));
+                    joints_of[b].push((j, a));
                 }
+                // Roots: bodies joined to a fixed one (the other end is not in the group).
+                (Some(b), None) | (None, Some(b)) if !reached[b] => {
+                    reached[b] = true;
+                    links.push(Link { body: b, parent: None, joint: j });
+                }
+                _ => {}
             }
         }
         let mut next = 0;
         while next < links.len() {
             let from = links[next].body;
             next += 1;
-            for &(joint, p, c) in &edges {
-                let other = match (p, c) {
-                    (Some(a), Some(b)) if a == from => b,
-                    (Some(a), Some(b)) if b == from => a,
-                    _ => continue,
-                };
+            for &(joint, other) in &joints_of[from] {
                 if !reached[other] {
                     reached[other] = true;
                     links.push(Link { body: other, parent: Some(from), joint });

@@ -568,8 +568,8 @@ impl Simulation {
         let increments = ((largest / MAX_CLOSED_LOOP_INCREMENT).ceil() as usize).max(1);
         // Joints locked off the tree alone, in groups of plain bodies: at once where the
         // projection's convergence allows (`continuation.rs`).
-        let at_once = increments > 1 && moves.is_empty() && self.projected_groups_are_plain();
-        if at_once && locks_projected && self.jump_locked_commands_at_once(&locks) {
+        let at_once = locks_projected && increments > 1 && moves.is_empty() && self.projected_groups_are_plain();
+        if at_once && self.jump_locked_commands_at_once(&locks) {
             return;
         }
         // The multibodies moved. Forward kinematics settles each one's root (and so its

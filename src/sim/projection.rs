@@ -869,18 +869,21 @@ impl Simulation {
         if !self.poses_within(g, &rest.poses, RIGID_REST_FRACTION) {
             return None;
         }
-        if rest.generation == self.constraint_inputs {
-            self.set_group_poses(g, &rest.poses);
-            self.stop_bodies(&g.bodies);
-            return Some(rest.left);
-        }
-        let stepped = self.group_poses(g);
+        // The rows there are known while their other inputs are unchanged.
+        let known = rest.generation == self.constraint_inputs;
+        let stepped = (!known).then(|| self.group_poses(g));
         self.set_group_poses(g, &rest.poses);
-        let mut rows = Vec::new();
-        self.group_rows(g, taut, &mut rows);
-        let left = largest_abs(&rows);
+        let left = if known {
+            rest.left
+        } else {
+            let mut rows = Vec::new();
+            self.group_rows(g, taut, &mut rows);
+            largest_abs(&rows)
+        };
         if left > GAP_TOLERANCE_FRACTION * self.model.length_scale_m {
-            self.set_group_poses(g, &stepped);
+            if let Some(stepped) = stepped {
+                self.set_group_poses(g, &stepped);
+            }
             return None;
         }
         self.stop_bodies(&g.bodies);
