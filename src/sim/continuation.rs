@@ -38,7 +38,7 @@ impl Simulation {
         for &(j, _, command) in locks {
             self.lock_joint_at(j, command);
         }
-        let p = self.project_groups_to(GAP_TOLERANCE_FRACTION, MAX_FIRST_CONTRACTION);
+        let p = self.project_groups_with(GAP_TOLERANCE_FRACTION, MAX_FIRST_CONTRACTION, true);
         let closed = p.left <= GAP_TOLERANCE_FRACTION * self.model.length_scale_m;
         if closed && p.first_contraction <= MAX_FIRST_CONTRACTION {
             return true;

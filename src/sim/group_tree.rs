@@ -21,10 +21,10 @@ use rapier3d_f64::prelude::*;
 /// One body of the tree: its index in the group's bodies, its tree parent's (None: a fixed
 /// body) and the joint between them.
 #[derive(Clone, Copy, Debug)]
-struct Link {
-    body: usize,
-    parent: Option<usize>,
-    joint: usize,
+pub(super) struct Link {
+    pub body: usize,
+    pub parent: Option<usize>,
+    pub joint: usize,
 }
 
 /// The spanning tree of a group's plain bodies, parents before children.
@@ -34,6 +34,11 @@ pub(super) struct GroupTree {
 }
 
 impl GroupTree {
+    /// The links, parents before children.
+    pub(super) fn links(&self) -> &[Link] {
+        &self.links
+    }
+
     /// The breadth-first tree over `joints` (structure indices) of the plain `bodies`
     /// (structure indices), from the bodies joined to fixed ones.
     pub(super) fn of(sim: &Simulation, bodies: &[usize], joints: &[usize]) -> GroupTree {

@@ -21,6 +21,7 @@ mod damping;
 mod drive;
 mod forces;
 mod group_tree;
+mod joint_coordinates;
 mod joint_modes;
 pub(crate) mod least_squares;
 pub mod modes;
@@ -129,6 +130,8 @@ pub struct Simulation {
     locked_coordinates: Vec<f64>,
     /// Each projected group's Jacobian kept from its last projection (`projection.rs`).
     kept_jacobians: Vec<Option<projection::KeptJacobian>>,
+    /// Each projected group's rigid rest, where it was last closed (`projection.rs`).
+    rigid_rests: Vec<Option<projection::RigidRest>>,
     /// Counts the changes of what the projection's rows depend on besides the bodies' poses:
     /// a locked coordinate, a cable's length, a fixed body's place.
     constraint_inputs: u64,

@@ -49,7 +49,7 @@ fn min_norm_solve(a: &nalgebra::DMatrix<f64>, b: &nalgebra::DVector<f64>) -> Opt
 
 /// A group's closure Jacobian (rows x coordinates): dense for small groups and groups with
 /// multibodies, sparse for large groups of plain bodies ([`SPARSE_MIN_COORDINATES`]).
-enum Jacobian {
+pub(super) enum Jacobian {
     Dense(nalgebra::DMatrix<f64>),
     /// With its factorization, which the Gauss-Newton step and the velocity projection share.
     Sparse(Box<super::least_squares::SparseLeastSquares>),
@@ -77,7 +77,7 @@ impl Jacobian {
 
     /// A sparse Jacobian factorized; one with redundant rows becomes dense (whose solve drops
     /// them).
-    fn sparse(j: super::least_squares::SparseRows) -> Self {
+    pub(super) fn sparse(j: super::least_squares::SparseRows) -> Self {
         match super::least_squares::SparseLeastSquares::new(j) {
             Ok(f) => Jacobian::Sparse(Box::new(f)),
             Err(j) => Jacobian::Dense(j.to_dense()),
@@ -105,7 +105,7 @@ impl Jacobian {
     /// many rows as coordinates means full column rank: no motion keeps every row closed, the
     /// closed configurations are isolated points, and the only velocity left by the projection
     /// is zero.
-    fn rigid(&self) -> bool {
+    pub(super) fn rigid(&self) -> bool {
         matches!(self, Jacobian::Sparse(j) if j.matrix().nrows() >= j.matrix().ncols)
     }
 }
@@ -117,7 +117,7 @@ impl Jacobian {
 /// contracts too little). Iterates until every row is within `tolerance_fraction` of the
 /// structure's size (at most [`MAX_ITERATIONS`]), or gives up when the first step shrinks the
 /// largest row by less than `max_first_contraction`.
-fn close_rows(
+pub(super) fn close_rows(
     sim: &mut Simulation,
     rows: &dyn Fn(&Simulation) -> Vec<f64>,
     jacobian: &dyn Fn(&mut Simulation, &[f64]) -> Jacobian,
@@ -183,11 +183,11 @@ fn close_rows(
 /// left [m], and the first contraction: the largest row after the first Gauss-Newton step over
 /// the largest before it (0 when no step was taken). A small first contraction says the start
 /// was well inside the iteration's region of convergence (see `continuation.rs`).
-struct Closing {
-    jacobian: Option<Jacobian>,
-    formed: bool,
-    left: f64,
-    first_contraction: f64,
+pub(super) struct Closing {
+    pub jacobian: Option<Jacobian>,
+    pub formed: bool,
+    pub left: f64,
+    pub first_contraction: f64,
 }
 
 /// What a projection leaves: the largest row [m] and the largest first contraction over the
@@ -208,17 +208,17 @@ impl Projected {
 }
 
 /// The largest magnitude among `rows` (0 for none).
-fn largest_abs(rows: &[f64]) -> f64 {
+pub(super) fn largest_abs(rows: &[f64]) -> f64 {
     rows.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
 }
 
 /// A body's first-order motion per unit of one coordinate: velocity `v` of the point `at`
 /// and angular velocity `w`.
 #[derive(Clone, Copy, Debug)]
-struct Twist {
-    v: Vector,
-    w: Vector,
-    at: Vector,
+pub(super) struct Twist {
+    pub v: Vector,
+    pub w: Vector,
+    pub at: Vector,
 }
 
 impl Twist {
@@ -231,7 +231,7 @@ impl Twist {
 /// A joint's geometry at the current poses ([`Simulation::joint_frame`]): its rows' rates
 /// are linear in its two bodies' twists, with these as coefficients. The sparse Jacobian forms
 /// it once per joint for its twelve unit twists.
-struct JointFrame {
+pub(super) struct JointFrame {
     parent: usize,
     child: usize,
     /// The anchor as carried by each body [m].
@@ -243,7 +243,7 @@ struct JointFrame {
 }
 
 /// The axes a joint's angular rows (or, for a planar pin, its in-plane rows) are taken along.
-enum JointAxes {
+pub(super) enum JointAxes {
     /// The in-plane pair of the plane's normal (parent's frame).
     PlanarPin { pair: [Vector; 2] },
     /// The axis as carried by the parent and by the child, the pair across the parent's, and
@@ -351,7 +351,8 @@ impl Simulation {
             // The loops of one multibody: a group of its free coordinates alone.
             let joints = closures.iter().filter(|c| c.multibody == mb_index).map(|c| c.joint).collect();
             let g = ProjectedGroup { multibodies: vec![mb_index], joints, ..Default::default() };
-            largest = largest.max(self.project_group(&g, &[], &mut None, GAP_TOLERANCE_FRACTION, f64::INFINITY).left);
+            let p = self.project_group(&g, &[], &mut None, &mut None, GAP_TOLERANCE_FRACTION, f64::INFINITY);
+            largest = largest.max(p.left);
         }
         self.model.internal_closures = closures;
         largest
@@ -375,15 +376,15 @@ impl Simulation {
 #[derive(Clone, Debug, Default)]
 pub(super) struct ProjectedGroup {
     /// Structure body indices of the group's free plain bodies.
-    bodies: Vec<usize>,
+    pub bodies: Vec<usize>,
     /// Multibodies whose links the group's joints or cables touch.
-    multibodies: Vec<MultibodyIndex>,
+    pub multibodies: Vec<MultibodyIndex>,
     /// Impulse joints (structure indices) between the group's bodies or to fixed bodies.
-    joints: Vec<usize>,
+    pub joints: Vec<usize>,
     /// Inextensible cables with a rope joint.
     cables: Vec<usize>,
     /// A sparse group's spanning tree, along which its Gauss-Newton steps move it.
-    tree: Option<super::group_tree::GroupTree>,
+    pub tree: Option<super::group_tree::GroupTree>,
 }
 
 /// A cable within this fraction of the structure's size of its length counts as taut.
@@ -591,7 +592,7 @@ impl Simulation {
     /// The constraint rows of one joint: its anchor gap (for a planar pin only the two
     /// components across its axis) and its angular rows. Lengths in m; angular rows
     /// (dimensionless) times the structure's size, so that every row is a length.
-    fn joint_rows(&self, j: usize, out: &mut Vec<f64>) {
+    pub(super) fn joint_rows(&self, j: usize, out: &mut Vec<f64>) {
         let s = &self.model.structure;
         let scale = self.model.length_scale_m;
         let pose = |b: usize| *self.bodies[self.model.handles[b]].position();
@@ -634,7 +635,7 @@ impl Simulation {
 
     /// The constraint rows of a projected group: each joint's ([`Self::joint_rows`]), then the
     /// stretch of each cable in `taut` [m].
-    fn group_rows(&self, g: &ProjectedGroup, taut: &[usize], out: &mut Vec<f64>) {
+    pub(super) fn group_rows(&self, g: &ProjectedGroup, taut: &[usize], out: &mut Vec<f64>) {
         let s = &self.model.structure;
         for &j in &g.joints {
             self.joint_rows(j, out);
@@ -665,7 +666,7 @@ impl Simulation {
     }
 
     /// The number of [`Self::joint_rows`] of joint `j`.
-    fn joint_row_count(&self, j: usize) -> usize {
+    pub(super) fn joint_row_count(&self, j: usize) -> usize {
         match self.model.structure.joints[j].kind {
             JointKind::PlanarPin { .. } => 2,
             JointKind::Revolute { .. } => 5 + usize::from(self.locked_angle(j).is_some()),
@@ -686,7 +687,7 @@ impl Simulation {
     }
 
     /// Joint `j`'s geometry at the current poses, which its rows' rates are linear in.
-    fn joint_frame(&self, j: usize) -> JointFrame {
+    pub(super) fn joint_frame(&self, j: usize) -> JointFrame {
         let s = &self.model.structure;
         let pose = |b: usize| *self.bodies[self.model.handles[b]].position();
         let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
@@ -735,7 +736,7 @@ impl Simulation {
 
     /// The commanded angle of an actuated revolute joint off the tree, locked there
     /// (`build::locked_joint`, relative to the drawn pose) [rad]; None for any other joint.
-    fn locked_angle(&self, j: usize) -> Option<f64> {
+    pub(super) fn locked_angle(&self, j: usize) -> Option<f64> {
         let revolute = matches!(self.model.structure.joints[j].kind, JointKind::Revolute { .. });
         (self.model.actuated[j] && revolute && self.model.joint_impulse[j].is_some())
             .then(|| self.locked_coordinates[j])
@@ -761,33 +762,58 @@ impl Simulation {
     /// a group gives up once its first Gauss-Newton step shrinks its largest row by less than
     /// `max_first_contraction` ([`close_rows`]).
     pub(super) fn project_groups_to(&mut self, tolerance_fraction: f64, max_first_contraction: f64) -> Projected {
+        self.project_groups_with(tolerance_fraction, max_first_contraction, false)
+    }
+
+    /// [`Self::project_groups_to`]; with `in_joint_coordinates`, a group that can be closed in
+    /// its tree's joint coordinates is (`joint_coordinates.rs`).
+    pub(super) fn project_groups_with(
+        &mut self,
+        tolerance_fraction: f64,
+        max_first_contraction: f64,
+        in_joint_coordinates: bool,
+    ) -> Projected {
         let groups = std::mem::take(&mut self.model.projected_groups);
         let mut kept = std::mem::take(&mut self.kept_jacobians);
+        let mut rests = std::mem::take(&mut self.rigid_rests);
         kept.resize_with(groups.len(), || None);
+        rests.resize_with(groups.len(), || None);
         let mut largest = Projected::default();
-        for (g, kept) in groups.iter().zip(kept.iter_mut()) {
+        for ((g, kept), rest) in groups.iter().zip(kept.iter_mut()).zip(rests.iter_mut()) {
             let Some(taut) = self.projected_taut_cables(g) else { continue };
-            largest = largest.max(self.project_group(g, &taut, kept, tolerance_fraction, max_first_contraction));
+            let joint_closed = if in_joint_coordinates {
+                self.close_in_joint_coordinates(g, &taut, kept, rest, max_first_contraction)
+            } else {
+                None
+            };
+            let p = match joint_closed {
+                Some(p) => p,
+                None => self.project_group(g, &taut, kept, rest, tolerance_fraction, max_first_contraction),
+            };
+            largest = largest.max(p);
         }
         self.model.projected_groups = groups;
         self.kept_jacobians = kept;
+        self.rigid_rests = rests;
         largest
     }
 
     /// Closes the group's joints and its `taut` cables to round-off (Gauss-Newton in its
     /// coordinates, the Jacobian from the bodies' twists) and removes the velocities that would
     /// open them. A sparse Jacobian is `kept` for the next call ([`KeptJacobian`]).
-    fn project_group(
+    pub(super) fn project_group(
         &mut self,
         g: &ProjectedGroup,
         taut: &[usize],
         kept: &mut Option<KeptJacobian>,
+        rest: &mut Option<RigidRest>,
         tolerance_fraction: f64,
         max_first_contraction: f64,
     ) -> Projected {
-        if let Some(left) = self.back_to_rigid_rest(g, taut, kept.as_ref()) {
+        if let Some(left) = self.back_to_rigid_rest(g, taut, rest.as_ref()) {
             return Projected { left, first_contraction: 0.0 };
         }
+        *rest = None;
         let coords = GroupCoordinates::of(self, g);
         // The body Jacobians at the current coordinates (the Jacobian below reads them).
         for &m in &g.multibodies {
@@ -845,12 +871,8 @@ impl Simulation {
             if let (Jacobian::Sparse(_), Some(poses)) = (&jac, formed_at.take()) {
                 let closed_to_round_off = tolerance_fraction <= GAP_TOLERANCE_FRACTION
                     && left <= GAP_TOLERANCE_FRACTION * self.model.length_scale_m;
-                let rest = (jac.rigid() && closed_to_round_off).then(|| RigidRest {
-                    poses: self.group_poses(g),
-                    left,
-                    generation: self.constraint_inputs,
-                });
-                *kept = Some(KeptJacobian { jacobian: jac, poses, taut: taut.to_vec(), rest });
+                *rest = (jac.rigid() && closed_to_round_off).then(|| self.rigid_rest(g, taut, left));
+                *kept = Some(KeptJacobian { jacobian: jac, poses, taut: taut.to_vec() });
             }
         }
         Projected { left, first_contraction }
@@ -864,8 +886,8 @@ impl Simulation {
     /// the rows are evaluated again only when their other inputs have changed since
     /// ([`RigidRest`]). Returns the largest row left, or None (nothing changed) when the
     /// projection must run.
-    fn back_to_rigid_rest(&mut self, g: &ProjectedGroup, taut: &[usize], kept: Option<&KeptJacobian>) -> Option<f64> {
-        let rest = kept.filter(|k| k.taut == taut)?.rest.as_ref()?;
+    fn back_to_rigid_rest(&mut self, g: &ProjectedGroup, taut: &[usize], rest: Option<&RigidRest>) -> Option<f64> {
+        let rest = rest.filter(|r| r.taut == taut)?;
         if !self.poses_within(g, &rest.poses, RIGID_REST_FRACTION) {
             return None;
         }
@@ -888,6 +910,11 @@ impl Simulation {
         }
         self.stop_bodies(&g.bodies);
         Some(left)
+    }
+
+    /// The group's rest at its current poses, closed there to `left` [m].
+    pub(super) fn rigid_rest(&self, g: &ProjectedGroup, taut: &[usize], left: f64) -> RigidRest {
+        RigidRest { poses: self.group_poses(g), taut: taut.to_vec(), left, generation: self.constraint_inputs }
     }
 
     /// Whether every projected group is of plain bodies alone (no multibody coordinates).
@@ -950,16 +977,16 @@ pub(super) struct KeptJacobian {
     poses: Vec<Pose>,
     /// The taut cables whose rows it has.
     taut: Vec<usize>,
-    /// A rigid group's poses where it was last closed to round-off ([`Jacobian::rigid`]).
-    rest: Option<RigidRest>,
 }
 
-/// Where a rigid group was last closed to round-off: its plain bodies' poses, the largest row
-/// left there [m], and the generation of the rows' other inputs then (`constraint_inputs` in
-/// `mod.rs`: locked coordinates, cable lengths, fixed bodies' places). While that generation
-/// holds, the rows at these poses are what they were: a function of the poses and those inputs.
-struct RigidRest {
+/// Where a rigid group ([`Jacobian::rigid`]) was last closed to round-off: its plain bodies'
+/// poses, the taut cables whose rows it closed, the largest row left there [m], and the
+/// generation of the rows' other inputs then (`constraint_inputs` in `mod.rs`: locked
+/// coordinates, cable lengths, fixed bodies' places). While that generation holds, the rows at
+/// these poses are what they were: a function of the poses and those inputs.
+pub(super) struct RigidRest {
     poses: Vec<Pose>,
+    taut: Vec<usize>,
     left: f64,
     generation: u64,
 }
@@ -1168,13 +1195,13 @@ impl GroupCoordinates {
 
 /// A member whose rows a projected group closes: a joint (its geometry at the current poses)
 /// or a taut cable.
-enum Member {
+pub(super) enum Member {
     Joint(JointFrame),
     Cable(usize),
 }
 
 impl Member {
-    fn row_rates(&self, sim: &Simulation, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
+    pub(super) fn row_rates(&self, sim: &Simulation, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
         match self {
             Member::Joint(frame) => frame.row_rates(twist, out),
             Member::Cable(c) => sim.cable_row_rate(*c, twist, out),

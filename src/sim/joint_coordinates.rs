@@ -1,0 +1,216 @@
+//! A command jump of a sparse group closed in the joint coordinates of its tree
+//! (`group_tree.rs`).
+//!
+//! The projection's own coordinates are six per plain body (`projection.rs`): a 10-X chain
+//! has 180, its Jacobian 210 rows, and a jump took two factorizations of that size and eight
+//! solves (0.2 ms of a 0.66 ms settle). Here each tree link's joint instead contributes the
+//! turns it allows: one about a revolute's axis, two about a universal's axes, three about a
+//! spherical's anchor. A turn of link L moves L's body and every body beyond it about L's
+//! anchor, so every tree joint stays closed to round-off and the coordinates left are the
+//! loops' (30 for a 10-X chain). The rows are the group's own, unchanged; a member's rows move
+//! only with the links on the tree path between its two bodies (to first order the links
+//! above both turn the member as a whole, which leaves its rows at a closed joint unchanged).
+//!
+//! This is the relative-coordinate form of the same closure: on a rigid group the
+//! configuration that closes every row is isolated, so Gauss-Newton in these coordinates and
+//! in the bodies' lands on the same one, to round-off. It is used only where it applies
+//! exactly: every body on the tree and every tree joint closed at the start (a group at rest),
+//! with the jump's first-contraction test unchanged (`continuation.rs`).
+
+use super::group_tree::GroupTree;
+use super::projection::{
+    close_rows, largest_abs, Closing, Jacobian, KeptJacobian, Member, Projected, ProjectedGroup, RigidRest, Twist,
+    GAP_TOLERANCE_FRACTION,
+};
+use super::Simulation;
+use crate::structure::JointKind;
+use rapier3d_f64::prelude::*;
+
+/// A tree link's joint coordinates: its anchor [m] and the unit axes it turns about (world).
+struct LinkAxes {
+    anchor: Vector,
+    axes: Vec<Vector>,
+    /// The index of its first coordinate.
+    first: usize,
+}
+
+impl Simulation {
+    /// Closes group `g` (its `taut` cables held) in its tree's joint coordinates, when every
+    /// one of its bodies is on the tree and every tree joint is closed; None (nothing moved)
+    /// otherwise. A rigid group is stopped and its `rest` recorded; any other is handed on to
+    /// [`Self::project_group`] once closed, for its velocities.
+    pub(super) fn close_in_joint_coordinates(
+        &mut self,
+        g: &ProjectedGroup,
+        taut: &[usize],
+        kept: &mut Option<KeptJacobian>,
+        rest: &mut Option<RigidRest>,
+        max_first_contraction: f64,
+    ) -> Option<Projected> {
+        let tree = g.tree.as_ref()?;
+        let tol = GAP_TOLERANCE_FRACTION * self.model.length_scale_m;
+        if !g.multibodies.is_empty() || tree.links().len() != g.bodies.len() || !self.tree_joints_closed(tree, tol) {
+            return None;
+        }
+        let rows = |sim: &Simulation| {
+            let mut out = Vec::new();
+            sim.group_rows(g, taut, &mut out);
+            out
+        };
+        let jacobian = |sim: &mut Simulation, g0: &[f64]| Jacobian::sparse(sim.joint_jacobian(g, taut, tree, g0.len()));
+        let displace = |sim: &mut Simulation, dq: &[f64]| sim.turn_links(g, tree, dq);
+        let Closing { jacobian: jac, left, first_contraction, .. } =
+            close_rows(self, &rows, &jacobian, &displace, None, GAP_TOLERANCE_FRACTION, max_first_contraction);
+        let closed = left <= tol && first_contraction <= max_first_contraction;
+        if closed && jac.as_ref().is_some_and(Jacobian::rigid) {
+            self.stop_bodies(&g.bodies);
+            *rest = Some(self.rigid_rest(g, taut, left));
+        } else if closed {
+            let p = self.project_group(g, taut, kept, rest, GAP_TOLERANCE_FRACTION, f64::INFINITY);
+            return Some(Projected { left: p.left, first_contraction });
+        }
+        Some(Projected { left, first_contraction })
+    }
+
+    /// Whether every tree joint's rows but a locked angle's are within `tol` [m]: the rows no
+    /// joint coordinate moves.
+    fn tree_joints_closed(&self, tree: &GroupTree, tol: f64) -> bool {
+        let mut rows = Vec::new();
+        tree.links().iter().all(|link| {
+            rows.clear();
+            self.joint_rows(link.joint, &mut rows);
+            if self.locked_angle(link.joint).is_some() {
+                rows.pop();
+            }
+            largest_abs(&rows) <= tol
+        })
+    }
+
+    /// Each tree link's anchor and axes at the current poses, in link order.
+    fn link_axes(&self, tree: &GroupTree) -> Vec<LinkAxes> {
+        let s = &self.model.structure;
+        let rotation = |b: usize| self.bodies[self.model.handles[b]].position().rotation;
+        let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
+        let mut first = 0;
+        tree.links()
+            .iter()
+            .map(|link| {
+                let joint = &s.joints[link.joint];
+                let axes = match joint.kind {
+                    JointKind::Revolute { axis } => vec![(rotation(joint.parent) * vec3(axis)).normalize()],
+                    JointKind::Universal { axis1, axis2 } => vec![
+                        (rotation(joint.parent) * vec3(axis1)).normalize(),
+                        (rotation(joint.child) * vec3(axis2)).normalize(),
+                    ],
+                    _ => vec![Vector::X, Vector::Y, Vector::Z],
+                };
+                let la = LinkAxes { anchor: vec3(self.node_position(joint.anchor)), first, axes };
+                first += la.axes.len();
+                la
+            })
+            .collect()
+    }
+
+    /// Turns every link's subtree by its coordinates in `dq` (angle times the structure's size
+    /// [m]) about its anchor, parents first: each body moves with its parent, then turns.
+    fn turn_links(&mut self, g: &ProjectedGroup, tree: &GroupTree, dq: &[f64]) {
+        let scale = self.model.length_scale_m;
+        let axes = self.link_axes(tree);
+        let mut delta: Vec<Pose> = vec![Pose::IDENTITY; g.bodies.len()];
+        for (link, la) in tree.links().iter().zip(&axes) {
+            let turn = la.axes.iter().enumerate().fold(Vector::ZERO, |r, (k, a)| r + *a * (dq[la.first + k] / scale));
+            let carried = link.parent.map_or(Pose::IDENTITY, |p| delta[p]);
+            delta[link.body] = carried * super::group_tree::turn_about(la.anchor, Vector::ZERO, turn);
+        }
+        for (&b, d) in g.bodies.iter().zip(delta) {
+            let h = self.model.handles[b];
+            let moved = d * *self.bodies[h].position();
+            self.bodies[h].set_position(moved, true);
+        }
+    }
+
+    /// The Jacobian of the group's `rows` rows by the joint coordinates: each member's rows by
+    /// the coordinates of the links on the tree path between its two bodies.
+    fn joint_jacobian(
+        &self,
+        g: &ProjectedGroup,
+        taut: &[usize],
+        tree: &GroupTree,
+        rows: usize,
+    ) -> super::least_squares::SparseRows {
+        let s = &self.model.structure;
+        let scale = self.model.length_scale_m;
+        let axes = self.link_axes(tree);
+        let path = TreePaths::of(self, g, tree);
+        let joints = g.joints.iter().map(|&j| {
+            let joint = &s.joints[j];
+            (Member::Joint(self.joint_frame(j)), [joint.parent, joint.child], self.joint_row_count(j))
+        });
+        let cables =
+            taut.iter().map(|&c| (Member::Cable(c), [s.nodes[s.cables[c].a].body, s.nodes[s.cables[c].b].body], 1));
+        let (mut entries, mut first_row, mut block) = (Vec::new(), 0, Vec::new());
+        for (member, [a, b], count) in joints.chain(cables) {
+            for (link, moved) in path.between(a, b) {
+                let la = &axes[link];
+                for (k, axis) in la.axes.iter().enumerate() {
+                    let t = Twist { v: Vector::ZERO, w: *axis / scale, at: la.anchor };
+                    block.clear();
+                    member.row_rates(self, &|x| (x == moved).then_some(t), &mut block);
+                    entries.extend(block.iter().enumerate().map(|(r, &x)| (first_row + r, la.first + k, x)));
+                }
+            }
+            first_row += count;
+        }
+        debug_assert_eq!(first_row, rows, "one block of rows per member");
+        let coordinates = axes.last().map_or(0, |la| la.first + la.axes.len());
+        super::least_squares::SparseRows::new(rows, coordinates, &entries)
+    }
+}
+
+/// The tree's links by body, with their parents and depths, for the paths between bodies.
+struct TreePaths {
+    /// Each structure body's link (None: a fixed body, above every root).
+    link_of: Vec<Option<usize>>,
+    /// Each link's parent link and its depth (roots 0).
+    parent: Vec<Option<usize>>,
+    depth: Vec<usize>,
+}
+
+impl TreePaths {
+    fn of(sim: &Simulation, g: &ProjectedGroup, tree: &GroupTree) -> Self {
+        let links = tree.links();
+        let mut link_of_group_body = vec![0; g.bodies.len()];
+        for (l, link) in links.iter().enumerate() {
+            link_of_group_body[link.body] = l;
+        }
+        let mut link_of = vec![None; sim.model.structure.bodies.len()];
+        let (mut parent, mut depth) = (Vec::new(), Vec::new());
+        for link in links {
+            let p = link.parent.map(|p| link_of_group_body[p]);
+            link_of[g.bodies[link.body]] = Some(parent.len());
+            depth.push(p.map_or(0, |p: usize| depth[p] + 1));
+            parent.push(p);
+        }
+        TreePaths { link_of, parent, depth }
+    }
+
+    /// The links on the tree path between bodies `a` and `b` (structure indices), each with
+    /// the one of the two that it moves.
+    fn between(&self, a: usize, b: usize) -> Vec<(usize, usize)> {
+        let (mut la, mut lb) = (self.link_of[a], self.link_of[b]);
+        let mut out = Vec::new();
+        let depth = |l: Option<usize>| l.map_or(-1, |l| self.depth[l] as i64);
+        while la != lb {
+            if depth(la) >= depth(lb) {
+                let l = la.expect("a link is deeper than a fixed body");
+                out.push((l, a));
+                la = self.parent[l];
+            } else {
+                let l = lb.expect("a link is deeper than a fixed body");
+                out.push((l, b));
+                lb = self.parent[l];
+            }
+        }
+        out
+    }
+}
