@@ -26,12 +26,20 @@ use super::Simulation;
 use crate::structure::JointKind;
 use rapier3d_f64::prelude::*;
 
-/// A tree link's joint coordinates: its anchor [m] and the unit axes it turns about (world).
+/// A tree link's joint coordinates: its anchor [m] and the unit axes it turns about (world,
+/// the first `count` of `all`).
 struct LinkAxes {
     anchor: Vector,
-    axes: Vec<Vector>,
+    all: [Vector; 3],
+    count: usize,
     /// The index of its first coordinate.
     first: usize,
+}
+
+impl LinkAxes {
+    fn axes(&self) -> &[Vector] {
+        &self.all[..self.count]
+    }
 }
 
 impl Simulation {
@@ -96,16 +104,16 @@ impl Simulation {
             .iter()
             .map(|link| {
                 let joint = &s.joints[link.joint];
-                let axes = match joint.kind {
-                    JointKind::Revolute { axis } => vec![(rotation(joint.parent) * vec3(axis)).normalize()],
-                    JointKind::Universal { axis1, axis2 } => vec![
-                        (rotation(joint.parent) * vec3(axis1)).normalize(),
-                        (rotation(joint.child) * vec3(axis2)).normalize(),
-                    ],
-                    _ => vec![Vector::X, Vector::Y, Vector::Z],
+                let (all, count) = match joint.kind {
+                    JointKind::Revolute { axis } => ([(rotation(joint.parent) * vec3(axis)).normalize(); 3], 1),
+                    JointKind::Universal { axis1, axis2 } => {
+                        let a1 = (rotation(joint.parent) * vec3(axis1)).normalize();
+                        ([a1, (rotation(joint.child) * vec3(axis2)).normalize(), a1], 2)
+                    }
+                    _ => ([Vector::X, Vector::Y, Vector::Z], 3),
                 };
-                let la = LinkAxes { anchor: vec3(self.node_position(joint.anchor)), first, axes };
-                first += la.axes.len();
+                let la = LinkAxes { anchor: vec3(self.node_position(joint.anchor)), all, count, first };
+                first += count;
                 la
             })
             .collect()
@@ -118,7 +126,7 @@ impl Simulation {
         let axes = self.link_axes(tree);
         let mut delta: Vec<Pose> = vec![Pose::IDENTITY; g.bodies.len()];
         for (link, la) in tree.links().iter().zip(&axes) {
-            let turn = la.axes.iter().enumerate().fold(Vector::ZERO, |r, (k, a)| r + *a * (dq[la.first + k] / scale));
+            let turn = la.axes().iter().enumerate().fold(Vector::ZERO, |r, (k, a)| r + *a * (dq[la.first + k] / scale));
             let carried = link.parent.map_or(Pose::IDENTITY, |p| delta[p]);
             delta[link.body] = carried * super::group_tree::turn_about(la.anchor, Vector::ZERO, turn);
         }
@@ -152,7 +160,7 @@ impl Simulation {
         for (member, [a, b], count) in joints.chain(cables) {
             for (link, moved) in path.between(a, b) {
                 let la = &axes[link];
-                for (k, axis) in la.axes.iter().enumerate() {
+                for (k, axis) in la.axes().iter().enumerate() {
                     let t = Twist { v: Vector::ZERO, w: *axis / scale, at: la.anchor };
                     block.clear();
                     member.row_rates(self, &|x| (x == moved).then_some(t), &mut block);
@@ -162,7 +170,7 @@ impl Simulation {
             first_row += count;
         }
         debug_assert_eq!(first_row, rows, "one block of rows per member");
-        let coordinates = axes.last().map_or(0, |la| la.first + la.axes.len());
+        let coordinates = axes.last().map_or(0, |la| la.first + la.count);
         super::least_squares::SparseRows::new(rows, coordinates, &entries)
     }
 }

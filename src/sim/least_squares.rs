@@ -171,8 +171,9 @@ impl BandCholesky {
         for rs in by_column.rows() {
             for (a, &(i, vi)) in rs.iter().enumerate() {
                 first[i] = first[i].min(rs[0].0);
+                let row = &mut l[i * w..i * w + w];
                 for &(k, vk) in &rs[..=a] {
-                    l[i * w + (i - k)] += vi * vk;
+                    row[i - k] += vi * vk;
                 }
             }
         }
@@ -186,25 +187,24 @@ impl BandCholesky {
         for i in 0..n {
             l[i * w] += shift * largest;
         }
-        // Row i holds L[i][i - b] at b = 0 ..= band; L[i][j] L[j][k] pairs are (b + off, b)
-        // with off = i - j, b = j - k.
-        for j in 0..n {
-            let reach = j - first[j];
-            let d = l[j * w] - l[j * w + 1..=j * w + reach].iter().map(|x| x * x).sum::<f64>();
+        // Row by row (Cholesky-Banachiewicz): row i holds L[i][i - b] at b = 0 ..= band, and
+        // L[i][j] takes the dot of rows i and j over the columns left of j where both can be
+        // nonzero, k = j - 1 down to the later of their first columns.
+        for i in 0..n {
+            let fi = first[i];
+            let (above, rest) = l.split_at_mut(i * w);
+            let row_i = &mut rest[..w];
+            for j in fi..i {
+                let (off, reach) = (i - j, j - fi.max(first[j]));
+                let row_j = &above[j * w..j * w + w];
+                let dot: f64 = row_i[off + 1..=off + reach].iter().zip(&row_j[1..=reach]).map(|(a, b)| a * b).sum();
+                row_i[off] = (row_i[off] - dot) / row_j[0];
+            }
+            let d = row_i[0] - row_i[1..=i - fi].iter().map(|x| x * x).sum::<f64>();
             if !(d > PIVOT_FLOOR * largest) {
                 return None;
             }
-            let d = d.sqrt();
-            l[j * w] = d;
-            for i in (j + 1..=last[j]).filter(|&i| first[i] <= j) {
-                let off = i - j;
-                let reach = j - first[i].max(first[j]);
-                let dot: f64 = {
-                    let (row_i, row_j) = (&l[i * w + off + 1..=i * w + off + reach], &l[j * w + 1..=j * w + reach]);
-                    row_i.iter().zip(row_j).map(|(a, b)| a * b).sum()
-                };
-                l[i * w + off] = (l[i * w + off] - dot) / d;
-            }
+            row_i[0] = d.sqrt();
         }
         Some(BandCholesky { band, l, first, last })
     }
