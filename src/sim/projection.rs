@@ -421,7 +421,7 @@ impl Simulation {
     /// then hold still together short of the equilibrium (measured on gravity_hanging.toml's
     /// (1, 1, 3): at rest 5e-3 N m from it), so the group is left to rapier alone until the
     /// cables are taut again.
-    fn projected_taut_cables(&self, g: &ProjectedGroup) -> Option<Vec<usize>> {
+    pub(super) fn projected_taut_cables(&self, g: &ProjectedGroup) -> Option<Vec<usize>> {
         let taut: Vec<usize> = g.cables.iter().copied().filter(|&c| self.cable_is_taut(c)).collect();
         (g.multibodies.is_empty() || taut.len() == g.cables.len()).then_some(taut)
     }
@@ -944,14 +944,14 @@ impl Simulation {
         }
     }
 
-    fn set_group_poses(&mut self, g: &ProjectedGroup, poses: &[Pose]) {
+    pub(super) fn set_group_poses(&mut self, g: &ProjectedGroup, poses: &[Pose]) {
         for (&b, p) in g.bodies.iter().zip(poses) {
             self.bodies[self.model.handles[b]].set_position(*p, true);
         }
     }
 
     /// The poses of the group's plain bodies.
-    fn group_poses(&self, g: &ProjectedGroup) -> Vec<Pose> {
+    pub(super) fn group_poses(&self, g: &ProjectedGroup) -> Vec<Pose> {
         g.bodies.iter().map(|&b| *self.bodies[self.model.handles[b]].position()).collect()
     }
 
