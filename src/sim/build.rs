@@ -60,6 +60,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         locked_coordinates: vec![0.0; s.joints.len()],
         kept_jacobians: Vec::new(),
         rigid_rests: Vec::new(),
+        closure_rests: Vec::new(),
         constraint_inputs: 0,
     };
     sim.model.tree = sim.link_tree();

@@ -16,6 +16,7 @@
 //!   (implicit, and zero at rest, so it does not move the equilibrium).
 
 mod build;
+mod closure_rest;
 mod continuation;
 mod damping;
 mod drive;
@@ -132,8 +133,12 @@ pub struct Simulation {
     kept_jacobians: Vec<Option<projection::KeptJacobian>>,
     /// Each projected group's rigid rest, where it was last closed (`projection.rs`).
     rigid_rests: Vec<Option<projection::RigidRest>>,
-    /// Counts the changes of what the projection's rows depend on besides the bodies' poses:
-    /// a locked coordinate, a cable's length, a fixed body's place.
+    /// Each looped multibody's rest, where its loops were last closed (`closure_rest.rs`).
+    closure_rests: Vec<closure_rest::ClosureRest>,
+    /// Counts the changes of what the projection's rows depend on besides the bodies' poses
+    /// (a locked coordinate, a cable's length, a fixed body's place) and of the state set from
+    /// outside the step (an actuated multibody coordinate, a perturbation, a restart): the
+    /// rests recorded before such a change are not returned to after it.
     constraint_inputs: u64,
 }
 
@@ -226,6 +231,7 @@ impl Simulation {
             let name = &self.model.structure.joints[j].name;
             return Err(format!("joint '{name}' is actuated: its coordinate is commanded"));
         }
+        self.constraint_inputs += 1;
         self.move_joint(j, displacement, Some(rate))
     }
 
@@ -487,6 +493,7 @@ impl Simulation {
     /// Displaces every free joint coordinate of every multibody by `delta` (rad or m) and zeroes
     /// the velocities: the perturbation used to classify an equilibrium.
     pub fn perturb_free_coordinates(&mut self, delta: f64) {
+        self.constraint_inputs += 1;
         let mut touched = Vec::new();
         let free_links = self
             .model
@@ -616,6 +623,7 @@ impl Simulation {
                     disp[dof] = d;
                 }
                 mb.apply_displacements(&disp);
+                self.constraint_inputs += 1;
                 for &(dof, _) in dofs {
                     mb.generalized_velocity_mut()[dof] = 0.0;
                 }

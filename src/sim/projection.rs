@@ -349,10 +349,15 @@ impl Simulation {
                 continue;
             }
             // The loops of one multibody: a group of its free coordinates alone.
+            if let Some(left) = self.back_to_closure_rest(mb_index) {
+                largest = largest.max(left);
+                continue;
+            }
             let joints = closures.iter().filter(|c| c.multibody == mb_index).map(|c| c.joint).collect();
             let g = ProjectedGroup { multibodies: vec![mb_index], joints, ..Default::default() };
             let p = self.project_group(&g, &[], &mut None, &mut None, GAP_TOLERANCE_FRACTION, f64::INFINITY);
             largest = largest.max(p.left);
+            self.note_closure_closed(mb_index, &g, p.left);
         }
         self.model.internal_closures = closures;
         largest
@@ -917,6 +922,17 @@ impl Simulation {
         RigidRest { poses: self.group_poses(g), taut: taut.to_vec(), left, generation: self.constraint_inputs }
     }
 
+    /// The dense Jacobian of group `g`'s rows (no taut cables) by its coordinates, at the
+    /// current poses and body Jacobians.
+    pub(super) fn group_jacobian_dense(&self, g: &ProjectedGroup) -> nalgebra::DMatrix<f64> {
+        let mut rows = Vec::new();
+        self.group_rows(g, &[], &mut rows);
+        match GroupCoordinates::of(self, g).jacobian(self, g, &[], rows.len()) {
+            Jacobian::Dense(j) => j,
+            Jacobian::Sparse(j) => j.matrix().to_dense(),
+        }
+    }
+
     /// Whether every projected group is of plain bodies alone (no multibody coordinates).
     pub(super) fn projected_groups_are_plain(&self) -> bool {
         self.model.projected_groups.iter().all(|g| g.multibodies.is_empty())
@@ -995,7 +1011,7 @@ pub(super) struct RigidRest {
 /// structure's size of it: well inside the moves that Gauss-Newton follows on one assembly
 /// mode (a command jump's increments move a chain's joints by up to 5e-2 of its size), and
 /// ten times the 1.5e-3 that rapier's step moves a 10-X chain at rest.
-const RIGID_REST_FRACTION: f64 = 1e-2;
+pub(super) const RIGID_REST_FRACTION: f64 = 1e-2;
 
 /// A kept Jacobian removes the velocities only while every body is back within this fraction
 /// of the structure's size of where it was formed: the velocities it leaves across the joints

@@ -89,6 +89,7 @@ impl Simulation {
             return false;
         }
         self.probe_loads.iter_mut().for_each(|p| *p = ([0.0; 3], [0.0; 3]));
+        self.constraint_inputs += 1;
         // The actuators to the commands `s` was built at, as for any new command.
         self.set_commands(&s.initial_commands());
         // Then every free joint, parents first, turned (slid) so that a node of its child lands

@@ -183,6 +183,23 @@ fn a_cut_chain_follows_small_and_large_command_jumps_on_its_assembly_mode() {
     }
 }
 
+/// A settled 2-X chain (one multibody whose loops close inside it) goes back to its loops'
+/// rest after every step (`sim/closure_rest.rs`): ten more steps leave every node where it
+/// was to the bit, its end point within 1e-12 m of Eq. 2.
+#[test]
+fn a_settled_looped_multibody_stays_at_its_closure_rest_to_the_bit() {
+    let case = furet::case(2);
+    let mut sim = scale::settle(&case.start, &case.settings, &case.commands, &DEFAULT_CAPS).unwrap().sim;
+    let settled = sim.node_positions();
+    for _ in 0..10 {
+        sim.step().unwrap();
+    }
+    assert_eq!(sim.node_positions(), settled, "the nodes moved at rest");
+    let (end, target) = case.target[0];
+    let error = scale::max_distance(&[sim.node_position(end)], &[target]);
+    assert!(error <= 1e-12, "{error:.3e} m from Eq. 2");
+}
+
 /// The growth exponent is the slope of ln(wall) against ln(struts): wall = 1e-6 struts^2.5
 /// gives 2.5 within 1e-12.
 #[test]
