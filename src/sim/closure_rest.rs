@@ -14,13 +14,9 @@
 //! (a structure at rest, not one whose commands change every tick), and is used while that
 //! generation holds and the joints are within [`super::projection::RIGID_REST_FRACTION`] of it.
 
-use super::projection::{ProjectedGroup, GAP_TOLERANCE_FRACTION, RIGID_REST_FRACTION};
+use super::projection::{ProjectedGroup, GAP_TOLERANCE_FRACTION, RIGID_REST_FRACTION, SVD_RELATIVE_TOLERANCE};
 use super::Simulation;
 use rapier3d_f64::prelude::*;
-
-/// The singular values of a multibody's loop Jacobian above this fraction of the largest count
-/// towards its rank (the projection's own cut for redundant rows).
-const RANK_RELATIVE_TOLERANCE: f64 = 1e-10;
 
 /// Where a looped multibody's loops were last closed, at the generation of the constraint
 /// inputs then; `joints` once a second closing at that generation found them rigid.
@@ -73,7 +69,7 @@ impl Simulation {
 
     /// Whether the loops of a multibody's group leave none of its free coordinates a motion:
     /// at least as many rows as coordinates and every singular value of their Jacobian above
-    /// [`RANK_RELATIVE_TOLERANCE`] of the largest.
+    /// [`SVD_RELATIVE_TOLERANCE`] of the largest (the projection's own cut for redundant rows).
     fn loops_are_rigid(&self, g: &ProjectedGroup) -> bool {
         let jacobian = self.group_jacobian_dense(g);
         if jacobian.nrows() < jacobian.ncols() || jacobian.ncols() == 0 {
@@ -81,6 +77,6 @@ impl Simulation {
         }
         let sv = jacobian.singular_values();
         let largest = sv.max();
-        sv.iter().all(|&s| s > RANK_RELATIVE_TOLERANCE * largest)
+        sv.iter().all(|&s| s > SVD_RELATIVE_TOLERANCE * largest)
     }
 }

@@ -60,11 +60,7 @@ impl Simulation {
         if !g.multibodies.is_empty() || tree.links().len() != g.bodies.len() || !self.tree_joints_closed(tree, tol) {
             return None;
         }
-        let rows = |sim: &Simulation| {
-            let mut out = Vec::new();
-            sim.group_rows(g, taut, &mut out);
-            out
-        };
+        let rows = |sim: &Simulation| sim.group_rows(g, taut);
         let jacobian = |sim: &mut Simulation, g0: &[f64]| Jacobian::sparse(sim.joint_jacobian(g, taut, tree, g0.len()));
         let displace = |sim: &mut Simulation, dq: &[f64]| sim.turn_links(g, tree, dq);
         let Closing { jacobian: jac, left, first_contraction, .. } =
@@ -283,11 +279,7 @@ mod tests {
         let g = sim.model.projected_groups.first().cloned().expect("the chain is one projected group");
         let tree = g.tree.clone().expect("a sparse group has a tree");
         let taut = sim.projected_taut_cables(&g).expect("no slack cable");
-        let rows = |sim: &Simulation| {
-            let mut out = Vec::new();
-            sim.group_rows(&g, &taut, &mut out);
-            out
-        };
+        let rows = |sim: &Simulation| sim.group_rows(&g, &taut);
         let jacobian = sim.joint_jacobian(&g, &taut, &tree, rows(&sim).len()).to_dense();
         assert_eq!(jacobian.ncols(), 9, "one turn per revolute link of 9 bodies");
         let start = sim.group_poses(&g);

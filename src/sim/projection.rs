@@ -39,7 +39,7 @@ pub(super) const GAP_TOLERANCE_FRACTION: f64 = 1e-14;
 
 /// Singular values of the closure Jacobian below this fraction of the largest are treated as
 /// zero (redundant closure rows).
-const SVD_RELATIVE_TOLERANCE: f64 = 1e-10;
+pub(super) const SVD_RELATIVE_TOLERANCE: f64 = 1e-10;
 
 /// The minimum-norm least-squares solution of `a x = b` for the projection (redundant closure
 /// rows dropped by [`SVD_RELATIVE_TOLERANCE`]).
@@ -348,11 +348,11 @@ impl Simulation {
             if self.free_dofs(mb_index).is_empty() {
                 continue;
             }
-            // The loops of one multibody: a group of its free coordinates alone.
             if let Some(left) = self.back_to_closure_rest(mb_index) {
                 largest = largest.max(left);
                 continue;
             }
+            // The loops of one multibody: a group of its free coordinates alone.
             let joints = closures.iter().filter(|c| c.multibody == mb_index).map(|c| c.joint).collect();
             let g = ProjectedGroup { multibodies: vec![mb_index], joints, ..Default::default() };
             let p = self.project_group(&g, &[], &mut None, &mut None, GAP_TOLERANCE_FRACTION, f64::INFINITY);
@@ -640,16 +640,18 @@ impl Simulation {
 
     /// The constraint rows of a projected group: each joint's ([`Self::joint_rows`]), then the
     /// stretch of each cable in `taut` [m].
-    pub(super) fn group_rows(&self, g: &ProjectedGroup, taut: &[usize], out: &mut Vec<f64>) {
+    pub(super) fn group_rows(&self, g: &ProjectedGroup, taut: &[usize]) -> Vec<f64> {
         let s = &self.model.structure;
+        let mut out = Vec::new();
         for &j in &g.joints {
-            self.joint_rows(j, out);
+            self.joint_rows(j, &mut out);
         }
         for &c in taut {
             let cable = &s.cables[c];
             let (pa, pb) = (self.node_position(cable.a), self.node_position(cable.b));
             out.push(crate::structure::distance(pa, pb) - self.cable_lengths[c]);
         }
+        out
     }
 
     /// The rates of [`Self::group_rows`] (same order and scaling) when each body moves with
@@ -826,11 +828,7 @@ impl Simulation {
                 mb.forward_kinematics(&self.bodies, false);
             }
         }
-        let rows = |sim: &Simulation| {
-            let mut out = Vec::new();
-            sim.group_rows(g, taut, &mut out);
-            out
-        };
+        let rows = |sim: &Simulation| sim.group_rows(g, taut);
         let (start, start_poses) = match kept.take().filter(|k| k.taut == taut) {
             Some(k) => (Some(k.jacobian), Some(k.poses)),
             None => (None, None),
@@ -900,13 +898,7 @@ impl Simulation {
         let known = rest.generation == self.constraint_inputs;
         let stepped = (!known).then(|| self.group_poses(g));
         self.set_group_poses(g, &rest.poses);
-        let left = if known {
-            rest.left
-        } else {
-            let mut rows = Vec::new();
-            self.group_rows(g, taut, &mut rows);
-            largest_abs(&rows)
-        };
+        let left = if known { rest.left } else { largest_abs(&self.group_rows(g, taut)) };
         if left > GAP_TOLERANCE_FRACTION * self.model.length_scale_m {
             if let Some(stepped) = stepped {
                 self.set_group_poses(g, &stepped);
@@ -925,9 +917,8 @@ impl Simulation {
     /// The dense Jacobian of group `g`'s rows (no taut cables) by its coordinates, at the
     /// current poses and body Jacobians.
     pub(super) fn group_jacobian_dense(&self, g: &ProjectedGroup) -> nalgebra::DMatrix<f64> {
-        let mut rows = Vec::new();
-        self.group_rows(g, &[], &mut rows);
-        match GroupCoordinates::of(self, g).jacobian(self, g, &[], rows.len()) {
+        let rows = g.joints.iter().map(|&j| self.joint_row_count(j)).sum();
+        match GroupCoordinates::of(self, g).jacobian(self, g, &[], rows) {
             Jacobian::Dense(j) => j,
             Jacobian::Sparse(j) => j.matrix().to_dense(),
         }
