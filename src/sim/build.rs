@@ -30,7 +30,8 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         cable_ropes,
         external_loads: external_loads(s),
         length_scale_m: crate::structure::structure_size(s),
-        tree: super::forces::Tree::default(),
+        tree: super::tree::Tree::default(),
+        fit_tree: super::tree::Tree::default(),
         relaxation_applies: super::relaxation::applies(s),
     };
     let mut sim = Simulation {
@@ -66,6 +67,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
     sim.model.tree = sim.link_tree();
     sim.model.internal_closures = sim.find_internal_closures();
     sim.model.projected_groups = sim.find_projected_groups();
+    sim.model.fit_tree = sim.fit_tree();
     sim.set_commands(&commands);
     sim.set_relaxation(true);
     Ok(sim)

@@ -142,7 +142,7 @@ impl Simulation {
         let joint = &s.joints[j];
         let motion = self.joint_motion(j).expect("scheduled joints are revolute or prismatic");
         let revolute = motion.revolute;
-        let carried = |b: usize| self.is_free(b) && tree.descends_from(s, b, joint.child);
+        let carried = |b: usize| self.is_free(b) && tree.descends_from(b, joint.child);
         let g = Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]);
         let mut load = JointLoad { force: 0.0, stiffness: 0.0, inertia: 0.0 };
         // Loads on the carried bodies as rapier will apply them (member forces were put on the

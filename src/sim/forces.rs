@@ -1,11 +1,14 @@
 //! Member forces: applying the explicit ones every step, reading all of them back, and the
 //! equilibrium residual computed from them independently of the solver.
 
+use super::least_squares::SparseRows;
+use super::tree::Tree;
 use super::{MemberForces, Residual, Simulation};
 use crate::structure::{ActuatorTarget, CableLaw, JointKind};
 use rapier3d_f64::prelude::*;
 
-type Wrench = (Vector, Vector); // (force, moment about the world origin)
+/// (force, moment about the world origin)
+pub(super) type Wrench = (Vector, Vector);
 
 /// A member whose force follows from its length: a spring (pushes and pulls) or an elastic
 /// cable (pulls only).
@@ -277,14 +280,16 @@ impl Simulation {
 
     /// The magnitudes of the unit closure loads that best balance every free coordinate
     /// against `wrench` (least squares, minimum norm; torques divided by the structure's size);
-    /// None when there is nothing to fit. Without multibody links each load moves only the
-    /// coordinates of its own two bodies, and large fits take the sparse solve.
+    /// None when there is nothing to fit. The coordinates are the fit tree's (`tree.rs`): the
+    /// tree joints' turns and the free roots' six. Without multibody links each load moves only
+    /// the coordinates on the tree path between its two bodies, and large fits, or fits on a
+    /// group's tree, take the sparse solve.
     fn closure_magnitudes(
         &self,
         closure_loads: &[ClosureComponent],
         wrench: &[Wrench],
     ) -> Option<nalgebra::DVector<f64>> {
-        let tree = &self.model.tree;
+        let tree = &self.model.fit_tree;
         let scale = self.model.length_scale_m;
         let base = self.coordinate_forces(tree, wrench, true);
         if closure_loads.is_empty() || base.is_empty() {
@@ -293,8 +298,8 @@ impl Simulation {
         let scaled = |c: &CoordinateForce| if c.is_torque { c.value / scale } else { c.value };
         let r0 = nalgebra::DVector::<f64>::from_iterator(base.len(), base.iter().map(scaled));
         let no_links = self.model.joint_links.iter().all(Option::is_none);
-        if no_links && closure_loads.len() >= SPARSE_MIN_CLOSURE_LOADS {
-            let g = self.plain_closure_matrix(closure_loads, base.len());
+        if no_links && (closure_loads.len() >= SPARSE_MIN_CLOSURE_LOADS || tree.has_group_links()) {
+            let g = self.tree_closure_matrix(tree, closure_loads, base.len());
             if let Some(lambda) = super::least_squares::sparse_min_norm_solve(g, &(-&r0)) {
                 return Some(lambda);
             }
@@ -314,36 +319,72 @@ impl Simulation {
         super::least_squares::min_norm_solve(&g, &(-r0), CLOSURE_SVD_RELATIVE_TOLERANCE)
     }
 
-    /// The closure loads' generalized forces as a sparse matrix (coordinates x loads) where every
-    /// free body is a plain body: six coordinates per free body in body order, as
-    /// [`Self::coordinate_forces`] lists them (force, then moment about the centre of mass
-    /// divided by the structure's size).
-    fn plain_closure_matrix(
-        &self,
-        closure_loads: &[ClosureComponent],
-        rows: usize,
-    ) -> super::least_squares::SparseRows {
+    /// The closure loads' generalized forces on the coordinates of `tree` as a sparse matrix
+    /// (coordinates x loads, torques divided by the structure's size), in the order of
+    /// [`Self::coordinate_forces`]. Every closure load is balanced (a reaction and its
+    /// opposite, or a tension pulling two nodes together), so it adds nothing above the point
+    /// where the tree paths up from its two bodies meet: it moves only the coordinates on the
+    /// path between them, and a free root's where a path ends at one. Without tree joints each
+    /// load moves the six coordinates of each of its two bodies.
+    fn tree_closure_matrix(&self, tree: &Tree, closure_loads: &[ClosureComponent], rows: usize) -> SparseRows {
         let s = &self.model.structure;
-        let mut first_row = vec![None; s.bodies.len()];
-        let mut next = 0;
-        for (b, r) in first_row.iter_mut().enumerate() {
-            if self.is_free(b) {
-                *r = Some(next);
-                next += 6;
-            }
-        }
-        let coms: Vec<Vector> = (0..s.bodies.len()).map(|b| self.world_com(b)).collect();
-        let mut entries = Vec::new();
+        let scale = self.model.length_scale_m;
+        let (joint_row, root_row) = self.coordinate_rows(tree);
+        let free = |b: usize| self.is_free(b).then_some(b);
+        let (mut entries, mut values) = (Vec::new(), Vec::new());
         for (k, load) in closure_loads.iter().enumerate() {
-            for &(b, (f, m)) in &load.loads {
-                let Some(r) = first_row[b] else { continue };
-                let m = (m - coms[b].cross(f)) / self.model.length_scale_m;
-                for (i, x) in [f.x, f.y, f.z, m.x, m.y, m.z].into_iter().enumerate() {
-                    entries.push((r + i, k, x));
+            let mut side = load.loads.map(|(b, w)| (free(b), w));
+            loop {
+                let i = match (side[0].0, side[1].0) {
+                    (Some(a), Some(b)) if a == b => break,
+                    (Some(a), Some(b)) => usize::from(tree.depth(a) < tree.depth(b)),
+                    (Some(_), None) => 0,
+                    (None, Some(_)) => 1,
+                    (None, None) => break,
+                };
+                let (Some(b), w) = side[i] else { break };
+                values.clear();
+                let (first, up) = match tree.hang(b) {
+                    Some(h) => {
+                        if joint_row[h.joint].is_some() {
+                            self.joint_coordinate_forces(h.joint, w, &mut values);
+                        }
+                        (joint_row[h.joint], free(h.parent))
+                    }
+                    None => {
+                        self.root_coordinate_forces(b, w, &mut values);
+                        (root_row[b], None)
+                    }
+                };
+                if let Some(first) = first {
+                    let scaled = values.iter().map(|c| if c.is_torque { c.value / scale } else { c.value });
+                    entries.extend(scaled.enumerate().map(|(r, x)| (first + r, k, x)));
                 }
+                side[i].0 = up;
             }
         }
-        super::least_squares::SparseRows::new(rows, closure_loads.len(), &entries)
+        debug_assert!(joint_row.iter().chain(&root_row).flatten().all(|&r| r < rows) || s.bodies.is_empty());
+        SparseRows::new(rows, closure_loads.len(), &entries)
+    }
+
+    /// The first row of each tree joint's free coordinates (joint order) and of each free
+    /// root's six (body order), as [`Self::coordinate_forces`] lists them.
+    fn coordinate_rows(&self, tree: &Tree) -> (Vec<Option<usize>>, Vec<Option<usize>>) {
+        let s = &self.model.structure;
+        let mut next = 0;
+        let mut at = |count: usize| {
+            next += count;
+            Some(next - count)
+        };
+        let joint_row = (0..s.joints.len())
+            .map(|j| match tree.carried(j).filter(|_| !self.model.actuated[j]) {
+                Some(_) => at(coordinate_count(&s.joints[j].kind)),
+                None => None,
+            })
+            .collect();
+        let root_row =
+            (0..s.bodies.len()).map(|b| (self.is_free(b) && tree.hang(b).is_none()).then(|| at(6)).flatten()).collect();
+        (joint_row, root_row)
     }
 
     /// The largest generalized force left on a free coordinate once every load is on the
@@ -356,7 +397,7 @@ impl Simulation {
                 residual.max_force_n = residual.max_force_n.max((-out.cable_tension_n[c]).max(0.0));
             }
         }
-        for c in self.coordinate_forces(&self.model.tree, wrench, true) {
+        for c in self.coordinate_forces(&self.model.fit_tree, wrench, true) {
             if c.is_torque {
                 residual.max_torque_nm = residual.max_torque_nm.max(c.value.abs());
             } else {
@@ -368,11 +409,11 @@ impl Simulation {
 
     /// Each actuator's force along its joint axis (or its cable's tension): minus the load of
     /// everything the actuated joint carries, or the fitted reaction of a joint locked off the
-    /// tree.
+    /// fit tree.
     fn actuator_forces(&self, wrench: &[Wrench], closure_reaction: &[Wrench], out: &MemberForces) -> Vec<f64> {
         let s = &self.model.structure;
-        let subtree = self.model.tree.subtree_wrenches(s, wrench);
-        let about = |w: Wrench, p: Vector| -> Vector { w.1 - p.cross(w.0) };
+        let tree = &self.model.fit_tree;
+        let subtree = tree.subtree_wrenches(wrench);
         let along = |joint: &crate::structure::Joint, force: Vector, moment: Vector| {
             let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
             match &joint.kind {
@@ -387,15 +428,23 @@ impl Simulation {
                 ActuatorTarget::CableLength(c) => out.cable_tension_n[c],
                 // The force that holds the moved body against its members, along the direction.
                 ActuatorTarget::FixedNode { node, direction } => -wrench[s.nodes[node].body].0.dot(v(direction)),
-                ActuatorTarget::Joint(j) if self.model.joint_impulse[j].is_some() => {
+                ActuatorTarget::Joint(j) if self.model.joint_impulse[j].is_some() && tree.carried(j).is_none() => {
                     let (f, m) = closure_reaction[j];
                     along(&s.joints[j], f, m)
                 }
+                // A tree joint: the reaction on its child balances what the carried side
+                // receives (the child's side, or the parent's where a group's tree runs the
+                // joint backwards).
                 ActuatorTarget::Joint(j) => {
                     let joint = &s.joints[j];
-                    let w = subtree[joint.child];
-                    let anchor = v(self.node_position(joint.anchor));
-                    -along(joint, w.0, about(w, anchor))
+                    let carried = tree.carried(j).unwrap_or(joint.child);
+                    let w = subtree[carried];
+                    let on_carried = along(joint, w.0, about(w, v(self.node_position(joint.anchor))));
+                    if carried == joint.child {
+                        -on_carried
+                    } else {
+                        on_carried
+                    }
                 }
             })
             .collect()
@@ -445,116 +494,63 @@ struct CoordinateForce {
     is_torque: bool,
 }
 
-/// The tree of joints that carry bodies (multibody links and actuator drives).
-#[derive(Clone, Debug, Default)]
-pub(super) struct Tree {
-    /// The joint each body hangs from, if any.
-    parent_joint: Vec<Option<usize>>,
-}
-
-impl Tree {
-    pub(super) fn descends_from(&self, s: &crate::structure::Structure, mut b: usize, ancestor: usize) -> bool {
-        for _ in 0..=self.parent_joint.len() {
-            if b == ancestor {
-                return true;
-            }
-            match self.parent_joint[b] {
-                Some(j) => b = s.joints[j].parent,
-                None => return false,
-            }
-        }
-        false
-    }
-
-    /// Number of joints between body `b` and the root of its tree.
-    pub(super) fn depth(&self, s: &crate::structure::Structure, mut b: usize) -> usize {
-        let mut depth = 0;
-        while let (Some(j), true) = (self.parent_joint[b], depth < self.parent_joint.len()) {
-            depth += 1;
-            b = s.joints[j].parent;
-        }
-        depth
-    }
-
-    /// For every body, the sum of the wrenches of it and of every body hanging from it: each
-    /// body's sum handed to its parent, deepest bodies first (one pass, where a search of every
-    /// body's descendants for each joint grew with the cube of a chain's length).
-    fn subtree_wrenches(&self, s: &crate::structure::Structure, wrench: &[Wrench]) -> Vec<Wrench> {
-        let mut order: Vec<(usize, usize)> = (0..wrench.len()).map(|b| (self.depth(s, b), b)).collect();
-        order.sort_unstable_by(|a, b| b.cmp(a));
-        let mut sums = wrench.to_vec();
-        for (_, b) in order {
-            if let Some(j) = self.parent_joint[b] {
-                let (w, p) = (sums[b], s.joints[j].parent);
-                sums[p].0 += w.0;
-                sums[p].1 += w.1;
-            }
-        }
-        sums
-    }
-}
-
 impl Simulation {
-    /// The tree of the multibody links: the joint each body hangs from.
-    pub(super) fn link_tree(&self) -> Tree {
-        let s = &self.model.structure;
-        let mut parent_joint: Vec<Option<usize>> = vec![None; s.bodies.len()];
-        for (j, joint) in s.joints.iter().enumerate() {
-            if self.model.joint_links[j].is_some() {
-                parent_joint[joint.child] = Some(j);
-            }
-        }
-        Tree { parent_joint }
-    }
-
-    /// Generalized force on every free coordinate for the body loads `wrench` (force, moment
-    /// about the world origin), torsion springs included when `with_springs`.
+    /// Generalized force on every free coordinate of `tree` for the body loads `wrench`
+    /// (force, moment about the world origin), torsion springs included when `with_springs`:
+    /// each tree joint's turns (slide) in joint order, then all six coordinates of each free
+    /// root in body order.
     fn coordinate_forces(&self, tree: &Tree, wrench: &[Wrench], with_springs: bool) -> Vec<CoordinateForce> {
         let s = &self.model.structure;
-        let about = |w: Wrench, p: Vector| -> Vector { w.1 - p.cross(w.0) };
-        let force = |value: f64| CoordinateForce { value, is_torque: false };
-        let torque = |value: f64| CoordinateForce { value, is_torque: true };
-        let subtree = tree.subtree_wrenches(s, wrench);
+        let subtree = tree.subtree_wrenches(wrench);
         let mut out = Vec::new();
-        for (j, joint) in s.joints.iter().enumerate() {
+        for j in 0..s.joints.len() {
             // Only the free coordinates: an actuated joint's coordinate is set, not balanced.
-            if self.model.joint_links[j].is_none() || self.model.actuated[j] {
-                continue;
-            }
-            let w = subtree[joint.child];
-            let anchor = v(self.node_position(joint.anchor));
-            let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
-            let child_rot = self.bodies[self.model.handles[joint.child]].position().rotation;
-            let m = about(w, anchor);
-            match &joint.kind {
-                JointKind::Revolute { axis } => {
-                    let a = (parent_rot * v(*axis)).normalize();
-                    // A torsion spring on this joint is a generalized force on its coordinate.
-                    let spring = if with_springs { self.torsion_spring_torque(j) } else { 0.0 };
-                    out.push(torque(m.dot(a) + spring));
-                }
-                JointKind::Prismatic { axis } => {
-                    out.push(force(w.0.dot((parent_rot * v(*axis)).normalize())));
-                }
-                JointKind::Universal { axis1, axis2 } => {
-                    out.push(torque(m.dot((parent_rot * v(*axis1)).normalize())));
-                    out.push(torque(m.dot((child_rot * v(*axis2)).normalize())));
-                }
-                JointKind::Spherical => {
-                    out.extend([torque(m.x), torque(m.y), torque(m.z)]);
-                }
-                JointKind::Fixed | JointKind::PlanarPin { .. } => {}
+            let Some(b) = tree.carried(j).filter(|_| !self.model.actuated[j]) else { continue };
+            let first = out.len();
+            self.joint_coordinate_forces(j, subtree[b], &mut out);
+            // A torsion spring on this joint is a generalized force on its coordinate.
+            if with_springs && matches!(s.joints[j].kind, JointKind::Revolute { .. }) {
+                out[first].value += self.torsion_spring_torque(j);
             }
         }
-        // Free bodies with no parent joint: all six coordinates.
         for b in 0..s.bodies.len() {
-            if self.is_free(b) && tree.parent_joint[b].is_none() {
-                let w = subtree[b];
-                let m = about(w, self.world_com(b));
-                out.extend([force(w.0.x), force(w.0.y), force(w.0.z), torque(m.x), torque(m.y), torque(m.z)]);
+            if self.is_free(b) && tree.hang(b).is_none() {
+                self.root_coordinate_forces(b, subtree[b], &mut out);
             }
         }
         out
+    }
+
+    /// The generalized forces on joint `j`'s coordinates of the wrench `w` its carried
+    /// bodies receive: the moment about its anchor along each axis it turns about, or the
+    /// force along its slide.
+    fn joint_coordinate_forces(&self, j: usize, w: Wrench, out: &mut Vec<CoordinateForce>) {
+        let joint = &self.model.structure.joints[j];
+        let torque = |value: f64| CoordinateForce { value, is_torque: true };
+        let rotation = |b: usize| self.bodies[self.model.handles[b]].position().rotation;
+        let m = about(w, v(self.node_position(joint.anchor)));
+        match &joint.kind {
+            JointKind::Revolute { axis } => out.push(torque(m.dot((rotation(joint.parent) * v(*axis)).normalize()))),
+            JointKind::Prismatic { axis } => out.push(CoordinateForce {
+                value: w.0.dot((rotation(joint.parent) * v(*axis)).normalize()),
+                is_torque: false,
+            }),
+            JointKind::Universal { axis1, axis2 } => {
+                out.push(torque(m.dot((rotation(joint.parent) * v(*axis1)).normalize())));
+                out.push(torque(m.dot((rotation(joint.child) * v(*axis2)).normalize())));
+            }
+            JointKind::Spherical => out.extend([torque(m.x), torque(m.y), torque(m.z)]),
+            JointKind::Fixed | JointKind::PlanarPin { .. } => {}
+        }
+    }
+
+    /// A free root's six generalized forces of the wrench `w` on it and what hangs from it:
+    /// the force, then the moment about its centre of mass.
+    fn root_coordinate_forces(&self, b: usize, w: Wrench, out: &mut Vec<CoordinateForce>) {
+        let force = |value: f64| CoordinateForce { value, is_torque: false };
+        let torque = |value: f64| CoordinateForce { value, is_torque: true };
+        let m = about(w, self.world_com(b));
+        out.extend([force(w.0.x), force(w.0.y), force(w.0.z), torque(m.x), torque(m.y), torque(m.z)]);
     }
 
     /// For every inextensible cable held at its length by the projection: the body loads of a
@@ -582,7 +578,8 @@ impl Simulation {
         let axes = [Vector::X, Vector::Y, Vector::Z];
         let mut out = Vec::new();
         for (j, joint) in s.joints.iter().enumerate() {
-            if self.model.joint_impulse[j].is_none() {
+            // A joint of the fit tree carries its reaction by recursion (`tree.rs`).
+            if self.model.joint_impulse[j].is_none() || self.model.fit_tree.carried(j).is_some() {
                 continue;
             }
             let anchor = v(self.node_position(joint.anchor));
@@ -634,6 +631,22 @@ impl Simulation {
         }
         out
     }
+}
+
+/// The number of coordinates a tree joint of this kind leaves free (as
+/// `Simulation::joint_coordinate_forces` lists them).
+fn coordinate_count(kind: &JointKind) -> usize {
+    match kind {
+        JointKind::Revolute { .. } | JointKind::Prismatic { .. } => 1,
+        JointKind::Universal { .. } => 2,
+        JointKind::Spherical => 3,
+        JointKind::Fixed | JointKind::PlanarPin { .. } => 0,
+    }
+}
+
+/// The moment of wrench `w` (force, moment about the world origin) about point `p`.
+fn about(w: Wrench, p: Vector) -> Vector {
+    w.1 - p.cross(w.0)
 }
 
 /// Two unit vectors orthogonal to `a` and to each other.

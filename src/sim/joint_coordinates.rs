@@ -220,7 +220,7 @@ impl TreePaths {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use crate::settings::SimSettings;
     use crate::sim::Simulation;
     use crate::structure::{BodyKind, Inertia, Joint, JointKind, Structure};
@@ -233,7 +233,7 @@ mod tests {
     /// top bar across them, joined by revolute joints about z but for a planar pin that closes
     /// the loop. Its 3 n links are past the looped multibody's limit, so it is cut into plain
     /// bodies with a tree.
-    fn four_bar_chain(n: usize) -> Structure {
+    pub(in crate::sim) fn four_bar_chain(n: usize) -> Structure {
         let mut s = Structure { name: "four-bar chain".into(), gravity: [0.0; 3], ..Default::default() };
         let base = s.add_body("base", BodyKind::Fixed, None);
         let (mut below, mut left, mut right) = (base, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);

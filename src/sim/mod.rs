@@ -29,6 +29,7 @@ pub mod modes;
 mod projection;
 mod relaxation;
 mod restart;
+mod tree;
 
 pub use build::LOOPED_MULTIBODY_MAX_LINKS;
 
@@ -77,7 +78,10 @@ pub struct Model {
     /// For each inextensible cable: its rope joint.
     cable_ropes: Vec<Option<ImpulseJointHandle>>,
     /// The joint each body hangs from in the multibody forest (fixed at build).
-    tree: forces::Tree,
+    tree: tree::Tree,
+    /// The reaction fit's tree: the multibody forest and the sparse groups' spanning trees
+    /// (`tree.rs`).
+    fit_tree: tree::Tree,
     /// The structure's constant external forces, summed per body [N].
     external_loads: Vec<[f64; 3]>,
     /// Characteristic length of the structure [m], for speeds and tolerances.

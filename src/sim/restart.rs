@@ -95,7 +95,7 @@ impl Simulation {
         // Then every free joint, parents first, turned (slid) so that a node of its child lands
         // where `s` has it.
         let mut order: Vec<usize> = (0..s.joints.len()).filter(|j| !self.model.actuated[*j]).collect();
-        order.sort_by_key(|&j| self.model.tree.depth(s, s.joints[j].child));
+        order.sort_by_key(|&j| self.model.tree.depth(s.joints[j].child));
         for j in order {
             if !self.place_free_joint(j, s) {
                 return false;
