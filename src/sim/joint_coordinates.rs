@@ -60,11 +60,15 @@ impl Simulation {
         if !g.multibodies.is_empty() || tree.links().len() != g.bodies.len() || !self.tree_joints_closed(tree, tol) {
             return None;
         }
-        let rows = |sim: &Simulation| sim.group_rows(g, taut);
-        let jacobian = |sim: &mut Simulation, g0: &[f64]| Jacobian::sparse(sim.joint_jacobian(g, taut, tree, g0.len()));
+        let on_tree = self.tree_joint_flags(tree);
+        let rows = |sim: &Simulation| sim.loop_rows(g, taut, &on_tree);
+        let jacobian =
+            |sim: &mut Simulation, g0: &[f64]| Jacobian::sparse(sim.joint_jacobian(g, taut, tree, &on_tree, g0.len()));
         let displace = |sim: &mut Simulation, dq: &[f64]| sim.turn_links(g, tree, dq);
-        let Closing { jacobian: jac, left, first_contraction, .. } =
+        let Closing { jacobian: jac, first_contraction, .. } =
             close_rows(self, &rows, &jacobian, &displace, None, GAP_TOLERANCE_FRACTION, max_first_contraction);
+        // Every row, the tree joints' included, for the verdict.
+        let left = largest_abs(&self.group_rows(g, taut));
         let closed = left <= tol && first_contraction <= max_first_contraction;
         if closed && jac.as_ref().is_some_and(Jacobian::rigid) {
             self.stop_bodies(&g.bodies);
@@ -88,6 +92,34 @@ impl Simulation {
             }
             largest_abs(&rows) <= tol
         })
+    }
+
+    /// For each structure joint: whether it is one of the tree's links.
+    fn tree_joint_flags(&self, tree: &GroupTree) -> Vec<bool> {
+        let mut on_tree = vec![false; self.model.structure.joints.len()];
+        for link in tree.links() {
+            on_tree[link.joint] = true;
+        }
+        on_tree
+    }
+
+    /// The rows the joint coordinates leave to close, in the group's member order: every row
+    /// of a joint off the tree, a tree joint's locked angle, each taut cable's stretch. A
+    /// turn keeps every other row of a tree joint as it was (closed: the jump starts from a
+    /// group whose tree joints are closed), so they are not evaluated while it closes.
+    fn loop_rows(&self, g: &ProjectedGroup, taut: &[usize], on_tree: &[bool]) -> Vec<f64> {
+        let s = &self.model.structure;
+        let rotation = |b: usize| self.bodies[self.model.handles[b]].position().rotation;
+        let mut out = Vec::new();
+        for &j in &g.joints {
+            if !on_tree[j] {
+                self.joint_rows(j, &mut out);
+            } else if let Some(target) = self.locked_angle(j) {
+                out.push(self.lock_row(j, rotation(s.joints[j].parent), rotation(s.joints[j].child), target));
+            }
+        }
+        self.cable_rows(taut, &mut out);
+        out
     }
 
     /// Each tree link's anchor and axes at the current poses, in link order.
@@ -133,22 +165,27 @@ impl Simulation {
         }
     }
 
-    /// The Jacobian of the group's `rows` rows by the joint coordinates: each member's rows by
-    /// the coordinates of the links on the tree path between its two bodies.
+    /// The Jacobian of the group's [`Self::loop_rows`] (`rows` of them) by the joint
+    /// coordinates: each member's rows by the coordinates of the links on the tree path between
+    /// its two bodies (a locked tree joint's: its own link's turn).
     fn joint_jacobian(
         &self,
         g: &ProjectedGroup,
         taut: &[usize],
         tree: &GroupTree,
+        on_tree: &[bool],
         rows: usize,
     ) -> super::least_squares::SparseRows {
         let s = &self.model.structure;
         let scale = self.model.length_scale_m;
         let axes = self.link_axes(tree);
         let path = TreePaths::of(self, g, tree);
-        let joints = g.joints.iter().map(|&j| {
+        // Each member with its two bodies and its rows' count; of a tree joint only the last
+        // row (its lock) is kept.
+        let joints = g.joints.iter().filter(|&&j| !on_tree[j] || self.locked_angle(j).is_some()).map(|&j| {
             let joint = &s.joints[j];
-            (Member::Joint(self.joint_frame(j)), [joint.parent, joint.child], self.joint_row_count(j))
+            let count = if on_tree[j] { 1 } else { self.joint_row_count(j) };
+            (Member::Joint(self.joint_frame(j)), [joint.parent, joint.child], count)
         });
         let cables =
             taut.iter().map(|&c| (Member::Cable(c), [s.nodes[s.cables[c].a].body, s.nodes[s.cables[c].b].body], 1));
@@ -160,7 +197,8 @@ impl Simulation {
                     let t = Twist { v: Vector::ZERO, w: *axis / scale, at: la.anchor };
                     block.clear();
                     member.row_rates(self, &|x| (x == moved).then_some(t), &mut block);
-                    entries.extend(block.iter().enumerate().map(|(r, &x)| (first_row + r, la.first + k, x)));
+                    let kept = &block[block.len() - count..];
+                    entries.extend(kept.iter().enumerate().map(|(r, &x)| (first_row + r, la.first + k, x)));
                 }
             }
             first_row += count;
@@ -270,35 +308,51 @@ pub(super) mod tests {
     }
 
     /// The joint-coordinate Jacobian of a 3-module four-bar chain cut into plain bodies is the
-    /// derivative of its rows as `turn_links` moves it: central differences agree with every
-    /// entry within 1e-8 (measured 1.9e-10; entries are of order 1, and a link left off a path
-    /// would be off by that much).
+    /// derivative of its loop rows as `turn_links` moves it: central differences agree with
+    /// every entry within 1e-8 (measured 1.9e-10; entries are of order 1, and a link left off
+    /// a path would be off by that much). The tree joints' rows, which the jump leaves out, do
+    /// not move with any turn: their central differences are at most 1e-8 too (measured 0).
     #[test]
     fn the_joint_jacobian_is_the_derivative_of_the_rows_along_the_tree() {
         let mut sim = Simulation::new(&four_bar_chain(3), &SimSettings::default()).expect("builds");
         let g = sim.model.projected_groups.first().cloned().expect("the chain is one projected group");
         let tree = g.tree.clone().expect("a sparse group has a tree");
         let taut = sim.projected_taut_cables(&g).expect("no slack cable");
-        let rows = |sim: &Simulation| sim.group_rows(&g, &taut);
-        let jacobian = sim.joint_jacobian(&g, &taut, &tree, rows(&sim).len()).to_dense();
+        let on_tree = sim.tree_joint_flags(&tree);
+        let rows = |sim: &Simulation| sim.loop_rows(&g, &taut, &on_tree);
+        let jacobian = sim.joint_jacobian(&g, &taut, &tree, &on_tree, rows(&sim).len()).to_dense();
         assert_eq!(jacobian.ncols(), 9, "one turn per revolute link of 9 bodies");
+        let mut left_out = Vec::new();
+        let mut first = 0;
+        for &j in &g.joints {
+            let count = sim.joint_row_count(j);
+            if on_tree[j] {
+                left_out.extend(first..first + count - usize::from(sim.locked_angle(j).is_some()));
+            }
+            first += count;
+        }
+        assert!(!left_out.is_empty(), "the tree joints' rows");
         let start = sim.group_poses(&g);
-        let mut worst = 0.0_f64;
+        let (mut worst, mut worst_left_out) = (0.0_f64, 0.0_f64);
         for k in 0..jacobian.ncols() {
             let mut moved = |h: f64| {
                 let mut dq = vec![0.0; jacobian.ncols()];
                 dq[k] = h;
                 sim.turn_links(&g, &tree, &dq);
-                let r = rows(&sim);
+                let r = (rows(&sim), sim.group_rows(&g, &taut));
                 sim.set_group_poses(&g, &start);
                 r
             };
             let (plus, minus) = (moved(STEP_M), moved(-STEP_M));
             for r in 0..jacobian.nrows() {
-                let difference = (plus[r] - minus[r]) / (2.0 * STEP_M);
+                let difference = (plus.0[r] - minus.0[r]) / (2.0 * STEP_M);
                 worst = worst.max((difference - jacobian[(r, k)]).abs());
+            }
+            for &r in &left_out {
+                worst_left_out = worst_left_out.max(((plus.1[r] - minus.1[r]) / (2.0 * STEP_M)).abs());
             }
         }
         assert!(worst <= 1e-8, "largest difference from the central differences {worst:.2e}");
+        assert!(worst_left_out <= 1e-8, "largest rate of a tree joint's row {worst_left_out:.2e}");
     }
 }

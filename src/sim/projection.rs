@@ -623,8 +623,7 @@ impl Simulation {
                 }
                 // An actuated joint locked off the tree: its angle at the command.
                 if let Some(target) = self.locked_angle(j) {
-                    let off = super::forces::relative_angle(pp.rotation, pc.rotation, vec3(axis)) - target;
-                    out.push(off.sin().atan2(off.cos()) * scale);
+                    out.push(self.lock_row(j, pp.rotation, pc.rotation, target));
                 }
             }
             JointKind::Universal { axis1, axis2 } => {
@@ -638,20 +637,34 @@ impl Simulation {
         debug_assert_eq!(out.len() - before, self.joint_row_count(j), "joint_row_count matches joint_rows");
     }
 
+    /// The row of revolute joint `j` locked at `target` [rad] (its parent's and child's
+    /// rotations `pp`, `pc`): the angle's offset, wrapped to (-pi, pi], times the structure's
+    /// size.
+    pub(super) fn lock_row(&self, j: usize, pp: Rotation, pc: Rotation, target: f64) -> f64 {
+        let JointKind::Revolute { axis } = self.model.structure.joints[j].kind else { return 0.0 };
+        let off = super::forces::relative_angle(pp, pc, Vector::new(axis[0], axis[1], axis[2])) - target;
+        off.sin().atan2(off.cos()) * self.model.length_scale_m
+    }
+
     /// The constraint rows of a projected group: each joint's ([`Self::joint_rows`]), then the
     /// stretch of each cable in `taut` [m].
     pub(super) fn group_rows(&self, g: &ProjectedGroup, taut: &[usize]) -> Vec<f64> {
-        let s = &self.model.structure;
         let mut out = Vec::new();
         for &j in &g.joints {
             self.joint_rows(j, &mut out);
         }
+        self.cable_rows(taut, &mut out);
+        out
+    }
+
+    /// The stretch of each cable in `taut` [m].
+    pub(super) fn cable_rows(&self, taut: &[usize], out: &mut Vec<f64>) {
+        let s = &self.model.structure;
         for &c in taut {
             let cable = &s.cables[c];
             let (pa, pb) = (self.node_position(cable.a), self.node_position(cable.b));
             out.push(crate::structure::distance(pa, pb) - self.cable_lengths[c]);
         }
-        out
     }
 
     /// The rates of [`Self::group_rows`] (same order and scaling) when each body moves with
