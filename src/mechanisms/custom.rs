@@ -24,7 +24,7 @@ pub struct Custom {
     params: Values,
     /// The structure at the other sets of parameters a sweep over them settles at.
     variants: Vec<(Values, Structure)>,
-    /// `structure`'s size [m] ([`crate::structure::structure_size`], quadratic in the nodes:
+    /// `structure`'s size [m] ([`crate::structure::structure_size`], up to quadratic in the nodes:
     /// computed once).
     size_m: f64,
 }
@@ -231,7 +231,7 @@ enum StrutReading {
 /// How the axial force of `st` is read, or None when it cannot be: a strut on a fixed body
 /// (its force goes into the ground) or with a joint at both ends (the joints' reactions share
 /// the axial force in a way the body's balance does not determine). `size`: the structure's
-/// ([`crate::structure::structure_size`], computed once by the caller: it is quadratic in the
+/// ([`crate::structure::structure_size`], computed once by the caller: it can be quadratic in the
 /// nodes, and computing it per strut had made checking a 1000-rod model take 10.9 s).
 fn strut_reading(s: &Structure, st: &crate::structure::Strut, size: f64) -> Option<StrutReading> {
     let fixed = |n: usize| s.bodies[s.nodes[n].body].kind == crate::structure::BodyKind::Fixed;
