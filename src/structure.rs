@@ -576,7 +576,8 @@ mod tests {
 
     /// The pruned structure size is the all-pairs one to the bit: on 50 clouds of 1 to 295
     /// pseudo-random nodes (a fixed linear congruential sequence), each stretched along x by
-    /// up to 50 times like a chain, and with one node alone.
+    /// up to 50 times, one of them a node alone; and on as many noisy half circles of nodes in
+    /// order, where most pairs of runs are left out.
     #[test]
     fn the_pruned_size_is_the_largest_pair_distance_to_the_bit() {
         let mut state: u64 = 0x2545_f491_4f6c_dd1d;
@@ -585,13 +586,20 @@ mod tests {
             (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         };
         for cloud in 0..50 {
-            let mut s = super::Structure::default();
-            let body = s.add_body("b", super::BodyKind::Fixed, None);
+            let (mut s, mut arc) = (super::Structure::default(), super::Structure::default());
+            let (body, arc_body) =
+                (s.add_body("b", super::BodyKind::Fixed, None), arc.add_body("b", super::BodyKind::Fixed, None));
             let stretch = 1.0 + 49.0 * (cloud as f64 / 49.0);
-            for i in 0..1 + cloud * 6 {
+            let nodes = 1 + cloud * 6;
+            for i in 0..nodes {
                 s.add_node(&format!("n{i}"), body, [stretch * next(), next(), 0.1 * next()]);
+                // In order along a half circle, as a curled chain is drawn.
+                let angle = std::f64::consts::PI * i as f64 / nodes as f64;
+                let at = [stretch * angle.cos() + 0.1 * next(), stretch * angle.sin() + 0.1 * next(), 0.1 * next()];
+                arc.add_node(&format!("n{i}"), arc_body, at);
             }
             assert_eq!(super::structure_size(&s).to_bits(), all_pairs_size(&s).to_bits(), "cloud {cloud}");
+            assert_eq!(super::structure_size(&arc).to_bits(), all_pairs_size(&arc).to_bits(), "arc {cloud}");
         }
     }
 
