@@ -327,7 +327,6 @@ impl Simulation {
     /// path between them, and a free root's where a path ends at one. Without tree joints each
     /// load moves the six coordinates of each of its two bodies.
     fn tree_closure_matrix(&self, tree: &Tree, closure_loads: &[ClosureComponent], rows: usize) -> SparseRows {
-        let s = &self.model.structure;
         let scale = self.model.length_scale_m;
         let (joint_row, root_row) = self.coordinate_rows(tree);
         let free = |b: usize| self.is_free(b).then_some(b);
@@ -363,7 +362,7 @@ impl Simulation {
                 side[i].0 = up;
             }
         }
-        debug_assert!(joint_row.iter().chain(&root_row).flatten().all(|&r| r < rows) || s.bodies.is_empty());
+        debug_assert!(joint_row.iter().chain(&root_row).flatten().all(|&r| r < rows), "rows as coordinate_forces");
         SparseRows::new(rows, closure_loads.len(), &entries)
     }
 

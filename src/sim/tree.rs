@@ -115,9 +115,14 @@ impl Tree {
 impl Simulation {
     /// The tree of the multibody links: the joint each body hangs from.
     pub(super) fn link_tree(&self) -> Tree {
+        Tree::new(&self.model.structure, self.link_hangs(), false)
+    }
+
+    /// Each multibody link's child, hung from its parent.
+    fn link_hangs(&self) -> Vec<(usize, Hang)> {
         let s = &self.model.structure;
         let links = s.joints.iter().enumerate().filter(|(j, _)| self.model.joint_links[*j].is_some());
-        Tree::new(s, links.map(|(j, joint)| (joint.child, Hang { joint: j, parent: joint.parent })), false)
+        links.map(|(j, joint)| (joint.child, Hang { joint: j, parent: joint.parent })).collect()
     }
 
     /// The reaction fit's tree: the multibody links, and each sparse projected group's
@@ -125,13 +130,7 @@ impl Simulation {
     /// the fit does not read, which stays a fitted closure).
     pub(super) fn fit_tree(&self) -> Tree {
         let s = &self.model.structure;
-        let mut hangs: Vec<(usize, Hang)> = s
-            .joints
-            .iter()
-            .enumerate()
-            .filter(|(j, _)| self.model.joint_links[*j].is_some())
-            .map(|(j, joint)| (joint.child, Hang { joint: j, parent: joint.parent }))
-            .collect();
+        let mut hangs = self.link_hangs();
         let links = hangs.len();
         for g in &self.model.projected_groups {
             for link in g.tree.iter().flat_map(|t| t.links()) {
