@@ -1230,7 +1230,7 @@ impl Member {
 }
 
 /// The root of `x` in the union-find forest `p`, halving the path on the way.
-fn find_root(p: &mut [usize], mut x: usize) -> usize {
+pub(super) fn find_root(p: &mut [usize], mut x: usize) -> usize {
     while p[x] != x {
         p[x] = p[p[x]];
         x = p[x];
