@@ -250,9 +250,7 @@ impl Simulation {
         let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) else {
             return Err(format!("joint '{name}' has no multibody link"));
         };
-        // Forward kinematics settles the multibody's root (fixed or free), and with it the
-        // degree-of-freedom indices read next.
-        mb.forward_kinematics(&self.bodies, true);
+        // The degree-of-freedom indices hold from the build, which settled every root.
         let Some(start) = mb.link(link_id).map(|l| l.assembly_id()).filter(|s| *s < mb.ndofs()) else {
             return Err(format!("joint '{name}' has no degree of freedom of its own in its multibody"));
         };
@@ -586,19 +584,14 @@ impl Simulation {
         if at_once && self.jump_locked_commands_at_once(&locks) {
             return;
         }
-        // The multibodies moved. Forward kinematics settles each one's root (and so its
-        // degree-of-freedom indices, read below) before the first move.
+        // The multibodies moved (their degree-of-freedom indices hold from the build, which
+        // settled every root).
         let mut multibodies: Vec<MultibodyIndex> = Vec::new();
         for &(j, _) in &moves {
             if let Some((m, _)) = self.dof_of(j) {
                 if !multibodies.contains(&m) {
                     multibodies.push(m);
                 }
-            }
-        }
-        for &m in &multibodies {
-            if let Some(mb) = self.multibody_joints.get_multibody_mut(m) {
-                mb.forward_kinematics(&self.bodies, true);
             }
         }
         // Each multibody's moves at once: (degree of freedom, displacement per increment).

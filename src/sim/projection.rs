@@ -1036,8 +1036,8 @@ struct GroupCoordinates {
 }
 
 impl GroupCoordinates {
-    /// The free coordinates are read here: rapier counts a fixed root's six degrees of freedom
-    /// until its first forward kinematics.
+    /// The free coordinates, read from the multibodies' links (their indices hold from the
+    /// build, which settled every root: `build.rs`).
     fn of(sim: &Simulation, g: &ProjectedGroup) -> Self {
         GroupCoordinates {
             n_plain: 6 * g.bodies.len(),
