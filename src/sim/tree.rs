@@ -46,17 +46,7 @@ impl Tree {
             hang[b] = Some(h);
             carried[h.joint] = Some(b);
         }
-        // Bounded by the bodies: a cycle (never built) cannot hang the walk.
-        let depth: Vec<usize> = (0..nb)
-            .map(|mut b| {
-                let mut d = 0;
-                while let (Some(h), true) = (hang[b], d < nb) {
-                    d += 1;
-                    b = h.parent;
-                }
-                d
-            })
-            .collect();
+        let depth = depths(&hang);
         let mut by_depth: Vec<(usize, usize)> = (0..nb).map(|b| (depth[b], b)).collect();
         by_depth.sort_unstable_by(|a, b| b.cmp(a));
         let order = by_depth.into_iter().map(|(_, b)| b).collect();
@@ -110,6 +100,37 @@ impl Tree {
         }
         sums
     }
+}
+
+/// Each body's number of hangs to its root, each branch walked once (walking up from every
+/// body grows with the square of a chain's length). Bounded by the bodies: a cycle (never
+/// built) cannot hang the walk.
+fn depths(hang: &[Option<Hang>]) -> Vec<usize> {
+    let mut depth: Vec<Option<usize>> = vec![None; hang.len()];
+    let mut below = Vec::new();
+    for b in 0..hang.len() {
+        let mut x = b;
+        let base = loop {
+            if let Some(d) = depth[x] {
+                break d;
+            }
+            match hang[x] {
+                Some(h) if below.len() < hang.len() => {
+                    below.push(x);
+                    x = h.parent;
+                }
+                _ => {
+                    depth[x] = Some(0);
+                    break 0;
+                }
+            }
+        };
+        for (k, &y) in below.iter().rev().enumerate() {
+            depth[y] = Some(base + k + 1);
+        }
+        below.clear();
+    }
+    depth.into_iter().map(|d| d.unwrap_or(0)).collect()
 }
 
 impl Simulation {
@@ -188,9 +209,9 @@ mod tests {
     fn the_fit_in_joint_coordinates_finds_the_torques_of_the_fit_in_body_coordinates() {
         let mut sim = Simulation::new(&locked_four_bar_chain(), &SimSettings::default()).expect("builds");
         assert!(sim.model.fit_tree.has_group_links(), "the chain is cut into plain bodies with a tree");
-        let backwards = (0..sim.model.structure.joints.len())
-            .filter(|&j| sim.model.fit_tree.carried(j).is_some_and(|b| b != sim.model.structure.joints[j].child));
-        assert!(backwards.clone().any(|j| j == FLIPPED), "the flipped joint is run backwards");
+        let backwards =
+            sim.model.fit_tree.carried(FLIPPED).is_some_and(|b| b != sim.model.structure.joints[FLIPPED].child);
+        assert!(backwards, "the flipped joint is run backwards");
         let in_joints = sim.member_forces();
         sim.model.fit_tree = sim.link_tree();
         let in_bodies = sim.member_forces();
