@@ -60,13 +60,10 @@ pub(super) fn run_motion(
         runner.sim.release_damping();
     }
     if let Some((c, displacement, rate)) = &m.coordinate {
-        runner
-            .sim
-            .set_joint_motion(c.index, *displacement, *rate)
-            .map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
+        runner.sim.set_joint_motion(c.index, *displacement, *rate)?;
     }
     if let Some((body, _, w)) = &m.spin {
-        runner.sim.set_body_spin(*body, *w).map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
+        runner.sim.set_body_spin(*body, *w)?;
     }
     let modes = start_modes(runner, m)?;
     for o in runner.observers.iter_mut() {
@@ -80,7 +77,7 @@ pub(super) fn run_motion(
     }
     runner.emit(format_args!("motion: {} steps of physical dynamics, every settle accelerator off", m.steps));
     if m.drive.is_some() {
-        runner.sim.drive_physically().map_err(|e| Stop::Model(ModelError::no_solution(e)))?;
+        runner.sim.drive_physically()?;
     }
     let mut prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
     let mut result = Ok(());

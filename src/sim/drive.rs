@@ -10,7 +10,7 @@
 //! closes a loop (locked off the tree, `build::locked_joint`) has no such degree of freedom and is
 //! refused.
 
-use super::Simulation;
+use super::{SimError, Simulation};
 use crate::structure::ActuatorTarget;
 use rapier3d_f64::prelude::*;
 
@@ -26,19 +26,20 @@ impl Simulation {
     /// From now on every actuated joint is driven through the solver ([`Simulation::drive_commands`]);
     /// Err naming a joint actuator that is not a multibody link of its own (a loop's closing
     /// joint) or an actuator that moves a fixed node.
-    pub fn drive_physically(&mut self) -> Result<(), String> {
+    pub fn drive_physically(&mut self) -> Result<(), SimError> {
         let s = &self.model.structure;
         for a in &s.actuators {
             let j = match a.target {
                 ActuatorTarget::Joint(j) => j,
                 ActuatorTarget::CableLength(_) => continue,
                 ActuatorTarget::FixedNode { .. } => {
-                    return Err(format!("actuator '{}' moves a fixed node: it cannot be followed physically", a.symbol))
+                    let what = format!("actuator '{}' moves a fixed node: it cannot be followed physically", a.symbol);
+                    return Err(SimError::Refused(what));
                 }
             };
             let name = &s.joints[j].name;
             let refused = || {
-                format!("actuated joint '{name}' closes a loop (locked at its command off the multibody tree): it cannot be driven physically")
+                SimError::Refused(format!("actuated joint '{name}' closes a loop (locked at its command off the multibody tree): it cannot be driven physically"))
             };
             let link = self.model.joint_links[j].ok_or_else(refused)?;
             let (mb, id) = self.multibody_joints.get_mut(link.multibody_joint).ok_or_else(refused)?;

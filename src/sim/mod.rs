@@ -45,6 +45,10 @@ pub enum SimError {
     Build(String),
     #[error("simulation diverged at tick {tick} (t = {time_s:.6} s): {what}")]
     Diverged { tick: u64, time_s: f64, what: String },
+    /// A request the built structure cannot carry out (a coordinate it does not have, a body
+    /// that is not free, an actuator that cannot be driven physically).
+    #[error("the simulator cannot do this: {0}")]
+    Refused(String),
 }
 
 /// Where a free body sits in a multibody, so its joint coordinates can be read and perturbed.
@@ -230,10 +234,10 @@ impl Simulation {
     /// by `displacement` and sets its rate to `rate` [rad/s or m/s], the bodies beyond it
     /// carried along; the other coordinates and rates stay. Only a joint that is a free
     /// (not actuated) link of a multibody has such a coordinate here.
-    pub fn set_joint_motion(&mut self, j: usize, displacement: f64, rate: f64) -> Result<(), String> {
+    pub fn set_joint_motion(&mut self, j: usize, displacement: f64, rate: f64) -> Result<(), SimError> {
         if self.model.actuated[j] {
             let name = &self.model.structure.joints[j].name;
-            return Err(format!("joint '{name}' is actuated: its coordinate is commanded"));
+            return Err(SimError::Refused(format!("joint '{name}' is actuated: its coordinate is commanded")));
         }
         self.constraint_inputs += 1;
         self.move_joint(j, displacement, Some(rate))
@@ -242,17 +246,17 @@ impl Simulation {
     /// Moves joint `j`'s coordinate by `displacement` (rad or m), the bodies beyond it along,
     /// and sets its rate (rad/s or m/s) where one is given; Err where the joint has no degree of
     /// freedom of its own in a multibody (a loop's closing joint).
-    pub(super) fn move_joint(&mut self, j: usize, displacement: f64, rate: Option<f64>) -> Result<(), String> {
+    pub(super) fn move_joint(&mut self, j: usize, displacement: f64, rate: Option<f64>) -> Result<(), SimError> {
         let name = &self.model.structure.joints[j].name;
         let Some(link) = self.model.joint_links[j] else {
-            return Err(format!("joint '{name}' closes a loop: it has no coordinate of its own"));
+            return Err(SimError::Refused(format!("joint '{name}' closes a loop: it has no coordinate of its own")));
         };
         let Some((mb, link_id)) = self.multibody_joints.get_mut(link.multibody_joint) else {
-            return Err(format!("joint '{name}' has no multibody link"));
+            return Err(SimError::Refused(format!("joint '{name}' has no multibody link")));
         };
         // The degree-of-freedom indices hold from the build, which settled every root.
         let Some(start) = mb.link(link_id).map(|l| l.assembly_id()).filter(|s| *s < mb.ndofs()) else {
-            return Err(format!("joint '{name}' has no degree of freedom of its own in its multibody"));
+            return Err(SimError::Refused(format!("joint '{name}' has no degree of freedom of its own in its multibody")));
         };
         let mut disp = vec![0.0; mb.ndofs()];
         disp[start] = displacement;
@@ -267,10 +271,11 @@ impl Simulation {
 
     /// Sets a free body's angular velocity [rad/s] (world frame); Err for a multibody link,
     /// whose velocity is its joints' rates.
-    pub fn set_body_spin(&mut self, body: usize, angular_velocity: [f64; 3]) -> Result<(), String> {
+    pub fn set_body_spin(&mut self, body: usize, angular_velocity: [f64; 3]) -> Result<(), SimError> {
         let h = self.model.handles[body];
         if !self.is_free(body) || self.multibody_joints.rigid_body_link(h).is_some() {
-            return Err(format!("body '{}' is not a free body of its own", self.model.structure.bodies[body].name));
+            let name = &self.model.structure.bodies[body].name;
+            return Err(SimError::Refused(format!("body '{name}' is not a free body of its own")));
         }
         let [x, y, z] = angular_velocity;
         self.bodies[h].set_angvel(Vector::new(x, y, z), true);
