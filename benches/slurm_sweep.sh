@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# A real Slurm run of the README's sharded sweep, on this machine (issue 22).
+# A real Slurm run of the sharded sweep of docs/command-line.md, on this machine (issue 22).
 #
 # Installs Slurm and MUNGE from Debian's packages (when missing), starts a one-node cluster
 # (munged + slurmctld + slurmd, node "localhost" with 2 CPUs, all state under $SLURM_SWEEP_DIR),
-# submits the README's job array (`tensegrity sweep S.toml --jobs 2 --shard K/N --out
+# submits that chapter's job array (`tensegrity sweep S.toml --jobs 2 --shard K/N --out
 # shard-K.csv`), waits for it, merges the shards with `tensegrity merge`, and compares the merged
 # CSV with the unsharded `tensegrity sweep` of the same scenario:
 #   - the same header and the same rows (`index,grid_points` equal, row for row);
@@ -26,7 +26,7 @@ REPO=$(pwd)
 TENSEGRITY_BIN=${TENSEGRITY_BIN:-/root/.cache/tensegrity-testbed/target/release/tensegrity}
 SCENARIO=${SCENARIO:-scenarios/mohr2011/workspace_sweep.toml}
 SHARDS=${SHARDS:-16}
-# Threads per array task (the README's `--jobs 2`); each task asks Slurm for as many CPUs.
+# Threads per array task (the chapter's `--jobs 2`); each task asks Slurm for as many CPUs.
 JOBS=${JOBS:-2}
 # The node's CPUs (this machine has 2).
 NODE_CPUS=${NODE_CPUS:-2}
@@ -172,7 +172,7 @@ done
 sinfo -N -l
 phase_done cluster "$t"
 
-# --- the README's job array -------------------------------------------------------------------
+# --- docs/command-line.md's job array ---------------------------------------------------------
 t=$(now)
 OUT=$WORK/out
 cat >"$WORK/shard.sbatch" <<EOF

@@ -85,24 +85,30 @@ fn structure_errors_name_file_line_and_column() {
     }
 }
 
-/// The README's example of a custom structure is a complete scenario that passes.
+/// The chapter on custom structures, moved there from the README.
+const CUSTOM_STRUCTURES: &str = "docs/custom-structures.md";
+
+/// The example of a custom structure (`docs/custom-structures.md`) is a complete scenario that
+/// passes.
 #[test]
 fn the_readme_example_runs_and_passes() {
-    let readme = std::fs::read_to_string("README.md").unwrap();
-    let start = readme.find("name = \"Snelson X module\"\nmechanism = \"custom\"").expect("example in README");
-    let text = &readme[start..start + readme[start..].find("```").unwrap()];
-    let sc = scenario::parse(Path::new("README.md"), text).expect("the example parses");
+    let chapter = std::fs::read_to_string(CUSTOM_STRUCTURES).unwrap();
+    let start = chapter
+        .find("name = \"Snelson X module\"\nmechanism = \"custom\"")
+        .expect("example in docs/custom-structures.md");
+    let text = &chapter[start..start + chapter[start..].find("```").unwrap()];
+    let sc = scenario::parse(Path::new(CUSTOM_STRUCTURES), text).expect("the example parses");
     let r = run(&sc, &RunOptions::default());
     assert!(r.passed, "{:?}", r.error);
 }
 
-/// The defaults the README's table states, read off the pinned strut of `common.rs` with its
+/// The defaults the table of `docs/custom-structures.md` states, read off the pinned strut of `common.rs` with its
 /// gravity, joint damping and spring length taken out and a cable added: the 1 m bar of 1 kg on
 /// nodes (0, 0, 0) and (1, 0, 0) gets its centre of mass at the midpoint and the isotropic
 /// moment 1 x 1^2 / 12 kg m^2 (a uniform thin rod's about its middle) within 1e-15; a strut
 /// radius 0.01 m, a cable's and a spring's 0.001 m, a cable inextensible of the drawn length
 /// 1 m (the spring's too), a joint undamped without torsion spring at coordinate 0, no
-/// gravity, and the `[sim]` and `[settle]` defaults; the README's table says each.
+/// gravity, and the `[sim]` and `[settle]` defaults; the chapter's table says each.
 #[test]
 fn the_documented_defaults_are_the_structures() {
     let text = common::PINNED_STRUT.replace("gravity = [0.0, 0.0, 0.0]\n", "").replace("damping = 0.5\n", "");
@@ -124,7 +130,7 @@ fn the_documented_defaults_are_the_structures() {
     assert!(sim.newton_damping, "a custom tree of joints");
     assert_eq!((settle.speed_tol_m_per_s, settle.window_steps, settle.max_time_s), (1e-10, 10, 60.0));
     assert_eq!((settle.residual_force_tol_n, settle.residual_torque_tol_nm), (1e-7, 1e-7));
-    let readme = std::fs::read_to_string("README.md").unwrap();
+    let chapter = std::fs::read_to_string(CUSTOM_STRUCTURES).unwrap();
     for row in [
         "| 0.01 s, 1, 8, 0 1/s, true, 1000 m, 1e6 J |",
         "| 1e-10 m/s, 10 steps, 1e-7 N, 1e-7 N m, 60 s |",
@@ -137,6 +143,6 @@ fn the_documented_defaults_are_the_structures() {
         "| joint damping, torsion spring, `torsion_rest`, `initial_coordinate` | 0 N m s/rad (N s/m), none, 0 rad, 0 |",
         "| gravity | none |",
     ] {
-        assert!(readme.contains(row), "the README's defaults table lacks: {row}");
+        assert!(chapter.contains(row), "the defaults table of {CUSTOM_STRUCTURES} lacks: {row}");
     }
 }

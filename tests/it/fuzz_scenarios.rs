@@ -4,7 +4,7 @@
 //! into extremes (1e300, 1e-300, subnormals), and each case must finish within
 //! `CASE_TIME_LIMIT_S` (no hang in parsing, validation or the analytic checks it runs).
 //!
-//! The test suite runs a few hundred cases. The long run (documented in the README):
+//! The test suite runs a few hundred cases. The long run (documented in `docs/testing.md`):
 //! `PROPTEST_CASES=1000000 cargo test --release --test it fuzz_scenarios` (stop it after 10
 //! minutes or more; any failing input is saved under `proptest-regressions/`).
 

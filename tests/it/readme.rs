@@ -1,13 +1,15 @@
-//! Every command the README shows in a code block runs, and exits 0: `tensegrity ...` and
-//! `cargo run --release -- ...` lines (the latter through the built binary), in a scratch
-//! directory that sees the repository's `scenarios/` and `tests/` (so outputs such as
-//! `out/report.json` never land in the repository). A line with `${SLURM_ARRAY_TASK_ID}` runs
-//! once for every task of its `--shard K/N`.
+//! Every command the README and the chapters of `docs/` show in a code block runs, and exits 0:
+//! `tensegrity ...` and `cargo run --release -- ...` lines (the latter through the built
+//! binary), in one scratch directory that sees the repository's `scenarios/` and `tests/` (so
+//! outputs such as `out/report.json` never land in the repository). README.md comes first, then
+//! `docs/*.md` in name order, each file's commands in its order; a command shown again (the
+//! README's tutorial steps are the chapters' first lines) runs once, where it is first shown. A
+//! line with `${SLURM_ARRAY_TASK_ID}` runs once for every task of its `--shard K/N`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The command lines of the README's code blocks, with their line numbers.
+/// The command lines of a Markdown file's code blocks, with their line numbers.
 fn commands(readme: &str) -> Vec<(usize, String)> {
     let mut inside = false;
     let mut out = Vec::new();
@@ -67,19 +69,39 @@ fn run(dir: &Path, command: &str, task: usize) -> (bool, String) {
     (out.status.success(), text)
 }
 
+/// README.md, then every `docs/*.md` in name order.
+fn documents() -> Vec<PathBuf> {
+    let mut docs: Vec<PathBuf> = std::fs::read_dir("docs")
+        .expect("docs/")
+        .map(|e| e.expect("docs/ entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "md"))
+        .collect();
+    docs.sort();
+    assert!(docs.len() >= 10, "docs/ has {} Markdown files", docs.len());
+    std::iter::once(PathBuf::from("README.md")).chain(docs).collect()
+}
+
 #[test]
-fn every_command_the_readme_shows_runs_and_exits_0() {
-    let readme = std::fs::read_to_string("README.md").expect("README.md");
-    let list = commands(&readme);
-    assert!(list.len() >= 10, "the README shows {} commands", list.len());
+fn every_command_the_readme_and_docs_show_runs_and_exits_0() {
+    let mut list: Vec<(String, usize, String)> = Vec::new();
+    for file in documents() {
+        let text = std::fs::read_to_string(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        list.extend(commands(&text).into_iter().map(|(line, c)| (file.display().to_string(), line, c)));
+    }
+    assert!(list.len() >= 20, "the README and docs/ show {} commands", list.len());
+    assert!(list.iter().filter(|(f, ..)| f == "README.md").count() >= 5, "the README's own commands");
     let dir = scratch();
     let mut failed = Vec::new();
-    for (line, command) in &list {
+    let mut seen = std::collections::HashSet::new();
+    for (file, line, command) in &list {
+        if !seen.insert(command.clone()) {
+            continue;
+        }
         for task in 1..=shards(command) {
             let (ok, text) = run(&dir, command, task);
             if !ok {
                 failed.push(format!(
-                    "README.md:{line}: {command} (task {task})\n{}",
+                    "{file}:{line}: {command} (task {task})\n{}",
                     text.lines().take(5).collect::<Vec<_>>().join("\n")
                 ));
             }

@@ -18,9 +18,9 @@ fn run_text(name: &str, text: &str) -> ScenarioReport {
     run(&sc, &RunOptions::default())
 }
 
-/// An n-strut prism in the README's format: bottom node i joined by strut i to top node i, the
-/// top polygon turned by `twist_rad` from the bottom, polygon and side cables elastic (100 N/m)
-/// at 90 % of their drawn length, strut 1 held. `extra` is appended (more members, sections).
+/// An n-strut prism in the format of `docs/custom-structures.md`: bottom node i joined by strut
+/// i to top node i, the top polygon turned by `twist_rad` from the bottom, polygon and side
+/// cables elastic (100 N/m) at 90 % of their drawn length, strut 1 held. `extra` is appended (more members, sections).
 fn prism(n: usize, twist_rad: f64, extra: &str) -> String {
     let (r, h) = (1.0, 1.5);
     let at = |k: usize, z: f64, phase: f64| {
