@@ -1,6 +1,6 @@
 //! Structure -> rapier sets.
 
-use super::{LinkRef, Model, SimError, SimSettings, Simulation};
+use super::{Data, LinkRef, Model, SimError, SimSettings};
 use crate::structure::{ActuatorTarget, BodyKind, CableLaw, Joint, JointKind, Structure, Vec3};
 use rapier3d_f64::prelude::*;
 
@@ -8,7 +8,9 @@ fn v(a: Vec3) -> Vector {
     Vector::new(a[0], a[1], a[2])
 }
 
-pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation, SimError> {
+/// The model and the data of `s`: the model is complete when this returns, and nothing
+/// writes it after. The commands are not yet applied (`Simulation::new` applies them).
+pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<(Model, Data), SimError> {
     check_settings(settings)?;
     let n = s.bodies.len();
     let actuated = actuated_joints(s)?;
@@ -16,8 +18,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
     let joints = insert_joints(s, &mut bodies, &handles, &actuated)?;
     let Joints { mut impulse_joints, multibody_joints, joint_links, joint_impulse, hidden_links } = joints;
     let cable_ropes = insert_ropes(s, &mut impulse_joints, &handles)?;
-    let commands = s.initial_commands();
-    let model = Model {
+    let mut model = Model {
         structure: s.clone(),
         settings: settings.clone(),
         handles,
@@ -34,8 +35,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         fit_tree: super::tree::Tree::default(),
         relaxation_applies: super::relaxation::applies(s),
     };
-    let mut sim = Simulation {
-        model,
+    let mut data = Data {
         pipeline: PhysicsPipeline::new(),
         params: integration_parameters(settings),
         islands: IslandManager::new(),
@@ -48,43 +48,31 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<Simulation,
         soft_bodies: SoftBodySet::new(),
         ccd: CCDSolver::new(),
         cable_lengths: s.cables.iter().map(|c| c.length_m).collect(),
-        commands: commands.clone(),
+        commands: s.initial_commands(),
         probe_loads: vec![([0.0; 3], [0.0; 3]); n],
         tick: 0,
-        relaxing: false,
-        relaxation_shift: 0.0,
-        relaxation_last_force: f64::INFINITY,
-        physical: false,
-        last_step_accelerated: false,
-        accelerated_steps: 0,
-        driven: false,
         locked_coordinates: vec![0.0; s.joints.len()],
-        kept_jacobians: Vec::new(),
-        rigid_rests: Vec::new(),
-        closure_rests: Vec::new(),
         constraint_inputs: 0,
     };
-    sim.settle_multibody_roots();
-    sim.model.tree = sim.link_tree();
-    sim.model.internal_closures = sim.find_internal_closures();
-    sim.model.projected_groups = sim.find_projected_groups();
-    sim.model.fit_tree = sim.fit_tree();
-    sim.set_commands(&commands);
-    sim.set_relaxation(true);
-    Ok(sim)
+    data.settle_multibody_roots(&model);
+    model.tree = data.link_tree(&model);
+    model.internal_closures = data.find_internal_closures(&model);
+    model.projected_groups = data.find_projected_groups(&model);
+    model.fit_tree = data.fit_tree(&model);
+    Ok((model, data))
 }
 
-impl Simulation {
+impl Data {
     /// rapier counts a fixed root's six degrees of freedom until the multibody's first forward
     /// kinematics: every multibody's root is settled here, so that the degree-of-freedom
     /// indices read before the first step (the loops' projection at the drawn configuration)
     /// stay valid through it. Without it an unactuated looped multibody (a four-bar hung from
     /// the base) panicked at its first projection.
-    fn settle_multibody_roots(&mut self) {
+    fn settle_multibody_roots(&mut self, m: &Model) {
         let mut settled = Vec::new();
-        for (j, link) in self.model.joint_links.iter().enumerate() {
+        for (j, link) in m.joint_links.iter().enumerate() {
             let Some(link) = link else { continue };
-            let child = self.model.handles[self.model.structure.joints[j].child];
+            let child = m.handles[m.structure.joints[j].child];
             let Some(index) = self.multibody_joints.rigid_body_link(child).map(|l| l.multibody) else { continue };
             if settled.contains(&index) {
                 continue;

@@ -15,7 +15,7 @@
 //! generation holds and the joints are within [`super::projection::RIGID_REST_FRACTION`] of it.
 
 use super::projection::{ProjectedGroup, GAP_TOLERANCE_FRACTION, RIGID_REST_FRACTION, SVD_RELATIVE_TOLERANCE};
-use super::Simulation;
+use super::{Data, Model};
 use rapier3d_f64::prelude::*;
 
 /// Where a looped multibody's loops were last closed, at the generation of the constraint
@@ -27,15 +27,50 @@ pub(super) struct ClosureRest {
     joints: Option<(Vec<MultibodyJoint>, f64)>,
 }
 
-impl Simulation {
-    /// Puts multibody `m` back at its rest and stops it, when one is recorded at the current
-    /// generation and every joint coordinate is within [`RIGID_REST_FRACTION`] of the
+/// Every looped multibody's closure rest.
+#[derive(Default)]
+pub(super) struct ClosureRests {
+    rests: Vec<ClosureRest>,
+}
+
+impl ClosureRests {
+    /// Closes every loop inside a multibody to round-off and projects the velocities onto the
+    /// closures' tangent space, putting a multibody back at its rest where it has one. Returns
+    /// the largest gap left [m].
+    pub(super) fn project_internal_closures(&mut self, m: &Model, d: &mut Data) -> f64 {
+        let mut largest = 0.0_f64;
+        let mut multibodies: Vec<MultibodyIndex> = Vec::new();
+        for c in &m.internal_closures {
+            if !multibodies.contains(&c.multibody) {
+                multibodies.push(c.multibody);
+            }
+        }
+        for &index in &multibodies {
+            if d.free_dofs(index).is_empty() {
+                continue;
+            }
+            if let Some(left) = self.back_to_closure_rest(m, d, index) {
+                largest = largest.max(left);
+                continue;
+            }
+            // The loops of one multibody: a group of its free coordinates alone.
+            let joints = m.internal_closures.iter().filter(|c| c.multibody == index).map(|c| c.joint).collect();
+            let g = ProjectedGroup { multibodies: vec![index], joints, ..Default::default() };
+            let p = d.project_group(m, &g, &[], &mut None, &mut None, GAP_TOLERANCE_FRACTION, f64::INFINITY);
+            largest = largest.max(p.left);
+            self.note_closure_closed(m, d, index, &g, p.left);
+        }
+        largest
+    }
+
+    /// Puts multibody `index` back at its rest and stops it, when one is recorded at the
+    /// current generation and every joint coordinate is within [`RIGID_REST_FRACTION`] of the
     /// structure's size of it (angles times the size); the largest row left there [m], or None.
-    pub(super) fn back_to_closure_rest(&mut self, m: MultibodyIndex) -> Option<f64> {
-        let scale = self.model.length_scale_m;
-        let rest = self.closure_rests.iter().find(|r| r.multibody == m && r.generation == self.constraint_inputs)?;
+    fn back_to_closure_rest(&mut self, m: &Model, d: &mut Data, index: MultibodyIndex) -> Option<f64> {
+        let scale = m.length_scale_m;
+        let rest = self.rests.iter().find(|r| r.multibody == index && r.generation == d.constraint_inputs)?;
         let (joints, left) = rest.joints.as_ref()?;
-        let mb = self.multibody_joints.get_multibody_mut(m)?;
+        let mb = d.multibody_joints.get_multibody_mut(index)?;
         let near = mb.links().zip(joints).all(|(link, then)| {
             let (now, then) = (link.joint().coords(), then.coords());
             (0..6).all(|k| (now[k] - then[k]).abs() * if k < 3 { 1.0 } else { scale } <= RIGID_REST_FRACTION * scale)
@@ -46,32 +81,34 @@ impl Simulation {
         for (i, joint) in joints.iter().enumerate() {
             mb.link_mut(i)?.joint = *joint;
         }
-        mb.forward_kinematics(&self.bodies, false);
-        mb.update_rigid_bodies(&mut self.bodies, true);
+        mb.forward_kinematics(&d.bodies, false);
+        mb.update_rigid_bodies(&mut d.bodies, true);
         mb.generalized_velocity_mut().fill(0.0);
         Some(*left)
     }
 
-    /// Notes that the loops of multibody `m` (group `g`) closed to `left` [m]; on the second
-    /// closing at the same generation, records the rest when they are rigid.
-    pub(super) fn note_closure_closed(&mut self, m: MultibodyIndex, g: &ProjectedGroup, left: f64) {
-        let generation = self.constraint_inputs;
-        let again = self.closure_rests.iter().any(|r| r.multibody == m && r.generation == generation);
-        self.closure_rests.retain(|r| r.multibody != m);
-        if left > GAP_TOLERANCE_FRACTION * self.model.length_scale_m {
+    /// Notes that the loops of multibody `index` (group `g`) closed to `left` [m]; on the
+    /// second closing at the same generation, records the rest when they are rigid.
+    fn note_closure_closed(&mut self, m: &Model, d: &Data, index: MultibodyIndex, g: &ProjectedGroup, left: f64) {
+        let generation = d.constraint_inputs;
+        let again = self.rests.iter().any(|r| r.multibody == index && r.generation == generation);
+        self.rests.retain(|r| r.multibody != index);
+        if left > GAP_TOLERANCE_FRACTION * m.length_scale_m {
             return;
         }
-        let joints = (again && self.loops_are_rigid(g))
-            .then(|| self.multibody_joints.get_multibody(m).map(|mb| (mb.links().map(|l| *l.joint()).collect(), left)))
+        let joints = (again && d.loops_are_rigid(m, g))
+            .then(|| d.multibody_joints.get_multibody(index).map(|mb| (mb.links().map(|l| *l.joint()).collect(), left)))
             .flatten();
-        self.closure_rests.push(ClosureRest { multibody: m, generation, joints });
+        self.rests.push(ClosureRest { multibody: index, generation, joints });
     }
+}
 
+impl Data {
     /// Whether the loops of a multibody's group leave none of its free coordinates a motion:
     /// at least as many rows as coordinates and every singular value of their Jacobian above
     /// [`SVD_RELATIVE_TOLERANCE`] of the largest (the projection's own cut for redundant rows).
-    fn loops_are_rigid(&self, g: &ProjectedGroup) -> bool {
-        let jacobian = self.group_jacobian_dense(g);
+    fn loops_are_rigid(&self, m: &Model, g: &ProjectedGroup) -> bool {
+        let jacobian = self.group_jacobian_dense(m, g);
         if jacobian.nrows() < jacobian.ncols() || jacobian.ncols() == 0 {
             return false;
         }

@@ -16,8 +16,8 @@
 //! bodies go back and the increments run, starting from the Jacobian the attempt formed at the
 //! start.
 
-use super::projection::GAP_TOLERANCE_FRACTION;
-use super::Simulation;
+use super::projection::{Projection, GAP_TOLERANCE_FRACTION};
+use super::{Data, Model};
 
 /// A jump is taken at once only if the first Gauss-Newton step of its projection left at most
 /// this fraction of the gap that the jump opened: a quarter, Deuflhard's bound for a
@@ -28,25 +28,30 @@ use super::Simulation;
 /// 10 and 1.0 at 15). A 0.35 rad jump of 5 modules takes the increments.
 const MAX_FIRST_CONTRACTION: f64 = 0.25;
 
-impl Simulation {
+impl Projection {
     /// Moves the actuated joints locked off the tree (`locks`: joint, locked coordinate now,
     /// command) to their commands in one stretch, followed by the projection to round-off.
     /// Returns false, with every body back where it was, when the first contraction or the
     /// closure says the stretch was too long.
-    pub(super) fn jump_locked_commands_at_once(&mut self, locks: &[(usize, f64, f64)]) -> bool {
-        let before = self.projected_states();
+    pub(super) fn jump_locked_commands_at_once(
+        &mut self,
+        m: &Model,
+        d: &mut Data,
+        locks: &[(usize, f64, f64)],
+    ) -> bool {
+        let before = d.projected_states(m);
         for &(j, _, command) in locks {
-            self.lock_joint_at(j, command);
+            d.lock_joint_at(m, j, command);
         }
-        let p = self.project_groups_with(GAP_TOLERANCE_FRACTION, MAX_FIRST_CONTRACTION, true);
-        let closed = p.left <= GAP_TOLERANCE_FRACTION * self.model.length_scale_m;
+        let p = self.project_groups_with(m, d, GAP_TOLERANCE_FRACTION, MAX_FIRST_CONTRACTION, true);
+        let closed = p.left <= GAP_TOLERANCE_FRACTION * m.length_scale_m;
         if closed && p.first_contraction <= MAX_FIRST_CONTRACTION {
             return true;
         }
         for &(j, from, _) in locks {
-            self.lock_joint_at(j, from);
+            d.lock_joint_at(m, j, from);
         }
-        self.restore_projected_states(before);
+        d.restore_projected_states(m, before);
         false
     }
 }

@@ -19,7 +19,7 @@
 //! at rest, so the equilibrium is the same as with any fixed damping; only the path to it
 //! changes.
 
-use super::Simulation;
+use super::{Data, Model};
 use crate::structure::JointKind;
 use rapier3d_f64::prelude::*;
 
@@ -107,12 +107,12 @@ impl JointMotion {
     }
 }
 
-impl Simulation {
+impl Data {
     /// The joints the schedule drives: damped, free, revolute or prismatic multibody links.
-    pub(super) fn scheduled(&self, j: usize) -> bool {
-        let joint = &self.model.structure.joints[j];
-        self.model.joint_links[j].is_some()
-            && !self.model.actuated[j]
+    pub(super) fn scheduled(&self, m: &Model, j: usize) -> bool {
+        let joint = &m.structure.joints[j];
+        m.joint_links[j].is_some()
+            && !m.actuated[j]
             && joint.damping > 0.0
             && matches!(joint.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. })
     }
@@ -120,15 +120,15 @@ impl Simulation {
     /// Joint `j`'s generalized force, tangent stiffness and inertia for the coming step (after
     /// the member forces are applied).
     /// Joint `j`'s axis and anchor as its parent now carries them, if revolute or prismatic.
-    pub(super) fn joint_motion(&self, j: usize) -> Option<JointMotion> {
-        let s = &self.model.structure;
+    pub(super) fn joint_motion(&self, m: &Model, j: usize) -> Option<JointMotion> {
+        let s = &m.structure;
         let joint = &s.joints[j];
         let (axis, revolute) = match joint.kind {
             JointKind::Revolute { axis } => (axis, true),
             JointKind::Prismatic { axis } => (axis, false),
             _ => return None,
         };
-        let parent = self.bodies[self.model.handles[joint.parent]].position();
+        let parent = self.bodies[m.handles[joint.parent]].position();
         Some(JointMotion {
             axis: (parent.rotation * Vector::from(axis)).normalize(),
             anchor: parent.transform_point(Vector::from(s.nodes[joint.anchor].position)),
@@ -136,27 +136,27 @@ impl Simulation {
         })
     }
 
-    fn joint_load(&self, j: usize) -> JointLoad {
-        let tree = &self.model.tree;
-        let s = &self.model.structure;
+    fn joint_load(&self, m: &Model, j: usize) -> JointLoad {
+        let tree = &m.tree;
+        let s = &m.structure;
         let joint = &s.joints[j];
-        let motion = self.joint_motion(j).expect("scheduled joints are revolute or prismatic");
+        let motion = self.joint_motion(m, j).expect("scheduled joints are revolute or prismatic");
         let revolute = motion.revolute;
-        let carried = |b: usize| self.is_free(b) && tree.descends_from(b, joint.child);
+        let carried = |b: usize| m.is_free(b) && tree.descends_from(b, joint.child);
         let g = Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]);
         let mut load = JointLoad { force: 0.0, stiffness: 0.0, inertia: 0.0 };
         // Loads on the carried bodies as rapier will apply them (member forces were put on the
         // bodies as a force at the centre of mass plus its moment): their generalized force.
         for b in (0..s.bodies.len()).filter(|b| carried(*b)) {
-            let rb = &self.bodies[self.model.handles[b]];
+            let rb = &self.bodies[m.handles[b]];
             // From the current pose: rapier's cached centre of mass is stale before the first step.
-            let com = self.world_com(b);
+            let com = self.world_com(m, b);
             let gravity = g * rb.mass() * rb.gravity_scale();
             let f = rb.user_force() + gravity;
             load.force += motion.rate(com).dot(f) + if revolute { motion.axis.dot(rb.user_torque()) } else { 0.0 };
             // Forces that do not change with the coordinate: gravity and the external loads.
             let (probe, _) = self.probe_loads[b];
-            let e = self.model.external_loads[b];
+            let e = m.external_loads[b];
             let constant = gravity + Vector::new(probe[0] + e[0], probe[1] + e[1], probe[2] + e[2]);
             load.stiffness += motion.constant_force_stiffness(com, constant);
             let inertia = s.bodies[b].inertia.expect("free bodies have inertia");
@@ -174,22 +174,22 @@ impl Simulation {
         // Springs and elastic cables with one end carried: their force changes with the
         // coordinate (a member with both ends carried moves rigidly and adds nothing).
         for i in 0..s.springs.len() + s.cables.len() {
-            let Some(m) = self.elastic_member(i) else { continue };
-            let (a_carried, b_carried) = (carried(s.nodes[m.a].body), carried(s.nodes[m.b].body));
+            let Some(member) = self.elastic_member(m, i) else { continue };
+            let (a_carried, b_carried) = (carried(s.nodes[member.a].body), carried(s.nodes[member.b].body));
             if a_carried == b_carried {
                 continue;
             }
-            let (x, other) = if a_carried { (m.a, m.b) } else { (m.b, m.a) };
-            let (px, po) = (Vector::from(self.node_position(x)), Vector::from(self.node_position(other)));
+            let (x, other) = if a_carried { (member.a, member.b) } else { (member.b, member.a) };
+            let (px, po) = (Vector::from(self.node_position(m, x)), Vector::from(self.node_position(m, other)));
             let d = po - px;
             let l = d.length();
-            if l <= 0.0 || !m.engaged(l) {
+            if l <= 0.0 || !member.engaged(l) {
                 continue;
             }
-            load.stiffness += motion.member_stiffness(px, d / l, m.tension_n(l), m.stiffness_n_per_m, l);
+            load.stiffness += motion.member_stiffness(px, d / l, member.tension_n(l), member.stiffness_n_per_m, l);
         }
         if let (Some(t), true) = (&joint.torsion_spring, revolute) {
-            load.force += self.torsion_spring_torque(j);
+            load.force += self.torsion_spring_torque(m, j);
             load.stiffness += t.stiffness_nm_per_rad;
         }
         load
@@ -198,29 +198,29 @@ impl Simulation {
     /// Sets every scheduled joint's velocity and damping for the coming step (after the loads
     /// are applied). Whether it set any (a joint with k > 0: its velocity quenched or set, its
     /// damping not the structure's; the step is then no part of a physical path).
-    pub(super) fn schedule_damping(&mut self) -> bool {
-        let dt = self.model.settings.dt_s;
+    pub(super) fn schedule_damping(&mut self, m: &Model) -> bool {
+        let dt = m.settings.dt_s;
         let mut acted = false;
-        for j in 0..self.model.structure.joints.len() {
-            if !self.scheduled(j) {
+        for j in 0..m.structure.joints.len() {
+            if !self.scheduled(m, j) {
                 continue;
             }
-            let Some((mb_index, dof)) = self.dof_of(j) else { continue };
-            let load = self.joint_load(j);
-            let mut damping = self.model.structure.joints[j].damping;
+            let Some((mb_index, dof)) = self.dof_of(m, j) else { continue };
+            let load = self.joint_load(m, j);
+            let mut damping = m.structure.joints[j].damping;
             if load.stiffness > 0.0 && load.inertia > 0.0 {
                 acted = true;
                 damping = newton_damping(dt, load.stiffness, load.inertia);
-                let max_step = match self.model.structure.joints[j].kind {
+                let max_step = match m.structure.joints[j].kind {
                     JointKind::Revolute { .. } => MAX_NEWTON_TURN_RAD,
-                    _ => MAX_NEWTON_SLIDE_FRACTION * self.model.length_scale_m,
+                    _ => MAX_NEWTON_SLIDE_FRACTION * m.length_scale_m,
                 };
                 let velocity = newton_velocity(dt, load.force, load.stiffness, load.inertia, max_step);
                 if let Some(mb) = self.multibody_joints.get_multibody_mut(mb_index) {
                     mb.generalized_velocity_mut()[dof] = velocity;
                 }
             }
-            if let Some(link) = self.model.joint_links[j] {
+            if let Some(link) = m.joint_links[j] {
                 super::build::set_link_damping(&mut self.multibody_joints, link.multibody_joint, damping);
             }
         }

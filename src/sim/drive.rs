@@ -10,7 +10,7 @@
 //! closes a loop (locked off the tree, `build::locked_joint`) has no such degree of freedom and is
 //! refused.
 
-use super::{SimError, Simulation};
+use super::{Data, Model, SimError};
 use crate::structure::ActuatorTarget;
 use rapier3d_f64::prelude::*;
 
@@ -22,12 +22,18 @@ const RIGID_MOTOR_DAMPING: f64 = f64::INFINITY;
 const AXES: [JointAxis; 6] =
     [JointAxis::LinX, JointAxis::LinY, JointAxis::LinZ, JointAxis::AngX, JointAxis::AngY, JointAxis::AngZ];
 
-impl Simulation {
-    /// From now on every actuated joint is driven through the solver ([`Simulation::drive_commands`]);
+/// Whether the actuated joints are driven through the solver rather than set.
+#[derive(Default)]
+pub(super) struct Drive {
+    driven: bool,
+}
+
+impl Drive {
+    /// From now on every actuated joint is driven through the solver ([`Drive::commands`]);
     /// Err naming a joint actuator that is not a multibody link of its own (a loop's closing
     /// joint) or an actuator that moves a fixed node.
-    pub fn drive_physically(&mut self) -> Result<(), SimError> {
-        let s = &self.model.structure;
+    pub(super) fn start(&mut self, m: &Model, d: &mut Data) -> Result<(), SimError> {
+        let s = &m.structure;
         for a in &s.actuators {
             let j = match a.target {
                 ActuatorTarget::Joint(j) => j,
@@ -41,8 +47,8 @@ impl Simulation {
             let refused = || {
                 SimError::Refused(format!("actuated joint '{name}' closes a loop (locked at its command off the multibody tree): it cannot be driven physically"))
             };
-            let link = self.model.joint_links[j].ok_or_else(refused)?;
-            let (mb, id) = self.multibody_joints.get_mut(link.multibody_joint).ok_or_else(refused)?;
+            let link = m.joint_links[j].ok_or_else(refused)?;
+            let (mb, id) = d.multibody_joints.get_mut(link.multibody_joint).ok_or_else(refused)?;
             let l = mb.link_mut(id).ok_or_else(refused)?;
             let axis = AXES[super::joint_free_axis(&l.joint.data)];
             l.joint.kinematic = false;
@@ -54,17 +60,17 @@ impl Simulation {
 
     /// Sets every actuator's command for the end of the next step: cable lengths at once, each
     /// driven joint's motor to the secant rate that reaches its command in one step.
-    pub fn drive_commands(&mut self, values: &[f64]) {
+    pub(super) fn commands(&self, m: &Model, d: &mut Data, values: &[f64]) {
         assert!(self.driven, "drive_physically first");
-        assert_eq!(values.len(), self.model.structure.actuators.len(), "one command per actuator");
-        self.commands.copy_from_slice(values);
-        self.apply_cable_commands();
-        let dt = self.model.settings.dt_s;
-        for (a, command) in self.model.structure.actuators.iter().zip(values) {
+        assert_eq!(values.len(), m.structure.actuators.len(), "one command per actuator");
+        d.commands.copy_from_slice(values);
+        d.apply_cable_commands(m);
+        let dt = m.settings.dt_s;
+        for (a, command) in m.structure.actuators.iter().zip(values) {
             let ActuatorTarget::Joint(j) = a.target else { continue };
-            let Some(link) = self.model.joint_links[j] else { continue };
-            let target = command - self.model.structure.joints[j].initial_coordinate;
-            let Some((mb, id)) = self.multibody_joints.get_mut(link.multibody_joint) else { continue };
+            let Some(link) = m.joint_links[j] else { continue };
+            let target = command - m.structure.joints[j].initial_coordinate;
+            let Some((mb, id)) = d.multibody_joints.get_mut(link.multibody_joint) else { continue };
             let Some(l) = mb.link_mut(id) else { continue };
             let k = super::joint_free_axis(&l.joint.data);
             let rate = (target - l.joint.coords()[k]) / dt;

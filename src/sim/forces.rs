@@ -3,7 +3,7 @@
 
 use super::least_squares::SparseRows;
 use super::tree::Tree;
-use super::{MemberForces, Residual, Simulation};
+use super::{Data, MemberForces, Model, Residual};
 use crate::structure::{ActuatorTarget, CableLaw, JointKind};
 use rapier3d_f64::prelude::*;
 
@@ -42,27 +42,27 @@ fn v(a: [f64; 3]) -> Vector {
     Vector::new(a[0], a[1], a[2])
 }
 
-impl Simulation {
+impl Data {
     /// Puts the explicit forces (springs, elastic cables, probes) on the bodies for the next step.
-    pub(super) fn apply_member_forces(&mut self) {
-        let n = self.model.structure.bodies.len();
+    pub(super) fn apply_member_forces(&mut self, m: &Model) {
+        let n = m.structure.bodies.len();
         for b in 0..n {
-            let rb = &mut self.bodies[self.model.handles[b]];
+            let rb = &mut self.bodies[m.handles[b]];
             rb.reset_forces(false);
             rb.reset_torques(false);
         }
-        for i in 0..self.model.structure.springs.len() + self.model.structure.cables.len() {
-            if let Some(m) = self.elastic_member(i) {
-                self.add_member_load(&m);
+        for i in 0..m.structure.springs.len() + m.structure.cables.len() {
+            if let Some(member) = self.elastic_member(m, i) {
+                self.add_member_load(m, &member);
             }
         }
         for b in 0..n {
             let (mut f, t) = self.probe_loads[b];
             for k in 0..3 {
-                f[k] += self.model.external_loads[b][k];
+                f[k] += m.external_loads[b][k];
             }
-            if self.is_free(b) && (f != [0.0; 3] || t != [0.0; 3]) {
-                let rb = &mut self.bodies[self.model.handles[b]];
+            if m.is_free(b) && (f != [0.0; 3] || t != [0.0; 3]) {
+                let rb = &mut self.bodies[m.handles[b]];
                 rb.add_force(v(f), false);
                 rb.add_torque(v(t), false);
             }
@@ -71,8 +71,8 @@ impl Simulation {
 
     /// Member `i` of the springs followed by the cables, if its force follows from its length
     /// (a spring, or an elastic cable at its current rest length).
-    pub(super) fn elastic_member(&self, i: usize) -> Option<ElasticMember> {
-        let s = &self.model.structure;
+    pub(super) fn elastic_member(&self, m: &Model, i: usize) -> Option<ElasticMember> {
+        let s = &m.structure;
         if let Some(sp) = s.springs.get(i) {
             return Some(ElasticMember {
                 a: sp.a,
@@ -99,19 +99,19 @@ impl Simulation {
     /// centre of mass plus its moment, with the centre of mass taken from the current pose:
     /// rapier's cached world centre of mass is stale before the first step, which gave a
     /// spurious kick of |c x F| there.
-    fn add_member_load(&mut self, m: &ElasticMember) {
-        let (a, b) = (m.a, m.b);
-        let (pa, pb) = (v(self.node_position(a)), v(self.node_position(b)));
+    fn add_member_load(&mut self, m: &Model, member: &ElasticMember) {
+        let (a, b) = (member.a, member.b);
+        let (pa, pb) = (v(self.node_position(m, a)), v(self.node_position(m, b)));
         let d = pb - pa;
         let l = d.length();
-        let t = m.tension_n(l);
+        let t = member.tension_n(l);
         if l > 0.0 && t != 0.0 {
             let f = d / l * t;
             for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
-                let body = self.model.structure.nodes[node].body;
-                if self.is_free(body) {
-                    let com = self.world_com(body);
-                    let rb = &mut self.bodies[self.model.handles[body]];
+                let body = m.structure.nodes[node].body;
+                if m.is_free(body) {
+                    let com = self.world_com(m, body);
+                    let rb = &mut self.bodies[m.handles[body]];
                     rb.add_force(f, false);
                     rb.add_torque((p - com).cross(f), false);
                 }
@@ -122,68 +122,67 @@ impl Simulation {
     /// Torque of joint `j`'s torsion spring at the joint's current angle [N m]: -k (q - q_rest),
     /// q counted as the structure's coordinates are (initial coordinate plus the rotation since
     /// the build). Zero without a spring or off a revolute joint.
-    pub(super) fn torsion_spring_torque(&self, j: usize) -> f64 {
-        let joint = &self.model.structure.joints[j];
+    pub(super) fn torsion_spring_torque(&self, m: &Model, j: usize) -> f64 {
+        let joint = &m.structure.joints[j];
         let (Some(t), JointKind::Revolute { axis }) = (&joint.torsion_spring, &joint.kind) else { return 0.0 };
-        let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
-        let child_rot = self.bodies[self.model.handles[joint.child]].position().rotation;
+        let parent_rot = self.bodies[m.handles[joint.parent]].position().rotation;
+        let child_rot = self.bodies[m.handles[joint.child]].position().rotation;
         let q = joint.initial_coordinate + relative_angle(parent_rot, child_rot, v(*axis));
         -t.stiffness_nm_per_rad * (q - t.rest_angle_rad)
     }
 
     /// World position of a free body's centre of mass, from its current pose [m].
-    pub(super) fn world_com(&self, body: usize) -> Vector {
-        let local = self.model.structure.bodies[body].inertia.map_or([0.0; 3], |i| i.com);
-        self.bodies[self.model.handles[body]].position().transform_point(v(local))
+    pub(super) fn world_com(&self, m: &Model, body: usize) -> Vector {
+        let local = m.structure.bodies[body].inertia.map_or([0.0; 3], |i| i.com);
+        self.bodies[m.handles[body]].position().transform_point(v(local))
     }
 
     /// Reads every member force and computes the equilibrium residual.
-    pub fn member_forces(&self) -> MemberForces {
-        self.member_forces_with(true)
+    pub fn member_forces(&self, m: &Model) -> MemberForces {
+        self.member_forces_with(m, true)
     }
 
     /// Whether the member forces themselves need the fit of the loop-closure reactions: a
     /// joint actuator's force where loops close, or a cable held by the projection (`held`).
-    fn forces_need_closure_fit(&self, held: &[bool]) -> bool {
-        let closures = self.model.joint_impulse.iter().any(Option::is_some);
-        let joint_actuators =
-            self.model.structure.actuators.iter().any(|a| matches!(a.target, ActuatorTarget::Joint(_)));
+    fn forces_need_closure_fit(&self, m: &Model, held: &[bool]) -> bool {
+        let closures = m.joint_impulse.iter().any(Option::is_some);
+        let joint_actuators = m.structure.actuators.iter().any(|a| matches!(a.target, ActuatorTarget::Joint(_)));
         (closures && joint_actuators) || held.contains(&true)
     }
 
     /// Reads every member force; the equilibrium residual (a least-squares fit of the loop
     /// reactions, the costliest part) only when `with_residual` or when the forces need the fit.
-    pub fn member_forces_with(&self, with_residual: bool) -> MemberForces {
+    pub fn member_forces_with(&self, m: &Model, with_residual: bool) -> MemberForces {
         // Cables held at their length by the projection: their tension is fitted, not read.
-        let held = self.cables_held_by_projection();
-        let (mut out, mut wrench) = self.member_loads(&held);
-        self.add_body_loads(&mut wrench);
+        let held = self.cables_held_by_projection(m);
+        let (mut out, mut wrench) = self.member_loads(m, &held);
+        self.add_body_loads(m, &mut wrench);
         // Loop-closing joints carry reactions that no force law gives. They are the unknowns of
         // a least-squares fit: the reactions that best balance every free coordinate. At an
         // equilibrium the fit is exact and the residual is zero; the fitted reactions are
         // added to the bodies' loads.
-        let fit = with_residual || self.forces_need_closure_fit(&held);
+        let fit = with_residual || self.forces_need_closure_fit(m, &held);
         let closure_reaction = if fit {
-            self.fit_closure_reactions(&held, &mut wrench, &mut out)
+            self.fit_closure_reactions(m, &held, &mut wrench, &mut out)
         } else {
-            vec![(Vector::ZERO, Vector::ZERO); self.model.structure.joints.len()]
+            vec![(Vector::ZERO, Vector::ZERO); m.structure.joints.len()]
         };
         if fit {
-            out.residual = Some(self.residual_of(&held, &wrench, &out));
+            out.residual = Some(self.residual_of(m, &held, &wrench, &out));
         }
-        out.actuator_force = self.actuator_forces(&wrench, &closure_reaction, &out);
+        out.actuator_force = self.actuator_forces(m, &wrench, &closure_reaction, &out);
         out
     }
 
     /// Spring and cable forces at the current pose, and the wrench they put on each body
     /// (force, moment about the world origin).
-    fn member_loads(&self, held: &[bool]) -> (MemberForces, Vec<Wrench>) {
-        let s = &self.model.structure;
+    fn member_loads(&self, m: &Model, held: &[bool]) -> (MemberForces, Vec<Wrench>) {
+        let s = &m.structure;
         let mut wrench: Vec<Wrench> = vec![(Vector::ZERO, Vector::ZERO); s.bodies.len()];
         // The member from node a to node b at its current length l pulls both ends with
         // `tension_at(l)`; returns (l, tension).
         let mut pull = |a: usize, b: usize, tension_at: &dyn Fn(f64) -> f64| -> (f64, f64) {
-            let (pa, pb) = (v(self.node_position(a)), v(self.node_position(b)));
+            let (pa, pb) = (v(self.node_position(m, a)), v(self.node_position(m, b)));
             let d = pb - pa;
             let l = d.length();
             let tension = tension_at(l);
@@ -199,19 +198,19 @@ impl Simulation {
         };
         let mut out = MemberForces::default();
         for (i, sp) in s.springs.iter().enumerate() {
-            let m = self.elastic_member(i).expect("a spring is elastic");
-            let (l, force) = pull(sp.a, sp.b, &|l| m.tension_n(l));
+            let member = self.elastic_member(m, i).expect("a spring is elastic");
+            let (l, force) = pull(sp.a, sp.b, &|l| member.tension_n(l));
             out.spring_force_n.push(force);
             out.spring_length_m.push(l);
         }
-        let inv_h = self.model.settings.substeps as f64 / self.model.settings.dt_s;
+        let inv_h = m.settings.substeps as f64 / m.settings.dt_s;
         for (c, cable) in s.cables.iter().enumerate() {
-            let (l, tension) = match self.elastic_member(s.springs.len() + c) {
-                Some(m) => pull(cable.a, cable.b, &|l| m.tension_n(l)),
+            let (l, tension) = match self.elastic_member(m, s.springs.len() + c) {
+                Some(member) => pull(cable.a, cable.b, &|l| member.tension_n(l)),
                 // Held at its length by the projection: its tension is fitted later.
                 None if held[c] => pull(cable.a, cable.b, &|_| 0.0),
                 None => {
-                    let rope = self.model.cable_ropes[c]
+                    let rope = m.cable_ropes[c]
                         .and_then(|h| self.impulse_joints.get(h))
                         .map(|j| j.data.limits[0].impulse.abs() * inv_h)
                         .unwrap_or(0.0);
@@ -227,22 +226,22 @@ impl Simulation {
     }
 
     /// Adds gravity, the probe loads and the constant external loads of every free body.
-    fn add_body_loads(&self, wrench: &mut [Wrench]) {
-        let s = &self.model.structure;
+    fn add_body_loads(&self, m: &Model, wrench: &mut [Wrench]) {
+        let s = &m.structure;
         let g = v(s.gravity);
         for (b, body) in s.bodies.iter().enumerate() {
-            if self.is_free(b) {
+            if m.is_free(b) {
                 if let Some(i) = body.inertia {
-                    let com = self.bodies[self.model.handles[b]].position().transform_point(v(i.com));
+                    let com = self.bodies[m.handles[b]].position().transform_point(v(i.com));
                     let f = g * i.mass_kg;
                     wrench[b].0 += f;
                     wrench[b].1 += com.cross(f);
                 }
                 let (mut pf, pt) = self.probe_loads[b];
                 for k in 0..3 {
-                    pf[k] += self.model.external_loads[b][k];
+                    pf[k] += m.external_loads[b][k];
                 }
-                let com = self.world_com(b);
+                let com = self.world_com(m, b);
                 wrench[b].0 += v(pf);
                 wrench[b].1 += com.cross(v(pf)) + v(pt);
             }
@@ -252,11 +251,17 @@ impl Simulation {
     /// Fits the reactions of the loop-closing joints and the tensions of the held cables by
     /// least squares, adds them to `wrench` and `out`, and returns each closing joint's
     /// reaction on its child (force, moment about the anchor).
-    fn fit_closure_reactions(&self, held: &[bool], wrench: &mut [Wrench], out: &mut MemberForces) -> Vec<Wrench> {
-        let mut closure_loads = self.closure_unit_loads();
-        closure_loads.extend(self.projected_cable_unit_loads(held));
-        let mut closure_reaction = vec![(Vector::ZERO, Vector::ZERO); self.model.structure.joints.len()];
-        let Some(lambda) = self.closure_magnitudes(&closure_loads, wrench) else {
+    fn fit_closure_reactions(
+        &self,
+        m: &Model,
+        held: &[bool],
+        wrench: &mut [Wrench],
+        out: &mut MemberForces,
+    ) -> Vec<Wrench> {
+        let mut closure_loads = self.closure_unit_loads(m);
+        closure_loads.extend(self.projected_cable_unit_loads(m, held));
+        let mut closure_reaction = vec![(Vector::ZERO, Vector::ZERO); m.structure.joints.len()];
+        let Some(lambda) = self.closure_magnitudes(m, &closure_loads, wrench) else {
             return closure_reaction;
         };
         for (k, load) in closure_loads.iter().enumerate() {
@@ -286,25 +291,26 @@ impl Simulation {
     /// group's tree, take the sparse solve.
     fn closure_magnitudes(
         &self,
+        m: &Model,
         closure_loads: &[ClosureComponent],
         wrench: &[Wrench],
     ) -> Option<nalgebra::DVector<f64>> {
-        let tree = &self.model.fit_tree;
-        let scale = self.model.length_scale_m;
-        let base = self.coordinate_forces(tree, wrench, true);
+        let tree = &m.fit_tree;
+        let scale = m.length_scale_m;
+        let base = self.coordinate_forces(m, tree, wrench, true);
         if closure_loads.is_empty() || base.is_empty() {
             return None;
         }
         let scaled = |c: &CoordinateForce| if c.is_torque { c.value / scale } else { c.value };
         let r0 = nalgebra::DVector::<f64>::from_iterator(base.len(), base.iter().map(scaled));
-        let no_links = self.model.joint_links.iter().all(Option::is_none);
+        let no_links = m.joint_links.iter().all(Option::is_none);
         if no_links && (closure_loads.len() >= SPARSE_MIN_CLOSURE_LOADS || tree.has_group_links()) {
-            let g = self.tree_closure_matrix(tree, closure_loads, base.len());
+            let g = self.tree_closure_matrix(m, tree, closure_loads, base.len());
             if let Some(lambda) = super::least_squares::sparse_min_norm_solve(g, &(-&r0)) {
                 return Some(lambda);
             }
         }
-        let nb = self.model.structure.bodies.len();
+        let nb = m.structure.bodies.len();
         let mut g = nalgebra::DMatrix::<f64>::zeros(base.len(), closure_loads.len());
         for (k, load) in closure_loads.iter().enumerate() {
             let mut loads = vec![(Vector::ZERO, Vector::ZERO); nb];
@@ -312,7 +318,7 @@ impl Simulation {
                 loads[b].0 += l.0;
                 loads[b].1 += l.1;
             }
-            for (r, c) in self.coordinate_forces(tree, &loads, false).iter().enumerate() {
+            for (r, c) in self.coordinate_forces(m, tree, &loads, false).iter().enumerate() {
                 g[(r, k)] = scaled(c);
             }
         }
@@ -326,10 +332,16 @@ impl Simulation {
     /// where the tree paths up from its two bodies meet: it moves only the coordinates on the
     /// path between them, and a free root's where a path ends at one. Without tree joints each
     /// load moves the six coordinates of each of its two bodies.
-    fn tree_closure_matrix(&self, tree: &Tree, closure_loads: &[ClosureComponent], rows: usize) -> SparseRows {
-        let scale = self.model.length_scale_m;
-        let (joint_row, root_row) = self.coordinate_rows(tree);
-        let free = |b: usize| self.is_free(b).then_some(b);
+    fn tree_closure_matrix(
+        &self,
+        m: &Model,
+        tree: &Tree,
+        closure_loads: &[ClosureComponent],
+        rows: usize,
+    ) -> SparseRows {
+        let scale = m.length_scale_m;
+        let (joint_row, root_row) = self.coordinate_rows(m, tree);
+        let free = |b: usize| m.is_free(b).then_some(b);
         let (mut entries, mut values) = (Vec::new(), Vec::new());
         for (k, load) in closure_loads.iter().enumerate() {
             let mut side = load.loads.map(|(b, w)| (free(b), w));
@@ -346,12 +358,12 @@ impl Simulation {
                 let (first, up) = match tree.hang(b) {
                     Some(h) => {
                         if joint_row[h.joint].is_some() {
-                            self.joint_coordinate_forces(h.joint, w, &mut values);
+                            self.joint_coordinate_forces(m, h.joint, w, &mut values);
                         }
                         (joint_row[h.joint], free(h.parent))
                     }
                     None => {
-                        self.root_coordinate_forces(b, w, &mut values);
+                        self.root_coordinate_forces(m, b, w, &mut values);
                         (root_row[b], None)
                     }
                 };
@@ -368,35 +380,35 @@ impl Simulation {
 
     /// The first row of each tree joint's free coordinates (joint order) and of each free
     /// root's six (body order), as [`Self::coordinate_forces`] lists them.
-    fn coordinate_rows(&self, tree: &Tree) -> (Vec<Option<usize>>, Vec<Option<usize>>) {
-        let s = &self.model.structure;
+    fn coordinate_rows(&self, m: &Model, tree: &Tree) -> (Vec<Option<usize>>, Vec<Option<usize>>) {
+        let s = &m.structure;
         let mut next = 0;
         let mut at = |count: usize| {
             next += count;
             Some(next - count)
         };
         let joint_row = (0..s.joints.len())
-            .map(|j| match tree.carried(j).filter(|_| !self.model.actuated[j]) {
+            .map(|j| match tree.carried(j).filter(|_| !m.actuated[j]) {
                 Some(_) => at(coordinate_count(&s.joints[j].kind)),
                 None => None,
             })
             .collect();
         let root_row =
-            (0..s.bodies.len()).map(|b| (self.is_free(b) && tree.hang(b).is_none()).then(|| at(6)).flatten()).collect();
+            (0..s.bodies.len()).map(|b| (m.is_free(b) && tree.hang(b).is_none()).then(|| at(6)).flatten()).collect();
         (joint_row, root_row)
     }
 
     /// The largest generalized force left on a free coordinate once every load is on the
     /// bodies, and a held cable's push (a negative fitted tension: no equilibrium).
-    fn residual_of(&self, held: &[bool], wrench: &[Wrench], out: &MemberForces) -> Residual {
-        let s = &self.model.structure;
+    fn residual_of(&self, m: &Model, held: &[bool], wrench: &[Wrench], out: &MemberForces) -> Residual {
+        let s = &m.structure;
         let mut residual = Residual::default();
         for (c, cable) in s.cables.iter().enumerate() {
             if matches!(cable.law, CableLaw::Inextensible) && held[c] {
                 residual.max_force_n = residual.max_force_n.max((-out.cable_tension_n[c]).max(0.0));
             }
         }
-        for c in self.coordinate_forces(&self.model.fit_tree, wrench, true) {
+        for c in self.coordinate_forces(m, &m.fit_tree, wrench, true) {
             if c.is_torque {
                 residual.max_torque_nm = residual.max_torque_nm.max(c.value.abs());
             } else {
@@ -409,12 +421,18 @@ impl Simulation {
     /// Each actuator's force along its joint axis (or its cable's tension): minus the load of
     /// everything the actuated joint carries, or the fitted reaction of a joint locked off the
     /// fit tree.
-    fn actuator_forces(&self, wrench: &[Wrench], closure_reaction: &[Wrench], out: &MemberForces) -> Vec<f64> {
-        let s = &self.model.structure;
-        let tree = &self.model.fit_tree;
+    fn actuator_forces(
+        &self,
+        m: &Model,
+        wrench: &[Wrench],
+        closure_reaction: &[Wrench],
+        out: &MemberForces,
+    ) -> Vec<f64> {
+        let s = &m.structure;
+        let tree = &m.fit_tree;
         let subtree = tree.subtree_wrenches(wrench);
         let along = |joint: &crate::structure::Joint, force: Vector, moment: Vector| {
-            let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
+            let parent_rot = self.bodies[m.handles[joint.parent]].position().rotation;
             match &joint.kind {
                 JointKind::Revolute { axis } => moment.dot((parent_rot * v(*axis)).normalize()),
                 JointKind::Prismatic { axis } => force.dot((parent_rot * v(*axis)).normalize()),
@@ -427,7 +445,7 @@ impl Simulation {
                 ActuatorTarget::CableLength(c) => out.cable_tension_n[c],
                 // The force that holds the moved body against its members, along the direction.
                 ActuatorTarget::FixedNode { node, direction } => -wrench[s.nodes[node].body].0.dot(v(direction)),
-                ActuatorTarget::Joint(j) if self.model.joint_impulse[j].is_some() && tree.carried(j).is_none() => {
+                ActuatorTarget::Joint(j) if m.joint_impulse[j].is_some() && tree.carried(j).is_none() => {
                     let (f, m) = closure_reaction[j];
                     along(&s.joints[j], f, m)
                 }
@@ -438,7 +456,7 @@ impl Simulation {
                     let joint = &s.joints[j];
                     let carried = tree.carried(j).unwrap_or(joint.child);
                     let w = subtree[carried];
-                    let on_carried = along(joint, w.0, about(w, v(self.node_position(joint.anchor))));
+                    let on_carried = along(joint, w.0, about(w, v(self.node_position(m, joint.anchor))));
                     if carried == joint.child {
                         -on_carried
                     } else {
@@ -493,28 +511,28 @@ struct CoordinateForce {
     is_torque: bool,
 }
 
-impl Simulation {
+impl Data {
     /// Generalized force on every free coordinate of `tree` for the body loads `wrench`
     /// (force, moment about the world origin), torsion springs included when `with_springs`:
     /// each tree joint's turns (slide) in joint order, then all six coordinates of each free
     /// root in body order.
-    fn coordinate_forces(&self, tree: &Tree, wrench: &[Wrench], with_springs: bool) -> Vec<CoordinateForce> {
-        let s = &self.model.structure;
+    fn coordinate_forces(&self, m: &Model, tree: &Tree, wrench: &[Wrench], with_springs: bool) -> Vec<CoordinateForce> {
+        let s = &m.structure;
         let subtree = tree.subtree_wrenches(wrench);
         let mut out = Vec::new();
         for j in 0..s.joints.len() {
             // Only the free coordinates: an actuated joint's coordinate is set, not balanced.
-            let Some(b) = tree.carried(j).filter(|_| !self.model.actuated[j]) else { continue };
+            let Some(b) = tree.carried(j).filter(|_| !m.actuated[j]) else { continue };
             let first = out.len();
-            self.joint_coordinate_forces(j, subtree[b], &mut out);
+            self.joint_coordinate_forces(m, j, subtree[b], &mut out);
             // A torsion spring on this joint is a generalized force on its coordinate.
             if with_springs && matches!(s.joints[j].kind, JointKind::Revolute { .. }) {
-                out[first].value += self.torsion_spring_torque(j);
+                out[first].value += self.torsion_spring_torque(m, j);
             }
         }
         for b in 0..s.bodies.len() {
-            if self.is_free(b) && tree.hang(b).is_none() {
-                self.root_coordinate_forces(b, subtree[b], &mut out);
+            if m.is_free(b) && tree.hang(b).is_none() {
+                self.root_coordinate_forces(m, b, subtree[b], &mut out);
             }
         }
         out
@@ -523,45 +541,47 @@ impl Simulation {
     /// The generalized forces on joint `j`'s coordinates of the wrench `w` its carried
     /// bodies receive: the moment about its anchor along each axis it turns about, or the
     /// force along its slide.
-    fn joint_coordinate_forces(&self, j: usize, w: Wrench, out: &mut Vec<CoordinateForce>) {
-        let joint = &self.model.structure.joints[j];
+    fn joint_coordinate_forces(&self, m: &Model, j: usize, w: Wrench, out: &mut Vec<CoordinateForce>) {
+        let joint = &m.structure.joints[j];
         let torque = |value: f64| CoordinateForce { value, is_torque: true };
-        let rotation = |b: usize| self.bodies[self.model.handles[b]].position().rotation;
-        let m = about(w, v(self.node_position(joint.anchor)));
+        let rotation = |b: usize| self.bodies[m.handles[b]].position().rotation;
+        let moment = about(w, v(self.node_position(m, joint.anchor)));
         match &joint.kind {
-            JointKind::Revolute { axis } => out.push(torque(m.dot((rotation(joint.parent) * v(*axis)).normalize()))),
+            JointKind::Revolute { axis } => {
+                out.push(torque(moment.dot((rotation(joint.parent) * v(*axis)).normalize())))
+            }
             JointKind::Prismatic { axis } => out.push(CoordinateForce {
                 value: w.0.dot((rotation(joint.parent) * v(*axis)).normalize()),
                 is_torque: false,
             }),
             JointKind::Universal { axis1, axis2 } => {
-                out.push(torque(m.dot((rotation(joint.parent) * v(*axis1)).normalize())));
-                out.push(torque(m.dot((rotation(joint.child) * v(*axis2)).normalize())));
+                out.push(torque(moment.dot((rotation(joint.parent) * v(*axis1)).normalize())));
+                out.push(torque(moment.dot((rotation(joint.child) * v(*axis2)).normalize())));
             }
-            JointKind::Spherical => out.extend([torque(m.x), torque(m.y), torque(m.z)]),
+            JointKind::Spherical => out.extend([torque(moment.x), torque(moment.y), torque(moment.z)]),
             JointKind::Fixed | JointKind::PlanarPin { .. } => {}
         }
     }
 
     /// A free root's six generalized forces of the wrench `w` on it and what hangs from it:
     /// the force, then the moment about its centre of mass.
-    fn root_coordinate_forces(&self, b: usize, w: Wrench, out: &mut Vec<CoordinateForce>) {
+    fn root_coordinate_forces(&self, m: &Model, b: usize, w: Wrench, out: &mut Vec<CoordinateForce>) {
         let force = |value: f64| CoordinateForce { value, is_torque: false };
         let torque = |value: f64| CoordinateForce { value, is_torque: true };
-        let m = about(w, self.world_com(b));
-        out.extend([force(w.0.x), force(w.0.y), force(w.0.z), torque(m.x), torque(m.y), torque(m.z)]);
+        let moment = about(w, self.world_com(m, b));
+        out.extend([force(w.0.x), force(w.0.y), force(w.0.z), torque(moment.x), torque(moment.y), torque(moment.z)]);
     }
 
     /// For every inextensible cable held at its length by the projection: the body loads of a
     /// unit tension (pulling its two nodes together).
-    fn projected_cable_unit_loads(&self, held: &[bool]) -> Vec<ClosureComponent> {
-        let s = &self.model.structure;
+    fn projected_cable_unit_loads(&self, m: &Model, held: &[bool]) -> Vec<ClosureComponent> {
+        let s = &m.structure;
         let mut out = Vec::new();
         for (c, cable) in s.cables.iter().enumerate() {
             if !held[c] {
                 continue;
             }
-            let (pa, pb) = (v(self.node_position(cable.a)), v(self.node_position(cable.b)));
+            let (pa, pb) = (v(self.node_position(m, cable.a)), v(self.node_position(m, cable.b)));
             let d = (pb - pa).normalize();
             let (ba, bb) = (s.nodes[cable.a].body, s.nodes[cable.b].body);
             let w = [(ba, (d, pa.cross(d))), (bb, (-d, -pb.cross(d)))];
@@ -572,24 +592,24 @@ impl Simulation {
 
     /// For every reaction component of every loop-closing joint: the body loads of a unit
     /// reaction (child +, parent -), world frame.
-    fn closure_unit_loads(&self) -> Vec<ClosureComponent> {
-        let s = &self.model.structure;
+    fn closure_unit_loads(&self, m: &Model) -> Vec<ClosureComponent> {
+        let s = &m.structure;
         let axes = [Vector::X, Vector::Y, Vector::Z];
         let mut out = Vec::new();
         for (j, joint) in s.joints.iter().enumerate() {
             // A joint of the fit tree carries its reaction by recursion (`tree.rs`).
-            if self.model.joint_impulse[j].is_none() || self.model.fit_tree.carried(j).is_some() {
+            if m.joint_impulse[j].is_none() || m.fit_tree.carried(j).is_some() {
                 continue;
             }
-            let anchor = v(self.node_position(joint.anchor));
-            let parent_rot = self.bodies[self.model.handles[joint.parent]].position().rotation;
-            let child_rot = self.bodies[self.model.handles[joint.child]].position().rotation;
+            let anchor = v(self.node_position(m, joint.anchor));
+            let parent_rot = self.bodies[m.handles[joint.parent]].position().rotation;
+            let child_rot = self.bodies[m.handles[joint.child]].position().rotation;
             // Directions the joint transmits: forces, then moments.
             let (forces, moments): (Vec<Vector>, Vec<Vector>) = match &joint.kind {
                 JointKind::Spherical => (axes.to_vec(), vec![]),
                 // An actuated (locked) revolute also carries the torque about its axis.
-                JointKind::Revolute { axis } if self.model.actuated[j] => (axes.to_vec(), axes.to_vec()),
-                JointKind::Prismatic { .. } if self.model.actuated[j] => (axes.to_vec(), axes.to_vec()),
+                JointKind::Revolute { axis } if m.actuated[j] => (axes.to_vec(), axes.to_vec()),
+                JointKind::Prismatic { .. } if m.actuated[j] => (axes.to_vec(), axes.to_vec()),
                 JointKind::Revolute { axis } => {
                     let a = (parent_rot * v(*axis)).normalize();
                     (axes.to_vec(), orthogonal_pair(a).to_vec())

@@ -14,7 +14,7 @@
 //! tree runs over the group's joints that hold a point (spherical, revolute, universal) from
 //! the bodies joined to fixed ones; a body it does not reach moves by its own twist.
 
-use super::Simulation;
+use super::{Data, Model};
 use crate::structure::JointKind;
 use rapier3d_f64::prelude::*;
 
@@ -41,8 +41,8 @@ impl GroupTree {
 
     /// The breadth-first tree over `joints` (structure indices) of the plain `bodies`
     /// (structure indices), from the bodies joined to fixed ones.
-    pub(super) fn of(sim: &Simulation, bodies: &[usize], joints: &[usize]) -> GroupTree {
-        let s = &sim.model.structure;
+    pub(super) fn of(m: &Model, bodies: &[usize], joints: &[usize]) -> GroupTree {
+        let s = &m.structure;
         let mut position = vec![None; s.bodies.len()];
         for (i, &b) in bodies.iter().enumerate() {
             position[b] = Some(i);
@@ -86,12 +86,12 @@ impl GroupTree {
     /// rotation vector times `scale` [m]), each along the tree: with its parent, then about the
     /// joint's anchor by its twist relative to the parent. Bodies off the tree move by their
     /// own twist.
-    pub(super) fn displace(&self, sim: &mut Simulation, bodies: &[usize], dq: &[f64], scale: f64) {
+    pub(super) fn displace(&self, m: &Model, sim: &mut Data, bodies: &[usize], dq: &[f64], scale: f64) {
         let twist = |i: usize| {
             let q = &dq[6 * i..6 * i + 6];
             (Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / scale)
         };
-        let com: Vec<Vector> = bodies.iter().map(|&b| sim.world_com(b)).collect();
+        let com: Vec<Vector> = bodies.iter().map(|&b| sim.world_com(m, b)).collect();
         let rate_at = |i: usize, p: Vector| {
             let (v, w) = twist(i);
             v + w.cross(p - com[i])
@@ -99,7 +99,7 @@ impl GroupTree {
         // Each body's displacement (world), parents first: every anchor read before any move.
         let mut delta: Vec<Option<Pose>> = vec![None; bodies.len()];
         for link in &self.links {
-            let a = sim.node_position(sim.model.structure.joints[link.joint].anchor);
+            let a = sim.node_position(m, m.structure.joints[link.joint].anchor);
             let a = Vector::new(a[0], a[1], a[2]);
             let (carried, w_parent, rate_parent) = match link.parent {
                 Some(p) => (delta[p].unwrap_or(Pose::IDENTITY), twist(p).1, rate_at(p, a)),
@@ -113,7 +113,7 @@ impl GroupTree {
                 let (v, w) = twist(i);
                 turn_about(com[i], v, w)
             });
-            let h = sim.model.handles[b];
+            let h = m.handles[b];
             let moved = d * *sim.bodies[h].position();
             sim.bodies[h].set_position(moved, true);
         }

@@ -22,7 +22,7 @@ use super::projection::{
     close_rows, largest_abs, Closing, Jacobian, KeptJacobian, Member, Projected, ProjectedGroup, RigidRest, Twist,
     GAP_TOLERANCE_FRACTION,
 };
-use super::Simulation;
+use super::{Data, Model};
 use crate::structure::JointKind;
 use rapier3d_f64::prelude::*;
 
@@ -42,13 +42,14 @@ impl LinkAxes {
     }
 }
 
-impl Simulation {
+impl Data {
     /// Closes group `g` (its `taut` cables held) in its tree's joint coordinates, when every
     /// one of its bodies is on the tree and every tree joint is closed; None (nothing moved)
     /// otherwise. A rigid group is stopped and its `rest` recorded; any other is handed on to
     /// [`Self::project_group`] once closed, for its velocities.
     pub(super) fn close_in_joint_coordinates(
         &mut self,
+        m: &Model,
         g: &ProjectedGroup,
         taut: &[usize],
         kept: &mut Option<KeptJacobian>,
@@ -56,25 +57,25 @@ impl Simulation {
         max_first_contraction: f64,
     ) -> Option<Projected> {
         let tree = g.tree.as_ref()?;
-        let tol = GAP_TOLERANCE_FRACTION * self.model.length_scale_m;
-        if !g.multibodies.is_empty() || tree.links().len() != g.bodies.len() || !self.tree_joints_closed(tree, tol) {
+        let tol = GAP_TOLERANCE_FRACTION * m.length_scale_m;
+        if !g.multibodies.is_empty() || tree.links().len() != g.bodies.len() || !self.tree_joints_closed(m, tree, tol) {
             return None;
         }
-        let on_tree = self.tree_joint_flags(tree);
-        let rows = |sim: &Simulation| sim.loop_rows(g, taut, &on_tree);
+        let on_tree = self.tree_joint_flags(m, tree);
+        let rows = |sim: &Data| sim.loop_rows(m, g, taut, &on_tree);
         let jacobian =
-            |sim: &mut Simulation, g0: &[f64]| Jacobian::sparse(sim.joint_jacobian(g, taut, tree, &on_tree, g0.len()));
-        let displace = |sim: &mut Simulation, dq: &[f64]| sim.turn_links(g, tree, dq);
+            |sim: &mut Data, g0: &[f64]| Jacobian::sparse(sim.joint_jacobian(m, g, taut, tree, &on_tree, g0.len()));
+        let displace = |sim: &mut Data, dq: &[f64]| sim.turn_links(m, g, tree, dq);
         let Closing { jacobian: jac, first_contraction, .. } =
-            close_rows(self, &rows, &jacobian, &displace, None, GAP_TOLERANCE_FRACTION, max_first_contraction);
+            close_rows(m, self, &rows, &jacobian, &displace, None, GAP_TOLERANCE_FRACTION, max_first_contraction);
         // Every row, the tree joints' included, for the verdict.
-        let left = largest_abs(&self.group_rows(g, taut));
+        let left = largest_abs(&self.group_rows(m, g, taut));
         let closed = left <= tol && first_contraction <= max_first_contraction;
         if closed && jac.as_ref().is_some_and(Jacobian::rigid) {
-            self.stop_bodies(&g.bodies);
-            *rest = Some(self.rigid_rest(g, taut, left));
+            self.stop_bodies(m, &g.bodies);
+            *rest = Some(self.rigid_rest(m, g, taut, left));
         } else if closed {
-            let p = self.project_group(g, taut, kept, rest, GAP_TOLERANCE_FRACTION, f64::INFINITY);
+            let p = self.project_group(m, g, taut, kept, rest, GAP_TOLERANCE_FRACTION, f64::INFINITY);
             return Some(Projected { left: p.left, first_contraction });
         }
         Some(Projected { left, first_contraction })
@@ -82,12 +83,12 @@ impl Simulation {
 
     /// Whether every tree joint's rows but a locked angle's are within `tol` [m]: the rows no
     /// joint coordinate moves.
-    fn tree_joints_closed(&self, tree: &GroupTree, tol: f64) -> bool {
+    fn tree_joints_closed(&self, m: &Model, tree: &GroupTree, tol: f64) -> bool {
         let mut rows = Vec::new();
         tree.links().iter().all(|link| {
             rows.clear();
-            self.joint_rows(link.joint, &mut rows);
-            if self.locked_angle(link.joint).is_some() {
+            self.joint_rows(m, link.joint, &mut rows);
+            if self.locked_angle(m, link.joint).is_some() {
                 rows.pop();
             }
             largest_abs(&rows) <= tol
@@ -95,8 +96,8 @@ impl Simulation {
     }
 
     /// For each structure joint: whether it is one of the tree's links.
-    fn tree_joint_flags(&self, tree: &GroupTree) -> Vec<bool> {
-        let mut on_tree = vec![false; self.model.structure.joints.len()];
+    fn tree_joint_flags(&self, m: &Model, tree: &GroupTree) -> Vec<bool> {
+        let mut on_tree = vec![false; m.structure.joints.len()];
         for link in tree.links() {
             on_tree[link.joint] = true;
         }
@@ -107,25 +108,25 @@ impl Simulation {
     /// of a joint off the tree, a tree joint's locked angle, each taut cable's stretch. A
     /// turn keeps every other row of a tree joint as it was (closed: the jump starts from a
     /// group whose tree joints are closed), so they are not evaluated while it closes.
-    fn loop_rows(&self, g: &ProjectedGroup, taut: &[usize], on_tree: &[bool]) -> Vec<f64> {
-        let s = &self.model.structure;
-        let rotation = |b: usize| self.bodies[self.model.handles[b]].position().rotation;
+    fn loop_rows(&self, m: &Model, g: &ProjectedGroup, taut: &[usize], on_tree: &[bool]) -> Vec<f64> {
+        let s = &m.structure;
+        let rotation = |b: usize| self.bodies[m.handles[b]].position().rotation;
         let mut out = Vec::new();
         for &j in &g.joints {
             if !on_tree[j] {
-                self.joint_rows(j, &mut out);
-            } else if let Some(target) = self.locked_angle(j) {
-                out.push(self.lock_row(j, rotation(s.joints[j].parent), rotation(s.joints[j].child), target));
+                self.joint_rows(m, j, &mut out);
+            } else if let Some(target) = self.locked_angle(m, j) {
+                out.push(self.lock_row(m, j, rotation(s.joints[j].parent), rotation(s.joints[j].child), target));
             }
         }
-        self.cable_rows(taut, &mut out);
+        self.cable_rows(m, taut, &mut out);
         out
     }
 
     /// Each tree link's anchor and axes at the current poses, in link order.
-    fn link_axes(&self, tree: &GroupTree) -> Vec<LinkAxes> {
-        let s = &self.model.structure;
-        let rotation = |b: usize| self.bodies[self.model.handles[b]].position().rotation;
+    fn link_axes(&self, m: &Model, tree: &GroupTree) -> Vec<LinkAxes> {
+        let s = &m.structure;
+        let rotation = |b: usize| self.bodies[m.handles[b]].position().rotation;
         let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
         let mut first = 0;
         tree.links()
@@ -140,7 +141,7 @@ impl Simulation {
                     }
                     _ => ([Vector::X, Vector::Y, Vector::Z], 3),
                 };
-                let la = LinkAxes { anchor: vec3(self.node_position(joint.anchor)), all, count, first };
+                let la = LinkAxes { anchor: vec3(self.node_position(m, joint.anchor)), all, count, first };
                 first += count;
                 la
             })
@@ -149,9 +150,9 @@ impl Simulation {
 
     /// Turns every link's subtree by its coordinates in `dq` (angle times the structure's size
     /// [m]) about its anchor, parents first: each body moves with its parent, then turns.
-    fn turn_links(&mut self, g: &ProjectedGroup, tree: &GroupTree, dq: &[f64]) {
-        let scale = self.model.length_scale_m;
-        let axes = self.link_axes(tree);
+    fn turn_links(&mut self, m: &Model, g: &ProjectedGroup, tree: &GroupTree, dq: &[f64]) {
+        let scale = m.length_scale_m;
+        let axes = self.link_axes(m, tree);
         let mut delta: Vec<Pose> = vec![Pose::IDENTITY; g.bodies.len()];
         for (link, la) in tree.links().iter().zip(&axes) {
             let turn = la.axes().iter().enumerate().fold(Vector::ZERO, |r, (k, a)| r + *a * (dq[la.first + k] / scale));
@@ -159,7 +160,7 @@ impl Simulation {
             delta[link.body] = carried * super::group_tree::turn_about(la.anchor, Vector::ZERO, turn);
         }
         for (&b, d) in g.bodies.iter().zip(delta) {
-            let h = self.model.handles[b];
+            let h = m.handles[b];
             let moved = d * *self.bodies[h].position();
             self.bodies[h].set_position(moved, true);
         }
@@ -170,22 +171,23 @@ impl Simulation {
     /// its two bodies (a locked tree joint's: its own link's turn).
     fn joint_jacobian(
         &self,
+        m: &Model,
         g: &ProjectedGroup,
         taut: &[usize],
         tree: &GroupTree,
         on_tree: &[bool],
         rows: usize,
     ) -> super::least_squares::SparseRows {
-        let s = &self.model.structure;
-        let scale = self.model.length_scale_m;
-        let axes = self.link_axes(tree);
-        let path = TreePaths::of(self, g, tree);
+        let s = &m.structure;
+        let scale = m.length_scale_m;
+        let axes = self.link_axes(m, tree);
+        let path = TreePaths::of(m, g, tree);
         // Each member with its two bodies and its rows' count; of a tree joint only the last
         // row (its lock) is kept.
-        let joints = g.joints.iter().filter(|&&j| !on_tree[j] || self.locked_angle(j).is_some()).map(|&j| {
+        let joints = g.joints.iter().filter(|&&j| !on_tree[j] || self.locked_angle(m, j).is_some()).map(|&j| {
             let joint = &s.joints[j];
-            let count = if on_tree[j] { 1 } else { self.joint_row_count(j) };
-            (Member::Joint(self.joint_frame(j)), [joint.parent, joint.child], count)
+            let count = if on_tree[j] { 1 } else { self.joint_row_count(m, j) };
+            (Member::Joint(self.joint_frame(m, j)), [joint.parent, joint.child], count)
         });
         let cables =
             taut.iter().map(|&c| (Member::Cable(c), [s.nodes[s.cables[c].a].body, s.nodes[s.cables[c].b].body], 1));
@@ -196,7 +198,7 @@ impl Simulation {
                 for (k, axis) in la.axes().iter().enumerate() {
                     let t = Twist { v: Vector::ZERO, w: *axis / scale, at: la.anchor };
                     block.clear();
-                    member.row_rates(self, &|x| (x == moved).then_some(t), &mut block);
+                    member.row_rates(m, self, &|x| (x == moved).then_some(t), &mut block);
                     let kept = &block[block.len() - count..];
                     entries.extend(kept.iter().enumerate().map(|(r, &x)| (first_row + r, la.first + k, x)));
                 }
@@ -219,13 +221,13 @@ struct TreePaths {
 }
 
 impl TreePaths {
-    fn of(sim: &Simulation, g: &ProjectedGroup, tree: &GroupTree) -> Self {
+    fn of(m: &Model, g: &ProjectedGroup, tree: &GroupTree) -> Self {
         let links = tree.links();
         let mut link_of_group_body = vec![0; g.bodies.len()];
         for (l, link) in links.iter().enumerate() {
             link_of_group_body[link.body] = l;
         }
-        let mut link_of = vec![None; sim.model.structure.bodies.len()];
+        let mut link_of = vec![None; m.structure.bodies.len()];
         let (mut parent, mut depth) = (Vec::new(), Vec::new());
         for link in links {
             let p = link.parent.map(|p| link_of_group_body[p]);
@@ -259,6 +261,7 @@ impl TreePaths {
 
 #[cfg(test)]
 pub(super) mod tests {
+    use super::Data;
     use crate::settings::SimSettings;
     use crate::sim::Simulation;
     use crate::structure::{BodyKind, Inertia, Joint, JointKind, Structure};
@@ -317,30 +320,31 @@ pub(super) mod tests {
         let mut sim = Simulation::new(&four_bar_chain(3), &SimSettings::default()).expect("builds");
         let g = sim.model.projected_groups.first().cloned().expect("the chain is one projected group");
         let tree = g.tree.clone().expect("a sparse group has a tree");
-        let taut = sim.projected_taut_cables(&g).expect("no slack cable");
-        let on_tree = sim.tree_joint_flags(&tree);
-        let rows = |sim: &Simulation| sim.loop_rows(&g, &taut, &on_tree);
-        let jacobian = sim.joint_jacobian(&g, &taut, &tree, &on_tree, rows(&sim).len()).to_dense();
+        let taut = sim.data.projected_taut_cables(&sim.model, &g).expect("no slack cable");
+        let on_tree = sim.data.tree_joint_flags(&sim.model, &tree);
+        let rows = |d: &Data| d.loop_rows(&sim.model, &g, &taut, &on_tree);
+        let jacobian =
+            sim.data.joint_jacobian(&sim.model, &g, &taut, &tree, &on_tree, rows(&sim.data).len()).to_dense();
         assert_eq!(jacobian.ncols(), 9, "one turn per revolute link of 9 bodies");
         let mut left_out = Vec::new();
         let mut first = 0;
         for &j in &g.joints {
-            let count = sim.joint_row_count(j);
+            let count = sim.data.joint_row_count(&sim.model, j);
             if on_tree[j] {
-                left_out.extend(first..first + count - usize::from(sim.locked_angle(j).is_some()));
+                left_out.extend(first..first + count - usize::from(sim.data.locked_angle(&sim.model, j).is_some()));
             }
             first += count;
         }
         assert!(!left_out.is_empty(), "the tree joints' rows");
-        let start = sim.group_poses(&g);
+        let start = sim.data.group_poses(&sim.model, &g);
         let (mut worst, mut worst_left_out) = (0.0_f64, 0.0_f64);
         for k in 0..jacobian.ncols() {
             let mut moved = |h: f64| {
                 let mut dq = vec![0.0; jacobian.ncols()];
                 dq[k] = h;
-                sim.turn_links(&g, &tree, &dq);
-                let r = (rows(&sim), sim.group_rows(&g, &taut));
-                sim.set_group_poses(&g, &start);
+                sim.data.turn_links(&sim.model, &g, &tree, &dq);
+                let r = (rows(&sim.data), sim.data.group_rows(&sim.model, &g, &taut));
+                sim.data.set_group_poses(&sim.model, &g, &start);
                 r
             };
             let (plus, minus) = (moved(STEP_M), moved(-STEP_M));

@@ -14,7 +14,7 @@
 //! coordinate are refused, by name.
 
 use super::modes::{ModesError, StructureMode, StructureModes, ZERO_MODE_RATIO};
-use super::Simulation;
+use super::{Data, Model};
 use crate::structure::{BodyKind, JointKind};
 use nalgebra::{DMatrix, DVector, Quaternion, UnitQuaternion, Vector3};
 
@@ -23,13 +23,13 @@ const STEP_RAD: f64 = 1e-4;
 /// Finite-difference step of a prismatic coordinate, a fraction of the structure's length.
 const STEP_FRACTION: f64 = 1e-4;
 
-impl Simulation {
+impl Data {
     /// The joints whose coordinates are the analysis's, or why the structure is refused.
-    fn modal_joints(&self) -> Result<Vec<usize>, ModesError> {
-        let s = &self.model.structure;
+    fn modal_joints(&self, m: &Model) -> Result<Vec<usize>, ModesError> {
+        let s = &m.structure;
         // A joint that closes a loop is an impulse joint, no link of a multibody.
         for (j, joint) in s.joints.iter().enumerate() {
-            if self.model.joint_links[j].is_none() {
+            if m.joint_links[j].is_none() {
                 return Err(ModesError::Loop(joint.name.clone()));
             }
         }
@@ -37,7 +37,7 @@ impl Simulation {
         if let Some(b) = s.bodies.iter().enumerate().find(|(b, body)| body.kind == BodyKind::Free && !jointed(*b)) {
             return Err(ModesError::Unjointed(b.1.name.clone()));
         }
-        let free: Vec<usize> = (0..s.joints.len()).filter(|j| !self.model.actuated[*j]).collect();
+        let free: Vec<usize> = (0..s.joints.len()).filter(|j| !m.actuated[*j]).collect();
         if let Some(&j) = free
             .iter()
             .find(|&&j| !matches!(s.joints[j].kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. }))
@@ -48,9 +48,9 @@ impl Simulation {
     }
 
     /// The finite-difference step of joint `j`'s coordinate.
-    fn modal_step(&self, j: usize) -> f64 {
-        match self.model.structure.joints[j].kind {
-            JointKind::Prismatic { .. } => STEP_FRACTION * self.model.length_scale_m,
+    fn modal_step(&self, m: &Model, j: usize) -> f64 {
+        match m.structure.joints[j].kind {
+            JointKind::Prismatic { .. } => STEP_FRACTION * m.length_scale_m,
             _ => STEP_RAD,
         }
     }
@@ -58,58 +58,59 @@ impl Simulation {
     /// Moves joint `j`'s coordinate by `d` (rad or m), the bodies beyond it along.
     /// [`Simulation::modal_joints`] admits only joints that are links of a multibody, so the
     /// move cannot fail here.
-    pub(super) fn displace_joint(&mut self, j: usize, d: f64) {
-        let _ = self.move_joint(j, d, None);
+    pub(super) fn displace_joint(&mut self, m: &Model, j: usize, d: f64) {
+        let _ = self.move_joint(m, j, d, None);
     }
 
     /// The potential energy now [J]: elastic members (engaged), torsion springs, and the work
     /// of the constant loads (gravity, external loads) on the centres of mass.
-    fn potential_energy_j(&self) -> f64 {
-        let s = &self.model.structure;
+    fn potential_energy_j(&self, m: &Model) -> f64 {
+        let s = &m.structure;
         let mut e = 0.0;
-        for m in (0..s.springs.len() + s.cables.len()).filter_map(|i| self.elastic_member(i)) {
-            let l = (Vector3::from(self.node_position(m.b)) - Vector3::from(self.node_position(m.a))).norm();
-            if m.engaged(l) {
-                e += 0.5 * m.stiffness_n_per_m * (l - m.rest_length_m).powi(2);
+        for member in (0..s.springs.len() + s.cables.len()).filter_map(|i| self.elastic_member(m, i)) {
+            let l = (Vector3::from(self.node_position(m, member.b)) - Vector3::from(self.node_position(m, member.a)))
+                .norm();
+            if member.engaged(l) {
+                e += 0.5 * member.stiffness_n_per_m * (l - member.rest_length_m).powi(2);
             }
         }
-        let snap = self.snapshot_with(false);
+        let snap = self.snapshot_with(m, false);
         for (j, joint) in s.joints.iter().enumerate() {
             if let (Some(t), Some(q)) = (&joint.torsion_spring, snap.joint_coordinate(s, j)) {
                 e += 0.5 * t.stiffness_nm_per_rad * (q - t.rest_angle_rad).powi(2);
             }
         }
-        for b in (0..s.bodies.len()).filter(|b| self.is_free(*b)) {
-            let (f, _) = self.constant_load(b);
-            let com = self.world_com(b);
+        for b in (0..s.bodies.len()).filter(|b| m.is_free(*b)) {
+            let (f, _) = self.constant_load(m, b);
+            let com = self.world_com(m, b);
             e -= f.x * com.x + f.y * com.y + f.z * com.z;
         }
         e
     }
 
     /// V with the coordinates `joints` moved by `d`, the state restored after.
-    fn energy_moved(&mut self, moves: &[(usize, f64)]) -> f64 {
-        moves.iter().for_each(|&(j, d)| self.displace_joint(j, d));
-        let e = self.potential_energy_j();
-        moves.iter().rev().for_each(|&(j, d)| self.displace_joint(j, -d));
+    fn energy_moved(&mut self, m: &Model, moves: &[(usize, f64)]) -> f64 {
+        moves.iter().for_each(|&(j, d)| self.displace_joint(m, j, d));
+        let e = self.potential_energy_j(m);
+        moves.iter().rev().for_each(|&(j, d)| self.displace_joint(m, j, -d));
         e
     }
 
     /// K = d2V/dq2 by central second differences.
-    fn joint_stiffness(&mut self, joints: &[usize]) -> DMatrix<f64> {
+    fn joint_stiffness(&mut self, m: &Model, joints: &[usize]) -> DMatrix<f64> {
         let n = joints.len();
-        let h: Vec<f64> = joints.iter().map(|&j| self.modal_step(j)).collect();
-        let e0 = self.potential_energy_j();
+        let h: Vec<f64> = joints.iter().map(|&j| self.modal_step(m, j)).collect();
+        let e0 = self.potential_energy_j(m);
         let mut k = DMatrix::zeros(n, n);
         for a in 0..n {
             let (ja, ha) = (joints[a], h[a]);
-            k[(a, a)] = (self.energy_moved(&[(ja, ha)]) - 2.0 * e0 + self.energy_moved(&[(ja, -ha)])) / (ha * ha);
+            k[(a, a)] = (self.energy_moved(m, &[(ja, ha)]) - 2.0 * e0 + self.energy_moved(m, &[(ja, -ha)])) / (ha * ha);
             for b in 0..a {
                 let (jb, hb) = (joints[b], h[b]);
-                let pp = self.energy_moved(&[(ja, ha), (jb, hb)]);
-                let pm = self.energy_moved(&[(ja, ha), (jb, -hb)]);
-                let mp = self.energy_moved(&[(ja, -ha), (jb, hb)]);
-                let mm = self.energy_moved(&[(ja, -ha), (jb, -hb)]);
+                let pp = self.energy_moved(m, &[(ja, ha), (jb, hb)]);
+                let pm = self.energy_moved(m, &[(ja, ha), (jb, -hb)]);
+                let mp = self.energy_moved(m, &[(ja, -ha), (jb, hb)]);
+                let mm = self.energy_moved(m, &[(ja, -ha), (jb, -hb)]);
                 k[(a, b)] = (pp - pm - mp + mm) / (4.0 * ha * hb);
                 k[(b, a)] = k[(a, b)];
             }
@@ -118,12 +119,12 @@ impl Simulation {
     }
 
     /// Each moving body's centre of mass and rotation (as a quaternion) now.
-    fn body_states(&self, bodies: &[usize]) -> Vec<(Vector3<f64>, UnitQuaternion<f64>)> {
+    fn body_states(&self, m: &Model, bodies: &[usize]) -> Vec<(Vector3<f64>, UnitQuaternion<f64>)> {
         bodies
             .iter()
             .map(|&b| {
-                let q = self.body_pose(b).rotation_xyzw;
-                let com = self.world_com(b);
+                let q = self.body_pose(m, b).rotation_xyzw;
+                let com = self.world_com(m, b);
                 (
                     Vector3::new(com.x, com.y, com.z),
                     UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2])),
@@ -134,15 +135,15 @@ impl Simulation {
 
     /// J (6 per moving body x n): the bodies' centre-of-mass velocity and angular velocity per
     /// unit rate of each coordinate, by central differences.
-    fn body_jacobian(&mut self, joints: &[usize], bodies: &[usize]) -> DMatrix<f64> {
+    fn body_jacobian(&mut self, m: &Model, joints: &[usize], bodies: &[usize]) -> DMatrix<f64> {
         let mut jac = DMatrix::zeros(6 * bodies.len(), joints.len());
         for (c, &j) in joints.iter().enumerate() {
-            let h = self.modal_step(j);
-            self.displace_joint(j, h);
-            let plus = self.body_states(bodies);
-            self.displace_joint(j, -2.0 * h);
-            let minus = self.body_states(bodies);
-            self.displace_joint(j, h);
+            let h = self.modal_step(m, j);
+            self.displace_joint(m, j, h);
+            let plus = self.body_states(m, bodies);
+            self.displace_joint(m, j, -2.0 * h);
+            let minus = self.body_states(m, bodies);
+            self.displace_joint(m, j, h);
             for (i, ((xp, rp), (xm, rm))) in plus.iter().zip(&minus).enumerate() {
                 let dx = (xp - xm) / (2.0 * h);
                 let dtheta = (rp * rm.inverse()).scaled_axis() / (2.0 * h);
@@ -154,21 +155,21 @@ impl Simulation {
     }
 
     /// The modes of a jointed structure in its free joints' coordinates (module docs).
-    pub(super) fn joint_modes(&mut self) -> Result<StructureModes, ModesError> {
-        let joints = self.modal_joints()?;
+    pub(super) fn joint_modes(&mut self, m: &Model) -> Result<StructureModes, ModesError> {
+        let joints = self.modal_joints(m)?;
         if joints.is_empty() {
             return Err(ModesError::NoFreeBody);
         }
-        let s = &self.model.structure;
-        let bodies: Vec<usize> = (0..s.bodies.len()).filter(|b| self.is_free(*b)).collect();
-        let stiffness = self.joint_stiffness(&joints);
-        let jac = self.body_jacobian(&joints, &bodies);
-        let body_mass = self.mass_matrix(&bodies);
+        let s = &m.structure;
+        let bodies: Vec<usize> = (0..s.bodies.len()).filter(|b| m.is_free(*b)).collect();
+        let stiffness = self.joint_stiffness(m, &joints);
+        let jac = self.body_jacobian(m, &joints, &bodies);
+        let body_mass = self.mass_matrix(m, &bodies);
         let mass = jac.transpose() * &body_mass * &jac;
         let eigen =
             crate::eigen::modes(&(0.5 * (&stiffness + stiffness.transpose())), &(0.5 * (&mass + mass.transpose())))?;
         let largest = eigen.iter().fold(0.0f64, |m, e| m.max(e.omega_squared.abs()));
-        let com: Vec<_> = self.body_states(&bodies).iter().map(|(c, _)| *c).collect();
+        let com: Vec<_> = self.body_states(m, &bodies).iter().map(|(c, _)| *c).collect();
         let modes: Vec<StructureMode> = eigen
             .into_iter()
             .map(|e| {
@@ -176,14 +177,14 @@ impl Simulation {
                 StructureMode {
                     omega_squared: e.omega_squared,
                     rigid: e.omega_squared.abs() <= ZERO_MODE_RATIO * largest,
-                    node_motion: self.node_motion(&bodies, &com, &shape),
+                    node_motion: self.node_motion(m, &bodies, &com, &shape),
                     shape,
                     joint_shape: e.shape.iter().copied().collect(),
                 }
             })
             .collect();
         let rigid = modes.iter().filter(|m| m.rigid).count();
-        let poses = bodies.iter().map(|b| self.body_pose(*b)).collect();
+        let poses = bodies.iter().map(|b| self.body_pose(m, *b)).collect();
         Ok(StructureModes { bodies, joints, poses, mass: body_mass, modes, rigid })
     }
 }

@@ -9,7 +9,7 @@
 //! joints' coordinates (`joint_modes.rs`); others are refused, by name. Modes with |omega^2| below [`ZERO_MODE_RATIO`] of the largest are rigid-body modes
 //! (a free turn or translation, a strut's spin about its axis): reported as ~0 and counted.
 
-use super::Simulation;
+use super::{Data, Model, Simulation};
 use crate::eigen::EigenError;
 use crate::snapshot::{BodyPose, ModalProjector};
 use crate::structure::{BodyKind, CableLaw};
@@ -89,11 +89,11 @@ pub enum ModesError {
     Eigen(#[from] EigenError),
 }
 
-impl Simulation {
+impl Data {
     /// The structure's natural modes at its current state: over six coordinates per free body,
     /// or reduced to the joints' coordinates where there are joints (`joint_modes.rs`).
-    pub fn modes(&mut self) -> Result<StructureModes, ModesError> {
-        let s = &self.model.structure;
+    pub(super) fn modes(&mut self, m: &Model) -> Result<StructureModes, ModesError> {
+        let s = &m.structure;
         if let Some(c) = s.cables.iter().find(|c| !matches!(c.law, CableLaw::Elastic { .. })) {
             return Err(ModesError::InextensibleCable(c.name.clone()));
         }
@@ -101,24 +101,24 @@ impl Simulation {
             return Err(ModesError::NoFreeBody);
         }
         if !s.joints.is_empty() {
-            return self.joint_modes();
+            return self.joint_modes(m);
         }
-        let tangent = self.tangent_stiffness();
-        let mass = self.mass_matrix(&tangent.bodies);
+        let tangent = self.tangent_stiffness(m);
+        let mass = self.mass_matrix(m, &tangent.bodies);
         let eigen = crate::eigen::modes(&tangent.hessian, &mass)?;
-        let largest = eigen.iter().fold(0.0f64, |m, e| m.max(e.omega_squared.abs()));
+        let largest = eigen.iter().fold(0.0f64, |l, e| l.max(e.omega_squared.abs()));
         let modes: Vec<StructureMode> = eigen
             .into_iter()
             .map(|e| StructureMode {
                 omega_squared: e.omega_squared,
                 rigid: e.omega_squared.abs() <= ZERO_MODE_RATIO * largest,
-                node_motion: self.node_motion(&tangent.bodies, &tangent.com, e.shape.as_slice()),
+                node_motion: self.node_motion(m, &tangent.bodies, &tangent.com, e.shape.as_slice()),
                 shape: e.shape.iter().copied().collect(),
                 joint_shape: vec![],
             })
             .collect();
-        let rigid = modes.iter().filter(|m| m.rigid).count();
-        let poses = tangent.bodies.iter().map(|b| self.body_pose(*b)).collect();
+        let rigid = modes.iter().filter(|mode| mode.rigid).count();
+        let poses = tangent.bodies.iter().map(|b| self.body_pose(m, *b)).collect();
         Ok(StructureModes { bodies: tangent.bodies, joints: vec![], poses, mass, modes, rigid })
     }
 
@@ -126,15 +126,21 @@ impl Simulation {
     /// state) so that its largest node displacement is `amplitude_m`; returns the modal
     /// coordinate reached (the mass-normalised amplitude). Linear in the shape: a rotation of
     /// dtheta about each centre of mass, exact for a rigid body.
-    pub fn displace_along_mode(&mut self, analysis: &StructureModes, index: usize, amplitude_m: f64) -> f64 {
+    pub(super) fn displace_along_mode(
+        &mut self,
+        m: &Model,
+        analysis: &StructureModes,
+        index: usize,
+        amplitude_m: f64,
+    ) -> f64 {
         let mode = &analysis.modes[index];
         let largest = mode.node_motion.iter().map(|d| Vector3::from(*d).norm()).fold(0.0, f64::max);
         let eta = if largest > 0.0 { amplitude_m / largest } else { 0.0 };
         if analysis.joints.is_empty() {
-            self.displace_free_bodies(&(DVector::from_column_slice(&mode.shape) * eta));
+            self.displace_free_bodies(m, &(DVector::from_column_slice(&mode.shape) * eta));
         } else {
             for (&j, v) in analysis.joints.iter().zip(&mode.joint_shape) {
-                self.displace_joint(j, eta * v);
+                self.displace_joint(m, j, eta * v);
             }
         }
         eta
@@ -142,27 +148,33 @@ impl Simulation {
 
     /// The mass matrix of the free bodies' blocks: m 1 for the translation, R diag(I) R^T for
     /// the rotation (the principal moments about the centre of mass, turned with the body).
-    pub(super) fn mass_matrix(&self, bodies: &[usize]) -> DMatrix<f64> {
-        let mut m = DMatrix::zeros(6 * bodies.len(), 6 * bodies.len());
+    pub(super) fn mass_matrix(&self, m: &Model, bodies: &[usize]) -> DMatrix<f64> {
+        let mut mass = DMatrix::zeros(6 * bodies.len(), 6 * bodies.len());
         for (i, &b) in bodies.iter().enumerate() {
-            let inertia = self.model.structure.bodies[b].inertia.expect("free bodies have inertia");
-            let q = self.body_pose(b).rotation_xyzw;
+            let inertia = m.structure.bodies[b].inertia.expect("free bodies have inertia");
+            let q = self.body_pose(m, b).rotation_xyzw;
             let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2])).to_rotation_matrix();
             let world =
                 r.matrix() * Matrix3::from_diagonal(&Vector3::from(inertia.principal_kg_m2)) * r.matrix().transpose();
-            m.view_mut((6 * i, 6 * i), (3, 3)).copy_from(&(Matrix3::identity() * inertia.mass_kg));
-            m.view_mut((6 * i + 3, 6 * i + 3), (3, 3)).copy_from(&(0.5 * (world + world.transpose())));
+            mass.view_mut((6 * i, 6 * i), (3, 3)).copy_from(&(Matrix3::identity() * inertia.mass_kg));
+            mass.view_mut((6 * i + 3, 6 * i + 3), (3, 3)).copy_from(&(0.5 * (world + world.transpose())));
         }
-        m
+        mass
     }
 
     /// Each node's displacement for the coordinates `shape`: dx + dtheta x rho.
-    pub(super) fn node_motion(&self, bodies: &[usize], com: &[Vector3<f64>], shape: &[f64]) -> Vec<[f64; 3]> {
-        let s = &self.model.structure;
+    pub(super) fn node_motion(
+        &self,
+        m: &Model,
+        bodies: &[usize],
+        com: &[Vector3<f64>],
+        shape: &[f64],
+    ) -> Vec<[f64; 3]> {
+        let s = &m.structure;
         (0..s.nodes.len())
             .map(|n| {
                 let Some(i) = bodies.iter().position(|&b| b == s.nodes[n].body) else { return [0.0; 3] };
-                let rho = Vector3::from(self.node_position(n)) - com[i];
+                let rho = Vector3::from(self.node_position(m, n)) - com[i];
                 let dx = Vector3::from_column_slice(&shape[6 * i..6 * i + 3]);
                 let dtheta = Vector3::from_column_slice(&shape[6 * i + 3..6 * i + 6]);
                 let d = dx + dtheta.cross(&rho);

@@ -17,7 +17,7 @@
 //! closed, with no velocity and no solve, while nothing has opened a row there
 //! ([`Jacobian::rigid`]).
 
-use super::Simulation;
+use super::{Data, Model};
 use crate::structure::JointKind;
 use rapier3d_f64::prelude::*;
 
@@ -118,15 +118,16 @@ impl Jacobian {
 /// structure's size (at most [`MAX_ITERATIONS`]), or gives up when the first step shrinks the
 /// largest row by less than `max_first_contraction`.
 pub(super) fn close_rows(
-    sim: &mut Simulation,
-    rows: &dyn Fn(&Simulation) -> Vec<f64>,
-    jacobian: &dyn Fn(&mut Simulation, &[f64]) -> Jacobian,
-    displace: &dyn Fn(&mut Simulation, &[f64]),
+    m: &Model,
+    sim: &mut Data,
+    rows: &dyn Fn(&Data) -> Vec<f64>,
+    jacobian: &dyn Fn(&mut Data, &[f64]) -> Jacobian,
+    displace: &dyn Fn(&mut Data, &[f64]),
     start: Option<Jacobian>,
     tolerance_fraction: f64,
     max_first_contraction: f64,
 ) -> Closing {
-    let tol = tolerance_fraction * sim.model.length_scale_m;
+    let tol = tolerance_fraction * m.length_scale_m;
     let mut jac: Option<Jacobian> = start;
     let mut formed = false;
     let (mut previous, mut polished) = (f64::INFINITY, false);
@@ -291,19 +292,19 @@ impl JointFrame {
 /// A loop-closing joint inside one multibody: the rows of its gap that the projection zeroes.
 #[derive(Clone, Debug)]
 pub(super) struct InternalClosure {
-    joint: usize,
-    multibody: MultibodyIndex,
+    pub(super) joint: usize,
+    pub(super) multibody: MultibodyIndex,
 }
 
-impl Simulation {
+impl Data {
     /// The loop-closing joints whose two bodies are links of the same multibody.
-    pub(super) fn find_internal_closures(&self) -> Vec<InternalClosure> {
+    pub(super) fn find_internal_closures(&self, m: &Model) -> Vec<InternalClosure> {
         let mut out = Vec::new();
-        for (j, joint) in self.model.structure.joints.iter().enumerate() {
-            if self.model.joint_impulse[j].is_none() || !matches!(joint.kind, JointKind::PlanarPin { .. }) {
+        for (j, joint) in m.structure.joints.iter().enumerate() {
+            if m.joint_impulse[j].is_none() || !matches!(joint.kind, JointKind::PlanarPin { .. }) {
                 continue;
             }
-            let link = |b: usize| self.multibody_joints.rigid_body_link(self.model.handles[b]).map(|l| l.multibody);
+            let link = |b: usize| self.multibody_joints.rigid_body_link(m.handles[b]).map(|l| l.multibody);
             if let (Some(a), Some(b)) = (link(joint.parent), link(joint.child)) {
                 if a == b {
                     out.push(InternalClosure { joint: j, multibody: a });
@@ -315,7 +316,7 @@ impl Simulation {
 
     /// The free coordinates of a multibody: every degree of freedom of a link that no actuator
     /// sets.
-    fn free_dofs(&self, multibody: MultibodyIndex) -> Vec<usize> {
+    pub(super) fn free_dofs(&self, multibody: MultibodyIndex) -> Vec<usize> {
         self.multibody_joints.get_multibody(multibody).map_or_else(Vec::new, |mb| {
             mb.links()
                 .filter(|l| !l.joint().kinematic)
@@ -331,36 +332,6 @@ impl Simulation {
             mb.forward_kinematics(&self.bodies, false);
             mb.update_rigid_bodies(&mut self.bodies, true);
         }
-    }
-
-    /// Closes every loop inside a multibody to round-off and projects the velocities onto the
-    /// closures' tangent space. Returns the largest gap left [m].
-    pub(super) fn project_internal_closures(&mut self) -> f64 {
-        let closures = std::mem::take(&mut self.model.internal_closures);
-        let mut largest = 0.0_f64;
-        let mut multibodies: Vec<MultibodyIndex> = Vec::new();
-        for c in &closures {
-            if !multibodies.contains(&c.multibody) {
-                multibodies.push(c.multibody);
-            }
-        }
-        for &mb_index in &multibodies {
-            if self.free_dofs(mb_index).is_empty() {
-                continue;
-            }
-            if let Some(left) = self.back_to_closure_rest(mb_index) {
-                largest = largest.max(left);
-                continue;
-            }
-            // The loops of one multibody: a group of its free coordinates alone.
-            let joints = closures.iter().filter(|c| c.multibody == mb_index).map(|c| c.joint).collect();
-            let g = ProjectedGroup { multibodies: vec![mb_index], joints, ..Default::default() };
-            let p = self.project_group(&g, &[], &mut None, &mut None, GAP_TOLERANCE_FRACTION, f64::INFINITY);
-            largest = largest.max(p.left);
-            self.note_closure_closed(mb_index, &g, p.left);
-        }
-        self.model.internal_closures = closures;
-        largest
     }
 }
 
@@ -387,7 +358,7 @@ pub(super) struct ProjectedGroup {
     /// Impulse joints (structure indices) between the group's bodies or to fixed bodies.
     pub joints: Vec<usize>,
     /// Inextensible cables with a rope joint.
-    cables: Vec<usize>,
+    pub(super) cables: Vec<usize>,
     /// A sparse group's spanning tree, along which its Gauss-Newton steps move it.
     pub tree: Option<super::group_tree::GroupTree>,
 }
@@ -395,25 +366,25 @@ pub(super) struct ProjectedGroup {
 /// A cable within this fraction of the structure's size of its length counts as taut.
 const TAUT_TOLERANCE_FRACTION: f64 = 1e-12;
 
-impl Simulation {
+impl Data {
     /// A rope cable is taut when stretched to its length (within round-off) or when rapier's
     /// rope pulled in the last step.
-    fn cable_is_taut(&self, c: usize) -> bool {
-        let cable = &self.model.structure.cables[c];
-        let l = crate::structure::distance(self.node_position(cable.a), self.node_position(cable.b));
-        let inv_h = self.model.settings.substeps as f64 / self.model.settings.dt_s;
-        let impulse = self.model.cable_ropes[c]
+    fn cable_is_taut(&self, m: &Model, c: usize) -> bool {
+        let cable = &m.structure.cables[c];
+        let l = crate::structure::distance(self.node_position(m, cable.a), self.node_position(m, cable.b));
+        let inv_h = m.settings.substeps as f64 / m.settings.dt_s;
+        let impulse = m.cable_ropes[c]
             .and_then(|h| self.impulse_joints.get(h))
             .map_or(0.0, |j| j.data.limits[0].impulse.abs() * inv_h);
-        l >= self.cable_lengths[c] - TAUT_TOLERANCE_FRACTION * self.model.length_scale_m || impulse > 0.0
+        l >= self.cable_lengths[c] - TAUT_TOLERANCE_FRACTION * m.length_scale_m || impulse > 0.0
     }
 
     /// For every cable: whether it is taut and held at its length by a group's projection (its
     /// tension is then fitted from the equilibrium, not read from rapier's impulse).
-    pub(super) fn cables_held_by_projection(&self) -> Vec<bool> {
-        let mut held = vec![false; self.model.structure.cables.len()];
-        for g in &self.model.projected_groups {
-            for c in self.projected_taut_cables(g).unwrap_or_default() {
+    pub(super) fn cables_held_by_projection(&self, m: &Model) -> Vec<bool> {
+        let mut held = vec![false; m.structure.cables.len()];
+        for g in &m.projected_groups {
+            for c in self.projected_taut_cables(m, g).unwrap_or_default() {
                 held[c] = true;
             }
         }
@@ -426,8 +397,8 @@ impl Simulation {
     /// then hold still together short of the equilibrium (measured on gravity_hanging.toml's
     /// (1, 1, 3): at rest 5e-3 N m from it), so the group is left to rapier alone until the
     /// cables are taut again.
-    pub(super) fn projected_taut_cables(&self, g: &ProjectedGroup) -> Option<Vec<usize>> {
-        let taut: Vec<usize> = g.cables.iter().copied().filter(|&c| self.cable_is_taut(c)).collect();
+    pub(super) fn projected_taut_cables(&self, m: &Model, g: &ProjectedGroup) -> Option<Vec<usize>> {
+        let taut: Vec<usize> = g.cables.iter().copied().filter(|&c| self.cable_is_taut(m, c)).collect();
         (g.multibodies.is_empty() || taut.len() == g.cables.len()).then_some(taut)
     }
 
@@ -435,13 +406,13 @@ impl Simulation {
     /// touches an actuated joint other than a revolute (which the projection holds at its
     /// command), a joint kind without projection rows, or a multibody with a
     /// loop inside (closed by [`Self::project_internal_closures`]) is left to rapier alone.
-    pub(super) fn find_projected_groups(&self) -> Vec<ProjectedGroup> {
-        let s = &self.model.structure;
-        let multibody_of = |b: usize| self.multibody_of(b);
-        let looped: Vec<MultibodyIndex> = self.model.internal_closures.iter().map(|c| c.multibody).collect();
-        let plain = |b: usize| self.is_free(b) && multibody_of(b).is_none();
-        let fixed = |b: usize| self.is_fixed_body(b);
-        let mut parent = self.constrained_together();
+    pub(super) fn find_projected_groups(&self, m: &Model) -> Vec<ProjectedGroup> {
+        let s = &m.structure;
+        let multibody_of = |b: usize| self.multibody_of(m, b);
+        let looped: Vec<MultibodyIndex> = m.internal_closures.iter().map(|c| c.multibody).collect();
+        let plain = |b: usize| m.is_free(b) && multibody_of(b).is_none();
+        let fixed = |b: usize| self.is_fixed_body(m, b);
+        let mut parent = self.constrained_together(m);
         let find = find_root;
         let mut groups: Vec<(usize, ProjectedGroup, bool)> = Vec::new();
         let group_of = |root: usize, groups: &mut Vec<(usize, ProjectedGroup, bool)>| -> usize {
@@ -454,7 +425,7 @@ impl Simulation {
         };
         let movable = |b: usize| if fixed(b) { None } else { Some(b) };
         for (j, joint) in s.joints.iter().enumerate() {
-            if self.model.joint_impulse[j].is_none() {
+            if m.joint_impulse[j].is_none() {
                 continue;
             }
             let Some(b) = movable(joint.child).or(movable(joint.parent)) else { continue };
@@ -469,11 +440,11 @@ impl Simulation {
                     | JointKind::PlanarPin { .. }
             );
             // An actuated revolute off the tree is locked at its command: one row more.
-            let actuated_ok = !self.model.actuated[j] || matches!(joint.kind, JointKind::Revolute { .. });
+            let actuated_ok = !m.actuated[j] || matches!(joint.kind, JointKind::Revolute { .. });
             groups[g].2 &= supported && actuated_ok;
         }
         for (c, cable) in s.cables.iter().enumerate() {
-            if self.model.cable_ropes[c].is_none() {
+            if m.cable_ropes[c].is_none() {
                 continue;
             }
             let (a, b) = (s.nodes[cable.a].body, s.nodes[cable.b].body);
@@ -505,8 +476,8 @@ impl Simulation {
             .filter(|(_, g, ok)| *ok && !(g.bodies.is_empty() && g.multibodies.is_empty()))
             .map(|(_, mut g, _)| {
                 if g.multibodies.is_empty() && 6 * g.bodies.len() >= SPARSE_MIN_COORDINATES {
-                    self.order_joints_by_band(&mut g);
-                    g.tree = Some(super::group_tree::GroupTree::of(self, &g.bodies, &g.joints));
+                    self.order_joints_by_band(m, &mut g);
+                    g.tree = Some(super::group_tree::GroupTree::of(m, &g.bodies, &g.joints));
                 }
                 g
             })
@@ -518,12 +489,12 @@ impl Simulation {
     /// the band squared. Measured on a chain of 10 furet2018 X modules cut into plain bodies:
     /// the band of its 180 rows went from 27 in the structure's order to 17, and a settle from
     /// 2.7 to 2.4 ms.
-    fn order_joints_by_band(&self, g: &mut ProjectedGroup) {
-        let s = &self.model.structure;
+    fn order_joints_by_band(&self, m: &Model, g: &mut ProjectedGroup) {
+        let s = &m.structure;
         let mut members_of_body: Vec<Vec<usize>> = vec![Vec::new(); s.bodies.len()];
         for (k, &j) in g.joints.iter().enumerate() {
             for b in [s.joints[j].parent, s.joints[j].child] {
-                if !self.is_fixed_body(b) {
+                if !self.is_fixed_body(m, b) {
                     members_of_body[b].push(k);
                 }
             }
@@ -552,41 +523,41 @@ impl Simulation {
     }
 
     /// The multibody that body `b` is a link of, if any.
-    fn multibody_of(&self, b: usize) -> Option<MultibodyIndex> {
-        self.multibody_joints.rigid_body_link(self.model.handles[b]).map(|l| l.multibody)
+    fn multibody_of(&self, m: &Model, b: usize) -> Option<MultibodyIndex> {
+        self.multibody_joints.rigid_body_link(m.handles[b]).map(|l| l.multibody)
     }
 
-    fn is_fixed_body(&self, b: usize) -> bool {
-        self.model.structure.bodies[b].kind == crate::structure::BodyKind::Fixed
+    fn is_fixed_body(&self, m: &Model, b: usize) -> bool {
+        m.structure.bodies[b].kind == crate::structure::BodyKind::Fixed
     }
 
     /// A union-find forest (each body's parent, [`find_root`]) over the bodies joined by an
     /// impulse joint, a rope cable or a common multibody; fixed bodies join nothing.
-    fn constrained_together(&self) -> Vec<usize> {
-        let s = &self.model.structure;
+    fn constrained_together(&self, m: &Model) -> Vec<usize> {
+        let s = &m.structure;
         let n = s.bodies.len();
         let mut edges: Vec<(usize, usize)> = Vec::new();
         for (j, joint) in s.joints.iter().enumerate() {
-            if self.model.joint_impulse[j].is_some() {
+            if m.joint_impulse[j].is_some() {
                 edges.push((joint.parent, joint.child));
             }
         }
         for (c, cable) in s.cables.iter().enumerate() {
-            if self.model.cable_ropes[c].is_some() {
+            if m.cable_ropes[c].is_some() {
                 edges.push((s.nodes[cable.a].body, s.nodes[cable.b].body));
             }
         }
         // The links of one multibody move together: one group.
         for a in 0..n {
             for b in a + 1..n {
-                if self.multibody_of(a).is_some() && self.multibody_of(a) == self.multibody_of(b) {
+                if self.multibody_of(m, a).is_some() && self.multibody_of(m, a) == self.multibody_of(m, b) {
                     edges.push((a, b));
                 }
             }
         }
         let mut parent: Vec<usize> = (0..n).collect();
         for &(a, b) in &edges {
-            if !self.is_fixed_body(a) && !self.is_fixed_body(b) {
+            if !self.is_fixed_body(m, a) && !self.is_fixed_body(m, b) {
                 let (ra, rb) = (find_root(&mut parent, a), find_root(&mut parent, b));
                 parent[ra] = rb;
             }
@@ -597,10 +568,10 @@ impl Simulation {
     /// The constraint rows of one joint: its anchor gap (for a planar pin only the two
     /// components across its axis) and its angular rows. Lengths in m; angular rows
     /// (dimensionless) times the structure's size, so that every row is a length.
-    pub(super) fn joint_rows(&self, j: usize, out: &mut Vec<f64>) {
-        let s = &self.model.structure;
-        let scale = self.model.length_scale_m;
-        let pose = |b: usize| *self.bodies[self.model.handles[b]].position();
+    pub(super) fn joint_rows(&self, m: &Model, j: usize, out: &mut Vec<f64>) {
+        let s = &m.structure;
+        let scale = m.length_scale_m;
+        let pose = |b: usize| *self.bodies[m.handles[b]].position();
         let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
         let joint = &s.joints[j];
         let (pp, pc) = (pose(joint.parent), pose(joint.child));
@@ -622,8 +593,8 @@ impl Simulation {
                     out.push(ac.dot(t) * scale);
                 }
                 // An actuated joint locked off the tree: its angle at the command.
-                if let Some(target) = self.locked_angle(j) {
-                    out.push(self.lock_row(j, pp.rotation, pc.rotation, target));
+                if let Some(target) = self.locked_angle(m, j) {
+                    out.push(self.lock_row(m, j, pp.rotation, pc.rotation, target));
                 }
             }
             JointKind::Universal { axis1, axis2 } => {
@@ -634,35 +605,35 @@ impl Simulation {
             }
             _ => out.extend([gap.x, gap.y, gap.z]),
         }
-        debug_assert_eq!(out.len() - before, self.joint_row_count(j), "joint_row_count matches joint_rows");
+        debug_assert_eq!(out.len() - before, self.joint_row_count(m, j), "joint_row_count matches joint_rows");
     }
 
     /// The row of revolute joint `j` locked at `target` [rad] (its parent's and child's
     /// rotations `pp`, `pc`): the angle's offset, wrapped to (-pi, pi], times the structure's
     /// size.
-    pub(super) fn lock_row(&self, j: usize, pp: Rotation, pc: Rotation, target: f64) -> f64 {
-        let JointKind::Revolute { axis } = self.model.structure.joints[j].kind else { return 0.0 };
+    pub(super) fn lock_row(&self, m: &Model, j: usize, pp: Rotation, pc: Rotation, target: f64) -> f64 {
+        let JointKind::Revolute { axis } = m.structure.joints[j].kind else { return 0.0 };
         let off = super::forces::relative_angle(pp, pc, Vector::new(axis[0], axis[1], axis[2])) - target;
-        off.sin().atan2(off.cos()) * self.model.length_scale_m
+        off.sin().atan2(off.cos()) * m.length_scale_m
     }
 
     /// The constraint rows of a projected group: each joint's ([`Self::joint_rows`]), then the
     /// stretch of each cable in `taut` [m].
-    pub(super) fn group_rows(&self, g: &ProjectedGroup, taut: &[usize]) -> Vec<f64> {
+    pub(super) fn group_rows(&self, m: &Model, g: &ProjectedGroup, taut: &[usize]) -> Vec<f64> {
         let mut out = Vec::new();
         for &j in &g.joints {
-            self.joint_rows(j, &mut out);
+            self.joint_rows(m, j, &mut out);
         }
-        self.cable_rows(taut, &mut out);
+        self.cable_rows(m, taut, &mut out);
         out
     }
 
     /// The stretch of each cable in `taut` [m].
-    pub(super) fn cable_rows(&self, taut: &[usize], out: &mut Vec<f64>) {
-        let s = &self.model.structure;
+    pub(super) fn cable_rows(&self, m: &Model, taut: &[usize], out: &mut Vec<f64>) {
+        let s = &m.structure;
         for &c in taut {
             let cable = &s.cables[c];
-            let (pa, pb) = (self.node_position(cable.a), self.node_position(cable.b));
+            let (pa, pb) = (self.node_position(m, cable.a), self.node_position(m, cable.b));
             out.push(crate::structure::distance(pa, pb) - self.cable_lengths[c]);
         }
     }
@@ -672,44 +643,45 @@ impl Simulation {
     /// that multiply a gap are dropped (the gap is round-off once projected).
     fn group_row_rates(
         &self,
+        m: &Model,
         g: &ProjectedGroup,
         taut: &[usize],
         twist: &dyn Fn(usize) -> Option<Twist>,
         out: &mut Vec<f64>,
     ) {
         for &j in &g.joints {
-            self.joint_row_rates(j, twist, out);
+            self.joint_row_rates(m, j, twist, out);
         }
         for &c in taut {
-            self.cable_row_rate(c, twist, out);
+            self.cable_row_rate(m, c, twist, out);
         }
     }
 
     /// The number of [`Self::joint_rows`] of joint `j`.
-    pub(super) fn joint_row_count(&self, j: usize) -> usize {
-        match self.model.structure.joints[j].kind {
+    pub(super) fn joint_row_count(&self, m: &Model, j: usize) -> usize {
+        match m.structure.joints[j].kind {
             JointKind::PlanarPin { .. } => 2,
-            JointKind::Revolute { .. } => 5 + usize::from(self.locked_angle(j).is_some()),
+            JointKind::Revolute { .. } => 5 + usize::from(self.locked_angle(m, j).is_some()),
             JointKind::Universal { .. } => 4,
             _ => 3,
         }
     }
 
     /// The rates of [`Self::joint_rows`] of joint `j` for the bodies' twists.
-    fn joint_row_rates(&self, j: usize, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
-        let s = &self.model.structure;
+    fn joint_row_rates(&self, m: &Model, j: usize, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
+        let s = &m.structure;
         // Neither body moves: zero rates (the multibody Jacobian's columns above the joint).
         if twist(s.joints[j].parent).is_none() && twist(s.joints[j].child).is_none() {
-            out.extend(std::iter::repeat_n(0.0, self.joint_row_count(j)));
+            out.extend(std::iter::repeat_n(0.0, self.joint_row_count(m, j)));
             return;
         }
-        self.joint_frame(j).row_rates(twist, out);
+        self.joint_frame(m, j).row_rates(twist, out);
     }
 
     /// Joint `j`'s geometry at the current poses, which its rows' rates are linear in.
-    pub(super) fn joint_frame(&self, j: usize) -> JointFrame {
-        let s = &self.model.structure;
-        let pose = |b: usize| *self.bodies[self.model.handles[b]].position();
+    pub(super) fn joint_frame(&self, m: &Model, j: usize) -> JointFrame {
+        let s = &m.structure;
+        let pose = |b: usize| *self.bodies[m.handles[b]].position();
         let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
         let joint = &s.joints[j];
         let (pp, pc) = (pose(joint.parent), pose(joint.child));
@@ -723,7 +695,7 @@ impl Simulation {
                 let ap = (pp.rotation * vec3(axis)).normalize();
                 let ac = (pc.rotation * vec3(axis)).normalize();
                 let pair = super::forces::orthogonal_pair(ap);
-                JointAxes::Revolute { ap, ac, pair, locked: self.locked_angle(j).is_some() }
+                JointAxes::Revolute { ap, ac, pair, locked: self.locked_angle(m, j).is_some() }
             }
             JointKind::Universal { axis1, axis2 } => JointAxes::Universal {
                 a1: pp.rotation * vec3(axis1).normalize(),
@@ -737,17 +709,17 @@ impl Simulation {
             anchor_on_parent: pp.transform_point(a),
             anchor_on_child: pc.transform_point(a),
             axes,
-            scale: self.model.length_scale_m,
+            scale: m.length_scale_m,
         }
     }
 
     /// The rate of a taut cable's stretch for the bodies' twists.
-    fn cable_row_rate(&self, c: usize, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
-        let s = &self.model.structure;
+    fn cable_row_rate(&self, m: &Model, c: usize, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
+        let s = &m.structure;
         let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
         let point_rate = |b: usize, p: Vector| twist(b).map_or(Vector::ZERO, |t| t.of_point(p));
         let cable = &s.cables[c];
-        let (pa, pb) = (vec3(self.node_position(cable.a)), vec3(self.node_position(cable.b)));
+        let (pa, pb) = (vec3(self.node_position(m, cable.a)), vec3(self.node_position(m, cable.b)));
         let d = pb - pa;
         let l = d.length();
         let rate = point_rate(s.nodes[cable.b].body, pb) - point_rate(s.nodes[cable.a].body, pa);
@@ -756,66 +728,19 @@ impl Simulation {
 
     /// The commanded angle of an actuated revolute joint off the tree, locked there
     /// (`build::locked_joint`, relative to the drawn pose) [rad]; None for any other joint.
-    pub(super) fn locked_angle(&self, j: usize) -> Option<f64> {
-        let revolute = matches!(self.model.structure.joints[j].kind, JointKind::Revolute { .. });
-        (self.model.actuated[j] && revolute && self.model.joint_impulse[j].is_some())
-            .then(|| self.locked_coordinates[j])
+    pub(super) fn locked_angle(&self, m: &Model, j: usize) -> Option<f64> {
+        let revolute = matches!(m.structure.joints[j].kind, JointKind::Revolute { .. });
+        (m.actuated[j] && revolute && m.joint_impulse[j].is_some()).then(|| self.locked_coordinates[j])
     }
 
     /// Moves body `b` by a translation `t` [m] and a rotation `r` [rad, rotation vector] about
     /// its centre of mass.
-    fn nudge(&mut self, b: usize, t: Vector, r: Vector) {
-        let com = self.world_com(b);
-        let h = self.model.handles[b];
+    fn nudge(&mut self, m: &Model, b: usize, t: Vector, r: Vector) {
+        let com = self.world_com(m, b);
+        let h = m.handles[b];
         let pose = *self.bodies[h].position();
         let moved = super::group_tree::turn_about(com, t, r) * pose;
         self.bodies[h].set_position(moved, true);
-    }
-
-    /// Closes every projected group's joints and taut cables to round-off and projects the
-    /// velocities of its bodies and multibodies. Returns the largest row left [m].
-    pub(super) fn project_groups(&mut self) -> f64 {
-        self.project_groups_to(GAP_TOLERANCE_FRACTION, f64::INFINITY).left
-    }
-
-    /// [`Self::project_groups`] to rows within `tolerance_fraction` of the structure's size;
-    /// a group gives up once its first Gauss-Newton step shrinks its largest row by less than
-    /// `max_first_contraction` ([`close_rows`]).
-    pub(super) fn project_groups_to(&mut self, tolerance_fraction: f64, max_first_contraction: f64) -> Projected {
-        self.project_groups_with(tolerance_fraction, max_first_contraction, false)
-    }
-
-    /// [`Self::project_groups_to`]; with `in_joint_coordinates`, a group that can be closed in
-    /// its tree's joint coordinates is (`joint_coordinates.rs`).
-    pub(super) fn project_groups_with(
-        &mut self,
-        tolerance_fraction: f64,
-        max_first_contraction: f64,
-        in_joint_coordinates: bool,
-    ) -> Projected {
-        let groups = std::mem::take(&mut self.model.projected_groups);
-        let mut kept = std::mem::take(&mut self.kept_jacobians);
-        let mut rests = std::mem::take(&mut self.rigid_rests);
-        kept.resize_with(groups.len(), || None);
-        rests.resize_with(groups.len(), || None);
-        let mut largest = Projected::default();
-        for ((g, kept), rest) in groups.iter().zip(kept.iter_mut()).zip(rests.iter_mut()) {
-            let Some(taut) = self.projected_taut_cables(g) else { continue };
-            let joint_closed = if in_joint_coordinates {
-                self.close_in_joint_coordinates(g, &taut, kept, rest, max_first_contraction)
-            } else {
-                None
-            };
-            let p = match joint_closed {
-                Some(p) => p,
-                None => self.project_group(g, &taut, kept, rest, tolerance_fraction, max_first_contraction),
-            };
-            largest = largest.max(p);
-        }
-        self.model.projected_groups = groups;
-        self.kept_jacobians = kept;
-        self.rigid_rests = rests;
-        largest
     }
 
     /// Closes the group's joints and its `taut` cables to round-off (Gauss-Newton in its
@@ -823,6 +748,7 @@ impl Simulation {
     /// open them. A sparse Jacobian is `kept` for the next call ([`KeptJacobian`]).
     pub(super) fn project_group(
         &mut self,
+        m: &Model,
         g: &ProjectedGroup,
         taut: &[usize],
         kept: &mut Option<KeptJacobian>,
@@ -830,41 +756,41 @@ impl Simulation {
         tolerance_fraction: f64,
         max_first_contraction: f64,
     ) -> Projected {
-        if let Some(left) = self.back_to_rigid_rest(g, taut, rest.as_ref()) {
+        if let Some(left) = self.back_to_rigid_rest(m, g, taut, rest.as_ref()) {
             return Projected { left, first_contraction: 0.0 };
         }
         *rest = None;
-        let coords = GroupCoordinates::of(self, g);
+        let coords = GroupCoordinates::of(m, self, g);
         // The body Jacobians at the current coordinates (the Jacobian below reads them).
         for &m in &g.multibodies {
             if let Some(mb) = self.multibody_joints.get_multibody_mut(m) {
                 mb.forward_kinematics(&self.bodies, false);
             }
         }
-        let rows = |sim: &Simulation| sim.group_rows(g, taut);
+        let rows = |sim: &Data| sim.group_rows(m, g, taut);
         let (start, start_poses) = match kept.take().filter(|k| k.taut == taut) {
             Some(k) => (Some(k.jacobian), Some(k.poses)),
             None => (None, None),
         };
         // Where the last sparse Jacobian was formed: the poses a kept one is judged by.
         let formed_at = std::cell::RefCell::new(start_poses);
-        let jacobian = |sim: &mut Simulation, g0: &[f64]| {
-            let j = coords.jacobian(sim, g, taut, g0.len());
+        let jacobian = |sim: &mut Data, g0: &[f64]| {
+            let j = coords.jacobian(m, sim, g, taut, g0.len());
             if matches!(j, Jacobian::Sparse(_)) {
-                *formed_at.borrow_mut() = Some(sim.group_poses(g));
+                *formed_at.borrow_mut() = Some(sim.group_poses(m, g));
             }
             j
         };
-        let displace = |sim: &mut Simulation, dq: &[f64]| coords.displace(sim, g, dq);
+        let displace = |sim: &mut Data, dq: &[f64]| coords.displace(m, sim, g, dq);
         let Closing { jacobian: jac, formed, left, first_contraction } =
-            close_rows(self, &rows, &jacobian, &displace, start, tolerance_fraction, max_first_contraction);
-        let u = coords.velocities(self, g);
+            close_rows(m, self, &rows, &jacobian, &displace, start, tolerance_fraction, max_first_contraction);
+        let u = coords.velocities(m, self, g);
         let moving = u.iter().any(|&x| x != 0.0);
         // A Jacobian kept from an earlier call serves the velocities only where the bodies are
         // back where it was formed (at rest); otherwise they take one formed here.
-        let stale = |sim: &Simulation| {
+        let stale = |sim: &Data| {
             let at = formed_at.borrow();
-            !at.as_ref().is_some_and(|p| sim.poses_within(g, p, KEPT_POSE_TOLERANCE_FRACTION))
+            !at.as_ref().is_some_and(|p| sim.poses_within(m, g, p, KEPT_POSE_TOLERANCE_FRACTION))
         };
         let jac = match jac {
             Some(j) if matches!(j, Jacobian::Sparse(_)) && !formed && moving && stale(self) => {
@@ -878,16 +804,16 @@ impl Simulation {
             // were just held at their length: a cable goes slack when rapier's rope stops
             // pulling, and is then no longer taut here). A rigid group keeps none: J^+ J = I.
             if moving && jac.rigid() {
-                self.stop_bodies(&g.bodies);
+                self.stop_bodies(m, &g.bodies);
             } else if moving {
                 if let Some(du) = jac.solve(&jac.mul(&u)) {
-                    coords.remove_velocities(self, g, &du);
+                    coords.remove_velocities(m, self, g, &du);
                 }
             }
             if let (Jacobian::Sparse(_), Some(poses)) = (&jac, formed_at.take()) {
-                let closed_to_round_off = tolerance_fraction <= GAP_TOLERANCE_FRACTION
-                    && left <= GAP_TOLERANCE_FRACTION * self.model.length_scale_m;
-                *rest = (jac.rigid() && closed_to_round_off).then(|| self.rigid_rest(g, taut, left));
+                let closed_to_round_off =
+                    tolerance_fraction <= GAP_TOLERANCE_FRACTION && left <= GAP_TOLERANCE_FRACTION * m.length_scale_m;
+                *rest = (jac.rigid() && closed_to_round_off).then(|| self.rigid_rest(m, g, taut, left));
                 *kept = Some(KeptJacobian { jacobian: jac, poses, taut: taut.to_vec() });
             }
         }
@@ -902,52 +828,53 @@ impl Simulation {
     /// the rows are evaluated again only when their other inputs have changed since
     /// ([`RigidRest`]). Returns the largest row left, or None (nothing changed) when the
     /// projection must run.
-    fn back_to_rigid_rest(&mut self, g: &ProjectedGroup, taut: &[usize], rest: Option<&RigidRest>) -> Option<f64> {
+    fn back_to_rigid_rest(
+        &mut self,
+        m: &Model,
+        g: &ProjectedGroup,
+        taut: &[usize],
+        rest: Option<&RigidRest>,
+    ) -> Option<f64> {
         let rest = rest.filter(|r| r.taut == taut)?;
-        if !self.poses_within(g, &rest.poses, RIGID_REST_FRACTION) {
+        if !self.poses_within(m, g, &rest.poses, RIGID_REST_FRACTION) {
             return None;
         }
         // The rows there are known while their other inputs are unchanged.
         let known = rest.generation == self.constraint_inputs;
-        let stepped = (!known).then(|| self.group_poses(g));
-        self.set_group_poses(g, &rest.poses);
-        let left = if known { rest.left } else { largest_abs(&self.group_rows(g, taut)) };
-        if left > GAP_TOLERANCE_FRACTION * self.model.length_scale_m {
+        let stepped = (!known).then(|| self.group_poses(m, g));
+        self.set_group_poses(m, g, &rest.poses);
+        let left = if known { rest.left } else { largest_abs(&self.group_rows(m, g, taut)) };
+        if left > GAP_TOLERANCE_FRACTION * m.length_scale_m {
             if let Some(stepped) = stepped {
-                self.set_group_poses(g, &stepped);
+                self.set_group_poses(m, g, &stepped);
             }
             return None;
         }
-        self.stop_bodies(&g.bodies);
+        self.stop_bodies(m, &g.bodies);
         Some(left)
     }
 
     /// The group's rest at its current poses, closed there to `left` [m].
-    pub(super) fn rigid_rest(&self, g: &ProjectedGroup, taut: &[usize], left: f64) -> RigidRest {
-        RigidRest { poses: self.group_poses(g), taut: taut.to_vec(), left, generation: self.constraint_inputs }
+    pub(super) fn rigid_rest(&self, m: &Model, g: &ProjectedGroup, taut: &[usize], left: f64) -> RigidRest {
+        RigidRest { poses: self.group_poses(m, g), taut: taut.to_vec(), left, generation: self.constraint_inputs }
     }
 
     /// The dense Jacobian of group `g`'s rows (no taut cables) by its coordinates, at the
     /// current poses and body Jacobians.
-    pub(super) fn group_jacobian_dense(&self, g: &ProjectedGroup) -> nalgebra::DMatrix<f64> {
-        let rows = g.joints.iter().map(|&j| self.joint_row_count(j)).sum();
-        match GroupCoordinates::of(self, g).jacobian(self, g, &[], rows) {
+    pub(super) fn group_jacobian_dense(&self, m: &Model, g: &ProjectedGroup) -> nalgebra::DMatrix<f64> {
+        let rows = g.joints.iter().map(|&j| self.joint_row_count(m, j)).sum();
+        match GroupCoordinates::of(m, self, g).jacobian(m, self, g, &[], rows) {
             Jacobian::Dense(j) => j,
             Jacobian::Sparse(j) => j.matrix().to_dense(),
         }
     }
 
-    /// Whether every projected group is of plain bodies alone (no multibody coordinates).
-    pub(super) fn projected_groups_are_plain(&self) -> bool {
-        self.model.projected_groups.iter().all(|g| g.multibodies.is_empty())
-    }
-
     /// The pose and velocities of every plain body of the projected groups.
-    pub(super) fn projected_states(&self) -> Vec<(usize, Pose, Vector, Vector)> {
-        let bodies = self.model.projected_groups.iter().flat_map(|g| g.bodies.iter().copied());
+    pub(super) fn projected_states(&self, m: &Model) -> Vec<(usize, Pose, Vector, Vector)> {
+        let bodies = m.projected_groups.iter().flat_map(|g| g.bodies.iter().copied());
         bodies
             .map(|b| {
-                let rb = &self.bodies[self.model.handles[b]];
+                let rb = &self.bodies[m.handles[b]];
                 (b, *rb.position(), rb.linvel(), rb.angvel())
             })
             .collect()
@@ -955,35 +882,94 @@ impl Simulation {
 
     /// Puts the bodies back as [`Self::projected_states`] read them. A Jacobian kept since is
     /// kept: formed where they started (or earlier), it is judged by where it was formed.
-    pub(super) fn restore_projected_states(&mut self, states: Vec<(usize, Pose, Vector, Vector)>) {
+    pub(super) fn restore_projected_states(&mut self, m: &Model, states: Vec<(usize, Pose, Vector, Vector)>) {
         for (b, pose, v, w) in states {
-            let rb = &mut self.bodies[self.model.handles[b]];
+            let rb = &mut self.bodies[m.handles[b]];
             rb.set_position(pose, true);
             rb.set_linvel(v, true);
             rb.set_angvel(w, true);
         }
     }
 
-    pub(super) fn set_group_poses(&mut self, g: &ProjectedGroup, poses: &[Pose]) {
+    pub(super) fn set_group_poses(&mut self, m: &Model, g: &ProjectedGroup, poses: &[Pose]) {
         for (&b, p) in g.bodies.iter().zip(poses) {
-            self.bodies[self.model.handles[b]].set_position(*p, true);
+            self.bodies[m.handles[b]].set_position(*p, true);
         }
     }
 
     /// The poses of the group's plain bodies.
-    pub(super) fn group_poses(&self, g: &ProjectedGroup) -> Vec<Pose> {
-        g.bodies.iter().map(|&b| *self.bodies[self.model.handles[b]].position()).collect()
+    pub(super) fn group_poses(&self, m: &Model, g: &ProjectedGroup) -> Vec<Pose> {
+        g.bodies.iter().map(|&b| *self.bodies[m.handles[b]].position()).collect()
     }
 
     /// Whether every plain body of the group is within `fraction` of the structure's size of
     /// its pose in `poses` (rotations times the size).
-    fn poses_within(&self, g: &ProjectedGroup, poses: &[Pose], fraction: f64) -> bool {
-        let (scale, tol) = (self.model.length_scale_m, fraction * self.model.length_scale_m);
+    fn poses_within(&self, m: &Model, g: &ProjectedGroup, poses: &[Pose], fraction: f64) -> bool {
+        let (scale, tol) = (m.length_scale_m, fraction * m.length_scale_m);
         g.bodies.iter().zip(poses).all(|(&b, p)| {
-            let now = self.bodies[self.model.handles[b]].position();
+            let now = self.bodies[m.handles[b]].position();
             let turn = (now.rotation * p.rotation.inverse()).to_scaled_axis().length();
             (now.translation - p.translation).length() <= tol && turn * scale <= tol
         })
+    }
+}
+
+/// The projection's own state: each projected group's Jacobian kept from its last projection
+/// and its rigid rest, where it was last closed.
+#[derive(Default)]
+pub(super) struct Projection {
+    kept_jacobians: Vec<Option<KeptJacobian>>,
+    rigid_rests: Vec<Option<RigidRest>>,
+}
+
+impl Projection {
+    /// Closes every projected group's joints and taut cables to round-off and projects the
+    /// velocities of its bodies and multibodies. Returns the largest row left [m].
+    pub(super) fn project_groups(&mut self, m: &Model, d: &mut Data) -> f64 {
+        self.project_groups_to(m, d, GAP_TOLERANCE_FRACTION, f64::INFINITY).left
+    }
+
+    /// [`Self::project_groups`] to rows within `tolerance_fraction` of the structure's size;
+    /// a group gives up once its first Gauss-Newton step shrinks its largest row by less than
+    /// `max_first_contraction` ([`close_rows`]).
+    pub(super) fn project_groups_to(
+        &mut self,
+        m: &Model,
+        d: &mut Data,
+        tolerance_fraction: f64,
+        max_first_contraction: f64,
+    ) -> Projected {
+        self.project_groups_with(m, d, tolerance_fraction, max_first_contraction, false)
+    }
+
+    /// [`Self::project_groups_to`]; with `in_joint_coordinates`, a group that can be closed in
+    /// its tree's joint coordinates is (`joint_coordinates.rs`).
+    pub(super) fn project_groups_with(
+        &mut self,
+        m: &Model,
+        d: &mut Data,
+        tolerance_fraction: f64,
+        max_first_contraction: f64,
+        in_joint_coordinates: bool,
+    ) -> Projected {
+        let groups = &m.projected_groups;
+        self.kept_jacobians.resize_with(groups.len(), || None);
+        self.rigid_rests.resize_with(groups.len(), || None);
+        let mut largest = Projected::default();
+        for ((g, kept), rest) in groups.iter().zip(self.kept_jacobians.iter_mut()).zip(self.rigid_rests.iter_mut()) {
+            let Some(taut) = d.projected_taut_cables(m, g) else { continue };
+            let joint_closed = if in_joint_coordinates {
+                d.close_in_joint_coordinates(m, g, &taut, kept, rest, max_first_contraction)
+            } else {
+                None
+            };
+            let p = match joint_closed {
+                Some(p) => p,
+                None => d.project_group(m, g, &taut, kept, rest, tolerance_fraction, max_first_contraction),
+            };
+            largest = largest.max(p);
+        }
+        largest
     }
 }
 
@@ -1038,11 +1024,11 @@ struct GroupCoordinates {
 impl GroupCoordinates {
     /// The free coordinates, read from the multibodies' links (their indices hold from the
     /// build, which settled every root: `build.rs`).
-    fn of(sim: &Simulation, g: &ProjectedGroup) -> Self {
+    fn of(m: &Model, sim: &Data, g: &ProjectedGroup) -> Self {
         GroupCoordinates {
             n_plain: 6 * g.bodies.len(),
             multibodies: g.multibodies.iter().map(|&m| (m, sim.free_dofs(m))).collect(),
-            scale: sim.model.length_scale_m,
+            scale: m.length_scale_m,
         }
     }
 
@@ -1063,13 +1049,13 @@ impl GroupCoordinates {
     }
 
     /// Moves every coordinate by `dq`.
-    fn displace(&self, sim: &mut Simulation, g: &ProjectedGroup, dq: &[f64]) {
+    fn displace(&self, m: &Model, sim: &mut Data, g: &ProjectedGroup, dq: &[f64]) {
         if let Some(tree) = &g.tree {
-            tree.displace(sim, &g.bodies, &dq[..self.n_plain], self.scale);
+            tree.displace(m, sim, &g.bodies, &dq[..self.n_plain], self.scale);
         } else {
             for (i, &b) in g.bodies.iter().enumerate() {
                 let q = &dq[6 * i..6 * i + 6];
-                sim.nudge(b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / self.scale);
+                sim.nudge(m, b, Vector::new(q[0], q[1], q[2]), Vector::new(q[3], q[4], q[5]) / self.scale);
             }
         }
         let mut k = self.n_plain;
@@ -1088,24 +1074,24 @@ impl GroupCoordinates {
     /// moves: a plain body's unit translation or rotation about its centre of mass, a
     /// multibody link's column of rapier's body Jacobian (centre-of-mass velocity and angular
     /// velocity).
-    fn jacobian(&self, sim: &Simulation, g: &ProjectedGroup, taut: &[usize], rows: usize) -> Jacobian {
+    fn jacobian(&self, m: &Model, sim: &Data, g: &ProjectedGroup, taut: &[usize], rows: usize) -> Jacobian {
         if self.multibodies.is_empty() && self.n_plain >= SPARSE_MIN_COORDINATES {
-            return Jacobian::sparse(self.sparse_jacobian(sim, g, taut, rows));
+            return Jacobian::sparse(self.sparse_jacobian(m, sim, g, taut, rows));
         }
         let ndof = self.count();
         let mut jac = nalgebra::DMatrix::<f64>::zeros(rows, ndof);
-        let mut twists: Vec<Option<Twist>> = vec![None; sim.model.structure.bodies.len()];
+        let mut twists: Vec<Option<Twist>> = vec![None; m.structure.bodies.len()];
         for k in 0..ndof {
             twists.iter_mut().for_each(|t| *t = None);
             if k < self.n_plain {
                 let b = g.bodies[k / 6];
-                twists[b] = Some(self.unit_twist(sim, b, k % 6));
+                twists[b] = Some(self.unit_twist(m, sim, b, k % 6));
             } else {
-                let (m, dof) = self.multibody_dof(k);
-                let Some(mb) = sim.multibody_joints.get_multibody(m) else { continue };
+                let (index, dof) = self.multibody_dof(k);
+                let Some(mb) = sim.multibody_joints.get_multibody(index) else { continue };
                 for (b, twist) in twists.iter_mut().enumerate() {
-                    let h = sim.model.handles[b];
-                    let Some(link) = sim.multibody_joints.rigid_body_link(h).filter(|l| l.multibody == m) else {
+                    let h = m.handles[b];
+                    let Some(link) = sim.multibody_joints.rigid_body_link(h).filter(|l| l.multibody == index) else {
                         continue;
                     };
                     let col = mb.body_jacobian(link.id).column(dof);
@@ -1121,7 +1107,7 @@ impl GroupCoordinates {
                 }
             }
             let mut column = Vec::with_capacity(rows);
-            sim.group_row_rates(g, taut, &|b| twists[b], &mut column);
+            sim.group_row_rates(m, g, taut, &|b| twists[b], &mut column);
             for (r, x) in column.into_iter().enumerate() {
                 jac[(r, k)] = x;
             }
@@ -1131,10 +1117,10 @@ impl GroupCoordinates {
 
     /// Plain body `b`'s motion per unit of its coordinate `k` (0..3 translation [m], 3..6
     /// rotation times the structure's size [m]) about its centre of mass.
-    fn unit_twist(&self, sim: &Simulation, b: usize, k: usize) -> Twist {
+    fn unit_twist(&self, m: &Model, sim: &Data, b: usize, k: usize) -> Twist {
         let mut q = [Vector::ZERO; 2];
         q[k / 3][k % 3] = 1.0;
-        Twist { v: q[0], w: q[1] / self.scale, at: sim.world_com(b) }
+        Twist { v: q[0], w: q[1] / self.scale, at: sim.world_com(m, b) }
     }
 
     /// The Jacobian of a group of plain bodies, member by member: each joint's or cable's rows
@@ -1142,19 +1128,20 @@ impl GroupCoordinates {
     /// in proportion to the members where the dense one costs rows times coordinates.
     fn sparse_jacobian(
         &self,
-        sim: &Simulation,
+        m: &Model,
+        sim: &Data,
         g: &ProjectedGroup,
         taut: &[usize],
         rows: usize,
     ) -> super::least_squares::SparseRows {
-        let s = &sim.model.structure;
+        let s = &m.structure;
         let mut position = vec![None; s.bodies.len()];
         for (i, &b) in g.bodies.iter().enumerate() {
             position[b] = Some(i);
         }
         // Each member's rows for a twist of one body: a joint's or a cable's.
         let joints =
-            g.joints.iter().map(|&j| (Member::Joint(sim.joint_frame(j)), [s.joints[j].parent, s.joints[j].child]));
+            g.joints.iter().map(|&j| (Member::Joint(sim.joint_frame(m, j)), [s.joints[j].parent, s.joints[j].child]));
         let cables =
             taut.iter().map(|&c| (Member::Cable(c), [s.nodes[s.cables[c].a].body, s.nodes[s.cables[c].b].body]));
         // At most two bodies' six twists per row.
@@ -1163,9 +1150,9 @@ impl GroupCoordinates {
             let mut count = 0;
             for (b, i) in bodies.into_iter().filter_map(|b| position[b].map(|i| (b, i))) {
                 for k in 0..6 {
-                    let t = self.unit_twist(sim, b, k);
+                    let t = self.unit_twist(m, sim, b, k);
                     block.clear();
-                    member.row_rates(sim, &|x| (x == b).then_some(t), &mut block);
+                    member.row_rates(m, sim, &|x| (x == b).then_some(t), &mut block);
                     entries.extend(block.iter().enumerate().map(|(r, &x)| (first_row + r, 6 * i + k, x)));
                     count = block.len();
                 }
@@ -1178,11 +1165,11 @@ impl GroupCoordinates {
 
     /// The velocities in these coordinates: u = [v, w L] per plain body, then the
     /// multibodies' free generalized velocities.
-    fn velocities(&self, sim: &Simulation, g: &ProjectedGroup) -> nalgebra::DVector<f64> {
+    fn velocities(&self, m: &Model, sim: &Data, g: &ProjectedGroup) -> nalgebra::DVector<f64> {
         let ndof = self.count();
         let mut u = nalgebra::DVector::<f64>::zeros(ndof);
         for (i, &b) in g.bodies.iter().enumerate() {
-            let rb = &sim.bodies[sim.model.handles[b]];
+            let rb = &sim.bodies[m.handles[b]];
             let (v, w) = (rb.linvel(), rb.angvel() * self.scale);
             for (r, x) in [v.x, v.y, v.z, w.x, w.y, w.z].into_iter().enumerate() {
                 u[6 * i + r] = x;
@@ -1196,9 +1183,9 @@ impl GroupCoordinates {
     }
 
     /// Subtracts `du` (in these coordinates) from the bodies' and multibodies' velocities.
-    fn remove_velocities(&self, sim: &mut Simulation, g: &ProjectedGroup, du: &nalgebra::DVector<f64>) {
+    fn remove_velocities(&self, m: &Model, sim: &mut Data, g: &ProjectedGroup, du: &nalgebra::DVector<f64>) {
         for (i, &b) in g.bodies.iter().enumerate() {
-            let rb = &mut sim.bodies[sim.model.handles[b]];
+            let rb = &mut sim.bodies[m.handles[b]];
             let v = rb.linvel() - Vector::new(du[6 * i], du[6 * i + 1], du[6 * i + 2]);
             let w = rb.angvel() - Vector::new(du[6 * i + 3], du[6 * i + 4], du[6 * i + 5]) / self.scale;
             rb.set_linvel(v, true);
@@ -1221,10 +1208,10 @@ pub(super) enum Member {
 }
 
 impl Member {
-    pub(super) fn row_rates(&self, sim: &Simulation, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
+    pub(super) fn row_rates(&self, m: &Model, sim: &Data, twist: &dyn Fn(usize) -> Option<Twist>, out: &mut Vec<f64>) {
         match self {
             Member::Joint(frame) => frame.row_rates(twist, out),
-            Member::Cable(c) => sim.cable_row_rate(*c, twist, out),
+            Member::Cable(c) => sim.cable_row_rate(m, *c, twist, out),
         }
     }
 }

@@ -7,7 +7,7 @@
 //! The restarted state is checked against the new structure (every node, centre of mass and
 //! inertia tensor); anything else, or a failed check, asks the caller to build afresh.
 
-use super::Simulation;
+use super::{Data, Model};
 use crate::structure::{JointKind, Structure};
 use rapier3d_f64::prelude::*;
 
@@ -64,73 +64,62 @@ impl Structure {
     }
 }
 
-impl Simulation {
+impl Data {
     /// Whether the placement of this structure is its joint coordinates alone.
-    fn restartable(&self) -> bool {
-        let s = &self.model.structure;
-        self.model.hidden_links.is_empty()
-            && self.model.internal_closures.is_empty()
-            && self.model.projected_groups.is_empty()
-            && self.model.cable_ropes.iter().all(Option::is_none)
-            && self.model.joint_impulse.iter().all(Option::is_none)
+    pub(super) fn restartable(&self, m: &Model) -> bool {
+        let s = &m.structure;
+        m.hidden_links.is_empty()
+            && m.internal_closures.is_empty()
+            && m.projected_groups.is_empty()
+            && m.cable_ropes.iter().all(Option::is_none)
+            && m.joint_impulse.iter().all(Option::is_none)
             && s.joints
                 .iter()
-                .zip(&self.model.joint_links)
+                .zip(&m.joint_links)
                 .all(|(j, l)| l.is_some() && matches!(j.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. }))
-            && (0..s.bodies.len()).all(|b| !self.is_free(b) || s.joints.iter().any(|j| j.child == b))
+            && (0..s.bodies.len()).all(|b| !m.is_free(b) || s.joints.iter().any(|j| j.child == b))
     }
 
-    /// Puts the simulation at rest in the start state of `s`, the same structure in another
-    /// placement (see [`Structure::same_but_placement`]), with the actuator commands `s` was
-    /// built with, and forgets the probe loads. Returns false when `s` does not qualify or the
-    /// restarted state does not reproduce it; the simulation must then be built afresh.
-    pub fn restart_from(&mut self, s: &Structure) -> bool {
-        if !self.restartable() || !self.model.structure.same_but_placement(s) {
-            return false;
-        }
-        self.probe_loads.iter_mut().for_each(|p| *p = ([0.0; 3], [0.0; 3]));
-        self.constraint_inputs += 1;
-        // The actuators to the commands `s` was built at, as for any new command.
-        self.set_commands(&s.initial_commands());
-        // Then every free joint, parents first, turned (slid) so that a node of its child lands
-        // where `s` has it.
-        let mut order: Vec<usize> = (0..s.joints.len()).filter(|j| !self.model.actuated[*j]).collect();
-        order.sort_by_key(|&j| self.model.tree.depth(s.joints[j].child));
+    /// Turns every free joint, parents first, so that a node of its child lands where `s`
+    /// has it, stops every body, and checks that the state reproduces `s`.
+    pub(super) fn place_free_joints(&mut self, m: &Model, s: &Structure) -> bool {
+        let mut order: Vec<usize> = (0..s.joints.len()).filter(|j| !m.actuated[*j]).collect();
+        order.sort_by_key(|&j| m.tree.depth(s.joints[j].child));
         for j in order {
-            if !self.place_free_joint(j, s) {
+            if !self.place_free_joint(m, j, s) {
                 return false;
             }
         }
-        for link in self.model.joint_links.iter().flatten() {
+        for link in m.joint_links.iter().flatten() {
             if let Some((mb, _)) = self.multibody_joints.get_mut(link.multibody_joint) {
                 mb.generalized_velocity_mut().fill(0.0);
             }
         }
-        self.zero_body_velocities();
-        self.reproduces(s)
+        self.zero_body_velocities(m);
+        self.reproduces(m, s)
     }
 
     /// Moves free joint `j` so that a node of its child body (off the axis, for a revolute)
     /// lands where `s` places it; false when the child has no such node.
-    fn place_free_joint(&mut self, j: usize, s: &Structure) -> bool {
-        let Some(motion) = self.joint_motion(j) else { return false };
-        let child = self.model.structure.joints[j].child;
+    fn place_free_joint(&mut self, m: &Model, j: usize, s: &Structure) -> bool {
+        let Some(motion) = self.joint_motion(m, j) else { return false };
+        let child = m.structure.joints[j].child;
         let off_axis = |x: Vector| (x - motion.anchor).reject_from_normalized(motion.axis);
-        let scale = self.model.length_scale_m;
-        let node = (0..self.model.structure.nodes.len()).find(|&n| {
-            self.model.structure.nodes[n].body == child
+        let scale = m.length_scale_m;
+        let node = (0..m.structure.nodes.len()).find(|&n| {
+            m.structure.nodes[n].body == child
                 && (!motion.revolute
-                    || off_axis(Vector::from(self.node_position(n))).length() > OFF_AXIS_FRACTION * scale)
+                    || off_axis(Vector::from(self.node_position(m, n))).length() > OFF_AXIS_FRACTION * scale)
         });
         let Some(n) = node else { return false };
-        let (now, wanted) = (Vector::from(self.node_position(n)), Vector::from(s.nodes[n].position));
+        let (now, wanted) = (Vector::from(self.node_position(m, n)), Vector::from(s.nodes[n].position));
         let displacement = if motion.revolute {
             let (a, b) = (off_axis(now), off_axis(wanted));
             motion.axis.dot(a.cross(b)).atan2(a.dot(b))
         } else {
             (wanted - now).dot(motion.axis)
         };
-        let Some((m, dof)) = self.dof_of(j) else { return false };
+        let Some((m, dof)) = self.dof_of(m, j) else { return false };
         let Some(mb) = self.multibody_joints.get_multibody_mut(m) else { return false };
         let mut disp = vec![0.0; mb.ndofs()];
         disp[dof] = displacement;
@@ -141,15 +130,15 @@ impl Simulation {
     }
 
     /// Whether every node, free body's centre of mass and inertia tensor is where `s` has it.
-    fn reproduces(&self, s: &Structure) -> bool {
-        let tol = PLACEMENT_TOLERANCE * self.model.length_scale_m;
+    fn reproduces(&self, m: &Model, s: &Structure) -> bool {
+        let tol = PLACEMENT_TOLERANCE * m.length_scale_m;
         let close = |a: Vector, b: [f64; 3]| (a - Vector::from(b)).length() <= tol;
-        let nodes = (0..s.nodes.len()).all(|i| close(Vector::from(self.node_position(i)), s.nodes[i].position));
-        let bodies = (0..s.bodies.len()).filter(|b| self.is_free(*b)).all(|b| {
-            let (Some(now), Some(then)) = (self.model.structure.bodies[b].inertia, s.bodies[b].inertia) else {
+        let nodes = (0..s.nodes.len()).all(|i| close(Vector::from(self.node_position(m, i)), s.nodes[i].position));
+        let bodies = (0..s.bodies.len()).filter(|b| m.is_free(*b)).all(|b| {
+            let (Some(now), Some(then)) = (m.structure.bodies[b].inertia, s.bodies[b].inertia) else {
                 return false;
             };
-            let rotation = self.bodies[self.model.handles[b]].position().rotation;
+            let rotation = self.bodies[m.handles[b]].position().rotation;
             // The inertia tensor now, R diag(I) R^T, against the new structure's diag(I').
             let scale = then.principal_kg_m2.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
             let axes = [Vector::X, Vector::Y, Vector::Z];
@@ -162,7 +151,7 @@ impl Simulation {
                     (value - wanted).abs() <= PLACEMENT_TOLERANCE * scale
                 })
             });
-            close(self.world_com(b), then.com) && tensor_ok
+            close(self.world_com(m, b), then.com) && tensor_ok
         });
         nodes && bodies
     }

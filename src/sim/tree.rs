@@ -9,7 +9,7 @@
 //! 10-X chain cut into plain bodies, 20 free turns instead of 180 body coordinates.
 
 use super::forces::Wrench;
-use super::Simulation;
+use super::{Data, Model};
 use crate::structure::Structure;
 
 /// Where a body hangs in a tree: the joint that carries it and the body on that joint's other
@@ -133,27 +133,27 @@ fn depths(hang: &[Option<Hang>]) -> Vec<usize> {
     depth.into_iter().map(|d| d.unwrap_or(0)).collect()
 }
 
-impl Simulation {
+impl Data {
     /// The tree of the multibody links: the joint each body hangs from.
-    pub(super) fn link_tree(&self) -> Tree {
-        Tree::new(&self.model.structure, self.link_hangs(), false)
+    pub(super) fn link_tree(&self, m: &Model) -> Tree {
+        Tree::new(&m.structure, self.link_hangs(m), false)
     }
 
     /// Each multibody link's child, hung from its parent.
-    fn link_hangs(&self) -> Vec<(usize, Hang)> {
-        let s = &self.model.structure;
-        let links = s.joints.iter().enumerate().filter(|(j, _)| self.model.joint_links[*j].is_some());
+    fn link_hangs(&self, m: &Model) -> Vec<(usize, Hang)> {
+        let s = &m.structure;
+        let links = s.joints.iter().enumerate().filter(|(j, _)| m.joint_links[*j].is_some());
         links.map(|(j, joint)| (joint.child, Hang { joint: j, parent: joint.parent })).collect()
     }
 
     /// The reaction fit's tree: the multibody links, and each sparse projected group's
     /// spanning tree over its impulse joints (but a joint with a torsion spring, whose torque
     /// the fit does not read, which stays a fitted closure).
-    pub(super) fn fit_tree(&self) -> Tree {
-        let s = &self.model.structure;
-        let mut hangs = self.link_hangs();
+    pub(super) fn fit_tree(&self, m: &Model) -> Tree {
+        let s = &m.structure;
+        let mut hangs = self.link_hangs(m);
         let links = hangs.len();
-        for g in &self.model.projected_groups {
+        for g in &m.projected_groups {
             for link in g.tree.iter().flat_map(|t| t.links()) {
                 let joint = &s.joints[link.joint];
                 let body = g.bodies[link.body];
@@ -213,7 +213,7 @@ mod tests {
             sim.model.fit_tree.carried(FLIPPED).is_some_and(|b| b != sim.model.structure.joints[FLIPPED].child);
         assert!(backwards, "the flipped joint is run backwards");
         let in_joints = sim.member_forces();
-        sim.model.fit_tree = sim.link_tree();
+        sim.model.fit_tree = sim.data.link_tree(&sim.model);
         let in_bodies = sim.member_forces();
         for forces in [&in_joints, &in_bodies] {
             let r = forces.residual.as_ref().expect("fitted");
@@ -232,7 +232,7 @@ mod tests {
         s.actuators.clear();
         let mut sim = Simulation::new(&s, &SimSettings::default()).expect("builds");
         let in_joints = sim.member_forces().residual.expect("fitted");
-        sim.model.fit_tree = sim.link_tree();
+        sim.model.fit_tree = sim.data.link_tree(&sim.model);
         let in_bodies = sim.member_forces().residual.expect("fitted");
         for r in [in_joints, in_bodies] {
             assert!(r.max_force_n.max(r.max_torque_nm) >= 1.0, "residual {r:?}");

@@ -43,6 +43,7 @@ mod restart;
 mod scripting;
 mod shipped_scenarios;
 mod sim_divergence;
+mod sim_layout;
 mod sweep;
 mod table;
 mod verdicts;

@@ -2,7 +2,7 @@
 //! f = -grad E and the Hessian H of the potential energy as 6x6 blocks (one per pair of
 //! coupled bodies), assembled from the force laws.
 
-use super::super::Simulation;
+use super::super::{Data, Model};
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix3x6, Matrix6, Vector3};
 use rapier3d_f64::prelude::*;
 use std::ops::AddAssign;
@@ -63,14 +63,14 @@ impl System {
     }
 }
 
-impl Simulation {
-    pub(super) fn relaxation_dofs(&self) -> Dofs {
-        let s = &self.model.structure;
+impl Data {
+    pub(super) fn relaxation_dofs(&self, m: &Model) -> Dofs {
+        let s = &m.structure;
         let mut dofs = Dofs { index: vec![None; s.bodies.len()], com: Vec::new(), scale: Vec::new() };
-        for b in (0..s.bodies.len()).filter(|b| self.is_free(*b)) {
+        for b in (0..s.bodies.len()).filter(|b| m.is_free(*b)) {
             let inertia = s.bodies[b].inertia.expect("free bodies have inertia");
             dofs.index[b] = Some(dofs.com.len());
-            dofs.com.push(self.world_com(b));
+            dofs.com.push(self.world_com(m, b));
             let p = inertia.principal_kg_m2;
             dofs.scale.push((inertia.mass_kg, ((p[0] + p[1] + p[2]) / 3.0).max(f64::MIN_POSITIVE)));
         }
@@ -78,18 +78,18 @@ impl Simulation {
     }
 
     /// Constant loads on body `b` (gravity, external and probe loads): force [N], torque [N m].
-    pub(in crate::sim) fn constant_load(&self, b: usize) -> (Vector3<f64>, Vector3<f64>) {
-        let s = &self.model.structure;
+    pub(in crate::sim) fn constant_load(&self, m: &Model, b: usize) -> (Vector3<f64>, Vector3<f64>) {
+        let s = &m.structure;
         let g = Vector3::from(s.gravity);
         let mass = s.bodies[b].inertia.map_or(0.0, |i| i.mass_kg);
         let (probe_f, probe_t) = self.probe_loads[b];
-        let f = g * mass + Vector3::from(probe_f) + Vector3::from(self.model.external_loads[b]);
+        let f = g * mass + Vector3::from(probe_f) + Vector3::from(m.external_loads[b]);
         (f, Vector3::from(probe_t))
     }
 
     /// Node Jacobian J = [1, -[rho]x] of the node's block, if its body is free.
-    fn node_jacobian(&self, dofs: &Dofs, node: usize, p: Vector3<f64>) -> Option<(usize, Matrix3x6<f64>)> {
-        let i = dofs.index[self.model.structure.nodes[node].body]?;
+    fn node_jacobian(&self, m: &Model, dofs: &Dofs, node: usize, p: Vector3<f64>) -> Option<(usize, Matrix3x6<f64>)> {
+        let i = dofs.index[m.structure.nodes[node].body]?;
         let rho = p - v3(dofs.com[i]);
         let mut j = Matrix3x6::zeros();
         j.fixed_view_mut::<3, 3>(0, 0).copy_from(&Matrix3::identity());
@@ -101,21 +101,24 @@ impl Simulation {
     /// free body (translation, then rotation): per member J^T K_m J with
     /// K_m = k e e^T + (t / l)(1 - e e^T), plus the rotations' geometric term
     /// (F . rho) 1 - sym(F rho^T) of a node force F at the arm rho.
-    pub(super) fn relaxation_system(&self, dofs: &Dofs) -> System {
-        let s = &self.model.structure;
+    pub(super) fn relaxation_system(&self, m: &Model, dofs: &Dofs) -> System {
+        let s = &m.structure;
         let mut f = DVector::zeros(6 * dofs.blocks());
         let mut blocks = Vec::new();
-        for m in (0..s.springs.len() + s.cables.len()).filter_map(|i| self.elastic_member(i)) {
-            let (pa, pb) = (Vector3::from(self.node_position(m.a)), Vector3::from(self.node_position(m.b)));
+        for member in (0..s.springs.len() + s.cables.len()).filter_map(|i| self.elastic_member(m, i)) {
+            let (pa, pb) =
+                (Vector3::from(self.node_position(m, member.a)), Vector3::from(self.node_position(m, member.b)));
             let d = pb - pa;
             let l = d.norm();
-            if l <= 0.0 || !m.engaged(l) {
+            if l <= 0.0 || !member.engaged(l) {
                 continue;
             }
-            let (t, e) = (m.tension_n(l), d / l);
-            let km = e * e.transpose() * m.stiffness_n_per_m + (Matrix3::identity() - e * e.transpose()) * (t / l);
-            let ends =
-                [(self.node_jacobian(dofs, m.a, pa), pa, e * t), (self.node_jacobian(dofs, m.b, pb), pb, -e * t)];
+            let (t, e) = (member.tension_n(l), d / l);
+            let km = e * e.transpose() * member.stiffness_n_per_m + (Matrix3::identity() - e * e.transpose()) * (t / l);
+            let ends = [
+                (self.node_jacobian(m, dofs, member.a, pa), pa, e * t),
+                (self.node_jacobian(m, dofs, member.b, pb), pb, -e * t),
+            ];
             for (x, (jx, px, fx)) in ends.iter().enumerate() {
                 let Some((i, ji)) = jx else { continue };
                 let rho = px - v3(dofs.com[*i]);
@@ -133,7 +136,7 @@ impl Simulation {
             }
         }
         for (b, i) in dofs.free() {
-            let (force, torque) = self.constant_load(b);
+            let (force, torque) = self.constant_load(m, b);
             f.fixed_rows_mut::<3>(6 * i).add_assign(&force);
             f.fixed_rows_mut::<3>(6 * i + 3).add_assign(&torque);
         }
@@ -148,8 +151,8 @@ impl Simulation {
     /// wherever that motion keeps its anchors in place (six motions without anchors, the turns
     /// about a single anchor, the turn about a line of anchors, as a prism's held strut, or a
     /// strut's spin about its axis). Blocks and anchors, per group.
-    pub(super) fn rigid_groups(&self, dofs: &Dofs) -> Vec<(Vec<usize>, Vec<Vector3<f64>>)> {
-        let s = &self.model.structure;
+    pub(super) fn rigid_groups(&self, m: &Model, dofs: &Dofs) -> Vec<(Vec<usize>, Vec<Vector3<f64>>)> {
+        let s = &m.structure;
         let n = dofs.blocks();
         let mut parent: Vec<usize> = (0..n).collect();
         fn root(parent: &mut [usize], mut i: usize) -> usize {
@@ -161,7 +164,7 @@ impl Simulation {
         }
         let mut anchors_of = vec![Vec::new(); n];
         let mut own_nodes = vec![Vec::new(); n];
-        let ends = s.springs.iter().map(|m| (m.a, m.b)).chain(s.cables.iter().map(|c| (c.a, c.b)));
+        let ends = s.springs.iter().map(|sp| (sp.a, sp.b)).chain(s.cables.iter().map(|c| (c.a, c.b)));
         for (a, b) in ends {
             for node in [a, b] {
                 if let Some(i) = dofs.index[s.nodes[node].body] {
@@ -187,7 +190,7 @@ impl Simulation {
         let place = |mut nodes: Vec<usize>| {
             nodes.sort_unstable();
             nodes.dedup();
-            nodes.into_iter().map(|a| Vector3::from(self.node_position(a))).collect::<Vec<_>>()
+            nodes.into_iter().map(|a| Vector3::from(self.node_position(m, a))).collect::<Vec<_>>()
         };
         let bodies = own_nodes.into_iter().enumerate().map(|(i, nodes)| {
             let mut anchors = place(nodes);

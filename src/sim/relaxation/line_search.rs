@@ -1,16 +1,16 @@
 //! The relaxation's line search: the energy after a trial step, and the limits of a step.
 
-use super::super::Simulation;
+use super::super::{Data, Model};
 use super::assemble::{v3, Dofs};
 use super::{MAX_STEP_FRACTION, MAX_STEP_ROTATION_RAD};
 use nalgebra::{DVector, Vector3};
 use rapier3d_f64::prelude::*;
 
-impl Simulation {
+impl Data {
     /// Node position after moving every free body by `alpha` times `step` [m].
-    fn moved_node(&self, dofs: &Dofs, step: &DVector<f64>, alpha: f64, node: usize) -> Vector3<f64> {
-        let p = Vector3::from(self.node_position(node));
-        let Some(i) = dofs.index[self.model.structure.nodes[node].body] else { return p };
+    fn moved_node(&self, m: &Model, dofs: &Dofs, step: &DVector<f64>, alpha: f64, node: usize) -> Vector3<f64> {
+        let p = Vector3::from(self.node_position(m, node));
+        let Some(i) = dofs.index[m.structure.nodes[node].body] else { return p };
         let c = v3(dofs.com[i]);
         let u = step.fixed_rows::<3>(6 * i) * alpha;
         let theta = step.fixed_rows::<3>(6 * i + 3) * alpha;
@@ -20,35 +20,45 @@ impl Simulation {
 
     /// Energy after moving by `alpha` times `step`, less the energy now [J], and the energy's
     /// scale (the sum of the magnitudes of its terms) [J].
-    pub(super) fn relaxation_energy_change(&self, dofs: &Dofs, step: &DVector<f64>, alpha: f64) -> (f64, f64) {
-        let s = &self.model.structure;
+    pub(super) fn relaxation_energy_change(
+        &self,
+        m: &Model,
+        dofs: &Dofs,
+        step: &DVector<f64>,
+        alpha: f64,
+    ) -> (f64, f64) {
+        let s = &m.structure;
         let (mut change, mut scale) = (0.0, 0.0);
-        for m in (0..s.springs.len() + s.cables.len()).filter_map(|i| self.elastic_member(i)) {
+        for member in (0..s.springs.len() + s.cables.len()).filter_map(|i| self.elastic_member(m, i)) {
             let energy = |pa: Vector3<f64>, pb: Vector3<f64>| {
                 let l = (pb - pa).norm();
-                if m.engaged(l) {
-                    0.5 * m.stiffness_n_per_m * (l - m.rest_length_m).powi(2)
+                if member.engaged(l) {
+                    0.5 * member.stiffness_n_per_m * (l - member.rest_length_m).powi(2)
                 } else {
                     0.0
                 }
             };
-            let now = energy(Vector3::from(self.node_position(m.a)), Vector3::from(self.node_position(m.b)));
-            let then = energy(self.moved_node(dofs, step, alpha, m.a), self.moved_node(dofs, step, alpha, m.b));
+            let now =
+                energy(Vector3::from(self.node_position(m, member.a)), Vector3::from(self.node_position(m, member.b)));
+            let then = energy(
+                self.moved_node(m, dofs, step, alpha, member.a),
+                self.moved_node(m, dofs, step, alpha, member.b),
+            );
             change += then - now;
             scale += now.abs() + then.abs();
         }
         for (b, i) in dofs.free() {
-            let (force, torque) = self.constant_load(b);
+            let (force, torque) = self.constant_load(m, b);
             let work = (force.dot(&step.fixed_rows::<3>(6 * i)) + torque.dot(&step.fixed_rows::<3>(6 * i + 3))) * alpha;
             change -= work;
-            scale += work.abs() + force.norm() * self.model.length_scale_m;
+            scale += work.abs() + force.norm() * m.length_scale_m;
         }
         (change, scale)
     }
 
     /// The largest fraction (at most 1) of `step` that keeps every body within the step limits.
-    pub(super) fn relaxation_step_limit(&self, dofs: &Dofs, step: &DVector<f64>) -> f64 {
-        let max_shift = MAX_STEP_FRACTION * self.model.length_scale_m;
+    pub(super) fn relaxation_step_limit(&self, m: &Model, dofs: &Dofs, step: &DVector<f64>) -> f64 {
+        let max_shift = MAX_STEP_FRACTION * m.length_scale_m;
         (0..dofs.blocks()).fold(1.0_f64, |alpha, i| {
             let shift = step.fixed_rows::<3>(6 * i).norm();
             let turn = step.fixed_rows::<3>(6 * i + 3).norm();
@@ -58,13 +68,13 @@ impl Simulation {
 
     /// Moves every free body by `alpha` times `step` (translation of the centre of mass, then
     /// rotation about it).
-    pub(super) fn move_bodies(&mut self, dofs: &Dofs, step: &DVector<f64>, alpha: f64) {
+    pub(super) fn move_bodies(&mut self, m: &Model, dofs: &Dofs, step: &DVector<f64>, alpha: f64) {
         for (b, i) in dofs.free() {
             let u = step.fixed_rows::<3>(6 * i) * alpha;
             let theta = step.fixed_rows::<3>(6 * i + 3) * alpha;
             let com = dofs.com[i];
             let turn = Rotation::from_scaled_axis(Vector::new(theta.x, theta.y, theta.z));
-            let h = self.model.handles[b];
+            let h = m.handles[b];
             let pose = *self.bodies[h].position();
             let moved = Pose::from_translation(com + Vector::new(u.x, u.y, u.z))
                 * Pose::from_rotation(turn)

@@ -35,7 +35,7 @@ mod line_search;
 pub(super) mod ordering;
 mod sparse;
 
-use super::Simulation;
+use super::{Data, Model};
 use crate::structure::{BodyKind, CableLaw, Structure};
 use nalgebra::DVector;
 
@@ -110,49 +110,39 @@ pub(super) struct Tangent {
     pub(super) hessian: nalgebra::DMatrix<f64>,
 }
 
-impl Simulation {
-    /// The Hessian the relaxation assembles, at the current state.
-    pub(super) fn tangent_stiffness(&self) -> Tangent {
-        let dofs = self.relaxation_dofs();
-        let hessian = self.relaxation_system(&dofs).dense();
-        let mut bodies = vec![0; dofs.blocks()];
-        for (b, i) in dofs.free() {
-            bodies[i] = b;
-        }
-        Tangent { bodies, com: dofs.com.iter().map(|c| assemble::v3(*c)).collect(), hessian }
-    }
+/// The static relaxation's state: whether it runs before each step, its current shift and
+/// the largest force at its last step.
+pub(super) struct Relaxation {
+    /// Whether the static relaxation runs before each step (the settings' choice where it
+    /// applies; the settle loop turns it off for its quiet window).
+    pub(super) on: bool,
+    /// The current shift, a fraction of the stiffest mode.
+    shift: f64,
+    /// The largest generalized force component at the last step, for the test of a round-off
+    /// stall.
+    last_force: f64,
+}
 
-    /// Moves every free body by `step` (six coordinates per body, in the order of
-    /// [`Simulation::tangent_stiffness`]'s blocks: translation of the centre of mass, then a
-    /// rotation about it).
-    pub(super) fn displace_free_bodies(&mut self, step: &nalgebra::DVector<f64>) {
-        let dofs = self.relaxation_dofs();
-        self.move_bodies(&dofs, step, 1.0);
+impl Default for Relaxation {
+    fn default() -> Self {
+        Relaxation { on: false, shift: 0.0, last_force: f64::INFINITY }
     }
+}
 
-    /// The step solver for the structure's size: dense up to [`DENSE_MAX_BODIES`] free
-    /// bodies, sparse above.
-    fn relaxation_solver(&self, dofs: &assemble::Dofs, system: &assemble::System) -> Box<dyn StepSolver> {
-        if dofs.blocks() <= DENSE_MAX_BODIES {
-            Box::new(dense::Modes::new(dofs, system))
-        } else {
-            Box::new(sparse::ShiftedCholesky::new(dofs, system, &self.rigid_groups(dofs), self.model.length_scale_m))
-        }
-    }
-
+impl Relaxation {
     /// One relaxation step (before the member forces are applied): the shifted Newton step on
     /// the energy, its shift raised until the energy decreases (Levenberg-Marquardt), then
     /// every free body at rest. Without a step (no stiffness, as a body in free fall, or no
     /// decrease found) the velocities stay: the dynamics move alone.
     #[inline(never)]
-    pub(super) fn relax(&mut self) {
-        let dofs = self.relaxation_dofs();
-        let system = self.relaxation_system(&dofs);
+    pub(super) fn relax(&mut self, m: &Model, d: &mut Data) {
+        let dofs = d.relaxation_dofs(m);
+        let system = d.relaxation_system(m, &dofs);
         let f = &system.force;
-        let mut solver = self.relaxation_solver(&dofs, &system);
-        let last_force = std::mem::replace(&mut self.relaxation_last_force, f.amax());
+        let mut solver = d.relaxation_solver(m, &dofs, &system);
+        let last_force = std::mem::replace(&mut self.last_force, f.amax());
         let stalled = f.amax() > STALL_RATIO * last_force;
-        let mut shift = self.relaxation_shift;
+        let mut shift = self.shift;
         for trial in 1..=MAX_TRIALS {
             let Some(step) = solver.step(shift) else {
                 shift = raised(shift);
@@ -165,24 +155,55 @@ impl Simulation {
             // A step beyond the limits is a rejected trial (the shift shortens the soft modes'
             // steps first, where a common factor would shorten the stiff ones' as much); the
             // last trial is cut to the limits instead.
-            let alpha = self.relaxation_step_limit(&dofs, &step);
+            let alpha = d.relaxation_step_limit(m, &dofs, &step);
             if alpha < 1.0 && trial < MAX_TRIALS {
                 shift = raised(shift);
                 continue;
             }
-            let (change, scale) = self.relaxation_energy_change(&dofs, &step, alpha);
+            let (change, scale) = d.relaxation_energy_change(m, &dofs, &step, alpha);
             let round_off = alpha * predicted <= ENERGY_ROUND_OFF * scale;
             if round_off && stalled {
                 break;
             }
             if change <= -ARMIJO * alpha * predicted || round_off {
-                self.move_bodies(&dofs, &step, alpha);
-                self.zero_body_velocities();
+                d.move_bodies(m, &dofs, &step, alpha);
+                d.zero_body_velocities(m);
                 let next = shift * SHIFT_DECAY;
-                self.relaxation_shift = if next < MIN_SHIFT_RATIO { 0.0 } else { next };
+                self.shift = if next < MIN_SHIFT_RATIO { 0.0 } else { next };
                 break;
             }
             shift = raised(shift);
+        }
+    }
+}
+
+impl Data {
+    /// The Hessian the relaxation assembles, at the current state.
+    pub(super) fn tangent_stiffness(&self, m: &Model) -> Tangent {
+        let dofs = self.relaxation_dofs(m);
+        let hessian = self.relaxation_system(m, &dofs).dense();
+        let mut bodies = vec![0; dofs.blocks()];
+        for (b, i) in dofs.free() {
+            bodies[i] = b;
+        }
+        Tangent { bodies, com: dofs.com.iter().map(|c| assemble::v3(*c)).collect(), hessian }
+    }
+
+    /// Moves every free body by `step` (six coordinates per body, in the order of
+    /// [`Simulation::tangent_stiffness`]'s blocks: translation of the centre of mass, then a
+    /// rotation about it).
+    pub(super) fn displace_free_bodies(&mut self, m: &Model, step: &nalgebra::DVector<f64>) {
+        let dofs = self.relaxation_dofs(m);
+        self.move_bodies(m, &dofs, step, 1.0);
+    }
+
+    /// The step solver for the structure's size: dense up to [`DENSE_MAX_BODIES`] free
+    /// bodies, sparse above.
+    fn relaxation_solver(&self, m: &Model, dofs: &assemble::Dofs, system: &assemble::System) -> Box<dyn StepSolver> {
+        if dofs.blocks() <= DENSE_MAX_BODIES {
+            Box::new(dense::Modes::new(dofs, system))
+        } else {
+            Box::new(sparse::ShiftedCholesky::new(dofs, system, &self.rigid_groups(m, dofs), m.length_scale_m))
         }
     }
 }
@@ -191,6 +212,7 @@ impl Simulation {
 mod tests {
     use super::assemble::cross_matrix;
     use super::*;
+    use crate::sim::Simulation;
     use nalgebra::{DMatrix, Vector3};
 
     /// Two free bodies hung from a fixed triangle by cables stretched to 1.6 times their rest
@@ -233,12 +255,12 @@ mod tests {
     #[test]
     fn force_and_hessian_are_the_derivatives_of_the_energy() {
         let sim = hung_bodies();
-        let dofs = sim.relaxation_dofs();
-        let system = sim.relaxation_system(&dofs);
+        let dofs = sim.data.relaxation_dofs(&sim.model);
+        let system = sim.data.relaxation_system(&sim.model, &dofs);
         let (h, f) = (system.dense(), system.force);
         let n = f.len();
         let step = 1e-4;
-        let energy = |d: &DVector<f64>| sim.relaxation_energy_change(&dofs, d, 1.0).0;
+        let energy = |d: &DVector<f64>| sim.data.relaxation_energy_change(&sim.model, &dofs, d, 1.0).0;
         let unit = |i: usize| DVector::from_fn(n, |r, _| if r == i { step } else { 0.0 });
         let largest_f = f.amax();
         let largest_h = h.amax();
@@ -262,9 +284,9 @@ mod tests {
     #[test]
     fn the_sparse_step_solves_the_shifted_newton_system() {
         let sim = hung_bodies();
-        let dofs = sim.relaxation_dofs();
-        let system = sim.relaxation_system(&dofs);
-        let mut solver = sparse::ShiftedCholesky::new(&dofs, &system, &sim.rigid_groups(&dofs), 1.0);
+        let dofs = sim.data.relaxation_dofs(&sim.model);
+        let system = sim.data.relaxation_system(&sim.model, &dofs);
+        let mut solver = sparse::ShiftedCholesky::new(&dofs, &system, &sim.data.rigid_groups(&sim.model, &dofs), 1.0);
         let mass = dofs.weight().map(|w| 1.0 / (w * w));
         // The mass-weighted Hessian's lowest mode is -267 1/s^2 (the compressed spring, the
         // cables' geometric stiffness), the Gershgorin bound 2249 1/s^2: a shift of 0.1 of it
@@ -298,11 +320,11 @@ mod tests {
             radius_m: 0.001,
         });
         let sim = Simulation::new(&s, &crate::settings::SimSettings::default()).unwrap();
-        let dofs = sim.relaxation_dofs();
-        let groups = sim.rigid_groups(&dofs);
+        let dofs = sim.data.relaxation_dofs(&sim.model);
+        let groups = sim.data.rigid_groups(&sim.model, &dofs);
         assert_eq!(groups.last(), Some(&(vec![0, 1], vec![])));
-        let system = sim.relaxation_system(&dofs);
-        let mut solver = sparse::ShiftedCholesky::new(&dofs, &system, &sim.rigid_groups(&dofs), 1.0);
+        let system = sim.data.relaxation_system(&sim.model, &dofs);
+        let mut solver = sparse::ShiftedCholesky::new(&dofs, &system, &sim.data.rigid_groups(&sim.model, &dofs), 1.0);
         let dx = solver.step(1.0).expect("positive definite at the Gershgorin bound");
         // Mass-weighted momentum of the step: sum m_i u_i (the rigid translation's component).
         let momentum: Vector3<f64> = (0..2).map(|i| dx.fixed_rows::<3>(6 * i) * dofs.scale[i].0).sum();

@@ -1,0 +1,70 @@
+//! The simulator's layout, read from `src/sim/`: an immutable model beside the state that
+//! steps (after MuJoCo's `mjModel` and `mjData`). Only the build writes the model; each
+//! concept's state is its own struct, so no file takes another's state apart to get past the
+//! borrow checker, and only `mod.rs` orders the concepts through a step.
+
+use std::path::{Path, PathBuf};
+
+/// Every `.rs` file under `src/sim/`, with its text up to its unit tests.
+fn sim_sources() -> Vec<(PathBuf, String)> {
+    fn walk(dir: &Path, out: &mut Vec<(PathBuf, String)>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                let text = std::fs::read_to_string(&p).unwrap();
+                let code = text.split("#[cfg(test)]").next().unwrap_or_default().to_string();
+                out.push((p, code));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(Path::new("src/sim"), &mut out);
+    out
+}
+
+#[test]
+fn no_simulator_state_is_taken_apart_with_mem_take() {
+    let sources = sim_sources();
+    assert!(sources.len() >= 20, "read only {} files of src/sim", sources.len());
+    let offenders: Vec<String> =
+        sources.iter().filter(|(_, code)| code.contains("mem::take")).map(|(p, _)| p.display().to_string()).collect();
+    assert!(offenders.is_empty(), "files of src/sim that mem::take state: {offenders:?}");
+}
+
+#[test]
+fn only_the_simulators_own_file_orders_the_concepts() {
+    let offenders: Vec<String> = sim_sources()
+        .iter()
+        .filter(|(p, code)| !p.ends_with("sim/mod.rs") && code.contains("impl Simulation"))
+        .map(|(p, _)| p.display().to_string())
+        .collect();
+    assert!(offenders.is_empty(), "files of src/sim besides mod.rs with `impl Simulation`: {offenders:?}");
+}
+
+#[test]
+fn only_the_build_writes_the_model() {
+    // An assignment to a model's field (`model.x = ...` or `m.x = ...`) or a mutable borrow of
+    // the model anywhere but the build.
+    let mut offenders = Vec::new();
+    for (p, code) in sim_sources() {
+        if p.ends_with("sim/build.rs") {
+            continue;
+        }
+        for (k, line) in code.lines().enumerate() {
+            let l = line.trim();
+            let writes = ["model.", "m."].iter().any(|prefix| {
+                l.strip_prefix(prefix).is_some_and(|rest| {
+                    let field: String = rest.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+                    let after = rest[field.len()..].trim_start();
+                    !field.is_empty() && after.starts_with('=') && !after.starts_with("==")
+                })
+            });
+            if writes || l.contains("&mut self.model") || l.contains("m: &mut Model") {
+                offenders.push(format!("{}:{}: {l}", p.display(), k + 1));
+            }
+        }
+    }
+    assert!(offenders.is_empty(), "the model written outside the build: {offenders:?}");
+}
