@@ -10,7 +10,7 @@
 
 use crate::mechanisms::Values;
 use crate::report::{PointReport, WorkspaceAgreement};
-use crate::run::{run, RunOptions};
+use crate::run::{run, RunError, RunOptions};
 use crate::scenario::{Actuation, Scenario};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -55,22 +55,39 @@ pub struct SweepSummary {
     /// `[prestress] on_loss` fails).
     pub disagreements: Vec<usize>,
     /// Errors of the blocks that stopped early (divergence, interruption).
-    pub errors: Vec<String>,
+    pub errors: Vec<RunError>,
     /// The sweep's verdict, with `run`'s pass policy: no block stopped early, and either the
     /// workspace agreement reaches `min_agreement_percent` or every point settled within
     /// tolerance (points outside the model's validity aside).
     pub passed: bool,
 }
 
+/// A `--shard` that is not `K/N` with 1 <= K <= N.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ShardError {
+    /// No `/`.
+    #[error("--shard must be K/N, got '{0}'")]
+    NotKOfN(String),
+    /// K is not a whole number.
+    #[error("bad K in '{0}'")]
+    BadK(String),
+    /// N is not a whole number.
+    #[error("bad N in '{0}'")]
+    BadN(String),
+    /// K or N out of range.
+    #[error("--shard K/N needs 1 <= K <= N, got {k}/{n}")]
+    OutOfRange { k: usize, n: usize },
+}
+
 /// Parses `K/N` (1 <= K <= N).
-pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
-    let (k, n) = s.split_once('/').ok_or_else(|| format!("--shard must be K/N, got '{s}'"))?;
+pub fn parse_shard(s: &str) -> Result<(usize, usize), ShardError> {
+    let (k, n) = s.split_once('/').ok_or_else(|| ShardError::NotKOfN(s.to_string()))?;
     let (k, n): (usize, usize) = (
-        k.trim().parse().map_err(|_| format!("bad K in '{s}'"))?,
-        n.trim().parse().map_err(|_| format!("bad N in '{s}'"))?,
+        k.trim().parse().map_err(|_| ShardError::BadK(s.to_string()))?,
+        n.trim().parse().map_err(|_| ShardError::BadN(s.to_string()))?,
     );
     if n == 0 || k == 0 || k > n {
-        return Err(format!("--shard K/N needs 1 <= K <= N, got {k}/{n}"));
+        return Err(ShardError::OutOfRange { k, n });
     }
     Ok((k, n))
 }
@@ -126,7 +143,7 @@ pub fn sweep(
         progress(n, total);
         r
     };
-    let results: Vec<(Vec<Row>, Option<String>)> = pool.install(|| blocks.par_iter().map(settle_block).collect());
+    let results: Vec<(Vec<Row>, Option<RunError>)> = pool.install(|| blocks.par_iter().map(settle_block).collect());
     let mut rows = Vec::new();
     let mut errors = Vec::new();
     for (r, e) in results {
@@ -147,14 +164,15 @@ type Swept = Result<(Vec<Row>, SweepSummary), SweepError>;
 fn sweep_topologies(
     sc: &Scenario,
     each: &dyn Fn(&Scenario) -> Swept,
-) -> Result<(Vec<Row>, Vec<String>, f64), SweepError> {
+) -> Result<(Vec<Row>, Vec<RunError>, f64), SweepError> {
     let start = std::time::Instant::now();
     let grid_points = sc.actuation.all_inputs().len();
     let (mut rows, mut errors, mut offset) = (Vec::new(), Vec::new(), 0);
     for variant in &sc.topologies {
         let (variant_rows, summary) = each(variant)?;
         let note = crate::run::rebuilt(sc, variant);
-        errors.extend(summary.errors.into_iter().map(|e| format!("{note}: {e}")));
+        errors
+            .extend(summary.errors.into_iter().map(|e| RunError::Topology { note: note.clone(), source: Box::new(e) }));
         rows.extend(variant_rows.into_iter().map(|mut r| {
             r.index += offset;
             r.point.index = r.index;
@@ -174,7 +192,7 @@ fn settle_block(
     continuation: bool,
     grid_points: usize,
     cancel: Option<&AtomicBool>,
-) -> (Vec<Row>, Option<String>) {
+) -> (Vec<Row>, Option<RunError>) {
     let mut sub = template.clone();
     sub.actuation = Actuation::Points { points: block.iter().map(|(_, v)| v.clone()).collect(), continuation };
     let r = run(&sub, &RunOptions { cancel, skip_findings: true, ..RunOptions::default() });
@@ -194,7 +212,7 @@ fn settle_block(
 fn summarise(
     sc: &Scenario,
     rows: &[Row],
-    errors: Vec<String>,
+    errors: Vec<RunError>,
     shard: Option<(usize, usize)>,
     jobs: usize,
     wall_s: f64,

@@ -16,7 +16,7 @@ pub struct Report {
     pub scenarios: Vec<ScenarioReport>,
 }
 
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, PartialEq, Default)]
 pub struct ScenarioReport {
     pub name: String,
     pub file: String,
@@ -52,7 +52,11 @@ pub struct ScenarioReport {
     /// (for example the smallest |det J| on a path that must avoid singularities).
     pub trajectory_ranges: std::collections::BTreeMap<String, QuantityRange>,
     /// Why the run stopped early (divergence, interruption), if it did.
-    pub error: Option<String>,
+    pub error: Option<crate::run::RunError>,
+    /// What the run went on without (a live viewer nobody runs), for the command line to say
+    /// (absent from the JSON when there is nothing).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// The file's own model: its `[[predictions]]` and `[[equations]]`, judged (absent from the
     /// JSON when the file states none).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -141,7 +145,7 @@ pub struct LagrangianReport {
     pub integrator_steps: usize,
     /// Why the model could not be compared (every coordinate then fails, its error infinite).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub error: Option<String>,
+    pub error: Option<crate::observers::lagrangian::LagrangianError>,
     pub coordinates: Vec<LagrangianCoordinateReport>,
 }
 
