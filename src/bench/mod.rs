@@ -30,6 +30,9 @@ pub enum BenchError {
     /// A case's scenario is not valid.
     #[error(transparent)]
     Scenario(#[from] scenario::ScenarioError),
+    /// The scale bench's tower has no design.
+    #[error(transparent)]
+    Tower(#[from] scale::tower::TowerError),
     /// A case's model gave no result.
     #[error(transparent)]
     Model(#[from] crate::mechanisms::ModelError),

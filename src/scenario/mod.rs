@@ -41,7 +41,7 @@ use std::path::{Path, PathBuf};
 
 pub use bounds::{MAX_STEPS_PER_RUN, MAX_STEPS_PER_SETTLE};
 pub use error::ScenarioError;
-pub use overrides::Override;
+pub use overrides::{Override, OverrideError};
 
 /// A validated scenario, ready to run.
 #[derive(Clone, Debug)]
