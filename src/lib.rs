@@ -21,6 +21,5 @@ pub mod scenario;
 pub mod settings;
 pub mod sim;
 pub mod snapshot;
-pub mod stoppable;
 pub mod structure;
 pub mod sweep;

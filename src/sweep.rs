@@ -9,7 +9,7 @@
 //! numbers agree with it within the scenario's tolerances, not bit for bit.
 
 use crate::mechanisms::Values;
-use crate::report::{PointReport, WorkspaceAgreement};
+use crate::report::{PointReport, ReportedError, WorkspaceAgreement};
 use crate::run::{run, RunError, RunOptions};
 use crate::scenario::{Actuation, Scenario};
 use rayon::prelude::*;
@@ -55,7 +55,7 @@ pub struct SweepSummary {
     /// `[prestress] on_loss` fails).
     pub disagreements: Vec<usize>,
     /// Errors of the blocks that stopped early (divergence, interruption).
-    pub errors: Vec<RunError>,
+    pub errors: Vec<ReportedError>,
     /// The sweep's verdict, with `run`'s pass policy: no block stopped early, and either the
     /// workspace agreement reaches `min_agreement_percent` or every point settled within
     /// tolerance (points outside the model's validity aside).
@@ -143,7 +143,8 @@ pub fn sweep(
         progress(n, total);
         r
     };
-    let results: Vec<(Vec<Row>, Option<RunError>)> = pool.install(|| blocks.par_iter().map(settle_block).collect());
+    let results: Vec<(Vec<Row>, Option<ReportedError>)> =
+        pool.install(|| blocks.par_iter().map(settle_block).collect());
     let mut rows = Vec::new();
     let mut errors = Vec::new();
     for (r, e) in results {
@@ -164,7 +165,7 @@ type Swept = Result<(Vec<Row>, SweepSummary), SweepError>;
 fn sweep_topologies(
     sc: &Scenario,
     each: &dyn Fn(&Scenario) -> Swept,
-) -> Result<(Vec<Row>, Vec<RunError>, f64), SweepError> {
+) -> Result<(Vec<Row>, Vec<ReportedError>, f64), SweepError> {
     let start = std::time::Instant::now();
     let grid_points = sc.actuation.all_inputs().len();
     let (mut rows, mut errors, mut offset) = (Vec::new(), Vec::new(), 0);
@@ -172,7 +173,7 @@ fn sweep_topologies(
         let (variant_rows, summary) = each(variant)?;
         let note = crate::run::rebuilt(sc, variant);
         errors
-            .extend(summary.errors.into_iter().map(|e| RunError::Topology { note: note.clone(), source: Box::new(e) }));
+            .extend(summary.errors.into_iter().map(|source| RunError::Topology { note: note.clone(), source }.into()));
         rows.extend(variant_rows.into_iter().map(|mut r| {
             r.index += offset;
             r.point.index = r.index;
@@ -192,7 +193,7 @@ fn settle_block(
     continuation: bool,
     grid_points: usize,
     cancel: Option<&AtomicBool>,
-) -> (Vec<Row>, Option<RunError>) {
+) -> (Vec<Row>, Option<ReportedError>) {
     let mut sub = template.clone();
     sub.actuation = Actuation::Points { points: block.iter().map(|(_, v)| v.clone()).collect(), continuation };
     let r = run(&sub, &RunOptions { cancel, skip_findings: true, ..RunOptions::default() });
@@ -212,7 +213,7 @@ fn settle_block(
 fn summarise(
     sc: &Scenario,
     rows: &[Row],
-    errors: Vec<RunError>,
+    errors: Vec<ReportedError>,
     shard: Option<(usize, usize)>,
     jobs: usize,
     wall_s: f64,

@@ -19,9 +19,9 @@ use std::sync::{Arc, Mutex};
 use tensegrity_testbed::file_model::spec::ErrorClass;
 use tensegrity_testbed::observers::external::{External, ExternalError, ExternalModel, ExternalPrediction};
 use tensegrity_testbed::observers::table::{MemoryTable, TableTarget};
+use tensegrity_testbed::run::stoppable::Stoppable;
 use tensegrity_testbed::run::{self, RunOptions};
 use tensegrity_testbed::scenario::{self, Override, Scenario, ScenarioError};
-use tensegrity_testbed::stoppable::Stoppable;
 
 create_exception!(
     _tensegrity,

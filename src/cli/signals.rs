@@ -1,10 +1,10 @@
 //! SIGINT/SIGTERM and the command's thread: the command runs on a thread of its own while the
 //! main thread watches for a signal, so that every phase stops within
-//! [`crate::stoppable::POLL_S`].
+//! [`crate::run::stoppable::POLL_S`].
 
 use super::EXIT_INTERNAL_ERROR;
 use crate::report::EXIT_FAIL;
-use crate::stoppable::{Halted, Stoppable};
+use crate::run::stoppable::{Halted, Stoppable};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Set by SIGINT or SIGTERM: the running scenario stops at its next tick, the reports of what
@@ -13,7 +13,7 @@ pub static CANCEL: AtomicBool = AtomicBool::new(false);
 
 /// Set while the command runs a phase that stops by itself on [`CANCEL`] (the scenarios' runs and
 /// the writing of their reports). In every other phase (parsing, an analytic solve, findings,
-/// figures) a signal ends the command within [`crate::stoppable::POLL_S`]: its temporary files are
+/// figures) a signal ends the command within [`crate::run::stoppable::POLL_S`]: its temporary files are
 /// removed, its outputs stay as they were, exit 1.
 static STOPS_ITSELF: AtomicBool = AtomicBool::new(false);
 
@@ -48,7 +48,7 @@ pub fn cancelled() -> bool {
 }
 
 /// Runs `command` on its own thread and returns its exit code, or exit 1 within
-/// [`crate::stoppable::POLL_S`] of a signal in a phase that does not stop by itself (its temporary files
+/// [`crate::run::stoppable::POLL_S`] of a signal in a phase that does not stop by itself (its temporary files
 /// removed), or [`EXIT_INTERNAL_ERROR`] when it panicked (its message is printed).
 pub fn run_stoppable(command: impl FnOnce() -> u8 + Send + 'static) -> u8 {
     let work = match Stoppable::spawn(Some(COMMAND_STACK_BYTES), command) {

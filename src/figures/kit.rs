@@ -35,7 +35,7 @@ pub enum FigureError {
     Sweep(#[from] SweepError),
     /// A scenario run stopped early (divergence, bad model).
     #[error("{path}: {error}")]
-    Run { path: String, error: crate::run::RunError },
+    Run { path: String, error: crate::report::ReportedError },
     /// A scenario run did not meet its declared verdict.
     #[error("{path} did not meet its declared verdict (failures: {failures})")]
     Verdict { path: String, failures: String },

@@ -71,13 +71,6 @@ pub enum LagrangianError {
     NotIntegrable(crate::file_model::dynamics::DynamicsError),
 }
 
-/// In the JSON report the error is its message.
-impl serde::Serialize for LagrangianError {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.collect_str(self)
-    }
-}
-
 /// Integrates the model of `energy` (its parameters and inputs in `values`) beside the
 /// `samples` and compares them; `tolerances` = (max, rms) per coordinate. Err with the reason
 /// when there are too few samples or the model cannot be integrated.
@@ -182,7 +175,7 @@ pub fn not_compared(
         start_coordinates: vec![],
         start_rates: vec![],
         integrator_steps: 0,
-        error: Some(why),
+        error: Some(crate::report::ReportedError::new(why)),
         coordinates,
     }
 }

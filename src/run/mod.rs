@@ -28,7 +28,7 @@ pub use settle::SettleDetector;
 pub use settled::{settle_first_point, SettledState};
 pub use topologies::rebuilt;
 
-use crate::stoppable::{interruptible, Halted};
+use stoppable::{interruptible, Halted};
 
 /// How a run is observed beyond the comparison.
 #[derive(Default)]
@@ -81,7 +81,7 @@ pub enum RunError {
     UnstableBranch { index: usize, branch: String },
     /// The run of one topology of a topology sweep (`note`: the parameters that rebuilt it).
     #[error("{note}: {source}")]
-    Topology { note: String, source: Box<RunError> },
+    Topology { note: String, source: crate::report::ReportedError },
 }
 
 impl From<ObserverError> for RunError {
@@ -90,17 +90,10 @@ impl From<ObserverError> for RunError {
     }
 }
 
-/// Two errors are the same when they say the same (an I/O error has no equality of its own).
-impl PartialEq for RunError {
-    fn eq(&self, other: &Self) -> bool {
-        self.to_string() == other.to_string()
-    }
-}
-
-/// In the JSON report an error is its message.
-impl serde::Serialize for RunError {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.collect_str(self)
+/// The report keeps the error as its own kind.
+impl From<RunError> for crate::report::ReportedError {
+    fn from(e: RunError) -> Self {
+        crate::report::ReportedError::new(e)
     }
 }
 
@@ -111,7 +104,7 @@ pub fn panicked(sc: &Scenario, payload: &(dyn std::any::Any + Send)) -> Scenario
         .map(|s| s.to_string())
         .or_else(|| payload.downcast_ref::<String>().cloned())
         .unwrap_or_else(|| "unknown panic".into());
-    let mut report = ScenarioReport { error: Some(RunError::Panicked(msg)), ..empty_report(sc) };
+    let mut report = ScenarioReport { error: Some(RunError::Panicked(msg).into()), ..empty_report(sc) };
     conclude(&mut report, sc);
     report
 }
@@ -128,6 +121,103 @@ fn empty_report(sc: &Scenario) -> ScenarioReport {
         skipped_points: sc.skipped_points.len(),
         unseen_params: sc.unseen_params.clone(),
         ..ScenarioReport::default()
+    }
+}
+
+/// Work on a thread of its own, waited for one poll at a time so that the waiting thread can
+/// stop waiting: the command of the CLI (on SIGINT or SIGTERM), a run's analytic computations
+/// (on its cancel flag) and the Python package's runs (on Ctrl-C) all wait this way.
+pub mod stoppable {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+    use std::sync::Mutex;
+    use std::thread::JoinHandle;
+    use std::time::Duration;
+
+    /// How often a waiting thread looks for a reason to stop while the work runs [s].
+    pub const POLL_S: f64 = 0.05;
+
+    /// Why work on a thread of its own gave no result.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+    pub enum Halted {
+        /// The waiter stopped waiting (a signal, a cancel flag).
+        #[error("interrupted")]
+        Interrupted,
+        /// The work's thread panicked.
+        #[error("panicked")]
+        Panicked,
+    }
+
+    /// Work running on a thread of its own, its result awaited one poll ([`POLL_S`]) at a time.
+    pub struct Stoppable<T> {
+        /// In a mutex so that the waiter may poll from any thread (the Python package polls
+        /// without the GIL).
+        result: Mutex<Receiver<T>>,
+        thread: JoinHandle<()>,
+    }
+
+    impl<T: Send + 'static> Stoppable<T> {
+        /// Starts `work` on a thread of its own with `stack_bytes` of stack (None: the default).
+        pub fn spawn(stack_bytes: Option<usize>, work: impl FnOnce() -> T + Send + 'static) -> std::io::Result<Self> {
+            let (tx, rx) = mpsc::channel();
+            let builder = std::thread::Builder::new();
+            let builder = match stack_bytes {
+                Some(bytes) => builder.stack_size(bytes),
+                None => builder,
+            };
+            let thread = builder.spawn(move || {
+                // The receiver is gone only when its waiter stopped waiting: nobody wants the result.
+                let _ = tx.send(work());
+            })?;
+            Ok(Stoppable { result: Mutex::new(rx), thread })
+        }
+
+        /// Waits up to [`POLL_S`] for the result: `Some` the result, `None` still working, or
+        /// [`Halted::Panicked`].
+        pub fn poll(&self) -> Result<Option<T>, Halted> {
+            let result = self.result.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            match result.recv_timeout(Duration::from_secs_f64(POLL_S)) {
+                Ok(value) => Ok(Some(value)),
+                Err(RecvTimeoutError::Timeout) => Ok(None),
+                Err(RecvTimeoutError::Disconnected) => Err(Halted::Panicked),
+            }
+        }
+
+        /// Waits for the result, asking `stop` after every poll that brought none:
+        /// [`Halted::Interrupted`] as soon as it says so (the thread is left to finish on its own,
+        /// or to end with the process).
+        pub fn wait(&self, mut stop: impl FnMut() -> bool) -> Result<T, Halted> {
+            loop {
+                if let Some(value) = self.poll()? {
+                    return Ok(value);
+                }
+                if stop() {
+                    return Err(Halted::Interrupted);
+                }
+            }
+        }
+
+        /// Waits for the thread to end (after its result, or once the flag it watches is raised).
+        pub fn join(self) {
+            let _ = self.thread.join();
+        }
+    }
+
+    /// Runs `f` on a thread of its own and waits for its result, looking at `cancel` every
+    /// [`POLL_S`]: [`Halted::Interrupted`] when cancelled first (the thread is left to finish on
+    /// its own, or to end with the process), [`Halted::Panicked`] when it panicked. Analytic
+    /// computations (findings, solves) have no ticks to stop at; this makes them interruptible
+    /// without threading a flag through every model.
+    pub fn interruptible<T: Send + 'static>(
+        cancel: Option<&AtomicBool>,
+        f: impl FnOnce() -> T + Send + 'static,
+    ) -> Result<T, Halted> {
+        let Some(cancel) = cancel else { return Ok(f()) };
+        let cancelled = || cancel.load(Ordering::SeqCst);
+        if cancelled() {
+            return Err(Halted::Interrupted);
+        }
+        Stoppable::spawn(None, f).expect("a thread starts").wait(cancelled)
     }
 }
 
@@ -151,7 +241,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         match interruptible(opts.cancel, move || of.mechanism().findings(&of.params)) {
             Ok(f) => report.findings = f.into_iter().map(Into::into).collect(),
             Err(halted) => {
-                report.error = Some(RunError::Findings(halted));
+                report.error = Some(RunError::Findings(halted).into());
                 conclude(&mut report, sc);
                 return report;
             }
@@ -162,7 +252,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
     let mut runner = match start(mech, sc, opts, &mut report.warnings) {
         Ok(r) => r,
         Err(e) => {
-            report.error = Some(e);
+            report.error = Some(e.into());
             conclude(&mut report, sc);
             return report;
         }
@@ -175,7 +265,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
     };
     if let Err(e) = ran {
         runner.emit(format_args!("run stopped: {e}"));
-        report.error = Some(e);
+        report.error = Some(e.into());
     }
     finish(&mut runner, &mut report, &probe_errors, wall);
     report
@@ -267,7 +357,7 @@ fn finish(runner: &mut Runner, report: &mut ScenarioReport, probe_errors: &[f64]
     }
     report.warnings.extend(warnings);
     if let Some(e) = failed {
-        report.error.get_or_insert(e);
+        report.error.get_or_insert(e.into());
         conclude(report, sc);
     }
 }

@@ -271,7 +271,7 @@ fn landed_branch(
     let wanted_unstable = runner.mech.starts_on_unstable_branch(&sc.start);
     if analytic_stable == Some(false) && !wanted_unstable {
         runner.emit(format_args!("point {index}: landed on the analytically unstable branch '{branch}'"));
-        report.error.get_or_insert(RunError::UnstableBranch { index, branch: branch.clone() });
+        report.error.get_or_insert(RunError::UnstableBranch { index, branch: branch.clone() }.into());
     }
     (branch, analytic_stable, landed)
 }

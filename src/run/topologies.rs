@@ -31,7 +31,7 @@ pub(super) fn run_topologies(sc: &Scenario, opts: &RunOptions) -> ScenarioReport
         let mut r = run(variant, &options);
         let note = rebuilt(sc, variant);
         rebuilt_at.push(format!("{note} ({} point(s))", variant.actuation.all_inputs().len()));
-        r.error = r.error.map(|e| RunError::Topology { note: note.clone(), source: Box::new(e) });
+        r.error = r.error.map(|source| RunError::Topology { note: note.clone(), source }.into());
         let stop = r.error.is_some();
         joined = Some(match joined {
             None => r,
