@@ -19,12 +19,16 @@ pub enum ModelError {
 /// A parameter of an analytic model outside its domain.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ParamError {
+    /// Not a finite number.
     #[error("{name} must be finite, got {value}")]
     NotFinite { name: &'static str, value: f64 },
+    /// Not above 0.
     #[error("{name} must be > 0, got {value}")]
     NotPositive { name: &'static str, value: f64 },
+    /// Not a finite number above 0.
     #[error("{name} must be finite and > 0, got {value}")]
     NotFinitePositive { name: &'static str, value: f64 },
+    /// Not a finite number at or above 0.
     #[error("{name} must be finite and >= 0, got {value}")]
     NotFiniteNonNegative { name: &'static str, value: f64 },
     /// A condition between parameters, as the model states it.
@@ -35,8 +39,10 @@ pub enum ParamError {
 /// A name that names no built-in mechanism, or no query of one.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum UnknownName {
+    /// No built-in mechanism is called `name` (`known`: those that are).
     #[error("unknown mechanism '{name}' (expected one of: {known})")]
     Mechanism { name: String, known: String },
+    /// `mechanism` has no analytic query `query` (`known`: those it has).
     #[error("unknown query '{query}' for {mechanism} (expected one of: {known})")]
     Query { query: String, mechanism: String, known: String },
 }
