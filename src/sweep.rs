@@ -19,12 +19,15 @@ use std::sync::atomic::AtomicBool;
 /// Points settled one after the other (continuation) in one parallel task.
 pub const BLOCK_POINTS: usize = 8;
 
+/// Why a sweep, or a merge of its shards, gave no result.
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
+    /// A grid or shard CSV the sweep cannot take (its message).
     #[error("{0}")]
     BadInput(String),
-    #[error("{0}")]
-    Io(String),
+    /// The pool of `jobs` threads could not be started.
+    #[error("cannot start {jobs} threads: {source}")]
+    Threads { jobs: usize, source: rayon::ThreadPoolBuildError },
 }
 
 /// One settled grid point, in the order of the full grid.
@@ -125,7 +128,7 @@ pub fn sweep(
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs.max(1))
         .build()
-        .map_err(|e| SweepError::Io(format!("cannot start {jobs} threads: {e}")))?;
+        .map_err(|source| SweepError::Threads { jobs, source })?;
     // What every block's run shares, without the grid's points and the file's text (cloned
     // once here, not once per block: a million points had made a signal take 29 s to stop).
     let mut template = sc.clone();
