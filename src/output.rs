@@ -12,6 +12,26 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 
+/// Why an output was refused or could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// The path exists and is not a regular file (`what` it is instead).
+    #[error("{} exists and is not a regular file ({what}): outputs only ever replace regular files", path.display())]
+    NotRegular { path: PathBuf, what: &'static str },
+    /// The output `what` is on the input `input`.
+    #[error("{what} {} is the input {}: refusing to overwrite it", path.display(), input.display())]
+    IsInput { what: String, path: PathBuf, input: PathBuf },
+    /// The outputs `what` and `other` are on one path.
+    #[error("{what} and {other} both write {}: give each its own path", path.display())]
+    Shared { what: String, other: String, path: PathBuf },
+    /// The output's directory could not be made.
+    #[error("cannot create {}: {source}", dir.display())]
+    CreateDir { dir: PathBuf, source: std::io::Error },
+    /// The output could not be written or renamed into place.
+    #[error("cannot write {}: {source}", path.display())]
+    Write { path: PathBuf, source: std::io::Error },
+}
+
 /// Counter that keeps the temporary names of one process apart.
 static PARTIAL_SEQ: AtomicU64 = AtomicU64::new(0);
 
@@ -48,13 +68,12 @@ pub fn identity(p: &Path) -> PathBuf {
 }
 
 /// An error when `path` exists and is not a regular file (followed through links).
-pub fn check_replaceable(path: &Path) -> Result<(), String> {
+pub fn check_replaceable(path: &Path) -> Result<(), OutputError> {
     match std::fs::metadata(path) {
-        Ok(m) if !m.is_file() => Err(format!(
-            "{} exists and is not a regular file ({}): outputs only ever replace regular files",
-            path.display(),
-            if m.is_dir() { "a directory" } else { "a device, socket or pipe" }
-        )),
+        Ok(m) if !m.is_file() => Err(OutputError::NotRegular {
+            path: path.to_path_buf(),
+            what: if m.is_dir() { "a directory" } else { "a device, socket or pipe" },
+        }),
         _ => Ok(()),
     }
 }
@@ -62,20 +81,17 @@ pub fn check_replaceable(path: &Path) -> Result<(), String> {
 /// Refuses, before anything runs: an output equal to an input, two outputs on one path, and an
 /// output that exists but is not a regular file. `outputs` pairs each path with what it is
 /// (`--json`, a recording of scenario X, ...), for the message.
-pub fn check_outputs(inputs: &[PathBuf], outputs: &[(String, PathBuf)]) -> Result<(), String> {
+pub fn check_outputs(inputs: &[PathBuf], outputs: &[(String, PathBuf)]) -> Result<(), OutputError> {
     let ins: Vec<PathBuf> = inputs.iter().map(|p| identity(p)).collect();
     let mut seen: Vec<(PathBuf, &str)> = Vec::new();
     for (what, path) in outputs {
         let id = identity(path);
         if let Some(k) = ins.iter().position(|i| *i == id) {
-            return Err(format!(
-                "{what} {} is the input {}: refusing to overwrite it",
-                path.display(),
-                inputs[k].display()
-            ));
+            return Err(OutputError::IsInput { what: what.clone(), path: path.clone(), input: inputs[k].clone() });
         }
         if let Some((_, other)) = seen.iter().find(|(p, _)| *p == id) {
-            return Err(format!("{what} and {other} both write {}: give each its own path", path.display()));
+            let (what, other) = (what.clone(), other.to_string());
+            return Err(OutputError::Shared { what, other, path: path.clone() });
         }
         check_replaceable(path)?;
         seen.push((id, what));
@@ -106,9 +122,10 @@ pub fn discard(partial: &Path) {
 
 /// Renames the complete temporary file `partial` over `path` (a regular file or nothing);
 /// removes `partial` when that fails.
-pub fn commit(partial: &Path, path: &Path) -> Result<(), String> {
-    let done = check_replaceable(path)
-        .and_then(|()| std::fs::rename(partial, path).map_err(|e| format!("cannot write {}: {e}", path.display())));
+pub fn commit(partial: &Path, path: &Path) -> Result<(), OutputError> {
+    let done = check_replaceable(path).and_then(|()| {
+        std::fs::rename(partial, path).map_err(|source| OutputError::Write { path: path.to_path_buf(), source })
+    });
     if done.is_err() {
         let _ = std::fs::remove_file(partial);
     }
@@ -118,10 +135,10 @@ pub fn commit(partial: &Path, path: &Path) -> Result<(), String> {
 
 /// Writes `bytes` to `path` through a unique temporary file and a rename: never half-written,
 /// never over anything but a regular file, and the previous file intact on any failure.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     check_replaceable(path)?;
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        create_dir(dir)?;
     }
     let tmp = partial_path(path);
     let written = (|| {
@@ -129,9 +146,14 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
         f.write_all(bytes)?;
         f.sync_all()
     })();
-    if let Err(e) = written {
+    if let Err(source) = written {
         discard(&tmp);
-        return Err(format!("cannot write {}: {e}", path.display()));
+        return Err(OutputError::Write { path: path.to_path_buf(), source });
     }
     commit(&tmp, path)
+}
+
+/// Makes the directory `dir` (and its parents) for an output.
+pub fn create_dir(dir: &Path) -> Result<(), OutputError> {
+    std::fs::create_dir_all(dir).map_err(|source| OutputError::CreateDir { dir: dir.to_path_buf(), source })
 }

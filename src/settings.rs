@@ -123,7 +123,7 @@ impl InterferenceSettings {
 
     /// Whether every excluded pair names members of `s` (else the error names the first that
     /// does not, and the members there are).
-    pub fn check_member_names(&self, s: &Structure) -> Result<(), String> {
+    pub fn check_member_names(&self, s: &Structure) -> Result<(), UnknownMember> {
         let names: Vec<&str> = s
             .struts
             .iter()
@@ -131,15 +131,10 @@ impl InterferenceSettings {
             .chain(s.cables.iter().map(|c| c.name.as_str()))
             .chain(s.springs.iter().map(|c| c.name.as_str()))
             .collect();
-        for name in self.exclude.iter().flat_map(|(a, b)| [a, b]) {
-            if !names.contains(&name.as_str()) {
-                return Err(format!(
-                    "interference exclusion names member '{name}', which does not exist (members: {})",
-                    names.join(", ")
-                ));
-            }
+        match self.exclude.iter().flat_map(|(a, b)| [a, b]).find(|n| !names.contains(&n.as_str())) {
+            Some(name) => Err(UnknownMember { name: name.clone(), members: names.join(", ") }),
+            None => Ok(()),
         }
-        Ok(())
     }
 }
 
@@ -398,4 +393,14 @@ pub fn interpolate(waypoints: &[(f64, crate::mechanisms::Values)], t: f64) -> cr
         }
     }
     waypoints.last().unwrap().1.clone()
+}
+
+/// An interference exclusion that names no member of the structure.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("interference exclusion names member '{name}', which does not exist (members: {members})")]
+pub struct UnknownMember {
+    /// The name given.
+    pub name: String,
+    /// The structure's members, listed.
+    pub members: String,
 }

@@ -9,8 +9,8 @@
 //! numbers agree with it within the scenario's tolerances, not bit for bit.
 
 use crate::mechanisms::Values;
-use crate::report::{PointReport, WorkspaceAgreement};
-use crate::run::{run, RunOptions};
+use crate::report::{PointReport, ReportedError, WorkspaceAgreement};
+use crate::run::{run, RunError, RunOptions};
 use crate::scenario::{Actuation, Scenario};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -19,12 +19,15 @@ use std::sync::atomic::AtomicBool;
 /// Points settled one after the other (continuation) in one parallel task.
 pub const BLOCK_POINTS: usize = 8;
 
+/// Why a sweep, or a merge of its shards, gave no result.
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
+    /// A grid or shard CSV the sweep cannot take (its message).
     #[error("{0}")]
     BadInput(String),
-    #[error("{0}")]
-    Io(String),
+    /// The pool of `jobs` threads could not be started.
+    #[error("cannot start {jobs} threads: {source}")]
+    Threads { jobs: usize, source: rayon::ThreadPoolBuildError },
 }
 
 /// One settled grid point, in the order of the full grid.
@@ -55,22 +58,39 @@ pub struct SweepSummary {
     /// `[prestress] on_loss` fails).
     pub disagreements: Vec<usize>,
     /// Errors of the blocks that stopped early (divergence, interruption).
-    pub errors: Vec<String>,
+    pub errors: Vec<ReportedError>,
     /// The sweep's verdict, with `run`'s pass policy: no block stopped early, and either the
     /// workspace agreement reaches `min_agreement_percent` or every point settled within
     /// tolerance (points outside the model's validity aside).
     pub passed: bool,
 }
 
+/// A `--shard` that is not `K/N` with 1 <= K <= N.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ShardError {
+    /// No `/`.
+    #[error("--shard must be K/N, got '{0}'")]
+    NotKOfN(String),
+    /// K is not a whole number.
+    #[error("bad K in '{0}'")]
+    BadK(String),
+    /// N is not a whole number.
+    #[error("bad N in '{0}'")]
+    BadN(String),
+    /// K or N out of range.
+    #[error("--shard K/N needs 1 <= K <= N, got {k}/{n}")]
+    OutOfRange { k: usize, n: usize },
+}
+
 /// Parses `K/N` (1 <= K <= N).
-pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
-    let (k, n) = s.split_once('/').ok_or_else(|| format!("--shard must be K/N, got '{s}'"))?;
+pub fn parse_shard(s: &str) -> Result<(usize, usize), ShardError> {
+    let (k, n) = s.split_once('/').ok_or_else(|| ShardError::NotKOfN(s.to_string()))?;
     let (k, n): (usize, usize) = (
-        k.trim().parse().map_err(|_| format!("bad K in '{s}'"))?,
-        n.trim().parse().map_err(|_| format!("bad N in '{s}'"))?,
+        k.trim().parse().map_err(|_| ShardError::BadK(s.to_string()))?,
+        n.trim().parse().map_err(|_| ShardError::BadN(s.to_string()))?,
     );
     if n == 0 || k == 0 || k > n {
-        return Err(format!("--shard K/N needs 1 <= K <= N, got {k}/{n}"));
+        return Err(ShardError::OutOfRange { k, n });
     }
     Ok((k, n))
 }
@@ -108,7 +128,7 @@ pub fn sweep(
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs.max(1))
         .build()
-        .map_err(|e| SweepError::Io(format!("cannot start {jobs} threads: {e}")))?;
+        .map_err(|source| SweepError::Threads { jobs, source })?;
     // What every block's run shares, without the grid's points and the file's text (cloned
     // once here, not once per block: a million points had made a signal take 29 s to stop).
     let mut template = sc.clone();
@@ -126,7 +146,8 @@ pub fn sweep(
         progress(n, total);
         r
     };
-    let results: Vec<(Vec<Row>, Option<String>)> = pool.install(|| blocks.par_iter().map(settle_block).collect());
+    let results: Vec<(Vec<Row>, Option<ReportedError>)> =
+        pool.install(|| blocks.par_iter().map(settle_block).collect());
     let mut rows = Vec::new();
     let mut errors = Vec::new();
     for (r, e) in results {
@@ -147,14 +168,15 @@ type Swept = Result<(Vec<Row>, SweepSummary), SweepError>;
 fn sweep_topologies(
     sc: &Scenario,
     each: &dyn Fn(&Scenario) -> Swept,
-) -> Result<(Vec<Row>, Vec<String>, f64), SweepError> {
+) -> Result<(Vec<Row>, Vec<ReportedError>, f64), SweepError> {
     let start = std::time::Instant::now();
     let grid_points = sc.actuation.all_inputs().len();
     let (mut rows, mut errors, mut offset) = (Vec::new(), Vec::new(), 0);
     for variant in &sc.topologies {
         let (variant_rows, summary) = each(variant)?;
         let note = crate::run::rebuilt(sc, variant);
-        errors.extend(summary.errors.into_iter().map(|e| format!("{note}: {e}")));
+        errors
+            .extend(summary.errors.into_iter().map(|source| RunError::Topology { note: note.clone(), source }.into()));
         rows.extend(variant_rows.into_iter().map(|mut r| {
             r.index += offset;
             r.point.index = r.index;
@@ -174,7 +196,7 @@ fn settle_block(
     continuation: bool,
     grid_points: usize,
     cancel: Option<&AtomicBool>,
-) -> (Vec<Row>, Option<String>) {
+) -> (Vec<Row>, Option<ReportedError>) {
     let mut sub = template.clone();
     sub.actuation = Actuation::Points { points: block.iter().map(|(_, v)| v.clone()).collect(), continuation };
     let r = run(&sub, &RunOptions { cancel, skip_findings: true, ..RunOptions::default() });
@@ -194,7 +216,7 @@ fn settle_block(
 fn summarise(
     sc: &Scenario,
     rows: &[Row],
-    errors: Vec<String>,
+    errors: Vec<ReportedError>,
     shard: Option<(usize, usize)>,
     jobs: usize,
     wall_s: f64,

@@ -16,10 +16,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
 use tensegrity_testbed::file_model::spec::ErrorClass;
-use tensegrity_testbed::observers::external::{External, ExternalModel, ExternalPrediction};
+use tensegrity_testbed::observers::external::{External, ExternalError, ExternalModel, ExternalPrediction};
 use tensegrity_testbed::observers::table::{MemoryTable, TableTarget};
+use tensegrity_testbed::run::stoppable::Stoppable;
 use tensegrity_testbed::run::{self, RunOptions};
 use tensegrity_testbed::scenario::{self, Override, Scenario, ScenarioError};
 
@@ -30,9 +30,6 @@ create_exception!(
     "A scenario the testbed refuses (args: file, line, col, message)."
 );
 
-/// How often a run's waiting thread looks for Ctrl-C [s].
-const SIGNAL_POLL_S: f64 = 0.05;
-
 fn scenario_error(e: ScenarioError) -> PyErr {
     TestbedError::new_err((e.file.clone(), e.line, e.col, e.message.clone()))
 }
@@ -40,8 +37,10 @@ fn scenario_error(e: ScenarioError) -> PyErr {
 /// The scenario from a path (`text` None) or from TOML text named `path`, with `NAME=VALUE`
 /// overrides.
 fn load(path: &str, text: Option<&str>, set: &[String]) -> PyResult<Scenario> {
-    let overrides: Vec<Override> =
-        set.iter().map(|s| Override::parse(s).map_err(PyValueError::new_err)).collect::<PyResult<_>>()?;
+    let overrides: Vec<Override> = set
+        .iter()
+        .map(|s| Override::parse(s).map_err(|e| PyValueError::new_err(e.to_string())))
+        .collect::<PyResult<_>>()?;
     match text {
         Some(t) => scenario::parse_with(Path::new(path), t, &overrides),
         None => scenario::load_with(Path::new(path), &overrides),
@@ -56,37 +55,29 @@ fn check(path: &str, text: Option<&str>, set: Vec<String>) -> PyResult<String> {
     Ok(load(path, text, &set)?.name)
 }
 
-/// Runs `work` on a thread of its own without the GIL, polling for Ctrl-C every
-/// [`SIGNAL_POLL_S`]: on one it raises the flag `work` watches (the run stops at its next
-/// tick), waits for it and raises KeyboardInterrupt.
+/// Runs `work` on a thread of its own (`stoppable`) and waits for it without the GIL, looking
+/// for Ctrl-C at every poll: on one it raises the flag `work` watches (the run stops at its
+/// next tick), waits for it and raises KeyboardInterrupt.
 fn on_own_thread<T: Send + 'static>(
     py: Python<'_>,
     work: impl FnOnce(&AtomicBool) -> T + Send + 'static,
 ) -> PyResult<T> {
     let cancel = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&cancel);
-    let (done, result) = std::sync::mpsc::channel();
-    let worker = std::thread::spawn(move || {
-        // The receiver is gone only after an interruption: nothing is waiting for the result.
-        let _ = done.send(work(&flag));
-    });
-    let poll = Duration::from_secs_f64(SIGNAL_POLL_S);
-    // Waited on without the GIL, which needs a Sync receiver.
-    let result = Mutex::new(result);
+    let worker = Stoppable::spawn(None, move || work(&flag))
+        .map_err(|e| PyException::new_err(format!("cannot start the run's thread: {e}")))?;
     loop {
-        match py.detach(|| result.lock().expect("one waiter").recv_timeout(poll)) {
-            Ok(value) => {
-                let _ = py.detach(|| worker.join());
+        match py.detach(|| worker.poll()) {
+            Ok(Some(value)) => {
+                py.detach(move || worker.join());
                 return Ok(value);
             }
-            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
-                return Err(PyException::new_err("the run panicked"));
-            }
-            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+            Err(_) => return Err(PyException::new_err("the run panicked")),
+            Ok(None) => {}
         }
         if let Err(e) = py.check_signals() {
             cancel.store(true, Ordering::SeqCst);
-            let _ = py.detach(|| worker.join());
+            py.detach(move || worker.join());
             return Err(e);
         }
     }
@@ -161,13 +152,13 @@ impl ExternalModel for PyModel {
         params: &BTreeMap<String, f64>,
         inputs: &BTreeMap<String, f64>,
         time_s: Option<f64>,
-    ) -> Result<BTreeMap<String, f64>, String> {
+    ) -> Result<BTreeMap<String, f64>, ExternalError> {
         Python::attach(|py| {
             self.call(py, params, inputs, time_s).map_err(|e| {
-                let message = e.to_string();
+                let raised = ExternalError::Raised(e.to_string());
                 let mut failure = self.failure.lock().expect("one lock holder at a time");
                 failure.get_or_insert(e);
-                message
+                raised
             })
         })
     }
@@ -362,8 +353,9 @@ fn import_ntrt(path: PathBuf, text: Option<&str>, keep_axes: bool) -> PyResult<(
 #[pyfunction]
 fn write_scenario(path: PathBuf, text: &str, inputs: Vec<PathBuf>) -> PyResult<()> {
     use tensegrity_testbed::output;
-    output::check_outputs(&inputs, &[("the scenario".into(), path.clone())]).map_err(PyValueError::new_err)?;
-    output::write_atomic(&path, text.as_bytes()).map_err(pyo3::exceptions::PyOSError::new_err)
+    output::check_outputs(&inputs, &[("the scenario".into(), path.clone())])
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    output::write_atomic(&path, text.as_bytes()).map_err(|e| pyo3::exceptions::PyOSError::new_err(e.to_string()))
 }
 
 /// The MJCF export of a scenario's first structure (`tensegrity export mjcf`): (the XML, what
@@ -380,13 +372,13 @@ fn export_mjcf(
 ) -> PyResult<(String, Vec<String>)> {
     use tensegrity_testbed::export::{mjcf::ActuatorMode, scenario_mjcf, validate_mjcf_options};
     let sc = load(path, text, &set)?;
-    validate_mjcf_options(kp, cable_damping).map_err(PyValueError::new_err)?;
+    validate_mjcf_options(kp, cable_damping).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let mode = match actuators {
         "mocap" => ActuatorMode::Mocap,
         "position" => ActuatorMode::Position,
         other => return Err(PyValueError::new_err(format!("actuators '{other}': \"mocap\" or \"position\""))),
     };
-    let mjcf = scenario_mjcf(&sc, mode, kp, cable_damping).map_err(PyValueError::new_err)?;
+    let mjcf = scenario_mjcf(&sc, mode, kp, cable_damping).map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok((mjcf.xml, mjcf.warnings))
 }
 
@@ -397,7 +389,7 @@ fn mechanism_values(
     values: BTreeMap<String, f64>,
 ) -> PyResult<(Box<dyn tensegrity_testbed::mechanisms::Mechanism>, BTreeMap<String, f64>, BTreeMap<String, f64>)> {
     use tensegrity_testbed::mechanisms;
-    let m = mechanisms::find_named(name).map_err(PyValueError::new_err)?;
+    let m = mechanisms::find_named(name).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let (params, inputs): (BTreeMap<_, _>, BTreeMap<_, _>) =
         values.into_iter().partition(|(k, _)| m.params().iter().any(|p| p.symbol == k));
     if let Some((k, v)) = params.iter().chain(&inputs).find(|(_, v)| !v.is_finite()) {
@@ -417,7 +409,8 @@ fn solve(
     values: BTreeMap<String, f64>,
 ) -> PyResult<Vec<(String, BTreeMap<String, f64>, Option<bool>)>> {
     let (m, params, inputs) = mechanism_values(mechanism, values)?;
-    let q = tensegrity_testbed::mechanisms::query_named(m.as_ref(), query).map_err(PyValueError::new_err)?;
+    let q = tensegrity_testbed::mechanisms::query_named(m.as_ref(), query)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
     if let Some(k) = inputs.keys().find(|k| !q.inputs.contains(&k.as_str())) {
         return Err(PyValueError::new_err(format!(
             "'{k}' is neither a parameter of {mechanism} nor an input of '{query}' ({})",

@@ -22,34 +22,33 @@ pub enum BenchError {
     #[error("{0}")]
     Peer(String),
     /// A file the bench writes for its peer.
-    #[error("cannot write {}: {message}", path.display())]
-    Write { path: PathBuf, message: String },
+    #[error("cannot write {}: {source}", path.display())]
+    Write { path: PathBuf, source: std::io::Error },
+    /// An output refused or not written (`output`).
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    /// A case's scenario is not valid.
+    #[error(transparent)]
+    Scenario(#[from] scenario::ScenarioError),
+    /// The scale bench's tower has no design.
+    #[error(transparent)]
+    Tower(#[from] scale::tower::TowerError),
+    /// A case's model gave no result.
+    #[error(transparent)]
+    Model(#[from] crate::mechanisms::ModelError),
     /// The simulation could not be built, or diverged.
     #[error(transparent)]
     Sim(#[from] crate::sim::SimError),
 }
 
-impl From<scenario::ScenarioError> for BenchError {
-    fn from(e: scenario::ScenarioError) -> Self {
-        BenchError::Case(e.to_string())
-    }
-}
-
-impl From<crate::mechanisms::ModelError> for BenchError {
-    fn from(e: crate::mechanisms::ModelError) -> Self {
-        BenchError::Case(e.to_string())
-    }
-}
-
 /// A write error at `path`.
 pub(crate) fn write_error(path: &Path) -> impl FnOnce(std::io::Error) -> BenchError + '_ {
-    move |e| BenchError::Write { path: path.to_path_buf(), message: e.to_string() }
+    move |source| BenchError::Write { path: path.to_path_buf(), source }
 }
 
 /// Writes `text` to `path` whole or not at all (`output::write_atomic`).
 pub(crate) fn write_whole(path: &Path, text: &str) -> Result<(), BenchError> {
-    crate::output::write_atomic(path, text.as_bytes())
-        .map_err(|message| BenchError::Write { path: path.to_path_buf(), message })
+    Ok(crate::output::write_atomic(path, text.as_bytes())?)
 }
 
 #[derive(Clone, Debug, Serialize)]

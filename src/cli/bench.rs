@@ -110,7 +110,7 @@ fn scale_peer(
     command: &[String],
 ) -> Result<Outcome, CliError> {
     let dir = std::env::temp_dir().join(format!("tensegrity-bench-scale-peer-{}", std::process::id()));
-    let out = scale::peer::compare(families, max_struts, caps, command, &dir);
+    let out = scale::peer::compare(families, max_struts, caps, command, &dir, &|line| eprintln!("{line}"));
     let _ = std::fs::remove_dir_all(&dir);
     let (reports, rows) = out.map_err(bad_input)?;
     if json {
@@ -129,7 +129,7 @@ fn scale_motion(
     command: &[String],
 ) -> Result<Outcome, CliError> {
     let dir = std::env::temp_dir().join(format!("tensegrity-bench-scale-motion-{}", std::process::id()));
-    let out = scale::motion::compare(families, max_struts, command, &dir);
+    let out = scale::motion::compare(families, max_struts, command, &dir, &|line| eprintln!("{line}"));
     let _ = std::fs::remove_dir_all(&dir);
     let cases = out.map_err(bad_input)?;
     if json {

@@ -50,26 +50,30 @@ impl Outcome {
     }
 }
 
+/// The error of one of the library's seams (a scenario, an output, a run, an import, ...),
+/// kept as its own kind until [`exit_code`] prints it.
+pub type Cause = Box<dyn std::error::Error + Send + Sync>;
+
 /// Why a command stopped before its end.
 #[derive(Debug, thiserror::Error)]
 pub enum CliError {
     /// Bad input: a malformed scenario or flag, an unknown name, an output that would destroy
-    /// an input (exit 2). One message per problem found.
-    #[error("{}", .0.join("\nerror: "))]
-    BadInput(Vec<String>),
+    /// an input (exit 2). One error per problem found.
+    #[error("{}", .0.iter().map(|e| e.to_string()).collect::<Vec<_>>().join("\nerror: "))]
+    BadInput(Vec<Cause>),
     /// The work failed: an output could not be written (exit 1).
     #[error("{0}")]
-    Failed(String),
+    Failed(Cause),
 }
 
-/// Bad input with one message.
-pub fn bad_input(message: impl std::fmt::Display) -> CliError {
-    CliError::BadInput(vec![message.to_string()])
+/// Bad input with one error (a message is an error too).
+pub fn bad_input(error: impl Into<Cause>) -> CliError {
+    CliError::BadInput(vec![error.into()])
 }
 
-/// A failure with one message.
-pub fn failed(message: impl std::fmt::Display) -> CliError {
-    CliError::Failed(message.to_string())
+/// A failure with one error (a message is an error too).
+pub fn failed(error: impl Into<Cause>) -> CliError {
+    CliError::Failed(error.into())
 }
 
 /// The binary's `main`: parse the arguments, run the command on its own thread, print its
@@ -145,7 +149,7 @@ fn load_all(paths: &[PathBuf], overrides: &[Override]) -> Result<Vec<Scenario>, 
     for p in paths {
         match scenario::load_with(p, overrides) {
             Ok(s) => list.push(s),
-            Err(e) => errors.push(e.to_string()),
+            Err(e) => errors.push(e.into()),
         }
     }
     if errors.is_empty() {

@@ -46,13 +46,17 @@ pub fn modes(
         write_atomic(j, &serde_json::to_string_pretty(&report).expect("report serialises"))?;
     }
     if let Some(r) = record {
-        record_modes(r, &state.sim, &analysis).map_err(|e| failed(format!("{}: {e}", r.display())))?;
+        record_modes(r, &state.sim, &analysis).map_err(failed)?;
     }
     Ok(Outcome::from_passed(state.settled))
 }
 
 /// The non-rigid modes animated at their frequencies (`observers::modes_record`).
-fn record_modes(path: &Path, sim: &crate::sim::Simulation, analysis: &StructureModes) -> Result<(), String> {
+fn record_modes(
+    path: &Path,
+    sim: &crate::sim::Simulation,
+    analysis: &StructureModes,
+) -> Result<(), crate::observers::record::RecordError> {
     use crate::observers::modes_record::{DrawnMode, DrawnStructure};
     let s = sim.structure();
     let drawn = DrawnStructure {

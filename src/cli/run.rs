@@ -95,6 +95,9 @@ pub fn run(
         // A panic inside one scenario fails that scenario, with its message; the batch goes on.
         let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_scenario(sc, &opts)))
             .unwrap_or_else(|payload| crate::run::panicked(sc, payload.as_ref()));
+        for w in &r.warnings {
+            eprintln!("note: {w}");
+        }
         report.scenarios.push(r);
     }
     // With the JSON report on standard output the table goes to standard error.

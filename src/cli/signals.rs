@@ -1,11 +1,11 @@
 //! SIGINT/SIGTERM and the command's thread: the command runs on a thread of its own while the
-//! main thread watches for a signal, so that every phase stops within [`SIGNAL_POLL_S`].
+//! main thread watches for a signal, so that every phase stops within
+//! [`crate::run::stoppable::POLL_S`].
 
 use super::EXIT_INTERNAL_ERROR;
 use crate::report::EXIT_FAIL;
+use crate::run::stoppable::{Halted, Stoppable};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::RecvTimeoutError;
-use std::time::Duration;
 
 /// Set by SIGINT or SIGTERM: the running scenario stops at its next tick, the reports of what
 /// ran are written, and the batch stops.
@@ -13,12 +13,9 @@ pub static CANCEL: AtomicBool = AtomicBool::new(false);
 
 /// Set while the command runs a phase that stops by itself on [`CANCEL`] (the scenarios' runs and
 /// the writing of their reports). In every other phase (parsing, an analytic solve, findings,
-/// figures) a signal ends the command within [`SIGNAL_POLL_S`]: its temporary files are
+/// figures) a signal ends the command within [`crate::run::stoppable::POLL_S`]: its temporary files are
 /// removed, its outputs stay as they were, exit 1.
 static STOPS_ITSELF: AtomicBool = AtomicBool::new(false);
-
-/// How often the main thread looks for a signal while the command's thread works [s].
-const SIGNAL_POLL_S: f64 = 0.05;
 
 /// Stack of the command's thread [bytes] (the main thread's usual 8 MiB, with room).
 const COMMAND_STACK_BYTES: usize = 64 << 20;
@@ -51,31 +48,26 @@ pub fn cancelled() -> bool {
 }
 
 /// Runs `command` on its own thread and returns its exit code, or exit 1 within
-/// [`SIGNAL_POLL_S`] of a signal in a phase that does not stop by itself (its temporary files
+/// [`crate::run::stoppable::POLL_S`] of a signal in a phase that does not stop by itself (its temporary files
 /// removed), or [`EXIT_INTERNAL_ERROR`] when it panicked (its message is printed).
 pub fn run_stoppable(command: impl FnOnce() -> u8 + Send + 'static) -> u8 {
-    let (tx, rx) = std::sync::mpsc::channel();
-    let worker = std::thread::Builder::new().stack_size(COMMAND_STACK_BYTES).spawn(move || {
-        let _ = tx.send(command());
-    });
-    if let Err(e) = worker {
-        eprintln!("error: cannot start the command's thread: {e}");
-        return EXIT_FAIL as u8;
-    }
-    loop {
-        match rx.recv_timeout(Duration::from_secs_f64(SIGNAL_POLL_S)) {
-            Ok(code) => return code,
-            Err(RecvTimeoutError::Timeout) => {
-                if cancelled() && !STOPS_ITSELF.load(Ordering::SeqCst) {
-                    crate::output::remove_partials();
-                    eprintln!("interrupted");
-                    return EXIT_FAIL as u8;
-                }
-            }
-            Err(RecvTimeoutError::Disconnected) => {
-                crate::output::remove_partials();
-                return EXIT_INTERNAL_ERROR;
-            }
+    let work = match Stoppable::spawn(Some(COMMAND_STACK_BYTES), command) {
+        Ok(work) => work,
+        Err(e) => {
+            eprintln!("error: cannot start the command's thread: {e}");
+            return EXIT_FAIL as u8;
+        }
+    };
+    match work.wait(|| cancelled() && !STOPS_ITSELF.load(Ordering::SeqCst)) {
+        Ok(code) => code,
+        Err(Halted::Interrupted) => {
+            crate::output::remove_partials();
+            eprintln!("interrupted");
+            EXIT_FAIL as u8
+        }
+        Err(Halted::Panicked) => {
+            crate::output::remove_partials();
+            EXIT_INTERNAL_ERROR
         }
     }
 }

@@ -5,14 +5,39 @@
 
 pub mod mjcf;
 
+use crate::mechanisms::ModelError;
+use crate::structure::StructureError;
+
+/// An MJCF export's option out of its range, named by its flag.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MjcfOptionError {
+    /// `--kp`: the position servos' gain.
+    #[error("--kp must be a finite number > 0, got {0}")]
+    Kp(f64),
+    /// `--cable-damping` [N s/m].
+    #[error("--cable-damping must be a finite number >= 0, got {0}")]
+    CableDamping(f64),
+}
+
+/// Why a scenario's first structure could not be exported.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// The mechanism could not build it.
+    #[error("{0}")]
+    Model(#[from] ModelError),
+    /// It was built but is not a valid structure.
+    #[error("the structure is not valid: {0}")]
+    Invalid(#[from] StructureError),
+}
+
 /// Every option of an MJCF export in its range, or the first that is not, named by its flag:
 /// the position servos' gain `joint_kp` [N/m or N m/rad] and the cables' damping [N s/m].
-pub fn validate_mjcf_options(joint_kp: f64, cable_damping_n_s_per_m: f64) -> Result<(), String> {
+pub fn validate_mjcf_options(joint_kp: f64, cable_damping_n_s_per_m: f64) -> Result<(), MjcfOptionError> {
     if !(joint_kp > 0.0 && joint_kp.is_finite()) {
-        return Err(format!("--kp must be a finite number > 0, got {joint_kp}"));
+        return Err(MjcfOptionError::Kp(joint_kp));
     }
     if !(cable_damping_n_s_per_m >= 0.0 && cable_damping_n_s_per_m.is_finite()) {
-        return Err(format!("--cable-damping must be a finite number >= 0, got {cable_damping_n_s_per_m}"));
+        return Err(MjcfOptionError::CableDamping(cable_damping_n_s_per_m));
     }
     Ok(())
 }
@@ -23,7 +48,7 @@ pub fn scenario_mjcf(
     actuators: mjcf::ActuatorMode,
     joint_kp: f64,
     cable_damping_n_s_per_m: f64,
-) -> Result<mjcf::Mjcf, String> {
+) -> Result<mjcf::Mjcf, ExportError> {
     let (s, commands) = first_structure(sc)?;
     let options = mjcf::MjcfOptions {
         model_name: sc.name.clone(),
@@ -43,15 +68,15 @@ use crate::structure::Structure;
 /// The structure a scenario starts its run with, built at the first point's (or first
 /// waypoint's) inputs from the scenario's `[start]` as `run` builds it, and the actuator
 /// commands of that point (actuator order, m or rad).
-pub fn first_structure(sc: &Scenario) -> Result<(Structure, Vec<f64>), String> {
+pub fn first_structure(sc: &Scenario) -> Result<(Structure, Vec<f64>), ExportError> {
     let first_inputs = match &sc.actuation {
         Actuation::Points { points, .. } => points[0].clone(),
         Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
     };
     let mech = sc.mechanism();
     let params = sc.params_at(&first_inputs);
-    let mut s = mech.build(&params, &first_inputs, &sc.start).map_err(|e| e.to_string())?;
-    s.validate().map_err(|e| format!("the structure is not valid: {e}"))?;
+    let mut s = mech.build(&params, &first_inputs, &sc.start)?;
+    s.validate()?;
     let commands = s.commands_from(&mech.commands(&params, &first_inputs));
     // Moved nodes are exported where their commands place them (MJCF has no such actuator).
     s.displace_fixed_nodes(&commands);

@@ -26,16 +26,16 @@ pub enum FigureError {
     /// A scenario file a figure edits before running it cannot be read.
     #[error("{}: {source}", .path.display())]
     Read { path: PathBuf, source: std::io::Error },
-    /// An output cannot be written or replaced (`crate::output`'s message).
-    #[error("{0}")]
-    Output(String),
+    /// An output cannot be written or replaced (`crate::output`).
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
     #[error(transparent)]
     Sweep(#[from] SweepError),
     /// A scenario run stopped early (divergence, bad model).
     #[error("{path}: {error}")]
-    Run { path: String, error: String },
+    Run { path: String, error: crate::report::ReportedError },
     /// A scenario run did not meet its declared verdict.
     #[error("{path} did not meet its declared verdict (failures: {failures})")]
     Verdict { path: String, failures: String },

@@ -103,17 +103,33 @@ fn multiline(s: &str) -> String {
     s.replace('\\', "\\\\").replace("\"\"\"", "\"\"\\\"")
 }
 
+/// Why a draft cannot become a scenario file.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DraftError {
+    /// A number TOML cannot carry (inf or nan would make a scenario that means nothing).
+    #[error("{what} would be {value}: the model's numbers are too large (or not numbers) to write")]
+    NotFinite { what: String, value: f64 },
+    /// A cable's share of the self-stress leaves it no rest length.
+    #[error(
+        "cable {cable}: its share of the self-stress, {tension_n} N at {stiffness_n_per_m} N/m, leaves no rest length (drawn {drawn_m} m)"
+    )]
+    SelfStressNoRest { cable: String, tension_n: f64, stiffness_n_per_m: f64, drawn_m: f64 },
+    /// A string at the tension every string is given leaves it no rest length.
+    #[error("string {string}: {tension_n} N at {stiffness_n_per_m} N/m leaves no rest length (drawn {drawn_m})")]
+    TensionNoRest { string: String, tension_n: f64, stiffness_n_per_m: f64, drawn_m: f64 },
+}
+
 /// A number as TOML writes it back exactly, or an error naming `what` when it is not finite (TOML's
 /// inf and nan would make a scenario that means nothing).
-fn num(x: f64, what: &str) -> Result<String, String> {
+fn num(x: f64, what: &str) -> Result<String, DraftError> {
     if x.is_finite() {
         Ok(format!("{x:?}"))
     } else {
-        Err(format!("{what} would be {x}: the model's numbers are too large (or not numbers) to write"))
+        Err(DraftError::NotFinite { what: what.to_string(), value: x })
     }
 }
 
-fn xyz(v: Vec3, what: &str) -> Result<String, String> {
+fn xyz(v: Vec3, what: &str) -> Result<String, DraftError> {
     Ok(format!("[{}, {}, {}]", num(v[0], what)?, num(v[1], what)?, num(v[2], what)?))
 }
 
@@ -179,7 +195,7 @@ impl Draft {
 
     /// The `[sim]` and `[settle]` tables: a step and a damping from the fastest body, a time
     /// limit from the slowest.
-    fn settings(&self) -> Result<String, String> {
+    fn settings(&self) -> Result<String, DraftError> {
         let (fastest, slowest) = self.rates();
         let size = self.size_m();
         let k_max = self.cables.iter().filter_map(|c| c.stiffness_n_per_m).fold(0.0, f64::max).max(1.0);
@@ -197,7 +213,7 @@ impl Draft {
 
     /// The scenario file: name, description, settings, one point, the structure; an error when
     /// a number of it would not be finite.
-    pub fn to_toml(&self) -> Result<String, String> {
+    pub fn to_toml(&self) -> Result<String, DraftError> {
         let mut t = String::new();
         let _ = writeln!(t, "name = {}", quote(&self.name));
         let _ = writeln!(t, "description = \"\"\"\n{}\n\"\"\"", multiline(&self.description));
@@ -215,7 +231,7 @@ impl Draft {
                 }
             }
             let node = |(n, p): &(String, Vec3)| Ok(format!("{} = {}", quote(n), xyz(*p, &format!("node {n}"))?));
-            let nodes: Vec<String> = b.nodes.iter().map(node).collect::<Result<_, String>>()?;
+            let nodes: Vec<String> = b.nodes.iter().map(node).collect::<Result<_, DraftError>>()?;
             let _ = writeln!(t, "nodes = {{ {} }}", nodes.join(", "));
         }
         for s in &self.struts {

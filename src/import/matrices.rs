@@ -11,7 +11,7 @@
 //! bar or string) or [`MemberProperties`] (one value per member, with springs, pins and
 //! quantities: the Python package's `from_matrices`, through [`from_arrays`]).
 
-use super::draft::{Draft, DraftBody, DraftCable, DraftJoint, DraftStrut};
+use super::draft::{Draft, DraftBody, DraftCable, DraftError, DraftJoint, DraftStrut};
 use super::{ImportError, Imported};
 use crate::structure::{distance, Vec3};
 use std::path::Path;
@@ -43,17 +43,18 @@ impl MatrixOptions {
     };
 
     /// Every option in its range, or the first that is not, named by its flag.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), PropertyError> {
         let positive = [
             ("--bar-mass", self.bar_mass_kg),
             ("--bar-radius", self.bar_radius_m),
             ("--string-stiffness", self.string_stiffness_n_per_m),
         ];
-        if let Some((flag, x)) = positive.iter().find(|(_, x)| !(*x > 0.0 && x.is_finite())) {
-            return Err(format!("{flag} must be a finite number > 0, got {x}"));
+        if let Some(&(flag, value)) = positive.iter().find(|(_, x)| !(*x > 0.0 && x.is_finite())) {
+            return Err(PropertyError::Range { at: flag.to_string(), range: "> 0", value });
         }
         if !(self.string_tension_n >= 0.0 && self.string_tension_n.is_finite()) {
-            return Err(format!("--string-tension must be a finite number >= 0, got {}", self.string_tension_n));
+            let value = self.string_tension_n;
+            return Err(PropertyError::Range { at: "--string-tension".into(), range: ">= 0", value });
         }
         Ok(())
     }
@@ -117,10 +118,21 @@ pub enum DrawnTension {
     AsGiven,
 }
 
+/// An import option or member property out of its range.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PropertyError {
+    /// A list of per-member values of the wrong length.
+    #[error("{name} has {got} values: expected {want} (one per {what}) or one number")]
+    Count { name: &'static str, got: usize, want: usize, what: &'static str },
+    /// A value out of its range (`at`: the flag or argument, with the member's index).
+    #[error("{at} must be a finite number {range}, got {value}")]
+    Range { at: String, range: &'static str, value: f64 },
+}
+
 impl MemberProperties {
     /// One value per member, each in its range: errors name the Python argument (and the
     /// member's index from 0 when there are several).
-    pub fn validate(&self, bars: usize, strings: usize) -> Result<(), String> {
+    pub fn validate(&self, bars: usize, strings: usize) -> Result<(), PropertyError> {
         let (rest_name, rest) = match &self.string_rest {
             StringRest::TensionN(t) => ("string_tension_n", t),
             StringRest::LengthM(l) => ("string_rest_length_m", l),
@@ -132,8 +144,8 @@ impl MemberProperties {
             (rest_name, rest.len(), strings, "string"),
             ("tension_only", self.tension_only.len(), strings, "string"),
         ];
-        if let Some((name, got, want, what)) = counts.iter().find(|(_, got, want, _)| got != want) {
-            return Err(format!("{name} has {got} values: expected {want} (one per {what}) or one number"));
+        if let Some(&(name, got, want, what)) = counts.iter().find(|(_, got, want, _)| got != want) {
+            return Err(PropertyError::Count { name, got, want, what });
         }
         let ranges: [(&str, &[f64], bool); 4] = [
             ("bar_mass_kg", &self.bar_mass_kg, true),
@@ -146,7 +158,7 @@ impl MemberProperties {
             if let Some((i, x)) = values.iter().enumerate().find(|(_, x)| bad(**x)) {
                 let at = if values.len() > 1 { format!("{name}[{i}]") } else { name.to_string() };
                 let range = if positive { "> 0" } else { ">= 0" };
-                return Err(format!("{at} must be a finite number {range}, got {x}"));
+                return Err(PropertyError::Range { at, range, value: *x });
             }
         }
         Ok(())
@@ -243,7 +255,7 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
         grounded,
     ) + "\n"
         + &chosen;
-    let toml = draft.to_toml().map_err(|message| ImportError::whole(n_path, message))?;
+    let toml = draft.to_toml().map_err(|e| ImportError::whole(n_path, e.to_string()))?;
     Ok(Imported { toml, skipped: Vec::new(), chosen: vec![chosen] })
 }
 
@@ -267,12 +279,12 @@ pub fn from_arrays(
     let nodes = node_columns(paths[0], &n_rows)?;
     let bars = members(paths[1], &rows(cb), nodes.len())?;
     let strings = members(paths[2], &rows(cs), nodes.len())?;
-    p.validate(bars.len(), strings.len()).map_err(|message| ImportError::whole(Path::new(""), message))?;
+    p.validate(bars.len(), strings.len()).map_err(|e| ImportError::whole(Path::new(""), e.to_string()))?;
     let (mut draft, grounded, chosen) = build(paths, &nodes, &bars, &strings, p)?;
     draft.name = name.to_string();
     draft.description =
         description("numpy arrays N, C_b, C_s", "tensegrity_testbed.from_matrices", p, grounded) + "\n" + &chosen;
-    let toml = draft.to_toml().map_err(|message| ImportError::whole(Path::new(""), message))?;
+    let toml = draft.to_toml().map_err(|e| ImportError::whole(Path::new(""), e.to_string()))?;
     Ok(Imported { toml, skipped: Vec::new(), chosen: vec![chosen] })
 }
 
@@ -329,7 +341,7 @@ fn build(
         });
     }
     add_strings(&mut draft, nodes, strings, cs_path, p)?;
-    let chosen = prestress(&mut draft, p).map_err(|message| ImportError::whole(cs_path, message))?;
+    let chosen = prestress(&mut draft, p).map_err(|e| ImportError::whole(cs_path, e.to_string()))?;
     draft.quantities = p.quantities.clone();
     Ok((draft, ground.len(), chosen))
 }
@@ -463,7 +475,7 @@ fn said(v: &[f64]) -> String {
 /// string tension `least_n` ([`DrawnTension::SelfStress`]), unless the strings are as given or
 /// the drawing has no self-stress with every string in tension (then as [`add_strings`] set
 /// them); what was chosen, in a sentence.
-fn prestress(draft: &mut Draft, p: &MemberProperties) -> Result<String, String> {
+fn prestress(draft: &mut Draft, p: &MemberProperties) -> Result<String, DraftError> {
     let least_n = match p.prestress {
         DrawnTension::AsGiven => {
             return Ok("prestress: every string's tension or rest length as given (not the drawn self-stress).".into())

@@ -27,7 +27,7 @@ pub const MAX_IMPORT_BYTES: u64 = 16 << 20;
 /// The text of an input file (a regular file, at most [`MAX_IMPORT_BYTES`]), or an error
 /// naming it.
 pub(crate) fn read_text(path: &std::path::Path) -> Result<String, ImportError> {
-    crate::input::read_text(path, MAX_IMPORT_BYTES, false).map_err(|message| ImportError::whole(path, message))
+    crate::input::read_text(path, MAX_IMPORT_BYTES, false).map_err(|e| ImportError::whole(path, e.to_string()))
 }
 
 impl std::fmt::Display for ImportError {

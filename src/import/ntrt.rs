@@ -20,7 +20,7 @@
 //! `m_restLength = pos1.distance(pos2) - pretension / coefK`). Everything else is listed as
 //! skipped, never dropped silently.
 
-use super::draft::{Draft, DraftBody, DraftCable, DraftStrut};
+use super::draft::{Draft, DraftBody, DraftCable, DraftError, DraftStrut};
 use super::yaml::{self, At, Yaml};
 use super::{ImportError, Imported};
 use crate::structure::{distance, Vec3};
@@ -260,9 +260,9 @@ pub fn import_text(path: &Path, text: &str, axes: Axes) -> Result<Imported, Impo
     let mut r = Reader { builders: default_builders(), skipped: Vec::new(), pretension_given: false };
     let top = r.load(path, text, "", 0)?;
     let mut draft = r.draft(path, &top, axes)?;
-    let chosen = prestress(&mut draft, r.pretension_given).map_err(|message| ImportError::whole(path, message))?;
+    let chosen = prestress(&mut draft, r.pretension_given).map_err(|e| ImportError::whole(path, e.to_string()))?;
     draft.description.push_str(&format!("\n{chosen}"));
-    let toml = draft.to_toml().map_err(|message| ImportError::whole(path, message))?;
+    let toml = draft.to_toml().map_err(|e| ImportError::whole(path, e.to_string()))?;
     Ok(Imported { toml, skipped: r.skipped, chosen: vec![chosen] })
 }
 
@@ -271,7 +271,7 @@ pub fn import_text(path: &Path, text: &str, axes: Axes) -> Result<Imported, Impo
 /// structure's self-stress, its least tension [`super::DEFAULT_LEAST_TENSION_N`], or that
 /// tension on every string when the drawing has no self-stress with every string taut. What
 /// was chosen, in a sentence.
-fn prestress(draft: &mut Draft, pretension_given: bool) -> Result<String, String> {
+fn prestress(draft: &mut Draft, pretension_given: bool) -> Result<String, DraftError> {
     if pretension_given {
         return Ok("prestress: the file's pretensions (rest length = drawn - pretension / stiffness).".into());
     }
@@ -288,7 +288,12 @@ fn prestress(draft: &mut Draft, pretension_given: bool) -> Result<String, String
         let (Some(k), drawn) = (c.stiffness_n_per_m, distance(pos(&c.a), pos(&c.b))) else { continue };
         c.length_m = drawn - least / k;
         if !(c.length_m > 0.0) {
-            return Err(format!("string {}: {least} N at {k} N/m leaves no rest length (drawn {drawn})", c.name));
+            return Err(DraftError::TensionNoRest {
+                string: c.name.clone(),
+                tension_n: least,
+                stiffness_n_per_m: k,
+                drawn_m: drawn,
+            });
         }
     }
     Ok(format!(

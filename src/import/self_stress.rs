@@ -10,7 +10,7 @@
 //! stress (cables +1, struts -1) on it (Pellegrino 1993, "Structural computations with the
 //! singular value decomposition of the equilibrium matrix").
 
-use super::draft::Draft;
+use super::draft::{Draft, DraftError};
 use crate::structure::{distance, Vec3};
 use nalgebra::DMatrix;
 
@@ -98,7 +98,7 @@ fn projected_uniform_stress(a: &DMatrix<f64>, cables: usize) -> Option<Vec<f64>>
 /// `least_n` [N]: each elastic cable's rest length set to its drawn length less its tension
 /// over its stiffness. None when there is no such self-stress (nothing changed); an error
 /// naming the cable when a tension leaves it no rest length.
-pub fn prestress(draft: &mut Draft, least_n: f64) -> Result<Option<Chosen>, String> {
+pub fn prestress(draft: &mut Draft, least_n: f64) -> Result<Option<Chosen>, DraftError> {
     let Some(stress) = self_stress(draft) else { return Ok(None) };
     let positions: Vec<(String, Vec3)> = draft.bodies.iter().flat_map(|b| b.nodes.clone()).collect();
     let pos = |n: &str| positions.iter().find(|(m, _)| m == n).map(|(_, p)| *p).unwrap_or_default();
@@ -107,10 +107,12 @@ pub fn prestress(draft: &mut Draft, least_n: f64) -> Result<Option<Chosen>, Stri
         let (tension, drawn) = (t * least_n, distance(pos(&c.a), pos(&c.b)));
         c.length_m = drawn - tension / k;
         if !(c.length_m > 0.0) {
-            return Err(format!(
-                "cable {}: its share of the self-stress, {tension} N at {k} N/m, leaves no rest length (drawn {drawn} m)",
-                c.name
-            ));
+            return Err(DraftError::SelfStressNoRest {
+                cable: c.name.clone(),
+                tension_n: tension,
+                stiffness_n_per_m: k,
+                drawn_m: drawn,
+            });
         }
     }
     let largest = stress.iter().copied().fold(0.0, f64::max) * least_n;

@@ -13,7 +13,7 @@ pub mod manriquez2019;
 pub mod mohr2011;
 
 pub use angle::wrap_angle;
-pub use error::ModelError;
+pub use error::{ModelError, ParamError, UnknownName};
 pub use finding::{finding, Finding};
 
 use crate::snapshot::Snapshot;
@@ -216,18 +216,18 @@ pub fn find(name: &str) -> Option<Box<dyn Mechanism>> {
 }
 
 /// The built-in mechanism called `name`, or the message that lists the known ones.
-pub fn find_named(name: &str) -> Result<Box<dyn Mechanism>, String> {
+pub fn find_named(name: &str) -> Result<Box<dyn Mechanism>, UnknownName> {
     find(name).ok_or_else(|| {
         let known: Vec<_> = registry().iter().map(|m| m.name()).collect();
-        format!("unknown mechanism '{name}' (expected one of: {})", known.join(", "))
+        UnknownName::Mechanism { name: name.to_string(), known: known.join(", ") }
     })
 }
 
 /// The analytic query `query` of `m`, or the message that lists its queries.
-pub fn query_named(m: &dyn Mechanism, query: &str) -> Result<&'static QuerySpec, String> {
+pub fn query_named(m: &dyn Mechanism, query: &str) -> Result<&'static QuerySpec, UnknownName> {
     m.queries().iter().find(|q| q.name == query).ok_or_else(|| {
         let known: Vec<_> = m.queries().iter().map(|q| q.name).collect();
-        format!("unknown query '{query}' for {} (expected one of: {})", m.name(), known.join(", "))
+        UnknownName::Query { query: query.to_string(), mechanism: m.name().to_string(), known: known.join(", ") }
     })
 }
 

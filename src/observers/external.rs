@@ -17,7 +17,15 @@ use std::sync::Arc;
 /// A model given as a function: `predict(params, inputs, t)` -> predictions by name; `t` is the
 /// time since a motion started [s], None outside a motion.
 pub trait ExternalModel: Send + Sync {
-    fn predict(&self, params: &Values, inputs: &Values, time_s: Option<f64>) -> Result<Values, String>;
+    fn predict(&self, params: &Values, inputs: &Values, time_s: Option<f64>) -> Result<Values, ExternalError>;
+}
+
+/// Why an external model gave no predictions.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ExternalError {
+    /// The model raised (its message; the model keeps the error itself, for its caller).
+    #[error("the model raised: {0}")]
+    Raised(String),
 }
 
 /// One prediction of an external model: its name, the simulated quantity it predicts, the

@@ -235,6 +235,17 @@ pub struct ModelObserver {
     trajectory: Option<(Samples, Vec<f64>)>,
 }
 
+/// Why the file's dynamic model has no modes at a settle point.
+#[derive(Debug, thiserror::Error)]
+enum ModelModesError {
+    /// The dynamics landed on no stationary point of the energy.
+    #[error("no stationary point landed on")]
+    NotLanded,
+    /// The mass matrix at the coordinates `q` is not positive definite.
+    #[error("energy kinetic at {q:?}: {source}")]
+    Kinetic { q: Vec<f64>, source: crate::eigen::EigenError },
+}
+
 impl ModelObserver {
     /// The observer of `spec` on the run's `structure`; `recorded`: the run is recorded (each
     /// error per tick then goes to the recording).
@@ -343,17 +354,17 @@ impl ModelObserver {
     /// The dynamic model's modes at the stationary point landed on, and each frequency
     /// prediction's relative error there (infinite where there are no modes: no point landed
     /// on, or a mass matrix that is not positive definite, which is `Err` with the message).
-    fn model_modes(&self, v: &[f64], report: &EnergyPointReport) -> Option<Result<ModesAt, String>> {
+    fn model_modes(&self, v: &[f64], report: &EnergyPointReport) -> Option<Result<ModesAt, ModelModesError>> {
         let e = self.spec.energy.as_ref()?;
         let d = e.dynamics.as_ref()?;
         let landed = report.landed.map(|i| &report.stationary[i]);
-        let Some(point) = landed else { return Some(Err("no stationary point landed on".into())) };
+        let Some(point) = landed else { return Some(Err(ModelModesError::NotLanded)) };
         let q: Vec<f64> = e.coordinates.iter().map(|c| point.coordinates[&c.name]).collect();
         let mut values = v.to_vec();
         values.resize(e.values_len(), 0.0);
         let modes = match e.modes_at(&mut values, &q)? {
             Ok(m) => m,
-            Err(err) => return Some(Err(format!("energy kinetic at {q:?}: {err}"))),
+            Err(source) => return Some(Err(ModelModesError::Kinetic { q, source })),
         };
         let errors = d
             .frequencies

@@ -205,7 +205,7 @@ pub struct Interference {
 
 impl Interference {
     /// Sets up the pairs for `s`. Unknown member names in `exclude` are an error.
-    pub fn new(s: &Structure, settings: &InterferenceSettings) -> Result<Self, String> {
+    pub fn new(s: &Structure, settings: &InterferenceSettings) -> Result<Self, crate::settings::UnknownMember> {
         settings.check_member_names(s)?;
         let members = if settings.enabled { members(s, settings.tendons) } else { Vec::new() };
         let mut excluded = attached_pairs(s, &members);

@@ -60,6 +60,17 @@ fn start(series: &[Vec<f64>], times: &[f64]) -> (f64, Vec<f64>, Vec<f64>) {
     (0.5 * (times[0] + times[1]), q, v)
 }
 
+/// Why a motion was not compared with the Lagrangian model.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LagrangianError {
+    /// Too few ticks of motion to read the start from.
+    #[error("{ticks} tick(s) of motion: at least {needed} are needed")]
+    TooFewTicks { ticks: usize, needed: usize },
+    /// The model's integration failed.
+    #[error("the Lagrangian model cannot be integrated: {0}")]
+    NotIntegrable(crate::file_model::dynamics::DynamicsError),
+}
+
 /// Integrates the model of `energy` (its parameters and inputs in `values`) beside the
 /// `samples` and compares them; `tolerances` = (max, rms) per coordinate. Err with the reason
 /// when there are too few samples or the model cannot be integrated.
@@ -68,10 +79,10 @@ pub fn compare(
     values: &[f64],
     samples: &Samples,
     (tolerance, rms_tolerance): (f64, Option<f64>),
-) -> Result<LagrangianReport, String> {
+) -> Result<LagrangianReport, LagrangianError> {
     let n = samples.times.len();
     if n < START_SAMPLES + 1 {
-        return Err(format!("{n} tick(s) of motion: at least {} are needed", START_SAMPLES + 1));
+        return Err(LagrangianError::TooFewTicks { ticks: n, needed: START_SAMPLES + 1 });
     }
     let series: Vec<Vec<f64>> =
         energy.coordinates.iter().enumerate().map(|(i, c)| samples.series(i, c.class)).collect();
@@ -83,7 +94,7 @@ pub fn compare(
     work.resize(energy.values_len(), 0.0);
     let model = energy
         .integrate(&work, &q0, &v0, &shifted, &Tolerance::default(), None)
-        .map_err(|e| format!("the Lagrangian model cannot be integrated: {e}"))?;
+        .map_err(LagrangianError::NotIntegrable)?;
     let coordinates = energy
         .coordinates
         .iter()
@@ -139,7 +150,7 @@ fn coordinate_report(
 /// The report of a comparison that could not be made (`why`): every coordinate fails.
 pub fn not_compared(
     energy: &EnergySpec,
-    why: String,
+    why: LagrangianError,
     (tolerance, rms_tolerance): (f64, Option<f64>),
 ) -> LagrangianReport {
     let coordinates = energy
@@ -164,7 +175,7 @@ pub fn not_compared(
         start_coordinates: vec![],
         start_rates: vec![],
         integrator_steps: 0,
-        error: Some(why),
+        error: Some(crate::report::ReportedError::new(why)),
         coordinates,
     }
 }

@@ -96,10 +96,30 @@ pub trait Observer {
     fn settle_point(&mut self, _p: &SettlePoint, _point: &mut PointReport, _notes: &mut Vec<Note>) {}
     /// The run is over: put what was gathered into the report.
     fn finish(&mut self, _report: &mut ScenarioReport) {}
-    /// The verdict is in (`report` is final): write what carries it. An error fails the run.
-    fn close(&mut self, _tick: u64, _report: &ScenarioReport) -> Result<(), String> {
+    /// The verdict is in (`report` is final): write what carries it. An error fails the run;
+    /// what the run goes on without goes into `warnings`.
+    fn close(
+        &mut self,
+        _tick: u64,
+        _report: &ScenarioReport,
+        _warnings: &mut Vec<String>,
+    ) -> Result<(), ObserverError> {
         Ok(())
     }
+}
+
+/// Why an observer could not start, or could not write what carries the verdict.
+#[derive(Debug, thiserror::Error)]
+pub enum ObserverError {
+    /// An interference exclusion names no member of the structure.
+    #[error(transparent)]
+    Interference(#[from] crate::settings::UnknownMember),
+    /// The per-tick table could not be written.
+    #[error(transparent)]
+    Table(#[from] table::TableError),
+    /// The recording could not be written.
+    #[error(transparent)]
+    Record(#[from] record::RecordError),
 }
 
 /// What the observers of a run are made from.
@@ -122,8 +142,9 @@ pub struct Setup<'a> {
     pub external: Option<external::External>,
 }
 
-/// Every observer of a run, in the order they see each tick.
-pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
+/// Every observer of a run, in the order they see each tick; what the run goes on without (a
+/// live viewer nobody runs) goes into `warnings`.
+pub fn observers(setup: Setup, warnings: &mut Vec<String>) -> Result<Vec<Box<dyn Observer>>, ObserverError> {
     let mut list: Vec<Box<dyn Observer>> =
         vec![Box::new(compare::Compare::new(setup.checks, setup.length_scale_m)), Box::new(slack::SlackTracker::new())];
     list.push(Box::new(interference::Interference::new(setup.structure, setup.interference)?));
@@ -148,7 +169,7 @@ pub fn observers(setup: Setup) -> Result<Vec<Box<dyn Observer>>, String> {
         }));
     }
     if let Some(r) = &setup.recording {
-        if let Some(recorder) = record::Recorder::start(r)? {
+        if let Some(recorder) = record::Recorder::start(r, warnings)? {
             list.push(Box::new(recorder));
         }
     }

@@ -5,6 +5,7 @@
 //! displacement in the mode, the largest scaled to [`AMPLITUDE_FRACTION`] of the structure's
 //! extent. Plain data in, as every observer: no simulation here.
 
+use super::record::RecordError;
 use std::path::Path;
 
 /// Periods shown per mode.
@@ -31,10 +32,13 @@ pub struct DrawnStructure {
 }
 
 /// Writes the animation of `modes` to `path` (through `<path>.partial`, renamed when complete).
-pub fn record_modes(path: &Path, s: &DrawnStructure, modes: &[DrawnMode]) -> Result<(), String> {
-    crate::output::check_replaceable(path)?;
+pub fn record_modes(path: &Path, s: &DrawnStructure, modes: &[DrawnMode]) -> Result<(), RecordError> {
+    let shown = || path.display().to_string();
+    let output = |source| RecordError::Output { path: shown(), source };
+    let refused = |e: &dyn std::fmt::Display| RecordError::Rerun { path: shown(), message: e.to_string() };
+    crate::output::check_replaceable(path).map_err(output)?;
     let partial = crate::output::partial_path(path);
-    let rec = rerun::RecordingStreamBuilder::new("tensegrity-modes").save(&partial).map_err(|e| e.to_string())?;
+    let rec = rerun::RecordingStreamBuilder::new("tensegrity-modes").save(&partial).map_err(|e| refused(&e))?;
     let _ = rec.log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP());
     let extent = extent(&s.nodes);
     let mut start = 0.0;
@@ -60,9 +64,9 @@ pub fn record_modes(path: &Path, s: &DrawnStructure, modes: &[DrawnMode]) -> Res
     drop(rec);
     if let Err(e) = flushed {
         crate::output::discard(&partial);
-        return Err(e.to_string());
+        return Err(refused(&e));
     }
-    crate::output::commit(&partial, path)
+    crate::output::commit(&partial, path).map_err(output)
 }
 
 fn norm(d: &[f64; 3]) -> f64 {

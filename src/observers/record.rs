@@ -14,15 +14,23 @@
 //! The file is written to `<path>.partial` and renamed when the run ends, so a reader never
 //! sees a half-written recording under the final name.
 
-use super::{Note, Observer, Tick};
+use super::{Note, Observer, ObserverError, Tick};
 use crate::mechanisms::wrap_angle;
 use crate::report::ScenarioReport;
 use std::path::{Path, PathBuf};
 
+/// Why a recording could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum RecordError {
+    /// The file was refused, or could not be put in place (`output`).
+    #[error("cannot record to {path}: {source}")]
+    Output { path: String, source: crate::output::OutputError },
+    /// The file's directory could not be made.
+    #[error("cannot record to {path}: {source}")]
+    Io { path: String, source: std::io::Error },
+    /// rerun's SDK refused (in its words).
     #[error("cannot record to {path}: {message}")]
-    Io { path: String, message: String },
+    Rerun { path: String, message: String },
 }
 
 /// Where a recording goes.
@@ -339,13 +347,12 @@ fn force_colour(force: f64, max_abs: f64) -> [u8; 4] {
 
 impl Recorder {
     /// Starts the recording `r` with the scenario stored in it (None: a live viewer that
-    /// nobody runs).
-    pub fn start(r: &Recording) -> Result<Option<Self>, String> {
-        let recorder = match &r.target {
+    /// nobody runs, said in `warnings`).
+    pub fn start(r: &Recording, warnings: &mut Vec<String>) -> Result<Option<Self>, RecordError> {
+        let mut recorder = match &r.target {
             RecordTarget::File(path) => Recorder::create(path, APP, r.every, r.file_model).map(Some),
-            RecordTarget::Live(url) => Recorder::connect(url, APP, r.every, r.file_model),
-        };
-        let mut recorder = recorder.map_err(|e| e.to_string())?;
+            RecordTarget::Live(url) => Recorder::connect(url, APP, r.every, r.file_model, warnings),
+        }?;
         if let Some(rec) = recorder.as_mut() {
             rec.document("scenario", r.scenario);
         }
@@ -354,18 +361,18 @@ impl Recorder {
 
     /// Starts a recording that will be renamed to `path` by [`Recorder::finish`].
     pub fn create(path: &Path, app: &'static str, every: u64, file_model: bool) -> Result<Self, RecordError> {
-        let io = |e: String| RecordError::Io { path: path.display().to_string(), message: e };
+        let shown = || path.display().to_string();
         if let Some(dir) = path.parent() {
             if !dir.as_os_str().is_empty() {
-                std::fs::create_dir_all(dir).map_err(|e| io(e.to_string()))?;
+                std::fs::create_dir_all(dir).map_err(|source| RecordError::Io { path: shown(), source })?;
             }
         }
-        crate::output::check_replaceable(path).map_err(io)?;
+        crate::output::check_replaceable(path).map_err(|source| RecordError::Output { path: shown(), source })?;
         let partial = crate::output::partial_path(path);
         let rec = rerun::RecordingStreamBuilder::new(app)
             .with_blueprint(blueprint(file_model))
             .save(&partial)
-            .map_err(|e| io(e.to_string()))?;
+            .map_err(|e| RecordError::Rerun { path: shown(), message: e.to_string() })?;
         Ok(Recorder::new(rec, Target::File { partial, path: path.to_path_buf() }, every))
     }
 
@@ -385,19 +392,25 @@ impl Recorder {
     }
 
     /// Streams the same data live to a rerun viewer or server at `url` (rerun's default when
-    /// empty). A run never fails or waits because nobody listens: the end of the run says so once.
-    pub fn connect(url: &str, app: &'static str, every: u64, file_model: bool) -> Result<Option<Self>, RecordError> {
+    /// empty). A run never fails or waits because nobody listens: `warnings` says so once.
+    pub fn connect(
+        url: &str,
+        app: &'static str,
+        every: u64,
+        file_model: bool,
+        warnings: &mut Vec<String>,
+    ) -> Result<Option<Self>, RecordError> {
         let url = if url.is_empty() { DEFAULT_CONNECT_URL.to_string() } else { url.to_string() };
         // rerun's gRPC sink blocks the logging calls while nobody listens (measured: a run
         // stalled for good): check that a viewer or server answers first.
         if !listening(&url) {
-            eprintln!("note: no rerun viewer or server listens at {url}; the run goes on without streaming");
+            warnings.push(format!("no rerun viewer or server listens at {url}; the run goes on without streaming"));
             return Ok(None);
         }
         let rec = rerun::RecordingStreamBuilder::new(app)
             .with_blueprint(blueprint(file_model))
             .connect_grpc_opts(url.clone())
-            .map_err(|e| RecordError::Io { path: url.clone(), message: e.to_string() })?;
+            .map_err(|e| RecordError::Rerun { path: url.clone(), message: e.to_string() })?;
         Ok(Some(Recorder::new(rec, Target::Live { url }, every)))
     }
 
@@ -484,25 +497,26 @@ impl Recorder {
     }
 
     /// Flushes and moves the recording to its final name (a live stream: waits a moment for
-    /// the viewer, and says once if none took the data). The recorder records nothing after.
-    pub fn finish(&mut self) -> Result<Option<PathBuf>, RecordError> {
+    /// the viewer, and says once in `warnings` if none took the data). The recorder records
+    /// nothing after.
+    pub fn finish(&mut self, warnings: &mut Vec<String>) -> Result<Option<PathBuf>, RecordError> {
         self.send();
         let rec = std::mem::replace(&mut self.rec, rerun::RecordingStream::disabled());
         match &self.target {
             Target::File { partial, path } => {
-                let io = |e: String| RecordError::Io { path: path.display().to_string(), message: e };
+                let shown = || path.display().to_string();
                 let flushed = rec.flush_blocking();
                 drop(rec);
                 if let Err(e) = flushed {
                     crate::output::discard(partial);
-                    return Err(io(e.to_string()));
+                    return Err(RecordError::Rerun { path: shown(), message: e.to_string() });
                 }
-                crate::output::commit(partial, path).map_err(io)?;
+                crate::output::commit(partial, path).map_err(|source| RecordError::Output { path: shown(), source })?;
                 Ok(Some(path.clone()))
             }
             Target::Live { url } => {
                 if rec.flush_with_timeout(std::time::Duration::from_secs_f64(LIVE_FLUSH_TIMEOUT_S)).is_err() {
-                    eprintln!("note: no rerun viewer took the live stream at {url}; the run went on without it");
+                    warnings.push(format!("no rerun viewer took the live stream at {url}; the run went on without it"));
                 }
                 Ok(None)
             }
@@ -608,10 +622,11 @@ impl Observer for Recorder {
     }
 
     /// Stores the final report, the verdict as the last event, and writes the file.
-    fn close(&mut self, tick: u64, report: &ScenarioReport) -> Result<(), String> {
+    fn close(&mut self, tick: u64, report: &ScenarioReport, warnings: &mut Vec<String>) -> Result<(), ObserverError> {
         self.document("report", &serde_json::to_string_pretty(report).unwrap_or_default());
         self.note(tick, &Note::Event(if report.passed { "run passed" } else { "run FAILED" }.into()));
-        self.finish().map(|_| ()).map_err(|e| e.to_string())
+        self.finish(warnings)?;
+        Ok(())
     }
 }
 

@@ -19,7 +19,7 @@
 //! the same f64 bit for bit. The file is written to a temporary file (`output::partial_path`) and renamed when the run
 //! is over.
 
-use super::{Observer, Tick};
+use super::{Observer, ObserverError, Tick};
 use crate::report::ScenarioReport;
 use crate::structure::ActuatorTarget;
 use arrow_array::{ArrayRef, Float64Array, RecordBatch, UInt64Array};
@@ -89,6 +89,23 @@ enum Sink {
     },
 }
 
+/// Why the table could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum TableError {
+    /// The output was refused or its directory could not be made.
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    /// The file could not be made or written.
+    #[error("cannot write the table {}: {source}", path.display())]
+    Io { path: PathBuf, source: std::io::Error },
+    /// The Arrow IPC writer failed.
+    #[error("cannot write the table {}: {source}", path.display())]
+    Arrow { path: PathBuf, source: arrow_schema::ArrowError },
+    /// The file was handed to its writer already.
+    #[error("cannot write the table {}: the file is gone", path.display())]
+    Gone { path: PathBuf },
+}
+
 pub struct Table {
     /// The file, or "(memory)" for a table kept in memory (for messages).
     path: PathBuf,
@@ -97,7 +114,7 @@ pub struct Table {
     sink: Sink,
     keys: Option<Keys>,
     /// The first write error, reported when the run closes.
-    error: Option<String>,
+    error: Option<TableError>,
     /// The file's model, evaluated for its columns (quantities, predictions, errors).
     model: Option<super::file_model::ModelObserver>,
 }
@@ -125,15 +142,15 @@ impl Table {
     /// Starts the table at `path` (its directory is made if needed); Arrow IPC for the endings
     /// in [`ARROW_ENDINGS`], CSV otherwise.
     /// `model`: the file's model, whose quantities, predictions and errors get columns.
-    pub fn start(path: &Path, model: Option<super::file_model::ModelObserver>) -> Result<Self, String> {
+    pub fn start(path: &Path, model: Option<super::file_model::ModelObserver>) -> Result<Self, TableError> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+            crate::output::create_dir(dir)?;
         }
         crate::output::check_replaceable(path)?;
         let partial = crate::output::partial_path(path);
-        let file = std::fs::File::create(&partial).map_err(|e| {
+        let file = std::fs::File::create(&partial).map_err(|source| {
             crate::output::discard(&partial);
-            format!("cannot write the table {}: {e}", path.display())
+            TableError::Io { path: path.to_path_buf(), source }
         })?;
         let arrow = path.extension().and_then(|e| e.to_str()).is_some_and(|e| ARROW_ENDINGS.contains(&e));
         let sink = if arrow {
@@ -199,8 +216,9 @@ impl Table {
     }
 
     /// Writes one tick (`header`: the column names, at the first tick).
-    fn write(&mut self, tick: u64, header: Option<Vec<String>>, values: Vec<Option<f64>>) -> Result<(), String> {
-        let fail = |e: &dyn std::fmt::Display| format!("cannot write the table {}: {e}", self.path.display());
+    fn write(&mut self, tick: u64, header: Option<Vec<String>>, values: Vec<Option<f64>>) -> Result<(), TableError> {
+        let io = |source| TableError::Io { path: self.path.clone(), source };
+        let arrow = |source| TableError::Arrow { path: self.path.clone(), source };
         match &mut self.sink {
             Sink::Csv(out) => {
                 let mut text = String::new();
@@ -217,7 +235,7 @@ impl Table {
                     }
                 }
                 text.push('\n');
-                out.write_all(text.as_bytes()).map_err(|e| fail(&e))
+                out.write_all(text.as_bytes()).map_err(io)
             }
             Sink::Arrow { out, schema, ticks, columns } => {
                 if let Some(h) = header {
@@ -225,8 +243,8 @@ impl Table {
                     fields.extend(h.iter().map(|c| Field::new(c, DataType::Float64, true)));
                     let s = Arc::new(Schema::new(fields));
                     if let Batches::File { file, writer } = out {
-                        let f = file.take().ok_or_else(|| fail(&"the file is gone"))?;
-                        *writer = Some(arrow_ipc::writer::FileWriter::try_new(f, &s).map_err(|e| fail(&e))?);
+                        let f = file.take().ok_or_else(|| TableError::Gone { path: self.path.clone() })?;
+                        *writer = Some(arrow_ipc::writer::FileWriter::try_new(f, &s).map_err(arrow)?);
                     }
                     *schema = Some(s);
                     *columns = vec![Vec::with_capacity(ARROW_BATCH_ROWS); h.len()];
@@ -236,7 +254,7 @@ impl Table {
                     c.push(x);
                 }
                 if ticks.len() >= ARROW_BATCH_ROWS {
-                    Self::flush_batch(out, schema, ticks, columns).map_err(|e| fail(&e))?;
+                    Self::flush_batch(out, schema, ticks, columns).map_err(arrow)?;
                 }
                 Ok(())
             }
@@ -268,19 +286,20 @@ impl Table {
     }
 
     /// Finishes the file (the last batch and the Arrow footer, or the CSV buffer) and syncs it.
-    fn finish_file(&mut self) -> Result<(), String> {
-        let fail = |e: &dyn std::fmt::Display| format!("cannot write the table {}: {e}", self.path.display());
+    fn finish_file(&mut self) -> Result<(), TableError> {
+        let io = |source| TableError::Io { path: self.path.clone(), source };
+        let arrow = |source| TableError::Arrow { path: self.path.clone(), source };
         match &mut self.sink {
-            Sink::Csv(out) => out.flush().and_then(|_| out.get_ref().sync_all()).map_err(|e| fail(&e)),
+            Sink::Csv(out) => out.flush().and_then(|_| out.get_ref().sync_all()).map_err(io),
             Sink::Arrow { out, schema, ticks, columns } => {
-                Self::flush_batch(out, schema, ticks, columns).map_err(|e| fail(&e))?;
+                Self::flush_batch(out, schema, ticks, columns).map_err(arrow)?;
                 match out {
                     Batches::File { writer, file } => match (writer.take(), file.take()) {
                         (Some(mut w), _) => {
-                            w.finish().map_err(|e| fail(&e))?;
-                            w.into_inner().and_then(|f| f.sync_all().map_err(Into::into)).map_err(|e| fail(&e))
+                            w.finish().map_err(arrow)?;
+                            w.into_inner().and_then(|f| f.sync_all().map_err(Into::into)).map_err(arrow)
                         }
-                        (None, Some(f)) => f.sync_all().map_err(|e| fail(&e)),
+                        (None, Some(f)) => f.sync_all().map_err(io),
                         (None, None) => Ok(()),
                     },
                     Batches::Memory { kept, to } => {
@@ -330,17 +349,22 @@ impl Observer for Table {
         }
     }
 
-    fn close(&mut self, _tick: u64, _report: &ScenarioReport) -> Result<(), String> {
+    fn close(
+        &mut self,
+        _tick: u64,
+        _report: &ScenarioReport,
+        _warnings: &mut Vec<String>,
+    ) -> Result<(), ObserverError> {
         let written = match self.error.take() {
             Some(e) => Err(e),
             None => self.finish_file(),
         };
-        let Some(partial) = &self.partial else { return written };
+        let Some(partial) = &self.partial else { return Ok(written?) };
         match written {
-            Ok(()) => crate::output::commit(partial, &self.path),
+            Ok(()) => Ok(crate::output::commit(partial, &self.path).map_err(TableError::Output)?),
             Err(e) => {
                 crate::output::discard(partial);
-                Err(e)
+                Err(e.into())
             }
         }
     }

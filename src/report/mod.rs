@@ -16,7 +16,7 @@ pub struct Report {
     pub scenarios: Vec<ScenarioReport>,
 }
 
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, PartialEq, Default)]
 pub struct ScenarioReport {
     pub name: String,
     pub file: String,
@@ -52,7 +52,11 @@ pub struct ScenarioReport {
     /// (for example the smallest |det J| on a path that must avoid singularities).
     pub trajectory_ranges: std::collections::BTreeMap<String, QuantityRange>,
     /// Why the run stopped early (divergence, interruption), if it did.
-    pub error: Option<String>,
+    pub error: Option<ReportedError>,
+    /// What the run went on without (a live viewer nobody runs), for the command line to say
+    /// (absent from the JSON when there is nothing).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// The file's own model: its `[[predictions]]` and `[[equations]]`, judged (absent from the
     /// JSON when the file states none).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -76,6 +80,48 @@ pub struct ScenarioReport {
     /// them (a structure drawn for one value, swept over others).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub unseen_params: Vec<String>,
+}
+
+/// An error kept in a report as its own kind (a `run::RunError`, an
+/// `observers::lagrangian::LagrangianError`, ...: [`ReportedError::get`] and `downcast_ref`
+/// recover it), written as its message. Two are equal when they say the same.
+#[derive(Clone, Debug)]
+pub struct ReportedError(std::sync::Arc<dyn std::error::Error + Send + Sync>);
+
+impl ReportedError {
+    /// Keeps `error` as it is.
+    pub fn new(error: impl std::error::Error + Send + Sync + 'static) -> Self {
+        ReportedError(std::sync::Arc::new(error))
+    }
+
+    /// The error as it was reported.
+    pub fn get(&self) -> &(dyn std::error::Error + Send + Sync + 'static) {
+        self.0.as_ref()
+    }
+}
+
+impl std::fmt::Display for ReportedError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for ReportedError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.0.source()
+    }
+}
+
+impl PartialEq for ReportedError {
+    fn eq(&self, other: &Self) -> bool {
+        self.to_string() == other.to_string()
+    }
+}
+
+impl Serialize for ReportedError {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
 }
 
 /// Which kind of path a run took (see [`ScenarioReport::path`]).
@@ -141,7 +187,7 @@ pub struct LagrangianReport {
     pub integrator_steps: usize,
     /// Why the model could not be compared (every coordinate then fails, its error infinite).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub error: Option<String>,
+    pub error: Option<ReportedError>,
     pub coordinates: Vec<LagrangianCoordinateReport>,
 }
 

@@ -60,115 +60,93 @@ pub fn failures(report: &ScenarioReport, min_agreement_percent: Option<f64>) -> 
     out
 }
 
-/// One part of a run's verdict that failed.
-#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Failure {
+/// Defines [`Failure`] from one table: each variant with its name in `[expect] failing`
+/// (`NAME`, or `NAME:PLACEHOLDER` for a part named by what follows the colon), and from that
+/// table alone [`FAILURE_NAMES`], `Display` and `FromStr`.
+macro_rules! failures {
+    ($($(#[doc = $doc:literal])* $variant:ident $(($field:ident: $placeholder:literal))? = $name:literal,)*) => {
+        /// One part of a run's verdict that failed.
+        #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+        pub enum Failure {
+            $($(#[doc = $doc])* $variant $((failures!(@string $field)))?,)*
+        }
+
+        /// The names a scenario may give in `[expect] failing` (a check is `check:QUANTITY`).
+        pub const FAILURE_NAMES: &[&str] = &[$(concat!($name $(, ":", $placeholder)?)),*];
+
+        impl fmt::Display for Failure {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                match self {
+                    $(Failure::$variant $(($field))? => {
+                        f.write_str($name)?;
+                        $(write!(f, ":{}", $field)?;)?
+                        Ok(())
+                    })*
+                }
+            }
+        }
+
+        impl std::str::FromStr for Failure {
+            type Err = UnknownFailure;
+            fn from_str(s: &str) -> Result<Self, UnknownFailure> {
+                $(failures!(@parse s, $variant, $name $(, $field)?);)*
+                Err(UnknownFailure(s.to_string()))
+            }
+        }
+    };
+    (@string $field:ident) => { String };
+    (@parse $s:ident, $variant:ident, $name:literal) => {
+        if $s == $name {
+            return Ok(Failure::$variant);
+        }
+    };
+    (@parse $s:ident, $variant:ident, $name:literal, $field:ident) => {
+        if let Some($field) = $s.strip_prefix(concat!($name, ":")).filter(|n| !n.is_empty()) {
+            return Ok(Failure::$variant($field.to_string()));
+        }
+    };
+}
+
+failures! {
     /// The run stopped early (divergence, interruption, a model error, a panic, a recording
     /// that could not be written): `error`.
-    Error,
+    Error = "error",
     /// A settle point did not settle within `settle.max_time`: `settle`.
-    Settle,
+    Settle = "settle",
     /// A `[[checks]]` quantity exceeded its tolerance: `check:QUANTITY`.
-    Check(String),
+    Check(quantity: "QUANTITY") = "check",
     /// The stiffness probe disagreed with the analytic stiffness: `probe`.
-    Probe,
+    Probe = "probe",
     /// The perturbation test disagreed with the analytic stability: `stability`.
-    Stability,
+    Stability = "stability",
     /// The slack cables differ from the analytic model's: `slack`.
-    Slack,
+    Slack = "slack",
     /// The structure lost its self-stress (every cable slack, or below `[prestress]
     /// min_fraction` of the drawn tension) where `[prestress] on_loss` fails: `prestress`.
-    Prestress,
+    Prestress = "prestress",
     /// Two members came closer than the interference threshold: `interference`.
-    Interference,
+    Interference = "interference",
     /// A workspace sweep's agreement fell below `workspace.min_agreement_percent`: `workspace`.
-    Workspace,
+    Workspace = "workspace",
     /// A `[[predictions]]` entry of the file's model exceeded its tolerance: `prediction:NAME`.
-    Prediction(String),
+    Prediction(name: "NAME") = "prediction",
     /// A `[[equations]]` residual exceeded its tolerance: `equation:NAME`.
-    Equation(String),
+    Equation(name: "NAME") = "equation",
     /// The dynamics settled away from the `[energy]` model's minima: `energy`.
-    Energy,
+    Energy = "energy",
     /// A frequency prediction failed: a `[[energy.frequencies]]` one against the dynamic
     /// model's natural frequency, or a `[[motion.frequencies]]` one against the frequency
     /// measured from a motion run: `frequency:NAME`.
-    Frequency(String),
+    Frequency(name: "NAME") = "frequency",
     /// A coordinate of the `[energy]` model strayed from its Lagrangian trajectory
     /// (`[energy.trajectory]`) in a motion run: `trajectory:COORDINATE`.
-    Trajectory(String),
+    Trajectory(coordinate: "COORDINATE") = "trajectory",
 }
 
-/// The names a scenario may give in `[expect] failing` (a check is `check:QUANTITY`).
-pub const FAILURE_NAMES: &[&str] = &[
-    "error",
-    "settle",
-    "check:QUANTITY",
-    "probe",
-    "stability",
-    "slack",
-    "prestress",
-    "interference",
-    "workspace",
-    "prediction:NAME",
-    "equation:NAME",
-    "energy",
-    "frequency:NAME",
-    "trajectory:COORDINATE",
-];
-
-impl fmt::Display for Failure {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Failure::Error => f.write_str("error"),
-            Failure::Settle => f.write_str("settle"),
-            Failure::Check(q) => write!(f, "check:{q}"),
-            Failure::Probe => f.write_str("probe"),
-            Failure::Stability => f.write_str("stability"),
-            Failure::Slack => f.write_str("slack"),
-            Failure::Prestress => f.write_str("prestress"),
-            Failure::Interference => f.write_str("interference"),
-            Failure::Workspace => f.write_str("workspace"),
-            Failure::Prediction(n) => write!(f, "prediction:{n}"),
-            Failure::Equation(n) => write!(f, "equation:{n}"),
-            Failure::Energy => f.write_str("energy"),
-            Failure::Frequency(n) => write!(f, "frequency:{n}"),
-            Failure::Trajectory(n) => write!(f, "trajectory:{n}"),
-        }
-    }
-}
-
-impl std::str::FromStr for Failure {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Ok(match s {
-            "error" => Failure::Error,
-            "settle" => Failure::Settle,
-            "probe" => Failure::Probe,
-            "stability" => Failure::Stability,
-            "slack" => Failure::Slack,
-            "prestress" => Failure::Prestress,
-            "interference" => Failure::Interference,
-            "workspace" => Failure::Workspace,
-            "energy" => Failure::Energy,
-            _ if s.strip_prefix("prediction:").is_some_and(|n| !n.is_empty()) => {
-                Failure::Prediction(s["prediction:".len()..].to_string())
-            }
-            _ if s.strip_prefix("frequency:").is_some_and(|n| !n.is_empty()) => {
-                Failure::Frequency(s["frequency:".len()..].to_string())
-            }
-            _ if s.strip_prefix("trajectory:").is_some_and(|n| !n.is_empty()) => {
-                Failure::Trajectory(s["trajectory:".len()..].to_string())
-            }
-            _ if s.strip_prefix("equation:").is_some_and(|n| !n.is_empty()) => {
-                Failure::Equation(s["equation:".len()..].to_string())
-            }
-            _ => match s.strip_prefix("check:") {
-                Some(q) if !q.is_empty() => Failure::Check(q.to_string()),
-                _ => return Err(format!("unknown failure '{s}' (expected one of: {})", FAILURE_NAMES.join(", "))),
-            },
-        })
-    }
-}
+/// A name in `[expect] failing` that names no [`Failure`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown failure '{0}' (expected one of: {names})", names = FAILURE_NAMES.join(", "))]
+pub struct UnknownFailure(pub String);
 
 impl serde::Serialize for Failure {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {

@@ -13,19 +13,22 @@ mod topologies;
 
 use crate::mechanisms::{Mechanism, ModelError};
 use crate::observers::record::{RecordTarget, Recording};
-use crate::observers::{self, Setup};
+use crate::observers::{self, ObserverError, Setup};
 use crate::report::{PointReport, ProbeReport, ScenarioReport, SettleSummary, WorkspaceAgreement};
 use crate::scenario::{Actuation, Scenario};
 use crate::sim::{SimError, Simulation};
 use runner::Runner;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 use std::time::Instant;
 
 pub use point::NO_BRANCH;
 pub use settle::SettleDetector;
 pub use settled::{settle_first_point, SettledState};
 pub use topologies::rebuilt;
+
+use stoppable::{interruptible, Halted};
 
 /// How a run is observed beyond the comparison.
 #[derive(Default)]
@@ -48,14 +51,50 @@ pub struct RunOptions<'a> {
     pub external: Option<crate::observers::external::External>,
 }
 
-#[derive(Debug, thiserror::Error)]
-enum Stop {
+/// Why a run stopped early, or failed after its end: the report's `error`, each kind kept as
+/// its own until the report is printed or written.
+#[derive(Clone, Debug, thiserror::Error)]
+pub enum RunError {
+    /// The simulator refused or diverged.
     #[error("{0}")]
     Sim(#[from] SimError),
+    /// The cancel flag was raised (a signal, Ctrl-C).
     #[error("interrupted at tick {0}")]
     Interrupted(u64),
+    /// The mechanism's model gave no result.
     #[error("{0}")]
     Model(#[from] ModelError),
+    /// The structure's modes at a motion's start could not be computed.
+    #[error("{0}")]
+    Modes(#[from] crate::sim::modes::ModesError),
+    /// An observer could not start, or could not write what carries the verdict.
+    #[error("{0}")]
+    Observer(Arc<ObserverError>),
+    /// The paper's equations (findings) were not checked.
+    #[error("{0} while checking the paper's equations (findings)")]
+    Findings(Halted),
+    /// The run panicked (its message).
+    #[error("panicked: {0}")]
+    Panicked(String),
+    /// A point settled on an analytically unstable branch the scenario does not start on.
+    #[error("point {index} settled on the analytically unstable branch '{branch}'")]
+    UnstableBranch { index: usize, branch: String },
+    /// The run of one topology of a topology sweep (`note`: the parameters that rebuilt it).
+    #[error("{note}: {source}")]
+    Topology { note: String, source: crate::report::ReportedError },
+}
+
+impl From<ObserverError> for RunError {
+    fn from(e: ObserverError) -> Self {
+        RunError::Observer(Arc::new(e))
+    }
+}
+
+/// The report keeps the error as its own kind.
+impl From<RunError> for crate::report::ReportedError {
+    fn from(e: RunError) -> Self {
+        crate::report::ReportedError::new(e)
+    }
 }
 
 /// The report of a scenario whose run panicked: failed, with the panic's message.
@@ -65,80 +104,120 @@ pub fn panicked(sc: &Scenario, payload: &(dyn std::any::Any + Send)) -> Scenario
         .map(|s| s.to_string())
         .or_else(|| payload.downcast_ref::<String>().cloned())
         .unwrap_or_else(|| "unknown panic".into());
-    let mut report = ScenarioReport { error: Some(format!("panicked: {msg}")), ..empty_report(sc) };
+    let mut report = ScenarioReport { error: Some(RunError::Panicked(msg).into()), ..empty_report(sc) };
     conclude(&mut report, sc);
     report
 }
 
-/// The report of `sc` before anything has run: not passed, no points, no findings.
+/// The report of `sc` before anything has run: not passed, no points, no findings (the one
+/// place a run's report is made; every phase then fills in its part).
 fn empty_report(sc: &Scenario) -> ScenarioReport {
     ScenarioReport {
         name: sc.name.clone(),
         file: sc.file.display().to_string(),
         mechanism: sc.mechanism.clone(),
-        passed: false,
-        failures: vec![],
         expect: sc.expect.clone(),
-        as_expected: None,
         params: sc.params.clone(),
-        settle: SettleSummary::default(),
-        checks: vec![],
-        points: vec![],
-        stiffness_probe: None,
-        slack_intervals: vec![],
-        prestress: None,
-        workspace: None,
         skipped_points: sc.skipped_points.len(),
-        interference: None,
-        findings: vec![],
-        trajectory_ranges: Default::default(),
-        error: None,
-        model_checks: vec![],
-        path: crate::report::PathKind::Accelerated,
-        accelerated_steps: 0,
-        motion: None,
-        topologies: vec![],
         unseen_params: sc.unseen_params.clone(),
+        ..ScenarioReport::default()
     }
 }
 
-/// Why a computation on a thread of its own gave no result.
-#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-pub enum Halted {
-    #[error("interrupted")]
-    Interrupted,
-    #[error("panicked")]
-    Panicked,
-}
+/// Work on a thread of its own, waited for one poll at a time so that the waiting thread can
+/// stop waiting: the command of the CLI (on SIGINT or SIGTERM), a run's analytic computations
+/// (on its cancel flag) and the Python package's runs (on Ctrl-C) all wait this way.
+pub mod stoppable {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+    use std::sync::Mutex;
+    use std::thread::JoinHandle;
+    use std::time::Duration;
 
-/// How often a computation on a thread of its own is looked at for a cancellation [s].
-const CANCEL_POLL_S: f64 = 0.05;
+    /// How often a waiting thread looks for a reason to stop while the work runs [s].
+    pub const POLL_S: f64 = 0.05;
 
-/// Runs `f` on a thread of its own and waits for its result, looking at `cancel` every
-/// [`CANCEL_POLL_S`]: an error when cancelled first (the thread is left to finish on its own,
-/// or to end with the process) or when it panicked. Analytic computations (findings, solves)
-/// have no ticks to stop at; this makes them interruptible without threading a flag through
-/// every model.
-pub fn interruptible<T: Send + 'static>(
-    cancel: Option<&AtomicBool>,
-    f: impl FnOnce() -> T + Send + 'static,
-) -> Result<T, Halted> {
-    let Some(cancel) = cancel else { return Ok(f()) };
-    let cancelled = || cancel.load(std::sync::atomic::Ordering::SeqCst);
-    if cancelled() {
-        return Err(Halted::Interrupted);
+    /// Why work on a thread of its own gave no result.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+    pub enum Halted {
+        /// The waiter stopped waiting (a signal, a cancel flag).
+        #[error("interrupted")]
+        Interrupted,
+        /// The work's thread panicked.
+        #[error("panicked")]
+        Panicked,
     }
-    let (tx, rx) = std::sync::mpsc::channel();
-    std::thread::spawn(move || {
-        let _ = tx.send(f());
-    });
-    loop {
-        match rx.recv_timeout(std::time::Duration::from_secs_f64(CANCEL_POLL_S)) {
-            Ok(v) => return Ok(v),
-            Err(std::sync::mpsc::RecvTimeoutError::Timeout) if cancelled() => return Err(Halted::Interrupted),
-            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
-            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => return Err(Halted::Panicked),
+
+    /// Work running on a thread of its own, its result awaited one poll ([`POLL_S`]) at a time.
+    pub struct Stoppable<T> {
+        /// In a mutex so that the waiter may poll from any thread (the Python package polls
+        /// without the GIL).
+        result: Mutex<Receiver<T>>,
+        thread: JoinHandle<()>,
+    }
+
+    impl<T: Send + 'static> Stoppable<T> {
+        /// Starts `work` on a thread of its own with `stack_bytes` of stack (None: the default).
+        pub fn spawn(stack_bytes: Option<usize>, work: impl FnOnce() -> T + Send + 'static) -> std::io::Result<Self> {
+            let (tx, rx) = mpsc::channel();
+            let builder = std::thread::Builder::new();
+            let builder = match stack_bytes {
+                Some(bytes) => builder.stack_size(bytes),
+                None => builder,
+            };
+            let thread = builder.spawn(move || {
+                // The receiver is gone only when its waiter stopped waiting: nobody wants the result.
+                let _ = tx.send(work());
+            })?;
+            Ok(Stoppable { result: Mutex::new(rx), thread })
         }
+
+        /// Waits up to [`POLL_S`] for the result: `Some` the result, `None` still working, or
+        /// [`Halted::Panicked`].
+        pub fn poll(&self) -> Result<Option<T>, Halted> {
+            let result = self.result.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            match result.recv_timeout(Duration::from_secs_f64(POLL_S)) {
+                Ok(value) => Ok(Some(value)),
+                Err(RecvTimeoutError::Timeout) => Ok(None),
+                Err(RecvTimeoutError::Disconnected) => Err(Halted::Panicked),
+            }
+        }
+
+        /// Waits for the result, asking `stop` after every poll that brought none:
+        /// [`Halted::Interrupted`] as soon as it says so (the thread is left to finish on its own,
+        /// or to end with the process).
+        pub fn wait(&self, mut stop: impl FnMut() -> bool) -> Result<T, Halted> {
+            loop {
+                if let Some(value) = self.poll()? {
+                    return Ok(value);
+                }
+                if stop() {
+                    return Err(Halted::Interrupted);
+                }
+            }
+        }
+
+        /// Waits for the thread to end (after its result, or once the flag it watches is raised).
+        pub fn join(self) {
+            let _ = self.thread.join();
+        }
+    }
+
+    /// Runs `f` on a thread of its own and waits for its result, looking at `cancel` every
+    /// [`POLL_S`]: [`Halted::Interrupted`] when cancelled first (the thread is left to finish on
+    /// its own, or to end with the process), [`Halted::Panicked`] when it panicked. Analytic
+    /// computations (findings, solves) have no ticks to stop at; this makes them interruptible
+    /// without threading a flag through every model.
+    pub fn interruptible<T: Send + 'static>(
+        cancel: Option<&AtomicBool>,
+        f: impl FnOnce() -> T + Send + 'static,
+    ) -> Result<T, Halted> {
+        let Some(cancel) = cancel else { return Ok(f()) };
+        let cancelled = || cancel.load(Ordering::SeqCst);
+        if cancelled() {
+            return Err(Halted::Interrupted);
+        }
+        Stoppable::spawn(None, f).expect("a thread starts").wait(cancelled)
     }
 }
 
@@ -162,7 +241,7 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         match interruptible(opts.cancel, move || of.mechanism().findings(&of.params)) {
             Ok(f) => report.findings = f.into_iter().map(Into::into).collect(),
             Err(halted) => {
-                report.error = Some(format!("{halted} while checking the paper's equations (findings)"));
+                report.error = Some(RunError::Findings(halted).into());
                 conclude(&mut report, sc);
                 return report;
             }
@@ -170,10 +249,10 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
     }
     // Wall time counts the simulation, not the findings computed above.
     let wall = Instant::now();
-    let mut runner = match start(mech, sc, opts) {
+    let mut runner = match start(mech, sc, opts, &mut report.warnings) {
         Ok(r) => r,
         Err(e) => {
-            report.error = Some(e);
+            report.error = Some(e.into());
             conclude(&mut report, sc);
             return report;
         }
@@ -185,43 +264,52 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         None => run_actuation(&mut runner, sc, &mut report, &mut probe_errors),
     };
     if let Err(e) = ran {
-        report.error = Some(e.to_string());
         runner.emit(format_args!("run stopped: {e}"));
+        report.error = Some(e.into());
     }
     finish(&mut runner, &mut report, &probe_errors, wall);
     report
 }
 
-/// The simulation at the first point, and the observers of the run.
-fn start<'a>(mech: Box<dyn Mechanism>, sc: &'a Scenario, opts: &RunOptions<'a>) -> Result<Runner<'a>, String> {
+/// The simulation at the first point, and the observers of the run (what the run goes on
+/// without goes into `warnings`).
+fn start<'a>(
+    mech: Box<dyn Mechanism>,
+    sc: &'a Scenario,
+    opts: &RunOptions<'a>,
+    warnings: &mut Vec<String>,
+) -> Result<Runner<'a>, RunError> {
     let first_inputs = match &sc.actuation {
         Actuation::Points { points, .. } => points[0].clone(),
         Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
     };
     let params = sc.params_at(&first_inputs);
-    let structure = mech.build(&params, &first_inputs, &sc.start).map_err(|e| e.to_string())?;
-    let sim = Simulation::new(&structure, &sc.sim).map_err(|e| e.to_string())?;
+    let structure = mech.build(&params, &first_inputs, &sc.start)?;
+    let sim = Simulation::new(&structure, &sc.sim)?;
     let target = match (&opts.connect, opts.record.clone().or_else(|| sc.record.clone())) {
         (Some(url), _) => Some(RecordTarget::Live(url.clone())),
         (None, Some(path)) => Some(RecordTarget::File(path)),
         (None, None) => None,
     };
-    let observers = observers::observers(Setup {
-        structure: &sim.structure(),
-        checks: &sc.checks,
-        length_scale_m: mech.length_scale(&params),
-        interference: &sc.interference,
-        model: sc.model.as_ref(),
-        recording: target.map(|target| Recording {
-            target,
-            every: opts.record_every.max(1),
-            scenario: &sc.source,
-            file_model: sc.model.is_some(),
-        }),
-        table: opts.table.clone(),
-        motion: sc.motion.as_ref(),
-        external: opts.external.clone(),
-    })?;
+    let observers = observers::observers(
+        Setup {
+            structure: &sim.structure(),
+            checks: &sc.checks,
+            length_scale_m: mech.length_scale(&params),
+            interference: &sc.interference,
+            model: sc.model.as_ref(),
+            recording: target.map(|target| Recording {
+                target,
+                every: opts.record_every.max(1),
+                scenario: &sc.source,
+                file_model: sc.model.is_some(),
+            }),
+            table: opts.table.clone(),
+            motion: sc.motion.as_ref(),
+            external: opts.external.clone(),
+        },
+        warnings,
+    )?;
     let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel, params);
     // The first point's commands (a no-op where the build already placed them).
     runner.command(&first_inputs);
@@ -261,13 +349,15 @@ fn finish(runner: &mut Runner, report: &mut ScenarioReport, probe_errors: &[f64]
     conclude(report, sc);
     let tick = runner.sim.tick();
     let mut failed = None;
+    let mut warnings = Vec::new();
     for o in &mut runner.observers {
-        if let Err(e) = o.close(tick, report) {
-            failed.get_or_insert(e);
+        if let Err(e) = o.close(tick, report, &mut warnings) {
+            failed.get_or_insert(RunError::from(e));
         }
     }
+    report.warnings.extend(warnings);
     if let Some(e) = failed {
-        report.error.get_or_insert(e);
+        report.error.get_or_insert(e.into());
         conclude(report, sc);
     }
 }
@@ -304,14 +394,14 @@ fn run_actuation(
     sc: &Scenario,
     report: &mut ScenarioReport,
     probe_errors: &mut Vec<f64>,
-) -> Result<(), Stop> {
+) -> Result<(), RunError> {
     match &sc.actuation {
         Actuation::Points { points, continuation } => {
             for (i, inputs) in points.iter().enumerate() {
                 let params = sc.params_at(inputs);
                 if i > 0 && params != runner.params {
                     // Other parameters (a sweep over them): another structure, built afresh.
-                    let s = runner.mech.build(&params, inputs, &sc.start).map_err(Stop::Model)?;
+                    let s = runner.mech.build(&params, inputs, &sc.start).map_err(RunError::Model)?;
                     let tick = runner.sim.tick();
                     runner.sim = Simulation::new(&s, &sc.sim)?;
                     runner.sim.set_tick(tick);
@@ -322,7 +412,7 @@ fn run_actuation(
                     if *continuation {
                         runner.command(inputs);
                     } else {
-                        let s = runner.mech.build(&runner.params, inputs, &sc.start).map_err(Stop::Model)?;
+                        let s = runner.mech.build(&runner.params, inputs, &sc.start).map_err(RunError::Model)?;
                         // The same structure placed anew: restarted in place where it can be
                         // (no rebuild of the rapier sets), else built afresh.
                         if !runner.sim.restart_from(&s) {
@@ -346,7 +436,7 @@ fn run_actuation(
                 }
                 let inputs = interpolate(waypoints, t);
                 runner.command(&inputs);
-                let prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
+                let prediction = runner.mech.predict(&runner.params, &inputs).map_err(RunError::Model)?;
                 let (_, simulated) = runner.step(&inputs, &prediction)?;
                 for (q, v) in simulated {
                     report

@@ -5,9 +5,9 @@
 
 use super::runner::Runner;
 use super::settle::SettleDetector;
-use super::{point, Stop};
-use crate::mechanisms::{ModelError, Values};
-use crate::observers::{ModeAtStart, SettlePoint};
+use super::{point, RunError};
+use crate::mechanisms::Values;
+use crate::observers::ModeAtStart;
 use crate::report::{MotionReport, PointReport, ScenarioReport};
 use crate::scenario::Scenario;
 use crate::settings::{Drive, FrequencySignal, Motion, MotionStart};
@@ -45,7 +45,7 @@ pub(super) fn run_motion(
     m: &Motion,
     report: &mut ScenarioReport,
     probe_errors: &mut Vec<f64>,
-) -> Result<(), Stop> {
+) -> Result<(), RunError> {
     let inputs = sc.actuation.first_inputs().clone();
     match m.start {
         MotionStart::Settled => point::settle_point(runner, sc, 0, &inputs, report, probe_errors)?,
@@ -79,7 +79,7 @@ pub(super) fn run_motion(
     if m.drive.is_some() {
         runner.sim.drive_physically()?;
     }
-    let mut prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
+    let mut prediction = runner.mech.predict(&runner.params, &inputs).map_err(RunError::Model)?;
     let mut result = Ok(());
     let mut inputs = inputs;
     for k in 1..=m.steps {
@@ -87,7 +87,7 @@ pub(super) fn run_motion(
             // The commands at the end of this step, t = k dt after the motion's start.
             inputs = d.inputs_at(&runner.params, k as f64 * sc.sim.dt_s);
             runner.drive(&inputs);
-            prediction = runner.mech.predict(&runner.params, &inputs).map_err(Stop::Model)?;
+            prediction = runner.mech.predict(&runner.params, &inputs).map_err(RunError::Model)?;
         }
         result = runner.step(&inputs, &prediction).map(|_| ());
         if result.is_err() {
@@ -118,7 +118,7 @@ fn driven_text(d: &Drive) -> String {
 
 /// The structure's own modes at the start that the motion needs (its displacement along one,
 /// the frequencies fitted to them), analysed before the displacement, which follows.
-fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, Stop> {
+fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, RunError> {
     let fitted = m.frequencies.iter().filter_map(|f| match f.signal {
         FrequencySignal::Mode(i) => Some(i),
         FrequencySignal::Joint(_) => None,
@@ -129,7 +129,7 @@ fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, Stop
     if wanted.is_empty() {
         return Ok(vec![]);
     }
-    let analysis = runner.sim.modes().map_err(|e| Stop::Model(ModelError::no_solution(e.to_string())))?;
+    let analysis = runner.sim.modes()?;
     let modes: Vec<ModeAtStart> = wanted
         .iter()
         .map(|&index| ModeAtStart {
@@ -152,40 +152,25 @@ fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, Stop
 /// The drawn state as the motion's start point (no step taken): at rest, so an equilibrium
 /// exactly when its residual meets the settle tolerances (then `settled`); the settle-point
 /// judgments of the file (checks, equations, energy) are made there.
-fn start_point(runner: &mut Runner, sc: &Scenario, inputs: &Values, report: &mut ScenarioReport) -> Result<(), Stop> {
-    let prediction = runner.mech.predict(&runner.params, inputs).map_err(Stop::Model)?;
+fn start_point(
+    runner: &mut Runner,
+    sc: &Scenario,
+    inputs: &Values,
+    report: &mut ScenarioReport,
+) -> Result<(), RunError> {
+    let prediction = runner.mech.predict(&runner.params, inputs).map_err(RunError::Model)?;
     let snapshot = runner.sim.snapshot();
     let simulated = runner.observe(&snapshot);
     let settled = SettleDetector::residual_ok(&snapshot, &sc.settle);
-    let residual = snapshot.forces.residual;
-    let slack_cables = point::slack_cables(runner, &snapshot);
-    let prestress_fraction = point::prestress_fraction(runner, &snapshot);
-    let cables = runner.sim.structure().cables.len();
-    let prestress_lost = sc.prestress.as_ref().map(|p| p.lost(cables, slack_cables.len(), prestress_fraction));
+    let measured = point::measured_point(runner, sc, (0, inputs), &snapshot, runner.sim.kinetic_energy_j());
     let mut point = PointReport {
-        index: 0,
-        inputs: inputs.clone(),
         analytic: prediction.expected.clone(),
         simulated,
         settled,
-        residual_force_n: residual.map_or(f64::NAN, |r| r.max_force_n),
-        residual_torque_nm: residual.map_or(f64::NAN, |r| r.max_torque_nm),
-        final_kinetic_energy_j: runner.sim.kinetic_energy_j(),
         branch: "the drawn state".into(),
-        slack_cables,
-        prestress_fraction,
-        prestress_lost,
-        ..PointReport::default()
+        ..measured
     };
-    let seen = SettlePoint {
-        structure: &runner.sim.structure(),
-        snapshot: &snapshot,
-        params: &runner.params,
-        outside_model: false,
-    };
-    for o in runner.observers.iter_mut() {
-        o.settle_point(&seen, &mut point, &mut runner.notes);
-    }
+    point::observe_point(runner, &snapshot, false, &mut point);
     runner.emit(format_args!(
         "start: the drawn state, {} (residual {:.3e} N, {:.3e} N m)",
         if settled { "an equilibrium" } else { "not an equilibrium" },

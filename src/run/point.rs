@@ -3,7 +3,7 @@
 //! observers.
 
 use super::runner::Runner;
-use super::Stop;
+use super::RunError;
 use crate::file_model::energy_model::Kind;
 use crate::mechanisms::{self, Mechanism, ModelError, Prediction, Values};
 use crate::observers::compare;
@@ -21,7 +21,7 @@ impl Runner<'_> {
         prediction: &Prediction,
         before: &Snapshot,
         delta: f64,
-    ) -> Result<bool, Stop> {
+    ) -> Result<bool, RunError> {
         self.sim.perturb_free_coordinates(delta);
         self.emit(format_args!("perturbed every free coordinate by {delta}"));
         let after = self.settle(inputs, prediction)?;
@@ -45,13 +45,18 @@ impl Runner<'_> {
     /// the quantity it is reported as. The mechanism's probe: a torque on its probe body; a
     /// joint probe: equal and opposite torques (forces) on the joint's child and parent about
     /// (along) its axis, q the joint's coordinate.
-    fn probe(&mut self, inputs: &Values, prediction: &Prediction, p: &Probe) -> Result<Option<(String, f64)>, Stop> {
+    fn probe(
+        &mut self,
+        inputs: &Values,
+        prediction: &Prediction,
+        p: &Probe,
+    ) -> Result<Option<(String, f64)>, RunError> {
         let (quantity, loads, read): (String, Vec<(usize, [f64; 3], bool)>, Reading) = match &p.joint {
             Some(j) => {
                 let s = self.sim.structure();
                 let joint = &s.joints[j.index];
                 let axis = self.sim.snapshot_with(false).joint_axis_world(&s, j.index).ok_or_else(|| {
-                    Stop::Model(ModelError::no_solution(format!("probe joint '{}' has no axis", j.joint)))
+                    RunError::Model(ModelError::no_solution(format!("probe joint '{}' has no axis", j.joint)))
                 })?;
                 let mut loads = vec![(joint.child, axis, j.prismatic)];
                 if s.bodies[joint.parent].kind == crate::structure::BodyKind::Free {
@@ -64,7 +69,7 @@ impl Runner<'_> {
                     return Ok(None);
                 };
                 let body = self.sim.structure().body_id(&spec.body).ok_or_else(|| {
-                    Stop::Model(ModelError::no_solution(format!("probe body '{}' not found", spec.body)))
+                    RunError::Model(ModelError::no_solution(format!("probe body '{}' not found", spec.body)))
                 })?;
                 (spec.analytic, vec![(body, spec.torque_axis, false)], Reading::Quantity(spec.coordinate))
             }
@@ -155,11 +160,12 @@ pub(super) fn settle_point(
     inputs: &Values,
     report: &mut ScenarioReport,
     probe_errors: &mut Vec<f64>,
-) -> Result<(), Stop> {
-    let prediction = runner.mech.predict(&runner.params, inputs).map_err(Stop::Model)?;
+) -> Result<(), RunError> {
+    let prediction = runner.mech.predict(&runner.params, inputs).map_err(RunError::Model)?;
     let s = runner.settle(inputs, &prediction)?;
     let final_energy = runner.sim.kinetic_energy_j();
     say_settled(runner, sc, index, &s, final_energy);
+    let measured = measured_point(runner, sc, (index, inputs), &s.snapshot, final_energy);
     let mut simulated = s.simulated.clone();
     let (branch, analytic_stable, mut landed) = landed_branch(runner, sc, index, &prediction, &simulated, report);
     let stable = match sc.stability_perturbation {
@@ -173,38 +179,21 @@ pub(super) fn settle_point(
     if let (Some(p), true) = (&sc.probe, s.settled) {
         probe_point(runner, inputs, &prediction, p, (&mut landed, &mut simulated, &mut errors), probe_errors)?;
     }
-    let slack_cables = slack_cables(runner, &s.snapshot);
-    let slack_agrees = slack_agreement(runner, index, &prediction, &slack_cables);
+    let slack_agrees = slack_agreement(runner, index, &prediction, &measured.slack_cables);
     let outside = prediction.expected_slack.as_ref().is_some_and(|e| !e.is_empty());
-    let prestress_fraction = prestress_fraction(runner, &s.snapshot);
-    let cables = runner.sim.structure().cables.len();
-    let prestress_lost = sc.prestress.as_ref().map(|p| p.lost(cables, slack_cables.len(), prestress_fraction));
     let mut point = PointReport {
-        index,
-        inputs: inputs.clone(),
         settled: s.settled,
         steps: s.steps,
-        residual_force_n: s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_force_n),
-        residual_torque_nm: s.snapshot.forces.residual.map_or(f64::NAN, |r| r.max_torque_nm),
         final_speed_m_per_s: s.final_speed,
-        final_kinetic_energy_j: final_energy,
         branch,
         stable,
         analytic_stable,
         expected_stable: sc.expected_stable(index),
-        slack_cables,
         expected_slack: prediction.expected_slack.clone(),
         slack_agrees,
-        prestress_fraction,
-        prestress_lost,
         // Outside the analytic model's validity the analytic point is no equilibrium: report
         // the distance from it instead of checking against it.
         distance_from_analytic_m: outside.then(|| distance_m(runner.mech.as_ref(), &landed, &simulated)),
-        // Filled in by the observers:
-        within_tolerance: false,
-        min_clearance_m: None,
-        interference_free: None,
-        energy: None,
         errors,
         paper: runner
             .mech
@@ -212,22 +201,53 @@ pub(super) fn settle_point(
             .map(|(source, values)| crate::report::PaperValues { source, values }),
         analytic: landed,
         simulated,
+        // The observers fill in the tolerances, the clearance, the interference and the energy.
+        ..measured
     };
-    let seen = SettlePoint {
-        structure: &runner.sim.structure(),
-        snapshot: &s.snapshot,
-        params: &runner.params,
-        outside_model: outside,
-    };
-    for o in runner.observers.iter_mut() {
-        o.settle_point(&seen, &mut point, &mut runner.notes);
-    }
+    observe_point(runner, &s.snapshot, outside, &mut point);
     if sc.expected_stability == crate::scenario::ExpectedStability::FromEnergy {
         point.expected_stable = energy_stability(&point);
     }
     runner.hand_out_notes();
     report.points.push(point);
     Ok(())
+}
+
+/// The report of the point `(index, inputs)` with what every point reads off its state the
+/// same way: the residual, the kinetic energy [J], the slack cables and the self-stress kept.
+/// The rest is the caller's.
+pub(super) fn measured_point(
+    runner: &Runner,
+    sc: &Scenario,
+    (index, inputs): (usize, &Values),
+    snapshot: &Snapshot,
+    kinetic_energy_j: f64,
+) -> PointReport {
+    let slack_cables = slack_cables(runner, snapshot);
+    let prestress_fraction = prestress_fraction(runner, snapshot);
+    let cables = runner.sim.structure().cables.len();
+    let prestress_lost = sc.prestress.as_ref().map(|p| p.lost(cables, slack_cables.len(), prestress_fraction));
+    let residual = snapshot.forces.residual;
+    PointReport {
+        index,
+        inputs: inputs.clone(),
+        residual_force_n: residual.map_or(f64::NAN, |r| r.max_force_n),
+        residual_torque_nm: residual.map_or(f64::NAN, |r| r.max_torque_nm),
+        final_kinetic_energy_j: kinetic_energy_j,
+        slack_cables,
+        prestress_fraction,
+        prestress_lost,
+        ..PointReport::default()
+    }
+}
+
+/// Every observer fills in what it measures at a settle point (`outside_model`: outside the
+/// analytic model's validity).
+pub(super) fn observe_point(runner: &mut Runner, snapshot: &Snapshot, outside_model: bool, point: &mut PointReport) {
+    let seen = SettlePoint { structure: &runner.sim.structure(), snapshot, params: &runner.params, outside_model };
+    for o in runner.observers.iter_mut() {
+        o.settle_point(&seen, point, &mut runner.notes);
+    }
 }
 
 /// The analytic branch the settled state landed on: its label, its stability and its values
@@ -251,7 +271,7 @@ fn landed_branch(
     let wanted_unstable = runner.mech.starts_on_unstable_branch(&sc.start);
     if analytic_stable == Some(false) && !wanted_unstable {
         runner.emit(format_args!("point {index}: landed on the analytically unstable branch '{branch}'"));
-        report.error.get_or_insert(format!("point {index} settled on the analytically unstable branch '{branch}'"));
+        report.error.get_or_insert(RunError::UnstableBranch { index, branch: branch.clone() }.into());
     }
     (branch, analytic_stable, landed)
 }
@@ -281,7 +301,7 @@ fn probe_point(
     p: &Probe,
     (landed, simulated, errors): (&mut Values, &mut Values, &mut Values),
     probe_errors: &mut Vec<f64>,
-) -> Result<(), Stop> {
+) -> Result<(), RunError> {
     if let Some((quantity, k)) = runner.probe(inputs, prediction, p)? {
         if let Some(k) = p.joint.as_ref().and_then(|j| j.predicted(&runner.params, inputs)) {
             landed.insert(quantity.clone(), k);

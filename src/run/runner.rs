@@ -1,7 +1,7 @@
 //! The state of one running scenario: its mechanism, its simulation and its observers, and the
 //! one step that every phase (settle, perturbation, probe, trajectory) goes through.
 
-use super::Stop;
+use super::RunError;
 use crate::mechanisms::{Mechanism, Prediction, Values};
 use crate::observers::{Note, Observer, Tick};
 use crate::scenario::Scenario;
@@ -120,9 +120,9 @@ impl<'a> Runner<'a> {
     }
 
     /// One step followed by every observer.
-    pub fn step(&mut self, inputs: &Values, prediction: &Prediction) -> Result<(Snapshot, Values), Stop> {
+    pub fn step(&mut self, inputs: &Values, prediction: &Prediction) -> Result<(Snapshot, Values), RunError> {
         if self.cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
-            return Err(Stop::Interrupted(self.sim.tick()));
+            return Err(RunError::Interrupted(self.sim.tick()));
         }
         self.sim.step()?;
         self.steps += 1;

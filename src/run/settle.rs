@@ -5,7 +5,7 @@
 //! running out of `settle.max_time` is a failure, never a pass.
 
 use super::runner::Runner;
-use super::Stop;
+use super::RunError;
 use crate::mechanisms::{Prediction, Values};
 use crate::settings::SettleCriteria;
 use crate::snapshot::Snapshot;
@@ -26,7 +26,7 @@ const APPROACH_SWITCH_SPEED_FACTOR: f64 = 1e6;
 impl Runner<'_> {
     /// Steps until the speed stays below the threshold for the window and the residual passes,
     /// or until the settle time runs out (a failure, never a pass).
-    pub(super) fn settle(&mut self, inputs: &Values, prediction: &Prediction) -> Result<Settled, Stop> {
+    pub(super) fn settle(&mut self, inputs: &Values, prediction: &Prediction) -> Result<Settled, RunError> {
         let criteria = self.sc.settle.clone();
         let dt = self.sc.sim.dt_s;
         let max_steps = (criteria.max_time_s / dt).ceil() as u64;

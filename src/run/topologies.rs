@@ -3,7 +3,7 @@
 //! structure, and the reports join into one. Checks and predictions of the same name join by
 //! their worst error; each point keeps its own values.
 
-use super::{conclude, run, RunOptions};
+use super::{conclude, run, RunError, RunOptions};
 use crate::observers::table::TableTarget;
 use crate::report::{CheckReport, ModelCheckReport, PrestressReport, ScenarioReport};
 use crate::scenario::Scenario;
@@ -31,7 +31,7 @@ pub(super) fn run_topologies(sc: &Scenario, opts: &RunOptions) -> ScenarioReport
         let mut r = run(variant, &options);
         let note = rebuilt(sc, variant);
         rebuilt_at.push(format!("{note} ({} point(s))", variant.actuation.all_inputs().len()));
-        r.error = r.error.map(|e| format!("{note}: {e}"));
+        r.error = r.error.map(|source| RunError::Topology { note: note.clone(), source }.into());
         let stop = r.error.is_some();
         joined = Some(match joined {
             None => r,
@@ -119,6 +119,7 @@ fn join(j: &mut ScenarioReport, r: ScenarioReport) {
     j.settle.sim_time_s += r.settle.sim_time_s;
     j.settle.wall_s += r.settle.wall_s;
     j.error = j.error.take().or(r.error);
+    j.warnings.extend(r.warnings);
 }
 
 fn join_check(x: &mut CheckReport, c: &CheckReport) {

@@ -41,40 +41,50 @@ fn trajectory_coordinates<'a>(parts: &Parts<'a>) -> Vec<&'a str> {
     compared.into_iter().flat_map(|e| e.coordinates.iter().map(|c| c.name.as_str())).collect()
 }
 
-/// Whether the scenario has the part `failure` names; else the message saying what it has.
-fn has_part(parts: &Parts, failure: &crate::report::verdict::Failure) -> Result<(), String> {
+/// A part `[expect] failing` names that the scenario does not have.
+#[derive(Debug, thiserror::Error)]
+enum MissingPart {
+    /// A named part (a check, a prediction, ...) that is not among those `among` lists.
+    #[error("'{name}' is not among {among} ({listed})")]
+    NotAmong { name: String, among: &'static str, listed: String },
+    /// A part that needs a section the scenario does not have.
+    #[error("'{name}' needs {needs}")]
+    Needs { name: &'static str, needs: &'static str },
+}
+
+/// Whether the scenario has the part `failure` names; else what it has.
+fn has_part(parts: &Parts, failure: &crate::report::verdict::Failure) -> Result<(), MissingPart> {
     use crate::report::verdict::Failure;
     let model = parts.model;
+    let not_among =
+        |name: &String, among, names| Err(MissingPart::NotAmong { name: name.clone(), among, listed: listed(names) });
+    let needs = |name, needs| Err(MissingPart::Needs { name, needs });
     match failure {
-        Failure::Check(q) if !parts.checks.iter().any(|c| &c.quantity == q) => Err(format!(
-            "'{q}' is not among this scenario's checks ({})",
-            listed(parts.checks.iter().map(|c| c.quantity.as_str()).collect())
-        )),
-        Failure::Prediction(p) if !model.is_some_and(|m| m.predictions.iter().any(|x| &x.name == p)) => Err(format!(
-            "'{p}' is not among this scenario's [[predictions]] ({})",
-            listed(model.map_or(vec![], |m| m.predictions.iter().map(|x| x.name.as_str()).collect()))
-        )),
-        Failure::Equation(q) if !model.is_some_and(|m| m.equations.iter().any(|x| &x.name == q)) => Err(format!(
-            "'{q}' is not among this scenario's [[equations]] ({})",
-            listed(model.map_or(vec![], |m| m.equations.iter().map(|x| x.name.as_str()).collect()))
-        )),
-        Failure::Frequency(q) if !frequency_names(parts).contains(&q.as_str()) => Err(format!(
-            "'{q}' is not among this scenario's [[energy.frequencies]] and [[motion.frequencies]] ({})",
-            listed(frequency_names(parts))
-        )),
-        Failure::Trajectory(q) if !trajectory_coordinates(parts).contains(&q.as_str()) => Err(format!(
-            "'{q}' is not among the coordinates compared by [energy.trajectory] ({})",
-            listed(trajectory_coordinates(parts))
-        )),
+        Failure::Check(q) if !parts.checks.iter().any(|c| &c.quantity == q) => {
+            not_among(q, "this scenario's checks", parts.checks.iter().map(|c| c.quantity.as_str()).collect())
+        }
+        Failure::Prediction(p) if !model.is_some_and(|m| m.predictions.iter().any(|x| &x.name == p)) => not_among(
+            p,
+            "this scenario's [[predictions]]",
+            model.map_or(vec![], |m| m.predictions.iter().map(|x| x.name.as_str()).collect()),
+        ),
+        Failure::Equation(q) if !model.is_some_and(|m| m.equations.iter().any(|x| &x.name == q)) => not_among(
+            q,
+            "this scenario's [[equations]]",
+            model.map_or(vec![], |m| m.equations.iter().map(|x| x.name.as_str()).collect()),
+        ),
+        Failure::Frequency(q) if !frequency_names(parts).contains(&q.as_str()) => {
+            not_among(q, "this scenario's [[energy.frequencies]] and [[motion.frequencies]]", frequency_names(parts))
+        }
+        Failure::Trajectory(q) if !trajectory_coordinates(parts).contains(&q.as_str()) => {
+            not_among(q, "the coordinates compared by [energy.trajectory]", trajectory_coordinates(parts))
+        }
         Failure::Energy if !model.is_some_and(|m| m.energy.is_some()) => {
-            Err("'energy' needs an [energy] section in this scenario".into())
+            needs("energy", "an [energy] section in this scenario")
         }
-        Failure::Probe if !parts.probe => {
-            Err("'probe' needs a [probe] section that compares (expected and tolerance)".into())
-        }
+        Failure::Probe if !parts.probe => needs("probe", "a [probe] section that compares (expected and tolerance)"),
         Failure::Prestress if !parts.prestress => {
-            Err("'prestress' needs cables whose tension is judged ([prestress], or a custom structure with cables)"
-                .into())
+            needs("prestress", "cables whose tension is judged ([prestress], or a custom structure with cables)")
         }
         _ => Ok(()),
     }
@@ -88,12 +98,12 @@ pub(super) fn expectation(
     raw: &Spanned<RawExpect>,
     parts: &Parts,
 ) -> Result<crate::report::verdict::Expectation, ScenarioError> {
-    use crate::report::verdict::{Expectation, Failure};
+    use crate::report::verdict::{Expectation, Failure, UnknownFailure};
     let e = raw.get_ref();
     let mut failing = Vec::new();
     for f in &e.failing {
-        let failure: Failure = f.get_ref().parse().map_err(|m: String| ctx.err(f, m))?;
-        has_part(parts, &failure).map_err(|m| ctx.err(f, m))?;
+        let failure: Failure = f.get_ref().parse().map_err(|e: UnknownFailure| ctx.err(f, e.to_string()))?;
+        has_part(parts, &failure).map_err(|e| ctx.err(f, e.to_string()))?;
         failing.push(failure);
     }
     match e.verdict.get_ref().as_str() {

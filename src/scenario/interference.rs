@@ -60,12 +60,12 @@ pub(super) fn interference(
     if let Err(e) = settings.check_member_names(structure) {
         let named = |p: &Spanned<(String, String)>| {
             let (a, b) = p.get_ref();
-            e.contains(&format!("'{a}'")) || e.contains(&format!("'{b}'"))
+            *a == e.name || *b == e.name
         };
         let at = i.get_ref().exclude.iter().find(|p| named(p));
         return Err(match at {
-            Some(p) => ctx.err(p, e),
-            None => ctx.err(i, e),
+            Some(p) => ctx.err(p, e.to_string()),
+            None => ctx.err(i, e.to_string()),
         });
     }
     Ok(settings)

@@ -117,25 +117,22 @@ pub(super) fn with_variants(
     Ok(custom.with_variants(variants))
 }
 
-/// The scenario's mechanism: the custom one, or the built-in one `raw.mechanism` names.
-pub(super) fn mechanism(
-    ctx: &Ctx,
-    raw: &RawScenario,
-    custom: Option<&Custom>,
-) -> Result<Box<dyn Mechanism>, ScenarioError> {
+/// The built-in mechanism `raw.mechanism` names (a scenario without its own structure).
+pub(super) fn builtin(ctx: &Ctx, raw: &RawScenario) -> Result<Box<dyn Mechanism>, ScenarioError> {
+    mechanisms::find(raw.mechanism.get_ref()).ok_or_else(|| {
+        let known: Vec<_> = mechanisms::registry().iter().map(|m| m.name()).collect();
+        ctx.err(
+            &raw.mechanism,
+            format!("unknown mechanism '{}' (expected one of: {}, custom)", raw.mechanism.get_ref(), known.join(", ")),
+        )
+    })
+}
+
+/// The scenario's mechanism: its custom one, else its built-in one (one of the two is there).
+pub(super) fn of<'a>(custom: Option<&'a Custom>, builtin: Option<&'a dyn Mechanism>) -> &'a dyn Mechanism {
     match custom {
-        Some(c) => Ok(Box::new(c.clone())),
-        None => mechanisms::find(raw.mechanism.get_ref()).ok_or_else(|| {
-            let known: Vec<_> = mechanisms::registry().iter().map(|m| m.name()).collect();
-            ctx.err(
-                &raw.mechanism,
-                format!(
-                    "unknown mechanism '{}' (expected one of: {}, custom)",
-                    raw.mechanism.get_ref(),
-                    known.join(", ")
-                ),
-            )
-        }),
+        Some(c) => c,
+        None => builtin.expect("a scenario has a custom or a built-in mechanism"),
     }
 }
 

@@ -41,7 +41,7 @@ use std::path::{Path, PathBuf};
 
 pub use bounds::{MAX_STEPS_PER_RUN, MAX_STEPS_PER_SETTLE};
 pub use error::ScenarioError;
-pub use overrides::Override;
+pub use overrides::{Override, OverrideError};
 
 /// A validated scenario, ready to run.
 #[derive(Clone, Debug)]
@@ -372,7 +372,30 @@ impl Structures<'_> {
     }
 }
 
-/// The values of a scenario whose shape serde has read, section by section.
+/// The sections of a scenario read before its structures are built.
+struct Sections {
+    params: Values,
+    param_table: crate::file_model::params::ParamTable,
+    sim: SimSettings,
+    settle: SettleCriteria,
+    start: Values,
+    actuation: Actuation,
+    skipped_points: Vec<(Values, String)>,
+}
+
+/// What a scenario judges, read before its structures are built.
+struct Judged {
+    checks: Vec<Check>,
+    model: Option<crate::file_model::spec::ModelSpec>,
+    stability_perturbation: Option<f64>,
+    expected_stability: ExpectedStability,
+    record: Option<PathBuf>,
+    min_agreement_percent: Option<f64>,
+}
+
+/// The values of a scenario whose shape serde has read, section by section. The built-in
+/// mechanism is found once; a custom one is the file's own structure, used as it is and then
+/// with its variants at every set of parameters the points ask for.
 fn validate(
     ctx: &Ctx,
     path: &Path,
@@ -385,98 +408,119 @@ fn validate(
     let topology_params = expand_patterns(ctx, &mut raw, topology)?;
     names::names(ctx, &raw)?;
     let custom = mechanism::custom(ctx, &raw)?;
-    let mech = mechanism::mechanism(ctx, &raw, custom.as_ref())?;
-    let m = mech.as_ref();
-    let params = params::params(ctx, m, &raw.params)?;
-    let param_table = number::param_table(ctx, &raw.params)?;
-    let mut sim = sim::sim(ctx, &raw.sim)?;
-    let settle = sim::settle(ctx, &raw.settle)?;
-    let start = params::start(ctx, m, &raw.start)?;
-    let (mut actuation, skipped_points) = actuation::actuation(ctx, m, &param_table, &params, &raw.actuation)?;
+    let builtin = if custom.is_some() { None } else { Some(mechanism::builtin(ctx, &raw)?) };
+    let mut s = sections(ctx, &raw, mechanism::of(custom.as_ref(), builtin.as_deref()))?;
     match topology {
         Some(t) => {
-            let continuation = matches!(actuation, Actuation::Points { continuation: true, .. });
-            actuation = Actuation::Points { points: t.points.clone(), continuation };
+            let continuation = matches!(s.actuation, Actuation::Points { continuation: true, .. });
+            s.actuation = Actuation::Points { points: t.points.clone(), continuation };
         }
         None => {
-            let split = topologies(&param_table, &params, &actuation, &topology_params);
+            let split = topologies(&s.param_table, &s.params, &s.actuation, &topology_params);
             if split.len() > 1 {
                 return Ok(Validated::Split(split));
             }
         }
     }
-    bounds::bounds(ctx, &raw, &sim, &settle, &actuation)?;
-    let checks = checks::checks(ctx, m, &raw.checks, raw.probe.is_some())?;
-    let model = file_model::model(ctx, &raw, m, &params, &start, &actuation)?;
-    // A custom structure is checked by its settling and force balance even without [[checks]].
-    if checks.is_empty() && raw.probe.is_none() && custom.is_none() && model.is_none() && raw.motion.is_none() {
-        return Err(ctx
-            .err_at(0, "the scenario checks nothing: add at least one [[checks]] entry (quantity, tolerance)".into()));
-    }
-    let stability_perturbation = checks::stability(ctx, &raw.stability)?;
-    let has_energy = model.as_ref().is_some_and(|m| m.energy.is_some());
-    let expected_stability = checks::expected_stability(ctx, &raw.stability, &actuation, has_energy)?;
-    let record = record::record(ctx, &raw.record)?;
-    let min_agreement_percent = checks::workspace(ctx, &raw.workspace)?;
+    let judged = judged(ctx, &raw, mechanism::of(custom.as_ref(), builtin.as_deref()), &s, custom.is_some())?;
     // Every set of parameters the points ask for (a sweep over parameters): the custom
     // structure resolved with each, and each structure checked as the first point's is.
-    let parameter_sets = mechanism::parameter_sets(ctx, &raw, &param_table, &params, &actuation)?;
-    let custom = match custom {
-        Some(c) => Some(mechanism::with_variants(ctx, &raw, c, &params, &parameter_sets)?),
-        None => None,
-    };
-    let mut swept: Vec<String> = Vec::new();
-    for k in actuation.all_inputs().into_iter().flat_map(|p| p.keys()) {
-        if params.contains_key(k) && !swept.contains(k) {
-            swept.push(k.clone());
-        }
-    }
-    let unseen_params = custom.as_ref().map(|c| c.unseen(&swept)).unwrap_or_default();
-    let mech = mechanism::mechanism(ctx, &raw, custom.as_ref())?;
-    let m = mech.as_ref();
-    let first_params = params::params_at(&param_table, &params, actuation.first_inputs());
-    let structures = Structures { sets: &parameter_sets, first: &first_params, start: &start, actuation: &actuation };
-    let first = structures.check(ctx, &raw, m, &mut sim, custom.is_some())?;
+    let parameter_sets = mechanism::parameter_sets(ctx, &raw, &s.param_table, &s.params, &s.actuation)?;
+    let custom = custom.map(|c| mechanism::with_variants(ctx, &raw, c, &s.params, &parameter_sets)).transpose()?;
+    let m = mechanism::of(custom.as_ref(), builtin.as_deref());
+    let first_params = params::params_at(&s.param_table, &s.params, s.actuation.first_inputs());
+    let structures =
+        Structures { sets: &parameter_sets, first: &first_params, start: &s.start, actuation: &s.actuation };
+    let first = structures.check(ctx, &raw, m, &mut s.sim, custom.is_some())?;
     let interference = interference::interference(ctx, &raw.interference, m, &first_params, &first)?;
-    let probe = checks::probe(ctx, m, &raw.probe, &first, &params)?;
+    let probe = checks::probe(ctx, m, &raw.probe, &first, &s.params)?;
     let prestress = prestress::prestress(ctx, &raw.prestress, &first, custom.is_some())?;
-    closed_forms(ctx, &raw, probe.as_ref(), model.as_ref(), &param_table, &params, &actuation)?;
-    let motion = motion::motion(ctx, &raw, sim.dt_s, (m, &first), &first_params, &actuation)?;
-    let parts = expect::Parts {
-        checks: &checks,
-        model: model.as_ref(),
-        probe: probe.as_ref().is_some_and(|p| p.tolerance.is_some()),
-        motion: motion.as_ref(),
-        prestress: prestress.is_some(),
-    };
+    let (checks, model) = (&judged.checks, judged.model.as_ref());
+    closed_forms(ctx, &raw, probe.as_ref(), model, &s.param_table, &s.params, &s.actuation)?;
+    let motion = motion::motion(ctx, &raw, s.sim.dt_s, (m, &first), &first_params, &s.actuation)?;
+    let has_probe = probe.as_ref().is_some_and(|p| p.tolerance.is_some());
+    let parts =
+        expect::Parts { checks, model, probe: has_probe, motion: motion.as_ref(), prestress: prestress.is_some() };
     let expect = raw.expect.as_ref().map(|e| expect::expectation(ctx, e, &parts)).transpose()?;
+    let unseen_params = custom.as_ref().map(|c| c.unseen(&swept(&s))).unwrap_or_default();
     Ok(Validated::One(Box::new(Scenario {
         file: path.to_path_buf(),
         source: ctx.source.to_string(),
         name: raw.name.into_inner(),
         description: raw.description,
         mechanism: m.name().into(),
-        params,
-        param_table,
-        sim,
-        settle,
-        start,
-        actuation,
-        checks,
-        stability_perturbation,
-        expected_stability,
+        params: s.params,
+        param_table: s.param_table,
+        sim: s.sim,
+        settle: s.settle,
+        start: s.start,
+        actuation: s.actuation,
+        checks: judged.checks,
+        stability_perturbation: judged.stability_perturbation,
+        expected_stability: judged.expected_stability,
         probe,
-        record,
+        record: judged.record,
         interference,
-        min_agreement_percent,
-        skipped_points,
+        min_agreement_percent: judged.min_agreement_percent,
+        skipped_points: s.skipped_points,
         custom,
         expect,
-        model,
+        model: judged.model,
         motion,
         topologies: Vec::new(),
         topology_params,
         unseen_params,
         prestress,
     })))
+}
+
+/// The parameters, settings, start and actuation of a scenario of the mechanism `m`.
+fn sections(ctx: &Ctx, raw: &RawScenario, m: &dyn Mechanism) -> Result<Sections, ScenarioError> {
+    let params = params::params(ctx, m, &raw.params)?;
+    let param_table = number::param_table(ctx, &raw.params)?;
+    let sim = sim::sim(ctx, &raw.sim)?;
+    let settle = sim::settle(ctx, &raw.settle)?;
+    let start = params::start(ctx, m, &raw.start)?;
+    let (actuation, skipped_points) = actuation::actuation(ctx, m, &param_table, &params, &raw.actuation)?;
+    Ok(Sections { params, param_table, sim, settle, start, actuation, skipped_points })
+}
+
+/// The checks, the file's model, the stability test, the recording and the workspace
+/// agreement of a scenario of the mechanism `m` (`custom`: its own structure); an error when
+/// it judges nothing.
+fn judged(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    m: &dyn Mechanism,
+    s: &Sections,
+    custom: bool,
+) -> Result<Judged, ScenarioError> {
+    bounds::bounds(ctx, raw, &s.sim, &s.settle, &s.actuation)?;
+    let checks = checks::checks(ctx, m, &raw.checks, raw.probe.is_some())?;
+    let model = file_model::model(ctx, raw, m, &s.params, &s.start, &s.actuation)?;
+    // A custom structure is checked by its settling and force balance even without [[checks]].
+    if checks.is_empty() && raw.probe.is_none() && !custom && model.is_none() && raw.motion.is_none() {
+        return Err(ctx
+            .err_at(0, "the scenario checks nothing: add at least one [[checks]] entry (quantity, tolerance)".into()));
+    }
+    let has_energy = model.as_ref().is_some_and(|m| m.energy.is_some());
+    Ok(Judged {
+        stability_perturbation: checks::stability(ctx, &raw.stability)?,
+        expected_stability: checks::expected_stability(ctx, &raw.stability, &s.actuation, has_energy)?,
+        record: record::record(ctx, &raw.record)?,
+        min_agreement_percent: checks::workspace(ctx, &raw.workspace)?,
+        checks,
+        model,
+    })
+}
+
+/// The parameters the points set (a sweep over them), in the order they first appear.
+fn swept(s: &Sections) -> Vec<String> {
+    let mut swept: Vec<String> = Vec::new();
+    for k in s.actuation.all_inputs().into_iter().flat_map(|p| p.keys()) {
+        if s.params.contains_key(k) && !swept.contains(k) {
+            swept.push(k.clone());
+        }
+    }
+    swept
 }

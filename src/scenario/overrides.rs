@@ -11,6 +11,17 @@ use super::number::ParamMap;
 use super::raw::{RawScenario, RawSettle, RawSim};
 use serde::de::DeserializeOwned;
 
+/// A `--set` flag that is not `NAME=VALUE`.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum OverrideError {
+    /// No `=`.
+    #[error("--set {0}: expected NAME=VALUE")]
+    NoEquals(String),
+    /// No name or no value around the `=`.
+    #[error("--set {0}: expected NAME=VALUE with a name and a value")]
+    Empty(String),
+}
+
 /// One `--set NAME=VALUE`, as given.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Override {
@@ -20,11 +31,11 @@ pub struct Override {
 
 impl Override {
     /// Parses `NAME=VALUE`.
-    pub fn parse(flag: &str) -> Result<Override, String> {
-        let (name, value) = flag.split_once('=').ok_or_else(|| format!("--set {flag}: expected NAME=VALUE"))?;
+    pub fn parse(flag: &str) -> Result<Override, OverrideError> {
+        let (name, value) = flag.split_once('=').ok_or_else(|| OverrideError::NoEquals(flag.to_string()))?;
         let (name, value) = (name.trim(), value.trim());
         if name.is_empty() || value.is_empty() {
-            return Err(format!("--set {flag}: expected NAME=VALUE with a name and a value"));
+            return Err(OverrideError::Empty(flag.to_string()));
         }
         Ok(Override { name: name.to_string(), value: value.to_string() })
     }

@@ -61,10 +61,10 @@ impl<'a> Env<'a> {
     }
 
     /// The integer value of a name: a loop index or an integral parameter.
-    fn integer(&self, name: &str) -> Result<Option<i64>, String> {
+    fn integer(&self, name: &str) -> Result<Option<i64>, NotAnInteger> {
         match self.lookup(name) {
             Some(Binding::Index(v)) => return Ok(Some(*v)),
-            Some(Binding::Member(_)) => return Err(format!("'{name}' names a member, not a number")),
+            Some(Binding::Member(_)) => return Err(NotAnInteger::Member(name.to_string())),
             None => {}
         }
         let Some(x) = self.params.get(name) else { return Ok(None) };
@@ -72,9 +72,20 @@ impl<'a> Env<'a> {
         if (x - x.round()).abs() <= 1e-9 && x.abs() < 1e15 {
             Ok(Some(x.round() as i64))
         } else {
-            Err(format!("parameter '{name}' = {x} is not a whole number"))
+            Err(NotAnInteger::Fraction { name: name.to_string(), value: *x })
         }
     }
+}
+
+/// A name in a whole-number expression that has no whole-number value.
+#[derive(Debug, thiserror::Error)]
+enum NotAnInteger {
+    /// The name is a loop variable over members.
+    #[error("'{0}' names a member, not a number")]
+    Member(String),
+    /// The name is a parameter whose value is not whole.
+    #[error("parameter '{name}' = {value} is not a whole number")]
+    Fraction { name: String, value: f64 },
 }
 
 /// An error at byte `offset` of a template string.
@@ -399,7 +410,7 @@ impl IntParser<'_, '_> {
             }
             Some((_, Tok::Name(n))) => {
                 self.pos += 1;
-                match self.env.integer(n).map_err(|m| at(k, m))? {
+                match self.env.integer(n).map_err(|e| at(k, e.to_string()))? {
                     Some(v) => Ok(v),
                     None => {
                         self.unknown = true;

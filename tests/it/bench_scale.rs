@@ -268,7 +268,7 @@ fn mujoco_settles_the_small_members_side_by_side() {
     };
     let dir = std::env::temp_dir().join(format!("tensegrity-test-scale-peer-{}", std::process::id()));
     let command = [py, "benches/peers/mujoco/scale_peer.py".to_string()];
-    let out = scale::peer::compare(&scale::FAMILIES, 6, &DEFAULT_CAPS, &command, &dir);
+    let out = scale::peer::compare(&scale::FAMILIES, 6, &DEFAULT_CAPS, &command, &dir, &|line| eprintln!("{line}"));
     let _ = std::fs::remove_dir_all(&dir);
     let (reports, rows) = out.unwrap();
     // Every family reports; the spine's smallest member has 8 struts, so it has no row here.
@@ -323,7 +323,7 @@ fn motion_beside_mujoco_converges_at_first_order_on_both_sides() {
     };
     let dir = std::env::temp_dir().join(format!("tensegrity-test-scale-motion-{}", std::process::id()));
     let command = [py, "benches/peers/mujoco/scale_peer.py".to_string()];
-    let out = scale::motion::compare(&["prism"], 4, &command, &dir);
+    let out = scale::motion::compare(&["prism"], 4, &command, &dir, &|line| eprintln!("{line}"));
     let _ = std::fs::remove_dir_all(&dir);
     let cases = out.unwrap();
     assert_eq!(cases.len(), 2, "prisms 3 and 4");

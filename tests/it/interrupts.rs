@@ -171,7 +171,7 @@ fn an_interrupted_findings_phase_is_reported() {
         &sc,
         &tensegrity_testbed::run::RunOptions { cancel: Some(&flag), ..Default::default() },
     );
-    let err = r.error.as_deref().unwrap_or_default();
+    let err = r.error.as_ref().map(|e| e.to_string()).unwrap_or_default();
     assert!(err.contains("interrupted while checking the paper's equations"), "{err}");
     assert!(!r.passed);
 }

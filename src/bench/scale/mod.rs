@@ -307,7 +307,7 @@ pub fn cases(family: &str, max_struts: usize) -> Result<Vec<Case>, BenchError> {
         "tower" => tower::STAGES
             .iter()
             .filter(|&&m| tower::N * m <= max_struts)
-            .map(|&m| tower::case(m).map_err(BenchError::Case))
+            .map(|&m| tower::case(m).map_err(BenchError::Tower))
             .collect(),
         // n modules: 3 n struts and the base bar.
         "furet" => Ok(furet::MODULES.iter().filter(|&&n| 3 * n < max_struts).map(|&n| furet::case(n)).collect()),

@@ -158,18 +158,20 @@ fn run(dt_s: f64, steps: u64, wall_s: f64, error_m: f64) -> MotionRun {
 }
 
 /// Every case of `families` (free-body ones) up to `max_struts`: the testbed's runs, then the
-/// peer's with its reference, compared.
+/// peer's with its reference, compared. `progress` is told what starts (a line of text, for
+/// the command line to show).
 pub fn compare(
     families: &[&'static str],
     max_struts: usize,
     command: &[String],
     dir: &Path,
+    progress: &dyn Fn(&str),
 ) -> Result<Vec<MotionCase>, BenchError> {
     std::fs::create_dir_all(dir).map_err(write_error(dir))?;
     let (mut ours, mut listed) = (Vec::new(), Vec::new());
     for family in families.iter().filter(|f| FAMILIES.contains(f)) {
         for case in cases(family, max_struts)? {
-            eprintln!("{} {}: testbed motion ...", case.family, case.size);
+            progress(&format!("{} {}: testbed motion ...", case.family, case.size));
             let runs = DT_S.iter().map(|&dt| testbed_run(&case, dt)).collect::<Result<Vec<_>, _>>()?;
             listed.push(peer_case(&case, dir)?);
             ours.push((case, runs));
@@ -181,7 +183,7 @@ pub fn compare(
         "cases": listed,
     });
     crate::bench::write_whole(&file, &serde_json::to_string_pretty(&list).expect("case list serialises"))?;
-    eprintln!("{} cases: peer motion ...", listed.len());
+    progress(&format!("{} cases: peer motion ...", listed.len()));
     let v = crate::bench::run_peer(command, &file, &[])?;
     let theirs = v.get("cases").and_then(|c| c.as_array()).filter(|c| c.len() == ours.len());
     let theirs =

@@ -167,19 +167,21 @@ fn row(t: &ScaleCase, p: &serde_json::Value, pc: &PeerCase, about: &serde_json::
 }
 
 /// Every case of `families` up to `max_struts`, settled by the testbed and then by the peer:
-/// the testbed's family tables and the side-by-side rows.
+/// the testbed's family tables and the side-by-side rows. `progress` is told what starts (a
+/// line of text, for the command line to show).
 pub fn compare(
     families: &[&'static str],
     max_struts: usize,
     caps: &Caps,
     command: &[String],
     dir: &Path,
+    progress: &dyn Fn(&str),
 ) -> Result<(Vec<FamilyReport>, Vec<PeerRow>), BenchError> {
     std::fs::create_dir_all(dir).map_err(write_error(dir))?;
     let (mut ours, mut theirs) = (Vec::new(), Vec::new());
     for family in families {
         for case in cases(family, max_struts)? {
-            eprintln!("{} {}: testbed ...", case.family, case.size);
+            progress(&format!("{} {}: testbed ...", case.family, case.size));
             ours.push(run_case(&case, caps)?);
             theirs.push(peer_case(&case, caps, dir)?);
         }
@@ -187,7 +189,7 @@ pub fn compare(
     let file = dir.join("scale_cases.json");
     let list = serde_json::json!({ "cases": theirs });
     crate::bench::write_whole(&file, &serde_json::to_string_pretty(&list).expect("case list serialises"))?;
-    eprintln!("{} cases: peer ...", theirs.len());
+    progress(&format!("{} cases: peer ...", theirs.len()));
     let v = crate::bench::run_peer(command, &file, &[])?;
     let peer_cases = v
         .get("cases")

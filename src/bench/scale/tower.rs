@@ -206,9 +206,23 @@ const REGULARISATION: f64 = 1e-12;
 /// Passes of the projection (each removes the residual A q that the last one left).
 const PROJECTION_PASSES: usize = 3;
 
+/// Why the tower has no design.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum TowerError {
+    /// A A^T cannot be factored.
+    #[error("A A^T is singular: the tower has too few members")]
+    Singular,
+    /// The projection of the force densities gave a number that is not finite.
+    #[error("the force density projection is not finite")]
+    NotFinite,
+    /// A cable's force density is too small a share of the largest.
+    #[error("the design leaves a cable at force density {least} of the largest {largest}")]
+    SlackCable { least: f64, largest: f64 },
+}
+
 /// A (free node coordinates x members) from the members' columns, with A A^T + shift factored
 /// (`sim::least_squares`: a band Cholesky, the nodes numbered stage by stage).
-fn normal_matrix(cols: &[Vec<(usize, Vec3)>], n: usize) -> Result<SparseLeastSquares, String> {
+fn normal_matrix(cols: &[Vec<(usize, Vec3)>], n: usize) -> Result<SparseLeastSquares, TowerError> {
     let mut entries = Vec::new();
     for (m, c) in cols.iter().enumerate() {
         for (i, u) in c {
@@ -216,12 +230,12 @@ fn normal_matrix(cols: &[Vec<(usize, Vec3)>], n: usize) -> Result<SparseLeastSqu
         }
     }
     SparseLeastSquares::regularised(SparseRows::new(3 * n, cols.len(), &entries), REGULARISATION)
-        .map_err(|_| "A A^T is singular: the tower has too few members".to_string())
+        .map_err(|_| TowerError::Singular)
 }
 
 /// The force densities nearest the target pattern that make the drawn shape an equilibrium,
 /// scaled so the most strained cable is stretched [`MAX_CABLE_STRAIN`] [N/m].
-pub fn force_densities(d: &Design) -> Result<Vec<f64>, String> {
+pub fn force_densities(d: &Design) -> Result<Vec<f64>, TowerError> {
     let (idx, n) = free_index(d);
     let cols: Vec<Vec<(usize, Vec3)>> = d.members.iter().map(|(_, a, b)| column(d, *a, *b, &idx)).collect();
     let a = normal_matrix(&cols, n)?;
@@ -229,20 +243,20 @@ pub fn force_densities(d: &Design) -> Result<Vec<f64>, String> {
     // Each pass takes off A^T (A A^T + shift)^-1 A q: the part of q that A q sees.
     for _ in 0..PROJECTION_PASSES {
         let aq = a.matrix().mul(&q);
-        let off = a.solve_refined(&aq, 0).ok_or_else(|| "the force density projection is not finite".to_string())?;
+        let off = a.solve_refined(&aq, 0).ok_or(TowerError::NotFinite)?;
         q -= off;
     }
     let cable_q = d.members.iter().zip(&q).filter(|((k, _, _), _)| k.is_cable()).map(|(_, q)| *q);
     let (lo, hi) = cable_q.fold((f64::INFINITY, 0.0f64), |(lo, hi), q| (lo.min(q), hi.max(q)));
     if lo < MIN_CABLE_Q_RATIO * hi {
-        return Err(format!("the design leaves a cable at force density {lo} of the largest {hi}"));
+        return Err(TowerError::SlackCable { least: lo, largest: hi });
     }
     let scale = MAX_CABLE_STRAIN * CABLE_STIFFNESS_N_PER_M / hi;
     Ok(q.iter().map(|q| q * scale).collect())
 }
 
 /// The designed tower: geometry and force densities.
-pub fn design(stages: usize) -> Result<Design, String> {
+pub fn design(stages: usize) -> Result<Design, TowerError> {
     let mut d = geometry(stages);
     d.q = force_densities(&d)?;
     Ok(d)
@@ -306,7 +320,7 @@ pub fn structure(d: &Design, perturbation_m: f64) -> Structure {
 
 /// The m-stage tower's case: perturbed start, the design as target (node indices of the
 /// structure: each strut's nodes in strut order).
-pub fn case(stages: usize) -> Result<Case, String> {
+pub fn case(stages: usize) -> Result<Case, TowerError> {
     let d = design(stages)?;
     let start = structure(&d, PERTURBATION_M);
     let drawn = structure(&d, 0.0);

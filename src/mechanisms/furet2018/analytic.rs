@@ -62,6 +62,7 @@
 
 /// Wraps an angle to `(-pi, pi]` (one definition for the testbed, in `mechanisms`).
 pub use crate::mechanisms::wrap_angle;
+use crate::mechanisms::ParamError;
 use nalgebra::{Complex, Matrix2, Matrix4, Vector2};
 use std::collections::VecDeque;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -111,17 +112,20 @@ impl Params {
     pub const PAPER: Params = Params { l: 1.0, b: PAPER_FIG3_B };
 
     /// `L` and `b` finite, `b > 0`, `L > b` (crossed-bar assembly condition).
-    pub fn validate(&self) -> Result<(), String> {
-        for (name, v) in [("L", self.l), ("b", self.b)] {
-            if !v.is_finite() {
-                return Err(format!("{name} must be finite, got {v}"));
+    pub fn validate(&self) -> Result<(), ParamError> {
+        for (name, value) in [("L", self.l), ("b", self.b)] {
+            if !value.is_finite() {
+                return Err(ParamError::NotFinite { name, value });
             }
         }
         if self.b <= 0.0 {
-            return Err(format!("b must be > 0, got {}", self.b));
+            return Err(ParamError::NotPositive { name: "b", value: self.b });
         }
         if self.l <= self.b {
-            return Err(format!("L must be > b (assembly condition), got L = {} <= b = {}", self.l, self.b));
+            return Err(ParamError::Condition(format!(
+                "L must be > b (assembly condition), got L = {} <= b = {}",
+                self.l, self.b
+            )));
         }
         Ok(())
     }

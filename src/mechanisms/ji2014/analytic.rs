@@ -30,6 +30,7 @@
 
 /// Wraps an angle to `(-pi, pi]` (one definition for the testbed, in `mechanisms`).
 pub use crate::mechanisms::wrap_angle;
+use crate::mechanisms::ParamError;
 use nalgebra::{Matrix2, Vector2};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_3, PI};
 
@@ -73,13 +74,13 @@ impl Params {
     pub const PAPER_FIG4: Params = Params { l: 1.0, k1: 100.0, k2: 10.0 };
 
     /// `L > 0`, `K1 > 0`, `K2 > 0`, all finite.
-    pub fn validate(&self) -> Result<(), String> {
-        for (name, v) in [("L", self.l), ("K1", self.k1), ("K2", self.k2)] {
-            if !v.is_finite() {
-                return Err(format!("{name} must be finite, got {v}"));
+    pub fn validate(&self) -> Result<(), ParamError> {
+        for (name, value) in [("L", self.l), ("K1", self.k1), ("K2", self.k2)] {
+            if !value.is_finite() {
+                return Err(ParamError::NotFinite { name, value });
             }
-            if v <= 0.0 {
-                return Err(format!("{name} must be > 0, got {v}"));
+            if value <= 0.0 {
+                return Err(ParamError::NotPositive { name, value });
             }
         }
         Ok(())

@@ -47,6 +47,7 @@
 //! universal joint carries tension as well. As printed, Eq. 26-27 require
 //! `|f_joint| <= 0` and `|m_joint| = 0`, which Table 5 itself violates.
 
+use crate::mechanisms::ParamError;
 use nalgebra::{Matrix2, Matrix3, Matrix4, Vector2, Vector3};
 
 // ---------------------------------------------------------------------------
@@ -228,32 +229,35 @@ impl Params {
     /// Lengths `a2, l2, base_half > 0`, `l1`, `base_x` finite, `mass, gravity,
     /// spring_k >= 0`, `spring_rest >= 0`, centroid finite, and the base plane
     /// not through the joint centre.
-    pub fn validate(&self) -> Result<(), String> {
-        for (name, v) in [("a2", self.a2), ("l2", self.l2), ("base_half", self.base_half)] {
-            if !v.is_finite() || v <= 0.0 {
-                return Err(format!("{name} must be finite and > 0, got {v}"));
+    pub fn validate(&self) -> Result<(), ParamError> {
+        for (name, value) in [("a2", self.a2), ("l2", self.l2), ("base_half", self.base_half)] {
+            if !value.is_finite() || value <= 0.0 {
+                return Err(ParamError::NotFinitePositive { name, value });
             }
         }
-        for (name, v) in [
+        for (name, value) in [
             ("mass", self.mass),
             ("gravity", self.gravity),
             ("spring_k", self.spring_k),
             ("spring_rest", self.spring_rest),
         ] {
-            if !v.is_finite() || v < 0.0 {
-                return Err(format!("{name} must be finite and >= 0, got {v}"));
+            if !value.is_finite() || value < 0.0 {
+                return Err(ParamError::NotFiniteNonNegative { name, value });
             }
         }
-        for (name, v) in [("l1", self.l1), ("base_x", self.base_x)] {
-            if !v.is_finite() {
-                return Err(format!("{name} must be finite, got {v}"));
+        for (name, value) in [("l1", self.l1), ("base_x", self.base_x)] {
+            if !value.is_finite() {
+                return Err(ParamError::NotFinite { name, value });
             }
         }
         if self.centroid_local.iter().any(|c| !c.is_finite()) {
-            return Err(format!("centroid_local must be finite, got {:?}", self.centroid_local));
+            return Err(ParamError::Condition(format!("centroid_local must be finite, got {:?}", self.centroid_local)));
         }
         if (self.base_x - self.l1).abs() < 1e-9 {
-            return Err(format!("base_x must differ from l1 (base plane through the joint), got {}", self.base_x));
+            return Err(ParamError::Condition(format!(
+                "base_x must differ from l1 (base plane through the joint), got {}",
+                self.base_x
+            )));
         }
         Ok(())
     }
@@ -488,13 +492,24 @@ pub fn ik_pose_as_printed(t: &Matrix4<f64>) -> (f64, f64) {
 }
 
 /// Inverse kinematics from the position of `M` (translation of Eq. 14) [m]:
+/// A platform point `M` off the sphere of radius `a2` about the joint centre `O`: no joint
+/// angles place it.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("|M - O| = {distance_m:.6} m must equal a2 = {a2_m:.6} m")]
+pub struct OffSphere {
+    /// `|M - O|` [m].
+    pub distance_m: f64,
+    /// `a2` [m].
+    pub a2_m: f64,
+}
+
 /// `θ1 = atan2(y_m, x_m - l1)`, `θ2 = atan2(-z_m, sqrt((x_m-l1)^2 + y_m^2))`
 /// (branch `cos θ2 > 0`). Errors when `|M - O|` differs from `a2` by more than
 /// [`IK_RADIUS_REL_TOL`].
-pub fn ik_position(p: &Params, m: &Vector3<f64>) -> Result<(f64, f64), String> {
+pub fn ik_position(p: &Params, m: &Vector3<f64>) -> Result<(f64, f64), OffSphere> {
     let d = m - joint_centre(p);
     if (d.norm() - p.a2).abs() > IK_RADIUS_REL_TOL * p.a2 {
-        return Err(format!("|M - O| = {:.6} m must equal a2 = {:.6} m", d.norm(), p.a2));
+        return Err(OffSphere { distance_m: d.norm(), a2_m: p.a2 });
     }
     let rho = (d.x * d.x + d.y * d.y).sqrt();
     Ok((d.y.atan2(d.x), (-d.z).atan2(rho)))

@@ -219,7 +219,7 @@ impl Mechanism for Manriquez2019 {
             v,
             &[("g", "m/s^2"), ("l0_spring", "m"), ("c_joint", "N m s/rad"), ("r_strut", "m")],
         )?;
-        params_of(v).validate().map_err(|e| ModelError::value("base_x", e))
+        params_of(v).validate().map_err(|e| ModelError::param("base_x", e))
     }
     fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), ModelError> {
         for s in ["theta1", "theta2"] {
@@ -240,7 +240,7 @@ impl Mechanism for Manriquez2019 {
             "fk" => fk_solution(&p, inputs),
             "ik" => {
                 let m = Vector3::new(input(inputs, "x_m")?, input(inputs, "y_m")?, input(inputs, "z_m")?);
-                let (t1, t2) = analytic::ik_position(&p, &m).map_err(ModelError::NoSolution)?;
+                let (t1, t2) = analytic::ik_position(&p, &m).map_err(|e| ModelError::no_solution(e.to_string()))?;
                 Ok(vec![Solution {
                     label: "derived Eq. 16-17".into(),
                     values: Values::from([("theta1".into(), t1), ("theta2".into(), t2)]),

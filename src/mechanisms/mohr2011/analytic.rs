@@ -56,6 +56,7 @@
 //! * `det W_t = det[p+a1, p+a2, p+a3] * (-3/2 lb^4 z^2) / (rho1 rho2 rho3)^2`
 //!   `= -3 sqrt3/4 z^3 lb^6 / (rho1 rho2 rho3)^2` (Eq. 25 holds).
 
+use crate::mechanisms::ParamError;
 use nalgebra::{Matrix3, Matrix6, Matrix6x3, Rotation3, Vector3, Vector6};
 use std::f64::consts::PI;
 
@@ -102,19 +103,19 @@ impl Params {
         Params { lb: PAPER_LB, lo: PAPER_LO_OVER_LB * PAPER_LB, kappa: DEFAULT_KAPPA, l_min: 0.0 };
 
     /// `lb > 0`, `lo > 0`, `kappa > 0`, `0 <= l_min < lo`, all finite.
-    pub fn validate(&self) -> Result<(), String> {
-        for (name, v) in [("lb", self.lb), ("lo", self.lo), ("kappa", self.kappa), ("l_min", self.l_min)] {
-            if !v.is_finite() {
-                return Err(format!("{name} must be finite, got {v}"));
+    pub fn validate(&self) -> Result<(), ParamError> {
+        for (name, value) in [("lb", self.lb), ("lo", self.lo), ("kappa", self.kappa), ("l_min", self.l_min)] {
+            if !value.is_finite() {
+                return Err(ParamError::NotFinite { name, value });
             }
         }
-        for (name, v) in [("lb", self.lb), ("lo", self.lo), ("kappa", self.kappa)] {
-            if v <= 0.0 {
-                return Err(format!("{name} must be > 0, got {v}"));
+        for (name, value) in [("lb", self.lb), ("lo", self.lo), ("kappa", self.kappa)] {
+            if value <= 0.0 {
+                return Err(ParamError::NotPositive { name, value });
             }
         }
         if self.l_min < 0.0 || self.l_min >= self.lo {
-            return Err(format!("l_min must be in [0, lo = {}), got {}", self.lo, self.l_min));
+            return Err(ParamError::Condition(format!("l_min must be in [0, lo = {}), got {}", self.lo, self.l_min)));
         }
         Ok(())
     }
@@ -711,13 +712,13 @@ mod tests {
     fn paper_parameters_validate_and_bad_ones_are_named() {
         assert!(P.validate().is_ok());
         assert_relative_eq!(P.lo, 6.0, epsilon = 0.0);
-        let e = Params { lb: -1.0, ..P }.validate().unwrap_err();
+        let e = Params { lb: -1.0, ..P }.validate().unwrap_err().to_string();
         assert!(e.contains("lb"), "{e}");
-        let e = Params { kappa: 0.0, ..P }.validate().unwrap_err();
+        let e = Params { kappa: 0.0, ..P }.validate().unwrap_err().to_string();
         assert!(e.contains("kappa"), "{e}");
-        let e = Params { l_min: 6.0, ..P }.validate().unwrap_err();
+        let e = Params { l_min: 6.0, ..P }.validate().unwrap_err().to_string();
         assert!(e.contains("l_min"), "{e}");
-        let e = Params { lo: f64::NAN, ..P }.validate().unwrap_err();
+        let e = Params { lo: f64::NAN, ..P }.validate().unwrap_err().to_string();
         assert!(e.contains("lo"), "{e}");
     }
 

@@ -284,7 +284,7 @@ impl Mechanism for Mohr2011 {
         if !g_z.is_finite() {
             return Err(ModelError::value("g_z", format!("g_z must be a finite number (m/s^2), got {g_z}")));
         }
-        params_of(v).validate().map_err(|m| ModelError::value("lo", m))
+        params_of(v).validate().map_err(|e| ModelError::param("lo", e))
     }
     fn validate_inputs(&self, params: &Values, inputs: &Values) -> Result<(), ModelError> {
         let pa = params_of(params);
