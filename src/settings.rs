@@ -330,6 +330,10 @@ pub struct Motion {
     /// A free body without joints started spinning: (body, its name, angular velocity
     /// [rad/s], world frame).
     pub spin: Option<(usize, String, [f64; 3])>,
+    /// Judge the motion extrapolated over the time step: the same motion at h, h/2 and h/4,
+    /// combined by Richardson's rule at fourth order, with its own error estimate
+    /// (`run/levels.rs`).
+    pub extrapolate: bool,
 }
 
 /// Inputs as functions of the motion's time, followed physically: each actuated joint a

@@ -175,3 +175,45 @@ impl ModalProjector {
         eta
     }
 }
+
+/// One Richardson step over the time step: from the same motion at step h (`coarse`) and h / 2
+/// (`fine`), a method whose error is c h^p + ... gives fine + (fine - coarse) / (2^p - 1),
+/// which cancels the h^p term. Every number of the state is combined so: node positions,
+/// body translations and rotations (each quaternion taken on `fine`'s side of the sphere, the
+/// result normalised), member forces and lengths, actuator forces, the kinetic energy. The
+/// tick, time, commands and the cables' slack are `fine`'s.
+pub fn richardson(coarse: &Snapshot, fine: &Snapshot, order: i32) -> Snapshot {
+    let r = 1.0 / (2f64.powi(order) - 1.0);
+    let x = |c: f64, f: f64| f + (f - c) * r;
+    let v = |c: &[f64], f: &[f64]| -> Vec<f64> { c.iter().zip(f).map(|(c, f)| x(*c, *f)).collect() };
+    let p3 = |c: &[f64; 3], f: &[f64; 3]| [x(c[0], f[0]), x(c[1], f[1]), x(c[2], f[2])];
+    let pose = |c: &BodyPose, f: &BodyPose| {
+        let (qc, qf) = (c.rotation_xyzw, f.rotation_xyzw);
+        let side = if (0..4).map(|k| qc[k] * qf[k]).sum::<f64>() < 0.0 { -1.0 } else { 1.0 };
+        let q: Vec<f64> = (0..4).map(|k| x(side * qc[k], qf[k])).collect();
+        let n = q.iter().map(|a| a * a).sum::<f64>().sqrt();
+        BodyPose {
+            translation: p3(&c.translation, &f.translation),
+            rotation_xyzw: [q[0] / n, q[1] / n, q[2] / n, q[3] / n],
+        }
+    };
+    let (cf, ff) = (&coarse.forces, &fine.forces);
+    Snapshot {
+        tick: fine.tick,
+        time_s: fine.time_s,
+        nodes: coarse.nodes.iter().zip(&fine.nodes).map(|(c, f)| p3(c, f)).collect(),
+        body_poses: coarse.body_poses.iter().zip(&fine.body_poses).map(|(c, f)| pose(c, f)).collect(),
+        forces: MemberForces {
+            spring_force_n: v(&cf.spring_force_n, &ff.spring_force_n),
+            spring_length_m: v(&cf.spring_length_m, &ff.spring_length_m),
+            cable_tension_n: v(&cf.cable_tension_n, &ff.cable_tension_n),
+            cable_length_m: v(&cf.cable_length_m, &ff.cable_length_m),
+            cable_rest_length_m: ff.cable_rest_length_m.clone(),
+            cable_slack: ff.cable_slack.clone(),
+            actuator_force: v(&cf.actuator_force, &ff.actuator_force),
+            residual: None,
+        },
+        actuator_values: fine.actuator_values.clone(),
+        kinetic_energy_j: x(coarse.kinetic_energy_j, fine.kinetic_energy_j),
+    }
+}

@@ -41,6 +41,9 @@ pub struct Tick<'a> {
     /// The step to this tick took a settle accelerator (the static relaxation or the Newton
     /// damping schedule): it is no part of a physical path.
     pub accelerated: bool,
+    /// In a motion judged extrapolated over the time step: each quantity's estimate of the
+    /// simulation's own error at this tick (`run/levels.rs`).
+    pub estimate: Option<&'a Values>,
 }
 
 /// What the observers see of a settle point besides its report (which holds the inputs, the
@@ -162,10 +165,11 @@ pub fn observers(setup: Setup, warnings: &mut Vec<String>) -> Result<Vec<Box<dyn
     }
     if let Some(target) = &setup.table {
         let motion = setup.motion.is_some();
+        let extrapolated = setup.motion.is_some_and(|m| m.extrapolate);
         let model = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, motion));
         list.push(Box::new(match target {
-            table::TableTarget::File(path) => table::Table::start(path, model)?,
-            table::TableTarget::Memory(to) => table::Table::in_memory(to.clone(), model),
+            table::TableTarget::File(path) => table::Table::start(path, model)?.with_estimates(extrapolated),
+            table::TableTarget::Memory(to) => table::Table::in_memory(to.clone(), model).with_estimates(extrapolated),
         }));
     }
     if let Some(r) = &setup.recording {

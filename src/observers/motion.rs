@@ -21,6 +21,11 @@ use crate::settings::{FrequencyPrediction, FrequencySignal, Motion};
 pub const METHOD: &str = "least-squares fit of c + A cos(w t + p) over every tick of the motion, \
     w corrected for symplectic Euler's dispersion: w = (2/dt) sin(w_d dt/2)";
 
+/// How the frequencies are measured from a motion judged extrapolated over the time step
+/// (`run/levels.rs`): its dispersion is gone with its h^2 term, so nothing is corrected.
+pub const METHOD_EXTRAPOLATED: &str = "least-squares fit of c + A cos(w t + p) over every tick of \
+    the motion extrapolated over the time step (fourth order: no dispersion to correct)";
+
 /// Fewest samples a fit is made from.
 const MIN_FIT_SAMPLES: usize = 16;
 /// Fewest crossings of the mean (a full period) for a start frequency.
@@ -150,6 +155,8 @@ pub struct MotionObserver {
     at: Option<(Values, Values, Values)>,
     /// The structure's own modes at the motion's start that frequencies are fitted to.
     modes: Vec<ModeAtStart>,
+    /// The motion is judged extrapolated over the time step: no dispersion to correct.
+    extrapolated: bool,
 }
 
 impl MotionObserver {
@@ -159,6 +166,7 @@ impl MotionObserver {
             samples: vec![(Vec::new(), Vec::new()); m.frequencies.len()],
             at: None,
             modes: Vec::new(),
+            extrapolated: m.extrapolate,
         }
     }
 
@@ -180,7 +188,7 @@ impl MotionObserver {
         let predicted = self.predicted(f);
         let fit = fit_cosine(t, q);
         let measured = fit.map_or(f64::NAN, |x| x.omega_rad_per_s);
-        let corrected = corrected_for_symplectic_euler(measured, dt_s);
+        let corrected = if self.extrapolated { measured } else { corrected_for_symplectic_euler(measured, dt_s) };
         let error = (corrected - predicted).abs() / predicted.abs();
         FrequencyReport {
             name: f.name.clone(),
@@ -196,7 +204,7 @@ impl MotionObserver {
             fit_amplitude: fit.map_or(f64::NAN, |x| x.amplitude),
             fit_rms_residual: fit.map_or(f64::NAN, |x| x.rms_residual),
             samples: t.len(),
-            method: METHOD.into(),
+            method: if self.extrapolated { METHOD_EXTRAPOLATED } else { METHOD }.into(),
         }
     }
 }

@@ -117,11 +117,14 @@ pub struct Table {
     error: Option<TableError>,
     /// The file's model, evaluated for its columns (quantities, predictions, errors).
     model: Option<super::file_model::ModelObserver>,
+    /// Whether each joint coordinate gets a column of the motion's own error estimate
+    /// (`estimate:joint:NAME.angle`: a motion judged extrapolated over the time step).
+    estimates: bool,
 }
 
 /// Every joint with one coordinate: its index and column (`joint:NAME.angle` [rad] for a
 /// revolute, `joint:NAME.slide` [m] for a prismatic).
-fn coordinates(s: &crate::structure::Structure) -> impl Iterator<Item = (usize, String)> + '_ {
+pub fn coordinates(s: &crate::structure::Structure) -> impl Iterator<Item = (usize, String)> + '_ {
     s.joints.iter().enumerate().filter_map(|(j, joint)| match joint.kind {
         crate::structure::JointKind::Revolute { .. } => Some((j, format!("joint:{}.angle", joint.name))),
         crate::structure::JointKind::Prismatic { .. } => Some((j, format!("joint:{}.slide", joint.name))),
@@ -139,6 +142,11 @@ fn field(s: &str) -> String {
 }
 
 impl Table {
+    /// With a column of the motion's own error estimate per joint coordinate.
+    pub fn with_estimates(self, estimates: bool) -> Self {
+        Table { estimates, ..self }
+    }
+
     /// Starts the table at `path` (its directory is made if needed); Arrow IPC for the endings
     /// in [`ARROW_ENDINGS`], CSV otherwise.
     /// `model`: the file's model, whose quantities, predictions and errors get columns.
@@ -158,13 +166,21 @@ impl Table {
         } else {
             Sink::Csv(std::io::BufWriter::new(file))
         };
-        Ok(Table { path: path.to_path_buf(), partial: Some(partial), sink, keys: None, error: None, model })
+        Ok(Table {
+            path: path.to_path_buf(),
+            partial: Some(partial),
+            sink,
+            keys: None,
+            error: None,
+            model,
+            estimates: false,
+        })
     }
 
     /// Starts a table kept in memory, handed to `to` when the run closes.
     pub fn in_memory(to: MemoryTable, model: Option<super::file_model::ModelObserver>) -> Self {
         let sink = Self::arrow(Batches::Memory { kept: Vec::new(), to });
-        Table { path: PathBuf::from("(memory)"), partial: None, sink, keys: None, error: None, model }
+        Table { path: PathBuf::from("(memory)"), partial: None, sink, keys: None, error: None, model, estimates: false }
     }
 
     fn arrow(out: Batches) -> Sink {
@@ -194,6 +210,9 @@ impl Table {
         cols.extend(keys.2.iter().map(|k| format!("analytic:{k}")));
         cols.extend(["path_accelerated".to_string(), "motion_time_s".to_string()]);
         cols.extend(coordinates(s).map(|(_, name)| name));
+        if self.estimates {
+            cols.extend(coordinates(s).map(|(_, name)| format!("estimate:{name}")));
+        }
         cols.extend(self.model.iter().flat_map(|m| m.table_columns()));
         cols
     }
@@ -211,6 +230,9 @@ impl Table {
         v.push(Some(if t.accelerated { 1.0 } else { 0.0 }));
         v.push(t.motion_time_s);
         v.extend(coordinates(t.structure).map(|(j, _)| snap.joint_coordinate(t.structure, j)));
+        if self.estimates {
+            v.extend(coordinates(t.structure).map(|(_, name)| t.estimate.and_then(|e| e.get(&name)).copied()));
+        }
         v.extend(self.model.iter().flat_map(|m| m.table_values(t)));
         v
     }

@@ -171,6 +171,26 @@ pub struct MotionReport {
     /// The inputs followed in time and how (`[actuation] waypoints` or `[motion] inputs`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub driven: Option<String>,
+    /// How the judged motion was made: "leapfrog from a half step" (rapier's steps), or
+    /// extrapolated over the time step (`run/levels.rs`).
+    pub integration: String,
+    /// In a motion judged extrapolated: each quantity's largest error estimate.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub extrapolation: Option<ExtrapolationReport>,
+}
+
+/// A motion judged extrapolated over the time step: the steps combined, each quantity's largest
+/// estimate of the simulation's own error over the motion, and where the motion stopped being
+/// smooth in time (the estimates after it do not hold).
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct ExtrapolationReport {
+    /// The time steps combined [s]: h, h/2, h/4.
+    pub steps_s: Vec<f64>,
+    /// Each quantity's largest error estimate over the motion (its unit).
+    pub largest_estimate: std::collections::BTreeMap<String, f64>,
+    /// The first tick at which the levels disagree on a cable's slack, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub not_smooth_from_tick: Option<u64>,
 }
 
 /// A motion against the file's Lagrangian model, compared tick by tick

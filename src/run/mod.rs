@@ -4,6 +4,7 @@
 //! `settle.rs` the settle loop, `point.rs` one settle point (branch, stability, probe,
 //! read-out) (the pass policy is `report::verdict`).
 
+mod levels;
 mod motion;
 mod point;
 mod runner;

@@ -3,12 +3,13 @@
 //! for good, the named coordinate displaced and given its rate, and the physical dynamics for
 //! the stated time. The observers judge it tick by tick; nothing here settles it.
 
+use super::levels::Levels;
 use super::runner::Runner;
 use super::settle::SettleDetector;
 use super::{point, RunError};
 use crate::mechanisms::Values;
 use crate::observers::ModeAtStart;
-use crate::report::{MotionReport, PointReport, ScenarioReport};
+use crate::report::{ExtrapolationReport, MotionReport, PointReport, ScenarioReport};
 use crate::scenario::Scenario;
 use crate::settings::{Drive, FrequencySignal, Motion, MotionStart};
 use crate::sim::modes::modal_projector;
@@ -35,6 +36,8 @@ pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
         frequencies: vec![],
         lagrangian: None,
         driven: m.drive.as_ref().map(|d| driven_text(d)),
+        integration: integration_text(m.extrapolate).into(),
+        extrapolation: None,
     }
 }
 
@@ -79,6 +82,13 @@ pub(super) fn run_motion(
     if m.drive.is_some() {
         runner.sim.drive_physically()?;
     }
+    // The steps from here are the leapfrog scheme from the stated start (`sim/levels.rs`):
+    // second order at the tick times; extrapolated over the step, fourth (`levels.rs`).
+    if m.extrapolate {
+        runner.levels = Some(Levels::new(&runner.sim)?);
+        runner.motion_drive = m.drive.clone();
+    }
+    runner.sim.start_at_half_step()?;
     let mut prediction = runner.mech.predict(&runner.params, &inputs).map_err(RunError::Model)?;
     let mut result = Ok(());
     let mut inputs = inputs;
@@ -99,8 +109,22 @@ pub(super) fn run_motion(
     }
     if let Some(r) = report.motion.as_mut() {
         r.accelerated_steps = runner.accelerated_steps - accelerated_before;
+        r.extrapolation = runner.levels.take().map(|l| ExtrapolationReport {
+            steps_s: vec![sc.sim.dt_s, sc.sim.dt_s / 2.0, sc.sim.dt_s / 4.0],
+            largest_estimate: l.largest,
+            not_smooth_from_tick: l.rough_from_tick,
+        });
     }
     result
+}
+
+/// How a motion's judged trajectory is made.
+fn integration_text(extrapolated: bool) -> &'static str {
+    if extrapolated {
+        "extrapolated over the time step: the motion at h, h/2 and h/4, each rapier's steps from a half step (leapfrog), combined by Richardson's rule (fourth order), its error estimated from the three"
+    } else {
+        "rapier's steps from a half step (leapfrog: second order at the tick times)"
+    }
 }
 
 /// What the report says of a motion's drive.

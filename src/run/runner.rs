@@ -1,10 +1,12 @@
 //! The state of one running scenario: its mechanism, its simulation and its observers, and the
 //! one step that every phase (settle, perturbation, probe, trajectory) goes through.
 
+use super::levels::Levels;
 use super::RunError;
 use crate::mechanisms::{Mechanism, Prediction, Values};
 use crate::observers::{Note, Observer, Tick};
 use crate::scenario::Scenario;
+use crate::settings::Drive;
 use crate::sim::Simulation;
 use crate::snapshot::Snapshot;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -35,6 +37,10 @@ pub(super) struct Runner<'a> {
     was_accelerated: Option<bool>,
     /// Steps over the whole run that took a settle accelerator.
     pub accelerated_steps: u64,
+    /// A motion judged extrapolated over the time step: its finer levels (`levels.rs`).
+    pub levels: Option<Levels>,
+    /// A driven motion's inputs in time, which the finer levels follow too.
+    pub motion_drive: Option<Drive>,
 }
 
 impl<'a> Runner<'a> {
@@ -61,6 +67,8 @@ impl<'a> Runner<'a> {
             motion_start_tick: None,
             was_accelerated: None,
             accelerated_steps: 0,
+            levels: None,
+            motion_drive: None,
         }
     }
 
@@ -119,6 +127,32 @@ impl<'a> Runner<'a> {
         }
     }
 
+    /// The state the observers judge after a step, with each quantity's error estimate: the
+    /// simulation's own, or in a motion judged extrapolated, the finer levels stepped to the
+    /// same time and the three combined (`levels.rs`).
+    fn judged_state(&mut self) -> Result<(Snapshot, Option<Values>), RunError> {
+        let snap = self.sim.snapshot_with(false);
+        let Some(levels) = self.levels.as_mut() else { return Ok((snap, None)) };
+        let dt_s = self.sc.sim.dt_s;
+        let end_s = self.motion_start_tick.map_or(0.0, |t0| snap.tick.saturating_sub(t0) as f64 * dt_s);
+        let (mech, params, structure) = (&self.mech, &self.params, self.sim.structure());
+        let commands = |t: f64| {
+            let inputs = self.motion_drive.as_ref().map(|d| d.inputs_at(params, t)).unwrap_or_default();
+            structure.commands_from(&mech.commands(params, &inputs))
+        };
+        let driven: Option<&dyn Fn(f64) -> Vec<f64>> = self.motion_drive.as_ref().map(|_| &commands as _);
+        levels.step(end_s, dt_s, driven)?;
+        let observe = |s: &Snapshot| {
+            let mut values = mech.observe(params, structure, s);
+            for (j, name) in crate::observers::table::coordinates(structure) {
+                values.extend(s.joint_coordinate(structure, j).map(|q| (name, q)));
+            }
+            values
+        };
+        let (judged, estimate) = levels.judge(&snap, &observe);
+        Ok((judged, Some(estimate)))
+    }
+
     /// One step followed by every observer.
     pub fn step(&mut self, inputs: &Values, prediction: &Prediction) -> Result<(Snapshot, Values), RunError> {
         if self.cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
@@ -129,7 +163,7 @@ impl<'a> Runner<'a> {
         // The residual (a least-squares fit, the costliest read-out) is left out here: the
         // settle loop computes it once the motion has stopped, and only those ticks carry it
         // (into the recording too).
-        let snap = self.sim.snapshot_with(false);
+        let (snap, estimate) = self.judged_state()?;
         let simulated = self.observe(&snap);
         // The ghost overlay is only drawn in recordings, and only recomputed when the inputs
         // change.
@@ -158,6 +192,7 @@ impl<'a> Runner<'a> {
             prediction,
             simulated: &simulated,
             ghost_nodes: self.ghost.as_ref().and_then(|(_, g)| g.as_deref()),
+            estimate: estimate.as_ref(),
         };
         for o in &mut self.observers {
             o.tick(&tick, &mut self.notes);

@@ -62,6 +62,13 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<(Model, Dat
     Ok((model, data))
 }
 
+impl Model {
+    /// The same model stepped at `dt_s` [s] (a copy: the model itself never changes).
+    pub(super) fn at_time_step(&self, dt_s: f64) -> Model {
+        Model { settings: SimSettings { dt_s, ..self.settings.clone() }, ..self.clone() }
+    }
+}
+
 impl Data {
     /// rapier counts a fixed root's six degrees of freedom until the multibody's first forward
     /// kinematics: every multibody's root is settled here, so that the degree-of-freedom

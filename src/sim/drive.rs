@@ -23,7 +23,7 @@ const AXES: [JointAxis; 6] =
     [JointAxis::LinX, JointAxis::LinY, JointAxis::LinZ, JointAxis::AngX, JointAxis::AngY, JointAxis::AngZ];
 
 /// Whether the actuated joints are driven through the solver rather than set.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub(super) struct Drive {
     driven: bool,
 }

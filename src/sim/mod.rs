@@ -26,6 +26,7 @@ mod group_tree;
 mod joint_coordinates;
 mod joint_modes;
 pub(crate) mod least_squares;
+mod levels;
 pub mod modes;
 mod path;
 mod projection;
@@ -63,6 +64,7 @@ struct LinkRef {
 /// What a simulation is built from and keeps for its whole life (MuJoCo's `mjModel`): the
 /// structure and settings, and how the build mapped them onto rapier (handles, multibody
 /// links, loop closures, rope joints, the link tree, constant loads). Only the build writes it.
+#[derive(Clone)]
 pub struct Model {
     pub structure: Structure,
     pub settings: SimSettings,

@@ -3,7 +3,7 @@
 //! [`super::Simulation::end_acceleration`] every step is physical.
 
 /// Whether the steps are physical for good, and how many took an accelerator.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub(super) struct Path {
     /// Only the physical dynamics from now on: no static relaxation, no Newton damping
     /// schedule, every joint's damping as stated.

@@ -1,0 +1,90 @@
+//! A motion judged at fourth order, with its own error estimate.
+//!
+//! From its stated start at a half step (`sim/levels.rs`) rapier's steps are the leapfrog
+//! scheme, whose error at the tick times is an even series in the step h: x_h = x + c2 h^2 +
+//! c4 h^4 + ... The same motion is stepped at h, h/2 and h/4 from the same start. Richardson's
+//! rule over two of them, T(h, h/2) = x_{h/2} + (x_{h/2} - x_h) / 3, cancels the h^2 term; the
+//! judged state is T(h/2, h/4), whose error is -c4 h^4 / 64, and T(h/2, h/4) - T(h, h/2) =
+//! 15 c4 h^4 / 64, so a fifteenth of that difference is the judged state's own error estimate.
+//! Every number of the state is combined (`snapshot::richardson`), and each quantity's estimate
+//! is reported per tick and at its largest over the motion.
+//!
+//! The rule holds where the motion is smooth in time. A cable that goes slack or taut between
+//! two ticks at one level and not at another breaks it: the first tick where the levels
+//! disagree on any cable's slack is reported, and the estimates after it are not to be trusted.
+
+use crate::mechanisms::Values;
+use crate::sim::{SimError, Simulation};
+use crate::snapshot::{richardson, Snapshot};
+
+/// The order of the leapfrog scheme's leading error term, cancelled by one Richardson step.
+const LEAPFROG_ORDER: i32 = 2;
+
+/// The judged state's error estimate: the difference of the two Richardson values over
+/// (2^4 - 1), the next term's factor.
+const ESTIMATE_DIVISOR: f64 = 15.0;
+
+/// The motion at h/2 and h/4 beside the runner's own at h.
+pub(super) struct Levels {
+    half: Simulation,
+    quarter: Simulation,
+    /// Each quantity's largest error estimate over the motion so far.
+    pub largest: Values,
+    /// The first tick at which the levels disagree on a cable's slack, if any.
+    pub rough_from_tick: Option<u64>,
+}
+
+/// Actuator commands at a time of the motion [s] (a driven motion's inputs).
+pub(super) type CommandsAt<'a> = &'a dyn Fn(f64) -> Vec<f64>;
+
+impl Levels {
+    /// The finer levels of `sim`, each from its present state started at its own half step.
+    /// Call before `sim` itself starts at its half step.
+    pub fn new(sim: &Simulation) -> Result<Self, SimError> {
+        let dt_s = sim.model().settings.dt_s;
+        let mut half = sim.at_time_step(dt_s / 2.0);
+        half.start_at_half_step()?;
+        let mut quarter = sim.at_time_step(dt_s / 4.0);
+        quarter.start_at_half_step()?;
+        Ok(Levels { half, quarter, largest: Values::new(), rough_from_tick: None })
+    }
+
+    /// Steps the finer levels over the coarse step that ends at motion time `end_s` [s] (of
+    /// length `dt_s`), a driven motion's commands set at the end of each of their steps.
+    pub fn step(&mut self, end_s: f64, dt_s: f64, commands_at: Option<CommandsAt>) -> Result<(), SimError> {
+        for (sim, n) in [(&mut self.half, 2u32), (&mut self.quarter, 4)] {
+            for j in 1..=n {
+                if let Some(c) = commands_at {
+                    sim.drive_commands(&c(end_s - dt_s + f64::from(j) * dt_s / f64::from(n)));
+                }
+                sim.step()?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The judged state at this tick (`coarse` the runner's own, at h) and each quantity's
+    /// error estimate, `observe` reading the quantities off a state.
+    pub fn judge(&mut self, coarse: &Snapshot, observe: &dyn Fn(&Snapshot) -> Values) -> (Snapshot, Values) {
+        let half = self.half.snapshot_with(false);
+        let quarter = self.quarter.snapshot_with(false);
+        let smooth = coarse.forces.cable_slack == half.forces.cable_slack
+            && half.forces.cable_slack == quarter.forces.cable_slack;
+        if !smooth && self.rough_from_tick.is_none() {
+            self.rough_from_tick = Some(coarse.tick);
+        }
+        let mut judged = richardson(&half, &quarter, LEAPFROG_ORDER);
+        let rougher = richardson(coarse, &half, LEAPFROG_ORDER);
+        (judged.tick, judged.time_s) = (coarse.tick, coarse.time_s);
+        let (values, rough_values) = (observe(&judged), observe(&rougher));
+        let estimate: Values = values
+            .iter()
+            .filter_map(|(k, v)| rough_values.get(k).map(|r| (k.clone(), (v - r).abs() / ESTIMATE_DIVISOR)))
+            .collect();
+        for (k, e) in &estimate {
+            let largest = self.largest.entry(k.clone()).or_insert(0.0);
+            *largest = largest.max(*e);
+        }
+        (judged, estimate)
+    }
+}
