@@ -332,8 +332,9 @@ pub struct Motion {
     pub spin: Option<(usize, String, [f64; 3])>,
     /// Judge the motion extrapolated over the time step: the same motion at h, h/2 and h/4,
     /// combined by Richardson's rule at fourth order, with its own error estimate
-    /// (`run/levels.rs`).
-    pub extrapolate: bool,
+    /// (`run/levels.rs`). None: where every free body moves in joint coordinates (rapier
+    /// integrates a plain free body's rotation at first order, which the rule does not cancel).
+    pub extrapolate: Option<bool>,
 }
 
 /// Inputs as functions of the motion's time, followed physically: each actuated joint a

@@ -508,6 +508,7 @@ impl Observer for ModelObserver {
                 }
                 samples.times.push(time_s);
                 samples.coordinates.push(e.measured(&v));
+                samples.extrapolated |= t.estimate.is_some();
             }
         }
         if let Some(series) = &self.series {

@@ -165,7 +165,7 @@ pub fn observers(setup: Setup, warnings: &mut Vec<String>) -> Result<Vec<Box<dyn
     }
     if let Some(target) = &setup.table {
         let motion = setup.motion.is_some();
-        let extrapolated = setup.motion.is_some_and(|m| m.extrapolate);
+        let extrapolated = setup.motion.is_some_and(|m| m.extrapolate != Some(false));
         let model = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, motion));
         list.push(Box::new(match target {
             table::TableTarget::File(path) => table::Table::start(path, model)?.with_estimates(extrapolated),

@@ -166,7 +166,7 @@ impl MotionObserver {
             samples: vec![(Vec::new(), Vec::new()); m.frequencies.len()],
             at: None,
             modes: Vec::new(),
-            extrapolated: m.extrapolate,
+            extrapolated: false,
         }
     }
 
@@ -212,6 +212,7 @@ impl MotionObserver {
 impl Observer for MotionObserver {
     fn tick(&mut self, t: &Tick, _notes: &mut Vec<Note>) {
         let Some(time_s) = t.motion_time_s else { return };
+        self.extrapolated |= t.estimate.is_some();
         if self.at.is_none() {
             self.at = Some((t.params.clone(), t.inputs.clone(), t.prediction.expected.clone()));
         }

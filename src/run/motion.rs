@@ -36,7 +36,7 @@ pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
         frequencies: vec![],
         lagrangian: None,
         driven: m.drive.as_ref().map(|d| driven_text(d)),
-        integration: integration_text(m.extrapolate).into(),
+        integration: String::new(),
         extrapolation: None,
     }
 }
@@ -84,7 +84,11 @@ pub(super) fn run_motion(
     }
     // The steps from here are the leapfrog scheme from the stated start (`sim/levels.rs`):
     // second order at the tick times; extrapolated over the step, fourth (`levels.rs`).
-    if m.extrapolate {
+    let extrapolate = m.extrapolate.unwrap_or(!runner.sim.has_plain_free_bodies());
+    if let Some(r) = report.motion.as_mut() {
+        r.integration = integration_text(extrapolate).into();
+    }
+    if extrapolate {
         runner.levels = Some(Levels::new(&runner.sim)?);
         runner.motion_drive = m.drive.clone();
     }

@@ -18,7 +18,9 @@
 //! undamped = false        # true: every joint's damping released for the motion (a settle to
 //!                         # the start keeps it: damped to equilibrium, then free vibration)
 //! extrapolate = true      # judge the motion extrapolated over the time step (h, h/2, h/4:
-//!                         # fourth order, with its own error estimate); false: rapier's steps
+//!                         # fourth order, with its own error estimate); false: rapier's steps.
+//!                         # Default: true where every free body moves in joint coordinates
+//!                         # (a plain free body's rotation is integrated at first order)
 //! inputs = { x = "A*sin(w*t)" }  # optional: inputs as functions of the parameters and the
 //!                         # motion's time t, followed at their real speed (as [actuation]
 //!                         # waypoints are): each actuated joint driven through the solver
@@ -45,9 +47,6 @@ use crate::structure::{JointKind, Structure};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use toml::Spanned;
-
-/// Whether a motion is judged extrapolated over the time step when its file does not say.
-const EXTRAPOLATE_BY_DEFAULT: bool = true;
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -77,7 +76,8 @@ pub(super) struct RawMotion {
     pub(super) inputs: Option<Spanned<BTreeMap<Spanned<String>, Spanned<String>>>>,
     /// A free body without joints started spinning (a torque-free rigid body).
     pub(super) spin: Option<Spanned<RawSpin>>,
-    /// Judge the motion extrapolated over the time step (`run/levels.rs`); default true.
+    /// Judge the motion extrapolated over the time step (`run/levels.rs`); by default where
+    /// every free body moves in joint coordinates.
     pub(super) extrapolate: Option<bool>,
 }
 
@@ -150,7 +150,7 @@ pub(super) fn motion(
         .map(|f| frequency(ctx, f, (mech, first), params, inputs))
         .collect::<Result<_, _>>()?;
     let undamped = section.undamped;
-    let extrapolate = section.extrapolate.unwrap_or(EXTRAPOLATE_BY_DEFAULT);
+    let extrapolate = section.extrapolate;
     let spin = section.spin.as_ref().map(|sp| spin(ctx, sp, first, params)).transpose()?;
     Ok(Some(Motion {
         duration_s,

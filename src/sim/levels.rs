@@ -5,13 +5,13 @@
 //! symmetric: its global error at the tick times is an even series in h (h^2, h^4, ...). It
 //! starts there only when the velocity it starts from is the one half a step before the start,
 //! v(-h/2) = v(0) - h/2 a(x(0)); from v(0) itself the error is first order (the pinned bar at
-//! 0.5 rad: 4.3e-3 rad at h = 1e-3 s). [`Simulation::start_at_half_step`] takes the velocity back
+//! 0.5 rad: 4.3e-3 rad at h = 1e-3 s). `Simulation::start_at_half_step` takes the velocity back
 //! by half of what one step adds to it, with the step itself measuring a(x(0)) on a copy.
 //!
-//! Copies at h / 2, h / 4, ... ([`Simulation::at_time_step`]) from the same state are what a
+//! Copies at h / 2, h / 4, ... (`Simulation::at_time_step`) from the same state are what a
 //! Richardson extrapolation over the step combines (`run/levels.rs`).
 
-use super::{Data, Model, Simulation};
+use super::{Data, Model};
 use nalgebra::DVector;
 use rapier3d_f64::prelude::*;
 
@@ -48,6 +48,11 @@ struct Velocities {
 }
 
 impl Data {
+    /// Whether any free body is a plain rigid body, not a multibody link.
+    pub(super) fn has_plain_free_bodies(&self, m: &Model) -> bool {
+        m.handles.iter().enumerate().any(|(b, &h)| m.is_free(b) && self.multibody_joints.rigid_body_link(h).is_none())
+    }
+
     fn velocities(&self, m: &Model) -> Velocities {
         let mut multibodies: Vec<(MultibodyIndex, DVector<f64>)> = Vec::new();
         let mut bodies = Vec::new();
@@ -108,36 +113,11 @@ impl Velocities {
     }
 }
 
-impl Simulation {
-    /// This simulation's state, stepped from now on at `dt_s` [s]: the same structure and
-    /// settings but the time step, the same bodies, joints, inputs and tick. The projection's
-    /// kept Jacobians and rests start afresh (they are caches of the state).
-    pub fn at_time_step(&self, dt_s: f64) -> Simulation {
-        let model = self.model.at_time_step(dt_s);
-        let mut data = self.data.clone();
-        data.params.dt = dt_s;
-        Simulation {
-            model,
-            data,
-            relaxation: super::relaxation::Relaxation::default(),
-            path: self.path.clone(),
-            drive: self.drive.clone(),
-            projection: super::projection::Projection::default(),
-            closure_rests: super::closure_rest::ClosureRests::default(),
-        }
-    }
-
-    /// Starts the dynamics from now at a half step: every velocity taken back by half of what
-    /// one step from here adds to it (measured on a copy), so that the steps that follow are
-    /// the leapfrog scheme from the present state, second order at the tick times. Only for
-    /// physical motion ([`Simulation::end_acceleration`] first); Err where the trial step
-    /// diverges.
-    pub fn start_at_half_step(&mut self) -> Result<(), super::SimError> {
-        let before = self.data.velocities(&self.model);
-        let mut trial = self.at_time_step(self.model.settings.dt_s);
-        trial.step()?;
-        let after = trial.data.velocities(&trial.model);
-        self.data.set_velocities(&self.model, &before.half_step_back(&after));
-        Ok(())
+impl Data {
+    /// Takes every velocity back by half of what one step adds to it: `after` is the state one
+    /// step on from this one (a trial step of a copy).
+    pub(super) fn half_step_back(&mut self, m: &Model, after: &Data) {
+        let (before, after) = (self.velocities(m), after.velocities(m));
+        self.set_velocities(m, &before.half_step_back(&after));
     }
 }

@@ -325,6 +325,12 @@ impl Simulation {
         self.model.is_free(body)
     }
 
+    /// Whether a free body moves as a plain rigid body (not a link of a multibody): rapier
+    /// integrates its rotation at first order (its gyroscopic term explicitly).
+    pub fn has_plain_free_bodies(&self) -> bool {
+        self.data.has_plain_free_bodies(&self.model)
+    }
+
     /// Displaces every free joint coordinate of every multibody by `delta` (rad or m) and zeroes
     /// the velocities: the perturbation used to classify an equilibrium.
     pub fn perturb_free_coordinates(&mut self, delta: f64) {
@@ -370,6 +376,35 @@ impl Simulation {
         // The actuators to the commands `s` was built at, as for any new command.
         self.set_commands(&s.initial_commands());
         self.data.place_free_joints(&self.model, s)
+    }
+
+    /// This simulation's state, stepped from now on at `dt_s` [s]: the same structure and
+    /// settings but the time step, the same bodies, joints, inputs and tick (`levels.rs`). The
+    /// projection's kept Jacobians and rests start afresh (they are caches of the state).
+    pub fn at_time_step(&self, dt_s: f64) -> Simulation {
+        let mut data = self.data.clone();
+        data.params.dt = dt_s;
+        Simulation {
+            model: self.model.at_time_step(dt_s),
+            data,
+            relaxation: relaxation::Relaxation::default(),
+            path: self.path.clone(),
+            drive: self.drive.clone(),
+            projection: projection::Projection::default(),
+            closure_rests: closure_rest::ClosureRests::default(),
+        }
+    }
+
+    /// Starts the dynamics from now at a half step: every velocity taken back by half of what
+    /// one step from here adds to it (measured on a copy), so that the steps that follow are
+    /// the leapfrog scheme from the present state, second order at the tick times
+    /// (`levels.rs`). For physical motion ([`Simulation::end_acceleration`] first); Err where
+    /// the trial step diverges.
+    pub fn start_at_half_step(&mut self) -> Result<(), SimError> {
+        let mut trial = self.at_time_step(self.model.settings.dt_s);
+        trial.step()?;
+        self.data.half_step_back(&self.model, &trial.data);
+        Ok(())
     }
 
     /// Sets every actuated joint's coordinate to its command, with zero velocity (ideal

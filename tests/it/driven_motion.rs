@@ -83,29 +83,35 @@ fn the_shipped_driven_cart_passes_with_a_physical_path() {
 /// theta follows the nonlinear equation tick by tick within an error falling as dt^2.
 #[test]
 fn the_driven_swing_matches_the_exact_equation_with_an_error_falling_as_dt_squared() {
-    let stroke_m = 0.3;
     let steps = [4e-3, 2e-3, 1e-3];
-    let mut errors = Vec::new();
-    for dt in steps {
-        let text = variant(&[
-            ("[sim]\ndt = 1e-3", &format!("[sim]\ndt = {dt}")),
-            ("A = { value = 0.01", &format!("A = {{ value = {stroke_m}")),
-            ("duration_s = 10.0", "duration_s = 4.0"),
-            ("tolerance = 1e-5 ", "tolerance = 1.0 "),
-        ]);
-        let (report, rows) = swing(&text, &format!("{dt}"));
-        assert!(report.error.is_none(), "{:?}", report.error);
-        let times: Vec<f64> = rows.iter().map(|r| r.0).collect();
-        let exact = exact_swing(stroke_m, &times);
-        let largest = exact.iter().fold(0.0_f64, |m, q| m.max(q.abs()));
-        assert!(largest > 0.4, "the swing reaches {largest} rad");
-        let e = rows.iter().zip(&exact).map(|(r, q)| (r.1 - q).abs()).fold(0.0, f64::max);
-        errors.push(e);
+    let errors_of = |extrapolate: bool| -> Vec<f64> { steps.iter().map(|dt| swing_error(*dt, extrapolate)).collect() };
+    let (stepped, extrapolated) = (errors_of(false), errors_of(true));
+    let p = super::common::fitted_order(&steps, &stepped);
+    eprintln!("driven swing against the exact equation at dt {steps:?}: {stepped:?} rad (order {p:.3}); extrapolated {extrapolated:?}");
+    assert!((p - 2.0).abs() <= 0.1, "order {p}: {stepped:?}");
+    assert!(stepped[2] <= 1e-3, "{stepped:?}");
+    for e in &extrapolated {
+        assert!(*e <= 1e-10, "extrapolated {extrapolated:?}");
     }
-    let p = super::common::fitted_order(&steps, &errors);
-    eprintln!("driven swing against the exact equation at dt {steps:?}: {errors:?} rad (order {p:.3})");
-    assert!((p - 2.0).abs() <= 0.1, "order {p}: {errors:?}");
-    assert!(errors[2] <= 1e-3, "{errors:?}");
+}
+
+/// The largest error of the simulated swing at a stroke of 0.3 m against the exact equation,
+/// at time step `dt_s`, the motion extrapolated over the step or rapier's steps alone [rad].
+fn swing_error(dt_s: f64, extrapolate: bool) -> f64 {
+    let stroke_m = 0.3;
+    let text = variant(&[
+        ("[sim]\ndt = 1e-3", &format!("[sim]\ndt = {dt_s}")),
+        ("A = { value = 0.01", &format!("A = {{ value = {stroke_m}")),
+        ("duration_s = 10.0", &format!("duration_s = 4.0\nextrapolate = {extrapolate}")),
+        ("tolerance = 1e-5 ", "tolerance = 1.0 "),
+    ]);
+    let (report, rows) = swing(&text, &format!("{dt_s}-{extrapolate}"));
+    assert!(report.error.is_none(), "{:?}", report.error);
+    let times: Vec<f64> = rows.iter().map(|r| r.0).collect();
+    let exact = exact_swing(stroke_m, &times);
+    let largest = exact.iter().fold(0.0_f64, |m, q| m.max(q.abs()));
+    assert!(largest > 0.4, "the swing reaches {largest} rad");
+    rows.iter().zip(&exact).map(|(r, q)| (r.1 - q).abs()).fold(0.0, f64::max)
 }
 
 /// Waypoints are followed at their speed too: a ramp of 0.1 m in 1 s starts the cart at

@@ -43,10 +43,12 @@ fn table_columns(text: &str, name: &str, columns: &[&str]) -> (ScenarioReport, V
     super::common::table_columns(text, name, columns)
 }
 
-/// The shipped free vibration passes: the frequency measured from the motion and corrected for
-/// symplectic Euler's dispersion is within 1e-6 of sqrt(V''/I) (measured 6.25e-8: the
-/// pendulum's own shift A^2/16 at A = 1e-3), uncorrected 1.09e-5 = (omega dt)^2/24; its path is
-/// physical, its closed-form trajectory met within 1.5e-5 rad at every tick.
+/// The shipped free vibration passes: judged extrapolated over the step (the default), the
+/// frequency measured from the motion needs no dispersion correction (corrected and uncorrected
+/// are the same) and is within 1e-6 of sqrt(V''/I) (measured 6.25e-8: the pendulum's own shift
+/// A^2/16 at A = 1e-3); rapier's steps alone at 1 ms are (omega dt)^2/24 = 1.1e-5 fast. Its
+/// path is physical, its closed-form trajectory met within 1.5e-5 rad at every tick (measured
+/// 4.0e-9: the linear closed form's own error at A = 1e-3).
 #[test]
 fn the_shipped_free_vibration_meets_the_linear_frequency_within_1e_6_once_corrected() {
     let report = super::common::run_file(SHIPPED);
@@ -54,10 +56,14 @@ fn the_shipped_free_vibration_meets_the_linear_frequency_within_1e_6_once_correc
     assert_eq!(report.path, PathKind::Physical);
     let m = report.motion.as_ref().expect("a motion report");
     assert_eq!((m.steps_taken, m.accelerated_steps), (4000, 0));
+    assert!(m.extrapolation.is_some(), "{}", m.integration);
     let f = &m.frequencies[0];
     assert!(f.error <= 1e-6, "corrected error {:e}", f.error);
+    assert_eq!(f.uncorrected_error, f.error);
+    let stepped = run_text(&variant(&[("[motion]", "[motion]\nextrapolate = false")]), &RunOptions::default());
+    let s = &stepped.motion.as_ref().expect("a motion report").frequencies[0];
     let dispersion = (omega() * 1e-3).powi(2) / 24.0;
-    assert!((f.uncorrected_error - dispersion).abs() <= 0.02 * dispersion, "uncorrected {:e}", f.uncorrected_error);
+    assert!((s.uncorrected_error - dispersion).abs() <= 0.02 * dispersion, "uncorrected {:e}", s.uncorrected_error);
     let amplitude_shift = 1e-6 / 16.0;
     assert!((f.error - amplitude_shift).abs() <= 0.05 * amplitude_shift, "corrected {:e}", f.error);
     let p = report.model_checks.iter().find(|c| c.name == "small oscillation").unwrap();
@@ -104,7 +110,7 @@ fn a_motion_run_is_labelled_physical_and_an_accelerated_settle_accelerated() {
 fn undamped_free_vibration_keeps_its_energy_within_the_integrators_bound_over_100_periods() {
     let period_s = 2.0 * std::f64::consts::PI / omega();
     let duration = format!("duration_s = {}", 100.0 * period_s);
-    let text = variant(&[("duration_s = 4.0", &duration)]);
+    let text = variant(&[("duration_s = 4.0", &format!("{duration}\nextrapolate = false"))]);
     let (report, cols) = table_columns(&text, "energy", &["kinetic_energy_j", "node:P.x", "node:P.y"]);
     assert!(report.passed, "{}", report.verdict_line());
     let q_star = f64::atan2(K1 * 0.8, K2 * 0.6);
@@ -155,39 +161,49 @@ fn damped_free_vibration_decays_at_the_rate_the_damping_predicts() {
 }
 
 /// Trajectory error against the exact linear solution q* + A cos(omega t) at three time steps,
-/// with the fitted order of log(error) against log(dt): symplectic Euler's samples lead the
-/// exact motion by half a step, a first-order error (measured: 3.8e-5, 1.8e-5, 8.4e-6 rad at
-/// dt = 4, 2, 1 ms, order 1.08; about A omega dt / 2); against the exact solution at t + dt/2
-/// the error is second order (5.3e-6, 1.3e-6, 3.3e-7 rad, order 2.00).
+/// with the fitted order of log(error) against log(dt). rapier's steps from the stated start
+/// taken back half a step are the leapfrog scheme: second order at the samples' times
+/// (measured 5.3e-6, 1.3e-6, 3.3e-7 rad at dt = 4, 2, 1 ms, order 2.00); against the exact
+/// solution half a step on they are first order (3.2e-5, 1.6e-5, 8.1e-6). Extrapolated over the
+/// step, what is left at every dt is the linear closed form's own error at A = 1e-3 (measured
+/// 1.9e-9 at each).
 #[test]
 fn trajectory_error_against_the_exact_solution_falls_as_dt_and_as_dt_squared_half_a_step_on() {
-    let mut lag = Vec::new();
-    let mut shifted = Vec::new();
+    let (mut at_samples, mut shifted, mut extrapolated) = (Vec::new(), Vec::new(), Vec::new());
     let steps = [4e-3, 2e-3, 1e-3];
     for dt in steps {
-        let text = variant(&[
-            ("[sim]\ndt = 1e-3", &format!("[sim]\ndt = {dt}")),
-            ("A = { value = 1e-3", &format!("dt = {dt}\nA = {{ value = 1e-3")),
-            ("duration_s = 4.0", "duration_s = 2.0"),
-            ("tolerance = 1.5e-5", "tolerance = 1.0"),
-            ("rms_tolerance = 1e-5", "rms_tolerance = 1.0"),
-            (
-                "[energy]",
-                "[[predictions]]\nname = \"half a step on\"\nquantity = \"q\"\nformula = \"q_star + A*cos(omega*(t + dt/2))\"\nclass = \"angle\"\ntolerance = 1.0\n\n[energy]",
-            ),
-        ]);
-        let report = run_text(&text, &RunOptions::default());
-        let err = |name: &str| report.model_checks.iter().find(|c| c.name == name).unwrap().max_error;
-        lag.push(err("small oscillation"));
-        shifted.push(err("half a step on"));
+        for extrapolate in [false, true] {
+            let text = variant(&[
+                ("[sim]\ndt = 1e-3", &format!("[sim]\ndt = {dt}")),
+                ("A = { value = 1e-3", &format!("dt = {dt}\nA = {{ value = 1e-3")),
+                ("duration_s = 4.0", &format!("duration_s = 2.0\nextrapolate = {extrapolate}")),
+                ("tolerance = 1.5e-5", "tolerance = 1.0"),
+                ("rms_tolerance = 1e-5", "rms_tolerance = 1.0"),
+                (
+                    "[energy]",
+                    "[[predictions]]\nname = \"half a step on\"\nquantity = \"q\"\nformula = \"q_star + A*cos(omega*(t + dt/2))\"\nclass = \"angle\"\ntolerance = 1.0\n\n[energy]",
+                ),
+            ]);
+            let report = run_text(&text, &RunOptions::default());
+            let err = |name: &str| report.model_checks.iter().find(|c| c.name == name).unwrap().max_error;
+            if extrapolate {
+                extrapolated.push(err("small oscillation"));
+            } else {
+                at_samples.push(err("small oscillation"));
+                shifted.push(err("half a step on"));
+            }
+        }
     }
     let order = |errors: &[f64]| super::common::fitted_order(&steps, errors);
-    let (p1, p2) = (order(&lag), order(&shifted));
+    let (p2, p1) = (order(&at_samples), order(&shifted));
     eprintln!(
-        "trajectory errors at dt {steps:?}: {lag:?} (order {p1:.3}); half a step on: {shifted:?} (order {p2:.3})"
+        "trajectory errors at dt {steps:?}: {at_samples:?} (order {p2:.3}); half a step on: {shifted:?} (order {p1:.3}); extrapolated {extrapolated:?}"
     );
-    assert!((p1 - 1.0).abs() <= 0.15, "order at the samples' times {p1}: {lag:?}");
-    assert!((p2 - 2.0).abs() <= 0.1, "order half a step on {p2}: {shifted:?}");
+    assert!((p2 - 2.0).abs() <= 0.1, "order at the samples' times {p2}: {at_samples:?}");
+    assert!((p1 - 1.0).abs() <= 0.15, "order half a step on {p1}: {shifted:?}");
+    for e in &extrapolated {
+        assert!(*e <= 5e-9, "extrapolated {extrapolated:?}");
+    }
 }
 
 /// `[expect]` works for motion runs: a frequency claimed 0.1 % high fails by name
@@ -238,7 +254,17 @@ const LARGE: &str = "scenarios/custom/pinned_bar_large_amplitude.toml";
 /// The shipped half-radian release at time step `dt_s` (and amplitude `amplitude_rad`): its
 /// Lagrangian comparison of qe.
 fn lagrangian_at(dt_s: f64, amplitude_rad: f64) -> tensegrity_testbed::report::LagrangianCoordinateReport {
+    lagrangian_with(dt_s, amplitude_rad, true)
+}
+
+/// [`lagrangian_at`], the motion extrapolated over the step or rapier's steps alone.
+fn lagrangian_with(
+    dt_s: f64,
+    amplitude_rad: f64,
+    extrapolate: bool,
+) -> tensegrity_testbed::report::LagrangianCoordinateReport {
     let text = std::fs::read_to_string(LARGE).expect("the shipped scenario");
+    let text = text.replacen("[motion]", &format!("[motion]\nextrapolate = {extrapolate}"), 1);
     let text = text.replacen("[sim]\ndt = 1e-3", &format!("[sim]\ndt = {dt_s}"), 1).replacen(
         "A = { value = 0.5,",
         &format!("A = {{ value = {amplitude_rad},"),
@@ -252,13 +278,19 @@ fn lagrangian_at(dt_s: f64, amplitude_rad: f64) -> tensegrity_testbed::report::L
 
 /// At 0.5 rad, where the linear frequency is 1.56 % off, the simulated motion and the file's
 /// Lagrangian model (integrated beside it) agree tick by tick within the simulator's own
-/// error, and that error falls as dt^2 over three time steps (measured 5.23e-3, 1.31e-3,
-/// 3.27e-4 rad at 4, 2, 1 ms: ratios 4.00).
+/// error: with rapier's steps alone that error falls as dt^2 over three time steps (measured
+/// 5.23e-3, 1.31e-3, 3.27e-4 rad at 4, 2, 1 ms: ratios 4.00).
 #[test]
 fn the_lagrangian_trajectory_at_half_a_radian_matches_the_motion_within_an_error_falling_as_dt_squared() {
     let steps = [4e-3, 2e-3, 1e-3];
-    let errors: Vec<f64> = steps.iter().map(|dt| lagrangian_at(*dt, 0.5).max_error).collect();
-    eprintln!("Lagrangian against the motion at dt {steps:?}: {errors:?}");
+    let errors: Vec<f64> = steps.iter().map(|dt| lagrangian_with(*dt, 0.5, false).max_error).collect();
+    let extrapolated: Vec<f64> = steps.iter().map(|dt| lagrangian_at(*dt, 0.5).max_error).collect();
+    eprintln!("Lagrangian against the motion at dt {steps:?}: {errors:?}; extrapolated {extrapolated:?}");
+    // Extrapolated, the model's start read from the motion's first samples is what is left
+    // (measured 7.4e-6, 9.2e-7, 1.16e-7 rad: third order), 700 to 2800 times below.
+    for (x, s) in extrapolated.iter().zip(&errors) {
+        assert!(*x <= s / 500.0, "extrapolated {extrapolated:?} against {errors:?}");
+    }
     for pair in errors.windows(2) {
         let ratio = pair[0] / pair[1];
         assert!((ratio - 4.0).abs() <= 0.05, "halving dt divides the error by {ratio}: {errors:?}");
