@@ -152,7 +152,7 @@ impl Dopri5 {
         let s = &mut self.s;
         while self.t < target {
             let steps = s.stats.accepted + s.stats.rejected;
-            if steps % CANCEL_POLL_STEPS == 0 && cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
+            if steps.is_multiple_of(CANCEL_POLL_STEPS) && cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
                 return Err(IntegrateError::Interrupted);
             }
             if steps >= s.tol.max_steps {

@@ -11,9 +11,8 @@
 //!   samples q_k are those of the leapfrog scheme, whose rates live at the half steps,
 //!   (q_{k+1} - q_k) / dt = q'(t_k + dt/2) + O(dt^2). The model therefore starts at
 //!   t_{3/2} = 1.5 dt, between the first two samples of the motion (ticks 1 and 2), with
-//!     q(t_{3/2})  = (q_1 + q_2) / 2 - (q_3 - 2 q_2 + q_1) / 8   (Taylor, error O(dt^3)),
-//!     q'(t_{3/2}) = (q_2 - q_1) / dt                            (error O(dt^2)),
-//!   and is compared from tick 2 on (the values of ticks 2 and 3 are known at tick 3). The
+//!   q(t_{3/2}) = (q_1 + q_2) / 2 - (q_3 - 2 q_2 + q_1) / 8 (Taylor, error O(dt^3)) and
+//!   q'(t_{3/2}) = (q_2 - q_1) / dt (error O(dt^2)), and is compared from tick 2 on (the values of ticks 2 and 3 are known at tick 3). The
 //!   leapfrog's own global error is O(dt^2), so the whole comparison falls as dt^2 where the
 //!   model is right (`tests/it/motion.rs` shows it over three time steps at 0.5 rad), and stays
 //!   where it is when it is not.
@@ -69,6 +68,9 @@ pub enum LagrangianError {
     NoStatedStart(String),
 }
 
+/// The file's initial condition in the model's coordinates, (q(0), q'(0)), or why there is none.
+pub type StatedStart = Result<(Vec<f64>, Vec<f64>), LagrangianError>;
+
 /// One tick of the motion against the model: the simulated coordinates (angles unwrapped,
 /// continuous through +-pi), and where the tick is compared the model's coordinates and the
 /// errors (in each coordinate's class), in the order of `[[energy.coordinates]]`.
@@ -92,8 +94,8 @@ pub struct Tracker {
     span_s: f64,
     /// Every symbol's value at the motion's first tick (its parameters and inputs).
     values: Vec<f64>,
-    /// The stated start (q(0), q'(0)), handed in before the motion's first tick.
-    stated: Option<Result<(Vec<f64>, Vec<f64>), LagrangianError>>,
+    /// The stated start, handed in before the motion's first tick.
+    stated: Option<StatedStart>,
     times: Vec<f64>,
     /// Per coordinate, its simulated value at every tick (angles unwrapped).
     series: Vec<Vec<f64>>,
@@ -139,7 +141,7 @@ impl Tracker {
 
     /// The file's initial condition (q(0), q'(0)) in the model's coordinates, or why there is
     /// none; used when the model starts from it.
-    pub fn set_stated(&mut self, stated: Result<(Vec<f64>, Vec<f64>), LagrangianError>) {
+    pub fn set_stated(&mut self, stated: StatedStart) {
         self.stated = Some(stated);
     }
 

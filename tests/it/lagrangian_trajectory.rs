@@ -94,45 +94,74 @@ fn the_table_holds_the_model_and_its_error_at_every_tick() {
     }
 }
 
-/// Per entity of a recording, the `tick` values logged.
-fn recorded_ticks(path: &Path) -> BTreeMap<String, BTreeSet<i64>> {
+/// Per entity of a recording, its scalar rows: (tick, the values logged there).
+type Scalars = BTreeMap<String, Vec<(i64, Vec<f64>)>>;
+
+/// The component of a `Scalars` archetype.
+const SCALARS_COMPONENT: &str = "Scalars:scalars";
+
+/// Per entity of a recording (data store only), the `tick` values logged, and its scalar rows.
+fn read_recording(path: &Path) -> (BTreeMap<String, BTreeSet<i64>>, Scalars) {
     let file = std::io::BufReader::new(std::fs::File::open(path).expect("recording exists"));
-    let mut out: BTreeMap<String, BTreeSet<i64>> = BTreeMap::new();
+    let (mut ticks, mut scalars): (BTreeMap<String, BTreeSet<i64>>, Scalars) = Default::default();
     for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
-        if let re_log_types::LogMsg::ArrowMsg(store, arrow) = msg.expect("decodes") {
-            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).expect("a chunk");
-            if store.kind() == re_log_types::StoreKind::Blueprint {
-                continue;
-            }
-            let ticks = out.entry(chunk.entity_path().to_string()).or_default();
-            if let Some(col) = chunk.timelines().iter().find(|(name, _)| name.as_str() == "tick").map(|(_, c)| c) {
-                ticks.extend(col.times_raw().iter().copied());
-            }
+        let re_log_types::LogMsg::ArrowMsg(store, arrow) = msg.expect("decodes") else { continue };
+        let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).expect("a chunk");
+        if store.kind() == re_log_types::StoreKind::Blueprint {
+            continue;
+        }
+        let entity = chunk.entity_path().to_string();
+        let Some(col) = chunk.timelines().iter().find(|(name, _)| name.as_str() == "tick").map(|(_, c)| c) else {
+            continue;
+        };
+        ticks.entry(entity.clone()).or_default().extend(col.times_raw().iter().copied());
+        let id = chunk.components_identifiers().find(|id| id.to_string() == SCALARS_COMPONENT);
+        if let Some(id) = id {
+            let rows = col.times_raw().iter().zip(chunk.iter_slices::<f64>(id));
+            scalars.entry(entity.clone()).or_default().extend(rows.map(|(t, v)| (*t, v.to_vec())));
         }
     }
-    out
+    (ticks, scalars)
 }
 
 /// The recording holds qe simulated against its model (`trajectory/qe`) and their error
-/// (`trajectory_error/qe`) at every compared tick (2 to 4000), and each frequency check's fit
-/// and model value over the motion (`frequencies/NAME`, at its first and last tick).
+/// (`trajectory_error/qe`) at every compared tick (2 to 4000), the table's values there bit for
+/// bit, and each frequency check's fit and model value over the motion (`frequencies/NAME`, at
+/// its first and last tick) as the report has them.
 #[test]
 fn the_recording_holds_the_model_beside_the_simulation() {
-    let rrd = dir("record").join("bar.rrd");
+    let d = dir("record");
+    let (rrd, csv) = (d.join("bar.rrd"), d.join("bar.csv"));
     let sc = scenario::load(Path::new(LARGE)).unwrap();
-    let r = run(&sc, &RunOptions { record: Some(rrd.clone()), ..RunOptions::default() });
-    let steps = r.motion.as_ref().unwrap().steps_taken as i64;
-    let entities = recorded_ticks(&rrd);
+    let r =
+        run(&sc, &RunOptions { record: Some(rrd.clone()), table: Some(csv.clone().into()), ..RunOptions::default() });
+    let m = r.motion.as_ref().unwrap();
+    let steps = m.steps_taken as i64;
+    let (entities, scalars) = read_recording(&rrd);
     let compared: BTreeSet<i64> = (2..=steps).collect();
     for e in ["/trajectory/qe", "/trajectory_error/qe"] {
         let ticks = entities.get(e).unwrap_or_else(|| panic!("{e} missing: {:?}", entities.keys()));
         assert_eq!(ticks, &compared, "{e}");
     }
-    // rerun's entity paths escape spaces and colons.
-    for e in ["/frequencies/linear", "/frequencies/at\\ amplitude\\ A", "/frequencies/trajectory\\:qe"] {
-        let ticks = entities.get(e).unwrap_or_else(|| panic!("{e} missing: {:?}", entities.keys()));
-        assert_eq!(ticks, &BTreeSet::from([0, steps]), "{e}");
+    let (header, rows) = read_csv(&csv);
+    let col = |name: &str| header.iter().position(|h| h == name).expect("the column");
+    let [sim, model, error] = COLUMNS.map(col);
+    let by_tick: BTreeMap<i64, &Vec<Option<f64>>> = rows.iter().map(|row| (row[0].unwrap() as i64, row)).collect();
+    for (tick, values) in &scalars["/trajectory/qe"] {
+        assert_eq!(values, &[by_tick[tick][sim].unwrap(), by_tick[tick][model].unwrap()], "tick {tick}");
     }
+    for (tick, values) in &scalars["/trajectory_error/qe"] {
+        assert_eq!(values, &[by_tick[tick][error].unwrap()], "tick {tick}");
+    }
+    // rerun's entity paths escape spaces and colons.
+    let checks = ["/frequencies/linear", "/frequencies/at\\ amplitude\\ A"];
+    for (e, f) in checks.iter().zip(&m.frequencies) {
+        let want = vec![f.corrected_rad_per_s, f.predicted_rad_per_s];
+        assert_eq!(scalars[*e], [(0, want.clone()), (steps, want)], "{e}");
+    }
+    let c = &m.lagrangian.as_ref().unwrap().coordinates[0];
+    let want = vec![c.simulated_omega_rad_per_s, c.model_omega_rad_per_s];
+    assert_eq!(scalars["/frequencies/trajectory\\:qe"], [(0, want.clone()), (steps, want)]);
 }
 
 /// The shipped file's text started from its stated initial condition, at time step `dt_s`.
