@@ -301,6 +301,26 @@ mod tests {
         assert!(order > 4.5 && order < 6.5, "observed order {order}");
     }
 
+    /// Advanced sample by sample, the integrator takes the steps it takes over all the samples
+    /// at once: the same states, to the bit, and the same counts.
+    #[test]
+    fn advancing_sample_by_sample_is_the_batch_integration_to_the_bit() {
+        let mut pendulum = |_: f64, y: &[f64], dy: &mut [f64]| {
+            dy[0] = y[1];
+            dy[1] = -263.0 * y[0].sin();
+            true
+        };
+        let times: Vec<f64> = (1..=500).map(|k| k as f64 * 1e-3).collect();
+        let (y0, tol) = ([0.5, 0.0], Tolerance::default());
+        let (batch, stats) = dopri5(&mut pendulum, 0.0, &y0, &times, &tol, None).unwrap();
+        let mut d = Dopri5::start(&mut pendulum, 0.0, &y0, times[times.len() - 1], &tol).unwrap();
+        for (t, y) in times.iter().zip(&batch) {
+            assert_eq!(d.advance(&mut pendulum, *t, None).unwrap(), y.as_slice(), "t {t}");
+        }
+        assert_eq!(d.stats(), stats);
+        assert_eq!(d.advance(&mut pendulum, 0.1, None).unwrap_err(), IntegrateError::Times);
+    }
+
     #[test]
     fn decreasing_times_are_refused() {
         let r = dopri5(|_, _, _| true, 0.0, &[0.0], &[1.0, 0.5], &Tolerance::default(), None);

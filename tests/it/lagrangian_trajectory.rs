@@ -219,6 +219,20 @@ fn a_stated_rate_starts_the_model_moving() {
     assert!(l.coordinates[0].max_error <= 2.0 * STATED_ERRORS_RAD[1], "{:?}", l.coordinates[0]);
 }
 
+/// From a settled start the stated start is the settled angle plus the displacement: the
+/// settle lands on q* (within the settle tolerances), so the model starts at q* + 0.5 rad
+/// within 1e-9 and the error is the drawn start's within 1 %.
+#[test]
+fn the_stated_start_after_a_settle_is_the_settled_state_displaced() {
+    let q_star = f64::atan2(50.0 * 0.8, 30.0 * 0.6);
+    let r = run_text(&stated(1e-3).replacen("start = \"drawn\"", "start = \"settled\"", 1), &RunOptions::default());
+    let l = lagrangian(&r);
+    assert_eq!(l.start, "stated");
+    assert!((l.start_coordinates[0] - (q_star + 0.5)).abs() <= 1e-9, "{:?}", l.start_coordinates);
+    let e = l.coordinates[0].max_error;
+    assert!((e - STATED_ERRORS_RAD[1]).abs() <= 0.01 * STATED_ERRORS_RAD[1], "{e}");
+}
+
 /// A start that is neither "samples" nor "stated" is refused where it is written.
 #[test]
 fn an_unknown_start_is_located() {
