@@ -54,6 +54,24 @@ def test_a_scenario_from_text_runs_and_keeps_its_table():
     assert "joint:pin.angle" in table.column_names
 
 
+LARGE = ROOT / "scenarios" / "custom" / "pinned_bar_large_amplitude.toml"
+
+
+def test_the_table_has_the_lagrangian_model_beside_the_simulation():
+    """A motion with [energy.trajectory]: per tick, qe simulated, the model's qe and their error
+    (the first motion tick, one the model starts from, uncompared), as the CLI's table has them;
+    the largest error is the report's."""
+    result = tt.run(LARGE, table=True)
+    frame = result.table.to_pandas()
+    sim, model, error = (frame[f"trajectory_{k}:qe"] for k in ("sim", "model", "error"))
+    compared = model.notna()
+    lagrangian = result.report["motion"]["lagrangian"]
+    assert lagrangian["start"] == "samples"
+    assert int(compared.sum()) == lagrangian["coordinates"][0]["ticks_compared"] == len(frame) - 1
+    assert ((model - sim).abs() - error)[compared].abs().max() <= 1e-15
+    assert error.max() == lagrangian["coordinates"][0]["max_error"]
+
+
 def test_bad_input_is_a_located_exception():
     text = QUICK.read_text().replace("[params]", "[params]\nK9 = 1.0", 1)
     with pytest.raises(tt.ScenarioError) as e:

@@ -11,7 +11,7 @@
 
 use super::energy_model::EnergySpec;
 use super::expr::Expr;
-use super::integrate::{dopri5, IntegrateError, Stats, Tolerance};
+use super::integrate::{Dopri5, IntegrateError, Stats, Tolerance};
 use super::spec::ModelSpec;
 use crate::eigen::{modes, EigenError, Mode};
 use crate::mechanisms::Values;
@@ -50,13 +50,48 @@ pub struct Dynamics {
     pub trajectory: Option<TrajectoryCheck>,
 }
 
-/// The tolerances of a motion against the Lagrangian model, per coordinate and in its class.
+/// The tolerances of a motion against the Lagrangian model, per coordinate and in its class,
+/// and where the model starts.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TrajectoryCheck {
     /// On the largest error over the motion's ticks [m or rad].
     pub tolerance: f64,
     /// On the rms error over them, if given.
     pub rms_tolerance: Option<f64>,
+    pub start: TrajectoryStart,
+}
+
+/// Where the Lagrangian model of `[energy.trajectory]` starts (`start = "..."`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TrajectoryStart {
+    /// From the simulation's own first three samples, at t = 1.5 dt (the leapfrog's
+    /// half-step rates): nothing is assumed of how the motion was started.
+    #[default]
+    Samples,
+    /// From the file's initial condition at t = 0: the coordinates of the state the motion
+    /// starts from (the settled or drawn equilibrium with `[motion]`'s displacement), and
+    /// `[motion]`'s rate along them. The paper's claim, as it states it.
+    Stated,
+}
+
+impl TrajectoryStart {
+    /// The names a file writes.
+    pub const NAMES: &'static [&'static str] = &["samples", "stated"];
+
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "samples" => Some(TrajectoryStart::Samples),
+            "stated" => Some(TrajectoryStart::Stated),
+            _ => None,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            TrajectoryStart::Samples => "samples",
+            TrajectoryStart::Stated => "stated",
+        }
+    }
 }
 
 /// The coordinates and rates of a trajectory at its sample times.
@@ -139,6 +174,32 @@ impl EnergySpec {
         tol: &Tolerance,
         cancel: Option<&AtomicBool>,
     ) -> Result<Trajectory, DynamicsError> {
+        if times.windows(2).any(|w| w[1] < w[0]) || times.first().is_some_and(|t| *t < 0.0) {
+            return Err(IntegrateError::Times.into());
+        }
+        let span = times.last().copied().unwrap_or(0.0);
+        let mut stepper = self.start_trajectory(values, q0, v0, span, tol)?;
+        let mut out = Trajectory { times: times.to_vec(), ..Trajectory::default() };
+        for &t in times {
+            let (q, v) = stepper.advance(self, t, cancel)?;
+            out.coordinates.push(q.to_vec());
+            out.rates.push(v.to_vec());
+        }
+        out.stats = stepper.stats();
+        Ok(out)
+    }
+
+    /// The model's motion from (q0, v0) at t = 0, to be advanced sample by sample
+    /// ([`TrajectoryStepper::advance`]) up to `span` [s]: the same steps, to the bit, as
+    /// [`EnergySpec::integrate`] over every sample at once.
+    pub fn start_trajectory(
+        &self,
+        values: &[f64],
+        q0: &[f64],
+        v0: &[f64],
+        span: f64,
+        tol: &Tolerance,
+    ) -> Result<TrajectoryStepper, DynamicsError> {
         self.dynamics.as_ref().ok_or(DynamicsError::NoKinetic)?;
         let n = self.coordinates.len();
         if q0.len() != n || v0.len() != n {
@@ -151,20 +212,47 @@ impl EnergySpec {
             return Err(DynamicsError::MassNotPositiveDefinite(q0.to_vec()));
         }
         let y0: Vec<f64> = q0.iter().chain(v0).copied().collect();
-        let rhs = |_t: f64, y: &[f64], dy: &mut [f64]| {
-            self.set_state(&mut work, &y[..n], &y[n..]);
-            let Some(a) = self.acceleration(&work) else { return false };
+        let dopri = Dopri5::start(&mut self.rhs(&mut work), 0.0, &y0, span, tol)?;
+        Ok(TrajectoryStepper { work, dopri })
+    }
+
+    /// The right-hand side of Eq. (1) as a first-order system y = (q, q'), evaluated in `work`.
+    fn rhs<'a>(&'a self, work: &'a mut [f64]) -> impl FnMut(f64, &[f64], &mut [f64]) -> bool + 'a {
+        let n = self.coordinates.len();
+        move |_t: f64, y: &[f64], dy: &mut [f64]| {
+            self.set_state(work, &y[..n], &y[n..]);
+            let Some(a) = self.acceleration(work) else { return false };
             dy[..n].copy_from_slice(&y[n..]);
             dy[n..].copy_from_slice(a.as_slice());
             true
-        };
-        let (ys, stats) = dopri5(rhs, 0.0, &y0, times, tol, cancel)?;
-        Ok(Trajectory {
-            times: times.to_vec(),
-            coordinates: ys.iter().map(|y| y[..n].to_vec()).collect(),
-            rates: ys.iter().map(|y| y[n..].to_vec()).collect(),
-            stats,
-        })
+        }
+    }
+}
+
+/// The model's motion between two samples: the integrator and the symbols' values it
+/// evaluates the model with.
+#[derive(Clone, Debug)]
+pub struct TrajectoryStepper {
+    work: Vec<f64>,
+    dopri: Dopri5,
+}
+
+impl TrajectoryStepper {
+    /// (q, q') at `t` [s since the start], not before the last sample.
+    pub fn advance(
+        &mut self,
+        energy: &EnergySpec,
+        t: f64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<(&[f64], &[f64]), DynamicsError> {
+        let n = energy.coordinates.len();
+        let y = self.dopri.advance(&mut energy.rhs(&mut self.work), t, cancel)?;
+        Ok((&y[..n], &y[n..]))
+    }
+
+    /// Counts so far.
+    pub fn stats(&self) -> Stats {
+        self.dopri.stats()
     }
 }
 

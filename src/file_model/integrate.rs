@@ -93,72 +93,113 @@ pub fn dopri5(
     tol: &Tolerance,
     cancel: Option<&AtomicBool>,
 ) -> Result<(Vec<Vec<f64>>, Stats), IntegrateError> {
-    if !(tol.rtol > 0.0 && tol.atol > 0.0 && tol.rtol.is_finite() && tol.atol.is_finite()) {
-        return Err(IntegrateError::Tolerance);
-    }
-    if !t0.is_finite() || times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| w[1] < w[0]) {
+    if times.windows(2).any(|w| w[1] < w[0]) || times.first().is_some_and(|t| *t < t0) {
         return Err(IntegrateError::Times);
     }
-    if times.first().is_some_and(|t| *t < t0) {
-        return Err(IntegrateError::Times);
-    }
-    let mut s = Stepper::new(y0.len(), *tol);
-    let mut eval = |t: f64, y: &[f64], dy: &mut [f64], stats: &mut Stats| {
-        stats.evaluations += 1;
-        if f(t, y, dy) && dy.iter().all(|x| x.is_finite()) {
-            Ok(())
-        } else {
-            Err(IntegrateError::NotFinite(t))
-        }
-    };
-    let (mut t, mut y) = (t0, y0.to_vec());
-    eval(t, &y, &mut s.k[0], &mut s.stats)?;
     let span = times.last().map_or(0.0, |e| e - t0);
-    let mut h = s.initial_step(&y, span);
+    let mut d = Dopri5::start(&mut f, t0, y0, span, tol)?;
     let mut out = Vec::with_capacity(times.len());
     for &target in times {
-        while t < target {
-            if (s.stats.accepted + s.stats.rejected) % CANCEL_POLL_STEPS == 0
-                && cancel.is_some_and(|c| c.load(Ordering::SeqCst))
-            {
+        out.push(d.advance(&mut f, target, cancel)?.to_vec());
+    }
+    Ok((out, d.stats()))
+}
+
+/// The right-hand side y' = f(t, y) as [`dopri5`] takes it.
+pub type Rhs<'a> = dyn FnMut(f64, &[f64], &mut [f64]) -> bool + 'a;
+
+/// Dormand-Prince 5(4) that is advanced sample by sample ([`Dopri5::advance`]), the
+/// right-hand side handed in at each call: the same steps, to the bit, as [`dopri5`] over all
+/// the samples at once (which is this, in a loop).
+#[derive(Clone, Debug)]
+pub struct Dopri5 {
+    t: f64,
+    y: Vec<f64>,
+    /// The next step's size [in t's unit].
+    h: f64,
+    s: Stepper,
+}
+
+impl Dopri5 {
+    /// Starts at (t0, y0); `span` is how far the samples will reach beyond t0 (the first step
+    /// is no longer).
+    pub fn start(f: &mut Rhs, t0: f64, y0: &[f64], span: f64, tol: &Tolerance) -> Result<Self, IntegrateError> {
+        if !(tol.rtol > 0.0 && tol.atol > 0.0 && tol.rtol.is_finite() && tol.atol.is_finite()) {
+            return Err(IntegrateError::Tolerance);
+        }
+        if !t0.is_finite() || !span.is_finite() {
+            return Err(IntegrateError::Times);
+        }
+        let mut s = Stepper::new(y0.len(), *tol);
+        let mut k0 = std::mem::take(&mut s.k[0]);
+        eval(f, t0, y0, &mut k0, &mut s.stats)?;
+        s.k[0] = k0;
+        let h = s.initial_step(y0, span);
+        Ok(Dopri5 { t: t0, y: y0.to_vec(), h, s })
+    }
+
+    /// Counts so far.
+    pub fn stats(&self) -> Stats {
+        self.s.stats
+    }
+
+    /// The state at `target` (not before the last sample); `cancel` is looked at every
+    /// [`CANCEL_POLL_STEPS`] steps.
+    pub fn advance(&mut self, f: &mut Rhs, target: f64, cancel: Option<&AtomicBool>) -> Result<&[f64], IntegrateError> {
+        if !target.is_finite() || target < self.t {
+            return Err(IntegrateError::Times);
+        }
+        let s = &mut self.s;
+        while self.t < target {
+            let steps = s.stats.accepted + s.stats.rejected;
+            if steps.is_multiple_of(CANCEL_POLL_STEPS) && cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
                 return Err(IntegrateError::Interrupted);
             }
-            if s.stats.accepted + s.stats.rejected >= tol.max_steps {
-                return Err(IntegrateError::TooManySteps(tol.max_steps));
+            if steps >= s.tol.max_steps {
+                return Err(IntegrateError::TooManySteps(s.tol.max_steps));
             }
             // Land exactly on the target (a step that would end within round-off of it too).
+            let (t, h) = (self.t, self.h);
             let last = t + h >= target - f64::EPSILON * target.abs().max(1.0);
             let step = if last { target - t } else { h };
             if step <= f64::EPSILON * t.abs().max(1.0) * 4.0 && !last {
                 return Err(IntegrateError::StepTooSmall(t));
             }
-            let (err, y_new) = s.trial(&mut eval, t, &y, step)?;
+            let (err, y_new) = s.trial(f, t, &self.y, step)?;
             let factor = (SAFETY * err.powf(-0.2)).clamp(FAC_MIN, FAC_MAX);
             if err <= 1.0 {
                 s.stats.accepted += 1;
-                t = if last { target } else { t + step };
-                y = y_new;
+                self.t = if last { target } else { t + step };
+                self.y = y_new;
                 s.k.swap(0, 6);
                 // A step shortened to land on a sample says nothing about the next one.
-                h = if last { h.max(step * factor) } else { step * factor };
+                self.h = if last { h.max(step * factor) } else { step * factor };
             } else {
                 s.stats.rejected += 1;
-                h = step * factor.min(1.0);
+                self.h = step * factor.min(1.0);
             }
         }
-        out.push(y.clone());
+        Ok(&self.y)
     }
-    Ok((out, s.stats))
+}
+
+/// `f` at (t, y) into `dy`, counted; Err where it is not defined or not finite.
+fn eval(f: &mut Rhs, t: f64, y: &[f64], dy: &mut [f64], stats: &mut Stats) -> Result<(), IntegrateError> {
+    stats.evaluations += 1;
+    if f(t, y, dy) && dy.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(IntegrateError::NotFinite(t))
+    }
 }
 
 /// The stages and counts of an integration.
+#[derive(Clone, Debug)]
 struct Stepper {
     k: Vec<Vec<f64>>,
     tol: Tolerance,
     stats: Stats,
 }
-
-type Eval<'a> = dyn FnMut(f64, &[f64], &mut [f64], &mut Stats) -> Result<(), IntegrateError> + 'a;
 
 impl Stepper {
     fn new(n: usize, tol: Tolerance) -> Self {
@@ -187,7 +228,7 @@ impl Stepper {
 
     /// One trial step of size h from (t, y): the error norm and the fifth-order solution
     /// (the stages k[1..=6] are left for the next step: k[6] = f(t + h, y_new)).
-    fn trial(&mut self, eval: &mut Eval, t: f64, y: &[f64], h: f64) -> Result<(f64, Vec<f64>), IntegrateError> {
+    fn trial(&mut self, f: &mut Rhs, t: f64, y: &[f64], h: f64) -> Result<(f64, Vec<f64>), IntegrateError> {
         let n = y.len();
         let mut tmp = vec![0.0; n];
         for stage in 1..7 {
@@ -195,7 +236,7 @@ impl Stepper {
                 tmp[i] = y[i] + h * (0..stage).map(|j| A[stage][j] * self.k[j][i]).sum::<f64>();
             }
             let mut dy = std::mem::take(&mut self.k[stage]);
-            eval(t + C[stage] * h, &tmp, &mut dy, &mut self.stats)?;
+            eval(f, t + C[stage] * h, &tmp, &mut dy, &mut self.stats)?;
             self.k[stage] = dy;
         }
         // The sixth row of A is B5, so tmp is the fifth-order solution.
@@ -258,6 +299,26 @@ mod tests {
         };
         let order = (err(10) / err(20)).log2();
         assert!(order > 4.5 && order < 6.5, "observed order {order}");
+    }
+
+    /// Advanced sample by sample, the integrator takes the steps it takes over all the samples
+    /// at once: the same states, to the bit, and the same counts.
+    #[test]
+    fn advancing_sample_by_sample_is_the_batch_integration_to_the_bit() {
+        let mut pendulum = |_: f64, y: &[f64], dy: &mut [f64]| {
+            dy[0] = y[1];
+            dy[1] = -263.0 * y[0].sin();
+            true
+        };
+        let times: Vec<f64> = (1..=500).map(|k| k as f64 * 1e-3).collect();
+        let (y0, tol) = ([0.5, 0.0], Tolerance::default());
+        let (batch, stats) = dopri5(&mut pendulum, 0.0, &y0, &times, &tol, None).unwrap();
+        let mut d = Dopri5::start(&mut pendulum, 0.0, &y0, times[times.len() - 1], &tol).unwrap();
+        for (t, y) in times.iter().zip(&batch) {
+            assert_eq!(d.advance(&mut pendulum, *t, None).unwrap(), y.as_slice(), "t {t}");
+        }
+        assert_eq!(d.stats(), stats);
+        assert_eq!(d.advance(&mut pendulum, 0.1, None).unwrap_err(), IntegrateError::Times);
     }
 
     #[test]

@@ -4,11 +4,11 @@
 //! run with `[energy.trajectory]` it gathers the energy coordinates at every tick for the
 //! comparison with the Lagrangian model (`lagrangian.rs`).
 
-use super::lagrangian::{self, Samples};
+use super::lagrangian::{LagrangianError, Row, Tracker};
 use super::{Note, Observer, SettlePoint, Tick};
 use crate::file_model::dynamics::TrajectoryCheck;
 use crate::file_model::energy_model::Kind;
-use crate::file_model::spec::{ModelSpec, Source};
+use crate::file_model::spec::{ErrorClass, ModelSpec, Source};
 use crate::mechanisms::Values;
 use crate::report::{
     EnergyPointReport, ModelCheckReport, ModelModeReport, PointReport, ScenarioReport, StationaryReport,
@@ -230,9 +230,78 @@ pub struct ModelObserver {
     series: Option<Vec<&'static str>>,
     /// A motion run: the predictions are judged over the motion's ticks, not at settle points.
     motion: bool,
-    /// With `[energy.trajectory]` in a motion run: the energy coordinates at every tick of the
-    /// motion, and every symbol's value at its first tick (the parameters and inputs).
-    trajectory: Option<(Samples, Vec<f64>)>,
+    /// With `[energy.trajectory]` in a motion run: the comparison with the Lagrangian model,
+    /// tick by tick.
+    trajectory: Option<Tracker>,
+    /// A motion run's `[motion]` as the stated start needs it.
+    stated: Option<StatedMotion>,
+    /// When the run is recorded, with `[energy.trajectory]`: each coordinate's series, and the
+    /// tick and simulated time [s] of every motion tick (a row of the comparison may be known
+    /// ticks later).
+    trajectory_series: Option<TrajectorySeries>,
+}
+
+/// What the stated start takes from `[motion]`.
+#[derive(Clone, Copy, Debug)]
+struct StatedMotion {
+    /// The displaced joint's displacement [rad or m] (0 when none).
+    displacement: f64,
+    /// Its rate [rad/s or m/s].
+    rate: f64,
+    /// A free body is spun at the start (a rate that no coordinate states).
+    spun: bool,
+}
+
+impl StatedMotion {
+    fn new(m: &crate::settings::Motion) -> Self {
+        let (displacement, rate) = m.coordinate.as_ref().map_or((0.0, 0.0), |(_, d, r)| (*d, *r));
+        StatedMotion { displacement, rate, spun: m.spin.is_some() }
+    }
+
+    /// The coordinates' rates at the start, `q0` the coordinates of the start state and `q_eq`
+    /// of the equilibrium it was displaced from: the stated rate times each coordinate's change
+    /// per unit of the joint's displacement (exact where a coordinate moves linearly with the
+    /// joint, as a joint angle does; no rate, no rates).
+    fn rates(&self, classes: &[ErrorClass], q0: &[f64], q_eq: &[f64]) -> Result<Vec<f64>, LagrangianError> {
+        if self.spun {
+            let why = "a spun body's rate is no coordinate's: start = \"samples\" reads it from the motion";
+            return Err(LagrangianError::NoStatedStart(why.into()));
+        }
+        if self.rate == 0.0 {
+            return Ok(vec![0.0; q0.len()]);
+        }
+        if self.displacement == 0.0 {
+            let why = "[motion] states a rate without a displacement: how it moves the coordinates is not known";
+            return Err(LagrangianError::NoStatedStart(why.into()));
+        }
+        let change = |(c, (a, b)): (&ErrorClass, (&f64, &f64))| match c {
+            ErrorClass::Angle => crate::mechanisms::wrap_angle(a - b),
+            _ => a - b,
+        };
+        Ok(classes.iter().zip(q0.iter().zip(q_eq)).map(change).map(|d| self.rate * d / self.displacement).collect())
+    }
+}
+
+/// The recording's series of the comparison with the Lagrangian model.
+#[derive(Clone, Debug)]
+struct TrajectorySeries {
+    /// Per coordinate: `trajectory/NAME` (simulated, model) and `trajectory_error/NAME`.
+    entities: Vec<(&'static str, &'static str)>,
+    /// (tick, simulated time [s]) of every motion tick so far.
+    ticks: Vec<(u64, f64)>,
+}
+
+/// The per-tick table's columns of the comparison, per coordinate: its simulated value, the
+/// model's, the error.
+pub const TRAJECTORY_COLUMNS: [&str; 3] = ["trajectory_sim", "trajectory_model", "trajectory_error"];
+
+/// The recording's entity of a coordinate's simulated and model values, and of its error.
+fn trajectory_entities(spec: &ModelSpec) -> Vec<(&'static str, &'static str)> {
+    let leak = |s: String| &*Box::leak(s.into_boxed_str());
+    let coordinates = spec.energy.iter().flat_map(|e| &e.coordinates);
+    coordinates
+        .map(|c| (leak(format!("trajectory/{}", c.name)), leak(format!("trajectory_error/{}", c.name))))
+        .collect()
 }
 
 /// Why the file's dynamic model has no modes at a settle point.
@@ -248,9 +317,13 @@ enum ModelModesError {
 
 impl ModelObserver {
     /// The observer of `spec` on the run's `structure`; `recorded`: the run is recorded (each
-    /// error per tick then goes to the recording).
-    /// `motion`: the run is a motion run.
-    pub fn new(spec: &ModelSpec, structure: &Structure, recorded: bool, motion: bool) -> Self {
+    /// error per tick then goes to the recording). `motion`: a motion run's `[motion]`.
+    pub fn new(
+        spec: &ModelSpec,
+        structure: &Structure,
+        recorded: bool,
+        motion: Option<&crate::settings::Motion>,
+    ) -> Self {
         let mut used = vec![false; spec.symbols.len()];
         let exprs = spec
             .quantities
@@ -285,9 +358,19 @@ impl ModelObserver {
             energy: Acc::default(),
             frequencies: vec![Acc::default(); frequency_count(spec)],
             series: recorded.then(|| series_names(spec)),
-            motion,
-            trajectory: trajectory_check(spec).filter(|_| motion).map(|_| (Samples::default(), Vec::new())),
+            motion: motion.is_some(),
+            trajectory: Self::tracker(spec, motion),
+            stated: motion.map(StatedMotion::new),
+            trajectory_series: Self::tracker(spec, motion)
+                .filter(|_| recorded)
+                .map(|_| TrajectorySeries { entities: trajectory_entities(spec), ticks: Vec::new() }),
         }
+    }
+
+    /// The comparison with the Lagrangian model, in a motion run with `[energy.trajectory]`.
+    fn tracker(spec: &ModelSpec, motion: Option<&crate::settings::Motion>) -> Option<Tracker> {
+        let (energy, check, m) = (spec.energy.as_ref()?, trajectory_check(spec)?, motion?);
+        Some(Tracker::new(energy, check.start, m.duration_s))
     }
 
     /// Every symbol's value in this state, at the model's time `time_s`.
@@ -467,6 +550,72 @@ impl ModelObserver {
         out
     }
 
+    /// A motion tick's coordinates (every symbol's value `v`, the motion's time [s]) to the
+    /// comparison with the Lagrangian model: the rows known now (none without one).
+    pub(super) fn push_trajectory(&mut self, v: &[f64], time_s: f64) -> Vec<Row> {
+        let (Some(tracker), Some(e)) = (self.trajectory.as_mut(), &self.spec.energy) else { return vec![] };
+        tracker.push(e, v, time_s, &e.measured(v))
+    }
+
+    /// This motion tick's coordinates to the comparison (as [`ModelObserver::push_trajectory`]).
+    pub(super) fn trajectory_tick(&mut self, t: &Tick) -> Vec<Row> {
+        let Some(time_s) = t.motion_time_s.filter(|_| self.trajectory.is_some()) else { return vec![] };
+        if let (Some(tracker), Some(_)) = (self.trajectory.as_mut(), t.estimate) {
+            tracker.note_extrapolated();
+        }
+        let v = self.values(t.snapshot, t.inputs, t.params, t.simulated, time_s);
+        self.push_trajectory(&v, time_s)
+    }
+
+    /// The rows the comparison still holds when the motion ends, uncompared.
+    pub(super) fn trajectory_flush(&mut self) -> Vec<Row> {
+        self.trajectory.as_mut().map_or(vec![], Tracker::flush)
+    }
+
+    /// Whether the run compares a motion with the Lagrangian model.
+    pub(super) fn has_trajectory(&self) -> bool {
+        self.trajectory.is_some()
+    }
+
+    /// The table's columns of the comparison with the Lagrangian model (none without one):
+    /// per coordinate, [`TRAJECTORY_COLUMNS`]`:NAME`.
+    pub(super) fn trajectory_columns(&self) -> Vec<String> {
+        let coordinates = self.spec.energy.iter().flat_map(|e| &e.coordinates).filter(|_| self.has_trajectory());
+        coordinates.flat_map(|c| TRAJECTORY_COLUMNS.map(|k| format!("{k}:{}", c.name))).collect()
+    }
+
+    /// A row's values of [`ModelObserver::trajectory_columns`] (None where uncompared).
+    pub(super) fn trajectory_cells(row: &Row) -> Vec<Option<f64>> {
+        let compared = |i: usize| row.compared.as_ref().map(|(m, e)| (m[i], e[i]));
+        let cells = row
+            .simulated
+            .iter()
+            .enumerate()
+            .map(|(i, s)| [Some(*s), compared(i).map(|c| c.0), compared(i).map(|c| c.1)]);
+        cells.flatten().collect()
+    }
+
+    /// The rows of the comparison to the recording (each at its own tick), and at the motion's
+    /// first tick the names of the series.
+    fn record_trajectory(&mut self, t: &Tick, rows: &[Row], notes: &mut Vec<Note>) {
+        let Some(series) = self.trajectory_series.as_mut() else { return };
+        if series.ticks.is_empty() {
+            for (values, errors) in &series.entities {
+                notes.push(Note::SeriesNames(values, vec!["simulated".into(), "model".into()]));
+                notes.push(Note::SeriesNames(errors, vec!["|simulated - model|".into()]));
+            }
+        }
+        series.ticks.push((t.snapshot.tick, t.snapshot.time_s));
+        for row in rows {
+            let Some((model, errors)) = &row.compared else { continue };
+            let (tick, time_s) = series.ticks[row.index];
+            for (i, (values, error)) in series.entities.iter().enumerate() {
+                notes.push(Note::ScalarsAt { entity: values, tick, time_s, values: vec![row.simulated[i], model[i]] });
+                notes.push(Note::ScalarsAt { entity: error, tick, time_s, values: vec![errors[i]] });
+            }
+        }
+    }
+
     pub fn reports(&self) -> Vec<ModelCheckReport> {
         let kinds = self.spec.predictions.iter().map(|p| ("prediction", p.class.name()));
         let kinds = kinds.chain(self.spec.equations.iter().map(|_| ("equation", "residual")));
@@ -502,18 +651,28 @@ impl Observer for ModelObserver {
             for (a, (_, _, e)) in self.acc.iter_mut().zip(&errors).take(predictions) {
                 a.motion_tick(*e);
             }
-            if let (Some((samples, first)), Some(e)) = (self.trajectory.as_mut(), self.spec.energy.as_ref()) {
-                if first.is_empty() {
-                    *first = v.clone();
-                }
-                samples.times.push(time_s);
-                samples.coordinates.push(e.measured(&v));
-                samples.extrapolated |= t.estimate.is_some();
+            if let (Some(tracker), Some(_)) = (self.trajectory.as_mut(), t.estimate) {
+                tracker.note_extrapolated();
             }
+            let rows = self.push_trajectory(&v, time_s);
+            self.record_trajectory(t, &rows, notes);
         }
         if let Some(series) = &self.series {
             notes.extend(series.iter().zip(&errors).map(|(s, (_, _, e))| Note::Scalar(s, *e)));
         }
+    }
+
+    fn motion_start_state(&mut self, equilibrium: &Tick, start: &Tick) {
+        let (Some(tracker), Some(e), Some(stated)) = (self.trajectory.as_mut(), &self.spec.energy, self.stated) else {
+            return;
+        };
+        let read = |t: &Tick| {
+            let v = self.spec.values(t.inputs, t.params, |i| self.bind[i].read(t.snapshot, t.simulated, 0.0));
+            e.measured(&v)
+        };
+        let (q_eq, q0) = (read(equilibrium), read(start));
+        let classes: Vec<ErrorClass> = e.coordinates.iter().map(|c| c.class).collect();
+        tracker.set_stated(stated.rates(&classes, &q0, &q_eq).map(|v0| (q0, v0)));
     }
 
     /// Compares at the point (outside the analytic model's validity: not compared), and adds
@@ -564,17 +723,12 @@ impl Observer for ModelObserver {
 
     fn finish(&mut self, report: &mut ScenarioReport) {
         report.model_checks = self.reports();
-        let (Some((samples, values)), Some(e), Some(check)) =
-            (&self.trajectory, &self.spec.energy, trajectory_check(&self.spec))
+        let (Some(tracker), Some(e), Some(check)) = (&self.trajectory, &self.spec.energy, trajectory_check(&self.spec))
         else {
             return;
         };
         if let Some(m) = report.motion.as_mut() {
-            let tolerances = (check.tolerance, check.rms_tolerance);
-            m.lagrangian = Some(
-                lagrangian::compare(e, values, samples, tolerances)
-                    .unwrap_or_else(|why| lagrangian::not_compared(e, why, tolerances)),
-            );
+            m.lagrangian = Some(tracker.report(e, (check.tolerance, check.rms_tolerance)));
         }
     }
 }

@@ -65,6 +65,11 @@ pub enum Note {
     Event(String),
     /// One value of a named time series.
     Scalar(&'static str, f64),
+    /// The values of an entity's named series at `tick` (this one or an earlier one, whose
+    /// simulated time is `time_s` [s]), in the order of its [`Note::SeriesNames`].
+    ScalarsAt { entity: &'static str, tick: u64, time_s: f64, values: Vec<f64> },
+    /// The names of an entity's series (once, before or with its first values).
+    SeriesNames(&'static str, Vec<String>),
 }
 
 /// One of the structure's own modes at a motion run's start (the simulation's modal analysis), for the
@@ -95,6 +100,10 @@ pub trait Observer {
     /// A motion run's motion starts (after its start point, before its first step), with the
     /// structure's own modes there that its frequencies are fitted to.
     fn motion_start(&mut self, _modes: &[ModeAtStart]) {}
+    /// A motion run's motion starts: the `equilibrium` it is displaced from (its start point)
+    /// and the state it `start`s from at t = 0 (the displacement and rate of `[motion]` set, no
+    /// step taken), each as a tick (`motion_time_s` Some(0)).
+    fn motion_start_state(&mut self, _equilibrium: &Tick, _start: &Tick) {}
     /// A settle point: fill in what this observer measures there (`point` has the rest).
     fn settle_point(&mut self, _p: &SettlePoint, _point: &mut PointReport, _notes: &mut Vec<Note>) {}
     /// The run is over: put what was gathered into the report.
@@ -153,20 +162,19 @@ pub fn observers(setup: Setup, warnings: &mut Vec<String>) -> Result<Vec<Box<dyn
     list.push(Box::new(interference::Interference::new(setup.structure, setup.interference)?));
     if let Some(spec) = setup.model {
         let recorded = setup.recording.is_some();
-        list.push(Box::new(file_model::ModelObserver::new(spec, setup.structure, recorded, setup.motion.is_some())));
+        list.push(Box::new(file_model::ModelObserver::new(spec, setup.structure, recorded, setup.motion)));
     }
     if let Some(m) = setup.motion {
         list.push(Box::new(motion::MotionObserver::new(m)));
     }
     if let Some(x) = setup.external {
         let motion = setup.motion.is_some();
-        let file = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, motion));
+        let file = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, setup.motion));
         list.push(Box::new(external::ExternalObserver::new(x, file, motion)));
     }
     if let Some(target) = &setup.table {
-        let motion = setup.motion.is_some();
         let extrapolated = setup.motion.is_some_and(|m| m.extrapolate != Some(false));
-        let model = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, motion));
+        let model = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, setup.motion));
         list.push(Box::new(match target {
             table::TableTarget::File(path) => table::Table::start(path, model)?.with_estimates(extrapolated),
             table::TableTarget::Memory(to) => table::Table::in_memory(to.clone(), model).with_estimates(extrapolated),

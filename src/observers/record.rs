@@ -4,7 +4,13 @@
 //! `analytic/{nodes,struts}` (the analytic prediction as a ghost overlay), and time series with
 //! one named series per quantity or member: `errors` (simulated - analytic), `errors_log10`
 //! (log10 of their magnitude: rerun 0.36 plots have no log axis), `forces/{springs,cables,actuators}`,
-//! `inputs`, `residual` (at the ticks where the settle loop computed it), `energy/kinetic_j`; `interference/min_clearance_m`; `events` (text log).
+//! `inputs`, `residual` (at the ticks where the settle loop computed it), `energy/kinetic_j`; `interference/min_clearance_m`; `events` (text log);
+//! with the file's model, `model/NAME` (each prediction's and equation's error) and, in a
+//! motion run with `[energy.trajectory]`, `trajectory/COORD` (the coordinate simulated and its
+//! Lagrangian model, two series in one plot) and `trajectory_error/COORD` at every compared
+//! tick; in a motion run, `frequencies/NAME` (each frequency check's fit, corrected, and its
+//! model value) and `frequencies/trajectory:COORD` (the frequencies fitted to the coordinate's
+//! simulated and model trajectories) over the motion, each with an event.
 //! The scenario file and the report summary are stored as documents. Timelines: `tick` and
 //! `sim_time`. A blueprint ([`blueprint`]) stored at the start of the recording lays the viewer
 //! out: the 3D structure, the error, force and energy plots, the events and the documents.
@@ -422,11 +428,16 @@ impl Recorder {
     /// Buffers one scalar time series value at `tick` (every `record_every`-th tick, like the
     /// rest).
     pub fn scalar(&mut self, tick: u64, entity: &str, value: f64) {
+        // Called right after `tick` for the same tick: its time is the last one seen.
+        self.scalars_at(tick, self.last_time_s, entity, &[value]);
+    }
+
+    /// Buffers the values of an entity's series at `tick` (simulated time `time_s` [s]), which
+    /// may be earlier than the last one seen (every `record_every`-th tick, like the rest).
+    pub fn scalars_at(&mut self, tick: u64, time_s: f64, entity: &str, values: &[f64]) {
         if tick % self.every != 0 {
             return;
         }
-        // Called right after `tick` for the same tick: its time is the last one seen.
-        let time_s = self.last_time_s;
         let column = match self.extra.iter().position(|c| c.entity == entity) {
             Some(i) => &mut self.extra[i],
             None => {
@@ -434,7 +445,7 @@ impl Recorder {
                 self.extra.last_mut().expect("just pushed")
             }
         };
-        column.push_values(tick, time_s, [value]);
+        column.push_values(tick, time_s, values.iter().copied());
     }
 
     /// Sends every buffered tick.
@@ -524,6 +535,48 @@ impl Recorder {
     }
 }
 
+/// The recording's entity of a frequency check (`frequencies/NAME`) and of the frequencies
+/// fitted to a coordinate's trajectory and to its Lagrangian model (`frequencies/trajectory:NAME`).
+pub const FREQUENCIES_ENTITY: &str = "frequencies";
+
+impl Recorder {
+    /// Each frequency check of a motion `m` (the fit, corrected, against the model's value) and
+    /// each frequency fitted to a coordinate's simulated and model trajectory, as two series
+    /// [rad/s] drawn over the motion (at its first and last tick), and one event each.
+    fn log_frequencies(&mut self, m: &crate::report::MotionReport) {
+        let (first, last) = (m.start_tick, m.start_tick + m.steps_taken);
+        let first_time_s = self.last_time_s - (self.last_tick.saturating_sub(first)) as f64 * m.dt_s;
+        let checks = m.frequencies.iter().map(|f| {
+            let event = format!(
+                "frequency {}: fit {:.9} rad/s (corrected), model {:.9} rad/s, error {:.3e} (tolerance {:.1e}) {}",
+                f.name,
+                f.corrected_rad_per_s,
+                f.predicted_rad_per_s,
+                f.error,
+                f.tolerance,
+                if f.passed { "pass" } else { "FAIL" }
+            );
+            (f.name.clone(), ["fit (corrected)", "model"], [f.corrected_rad_per_s, f.predicted_rad_per_s], event)
+        });
+        let lagrangian = m.lagrangian.iter().flat_map(|l| &l.coordinates).map(|c| {
+            let (simulated, model) = (c.simulated_omega_rad_per_s, c.model_omega_rad_per_s);
+            let event =
+                format!("trajectory {}: fit {simulated:.9} rad/s (corrected), model's fit {model:.9} rad/s", c.name);
+            (format!("trajectory:{}", c.name), ["simulated fit (corrected)", "model fit"], [simulated, model], event)
+        });
+        let all: Vec<_> = checks.chain(lagrangian).collect();
+        for (name, names, values, event) in all {
+            let entity = format!("{FREQUENCIES_ENTITY}/{name}");
+            let _ = self.rec.log_static(entity.as_str(), &rerun::SeriesLines::new().with_names(names));
+            let mut column = Column::new(&entity, Kind::Scalars);
+            column.push_values(first, first_time_s, values);
+            column.push_values(last, self.last_time_s, values);
+            column.send(&self.rec);
+            self.note(last, &Note::Event(event));
+        }
+    }
+}
+
 /// Errors below this magnitude are drawn at its log10 in `errors_log10` (an error can be exactly 0).
 const LOG10_FLOOR: f64 = 1e-20;
 
@@ -609,6 +662,10 @@ impl Observer for Recorder {
                 self.columns.events.push_text(tick, time_s, text);
             }
             Note::Scalar(entity, value) => self.scalar(tick, entity, *value),
+            Note::ScalarsAt { entity, tick, time_s, values } => self.scalars_at(*tick, *time_s, entity, values),
+            Note::SeriesNames(entity, names) => {
+                let _ = self.rec.log_static(*entity, &rerun::SeriesLines::new().with_names(names.clone()));
+            }
         }
     }
 
@@ -621,9 +678,13 @@ impl Observer for Recorder {
         self.columns.residual.push_values(tick, time_s, [r.max_force_n, r.max_torque_nm]);
     }
 
-    /// Stores the final report, the verdict as the last event, and writes the file.
+    /// Stores the final report, the frequency checks, the verdict as the last event, and
+    /// writes the file.
     fn close(&mut self, tick: u64, report: &ScenarioReport, warnings: &mut Vec<String>) -> Result<(), ObserverError> {
         self.document("report", &serde_json::to_string_pretty(report).unwrap_or_default());
+        if let Some(m) = &report.motion {
+            self.log_frequencies(m);
+        }
         self.note(tick, &Note::Event(if report.passed { "run passed" } else { "run FAILED" }.into()));
         self.finish(warnings)?;
         Ok(())
@@ -659,7 +720,11 @@ pub fn blueprint(file_model: bool) -> rerun::blueprint::Blueprint {
     ];
     if file_model {
         error_tabs.insert(0, series("the file's model: |error| per prediction and equation", &["/model/**"]).into());
+        let trajectory = "[energy.trajectory]: each coordinate simulated and its Lagrangian model";
+        error_tabs.insert(1, series(trajectory, &["/trajectory/**"]).into());
+        error_tabs.insert(2, series("[energy.trajectory]: |simulated - model|", &["/trajectory_error/**"]).into());
     }
+    error_tabs.push(series("frequency checks: fit and model [rad/s]", &["/frequencies/**"]).into());
     let errors = Tabs::new(error_tabs);
     let forces = series("member forces [N] (cables: tension)", &["/forces/springs", "/forces/cables"]);
     let others = Tabs::new([

@@ -15,7 +15,13 @@
 //! empty elsewhere), every revolute joint's angle and prismatic joint's slide
 //! (`joint:NAME.angle` rad, `joint:NAME.slide` m) and the file's model: each quantity
 //! (`model:NAME`), each prediction's predicted value and error (`predicted:NAME`,
-//! `error:NAME`), each equation's residual (`equation:NAME`). Numbers are written in Rust's shortest round-trip form, so reading them back gives
+//! `error:NAME`), each equation's residual (`equation:NAME`); in a motion run with
+//! `[energy.trajectory]`, per `[energy]` coordinate its simulated value (angles unwrapped,
+//! continuous through +-pi), the Lagrangian model's value and the error in the coordinate's
+//! class (`trajectory_sim:NAME`, `trajectory_model:NAME`, `trajectory_error:NAME`; the model's
+//! two empty where it is not compared: before the motion, and at the samples it starts from).
+//! A row waits until its model value is known (started from the samples, ticks 1 and 2 of the
+//! motion wait for tick 3). Numbers are written in Rust's shortest round-trip form, so reading them back gives
 //! the same f64 bit for bit. The file is written to a temporary file (`output::partial_path`) and renamed when the run
 //! is over.
 
@@ -120,6 +126,12 @@ pub struct Table {
     /// Whether each joint coordinate gets a column of the motion's own error estimate
     /// (`estimate:joint:NAME.angle`: a motion judged extrapolated over the time step).
     estimates: bool,
+    /// The column names, until the first row is written.
+    header: Option<Vec<String>>,
+    /// With the comparison with the Lagrangian model: the rows not written yet (tick, values),
+    /// the first `waiting` of them (from the back) still without the comparison's columns.
+    held: std::collections::VecDeque<(u64, Vec<Option<f64>>)>,
+    waiting: usize,
 }
 
 /// Every joint with one coordinate: its index and column (`joint:NAME.angle` [rad] for a
@@ -166,21 +178,23 @@ impl Table {
         } else {
             Sink::Csv(std::io::BufWriter::new(file))
         };
-        Ok(Table {
-            path: path.to_path_buf(),
-            partial: Some(partial),
-            sink,
-            keys: None,
-            error: None,
-            model,
-            estimates: false,
-        })
+        Ok(Table::new(path.to_path_buf(), Some(partial), sink, model))
+    }
+
+    fn new(
+        path: PathBuf,
+        partial: Option<PathBuf>,
+        sink: Sink,
+        model: Option<super::file_model::ModelObserver>,
+    ) -> Self {
+        let (header, held, waiting) = (None, std::collections::VecDeque::new(), 0);
+        Table { path, partial, sink, keys: None, error: None, model, estimates: false, header, held, waiting }
     }
 
     /// Starts a table kept in memory, handed to `to` when the run closes.
     pub fn in_memory(to: MemoryTable, model: Option<super::file_model::ModelObserver>) -> Self {
         let sink = Self::arrow(Batches::Memory { kept: Vec::new(), to });
-        Table { path: PathBuf::from("(memory)"), partial: None, sink, keys: None, error: None, model, estimates: false }
+        Table::new(PathBuf::from("(memory)"), None, sink, model)
     }
 
     fn arrow(out: Batches) -> Sink {
@@ -214,6 +228,7 @@ impl Table {
             cols.extend(coordinates(s).map(|(_, name)| format!("estimate:{name}")));
         }
         cols.extend(self.model.iter().flat_map(|m| m.table_columns()));
+        cols.extend(self.model.iter().flat_map(|m| m.trajectory_columns()));
         cols
     }
 
@@ -237,8 +252,9 @@ impl Table {
         v
     }
 
-    /// Writes one tick (`header`: the column names, at the first tick).
-    fn write(&mut self, tick: u64, header: Option<Vec<String>>, values: Vec<Option<f64>>) -> Result<(), TableError> {
+    /// Writes one tick (with the column names before the first).
+    fn write(&mut self, tick: u64, values: Vec<Option<f64>>) -> Result<(), TableError> {
+        let header = self.header.take();
         let io = |source| TableError::Io { path: self.path.clone(), source };
         let arrow = |source| TableError::Arrow { path: self.path.clone(), source };
         match &mut self.sink {
@@ -347,27 +363,79 @@ fn repeats_a_column(s: &crate::structure::Structure, key: &str) -> bool {
     }
 }
 
+impl Table {
+    /// The rows of the comparison with the Lagrangian model known at a tick (`rows`) complete
+    /// the rows waiting for them, in order; then the complete rows at the front are written.
+    fn complete(&mut self, rows: Vec<super::lagrangian::Row>) -> Result<(), TableError> {
+        for row in &rows {
+            let at = self.held.len() - self.waiting;
+            self.held[at].1.extend(super::file_model::ModelObserver::trajectory_cells(row));
+            self.waiting -= 1;
+        }
+        while self.held.len() > self.waiting {
+            let (tick, values) = self.held.pop_front().expect("a complete row");
+            self.write(tick, values)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the rows still held at the end, the comparison's columns empty where it never
+    /// reached them.
+    fn flush_held(&mut self) -> Result<(), TableError> {
+        let rows = self.model.as_mut().map_or(vec![], |m| m.trajectory_flush());
+        self.complete(rows)?;
+        let width = self.model.as_ref().map_or(0, |m| m.trajectory_columns().len());
+        while let Some((tick, mut values)) = self.held.pop_front() {
+            values.resize(values.len() + width, None);
+            self.write(tick, values)?;
+        }
+        self.waiting = 0;
+        Ok(())
+    }
+
+    /// One tick's row: written, or held until the comparison with the Lagrangian model reaches it.
+    fn row(&mut self, t: &Tick) -> Result<(), TableError> {
+        let mut values = self.values(t, self.keys.as_ref().expect("set at the first tick"));
+        let Some(model) = self.model.as_mut().filter(|m| m.has_trajectory()) else {
+            return self.write(t.snapshot.tick, values);
+        };
+        if t.motion_time_s.is_none() {
+            // After a motion (none follows one today) its rows are complete first.
+            let rest = if self.waiting > 0 { model.trajectory_flush() } else { vec![] };
+            values.resize(values.len() + model.trajectory_columns().len(), None);
+            self.complete(rest)?;
+            self.held.push_back((t.snapshot.tick, values));
+            return self.complete(vec![]);
+        }
+        let rows = model.trajectory_tick(t);
+        self.held.push_back((t.snapshot.tick, values));
+        self.waiting += 1;
+        self.complete(rows)
+    }
+}
+
 impl Observer for Table {
     fn tick(&mut self, t: &Tick, _notes: &mut Vec<super::Note>) {
         if self.error.is_some() {
             return;
         }
-        let header = match &self.keys {
-            Some(_) => None,
-            None => {
-                let keys: Keys = (
-                    t.inputs.keys().cloned().collect(),
-                    t.simulated.keys().filter(|k| !repeats_a_column(t.structure, k)).cloned().collect(),
-                    t.prediction.expected.keys().cloned().collect(),
-                );
-                let h = self.columns(t, &keys);
-                self.keys = Some(keys);
-                Some(h)
-            }
-        };
-        let values = self.values(t, self.keys.as_ref().expect("set above"));
-        if let Err(e) = self.write(t.snapshot.tick, header, values) {
+        if self.keys.is_none() {
+            let keys: Keys = (
+                t.inputs.keys().cloned().collect(),
+                t.simulated.keys().filter(|k| !repeats_a_column(t.structure, k)).cloned().collect(),
+                t.prediction.expected.keys().cloned().collect(),
+            );
+            self.header = Some(self.columns(t, &keys));
+            self.keys = Some(keys);
+        }
+        if let Err(e) = self.row(t) {
             self.error = Some(e);
+        }
+    }
+
+    fn motion_start_state(&mut self, equilibrium: &Tick, start: &Tick) {
+        if let Some(m) = self.model.as_mut() {
+            m.motion_start_state(equilibrium, start);
         }
     }
 
@@ -379,7 +447,7 @@ impl Observer for Table {
     ) -> Result<(), ObserverError> {
         let written = match self.error.take() {
             Some(e) => Err(e),
-            None => self.finish_file(),
+            None => self.flush_held().and_then(|_| self.finish_file()),
         };
         let Some(partial) = &self.partial else { return Ok(written?) };
         match written {

@@ -199,6 +199,9 @@ pub struct ExtrapolationReport {
 pub struct LagrangianReport {
     /// The integrator, its error control and how its start is read from the motion.
     pub method: String,
+    /// Where the model started (`[energy.trajectory] start`): "samples" (from the motion's
+    /// first three samples, at t = 1.5 dt) or "stated" (the file's initial condition, t = 0).
+    pub start: String,
     /// The model's start: the motion's time [s], the coordinates [m or rad] and rates there.
     pub start_time_s: f64,
     pub start_coordinates: Vec<f64>,
@@ -260,8 +263,12 @@ pub struct FrequencyReport {
 /// The motion against the Lagrangian model: one line per coordinate.
 fn table_lagrangian(l: &LagrangianReport, out: &mut String) {
     out.push_str(&format!(
-        "   lagrangian model from t = {:.6} s ({} integrator steps){}\n",
+        "   lagrangian model from t = {:.6} s, started from {} ({} integrator steps){}\n",
         l.start_time_s,
+        match l.start.as_str() {
+            "stated" => "the file's initial condition (start = \"stated\")",
+            _ => "the motion's first samples (start = \"samples\")",
+        },
         l.integrator_steps,
         l.error.as_ref().map_or(String::new(), |e| format!(": {e}"))
     ));

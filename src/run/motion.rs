@@ -58,6 +58,7 @@ pub(super) fn run_motion(
         runner.emit("the start did not settle: no motion");
         return Ok(());
     }
+    let equilibrium = runner.sim.snapshot_with(false);
     runner.sim.end_acceleration();
     if m.undamped {
         runner.sim.release_damping();
@@ -72,6 +73,7 @@ pub(super) fn run_motion(
     for o in runner.observers.iter_mut() {
         o.motion_start(&modes);
     }
+    runner.show_motion_start(&equilibrium, &inputs)?;
     let start_tick = runner.sim.tick();
     runner.motion_start_tick = Some(start_tick);
     let accelerated_before = runner.accelerated_steps;

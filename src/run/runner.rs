@@ -153,6 +153,32 @@ impl<'a> Runner<'a> {
         Ok((judged, Some(estimate)))
     }
 
+    /// Shows every observer the state a motion starts from (the simulation's, before its first
+    /// step) and the `equilibrium` it was displaced from, at the motion's time 0.
+    pub fn show_motion_start(&mut self, equilibrium: &Snapshot, inputs: &Values) -> Result<(), RunError> {
+        let prediction = self.mech.predict(&self.params, inputs).map_err(RunError::Model)?;
+        let start = self.sim.snapshot_with(false);
+        let (sim_eq, sim_start) = (self.observe(equilibrium), self.observe(&start));
+        let structure = self.sim.structure();
+        let tick = |snapshot, simulated| Tick {
+            motion_time_s: Some(0.0),
+            accelerated: false,
+            structure,
+            snapshot,
+            inputs,
+            params: &self.params,
+            prediction: &prediction,
+            simulated,
+            ghost_nodes: None,
+            estimate: None,
+        };
+        let (eq, at) = (tick(equilibrium, &sim_eq), tick(&start, &sim_start));
+        for o in &mut self.observers {
+            o.motion_start_state(&eq, &at);
+        }
+        Ok(())
+    }
+
     /// One step followed by every observer.
     pub fn step(&mut self, inputs: &Values, prediction: &Prediction) -> Result<(Snapshot, Values), RunError> {
         if self.cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {

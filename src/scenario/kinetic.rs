@@ -7,7 +7,7 @@
 use super::error::{positive_value, Ctx, ScenarioError};
 use super::number::expr_error;
 use super::raw::{RawEnergy, RawFrequency, RawTrajectory};
-use crate::file_model::dynamics::{Dynamics, FrequencyPrediction, TrajectoryCheck, RATE_SUFFIX};
+use crate::file_model::dynamics::{Dynamics, FrequencyPrediction, TrajectoryCheck, TrajectoryStart, RATE_SUFFIX};
 use crate::file_model::energy_model::Coordinate;
 use crate::file_model::expr::Expr;
 use crate::file_model::spec::ModelSpec;
@@ -68,12 +68,20 @@ pub(super) fn dynamics(
     Ok(Some(Dynamics { kinetic, mass, kinetic_gradient, mixed, first_rate, frequencies, trajectory }))
 }
 
-/// `[energy.trajectory]`: its tolerances, positive.
+/// `[energy.trajectory]`: its tolerances, positive, and its start (one of
+/// [`TrajectoryStart::NAMES`], "samples" when absent).
 fn trajectory(ctx: &Ctx, raw: &RawTrajectory) -> Result<TrajectoryCheck, ScenarioError> {
     let tolerance = positive_value(ctx, &raw.tolerance, "energy.trajectory.tolerance")?;
     let rms_tolerance =
         raw.rms_tolerance.as_ref().map(|t| positive_value(ctx, t, "energy.trajectory.rms_tolerance")).transpose()?;
-    Ok(TrajectoryCheck { tolerance, rms_tolerance })
+    let start = match &raw.start {
+        None => TrajectoryStart::default(),
+        Some(s) => TrajectoryStart::parse(s.get_ref()).ok_or_else(|| {
+            let expected = TrajectoryStart::NAMES.join(", ");
+            ctx.err(s, format!("unknown energy.trajectory.start '{}' (expected one of: {expected})", s.get_ref()))
+        })?,
+    };
+    Ok(TrajectoryCheck { tolerance, rms_tolerance, start })
 }
 
 /// An error at the first place `name` appears as a whole symbol in the expression `text` (not

@@ -92,6 +92,9 @@ pub(super) struct RawTrajectory {
     /// On the rms error of each coordinate over the motion.
     #[serde(default)]
     pub(super) rms_tolerance: Option<Spanned<f64>>,
+    /// Where the model starts: "samples" (the default) or "stated".
+    #[serde(default)]
+    pub(super) start: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -25,6 +25,7 @@ mod interrupts;
 mod ji2014_dynamics;
 mod joint_probe;
 mod joint_settling;
+mod lagrangian_trajectory;
 mod manriquez2019_dynamics;
 mod model_expressions;
 mod model_scenarios;
