@@ -84,17 +84,7 @@ pub(super) fn run_motion(
     if m.drive.is_some() {
         runner.sim.drive_physically()?;
     }
-    // The steps from here are the leapfrog scheme from the stated start (`sim/levels.rs`):
-    // second order at the tick times; extrapolated over the step, fourth (`levels.rs`).
-    let extrapolate = m.extrapolate.unwrap_or(!runner.sim.has_plain_free_bodies());
-    if let Some(r) = report.motion.as_mut() {
-        r.integration = integration_text(extrapolate).into();
-    }
-    if extrapolate {
-        runner.levels = Some(Levels::new(&runner.sim)?);
-        runner.motion_drive = m.drive.clone();
-    }
-    runner.sim.start_at_half_step()?;
+    start_integration(runner, m, report)?;
     let mut prediction = runner.mech.predict(&runner.params, &inputs).map_err(RunError::Model)?;
     let mut result = Ok(());
     let mut inputs = inputs;
@@ -122,6 +112,22 @@ pub(super) fn run_motion(
         });
     }
     result
+}
+
+/// Starts the motion's integration: the steps from here are the leapfrog scheme from the
+/// stated start (`sim/levels.rs`), second order at the tick times; extrapolated over the step,
+/// fourth (`levels.rs`), by default where every free body moves in joint coordinates.
+fn start_integration(runner: &mut Runner, m: &Motion, report: &mut ScenarioReport) -> Result<(), RunError> {
+    let extrapolate = m.extrapolate.unwrap_or(!runner.sim.has_plain_free_bodies());
+    if let Some(r) = report.motion.as_mut() {
+        r.integration = integration_text(extrapolate).into();
+    }
+    if extrapolate {
+        runner.levels = Some(Levels::new(&runner.sim)?);
+        runner.motion_drive = m.drive.clone();
+    }
+    runner.sim.start_at_half_step()?;
+    Ok(())
 }
 
 /// How a motion's judged trajectory is made.
