@@ -176,6 +176,10 @@ impl ModalProjector {
     }
 }
 
+/// The divisor of the difference between two Richardson values, T(h/2, h/4) - T(h, h/2), that
+/// estimates the error of the finer one for a scheme whose error is even in h: 2^4 - 1.
+pub const RICHARDSON_ESTIMATE_DIVISOR: f64 = 15.0;
+
 /// One Richardson step over the time step: from the same motion at step h (`coarse`) and h / 2
 /// (`fine`), a method whose error is c h^p + ... gives fine + (fine - coarse) / (2^p - 1),
 /// which cancels the h^p term. Every number of the state is combined so: node positions,

@@ -137,6 +137,8 @@ pub(super) struct Acc {
     motion_max: f64,
     motion_sum_sq: f64,
     motion_ticks: u64,
+    /// Over a motion judged extrapolated: the largest estimate of the simulation's own error.
+    estimate_max: Option<f64>,
 }
 
 impl Acc {
@@ -153,6 +155,11 @@ impl Acc {
         self.motion_max = self.motion_max.max(e);
         self.motion_sum_sq += e * e;
         self.motion_ticks += 1;
+    }
+
+    /// A motion tick's estimate of the simulation's own error in what the check compares.
+    pub(super) fn estimate(&mut self, e: f64) {
+        self.estimate_max = Some(self.estimate_max.unwrap_or(0.0).max(e));
     }
 
     fn motion_rms(&self) -> f64 {
@@ -198,6 +205,7 @@ pub(super) fn check_report(j: &Judged, a: &Acc, over_motion: bool) -> ModelCheck
         rms_error: None,
         rms_tolerance: None,
         motion_ticks: None,
+        simulation_error: a.estimate_max,
     };
     if over_motion {
         let rms = a.motion_rms();
@@ -383,6 +391,15 @@ impl ModelObserver {
         time_s: f64,
     ) -> Vec<f64> {
         self.spec.values(inputs, params, |i| self.bind[i].read(snap, observed, time_s))
+    }
+
+    /// The estimate of the simulation's own error in each prediction's simulated value (its
+    /// class's error) and each equation's residual, from the judged values `v` and those of the
+    /// state one level rougher (`run/levels.rs`: they differ by 15 times the judged error).
+    fn estimates(&self, v: &[f64], rougher: &[f64]) -> Vec<f64> {
+        let predictions = self.spec.predictions.iter().map(|p| p.class.error(rougher[p.symbol], v[p.symbol]));
+        let equations = self.spec.equations.iter().map(|e| (e.residual.eval(v) - e.residual.eval(rougher)).abs());
+        predictions.chain(equations).map(|d| d / crate::snapshot::RICHARDSON_ESTIMATE_DIVISOR).collect()
     }
 
     /// Each prediction's (predicted, simulated, error), then each equation's (0, residual,
@@ -651,6 +668,13 @@ impl Observer for ModelObserver {
             for (a, (_, _, e)) in self.acc.iter_mut().zip(&errors).take(predictions) {
                 a.motion_tick(*e);
             }
+            if let Some((rougher, observed)) = t.rougher {
+                let v_rougher = self.values(rougher, t.inputs, t.params, observed, time_s);
+                let estimates = self.estimates(&v, &v_rougher);
+                for (a, e) in self.acc.iter_mut().zip(estimates) {
+                    a.estimate(e);
+                }
+            }
             if let (Some(tracker), Some(_)) = (self.trajectory.as_mut(), t.estimate) {
                 tracker.note_extrapolated();
             }
@@ -723,6 +747,14 @@ impl Observer for ModelObserver {
 
     fn finish(&mut self, report: &mut ScenarioReport) {
         report.model_checks = self.reports();
+        for c in report.model_checks.iter().filter(|c| c.below_resolution()) {
+            report.warnings.push(format!(
+                "{}: tolerance {:.1e} below what this run resolves (its simulation error estimate {:.1e}): a finer time step resolves it",
+                c.failure(),
+                c.tolerance,
+                c.simulation_error.unwrap_or(f64::NAN)
+            ));
+        }
         let (Some(tracker), Some(e), Some(check)) = (&self.trajectory, &self.spec.energy, trajectory_check(&self.spec))
         else {
             return;

@@ -44,6 +44,10 @@ pub struct Tick<'a> {
     /// In a motion judged extrapolated over the time step: each quantity's estimate of the
     /// simulation's own error at this tick (`run/levels.rs`).
     pub estimate: Option<&'a Values>,
+    /// There too: the state one level rougher (Richardson's value from h and h/2) with the
+    /// mechanism's quantities in it; what an observer measures differs between it and
+    /// `snapshot` by 15 times its estimated error (`run/levels.rs`).
+    pub rougher: Option<(&'a Snapshot, &'a Values)>,
 }
 
 /// What the observers see of a settle point besides its report (which holds the inputs, the

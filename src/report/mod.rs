@@ -316,6 +316,11 @@ pub struct ModelCheckReport {
     pub rms_tolerance: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub motion_ticks: Option<u64>,
+    /// In a motion judged extrapolated over the time step: the largest estimate of the
+    /// simulation's own error in what the check compares (its class), over the motion. A
+    /// tolerance below it asks for more than the run resolves (`warnings` says so).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulation_error: Option<f64>,
 }
 
 impl ModelCheckReport {
@@ -343,7 +348,14 @@ impl ModelCheckReport {
             rms_error: None,
             rms_tolerance: None,
             motion_ticks: None,
+            simulation_error: None,
         }
+    }
+
+    /// Whether the check's tolerance is below what the run resolves: under the largest estimate
+    /// of the simulation's own error.
+    pub fn below_resolution(&self) -> bool {
+        self.simulation_error.is_some_and(|e| self.tolerance < e)
     }
 
     /// The failure this entry is when it does not pass (`prediction:NAME`, `equation:NAME`).
@@ -872,8 +884,15 @@ impl ScenarioReport {
             "model", "max err", "tolerance", "transient", "rms trans.", "verdict"
         ));
         for c in &self.model_checks {
+            let simulation = match c.simulation_error {
+                Some(e) if c.below_resolution() => {
+                    format!("; simulation error {e:.1e}: tolerance below what this run resolves")
+                }
+                Some(e) => format!("; simulation error {e:.1e}"),
+                None => String::new(),
+            };
             out.push_str(&format!(
-                "   {:<w$} {:>12.3e} {:>10.1e} {:>12.3e} {:>12.3e}  {} ({} {})\n",
+                "   {:<w$} {:>12.3e} {:>10.1e} {:>12.3e} {:>12.3e}  {} ({} {}{simulation})\n",
                 c.name,
                 c.max_error,
                 c.tolerance,

@@ -15,14 +15,20 @@
 
 use crate::mechanisms::Values;
 use crate::sim::{SimError, Simulation};
-use crate::snapshot::{richardson, Snapshot};
+use crate::snapshot::{richardson, Snapshot, RICHARDSON_ESTIMATE_DIVISOR};
 
 /// The order of the leapfrog scheme's leading error term, cancelled by one Richardson step.
 const LEAPFROG_ORDER: i32 = 2;
 
-/// The judged state's error estimate: the difference of the two Richardson values over
-/// (2^4 - 1), the next term's factor.
-const ESTIMATE_DIVISOR: f64 = 15.0;
+/// What [`Levels::judge`] gives at a tick.
+pub(super) struct Judged {
+    /// The judged state: Richardson's value from h/2 and h/4.
+    pub state: Snapshot,
+    /// Each quantity's estimate of the judged state's error.
+    pub estimate: Values,
+    /// Richardson's value from h and h/2, with the mechanism's quantities in it.
+    pub rougher: (Snapshot, Values),
+}
 
 /// The motion at h/2 and h/4 beside the runner's own at h.
 pub(super) struct Levels {
@@ -63,9 +69,10 @@ impl Levels {
         Ok(())
     }
 
-    /// The judged state at this tick (`coarse` the runner's own, at h) and each quantity's
-    /// error estimate, `observe` reading the quantities off a state.
-    pub fn judge(&mut self, coarse: &Snapshot, observe: &dyn Fn(&Snapshot) -> Values) -> (Snapshot, Values) {
+    /// The judged state at this tick (`coarse` the runner's own, at h), each quantity's error
+    /// estimate (`observe` reading the quantities off a state), and the state one level rougher
+    /// with its quantities.
+    pub fn judge(&mut self, coarse: &Snapshot, observe: &dyn Fn(&Snapshot) -> Values) -> Judged {
         let half = self.half.snapshot_with(false);
         let quarter = self.quarter.snapshot_with(false);
         let smooth = coarse.forces.cable_slack == half.forces.cable_slack
@@ -77,14 +84,15 @@ impl Levels {
         let rougher = richardson(coarse, &half, LEAPFROG_ORDER);
         (judged.tick, judged.time_s) = (coarse.tick, coarse.time_s);
         let (values, rough_values) = (observe(&judged), observe(&rougher));
+        let rougher = (rougher, rough_values.clone());
         let estimate: Values = values
             .iter()
-            .filter_map(|(k, v)| rough_values.get(k).map(|r| (k.clone(), (v - r).abs() / ESTIMATE_DIVISOR)))
+            .filter_map(|(k, v)| rough_values.get(k).map(|r| (k.clone(), (v - r).abs() / RICHARDSON_ESTIMATE_DIVISOR)))
             .collect();
         for (k, e) in &estimate {
             let largest = self.largest.entry(k.clone()).or_insert(0.0);
             *largest = largest.max(*e);
         }
-        (judged, estimate)
+        Judged { state: judged, estimate, rougher }
     }
 }

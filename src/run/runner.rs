@@ -130,7 +130,7 @@ impl<'a> Runner<'a> {
     /// The state the observers judge after a step, with each quantity's error estimate: the
     /// simulation's own, or in a motion judged extrapolated, the finer levels stepped to the
     /// same time and the three combined (`levels.rs`).
-    fn judged_state(&mut self) -> Result<(Snapshot, Option<Values>), RunError> {
+    fn judged_state(&mut self) -> Result<(Snapshot, Option<(Values, Snapshot, Values)>), RunError> {
         let snap = self.sim.snapshot_with(false);
         let Some(levels) = self.levels.as_mut() else { return Ok((snap, None)) };
         let dt_s = self.sc.sim.dt_s;
@@ -149,8 +149,8 @@ impl<'a> Runner<'a> {
             }
             values
         };
-        let (judged, estimate) = levels.judge(&snap, &observe);
-        Ok((judged, Some(estimate)))
+        let j = levels.judge(&snap, &observe);
+        Ok((j.state, Some((j.estimate, j.rougher.0, j.rougher.1))))
     }
 
     /// Shows every observer the state a motion starts from (the simulation's, before its first
@@ -171,6 +171,7 @@ impl<'a> Runner<'a> {
             simulated,
             ghost_nodes: None,
             estimate: None,
+            rougher: None,
         };
         let (eq, at) = (tick(equilibrium, &sim_eq), tick(&start, &sim_start));
         for o in &mut self.observers {
@@ -189,7 +190,7 @@ impl<'a> Runner<'a> {
         // The residual (a least-squares fit, the costliest read-out) is left out here: the
         // settle loop computes it once the motion has stopped, and only those ticks carry it
         // (into the recording too).
-        let (snap, estimate) = self.judged_state()?;
+        let (snap, levels) = self.judged_state()?;
         let simulated = self.observe(&snap);
         // The ghost overlay is only drawn in recordings, and only recomputed when the inputs
         // change.
@@ -218,7 +219,8 @@ impl<'a> Runner<'a> {
             prediction,
             simulated: &simulated,
             ghost_nodes: self.ghost.as_ref().and_then(|(_, g)| g.as_deref()),
-            estimate: estimate.as_ref(),
+            estimate: levels.as_ref().map(|l| &l.0),
+            rougher: levels.as_ref().map(|l| (&l.1, &l.2)),
         };
         for o in &mut self.observers {
             o.tick(&tick, &mut self.notes);

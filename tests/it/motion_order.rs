@@ -101,3 +101,31 @@ fn the_extrapolated_motion_is_fourth_order_and_estimates_its_own_error() {
         assert!((1.0 / 3.0..=3.0).contains(r), "estimate over true error {r}: {ratios:?}");
     }
 }
+
+/// A check asks for more than the run resolves when its tolerance is below the estimate of the
+/// simulation's own error in what it compares: the report carries the estimate beside the
+/// check's error and says so in its warnings. The shipped small oscillation at dt = 4 ms:
+/// its closed form's prediction compared with a simulation error estimate of 9.6e-10 rad (the
+/// 0.5 rad release's 4.4e-7 at 4 ms scaled by the amplitude: 8.9e-10).
+#[test]
+fn a_tolerance_below_the_simulation_error_is_reported() {
+    let shipped = "scenarios/custom/pinned_bar_vibration.toml";
+    let run = |tolerance: &str| {
+        let text = super::common::edited(
+            shipped,
+            &[("[sim]\ndt = 1e-3", "[sim]\ndt = 4e-3"), ("tolerance = 1.5e-5", &format!("tolerance = {tolerance}"))],
+        );
+        let sc = tensegrity_testbed::scenario::parse(std::path::Path::new("variant.toml"), &text).expect("valid");
+        tensegrity_testbed::run::run(&sc, &tensegrity_testbed::run::RunOptions::default())
+    };
+    let fine = run("1.5e-5");
+    let c = fine.model_checks.iter().find(|c| c.name == "small oscillation").expect("the prediction");
+    let estimate = c.simulation_error.expect("an estimate in an extrapolated motion");
+    eprintln!("simulation error estimate {estimate:e}, check error {:e}", c.max_error);
+    assert!(estimate > 3e-10 && estimate < 3e-9, "{estimate:e}");
+    assert!(fine.warnings.iter().all(|w| !w.contains("below what this run resolves")), "{:?}", fine.warnings);
+    let strict = run("1e-13");
+    let text = strict.warnings.join("\n");
+    assert!(text.contains("prediction:small oscillation: tolerance 1.0e-13 below what this run resolves"), "{text}");
+    assert!(strict.model_checks.iter().any(|c| c.below_resolution()));
+}
