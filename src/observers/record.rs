@@ -63,12 +63,19 @@ pub struct Recording<'a> {
 /// The application name recordings carry.
 const APP: &str = "tensegrity-testbed";
 
+/// The recording's series of the simulation's own error estimate per quantity, at every tick of
+/// a motion judged extrapolated over the time step (`run/levels.rs`).
+pub const ESTIMATE_SERIES: &str = "simulation_error";
+
 pub struct Recorder {
     rec: rerun::RecordingStream,
     target: Target,
     every: u64,
     /// Whether the static parts (labels, radii, fixed colours, series names) were logged.
     statics_logged: bool,
+    /// Whether the series of the simulation's own error estimate were named (a motion judged
+    /// extrapolated over the time step).
+    estimate_named: bool,
     /// Per-tick data waiting to be sent.
     columns: Columns,
     /// Scalar series logged through [`Recorder::scalar`], by entity.
@@ -388,6 +395,7 @@ impl Recorder {
             target,
             every: every.max(1),
             statics_logged: false,
+            estimate_named: false,
             columns: Columns::new(),
             extra: Vec::new(),
             pending: 0,
@@ -581,12 +589,20 @@ impl Recorder {
 const LOG10_FLOOR: f64 = 1e-20;
 
 impl Observer for Recorder {
-    fn tick(&mut self, t: &Tick, _notes: &mut Vec<Note>) {
+    fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>) {
         let snap = t.snapshot;
         self.last_tick = snap.tick;
         self.last_time_s = snap.time_s;
         if snap.tick % self.every != 0 {
             return;
+        }
+        if let Some(estimate) = t.estimate {
+            if !self.estimate_named {
+                self.estimate_named = true;
+                notes.push(Note::SeriesNames(ESTIMATE_SERIES, estimate.keys().cloned().collect()));
+            }
+            let values = estimate.values().copied().collect();
+            notes.push(Note::ScalarsAt { entity: ESTIMATE_SERIES, tick: snap.tick, time_s: snap.time_s, values });
         }
         let s = t.structure;
         let (tick, time) = (snap.tick, snap.time_s);

@@ -95,13 +95,13 @@ fn the_table_holds_the_model_and_its_error_at_every_tick() {
 }
 
 /// Per entity of a recording, its scalar rows: (tick, the values logged there).
-type Scalars = BTreeMap<String, Vec<(i64, Vec<f64>)>>;
+pub(super) type Scalars = BTreeMap<String, Vec<(i64, Vec<f64>)>>;
 
 /// The component of a `Scalars` archetype.
 const SCALARS_COMPONENT: &str = "Scalars:scalars";
 
 /// Per entity of a recording (data store only), the `tick` values logged, and its scalar rows.
-fn read_recording(path: &Path) -> (BTreeMap<String, BTreeSet<i64>>, Scalars) {
+pub(super) fn read_recording(path: &Path) -> (BTreeMap<String, BTreeSet<i64>>, Scalars) {
     let file = std::io::BufReader::new(std::fs::File::open(path).expect("recording exists"));
     let (mut ticks, mut scalars): (BTreeMap<String, BTreeSet<i64>>, Scalars) = Default::default();
     for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
@@ -162,6 +162,17 @@ fn the_recording_holds_the_model_beside_the_simulation() {
     let c = &m.lagrangian.as_ref().unwrap().coordinates[0];
     let want = vec![c.simulated_omega_rad_per_s, c.model_omega_rad_per_s];
     assert_eq!(scalars["/frequencies/trajectory\\:qe"], [(0, want.clone()), (steps, want)]);
+    // The simulation's own error estimate per quantity at every tick of the motion, the
+    // table's `estimate:` column bit for bit.
+    let keys: Vec<&String> = m.extrapolation.as_ref().expect("extrapolated").largest_estimate.keys().collect();
+    let k = keys.iter().position(|key| key.as_str() == "joint:pin.angle").expect("the pin's estimate");
+    let estimate = col("estimate:joint:pin.angle");
+    let series = &scalars["/simulation_error"];
+    assert_eq!(series.len() as i64, steps, "one row per tick of the motion");
+    for (tick, values) in series {
+        assert_eq!(values.len(), keys.len());
+        assert_eq!(Some(values[k]), by_tick[tick][estimate], "tick {tick}");
+    }
 }
 
 /// The shipped file's text started from its stated initial condition, at time step `dt_s`.
