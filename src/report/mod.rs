@@ -217,8 +217,10 @@ pub struct FrequencyReport {
     pub name: String,
     /// The joint whose coordinate was fitted.
     pub coordinate: String,
+    /// "cosine" (a least-squares cosine fit) or "period" (zero crossings of the rate).
+    pub measure: String,
     pub predicted_rad_per_s: f64,
-    /// The fitted angular frequency of the simulated samples, w_d [rad/s].
+    /// The measured angular frequency of the simulated samples, w_d [rad/s].
     pub measured_rad_per_s: f64,
     /// Corrected for symplectic Euler's dispersion: w = (2 / dt) sin(w_d dt / 2) [rad/s].
     pub corrected_rad_per_s: f64,
@@ -228,7 +230,8 @@ pub struct FrequencyReport {
     pub uncorrected_error: f64,
     pub tolerance: f64,
     pub passed: bool,
-    /// The fit: offset c, amplitude A and the rms of its residual [rad or m], samples fitted.
+    /// The cosine fit (with either measure): offset c, amplitude A and the rms of its residual
+    /// [rad or m], samples fitted.
     pub fit_offset: f64,
     pub fit_amplitude: f64,
     pub fit_rms_residual: f64,
@@ -792,8 +795,9 @@ impl ScenarioReport {
         }
         for f in &m.frequencies {
             out.push_str(&format!(
-                "   frequency {}: predicted {:.9} rad/s, measured {:.9}, corrected {:.9}: error {:.3e} (uncorrected {:.3e}), tolerance {:.1e}  {}\n",
+                "   frequency {} ({}): predicted {:.9} rad/s, measured {:.9}, corrected {:.9}: error {:.3e} (uncorrected {:.3e}), tolerance {:.1e}  {}\n",
                 f.name,
+                if f.measure == "period" { "period" } else { "cosine fit" },
                 f.predicted_rad_per_s,
                 f.measured_rad_per_s,
                 f.corrected_rad_per_s,
