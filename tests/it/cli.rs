@@ -308,3 +308,40 @@ fn meaningless_flags_are_refused_with_exit_2_before_any_work() {
         assert!(start.elapsed() < std::time::Duration::from_secs(1), "{args:?} took {:?}", start.elapsed());
     }
 }
+
+/// `--set` of a name the file's `[actuation]` grid or points set at every point would be
+/// ignored: every command that reads a scenario with `--set` refuses it with exit 2, naming the
+/// flag and the sweep's key at file:LINE:COL, before any work.
+#[test]
+fn a_set_of_a_swept_name_is_refused_naming_the_flag_and_the_sweep() {
+    let file = "scenarios/custom/pinned_bar_sweep.toml";
+    let text = std::fs::read_to_string(file).unwrap();
+    let (line, col) = common::line_col(&text, text.find("k1 = { from").expect("the grid's k1"));
+    let at = format!("{file}:{line}:{col}: ");
+    let commands: [&[&str]; 6] = [
+        &["run", file],
+        &["check", file],
+        &["list", file],
+        &["sweep", file, "--out", "-"],
+        &["modes", file],
+        &["export", "mjcf", file, "--out", "-"],
+    ];
+    for args in commands {
+        let args: Vec<&str> = args.iter().copied().chain(["--set", "k1=50"]).collect();
+        let (code, out, err) = tensegrity(&args);
+        assert_eq!(code, 2, "{args:?}: {out}{err}");
+        assert!(err.contains(&at), "{args:?}: {err}");
+        assert!(err.contains("--set k1=50 conflicts with the file: 'k1' is set here by [actuation] grid"), "{err}");
+        assert!(out.is_empty(), "{args:?}: nothing ran, yet: {out}");
+    }
+    // A name the grid does not sweep is still set.
+    assert_eq!(tensegrity(&["check", file, "--set", "k2=35"]).0, 0);
+    // An input a point sets is swept as well (a built-in mechanism's point).
+    let p = temp_file("swept_point.toml", VALID);
+    let (code, _, err) = tensegrity(&["check", p.to_str().unwrap(), "--set", "theta1=0.3"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(":6:24: --set theta1=0.3 conflicts with the file: 'theta1' is set here by [actuation] points"),
+        "{err}"
+    );
+}
