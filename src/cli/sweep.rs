@@ -34,6 +34,11 @@ pub fn sweep(
         outputs.push(("the CSV of an interrupted sweep".into(), partial_path(csv)));
     }
     check_outputs(&[path.to_path_buf()], &outputs)?;
+    if [&o.csv, &o.json].into_iter().all(|p| p.as_deref().is_some_and(super::is_stdio)) {
+        return Err(super::bad_input(
+            "--out - and --json - both write to standard output: give one of them a file, so that the other is alone there",
+        ));
+    }
     check_axis(&sc, o.x.as_deref())?;
     let jobs = capped_jobs(jobs);
     // From here on every block stops at its next tick on a signal and the outputs are written.
