@@ -32,6 +32,7 @@ mod model_scenarios;
 mod modes;
 mod mohr2011_dynamics;
 mod motion;
+mod motion_messages;
 mod moved_node;
 mod outputs;
 mod param_sweep;
