@@ -42,8 +42,8 @@ fn measured_at(dt_s: f64) -> (FrequencyReport, FrequencyReport) {
 }
 
 /// The period measure is unbiased at 0.5 rad: its error against the exact pendulum frequency
-/// falls at second order over dt = 1, 0.5, 0.25 ms with no floor (measured 1.003e-6,
-/// 2.507e-7, 6.268e-8: order 2.000, all low: the integrator's own error), within 1e-7 at
+/// falls at second order over dt = 1, 0.5, 0.25 ms with no floor (measured 1.0026e-6,
+/// 2.5071e-7, 6.2677e-8: order 2.000, all low: the integrator's own error), within 1e-7 at
 /// 0.25 ms. The cosine fit of the same motion does not converge: it lies 1.7e-7, 2.0e-7,
 /// 2.2e-7 above the period measure (its bias at this amplitude and record length, the same for
 /// the exact solution: `observers::motion`'s unit tests), so at 0.25 ms it is 1.5e-7 off and
