@@ -459,15 +459,12 @@ fn frequency(
 /// `measure = "cosine"` (the default without it) or `"period"`.
 fn measure(ctx: &Ctx, m: Option<&Spanned<String>>) -> Result<FrequencyMeasure, ScenarioError> {
     let Some(m) = m else { return Ok(FrequencyMeasure::default()) };
-    [FrequencyMeasure::Cosine, FrequencyMeasure::Period].into_iter().find(|x| x.label() == m.get_ref()).ok_or_else(
-        || {
-            ctx.err(
-                m,
-                format!(
-                    "measure must be \"cosine\" (a least-squares cosine fit) or \"period\" (zero crossings of the rate), got \"{}\"",
-                    m.get_ref()
-                ),
-            )
-        },
-    )
+    match m.get_ref().as_str() {
+        "cosine" => Ok(FrequencyMeasure::Cosine),
+        "period" => Ok(FrequencyMeasure::Period),
+        other => Err(ctx.err(
+            m,
+            format!("measure must be \"cosine\" (a least-squares cosine fit) or \"period\" (zero crossings of the rate), got \"{other}\""),
+        )),
+    }
 }
