@@ -270,12 +270,37 @@ impl FrequencySignal {
     }
 }
 
+/// How a motion's frequency is measured from the sampled coordinate (`[[motion.frequencies]]
+/// measure`); either is then corrected for symplectic Euler's dispersion.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FrequencyMeasure {
+    /// A least-squares fit of c + A cos(w t + p) over every tick: exact for a linear
+    /// oscillator, biased at large amplitude (the harmonics of a nonlinear motion pull the fit).
+    #[default]
+    Cosine,
+    /// The mean period between interpolated zero crossings of the rate over every full period
+    /// of the record: unbiased at any amplitude.
+    Period,
+}
+
+impl FrequencyMeasure {
+    /// As the file and the report name it.
+    pub fn label(self) -> &'static str {
+        match self {
+            FrequencyMeasure::Cosine => "cosine",
+            FrequencyMeasure::Period => "period",
+        }
+    }
+}
+
 /// A natural frequency predicted (in closed form, or by the structure's own modal analysis)
 /// and measured from the motion.
 #[derive(Clone, Debug)]
 pub struct FrequencyPrediction {
     pub name: String,
     pub signal: FrequencySignal,
+    /// How the frequency is measured from the motion.
+    pub measure: FrequencyMeasure,
     /// Compiled against [`FrequencyPrediction::symbols`]; None: the modal analysis's frequency
     /// of the mode fitted.
     pub formula: Option<crate::file_model::expr::Expr>,
@@ -288,6 +313,7 @@ pub struct FrequencyPrediction {
 impl PartialEq for FrequencyPrediction {
     fn eq(&self, other: &Self) -> bool {
         self.name == other.name
+            && self.measure == other.measure
             && self.formula.as_ref().map(|f| f.text()) == other.formula.as_ref().map(|f| f.text())
             && self.tolerance == other.tolerance
     }

@@ -52,10 +52,14 @@ pub enum Command {
         fail_on_declared: bool,
     },
     /// Natural frequencies and mode shapes of a scenario's structure at its settled state (its
-    /// first point, settled as `run` settles it): free bodies held by springs and elastic cables.
+    /// first point, settled as `run` settles it): free bodies held by springs and elastic
+    /// cables, or the revolute and prismatic joints of joint trees; refused (exit 2): joints
+    /// that close a loop, inextensible cables, spherical and universal joints, free bodies
+    /// beside joints.
     Modes {
         scenario: PathBuf,
-        /// Write the JSON report to this file.
+        /// Write the JSON report to this file (`-`: standard output, the table then going to
+        /// standard error).
         #[arg(long)]
         json: Option<PathBuf>,
         /// Record each mode animated at its frequency to this .rrd file (rerun).

@@ -1,6 +1,7 @@
 //! `tensegrity modes S.toml`: the structure's natural frequencies and mode shapes at its
 //! settled state (settled first as `run` settles its first point; `sim::modes`), as a table,
-//! as JSON with `--json FILE`, and animated in a rerun recording with `--record FILE.rrd`.
+//! as JSON with `--json FILE` (`-`: standard output, the table then going to standard error),
+//! and animated in a rerun recording with `--record FILE.rrd`.
 
 use super::{bad_input, check_outputs, failed, load_one, signals, write_atomic, CliError, Outcome};
 use crate::report::modes::{ModeReport, ModesReport};
@@ -41,7 +42,12 @@ pub fn modes(
         modes: rows(&analysis, &state.sim.structure().nodes),
         wall_s: wall.elapsed().as_secs_f64(),
     };
-    print!("{}", report.to_table());
+    // With `--json -` standard output is the JSON alone: the table goes to standard error.
+    if json.is_some_and(super::is_stdio) {
+        eprint!("{}", report.to_table());
+    } else {
+        print!("{}", report.to_table());
+    }
     if let Some(j) = json {
         write_atomic(j, &serde_json::to_string_pretty(&report).expect("report serialises"))?;
     }

@@ -13,14 +13,10 @@ pub struct Outputs {
     pub x: Option<String>,
 }
 
-pub fn sweep(
-    path: &Path,
-    overrides: &[Override],
-    o: &Outputs,
-    jobs: usize,
-    shard: Option<&str>,
-) -> Result<Outcome, CliError> {
-    let sc = load_one(path, overrides)?;
+/// Refuses outputs that mean nothing or would destroy data, before any work: a figure that is no
+/// .png or .svg, an output over the scenario, and the CSV and the JSON both on standard output
+/// (mixed, neither could be read).
+fn check_sweep_outputs(path: &Path, o: &Outputs) -> Result<(), CliError> {
     if let Some(f) =
         o.figure.as_deref().filter(|f| !matches!(f.extension().and_then(|e| e.to_str()), Some("png" | "svg")))
     {
@@ -34,6 +30,23 @@ pub fn sweep(
         outputs.push(("the CSV of an interrupted sweep".into(), partial_path(csv)));
     }
     check_outputs(&[path.to_path_buf()], &outputs)?;
+    if [&o.csv, &o.json].into_iter().all(|p| p.as_deref().is_some_and(super::is_stdio)) {
+        return Err(super::bad_input(
+            "--out - and --json - both write to standard output: give one of them a file, so that the other is alone there",
+        ));
+    }
+    Ok(())
+}
+
+pub fn sweep(
+    path: &Path,
+    overrides: &[Override],
+    o: &Outputs,
+    jobs: usize,
+    shard: Option<&str>,
+) -> Result<Outcome, CliError> {
+    let sc = load_one(path, overrides)?;
+    check_sweep_outputs(path, o)?;
     check_axis(&sc, o.x.as_deref())?;
     let jobs = capped_jobs(jobs);
     // From here on every block stops at its next tick on a signal and the outputs are written.

@@ -258,6 +258,12 @@ fn strut_reading(s: &Structure, st: &crate::structure::Strut, size: f64) -> Opti
 /// acts at that end.
 const JOINT_AT_NODE_FRACTION: f64 = 1e-9;
 
+/// The branch a custom structure's settled state lands on: the values its `[[checks]]` state.
+pub const EXPECTED_VALUES: &str = "expected values from the file";
+/// The label where the file's `[[checks]]` state no values: no branch to land on (the file's
+/// own model, `[[predictions]]` and the rest, is judged beside, not as a branch).
+pub const NO_EXPECTED_VALUES: &str = "none (the file's [[checks]] state no values)";
+
 impl Mechanism for Custom {
     fn spec(&self) -> &MechanismSpec {
         &self.spec
@@ -299,11 +305,12 @@ impl Mechanism for Custom {
         }
         Ok(s)
     }
+    /// The one branch: the file's `[[checks]] value`s, if it states any.
     fn predict(&self, _params: &Values, _inputs: &Values) -> Result<Prediction, ModelError> {
         Ok(Prediction {
             expected: self.expected.clone(),
             branches: vec![Solution {
-                label: "expected values from the file".into(),
+                label: if self.expected.is_empty() { NO_EXPECTED_VALUES } else { EXPECTED_VALUES }.into(),
                 values: self.expected.clone(),
                 stable: None,
             }],

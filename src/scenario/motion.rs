@@ -33,6 +33,10 @@
 //! formula = "sqrt(L*hypot(k1*a, k2*b)/I_pivot)"  # [rad/s]: parameters, inputs and the
 //!                         # mechanism's analytic quantities (ji2014's K of Eq. 42, say)
 //! tolerance = 1e-6        # relative, on the frequency corrected for the integrator
+//! measure = "cosine"      # or "period": a least-squares cosine fit over every tick (exact
+//!                         # for a linear oscillator, biased by the harmonics at large
+//!                         # amplitude: 1e-6 relative at 0.3 rad), or the mean period between
+//!                         # interpolated zero crossings of the rate (unbiased at any amplitude)
 //! ```
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
@@ -41,7 +45,9 @@ use super::raw::RawScenario;
 use super::Actuation;
 use crate::file_model::expr::Expr;
 use crate::mechanisms::{Mechanism, Values};
-use crate::settings::{Drive, FrequencyPrediction, FrequencySignal, JointCoordinate, Motion, MotionStart};
+use crate::settings::{
+    Drive, FrequencyMeasure, FrequencyPrediction, FrequencySignal, JointCoordinate, Motion, MotionStart,
+};
 use crate::structure::ActuatorTarget;
 use crate::structure::{JointKind, Structure};
 use serde::Deserialize;
@@ -102,6 +108,8 @@ pub(super) struct RawFrequency {
     pub(super) formula: Option<Spanned<String>>,
     /// Relative, on the corrected measured frequency.
     pub(super) tolerance: Spanned<f64>,
+    /// "cosine" (the default) or "period": how the frequency is measured from the motion.
+    pub(super) measure: Option<Spanned<String>>,
 }
 
 /// The validated `[motion]` section, or None without one. `first` is the structure at the first
@@ -448,20 +456,34 @@ fn frequency(
         }
     }
     let tolerance = positive_value(ctx, &f.tolerance, "tolerance")?;
+    let measure = measure(ctx, f.measure.as_ref())?;
     let Some(text) = &f.formula else {
         if let FrequencySignal::Joint(_) = signal {
             return Err(ctx.err(&f.name, format!("frequency '{name}' of a joint needs a formula [rad/s]")));
         }
-        return Ok(FrequencyPrediction { name, signal, formula: None, symbols, tolerance });
+        return Ok(FrequencyPrediction { name, signal, measure, formula: None, symbols, tolerance });
     };
     let names: Vec<&str> = symbols.iter().map(String::as_str).collect();
     let what = format!("frequency '{name}' (parameters, inputs and the mechanism's quantities)");
     let formula = Expr::compile(text.get_ref(), &names).map_err(|e| expr_error(ctx, text.span().start, &e, &what))?;
-    let p = FrequencyPrediction { name, signal, formula: Some(formula), symbols, tolerance };
+    let p = FrequencyPrediction { name, signal, measure, formula: Some(formula), symbols, tolerance };
     let Ok(prediction) = mech.predict(params, inputs) else { return Ok(p) };
     let w = p.predicted(params, inputs, &prediction.expected).unwrap_or(f64::NAN);
     if !(w.is_finite() && w > 0.0) {
         return Err(ctx.err(text, format!("frequency '{}' is {w} rad/s here; a frequency is finite and > 0", p.name)));
     }
     Ok(p)
+}
+
+/// `measure = "cosine"` (the default without it) or `"period"`.
+fn measure(ctx: &Ctx, m: Option<&Spanned<String>>) -> Result<FrequencyMeasure, ScenarioError> {
+    let Some(m) = m else { return Ok(FrequencyMeasure::default()) };
+    match m.get_ref().as_str() {
+        "cosine" => Ok(FrequencyMeasure::Cosine),
+        "period" => Ok(FrequencyMeasure::Period),
+        other => Err(ctx.err(
+            m,
+            format!("measure must be \"cosine\" (a least-squares cosine fit) or \"period\" (zero crossings of the rate), got \"{other}\""),
+        )),
+    }
 }

@@ -4,7 +4,9 @@
 //! Each override is read as one more line of TOML placed after the file's end, so that its
 //! value is validated exactly as the file's own would be, and an error in it (a wrong type, an
 //! unknown name, a value out of range) is located by line and column past the file's end and
-//! then reported at its flag (`--set NAME=VALUE:1:COL: message`).
+//! then reported at its flag (`--set NAME=VALUE:1:COL: message`). A name the file's
+//! `[actuation]` grid or points set at every point is refused at the sweep's key: the flag
+//! would be ignored.
 
 use super::error::{Ctx, ScenarioError};
 use super::number::ParamMap;
@@ -88,6 +90,7 @@ pub(super) fn apply(
         } else if o.name.starts_with("settle.") {
             merge_settle(&mut raw.settle, read(ctx, &snippet)?);
         } else {
+            swept(ctx, raw, o)?;
             // A file's own structure has only the parameters it names: another name would be
             // set and silently unused.
             let named = raw.params.keys().any(|k| k.get_ref() == &o.name);
@@ -110,6 +113,30 @@ pub(super) fn apply(
         }
     }
     Ok(())
+}
+
+/// A name the file's `[actuation]` grid or points set at every point (a swept parameter or
+/// input) cannot be fixed by `--set`: its value would be replaced at every point and the flag
+/// silently ignored. The error is located at the sweep's key and names the flag.
+fn swept(ctx: &Ctx, raw: &RawScenario, o: &Override) -> Result<(), ScenarioError> {
+    let a = raw.actuation.get_ref();
+    let in_grid = a.grid.as_ref().and_then(|g| g.keys().find(|k| k.get_ref() == &o.name).map(|k| (k, "grid")));
+    let in_points = || {
+        a.points
+            .iter()
+            .flatten()
+            .find_map(|p| p.get_ref().keys().find(|k| k.get_ref() == &o.name))
+            .map(|k| (k, "points"))
+    };
+    let Some((key, how)) = in_grid.or_else(in_points) else { return Ok(()) };
+    Err(ctx.err(
+        key,
+        format!(
+            "{} conflicts with the file: '{}' is set here by [actuation] {how}, at every point, so the flag would be ignored; remove the flag, or change the {how} in the file",
+            o.flag(),
+            o.name
+        ),
+    ))
 }
 
 /// The byte offset where line `n` (from 0) of `text` starts.

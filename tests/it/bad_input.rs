@@ -194,7 +194,21 @@ fn cases() -> Vec<(&'static str, String, usize, &'static str)> {
             6,
             "unknown quantity",
         ),
+        // A motion's frequency measured a way that does not exist.
+        {
+            let (text, line) = shipped_edit(LARGE_AMPLITUDE, "measure = \"period\"", "measure = \"zero crossings\"");
+            ("unknown frequency measure", text, line, "measure must be \"cosine\"")
+        },
     ]
+}
+
+const LARGE_AMPLITUDE: &str = "scenarios/custom/pinned_bar_large_amplitude.toml";
+
+/// The shipped file at `path` with `from` replaced by `to` (once), and the line of the edit.
+fn shipped_edit(path: &str, from: &str, to: &str) -> (String, usize) {
+    let text = common::edited(path, &[(from, to)]);
+    let line = text[..text.find(to).expect("the edit")].lines().count() + 1;
+    (text, line)
 }
 
 #[test]

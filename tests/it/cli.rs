@@ -308,3 +308,92 @@ fn meaningless_flags_are_refused_with_exit_2_before_any_work() {
         assert!(start.elapsed() < std::time::Duration::from_secs(1), "{args:?} took {:?}", start.elapsed());
     }
 }
+
+/// `--set` of a name the file's `[actuation]` grid or points set at every point would be
+/// ignored: every command that reads a scenario with `--set` refuses it with exit 2, naming the
+/// flag and the sweep's key at file:LINE:COL, before any work.
+#[test]
+fn a_set_of_a_swept_name_is_refused_naming_the_flag_and_the_sweep() {
+    let file = "scenarios/custom/pinned_bar_sweep.toml";
+    let text = std::fs::read_to_string(file).unwrap();
+    let (line, col) = common::line_col(&text, text.find("k1 = { from").expect("the grid's k1"));
+    let at = format!("{file}:{line}:{col}: ");
+    let commands: [&[&str]; 6] = [
+        &["run", file],
+        &["check", file],
+        &["list", file],
+        &["sweep", file, "--out", "-"],
+        &["modes", file],
+        &["export", "mjcf", file, "--out", "-"],
+    ];
+    for args in commands {
+        let args: Vec<&str> = args.iter().copied().chain(["--set", "k1=50"]).collect();
+        let (code, out, err) = tensegrity(&args);
+        assert_eq!(code, 2, "{args:?}: {out}{err}");
+        assert!(err.contains(&at), "{args:?}: {err}");
+        assert!(err.contains("--set k1=50 conflicts with the file: 'k1' is set here by [actuation] grid"), "{err}");
+        assert!(out.is_empty(), "{args:?}: nothing ran, yet: {out}");
+    }
+    // A name the grid does not sweep is still set.
+    assert_eq!(tensegrity(&["check", file, "--set", "k2=35"]).0, 0);
+    // An input a point sets is swept as well (a built-in mechanism's point).
+    let p = temp_file("swept_point.toml", VALID);
+    let (code, _, err) = tensegrity(&["check", p.to_str().unwrap(), "--set", "theta1=0.3"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(":6:24: --set theta1=0.3 conflicts with the file: 'theta1' is set here by [actuation] points"),
+        "{err}"
+    );
+}
+
+/// `--json -` (or `--json` where it is a switch) makes standard output the JSON alone, for
+/// every command that has it: the human table goes to standard error.
+#[test]
+fn json_to_stdout_is_json_alone_for_every_command() {
+    let commands: [&[&str]; 7] = [
+        &["run", "scenarios/custom/pinned_bar_vibration.toml", "--json", "-"],
+        &["modes", "scenarios/custom/pinned_bar_modes.toml", "--json", "-"],
+        &["sweep", "scenarios/custom/pinned_bar_sweep.toml", "--json", "-"],
+        &["solve", "ji2014", "ik", "--set", "x=-0.5", "--set", "y=0.8", "--json"],
+        &["findings", "ji2014", "--json"],
+        &["bench", "--mechanism", "ji2014", "--rounds", "1", "--json"],
+        &["run", "scenarios/custom/pinned_bar_vibration.toml", "scenarios/custom/pinned_bar_modes.toml", "--json", "-"],
+    ];
+    for args in commands {
+        let (code, out, err) = tensegrity(args);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        let v: serde_json::Value =
+            serde_json::from_str(&out).unwrap_or_else(|e| panic!("{args:?}: stdout is not JSON alone ({e}): {out}"));
+        assert!(v.is_object() || v.is_array(), "{args:?}");
+    }
+    // Two outputs on standard output would mix: refused before any work.
+    let (code, out, err) =
+        tensegrity(&["sweep", "scenarios/custom/pinned_bar_sweep.toml", "--json", "-", "--out", "-"]);
+    assert!(code == 2 && out.is_empty() && err.contains("both write to standard output"), "{out}{err}");
+    // The modes table still shows, on standard error.
+    let (_, _, err) = tensegrity(&["modes", "scenarios/custom/pinned_bar_modes.toml", "--json", "-"]);
+    assert!(err.contains("mode    omega [rad/s]"), "{err}");
+}
+
+/// What `tensegrity modes` analyses and refuses is said in the same words by its `--help`, the
+/// command table (docs/command-line.md) and the Modes chapter (docs/modes.md), and is true:
+/// it works on a joint tree (the pinned bar) and refuses a loop and an inextensible cable.
+#[test]
+fn modes_help_command_table_and_chapter_say_the_same_true_thing() {
+    let scope = "free bodies held by springs and elastic cables, or the revolute and prismatic joints of joint trees; refused (exit 2): joints that close a loop, inextensible cables, spherical and universal joints, free bodies beside joints";
+    let words = |s: &str| s.split_whitespace().collect::<Vec<_>>().join(" ");
+    let (code, help, _) = tensegrity(&["modes", "--help"]);
+    assert_eq!(code, 0);
+    for (what, text) in [
+        ("modes --help", help),
+        ("docs/command-line.md", std::fs::read_to_string("docs/command-line.md").unwrap()),
+        ("docs/modes.md", std::fs::read_to_string("docs/modes.md").unwrap()),
+    ] {
+        assert!(words(&text).contains(scope), "{what} does not say: {scope}");
+    }
+    assert_eq!(tensegrity(&["modes", "scenarios/custom/pinned_bar_modes.toml"]).0, 0);
+    let (code, _, err) = tensegrity(&["modes", "scenarios/furet2018/ik_solutions.toml"]);
+    assert!(code == 2 && err.contains("closes a loop"), "{err}");
+    let (code, _, err) = tensegrity(&["modes", "scenarios/mohr2011/quick.toml"]);
+    assert!(code == 2 && err.contains("inextensible cable"), "{err}");
+}
