@@ -44,7 +44,7 @@ fn a_drawn_start_keeps_the_predictions_errors_over_the_motion() {
             table.lines().find(|l| l.trim_start().starts_with(name)).unwrap_or_else(|| panic!("{name}: {table}"));
         line.split_whitespace().map(str::to_string).collect::<Vec<_>>()
     };
-    assert_eq!(row("small oscillation")[4..6], ["8.814e-6", "6.009e-6"]);
+    assert_eq!(row("small oscillation")[4..6], ["4.026e-9", "1.672e-9"]);
     assert_eq!(row("energy")[3..5], ["-", "-"]);
 }
 
