@@ -7,18 +7,7 @@ use std::path::Path;
 
 /// Top-level module -> the top-level modules its files name through `crate::`.
 fn imports() -> BTreeMap<String, BTreeSet<String>> {
-    fn walk(dir: &Path, files: &mut Vec<std::path::PathBuf>) {
-        for e in std::fs::read_dir(dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                walk(&p, files);
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                files.push(p);
-            }
-        }
-    }
-    let mut files = Vec::new();
-    walk(Path::new("src"), &mut files);
+    let files = super::common::rust_files(Path::new("src"));
     let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     for f in files {
         let rel = f.strip_prefix("src").unwrap();
@@ -91,20 +80,6 @@ fn architecture_chapter_bullets() -> Vec<String> {
     section[..end].split("\n- ").skip(1).map(str::to_string).collect()
 }
 
-/// Every `.rs` file under `dir`, as paths relative to the crate root.
-fn source_files(dir: &Path) -> Vec<std::path::PathBuf> {
-    let mut out = Vec::new();
-    for e in std::fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            out.extend(source_files(&p));
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
-    out
-}
-
 /// Whether `bullet` names `file`: a file at the root as `src/NAME.rs`; a file in a folder by
 /// the folder (`src/DIR/`) and its own name (`NAME.rs`, or for a sub-folder's `mod.rs` the
 /// sub-folder `SUB/`).
@@ -125,7 +100,7 @@ fn names_file(bullet: &str, file: &Path) -> bool {
 fn the_readme_architecture_names_every_source_file() {
     let bullets = architecture_chapter_bullets();
     assert!(bullets.len() >= 10, "read only {} bullets", bullets.len());
-    let files = source_files(Path::new("src"));
+    let files = super::common::rust_files(Path::new("src"));
     assert!(files.len() >= 50, "read only {} files", files.len());
     let missing: Vec<String> =
         files.iter().filter(|f| !bullets.iter().any(|b| names_file(b, f))).map(|f| f.display().to_string()).collect();

@@ -143,3 +143,18 @@ pub fn error_at(text: &str, at: &str, shift: usize, msg: &str) {
     assert!(err.message.contains(msg), "{err}");
     assert!(err.to_string().starts_with(&format!("variant.toml:{line}:{col}: ")), "{err}");
 }
+
+/// Every `.rs` file under `dir` (at any depth), sorted.
+pub fn rust_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(rust_files(&p));
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+    out.sort();
+    out
+}

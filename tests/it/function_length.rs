@@ -8,20 +8,7 @@ use std::path::{Path, PathBuf};
 /// The most lines a function may span.
 const MAX_LINES: usize = 80;
 
-/// Every `.rs` file under `dir`.
-fn rust_files(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    for e in std::fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            out.extend(rust_files(&p));
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
-    out.sort();
-    out
-}
+use super::common::rust_files;
 
 /// The index after the literal that opens at `i` (a string, a raw string or a character
 /// literal), or None when none opens there (a lifetime's quote is none).

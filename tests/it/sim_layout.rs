@@ -7,21 +7,14 @@ use std::path::{Path, PathBuf};
 
 /// Every `.rs` file under `src/sim/`, with its text up to its unit tests.
 fn sim_sources() -> Vec<(PathBuf, String)> {
-    fn walk(dir: &Path, out: &mut Vec<(PathBuf, String)>) {
-        for e in std::fs::read_dir(dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                walk(&p, out);
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                let text = std::fs::read_to_string(&p).unwrap();
-                let code = text.split("#[cfg(test)]").next().unwrap_or_default().to_string();
-                out.push((p, code));
-            }
-        }
-    }
-    let mut out = Vec::new();
-    walk(Path::new("src/sim"), &mut out);
-    out
+    super::common::rust_files(Path::new("src/sim"))
+        .into_iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(&p).unwrap();
+            let code = text.split("#[cfg(test)]").next().unwrap_or_default().to_string();
+            (p, code)
+        })
+        .collect()
 }
 
 #[test]
