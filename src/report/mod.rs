@@ -188,7 +188,8 @@ pub struct ExtrapolationReport {
     pub steps_s: Vec<f64>,
     /// Each quantity's largest error estimate over the motion (its unit).
     pub largest_estimate: std::collections::BTreeMap<String, f64>,
-    /// The first tick at which the levels disagree on a cable's slack, if any.
+    /// The first tick whose step saw a cable change between slack and taut (the levels disagree
+    /// on it, or it changed since the tick before), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub not_smooth_from_tick: Option<u64>,
 }

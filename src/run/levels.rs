@@ -9,9 +9,10 @@
 //! Every number of the state is combined (`snapshot::richardson`), and each quantity's estimate
 //! is reported per tick and at its largest over the motion.
 //!
-//! The rule holds where the motion is smooth in time. A cable that goes slack or taut between
-//! two ticks at one level and not at another breaks it: the first tick where the levels
-//! disagree on any cable's slack is reported, and the estimates after it are not to be trusted.
+//! The rule holds where the motion is smooth in time. A cable that goes slack or taut puts a
+//! kink into it (its force law changes there): the first tick whose step saw any cable change
+//! between slack and taut, at any level, is reported, and the estimates after it are not to be
+//! trusted.
 
 use crate::mechanisms::Values;
 use crate::sim::{SimError, Simulation};
@@ -36,8 +37,10 @@ pub(super) struct Levels {
     quarter: Simulation,
     /// Each quantity's largest error estimate over the motion so far.
     pub largest: Values,
-    /// The first tick at which the levels disagree on a cable's slack, if any.
+    /// The first tick whose step saw a cable change between slack and taut, if any.
     pub rough_from_tick: Option<u64>,
+    /// Each cable's slack at the last tick, at the finest level.
+    last_slack: Option<Vec<bool>>,
 }
 
 /// Actuator commands at a time of the motion [s] (a driven motion's inputs).
@@ -52,7 +55,7 @@ impl Levels {
         half.start_at_half_step()?;
         let mut quarter = sim.at_time_step(dt_s / 4.0);
         quarter.start_at_half_step()?;
-        Ok(Levels { half, quarter, largest: Values::new(), rough_from_tick: None })
+        Ok(Levels { half, quarter, largest: Values::new(), rough_from_tick: None, last_slack: None })
     }
 
     /// Steps the finer levels over the coarse step that ends at motion time `end_s` [s] (of
@@ -75,8 +78,11 @@ impl Levels {
     pub fn judge(&mut self, coarse: &Snapshot, observe: &dyn Fn(&Snapshot) -> Values) -> Judged {
         let half = self.half.snapshot_with(false);
         let quarter = self.quarter.snapshot_with(false);
-        let smooth = coarse.forces.cable_slack == half.forces.cable_slack
-            && half.forces.cable_slack == quarter.forces.cable_slack;
+        let slack = &quarter.forces.cable_slack;
+        let smooth = coarse.forces.cable_slack == *slack
+            && half.forces.cable_slack == *slack
+            && self.last_slack.as_ref().is_none_or(|last| last == slack);
+        self.last_slack = Some(slack.clone());
         if !smooth && self.rough_from_tick.is_none() {
             self.rough_from_tick = Some(coarse.tick);
         }
