@@ -568,20 +568,21 @@ impl ModelObserver {
     }
 
     /// A motion tick's coordinates (every symbol's value `v`, the motion's time [s]) to the
-    /// comparison with the Lagrangian model: the rows known now (none without one).
-    pub(super) fn push_trajectory(&mut self, v: &[f64], time_s: f64) -> Vec<Row> {
+    /// comparison with the Lagrangian model: the rows known now (none without one). `t` says
+    /// whether the motion is judged extrapolated (its estimate).
+    pub(super) fn push_trajectory(&mut self, t: &Tick, v: &[f64], time_s: f64) -> Vec<Row> {
         let (Some(tracker), Some(e)) = (self.trajectory.as_mut(), &self.spec.energy) else { return vec![] };
+        if t.estimate.is_some() {
+            tracker.note_extrapolated();
+        }
         tracker.push(e, v, time_s, &e.measured(v))
     }
 
     /// This motion tick's coordinates to the comparison (as [`ModelObserver::push_trajectory`]).
     pub(super) fn trajectory_tick(&mut self, t: &Tick) -> Vec<Row> {
         let Some(time_s) = t.motion_time_s.filter(|_| self.trajectory.is_some()) else { return vec![] };
-        if let (Some(tracker), Some(_)) = (self.trajectory.as_mut(), t.estimate) {
-            tracker.note_extrapolated();
-        }
         let v = self.values(t.snapshot, t.inputs, t.params, t.simulated, time_s);
-        self.push_trajectory(&v, time_s)
+        self.push_trajectory(t, &v, time_s)
     }
 
     /// The rows the comparison still holds when the motion ends, uncompared.
@@ -675,10 +676,7 @@ impl Observer for ModelObserver {
                     a.estimate(e);
                 }
             }
-            if let (Some(tracker), Some(_)) = (self.trajectory.as_mut(), t.estimate) {
-                tracker.note_extrapolated();
-            }
-            let rows = self.push_trajectory(&v, time_s);
+            let rows = self.push_trajectory(t, &v, time_s);
             self.record_trajectory(t, &rows, notes);
         }
         if let Some(series) = &self.series {

@@ -25,6 +25,8 @@ const LEAPFROG_ORDER: i32 = 2;
 pub(super) struct Judged {
     /// The judged state: Richardson's value from h/2 and h/4.
     pub state: Snapshot,
+    /// The mechanism's quantities in it.
+    pub values: Values,
     /// Each quantity's estimate of the judged state's error.
     pub estimate: Values,
     /// Richardson's value from h and h/2, with the mechanism's quantities in it.
@@ -72,10 +74,16 @@ impl Levels {
         Ok(())
     }
 
-    /// The judged state at this tick (`coarse` the runner's own, at h), each quantity's error
-    /// estimate (`observe` reading the quantities off a state), and the state one level rougher
-    /// with its quantities.
-    pub fn judge(&mut self, coarse: &Snapshot, observe: &dyn Fn(&Snapshot) -> Values) -> Judged {
+    /// The judged state at this tick (`coarse` the runner's own, at h) with the mechanism's
+    /// quantities in it (`observe` reads them off a state), the error estimate of each of them
+    /// and of each value `estimated_too` reads (the joint coordinates), and the state one level
+    /// rougher with its quantities.
+    pub fn judge(
+        &mut self,
+        coarse: &Snapshot,
+        observe: &dyn Fn(&Snapshot) -> Values,
+        estimated_too: &dyn Fn(&Snapshot) -> Values,
+    ) -> Judged {
         let half = self.half.snapshot_with(false);
         let quarter = self.quarter.snapshot_with(false);
         let slack = &quarter.forces.cable_slack;
@@ -90,15 +98,20 @@ impl Levels {
         let rougher = richardson(coarse, &half, LEAPFROG_ORDER);
         (judged.tick, judged.time_s) = (coarse.tick, coarse.time_s);
         let (values, rough_values) = (observe(&judged), observe(&rougher));
-        let rougher = (rougher, rough_values.clone());
+        let (too, rough_too) = (estimated_too(&judged), estimated_too(&rougher));
         let estimate: Values = values
             .iter()
-            .filter_map(|(k, v)| rough_values.get(k).map(|r| (k.clone(), (v - r).abs() / RICHARDSON_ESTIMATE_DIVISOR)))
+            .chain(&too)
+            .filter_map(|(k, v)| {
+                let r = rough_values.get(k).or_else(|| rough_too.get(k))?;
+                Some((k.clone(), (v - r).abs() / RICHARDSON_ESTIMATE_DIVISOR))
+            })
             .collect();
+        let rougher = (rougher, rough_values);
         for (k, e) in &estimate {
             let largest = self.largest.entry(k.clone()).or_insert(0.0);
             *largest = largest.max(*e);
         }
-        Judged { state: judged, estimate, rougher }
+        Judged { state: judged, values, estimate, rougher }
     }
 }

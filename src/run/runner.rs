@@ -127,12 +127,17 @@ impl<'a> Runner<'a> {
         }
     }
 
-    /// The state the observers judge after a step, with each quantity's error estimate: the
-    /// simulation's own, or in a motion judged extrapolated, the finer levels stepped to the
-    /// same time and the three combined (`levels.rs`).
-    fn judged_state(&mut self) -> Result<(Snapshot, Option<(Values, Snapshot, Values)>), RunError> {
+    /// The state the observers judge after a step with the mechanism's quantities in it, and
+    /// each quantity's error estimate with the state one level rougher: the simulation's own
+    /// state, or in a motion judged extrapolated, the finer levels stepped to the same time and
+    /// the three combined (`levels.rs`).
+    #[allow(clippy::type_complexity)]
+    fn judged_state(&mut self) -> Result<(Snapshot, Values, Option<(Values, Snapshot, Values)>), RunError> {
         let snap = self.sim.snapshot_with(false);
-        let Some(levels) = self.levels.as_mut() else { return Ok((snap, None)) };
+        let Some(levels) = self.levels.as_mut() else {
+            let simulated = self.observe(&snap);
+            return Ok((snap, simulated, None));
+        };
         let dt_s = self.sc.sim.dt_s;
         let end_s = self.motion_start_tick.map_or(0.0, |t0| snap.tick.saturating_sub(t0) as f64 * dt_s);
         let (mech, params, structure) = (&self.mech, &self.params, self.sim.structure());
@@ -142,15 +147,12 @@ impl<'a> Runner<'a> {
         };
         let driven: Option<&dyn Fn(f64) -> Vec<f64>> = self.motion_drive.as_ref().map(|_| &commands as _);
         levels.step(end_s, dt_s, driven)?;
-        let observe = |s: &Snapshot| {
-            let mut values = mech.observe(params, structure, s);
-            for (j, name) in crate::observers::table::coordinates(structure) {
-                values.extend(s.joint_coordinate(structure, j).map(|q| (name, q)));
-            }
-            values
+        let coordinates = |s: &Snapshot| {
+            let joints = crate::observers::table::coordinates(structure);
+            joints.filter_map(|(j, name)| s.joint_coordinate(structure, j).map(|q| (name, q))).collect()
         };
-        let j = levels.judge(&snap, &observe);
-        Ok((j.state, Some((j.estimate, j.rougher.0, j.rougher.1))))
+        let j = levels.judge(&snap, &|s| mech.observe(params, structure, s), &coordinates);
+        Ok((j.state, j.values, Some((j.estimate, j.rougher.0, j.rougher.1))))
     }
 
     /// Shows every observer the state a motion starts from (the simulation's, before its first
@@ -190,8 +192,7 @@ impl<'a> Runner<'a> {
         // The residual (a least-squares fit, the costliest read-out) is left out here: the
         // settle loop computes it once the motion has stopped, and only those ticks carry it
         // (into the recording too).
-        let (snap, levels) = self.judged_state()?;
-        let simulated = self.observe(&snap);
+        let (snap, simulated, levels) = self.judged_state()?;
         // The ghost overlay is only drawn in recordings, and only recomputed when the inputs
         // change.
         if self.recording && self.ghost.as_ref().is_none_or(|(i, _)| i != inputs) {
