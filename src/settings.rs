@@ -304,7 +304,8 @@ pub struct FrequencyPrediction {
     /// Compiled against [`FrequencyPrediction::symbols`]; None: the modal analysis's frequency
     /// of the mode fitted.
     pub formula: Option<crate::file_model::expr::Expr>,
-    /// The parameters, then the inputs, then the mechanism's analytic quantities.
+    /// The parameters, then the inputs, then the mechanism's analytic quantities, then the
+    /// energy model's solved equilibrium (`file_model::dynamics::solved_names`).
     pub symbols: Vec<String>,
     /// Relative.
     pub tolerance: f64,
@@ -320,15 +321,18 @@ impl PartialEq for FrequencyPrediction {
 }
 
 impl FrequencyPrediction {
-    /// The predicted angular frequency [rad/s] with these parameters, inputs and analytic
-    /// quantities (None without a formula).
+    /// The predicted angular frequency [rad/s] with these parameters, inputs, analytic
+    /// quantities and the energy model's solved equilibrium (`solved`: its coordinates and
+    /// `V_a_b`, `M_a_b` there; None without a formula).
     pub fn predicted(
         &self,
         params: &crate::mechanisms::Values,
         inputs: &crate::mechanisms::Values,
         analytic: &crate::mechanisms::Values,
+        solved: &crate::mechanisms::Values,
     ) -> Option<f64> {
-        let value = |s: &String| inputs.get(s).or_else(|| params.get(s)).or_else(|| analytic.get(s));
+        let value =
+            |s: &String| inputs.get(s).or_else(|| params.get(s)).or_else(|| analytic.get(s)).or_else(|| solved.get(s));
         let values: Vec<f64> = self.symbols.iter().map(|s| value(s).copied().unwrap_or(f64::NAN)).collect();
         Some(self.formula.as_ref()?.eval(&values))
     }

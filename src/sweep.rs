@@ -103,12 +103,27 @@ pub fn sweep(
     cancel: Option<&AtomicBool>,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(Vec<Row>, SweepSummary), SweepError> {
-    if !sc.topologies.is_empty() {
-        let each = |variant: &Scenario| sweep(variant, jobs, shard, cancel, progress);
-        let (rows, errors, wall_s) = sweep_topologies(sc, &each)?;
-        let summary = summarise(sc, &rows, errors, shard, jobs, wall_s);
-        return Ok((rows, summary));
-    }
+    let start = std::time::Instant::now();
+    let (rows, errors) = if sc.topologies.is_empty() {
+        let grid_points = sc.actuation.all_inputs().len();
+        sweep_points(sc, (0, grid_points), jobs, shard, cancel, progress)?
+    } else {
+        sweep_topologies(sc, jobs, shard, cancel, progress)?
+    };
+    let summary = summarise(sc, &rows, errors, shard, jobs, start.elapsed().as_secs_f64());
+    Ok((rows, summary))
+}
+
+/// The points of one structure, the first numbered `offset` in a grid of `grid_points` (a
+/// shard takes every N-th point of the whole grid): blocks settled in parallel.
+fn sweep_points(
+    sc: &Scenario,
+    (offset, grid_points): (usize, usize),
+    jobs: usize,
+    shard: Option<(usize, usize)>,
+    cancel: Option<&AtomicBool>,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(Vec<Row>, Vec<ReportedError>), SweepError> {
     let (points, continuation) = match &sc.actuation {
         Actuation::Points { points, continuation } => (points.clone(), *continuation),
         Actuation::Schedule { .. } => {
@@ -118,17 +133,16 @@ pub fn sweep(
             )))
         }
     };
-    let grid_points = points.len();
-    let indexed: Vec<(usize, Values)> =
-        points.into_iter().enumerate().filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1)).collect();
+    let indexed: Vec<(usize, Values)> = points
+        .into_iter()
+        .enumerate()
+        .map(|(i, p)| (offset + i, p))
+        .filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1))
+        .collect();
     let blocks: Vec<&[(usize, Values)]> = indexed.chunks(BLOCK_POINTS).collect();
     let total = indexed.len();
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let start = std::time::Instant::now();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs.max(1))
-        .build()
-        .map_err(|source| SweepError::Threads { jobs, source })?;
+    let pool = pool(jobs)?;
     // What every block's run shares, without the grid's points and the file's text (cloned
     // once here, not once per block: a million points had made a signal take 29 s to stop).
     let mut template = sc.clone();
@@ -155,37 +169,56 @@ pub fn sweep(
         errors.extend(e);
     }
     rows.sort_by_key(|r| r.index);
-    let summary = summarise(sc, &rows, errors, shard, jobs, start.elapsed().as_secs_f64());
-    Ok((rows, summary))
+    Ok((rows, errors))
 }
 
-/// The result of sweeping one scenario.
-type Swept = Result<(Vec<Row>, SweepSummary), SweepError>;
+/// A pool of `jobs` threads (at least one).
+fn pool(jobs: usize) -> Result<rayon::ThreadPool, SweepError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.max(1))
+        .build()
+        .map_err(|source| SweepError::Threads { jobs, source })
+}
 
-/// A sweep over a topology parameter: each topology's points swept with its own structure
-/// (`each`), the rows numbered in the whole grid's order; the rows, the errors and the wall
-/// time [s].
+/// A sweep over a topology parameter, or a motion over several points: each part's points
+/// swept with its own structure, the parts in parallel on `jobs` threads (each part's points
+/// on one), the rows numbered in the whole grid's order; the rows and the errors, each error
+/// saying which part it stopped.
 fn sweep_topologies(
     sc: &Scenario,
-    each: &dyn Fn(&Scenario) -> Swept,
-) -> Result<(Vec<Row>, Vec<ReportedError>, f64), SweepError> {
-    let start = std::time::Instant::now();
+    jobs: usize,
+    shard: Option<(usize, usize)>,
+    cancel: Option<&AtomicBool>,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(Vec<Row>, Vec<ReportedError>), SweepError> {
     let grid_points = sc.actuation.all_inputs().len();
-    let (mut rows, mut errors, mut offset) = (Vec::new(), Vec::new(), 0);
+    let mut offsets = Vec::with_capacity(sc.topologies.len());
+    let mut offset = 0;
     for variant in &sc.topologies {
-        let (variant_rows, summary) = each(variant)?;
-        let note = crate::run::rebuilt(sc, variant);
-        errors
-            .extend(summary.errors.into_iter().map(|source| RunError::Topology { note: note.clone(), source }.into()));
-        rows.extend(variant_rows.into_iter().map(|mut r| {
-            r.index += offset;
-            r.point.index = r.index;
-            r.grid_points = grid_points;
-            r
-        }));
+        offsets.push(offset);
         offset += variant.actuation.all_inputs().len();
     }
-    Ok((rows, errors, start.elapsed().as_secs_f64()))
+    let in_shard = |i: usize| shard.is_none_or(|(k, n)| i % n == k - 1);
+    let total = (0..grid_points).filter(|&i| in_shard(i)).count();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let quiet = |_: usize, _: usize| {};
+    let each = |(variant, &offset): (&Scenario, &usize)| {
+        let swept = sweep_points(variant, (offset, grid_points), 1, shard, cancel, &quiet);
+        let n = variant.actuation.all_inputs().len();
+        let part = (offset..offset + n).filter(|&i| in_shard(i)).count();
+        progress(done.fetch_add(part, std::sync::atomic::Ordering::SeqCst) + part, total);
+        swept.map(|(rows, errors)| (rows, errors, crate::run::rebuilt(sc, variant)))
+    };
+    let parts: Vec<Result<_, SweepError>> =
+        pool(jobs)?.install(|| sc.topologies.par_iter().zip(&offsets).map(each).collect());
+    let (mut rows, mut errors) = (Vec::new(), Vec::new());
+    for part in parts {
+        let (part_rows, part_errors, note) = part?;
+        errors.extend(part_errors.into_iter().map(|source| RunError::Topology { note: note.clone(), source }.into()));
+        rows.extend(part_rows);
+    }
+    rows.sort_by_key(|r| r.index);
+    Ok((rows, errors))
 }
 
 /// One block of points settled as one run (with continuation where the scenario asks): its
@@ -323,6 +356,7 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool, sweep: &str) -> Str
     }
     quantities.sort();
     let energy = EnergyColumns::of(rows);
+    let frequencies = FrequencyColumns::of(rows);
     let mut header = vec!["index".to_string(), "grid_points".to_string()];
     header.extend(inputs.iter().cloned());
     for q in &quantities {
@@ -331,6 +365,7 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool, sweep: &str) -> Str
         header.push(format!("error_{q}"));
     }
     header.extend(energy.header());
+    header.extend(frequencies.header());
     header.extend(
         [
             "settled",
@@ -362,6 +397,7 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool, sweep: &str) -> Str
             cells.push(opt(a.zip(s).map(error)));
         }
         cells.extend(energy.cells(p));
+        cells.extend(frequencies.cells(p));
         cells.push(p.settled.to_string());
         cells.push(p.steps.to_string());
         cells.push(p.within_tolerance.to_string());
@@ -444,6 +480,73 @@ impl EnergyColumns {
         for i in 0..self.stationary {
             c.extend(self.point_cells(e.and_then(|e| e.stationary.get(i))));
         }
+        c
+    }
+}
+
+/// The columns of the natural frequencies at each point: each `[[motion.frequencies]]` entry
+/// measured from the motion started there (`frequency_NAME_predicted`, `_measured`,
+/// `_corrected`, `_error`, and where a mode's modal analysis is judged beside a formula
+/// `_modal`, `_modal_error`; rad/s and relative), then the `[energy]` model's linearised
+/// frequencies (`model_omega_K`, K from 1, ascending) [rad/s].
+struct FrequencyColumns {
+    names: Vec<String>,
+    modal: Vec<bool>,
+    model_modes: usize,
+}
+
+impl FrequencyColumns {
+    fn of(rows: &[Row]) -> Self {
+        let mut names: Vec<String> = Vec::new();
+        let mut modal: Vec<bool> = Vec::new();
+        for f in rows.iter().flat_map(|r| &r.point.frequencies) {
+            match names.iter().position(|n| *n == f.name) {
+                Some(i) => modal[i] |= f.modal_rad_per_s.is_some(),
+                None => {
+                    names.push(f.name.clone());
+                    modal.push(f.modal_rad_per_s.is_some());
+                }
+            }
+        }
+        let model_modes = rows
+            .iter()
+            .filter_map(|r| r.point.energy.as_ref().and_then(|e| e.modes.as_ref()).map(Vec::len))
+            .max()
+            .unwrap_or(0);
+        FrequencyColumns { names, modal, model_modes }
+    }
+
+    fn header(&self) -> Vec<String> {
+        let mut h = Vec::new();
+        for (name, modal) in self.names.iter().zip(&self.modal) {
+            for part in ["predicted", "measured", "corrected", "error"] {
+                h.push(format!("frequency_{name}_{part}"));
+            }
+            if *modal {
+                h.push(format!("frequency_{name}_modal"));
+                h.push(format!("frequency_{name}_modal_error"));
+            }
+        }
+        h.extend((1..=self.model_modes).map(|k| format!("model_omega_{k}")));
+        h
+    }
+
+    fn cells(&self, p: &PointReport) -> Vec<String> {
+        let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+        let mut c = Vec::new();
+        for (name, modal) in self.names.iter().zip(&self.modal) {
+            let f = p.frequencies.iter().find(|f| f.name == *name);
+            c.push(opt(f.map(|f| f.predicted_rad_per_s)));
+            c.push(opt(f.map(|f| f.measured_rad_per_s)));
+            c.push(opt(f.map(|f| f.corrected_rad_per_s)));
+            c.push(opt(f.map(|f| f.error)));
+            if *modal {
+                c.push(opt(f.and_then(|f| f.modal_rad_per_s)));
+                c.push(opt(f.and_then(|f| f.modal_error)));
+            }
+        }
+        let modes = p.energy.as_ref().and_then(|e| e.modes.as_ref());
+        c.extend((0..self.model_modes).map(|k| opt(modes.and_then(|m| m.get(k)).map(|m| m.omega_rad_per_s))));
         c
     }
 }

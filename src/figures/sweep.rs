@@ -3,7 +3,9 @@
 //! quantity (checks, predictions, probed stiffness) the closed form as a line and the settled
 //! values as dots; a probe's stiffness without a closed form as dots; the `[energy]` model's
 //! equilibrium landed on (a line, the settled coordinates as dots) and its Hessian eigenvalues
-//! there (lines); below, log10 of every error.
+//! there (lines); each natural frequency of a motion over the points (`[[motion.frequencies]]`:
+//! the prediction as a line, the frequency measured from the motion as dots); below, log10 of
+//! every error.
 
 use super::kit::{self, range, titled_page, FigureError, Format, Plot};
 use crate::sweep::Row;
@@ -71,6 +73,9 @@ enum Source {
     Equilibrium(String),
     /// The Hessian's eigenvalue K (from 0, ascending) at the stationary point landed on.
     Eigenvalue(usize),
+    /// A natural frequency of the motion from each point: its prediction (a line) and the
+    /// frequency measured from the motion (dots) [rad/s].
+    Frequency(String),
 }
 
 impl Source {
@@ -79,6 +84,7 @@ impl Source {
             Source::Compared(q) | Source::Measured(q) => q.clone(),
             Source::Equilibrium(c) => format!("equilibrium {c}"),
             Source::Eigenvalue(k) => format!("eigenvalue {}", k + 1),
+            Source::Frequency(f) => format!("{f} [rad/s]"),
         }
     }
 
@@ -88,6 +94,7 @@ impl Source {
             Source::Measured(q) => format!("{q}: measured (dots), no closed form"),
             Source::Equilibrium(c) => format!("{c}: energy model's equilibrium landed on (line), settled (dots)"),
             Source::Eigenvalue(k) => format!("energy model's Hessian eigenvalue {} at that equilibrium (line)", k + 1),
+            Source::Frequency(f) => format!("{f}: predicted (line), measured from the free vibration (dots) [rad/s]"),
         }
     }
 
@@ -105,6 +112,10 @@ impl Source {
                 p.energy.as_ref().and_then(|e| e.measured.get(c).copied()).unwrap_or(nan),
             ),
             Source::Eigenvalue(k) => (landed().and_then(|s| s.eigenvalues.get(*k).copied()).unwrap_or(nan), nan),
+            Source::Frequency(f) => {
+                let f = p.frequencies.iter().find(|x| x.name == *f);
+                (f.map_or(nan, |f| f.predicted_rad_per_s), f.map_or(nan, |f| f.corrected_rad_per_s))
+            }
         }
     }
 
@@ -117,10 +128,16 @@ impl Source {
     }
 }
 
-/// The panels of a sweep: the compared quantities, the `measured` ones (a probe without a
-/// closed form), the energy model's equilibrium coordinates and Hessian eigenvalues.
+/// The panels of a sweep: the natural frequencies of a motion from each point, the compared
+/// quantities, the `measured` ones (a probe without a closed form), the energy model's
+/// equilibrium coordinates and Hessian eigenvalues.
 fn sources(rows: &[Row], measured: &[String]) -> Vec<Source> {
     let mut out: Vec<Source> = Vec::new();
+    for f in rows.iter().flat_map(|r| &r.point.frequencies) {
+        if !out.contains(&Source::Frequency(f.name.clone())) {
+            out.push(Source::Frequency(f.name.clone()));
+        }
+    }
     for r in rows {
         for q in r.point.analytic.keys().filter(|q| r.point.simulated.contains_key(*q)) {
             if !out.contains(&Source::Compared(q.clone())) {

@@ -20,13 +20,22 @@ use std::sync::atomic::AtomicBool;
 
 /// The suffix naming a coordinate's rate (`q` -> `q_dot`).
 pub const RATE_SUFFIX: &str = "_dot";
+/// The prefix naming the potential's second derivatives at the solved equilibrium in a
+/// formula (`V_q_r` = d2V/dq dr there).
+pub const STIFFNESS_PREFIX: &str = "V_";
+/// The prefix naming the mass matrix's entries there (`M_q_r` = d2T/dq' dr').
+pub const MASS_PREFIX: &str = "M_";
 
 /// A `[[energy.frequencies]]` entry: a closed form of the parameters and inputs predicting the
 /// natural frequency of one mode of the file's dynamic model [rad/s].
 #[derive(Clone, Debug)]
 pub struct FrequencyPrediction {
     pub name: String,
+    /// Compiled against the model's closed-form symbols, then [`EnergySpec::solved_names`].
     pub formula: Expr,
+    /// The formula reads the solved equilibrium (known only once the model is solved at a
+    /// settle point, so not checked at the file's points beforehand).
+    pub solved: bool,
     /// The mode, counted from 0 in ascending omega (the file counts from 1).
     pub mode: usize,
     /// On |omega - predicted| / |predicted|.
@@ -119,6 +128,24 @@ pub enum DynamicsError {
     Integrate(#[from] IntegrateError),
 }
 
+/// The names a formula over the model's solved equilibrium reads (a frequency formula: a
+/// paper's omega(k) = sqrt(V''(phi*(k)) / I) where phi* has no closed form): each coordinate,
+/// its value at the stationary point the dynamics landed on; `V_a_b`, the potential's second
+/// derivative in coordinates a and b there; with a kinetic energy (`kinetic`) `M_a_b`, the
+/// mass matrix's entry.
+pub fn solved_names(coordinates: &[super::energy_model::Coordinate], kinetic: bool) -> Vec<String> {
+    let names: Vec<&str> = coordinates.iter().map(|c| c.name.as_str()).collect();
+    let pairs = |prefix: &str| {
+        names.iter().flat_map(|a| names.iter().map(move |b| format!("{prefix}{a}_{b}"))).collect::<Vec<_>>()
+    };
+    let mut out: Vec<String> = names.iter().map(|n| n.to_string()).collect();
+    out.extend(pairs(STIFFNESS_PREFIX));
+    if kinetic {
+        out.extend(pairs(MASS_PREFIX));
+    }
+    out
+}
+
 impl EnergySpec {
     /// The slice length the dynamic model's expressions are evaluated with.
     pub fn values_len(&self) -> usize {
@@ -135,6 +162,23 @@ impl EnergySpec {
         let (f, n) = (self.first_coordinate, self.coordinates.len());
         values[f..f + n].copy_from_slice(q);
         values[f + n..f + 2 * n].copy_from_slice(v);
+    }
+
+    /// The names a formula over the model's solved equilibrium reads ([`solved_names`]).
+    pub fn solved_names(&self) -> Vec<String> {
+        solved_names(&self.coordinates, self.dynamics.is_some())
+    }
+
+    /// The values of [`EnergySpec::solved_names`] at the stationary point `q`, with the
+    /// parameters and inputs in `values` (of [`EnergySpec::values_len`]).
+    pub fn solved_values(&self, values: &mut [f64], q: &[f64]) -> Vec<f64> {
+        self.set_state(values, q, &vec![0.0; q.len()]);
+        let mut out = q.to_vec();
+        out.extend(self.hessian.iter().map(|h| h.eval(values)));
+        if let Some(d) = &self.dynamics {
+            out.extend(d.mass.iter().map(|m| m.eval(values)));
+        }
+        out
     }
 
     /// The mass matrix M(q) at the coordinates in `values` (None without a kinetic energy).

@@ -439,6 +439,12 @@ impl ModelObserver {
             _ => f64::INFINITY,
         };
         let named = |x: &[f64]| e.coordinates.iter().zip(x).map(|(c, v)| (c.name.clone(), *v)).collect::<Values>();
+        let solved = match landed {
+            Some(i) => {
+                e.solved_names().into_iter().zip(e.solved_values(&mut values, &stationary[i].coordinates)).collect()
+            }
+            None => Values::new(),
+        };
         let stationary = stationary
             .iter()
             .map(|s| StationaryReport {
@@ -448,7 +454,9 @@ impl ModelObserver {
                 kind: s.kind.name().into(),
             })
             .collect();
-        Some((EnergyPointReport { measured: named(&measured), stationary, landed, distance, modes: None }, error))
+        let report =
+            EnergyPointReport { measured: named(&measured), stationary, landed, distance, modes: None, solved };
+        Some((report, error))
     }
 
     /// The dynamic model's modes at the stationary point landed on, and each frequency
@@ -466,11 +474,14 @@ impl ModelObserver {
             Ok(m) => m,
             Err(source) => return Some(Err(ModelModesError::Kinetic { q, source })),
         };
+        let closed = &v[..self.spec.symbols.len()];
+        let solved = e.solved_names().into_iter().map(|n| report.solved.get(&n).copied().unwrap_or(f64::NAN));
+        let with_solved: Vec<f64> = closed.iter().copied().chain(solved).collect();
         let errors = d
             .frequencies
             .iter()
             .map(|f| {
-                let predicted = f.formula.eval(v);
+                let predicted = f.formula.eval(&with_solved);
                 crate::file_model::spec::ErrorClass::Relative.error(predicted, modes[f.mode].omega())
             })
             .collect();

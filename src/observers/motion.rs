@@ -255,18 +255,33 @@ impl MotionObserver {
         self.modes.iter().find(|m| m.index == index)
     }
 
-    /// The prediction of `f`: its formula, or the modal analysis's frequency of its mode.
-    fn predicted(&self, f: &FrequencyPrediction) -> f64 {
-        let formula = self.at.as_ref().and_then(|(p, i, a)| f.predicted(p, i, a));
-        let modal = || match f.signal {
+    /// The modal analysis's frequency of `f`'s mode, if it is fitted to one.
+    fn modal(&self, f: &FrequencyPrediction) -> Option<f64> {
+        match f.signal {
             FrequencySignal::Mode(i) => self.mode(i).map(|m| m.omega_rad_per_s),
             FrequencySignal::Joint(_) => None,
-        };
-        formula.or_else(modal).unwrap_or(f64::NAN)
+        }
     }
 
-    fn report(&self, f: &FrequencyPrediction, (t, q): &(Vec<f64>, Vec<f64>), dt_s: f64) -> FrequencyReport {
-        let predicted = self.predicted(f);
+    /// The prediction of `f`: its formula (over the parameters, inputs, analytic quantities
+    /// and the energy model's solved equilibrium `solved`), or the modal analysis's frequency
+    /// of its mode.
+    fn predicted(&self, f: &FrequencyPrediction, solved: &Values) -> f64 {
+        let formula = self.at.as_ref().and_then(|(p, i, a)| f.predicted(p, i, a, solved));
+        formula.or_else(|| self.modal(f)).unwrap_or(f64::NAN)
+    }
+
+    fn report(
+        &self,
+        f: &FrequencyPrediction,
+        (t, q): &(Vec<f64>, Vec<f64>),
+        dt_s: f64,
+        solved: &Values,
+    ) -> FrequencyReport {
+        let predicted = self.predicted(f, solved);
+        // With a formula and a mode, the modal analysis is a third value judged against it.
+        let modal = self.modal(f).filter(|_| f.formula.is_some());
+        let modal_error = modal.map(|w| (w - predicted).abs() / predicted.abs());
         let fit = fit_cosine(t, q);
         let (measured, method) = match (f.measure, self.extrapolated) {
             (FrequencyMeasure::Cosine, false) => (fit.map_or(f64::NAN, |x| x.omega_rad_per_s), METHOD),
@@ -287,8 +302,10 @@ impl MotionObserver {
             corrected_rad_per_s: corrected,
             error,
             uncorrected_error: (measured - predicted).abs() / predicted.abs(),
+            modal_rad_per_s: modal,
+            modal_error,
             tolerance: f.tolerance,
-            passed: error <= f.tolerance,
+            passed: error <= f.tolerance && modal_error.is_none_or(|e| e <= f.tolerance),
             fit_offset: fit.map_or(f64::NAN, |x| x.offset),
             fit_amplitude: fit.map_or(f64::NAN, |x| x.amplitude),
             fit_rms_residual: fit.map_or(f64::NAN, |x| x.rms_residual),
@@ -325,7 +342,14 @@ impl Observer for MotionObserver {
     fn finish(&mut self, report: &mut ScenarioReport) {
         let Some(m) = report.motion.as_mut() else { return };
         let dt_s = m.dt_s;
-        m.frequencies = self.frequencies.iter().zip(&self.samples).map(|(f, s)| self.report(f, s, dt_s)).collect();
+        // The energy model's solved equilibrium at the motion's start point, if the file has one.
+        let solved = report.points.last().and_then(|p| p.energy.as_ref()).map(|e| e.solved.clone()).unwrap_or_default();
+        m.frequencies =
+            self.frequencies.iter().zip(&self.samples).map(|(f, s)| self.report(f, s, dt_s, &solved)).collect();
+        if let Some(p) = report.points.last_mut() {
+            p.frequencies = m.frequencies.clone();
+            p.within_tolerance &= p.frequencies.iter().all(|f| f.passed);
+        }
     }
 }
 

@@ -244,6 +244,14 @@ pub struct FrequencyReport {
     /// "cosine" (a least-squares cosine fit) or "period" (zero crossings of the rate).
     pub measure: String,
     pub predicted_rad_per_s: f64,
+    /// The structure's own modal analysis at the motion's start, for a frequency fitted to a
+    /// mode (`mode = N`) that also has a formula: the mode's omega [rad/s], judged against the
+    /// formula too (the third of the three values a frequency claim compares).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub modal_rad_per_s: Option<f64>,
+    /// |modal - predicted| / predicted, where there is a modal value beside a formula.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub modal_error: Option<f64>,
     /// The measured angular frequency of the simulated samples, w_d [rad/s].
     pub measured_rad_per_s: f64,
     /// Corrected for symplectic Euler's dispersion: w = (2 / dt) sin(w_d dt / 2) [rad/s].
@@ -262,6 +270,26 @@ pub struct FrequencyReport {
     pub samples: usize,
     /// How it was measured.
     pub method: String,
+}
+
+/// A measured frequency against its prediction (and the modal analysis where it is judged too).
+fn frequency_line(f: &FrequencyReport) -> String {
+    let modal = match (f.modal_rad_per_s, f.modal_error) {
+        (Some(w), Some(e)) => format!(", modal {w:.9} (error {e:.3e})"),
+        _ => String::new(),
+    };
+    format!(
+        "frequency {} ({}): predicted {:.9} rad/s, measured {:.9}, corrected {:.9}: error {:.3e} (uncorrected {:.3e}){modal}, tolerance {:.1e}  {}",
+        f.name,
+        if f.measure == "period" { "period" } else { "cosine fit" },
+        f.predicted_rad_per_s,
+        f.measured_rad_per_s,
+        f.corrected_rad_per_s,
+        f.error,
+        f.uncorrected_error,
+        f.tolerance,
+        if f.passed { "pass" } else { "FAIL" }
+    )
 }
 
 /// The note under a table of checks in a motion run, whose transient cells are "-".
@@ -492,6 +520,10 @@ pub struct PointReport {
     /// dynamics landed on (absent without one).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub energy: Option<EnergyPointReport>,
+    /// A motion run's natural frequencies measured from the motion that started here (a motion
+    /// over several points has one motion per point; empty without `[[motion.frequencies]]`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub frequencies: Vec<FrequencyReport>,
     /// Each judged quantity's error here as its verdict measures it (a check's normalised
     /// error, a prediction's in its class, the probe's relative): what the table's point lines
     /// show (the JSON has them per check, prediction and probe).
@@ -514,6 +546,11 @@ pub struct EnergyPointReport {
     /// stationary point landed on (K v = omega^2 M v), omega ascending.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub modes: Option<Vec<ModelModeReport>>,
+    /// The solved equilibrium that formulas may read, at the stationary point landed on: each
+    /// coordinate, the potential's second derivatives `V_a_b` and, with a kinetic energy, the
+    /// mass matrix's entries `M_a_b` (empty where no point was landed on).
+    #[serde(skip_serializing_if = "Values::is_empty")]
+    pub solved: Values,
 }
 
 /// One linearised mode of the file's dynamic model.
@@ -861,19 +898,11 @@ impl ScenarioReport {
         if let Some(d) = &m.driven {
             out.push_str(&format!("   actuation: {d}\n"));
         }
+        if self.points.len() > 1 && !m.frequencies.is_empty() {
+            out.push_str("   (a motion from each point: each frequency's worst point below, every point's under it)\n");
+        }
         for f in &m.frequencies {
-            out.push_str(&format!(
-                "   frequency {} ({}): predicted {:.9} rad/s, measured {:.9}, corrected {:.9}: error {:.3e} (uncorrected {:.3e}), tolerance {:.1e}  {}\n",
-                f.name,
-                if f.measure == "period" { "period" } else { "cosine fit" },
-                f.predicted_rad_per_s,
-                f.measured_rad_per_s,
-                f.corrected_rad_per_s,
-                f.error,
-                f.uncorrected_error,
-                f.tolerance,
-                if f.passed { "pass" } else { "FAIL" }
-            ));
+            out.push_str(&format!("   {}\n", frequency_line(f)));
         }
         if let Some(l) = &m.lagrangian {
             table_lagrangian(l, out);
@@ -1153,6 +1182,11 @@ impl ScenarioReport {
                     .map(|m| format!("{:.9} rad/s ({:.6} Hz)", m.omega_rad_per_s, m.frequency_hz))
                     .collect();
                 out.push_str(&format!("              model's natural frequencies: {}\n", listed.join(", ")));
+            }
+            if self.points.len() > 1 {
+                for f in &p.frequencies {
+                    out.push_str(&format!("              {}\n", frequency_line(f)));
+                }
             }
             if let Some(paper) = &p.paper {
                 // The paper's value beside the testbed's analytic one, with their relative

@@ -63,13 +63,14 @@ pub(super) fn run_motion(
     if m.undamped {
         runner.sim.release_damping();
     }
+    // The modes at the start state itself, before the coordinate's displacement moves it.
+    let modes = start_modes(runner, m)?;
     if let Some((c, displacement, rate)) = &m.coordinate {
         runner.sim.set_joint_motion(c.index, *displacement, *rate)?;
     }
     if let Some((body, _, w)) = &m.spin {
         runner.sim.set_body_spin(*body, *w)?;
     }
-    let modes = start_modes(runner, m)?;
     for o in runner.observers.iter_mut() {
         o.motion_start(&modes);
     }

@@ -1,11 +1,15 @@
 //! A sweep over a parameter that changes the structure's topology (a pattern's range, an
-//! n-strut prism for n = 3..12): each topology's scenario runs on its own, with its own
-//! structure, and the reports join into one. Checks and predictions of the same name join by
-//! their worst error; each point keeps its own values.
+//! n-strut prism for n = 3..12), or a motion run over several points (one motion from each
+//! point): each part's scenario runs on its own, with its own structure, and the reports join
+//! into one. Checks, predictions and measured frequencies of the same name join by their worst
+//! error; each point keeps its own values (a motion's frequencies among them).
 
 use super::{conclude, run, RunError, RunOptions};
 use crate::observers::table::TableTarget;
-use crate::report::{CheckReport, ModelCheckReport, PrestressReport, ScenarioReport};
+use crate::report::{
+    CheckReport, FrequencyReport, LagrangianCoordinateReport, ModelCheckReport, MotionReport, PrestressReport,
+    ScenarioReport,
+};
 use crate::scenario::Scenario;
 use std::path::{Path, PathBuf};
 
@@ -14,7 +18,8 @@ pub(super) fn run_topologies(sc: &Scenario, opts: &RunOptions) -> ScenarioReport
     let mut joined: Option<ScenarioReport> = None;
     let mut rebuilt_at = Vec::new();
     for (k, variant) in sc.topologies.iter().enumerate() {
-        let record = opts.record.clone().or_else(|| sc.record.clone()).map(|p| numbered(&p, k));
+        let part = if sc.motion.is_some() { "point" } else { "topology" };
+        let record = opts.record.clone().or_else(|| sc.record.clone()).map(|p| numbered(&p, part, k));
         let options = RunOptions {
             record,
             cancel: opts.cancel,
@@ -23,7 +28,7 @@ pub(super) fn run_topologies(sc: &Scenario, opts: &RunOptions) -> ScenarioReport
             skip_findings: opts.skip_findings || k > 0,
             // A file per structure; a table in memory keeps the last structure's ticks.
             table: opts.table.as_ref().map(|t| match t {
-                TableTarget::File(p) => TableTarget::File(numbered(p, k)),
+                TableTarget::File(p) => TableTarget::File(numbered(p, part, k)),
                 other => other.clone(),
             }),
             external: opts.external.clone(),
@@ -44,16 +49,21 @@ pub(super) fn run_topologies(sc: &Scenario, opts: &RunOptions) -> ScenarioReport
             break;
         }
     }
-    let mut report = joined.expect("a topology sweep has at least two topologies");
+    let mut report = joined.expect("a topology sweep or a motion over points has at least two parts");
     report.params = sc.params.clone();
     report.topologies = rebuilt_at;
     conclude(&mut report, sc);
     report
 }
 
-/// What a topology's run says of itself: the parameters that rebuilt the structure.
+/// What a topology's run says of itself: the parameters that rebuilt the structure (a motion
+/// over points: the point it started from).
 pub fn rebuilt(sc: &Scenario, variant: &Scenario) -> String {
     let first = variant.actuation.first_inputs();
+    if sc.motion.is_some() {
+        let values: Vec<String> = first.iter().map(|(k, v)| format!("{k} = {v}")).collect();
+        return format!("motion from the point {}", if values.is_empty() { "{}".into() } else { values.join(", ") });
+    }
     let params = variant.params_at(first);
     let values: Vec<String> =
         sc.topology_params.iter().map(|k| format!("{k} = {}", params.get(k).copied().unwrap_or(f64::NAN))).collect();
@@ -75,12 +85,13 @@ pub fn rebuilt(sc: &Scenario, variant: &Scenario) -> String {
     format!("structure rebuilt at {}{size}", values.join(", "))
 }
 
-/// `path` with the topology's number before its extension (`run.rrd` -> `run.topology2.rrd`).
-fn numbered(path: &Path, k: usize) -> PathBuf {
+/// `path` with the part's number before its extension (`run.rrd` -> `run.topology2.rrd`, or
+/// `run.point2.rrd` for a motion over points).
+fn numbered(path: &Path, part: &str, k: usize) -> PathBuf {
     let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let name = match path.extension() {
-        Some(ext) => format!("{stem}.topology{k}.{}", ext.to_string_lossy()),
-        None => format!("{stem}.topology{k}"),
+        Some(ext) => format!("{stem}.{part}{k}.{}", ext.to_string_lossy()),
+        None => format!("{stem}.{part}{k}"),
     };
     path.with_file_name(name)
 }
@@ -111,6 +122,13 @@ fn join(j: &mut ScenarioReport, r: ScenarioReport) {
         }
         (x, p) => x.or(p),
     };
+    j.motion = match (j.motion.take(), r.motion) {
+        (Some(mut x), Some(m)) => {
+            join_motion(&mut x, m);
+            Some(x)
+        }
+        (x, m) => x.or(m),
+    };
     j.slack_intervals.extend(r.slack_intervals);
     j.skipped_points += r.skipped_points;
     j.accelerated_steps += r.accelerated_steps;
@@ -120,6 +138,40 @@ fn join(j: &mut ScenarioReport, r: ScenarioReport) {
     j.settle.wall_s += r.settle.wall_s;
     j.error = j.error.take().or(r.error);
     j.warnings.extend(r.warnings);
+}
+
+/// A later point's motion added: each frequency and each coordinate against the Lagrangian
+/// model keeps its worst error (the point's own values stay in its point report), the steps
+/// add up, the estimate of the simulation's own error keeps its largest.
+fn join_motion(x: &mut MotionReport, m: MotionReport) {
+    x.steps += m.steps;
+    x.steps_taken += m.steps_taken;
+    x.accelerated_steps += m.accelerated_steps;
+    for f in m.frequencies {
+        match x.frequencies.iter_mut().find(|y| y.name == f.name) {
+            Some(y) if !(y.error >= f.error) || !f.passed => *y = FrequencyReport { passed: y.passed && f.passed, ..f },
+            Some(_) => {}
+            None => x.frequencies.push(f),
+        }
+    }
+    if let (Some(xl), Some(ml)) = (x.lagrangian.as_mut(), m.lagrangian) {
+        for c in ml.coordinates {
+            match xl.coordinates.iter_mut().find(|y| y.name == c.name) {
+                Some(y) if !(y.max_error >= c.max_error) || !c.passed => {
+                    *y = LagrangianCoordinateReport { passed: y.passed && c.passed, ..c }
+                }
+                Some(_) => {}
+                None => xl.coordinates.push(c),
+            }
+        }
+    }
+    if let (Some(xe), Some(me)) = (x.extrapolation.as_mut(), m.extrapolation) {
+        for (q, e) in me.largest_estimate {
+            let v = xe.largest_estimate.entry(q).or_insert(e);
+            *v = v.max(e);
+        }
+        xe.not_smooth_from_tick = xe.not_smooth_from_tick.or(me.not_smooth_from_tick);
+    }
 }
 
 fn join_check(x: &mut CheckReport, c: &CheckReport) {

@@ -227,7 +227,8 @@ pub(super) fn closed_forms_at_points(
                 return Err(ctx.err(&r.formula, what));
             }
         }
-        for (f, r) in frequencies.clone().zip(raw_frequencies.clone()) {
+        // A formula over the solved equilibrium is judged where the model is solved.
+        for (f, r) in frequencies.clone().zip(raw_frequencies.clone()).filter(|(f, _)| !f.solved) {
             let w = f.formula.eval(&values);
             if !(w.is_finite() && w > 0.0) {
                 let what =

@@ -63,7 +63,7 @@ pub(super) fn dynamics(
     }
     mass_checks(ctx, spec, text, &mass, n)?;
     let kinetic_gradient = (0..n).map(|j| d(&kinetic, first + j)).collect::<Result<_, _>>()?;
-    let frequencies = frequencies(ctx, spec, &raw.frequencies, n)?;
+    let frequencies = frequencies(ctx, spec, &raw.frequencies, coordinates)?;
     let trajectory = raw.trajectory.as_ref().map(|t| trajectory(ctx, t.get_ref())).transpose()?;
     Ok(Some(Dynamics { kinetic, mass, kinetic_gradient, mixed, first_rate, frequencies, trajectory }))
 }
@@ -183,10 +183,13 @@ fn frequencies(
     ctx: &Ctx,
     spec: &ModelSpec,
     raw: &[RawFrequency],
-    n: usize,
+    coordinates: &[Coordinate],
 ) -> Result<Vec<FrequencyPrediction>, ScenarioError> {
+    let n = coordinates.len();
+    let solved = crate::file_model::dynamics::solved_names(coordinates, true);
     let closed: Vec<&str> = (0..spec.symbols.len())
         .map(|i| if spec.is_closed_form(i) { spec.symbols[i].name.as_str() } else { "" })
+        .chain(solved.iter().map(String::as_str))
         .collect();
     let mut out: Vec<FrequencyPrediction> = Vec::new();
     for f in raw {
@@ -194,7 +197,9 @@ fn frequencies(
         if name.trim().is_empty() || out.iter().any(|x| x.name == name) {
             return Err(ctx.err(&f.name, format!("a frequency needs a name of its own, got '{name}'")));
         }
-        let what = format!("frequency '{name}' (parameters, inputs and their quantities only)");
+        let what = format!(
+            "frequency '{name}' (parameters, inputs, their quantities, and the solved equilibrium: the coordinates, V_a_b, M_a_b)"
+        );
         let formula = Expr::compile(f.formula.get_ref(), &closed)
             .map_err(|e| expr_error(ctx, f.formula.span().start, &e, &what))?;
         let mode = *f.mode.get_ref();
@@ -202,7 +207,8 @@ fn frequencies(
             return Err(ctx.err(&f.mode, format!("mode must be from 1 to {n} (the number of coordinates), got {mode}")));
         }
         let tolerance = positive_value(ctx, &f.tolerance, "tolerance")?;
-        out.push(FrequencyPrediction { name, formula, mode: mode as usize - 1, tolerance });
+        let solved = formula.uses().iter().any(|&i| i >= spec.symbols.len());
+        out.push(FrequencyPrediction { name, formula, solved, mode: mode as usize - 1, tolerance });
     }
     Ok(out)
 }

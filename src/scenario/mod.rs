@@ -289,6 +289,40 @@ fn topologies(
     groups
 }
 
+/// A topology's own points, or the parts a scenario splits into: the topologies of a sweep over
+/// a pattern's parameter, or one motion per point (None: one scenario).
+fn split(raw: &RawScenario, s: &mut Sections, topology: Option<&Topology>, used: &[String]) -> Option<Vec<Topology>> {
+    if let Some(t) = topology {
+        let continuation = matches!(s.actuation, Actuation::Points { continuation: true, .. });
+        s.actuation = Actuation::Points { points: t.points.clone(), continuation };
+        return None;
+    }
+    let parts = match &raw.motion {
+        Some(_) => motion_points(&s.param_table, &s.params, &s.actuation, used),
+        None => topologies(&s.param_table, &s.params, &s.actuation, used),
+    };
+    (parts.len() > 1).then_some(parts)
+}
+
+/// A motion run over several points (a grid or points of inputs or parameters): one motion
+/// per point, each validated on its own with its point's parameters (its displacement, its
+/// formulas and, where a pattern reads a parameter, its structure), run one after the other
+/// and joined as a topology sweep's are. Waypoints are one motion (empty).
+fn motion_points(
+    table: &crate::file_model::params::ParamTable,
+    params: &Values,
+    actuation: &Actuation,
+    used: &[String],
+) -> Vec<Topology> {
+    let Actuation::Points { points, .. } = actuation else { return Vec::new() };
+    let each = |p: &Values| Topology {
+        params: params::params_at(table, params, p),
+        points: vec![p.clone()],
+        used: used.to_vec(),
+    };
+    points.iter().map(each).collect()
+}
+
 /// Expands the file's patterns (`repeat.rs`, `for_each.rs`) with the parameters of
 /// `topology`, or the file's own; returns the parameters their ranges and templates read.
 fn expand_patterns(
@@ -410,17 +444,8 @@ fn validate(
     let custom = mechanism::custom(ctx, &raw)?;
     let builtin = if custom.is_some() { None } else { Some(mechanism::builtin(ctx, &raw)?) };
     let mut s = sections(ctx, &raw, mechanism::of(custom.as_ref(), builtin.as_deref()))?;
-    match topology {
-        Some(t) => {
-            let continuation = matches!(s.actuation, Actuation::Points { continuation: true, .. });
-            s.actuation = Actuation::Points { points: t.points.clone(), continuation };
-        }
-        None => {
-            let split = topologies(&s.param_table, &s.params, &s.actuation, &topology_params);
-            if split.len() > 1 {
-                return Ok(Validated::Split(split));
-            }
-        }
+    if let Some(split) = split(&raw, &mut s, topology, &topology_params) {
+        return Ok(Validated::Split(split));
     }
     let judged = judged(ctx, &raw, mechanism::of(custom.as_ref(), builtin.as_deref()), &s, custom.is_some())?;
     // Every set of parameters the points ask for (a sweep over parameters): the custom
@@ -437,7 +462,8 @@ fn validate(
     let prestress = prestress::prestress(ctx, &raw.prestress, &first, custom.is_some())?;
     let (checks, model) = (&judged.checks, judged.model.as_ref());
     closed_forms(ctx, &raw, probe.as_ref(), model, &s.param_table, &s.params, &s.actuation)?;
-    let motion = motion::motion(ctx, &raw, s.sim.dt_s, (m, &first), &first_params, &s.actuation)?;
+    let solved = judged.model.as_ref().and_then(|m| m.energy.as_ref()).map(|e| e.solved_names()).unwrap_or_default();
+    let motion = motion::motion(ctx, &raw, s.sim.dt_s, (m, &first), (&first_params, &solved), &s.actuation)?;
     let has_probe = probe.as_ref().is_some_and(|p| p.tolerance.is_some());
     let parts =
         expect::Parts { checks, model, probe: has_probe, motion: motion.as_ref(), prestress: prestress.is_some() };

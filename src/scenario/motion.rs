@@ -113,13 +113,14 @@ pub(super) struct RawFrequency {
 }
 
 /// The validated `[motion]` section, or None without one. `first` is the structure at the first
-/// point; a motion run holds its single point's inputs.
+/// point; a motion run holds its single point's inputs. `solved`: the names of the energy
+/// model's solved equilibrium that a frequency formula may read (`file_model::dynamics`).
 pub(super) fn motion(
     ctx: &Ctx,
     raw: &RawScenario,
     dt_s: f64,
     (mech, first): (&dyn Mechanism, &Structure),
-    params: &Values,
+    (params, solved): (&Values, &[String]),
     actuation: &Actuation,
 ) -> Result<Option<Motion>, ScenarioError> {
     let Some(m) = &raw.motion else { return Ok(None) };
@@ -155,7 +156,7 @@ pub(super) fn motion(
     let frequencies = section
         .frequencies
         .iter()
-        .map(|f| frequency(ctx, f, (mech, first), params, inputs))
+        .map(|f| frequency(ctx, f, (mech, first), (params, inputs), solved))
         .collect::<Result<_, _>>()?;
     let undamped = section.undamped;
     let extrapolate = section.extrapolate;
@@ -426,14 +427,15 @@ fn param_number(ctx: &Ctx, v: &Spanned<Num>, params: &Values, what: &str) -> Res
 }
 
 /// A `[[motion.frequencies]]` entry: its joint or mode, its formula of the parameters, the
-/// inputs and the mechanism's analytic quantities (checked finite and positive where the
-/// mechanism predicts them at the first point; optional for a mode).
+/// inputs, the mechanism's analytic quantities and the energy model's solved equilibrium
+/// (`solved`; checked finite and positive where the mechanism predicts them at the first
+/// point, unless it reads the solved equilibrium; optional for a mode).
 fn frequency(
     ctx: &Ctx,
     f: &RawFrequency,
     (mech, s): (&dyn Mechanism, &Structure),
-    params: &Values,
-    inputs: &Values,
+    (params, inputs): (&Values, &Values),
+    solved: &[String],
 ) -> Result<FrequencyPrediction, ScenarioError> {
     let name = f.name.get_ref().clone();
     if name.trim().is_empty() {
@@ -455,6 +457,8 @@ fn frequency(
             symbols.push(q.symbol.to_string());
         }
     }
+    let known = symbols.len();
+    symbols.extend(solved.iter().filter(|n| !symbols.contains(n)).cloned().collect::<Vec<_>>());
     let tolerance = positive_value(ctx, &f.tolerance, "tolerance")?;
     let measure = measure(ctx, f.measure.as_ref())?;
     let Some(text) = &f.formula else {
@@ -464,11 +468,17 @@ fn frequency(
         return Ok(FrequencyPrediction { name, signal, measure, formula: None, symbols, tolerance });
     };
     let names: Vec<&str> = symbols.iter().map(String::as_str).collect();
-    let what = format!("frequency '{name}' (parameters, inputs and the mechanism's quantities)");
+    let what = format!(
+        "frequency '{name}' (parameters, inputs, the mechanism's quantities and the [energy] model's solved equilibrium)"
+    );
     let formula = Expr::compile(text.get_ref(), &names).map_err(|e| expr_error(ctx, text.span().start, &e, &what))?;
+    let reads_solved = formula.uses().iter().any(|&i| i >= known);
     let p = FrequencyPrediction { name, signal, measure, formula: Some(formula), symbols, tolerance };
     let Ok(prediction) = mech.predict(params, inputs) else { return Ok(p) };
-    let w = p.predicted(params, inputs, &prediction.expected).unwrap_or(f64::NAN);
+    if reads_solved {
+        return Ok(p); // judged once the energy model is solved at the motion's start
+    }
+    let w = p.predicted(params, inputs, &prediction.expected, &Values::new()).unwrap_or(f64::NAN);
     if !(w.is_finite() && w > 0.0) {
         return Err(ctx.err(text, format!("frequency '{}' is {w} rad/s here; a frequency is finite and > 0", p.name)));
     }

@@ -14,6 +14,7 @@ mod dynamic_model;
 mod export_mjcf;
 mod figures;
 mod free_spin;
+mod frequency_curves;
 mod frequency_measures;
 mod function_length;
 mod furet2018_dynamics;

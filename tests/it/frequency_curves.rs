@@ -1,0 +1,148 @@
+//! Dynamics over parameters: a motion from every point of a grid, the paper's frequency curve
+//! stated as one formula over the energy model's solved equilibrium, and the three values a
+//! frequency claim compares (formula, free vibration, modal analysis) per point in the sweep.
+
+use crate::common::tensegrity;
+
+const ROCKER: &str = "scenarios/custom/rocker_frequency_curve.toml";
+
+/// The rocker's parameters, as its file states them.
+const L: f64 = 1.0;
+const M: f64 = 0.5;
+const A_Y: f64 = 0.8;
+const B_X: f64 = 0.6;
+const L1: f64 = 0.5;
+const L2: f64 = 0.4;
+const K2: f64 = 30.0;
+
+/// V'(phi) and V''(phi) of the rocker's potential V = k1 (d1 - l1)^2 / 2 + k2 (d2 - l2)^2 / 2,
+/// d1^2 = L^2 + a^2 - 2 a L sin(phi), d2^2 = L^2 + b^2 - 2 b L cos(phi), differentiated by hand.
+fn rocker_derivatives(k1: f64, phi: f64) -> (f64, f64) {
+    let (s, c) = phi.sin_cos();
+    let d1 = (L * L + A_Y * A_Y - 2.0 * A_Y * L * s).sqrt();
+    let d2 = (L * L + B_X * B_X - 2.0 * B_X * L * c).sqrt();
+    let (d1p, d2p) = (-A_Y * L * c / d1, B_X * L * s / d2);
+    let (d1pp, d2pp) = (A_Y * L * s / d1 - d1p * d1p / d1, B_X * L * c / d2 - d2p * d2p / d2);
+    let first = k1 * (d1 - L1) * d1p + K2 * (d2 - L2) * d2p;
+    let second = k1 * (d1p * d1p + (d1 - L1) * d1pp) + K2 * (d2p * d2p + (d2 - L2) * d2pp);
+    (first, second)
+}
+
+/// omega = sqrt(V''(phi*) / I_O) with phi* found by Newton's method here, independently of the
+/// testbed.
+fn rocker_omega(k1: f64) -> f64 {
+    let mut phi = 0.8;
+    for _ in 0..50 {
+        let (v1, v2) = rocker_derivatives(k1, phi);
+        phi -= v1 / v2;
+    }
+    let (v1, v2) = rocker_derivatives(k1, phi);
+    assert!(v1.abs() < 1e-12 && v2 > 0.0, "a minimum at k1 = {k1}: V' = {v1}, V'' = {v2}");
+    (v2 / (M * L * L / 3.0)).sqrt()
+}
+
+fn columns(csv: &str) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    (header, lines.map(|l| l.split(',').map(String::from).collect()).collect())
+}
+
+fn cell(header: &[String], row: &[String], name: &str) -> f64 {
+    let k = header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"));
+    row[k].parse().unwrap_or_else(|_| panic!("{name} = '{}'", row[k]))
+}
+
+fn sweep_csv(args: &[&str]) -> String {
+    let out = std::env::temp_dir().join(format!(
+        "tensegrity-rocker-{}-{}.csv",
+        std::process::id(),
+        args.join("_").replace('/', "-")
+    ));
+    let mut all = vec!["sweep", ROCKER, "--out", out.to_str().unwrap()];
+    all.extend(args);
+    let (code, o, e) = tensegrity(&all);
+    assert_eq!(code, 0, "{o}{e}");
+    std::fs::read_to_string(out).unwrap()
+}
+
+#[test]
+fn the_rockers_frequency_curve_agrees_three_ways_at_every_point() {
+    let (header, rows) = columns(&sweep_csv(&[]));
+    assert_eq!(rows.len(), 8, "k1 from 10 to 80 N/m");
+    for row in &rows {
+        let k1 = cell(&header, row, "k1");
+        let predicted = cell(&header, row, "frequency_omega_predicted");
+        let corrected = cell(&header, row, "frequency_omega_corrected");
+        let modal = cell(&header, row, "frequency_omega_modal");
+        // The formula over the solved equilibrium is the closed form at phi*(k1).
+        let exact = rocker_omega(k1);
+        assert!((predicted - exact).abs() <= 1e-12 * exact, "k1 = {k1}: formula {predicted} vs {exact}");
+        // The free vibration at 1e-3 rad and the modal analysis, within 1e-6 of it and of each other.
+        for (what, w) in [("free vibration", corrected), ("modal analysis", modal)] {
+            assert!((w - exact).abs() <= 1e-6 * exact, "k1 = {k1}: {what} {w} vs {exact}");
+        }
+        assert!((corrected - modal).abs() <= 1e-6 * exact, "k1 = {k1}: {corrected} vs {modal}");
+        assert!((cell(&header, row, "model_omega_1") - exact).abs() <= 1e-12 * exact);
+    }
+}
+
+/// The relative shift of the frequency at amplitude `a` [rad] (Lindstedt-Poincare; Landau and
+/// Lifshitz, Mechanics, Sec. 28): a^2 (V4 / (16 V2) - 5 V3^2 / (48 V2^2)), the derivatives of V
+/// at phi*, V3 and V4 by central differences of V''.
+fn amplitude_shift(k1: f64, a: f64) -> f64 {
+    let mut phi = 0.8;
+    for _ in 0..50 {
+        let (v1, v2) = rocker_derivatives(k1, phi);
+        phi -= v1 / v2;
+    }
+    let h = 1e-3;
+    let v2 = |p: f64| rocker_derivatives(k1, p).1;
+    let (second, plus, minus) = (v2(phi), v2(phi + h), v2(phi - h));
+    let third = (plus - minus) / (2.0 * h);
+    let fourth = (plus - 2.0 * second + minus) / (h * h);
+    a * a * (fourth / (16.0 * second) - 5.0 * third * third / (48.0 * second * second))
+}
+
+#[test]
+fn what_separates_the_free_vibration_from_the_linear_frequency_is_the_amplitudes_own_shift() {
+    let (header, rows) = columns(&sweep_csv(&[]));
+    for row in &rows {
+        let k1 = cell(&header, row, "k1");
+        let exact = rocker_omega(k1);
+        let measured = (cell(&header, row, "frequency_omega_corrected") - exact) / exact;
+        let shift = amplitude_shift(k1, 1e-3);
+        assert!(shift < -1e-7, "k1 = {k1}: a shift {shift:e} the test can see");
+        assert!((measured - shift).abs() <= 1e-8, "k1 = {k1}: measured {measured:e}, Lindstedt {shift:e}");
+    }
+}
+
+#[test]
+fn a_motion_over_points_shards_and_merges_to_the_whole_sweep_bit_for_bit() {
+    let whole = sweep_csv(&[]);
+    let dir = std::env::temp_dir().join(format!("tensegrity-rocker-shards-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut shards = Vec::new();
+    for k in 1..=3 {
+        let p = dir.join(format!("s{k}.csv"));
+        let shard = format!("{k}/3");
+        let (code, o, e) = tensegrity(&["sweep", ROCKER, "--shard", &shard, "--out", p.to_str().unwrap()]);
+        assert_eq!(code, 0, "{o}{e}");
+        shards.push(p.to_str().unwrap().to_string());
+    }
+    let merged = dir.join("merged.csv");
+    let mut args = vec!["merge"];
+    args.extend(shards.iter().map(String::as_str));
+    args.extend(["--out", merged.to_str().unwrap()]);
+    let (code, o, e) = tensegrity(&args);
+    assert_eq!(code, 0, "{o}{e}");
+    // Each point's motion is its own run: a shard gives its points' rows exactly.
+    let (h, w) = columns(&whole);
+    let (hm, m) = columns(&std::fs::read_to_string(merged).unwrap());
+    assert_eq!(h, hm);
+    for (a, b) in w.iter().zip(&m) {
+        for name in ["index", "frequency_omega_corrected", "frequency_omega_modal"] {
+            assert_eq!(cell(&h, a, name).to_bits(), cell(&h, b, name).to_bits(), "{name}");
+        }
+    }
+    assert_eq!(m.len(), 8);
+}
