@@ -4,7 +4,10 @@
 //! (settled with the usual accelerators, which are then switched off for good), optionally
 //! displaced along a named joint coordinate and given a rate of it. Its verdict comes from its
 //! checks: the `[[predictions]]` judged over every tick of the motion (maximum and rms error),
-//! and the natural frequencies measured from it (`[[motion.frequencies]]`).
+//! and the natural frequencies measured from it (`[[motion.frequencies]]`). Over several points
+//! (`[actuation] points`, a grid, swept parameters) the scenario is split into one motion per
+//! point, each validated here with its point's parameters (`scenario/mod.rs`), run one after
+//! the other and joined (`run/topologies.rs`), or in parallel by `tensegrity sweep`.
 //!
 //! ```toml
 //! [motion]
@@ -30,8 +33,11 @@
 //! coordinate = "pin"      # the joint whose free vibration is fitted (or mode = N: the
 //!                         # coordinate of the structure's own mode N; formula then optional,
 //!                         # the modal analysis's frequency by default)
-//! formula = "sqrt(L*hypot(k1*a, k2*b)/I_pivot)"  # [rad/s]: parameters, inputs and the
-//!                         # mechanism's analytic quantities (ji2014's K of Eq. 42, say)
+//! formula = "sqrt(L*hypot(k1*a, k2*b)/I_pivot)"  # [rad/s]: parameters, inputs, the
+//!                         # mechanism's analytic quantities (ji2014's K of Eq. 42, say) and
+//!                         # the [energy] model's solved equilibrium at the start (each
+//!                         # coordinate there, V_a_b = d2V/da db, M_a_b): with mode = N too,
+//!                         # the modal analysis is judged against the formula as well
 //! tolerance = 1e-6        # relative, on the frequency corrected for the integrator
 //! measure = "cosine"      # or "period": a least-squares cosine fit over every tick (exact
 //!                         # for a linear oscillator, biased by the harmonics at large
