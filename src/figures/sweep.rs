@@ -94,7 +94,9 @@ impl Source {
             Source::Measured(q) => format!("{q}: measured (dots), no closed form"),
             Source::Equilibrium(c) => format!("{c}: energy model's equilibrium landed on (line), settled (dots)"),
             Source::Eigenvalue(k) => format!("energy model's Hessian eigenvalue {} at that equilibrium (line)", k + 1),
-            Source::Frequency(f) => format!("{f}: predicted (line), measured from the free vibration (dots) [rad/s]"),
+            Source::Frequency(f) => {
+                format!("{f}: prediction (line; the modal analysis without a formula), free vibration (dots) [rad/s]")
+            }
         }
     }
 

@@ -35,21 +35,36 @@ pub struct Chosen {
 pub fn self_stress(draft: &Draft) -> Option<Vec<f64>> {
     let nodes: Vec<(&str, Vec3)> =
         draft.bodies.iter().flat_map(|b| b.nodes.iter().map(|(n, p)| (n.as_str(), *p))).collect();
+    let index = |n: &str| nodes.iter().position(|(m, _)| *m == n);
     let on_strut = |n: &str| draft.struts.iter().any(|s| s.a == n || s.b == n);
-    let anchored =
-        |n: &str| draft.bodies.iter().any(|b| b.fixed && b.nodes.iter().any(|(m, _)| m == n)) && !on_strut(n);
-    let free: Vec<&(&str, Vec3)> = nodes.iter().filter(|(n, _)| !anchored(n)).collect();
-    let row = |n: &str| free.iter().position(|(m, _)| *m == n);
-    let pos = |n: &str| nodes.iter().find(|(m, _)| *m == n).map(|(_, p)| *p);
-    let members: Vec<(&str, &str)> = draft
-        .cables
+    let anchored: Vec<bool> = nodes
         .iter()
-        .map(|c| (c.a.as_str(), c.b.as_str()))
-        .chain(draft.struts.iter().map(|s| (s.a.as_str(), s.b.as_str())))
+        .map(|(n, _)| draft.bodies.iter().any(|b| b.fixed && b.nodes.iter().any(|(m, _)| m == n)) && !on_strut(n))
         .collect();
+    let cables: Vec<(usize, usize)> =
+        draft.cables.iter().map(|c| Some((index(&c.a)?, index(&c.b)?))).collect::<Option<_>>()?;
+    let struts: Vec<(usize, usize)> =
+        draft.struts.iter().map(|s| Some((index(&s.a)?, index(&s.b)?))).collect::<Option<_>>()?;
+    let positions: Vec<Vec3> = nodes.iter().map(|(_, p)| *p).collect();
+    self_stress_of(&positions, &anchored, &cables, &struts)
+}
+
+/// A drawing's self-stress: node positions [m], which nodes are anchored (held, and on no
+/// strut: no row of the equilibrium matrix), the tension members and the struts by their end
+/// nodes. One tension per tension member, the least of them 1 (struts in compression), or None
+/// when no self-stress keeps every tension member in tension.
+pub fn self_stress_of(
+    positions: &[Vec3],
+    anchored: &[bool],
+    tension: &[(usize, usize)],
+    struts: &[(usize, usize)],
+) -> Option<Vec<f64>> {
+    let free: Vec<usize> = (0..positions.len()).filter(|n| !anchored[*n]).collect();
+    let row = |n: usize| free.iter().position(|m| *m == n);
+    let members: Vec<(usize, usize)> = tension.iter().chain(struts).copied().collect();
     let mut a = DMatrix::<f64>::zeros(3 * free.len(), members.len());
-    for (j, (na, nb)) in members.iter().enumerate() {
-        let (pa, pb) = (pos(na)?, pos(nb)?);
+    for (j, &(na, nb)) in members.iter().enumerate() {
+        let (pa, pb) = (positions[na], positions[nb]);
         let l = distance(pa, pb);
         for (n, sign) in [(na, 1.0), (nb, -1.0)] {
             if let Some(r) = row(n) {
@@ -59,9 +74,9 @@ pub fn self_stress(draft: &Draft) -> Option<Vec<f64>> {
             }
         }
     }
-    let stress = projected_uniform_stress(&a, draft.cables.len())?;
+    let stress = projected_uniform_stress(&a, tension.len())?;
     let largest = stress.iter().fold(0.0f64, |m, t| m.max(t.abs()));
-    let cables = &stress[..draft.cables.len()];
+    let cables = &stress[..tension.len()];
     let least = cables.iter().copied().fold(f64::INFINITY, f64::min);
     if !(least > TAUT_FRACTION * largest) {
         return None;

@@ -20,7 +20,8 @@ pub(super) fn custom(ctx: &Ctx, raw: &RawScenario) -> Result<Option<Custom>, Sce
             let params = param_values(ctx, &raw.params)?;
             let mut st = st.clone();
             resolve_structure(ctx, st.get_mut(), &params)?;
-            let structure = structure_from_file(ctx, &st)?;
+            let mut structure = structure_from_file(ctx, &st)?;
+            super::prestress::set_self_stress(ctx, raw, &mut structure, &params)?;
             let mut expected = Values::new();
             for c in &raw.checks {
                 let v = c.value.as_ref().ok_or_else(|| {
@@ -112,7 +113,9 @@ pub(super) fn with_variants(
         let at_set =
             |e: ScenarioError| ScenarioError { message: format!("{} (with the parameters {set:?})", e.message), ..e };
         resolve_structure(ctx, st.get_mut(), set).map_err(at_set)?;
-        variants.push((set.clone(), structure_from_file(ctx, &st).map_err(at_set)?));
+        let mut structure = structure_from_file(ctx, &st).map_err(at_set)?;
+        super::prestress::set_self_stress(ctx, raw, &mut structure, set).map_err(at_set)?;
+        variants.push((set.clone(), structure));
     }
     Ok(custom.with_variants(variants))
 }

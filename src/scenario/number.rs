@@ -182,7 +182,7 @@ pub(super) fn param_values(ctx: &Ctx, raw: &ParamMap) -> Result<Values, Scenario
 }
 
 /// The value of a number or expression of the parameters `params`.
-fn evaluate(ctx: &Ctx, v: &Spanned<Num>, params: &Values, what: &str) -> Result<f64, ScenarioError> {
+pub(super) fn evaluate(ctx: &Ctx, v: &Spanned<Num>, params: &Values, what: &str) -> Result<f64, ScenarioError> {
     match v.get_ref() {
         Num::Value(x) => Ok(*x),
         Num::Expr(text) => {

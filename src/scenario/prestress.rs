@@ -1,11 +1,20 @@
 //! `[prestress]`: when a structure counts as having lost its self-stress, and whether that
 //! fails the run or warns. A custom structure with cables is judged without the section too
 //! ([`Prestress::DEFAULT`]: it fails when every cable is slack at a settle point).
+//!
+//! `least_tension = "t0"` [N] prestresses a custom structure with its drawn self-stress (the
+//! member forces in equilibrium at every node with no load, from the null space of the
+//! equilibrium matrix: `import::self_stress`), scaled so that the least cable tension is t0:
+//! each elastic cable's and spring's rest length set to its drawn length less its tension over
+//! its stiffness (what the file gives as `length` is replaced). The drawn state is then an
+//! equilibrium; t0 an expression of the parameters makes the prestress an axis to sweep
+//! (natural frequencies against prestress).
 
 use super::error::{finite, Ctx, ScenarioError};
-use super::raw::RawPrestress;
+use super::raw::{RawPrestress, RawScenario};
+use crate::mechanisms::Values;
 use crate::settings::{OnLoss, Prestress};
-use crate::structure::Structure;
+use crate::structure::{distance, BodyKind, CableLaw, Structure};
 use toml::Spanned;
 
 /// The prestress judgement of a scenario: the section's, the default for a custom structure
@@ -48,4 +57,69 @@ fn fraction(ctx: &Ctx, f: &Spanned<f64>, first: &Structure) -> Result<f64, Scena
         ));
     }
     Ok(x)
+}
+
+/// `[prestress] least_tension`: `s`'s elastic cables and springs given the rest lengths of its
+/// drawn self-stress with that least tension (module docs), at the parameters `params`. An error
+/// where the drawing has no self-stress that keeps every cable and spring in tension, or where a
+/// tension leaves a member no rest length.
+pub(super) fn set_self_stress(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    s: &mut Structure,
+    params: &Values,
+) -> Result<(), ScenarioError> {
+    let Some(t) = raw.prestress.as_ref().and_then(|p| p.get_ref().least_tension.as_ref()) else { return Ok(()) };
+    let least_n = super::number::evaluate(ctx, t, params, "prestress.least_tension")?;
+    if !(least_n.is_finite() && least_n > 0.0) {
+        return Err(ctx.err(t, format!("prestress.least_tension is {least_n} N: a tension is finite and > 0")));
+    }
+    let on_strut = |n: usize| s.struts.iter().any(|m| m.a == n || m.b == n);
+    let anchored: Vec<bool> =
+        (0..s.nodes.len()).map(|n| s.bodies[s.nodes[n].body].kind == BodyKind::Fixed && !on_strut(n)).collect();
+    let positions: Vec<_> = s.nodes.iter().map(|n| n.position).collect();
+    let tension: Vec<(usize, usize)> =
+        s.cables.iter().map(|c| (c.a, c.b)).chain(s.springs.iter().map(|m| (m.a, m.b))).collect();
+    let struts: Vec<(usize, usize)> = s.struts.iter().map(|m| (m.a, m.b)).collect();
+    let stress = crate::import::self_stress::self_stress_of(&positions, &anchored, &tension, &struts).ok_or_else(|| {
+        ctx.err(t, "prestress.least_tension: the drawn structure has no self-stress that keeps every cable and spring in tension (no load-free equilibrium of its members: check the drawing)")
+    })?;
+    let (cables, springs) = stress.split_at(s.cables.len());
+    for (c, share) in s.cables.iter_mut().zip(cables) {
+        let CableLaw::Elastic { stiffness_n_per_m } = c.law else { continue };
+        c.length_m =
+            rest_length(ctx, t, &c.name, least_n * share, stiffness_n_per_m, distance(positions[c.a], positions[c.b]))?;
+    }
+    for (m, share) in s.springs.iter_mut().zip(springs) {
+        m.rest_length_m = rest_length(
+            ctx,
+            t,
+            &m.name,
+            least_n * share,
+            m.stiffness_n_per_m,
+            distance(positions[m.a], positions[m.b]),
+        )?;
+    }
+    Ok(())
+}
+
+/// The rest length [m] that gives a member drawn `drawn_m` long `tension_n` [N]: positive.
+fn rest_length(
+    ctx: &Ctx,
+    at: &toml::Spanned<super::number::Num>,
+    name: &str,
+    tension_n: f64,
+    stiffness_n_per_m: f64,
+    drawn_m: f64,
+) -> Result<f64, ScenarioError> {
+    let rest = drawn_m - tension_n / stiffness_n_per_m;
+    if rest > 0.0 {
+        return Ok(rest);
+    }
+    Err(ctx.err(
+        at,
+        format!(
+            "prestress.least_tension: member '{name}' would carry {tension_n:.6} N at stiffness {stiffness_n_per_m} N/m, more than its drawn length {drawn_m:.6} m allows (its rest length {rest:.6} m): a smaller tension or a stiffer member"
+        ),
+    ))
 }

@@ -351,6 +351,9 @@ pub(super) struct RawPrestress {
     pub(super) min_fraction: Option<Spanned<f64>>,
     /// "fail" (default) or "warn".
     pub(super) on_loss: Option<Spanned<String>>,
+    /// A custom structure prestressed with its drawn self-stress, the least tension this [N]
+    /// (a number or an expression of the parameters: a prestress axis to sweep).
+    pub(super) least_tension: Option<Spanned<Num>>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -146,3 +146,59 @@ fn a_motion_over_points_shards_and_merges_to_the_whole_sweep_bit_for_bit() {
     }
     assert_eq!(m.len(), 8);
 }
+
+/// Every cable's and strut's force at each settled point of a prestress sweep: (cable forces,
+/// strut forces) [N], by the `NAME.force` quantities a custom structure reports.
+fn member_forces(p: &tensegrity_testbed::report::PointReport) -> (Vec<f64>, Vec<f64>) {
+    let forces = p.simulated.iter().filter(|(k, _)| k.ends_with(".force"));
+    let (struts, cables): (Vec<_>, Vec<_>) = forces.partition(|(k, _)| k.starts_with("strut"));
+    (cables.into_iter().map(|(_, v)| *v).collect(), struts.into_iter().map(|(_, v)| *v).collect())
+}
+
+#[test]
+fn the_icosahedron_prestressed_at_t0_has_every_cable_at_t0_and_every_strut_at_minus_sqrt6_t0() {
+    // The expanded octahedron's self-stress (Pellegrino 1993; Tibert and Pellegrino 2003): one
+    // tension in all 24 cables, the six struts compressed by sqrt(6) times it.
+    let r = crate::common::run_file("scenarios/custom/icosahedron6_prestress_frequencies.toml");
+    assert!(r.passed, "{:?}", r.failures);
+    assert_eq!(r.points.len(), 8);
+    let mut last_omega = 0.0;
+    for p in &r.points {
+        let t0 = p.inputs["t0"];
+        let (cables, struts) = member_forces(p);
+        // Strut a12 is held (fixed): its force is not read; the other five are.
+        assert_eq!((cables.len(), struts.len()), (24, 5));
+        for c in cables {
+            assert!((c - t0).abs() <= 1e-9 * t0, "t0 = {t0}: a cable at {c} N");
+        }
+        for s in struts {
+            assert!((s + 6f64.sqrt() * t0).abs() <= 1e-9 * t0, "t0 = {t0}: a strut at {s} N");
+        }
+        // The lowest frequency rises with the prestress, and the free vibration meets the modal
+        // analysis within 1e-6.
+        let f = &p.frequencies[0];
+        assert!(f.predicted_rad_per_s > last_omega, "t0 = {t0}: {} after {last_omega}", f.predicted_rad_per_s);
+        assert!(f.error <= 1e-6, "t0 = {t0}: {:e}", f.error);
+        last_omega = f.predicted_rad_per_s;
+    }
+}
+
+#[test]
+fn the_prisms_least_cable_tension_is_the_swept_prestress_and_its_mechanism_stiffens_with_it() {
+    let r = crate::common::run_file("scenarios/custom/prism3_prestress_frequencies.toml");
+    assert!(r.passed, "{:?}", r.failures);
+    assert_eq!(r.points.len(), 8);
+    for p in &r.points {
+        let t0 = p.inputs["t0"];
+        let (cables, _) = member_forces(p);
+        let least = cables.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!((least - t0).abs() <= 1e-9 * t0, "t0 = {t0}: least cable tension {least}");
+        let f = &p.frequencies[0];
+        assert!(f.error <= 1e-6, "t0 = {t0}: {:e}", f.error);
+        // The lowest mode is the prism's infinitesimal mechanism: stiff only by the prestress,
+        // omega^2 / t0 = 3.50 to 3.23 rad^2/(s^2 N) over t0 = 1 to 15 N (it mixes with the
+        // members' elastic stiffness as t0 grows).
+        let ratio = f.predicted_rad_per_s.powi(2) / t0;
+        assert!((3.2..3.55).contains(&ratio), "t0 = {t0}: omega^2 / t0 = {ratio}");
+    }
+}
