@@ -4,6 +4,7 @@
 
 use crate::mechanisms::QuantityKind;
 use crate::structure::Structure;
+use std::cmp::Ordering;
 
 /// Numerical settings of the integrator, all from the scenario file.
 #[derive(Clone, Debug, PartialEq)]
@@ -176,7 +177,8 @@ impl Prestress {
     /// Whether a settled state of a structure of `cables` cables, `slack` of them slack,
     /// keeping `fraction` of the drawn cable tension, has lost its self-stress.
     pub fn lost(&self, cables: usize, slack: usize, fraction: Option<f64>) -> bool {
-        (cables > 0 && slack == cables) || self.min_fraction.zip(fraction).is_some_and(|(min, f)| !(f >= min))
+        (cables > 0 && slack == cables)
+            || self.min_fraction.zip(fraction).is_some_and(|(min, f)| f.partial_cmp(&min).is_none_or(Ordering::is_lt))
     }
 }
 

@@ -239,14 +239,14 @@ impl Structure {
         for (a, command) in self.actuators.iter().zip(commands) {
             if let ActuatorTarget::FixedNode { node, direction } = a.target {
                 let o = &mut offsets[self.nodes[node].body];
-                for k in 0..3 {
-                    o[k] += direction[k] * command;
+                for (ok, d) in o.iter_mut().zip(direction) {
+                    *ok += d * command;
                 }
             }
         }
         for n in &mut self.nodes {
-            for k in 0..3 {
-                n.position[k] += offsets[n.body][k];
+            for (x, d) in n.position.iter_mut().zip(offsets[n.body]) {
+                *x += d;
             }
         }
     }
@@ -443,7 +443,8 @@ impl Structure {
             ));
         }
         let norm = direction.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if !((norm - 1.0).abs() <= 1e-12) {
+        let off = (norm - 1.0).abs();
+        if off.is_nan() || off > 1e-12 {
             return Err(invalid("actuator", symbol, "the direction of a moved node must be a unit vector"));
         }
         Ok(())
@@ -558,6 +559,58 @@ pub fn rotated(v: Vec3, axis: Vec3, angle: f64) -> Vec3 {
     let kdv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
     std::array::from_fn(|i| v[i] * c + kxv[i] * s + k[i] * kdv * (1.0 - c))
 }
+
+/// Largest distance between two nodes of the structure [m] (at least 1e-3 m). The squares
+/// are compared: the square root is monotonic and correctly rounded, so the root of the
+/// largest square is the largest of the roots, to the bit.
+///
+/// The nodes are taken in runs of [`SIZE_RUN_NODES`] in their order (a structure is drawn
+/// member by member, so a run is compact), each with its bounding box. The pairs between two
+/// runs are measured only where the two boxes' farthest corners are farther apart than the
+/// largest pair found so far, starting from a double sweep (the node farthest from the first,
+/// then the node farthest from it). Rounding is monotonic, so the boxes bound every pair as
+/// computed, and the result is the all-pairs maximum to the bit (a unit test compares them).
+/// Measuring every pair had been a third of building a 100-X furet2018 chain.
+pub fn structure_size(s: &Structure) -> f64 {
+    let p: Vec<Vec3> = s.nodes.iter().map(|n| n.position).collect();
+    let Some(first) = p.first() else { return MIN_STRUCTURE_SIZE_M };
+    let squared = |a: &Vec3, b: &Vec3| {
+        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+    };
+    let farthest =
+        |a: &Vec3| p.iter().map(|b| squared(a, b)).enumerate().fold((0, 0.0), |m, x| if x.1 > m.1 { x } else { m });
+    let mut largest_squared = farthest(&p[farthest(first).0]).1;
+    let runs: Vec<(&[Vec3], Vec3, Vec3)> = p
+        .chunks(SIZE_RUN_NODES)
+        .map(|run| {
+            let (lo, hi) = run.iter().fold((run[0], run[0]), |(lo, hi), q| {
+                (std::array::from_fn(|k| lo[k].min(q[k])), std::array::from_fn(|k| hi[k].max(q[k])))
+            });
+            (run, lo, hi)
+        })
+        .collect();
+    for (i, (a, alo, ahi)) in runs.iter().enumerate() {
+        for (b, blo, bhi) in &runs[i..] {
+            let bound = (0..3).map(|k| (ahi[k] - blo[k]).max(bhi[k] - alo[k])).fold(0.0, |x, d| x + d * d);
+            if bound <= largest_squared {
+                continue;
+            }
+            let same = std::ptr::eq(*a, *b);
+            for (x, pa) in a.iter().enumerate() {
+                let others = if same { &b[x + 1..] } else { &b[..] };
+                largest_squared = others.iter().fold(largest_squared, |m, pb| m.max(squared(pa, pb)));
+            }
+        }
+    }
+    largest_squared.sqrt().max(MIN_STRUCTURE_SIZE_M)
+}
+
+/// Nodes per run of [`structure_size`]'s bounding boxes.
+const SIZE_RUN_NODES: usize = 16;
+
+/// The smallest size [`structure_size`] reports [m].
+const MIN_STRUCTURE_SIZE_M: f64 = 1e-3;
 
 #[cfg(test)]
 mod tests {
@@ -675,55 +728,3 @@ mod tests {
         assert!(matches!(s.validate(), Err(StructureError::Invalid { what: "spring", .. })));
     }
 }
-
-/// Largest distance between two nodes of the structure [m] (at least 1e-3 m). The squares
-/// are compared: the square root is monotonic and correctly rounded, so the root of the
-/// largest square is the largest of the roots, to the bit.
-///
-/// The nodes are taken in runs of [`SIZE_RUN_NODES`] in their order (a structure is drawn
-/// member by member, so a run is compact), each with its bounding box. The pairs between two
-/// runs are measured only where the two boxes' farthest corners are farther apart than the
-/// largest pair found so far, starting from a double sweep (the node farthest from the first,
-/// then the node farthest from it). Rounding is monotonic, so the boxes bound every pair as
-/// computed, and the result is the all-pairs maximum to the bit (a unit test compares them).
-/// Measuring every pair had been a third of building a 100-X furet2018 chain.
-pub fn structure_size(s: &Structure) -> f64 {
-    let p: Vec<Vec3> = s.nodes.iter().map(|n| n.position).collect();
-    let Some(first) = p.first() else { return MIN_STRUCTURE_SIZE_M };
-    let squared = |a: &Vec3, b: &Vec3| {
-        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-        d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
-    };
-    let farthest =
-        |a: &Vec3| p.iter().map(|b| squared(a, b)).enumerate().fold((0, 0.0), |m, x| if x.1 > m.1 { x } else { m });
-    let mut largest_squared = farthest(&p[farthest(first).0]).1;
-    let runs: Vec<(&[Vec3], Vec3, Vec3)> = p
-        .chunks(SIZE_RUN_NODES)
-        .map(|run| {
-            let (lo, hi) = run.iter().fold((run[0], run[0]), |(lo, hi), q| {
-                (std::array::from_fn(|k| lo[k].min(q[k])), std::array::from_fn(|k| hi[k].max(q[k])))
-            });
-            (run, lo, hi)
-        })
-        .collect();
-    for (i, (a, alo, ahi)) in runs.iter().enumerate() {
-        for (b, blo, bhi) in &runs[i..] {
-            let bound = (0..3).map(|k| (ahi[k] - blo[k]).max(bhi[k] - alo[k])).fold(0.0, |x, d| x + d * d);
-            if bound <= largest_squared {
-                continue;
-            }
-            let same = std::ptr::eq(*a, *b);
-            for (x, pa) in a.iter().enumerate() {
-                let others = if same { &b[x + 1..] } else { &b[..] };
-                largest_squared = others.iter().fold(largest_squared, |m, pb| m.max(squared(pa, pb)));
-            }
-        }
-    }
-    largest_squared.sqrt().max(MIN_STRUCTURE_SIZE_M)
-}
-
-/// Nodes per run of [`structure_size`]'s bounding boxes.
-const SIZE_RUN_NODES: usize = 16;
-
-/// The smallest size [`structure_size`] reports [m].
-const MIN_STRUCTURE_SIZE_M: f64 = 1e-3;

@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use tensegrity_testbed::file_model::spec::ErrorClass;
+use tensegrity_testbed::mechanisms::Values;
 use tensegrity_testbed::observers::external::{External, ExternalError, ExternalModel, ExternalPrediction};
 use tensegrity_testbed::observers::table::{MemoryTable, TableTarget};
 use tensegrity_testbed::run::stoppable::Stoppable;
@@ -382,12 +383,12 @@ fn export_mjcf(
     Ok((mjcf.xml, mjcf.warnings))
 }
 
+/// A built-in mechanism, its parameters and its inputs.
+type MechanismValues = (Box<dyn tensegrity_testbed::mechanisms::Mechanism>, Values, Values);
+
 /// A built-in mechanism by name, its parameters (defaults for those not given, validated) and
 /// the remaining values as inputs.
-fn mechanism_values(
-    name: &str,
-    values: BTreeMap<String, f64>,
-) -> PyResult<(Box<dyn tensegrity_testbed::mechanisms::Mechanism>, BTreeMap<String, f64>, BTreeMap<String, f64>)> {
+fn mechanism_values(name: &str, values: Values) -> PyResult<MechanismValues> {
     use tensegrity_testbed::mechanisms;
     let m = mechanisms::find_named(name).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let (params, inputs): (BTreeMap<_, _>, BTreeMap<_, _>) =
@@ -400,14 +401,14 @@ fn mechanism_values(
     Ok((m, params, inputs))
 }
 
+/// One solution of the analytic model: its label, its values and whether it is stable (None
+/// where the model does not say).
+type Solution = (String, Values, Option<bool>);
+
 /// The analytic model alone (`tensegrity solve`): every solution of `query` as (label, values,
 /// stable).
 #[pyfunction]
-fn solve(
-    mechanism: &str,
-    query: &str,
-    values: BTreeMap<String, f64>,
-) -> PyResult<Vec<(String, BTreeMap<String, f64>, Option<bool>)>> {
+fn solve(mechanism: &str, query: &str, values: Values) -> PyResult<Vec<Solution>> {
     let (m, params, inputs) = mechanism_values(mechanism, values)?;
     let q = tensegrity_testbed::mechanisms::query_named(m.as_ref(), query)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;

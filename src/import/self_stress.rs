@@ -13,6 +13,7 @@
 use super::draft::{Draft, DraftError};
 use crate::structure::{distance, Vec3};
 use nalgebra::DMatrix;
+use std::cmp::Ordering;
 
 /// Singular values of the equilibrium matrix below this share of the largest are its null
 /// space's (a drawing given to 9 digits or more; the decomposition's own error is ~1e-16).
@@ -63,7 +64,8 @@ pub fn self_stress(draft: &Draft) -> Option<Vec<f64>> {
     let largest = stress.iter().fold(0.0f64, |m, t| m.max(t.abs()));
     let cables = &stress[..draft.cables.len()];
     let least = cables.iter().copied().fold(f64::INFINITY, f64::min);
-    if !(least > TAUT_FRACTION * largest) {
+    // Unordered (a NaN) counts as not taut.
+    if least.partial_cmp(&(TAUT_FRACTION * largest)).is_none_or(Ordering::is_le) {
         return None;
     }
     Some(cables.iter().map(|t| t / least).collect())
@@ -106,7 +108,7 @@ pub fn prestress(draft: &mut Draft, least_n: f64) -> Result<Option<Chosen>, Draf
         let Some(k) = c.stiffness_n_per_m else { continue };
         let (tension, drawn) = (t * least_n, distance(pos(&c.a), pos(&c.b)));
         c.length_m = drawn - tension / k;
-        if !(c.length_m > 0.0) {
+        if c.length_m.is_nan() || c.length_m <= 0.0 {
             return Err(DraftError::SelfStressNoRest {
                 cable: c.name.clone(),
                 tension_n: tension,

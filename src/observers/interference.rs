@@ -172,7 +172,7 @@ fn pair_clearance(capsules: &[Capsule], i: usize, j: usize, margin_m: f64) -> Op
     let s2 = parry3d_f64::shape::Segment::new(a2, b2);
     let (p1, p2) = (s1.point_at(&l1), s2.point_at(&l2));
     let clearance_m = (p1 - p2).length() - r1 - r2;
-    (clearance_m <= margin_m).then(|| PairClearance {
+    (clearance_m <= margin_m).then_some(PairClearance {
         i,
         j,
         clearance_m,

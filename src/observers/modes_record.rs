@@ -43,8 +43,8 @@ pub fn record_modes(path: &Path, s: &DrawnStructure, modes: &[DrawnMode]) -> Res
     let extent = extent(&s.nodes);
     let mut start = 0.0;
     for (k, m) in modes.iter().enumerate() {
-        let largest = m.node_motion.iter().map(|d| norm(d)).fold(0.0, f64::max);
-        if !(m.omega > 0.0) || largest == 0.0 {
+        let largest = m.node_motion.iter().map(norm).fold(0.0, f64::max);
+        if m.omega.is_nan() || m.omega <= 0.0 || largest == 0.0 {
             continue;
         }
         let scale = AMPLITUDE_FRACTION * extent / largest;

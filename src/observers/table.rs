@@ -62,11 +62,14 @@ impl From<PathBuf> for TableTarget {
 /// A table kept in memory: the run's record batches and their schema, handed over when the
 /// run closes (None before, and when no tick ran).
 #[derive(Clone, Default)]
-pub struct MemoryTable(Arc<Mutex<Option<(SchemaRef, Vec<RecordBatch>)>>>);
+pub struct MemoryTable(Arc<Mutex<Option<Batched>>>);
+
+/// A run's table: its schema and its record batches.
+pub type Batched = (SchemaRef, Vec<RecordBatch>);
 
 impl MemoryTable {
     /// The schema and the record batches of the finished run (once; None when no tick ran).
-    pub fn take(&self) -> Option<(SchemaRef, Vec<RecordBatch>)> {
+    pub fn take(&self) -> Option<Batched> {
         self.0.lock().ok().and_then(|mut t| t.take())
     }
 }
@@ -88,7 +91,7 @@ enum Sink {
     /// Record batches; the schema from the first tick, and the rows not yet made a batch
     /// (tick, then every other column).
     Arrow {
-        out: Batches,
+        out: Box<Batches>,
         schema: Option<SchemaRef>,
         ticks: Vec<u64>,
         columns: Vec<Vec<Option<f64>>>,
@@ -198,7 +201,7 @@ impl Table {
     }
 
     fn arrow(out: Batches) -> Sink {
-        Sink::Arrow { out, schema: None, ticks: Vec::new(), columns: Vec::new() }
+        Sink::Arrow { out: Box::new(out), schema: None, ticks: Vec::new(), columns: Vec::new() }
     }
 
     /// The column names after `tick`.
@@ -280,7 +283,7 @@ impl Table {
                     let mut fields = vec![Field::new("tick", DataType::UInt64, false)];
                     fields.extend(h.iter().map(|c| Field::new(c, DataType::Float64, true)));
                     let s = Arc::new(Schema::new(fields));
-                    if let Batches::File { file, writer } = out {
+                    if let Batches::File { file, writer } = &mut **out {
                         let f = file.take().ok_or_else(|| TableError::Gone { path: self.path.clone() })?;
                         *writer = Some(arrow_ipc::writer::FileWriter::try_new(f, &s).map_err(arrow)?);
                     }
@@ -331,7 +334,7 @@ impl Table {
             Sink::Csv(out) => out.flush().and_then(|_| out.get_ref().sync_all()).map_err(io),
             Sink::Arrow { out, schema, ticks, columns } => {
                 Self::flush_batch(out, schema, ticks, columns).map_err(arrow)?;
-                match out {
+                match &mut **out {
                     Batches::File { writer, file } => match (writer.take(), file.take()) {
                         (Some(mut w), _) => {
                             w.finish().map_err(arrow)?;

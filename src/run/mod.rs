@@ -294,7 +294,7 @@ fn start<'a>(
     };
     let observers = observers::observers(
         Setup {
-            structure: &sim.structure(),
+            structure: sim.structure(),
             checks: &sc.checks,
             length_scale_m: mech.length_scale(&params),
             interference: &sc.interference,

@@ -89,7 +89,7 @@ impl<'a> Runner<'a> {
 
     /// The mechanism's quantities in a snapshot of this simulation.
     pub fn observe(&self, snap: &Snapshot) -> Values {
-        self.mech.observe(&self.params, &self.sim.structure(), snap)
+        self.mech.observe(&self.params, self.sim.structure(), snap)
     }
 
     /// Tells every observer an event of the run (formatted only when one records).
@@ -213,7 +213,7 @@ impl<'a> Runner<'a> {
         let tick = Tick {
             motion_time_s,
             accelerated,
-            structure: &self.sim.structure(),
+            structure: self.sim.structure(),
             snapshot: &snap,
             inputs,
             params: &self.params,

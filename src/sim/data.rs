@@ -8,6 +8,7 @@ use crate::settings::DEFAULT_JOINT_GAP_FRACTION;
 use crate::snapshot::{BodyPose, Snapshot};
 use crate::structure::ActuatorTarget;
 use rapier3d_f64::prelude::*;
+use std::cmp::Ordering;
 
 pub(super) struct Data {
     pub(super) pipeline: PhysicsPipeline,
@@ -184,7 +185,7 @@ impl Data {
                 continue;
             }
             let gap = self.joint_gap_m(m, j);
-            if !(gap <= gap_limit) {
+            if gap.partial_cmp(&gap_limit).is_none_or(Ordering::is_gt) {
                 return Err(self.diverged(m, format!(
                     "joint '{}' came apart: its anchors are {gap:.3e} m apart (limit {gap_limit:.3e} m, sim.max_joint_gap)",
                     joint.name

@@ -134,8 +134,11 @@ fn peer_case(case: &Case, dir: &Path) -> Result<serde_json::Value, BenchError> {
     }))
 }
 
+/// One run of the peer: time step [s], steps, wall time [s] and the nodes' final positions.
+type PeerRun = (f64, u64, f64, Vec<Vec3>);
+
 /// The peer's runs of one case and its reference positions.
-fn peer_runs(p: &serde_json::Value) -> Result<(Vec<Vec3>, Vec<(f64, u64, f64, Vec<Vec3>)>), BenchError> {
+fn peer_runs(p: &serde_json::Value) -> Result<(Vec<Vec3>, Vec<PeerRun>), BenchError> {
     let bad = || BenchError::Peer("the peer's motion case lacks 'reference' or 'runs'".into());
     let points = |v: &serde_json::Value| -> Option<Vec<Vec3>> {
         v.as_array()?.iter().map(|p| serde_json::from_value::<Vec3>(p.clone()).ok()).collect()

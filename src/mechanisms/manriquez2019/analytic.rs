@@ -49,6 +49,7 @@
 
 use crate::mechanisms::ParamError;
 use nalgebra::{Matrix2, Matrix3, Matrix4, Vector2, Vector3};
+use std::cmp::Ordering;
 
 // ---------------------------------------------------------------------------
 // Paper constants (Table 1-3, 5) and unit helpers.
@@ -75,10 +76,14 @@ pub const CENTROID_RADIUS_MM: f64 = 181.0;
 /// on-axis centroid at `θ = (0, -CENTROID_ELEVATION_RAD)`.
 pub const CENTROID_ELEVATION_RAD: f64 = 0.4363;
 /// Table 2: first value of both joint coordinates [rad].
+// The paper's printed value, rounded to four decimals like its other angles: not `-π/6`.
+#[allow(clippy::approx_constant)]
 pub const GRID_START_RAD: f64 = -0.5236;
 /// Table 2: joint-coordinate increment [rad].
 pub const GRID_STEP_RAD: f64 = 0.0087;
 /// Upper end of the grid, symmetric to [`GRID_START_RAD`] (`π/6`, rounded) [rad].
+// The paper's printed value, rounded to four decimals like its other angles: not `π/6`.
+#[allow(clippy::approx_constant)]
 pub const GRID_END_RAD: f64 = 0.5236;
 /// Values per joint coordinate from `-0.5236` to `<= +0.5236` in steps of `0.0087`.
 pub const GRID_N_PER_AXIS: usize = 121;
@@ -649,16 +654,11 @@ pub fn statics(p: &Params, theta1: f64, theta2: f64) -> Statics {
                 .collect();
             let k = ss.len() as f64;
             let mut s = statics_regular_unchecked(p, theta1, theta2);
-            let avg2 = |g: &dyn Fn(&Statics) -> [f64; 2]| {
-                let mut r = [0.0; 2];
-                for x in &ss {
-                    let v = g(x);
-                    r[0] += v[0] / k;
-                    r[1] += v[1] / k;
-                }
-                r
-            };
-            s.cable_tensions = avg2(&|x| x.cable_tensions);
+            s.cable_tensions = [0.0; 2];
+            for x in &ss {
+                s.cable_tensions[0] += x.cable_tensions[0] / k;
+                s.cable_tensions[1] += x.cable_tensions[1] / k;
+            }
             s.joint_reaction_force = ss.iter().map(|x| x.joint_reaction_force).sum::<Vector3<f64>>() / k;
             s.joint_moment_paper_sign = ss.iter().map(|x| x.joint_moment_paper_sign).sum::<f64>() / k;
             s.joint_reaction_moment = s.joint_moment_paper_sign * joint_constrained_axis(theta1, theta2);
@@ -698,7 +698,8 @@ fn statics_regular_unchecked(p: &Params, theta1: f64, theta2: f64) -> Statics {
         n,
     ]);
     let scale = a.column(0).norm() * a.column(1).norm() * a.column(2).norm();
-    let singular = !(a.determinant().abs() > SINGULAR_REL_DET * scale);
+    // Unordered (a NaN in the matrix) counts as singular.
+    let singular = a.determinant().abs().partial_cmp(&(SINGULAR_REL_DET * scale)).is_none_or(Ordering::is_le);
     let x = if singular {
         Vector3::repeat(f64::NAN)
     } else {
@@ -1157,6 +1158,8 @@ mod tests {
     }
 
     #[test]
+    // The grid starts at Table 2's printed -0.5236 rad (rounded, not -π/6): the test says so.
+    #[allow(clippy::approx_constant)]
     fn paper_grid_has_121_by_121_points_not_14761() {
         let g = paper_grid();
         assert_eq!(g.len(), 14641);

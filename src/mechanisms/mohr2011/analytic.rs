@@ -602,7 +602,7 @@ pub struct WorkspacePoint {
 /// Kinematic constraints (`z > 0`, Eq. 17, Eq. 18) violated at `centroid`.
 pub fn kinematic_violations(p: &Params, centroid: &Vector3<f64>) -> Vec<Constraint> {
     let mut v = Vec::new();
-    if !(centroid.z > 0.0) {
+    if centroid.z.is_nan() || centroid.z <= 0.0 {
         v.push(Constraint::AboveBase);
     }
     for (i, l) in spring_lengths(p, centroid).iter().enumerate() {
@@ -621,7 +621,7 @@ pub fn static_violations(p: &Params, centroid: &Vector3<f64>) -> Vec<Constraint>
     static_margins(p, centroid)
         .iter()
         .enumerate()
-        .filter(|(_, m)| !(**m > 0.0))
+        .filter(|(_, m)| m.is_nan() || **m <= 0.0)
         .map(|(j, _)| Constraint::CableTension(j))
         .collect()
 }
@@ -814,7 +814,7 @@ mod tests {
         // Halfway: theta = pi/6, f = 2 kappa (pi/3 - pi)/(lo cos(pi/6)).
         let want = 2.0 * P.kappa * (PI / 3.0 - PI) / (P.lo * (PI / 6.0).cos());
         assert_relative_eq!(spring_force(&P, 3.0), want, max_relative = 1e-14);
-        assert_relative_eq!(spring_force(&P, 3.0), -8.061_330_507_707_079, max_relative = 1e-12);
+        assert_relative_eq!(spring_force(&P, 3.0), -8.061_330_507_707_08, max_relative = 1e-12);
         let mut prev = f64::NEG_INFINITY;
         for k in 0..=100 {
             let f = spring_force(&P, P.lo * k as f64 / 100.0);
@@ -865,14 +865,14 @@ mod tests {
         let c = Vector3::new(0.0, 0.0, 3.0);
         let a = base_nodes(&P);
         let mut knees = Vec::new();
-        for i in 0..3 {
+        for (i, ai) in a.iter().enumerate() {
             let s = spring_chain(&P, &c, i).unwrap();
             // Link lengths lo/2, knee in the plane normal to e2, axes orthogonal.
             assert_relative_eq!((s.knee - s.a).norm(), P.lo / 2.0, max_relative = 1e-13);
             assert_relative_eq!((s.knee - s.b).norm(), P.lo / 2.0, max_relative = 1e-13);
             assert!((s.knee - s.a).dot(&s.e2).abs() < 1e-13);
             assert!((s.b - s.a).dot(&s.e2).abs() < 1e-13);
-            assert!(s.e1.dot(&s.e2).abs() < 1e-15 && s.e1.dot(&a[i]).abs() < 1e-15 && s.e1.z == 0.0);
+            assert!(s.e1.dot(&s.e2).abs() < 1e-15 && s.e1.dot(ai).abs() < 1e-15 && s.e1.z == 0.0);
             let ang = (s.a - s.knee).angle(&(s.b - s.knee));
             assert_relative_eq!(ang, s.knee_angle, epsilon = 1e-12);
             assert_relative_eq!(s.length, (16.0f64 / 3.0 + 9.0).sqrt(), max_relative = 1e-14);
@@ -1017,12 +1017,12 @@ mod tests {
     fn spring_chain_matches_eq3_at_random_points() {
         for c in sample_points(&P, 100) {
             let l = spring_lengths(&P, &c);
-            for i in 0..3 {
+            for (i, li) in l.iter().enumerate() {
                 let s = spring_chain(&P, &c, i).unwrap();
-                assert_relative_eq!(s.knee_angle, 2.0 * (l[i] / P.lo).asin(), epsilon = 1e-12);
+                assert_relative_eq!(s.knee_angle, 2.0 * (li / P.lo).asin(), epsilon = 1e-12);
                 let ang = (s.a - s.knee).angle(&(s.b - s.knee));
                 assert_relative_eq!(ang, s.knee_angle, epsilon = 1e-6);
-                assert_relative_eq!(s.force, s.torque / knee_offset(&P, l[i]), max_relative = 1e-12);
+                assert_relative_eq!(s.force, s.torque / knee_offset(&P, *li), max_relative = 1e-12);
                 assert!(s.e1.dot(&s.e2).abs() < 1e-14);
             }
         }

@@ -228,12 +228,12 @@ fn values_at(params: &Values, p: Vector3<f64>) -> Values {
         tensions_with_load(pa, &p, forces, payload(params))
     };
     let mut v = Values::from([("x".into(), p.x), ("y".into(), p.y), ("z".into(), p.z), ("rotation".into(), 0.0)]);
-    for i in 0..3 {
-        v.insert(format!("l{}", i + 1), st.spring_lengths[i]);
-        v.insert(format!("f{}", i + 1), forces[i]);
+    for (i, (l, f)) in st.spring_lengths.iter().zip(forces).enumerate() {
+        v.insert(format!("l{}", i + 1), *l);
+        v.insert(format!("f{}", i + 1), f);
     }
-    for j in 0..6 {
-        v.insert(format!("t{}", j + 1), tensions[j]);
+    for (j, t) in tensions.iter().enumerate() {
+        v.insert(format!("t{}", j + 1), *t);
     }
     v
 }
