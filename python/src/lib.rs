@@ -1,7 +1,7 @@
 //! The testbed's own API for Python (`tensegrity_testbed._tensegrity`; the package's
 //! `__init__.py` wraps it): a scenario checked and run by the same code as the CLI, the report
 //! handed over as its JSON, the per-tick table as Arrow record batches in memory
-//! ([`ArrowTable`], the Arrow PyCapsule interface). Runs release the GIL and stop at the next
+//! (`ArrowTable`, the Arrow PyCapsule interface). Runs release the GIL and stop at the next
 //! tick on Ctrl-C.
 
 use arrow_array::ffi_stream::FFI_ArrowArrayStream;

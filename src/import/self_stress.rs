@@ -25,12 +25,12 @@ const TAUT_FRACTION: f64 = 1e-6;
 /// What an import did to prestress the structure, in a sentence.
 pub struct Chosen {
     pub sentence: String,
-    /// The least and largest cable tension at the drawn state [N].
+    /// The least and largest cable tension at the drawn state \[N\].
     pub least_n: f64,
     pub largest_n: f64,
 }
 
-/// The drawn structure's self-stress: one tension per cable [N] in `draft.cables` order, the
+/// The drawn structure's self-stress: one tension per cable \[N\] in `draft.cables` order, the
 /// least of them 1 (struts in compression), or None when no self-stress keeps every cable in
 /// tension.
 pub fn self_stress(draft: &Draft) -> Option<Vec<f64>> {
@@ -97,7 +97,7 @@ fn projected_uniform_stress(a: &DMatrix<f64>, cables: usize) -> Option<Vec<f64>>
 }
 
 /// Prestresses `draft` with its self-stress scaled so that the least cable tension is
-/// `least_n` [N]: each elastic cable's rest length set to its drawn length less its tension
+/// `least_n` \[N\]: each elastic cable's rest length set to its drawn length less its tension
 /// over its stiffness. None when there is no such self-stress (nothing changed); an error
 /// naming the cable when a tension leaves it no rest length.
 pub fn prestress(draft: &mut Draft, least_n: f64) -> Result<Option<Chosen>, DraftError> {

@@ -16,7 +16,7 @@ use std::cmp::Ordering;
 use std::sync::Arc;
 
 /// A model given as a function: `predict(params, inputs, t)` -> predictions by name; `t` is the
-/// time since a motion started [s], None outside a motion.
+/// time since a motion started \[s\], None outside a motion.
 pub trait ExternalModel: Send + Sync {
     fn predict(&self, params: &Values, inputs: &Values, time_s: Option<f64>) -> Result<Values, ExternalError>;
 }

@@ -19,11 +19,11 @@ pub const AMPLITUDE_FRACTION: f64 = 0.1;
 pub struct DrawnMode {
     /// [rad/s]
     pub omega: f64,
-    /// Each node's displacement in the mode (any scale; rescaled here) [m].
+    /// Each node's displacement in the mode (any scale; rescaled here) \[m\].
     pub node_motion: Vec<[f64; 3]>,
 }
 
-/// The structure at rest: node positions [m] and the members as node index pairs.
+/// The structure at rest: node positions \[m\] and the members as node index pairs.
 pub struct DrawnStructure {
     pub nodes: Vec<[f64; 3]>,
     pub struts: Vec<(usize, usize)>,

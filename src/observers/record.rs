@@ -440,7 +440,7 @@ impl Recorder {
         self.scalars_at(tick, self.last_time_s, entity, &[value]);
     }
 
-    /// Buffers the values of an entity's series at `tick` (simulated time `time_s` [s]), which
+    /// Buffers the values of an entity's series at `tick` (simulated time `time_s` \[s\]), which
     /// may be earlier than the last one seen (every `record_every`-th tick, like the rest).
     pub fn scalars_at(&mut self, tick: u64, time_s: f64, entity: &str, values: &[f64]) {
         if !tick.is_multiple_of(self.every) {

@@ -41,7 +41,7 @@ pub const ARROW_BATCH_ROWS: usize = 8192;
 /// The file endings that select the Arrow IPC format.
 const ARROW_ENDINGS: &[&str] = &["arrow", "feather", "ipc"];
 
-/// Whether `path` names a table file: `.csv`, or one of [`ARROW_ENDINGS`].
+/// Whether `path` names a table file: `.csv`, or one of `ARROW_ENDINGS`.
 pub fn is_table_file(path: &std::path::Path) -> bool {
     path.extension().and_then(|e| e.to_str()).is_some_and(|e| e == "csv" || ARROW_ENDINGS.contains(&e))
 }
@@ -137,8 +137,8 @@ pub struct Table {
     waiting: usize,
 }
 
-/// Every joint with one coordinate: its index and column (`joint:NAME.angle` [rad] for a
-/// revolute, `joint:NAME.slide` [m] for a prismatic).
+/// Every joint with one coordinate: its index and column (`joint:NAME.angle` \[rad\] for a
+/// revolute, `joint:NAME.slide` \[m\] for a prismatic).
 pub fn coordinates(s: &crate::structure::Structure) -> impl Iterator<Item = (usize, String)> + '_ {
     s.joints.iter().enumerate().filter_map(|(j, joint)| match joint.kind {
         crate::structure::JointKind::Revolute { .. } => Some((j, format!("joint:{}.angle", joint.name))),
@@ -163,7 +163,7 @@ impl Table {
     }
 
     /// Starts the table at `path` (its directory is made if needed); Arrow IPC for the endings
-    /// in [`ARROW_ENDINGS`], CSV otherwise.
+    /// in `ARROW_ENDINGS`, CSV otherwise.
     /// `model`: the file's model, whose quantities, predictions and errors get columns.
     pub fn start(path: &Path, model: Option<super::file_model::ModelObserver>) -> Result<Self, TableError> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {

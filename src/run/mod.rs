@@ -135,7 +135,7 @@ pub mod stoppable {
     use std::thread::JoinHandle;
     use std::time::Duration;
 
-    /// How often a waiting thread looks for a reason to stop while the work runs [s].
+    /// How often a waiting thread looks for a reason to stop while the work runs \[s\].
     pub const POLL_S: f64 = 0.05;
 
     /// Why work on a thread of its own gave no result.

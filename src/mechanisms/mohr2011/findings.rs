@@ -8,7 +8,7 @@ use crate::mechanisms::Finding;
 use nalgebra::Vector3;
 use std::f64::consts::{FRAC_PI_2, PI};
 
-/// Deterministic sample of centroids inside the kinematic workspace [m].
+/// Deterministic sample of centroids inside the kinematic workspace \[m\].
 pub fn sample_points(p: &Params, n: usize) -> Vec<Vector3<f64>> {
     // Low-discrepancy R3 sequence (additive recurrence with 1/g, 1/g^2, 1/g^3,
     // g = 1.2207440846 the root of g^4 = g + 1) in a box, filtered.

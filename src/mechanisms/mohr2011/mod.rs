@@ -156,7 +156,7 @@ fn rho_of(inputs: &Values) -> Result<[f64; 3], ModelError> {
     Ok([input(inputs, "rho1")?, input(inputs, "rho2")?, input(inputs, "rho3")?])
 }
 
-/// Cable tensions [N] at centroid `p` with an external force `load` [N] on the end-effector's
+/// Cable tensions \[N\] at centroid `p` with an external force `load` \[N\] on the end-effector's
 /// centroid, from the full wrench balance (Eq. 19 with the load added: W_f f + W_t t + w = 0).
 pub fn tensions_with_load(pa: &Params, p: &Vector3<f64>, f: [f64; 3], load: Vector3<f64>) -> [f64; 6] {
     let w = analytic::wf(pa, p) * nalgebra::Vector3::from(f)
