@@ -247,6 +247,7 @@ impl ArrowTable {
 /// the next tick and raises KeyboardInterrupt.
 #[pyfunction]
 #[pyo3(signature = (path, text=None, set=Vec::new(), table=false, model=None, predictions=Vec::new()))]
+// The Python function's keyword arguments, one parameter each (and the GIL token).
 #[allow(clippy::too_many_arguments)]
 fn run_json(
     py: Python<'_>,
@@ -290,6 +291,8 @@ fn array_error(e: tensegrity_testbed::import::ImportError) -> PyErr {
 /// property per member (`import::matrices::from_arrays`): ValueError on what is wrong.
 #[pyfunction]
 #[pyo3(signature = (name, n, cb, cs, bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n, string_rest_length_m, tension_only, pins, quantities))]
+// The Python function's keyword arguments, one parameter each: the arrays and one property per
+// member, as `tensegrity import matrices` takes them.
 #[allow(clippy::too_many_arguments)]
 fn structure_from_arrays(
     name: &str,

@@ -44,6 +44,10 @@ pub(super) struct Data {
 /// displacement per increment).
 pub(super) type MultibodyMoves = Vec<(MultibodyIndex, Vec<(usize, f64)>)>;
 
+/// (joint, displacement to its command) of every actuated multibody link, and (joint, locked
+/// coordinate now, command) of every actuated joint locked off the tree.
+type ActuatorMoves = (Vec<(usize, f64)>, Vec<(usize, f64, f64)>);
+
 impl Data {
     /// Moves the coordinate of joint `j` (a revolute's angle [rad], a prismatic's slide [m])
     /// by `displacement` and sets its rate to `rate` [rad/s or m/s], the bodies beyond it
@@ -317,8 +321,7 @@ impl Data {
 
     /// (joint, displacement to its command) of every actuated multibody link, and (joint,
     /// locked coordinate now, command) of every actuated joint locked off the tree.
-    #[allow(clippy::type_complexity)]
-    pub(super) fn actuator_moves(&self, m: &Model) -> (Vec<(usize, f64)>, Vec<(usize, f64, f64)>) {
+    pub(super) fn actuator_moves(&self, m: &Model) -> ActuatorMoves {
         let mut moves: Vec<(usize, f64)> = Vec::new();
         let mut locks: Vec<(usize, f64, f64)> = Vec::new();
         for j in 0..m.structure.joints.len() {
