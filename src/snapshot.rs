@@ -119,7 +119,7 @@ pub struct MemberForces {
     /// Force \[N\] or torque [N m] each actuator exerts along its joint axis (or the cable
     /// tension for a winch), in actuator order.
     pub actuator_force: Vec<f64>,
-    /// None when the snapshot was taken without it (see [`Simulation::member_forces_with`](crate::sim::Simulation::member_forces_with)).
+    /// None when the snapshot was taken without it (see `Simulation::member_forces_with`).
     pub residual: Option<Residual>,
 }
 
