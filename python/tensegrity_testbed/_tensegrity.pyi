@@ -1,11 +1,27 @@
 import os
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union, final
+
+__all__ = [
+    "check",
+    "run_json",
+    "sweep_csv",
+    "structure_from_arrays",
+    "import_ntrt",
+    "write_scenario",
+    "export_mjcf",
+    "solve",
+    "findings",
+    "ArrowTable",
+    "TestbedError",
+]
 
 # A path as `PathBuf` takes it: a str or an os.PathLike.
 _Path = Union[str, "os.PathLike[str]"]
 
 class TestbedError(Exception): ...
 
+# A #[pyclass] without `subclass`: Python cannot derive from it.
+@final
 class ArrowTable:
     """Every tick of a run as Arrow record batches in memory: `tick` (UInt64), the other columns
     of `tensegrity run --table FILE.arrow` (Float64, SI units: m, rad, N, N m, s, J; null where
