@@ -4,11 +4,12 @@
 
 use crate::mechanisms::QuantityKind;
 use crate::structure::Structure;
+use std::cmp::Ordering;
 
 /// Numerical settings of the integrator, all from the scenario file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimSettings {
-    /// Time step [s].
+    /// Time step \[s\].
     pub dt_s: f64,
     /// rapier substeps per step (`num_solver_iterations`).
     pub substeps: usize,
@@ -26,19 +27,19 @@ pub struct SimSettings {
     /// rest before every step (a settling strategy; on by default, ignored where it does not
     /// apply).
     pub relaxation: bool,
-    /// Half-size of the box that every node must stay inside, else the run diverged [m].
+    /// Half-size of the box that every node must stay inside, else the run diverged \[m\].
     pub bounding_box_m: f64,
     /// Linear and angular damping of free bodies [1/s] (applied after each step; it slows
     /// motion but does not move the equilibrium).
     pub body_damping_per_s: f64,
-    /// Kinetic energy above which the run has diverged [J].
+    /// Kinetic energy above which the run has diverged \[J\].
     pub max_kinetic_energy_j: f64,
-    /// Separation of a loop-closing joint's anchors above which the run has diverged [m]
+    /// Separation of a loop-closing joint's anchors above which the run has diverged \[m\]
     /// (None: 1 % of the structure's size).
     pub max_joint_gap_m: Option<f64>,
 }
 
-/// Default kinetic-energy limit [J]: far above anything a settling mechanism of this testbed
+/// Default kinetic-energy limit \[J\]: far above anything a settling mechanism of this testbed
 /// holds (a few J), far below what a numerical blow-up reaches within a few ticks.
 pub const DEFAULT_MAX_KINETIC_ENERGY_J: f64 = 1e6;
 
@@ -69,11 +70,11 @@ pub struct SettleCriteria {
     pub speed_tol_m_per_s: f64,
     /// Consecutive steps the speed must stay below the threshold.
     pub window_steps: u64,
-    /// Largest residual force on a free coordinate [N].
+    /// Largest residual force on a free coordinate \[N\].
     pub residual_force_tol_n: f64,
     /// Largest residual torque on a free coordinate [N m].
     pub residual_torque_tol_nm: f64,
-    /// Simulated time allowed for one settle [s]; past it the settle fails.
+    /// Simulated time allowed for one settle \[s\]; past it the settle fails.
     pub max_time_s: f64,
 }
 
@@ -97,9 +98,9 @@ pub struct InterferenceSettings {
     pub enabled: bool,
     /// Cables and springs are checked too (against struts and each other).
     pub tendons: bool,
-    /// A pair whose clearance falls below this is a violation [m] (0: only actual overlap).
+    /// A pair whose clearance falls below this is a violation \[m\] (0: only actual overlap).
     pub threshold_m: f64,
-    /// Pairs farther apart than this are not measured [m] (the broad phase's inflation).
+    /// Pairs farther apart than this are not measured \[m\] (the broad phase's inflation).
     pub margin_m: f64,
     /// Violations are reported but do not fail the run.
     pub informative: bool,
@@ -176,7 +177,8 @@ impl Prestress {
     /// Whether a settled state of a structure of `cables` cables, `slack` of them slack,
     /// keeping `fraction` of the drawn cable tension, has lost its self-stress.
     pub fn lost(&self, cables: usize, slack: usize, fraction: Option<f64>) -> bool {
-        (cables > 0 && slack == cables) || self.min_fraction.zip(fraction).is_some_and(|(min, f)| !(f >= min))
+        (cables > 0 && slack == cables)
+            || self.min_fraction.zip(fraction).is_some_and(|(min, f)| f.partial_cmp(&min).is_none_or(Ordering::is_lt))
     }
 }
 
@@ -184,7 +186,7 @@ impl Prestress {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Probe {
     /// The load applied as +load and -load: a torque [N m] (the mechanism's probe, a
-    /// revolute joint) or a force [N] (a prismatic joint).
+    /// revolute joint) or a force \[N\] (a prismatic joint).
     pub torque_nm: f64,
     /// A probe on a named joint of the structure, with its predicted stiffness.
     pub joint: Option<JointProbe>,
@@ -348,7 +350,7 @@ pub struct Motion {
     /// The displaced coordinate, with its displacement and start rate.
     pub coordinate: Option<(JointCoordinate, f64, f64)>,
     /// A displacement along one of the structure's own modes at the start: the mode (from 0,
-    /// rigid-body modes counted) and the largest node displacement [m].
+    /// rigid-body modes counted) and the largest node displacement \[m\].
     pub mode: Option<(usize, f64)>,
     pub frequencies: Vec<FrequencyPrediction>,
     /// Every joint's damping released (set to zero) for the motion; the settle to a settled
@@ -396,7 +398,7 @@ impl PartialEq for Drive {
 }
 
 impl Drive {
-    /// The inputs at motion time `t` [s] with these parameters.
+    /// The inputs at motion time `t` \[s\] with these parameters.
     pub fn inputs_at(&self, params: &crate::mechanisms::Values, t: f64) -> crate::mechanisms::Values {
         match self {
             Drive::Waypoints(w) => interpolate(w, t),

@@ -27,18 +27,18 @@ pub struct BodyPose {
 pub struct Snapshot {
     pub tick: u64,
     pub time_s: f64,
-    /// World position of every node, in structure order [m].
+    /// World position of every node, in structure order \[m\].
     pub nodes: Vec<[f64; 3]>,
     pub body_poses: Vec<BodyPose>,
     pub forces: MemberForces,
     /// Actuator commands, in structure order (m or rad).
     pub actuator_values: Vec<f64>,
-    /// Kinetic energy of the free bodies [J].
+    /// Kinetic energy of the free bodies \[J\].
     pub kinetic_energy_j: f64,
 }
 
 impl Snapshot {
-    /// The force of the spring or cable `name` of structure `s` [N] (tension positive).
+    /// The force of the spring or cable `name` of structure `s` \[N\] (tension positive).
     pub fn member_force_n(&self, s: &crate::structure::Structure, name: &str) -> Option<f64> {
         match s.spring_id(name) {
             Some(i) => self.forces.spring_force_n.get(i).copied(),
@@ -55,7 +55,7 @@ impl Snapshot {
     }
 
     /// The rotation of `child` relative to `parent` about the unit `axis` (parent frame) since
-    /// the build [rad], as the simulator counts a torsion spring's angle.
+    /// the build \[rad\], as the simulator counts a torsion spring's angle.
     pub fn joint_angle(&self, parent: usize, child: usize, axis: [f64; 3]) -> Option<f64> {
         let rel = self.pose(parent)?.rotation.inverse() * self.pose(child)?.rotation;
         let s = rel.i * axis[0] + rel.j * axis[1] + rel.k * axis[2];
@@ -63,7 +63,7 @@ impl Snapshot {
     }
 
     /// The displacement of `child` relative to `parent` at `anchor` (its place at the build),
-    /// along the unit `axis` (parent frame) since the build [m].
+    /// along the unit `axis` (parent frame) since the build \[m\].
     pub fn joint_slide(&self, parent: usize, child: usize, anchor: [f64; 3], axis: [f64; 3]) -> Option<f64> {
         let (p, c) = (self.pose(parent)?, self.pose(child)?);
         let a = Point3::from(anchor);
@@ -71,8 +71,8 @@ impl Snapshot {
         Some(d.dot(&Vector3::from(axis)))
     }
 
-    /// The coordinate of joint `j` of `s`: a revolute joint's angle [rad] or a prismatic
-    /// joint's slide [m], counted from its initial coordinate; None for other kinds.
+    /// The coordinate of joint `j` of `s`: a revolute joint's angle \[rad\] or a prismatic
+    /// joint's slide \[m\], counted from its initial coordinate; None for other kinds.
     pub fn joint_coordinate(&self, s: &Structure, j: usize) -> Option<f64> {
         let joint = s.joints.get(j)?;
         let q = match joint.kind {
@@ -107,19 +107,19 @@ impl Snapshot {
 /// Forces in every member at one instant. Tension is positive.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MemberForces {
-    /// Spring force k (l - l0) [N], in structure order.
+    /// Spring force k (l - l0) \[N\], in structure order.
     pub spring_force_n: Vec<f64>,
     pub spring_length_m: Vec<f64>,
-    /// Cable tension [N] (0 when slack).
+    /// Cable tension \[N\] (0 when slack).
     pub cable_tension_n: Vec<f64>,
     pub cable_length_m: Vec<f64>,
-    /// Unstretched (commanded) cable length [m].
+    /// Unstretched (commanded) cable length \[m\].
     pub cable_rest_length_m: Vec<f64>,
     pub cable_slack: Vec<bool>,
-    /// Force [N] or torque [N m] each actuator exerts along its joint axis (or the cable
+    /// Force \[N\] or torque [N m] each actuator exerts along its joint axis (or the cable
     /// tension for a winch), in actuator order.
     pub actuator_force: Vec<f64>,
-    /// None when the snapshot was taken without it (see [`Simulation::member_forces_with`]).
+    /// None when the snapshot was taken without it (see `Simulation::member_forces_with`).
     pub residual: Option<Residual>,
 }
 
@@ -129,7 +129,7 @@ pub struct MemberForces {
 /// loop-closing joints, which no force law gives, are fitted by least squares.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Residual {
-    /// Largest residual force on a translational coordinate [N].
+    /// Largest residual force on a translational coordinate \[N\].
     pub max_force_n: f64,
     /// Largest residual torque on a rotational coordinate [N m].
     pub max_torque_nm: f64,
@@ -146,7 +146,7 @@ pub struct ModalProjector {
     pub bodies: Vec<usize>,
     /// Their poses at the analysed state.
     pub start: Vec<BodyPose>,
-    /// Each body's centre of mass in its own frame [m].
+    /// Each body's centre of mass in its own frame \[m\].
     pub com_local: Vec<[f64; 3]>,
     /// M v: six per free body (translation, rotation).
     pub weights: Vec<f64>,

@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 /// A 3-vector in metres (or a unit axis).
 pub type Vec3 = [f64; 3];
 
-/// Radius of a cable or spring when nothing else is given [m]: a thin steel cable or wire
+/// Radius of a cable or spring when nothing else is given \[m\]: a thin steel cable or wire
 /// spring; used by the interference checks (a tendon through a strut or another tendon).
 pub const DEFAULT_TENDON_RADIUS_M: f64 = 1e-3;
 
@@ -32,9 +32,9 @@ pub enum BodyKind {
 /// Mass properties of a free body, expressed at its initial pose.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Inertia {
-    /// Mass [kg].
+    /// Mass \[kg\].
     pub mass_kg: f64,
-    /// Centre of mass, world coordinates in the initial configuration [m].
+    /// Centre of mass, world coordinates in the initial configuration \[m\].
     pub com: Vec3,
     /// Principal moments of inertia about the centre of mass, along the world axes [kg m^2].
     pub principal_kg_m2: Vec3,
@@ -52,7 +52,7 @@ pub struct Body {
 pub struct Node {
     pub name: String,
     pub body: BodyId,
-    /// World position in the initial configuration [m].
+    /// World position in the initial configuration \[m\].
     pub position: Vec3,
 }
 
@@ -63,7 +63,7 @@ pub struct Strut {
     pub name: String,
     pub a: NodeId,
     pub b: NodeId,
-    /// Radius of the capsule used for interference checks and drawing [m].
+    /// Radius of the capsule used for interference checks and drawing \[m\].
     pub radius_m: f64,
 }
 
@@ -74,9 +74,9 @@ pub struct Spring {
     pub a: NodeId,
     pub b: NodeId,
     pub stiffness_n_per_m: f64,
-    /// Free length [m]; zero is allowed (a zero-free-length spring).
+    /// Free length \[m\]; zero is allowed (a zero-free-length spring).
     pub rest_length_m: f64,
-    /// Radius of the segment used for interference checks and drawing [m].
+    /// Radius of the segment used for interference checks and drawing \[m\].
     pub radius_m: f64,
 }
 
@@ -94,9 +94,9 @@ pub struct Cable {
     pub a: NodeId,
     pub b: NodeId,
     pub law: CableLaw,
-    /// Unstretched length in the initial configuration [m] (an actuator may change it).
+    /// Unstretched length in the initial configuration \[m\] (an actuator may change it).
     pub length_m: f64,
-    /// Radius of the segment used for interference checks and drawing [m].
+    /// Radius of the segment used for interference checks and drawing \[m\].
     pub radius_m: f64,
 }
 
@@ -164,7 +164,7 @@ pub enum ActuatorTarget {
     /// Winch: the cable's unstretched length follows the command.
     CableLength(usize),
     /// A node of a fixed body moved directly: the body (with every node on it) is displaced
-    /// from its drawn place by the command [m] along `direction` (a unit vector, world);
+    /// from its drawn place by the command \[m\] along `direction` (a unit vector, world);
     /// several such actuators on one body add up.
     FixedNode { node: usize, direction: Vec3 },
 }
@@ -177,7 +177,7 @@ pub struct Actuator {
 }
 
 /// A constant external force on a body, applied at its centre of mass (a payload's weight,
-/// for example) [N], world frame.
+/// for example) \[N\], world frame.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExternalLoad {
     pub body: BodyId,
@@ -239,14 +239,14 @@ impl Structure {
         for (a, command) in self.actuators.iter().zip(commands) {
             if let ActuatorTarget::FixedNode { node, direction } = a.target {
                 let o = &mut offsets[self.nodes[node].body];
-                for k in 0..3 {
-                    o[k] += direction[k] * command;
+                for (ok, d) in o.iter_mut().zip(direction) {
+                    *ok += d * command;
                 }
             }
         }
         for n in &mut self.nodes {
-            for k in 0..3 {
-                n.position[k] += offsets[n.body][k];
+            for (x, d) in n.position.iter_mut().zip(offsets[n.body]) {
+                *x += d;
             }
         }
     }
@@ -279,7 +279,7 @@ impl Structure {
         self.actuators.iter().position(|a| a.symbol == symbol)
     }
 
-    /// The cables' total tension at the drawn state [N]: each elastic cable's stiffness times
+    /// The cables' total tension at the drawn state \[N\]: each elastic cable's stiffness times
     /// its stretch past its rest length (an inextensible cable carries none until loaded).
     pub fn drawn_cable_tension_n(&self) -> f64 {
         self.cables
@@ -443,7 +443,8 @@ impl Structure {
             ));
         }
         let norm = direction.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if !((norm - 1.0).abs() <= 1e-12) {
+        let off = (norm - 1.0).abs();
+        if off.is_nan() || off > 1e-12 {
             return Err(invalid("actuator", symbol, "the direction of a moved node must be a unit vector"));
         }
         Ok(())
@@ -532,7 +533,7 @@ impl Structure {
     }
 }
 
-/// Shortest strut or cable the description accepts [m]. (A spring may start at zero length:
+/// Shortest strut or cable the description accepts \[m\]. (A spring may start at zero length:
 /// a zero-free-length spring whose ends coincide carries no force and is legal.)
 pub const MIN_MEMBER_LENGTH_M: f64 = 1e-9;
 
@@ -548,7 +549,7 @@ pub fn distance(a: Vec3, b: Vec3) -> f64 {
     norm([a[0] - b[0], a[1] - b[1], a[2] - b[2]])
 }
 
-/// `v` turned by `angle` [rad] about `axis` (through the origin; any length but zero), by
+/// `v` turned by `angle` \[rad\] about `axis` (through the origin; any length but zero), by
 /// Rodrigues' formula.
 pub fn rotated(v: Vec3, axis: Vec3, angle: f64) -> Vec3 {
     let n = norm(axis);
@@ -558,6 +559,58 @@ pub fn rotated(v: Vec3, axis: Vec3, angle: f64) -> Vec3 {
     let kdv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
     std::array::from_fn(|i| v[i] * c + kxv[i] * s + k[i] * kdv * (1.0 - c))
 }
+
+/// Largest distance between two nodes of the structure \[m\] (at least 1e-3 m). The squares
+/// are compared: the square root is monotonic and correctly rounded, so the root of the
+/// largest square is the largest of the roots, to the bit.
+///
+/// The nodes are taken in runs of `SIZE_RUN_NODES` in their order (a structure is drawn
+/// member by member, so a run is compact), each with its bounding box. The pairs between two
+/// runs are measured only where the two boxes' farthest corners are farther apart than the
+/// largest pair found so far, starting from a double sweep (the node farthest from the first,
+/// then the node farthest from it). Rounding is monotonic, so the boxes bound every pair as
+/// computed, and the result is the all-pairs maximum to the bit (a unit test compares them).
+/// Measuring every pair had been a third of building a 100-X furet2018 chain.
+pub fn structure_size(s: &Structure) -> f64 {
+    let p: Vec<Vec3> = s.nodes.iter().map(|n| n.position).collect();
+    let Some(first) = p.first() else { return MIN_STRUCTURE_SIZE_M };
+    let squared = |a: &Vec3, b: &Vec3| {
+        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+    };
+    let farthest =
+        |a: &Vec3| p.iter().map(|b| squared(a, b)).enumerate().fold((0, 0.0), |m, x| if x.1 > m.1 { x } else { m });
+    let mut largest_squared = farthest(&p[farthest(first).0]).1;
+    let runs: Vec<(&[Vec3], Vec3, Vec3)> = p
+        .chunks(SIZE_RUN_NODES)
+        .map(|run| {
+            let (lo, hi) = run.iter().fold((run[0], run[0]), |(lo, hi), q| {
+                (std::array::from_fn(|k| lo[k].min(q[k])), std::array::from_fn(|k| hi[k].max(q[k])))
+            });
+            (run, lo, hi)
+        })
+        .collect();
+    for (i, (a, alo, ahi)) in runs.iter().enumerate() {
+        for (b, blo, bhi) in &runs[i..] {
+            let bound = (0..3).map(|k| (ahi[k] - blo[k]).max(bhi[k] - alo[k])).fold(0.0, |x, d| x + d * d);
+            if bound <= largest_squared {
+                continue;
+            }
+            let same = std::ptr::eq(*a, *b);
+            for (x, pa) in a.iter().enumerate() {
+                let others = if same { &b[x + 1..] } else { &b[..] };
+                largest_squared = others.iter().fold(largest_squared, |m, pb| m.max(squared(pa, pb)));
+            }
+        }
+    }
+    largest_squared.sqrt().max(MIN_STRUCTURE_SIZE_M)
+}
+
+/// Nodes per run of [`structure_size`]'s bounding boxes.
+const SIZE_RUN_NODES: usize = 16;
+
+/// The smallest size [`structure_size`] reports [m].
+const MIN_STRUCTURE_SIZE_M: f64 = 1e-3;
 
 #[cfg(test)]
 mod tests {
@@ -675,55 +728,3 @@ mod tests {
         assert!(matches!(s.validate(), Err(StructureError::Invalid { what: "spring", .. })));
     }
 }
-
-/// Largest distance between two nodes of the structure [m] (at least 1e-3 m). The squares
-/// are compared: the square root is monotonic and correctly rounded, so the root of the
-/// largest square is the largest of the roots, to the bit.
-///
-/// The nodes are taken in runs of [`SIZE_RUN_NODES`] in their order (a structure is drawn
-/// member by member, so a run is compact), each with its bounding box. The pairs between two
-/// runs are measured only where the two boxes' farthest corners are farther apart than the
-/// largest pair found so far, starting from a double sweep (the node farthest from the first,
-/// then the node farthest from it). Rounding is monotonic, so the boxes bound every pair as
-/// computed, and the result is the all-pairs maximum to the bit (a unit test compares them).
-/// Measuring every pair had been a third of building a 100-X furet2018 chain.
-pub fn structure_size(s: &Structure) -> f64 {
-    let p: Vec<Vec3> = s.nodes.iter().map(|n| n.position).collect();
-    let Some(first) = p.first() else { return MIN_STRUCTURE_SIZE_M };
-    let squared = |a: &Vec3, b: &Vec3| {
-        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-        d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
-    };
-    let farthest =
-        |a: &Vec3| p.iter().map(|b| squared(a, b)).enumerate().fold((0, 0.0), |m, x| if x.1 > m.1 { x } else { m });
-    let mut largest_squared = farthest(&p[farthest(first).0]).1;
-    let runs: Vec<(&[Vec3], Vec3, Vec3)> = p
-        .chunks(SIZE_RUN_NODES)
-        .map(|run| {
-            let (lo, hi) = run.iter().fold((run[0], run[0]), |(lo, hi), q| {
-                (std::array::from_fn(|k| lo[k].min(q[k])), std::array::from_fn(|k| hi[k].max(q[k])))
-            });
-            (run, lo, hi)
-        })
-        .collect();
-    for (i, (a, alo, ahi)) in runs.iter().enumerate() {
-        for (b, blo, bhi) in &runs[i..] {
-            let bound = (0..3).map(|k| (ahi[k] - blo[k]).max(bhi[k] - alo[k])).fold(0.0, |x, d| x + d * d);
-            if bound <= largest_squared {
-                continue;
-            }
-            let same = std::ptr::eq(*a, *b);
-            for (x, pa) in a.iter().enumerate() {
-                let others = if same { &b[x + 1..] } else { &b[..] };
-                largest_squared = others.iter().fold(largest_squared, |m, pb| m.max(squared(pa, pb)));
-            }
-        }
-    }
-    largest_squared.sqrt().max(MIN_STRUCTURE_SIZE_M)
-}
-
-/// Nodes per run of [`structure_size`]'s bounding boxes.
-const SIZE_RUN_NODES: usize = 16;
-
-/// The smallest size [`structure_size`] reports [m].
-const MIN_STRUCTURE_SIZE_M: f64 = 1e-3;

@@ -1,7 +1,7 @@
 //! The testbed's own API for Python (`tensegrity_testbed._tensegrity`; the package's
 //! `__init__.py` wraps it): a scenario checked and run by the same code as the CLI, the report
 //! handed over as its JSON, the per-tick table as Arrow record batches in memory
-//! ([`ArrowTable`], the Arrow PyCapsule interface). Runs release the GIL and stop at the next
+//! (`ArrowTable`, the Arrow PyCapsule interface). Runs release the GIL and stop at the next
 //! tick on Ctrl-C.
 
 use arrow_array::ffi_stream::FFI_ArrowArrayStream;
@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use tensegrity_testbed::file_model::spec::ErrorClass;
+use tensegrity_testbed::mechanisms::Values;
 use tensegrity_testbed::observers::external::{External, ExternalError, ExternalModel, ExternalPrediction};
 use tensegrity_testbed::observers::table::{MemoryTable, TableTarget};
 use tensegrity_testbed::run::stoppable::Stoppable;
@@ -246,6 +247,7 @@ impl ArrowTable {
 /// the next tick and raises KeyboardInterrupt.
 #[pyfunction]
 #[pyo3(signature = (path, text=None, set=Vec::new(), table=false, model=None, predictions=Vec::new()))]
+// The Python function's keyword arguments, one parameter each (and the GIL token).
 #[allow(clippy::too_many_arguments)]
 fn run_json(
     py: Python<'_>,
@@ -289,6 +291,8 @@ fn array_error(e: tensegrity_testbed::import::ImportError) -> PyErr {
 /// property per member (`import::matrices::from_arrays`): ValueError on what is wrong.
 #[pyfunction]
 #[pyo3(signature = (name, n, cb, cs, bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n, string_rest_length_m, tension_only, pins, quantities))]
+// The Python function's keyword arguments, one parameter each: the arrays and one property per
+// member, as `tensegrity import matrices` takes them.
 #[allow(clippy::too_many_arguments)]
 fn structure_from_arrays(
     name: &str,
@@ -382,12 +386,12 @@ fn export_mjcf(
     Ok((mjcf.xml, mjcf.warnings))
 }
 
+/// A built-in mechanism, its parameters and its inputs.
+type MechanismValues = (Box<dyn tensegrity_testbed::mechanisms::Mechanism>, Values, Values);
+
 /// A built-in mechanism by name, its parameters (defaults for those not given, validated) and
 /// the remaining values as inputs.
-fn mechanism_values(
-    name: &str,
-    values: BTreeMap<String, f64>,
-) -> PyResult<(Box<dyn tensegrity_testbed::mechanisms::Mechanism>, BTreeMap<String, f64>, BTreeMap<String, f64>)> {
+fn mechanism_values(name: &str, values: Values) -> PyResult<MechanismValues> {
     use tensegrity_testbed::mechanisms;
     let m = mechanisms::find_named(name).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let (params, inputs): (BTreeMap<_, _>, BTreeMap<_, _>) =
@@ -400,14 +404,14 @@ fn mechanism_values(
     Ok((m, params, inputs))
 }
 
+/// One solution of the analytic model: its label, its values and whether it is stable (None
+/// where the model does not say).
+type Solution = (String, Values, Option<bool>);
+
 /// The analytic model alone (`tensegrity solve`): every solution of `query` as (label, values,
 /// stable).
 #[pyfunction]
-fn solve(
-    mechanism: &str,
-    query: &str,
-    values: BTreeMap<String, f64>,
-) -> PyResult<Vec<(String, BTreeMap<String, f64>, Option<bool>)>> {
+fn solve(mechanism: &str, query: &str, values: Values) -> PyResult<Vec<Solution>> {
     let (m, params, inputs) = mechanism_values(mechanism, values)?;
     let q = tensegrity_testbed::mechanisms::query_named(m.as_ref(), query)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;

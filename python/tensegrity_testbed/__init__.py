@@ -126,7 +126,7 @@ class Result:
         return f"<Result {self.report['name']!r}: {verdict}, as expected: {self.as_expected}>"
 
 
-Model = Callable[[dict, dict, Optional[float]], Mapping[str, float]]
+Model = Callable[[dict, dict, Optional[float]], dict]
 
 
 def run(

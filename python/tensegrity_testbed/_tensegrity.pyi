@@ -1,7 +1,27 @@
-from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
+import os
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union, final
+
+__all__ = [
+    "check",
+    "run_json",
+    "sweep_csv",
+    "structure_from_arrays",
+    "import_ntrt",
+    "write_scenario",
+    "export_mjcf",
+    "solve",
+    "findings",
+    "ArrowTable",
+    "TestbedError",
+]
+
+# A path as `PathBuf` takes it: a str or an os.PathLike.
+_Path = Union[str, "os.PathLike[str]"]
 
 class TestbedError(Exception): ...
 
+# A #[pyclass] without `subclass`: Python cannot derive from it.
+@final
 class ArrowTable:
     """Every tick of a run as Arrow record batches in memory: `tick` (UInt64), the other columns
     of `tensegrity run --table FILE.arrow` (Float64, SI units: m, rad, N, N m, s, J; null where
@@ -17,6 +37,7 @@ class ArrowTable:
     @property
     def column_names(self) -> List[str]: ...
     def __len__(self) -> int: ...
+    def __repr__(self) -> str: ...
 
 def check(path: str, text: Optional[str] = None, set: Sequence[str] = ...) -> str:
     """The scenario's name; TestbedError(file, line, col, message) when it is refused."""
@@ -26,7 +47,7 @@ def run_json(
     text: Optional[str] = None,
     set: Sequence[str] = ...,
     table: bool = False,
-    model: Optional[Callable[[dict, dict, Optional[float]], Mapping[str, float]]] = None,
+    model: Optional[Callable[[Dict[str, float], Dict[str, float], Optional[float]], Dict[str, float]]] = None,
     predictions: Sequence[Tuple[str, str, str, float, Optional[float]]] = ...,
 ) -> Tuple[str, Optional[ArrowTable]]:
     """The run's report (one scenario) as JSON and, with `table`, every tick in memory (None
@@ -47,16 +68,16 @@ def structure_from_arrays(
     string_tension_n: Optional[Sequence[float]],
     string_rest_length_m: Optional[Sequence[float]],
     tension_only: Sequence[bool],
-    pins: Sequence[Tuple[str, Optional[Tuple[float, float, float]]]],
+    pins: Sequence[Tuple[str, Optional[Sequence[float]]]],
     quantities: Sequence[Tuple[str, str]],
 ) -> str:
     """A scenario's TOML from N (3 rows, m), Cb and Cs as rows and one property per member (kg,
     m, N/m, N or m); ValueError (`Cb[2]: ...`, `bar_mass_kg[1] must be ...`) when refused."""
 
-def import_ntrt(path: str, text: Optional[str] = None, keep_axes: bool = False) -> Tuple[str, List[str]]:
+def import_ntrt(path: _Path, text: Optional[str] = None, keep_axes: bool = False) -> Tuple[str, List[str]]:
     """(a scenario's TOML, what was skipped) from NTRT YAML at `path` or given as `text`."""
 
-def write_scenario(path: str, text: str, inputs: Sequence[str]) -> None:
+def write_scenario(path: _Path, text: str, inputs: Sequence[_Path]) -> None:
     """Writes `text` to `path` atomically, never over one of `inputs` (ValueError)."""
 
 def export_mjcf(
@@ -64,8 +85,8 @@ def export_mjcf(
 ) -> Tuple[str, List[str]]:
     """(the MJCF XML, what was not exported)."""
 
-def solve(mechanism: str, query: str, values: Mapping[str, float]) -> List[Tuple[str, Dict[str, float], Optional[bool]]]:
+def solve(mechanism: str, query: str, values: Dict[str, float]) -> List[Tuple[str, Dict[str, float], Optional[bool]]]:
     """Every solution of an analytic query: (label, values, stable)."""
 
-def findings(mechanism: str, params: Mapping[str, float]) -> List[Tuple[str, str, str, bool]]:
+def findings(mechanism: str, params: Dict[str, float]) -> List[Tuple[str, str, str, bool]]:
     """(equation, claim, measured, holds) for every printed equation checked."""

@@ -61,7 +61,7 @@ pub struct BenchResult {
     pub median_cases_per_s: f64,
     /// Median over cases of the steps needed to settle.
     pub median_steps_per_case: f64,
-    /// Median over rounds of the wall time per step [us].
+    /// Median over rounds of the wall time per step \[us\].
     pub median_us_per_step: f64,
     /// Median and largest normalised error over cases and checked quantities.
     pub median_error: f64,
@@ -383,7 +383,7 @@ pub struct PeerCaseSet {
     pub speed_tol_m_per_s: f64,
     pub window_steps: u64,
     pub max_time_s: f64,
-    /// The mechanism's characteristic length [m]: length errors are divided by it.
+    /// The mechanism's characteristic length \[m\]: length errors are divided by it.
     pub length_scale_m: f64,
     /// The checked quantities: `kind` is "length" (error / length_scale_m), "angle" (wrapped,
     /// rad) or "magnitude" (error / |analytic|).
@@ -403,9 +403,9 @@ pub struct PeerCase {
     pub inputs: crate::mechanisms::Values,
     /// Every analytic quantity of the testbed's prediction at this case.
     pub analytic: crate::mechanisms::Values,
-    /// Node positions of the testbed's start state (the scenario's `[start]`) [m].
+    /// Node positions of the testbed's start state (the scenario's `[start]`) \[m\].
     pub start_nodes: std::collections::BTreeMap<String, [f64; 3]>,
-    /// Node positions at the analytic equilibrium, where the model gives them [m].
+    /// Node positions at the analytic equilibrium, where the model gives them \[m\].
     pub analytic_nodes: Option<std::collections::BTreeMap<String, [f64; 3]>>,
 }
 

@@ -80,7 +80,7 @@ pub fn scale_peer(rows: &[PeerRow]) -> String {
     for r in rows {
         let _ = writeln!(
             t,
-            "{:<12} {:>5} {:>6} | {:>9.2} {:>7} {:>10.2e} {:>9} | {:>9.2} {:>7} {:>10.2e} {:>9} | {:>9.2} {:>9.2e}{}",
+            "{:<12} {:>5} {:>6} | {:>9.2} {:>7} {:>10.2e} {:>9} | {:>9.2} {:>7} {:>10.2e} {:>9} | {:>9.2} {:>9.2e} {}{}",
             r.family,
             r.size,
             r.struts,
@@ -94,15 +94,8 @@ pub fn scale_peer(rows: &[PeerRow]) -> String {
             r.peer_settled,
             r.ratio_cases_per_s,
             r.ratio_error,
-            format!(
-                " {}{}",
-                r.error_unit,
-                if r.peer_notes.is_empty() {
-                    String::new()
-                } else {
-                    format!("  (MuJoCo: {})", r.peer_notes.join("; "))
-                }
-            )
+            r.error_unit,
+            if r.peer_notes.is_empty() { String::new() } else { format!("  (MuJoCo: {})", r.peer_notes.join("; ")) }
         );
     }
     t

@@ -3,7 +3,7 @@
 //! thread, and here the one place that prints errors and maps outcomes to exit codes.
 //!
 //! Adding a subcommand: a variant in `args.rs`, its file here (a function returning
-//! `Result<Outcome, CliError>`), and one line in [`dispatch`].
+//! `Result<Outcome, CliError>`), and one line in `dispatch`.
 
 mod args;
 mod bench;
@@ -51,7 +51,7 @@ impl Outcome {
 }
 
 /// The error of one of the library's seams (a scenario, an output, a run, an import, ...),
-/// kept as its own kind until [`exit_code`] prints it.
+/// kept as its own kind until `exit_code` prints it.
 pub type Cause = Box<dyn std::error::Error + Send + Sync>;
 
 /// Why a command stopped before its end.

@@ -54,7 +54,7 @@ pub enum ActuatorMode {
 pub struct MjcfOptions {
     /// The `<mujoco model>` name.
     pub model_name: String,
-    /// `<option timestep>` [s].
+    /// `<option timestep>` \[s\].
     pub timestep_s: f64,
     /// The testbed's free-body damping [1/s]; written as the free joints' damping, times the
     /// body's mass [N s/m] (zero at rest: the equilibrium does not move).
@@ -77,7 +77,7 @@ pub struct Mjcf {
     pub warnings: Vec<String>,
 }
 
-/// Largest pulling force of a winch's `<position>` actuator [N]: its lower force bound (no
+/// Largest pulling force of a winch's `<position>` actuator \[N\]: its lower force bound (no
 /// upper one but zero, so it never pushes).
 pub const WINCH_MAX_TENSION_N: f64 = 1e12;
 

@@ -218,7 +218,7 @@ impl Plot for Fig4 {
         });
         chart.draw_series(cell_runs(colours, (d.cell, d.cell)))?;
         for line in &d.printed_zero {
-            chart.draw_series(DashedLineSeries::new(line.iter().copied(), 7, 5, PRINTED.stroke_width(2).into()))?;
+            chart.draw_series(DashedLineSeries::new(line.iter().copied(), 7, 5, PRINTED.stroke_width(2)))?;
         }
         for line in &d.folded {
             chart.draw_series(LineSeries::new(line.iter().copied(), FOLDED.stroke_width(3)))?;
@@ -310,9 +310,12 @@ const FIG5_B: [f64; 3] = [2.0 / 5.0, 2.0 / 3.0, 9.0 / 10.0];
 /// Cells per side of a furet2018 solution-count map over [-2L, 2L]^2.
 const FIG5_CELLS: usize = 160;
 
+/// One panel of Fig. 5: b, the cells (x, y, count) and the area fractions with 2 and 4 solutions.
+type Fig5Panel = (f64, Vec<(f64, f64, usize)>, (f64, f64));
+
 struct Fig5 {
     /// Per b: (b, cells (x, y, count), area fractions (2, 4)).
-    panels: Vec<(f64, Vec<(f64, f64, usize)>, (f64, f64))>,
+    panels: Vec<Fig5Panel>,
     cell: f64,
     /// Dynamics at b = 2/3 (`scenarios/furet2018/workspace_grid.toml`): per end point (x, y),
     /// the number of inverse solutions the simulation reached within the checks' tolerance.

@@ -248,25 +248,15 @@ impl Fig2 {
         // Curve vi (Eq. 31) and ii (Eq. 27): the edges of the range, ii dashed (not singular).
         chart.draw_series(LineSeries::new([(0.0, d.l3_max), (PI, d.l3_max)], CURVE_VI.stroke_width(3)))?;
         for t1 in [0.0, PI] {
-            chart.draw_series(DashedLineSeries::new(
-                [(t1, 0.0), (t1, d.l3_max)],
-                10,
-                6,
-                CURVE_II.stroke_width(4).into(),
-            ))?;
+            chart.draw_series(DashedLineSeries::new([(t1, 0.0), (t1, d.l3_max)], 10, 6, CURVE_II.stroke_width(4)))?;
         }
-        chart.draw_series(DashedLineSeries::new(
-            d.curve_iii.iter().copied(),
-            10,
-            6,
-            CURVE_III.stroke_width(3).into(),
-        ))?;
-        chart.draw_series(DashedLineSeries::new(d.curve_iv.iter().copied(), 10, 6, CURVE_IV.stroke_width(3).into()))?;
+        chart.draw_series(DashedLineSeries::new(d.curve_iii.iter().copied(), 10, 6, CURVE_III.stroke_width(3)))?;
+        chart.draw_series(DashedLineSeries::new(d.curve_iv.iter().copied(), 10, 6, CURVE_IV.stroke_width(3)))?;
         for line in &d.curve_v {
             chart.draw_series(LineSeries::new(line.iter().copied(), CURVE_V.stroke_width(3)))?;
         }
         for line in &d.curve_v_printed {
-            chart.draw_series(DashedLineSeries::new(line.iter().copied(), 6, 4, CURVE_V.stroke_width(2).into()))?;
+            chart.draw_series(DashedLineSeries::new(line.iter().copied(), 6, 4, CURVE_V.stroke_width(2)))?;
         }
         // Curve i (Eq. 26), the one singular curve: drawn last among the curves.
         chart.draw_series(LineSeries::new([(0.0, 0.0), (PI, 0.0)], CURVE_I.stroke_width(4)))?;
@@ -324,12 +314,11 @@ fn draw_grid_points<DB: DrawingBackend>(
     Ok(())
 }
 
+/// A diamond marker: a filled polygon and its rim, placed at a point of the chart.
+type Diamond<DB> = ComposedElement<(f64, f64), DB, Polygon<(i32, i32)>, PathElement<(i32, i32)>>;
+
 /// A diamond marker at `at`, filled with `fill`, with a black rim `rim_px` wide.
-fn rimmed_diamond<DB: DrawingBackend>(
-    at: (f64, f64),
-    fill: RGBColor,
-    rim_px: u32,
-) -> ComposedElement<(f64, f64), DB, Polygon<(i32, i32)>, PathElement<(i32, i32)>> {
+fn rimmed_diamond<DB: DrawingBackend>(at: (f64, f64), fill: RGBColor, rim_px: u32) -> Diamond<DB> {
     EmptyElement::at(at)
         + Polygon::new(DIAMOND_PX.to_vec(), fill.filled())
         + PathElement::new([&DIAMOND_PX[..], &DIAMOND_PX[..1]].concat(), BLACK.stroke_width(rim_px))
@@ -502,7 +491,7 @@ impl Fig3 {
     fn draw_curves<DB: DrawingBackend>(&self, chart: &mut Chart<'_, DB>) -> Result<(), FigureError> {
         let d = self;
         // The printed Cartesian curves (Eq. 34, 36, 37), thin dashed.
-        let dashed = |pts: Vec<(f64, f64)>, c: RGBColor| DashedLineSeries::new(pts, 8, 5, c.stroke_width(2).into());
+        let dashed = |pts: Vec<(f64, f64)>, c: RGBColor| DashedLineSeries::new(pts, 8, 5, c.stroke_width(2));
         chart.draw_series(dashed(circle(d.p.l), CURVE_I))?;
         chart.draw_series(dashed(circle(3.0 * d.p.l), CURVE_IV))?;
         // Eq. 36 as printed is a line: y = (2 sqrt3 K1 x + 2 sqrt3 L (K2 - K1)) / (K1 + 2 K2).
@@ -910,7 +899,7 @@ impl Plot for StiffnessMap<'_> {
         for l in &m.lines {
             let style = l.colour.stroke_width(l.width);
             if l.dashed {
-                chart.draw_series(DashedLineSeries::new(l.points.iter().copied(), 10, 6, style.into()))?;
+                chart.draw_series(DashedLineSeries::new(l.points.iter().copied(), 10, 6, style))?;
             } else {
                 chart.draw_series(LineSeries::new(l.points.iter().copied(), style))?;
             }

@@ -246,14 +246,12 @@ pub(crate) fn legend_box<'a, DB: DrawingBackend + 'a>(
     Ok(())
 }
 
+/// A dot marker: a filled circle and its rim, placed at a point of the chart.
+pub(crate) type Dot<DB> = ComposedElement<(f64, f64), DB, Circle<(i32, i32), i32>, Circle<(i32, i32), i32>>;
+
 /// A dot marker at `at`: a circle of `radius` [px] filled with `fill`, with a black rim `rim_px`
 /// wide.
-pub(crate) fn rimmed_dot<DB: DrawingBackend>(
-    at: (f64, f64),
-    radius: i32,
-    fill: RGBColor,
-    rim_px: u32,
-) -> ComposedElement<(f64, f64), DB, Circle<(i32, i32), i32>, Circle<(i32, i32), i32>> {
+pub(crate) fn rimmed_dot<DB: DrawingBackend>(at: (f64, f64), radius: i32, fill: RGBColor, rim_px: u32) -> Dot<DB> {
     EmptyElement::at(at)
         + Circle::new((0, 0), radius, fill.filled())
         + Circle::new((0, 0), radius, BLACK.stroke_width(rim_px))
@@ -346,6 +344,9 @@ pub(crate) fn zero_contour(
 /// An edge of the contour grid: (vertical?, i, j) from node (i, j) to (i + 1, j) or (i, j + 1).
 type Edge = (bool, usize, usize);
 
+/// Where the zero set crosses each crossed edge, and its segments, each between two edges.
+type Contour = (HashMap<Edge, (f64, f64)>, Vec<(Edge, Edge)>);
+
 /// The marching squares of [`zero_contour`]: where `f` crosses zero on each grid edge, and the
 /// segments of the zero set, each between two crossed edges of a cell.
 fn contour_segments(
@@ -353,7 +354,7 @@ fn contour_segments(
     xs: std::ops::Range<f64>,
     ys: std::ops::Range<f64>,
     cells: usize,
-) -> (HashMap<Edge, (f64, f64)>, Vec<(Edge, Edge)>) {
+) -> Contour {
     let n = cells + 1;
     let (hx, hy) = ((xs.end - xs.start) / cells as f64, (ys.end - ys.start) / cells as f64);
     let at = |i: usize, j: usize| (xs.start + hx * i as f64, ys.start + hy * j as f64);

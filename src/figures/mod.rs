@@ -27,7 +27,7 @@ pub struct Figure {
     pub name: &'static str,
     /// What it shows (`tensegrity figure --list`).
     pub description: &'static str,
-    /// Width and height [px].
+    /// Width and height \[px\].
     pub size: (u32, u32),
     /// Computes the figure's data and draws it into both files of the canvas.
     pub draw: fn(&Canvas) -> Result<(), FigureError>,

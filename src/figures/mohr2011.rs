@@ -271,12 +271,7 @@ impl Plot for Fig4 {
             chart.configure_mesh().disable_mesh().x_desc("x [m]").y_desc("y [m]").draw()?;
             chart.draw_series(cell_runs(s.cells.iter().map(|(x, y)| (*x, *y, KINEMATIC)), (d.cell, d.cell)))?;
             for line in &s.static_boundary {
-                chart.draw_series(DashedLineSeries::new(
-                    line.iter().copied(),
-                    6,
-                    4,
-                    STATIC_LINE.stroke_width(2).into(),
-                ))?;
+                chart.draw_series(DashedLineSeries::new(line.iter().copied(), 6, 4, STATIC_LINE.stroke_width(2)))?;
             }
             chart.draw_series(LineSeries::new(base_triangle(&d.p), BASE.stroke_width(2)))?;
             draw_grid(&mut chart, &s.grid, &|c| (c.x, c.y))?;

@@ -24,6 +24,10 @@ const ERROR_FLOOR: f64 = 1e-17;
 const PALETTE: [RGBColor; 6] = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
 
 /// What a sweep figure shows.
+/// One series of a sweep plot: its label and its rows' (x, analytic, simulated, |error|) per
+/// quantity.
+type Series = (String, Vec<Vec<(f64, f64, f64, f64)>>);
+
 struct SweepPlot {
     title: String,
     x: String,
@@ -32,7 +36,7 @@ struct SweepPlot {
     captions: Vec<String>,
     /// Per series (one value of the other axes): its label and its rows' (x, analytic,
     /// simulated, |error|) per quantity, sorted by x; NaN where a point has no such value.
-    series: Vec<(String, Vec<Vec<(f64, f64, f64, f64)>>)>,
+    series: Vec<Series>,
 }
 
 /// The axis to draw against: `x` if given (a column of the points), else the one with the
@@ -171,7 +175,7 @@ fn data(
                 .into(),
         ));
     }
-    let mut series: Vec<(String, Vec<Vec<(f64, f64, f64, f64)>>)> = Vec::new();
+    let mut series: Vec<Series> = Vec::new();
     for r in rows.iter().filter(|r| r.point.settled) {
         let p = &r.point;
         let others: Vec<String> =

@@ -106,7 +106,7 @@ impl TrajectoryStart {
 /// The coordinates and rates of a trajectory at its sample times.
 #[derive(Clone, Debug, Default)]
 pub struct Trajectory {
-    /// The sample times [s].
+    /// The sample times \[s\].
     pub times: Vec<f64>,
     /// q at each sample, in the order of `[[energy.coordinates]]` (m or rad).
     pub coordinates: Vec<Vec<f64>>,
@@ -234,7 +234,7 @@ impl EnergySpec {
     }
 
     /// The model's motion from (q0, v0) at t = 0, to be advanced sample by sample
-    /// ([`TrajectoryStepper::advance`]) up to `span` [s]: the same steps, to the bit, as
+    /// ([`TrajectoryStepper::advance`]) up to `span` \[s\]: the same steps, to the bit, as
     /// [`EnergySpec::integrate`] over every sample at once.
     pub fn start_trajectory(
         &self,
@@ -309,7 +309,7 @@ pub struct InitialState<'a> {
     pub rates: &'a [f64],
 }
 
-/// The file's dynamic model integrated from `start` at t = 0 and sampled at `times` [s]: the
+/// The file's dynamic model integrated from `start` at t = 0 and sampled at `times` \[s\]: the
 /// parameters (`params`, a swept set; one absent keeps the scenario's value) and inputs held
 /// at their values. The comparison with a simulated motion calls this.
 pub fn integrate(

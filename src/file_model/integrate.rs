@@ -84,7 +84,7 @@ pub enum IntegrateError {
 
 /// The state at each of `times` of y' = f(t, y), y(t0) = y0. `f(t, y, dy)` writes y' into
 /// `dy` and returns false where it is not defined. `cancel` is looked at every
-/// [`CANCEL_POLL_STEPS`] steps.
+/// `CANCEL_POLL_STEPS` steps.
 pub fn dopri5(
     mut f: impl FnMut(f64, &[f64], &mut [f64]) -> bool,
     t0: f64,
@@ -144,7 +144,7 @@ impl Dopri5 {
     }
 
     /// The state at `target` (not before the last sample); `cancel` is looked at every
-    /// [`CANCEL_POLL_STEPS`] steps.
+    /// `CANCEL_POLL_STEPS` steps.
     pub fn advance(&mut self, f: &mut Rhs, target: f64, cancel: Option<&AtomicBool>) -> Result<&[f64], IntegrateError> {
         if !target.is_finite() || target < self.t {
             return Err(IntegrateError::Times);

@@ -10,7 +10,8 @@ use crate::mechanisms::Values;
 #[derive(Clone, Debug)]
 enum Definition {
     Number(f64),
-    Expr(Expr),
+    // Boxed: an expression is some 19 kB, a number 8 bytes.
+    Expr(Box<Expr>),
 }
 
 /// The file's parameters in an order in which each expression's parameters come before it.
@@ -35,7 +36,7 @@ impl ParamTable {
             .into_iter()
             .map(|d| match d {
                 Ok(x) => Definition::Number(x),
-                Err(e) => Definition::Expr(e),
+                Err(e) => Definition::Expr(Box::new(e)),
             })
             .collect();
         let mut order = Vec::with_capacity(names.len());

@@ -12,18 +12,18 @@ pub enum Source {
     Param(f64),
     /// An input (actuator command) of the mechanism.
     Input(String),
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     Time,
-    /// Coordinate `axis` (0 x, 1 y, 2 z) of a node, by name [m].
+    /// Coordinate `axis` (0 x, 1 y, 2 z) of a node, by name \[m\].
     Node(String, usize),
-    /// Force of a spring or cable, tension positive [N].
+    /// Force of a spring or cable, tension positive \[N\].
     MemberForce(String),
-    /// Length of a spring, cable or strut (distance between its end nodes) [m].
+    /// Length of a spring, cable or strut (distance between its end nodes) \[m\].
     MemberLength(String),
-    /// Angle of a revolute joint [rad]: its initial coordinate plus the child's rotation
+    /// Angle of a revolute joint \[rad\]: its initial coordinate plus the child's rotation
     /// relative to the parent about the axis since the build.
     JointAngle(String),
-    /// Slide of a prismatic joint [m]: its initial coordinate plus the child's displacement
+    /// Slide of a prismatic joint \[m\]: its initial coordinate plus the child's displacement
     /// relative to the parent along the axis since the build.
     JointSlide(String),
     /// A quantity the mechanism observes (its `observe` values), by symbol.
@@ -53,9 +53,9 @@ pub struct Quantity {
 /// How a prediction's error is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ErrorClass {
-    /// |simulated - predicted| [m].
+    /// |simulated - predicted| \[m\].
     Length,
-    /// |simulated - predicted| wrapped to [0, pi] [rad].
+    /// |simulated - predicted| wrapped to [0, pi] \[rad\].
     Angle,
     /// |simulated - predicted| / |predicted| (divided by 1 when the prediction is zero).
     Relative,

@@ -9,7 +9,7 @@ use std::fmt::Write;
 pub struct DraftBody {
     pub name: String,
     pub fixed: bool,
-    /// Mass [kg] of a free body.
+    /// Mass \[kg\] of a free body.
     pub mass_kg: f64,
     /// Principal moments along the world axes [kg m^2] (None: the file format's default).
     pub inertia_kg_m2: Option<Vec3>,
@@ -31,7 +31,7 @@ pub struct DraftCable {
     pub b: String,
     /// [N/m]; None: inextensible.
     pub stiffness_n_per_m: Option<f64>,
-    /// Unstretched length [m].
+    /// Unstretched length \[m\].
     pub length_m: f64,
     /// A tension-only cable (true) or a linear spring that pushes as well (false, written as
     /// `[[structure.springs]]`; needs a stiffness).
@@ -39,7 +39,7 @@ pub struct DraftCable {
 }
 
 /// A joint from a fixed body to a node of a body: revolute about `axis`, or spherical (None);
-/// damped so that it settles ([`Draft::joint_damping`]).
+/// damped so that it settles (`Draft::joint_damping`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DraftJoint {
     pub name: String,
@@ -147,7 +147,7 @@ impl Draft {
         })
     }
 
-    /// Size of the structure [m]: the largest distance between two nodes (at least 1e-3).
+    /// Size of the structure \[m\]: the largest distance between two nodes (at least 1e-3).
     pub fn size_m(&self) -> f64 {
         let all: Vec<Vec3> = self.bodies.iter().flat_map(|b| b.nodes.iter().map(|(_, p)| *p)).collect();
         all.iter().flat_map(|a| all.iter().map(move |b| distance(*a, *b))).fold(1e-3, f64::max)

@@ -18,13 +18,13 @@ use std::path::Path;
 
 #[derive(Clone, Debug)]
 pub struct MatrixOptions {
-    /// Mass of each bar [kg].
+    /// Mass of each bar \[kg\].
     pub bar_mass_kg: f64,
-    /// Radius of each bar [m].
+    /// Radius of each bar \[m\].
     pub bar_radius_m: f64,
     /// Stiffness of each string [N/m].
     pub string_stiffness_n_per_m: f64,
-    /// The least string tension at the drawn state [N]: the drawn structure's self-stress is
+    /// The least string tension at the drawn state \[N\]: the drawn structure's self-stress is
     /// scaled to it (each string's rest length set by its share); with `uniform_tension`, or
     /// when the drawing has no self-stress with every string in tension, every string's.
     pub string_tension_n: f64,
@@ -78,8 +78,8 @@ impl MatrixOptions {
     }
 }
 
-/// Each string's rest length: from its tension at its drawn length [N] (rest = drawn -
-/// tension / stiffness), or given [m].
+/// Each string's rest length: from its tension at its drawn length \[N\] (rest = drawn -
+/// tension / stiffness), or given \[m\].
 #[derive(Clone, Debug)]
 pub enum StringRest {
     TensionN(Vec<f64>),
@@ -89,9 +89,9 @@ pub enum StringRest {
 /// One value per member, in the order of the rows of C_b (bars) and C_s (strings).
 #[derive(Clone, Debug)]
 pub struct MemberProperties {
-    /// Mass [kg] of each bar.
+    /// Mass \[kg\] of each bar.
     pub bar_mass_kg: Vec<f64>,
-    /// Radius [m] of each bar.
+    /// Radius \[m\] of each bar.
     pub bar_radius_m: Vec<f64>,
     /// Stiffness [N/m] of each string.
     pub string_stiffness_n_per_m: Vec<f64>,
@@ -112,7 +112,7 @@ pub struct MemberProperties {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum DrawnTension {
     /// The drawn structure's own self-stress, scaled so that its least string tension is
-    /// `least_n` [N] (each string's rest length then follows from its stiffness).
+    /// `least_n` \[N\] (each string's rest length then follows from its stiffness).
     SelfStress { least_n: f64 },
     /// Each string's tension or rest length as [`MemberProperties::string_rest`] gives it.
     AsGiven,

@@ -21,7 +21,7 @@ pub struct ImportError {
     pub message: String,
 }
 
-/// Largest input file an import reads [bytes] (as a scenario file: 16 MiB).
+/// Largest input file an import reads \[bytes\] (as a scenario file: 16 MiB).
 pub const MAX_IMPORT_BYTES: u64 = 16 << 20;
 
 /// The text of an input file (a regular file, at most [`MAX_IMPORT_BYTES`]), or an error
@@ -64,5 +64,5 @@ pub struct Imported {
     pub chosen: Vec<String>,
 }
 
-/// The least cable tension an import gives a structure whose source sets none [N].
+/// The least cable tension an import gives a structure whose source sets none \[N\].
 pub const DEFAULT_LEAST_TENSION_N: f64 = 10.0;

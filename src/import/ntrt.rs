@@ -287,7 +287,7 @@ fn prestress(draft: &mut Draft, pretension_given: bool) -> Result<String, DraftE
     for c in &mut draft.cables {
         let (Some(k), drawn) = (c.stiffness_n_per_m, distance(pos(&c.a), pos(&c.b))) else { continue };
         c.length_m = drawn - least / k;
-        if !(c.length_m > 0.0) {
+        if c.length_m.is_nan() || c.length_m <= 0.0 {
             return Err(DraftError::TensionNoRest {
                 string: c.name.clone(),
                 tension_n: least,
@@ -560,7 +560,8 @@ fn rotate(file: &str, rot: &Yaml, c: &mut Sub) -> Result<(), ImportError> {
         return Ok(()); // NTRT ignores a rotation without both
     };
     let axis = vec3(file, axis, "rotation axis")?;
-    if !(crate::structure::norm(axis) > 0.0) {
+    let norm = crate::structure::norm(axis);
+    if norm.is_nan() || norm <= 0.0 {
         return Err(err(file, rot.at(), "the rotation axis must not be zero"));
     }
     let theta = number(file, angle, "rotation angle")?.to_radians();
@@ -709,7 +710,7 @@ impl Reader {
         let rho = self.param(builder, "density", DEFAULT_ROD_DENSITY)?;
         // tgRodInfo::getMass: volume pi r^2 L times density.
         let mass = rho * std::f64::consts::PI * r * r * l;
-        if !(mass > 0.0) {
+        if mass.is_nan() || mass <= 0.0 {
             let message = format!("rod {}-{} has no mass (density {rho}, radius {r})", ends.0, ends.1);
             return Err(err(&pair.file, pair.at, message));
         }
@@ -728,12 +729,12 @@ impl Reader {
         let k = self.param(builder, "stiffness", DEFAULT_STRING_STIFFNESS)?;
         let p = self.param(builder, "pretension", DEFAULT_STRING_PRETENSION)?;
         let at = builder.params.get("stiffness").map_or(pair.at, |(_, at)| *at);
-        if !(k > 0.0) {
+        if k.is_nan() || k <= 0.0 {
             return Err(err(&builder.file, at, format!("builder '{tag}': stiffness must be > 0, got {k}")));
         }
         // tgSpringCable.cpp: rest length = drawn length - pretension / stiffness.
         let rest = l - p / k;
-        if !(rest > 0.0) {
+        if rest.is_nan() || rest <= 0.0 {
             let message = format!(
                 "string {}-{}: pretension {p} at stiffness {k} leaves no rest length (drawn {l})",
                 ends.0, ends.1

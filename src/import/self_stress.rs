@@ -13,6 +13,7 @@
 use super::draft::{Draft, DraftError};
 use crate::structure::{distance, Vec3};
 use nalgebra::DMatrix;
+use std::cmp::Ordering;
 
 /// Singular values of the equilibrium matrix below this share of the largest are its null
 /// space's (a drawing given to 9 digits or more; the decomposition's own error is ~1e-16).
@@ -24,12 +25,12 @@ const TAUT_FRACTION: f64 = 1e-6;
 /// What an import did to prestress the structure, in a sentence.
 pub struct Chosen {
     pub sentence: String,
-    /// The least and largest cable tension at the drawn state [N].
+    /// The least and largest cable tension at the drawn state \[N\].
     pub least_n: f64,
     pub largest_n: f64,
 }
 
-/// The drawn structure's self-stress: one tension per cable [N] in `draft.cables` order, the
+/// The drawn structure's self-stress: one tension per cable \[N\] in `draft.cables` order, the
 /// least of them 1 (struts in compression), or None when no self-stress keeps every cable in
 /// tension.
 pub fn self_stress(draft: &Draft) -> Option<Vec<f64>> {
@@ -78,7 +79,8 @@ pub fn self_stress_of(
     let largest = stress.iter().fold(0.0f64, |m, t| m.max(t.abs()));
     let cables = &stress[..tension.len()];
     let least = cables.iter().copied().fold(f64::INFINITY, f64::min);
-    if !(least > TAUT_FRACTION * largest) {
+    // Unordered (a NaN) counts as not taut.
+    if least.partial_cmp(&(TAUT_FRACTION * largest)).is_none_or(Ordering::is_le) {
         return None;
     }
     Some(cables.iter().map(|t| t / least).collect())
@@ -110,7 +112,7 @@ fn projected_uniform_stress(a: &DMatrix<f64>, cables: usize) -> Option<Vec<f64>>
 }
 
 /// Prestresses `draft` with its self-stress scaled so that the least cable tension is
-/// `least_n` [N]: each elastic cable's rest length set to its drawn length less its tension
+/// `least_n` \[N\]: each elastic cable's rest length set to its drawn length less its tension
 /// over its stiffness. None when there is no such self-stress (nothing changed); an error
 /// naming the cable when a tension leaves it no rest length.
 pub fn prestress(draft: &mut Draft, least_n: f64) -> Result<Option<Chosen>, DraftError> {
@@ -121,7 +123,7 @@ pub fn prestress(draft: &mut Draft, least_n: f64) -> Result<Option<Chosen>, Draf
         let Some(k) = c.stiffness_n_per_m else { continue };
         let (tension, drawn) = (t * least_n, distance(pos(&c.a), pos(&c.b)));
         c.length_m = drawn - tension / k;
-        if !(c.length_m > 0.0) {
+        if c.length_m.is_nan() || c.length_m <= 0.0 {
             return Err(DraftError::SelfStressNoRest {
                 cable: c.name.clone(),
                 tension_n: tension,

@@ -181,7 +181,7 @@ pub trait Mechanism: Send + Sync {
     fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, ModelError>;
     /// The simulated quantities read off a snapshot.
     fn observe(&self, params: &Values, structure: &Structure, snap: &Snapshot) -> Values;
-    /// Characteristic length [m] used to normalise length errors.
+    /// Characteristic length \[m\] used to normalise length errors.
     fn length_scale(&self, params: &Values) -> f64;
     /// The paper's own printed values at `inputs`, where it prints any (for example a table of
     /// forces): (source, values in the testbed's units). Shown beside the testbed's analytic and

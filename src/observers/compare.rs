@@ -4,6 +4,7 @@ use super::{Note, Observer, SettlePoint, Tick};
 use crate::mechanisms::{wrap_angle, QuantityKind};
 use crate::report::{CheckReport, PointReport, ScenarioReport};
 use crate::settings::Check;
+use std::cmp::Ordering;
 
 /// Error of `simulated` against `analytic` for a quantity: (absolute, normalised).
 /// Lengths are normalised by `length_scale`, angles are wrapped and taken in rad, other
@@ -179,7 +180,7 @@ impl Observer for Compare {
         let errors = self.point_errors(point);
         point.errors.extend(errors.iter().map(|(c, e)| (c.quantity.clone(), *e)));
         if point.settled {
-            for (c, e) in errors.iter().filter(|(c, e)| !(*e <= c.tolerance)) {
+            for (c, e) in errors.iter().filter(|(c, e)| e.partial_cmp(&c.tolerance).is_none_or(Ordering::is_gt)) {
                 notes.push(Note::Event(format!(
                     "point {}: check {} failed: error {e:.3e} > tolerance {:.1e}",
                     point.index, c.quantity, c.tolerance

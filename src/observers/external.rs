@@ -12,10 +12,11 @@ use super::{Note, Observer, SettlePoint, Tick};
 use crate::file_model::spec::ErrorClass;
 use crate::mechanisms::Values;
 use crate::report::{PointReport, ScenarioReport};
+use std::cmp::Ordering;
 use std::sync::Arc;
 
 /// A model given as a function: `predict(params, inputs, t)` -> predictions by name; `t` is the
-/// time since a motion started [s], None outside a motion.
+/// time since a motion started \[s\], None outside a motion.
 pub trait ExternalModel: Send + Sync {
     fn predict(&self, params: &Values, inputs: &Values, time_s: Option<f64>) -> Result<Values, ExternalError>;
 }
@@ -99,7 +100,7 @@ impl Observer for ExternalObserver {
         let errors = self.errors(p.params, &point.inputs, None, &point.simulated);
         for ((a, e), pr) in self.acc.iter_mut().zip(errors).zip(&self.external.predictions) {
             a.point(e, point.settled);
-            if point.settled && !(e <= pr.tolerance) {
+            if point.settled && e.partial_cmp(&pr.tolerance).is_none_or(Ordering::is_gt) {
                 point.within_tolerance = false;
             }
         }

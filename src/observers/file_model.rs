@@ -15,6 +15,7 @@ use crate::report::{
 };
 use crate::snapshot::{unit, Snapshot};
 use crate::structure::{JointKind, Structure};
+use std::cmp::Ordering;
 
 /// How a state symbol is read from a snapshot of the run's structure.
 #[derive(Clone, Debug)]
@@ -519,7 +520,7 @@ impl ModelObserver {
         let predictions = self.spec.energy.iter().flat_map(|e| e.dynamics.iter()).flat_map(|d| &d.frequencies);
         for ((a, e), f) in self.frequencies.iter_mut().zip(&errors).zip(predictions) {
             a.point(*e, point.settled);
-            if point.settled && !(*e <= f.tolerance) {
+            if point.settled && e.partial_cmp(&f.tolerance).is_none_or(Ordering::is_gt) {
                 notes.push(Note::Event(format!(
                     "point {}: frequency {} failed: relative error {e:.3e} > tolerance {:.1e}",
                     point.index, f.name, f.tolerance
@@ -721,7 +722,7 @@ impl Observer for ModelObserver {
         let skip = if self.motion { self.spec.predictions.len() } else { 0 };
         for ((a, (_, _, e)), (name, tol)) in self.acc.iter_mut().zip(&errors).zip(&tolerances).skip(skip) {
             a.point(*e, point.settled);
-            if point.settled && !(*e <= *tol) {
+            if point.settled && e.partial_cmp(tol).is_none_or(Ordering::is_gt) {
                 notes.push(Note::Event(format!(
                     "point {}: {name} failed: error {e:.3e} > tolerance {tol:.1e}",
                     point.index
@@ -742,7 +743,7 @@ impl Observer for ModelObserver {
         if let Some((report, error)) = self.energy_point(&v) {
             self.energy.point(error, point.settled);
             let tol = self.spec.energy.as_ref().map_or(0.0, |e| e.tolerance);
-            if point.settled && !(error <= tol) {
+            if point.settled && error.partial_cmp(&tol).is_none_or(Ordering::is_gt) {
                 notes.push(Note::Event(format!(
                     "point {}: energy: settled {:.3e} from a minimum (tolerance {tol:.1e})",
                     point.index, error

@@ -28,10 +28,10 @@ const MIN_CLEARANCE_SERIES: &str = "interference/min_clearance_m";
 /// Endpoints closer than this fraction of the structure's size count as the same joint.
 const COINCIDENT_FRACTION: f64 = 1e-9;
 
-/// One capsule: segment ends [m] and radius [m].
+/// One capsule: segment ends \[m\] and radius \[m\].
 pub type Capsule = ([f64; 3], [f64; 3], f64);
 
-/// A measured pair: indices (i < j), clearance [m] and the closest points on the two axes.
+/// A measured pair: indices (i < j), clearance \[m\] and the closest points on the two axes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairClearance {
     pub i: usize,
@@ -90,7 +90,7 @@ fn point_segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f64 {
 }
 
 /// The pairs (i < j) of `members` that touch by construction in the initial configuration:
-/// a shared node, coinciding endpoints (within [`COINCIDENT_FRACTION`] of the structure's size),
+/// a shared node, coinciding endpoints (within `COINCIDENT_FRACTION` of the structure's size),
 /// or an endpoint of one on a body that carries the other, inside the other's capsule.
 pub fn attached_pairs(s: &Structure, members: &[Member]) -> HashSet<(usize, usize)> {
     let size = crate::structure::structure_size(s);
@@ -172,7 +172,7 @@ fn pair_clearance(capsules: &[Capsule], i: usize, j: usize, margin_m: f64) -> Op
     let s2 = parry3d_f64::shape::Segment::new(a2, b2);
     let (p1, p2) = (s1.point_at(&l1), s2.point_at(&l2));
     let clearance_m = (p1 - p2).length() - r1 - r2;
-    (clearance_m <= margin_m).then(|| PairClearance {
+    (clearance_m <= margin_m).then_some(PairClearance {
         i,
         j,
         clearance_m,

@@ -114,7 +114,7 @@ pub struct Tracker {
 }
 
 impl Tracker {
-    /// The comparison of the model of `energy` from `start`, over a motion of `span_s` [s].
+    /// The comparison of the model of `energy` from `start`, over a motion of `span_s` \[s\].
     pub fn new(energy: &EnergySpec, start: TrajectoryStart, span_s: f64) -> Self {
         let n = energy.coordinates.len();
         Tracker {
@@ -154,7 +154,7 @@ impl Tracker {
         self.stated = Some(stated);
     }
 
-    /// One tick of the motion: its time [s], every symbol's value `v` there and the measured
+    /// One tick of the motion: its time \[s\], every symbol's value `v` there and the measured
     /// coordinates. The rows known now.
     pub fn push(&mut self, energy: &EnergySpec, v: &[f64], time_s: f64, measured: &[f64]) -> Vec<Row> {
         if self.values.is_empty() {

@@ -35,7 +35,7 @@ pub struct Tick<'a> {
     pub simulated: &'a Values,
     /// Analytic node positions for the ghost overlay (only for observers that record).
     pub ghost_nodes: Option<&'a [[f64; 3]]>,
-    /// In a motion run's motion: the time since the motion started [s] (the model's `t`
+    /// In a motion run's motion: the time since the motion started \[s\] (the model's `t`
     /// there). None before it (a settle to its start) and in every other run.
     pub motion_time_s: Option<f64>,
     /// The step to this tick took a settle accelerator (the static relaxation or the Newton
@@ -70,7 +70,7 @@ pub enum Note {
     /// One value of a named time series.
     Scalar(&'static str, f64),
     /// The values of an entity's named series at `tick` (this one or an earlier one, whose
-    /// simulated time is `time_s` [s]), in the order of its [`Note::SeriesNames`].
+    /// simulated time is `time_s` \[s\]), in the order of its [`Note::SeriesNames`].
     ScalarsAt { entity: &'static str, tick: u64, time_s: f64, values: Vec<f64> },
     /// The names of an entity's series (once, before or with its first values).
     SeriesNames(&'static str, Vec<String>),
@@ -142,7 +142,7 @@ pub enum ObserverError {
 pub struct Setup<'a> {
     pub structure: &'a Structure,
     pub checks: &'a [Check],
-    /// The mechanism's length scale [m], for normalised errors.
+    /// The mechanism's length scale \[m\], for normalised errors.
     pub length_scale_m: f64,
     pub interference: &'a InterferenceSettings,
     /// The scenario file's own model (`[[quantities]]`, `[[predictions]]`, `[[equations]]`).

@@ -19,11 +19,11 @@ pub const AMPLITUDE_FRACTION: f64 = 0.1;
 pub struct DrawnMode {
     /// [rad/s]
     pub omega: f64,
-    /// Each node's displacement in the mode (any scale; rescaled here) [m].
+    /// Each node's displacement in the mode (any scale; rescaled here) \[m\].
     pub node_motion: Vec<[f64; 3]>,
 }
 
-/// The structure at rest: node positions [m] and the members as node index pairs.
+/// The structure at rest: node positions \[m\] and the members as node index pairs.
 pub struct DrawnStructure {
     pub nodes: Vec<[f64; 3]>,
     pub struts: Vec<(usize, usize)>,
@@ -43,8 +43,8 @@ pub fn record_modes(path: &Path, s: &DrawnStructure, modes: &[DrawnMode]) -> Res
     let extent = extent(&s.nodes);
     let mut start = 0.0;
     for (k, m) in modes.iter().enumerate() {
-        let largest = m.node_motion.iter().map(|d| norm(d)).fold(0.0, f64::max);
-        if !(m.omega > 0.0) || largest == 0.0 {
+        let largest = m.node_motion.iter().map(norm).fold(0.0, f64::max);
+        if m.omega.is_nan() || m.omega <= 0.0 || largest == 0.0 {
             continue;
         }
         let scale = AMPLITUDE_FRACTION * extent / largest;

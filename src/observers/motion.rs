@@ -58,7 +58,7 @@ pub struct CosineFit {
     pub offset: f64,
     pub amplitude: f64,
     pub omega_rad_per_s: f64,
-    /// The phase at t = 0 [rad].
+    /// The phase at t = 0 \[rad\].
     pub phase_rad: f64,
     /// rms of the samples' residual from the fit.
     pub rms_residual: f64,

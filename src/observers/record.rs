@@ -440,10 +440,10 @@ impl Recorder {
         self.scalars_at(tick, self.last_time_s, entity, &[value]);
     }
 
-    /// Buffers the values of an entity's series at `tick` (simulated time `time_s` [s]), which
+    /// Buffers the values of an entity's series at `tick` (simulated time `time_s` \[s\]), which
     /// may be earlier than the last one seen (every `record_every`-th tick, like the rest).
     pub fn scalars_at(&mut self, tick: u64, time_s: f64, entity: &str, values: &[f64]) {
-        if tick % self.every != 0 {
+        if !tick.is_multiple_of(self.every) {
             return;
         }
         let column = match self.extra.iter().position(|c| c.entity == entity) {
@@ -593,7 +593,7 @@ impl Observer for Recorder {
         let snap = t.snapshot;
         self.last_tick = snap.tick;
         self.last_time_s = snap.time_s;
-        if snap.tick % self.every != 0 {
+        if !snap.tick.is_multiple_of(self.every) {
             return;
         }
         if let Some(estimate) = t.estimate {
@@ -687,7 +687,7 @@ impl Observer for Recorder {
 
     /// Buffers the equilibrium residual of `tick`, computed after the tick was recorded.
     fn residual(&mut self, tick: u64, r: &crate::snapshot::Residual) {
-        if tick % self.every != 0 {
+        if !tick.is_multiple_of(self.every) {
             return;
         }
         let time_s = self.last_time_s;

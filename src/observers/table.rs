@@ -41,7 +41,7 @@ pub const ARROW_BATCH_ROWS: usize = 8192;
 /// The file endings that select the Arrow IPC format.
 const ARROW_ENDINGS: &[&str] = &["arrow", "feather", "ipc"];
 
-/// Whether `path` names a table file: `.csv`, or one of [`ARROW_ENDINGS`].
+/// Whether `path` names a table file: `.csv`, or one of `ARROW_ENDINGS`.
 pub fn is_table_file(path: &std::path::Path) -> bool {
     path.extension().and_then(|e| e.to_str()).is_some_and(|e| e == "csv" || ARROW_ENDINGS.contains(&e))
 }
@@ -62,11 +62,14 @@ impl From<PathBuf> for TableTarget {
 /// A table kept in memory: the run's record batches and their schema, handed over when the
 /// run closes (None before, and when no tick ran).
 #[derive(Clone, Default)]
-pub struct MemoryTable(Arc<Mutex<Option<(SchemaRef, Vec<RecordBatch>)>>>);
+pub struct MemoryTable(Arc<Mutex<Option<Batched>>>);
+
+/// A run's table: its schema and its record batches.
+pub type Batched = (SchemaRef, Vec<RecordBatch>);
 
 impl MemoryTable {
     /// The schema and the record batches of the finished run (once; None when no tick ran).
-    pub fn take(&self) -> Option<(SchemaRef, Vec<RecordBatch>)> {
+    pub fn take(&self) -> Option<Batched> {
         self.0.lock().ok().and_then(|mut t| t.take())
     }
 }
@@ -88,7 +91,7 @@ enum Sink {
     /// Record batches; the schema from the first tick, and the rows not yet made a batch
     /// (tick, then every other column).
     Arrow {
-        out: Batches,
+        out: Box<Batches>,
         schema: Option<SchemaRef>,
         ticks: Vec<u64>,
         columns: Vec<Vec<Option<f64>>>,
@@ -134,8 +137,8 @@ pub struct Table {
     waiting: usize,
 }
 
-/// Every joint with one coordinate: its index and column (`joint:NAME.angle` [rad] for a
-/// revolute, `joint:NAME.slide` [m] for a prismatic).
+/// Every joint with one coordinate: its index and column (`joint:NAME.angle` \[rad\] for a
+/// revolute, `joint:NAME.slide` \[m\] for a prismatic).
 pub fn coordinates(s: &crate::structure::Structure) -> impl Iterator<Item = (usize, String)> + '_ {
     s.joints.iter().enumerate().filter_map(|(j, joint)| match joint.kind {
         crate::structure::JointKind::Revolute { .. } => Some((j, format!("joint:{}.angle", joint.name))),
@@ -160,7 +163,7 @@ impl Table {
     }
 
     /// Starts the table at `path` (its directory is made if needed); Arrow IPC for the endings
-    /// in [`ARROW_ENDINGS`], CSV otherwise.
+    /// in `ARROW_ENDINGS`, CSV otherwise.
     /// `model`: the file's model, whose quantities, predictions and errors get columns.
     pub fn start(path: &Path, model: Option<super::file_model::ModelObserver>) -> Result<Self, TableError> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -198,7 +201,7 @@ impl Table {
     }
 
     fn arrow(out: Batches) -> Sink {
-        Sink::Arrow { out, schema: None, ticks: Vec::new(), columns: Vec::new() }
+        Sink::Arrow { out: Box::new(out), schema: None, ticks: Vec::new(), columns: Vec::new() }
     }
 
     /// The column names after `tick`.
@@ -280,7 +283,7 @@ impl Table {
                     let mut fields = vec![Field::new("tick", DataType::UInt64, false)];
                     fields.extend(h.iter().map(|c| Field::new(c, DataType::Float64, true)));
                     let s = Arc::new(Schema::new(fields));
-                    if let Batches::File { file, writer } = out {
+                    if let Batches::File { file, writer } = &mut **out {
                         let f = file.take().ok_or_else(|| TableError::Gone { path: self.path.clone() })?;
                         *writer = Some(arrow_ipc::writer::FileWriter::try_new(f, &s).map_err(arrow)?);
                     }
@@ -331,7 +334,7 @@ impl Table {
             Sink::Csv(out) => out.flush().and_then(|_| out.get_ref().sync_all()).map_err(io),
             Sink::Arrow { out, schema, ticks, columns } => {
                 Self::flush_batch(out, schema, ticks, columns).map_err(arrow)?;
-                match out {
+                match &mut **out {
                     Batches::File { writer, file } => match (writer.take(), file.take()) {
                         (Some(mut w), _) => {
                             w.finish().map_err(arrow)?;

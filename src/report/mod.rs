@@ -184,7 +184,7 @@ pub struct MotionReport {
 /// smooth in time (the estimates after it do not hold).
 #[derive(Clone, Debug, Default, Serialize, PartialEq)]
 pub struct ExtrapolationReport {
-    /// The time steps combined [s]: h, h/2, h/4.
+    /// The time steps combined \[s\]: h, h/2, h/4.
     pub steps_s: Vec<f64>,
     /// Each quantity's largest error estimate over the motion (its unit).
     pub largest_estimate: std::collections::BTreeMap<String, f64>,
@@ -203,7 +203,7 @@ pub struct LagrangianReport {
     /// Where the model started (`[energy.trajectory] start`): "samples" (from the motion's
     /// first three samples, at t = 1.5 dt) or "stated" (the file's initial condition, t = 0).
     pub start: String,
-    /// The model's start: the motion's time [s], the coordinates [m or rad] and rates there.
+    /// The model's start: the motion's time \[s\], the coordinates [m or rad] and rates there.
     pub start_time_s: f64,
     pub start_coordinates: Vec<f64>,
     pub start_rates: Vec<f64>,
@@ -219,7 +219,7 @@ pub struct LagrangianReport {
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct LagrangianCoordinateReport {
     pub name: String,
-    /// "length" [m], "angle" [rad, wrapped] or "relative".
+    /// "length" \[m\], "angle" [rad, wrapped] or "relative".
     pub class: String,
     /// The largest and the rms error over the ticks compared, in the class.
     pub max_error: f64,
@@ -339,7 +339,7 @@ pub struct ModelCheckReport {
     /// "prediction", "equation", "energy" or "frequency".
     pub kind: String,
     pub name: String,
-    /// A prediction's error class (length [m], angle [rad, wrapped], relative); "residual" for
+    /// A prediction's error class (length \[m\], angle [rad, wrapped], relative); "residual" for
     /// an equation (|residual|); "coordinates" for the energy model (the largest coordinate
     /// difference from the settled state to the stationary point it landed on, infinite when
     /// that point is not a minimum); "relative" for a frequency of the dynamic model.
@@ -448,7 +448,7 @@ pub struct CheckReport {
     pub quantity: String,
     pub unit: String,
     /// How its error is measured, the one convention of `max_rel_error`, the transient
-    /// `_rel_` errors and the table: "length / L", "angle [rad]" or "relative".
+    /// `_rel_` errors and the table: "length / L", "angle \[rad\]" or "relative".
     pub convention: String,
     /// Largest error at the settle points, in the quantity's unit.
     pub max_abs_error: f64,
@@ -481,7 +481,7 @@ pub struct PointReport {
     pub residual_torque_nm: f64,
     /// Speed at the last tick of the settle [m/s].
     pub final_speed_m_per_s: f64,
-    /// Kinetic energy left at the last tick of the settle [J] (what an unsettled point still had).
+    /// Kinetic energy left at the last tick of the settle \[J\] (what an unsettled point still had).
     pub final_kinetic_energy_j: f64,
     /// The analytic branch the dynamics landed on.
     pub branch: String,
@@ -505,11 +505,11 @@ pub struct PointReport {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub prestress_lost: Option<bool>,
     /// Outside the analytic model's validity (some cable slack): the distance of the settled
-    /// state from the analytic point, over the length quantities [m].
+    /// state from the analytic point, over the length quantities \[m\].
     pub distance_from_analytic_m: Option<f64>,
     /// Settled, and every check within its tolerance at this point.
     pub within_tolerance: bool,
-    /// Smallest strut clearance at the settled state [m] (with an `[interference]` section;
+    /// Smallest strut clearance at the settled state \[m\] (with an `[interference]` section;
     /// None when no pair came within the margin).
     pub min_clearance_m: Option<f64>,
     /// No strut pair below the interference threshold at the settled state.
@@ -560,7 +560,7 @@ pub struct ModelModeReport {
     pub omega_squared: f64,
     /// sqrt(omega_squared) [rad/s] (minus sqrt(-omega_squared) where it is negative).
     pub omega_rad_per_s: f64,
-    /// omega / (2 pi) [Hz].
+    /// omega / (2 pi) \[Hz\].
     pub frequency_hz: f64,
     /// The shape in the coordinates, scaled so that its largest component is +1.
     pub shape: Values,
@@ -645,7 +645,7 @@ pub struct InterferenceReport {
     pub tendons: bool,
     /// Members checked (struts, then cables and springs).
     pub members_checked: usize,
-    /// Smallest clearance seen over the run [m] (None: no pair ever came within the margin).
+    /// Smallest clearance seen over the run \[m\] (None: no pair ever came within the margin).
     #[serde(rename = "min_clearance")]
     pub min_clearance_m: Option<f64>,
     pub closest_pair: Option<[String; 2]>,
@@ -687,7 +687,7 @@ pub struct InterferenceViolation {
     #[serde(rename = "min_clearance")]
     pub min_clearance_m: f64,
     pub tick_of_min: u64,
-    /// Closest points on the two member axes at the minimum [m].
+    /// Closest points on the two member axes at the minimum \[m\].
     pub closest_points: [[f64; 3]; 2],
 }
 

@@ -21,7 +21,7 @@ pub struct ModesReport {
     pub zero_mode_ratio: f64,
     /// Ascending omega^2.
     pub modes: Vec<ModeReport>,
-    /// Wall time of the analysis after the settle [s].
+    /// Wall time of the analysis after the settle \[s\].
     pub wall_s: f64,
 }
 
@@ -34,7 +34,7 @@ pub struct ModeReport {
     pub omega_squared: f64,
     /// [rad/s] (minus sqrt(-omega^2) where omega^2 < 0).
     pub omega_rad_per_s: f64,
-    /// omega / (2 pi) [Hz].
+    /// omega / (2 pi) \[Hz\].
     pub frequency_hz: f64,
     pub rigid: bool,
     /// The nodes that move most, with their motion relative to the largest.

@@ -7,6 +7,7 @@
 //! through each other, a model that does not hold) declares exactly which part must fail.
 
 use super::{PointReport, ScenarioReport};
+use std::cmp::Ordering;
 use std::fmt;
 
 /// Which parts of the verdict failed. A workspace sweep (`[workspace] min_agreement_percent`,
@@ -19,7 +20,7 @@ pub fn failures(report: &ScenarioReport, min_agreement_percent: Option<f64>) -> 
         out.push(Failure::Error);
     }
     if let (Some(min), Some(w)) = (min_agreement_percent, &report.workspace) {
-        if !(w.agreement_percent >= min) {
+        if w.agreement_percent.partial_cmp(&min).is_none_or(Ordering::is_lt) {
             out.push(Failure::Workspace);
         }
     } else {

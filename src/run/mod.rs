@@ -135,7 +135,7 @@ pub mod stoppable {
     use std::thread::JoinHandle;
     use std::time::Duration;
 
-    /// How often a waiting thread looks for a reason to stop while the work runs [s].
+    /// How often a waiting thread looks for a reason to stop while the work runs \[s\].
     pub const POLL_S: f64 = 0.05;
 
     /// Why work on a thread of its own gave no result.
@@ -294,7 +294,7 @@ fn start<'a>(
     };
     let observers = observers::observers(
         Setup {
-            structure: &sim.structure(),
+            structure: sim.structure(),
             checks: &sc.checks,
             length_scale_m: mech.length_scale(&params),
             interference: &sc.interference,

@@ -35,7 +35,7 @@ pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
         undamped: m.undamped,
         frequencies: vec![],
         lagrangian: None,
-        driven: m.drive.as_ref().map(|d| driven_text(d)),
+        driven: m.drive.as_ref().map(driven_text),
         integration: String::new(),
         extrapolation: None,
     }

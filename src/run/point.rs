@@ -51,11 +51,11 @@ impl Runner<'_> {
         prediction: &Prediction,
         p: &Probe,
     ) -> Result<Option<(String, f64)>, RunError> {
-        let (quantity, loads, read): (String, Vec<(usize, [f64; 3], bool)>, Reading) = match &p.joint {
+        let (quantity, loads, read): (String, Vec<ProbeLoad>, Reading) = match &p.joint {
             Some(j) => {
                 let s = self.sim.structure();
                 let joint = &s.joints[j.index];
-                let axis = self.sim.snapshot_with(false).joint_axis_world(&s, j.index).ok_or_else(|| {
+                let axis = self.sim.snapshot_with(false).joint_axis_world(s, j.index).ok_or_else(|| {
                     RunError::Model(ModelError::no_solution(format!("probe joint '{}' has no axis", j.joint)))
                 })?;
                 let mut loads = vec![(joint.child, axis, j.prismatic)];
@@ -89,7 +89,7 @@ impl Runner<'_> {
             }
             q[i] = match &read {
                 Reading::Quantity(c) => s.simulated[c],
-                Reading::Joint(j, _) => s.snapshot.joint_coordinate(&self.sim.structure(), *j).unwrap_or(f64::NAN),
+                Reading::Joint(j, _) => s.snapshot.joint_coordinate(self.sim.structure(), *j).unwrap_or(f64::NAN),
             };
         }
         loads.iter().for_each(|&(b, ..)| self.sim.set_probe_load(b, [0.0; 3], [0.0; 3]));
@@ -108,6 +108,10 @@ enum Reading {
     Quantity(String),
     Joint(usize, bool),
 }
+
+/// One load of a stiffness probe: the body, the direction (world) and whether it is a force
+/// (a torque if not).
+type ProbeLoad = (usize, [f64; 3], bool);
 
 /// A perturbed equilibrium counts as returned when every node is back within this fraction of
 /// the perturbation (times the structure's length).
@@ -244,7 +248,7 @@ pub(super) fn measured_point(
 /// Every observer fills in what it measures at a settle point (`outside_model`: outside the
 /// analytic model's validity).
 pub(super) fn observe_point(runner: &mut Runner, snapshot: &Snapshot, outside_model: bool, point: &mut PointReport) {
-    let seen = SettlePoint { structure: &runner.sim.structure(), snapshot, params: &runner.params, outside_model };
+    let seen = SettlePoint { structure: runner.sim.structure(), snapshot, params: &runner.params, outside_model };
     for o in runner.observers.iter_mut() {
         o.settle_point(&seen, point, &mut runner.notes);
     }

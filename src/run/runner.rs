@@ -43,6 +43,10 @@ pub(super) struct Runner<'a> {
     pub motion_drive: Option<Drive>,
 }
 
+/// The judged state and the mechanism's quantities in it; in a motion judged extrapolated also
+/// the quantities' error estimates, the state one level rougher and its quantities.
+type JudgedState = (Snapshot, Values, Option<(Values, Snapshot, Values)>);
+
 impl<'a> Runner<'a> {
     pub fn new(
         mech: Box<dyn Mechanism>,
@@ -89,7 +93,7 @@ impl<'a> Runner<'a> {
 
     /// The mechanism's quantities in a snapshot of this simulation.
     pub fn observe(&self, snap: &Snapshot) -> Values {
-        self.mech.observe(&self.params, &self.sim.structure(), snap)
+        self.mech.observe(&self.params, self.sim.structure(), snap)
     }
 
     /// Tells every observer an event of the run (formatted only when one records).
@@ -131,8 +135,7 @@ impl<'a> Runner<'a> {
     /// each quantity's error estimate with the state one level rougher: the simulation's own
     /// state, or in a motion judged extrapolated, the finer levels stepped to the same time and
     /// the three combined (`levels.rs`).
-    #[allow(clippy::type_complexity)]
-    fn judged_state(&mut self) -> Result<(Snapshot, Values, Option<(Values, Snapshot, Values)>), RunError> {
+    fn judged_state(&mut self) -> Result<JudgedState, RunError> {
         let snap = self.sim.snapshot_with(false);
         let Some(levels) = self.levels.as_mut() else {
             let simulated = self.observe(&snap);
@@ -213,7 +216,7 @@ impl<'a> Runner<'a> {
         let tick = Tick {
             motion_time_s,
             accelerated,
-            structure: &self.sim.structure(),
+            structure: self.sim.structure(),
             snapshot: &snap,
             inputs,
             params: &self.params,

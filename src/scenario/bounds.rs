@@ -31,7 +31,7 @@ pub(super) fn bounds(
     };
     let located = |e: ScenarioError, message: String| ScenarioError { message, ..e };
     let per_settle = (settle.max_time_s / sim.dt_s).ceil();
-    if !(per_settle <= MAX_STEPS_PER_SETTLE) {
+    if per_settle.is_nan() || per_settle > MAX_STEPS_PER_SETTLE {
         return Err(located(
             at_settle(),
             format!(
@@ -63,7 +63,7 @@ pub(super) fn bounds(
             }
             let last = waypoints.last().map_or(0.0, |w| w.0);
             let ticks = (last / sim.dt_s).ceil();
-            if !(ticks <= MAX_STEPS_PER_SETTLE) {
+            if ticks.is_nan() || ticks > MAX_STEPS_PER_SETTLE {
                 return Err(ctx.err(
                     &list[list.len() - 1],
                     format!("the last waypoint at t = {last} s is {ticks:e} time steps away; at most {MAX_STEPS_PER_SETTLE:e}"),

@@ -79,7 +79,7 @@ fn has_part(parts: &Parts, failure: &crate::report::verdict::Failure) -> Result<
         Failure::Trajectory(q) if !trajectory_coordinates(parts).contains(&q.as_str()) => {
             not_among(q, "the coordinates compared by [energy.trajectory]", trajectory_coordinates(parts))
         }
-        Failure::Energy if !model.is_some_and(|m| m.energy.is_some()) => {
+        Failure::Energy if model.is_none_or(|m| m.energy.is_none()) => {
             needs("energy", "an [energy] section in this scenario")
         }
         Failure::Probe if !parts.probe => needs("probe", "a [probe] section that compares (expected and tolerance)"),

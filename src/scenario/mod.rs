@@ -2,7 +2,7 @@
 //!
 //! Every error names the file, line and column (`file.toml:LINE:COL: ...`) and says what was
 //! expected. Parsing is two passes: serde for the shape (unknown keys, wrong types, missing
-//! fields), then [`validate`] for the values (ranges, the mechanism's own rules).
+//! fields), then `validate` for the values (ranges, the mechanism's own rules).
 //!
 //! One file per concern: `raw.rs` the shape serde reads, `error.rs` errors at a place in the file
 //! and the checks on single values, then one file per section, each read in turn by `validate`
@@ -189,7 +189,7 @@ fn read_source(path: &Path) -> Result<String, ScenarioError> {
     })
 }
 
-/// Largest scenario file read [bytes]: 16 MiB. A list of 1,000,001 points (28 MB) took 2.1 GB
+/// Largest scenario file read \[bytes\]: 16 MiB. A list of 1,000,001 points (28 MB) took 2.1 GB
 /// to parse before its length was checked.
 pub const MAX_SCENARIO_BYTES: u64 = 16 << 20;
 

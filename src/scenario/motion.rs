@@ -135,7 +135,7 @@ pub(super) fn motion(
     settle_only_sections(ctx, raw)?;
     let duration_s = positive_value(ctx, &section.duration_s, "motion.duration_s")?;
     let steps = (duration_s / dt_s).round();
-    if !(steps <= super::MAX_STEPS_PER_SETTLE) {
+    if steps.is_nan() || steps > super::MAX_STEPS_PER_SETTLE {
         return Err(ctx.err(
             &section.duration_s,
             format!(

@@ -48,7 +48,9 @@ impl Names<'_> {
         let n = name.get_ref();
         let mut chars = n.chars();
         let first_ok = chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
-        if !n.is_empty() && !(first_ok && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')) {
+        let identifier = first_ok && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
+        // An empty name is not refused here.
+        if !(n.is_empty() || identifier) {
             return Err(self
                 .ctx
                 .err(name, format!("{what} '{n}' must be an identifier (letters, digits and _, not first a digit)")));

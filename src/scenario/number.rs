@@ -238,7 +238,8 @@ fn resolve_placement(ctx: &Ctx, pl: &mut Placement, resolve: &mut Resolve) -> Re
         resolve_xyz(&mut r.axis, "rotate.axis", resolve)?;
         resolve(&mut r.angle, "rotate.angle")?;
         let axis = values(&r.axis);
-        if !(axis.iter().map(|c| c * c).sum::<f64>() > 0.0) {
+        let square = axis.iter().map(|c| c * c).sum::<f64>();
+        if square.is_nan() || square <= 0.0 {
             return Err(ctx.err(&r.axis, format!("rotate.axis is {axis:?}: a direction, not zero")));
         }
         turn = Some((axis, r.angle.get_ref().value()));

@@ -49,7 +49,8 @@ fn fraction(ctx: &Ctx, f: &Spanned<f64>, first: &Structure) -> Result<f64, Scena
     if !(x > 0.0 && x <= 1.0) {
         return Err(ctx.err(f, format!("prestress.min_fraction must lie in (0, 1], got {x}")));
     }
-    if !(first.drawn_cable_tension_n() > 0.0) {
+    let drawn = first.drawn_cable_tension_n();
+    if drawn.is_nan() || drawn <= 0.0 {
         return Err(ctx.err(
             f,
             "prestress.min_fraction is a share of the cables' tension at the drawn state, and they carry none \

@@ -265,22 +265,23 @@ fn insert_ropes(
 }
 
 fn integration_parameters(settings: &SimSettings) -> IntegrationParameters {
-    let mut params = IntegrationParameters::default();
-    params.dt = settings.dt_s;
-    params.num_solver_iterations = settings.substeps;
-    params.num_internal_pgs_iterations = settings.pgs_iterations;
-    // rapier caps body speeds at 400 m/s by default: a numerical blow-up would then look like
-    // a bounded oscillation. Uncapped, it shows as divergence (energy, bounding box, NaN).
-    params.normalized_max_linear_velocity = Real::MAX;
-    params
+    IntegrationParameters {
+        dt: settings.dt_s,
+        num_solver_iterations: settings.substeps,
+        num_internal_pgs_iterations: settings.pgs_iterations,
+        // rapier caps body speeds at 400 m/s by default: a numerical blow-up would then look
+        // like a bounded oscillation. Uncapped, it shows as divergence (energy, bounding box, NaN).
+        normalized_max_linear_velocity: Real::MAX,
+        ..IntegrationParameters::default()
+    }
 }
 
 /// The structure's constant external forces, summed per body [N].
 fn external_loads(s: &Structure) -> Vec<[f64; 3]> {
     let mut l = vec![[0.0; 3]; s.bodies.len()];
     for load in &s.loads {
-        for k in 0..3 {
-            l[load.body][k] += load.force_n[k];
+        for (sum, f) in l[load.body].iter_mut().zip(load.force_n) {
+            *sum += f;
         }
     }
     l

@@ -8,6 +8,7 @@ use crate::settings::DEFAULT_JOINT_GAP_FRACTION;
 use crate::snapshot::{BodyPose, Snapshot};
 use crate::structure::ActuatorTarget;
 use rapier3d_f64::prelude::*;
+use std::cmp::Ordering;
 
 pub(super) struct Data {
     pub(super) pipeline: PhysicsPipeline,
@@ -42,6 +43,10 @@ pub(super) struct Data {
 /// One multibody's actuated moves per increment of a command jump: (degree of freedom,
 /// displacement per increment).
 pub(super) type MultibodyMoves = Vec<(MultibodyIndex, Vec<(usize, f64)>)>;
+
+/// (joint, displacement to its command) of every actuated multibody link, and (joint, locked
+/// coordinate now, command) of every actuated joint locked off the tree.
+type ActuatorMoves = (Vec<(usize, f64)>, Vec<(usize, f64, f64)>);
 
 impl Data {
     /// Moves the coordinate of joint `j` (a revolute's angle [rad], a prismatic's slide [m])
@@ -184,7 +189,7 @@ impl Data {
                 continue;
             }
             let gap = self.joint_gap_m(m, j);
-            if !(gap <= gap_limit) {
+            if gap.partial_cmp(&gap_limit).is_none_or(Ordering::is_gt) {
                 return Err(self.diverged(m, format!(
                     "joint '{}' came apart: its anchors are {gap:.3e} m apart (limit {gap_limit:.3e} m, sim.max_joint_gap)",
                     joint.name
@@ -316,8 +321,7 @@ impl Data {
 
     /// (joint, displacement to its command) of every actuated multibody link, and (joint,
     /// locked coordinate now, command) of every actuated joint locked off the tree.
-    #[allow(clippy::type_complexity)]
-    pub(super) fn actuator_moves(&self, m: &Model) -> (Vec<(usize, f64)>, Vec<(usize, f64, f64)>) {
+    pub(super) fn actuator_moves(&self, m: &Model) -> ActuatorMoves {
         let mut moves: Vec<(usize, f64)> = Vec::new();
         let mut locks: Vec<(usize, f64, f64)> = Vec::new();
         for j in 0..m.structure.joints.len() {

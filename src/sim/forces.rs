@@ -58,8 +58,8 @@ impl Data {
         }
         for b in 0..n {
             let (mut f, t) = self.probe_loads[b];
-            for k in 0..3 {
-                f[k] += m.external_loads[b][k];
+            for (fk, e) in f.iter_mut().zip(m.external_loads[b]) {
+                *fk += e;
             }
             if m.is_free(b) && (f != [0.0; 3] || t != [0.0; 3]) {
                 let rb = &mut self.bodies[m.handles[b]];
@@ -238,8 +238,8 @@ impl Data {
                     wrench[b].1 += com.cross(f);
                 }
                 let (mut pf, pt) = self.probe_loads[b];
-                for k in 0..3 {
-                    pf[k] += m.external_loads[b][k];
+                for (fk, e) in pf.iter_mut().zip(m.external_loads[b]) {
+                    *fk += e;
                 }
                 let com = self.world_com(m, b);
                 wrench[b].0 += v(pf);
@@ -530,9 +530,9 @@ impl Data {
                 out[first].value += self.torsion_spring_torque(m, j);
             }
         }
-        for b in 0..s.bodies.len() {
+        for (b, &w) in subtree.iter().enumerate() {
             if m.is_free(b) && tree.hang(b).is_none() {
-                self.root_coordinate_forces(m, b, subtree[b], &mut out);
+                self.root_coordinate_forces(m, b, w, &mut out);
             }
         }
         out

@@ -10,6 +10,7 @@
 //! - K v = omega^2 M v (`eigen::modes`). Each mode's shape is also given per moving body
 //!   (J_b v, mass-normalised against the bodies' block mass), so that the modal coordinate and
 //!   the drawing are the same as for free bodies (`modes.rs`).
+//!
 //! Loops closed by joints, free bodies outside the trees and joints of more than one
 //! coordinate are refused, by name.
 

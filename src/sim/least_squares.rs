@@ -7,6 +7,7 @@
 //! fraction of that, with the same results to round-off (tests unchanged).
 
 use nalgebra::{DMatrix, DVector};
+use std::cmp::Ordering;
 
 /// The QR path is taken when every diagonal entry of R is above this fraction of the
 /// largest: a proxy for a condition number below 1e8 (QR is backward stable, so the solution
@@ -201,7 +202,8 @@ impl BandCholesky {
                 row_i[off] = (row_i[off] - dot) / row_j[0];
             }
             let d = row_i[0] - row_i[1..=i - fi].iter().map(|x| x * x).sum::<f64>();
-            if !(d > PIVOT_FLOOR * largest) {
+            // Unordered (a NaN) counts as a failed pivot.
+            if d.partial_cmp(&(PIVOT_FLOOR * largest)).is_none_or(Ordering::is_le) {
                 return None;
             }
             row_i[0] = d.sqrt();

@@ -93,7 +93,7 @@ pub struct Model {
     fit_tree: tree::Tree,
     /// The structure's constant external forces, summed per body [N].
     external_loads: Vec<[f64; 3]>,
-    /// Characteristic length of the structure [m], for speeds and tolerances.
+    /// Characteristic length of the structure \[m\], for speeds and tolerances.
     pub length_scale_m: f64,
     /// Whether the static relaxation applies to this structure (`relaxation/`).
     relaxation_applies: bool,
@@ -113,7 +113,7 @@ impl Model {
 
 /// A simulation: the immutable [`Model`] the build returned beside the state that steps. The
 /// state is split by concept, and each file's functions take what they read and what they
-/// write: [`data::Data`] (rapier's sets, the inputs and the tick: what every concept reads and
+/// write: `data::Data` (rapier's sets, the inputs and the tick: what every concept reads and
 /// moves), the static relaxation's state (`relaxation/`), the kind of path the steps take
 /// (`path.rs`), the physical drive (`drive.rs`), the projected groups' kept Jacobians and rigid
 /// rests (`projection.rs`) and the looped multibodies' closure rests (`closure_rest.rs`). This
@@ -140,7 +140,7 @@ impl Simulation {
         &self.model.structure
     }
 
-    /// Characteristic length of the structure [m], for speeds and tolerances.
+    /// Characteristic length of the structure \[m\], for speeds and tolerances.
     pub fn length_scale_m(&self) -> f64 {
         self.model.length_scale_m
     }
@@ -211,7 +211,7 @@ impl Simulation {
         self.path.accelerated_steps
     }
 
-    /// Moves the coordinate of joint `j` (a revolute's angle [rad], a prismatic's slide [m])
+    /// Moves the coordinate of joint `j` (a revolute's angle \[rad\], a prismatic's slide \[m\])
     /// by `displacement` and sets its rate to `rate` [rad/s or m/s], the bodies beyond it
     /// carried along; the other coordinates and rates stay. Only a joint that is a free
     /// (not actuated) link of a multibody has such a coordinate here.
@@ -296,22 +296,22 @@ impl Simulation {
         self.data.member_forces_with(&self.model, with_residual)
     }
 
-    /// Kinetic energy of every moving body [J].
+    /// Kinetic energy of every moving body \[J\].
     pub fn kinetic_energy_j(&self) -> f64 {
         self.data.kinetic_energy_j(&self.model)
     }
 
-    /// Distance between a joint's anchor as carried by its parent and by its child [m].
+    /// Distance between a joint's anchor as carried by its parent and by its child \[m\].
     pub fn joint_gap_m(&self, joint: usize) -> f64 {
         self.data.joint_gap_m(&self.model, joint)
     }
 
-    /// World position of a node [m].
+    /// World position of a node \[m\].
     pub fn node_position(&self, node: usize) -> [f64; 3] {
         self.data.node_position(&self.model, node)
     }
 
-    /// World position of every node [m].
+    /// World position of every node \[m\].
     pub fn node_positions(&self) -> Vec<[f64; 3]> {
         self.data.node_positions(&self.model)
     }
@@ -378,7 +378,7 @@ impl Simulation {
         self.data.place_free_joints(&self.model, s)
     }
 
-    /// This simulation's state, stepped from now on at `dt_s` [s]: the same structure and
+    /// This simulation's state, stepped from now on at `dt_s` \[s\]: the same structure and
     /// settings but the time step, the same bodies, joints, inputs and tick (`levels.rs`). The
     /// projection's kept Jacobians and rests start afresh (they are caches of the state).
     pub fn at_time_step(&self, dt_s: f64) -> Simulation {

@@ -117,6 +117,9 @@ impl Jacobian {
 /// contracts too little). Iterates until every row is within `tolerance_fraction` of the
 /// structure's size (at most [`MAX_ITERATIONS`]), or gives up when the first step shrinks the
 /// largest row by less than `max_first_contraction`.
+// Eight inputs, each its own: the rows, their Jacobian and the step as three closures, a kept
+// Jacobian and the two stopping thresholds its callers pass on; a struct would only rename them.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn close_rows(
     m: &Model,
     sim: &mut Data,
@@ -746,6 +749,9 @@ impl Data {
     /// Closes the group's joints and its `taut` cables to round-off (Gauss-Newton in its
     /// coordinates, the Jacobian from the bodies' twists) and removes the velocities that would
     /// open them. A sparse Jacobian is `kept` for the next call ([`KeptJacobian`]).
+    // The group, its taut cables, the two kept states it reads and updates, and the two stopping
+    // thresholds of `close_rows` that its callers pass on: eight with `self`, each its own.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn project_group(
         &mut self,
         m: &Model,

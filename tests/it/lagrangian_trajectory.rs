@@ -115,7 +115,7 @@ pub(super) fn read_recording(path: &Path) -> (BTreeMap<String, BTreeSet<i64>>, S
             continue;
         };
         ticks.entry(entity.clone()).or_default().extend(col.times_raw().iter().copied());
-        let id = chunk.components_identifiers().find(|id| id.to_string() == SCALARS_COMPONENT);
+        let id = chunk.components_identifiers().find(|id| id.as_str() == SCALARS_COMPONENT);
         if let Some(id) = id {
             let rows = col.times_raw().iter().zip(chunk.iter_slices::<f64>(id));
             scalars.entry(entity.clone()).or_default().extend(rows.map(|(t, v)| (*t, v.to_vec())));

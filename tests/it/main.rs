@@ -5,6 +5,7 @@ mod architecture;
 mod bad_input;
 mod bench;
 mod bench_scale;
+mod ci_checks;
 mod cli;
 mod common;
 mod compact_members;

@@ -1,8 +1,9 @@
 //! The furet2018 family of `tensegrity bench --scale`: n Snelson X modules in series (the bird
 //! neck of the paper's Fig. 1), n = 1 .. 100, each X as the built-in mechanism builds its two
-//! (`mechanisms/furet2018/build.rs`: crossed bars A-C and B-D in planes [`PLANE_OFFSET_M`]
-//! apart, top bar D-C, revolute joints about z at A (actuated), B and C, the loop closed at D
-//! by a planar pin, lateral springs A-D and B-C), X(i + 1) standing on X(i)'s top bar.
+//! (`mechanisms/furet2018/build.rs`: crossed bars A-C and B-D in planes twice
+//! [`plane_offset_m`](crate::mechanisms::furet2018::build::ModelChoices::plane_offset_m) apart,
+//! top bar D-C, revolute joints about z at A (actuated), B and C, the loop closed at D by a
+//! planar pin, lateral springs A-D and B-C), X(i + 1) standing on X(i)'s top bar.
 //!
 //! Every X is commanded to theta = [`THETA_RAD`] through its base-joint angle
 //! phi = theta + atan2(l, b cos theta) and drawn at theta + [`START_OFFSET_RAD`]; with ideal
@@ -20,9 +21,9 @@ use crate::structure::Structure;
 
 /// Module counts of the family.
 pub const MODULES: [usize; 10] = [1, 2, 3, 5, 10, 15, 20, 30, 50, 100];
-/// The commanded theta of every X [rad].
+/// The commanded theta of every X \[rad\].
 pub const THETA_RAD: f64 = 0.1;
-/// The start's theta past the commanded one [rad].
+/// The start's theta past the commanded one \[rad\].
 pub const START_OFFSET_RAD: f64 = 0.05;
 /// Time step [s] (the furet2018 scenarios').
 const DT_S: f64 = 0.005;

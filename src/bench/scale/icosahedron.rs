@@ -13,9 +13,9 @@ use super::{Case, Measure};
 use crate::settings::SimSettings;
 use crate::structure::{BodyKind, Cable, CableLaw, Inertia, Structure, Strut, Vec3};
 
-/// Strut length L [m].
+/// Strut length L \[m\].
 pub const STRUT_LENGTH_M: f64 = 1.0;
-/// The pairs' separation in the start (the shipped scenario's) [m].
+/// The pairs' separation in the start (the shipped scenario's) \[m\].
 pub const START_SEPARATION_M: f64 = 0.45;
 /// Cable stiffness [N/m] and rest length [m] (the shipped scenario's).
 const CABLE_STIFFNESS_N_PER_M: f64 = 100.0;

@@ -2,7 +2,7 @@
 //! each settled from a perturbed start with the structure's default settling, from 3 struts to
 //! a thousand. One family per file:
 //!
-//! - [`prism`]: regular n-strut prisms (twist pi/2 + pi/n);
+//! - [`prism`](mod@prism): regular n-strut prisms (twist pi/2 + pi/n);
 //! - [`icosahedron`]: the 6-strut icosahedron (the expanded octahedron, cable / strut length
 //!   sqrt(6)/4);
 //! - [`tower`]: stacked towers of 4-strut prisms designed by the force density method;
@@ -13,7 +13,7 @@
 //!
 //! Each case reports steps, wall time, memory (the process's resident set: `VmRSS` before the
 //! case and its peak `VmHWM` during it, after freed heap has been handed back to the system
-//! and the peak reset, [`reset_memory`]),
+//! and the peak reset, `reset_memory`),
 //! the error against the closed form and the force residual; each family the growth exponent
 //! of its cost ([`growth_exponent`]). [`peer`] runs the same structures through MuJoCo.
 
@@ -49,11 +49,11 @@ pub struct ScaleCase {
     pub joints: usize,
     pub settled: bool,
     pub steps: u64,
-    /// Building the simulation and settling it [s] (the structure's design is outside).
+    /// Building the simulation and settling it \[s\] (the structure's design is outside).
     pub wall_s: f64,
-    /// Resident set before the case [KiB] (None where `/proc/self/status` cannot be read).
+    /// Resident set before the case \[KiB\] (None where `/proc/self/status` cannot be read).
     pub rss_before_kib: Option<u64>,
-    /// Peak resident set during the case (`VmHWM`, reset before it) [KiB].
+    /// Peak resident set during the case (`VmHWM`, reset before it) \[KiB\].
     pub peak_rss_kib: Option<u64>,
     /// Error against the closed form, in [`ScaleCase::error_unit`]: see [`Measure`].
     pub error: f64,
@@ -62,7 +62,7 @@ pub struct ScaleCase {
     pub residual: f64,
     /// Why the case stopped without settling (step cap, wall cap), if it did.
     pub note: Option<String>,
-    /// The settled positions of the case's target nodes, in target order [m].
+    /// The settled positions of the case's target nodes, in target order \[m\].
     #[serde(skip)]
     pub settled_nodes: Vec<Vec3>,
 }
@@ -71,7 +71,7 @@ pub struct ScaleCase {
 #[derive(Clone, Copy, Debug)]
 pub struct Caps {
     pub max_steps: u64,
-    /// Checked between steps (one step is never interrupted) [s].
+    /// Checked between steps (one step is never interrupted) \[s\].
     pub max_wall_s: f64,
 }
 
@@ -105,7 +105,7 @@ pub struct Case {
     pub settings: SimSettings,
     /// Actuator commands (structure order), if any.
     pub commands: Vec<f64>,
-    /// The closed form: node index and its position [m].
+    /// The closed form: node index and its position \[m\].
     pub target: Vec<(usize, Vec3)>,
     pub measure: Measure,
 }
@@ -114,12 +114,12 @@ pub struct Case {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Measure {
-    /// The largest node distance after the best rigid alignment [m] (a structure held by one
+    /// The largest node distance after the best rigid alignment \[m\] (a structure held by one
     /// strut keeps a free rotation about it).
     Aligned,
-    /// The largest node distance as they are [m] (furet: the base is fixed).
+    /// The largest node distance as they are \[m\] (furet: the base is fixed).
     Absolute,
-    /// The n-strut prism's largest |twist - (pi/2 + pi/n)| [rad] (nodes: bottom i at 2 i, top
+    /// The n-strut prism's largest |twist - (pi/2 + pi/n)| \[rad\] (nodes: bottom i at 2 i, top
     /// i at 2 i + 1): its size depends on the drawn strut length, its twist does not.
     Twist,
 }
@@ -209,7 +209,7 @@ pub fn settle(s: &Structure, settings: &SimSettings, commands: &[f64], caps: &Ca
 }
 
 /// A case faster than this is settled again until the settles add up to it, and its wall time
-/// is the median [s]: one settle of a small structure takes well under a millisecond, where a
+/// is the median \[s\]: one settle of a small structure takes well under a millisecond, where a
 /// single timing varied by 10x within a run.
 pub const MIN_CASE_WALL_S: f64 = 0.2;
 
@@ -255,13 +255,13 @@ pub fn run_case(case: &Case, caps: &Caps) -> Result<ScaleCase, BenchError> {
     })
 }
 
-/// Largest distance between corresponding points [m].
+/// Largest distance between corresponding points \[m\].
 pub fn max_distance(a: &[Vec3], b: &[Vec3]) -> f64 {
     a.iter().zip(b).map(|(p, q)| crate::structure::distance(*p, *q)).fold(0.0, f64::max)
 }
 
 /// Largest distance between corresponding points after the rigid motion that best maps `a`
-/// onto `b` (least squares, Kabsch's SVD solution) [m].
+/// onto `b` (least squares, Kabsch's SVD solution) \[m\].
 pub fn aligned_distance(a: &[Vec3], b: &[Vec3]) -> f64 {
     let centroid = |v: &[Vec3]| v.iter().map(|p| Vector3::from(*p)).sum::<Vector3<f64>>() / v.len().max(1) as f64;
     let (ca, cb) = (centroid(a), centroid(b));

@@ -7,7 +7,7 @@
 //! MuJoCo's RK4 at [`REFERENCE_DT_S`]: the same equations of motion on both sides (rigid
 //! bodies, springs and tension-only cables as tendons, held bodies; no constraint). The furet
 //! chains are left out: MuJoCo closes their loops with soft equalities, another model. Error:
-//! the largest node distance from the reference at the end [m]. Steps per second: the steps
+//! the largest node distance from the reference at the end \[m\]. Steps per second: the steps
 //! over the wall time of stepping alone (building excluded on both sides; runs repeated until
 //! they add up to 0.2 s, the median taken; MuJoCo's steps are `mj_step` calls from a Python
 //! loop, as in its other comparisons).
@@ -27,13 +27,13 @@ use std::time::Instant;
 
 /// The families whose equations of motion are the same in MuJoCo (free bodies only).
 pub const FAMILIES: [&str; 4] = ["prism", "icosahedron", "tower", "spine"];
-/// Simulated time of every run [s].
+/// Simulated time of every run \[s\].
 pub const DURATION_S: f64 = 0.5;
-/// Time steps of both sides [s].
+/// Time steps of both sides \[s\].
 pub const DT_S: [f64; 4] = [4e-3, 2e-3, 1e-3, 5e-4];
-/// MuJoCo's RK4 step for the reference [s]: a tenth of the finest step, fourth order.
+/// MuJoCo's RK4 step for the reference \[s\]: a tenth of the finest step, fourth order.
 pub const REFERENCE_DT_S: f64 = 5e-5;
-/// The testbed's time step whose error sets the level compared [s].
+/// The testbed's time step whose error sets the level compared \[s\].
 pub const EQUAL_ERROR_DT_S: f64 = 1e-3;
 
 /// One run of one side at one time step.
@@ -41,10 +41,10 @@ pub const EQUAL_ERROR_DT_S: f64 = 1e-3;
 pub struct MotionRun {
     pub dt_s: f64,
     pub steps: u64,
-    /// Wall time of the steps alone [s].
+    /// Wall time of the steps alone \[s\].
     pub wall_s: f64,
     pub steps_per_s: f64,
-    /// Largest node distance from the reference at the end [m].
+    /// Largest node distance from the reference at the end \[m\].
     pub error_m: f64,
 }
 
@@ -57,7 +57,7 @@ pub struct MotionCase {
     pub struts: usize,
     pub testbed: Vec<MotionRun>,
     pub peer: Vec<MotionRun>,
-    /// The error level compared [m].
+    /// The error level compared \[m\].
     pub equal_error_m: f64,
     /// MuJoCo's time step and wall time reaching that level (interpolated), if within its runs.
     pub peer_dt_at_equal_error_s: Option<f64>,
@@ -134,8 +134,11 @@ fn peer_case(case: &Case, dir: &Path) -> Result<serde_json::Value, BenchError> {
     }))
 }
 
+/// One run of the peer: time step [s], steps, wall time [s] and the nodes' final positions.
+type PeerRun = (f64, u64, f64, Vec<Vec3>);
+
 /// The peer's runs of one case and its reference positions.
-fn peer_runs(p: &serde_json::Value) -> Result<(Vec<Vec3>, Vec<(f64, u64, f64, Vec<Vec3>)>), BenchError> {
+fn peer_runs(p: &serde_json::Value) -> Result<(Vec<Vec3>, Vec<PeerRun>), BenchError> {
     let bad = || BenchError::Peer("the peer's motion case lacks 'reference' or 'runs'".into());
     let points = |v: &serde_json::Value| -> Option<Vec<Vec3>> {
         v.as_array()?.iter().map(|p| serde_json::from_value::<Vec3>(p.clone()).ok()).collect()

@@ -5,10 +5,10 @@
 //! i to top node i - 1 and two polygons of cables is in equilibrium (has a self-stress) only
 //! at the relative twist pi/2 + pi/n of its top polygon (Tibert & Pellegrino, "Review of
 //! form-finding methods for tensegrity structures", 2003, Sec. 2.1). Each case draws the
-//! prism at radius [`RADIUS_M`] and height [`HEIGHT_M`], turned [`START_TWIST_OFFSET_FRACTION`]
+//! prism at radius `RADIUS_M` and height `HEIGHT_M`, turned `START_TWIST_OFFSET_FRACTION`
 //! of the polygons' angle short of that twist, with rest lengths that make the drawn closed-form shape the
 //! equilibrium (force densities side : polygon = 1 : 1 / (2 sin(pi/n)), ibid.; polygon cables
-//! stretched by [`POLYGON_STRAIN`]), strut 1 held; it settles with the structure's
+//! stretched by `POLYGON_STRAIN`), strut 1 held; it settles with the structure's
 //! default settling (the static relaxation) and reports steps, wall time and the largest
 //! twist error over the n struts.
 
@@ -45,7 +45,7 @@ fn distance(a: Vec3, b: Vec3) -> f64 {
     crate::structure::distance(a, b)
 }
 
-/// The n-strut prism drawn at `twist` [rad], rest lengths from the closed-form shape.
+/// The n-strut prism drawn at `twist` \[rad\], rest lengths from the closed-form shape.
 pub fn prism(n: usize, twist: f64) -> Structure {
     let closed = FRAC_PI_2 + PI / n as f64;
     let step = 2.0 * PI / n as f64;
@@ -88,7 +88,7 @@ pub fn prism(n: usize, twist: f64) -> Structure {
 }
 
 /// Largest |twist - (pi/2 + pi/n)| over the struts of settled node positions (bottom node i
-/// at 2 i, top node i at 2 i + 1) [rad], about the axis through the polygons' centroids.
+/// at 2 i, top node i at 2 i + 1) \[rad\], about the axis through the polygons' centroids.
 pub fn twist_error(nodes: &[Vec3], n: usize) -> f64 {
     let centroid = |k: usize| {
         let mut c = [0.0; 3];
@@ -116,7 +116,7 @@ pub fn twist_error(nodes: &[Vec3], n: usize) -> f64 {
 /// Strut counts of the family.
 pub const SIZES: [usize; 13] = [3, 4, 6, 8, 12, 16, 24, 32, 64, 128, 256, 512, 1000];
 
-/// The n-strut prism's case: drawn [`START_TWIST_OFFSET_FRACTION`] of the polygons' angle short
+/// The n-strut prism's case: drawn `START_TWIST_OFFSET_FRACTION` of the polygons' angle short
 /// of the closed-form twist, strut 1 held; compared by its twist.
 pub fn case(n: usize) -> Case {
     case_with(n, true)
@@ -140,7 +140,7 @@ pub fn case_with(n: usize, relaxation: bool) -> Case {
 
 /// Settles the n-strut prism from its twisted start, as the settle loop does: stepping until
 /// the speed stays below 1e-11 m/s per metre of size for 10 steps (the relaxation off once it is) and the
-/// residual is below 1e-9 N and N m, at most [`MAX_STEPS`] steps.
+/// residual is below 1e-9 N and N m, at most `MAX_STEPS` steps.
 /// `relaxation = false`: the plain dynamics (body damping alone), for comparison.
 pub fn settle_prism(n: usize, relaxation: bool) -> Result<ScaleCase, crate::bench::BenchError> {
     let caps = Caps { max_steps: MAX_STEPS, ..super::DEFAULT_CAPS };

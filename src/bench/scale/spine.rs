@@ -2,8 +2,8 @@
 //! tetrahedral vertebrae (the Tetraspine's), the lowest held, joined by cables and springs.
 //!
 //! Vertebra i is one rigid body centred on the z axis at z = i h ([`PITCH_M`]): four legs from
-//! its centre to two upper tips (+-a, 0, +c) and two lower tips (0, +-a, -c) ([`REACH_M`],
-//! [`RISE_M`]), so the tips span a tetrahedron. With h < 2 c the vertebrae overlap: each upper
+//! its centre to two upper tips (+-a, 0, +c) and two lower tips (0, +-a, -c) (`REACH_M`,
+//! `RISE_M`), so the tips span a tetrahedron. With h < 2 c the vertebrae overlap: each upper
 //! tip of vertebra i is joined to both lower tips of vertebra i + 1 by a saddle cable, which
 //! pushes them apart, and each tip to the same tip of the next vertebra by a vertical spring,
 //! which pulls them together.
@@ -31,7 +31,7 @@ pub const VERTEBRAE: [usize; 8] = [1, 2, 4, 8, 16, 32, 64, 128];
 const REACH_M: f64 = 0.5;
 /// Height c of the tips above (upper) and below (lower) the vertebra's centre [m].
 const RISE_M: f64 = 0.4;
-/// Distance h between the centres of consecutive vertebrae [m] (less than 2 c: they overlap).
+/// Distance h between the centres of consecutive vertebrae \[m\] (less than 2 c: they overlap).
 pub const PITCH_M: f64 = 0.6;
 /// Tension T of every saddle cable at the design [N].
 const SADDLE_TENSION_N: f64 = 10.0;
@@ -42,7 +42,7 @@ const VERTEBRA_MASS_KG: f64 = 0.2;
 /// Time step [s] and body damping [1/s] (the tower's).
 const DT_S: f64 = 0.005;
 const BODY_DAMPING_PER_S: f64 = 2.0;
-/// Displacement of every free vertebra in the start [m].
+/// Displacement of every free vertebra in the start \[m\].
 pub const PERTURBATION_M: f64 = 0.02;
 
 /// Vertebra i's centre and tips (upper +a, upper -a, lower +a, lower -a), displaced by `shift`.
@@ -53,13 +53,13 @@ fn vertebra(i: usize, shift: Vec3) -> [Vec3; 5] {
         .map(|p| [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]])
 }
 
-/// The length of a saddle cable at the design (an upper tip to a lower tip of the next) [m].
+/// The length of a saddle cable at the design (an upper tip to a lower tip of the next) \[m\].
 pub fn saddle_length_m() -> f64 {
     let d = 2.0 * RISE_M - PITCH_M;
     (2.0 * REACH_M * REACH_M + d * d).sqrt()
 }
 
-/// The tension of every vertical spring at the design [N]: V = T (2 c - h) / l_s.
+/// The tension of every vertical spring at the design \[N\]: V = T (2 c - h) / l_s.
 pub fn vertical_tension_n() -> f64 {
     SADDLE_TENSION_N * (2.0 * RISE_M - PITCH_M) / saddle_length_m()
 }

@@ -2,10 +2,10 @@
 //! by the force density method (Schek, "The force density method for form finding and
 //! computation of general networks", 1974; Tibert & Pellegrino 2003, Sec. 2.2).
 //!
-//! Geometry (drawn, then made an equilibrium): stage s is a prism of radius [`RADIUS_M`] and
-//! height [`HEIGHT_M`], its top polygon turned by the prism's twist pi/2 + pi/n from its bottom
-//! one; stage s + 1 stands [`PITCH_M`] higher, so that its bottom polygon lies
-//! [`OVERLAP_M`] below stage s's top polygon, turned by pi/n from it. Members: per stage n
+//! Geometry (drawn, then made an equilibrium): stage s is a prism of radius `RADIUS_M` and
+//! height `HEIGHT_M`, its top polygon turned by the prism's twist pi/2 + pi/n from its bottom
+//! one; stage s + 1 stands `PITCH_M` higher, so that its bottom polygon lies
+//! `OVERLAP_M` below stage s's top polygon, turned by pi/n from it. Members: per stage n
 //! struts, its two polygons and n side cables (the prism's); between stages, each top node of
 //! stage s is tied by two saddle members to the two nearest bottom nodes of stage s + 1 and
 //! by a vertical member each from its bottom and top nodes to the ones of stage s + 1 straight
@@ -14,7 +14,7 @@
 //! Force densities q (tension / length) that make the drawn shape an equilibrium solve
 //! A q = 0, A the equilibrium matrix (at every free node i, sum over members (i, j) of
 //! q (x_j - x_i) = 0). The design takes the one nearest (least squares) to a target pattern
-//! (the prism's self-stress in each stage, [`SADDLE_Q`] and the saddles' balance in the
+//! (the prism's self-stress in each stage, `SADDLE_Q` and the saddles' balance in the
 //! verticals): q = q_t - A^T (A A^T)^-1 A q_t, with A A^T banded (members only join a stage
 //! to the next), factored by a banded Cholesky. In this geometry the projection leaves the
 //! stage-to-stage members without force (measured: |q| below 1e-15 of the cables'; no
@@ -23,7 +23,7 @@
 //! stages together with two-sided stiffness while every stage holds its own prestress (a
 //! regular prism's self-stress is super-stable, so the tower is stable). Stage cables must
 //! stay in tension; the densities are scaled so that the most strained cable is stretched
-//! [`MAX_CABLE_STRAIN`], and rest lengths follow: l0 = l (1 - q / k). Each case starts with every free strut moved by
+//! `MAX_CABLE_STRAIN`, and rest lengths follow: l0 = l (1 - q / k). Each case starts with every free strut moved by
 //! [`PERTURBATION_M`] in a fixed pseudo-random direction; the error is the largest node
 //! distance from the design after the best rigid alignment.
 
@@ -60,7 +60,7 @@ const STRUT_MASS_KG: f64 = 1.0;
 /// Time step [s] and body damping [1/s] (the prisms').
 const DT_S: f64 = 0.005;
 const BODY_DAMPING_PER_S: f64 = 2.0;
-/// Displacement of each free strut in the start [m].
+/// Displacement of each free strut in the start \[m\].
 pub const PERTURBATION_M: f64 = 0.02;
 
 /// What a member is.
@@ -234,7 +234,7 @@ fn normal_matrix(cols: &[Vec<(usize, Vec3)>], n: usize) -> Result<SparseLeastSqu
 }
 
 /// The force densities nearest the target pattern that make the drawn shape an equilibrium,
-/// scaled so the most strained cable is stretched [`MAX_CABLE_STRAIN`] [N/m].
+/// scaled so the most strained cable is stretched `MAX_CABLE_STRAIN` [N/m].
 pub fn force_densities(d: &Design) -> Result<Vec<f64>, TowerError> {
     let (idx, n) = free_index(d);
     let cols: Vec<Vec<(usize, Vec3)>> = d.members.iter().map(|(_, a, b)| column(d, *a, *b, &idx)).collect();

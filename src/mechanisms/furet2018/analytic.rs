@@ -3,7 +3,7 @@
 //! manipulators", Advances in Robot Kinematics (ARK 2018), hal-01791317.
 //!
 //! Everything here is a pure function of `f64` / `nalgebra` values.
-//! Units: lengths in metres [m], angles in radians [rad]; `det J` in [m^2/rad^2].
+//! Units: lengths in metres \[m\], angles in radians \[rad\]; `det J` in [m^2/rad^2].
 //!
 //! # One X mechanism (Snelson's X, a crossed four-bar / anti-parallelogram)
 //! Local frame: origin at the middle of the base bar, `x` along the base bar
@@ -71,7 +71,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 pub(super) const TWO_PI: f64 = 2.0 * PI;
 /// Fig. 3 / Fig. 4: `L = 1`, `b = 2/3` (paper sets `L = 1`, units arbitrary: metres here).
 pub const PAPER_FIG3_B: f64 = 2.0 / 3.0;
-/// Fig. 3: target `(x, y) = (0.03, 1.6)` [m] with four inverse solutions.
+/// Fig. 3: target `(x, y) = (0.03, 1.6)` \[m\] with four inverse solutions.
 pub const PAPER_FIG3_POINT: (f64, f64) = (0.03, 1.6);
 /// Fig. 5: the three base/top bar lengths `b` (with `L = 1`).
 pub const PAPER_FIG5_B: [f64; 3] = [2.0 / 5.0, 2.0 / 3.0, 9.0 / 10.0];
@@ -101,9 +101,9 @@ const PATH_MARGINS: [f64; 7] = [0.2, 0.1, 0.05, 0.02, 0.01, 0.003, 0.0];
 /// Mechanism parameters (identical X mechanisms).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params {
-    /// Crossed-bar length `L` [m].
+    /// Crossed-bar length `L` \[m\].
     pub l: f64,
-    /// Base and top bar length `b` [m].
+    /// Base and top bar length `b` \[m\].
     pub b: f64,
 }
 
@@ -139,7 +139,7 @@ fn rot(a: f64) -> Vector2<f64> {
 // One X mechanism.
 // ---------------------------------------------------------------------------
 
-/// Eq. 1: mid-line length `l(theta) = sqrt(L^2 - b^2 cos^2 theta)` [m]
+/// Eq. 1: mid-line length `l(theta) = sqrt(L^2 - b^2 cos^2 theta)` \[m\]
 /// (in `[sqrt(L^2-b^2), L]`).
 pub fn midline_length(p: &Params, theta: f64) -> f64 {
     let c = theta.cos();
@@ -152,7 +152,7 @@ pub fn midline_length_rate(p: &Params, theta: f64) -> f64 {
     p.b * p.b * s * c / midline_length(p, theta)
 }
 
-/// Spring (lateral side) lengths `(l_left, l_right) = (|AD|, |BC|) = (l - b sin th, l + b sin th)` [m].
+/// Spring (lateral side) lengths `(l_left, l_right) = (|AD|, |BC|) = (l - b sin th, l + b sin th)` \[m\].
 /// Both are `> 0` for every `theta` since `l^2 - b^2 sin^2 th = L^2 - b^2 > 0`.
 pub fn spring_lengths(p: &Params, theta: f64) -> (f64, f64) {
     let l = midline_length(p, theta);
@@ -160,7 +160,7 @@ pub fn spring_lengths(p: &Params, theta: f64) -> (f64, f64) {
     (l - bs, l + bs)
 }
 
-/// Base-joint angle at `A` [rad]: angle of the crossed bar `A->C` measured CCW from
+/// Base-joint angle at `A` \[rad\]: angle of the crossed bar `A->C` measured CCW from
 /// the base direction `A->B`: `phi = theta + atan2(l, b cos theta)` (the paper's
 /// `phi_1`). Continuous and increasing in `theta`, `phi(theta + 2pi) = phi + 2pi`;
 /// `phi(0) = atan2(sqrt(L^2-b^2), b)`, `phi(pi/2) = pi`, `phi(-pi/2) = 0`.
@@ -179,7 +179,7 @@ pub fn base_joint_rate_a(p: &Params, theta: f64) -> f64 {
     1.0 + p.b * theta.sin() / midline_length(p, theta)
 }
 
-/// Base-joint angle at `B` [rad]: angle of the crossed bar `B->D` measured CCW from the
+/// Base-joint angle at `B` \[rad\]: angle of the crossed bar `B->D` measured CCW from the
 /// base direction `A->B`: `psi = theta + atan2(l, -b cos theta)` (the paper's `psi_2`).
 pub fn base_joint_angle_b(p: &Params, theta: f64) -> f64 {
     theta + midline_length(p, theta).atan2(-p.b * theta.cos())
@@ -201,7 +201,7 @@ pub fn crossed_mode_margin(theta: f64) -> f64 {
     theta.cos().abs()
 }
 
-/// Full geometry of one X mechanism in world coordinates [m] / [rad].
+/// Full geometry of one X mechanism in world coordinates \[m\] / \[rad\].
 #[derive(Clone, Copy, Debug)]
 pub struct XGeometry {
     /// Base-left node `A` (for X2: the top-left node of X1).
@@ -216,21 +216,21 @@ pub struct XGeometry {
     pub base_mid: Vector2<f64>,
     /// Top-bar midpoint (for the last X: the end point `(x, y)`).
     pub top_mid: Vector2<f64>,
-    /// World orientation of the base bar (`A->B`) [rad].
+    /// World orientation of the base bar (`A->B`) \[rad\].
     pub base_angle: f64,
-    /// World orientation of the top bar (`D->C`) = `base_angle + 2 theta` [rad].
+    /// World orientation of the top bar (`D->C`) = `base_angle + 2 theta` \[rad\].
     pub top_angle: f64,
-    /// The paper's `theta_i` [rad].
+    /// The paper's `theta_i` \[rad\].
     pub theta: f64,
-    /// Eq. 1 mid-line length `l_i` [m].
+    /// Eq. 1 mid-line length `l_i` \[m\].
     pub midline_length: f64,
-    /// `|AD| = l - b sin theta` [m].
+    /// `|AD| = l - b sin theta` \[m\].
     pub spring_left: f64,
-    /// `|BC| = l + b sin theta` [m].
+    /// `|BC| = l + b sin theta` \[m\].
     pub spring_right: f64,
-    /// Base-joint angle at `A` (crossed bar `A->C` relative to the base bar) [rad].
+    /// Base-joint angle at `A` (crossed bar `A->C` relative to the base bar) \[rad\].
     pub joint_angle_a: f64,
-    /// Base-joint angle at `B` (crossed bar `B->D` relative to the base bar) [rad].
+    /// Base-joint angle at `B` (crossed bar `B->D` relative to the base bar) \[rad\].
     pub joint_angle_b: f64,
 }
 
@@ -270,7 +270,7 @@ pub fn chain_nodes(p: &Params, thetas: &[f64]) -> Vec<XGeometry> {
     out
 }
 
-/// The two X mechanisms of the manipulator at `(theta1, theta2)` [rad].
+/// The two X mechanisms of the manipulator at `(theta1, theta2)` \[rad\].
 pub fn x_nodes(p: &Params, theta1: f64, theta2: f64) -> [XGeometry; 2] {
     let v = chain_nodes(p, &[theta1, theta2]);
     [v[0], v[1]]
@@ -280,7 +280,7 @@ pub fn x_nodes(p: &Params, theta1: f64, theta2: f64) -> [XGeometry; 2] {
 // Direct kinematics.
 // ---------------------------------------------------------------------------
 
-/// Eq. 2 as printed: end point of `n` X mechanisms in series [m],
+/// Eq. 2 as printed: end point of `n` X mechanisms in series \[m\],
 /// `x = sum l_i cos((pi - 2th_i)/2 + sum_{j<=i} 2th_j)`, `y` with `sin`.
 pub fn direct_kinematics_n(p: &Params, thetas: &[f64]) -> (f64, f64) {
     let (mut x, mut y, mut acc) = (0.0, 0.0, 0.0);
@@ -294,7 +294,7 @@ pub fn direct_kinematics_n(p: &Params, thetas: &[f64]) -> (f64, f64) {
     (x, y)
 }
 
-/// Eq. 3: end point `(x, y)` [m] of the 2-X manipulator,
+/// Eq. 3: end point `(x, y)` \[m\] of the 2-X manipulator,
 /// `x = -l1 sin th1 - l2 sin(2th1+th2)`, `y = l1 cos th1 + l2 cos(2th1+th2)`.
 pub fn direct_kinematics(p: &Params, theta1: f64, theta2: f64) -> (f64, f64) {
     let (l1, l2) = (midline_length(p, theta1), midline_length(p, theta2));
@@ -302,8 +302,8 @@ pub fn direct_kinematics(p: &Params, theta1: f64, theta2: f64) -> (f64, f64) {
     (-l1 * theta1.sin() - l2 * s.sin(), l1 * theta1.cos() + l2 * s.cos())
 }
 
-/// Eq. 4: end point [m] from the crossed-bar angles `phi1` (at `A1`), `psi2` (at `B2`,
-/// relative to X2's base) and the relative top-bar rotations `alpha1`, `alpha2` [rad].
+/// Eq. 4: end point \[m\] from the crossed-bar angles `phi1` (at `A1`), `psi2` (at `B2`,
+/// relative to X2's base) and the relative top-bar rotations `alpha1`, `alpha2` \[rad\].
 pub fn direct_kinematics_crossed_bars_eq4(p: &Params, phi1: f64, psi2: f64, alpha1: f64, alpha2: f64) -> (f64, f64) {
     let (l, b) = (p.l, p.b);
     (
@@ -526,17 +526,17 @@ fn x2_local_target(p: &Params, x: f64, y: f64, theta1: f64) -> (Vector2<f64>, f6
 /// One inverse-kinematics solution (crossed-bar assembly mode of both X).
 #[derive(Clone, Copy, Debug)]
 pub struct IkSolution {
-    /// [rad], `(-pi, pi]`.
+    /// \[rad\], `(-pi, pi]`.
     pub theta1: f64,
-    /// [rad], `(-pi, pi]`.
+    /// \[rad\], `(-pi, pi]`.
     pub theta2: f64,
-    /// Base-joint angle of X1 at `A1`, the paper's `phi1` [rad], `(-pi, pi]`.
+    /// Base-joint angle of X1 at `A1`, the paper's `phi1` \[rad\], `(-pi, pi]`.
     pub phi1: f64,
     /// `det J` [m^2/rad^2].
     pub det_j: f64,
     /// Aspect: sign of `det J` (`+1` / `-1`, `0` if exactly singular).
     pub aspect: i8,
-    /// `|DK(theta1, theta2) - (x, y)|` [m].
+    /// `|DK(theta1, theta2) - (x, y)|` \[m\].
     pub residual: f64,
 }
 
@@ -795,9 +795,9 @@ pub fn region_area_fractions(p: &Params, grid_n: usize) -> RegionAreas {
 /// Answer of the `dk` query.
 #[derive(Clone, Copy, Debug)]
 pub struct DkAnswer {
-    /// End point (top midpoint of X2) [m].
+    /// End point (top midpoint of X2) \[m\].
     pub x: f64,
-    /// [m].
+    /// \[m\].
     pub y: f64,
     /// `det J` [m^2/rad^2].
     pub det_j: f64,
@@ -805,13 +805,13 @@ pub struct DkAnswer {
     pub aspect: i8,
 }
 
-/// `dk` query: inputs `theta1`, `theta2` [rad] -> point and `det J`.
+/// `dk` query: inputs `theta1`, `theta2` \[rad\] -> point and `det J`.
 pub fn dk_query(p: &Params, theta1: f64, theta2: f64) -> DkAnswer {
     let (x, y) = direct_kinematics(p, theta1, theta2);
     DkAnswer { x, y, det_j: det_jacobian(p, theta1, theta2), aspect: aspect(p, theta1, theta2) }
 }
 
-/// `ik` query: inputs `x`, `y` [m] -> every solution with its `det J` and aspect
+/// `ik` query: inputs `x`, `y` \[m\] -> every solution with its `det J` and aspect
 /// (= [`inverse_kinematics`]).
 pub fn ik_query(p: &Params, x: f64, y: f64) -> Vec<IkSolution> {
     inverse_kinematics(p, x, y)
@@ -864,7 +864,7 @@ pub fn aspect_count(p: &Params, grid_n: usize) -> usize {
     comps
 }
 
-/// Minimum of `|det J|` along the polyline `path` (unwrapped joint angles [rad]),
+/// Minimum of `|det J|` along the polyline `path` (unwrapped joint angles \[rad\]),
 /// each segment resampled with `samples_per_segment` (>= 1) sub-steps; returns `0` if
 /// `det J` changes sign anywhere along the samples.
 pub fn min_abs_det_along(p: &Params, path: &[(f64, f64)], samples_per_segment: usize) -> f64 {
@@ -909,7 +909,7 @@ fn segment_ok(p: &Params, a: (f64, f64), b: (f64, f64), sgn: f64, thr: f64, step
     })
 }
 
-/// A joint-space path from `from` to `to` (`(theta1, theta2)` [rad]) that never
+/// A joint-space path from `from` to `to` (`(theta1, theta2)` \[rad\]) that never
 /// crosses `det J = 0`, or `None` if the two are in different aspects (or singular).
 ///
 /// Method: on a `grid_n x grid_n` grid of the torus, keep the cells of the aspect of

@@ -22,17 +22,17 @@ use nalgebra::Vector2;
 /// Model choices that the paper does not give (defaults in `Furet2018::params`).
 #[derive(Clone, Copy, Debug)]
 pub struct ModelChoices {
-    /// Mass of each bar [kg].
+    /// Mass of each bar \[kg\].
     pub bar_mass_kg: f64,
     /// Stiffness of the lateral springs [N/m].
     pub spring_stiffness_n_per_m: f64,
-    /// Free length of the lateral springs [m].
+    /// Free length of the lateral springs \[m\].
     pub spring_rest_length_m: f64,
     /// Viscous damping of the free joints [N m s/rad].
     pub joint_damping: f64,
-    /// Half the distance between the planes of the two crossed bars of an X [m].
+    /// Half the distance between the planes of the two crossed bars of an X \[m\].
     pub plane_offset_m: f64,
-    /// Bar radius for drawing and interference [m].
+    /// Bar radius for drawing and interference \[m\].
     pub strut_radius_m: f64,
 }
 

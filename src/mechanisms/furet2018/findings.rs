@@ -36,7 +36,7 @@ pub const EQUATION_GROUPS: &[EquationGroup<Params>] = &[
 ];
 
 /// Every printed equation and claim checked against the derivation, with numbers: the findings
-/// of every group of [`EQUATION_GROUPS`]. Generic identities use [`sample_joints`] with `p`;
+/// of every group of [`EQUATION_GROUPS`]. Generic identities use `sample_joints` with `p`;
 /// figure claims use the paper's parameters (`L = 1`, `b` of Fig. 3 / Fig. 5).
 pub fn findings(p: &Params) -> Vec<Finding> {
     check_all(EQUATION_GROUPS, p)

@@ -15,7 +15,7 @@ use analytic::Params;
 
 pub struct Furet2018;
 
-/// Inputs closer than this to a change point theta = +-pi/2 are refused [rad]: there the four
+/// Inputs closer than this to a change point theta = +-pi/2 are refused \[rad\]: there the four
 /// nodes of an X are collinear and the base-joint actuator cannot keep it crossed.
 pub const CHANGE_POINT_MARGIN_RAD: f64 = 1e-3;
 

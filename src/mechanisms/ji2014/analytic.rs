@@ -3,9 +3,9 @@
 //! parallel mechanism", Periodica Polytechnica Mech. Eng. 58(2) 101-111.
 //!
 //! Everything here is a pure function of `f64` / `nalgebra` values.
-//! Units: lengths in metres [m], angles in radians [rad], spring rates in
-//! newtons per metre [N/m], energies in joules [J], torques in newton-metres
-//! [N*m] and the rotational stiffness `K = d2U/dtheta2^2` in [N*m/rad].
+//! Units: lengths in metres \[m\], angles in radians \[rad\], spring rates in
+//! newtons per metre [N/m], energies in joules \[J\], torques in newton-metres
+//! \[N*m\] and the rotational stiffness `K = d2U/dtheta2^2` in [N*m/rad].
 //!
 //! # Model (paper Eq. 1-4)
 //! Base nodes `C1=(0,0)`, `C2=(-L,-sqrt3 L)`, `C3=(L,-sqrt3 L)`; actuator
@@ -59,7 +59,7 @@ const IK_DUPLICATE_TOL: f64 = 1e-12;
 /// Mechanism parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params {
-    /// Side of the mobile triangle `L` [m] (base triangle side is `2L`).
+    /// Side of the mobile triangle `L` \[m\] (base triangle side is `2L`).
     pub l: f64,
     /// Spring rate `K1` of spring `D2-C2` [N/m].
     pub k1: f64,
@@ -87,7 +87,7 @@ impl Params {
     }
 }
 
-/// Node positions [m] (Eq. 1-3).
+/// Node positions \[m\] (Eq. 1-3).
 #[derive(Clone, Copy, Debug)]
 pub struct Nodes {
     pub c1: Vector2<f64>,
@@ -98,8 +98,8 @@ pub struct Nodes {
     pub d3: Vector2<f64>,
 }
 
-/// Eq. 1-3: node coordinates for inputs `l3` [m], `theta1` [rad] and the free
-/// coordinate `theta2` [rad].
+/// Eq. 1-3: node coordinates for inputs `l3` \[m\], `theta1` \[rad\] and the free
+/// coordinate `theta2` \[rad\].
 pub fn nodes(p: &Params, l3: f64, theta1: f64, theta2: f64) -> Nodes {
     let l = p.l;
     let c1 = Vector2::zeros();
@@ -111,13 +111,13 @@ pub fn nodes(p: &Params, l3: f64, theta1: f64, theta2: f64) -> Nodes {
     Nodes { c1, c2, c3, d1, d2, d3 }
 }
 
-/// Spring lengths `(|D2-C2|, |D3-C3|)` [m].
+/// Spring lengths `(|D2-C2|, |D3-C3|)` \[m\].
 pub fn spring_lengths(p: &Params, l3: f64, theta1: f64, theta2: f64) -> (f64, f64) {
     let n = nodes(p, l3, theta1, theta2);
     ((n.d2 - n.c2).norm(), (n.d3 - n.c3).norm())
 }
 
-/// Ground-truth potential energy [J]: `K1/2 |D2-C2|^2 + K2/2 |D3-C3|^2`
+/// Ground-truth potential energy \[J\]: `K1/2 |D2-C2|^2 + K2/2 |D3-C3|^2`
 /// (zero free lengths).
 pub fn potential_energy(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
     let n = nodes(p, l3, theta1, theta2);
@@ -125,7 +125,7 @@ pub fn potential_energy(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
 }
 
 /// Coefficients of Eq. 4 written as `U = u0 + a cos th2 + b sin th2`
-/// (`u0` [J], `a` [J], `b` [J]).
+/// (`u0` \[J\], `a` \[J\], `b` \[J\]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EnergyCoefficients {
     pub u0: f64,
@@ -146,14 +146,14 @@ pub fn energy_coefficients_eq4(p: &Params, l3: f64, theta1: f64) -> EnergyCoeffi
     EnergyCoefficients { u0, a, b }
 }
 
-/// Eq. 4 exactly as printed [J].
+/// Eq. 4 exactly as printed \[J\].
 pub fn potential_energy_eq4(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
     let e = energy_coefficients_eq4(p, l3, theta1);
     let (s2, c2) = theta2.sin_cos();
     e.u0 + e.a * c2 + e.b * s2
 }
 
-/// Eq. 6-7: `(eta1, eta2)` [N], with
+/// Eq. 6-7: `(eta1, eta2)` \[N\], with
 /// `eta1 = (K1+2K2) L3 sin th1 - sqrt3 K1 L3 cos th1 + 2 sqrt3 K2 L` and
 /// `eta2 = 2(2K1-K2) L + (K1+2K2) L3 cos th1 + sqrt3 K1 L3 sin th1`.
 /// Note `eta1 = 2B/L`, `eta2 = 2A/L` with `A, B` the Eq. 4 coefficients.
@@ -177,7 +177,7 @@ fn perp(v: Vector2<f64>) -> Vector2<f64> {
     Vector2::new(-v.y, v.x)
 }
 
-/// `tau = dU/dtheta2` [N*m], derived directly from the spring vectors:
+/// `tau = dU/dtheta2` \[N*m\], derived directly from the spring vectors:
 /// `tau = K1 (D2-C2).perp(D2-D1) + K2 (D3-C3).perp(D3-D1)`.
 /// Equals Eq. 41 (`-A sin th2 + B cos th2`), which is correct as printed.
 pub fn torque(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
@@ -185,7 +185,7 @@ pub fn torque(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
     p.k1 * (n.d2 - n.c2).dot(&perp(n.d2 - n.d1)) + p.k2 * (n.d3 - n.c3).dot(&perp(n.d3 - n.d1))
 }
 
-/// Eq. 41 as printed: `tau = -A sin th2 + B cos th2` [N*m].
+/// Eq. 41 as printed: `tau = -A sin th2 + B cos th2` \[N*m\].
 pub fn torque_eq41(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
     let e = energy_coefficients_eq4(p, l3, theta1);
     let (s2, c2) = theta2.sin_cos();
@@ -211,13 +211,13 @@ pub fn stiffness_eq42(p: &Params, l3: f64, theta1: f64, theta2: f64) -> f64 {
 /// An equilibrium (`tau = 0`) for fixed inputs.
 #[derive(Clone, Copy, Debug)]
 pub struct Equilibrium {
-    /// [rad], wrapped to `(-pi, pi]` (by [`fk_paper`]: in `[0, pi]`).
+    /// \[rad\], wrapped to `(-pi, pi]` (by [`fk_paper`]: in `[0, pi]`).
     pub theta2: f64,
-    /// `D3.x` [m] (Eq. 2).
+    /// `D3.x` \[m\] (Eq. 2).
     pub x: f64,
-    /// `D3.y` [m] (Eq. 3).
+    /// `D3.y` \[m\] (Eq. 3).
     pub y: f64,
-    /// Potential energy [J].
+    /// Potential energy \[J\].
     pub energy: f64,
     /// `K = d2U/dtheta2^2` [N*m/rad].
     pub stiffness: f64,
@@ -264,18 +264,18 @@ pub fn fk_paper(p: &Params, l3: f64, theta1: f64) -> Equilibrium {
 /// One inverse-kinematics solution.
 #[derive(Clone, Copy, Debug)]
 pub struct IkSolution {
-    /// [m], `>= 0`.
+    /// \[m\], `>= 0`.
     pub l3: f64,
-    /// [rad], in `[0, pi]`.
+    /// \[rad\], in `[0, pi]`.
     pub theta1: f64,
-    /// [rad], `(-pi, pi]`, of the equilibrium whose `D3` is the target.
+    /// \[rad\], `(-pi, pi]`, of the equilibrium whose `D3` is the target.
     pub theta2: f64,
     pub stable: bool,
     /// [N*m/rad].
     pub stiffness: f64,
 }
 
-/// Eq. 50-51: `(delta1, delta2)` [N] of the target `(x, y)` [m]:
+/// Eq. 50-51: `(delta1, delta2)` \[N\] of the target `(x, y)` \[m\]:
 /// `delta1 = (K1+2K2) y - sqrt3 K1 x + 2 sqrt3 K2 L`,
 /// `delta2 = 2(2K1-K2) L + (K1+2K2) x + sqrt3 K1 y`.
 pub fn delta(p: &Params, x: f64, y: f64) -> (f64, f64) {
@@ -285,7 +285,7 @@ pub fn delta(p: &Params, x: f64, y: f64) -> (f64, f64) {
     (d1, d2)
 }
 
-/// Eq. 48 / 40 residual [N]: `delta1 cos th2 - delta2 sin th2 + sqrt3 K1 L`
+/// Eq. 48 / 40 residual \[N\]: `delta1 cos th2 - delta2 sin th2 + sqrt3 K1 L`
 /// (zero iff `theta2` is an equilibrium of the inputs with `D3 = (x, y)`;
 /// it equals `eta1 cos th2 - eta2 sin th2 = 2 tau / L`).
 pub fn equilibrium_residual_eq48(p: &Params, x: f64, y: f64, theta2: f64) -> f64 {
@@ -295,7 +295,7 @@ pub fn equilibrium_residual_eq48(p: &Params, x: f64, y: f64, theta2: f64) -> f64
 }
 
 /// Inverse kinematics. Every `(L3, theta1)` with `0 <= theta1 <= pi`,
-/// `L3 >= 0`, for which `(x, y)` [m] is `D3` of an equilibrium (stable or
+/// `L3 >= 0`, for which `(x, y)` \[m\] is `D3` of an equilibrium (stable or
 /// not) of that input. Each solution is verified by [`equilibria`] to
 /// `IK_VERIFY_REL_TOL * max(L, |(x,y)|)`.
 ///
@@ -418,7 +418,7 @@ pub fn bezout_eq13(p: &Params, x: f64, y: f64, theta1: f64) -> f64 {
     det2(e1, e2, f1, f2) * det2(e2, e3, f2, f3) - m * m
 }
 
-/// Eq. 14: common root `L3 = -|E2 E3; F2 F3| / |E1 E3; F1 F3|` [m].
+/// Eq. 14: common root `L3 = -|E2 E3; F2 F3| / |E1 E3; F1 F3|` \[m\].
 pub fn l3_eq14(p: &Params, x: f64, y: f64, theta1: f64) -> f64 {
     let [e1, e2, e3] = e_coefficients_eq10(p, x, y, theta1);
     let [f1, f2, f3] = f_coefficients_eq12(p, x, y, theta1);
@@ -607,7 +607,7 @@ pub fn det_jacobian_eq23_corrected(p: &Params, l3: f64, theta1: f64, theta2: f64
     }
 }
 
-/// Eq. 26, curve i: `L3 = 0` [m].
+/// Eq. 26, curve i: `L3 = 0` \[m\].
 pub fn curve_i_eq26(l3: f64) -> f64 {
     l3
 }
@@ -618,7 +618,7 @@ pub fn curve_ii_eq27(theta1: f64) -> f64 {
     theta1.sin()
 }
 
-/// Eq. 28, curve iii: `eta1 = 0` [N] (where the paper's `[0, pi]` FK branch
+/// Eq. 28, curve iii: `eta1 = 0` \[N\] (where the paper's `[0, pi]` FK branch
 /// jumps; `det J` stays finite on both true branches).
 pub fn curve_iii_eq28(p: &Params, l3: f64, theta1: f64) -> f64 {
     eta(p, l3, theta1).0
@@ -643,7 +643,7 @@ pub fn curve_iii_theta1(p: &Params, l3: f64) -> Option<f64> {
     Some(0.5 * (lo + hi))
 }
 
-/// Eq. 33, curve iv (`theta1 = theta2 mod pi` substituted in Eq. 5) [N*m]:
+/// Eq. 33, curve iv (`theta1 = theta2 mod pi` substituted in Eq. 5) \[N*m\]:
 /// `2(2K1-K2) L sin th1 - 2 sqrt3 K2 L cos th1 + sqrt3 K1 L3` (correct algebra;
 /// equals `eta2 sin th1 - eta1 cos th1`).
 pub fn curve_iv_eq33(p: &Params, l3: f64, theta1: f64) -> f64 {
@@ -652,7 +652,7 @@ pub fn curve_iv_eq33(p: &Params, l3: f64, theta1: f64) -> f64 {
     2.0 * (2.0 * k1 - k2) * l * s1 - 2.0 * SQRT_3 * k2 * l * c1 + SQRT_3 * k1 * l3
 }
 
-/// `L3` on curve iv (Eq. 33 solved for `L3`) [m]; may be negative.
+/// `L3` on curve iv (Eq. 33 solved for `L3`) \[m\]; may be negative.
 pub fn curve_iv_l3(p: &Params, theta1: f64) -> f64 {
     let (l, k1, k2) = (p.l, p.k1, p.k2);
     let (s1, c1) = theta1.sin_cos();
@@ -678,13 +678,13 @@ pub fn curve_ii_eq35(p: &Params, x: f64, y: f64, l3: f64) -> f64 {
     (x - l3).powi(2) + y * y - p.l * p.l
 }
 
-/// Eq. 36 as printed [N*m]: `2 sqrt3 K1 x - (K1+2K2) y + 2 sqrt3 L (K2 - K1)` (wrong).
+/// Eq. 36 as printed \[N*m\]: `2 sqrt3 K1 x - (K1+2K2) y + 2 sqrt3 L (K2 - K1)` (wrong).
 pub fn curve_iii_eq36_as_printed(p: &Params, x: f64, y: f64) -> f64 {
     let (l, k1, k2) = (p.l, p.k1, p.k2);
     2.0 * SQRT_3 * k1 * x - (k1 + 2.0 * k2) * y + 2.0 * SQRT_3 * l * (k2 - k1)
 }
 
-/// Curve iii (`eta1 = 0`) in Cartesian space, derived [N*m]. On `eta1 = 0`
+/// Curve iii (`eta1 = 0`) in Cartesian space, derived \[N*m\]. On `eta1 = 0`
 /// the equilibria are `theta2 = 0` and `theta2 = pi`; with `theta2 = 0`
 /// (`theta2_is_pi = false`, the paper's Eq. 38-39):
 /// `(K1+2K2) y - sqrt3 K1 x + sqrt3 (K1+2K2) L = 0`; with `theta2 = pi`:
@@ -712,7 +712,7 @@ pub fn curve_iv_cartesian(p: &Params, x: f64, y: f64) -> f64 {
     2.0 * (2.0 * k1 - k2) * l * y - 2.0 * SQRT_3 * k2 * l * x + SQRT_3 * k1 * (r * r - l * r)
 }
 
-/// The neutral point `D1*` [m]: the actuator-node position where
+/// The neutral point `D1*` \[m\]: the actuator-node position where
 /// `eta1 = eta2 = 0`, i.e. where `U` does not depend on `theta2` (`K = 0`).
 pub fn neutral_point(p: &Params) -> Vector2<f64> {
     let (l, k1, k2) = (p.l, p.k1, p.k2);
@@ -774,7 +774,7 @@ pub fn stiffness_xy_derived(p: &Params, x: f64, y: f64, theta2: f64) -> f64 {
         + (0.5 * k1 + k2) * l * l
 }
 
-/// The `theta2` root Eq. 52 uses [rad]:
+/// The `theta2` root Eq. 52 uses \[rad\]:
 /// `2 atan((delta2 + sqrt(delta1^2+delta2^2-3K1^2L^2)) / (sqrt3 K1 L - delta1))`
 /// (a correct root of Eq. 48; NaN outside the workspace).
 pub fn theta2_eq52(p: &Params, x: f64, y: f64) -> f64 {

@@ -14,11 +14,11 @@ use crate::structure::{
 /// Model choices that the paper does not give (defaults in `Ji2014::params`).
 #[derive(Clone, Copy, Debug)]
 pub struct ModelChoices {
-    /// Mass of the mobile triangle [kg], three equal point masses at its nodes.
+    /// Mass of the mobile triangle \[kg\], three equal point masses at its nodes.
     pub platform_mass_kg: f64,
     /// Viscous damping of the pivot at D1 [N m s/rad].
     pub pivot_damping: f64,
-    /// Strut radius for drawing and interference [m].
+    /// Strut radius for drawing and interference \[m\].
     pub strut_radius_m: f64,
 }
 

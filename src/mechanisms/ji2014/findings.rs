@@ -20,7 +20,7 @@ fn sample_inputs(p: &Params) -> Vec<(f64, f64)> {
     v
 }
 
-/// What every equation group receives: the parameters, the [`sample_inputs`] for them and the
+/// What every equation group receives: the parameters, the `sample_inputs` for them and the
 /// energy scale `(K1 + K2) L^2` that the errors are divided by.
 pub struct Samples {
     pub p: Params,
@@ -83,7 +83,7 @@ pub const EQUATION_GROUPS: &[EquationGroup<Samples>] = &[
 ];
 
 /// Every printed equation checked against the derivation, with numbers: the findings of every
-/// group of [`EQUATION_GROUPS`]. Generic identities are checked at [`sample_inputs`] for `p` (both
+/// group of [`EQUATION_GROUPS`]. Generic identities are checked at `sample_inputs` for `p` (both
 /// equilibria); figure-specific claims use [`Params::PAPER_WORKSPACE`] and
 /// [`Params::PAPER_FIG4`].
 pub fn findings(p: &Params) -> Vec<Finding> {

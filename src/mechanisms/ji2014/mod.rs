@@ -14,7 +14,7 @@ use analytic::Params;
 
 pub struct Ji2014;
 
-/// Default start of the free coordinate: this far from the stable root [rad], so that every
+/// Default start of the free coordinate: this far from the stable root \[rad\], so that every
 /// settle is a real dynamic approach rather than a check of the initial guess.
 pub const DEFAULT_START_OFFSET_RAD: f64 = 0.5;
 

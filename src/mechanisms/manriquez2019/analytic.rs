@@ -3,8 +3,8 @@
 //! "Form-Finding Analysis of a Class 2 Tensegrity Robot", Appl. Sci. 9, 2948.
 //!
 //! Everything here is a pure function of `f64` / `nalgebra` values.
-//! **Public API units are SI**: lengths [m], angles [rad], forces [N],
-//! moments [N*m], stiffness [N/m], energies [J]. The paper's tables are in
+//! **Public API units are SI**: lengths \[m\], angles \[rad\], forces \[N\],
+//! moments \[N*m\], stiffness [N/m], energies \[J\]. The paper's tables are in
 //! millimetres and N*mm; they are kept as `*_MM` / `*_NMM` constants and the
 //! helpers [`to_mm`], [`from_mm`], [`vec_to_mm`] convert.
 //!
@@ -49,6 +49,7 @@
 
 use crate::mechanisms::ParamError;
 use nalgebra::{Matrix2, Matrix3, Matrix4, Vector2, Vector3};
+use std::cmp::Ordering;
 
 // ---------------------------------------------------------------------------
 // Paper constants (Table 1-3, 5) and unit helpers.
@@ -56,17 +57,17 @@ use nalgebra::{Matrix2, Matrix3, Matrix4, Vector2, Vector3};
 
 /// Millimetres per metre.
 pub const MM_PER_M: f64 = 1000.0;
-/// Table 1-2: `a2`, distance from the joint centre to the platform [mm].
+/// Table 1-2: `a2`, distance from the joint centre to the platform \[mm\].
 pub const A2_MM: f64 = 210.0;
-/// Table 2: `l1`, distance from the base to the joint centre [mm].
+/// Table 2: `l1`, distance from the base to the joint centre \[mm\].
 pub const L1_MM: f64 = 190.0;
-/// Table 2: `l2`, width of the moving platform [mm].
+/// Table 2: `l2`, width of the moving platform \[mm\].
 pub const L2_MM: f64 = 220.0;
-/// Table 2: mass of the moving platform [kg].
+/// Table 2: mass of the moving platform \[kg\].
 pub const PLATFORM_MASS_KG: f64 = 0.4732;
 /// Gravitational acceleration used throughout [m/s^2] (the paper gives none).
 pub const GRAVITY_M_S2: f64 = 9.81;
-/// Table 2: "initial" centroid `(x_ce, y_ce, z_ce)` in `Σ_W` [mm].
+/// Table 2: "initial" centroid `(x_ce, y_ce, z_ce)` in `Σ_W` \[mm\].
 pub const TABLE2_CENTROID_MM: [f64; 3] = [354.0442, 0.0, 76.4886];
 /// Decoded from Table 2: `|O G| = sqrt(164.0442^2 + 76.4886^2) = 181.000 mm`.
 pub const CENTROID_RADIUS_MM: f64 = 181.0;
@@ -74,17 +75,21 @@ pub const CENTROID_RADIUS_MM: f64 = 181.0;
 /// to four decimals like the paper's other angles). Table 2's centroid is the
 /// on-axis centroid at `θ = (0, -CENTROID_ELEVATION_RAD)`.
 pub const CENTROID_ELEVATION_RAD: f64 = 0.4363;
-/// Table 2: first value of both joint coordinates [rad].
+/// Table 2: first value of both joint coordinates \[rad\].
+// The paper's printed value, rounded to four decimals like its other angles: not `-π/6`.
+#[allow(clippy::approx_constant)]
 pub const GRID_START_RAD: f64 = -0.5236;
-/// Table 2: joint-coordinate increment [rad].
+/// Table 2: joint-coordinate increment \[rad\].
 pub const GRID_STEP_RAD: f64 = 0.0087;
-/// Upper end of the grid, symmetric to [`GRID_START_RAD`] (`π/6`, rounded) [rad].
+/// Upper end of the grid, symmetric to [`GRID_START_RAD`] (`π/6`, rounded) \[rad\].
+// The paper's printed value, rounded to four decimals like its other angles: not `π/6`.
+#[allow(clippy::approx_constant)]
 pub const GRID_END_RAD: f64 = 0.5236;
 /// Values per joint coordinate from `-0.5236` to `<= +0.5236` in steps of `0.0087`.
 pub const GRID_N_PER_AXIS: usize = 121;
 /// Table 2: "number of geometrical configurations analyzed".
 pub const PAPER_N_CONFIGURATIONS: usize = 14761;
-/// Table 3: `(θ1, θ2)` [rad] of the four numerical experiments.
+/// Table 3: `(θ1, θ2)` \[rad\] of the four numerical experiments.
 pub const TABLE3_EXPERIMENTS: [(f64, f64); 4] =
     [(0.0941, 0.0332), (0.0854, -0.0277), (-0.0625, 0.0245), (-0.0799, -0.0364)];
 
@@ -120,7 +125,7 @@ pub const TABLE5_ERROR_PERCENT: [[f64; 6]; 4] = [
     [10.91, 10.90, 0.03, 0.03, 2.89, 1.40],
 ];
 
-/// Fitted (not in the paper): `x` of the base plane holding `B1..B4` in `Σ_W` [mm]
+/// Fitted (not in the paper): `x` of the base plane holding `B1..B4` in `Σ_W` \[mm\]
 /// (negative: 72 mm beyond the base origin, on the side away from the joint).
 ///
 /// How found: least squares of the 24 numbers of [`TABLE5_ANALYTICAL`]
@@ -135,11 +140,11 @@ pub const TABLE5_ERROR_PERCENT: [[f64; 6]; 4] = [
 /// 66.3, 67.9, 202, 1073). The test `fitted_constants_minimise_table5_cost`
 /// re-checks the minimum.
 pub const FIT_BASE_X_MM: f64 = -72.2183;
-/// Fitted: half-side `b` of the base square [mm] (see [`FIT_BASE_X_MM`]).
+/// Fitted: half-side `b` of the base square \[mm\] (see [`FIT_BASE_X_MM`]).
 pub const FIT_BASE_HALF_MM: f64 = 136.3245;
 /// Fitted: spring rate of `r1`, `r2` [N/m] (see [`FIT_BASE_X_MM`]).
 pub const FIT_SPRING_K_N_PER_M: f64 = 4.99007;
-/// Chosen: spring rest length [mm] (the fit drives it to its bound 0; the
+/// Chosen: spring rest length \[mm\] (the fit drives it to its bound 0; the
 /// paper's "spring attached to a fixed-length cable" makes any value plausible).
 pub const FIT_SPRING_REST_MM: f64 = 0.0;
 
@@ -152,12 +157,12 @@ const INERTIA_ROD_COM_FRACTION: f64 = 0.5;
 const THIN_BAR_INERTIA_FACTOR: f64 = 1.0 / 12.0;
 
 /// Form-finding/statics: a cable tension or spring stretch within this of zero
-/// counts as zero (rounding) [N] / [m].
+/// counts as zero (rounding) \[N\] / \[m\].
 pub const TENSION_TOL_N: f64 = 1e-9;
 /// [`statics`]: the moment system counts as singular when `|det A|` is below
 /// this fraction of the product of its column norms.
 pub const SINGULAR_REL_DET: f64 = 1e-10;
-/// [`statics`]: offset used for the limit at the singular pose [rad].
+/// [`statics`]: offset used for the limit at the singular pose \[rad\].
 pub const SINGULAR_LIMIT_STEP_RAD: f64 = 1e-6;
 /// Newton iterations for [`theta_from_cable_lengths`].
 const NEWTON_MAX_ITERS: usize = 50;
@@ -176,7 +181,7 @@ pub fn to_mm(x_m: f64) -> f64 {
 pub fn from_mm(x_mm: f64) -> f64 {
     x_mm / MM_PER_M
 }
-/// A point [m] -> [mm].
+/// A point \[m\] -> \[mm\].
 pub fn vec_to_mm(v: &Vector3<f64>) -> Vector3<f64> {
     v * MM_PER_M
 }
@@ -188,25 +193,25 @@ pub fn vec_to_mm(v: &Vector3<f64>) -> Vector3<f64> {
 /// Mechanism parameters (SI).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params {
-    /// `a2`: joint centre to platform centre `M` [m].
+    /// `a2`: joint centre to platform centre `M` \[m\].
     pub a2: f64,
-    /// `l1`: base origin to joint centre `O`, along `x_W` [m].
+    /// `l1`: base origin to joint centre `O`, along `x_W` \[m\].
     pub l1: f64,
-    /// `l2`: platform width; attachment points at `(±l2/2, ±l2/2)` [m].
+    /// `l2`: platform width; attachment points at `(±l2/2, ±l2/2)` \[m\].
     pub l2: f64,
-    /// Platform mass [kg].
+    /// Platform mass \[kg\].
     pub mass: f64,
     /// Gravity magnitude [m/s^2], acting along `+x_W`.
     pub gravity: f64,
-    /// Centroid `G` in the platform frame, measured from `O` [m].
+    /// Centroid `G` in the platform frame, measured from `O` \[m\].
     pub centroid_local: [f64; 3],
-    /// `x_W` of the base plane of `B1..B4` [m].
+    /// `x_W` of the base plane of `B1..B4` \[m\].
     pub base_x: f64,
-    /// Half-side of the base square `B1..B4` [m].
+    /// Half-side of the base square `B1..B4` \[m\].
     pub base_half: f64,
     /// Spring rate of `r1`, `r2` [N/m].
     pub spring_k: f64,
-    /// Rest length of `r1`, `r2` [m].
+    /// Rest length of `r1`, `r2` \[m\].
     pub spring_rest: f64,
 }
 
@@ -360,7 +365,7 @@ pub fn t_w_m2(p: &Params, theta1: f64, theta2: f64) -> Matrix4<f64> {
     t_w_m_chain(p, theta1, theta2) * t_m_m2(p)
 }
 
-/// Eq. 8 as printed: `^W P_{M1}` [m].
+/// Eq. 8 as printed: `^W P_{M1}` \[m\].
 pub fn p_m1_eq8(p: &Params, theta1: f64, theta2: f64) -> Vector3<f64> {
     let (s1, c1) = theta1.sin_cos();
     let (s2, c2) = theta2.sin_cos();
@@ -368,7 +373,7 @@ pub fn p_m1_eq8(p: &Params, theta1: f64, theta2: f64) -> Vector3<f64> {
     Vector3::new(c1 * (-s2 * h + p.a2 * c2) - s1 * h + p.l1, s1 * (-s2 * h + p.a2 * c2) + c1 * h, -c2 * h - p.a2 * s2)
 }
 
-/// Eq. 9 as printed: `^W P_{M2}` [m].
+/// Eq. 9 as printed: `^W P_{M2}` \[m\].
 pub fn p_m2_eq9(p: &Params, theta1: f64, theta2: f64) -> Vector3<f64> {
     let (s1, c1) = theta1.sin_cos();
     let (s2, c2) = theta2.sin_cos();
@@ -376,7 +381,7 @@ pub fn p_m2_eq9(p: &Params, theta1: f64, theta2: f64) -> Vector3<f64> {
     Vector3::new(c1 * (s2 * h + p.a2 * c2) + s1 * h + p.l1, s1 * (s2 * h + p.a2 * c2) - c1 * h, c2 * h - p.a2 * s2)
 }
 
-/// Universal-joint centre `O` (origin of `Σ_0`) in `Σ_W` [m].
+/// Universal-joint centre `O` (origin of `Σ_0`) in `Σ_W` \[m\].
 pub fn joint_centre(p: &Params) -> Vector3<f64> {
     Vector3::new(p.l1, 0.0, 0.0)
 }
@@ -404,38 +409,38 @@ pub fn gravity_vector(p: &Params) -> Vector3<f64> {
     Vector3::new(p.gravity, 0.0, 0.0)
 }
 
-/// Cable attachment points on the platform, platform frame from `O` [m]:
+/// Cable attachment points on the platform, platform frame from `O` \[m\]:
 /// `M1 = (a2, l2/2, -l2/2)`, `M2 = (a2, -l2/2, l2/2)` (Eq. 4-5).
 pub fn cable_platform_local(p: &Params) -> [Vector3<f64>; 2] {
     let h = 0.5 * p.l2;
     [Vector3::new(p.a2, h, -h), Vector3::new(p.a2, -h, h)]
 }
 
-/// Spring attachment points on the platform, platform frame from `O` [m]:
+/// Spring attachment points on the platform, platform frame from `O` \[m\]:
 /// `R1 = (a2, l2/2, l2/2)`, `R2 = (a2, -l2/2, -l2/2)` (model choice).
 pub fn spring_platform_local(p: &Params) -> [Vector3<f64>; 2] {
     let h = 0.5 * p.l2;
     [Vector3::new(p.a2, h, h), Vector3::new(p.a2, -h, -h)]
 }
 
-/// Cable base points `B1 = (bx, b, -b)`, `B2 = (bx, -b, b)` in `Σ_W` [m] (Eq. 10-11).
+/// Cable base points `B1 = (bx, b, -b)`, `B2 = (bx, -b, b)` in `Σ_W` \[m\] (Eq. 10-11).
 pub fn cable_base_points(p: &Params) -> [Vector3<f64>; 2] {
     let b = p.base_half;
     [Vector3::new(p.base_x, b, -b), Vector3::new(p.base_x, -b, b)]
 }
 
-/// Spring base points `B3 = (bx, b, b)`, `B4 = (bx, -b, -b)` in `Σ_W` [m].
+/// Spring base points `B3 = (bx, b, b)`, `B4 = (bx, -b, -b)` in `Σ_W` \[m\].
 pub fn spring_base_points(p: &Params) -> [Vector3<f64>; 2] {
     let b = p.base_half;
     [Vector3::new(p.base_x, b, b), Vector3::new(p.base_x, -b, -b)]
 }
 
-/// A platform-frame point (from `O`) in `Σ_W` at `(θ1, θ2)` [m].
+/// A platform-frame point (from `O`) in `Σ_W` at `(θ1, θ2)` \[m\].
 pub fn platform_point(p: &Params, theta1: f64, theta2: f64, local: &Vector3<f64>) -> Vector3<f64> {
     joint_centre(p) + rotation(theta1, theta2) * local
 }
 
-/// Named points of the platform in `Σ_W` [m].
+/// Named points of the platform in `Σ_W` \[m\].
 #[derive(Clone, Copy, Debug)]
 pub struct Points {
     /// Joint centre `O`.
@@ -464,14 +469,14 @@ pub fn points(p: &Params, theta1: f64, theta2: f64) -> Points {
     }
 }
 
-/// Eq. 12-13: cable lengths `(L_C1, L_C2)` [m].
+/// Eq. 12-13: cable lengths `(L_C1, L_C2)` \[m\].
 pub fn cable_lengths(p: &Params, theta1: f64, theta2: f64) -> [f64; 2] {
     let q = points(p, theta1, theta2);
     let b = cable_base_points(p);
     [(q.cable_platform[0] - b[0]).norm(), (q.cable_platform[1] - b[1]).norm()]
 }
 
-/// Spring lengths `(L_r1, L_r2)` [m].
+/// Spring lengths `(L_r1, L_r2)` \[m\].
 pub fn spring_lengths(p: &Params, theta1: f64, theta2: f64) -> [f64; 2] {
     let q = points(p, theta1, theta2);
     let b = spring_base_points(p);
@@ -491,15 +496,15 @@ pub fn ik_pose_as_printed(t: &Matrix4<f64>) -> (f64, f64) {
     (t[(1, 2)].atan2(t[(0, 2)]), (-t[(2, 0)]).atan2(t[(2, 2)]))
 }
 
-/// Inverse kinematics from the position of `M` (translation of Eq. 14) [m]:
+/// Inverse kinematics from the position of `M` (translation of Eq. 14) \[m\]:
 /// A platform point `M` off the sphere of radius `a2` about the joint centre `O`: no joint
 /// angles place it.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("|M - O| = {distance_m:.6} m must equal a2 = {a2_m:.6} m")]
 pub struct OffSphere {
-    /// `|M - O|` [m].
+    /// `|M - O|` \[m\].
     pub distance_m: f64,
-    /// `a2` [m].
+    /// `a2` \[m\].
     pub a2_m: f64,
 }
 
@@ -536,7 +541,7 @@ pub fn cable_length_jacobian(p: &Params, theta1: f64, theta2: f64) -> Matrix2<f6
 }
 
 /// Actuator-space forward kinematics: `(θ1, θ2)` whose Eq. 12-13 cable lengths
-/// are `lengths` [m], by Newton's method from `guess`. `None` if it does not
+/// are `lengths` \[m\], by Newton's method from `guess`. `None` if it does not
 /// converge (singular Jacobian or no solution nearby).
 pub fn theta_from_cable_lengths(p: &Params, lengths: [f64; 2], guess: (f64, f64)) -> Option<(f64, f64)> {
     let mut th = Vector2::new(guess.0, guess.1);
@@ -556,7 +561,7 @@ pub fn theta_from_cable_lengths(p: &Params, lengths: [f64; 2], guess: (f64, f64)
     ((l[0] - lengths[0]).abs().max((l[1] - lengths[1]).abs()) < 1e3 * NEWTON_TOL_M).then_some((th.x, th.y))
 }
 
-/// Every `(θ1, θ2)` in `[-π/2, π/2]^2` with the given cable lengths [m]: Newton
+/// Every `(θ1, θ2)` in `[-π/2, π/2]^2` with the given cable lengths \[m\]: Newton
 /// from a 7x7 grid of starts over `±0.6 rad`, duplicates (within 1e-9 rad)
 /// merged. Generically two solutions near `θ = 0`: the pose and (nearly) its
 /// mirror image in the cable plane `y = -z` (the map θ → (L_C1, L_C2) folds
@@ -586,7 +591,7 @@ pub fn all_thetas_from_cable_lengths(p: &Params, lengths: [f64; 2]) -> Vec<(f64,
 // Statics (Eq. 18-23, 26-27).
 // ---------------------------------------------------------------------------
 
-/// Spring forces `k max(0, L - L0)` [N] (tension-only).
+/// Spring forces `k max(0, L - L0)` \[N\] (tension-only).
 pub fn spring_forces(p: &Params, theta1: f64, theta2: f64) -> [f64; 2] {
     let l = spring_lengths(p, theta1, theta2);
     [p.spring_k * (l[0] - p.spring_rest).max(0.0), p.spring_k * (l[1] - p.spring_rest).max(0.0)]
@@ -595,27 +600,27 @@ pub fn spring_forces(p: &Params, theta1: f64, theta2: f64) -> [f64; 2] {
 /// Result of the static analysis of the moving platform.
 #[derive(Clone, Copy, Debug)]
 pub struct Statics {
-    /// Cable tensions `(T_C1, T_C2)` [N]; negative means the cable would have to push.
+    /// Cable tensions `(T_C1, T_C2)` \[N\]; negative means the cable would have to push.
     pub cable_tensions: [f64; 2],
-    /// Spring forces `(f_R1, f_R2)` [N], `k max(0, L - L0)`.
+    /// Spring forces `(f_R1, f_R2)` \[N\], `k max(0, L - L0)`.
     pub spring_forces: [f64; 2],
     /// Unit vectors from the platform ends toward `B1, B2` (cables) [-].
     pub cable_directions: [Vector3<f64>; 2],
     /// Unit vectors from the platform ends toward `B3, B4` (springs) [-].
     pub spring_directions: [Vector3<f64>; 2],
-    /// Force exerted by the joint on the platform, `Σ_W` [N].
+    /// Force exerted by the joint on the platform, `Σ_W` \[N\].
     pub joint_reaction_force: Vector3<f64>,
-    /// Moment exerted by the joint on the platform about `O`, `Σ_W` [N*m];
+    /// Moment exerted by the joint on the platform about `O`, `Σ_W` \[N*m\];
     /// always parallel to [`joint_constrained_axis`].
     pub joint_reaction_moment: Vector3<f64>,
-    /// The joint moment as a signed scalar along `n = z_W × y_M` [N*m]; this is
+    /// The joint moment as a signed scalar along `n = z_W × y_M` \[N*m\]; this is
     /// the sign convention of Table 5's `m_joint` (which is in N*mm).
     pub joint_moment_paper_sign: f64,
-    /// Weight `m g` on the platform [N] (`Σ_W`).
+    /// Weight `m g` on the platform \[N\] (`Σ_W`).
     pub weight: Vector3<f64>,
-    /// Cable lengths (Eq. 12-13) [m].
+    /// Cable lengths (Eq. 12-13) \[m\].
     pub cable_lengths: [f64; 2],
-    /// Spring lengths [m].
+    /// Spring lengths \[m\].
     pub spring_lengths: [f64; 2],
     /// Both cables in tension (`T >= -TENSION_TOL_N`).
     pub cables_taut: bool,
@@ -649,16 +654,11 @@ pub fn statics(p: &Params, theta1: f64, theta2: f64) -> Statics {
                 .collect();
             let k = ss.len() as f64;
             let mut s = statics_regular_unchecked(p, theta1, theta2);
-            let avg2 = |g: &dyn Fn(&Statics) -> [f64; 2]| {
-                let mut r = [0.0; 2];
-                for x in &ss {
-                    let v = g(x);
-                    r[0] += v[0] / k;
-                    r[1] += v[1] / k;
-                }
-                r
-            };
-            s.cable_tensions = avg2(&|x| x.cable_tensions);
+            s.cable_tensions = [0.0; 2];
+            for x in &ss {
+                s.cable_tensions[0] += x.cable_tensions[0] / k;
+                s.cable_tensions[1] += x.cable_tensions[1] / k;
+            }
             s.joint_reaction_force = ss.iter().map(|x| x.joint_reaction_force).sum::<Vector3<f64>>() / k;
             s.joint_moment_paper_sign = ss.iter().map(|x| x.joint_moment_paper_sign).sum::<f64>() / k;
             s.joint_reaction_moment = s.joint_moment_paper_sign * joint_constrained_axis(theta1, theta2);
@@ -698,7 +698,8 @@ fn statics_regular_unchecked(p: &Params, theta1: f64, theta2: f64) -> Statics {
         n,
     ]);
     let scale = a.column(0).norm() * a.column(1).norm() * a.column(2).norm();
-    let singular = !(a.determinant().abs() > SINGULAR_REL_DET * scale);
+    // Unordered (a NaN in the matrix) counts as singular.
+    let singular = a.determinant().abs().partial_cmp(&(SINGULAR_REL_DET * scale)).is_none_or(Ordering::is_le);
     let x = if singular {
         Vector3::repeat(f64::NAN)
     } else {
@@ -731,15 +732,15 @@ fn statics_regular_unchecked(p: &Params, theta1: f64, theta2: f64) -> Statics {
 }
 
 /// Eq. 27 as printed (garbled scan, read literally): all four flexible
-/// magnitudes `>= 0`, `|f_joint| <= 0`, `|m_joint| = 0` (within `tol_n` [N] and
-/// `tol_nm` [N*m]).
+/// magnitudes `>= 0`, `|f_joint| <= 0`, `|m_joint| = 0` (within `tol_n` \[N\] and
+/// `tol_nm` \[N*m\]).
 pub fn equilibrium_eq27_as_printed(s: &Statics, tol_n: f64, tol_nm: f64) -> bool {
     s.cable_tensions.iter().chain(s.spring_forces.iter()).all(|f| f.abs() >= 0.0)
         && s.joint_reaction_force.norm() <= tol_n
         && s.joint_reaction_moment.norm() <= tol_nm
 }
 
-/// Total potential of gravity and springs [J] (zero at `x_W = 0` / `L = L0`).
+/// Total potential of gravity and springs \[J\] (zero at `x_W = 0` / `L = L0`).
 pub fn potential_gravity_springs(p: &Params, theta1: f64, theta2: f64) -> f64 {
     let q = points(p, theta1, theta2);
     let ls = spring_lengths(p, theta1, theta2);
@@ -748,7 +749,7 @@ pub fn potential_gravity_springs(p: &Params, theta1: f64, theta2: f64) -> f64 {
 }
 
 /// Generalised forces `Q_j = a_j · M_O` [N*m/rad] of gravity, springs and cable
-/// tensions `tensions` [N] on the platform (`a_1 = z_W`, `a_2 = y_M`);
+/// tensions `tensions` \[N\] on the platform (`a_1 = z_W`, `a_2 = y_M`);
 /// `Q = -∇V_gs - J_Lᵀ T`. Zero at an equilibrium with the [`statics`] tensions.
 pub fn generalized_forces(p: &Params, theta1: f64, theta2: f64, tensions: [f64; 2]) -> Vector2<f64> {
     let q = points(p, theta1, theta2);
@@ -817,7 +818,7 @@ pub fn platform_inertia(p: &Params) -> Matrix3<f64> {
 /// Everything the dynamic-model builder needs at `(θ1, θ2)`, in `Σ_W`, SI.
 #[derive(Clone, Debug)]
 pub struct DynamicModel {
-    /// Joint centre `O` [m].
+    /// Joint centre `O` \[m\].
     pub joint_centre: Vector3<f64>,
     /// Joint axis fixed in the base (`θ1`) [unit].
     pub joint_axis_base: Vector3<f64>,
@@ -825,22 +826,22 @@ pub struct DynamicModel {
     pub joint_axis_platform: Vector3<f64>,
     /// Platform orientation `R = Rz(θ1) Ry(θ2)` (columns `x_M, y_M, z_M`).
     pub rotation: Matrix3<f64>,
-    /// Centre of mass `G` [m].
+    /// Centre of mass `G` \[m\].
     pub com: Vector3<f64>,
-    /// Platform mass [kg].
+    /// Platform mass \[kg\].
     pub mass: f64,
     /// Inertia about `G` in platform axes [kg*m^2] ([`platform_inertia`]).
     pub inertia_local: Matrix3<f64>,
     /// Gravity [m/s^2].
     pub gravity: Vector3<f64>,
-    /// Cable (base point, platform point) pairs [m].
+    /// Cable (base point, platform point) pairs \[m\].
     pub cables: [(Vector3<f64>, Vector3<f64>); 2],
-    /// Spring (base point, platform point) pairs [m].
+    /// Spring (base point, platform point) pairs \[m\].
     pub springs: [(Vector3<f64>, Vector3<f64>); 2],
-    /// Spring rate [N/m] and rest length [m].
+    /// Spring rate [N/m] and rest length \[m\].
     pub spring_k: f64,
     pub spring_rest: f64,
-    /// Cable lengths at this pose (the actuator commands) [m].
+    /// Cable lengths at this pose (the actuator commands) \[m\].
     pub cable_lengths: [f64; 2],
 }
 
@@ -903,7 +904,7 @@ pub fn table5_cost(p: &Params) -> f64 {
 }
 
 /// Grid of joint coordinates `(θ1, θ2)`, `θ1` outer: `start + i step`,
-/// `i < n1`, and `start + j step`, `j < n2` [rad].
+/// `i < n1`, and `start + j step`, `j < n2` \[rad\].
 pub fn form_finding_grid(start: f64, step: f64, n1: usize, n2: usize) -> Vec<(f64, f64)> {
     let mut v = Vec::with_capacity(n1 * n2);
     for i in 0..n1 {
@@ -1157,6 +1158,8 @@ mod tests {
     }
 
     #[test]
+    // The grid starts at Table 2's printed -0.5236 rad (rounded, not -π/6): the test says so.
+    #[allow(clippy::approx_constant)]
     fn paper_grid_has_121_by_121_points_not_14761() {
         let g = paper_grid();
         assert_eq!(g.len(), 14641);

@@ -21,11 +21,11 @@ fn arr(v: Vector3<f64>) -> Vec3 {
 pub struct ModelChoices {
     /// Viscous damping of the universal joint [N m s/rad] (zero at rest).
     pub joint_damping: f64,
-    /// Strut radius for drawing and interference [m].
+    /// Strut radius for drawing and interference \[m\].
     pub strut_radius_m: f64,
 }
 
-/// The structure at the start pose (theta1, theta2), cables at `cable_lengths` [m].
+/// The structure at the start pose (theta1, theta2), cables at `cable_lengths` \[m\].
 pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64, cable_lengths: [f64; 2]) -> Structure {
     let d = analytic::dynamic_model(p, theta1, theta2);
     let mut s = Structure { name: "manriquez2019".into(), gravity: arr(d.gravity), ..Default::default() };

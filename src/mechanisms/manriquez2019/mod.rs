@@ -16,7 +16,7 @@ use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 pub struct Manriquez2019;
 
-/// Default start: both joint angles this far from the target [rad], so every settle is a real
+/// Default start: both joint angles this far from the target \[rad\], so every settle is a real
 /// dynamic approach (the cable lengths are those of the target).
 pub const DEFAULT_START_OFFSET_RAD: f64 = 0.03;
 

@@ -3,9 +3,9 @@
 //! tensegrity mechanism", Trans. CSME 35(4).
 //!
 //! Everything here is a pure function of `f64` / `nalgebra` values.
-//! Units: lengths in metres [m], angles in radians [rad], forces in newtons
-//! [N], force densities (tension coefficients) in [N/m], torques in [N m],
-//! the torsion spring constant `kappa` in [N m/rad], energies in joules [J].
+//! Units: lengths in metres \[m\], angles in radians \[rad\], forces in newtons
+//! \[N\], force densities (tension coefficients) in [N/m], torques in [N m],
+//! the torsion spring constant `kappa` in [N m/rad], energies in joules \[J\].
 //!
 //! # Model (paper Eq. 1-6)
 //! * Fixed frame `XYZ` at the centroid `O` of the base triangle `A1A2A3`
@@ -47,7 +47,7 @@
 //!   The text's "fully extended springs no longer apply any compressive force"
 //!   is false. The outer static boundary coincides with the kinematic sphere
 //!   `l_i = lo` only where the triangle inequality below still holds (63% of
-//!   the sphere patch for `lo = 3 lb`, see [`outer_boundary_survey`]).
+//!   the sphere patch for `lo = 3 lb`, see [`outer_boundary_survey`](super::findings::outer_boundary_survey)).
 //! * Eq. 26-28 are the unique solution of Eq. 19 (for `z != 0`); Eq. 29-31
 //!   say that the three compression force densities `g_i = -f_i/l_i` obey
 //!   the strict triangle inequality. Because `f` is linear in `kappa`, the
@@ -85,14 +85,14 @@ const DKP_RADICAND_REL_TOL: f64 = 1e-12;
 /// Mechanism parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params {
-    /// Side of the base and end-effector triangles `l_b` [m].
+    /// Side of the base and end-effector triangles `l_b` \[m\].
     pub lb: f64,
-    /// Length of a straight virtual spring `l_o` [m] (two links of `lo/2`);
+    /// Length of a straight virtual spring `l_o` \[m\] (two links of `lo/2`);
     /// also the maximum spring length `l_max` of Eq. 18.
     pub lo: f64,
     /// Torsion spring constant `kappa` [N m/rad] (Eq. 4), same for all three.
     pub kappa: f64,
-    /// Minimum spring length `l_min` [m] of Eq. 17 (the paper uses 0).
+    /// Minimum spring length `l_min` \[m\] of Eq. 17 (the paper uses 0).
     pub l_min: f64,
 }
 
@@ -125,7 +125,7 @@ impl Params {
 // Geometry (Eq. 1-2, 6, 10, 15-16).
 // ---------------------------------------------------------------------------
 
-/// Eq. 1: base nodes `a_i` [m] in `XYZ` (index 0, 1, 2 = `A1, A2, A3`).
+/// Eq. 1: base nodes `a_i` \[m\] in `XYZ` (index 0, 1, 2 = `A1, A2, A3`).
 pub fn base_nodes(p: &Params) -> [Vector3<f64>; 3] {
     let l = p.lb;
     [
@@ -135,13 +135,13 @@ pub fn base_nodes(p: &Params) -> [Vector3<f64>; 3] {
     ]
 }
 
-/// Eq. 2: platform node offsets `b_i` [m] in the body frame `X'Y'Z'`
+/// Eq. 2: platform node offsets `b_i` \[m\] in the body frame `X'Y'Z'`
 /// (parallel to `XYZ`); `b_i = -a_i`.
 pub fn platform_offsets(p: &Params) -> [Vector3<f64>; 3] {
     base_nodes(p).map(|a| -a)
 }
 
-/// Platform nodes `B_i = p + b_i` [m] in `XYZ` for centroid `p` (pure translation).
+/// Platform nodes `B_i = p + b_i` \[m\] in `XYZ` for centroid `p` (pure translation).
 pub fn platform_nodes(p: &Params, centroid: &Vector3<f64>) -> [Vector3<f64>; 3] {
     platform_offsets(p).map(|b| centroid + b)
 }
@@ -167,7 +167,7 @@ pub const CABLES: [Cable; 6] = [
     Cable { base: 1, platform: 0, rho: 2 },
 ];
 
-/// Lengths [m] of the six cables ([`CABLES`] order) for a platform with
+/// Lengths \[m\] of the six cables ([`CABLES`] order) for a platform with
 /// centroid `centroid` and orientation `rot` (body frame -> `XYZ`). With
 /// `rot = identity` the pairs are equal (Eq. 7-9).
 pub fn cable_lengths_posed(p: &Params, centroid: &Vector3<f64>, rot: &Rotation3<f64>) -> [f64; 6] {
@@ -176,12 +176,12 @@ pub fn cable_lengths_posed(p: &Params, centroid: &Vector3<f64>, rot: &Rotation3<
     CABLES.map(|c| (centroid + rot * b[c.platform] - a[c.base]).norm())
 }
 
-/// Lengths [m] of the six cables for a translated platform.
+/// Lengths \[m\] of the six cables for a translated platform.
 pub fn cable_lengths(p: &Params, centroid: &Vector3<f64>) -> [f64; 6] {
     cable_lengths_posed(p, centroid, &Rotation3::identity())
 }
 
-/// Eq. 15 (IKP): `rho_j = |p + a_j|` [m].
+/// Eq. 15 (IKP): `rho_j = |p + a_j|` \[m\].
 pub fn ikp(p: &Params, centroid: &Vector3<f64>) -> [f64; 3] {
     base_nodes(p).map(|a| (centroid + a).norm())
 }
@@ -202,8 +202,8 @@ pub fn dkp_radicand_eq14(p: &Params, rho: &[f64; 3]) -> f64 {
     -u1 * u1 - u2 * u2 - u3 * u3 + u1 * u2 + u1 * u3 + u2 * u3 + l2 * (u1 + u2 + u3 - l2)
 }
 
-/// Eq. 12-14 (DKP), the `z >= 0` branch: centroid [m] from the actuated
-/// lengths `rho` [m]. `None` when the radicand of Eq. 14 is negative (no
+/// Eq. 12-14 (DKP), the `z >= 0` branch: centroid \[m\] from the actuated
+/// lengths `rho` \[m\]. `None` when the radicand of Eq. 14 is negative (no
 /// assembly) or a `rho` is negative / not finite. The `z < 0` mirror image
 /// is `(x, y, -z)`.
 pub fn dkp(p: &Params, rho: &[f64; 3]) -> Option<Vector3<f64>> {
@@ -223,7 +223,7 @@ pub fn dkp(p: &Params, rho: &[f64; 3]) -> Option<Vector3<f64>> {
     Some(Vector3::new(x, y, z))
 }
 
-/// Eq. 16: effective spring lengths `l_i = |p + b_i - a_i| = |p - 2 a_i|` [m].
+/// Eq. 16: effective spring lengths `l_i = |p + b_i - a_i| = |p - 2 a_i|` \[m\].
 pub fn spring_lengths(p: &Params, centroid: &Vector3<f64>) -> [f64; 3] {
     base_nodes(p).map(|a| (centroid - 2.0 * a).norm())
 }
@@ -232,7 +232,7 @@ pub fn spring_lengths(p: &Params, centroid: &Vector3<f64>) -> [f64; 3] {
 // Virtual compression spring (Eq. 3-5).
 // ---------------------------------------------------------------------------
 
-/// Eq. 3: half knee angle `theta = asin(l/lo)` [rad], for `0 <= l <= lo`
+/// Eq. 3: half knee angle `theta = asin(l/lo)` \[rad\], for `0 <= l <= lo`
 /// (NaN outside).
 pub fn half_angle(p: &Params, l: f64) -> f64 {
     if !(0.0..=p.lo).contains(&l) {
@@ -241,17 +241,17 @@ pub fn half_angle(p: &Params, l: f64) -> f64 {
     (l / p.lo).asin()
 }
 
-/// Knee angle `2 theta` [rad] between the two links (`pi` = straight, at rest).
+/// Knee angle `2 theta` \[rad\] between the two links (`pi` = straight, at rest).
 pub fn knee_angle(p: &Params, l: f64) -> f64 {
     2.0 * half_angle(p, l)
 }
 
-/// Spring length `l = lo sin(knee/2)` [m] for a knee angle in `[0, pi]`.
+/// Spring length `l = lo sin(knee/2)` \[m\] for a knee angle in `[0, pi]`.
 pub fn length_from_knee_angle(p: &Params, knee: f64) -> f64 {
     p.lo * (0.5 * knee).sin()
 }
 
-/// Distance `h = (lo/2) cos theta = sqrt(lo^2 - l^2)/2` [m] of the knee from
+/// Distance `h = (lo/2) cos theta = sqrt(lo^2 - l^2)/2` \[m\] of the knee from
 /// the line `A_iB_i` (the lever arm of the axial force about the knee).
 pub fn knee_offset(p: &Params, l: f64) -> f64 {
     0.5 * (p.lo * p.lo - l * l).max(0.0).sqrt()
@@ -264,29 +264,29 @@ pub fn torsion_torque(p: &Params, knee: f64) -> f64 {
     p.kappa * (knee - PI)
 }
 
-/// Torsion spring energy `E = kappa/2 (knee - pi)^2` [J].
+/// Torsion spring energy `E = kappa/2 (knee - pi)^2` \[J\].
 pub fn torsion_energy(p: &Params, knee: f64) -> f64 {
     0.5 * p.kappa * (knee - PI).powi(2)
 }
 
-/// Virtual spring energy as a function of its length, `E(l) = kappa/2 (2 asin(l/lo) - pi)^2` [J].
+/// Virtual spring energy as a function of its length, `E(l) = kappa/2 (2 asin(l/lo) - pi)^2` \[J\].
 pub fn spring_energy(p: &Params, l: f64) -> f64 {
     torsion_energy(p, knee_angle(p, l))
 }
 
-/// Moment balance about the knee: axial force `f = tau / h` [N] for knee
-/// torque `tau` [N m] (Eq. 4) at length `l` [m] (tension positive).
+/// Moment balance about the knee: axial force `f = tau / h` \[N\] for knee
+/// torque `tau` [N m] (Eq. 4) at length `l` \[m\] (tension positive).
 pub fn axial_force_from_torque(p: &Params, tau: f64, l: f64) -> f64 {
     tau / knee_offset(p, l)
 }
 
-/// Knee torque [N m] that balances axial force `f` [N] at length `l` [m]: `tau = f h`.
+/// Knee torque [N m] that balances axial force `f` \[N\] at length `l` \[m\]: `tau = f h`.
 pub fn torque_from_axial_force(p: &Params, f: f64, l: f64) -> f64 {
     f * knee_offset(p, l)
 }
 
 /// Eq. 5, derived and written without the `0/0` at `l = lo`:
-/// `f = dE/dl = -(4 kappa/lo) phi / sin(phi)`, `phi = acos(l/lo) = pi/2 - theta` [N].
+/// `f = dE/dl = -(4 kappa/lo) phi / sin(phi)`, `phi = acos(l/lo) = pi/2 - theta` \[N\].
 /// Tension positive, so `f < 0` (compression) on `0 <= l <= lo`, from
 /// `-2 pi kappa/lo` at `l = 0` to `-4 kappa/lo` at `l = lo`. NaN outside `[0, lo]`.
 pub fn spring_force(p: &Params, l: f64) -> f64 {
@@ -298,14 +298,14 @@ pub fn spring_force(p: &Params, l: f64) -> f64 {
     -FULL_EXTENSION_FORCE_FACTOR * p.kappa / p.lo * ratio
 }
 
-/// Eq. 5 exactly as printed: `f = 2 kappa (2 asin(l/lo) - pi) / (lo sqrt(1 - (l/lo)^2))` [N]
+/// Eq. 5 exactly as printed: `f = 2 kappa (2 asin(l/lo) - pi) / (lo sqrt(1 - (l/lo)^2))` \[N\]
 /// (NaN at `l = lo`: `0/0`).
 pub fn spring_force_eq5_as_printed(p: &Params, l: f64) -> f64 {
     let s = l / p.lo;
     2.0 * p.kappa * (2.0 * s.asin() - PI) / (p.lo * (1.0 - s * s).sqrt())
 }
 
-/// `lim_{l -> lo} f = -4 kappa / lo` [N]: the spring still pushes when fully extended.
+/// `lim_{l -> lo} f = -4 kappa / lo` \[N\]: the spring still pushes when fully extended.
 pub fn spring_force_full_extension_limit(p: &Params) -> f64 {
     -FULL_EXTENSION_FORCE_FACTOR * p.kappa / p.lo
 }
@@ -318,11 +318,11 @@ pub fn force_density(p: &Params, l: f64) -> f64 {
 /// One virtual spring placed in space, for the dynamic model.
 #[derive(Clone, Copy, Debug)]
 pub struct SpringChain {
-    /// Base node `A_i` (universal joint centre) [m].
+    /// Base node `A_i` (universal joint centre) \[m\].
     pub a: Vector3<f64>,
-    /// Platform node `B_i` (spherical joint centre) [m].
+    /// Platform node `B_i` (spherical joint centre) \[m\].
     pub b: Vector3<f64>,
-    /// Knee (revolute joint centre) [m]: `(A+B)/2 + h c`, `c` the unit vector in
+    /// Knee (revolute joint centre) \[m\]: `(A+B)/2 + h c`, `c` the unit vector in
     /// the chain plane perpendicular to `AB` with `c . e1 > 0`.
     pub knee: Vector3<f64>,
     /// First universal-joint axis (fixed to the base): `e1 = z x a_i/|a_i|`,
@@ -331,13 +331,13 @@ pub struct SpringChain {
     /// Second universal-joint axis = knee revolute axis = chain-plane normal:
     /// `e2 = (e1 x (B-A)) / |e1 x (B-A)|`.
     pub e2: Vector3<f64>,
-    /// Effective length `l_i` [m].
+    /// Effective length `l_i` \[m\].
     pub length: f64,
-    /// Knee angle `2 theta_i` [rad].
+    /// Knee angle `2 theta_i` \[rad\].
     pub knee_angle: f64,
     /// Eq. 4 torque [N m].
     pub torque: f64,
-    /// Eq. 5 axial force [N] (tension positive).
+    /// Eq. 5 axial force \[N\] (tension positive).
     pub force: f64,
 }
 
@@ -441,13 +441,13 @@ pub fn wt_as_printed(p: &Params, centroid: &Vector3<f64>) -> Matrix6<f64> {
     m
 }
 
-/// Spring forces `f_i` [N] (Eq. 5) at the platform pose (NaN if some `l_i > lo`).
+/// Spring forces `f_i` \[N\] (Eq. 5) at the platform pose (NaN if some `l_i > lo`).
 pub fn spring_forces(p: &Params, centroid: &Vector3<f64>) -> [f64; 3] {
     spring_lengths(p, centroid).map(|l| spring_force(p, l))
 }
 
-/// Eq. 24: `t = -W_t^{-1} W_f f` [N] by LU on the full 6x6 system, for given
-/// spring forces `f` [N]. NaN entries when `W_t` is singular (`z = 0`).
+/// Eq. 24: `t = -W_t^{-1} W_f f` \[N\] by LU on the full 6x6 system, for given
+/// spring forces `f` \[N\]. NaN entries when `W_t` is singular (`z = 0`).
 pub fn tensions_full_for(p: &Params, centroid: &Vector3<f64>, f: &[f64; 3]) -> [f64; 6] {
     let rhs = -(wf(p, centroid) * Vector3::from(*f));
     match wt(p, centroid).lu().solve(&rhs) {
@@ -456,8 +456,8 @@ pub fn tensions_full_for(p: &Params, centroid: &Vector3<f64>, f: &[f64; 3]) -> [
     }
 }
 
-/// Eq. 26-28 for given spring forces `f` [N]:
-/// `t_j = t_{j+3} = rho_j/2 (fh_j - fh_k - fh_l)` [N], `fh_i = f_i/l_i`.
+/// Eq. 26-28 for given spring forces `f` \[N\]:
+/// `t_j = t_{j+3} = rho_j/2 (fh_j - fh_k - fh_l)` \[N\], `fh_i = f_i/l_i`.
 pub fn tensions_closed_form_for(p: &Params, centroid: &Vector3<f64>, f: &[f64; 3]) -> [f64; 6] {
     let rho = ikp(p, centroid);
     let l = spring_lengths(p, centroid);
@@ -506,21 +506,21 @@ pub fn static_margins(p: &Params, centroid: &Vector3<f64>) -> [f64; 3] {
 /// Full static state at a translated pose.
 #[derive(Clone, Debug)]
 pub struct Statics {
-    /// Centroid `p` [m].
+    /// Centroid `p` \[m\].
     pub centroid: Vector3<f64>,
-    /// Actuated lengths `rho_j` [m] (Eq. 15).
+    /// Actuated lengths `rho_j` \[m\] (Eq. 15).
     pub rho: [f64; 3],
-    /// Spring lengths `l_i` [m] (Eq. 16).
+    /// Spring lengths `l_i` \[m\] (Eq. 16).
     pub spring_lengths: [f64; 3],
-    /// Knee angles `2 theta_i` [rad] (Eq. 3).
+    /// Knee angles `2 theta_i` \[rad\] (Eq. 3).
     pub knee_angles: [f64; 3],
-    /// Spring forces `f_i` [N] (Eq. 5), tension positive; NaN if `l_i > lo`.
+    /// Spring forces `f_i` \[N\] (Eq. 5), tension positive; NaN if `l_i > lo`.
     pub spring_forces: [f64; 3],
     /// Force densities `f_i / l_i` [N/m].
     pub force_densities: [f64; 3],
-    /// Cable tensions `t_1..t_6` [N] from the full 6x6 balance (Eq. 24).
+    /// Cable tensions `t_1..t_6` \[N\] from the full 6x6 balance (Eq. 24).
     pub tensions_full: [f64; 6],
-    /// Cable tensions from Eq. 26-28 [N].
+    /// Cable tensions from Eq. 26-28 \[N\].
     pub tensions_closed_form: [f64; 6],
     /// `det W_t` (Eq. 25).
     pub det_wt: f64,
@@ -532,7 +532,7 @@ pub struct Statics {
     pub in_static_workspace: bool,
 }
 
-/// Statics at centroid `centroid` [m]: spring forces from Eq. 5 and cable
+/// Statics at centroid `centroid` \[m\]: spring forces from Eq. 5 and cable
 /// tensions both by Eq. 24 and Eq. 26-28.
 pub fn statics(p: &Params, centroid: &Vector3<f64>) -> Statics {
     let l = spring_lengths(p, centroid);
@@ -602,7 +602,7 @@ pub struct WorkspacePoint {
 /// Kinematic constraints (`z > 0`, Eq. 17, Eq. 18) violated at `centroid`.
 pub fn kinematic_violations(p: &Params, centroid: &Vector3<f64>) -> Vec<Constraint> {
     let mut v = Vec::new();
-    if !(centroid.z > 0.0) {
+    if centroid.z.is_nan() || centroid.z <= 0.0 {
         v.push(Constraint::AboveBase);
     }
     for (i, l) in spring_lengths(p, centroid).iter().enumerate() {
@@ -621,7 +621,7 @@ pub fn static_violations(p: &Params, centroid: &Vector3<f64>) -> Vec<Constraint>
     static_margins(p, centroid)
         .iter()
         .enumerate()
-        .filter(|(_, m)| !(**m > 0.0))
+        .filter(|(_, m)| m.is_nan() || **m <= 0.0)
         .map(|(j, _)| Constraint::CableTension(j))
         .collect()
 }
@@ -638,8 +638,8 @@ pub fn classify(p: &Params, centroid: &Vector3<f64>) -> WorkspacePoint {
     WorkspacePoint { region, violated: s }
 }
 
-/// Horizontal slice at height `z` [m] (Figs. 4-6): a regular `n x n` grid on
-/// `[-half_width, half_width]^2` [m], returned as `(x, y, region)` row by row.
+/// Horizontal slice at height `z` \[m\] (Figs. 4-6): a regular `n x n` grid on
+/// `[-half_width, half_width]^2` \[m\], returned as `(x, y, region)` row by row.
 pub fn slice(p: &Params, z: f64, half_width: f64, n: usize) -> Vec<(f64, f64, Region)> {
     let mut out = Vec::with_capacity(n * n);
     let step = if n > 1 { 2.0 * half_width / (n - 1) as f64 } else { 0.0 };
@@ -653,7 +653,7 @@ pub fn slice(p: &Params, z: f64, half_width: f64, n: usize) -> Vec<(f64, f64, Re
 }
 
 /// Areas [m^2] of the kinematic workspace and of the static workspace in the
-/// slice at height `z` [m], by midpoint counting on an `n x n` grid over
+/// slice at height `z` \[m\], by midpoint counting on an `n x n` grid over
 /// `[-half_width, half_width]^2` (Figs. 4-5).
 pub fn slice_areas(p: &Params, z: f64, half_width: f64, n: usize) -> (f64, f64) {
     let cell = (2.0 * half_width / n as f64).powi(2);
@@ -675,7 +675,7 @@ pub fn slice_areas(p: &Params, z: f64, half_width: f64, n: usize) -> (f64, f64) 
     (kin as f64 * cell, sta as f64 * cell)
 }
 
-/// Top of the kinematic workspace on the `Z` axis, `z = sqrt(lo^2 - 4 lb^2/3)` [m]
+/// Top of the kinematic workspace on the `Z` axis, `z = sqrt(lo^2 - 4 lb^2/3)` \[m\]
 /// (`NaN` when `lo < 2 lb/sqrt3`: empty workspace).
 pub fn z_max_on_axis(p: &Params) -> f64 {
     (p.lo * p.lo - 4.0 * p.lb * p.lb / 3.0).sqrt()
@@ -814,7 +814,7 @@ mod tests {
         // Halfway: theta = pi/6, f = 2 kappa (pi/3 - pi)/(lo cos(pi/6)).
         let want = 2.0 * P.kappa * (PI / 3.0 - PI) / (P.lo * (PI / 6.0).cos());
         assert_relative_eq!(spring_force(&P, 3.0), want, max_relative = 1e-14);
-        assert_relative_eq!(spring_force(&P, 3.0), -8.061_330_507_707_079, max_relative = 1e-12);
+        assert_relative_eq!(spring_force(&P, 3.0), -8.061_330_507_707_08, max_relative = 1e-12);
         let mut prev = f64::NEG_INFINITY;
         for k in 0..=100 {
             let f = spring_force(&P, P.lo * k as f64 / 100.0);
@@ -865,14 +865,14 @@ mod tests {
         let c = Vector3::new(0.0, 0.0, 3.0);
         let a = base_nodes(&P);
         let mut knees = Vec::new();
-        for i in 0..3 {
+        for (i, ai) in a.iter().enumerate() {
             let s = spring_chain(&P, &c, i).unwrap();
             // Link lengths lo/2, knee in the plane normal to e2, axes orthogonal.
             assert_relative_eq!((s.knee - s.a).norm(), P.lo / 2.0, max_relative = 1e-13);
             assert_relative_eq!((s.knee - s.b).norm(), P.lo / 2.0, max_relative = 1e-13);
             assert!((s.knee - s.a).dot(&s.e2).abs() < 1e-13);
             assert!((s.b - s.a).dot(&s.e2).abs() < 1e-13);
-            assert!(s.e1.dot(&s.e2).abs() < 1e-15 && s.e1.dot(&a[i]).abs() < 1e-15 && s.e1.z == 0.0);
+            assert!(s.e1.dot(&s.e2).abs() < 1e-15 && s.e1.dot(ai).abs() < 1e-15 && s.e1.z == 0.0);
             let ang = (s.a - s.knee).angle(&(s.b - s.knee));
             assert_relative_eq!(ang, s.knee_angle, epsilon = 1e-12);
             assert_relative_eq!(s.length, (16.0f64 / 3.0 + 9.0).sqrt(), max_relative = 1e-14);
@@ -1017,12 +1017,12 @@ mod tests {
     fn spring_chain_matches_eq3_at_random_points() {
         for c in sample_points(&P, 100) {
             let l = spring_lengths(&P, &c);
-            for i in 0..3 {
+            for (i, li) in l.iter().enumerate() {
                 let s = spring_chain(&P, &c, i).unwrap();
-                assert_relative_eq!(s.knee_angle, 2.0 * (l[i] / P.lo).asin(), epsilon = 1e-12);
+                assert_relative_eq!(s.knee_angle, 2.0 * (li / P.lo).asin(), epsilon = 1e-12);
                 let ang = (s.a - s.knee).angle(&(s.b - s.knee));
                 assert_relative_eq!(ang, s.knee_angle, epsilon = 1e-6);
-                assert_relative_eq!(s.force, s.torque / knee_offset(&P, l[i]), max_relative = 1e-12);
+                assert_relative_eq!(s.force, s.torque / knee_offset(&P, *li), max_relative = 1e-12);
                 assert!(s.e1.dot(&s.e2).abs() < 1e-14);
             }
         }

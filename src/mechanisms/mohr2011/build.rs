@@ -24,15 +24,15 @@ use nalgebra::Vector3;
 /// Model choices that the paper does not give (defaults in `Mohr2011::params`).
 #[derive(Clone, Copy, Debug)]
 pub struct ModelChoices {
-    /// Mass of the end-effector triangle [kg] (three equal point masses at its nodes).
+    /// Mass of the end-effector triangle \[kg\] (three equal point masses at its nodes).
     pub platform_mass_kg: f64,
-    /// Mass of each link of a virtual compression spring [kg].
+    /// Mass of each link of a virtual compression spring \[kg\].
     pub link_mass_kg: f64,
     /// Viscous damping of every leg joint (universal and knee) [N m s/rad].
     pub joint_damping: f64,
     /// Cable law: `None` inextensible, `Some(k)` elastic with stiffness k [N/m].
     pub cable_stiffness_n_per_m: Option<f64>,
-    /// Strut (link) radius for drawing and interference [m].
+    /// Strut (link) radius for drawing and interference \[m\].
     pub strut_radius_m: f64,
     /// Gravity along the paper's Z axis [m/s^2], carried by the end-effector (a payload): 0 is
     /// the paper's assumption; negative pulls it towards the base (base below), positive away
@@ -45,13 +45,13 @@ pub struct ModelChoices {
 pub struct Geometry {
     /// Torsion spring constant kappa [N m/rad] (Eq. 4).
     pub kappa: f64,
-    /// Outer length of a virtual compression spring l_o [m].
+    /// Outer length of a virtual compression spring l_o \[m\].
     pub lo: f64,
     /// The three virtual springs placed at the start (A_i, knee, B_i, universal axes).
     pub legs: [SpringChain; 3],
     /// The six cables: (name, base node index, end-effector node index, actuated symbol).
     pub cables: Vec<(String, usize, usize, String)>,
-    /// Unstretched length of each cable at the start [m] (Eq. 6 with the commanded rho).
+    /// Unstretched length of each cable at the start \[m\] (Eq. 6 with the commanded rho).
     pub cable_lengths: Vec<f64>,
     /// Straight-strut variant: each leg a straight strut A_i-B_i, a linear spring of this
     /// stiffness [N/m] and free length l_o, instead of the two-link virtual spring.

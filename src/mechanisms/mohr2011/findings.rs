@@ -8,7 +8,7 @@ use crate::mechanisms::Finding;
 use nalgebra::Vector3;
 use std::f64::consts::{FRAC_PI_2, PI};
 
-/// Deterministic sample of centroids inside the kinematic workspace [m].
+/// Deterministic sample of centroids inside the kinematic workspace \[m\].
 pub fn sample_points(p: &Params, n: usize) -> Vec<Vector3<f64>> {
     // Low-discrepancy R3 sequence (additive recurrence with 1/g, 1/g^2, 1/g^3,
     // g = 1.2207440846 the root of g^4 = g + 1) in a box, filtered.
@@ -301,8 +301,8 @@ fn taut_cables_condition(samples: &Samples) -> Vec<Finding> {
     for c in &samples.pts {
         let s = statics(p, c);
         let m = static_margins(p, c);
-        for j in 0..3 {
-            if (m[j] > 0.0) != (s.tensions_full[j] > 0.0 && s.tensions_full[j + 3] > 0.0) {
+        for (j, margin) in m.iter().enumerate() {
+            if (*margin > 0.0) != (s.tensions_full[j] > 0.0 && s.tensions_full[j + 3] > 0.0) {
                 mismatch += 1;
             }
         }
@@ -421,9 +421,10 @@ pub fn outer_boundary_survey(p: &Params, n: usize) -> OuterSurvey {
                 s.static_with_eq5 += 1;
             } else {
                 let t = g[0] + g[1] + g[2];
-                for j in 0..3 {
-                    if !(2.0 * g[j] - t > 0.0) {
-                        s.slack_pair_counts[j] += 1;
+                for (gj, count) in g.iter().zip(&mut s.slack_pair_counts) {
+                    let margin = 2.0 * gj - t;
+                    if margin.is_nan() || margin <= 0.0 {
+                        *count += 1;
                     }
                 }
             }

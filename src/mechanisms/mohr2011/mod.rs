@@ -156,7 +156,7 @@ fn rho_of(inputs: &Values) -> Result<[f64; 3], ModelError> {
     Ok([input(inputs, "rho1")?, input(inputs, "rho2")?, input(inputs, "rho3")?])
 }
 
-/// Cable tensions [N] at centroid `p` with an external force `load` [N] on the end-effector's
+/// Cable tensions \[N\] at centroid `p` with an external force `load` \[N\] on the end-effector's
 /// centroid, from the full wrench balance (Eq. 19 with the load added: W_f f + W_t t + w = 0).
 pub fn tensions_with_load(pa: &Params, p: &Vector3<f64>, f: [f64; 3], load: Vector3<f64>) -> [f64; 6] {
     let w = analytic::wf(pa, p) * nalgebra::Vector3::from(f)
@@ -228,12 +228,12 @@ fn values_at(params: &Values, p: Vector3<f64>) -> Values {
         tensions_with_load(pa, &p, forces, payload(params))
     };
     let mut v = Values::from([("x".into(), p.x), ("y".into(), p.y), ("z".into(), p.z), ("rotation".into(), 0.0)]);
-    for i in 0..3 {
-        v.insert(format!("l{}", i + 1), st.spring_lengths[i]);
-        v.insert(format!("f{}", i + 1), forces[i]);
+    for (i, (l, f)) in st.spring_lengths.iter().zip(forces).enumerate() {
+        v.insert(format!("l{}", i + 1), *l);
+        v.insert(format!("f{}", i + 1), f);
     }
-    for j in 0..6 {
-        v.insert(format!("t{}", j + 1), tensions[j]);
+    for (j, t) in tensions.iter().enumerate() {
+        v.insert(format!("t{}", j + 1), *t);
     }
     v
 }
