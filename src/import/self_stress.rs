@@ -50,7 +50,7 @@ pub fn self_stress(draft: &Draft) -> Option<Vec<f64>> {
     self_stress_of(&positions, &anchored, &cables, &struts)
 }
 
-/// A drawing's self-stress: node positions [m], which nodes are anchored (held, and on no
+/// A drawing's self-stress: node positions \[m\], which nodes are anchored (held, and on no
 /// strut: no row of the equilibrium matrix), the tension members and the struts by their end
 /// nodes. One tension per tension member, the least of them 1 (struts in compression), or None
 /// when no self-stress keeps every tension member in tension.

@@ -149,7 +149,9 @@ fn join_motion(x: &mut MotionReport, m: MotionReport) {
     x.accelerated_steps += m.accelerated_steps;
     for f in m.frequencies {
         match x.frequencies.iter_mut().find(|y| y.name == f.name) {
-            Some(y) if !(y.error >= f.error) || !f.passed => *y = FrequencyReport { passed: y.passed && f.passed, ..f },
+            Some(y) if worse(f.error, y.error) || !f.passed => {
+                *y = FrequencyReport { passed: y.passed && f.passed, ..f }
+            }
             Some(_) => {}
             None => x.frequencies.push(f),
         }
@@ -157,7 +159,7 @@ fn join_motion(x: &mut MotionReport, m: MotionReport) {
     if let (Some(xl), Some(ml)) = (x.lagrangian.as_mut(), m.lagrangian) {
         for c in ml.coordinates {
             match xl.coordinates.iter_mut().find(|y| y.name == c.name) {
-                Some(y) if !(y.max_error >= c.max_error) || !c.passed => {
+                Some(y) if worse(c.max_error, y.max_error) || !c.passed => {
                     *y = LagrangianCoordinateReport { passed: y.passed && c.passed, ..c }
                 }
                 Some(_) => {}
@@ -172,6 +174,12 @@ fn join_motion(x: &mut MotionReport, m: MotionReport) {
         }
         xe.not_smooth_from_tick = xe.not_smooth_from_tick.or(me.not_smooth_from_tick);
     }
+}
+
+/// Whether a later part's error `new` is worse than the joined `old`: larger, or either NaN
+/// (a NaN error is never hidden behind a number).
+fn worse(new: f64, old: f64) -> bool {
+    old.partial_cmp(&new).is_none_or(std::cmp::Ordering::is_lt)
 }
 
 fn join_check(x: &mut CheckReport, c: &CheckReport) {
