@@ -442,6 +442,31 @@ fn findings(mechanism: &str, params: BTreeMap<String, f64>) -> PyResult<Vec<(Str
         .collect())
 }
 
+/// The modal analysis of `tensegrity modes --json`: the same report, as its JSON text, at the
+/// scenario's first point settled as `run` settles it. Ctrl-C stops the settle.
+#[pyfunction]
+#[pyo3(signature = (path, text=None, set=Vec::new()))]
+fn modes_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>) -> PyResult<String> {
+    let sc = load(path, text, &set)?;
+    let file = path.to_string();
+    let result = on_own_thread(py, move |cancel| run::modes(&sc, &file, Some(cancel)).map(|(report, ..)| report))?;
+    let report = result.map_err(|e| match e {
+        run::ModesRunError::Refused(_) => PyValueError::new_err(format!("{path}: {e}")),
+        _ => PyException::new_err(format!("{path}: {e}")),
+    })?;
+    Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))
+}
+
+/// Scenario sections given as a JSON object (`{"motion": {...}, "energy": {...}}`) as TOML
+/// text; a value TOML cannot hold (null, a mixed array) is a ValueError naming it.
+#[pyfunction]
+fn sections_toml(json: &str) -> PyResult<String> {
+    let value: serde_json::Value =
+        serde_json::from_str(json).map_err(|e| PyValueError::new_err(format!("sections: {e}")))?;
+    let table = toml::Value::try_from(value).map_err(|e| PyValueError::new_err(format!("sections: {e}")))?;
+    toml::to_string(&table).map_err(|e| PyValueError::new_err(format!("sections: {e}")))
+}
+
 #[pymodule]
 fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check, m)?)?;
@@ -453,6 +478,8 @@ fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(export_mjcf, m)?)?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(findings, m)?)?;
+    m.add_function(wrap_pyfunction!(modes_json, m)?)?;
+    m.add_function(wrap_pyfunction!(sections_toml, m)?)?;
     m.add_class::<ArrowTable>()?;
     m.add("TestbedError", m.py().get_type::<TestbedError>())?;
     Ok(())

@@ -18,7 +18,7 @@ from . import _tensegrity
 
 __all__ = [
     "ScenarioError", "Prediction", "Result", "Solution", "Finding", "Structure",
-    "check", "export_mjcf", "findings", "from_matrices", "from_ntrt", "from_toml", "run", "solve", "sweep",
+    "check", "export_mjcf", "findings", "from_matrices", "from_ntrt", "from_toml", "modes", "run", "solve", "sweep",
 ]
 
 Scenario = Union[str, "os.PathLike[str]", "Structure"]
@@ -178,6 +178,17 @@ def sweep(
     return pd.read_csv(io.StringIO(csv)), json.loads(summary)
 
 
+def modes(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml") -> dict:
+    """The structure's natural frequencies and mode shapes at its first point, settled as
+    ``run`` settles it: the report of ``tensegrity modes --json`` as a dict (``modes``: one per
+    mode, ascending omega^2, with ``omega_rad_per_s``, ``frequency_hz``, ``rigid`` and the
+    nodes that move most; ``coordinates``, ``joint_coordinates``, ``rigid_modes``). Raises
+    ScenarioError on bad input, ValueError where the structure's modes are not computed (the
+    reason named), KeyboardInterrupt on Ctrl-C."""
+    path, text = _source(scenario, name)
+    return json.loads(_call(_tensegrity.modes_json, path, text, _sets(set)))
+
+
 class Structure:
     """A structure made in Python (``from_matrices``, ``from_ntrt``, ``from_toml``) as the
     scenario file it is, checked when made: ``toml`` (the text), ``name`` (the file name its
@@ -257,6 +268,9 @@ def from_matrices(
     tension_only=True,
     pins: Optional[Mapping[str, Optional[Sequence[float]]]] = None,
     quantities: Optional[Mapping[str, str]] = None,
+    params: Optional[Mapping[str, Any]] = None,
+    motion: Optional[Mapping[str, Any]] = None,
+    energy: Optional[Mapping[str, Any]] = None,
     name: str = "from_matrices.toml",
 ) -> Structure:
     """A structure from numpy arrays in the notation of Skelton and de Oliveira: N (3 x n node
@@ -277,7 +291,18 @@ def from_matrices(
     ``{"n1": (0, 0, 1)}`` a revolute joint ``pin_n1`` about that axis, ``{"n1": None}`` a
     spherical one. ``quantities``: ``{"q": "atan2(n2.y - n1.y, n2.x - n1.x)"}``, the
     scenario's ``[[quantities]]`` (expressions of the state), for predictions to compare with.
+    ``params``, ``motion``, ``energy``: the scenario's ``[params]``, ``[motion]`` and ``[energy]``
+    sections as dicts, exactly as the file writes them (``motion={"duration_s": 4.0, "start":
+    "settled", "coordinate": "pin_n1", "displacement": 1e-3, "frequencies": [{"name": "omega",
+    "mode": 1, "tolerance": 1e-6}]}``): a motion run, a dynamic model, from Python.
     ``name``: the file name its errors carry (the scenario is named by its stem).
+
+    The physics is the scenario file's: a bar's inertia is the file's default for a body
+    without ``inertia`` (m l^2 / 12 about every axis, a thin rod's about its middle; the radius
+    only draws it and checks interference), so the same bar written in TOML and made here has
+    the same frequencies. The bodies and pins are damped so that the structure settles
+    (``[sim] body_damping``, each pin's ``damping``); ``[motion] undamped = true`` releases it
+    for a free vibration.
 
     Raises ValueError on a wrong shape or length (naming the argument and the expected length),
     a value that is not finite or out of range, a malformed connectivity row (``Cb[2]: ...``)
@@ -312,6 +337,9 @@ def from_matrices(
         pin_list,
         [(str(k), str(v)) for k, v in (quantities or {}).items()],
     )
+    sections = {k: dict(v) for k, v in (("params", params), ("motion", motion), ("energy", energy)) if v is not None}
+    if sections:
+        text = text.rstrip("\n") + "\n\n" + _tensegrity.sections_toml(json.dumps(sections))
     return Structure(text, name=name)
 
 

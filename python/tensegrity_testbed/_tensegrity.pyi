@@ -10,6 +10,8 @@ __all__ = [
     "write_scenario",
     "export_mjcf",
     "solve",
+    "modes_json",
+    "sections_toml",
     "findings",
     "ArrowTable",
     "TestbedError",
@@ -87,6 +89,12 @@ def export_mjcf(
 
 def solve(mechanism: str, query: str, values: Dict[str, float]) -> List[Tuple[str, Dict[str, float], Optional[bool]]]:
     """Every solution of an analytic query: (label, values, stable)."""
+
+def modes_json(path: str, text: Optional[str] = None, set: Sequence[str] = ...) -> str:
+    """The modal analysis of ``tensegrity modes --json``, as its JSON text."""
+
+def sections_toml(json: str) -> str:
+    """Scenario sections given as a JSON object, as TOML text."""
 
 def findings(mechanism: str, params: Dict[str, float]) -> List[Tuple[str, str, str, bool]]:
     """(equation, claim, measured, holds) for every printed equation checked."""

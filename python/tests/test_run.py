@@ -548,3 +548,69 @@ def test_bad_models_on_a_structure_from_arrays_raise_not_crash():
     with pytest.raises(ValueError, match=r"Cb has shape \(6,\): expected \(k, 6\)"):
         tt.from_matrices(N, Cb[0], Cs)
     assert tt.run(bar, model=lambda p, i, t: {"q_py": math.atan2(50.0 * 0.8, 30.0 * 0.6)}, predictions=pred).passed
+
+
+ROCKER = ROOT / "scenarios" / "custom" / "rocker_frequency_curve.toml"
+
+
+def cli_modes(path, *flags):
+    """The CLI's `tensegrity modes --json -` report."""
+    target = os.environ.get("CARGO_TARGET_DIR", str(ROOT / "target"))
+    out = subprocess.run(
+        [os.path.join(target, "release", "tensegrity"), "modes", str(path), "--json", "-", *flags],
+        capture_output=True, text=True, cwd=ROOT,
+    )
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout)
+
+
+def test_modes_from_python_are_the_clis_modes_json():
+    """tt.modes is `tensegrity modes --json`: every field equal (floats bit for bit), the
+    analysis's own wall time aside."""
+    py, cli = tt.modes(str(ROCKER)), cli_modes(ROCKER)
+    py.pop("wall_s"), cli.pop("wall_s")
+    assert py == cli
+    assert py["joint_coordinates"] == ["pin"] and len(py["modes"]) == 1
+
+
+def rocker_from_matrices(k1=10.0, k2=30.0, a=0.8, b=0.6, L=1.0, l1=0.5, l2=0.4, m=0.5):
+    """The rocker of rocker_frequency_curve.toml from numpy arrays: n1 the pin at the origin, n2
+    the strut's tip drawn at pi/4, n3 the anchor U = (0, a), n4 the anchor V = (b, 0); springs
+    n2-n3 (k1, l1) and n2-n4 (k2, l2); the motion and the energy model given as dicts."""
+    import numpy as np
+
+    q0 = math.pi / 4
+    N = np.array([[0.0, L * math.cos(q0), 0.0, b], [0.0, L * math.sin(q0), a, 0.0], [0.0, 0.0, 0.0, 0.0]])
+    Cb = np.array([[-1.0, 1.0, 0.0, 0.0]])
+    Cs = np.array([[0.0, -1.0, 1.0, 0.0], [0.0, -1.0, 0.0, 1.0]])
+    potential = (f"0.5*{k1}*(sqrt({L}^2 + {a}^2 - 2*{a}*{L}*sin(phi)) - {l1})^2"
+                 f" + 0.5*{k2}*(sqrt({L}^2 + {b}^2 - 2*{b}*{L}*cos(phi)) - {l2})^2")
+    return tt.from_matrices(
+        N, Cb, Cs, bar_mass_kg=m, string_stiffness_n_per_m=np.array([k1, k2]),
+        string_rest_length_m=np.array([l1, l2]), tension_only=False, pins={"n1": (0.0, 0.0, 1.0)},
+        params={"I": m * L * L / 3},
+        motion={"duration_s": 4.0, "start": "settled", "coordinate": "pin_n1", "displacement": 1e-3,
+                "undamped": True,
+                "frequencies": [{"name": "omega", "mode": 1, "formula": "sqrt(V_phi_phi/I)",
+                                 "tolerance": 1e-6, "measure": "period"}]},
+        energy={"potential": potential, "kinetic": "0.5*I*phi_dot^2", "tolerance": 1e-9,
+                "coordinates": [{"name": "phi", "measured": "atan2(n2.y - n1.y, n2.x - n1.x)", "class": "angle"}]},
+        name="rocker_from_matrices.toml",
+    )
+
+
+def test_the_rocker_from_matrices_has_the_toml_rockers_inertia_and_frequency():
+    """One set of physics per structure: the rocker made from arrays and the rocker written in
+    TOML have the same modal frequency within 1e-12 (the bar's inertia is the file's default by
+    either route, m L^2 / 12 about its middle), and its motion from Python passes the same
+    three-way frequency claim."""
+    rocker = rocker_from_matrices()
+    made, written = tt.modes(rocker), tt.modes(str(ROCKER))  # the file's first point: k1 = 10 N/m
+    assert made["settled"] and written["settled"]
+    made, written = made["modes"][0]["omega_rad_per_s"], written["modes"][0]["omega_rad_per_s"]
+    assert abs(made - written) <= 1e-12 * written, (made, written)
+    r = tt.run(rocker)
+    assert r.passed, r.failures
+    f = r.report["motion"]["frequencies"][0]
+    assert abs(f["predicted_rad_per_s"] - written) <= 1e-9 * written
+    assert f["error"] <= 1e-6 and f["modal_error"] <= 1e-8

@@ -4,10 +4,9 @@
 //! and animated in a rerun recording with `--record FILE.rrd`.
 
 use super::{bad_input, check_outputs, failed, load_one, signals, write_atomic, CliError, Outcome};
-use crate::report::modes::{ModeReport, ModesReport};
-use crate::sim::modes::{ModesError, StructureModes, NODES_LISTED, ZERO_MODE_RATIO};
+use crate::run::ModesRunError;
+use crate::sim::modes::StructureModes;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 pub fn modes(
     scenario: &Path,
@@ -22,26 +21,11 @@ pub fn modes(
         .filter_map(|(flag, p)| p.map(|p| (flag.to_string(), p.to_path_buf())))
         .collect();
     check_outputs(&[scenario.to_path_buf()], &outputs)?;
-    let mut state = crate::run::settle_first_point(&sc, Some(&signals::CANCEL))
-        .map_err(|e| failed(format!("{}: {e}", scenario.display())))?;
-    let wall = Instant::now();
-    let analysis = state.sim.modes().map_err(|e| match e {
-        ModesError::Eigen(_) => failed(format!("{}: {e}", scenario.display())),
-        _ => bad_input(format!("{}: {e}", scenario.display())),
-    })?;
-    let report = ModesReport {
-        name: sc.name.clone(),
-        file: scenario.display().to_string(),
-        settled: state.settled,
-        settle_steps: state.steps,
-        free_bodies: analysis.bodies.len(),
-        coordinates: if analysis.joints.is_empty() { 6 * analysis.bodies.len() } else { analysis.joints.len() },
-        joint_coordinates: analysis.joints.iter().map(|j| state.sim.structure().joints[*j].name.clone()).collect(),
-        rigid_modes: analysis.rigid,
-        zero_mode_ratio: ZERO_MODE_RATIO,
-        modes: rows(&analysis, &state.sim.structure().nodes),
-        wall_s: wall.elapsed().as_secs_f64(),
-    };
+    let (report, state, analysis) = crate::run::modes(&sc, &scenario.display().to_string(), Some(&signals::CANCEL))
+        .map_err(|e| match e {
+            ModesRunError::Refused(_) => bad_input(format!("{}: {e}", scenario.display())),
+            _ => failed(format!("{}: {e}", scenario.display())),
+        })?;
     // With `--json -` standard output is the JSON alone: the table goes to standard error.
     if json.is_some_and(super::is_stdio) {
         eprint!("{}", report.to_table());
@@ -78,25 +62,4 @@ fn record_modes(
         .map(|m| DrawnMode { omega: m.omega(), node_motion: m.node_motion.clone() })
         .collect();
     crate::observers::modes_record::record_modes(path, &drawn, &modes)
-}
-
-/// One report row per mode.
-fn rows(analysis: &StructureModes, nodes: &[crate::structure::Node]) -> Vec<ModeReport> {
-    analysis
-        .modes
-        .iter()
-        .enumerate()
-        .map(|(i, m)| ModeReport {
-            index: i + 1,
-            omega_squared: m.omega_squared,
-            omega_rad_per_s: m.omega(),
-            frequency_hz: m.omega() / std::f64::consts::TAU,
-            rigid: m.rigid,
-            largest_moving: m
-                .largest_moving(NODES_LISTED)
-                .into_iter()
-                .map(|(n, d)| (nodes[n].name.clone(), d))
-                .collect(),
-        })
-        .collect()
 }

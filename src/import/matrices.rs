@@ -400,18 +400,18 @@ fn bar_of_each_node(cb_path: &Path, bars: &[Member], count: usize) -> Result<Vec
     Ok(on_bar)
 }
 
-/// Each bar a strut on its own body (a uniform cylinder's inertia about its centre, taken
-/// as the same about every axis); the first held fixed when `fix_first` (nothing else fixed).
+/// Each bar a strut on its own body, its inertia the scenario file's default for a body that
+/// states none (m l^2 / 12 about every axis: a thin rod's about its middle), so that the bar
+/// made from matrices and the bar written in TOML have the same physics; the first held fixed
+/// when `fix_first` (nothing else fixed).
 fn add_bars(draft: &mut Draft, nodes: &[Vec3], bars: &[Member], fix_first: bool, p: &MemberProperties) {
     for (i, &(a, b, _)) in bars.iter().enumerate() {
         let (m, r) = (p.bar_mass_kg[i], p.bar_radius_m[i]);
-        let l = distance(nodes[a], nodes[b]);
-        let inertia = m * (3.0 * r * r + l * l) / 12.0;
         draft.bodies.push(DraftBody {
             name: format!("bar{}", i + 1),
             fixed: fix_first && i == 0,
             mass_kg: m,
-            inertia_kg_m2: Some([inertia; 3]),
+            inertia_kg_m2: None,
             nodes: vec![(node_name(a), nodes[a]), (node_name(b), nodes[b])],
         });
         draft.struts.push(DraftStrut { name: format!("bar{}", i + 1), a: node_name(a), b: node_name(b), radius_m: r });

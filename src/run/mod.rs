@@ -26,7 +26,7 @@ use std::time::Instant;
 
 pub use point::NO_BRANCH;
 pub use settle::SettleDetector;
-pub use settled::{settle_first_point, SettledState};
+pub use settled::{modes, settle_first_point, ModesRunError, SettledState};
 pub use topologies::rebuilt;
 
 use stoppable::{interruptible, Halted};

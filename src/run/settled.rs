@@ -3,9 +3,12 @@
 //! criteria as `run`), and the simulation handed back instead of a report.
 
 use super::{start, RunError, RunOptions};
+use crate::report::modes::{ModeReport, ModesReport};
 use crate::scenario::{Actuation, Scenario};
+use crate::sim::modes::{ModesError, StructureModes, NODES_LISTED, ZERO_MODE_RATIO};
 use crate::sim::Simulation;
 use std::sync::atomic::AtomicBool;
+use std::time::Instant;
 
 /// The simulation at its settled state.
 pub struct SettledState {
@@ -28,4 +31,70 @@ pub fn settle_first_point(sc: &Scenario, cancel: Option<&AtomicBool>) -> Result<
     let prediction = runner.mech.predict(&runner.params, &inputs)?;
     let settled = runner.settle(&inputs, &prediction)?;
     Ok(SettledState { sim: runner.sim, settled: settled.settled, steps: settled.steps })
+}
+
+/// Why a modal analysis gave no report.
+#[derive(Debug, thiserror::Error)]
+pub enum ModesRunError {
+    /// The settle to the first point stopped (divergence, interruption, a model error).
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// The structure's modes are not computed, by name (bad input).
+    #[error(transparent)]
+    Refused(ModesError),
+    /// The eigenproblem itself failed.
+    #[error(transparent)]
+    Eigen(ModesError),
+}
+
+/// The modal analysis of `sc` at its first point, settled as `run` settles it: the report
+/// `tensegrity modes` prints (and `tensegrity_testbed.modes` returns), named by `file`; the
+/// settled state and the analysis with it (for a recording of the modes).
+pub fn modes(
+    sc: &Scenario,
+    file: &str,
+    cancel: Option<&AtomicBool>,
+) -> Result<(ModesReport, SettledState, StructureModes), ModesRunError> {
+    let mut state = settle_first_point(sc, cancel)?;
+    let wall = Instant::now();
+    let analysis = state.sim.modes().map_err(|e| match e {
+        ModesError::Eigen(_) => ModesRunError::Eigen(e),
+        _ => ModesRunError::Refused(e),
+    })?;
+    let structure = state.sim.structure();
+    let report = ModesReport {
+        name: sc.name.clone(),
+        file: file.to_string(),
+        settled: state.settled,
+        settle_steps: state.steps,
+        free_bodies: analysis.bodies.len(),
+        coordinates: if analysis.joints.is_empty() { 6 * analysis.bodies.len() } else { analysis.joints.len() },
+        joint_coordinates: analysis.joints.iter().map(|j| structure.joints[*j].name.clone()).collect(),
+        rigid_modes: analysis.rigid,
+        zero_mode_ratio: ZERO_MODE_RATIO,
+        modes: rows(&analysis, &structure.nodes),
+        wall_s: wall.elapsed().as_secs_f64(),
+    };
+    Ok((report, state, analysis))
+}
+
+/// One report row per mode.
+fn rows(analysis: &StructureModes, nodes: &[crate::structure::Node]) -> Vec<ModeReport> {
+    analysis
+        .modes
+        .iter()
+        .enumerate()
+        .map(|(i, m)| ModeReport {
+            index: i + 1,
+            omega_squared: m.omega_squared,
+            omega_rad_per_s: m.omega(),
+            frequency_hz: m.omega() / std::f64::consts::TAU,
+            rigid: m.rigid,
+            largest_moving: m
+                .largest_moving(NODES_LISTED)
+                .into_iter()
+                .map(|(n, d)| (nodes[n].name.clone(), d))
+                .collect(),
+        })
+        .collect()
 }

@@ -277,9 +277,10 @@ fn prisms_imported_with_defaults_are_prestressed_and_settle_at_their_twist() {
 /// A 5-prism drawn 0.3 rad short of its twist has no self-stress: the import says so and puts
 /// every string at 10 N, so the drawn state is no equilibrium. It settles 0.17 rad off the
 /// closed-form twist with its cables' tension gone (measured 1.3e-14 of the drawn one; below
-/// the import's min_fraction 0.1) and seven strings slack: the run fails on `prestress`
-/// alone, the report and the table naming the slack strings; declared `on_loss = "warn"` it
-/// passes with a warning naming them.
+/// the import's min_fraction 0.1) and strings slack (12 of 15 with the file's default bar
+/// inertia; which ones is the collapse's path, not a property to pin): the run fails on
+/// `prestress` alone, the report and the table naming the slack strings, the report's list the
+/// settled point's own; declared `on_loss = "warn"` it passes with a warning naming them.
 #[test]
 fn a_slack_import_fails_naming_its_slack_strings() {
     let dir = temp("slack5");
@@ -295,7 +296,11 @@ fn a_slack_import_fails_naming_its_slack_strings() {
     assert!((twist_error(&r, 5) - 0.17).abs() <= 0.01, "{}", twist_error(&r, 5));
     assert!(p.least_fraction_kept.unwrap() <= 1e-6, "{p:?}");
     assert_eq!(p.lost_at, vec![0]);
-    assert_eq!(p.slack_cables.len(), 7, "{p:?}");
+    assert!(!p.slack_cables.is_empty(), "{p:?}");
+    assert_eq!(
+        p.slack_cables, r.points[0].slack_cables,
+        "the prestress judgement names the settled point's slack strings"
+    );
     assert!(p.slack_cables.iter().all(|c| c.starts_with("string")), "{p:?}");
     let table = tensegrity_testbed::report::Report { scenarios: vec![r] }.to_table();
     assert!(table.contains(&format!("slack: {}  FAIL", p.slack_cables.join(", "))), "{table}");
