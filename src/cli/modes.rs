@@ -4,8 +4,8 @@
 //! and animated in a rerun recording with `--record FILE.rrd`.
 
 use super::{bad_input, check_outputs, failed, load_one, signals, write_atomic, CliError, Outcome};
-use crate::report::modes::{ModeReport, ModesReport};
-use crate::sim::modes::{ModesError, StructureModes, NODES_LISTED, ZERO_MODE_RATIO};
+use crate::report::modes::{ConstraintsReport, ModeReport, ModesReport};
+use crate::sim::modes::{Constraints, ModesError, StructureModes, NODES_LISTED, ZERO_MODE_RATIO};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -35,8 +35,13 @@ pub fn modes(
         settled: state.settled,
         settle_steps: state.steps,
         free_bodies: analysis.bodies.len(),
-        coordinates: if analysis.joints.is_empty() { 6 * analysis.bodies.len() } else { analysis.joints.len() },
+        coordinates: match &analysis.constraints {
+            Some(c) => c.coordinates.len(),
+            None if analysis.joints.is_empty() => 6 * analysis.bodies.len(),
+            None => analysis.joints.len(),
+        },
         joint_coordinates: analysis.joints.iter().map(|j| state.sim.structure().joints[*j].name.clone()).collect(),
+        constraints: analysis.constraints.as_ref().map(|c| constraints_report(c, state.sim.structure())),
         rigid_modes: analysis.rigid,
         zero_mode_ratio: ZERO_MODE_RATIO,
         modes: rows(&analysis, &state.sim.structure().nodes),
@@ -55,6 +60,24 @@ pub fn modes(
         record_modes(r, &state.sim, &analysis).map_err(failed)?;
     }
     Ok(Outcome::from_passed(state.settled))
+}
+
+/// What the constrained analysis was reduced by, by name.
+fn constraints_report(c: &Constraints, s: &crate::structure::Structure) -> ConstraintsReport {
+    let loop_rows = c.multipliers.len() - c.taut_cables.len();
+    ConstraintsReport {
+        rows: c.rows,
+        rank: c.rank,
+        degrees_of_freedom: c.degrees_of_freedom(),
+        loop_closures: c.closures.iter().map(|&j| s.joints[j].name.clone()).collect(),
+        taut_cables: c
+            .taut_cables
+            .iter()
+            .zip(&c.multipliers[loop_rows..])
+            .map(|(&k, t)| (s.cables[k].name.clone(), *t))
+            .collect(),
+        slack_cables: c.slack_cables.iter().map(|&k| s.cables[k].name.clone()).collect(),
+    }
 }
 
 /// The non-rigid modes animated at their frequencies (`observers::modes_record`).
