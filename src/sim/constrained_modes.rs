@@ -10,8 +10,9 @@
 //! inextensible cable (a slack one contributes nothing: while slack it exerts no force). At
 //! the settled state, with V the potential energy (`joint_modes.rs`: elastic members, torsion
 //! springs, constant loads):
-//! - G = dg/dq and grad V by central differences (error O(h^2), h = [`STEP_RAD`] rad or
-//!   [`STEP_FRACTION`] of the structure's size);
+//! - G = dg/dq and grad V by central differences at steps h and 2 h (h = [`STEP_RAD`] rad or
+//!   [`STEP_FRACTION`] of the structure's size), extrapolated: (4 D(h) - D(2h)) / 3, error
+//!   O(h^4) (every derivative below is taken so);
 //! - the constraint forces lambda from the equilibrium grad V + G^T lambda = 0 (least
 //!   squares; a taut cable's lambda is its tension [N], a loop's its joint reaction);
 //! - K = d2L/dq2, the Hessian of the Lagrangian L = V + lambda . g with lambda held (the
@@ -19,7 +20,9 @@
 //!   constraint forces: a cable's T d2l/dq2, a loop reaction times the closure's curvature),
 //!   by central second differences;
 //! - M = sum over bodies J_b^T diag(m 1, R I R^T) J_b, J_b each body's centre-of-mass and
-//!   rotation Jacobian by central differences;
+//!   rotation Jacobian by central differences; the bodies include the hidden bodies that
+//!   split a universal joint into two revolute links (`build.rs`: 1e-3 of the child's mass
+//!   and moments, at the anchor), which rapier moves as the structure's own;
 //! - N, a basis of null(G) (the right singular vectors of G whose singular value is below
 //!   [`NULL_SPACE_RATIO`] of the largest), and the reduced problem
 //!   (N^T K N) v = omega^2 (N^T M N) v. Each mode's coordinates are N v.
@@ -34,13 +37,18 @@
 use super::modes::{ModesError, StructureMode, StructureModes, ZERO_MODE_RATIO};
 use super::{Data, Model};
 use crate::structure::{BodyKind, CableLaw, JointKind};
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
 
-/// Finite-difference step of an angular coordinate [rad].
-const STEP_RAD: f64 = 1e-4;
+/// Finite-difference step of an angular coordinate [rad]: every derivative is taken at steps
+/// h and 2 h and extrapolated (Richardson, [`richardson`]: error O(h^4), about 1e-12), so the
+/// step can be large enough that round-off, eps L / h^2 in a second difference, stays near
+/// 1e-10 of the stiffness.
+const STEP_RAD: f64 = 1e-3;
 /// Finite-difference step of a linear coordinate, a fraction of the structure's size.
-const STEP_FRACTION: f64 = 1e-4;
+const STEP_FRACTION: f64 = 1e-3;
+/// The second, coarser step of the Richardson extrapolation, as a multiple of the first.
+const COARSE_STEP_RATIO: f64 = 2.0;
 /// Singular values of G below this fraction of the largest span its null space: G by central
 /// differences carries an error of about h^2 = 1e-8 of its entries, far below this, and the
 /// constraints of the shipped structures have singular values above 1e-3 of the largest.
@@ -256,12 +264,12 @@ impl Data {
     }
 
     /// grad V and G = dg/dq by central differences.
-    fn first_derivatives(&mut self, m: &Model, setup: &Setup) -> FirstDerivatives {
+    fn first_derivatives(&mut self, m: &Model, setup: &Setup, ratio: f64) -> FirstDerivatives {
         let n = setup.coordinates.len();
         let rows = self.constraint_rows(m, setup.closures, setup.taut).len();
         let mut out = FirstDerivatives { gradient: DVector::zeros(n), jacobian: DMatrix::zeros(rows, n) };
         for k in 0..n {
-            let h = setup.steps[k];
+            let h = ratio * setup.steps[k];
             let at = |sim: &mut Data, d: f64| {
                 sim.move_coordinates(m, setup.coordinates, &[(k, d)]);
                 let v = sim.potential_energy_about(m, Some(&setup.com));
@@ -279,9 +287,9 @@ impl Data {
     }
 
     /// K = d2L/dq2 (lambda held) by central second differences, symmetrised.
-    fn lagrangian_hessian(&mut self, m: &Model, setup: &Setup, lambda: &DVector<f64>) -> DMatrix<f64> {
+    fn lagrangian_hessian(&mut self, m: &Model, setup: &Setup, lambda: &DVector<f64>, ratio: f64) -> DMatrix<f64> {
         let n = setup.coordinates.len();
-        let h = &setup.steps;
+        let h: Vec<f64> = setup.steps.iter().map(|h| ratio * h).collect();
         let l0 = self.lagrangian_moved(m, setup, lambda, &[]);
         let mut k = DMatrix::zeros(n, n);
         for a in 0..n {
@@ -304,16 +312,25 @@ impl Data {
         full
     }
 
-    /// J (6 per moving body x coordinates): each body's centre-of-mass velocity and angular
-    /// velocity per unit rate of each coordinate, by central differences.
-    fn coordinate_body_jacobian(&mut self, m: &Model, setup: &Setup, bodies: &[usize]) -> DMatrix<f64> {
-        let mut jac = DMatrix::zeros(6 * bodies.len(), setup.coordinates.len());
-        for (c, &h) in setup.steps.iter().enumerate() {
+    /// J (6 per moving body x coordinates): the centre-of-mass velocity and angular velocity
+    /// of each body that `states` reads, per unit rate of each coordinate, by central
+    /// differences.
+    fn coordinate_body_jacobian(
+        &mut self,
+        m: &Model,
+        setup: &Setup,
+        states: &dyn Fn(&Data) -> Vec<BodyState>,
+        ratio: f64,
+    ) -> DMatrix<f64> {
+        let count = states(self).len();
+        let mut jac = DMatrix::zeros(6 * count, setup.coordinates.len());
+        for (c, &step) in setup.steps.iter().enumerate() {
+            let h = ratio * step;
             self.move_coordinates(m, setup.coordinates, &[(c, h)]);
-            let plus = self.body_states(m, bodies);
+            let plus = states(self);
             self.restore_modal_state(m, &setup.saved);
             self.move_coordinates(m, setup.coordinates, &[(c, -h)]);
-            let minus = self.body_states(m, bodies);
+            let minus = states(self);
             self.restore_modal_state(m, &setup.saved);
             for (i, ((xp, rp), (xm, rm))) in plus.iter().zip(&minus).enumerate() {
                 jac.view_mut((6 * i, c), (3, 1)).copy_from(&((xp - xm) / (2.0 * h)));
@@ -322,6 +339,54 @@ impl Data {
         }
         jac
     }
+
+    /// The rapier bodies of the universal joints' hidden first links.
+    fn hidden_bodies(&self, m: &Model) -> Vec<RigidBodyHandle> {
+        m.hidden_links
+            .iter()
+            .filter_map(|l| self.multibody_joints.get(l.multibody_joint))
+            .filter_map(|(mb, id)| mb.link(id).map(|link| link.rigid_body_handle()))
+            .collect()
+    }
+
+    /// Each rapier body's centre of mass and rotation now.
+    fn handle_states(&self, handles: &[RigidBodyHandle]) -> Vec<BodyState> {
+        handles
+            .iter()
+            .map(|&h| {
+                let rb = &self.bodies[h];
+                let (c, q) = (rb.center_of_mass(), rb.position().rotation);
+                (Vector3::new(c.x, c.y, c.z), UnitQuaternion::from_quaternion(Quaternion::new(q.w, q.x, q.y, q.z)))
+            })
+            .collect()
+    }
+
+    /// The mass matrix of rapier bodies (six coordinates each): m 1 and R I R^T, from rapier's
+    /// own mass properties.
+    fn handle_mass_matrix(&self, handles: &[RigidBodyHandle]) -> DMatrix<f64> {
+        let mut mass = DMatrix::zeros(6 * handles.len(), 6 * handles.len());
+        for (i, &h) in handles.iter().enumerate() {
+            let rb = &self.bodies[h];
+            let props = &rb.mass_properties().local_mprops;
+            let local = Matrix3::from_column_slice(&props.reconstruct_inertia_matrix().to_cols_array());
+            let q = rb.position().rotation;
+            let r = UnitQuaternion::from_quaternion(Quaternion::new(q.w, q.x, q.y, q.z)).to_rotation_matrix();
+            let world = r.matrix() * local * r.matrix().transpose();
+            mass.view_mut((6 * i, 6 * i), (3, 3)).copy_from(&(Matrix3::identity() * props.mass()));
+            mass.view_mut((6 * i + 3, 6 * i + 3), (3, 3)).copy_from(&(0.5 * (world + world.transpose())));
+        }
+        mass
+    }
+}
+
+/// A body's centre of mass [m] and rotation.
+type BodyState = (Vector3<f64>, UnitQuaternion<f64>);
+
+/// Richardson's extrapolation of central differences at steps h and [`COARSE_STEP_RATIO`] h:
+/// the h^2 term of their error cancels.
+fn richardson(fine: &DMatrix<f64>, coarse: &DMatrix<f64>) -> DMatrix<f64> {
+    let r2 = COARSE_STEP_RATIO * COARSE_STEP_RATIO;
+    (fine * r2 - coarse) / (r2 - 1.0)
 }
 
 /// A basis of null(G) (coordinates x its dimension) and the rank of G: the right singular
@@ -377,13 +442,17 @@ impl Data {
             com: (0..s.bodies.len()).map(|b| self.world_com(m, b)).map(|c| Vector3::new(c.x, c.y, c.z)).collect(),
             saved: self.save_modal_state(m, &coordinates),
         };
-        let first = self.first_derivatives(m, &setup);
+        let first = self.first_derivatives_extrapolated(m, &setup);
         let lambda = multipliers(&first);
-        let stiffness = self.lagrangian_hessian(m, &setup, &lambda);
-        let jac = self.coordinate_body_jacobian(m, &setup, &bodies);
+        let stiffness = richardson(
+            &self.lagrangian_hessian(m, &setup, &lambda, 1.0),
+            &self.lagrangian_hessian(m, &setup, &lambda, COARSE_STEP_RATIO),
+        );
+        let mass = self.coordinate_mass(m, &setup, &bodies);
+        let jac = mass.1;
         let body_mass = self.mass_matrix(m, &bodies);
         let (basis, rank) = null_space(&first.jacobian, coordinates.len());
-        let reduced_mass = basis.transpose() * jac.transpose() * &body_mass * &jac * &basis;
+        let reduced_mass = basis.transpose() * &mass.0 * &basis;
         let reduced_stiffness = basis.transpose() * &stiffness * &basis;
         // No motion left (rank G = the coordinates): no mode.
         let eigen = if basis.ncols() == 0 {
@@ -431,6 +500,38 @@ impl Data {
             rigid,
             constraints: Some(constraints),
         })
+    }
+
+    /// grad V and G at steps h and 2 h, extrapolated.
+    fn first_derivatives_extrapolated(&mut self, m: &Model, setup: &Setup) -> FirstDerivatives {
+        let (fine, coarse) =
+            (self.first_derivatives(m, setup, 1.0), self.first_derivatives(m, setup, COARSE_STEP_RATIO));
+        let column = |v: &DVector<f64>| DMatrix::from_column_slice(v.len(), 1, v.as_slice());
+        FirstDerivatives {
+            gradient: richardson(&column(&fine.gradient), &column(&coarse.gradient)).column(0).into_owned(),
+            jacobian: richardson(&fine.jacobian, &coarse.jacobian),
+        }
+    }
+
+    /// The mass matrix in the coordinates, J^T M_b J over the structure's free bodies and the
+    /// hidden bodies, with the free bodies' J (for the modes' shapes).
+    fn coordinate_mass(&mut self, m: &Model, setup: &Setup, bodies: &[usize]) -> (DMatrix<f64>, DMatrix<f64>) {
+        let own = |sim: &Data| sim.body_states(m, bodies);
+        let jac = richardson(
+            &self.coordinate_body_jacobian(m, setup, &own, 1.0),
+            &self.coordinate_body_jacobian(m, setup, &own, COARSE_STEP_RATIO),
+        );
+        let mut mass = jac.transpose() * self.mass_matrix(m, bodies) * &jac;
+        let hidden = self.hidden_bodies(m);
+        if !hidden.is_empty() {
+            let states = |sim: &Data| sim.handle_states(&hidden);
+            let jh = richardson(
+                &self.coordinate_body_jacobian(m, setup, &states, 1.0),
+                &self.coordinate_body_jacobian(m, setup, &states, COARSE_STEP_RATIO),
+            );
+            mass += jh.transpose() * self.handle_mass_matrix(&hidden) * &jh;
+        }
+        (mass, jac)
     }
 
     /// Moves the constrained analysis's coordinates by `dq` (its mode's `joint_shape` times a
