@@ -53,9 +53,11 @@ pub enum Command {
     },
     /// Natural frequencies and mode shapes of a scenario's structure at its settled state (its
     /// first point, settled as `run` settles it): free bodies held by springs and elastic
-    /// cables, or the revolute and prismatic joints of joint trees; refused (exit 2): joints
-    /// that close a loop, inextensible cables, spherical and universal joints, free bodies
-    /// beside joints.
+    /// cables, or the revolute and prismatic joints of joint trees; joints that close loops and
+    /// taut inextensible cables are constraints; refused (exit 2): a loop closed by a prismatic
+    /// joint. The constrained modes are reduced to the constraints' tangent space, the
+    /// constraint forces' geometric stiffness included; slack cables are left out, and a
+    /// structure the constraints hold rigid has no mode.
     Modes {
         scenario: PathBuf,
         /// Write the JSON report to this file (`-`: standard output, the table then going to

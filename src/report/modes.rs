@@ -16,6 +16,9 @@ pub struct ModesReport {
     pub coordinates: usize,
     /// A jointed structure's coordinates: its free joints, by name (empty for free bodies).
     pub joint_coordinates: Vec<String>,
+    /// A structure held by constraints (loops, taut inextensible cables): what the coordinates
+    /// were reduced by; None for free bodies on springs and for joint trees.
+    pub constraints: Option<ConstraintsReport>,
     /// Modes with |omega^2| below `zero_mode_ratio` of the largest (free rigid motions).
     pub rigid_modes: usize,
     pub zero_mode_ratio: f64,
@@ -23,6 +26,23 @@ pub struct ModesReport {
     pub modes: Vec<ModeReport>,
     /// Wall time of the analysis after the settle \[s\].
     pub wall_s: f64,
+}
+
+/// The constraints a structure's modes were reduced by (`sim::constrained_modes`).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ConstraintsReport {
+    /// Constraint rows: each loop-closing joint's, then one per taut inextensible cable.
+    pub rows: usize,
+    /// The rank of their Jacobian.
+    pub rank: usize,
+    /// Coordinates less the rank: the dimension of the modal problem.
+    pub degrees_of_freedom: usize,
+    /// The joints that close loops, by name.
+    pub loop_closures: Vec<String>,
+    /// The taut inextensible cables with their tension from the equilibrium \[N\].
+    pub taut_cables: Vec<(String, f64)>,
+    /// The inextensible cables left out as slack.
+    pub slack_cables: Vec<String>,
 }
 
 /// One mode.
@@ -59,6 +79,9 @@ impl ModesReport {
             self.zero_mode_ratio,
             if self.settled { String::new() } else { ", NOT SETTLED".into() }
         );
+        if let Some(c) = &self.constraints {
+            out.push_str(&c.to_line());
+        }
         out.push_str(&format!(
             "   {:>4} {:>16} {:>14}  {}\n",
             "mode", "omega [rad/s]", "f [Hz]", "largest-moving nodes"
@@ -75,5 +98,22 @@ impl ModesReport {
             ));
         }
         out
+    }
+}
+
+impl ConstraintsReport {
+    /// The table's second header line.
+    fn to_line(&self) -> String {
+        let list = |v: &[String]| if v.is_empty() { "none".to_string() } else { v.join(", ") };
+        let taut: Vec<String> = self.taut_cables.iter().map(|(n, t)| format!("{n} {t:.6} N")).collect();
+        format!(
+            "   constraints: {} rows of rank {} ({} degree(s) of freedom); loops closed by {}; taut cables {}; slack cables {}\n",
+            self.rows,
+            self.rank,
+            self.degrees_of_freedom,
+            list(&self.loop_closures),
+            list(&taut),
+            list(&self.slack_cables)
+        )
     }
 }

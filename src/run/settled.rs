@@ -3,9 +3,9 @@
 //! criteria as `run`), and the simulation handed back instead of a report.
 
 use super::{start, RunError, RunOptions};
-use crate::report::modes::{ModeReport, ModesReport};
+use crate::report::modes::{ConstraintsReport, ModeReport, ModesReport};
 use crate::scenario::{Actuation, Scenario};
-use crate::sim::modes::{ModesError, StructureModes, NODES_LISTED, ZERO_MODE_RATIO};
+use crate::sim::modes::{Constraints, ModesError, StructureModes, NODES_LISTED, ZERO_MODE_RATIO};
 use crate::sim::Simulation;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -68,14 +68,37 @@ pub fn modes(
         settled: state.settled,
         settle_steps: state.steps,
         free_bodies: analysis.bodies.len(),
-        coordinates: if analysis.joints.is_empty() { 6 * analysis.bodies.len() } else { analysis.joints.len() },
+        coordinates: match &analysis.constraints {
+            Some(c) => c.coordinates.len(),
+            None if analysis.joints.is_empty() => 6 * analysis.bodies.len(),
+            None => analysis.joints.len(),
+        },
         joint_coordinates: analysis.joints.iter().map(|j| structure.joints[*j].name.clone()).collect(),
+        constraints: analysis.constraints.as_ref().map(|c| constraints_report(c, structure)),
         rigid_modes: analysis.rigid,
         zero_mode_ratio: ZERO_MODE_RATIO,
         modes: rows(&analysis, &structure.nodes),
         wall_s: wall.elapsed().as_secs_f64(),
     };
     Ok((report, state, analysis))
+}
+
+/// What the constrained analysis was reduced by, by name.
+fn constraints_report(c: &Constraints, s: &crate::structure::Structure) -> ConstraintsReport {
+    let loop_rows = c.multipliers.len() - c.taut_cables.len();
+    ConstraintsReport {
+        rows: c.rows,
+        rank: c.rank,
+        degrees_of_freedom: c.degrees_of_freedom(),
+        loop_closures: c.closures.iter().map(|&j| s.joints[j].name.clone()).collect(),
+        taut_cables: c
+            .taut_cables
+            .iter()
+            .zip(&c.multipliers[loop_rows..])
+            .map(|(&k, t)| (s.cables[k].name.clone(), *t))
+            .collect(),
+        slack_cables: c.slack_cables.iter().map(|&k| s.cables[k].name.clone()).collect(),
+    }
 }
 
 /// One report row per mode.

@@ -66,6 +66,13 @@ impl Data {
     /// The potential energy now [J]: elastic members (engaged), torsion springs, and the work
     /// of the constant loads (gravity, external loads) on the centres of mass.
     fn potential_energy_j(&self, m: &Model) -> f64 {
+        self.potential_energy_about(m, None)
+    }
+
+    /// [`Self::potential_energy_j`] with the loads' work taken from each body's centre of mass
+    /// at `reference` (indexed by body; None: the world origin), which keeps the large constant
+    /// -f . x_ref out of the sum and its round-off out of second differences.
+    pub(super) fn potential_energy_about(&self, m: &Model, reference: Option<&[Vector3<f64>]>) -> f64 {
         let s = &m.structure;
         let mut e = 0.0;
         for member in (0..s.springs.len() + s.cables.len()).filter_map(|i| self.elastic_member(m, i)) {
@@ -84,7 +91,8 @@ impl Data {
         for b in (0..s.bodies.len()).filter(|b| m.is_free(*b)) {
             let (f, _) = self.constant_load(m, b);
             let com = self.world_com(m, b);
-            e -= f.x * com.x + f.y * com.y + f.z * com.z;
+            let r = reference.map_or_else(Vector3::zeros, |r| r[b]);
+            e -= f.x * (com.x - r.x) + f.y * (com.y - r.y) + f.z * (com.z - r.z);
         }
         e
     }
@@ -120,7 +128,7 @@ impl Data {
     }
 
     /// Each moving body's centre of mass and rotation (as a quaternion) now.
-    fn body_states(&self, m: &Model, bodies: &[usize]) -> Vec<(Vector3<f64>, UnitQuaternion<f64>)> {
+    pub(super) fn body_states(&self, m: &Model, bodies: &[usize]) -> Vec<(Vector3<f64>, UnitQuaternion<f64>)> {
         bodies
             .iter()
             .map(|&b| {
@@ -186,6 +194,6 @@ impl Data {
             .collect();
         let rigid = modes.iter().filter(|m| m.rigid).count();
         let poses = bodies.iter().map(|b| self.body_pose(m, *b)).collect();
-        Ok(StructureModes { bodies, joints, poses, mass: body_mass, modes, rigid })
+        Ok(StructureModes { bodies, joints, poses, mass: body_mass, modes, rigid, constraints: None })
     }
 }

@@ -17,6 +17,7 @@
 
 mod build;
 mod closure_rest;
+mod constrained_modes;
 mod continuation;
 mod damping;
 mod data;

@@ -9,6 +9,7 @@
 //! joints' coordinates (`joint_modes.rs`); others are refused, by name. Modes with |omega^2| below [`ZERO_MODE_RATIO`] of the largest are rigid-body modes
 //! (a free turn or translation, a strut's spin about its axis): reported as ~0 and counted.
 
+pub use super::constrained_modes::{Constraints, ModalCoordinate};
 use super::{Data, Model, Simulation};
 use crate::eigen::EigenError;
 use crate::snapshot::{BodyPose, ModalProjector};
@@ -70,19 +71,20 @@ pub struct StructureModes {
     pub modes: Vec<StructureMode>,
     /// How many are rigid-body modes.
     pub rigid: usize,
+    /// A structure held by loops or inextensible cables: the constraints it was reduced by
+    /// (`constrained_modes.rs`; each mode's `joint_shape` is then in their coordinates).
+    pub constraints: Option<Constraints>,
 }
 
 /// Why a structure's modes are not computed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ModesError {
-    #[error("joint '{0}' closes a loop: modes are reduced to the coordinates of joint trees only")]
+    #[error("joint '{0}' closes a loop with a kind of joint that has no constraint rows (spherical, revolute, universal and planar pins have)")]
     Loop(String),
     #[error("free body '{0}' hangs on no joint: a structure of free bodies and joints together is not analysed")]
     Unjointed(String),
     #[error("joint '{0}' has more than one coordinate: modes are reduced to revolute and prismatic joints")]
     JointKind(String),
-    #[error("inextensible cable '{0}': modes are computed for springs and elastic cables only")]
-    InextensibleCable(String),
     #[error("no free body: nothing moves")]
     NoFreeBody,
     #[error(transparent)]
@@ -94,11 +96,12 @@ impl Data {
     /// or reduced to the joints' coordinates where there are joints (`joint_modes.rs`).
     pub(super) fn modes(&mut self, m: &Model) -> Result<StructureModes, ModesError> {
         let s = &m.structure;
-        if let Some(c) = s.cables.iter().find(|c| !matches!(c.law, CableLaw::Elastic { .. })) {
-            return Err(ModesError::InextensibleCable(c.name.clone()));
-        }
         if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
             return Err(ModesError::NoFreeBody);
+        }
+        let inextensible = s.cables.iter().any(|c| !matches!(c.law, CableLaw::Elastic { .. }));
+        if inextensible || m.joint_impulse.iter().any(Option::is_some) {
+            return self.constrained_modes(m);
         }
         if !s.joints.is_empty() {
             return self.joint_modes(m);
@@ -119,7 +122,7 @@ impl Data {
             .collect();
         let rigid = modes.iter().filter(|mode| mode.rigid).count();
         let poses = tangent.bodies.iter().map(|b| self.body_pose(m, *b)).collect();
-        Ok(StructureModes { bodies: tangent.bodies, joints: vec![], poses, mass, modes, rigid })
+        Ok(StructureModes { bodies: tangent.bodies, joints: vec![], poses, mass, modes, rigid, constraints: None })
     }
 
     /// Displaces the structure along mode `index` (from 0) of `analysis` (made at the current
@@ -136,7 +139,10 @@ impl Data {
         let mode = &analysis.modes[index];
         let largest = mode.node_motion.iter().map(|d| Vector3::from(*d).norm()).fold(0.0, f64::max);
         let eta = if largest > 0.0 { amplitude_m / largest } else { 0.0 };
-        if analysis.joints.is_empty() {
+        if let Some(c) = &analysis.constraints {
+            let dq: Vec<f64> = mode.joint_shape.iter().map(|v| eta * v).collect();
+            self.displace_constrained(m, c, &dq);
+        } else if analysis.joints.is_empty() {
             self.displace_free_bodies(m, &(DVector::from_column_slice(&mode.shape) * eta));
         } else {
             for (&j, v) in analysis.joints.iter().zip(&mode.joint_shape) {

@@ -329,7 +329,7 @@ impl Data {
     }
 
     /// Moves the multibody's coordinates by `disp` and places its bodies there.
-    fn displace(&mut self, multibody: MultibodyIndex, disp: &[f64]) {
+    pub(super) fn displace(&mut self, multibody: MultibodyIndex, disp: &[f64]) {
         if let Some(mb) = self.multibody_joints.get_multibody_mut(multibody) {
             mb.apply_displacements(disp);
             mb.forward_kinematics(&self.bodies, false);
@@ -372,7 +372,7 @@ const TAUT_TOLERANCE_FRACTION: f64 = 1e-12;
 impl Data {
     /// A rope cable is taut when stretched to its length (within round-off) or when rapier's
     /// rope pulled in the last step.
-    fn cable_is_taut(&self, m: &Model, c: usize) -> bool {
+    pub(super) fn cable_is_taut(&self, m: &Model, c: usize) -> bool {
         let cable = &m.structure.cables[c];
         let l = crate::structure::distance(self.node_position(m, cable.a), self.node_position(m, cable.b));
         let inv_h = m.settings.substeps as f64 / m.settings.dt_s;
@@ -526,7 +526,7 @@ impl Data {
     }
 
     /// The multibody that body `b` is a link of, if any.
-    fn multibody_of(&self, m: &Model, b: usize) -> Option<MultibodyIndex> {
+    pub(super) fn multibody_of(&self, m: &Model, b: usize) -> Option<MultibodyIndex> {
         self.multibody_joints.rigid_body_link(m.handles[b]).map(|l| l.multibody)
     }
 
@@ -738,7 +738,7 @@ impl Data {
 
     /// Moves body `b` by a translation `t` [m] and a rotation `r` [rad, rotation vector] about
     /// its centre of mass.
-    fn nudge(&mut self, m: &Model, b: usize, t: Vector, r: Vector) {
+    pub(super) fn nudge(&mut self, m: &Model, b: usize, t: Vector, r: Vector) {
         let com = self.world_com(m, b);
         let h = m.handles[b];
         let pose = *self.bodies[h].position();

@@ -121,12 +121,185 @@ fn a_jointed_structure_is_reduced_to_its_joints_coordinates() {
     assert!((ji.modes[0].omega() - eq42).abs() <= 1e-7 * eq42, "{}", ji.modes[0].omega());
 }
 
-/// A structure whose joints close a loop is refused, naming the closing joint, with exit 2.
+/// A rigid body (m = 2 kg, isotropic moment I = 0.05 kg m^2 about its centre of mass) hung
+/// from a fixed anchor by an inextensible cable of c = 1 m tied d = 0.25 m above its centre of
+/// mass, under g = 9.81 m/s^2.
+const HANGING_BODY: &str = r#"name = "body hanging on an inextensible cable"
+mechanism = "custom"
+[settle]
+speed_tol = 1e-12
+residual_force_tol = 1e-10
+residual_torque_tol = 1e-10
+[actuation]
+points = [ {} ]
+[structure]
+gravity = [0, 0, -9.81]
+[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { Q = [0, 0, 0] }
+[[structure.bodies]]
+name = "bob"
+mass = 2.0
+inertia = [0.05, 0.05, 0.05]
+nodes = { P = [0, 0, -1], S = [0, 0, -1.5] }
+[[structure.cables]]
+name = "rope"
+a = "Q"
+b = "P"
+length = 1.0
+"#;
+
+/// The frequencies [rad/s] of the body on its cable: in each vertical plane a double pendulum
+/// (cable angle phi, body angle psi) with M = [[m c^2, m c d], [m c d, m d^2 + I]] and
+/// K = [[m g c, 0], [0, m g d]] (the cable's stiffness m g c is its tension T = m g times the
+/// curvature of its length: all of it from the constraint force). det(K - w^2 M) = 0 is
+/// a w^4 + b w^2 + e = 0 with a = m c^2 I, b = -(m g c (m d^2 + I) + m^2 g c^2 d),
+/// e = m^2 g^2 c d.
+fn hanging_body_frequencies() -> [f64; 2] {
+    let (m, c, d, i, g): (f64, f64, f64, f64, f64) = (2.0, 1.0, 0.25, 0.05, 9.81);
+    let a = m * c * c * i;
+    let b = -(m * g * c * (m * d * d + i) + m * m * g * c * c * d);
+    let e = m * m * g * g * c * d;
+    let root = (b * b - 4.0 * a * e).sqrt();
+    [((-b - root) / (2.0 * a)).sqrt(), ((-b + root) / (2.0 * a)).sqrt()]
+}
+
+/// A body on a taut inextensible cable: the cable's length is a constraint (5 degrees of
+/// freedom of 6 coordinates), its tension from the equilibrium is the weight m g = 19.62 N,
+/// and the modes are the double pendulum's in both vertical planes (each twice) and the free
+/// spin about the vertical, within 1e-9 (measured 2e-10: the finite differences, extrapolated).
 #[test]
-fn loops_are_refused_by_name() {
-    let (code, _, err) = common::tensegrity(&["modes", "scenarios/custom/snelson-x.toml"]);
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("joint 'D' closes a loop"), "{err}");
+fn a_body_on_a_taut_inextensible_cable_swings_at_the_double_pendulum_frequencies() {
+    let m = modes_of("hanging.toml", Some(HANGING_BODY));
+    let c = m.constraints.as_ref().expect("held by a constraint");
+    assert_eq!((c.coordinates.len(), c.rows, c.degrees_of_freedom()), (6, 1, 5));
+    assert!((c.multipliers[0] - 2.0 * 9.81).abs() <= 1e-9 * 19.62, "tension {}", c.multipliers[0]);
+    assert_eq!((m.modes.len(), m.rigid), (5, 1));
+    let omega: Vec<f64> = m.modes.iter().filter(|x| !x.rigid).map(|x| x.omega()).collect();
+    let [low, high] = hanging_body_frequencies();
+    for (got, want) in omega.iter().zip([low, low, high, high]) {
+        assert!((got - want).abs() <= 1e-9 * want, "{got} against {want}");
+    }
+}
+
+/// A parallelogram four-bar hanging in gravity: cranks of a = 0.5 m (0.3 kg, 0.01 kg m^2 about
+/// their middles) pinned 0.8 m apart, a coupler of 0.7 kg, the loop closed at D by a planar
+/// pin.
+const FOUR_BAR: &str = r#"name = "hanging parallelogram four-bar"
+mechanism = "custom"
+[settle]
+speed_tol = 1e-12
+residual_force_tol = 1e-10
+residual_torque_tol = 1e-10
+[interference]
+informative = true
+[actuation]
+points = [ {} ]
+[structure]
+gravity = [0, -9.81, 0]
+[[structure.bodies]]
+name = "base"
+fixed = true
+nodes = { A = [0, 0, 0], B = [0.8, 0, 0] }
+[[structure.bodies]]
+name = "crank1"
+mass = 0.3
+inertia = [0.01, 0.01, 0.01]
+nodes = { A1 = [0, 0, 0], C1 = [0, -0.5, 0] }
+[[structure.bodies]]
+name = "crank2"
+mass = 0.3
+inertia = [0.01, 0.01, 0.01]
+nodes = { B2 = [0.8, 0, 0], D2 = [0.8, -0.5, 0] }
+[[structure.bodies]]
+name = "coupler"
+mass = 0.7
+inertia = [0.02, 0.02, 0.02]
+nodes = { C = [0, -0.5, 0], D = [0.8, -0.5, 0] }
+[[structure.joints]]
+name = "A"
+kind = "revolute"
+parent = "base"
+child = "crank1"
+at = "A"
+axis = [0, 0, 1]
+[[structure.joints]]
+name = "C"
+kind = "revolute"
+parent = "crank1"
+child = "coupler"
+at = "C"
+axis = [0, 0, 1]
+[[structure.joints]]
+name = "B"
+kind = "revolute"
+parent = "base"
+child = "crank2"
+at = "B"
+axis = [0, 0, 1]
+[[structure.joints]]
+name = "D"
+kind = "planar_pin"
+parent = "crank2"
+child = "coupler"
+at = "D"
+axis = [0, 0, 1]
+"#;
+
+/// The four-bar's loop is a constraint (3 joint coordinates, 2 rows, 1 degree of freedom): the
+/// coupler translates on a circle of radius a, so T = (2 (I + m a^2 / 4) + M a^2) w^2 / 2 and
+/// V = -(m + M) g a cos phi give w^2 = g a (m + M) / (2 I + m a^2 / 2 + M a^2) =
+/// (4.5931224884 rad/s)^2, met within 1e-9 (measured 5e-10).
+#[test]
+fn a_parallelogram_four_bar_closed_by_a_loop_swings_at_the_closed_form_frequency() {
+    let m = modes_of("four_bar.toml", Some(FOUR_BAR));
+    let c = m.constraints.as_ref().expect("held by its loop");
+    assert_eq!((c.coordinates.len(), c.rows, c.degrees_of_freedom(), m.modes.len()), (3, 2, 1, 1));
+    let (a, crank, inertia, coupler, g): (f64, f64, f64, f64, f64) = (0.5, 0.3, 0.01, 0.7, 9.81);
+    let want = (g * a * (crank + coupler) / (2.0 * inertia + crank * a * a / 2.0 + coupler * a * a)).sqrt();
+    assert!((m.modes[0].omega() - want).abs() <= 1e-9 * want, "{} against {want}", m.modes[0].omega());
+}
+
+/// A loop held at its actuator's command has no motion left: the Snelson X (one four-bar, its
+/// angle at A commanded) has 2 free joint coordinates and 2 loop rows of rank 2, so no mode.
+#[test]
+fn a_loop_held_by_its_actuator_has_no_mode() {
+    let m = modes_of("scenarios/custom/snelson-x.toml", None);
+    let c = m.constraints.as_ref().expect("held by its loop");
+    assert_eq!((c.coordinates.len(), c.rank, c.degrees_of_freedom(), m.modes.len()), (2, 2, 0, 0));
+}
+
+/// `modes` analyses every shipped scenario of the four seeds (the first point, settled or
+/// not): every frequency is finite. At every settled first point the tensions of the taut
+/// inextensible cables found from the equilibrium are the simulator's within 1e-6 relative.
+#[test]
+fn every_seed_scenario_has_finite_frequencies() {
+    for seed in ["ji2014", "mohr2011", "furet2018", "manriquez2019"] {
+        let mut files: Vec<_> = std::fs::read_dir(format!("scenarios/{seed}"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+            .collect();
+        files.sort();
+        for path in files {
+            let sc = scenario::load(&path).unwrap();
+            let mut state = settle_first_point(&sc, None).unwrap();
+            let m = state.sim.modes().unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert!(m.modes.iter().all(|x| x.omega().is_finite()), "{}", path.display());
+            let Some(c) = m.constraints.as_ref().filter(|_| state.settled) else { continue };
+            let forces = state.sim.member_forces();
+            let loop_rows = c.multipliers.len() - c.taut_cables.len();
+            for (&k, t) in c.taut_cables.iter().zip(&c.multipliers[loop_rows..]) {
+                let sim = forces.cable_tension_n[k];
+                assert!(
+                    (t - sim).abs() <= 1e-6 * sim.abs().max(1.0),
+                    "{}: cable {k} {t} N against {sim} N",
+                    path.display()
+                );
+            }
+        }
+    }
 }
 
 /// The Python that has MuJoCo (`TENSEGRITY_PYTHON`, else `python3`), or None.
