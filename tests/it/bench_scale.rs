@@ -248,24 +248,13 @@ fn the_aligned_distance_ignores_rigid_motions() {
 
 use crate::common;
 
-/// The Python that has MuJoCo: `TENSEGRITY_PYTHON` if set, else `python3`; None (the test
-/// then says it skipped) when `import mujoco` fails.
-fn python_with_mujoco() -> Option<String> {
-    let py = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
-    let ok = std::process::Command::new(&py).args(["-c", "import mujoco"]).output().is_ok_and(|o| o.status.success());
-    ok.then_some(py)
-}
-
 /// Every family's members up to 6 struts go through MuJoCo in the same run
 /// (`benches/peers/mujoco/scale_peer.py` on the testbed's MJCF export): MuJoCo settles every
 /// one, with no export warning, within 1e-5 of the closed form (measured 4e-14 rad to 7e-7 m),
 /// and the testbed's error is below a tenth of MuJoCo's on each (measured 1e-2 to 5e-10).
 #[test]
 fn mujoco_settles_the_small_members_side_by_side() {
-    let Some(py) = python_with_mujoco() else {
-        eprintln!("skipped: no Python with `import mujoco` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt)");
-        return;
-    };
+    let Some(py) = crate::common::peer_python(&["mujoco"], module_path!()) else { return };
     let dir = std::env::temp_dir().join(format!("tensegrity-test-scale-peer-{}", std::process::id()));
     let command = [py, "benches/peers/mujoco/scale_peer.py".to_string()];
     let out = scale::peer::compare(&scale::FAMILIES, 6, &DEFAULT_CAPS, &command, &dir, &|line| eprintln!("{line}"));
@@ -317,10 +306,7 @@ fn motion_beside_mujoco_converges_at_first_order_on_both_sides() {
     let (code, _, err) = common::tensegrity(&["bench", "--scale", "--motion", "--peer", "--family", "furet"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("--motion covers the free-body families"), "{err}");
-    let Some(py) = python_with_mujoco() else {
-        eprintln!("skipped the MuJoCo side: no Python with `import mujoco` (set TENSEGRITY_PYTHON)");
-        return;
-    };
+    let Some(py) = crate::common::peer_python(&["mujoco"], module_path!()) else { return };
     let dir = std::env::temp_dir().join(format!("tensegrity-test-scale-motion-{}", std::process::id()));
     let command = [py, "benches/peers/mujoco/scale_peer.py".to_string()];
     let out = scale::motion::compare(&["prism"], 4, &command, &dir, &|line| eprintln!("{line}"));

@@ -158,3 +158,27 @@ pub fn rust_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
     out.sort();
     out
 }
+
+/// Set (to 1) where no test may skip a check: `.ci/run` sets it, so a CI run skips nothing (no
+/// MuJoCo, pandas or pyarrow, no root for a tmpfs: the test fails); elsewhere a check that
+/// cannot run is skipped, saying so on stderr.
+pub const NO_SKIPS_VAR: &str = "TENSEGRITY_NO_SKIPS";
+
+/// Skips `check` because of `why`: a line on stderr, or a failure where [`NO_SKIPS_VAR`] is set.
+pub fn skip(check: &str, why: &str) {
+    assert!(std::env::var(NO_SKIPS_VAR).is_err(), "{check}: {why}, and {NO_SKIPS_VAR} forbids skipping it");
+    eprintln!("SKIPPED {check}: {why}");
+}
+
+/// The Python (`TENSEGRITY_PYTHON`, else `python3`) that imports every one of `modules`, or
+/// None after [`skip`]ping `check`.
+pub fn peer_python(modules: &[&str], check: &str) -> Option<String> {
+    let py = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
+    let import = format!("import {}", modules.join(", "));
+    let ok = Command::new(&py).args(["-c", &import]).output().is_ok_and(|o| o.status.success());
+    if !ok {
+        let why = format!("no Python with `{import}` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt pandas pyarrow)");
+        skip(check, &why);
+    }
+    ok.then_some(py)
+}

@@ -184,14 +184,6 @@ fn the_command_writes_the_xml_and_refuses_bad_input() {
 // MuJoCo: settle the export and compare with the testbed
 // ------------------------------------------------------------------------------------------
 
-/// The Python that has MuJoCo: `TENSEGRITY_PYTHON` if set, else `python3`; None (the test
-/// then says it skipped) when `import mujoco` fails.
-fn python_with_mujoco() -> Option<String> {
-    let py = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
-    let ok = Command::new(&py).args(["-c", "import mujoco"]).output().is_ok_and(|o| o.status.success());
-    ok.then_some(py)
-}
-
 /// Steps the testbed's simulation of the scenario's first structure until every node moves
 /// slower than the scenario's speed tolerance for its window (as the settle loop does).
 fn testbed_settled(sc: &Scenario) -> BTreeMap<String, P3> {
@@ -272,10 +264,7 @@ fn differences(a: &BTreeMap<String, P3>, b: &BTreeMap<String, P3>) -> (f64, f64)
 /// so positions are compared through the shape).
 #[test]
 fn prism3_settles_in_mujoco_to_the_testbed_shape() {
-    let Some(py) = python_with_mujoco() else {
-        eprintln!("skipped: no Python with `import mujoco` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt)");
-        return;
-    };
+    let Some(py) = crate::common::peer_python(&["mujoco"], module_path!()) else { return };
     let path = "scenarios/custom/prism3.toml";
     let ours = testbed_settled(&load(path));
     let (steps, theirs) = mujoco_settled(&py, path, ActuatorMode::Mocap);
@@ -289,10 +278,7 @@ fn prism3_settles_in_mujoco_to_the_testbed_shape() {
 /// MuJoCo model has no soft constraint, only springs and the damped hinge.
 #[test]
 fn ji2014_settles_in_mujoco_to_the_testbed_positions() {
-    let Some(py) = python_with_mujoco() else {
-        eprintln!("skipped: no Python with `import mujoco` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt)");
-        return;
-    };
+    let Some(py) = crate::common::peer_python(&["mujoco"], module_path!()) else { return };
     let path = "scenarios/ji2014/grid.toml";
     let ours = testbed_settled(&load(path));
     let (steps, theirs) = mujoco_settled(&py, path, ActuatorMode::Mocap);
@@ -337,10 +323,7 @@ fn differences_over_dt(py: &str, path: &str, cable_damping: f64) -> Vec<f64> {
 /// dt^2). Measured with mujoco 4.0.0: 2.9e-6, 1.8e-7 and 1.1e-8 m at dt, dt/4 and dt/16.
 #[test]
 fn mohr2011_settles_in_mujoco_to_the_testbed_within_its_soft_constraint_offset() {
-    let Some(py) = python_with_mujoco() else {
-        eprintln!("skipped: no Python with `import mujoco` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt)");
-        return;
-    };
+    let Some(py) = crate::common::peer_python(&["mujoco"], module_path!()) else { return };
     let d = differences_over_dt(&py, "scenarios/mohr2011/quick.toml", 0.0);
     assert!(d[0] <= 1e-5, "{d:?}");
     assert!(d.windows(2).all(|w| w[1] <= w[0] / 8.0), "{d:?}");
@@ -353,10 +336,7 @@ fn mohr2011_settles_in_mujoco_to_the_testbed_within_its_soft_constraint_offset()
 /// each quarter of dt. Measured with mujoco 4.0.0: 4.0e-5, 2.5e-6 and 1.6e-7 m.
 #[test]
 fn furet2018_settles_in_mujoco_to_the_testbed_within_its_soft_constraint_offset() {
-    let Some(py) = python_with_mujoco() else {
-        eprintln!("skipped: no Python with `import mujoco` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt)");
-        return;
-    };
+    let Some(py) = crate::common::peer_python(&["mujoco"], module_path!()) else { return };
     let d = differences_over_dt(&py, "scenarios/furet2018/ik_solutions.toml", 0.0);
     assert!(d[0] <= 1e-4, "{d:?}");
     assert!(d.windows(2).all(|w| w[1] <= w[0] / 8.0), "{d:?}");
@@ -374,10 +354,7 @@ const WINCH_TEST_DAMPING_N_S_PER_M: f64 = 10.0;
 /// 4.0.0: 1.0e-7, 6.4e-9 and 4.0e-10 m at dt, dt/4 and dt/16.
 #[test]
 fn mohr2011_with_winched_elastic_cables_settles_in_mujoco_to_the_testbed() {
-    let Some(py) = python_with_mujoco() else {
-        eprintln!("skipped: no Python with `import mujoco` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt)");
-        return;
-    };
+    let Some(py) = crate::common::peer_python(&["mujoco"], module_path!()) else { return };
     let d = differences_over_dt(&py, "scenarios/mohr2011/elastic_cables.toml", WINCH_TEST_DAMPING_N_S_PER_M);
     assert!(d[0] <= 1e-5, "{d:?}");
     assert!(d.windows(2).all(|w| w[1] <= w[0] / 8.0), "{d:?}");
@@ -389,10 +366,7 @@ fn mohr2011_with_winched_elastic_cables_settles_in_mujoco_to_the_testbed() {
 /// with each quarter of dt. Measured with mujoco 4.0.0: 2.1e-6, 1.3e-7 and 8.1e-9 m.
 #[test]
 fn manriquez2019_settles_in_mujoco_to_the_testbed_within_its_soft_constraint_offset() {
-    let Some(py) = python_with_mujoco() else {
-        eprintln!("skipped: no Python with `import mujoco` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt)");
-        return;
-    };
+    let Some(py) = crate::common::peer_python(&["mujoco"], module_path!()) else { return };
     let d = differences_over_dt(&py, "scenarios/manriquez2019/table3.toml", 0.0);
     assert!(d[0] <= 1e-5, "{d:?}");
     assert!(d.windows(2).all(|w| w[1] <= w[0] / 8.0), "{d:?}");

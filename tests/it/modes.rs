@@ -302,13 +302,6 @@ fn every_seed_scenario_has_finite_frequencies() {
     }
 }
 
-/// The Python that has MuJoCo (`TENSEGRITY_PYTHON`, else `python3`), or None.
-fn python_with_mujoco() -> Option<String> {
-    let py = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
-    let ok = Command::new(&py).args(["-c", "import mujoco"]).output().is_ok_and(|o| o.status.success());
-    ok.then_some(py)
-}
-
 /// MuJoCo's frequencies (dispersion-corrected) of the export of `path`, settled there.
 fn mujoco_modes(py: &str, path: &str) -> Vec<f64> {
     let dir = std::env::temp_dir().join(format!("tensegrity-modes-{}", std::process::id()));
@@ -340,10 +333,7 @@ fn mujoco_modes(py: &str, path: &str) -> Vec<f64> {
 /// elastic cables only), so MuJoCo adds no stiffness of its own.
 #[test]
 fn prism3_and_the_icosahedron_agree_with_mujoco() {
-    let Some(py) = python_with_mujoco() else {
-        eprintln!("skipped: no Python with `import mujoco` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt)");
-        return;
-    };
+    let Some(py) = crate::common::peer_python(&["mujoco"], module_path!()) else { return };
     const RIGID_RAD_PER_S: f64 = 1e-3;
     for path in ["scenarios/custom/prism3.toml", "scenarios/custom/icosahedron6.toml"] {
         let ours = modes_of(path, None);

@@ -135,7 +135,7 @@ fn a_full_disk_keeps_the_previous_report() {
         .status()
         .is_ok_and(|s| s.success());
     if !mounted {
-        eprintln!("skipped: cannot mount a tmpfs here (needs root)");
+        crate::common::skip("outputs: a report on a full disk", "cannot mount a tmpfs here (needs root)");
         return;
     }
     let json = mnt.join("report.json");

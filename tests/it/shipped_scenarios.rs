@@ -25,27 +25,34 @@ const MAX_LISTED: usize = 12;
 /// Set to 1 to write the baselines from this run instead of comparing with them.
 const BLESS_VAR: &str = "TENSEGRITY_BLESS";
 
-fn shipped_scenarios() -> Vec<PathBuf> {
-    let mut files = Vec::new();
-    for dir in std::fs::read_dir("scenarios").expect("scenarios/ exists") {
-        let dir = dir.unwrap().path();
-        if dir.is_dir() {
-            for f in std::fs::read_dir(&dir).unwrap() {
-                let f = f.unwrap().path();
-                if f.extension().is_some_and(|e| e == "toml") {
-                    files.push(f);
-                }
+/// Every file under `dir` (at any depth) whose name ends in `.ext`, sorted.
+fn files_under(dir: &Path, ext: &str) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut pending = vec![dir.to_path_buf()];
+    while let Some(d) = pending.pop() {
+        for entry in std::fs::read_dir(&d).unwrap_or_else(|e| panic!("{}: {e}", d.display())) {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                pending.push(path);
+            } else if path.extension().is_some_and(|e| e == ext) {
+                out.push(path);
             }
         }
     }
-    files.sort();
-    files
+    out.sort();
+    out
 }
 
-/// `scenarios/ji2014/grid.toml` -> `tests/baselines/ji2014/grid.json`.
+/// Every scenario file under `scenarios/`, at any depth.
+fn shipped_scenarios() -> Vec<PathBuf> {
+    files_under(Path::new("scenarios"), "toml")
+}
+
+/// `scenarios/ji2014/grid.toml` -> `tests/baselines/ji2014/grid.json` (the same path below
+/// `tests/baselines/`, at any depth).
 fn baseline_path(scenario: &Path) -> PathBuf {
-    let dir = scenario.parent().and_then(Path::file_name).unwrap();
-    Path::new("tests/baselines").join(dir).join(scenario.file_stem().unwrap()).with_extension("json")
+    let relative = scenario.strip_prefix("scenarios").expect("a scenario under scenarios/");
+    Path::new("tests/baselines").join(relative).with_extension("json")
 }
 
 /// The report without what differs from run to run (wall times).
@@ -187,9 +194,21 @@ fn check(file: &Path, bless: bool) -> Vec<String> {
 fn every_shipped_scenario_meets_its_declared_verdict_and_its_baseline_numbers() {
     let bless = std::env::var(BLESS_VAR).is_ok_and(|v| v == "1");
     let files = shipped_scenarios();
-    assert!(files.len() >= 27, "found only {} shipped scenarios", files.len());
     let problems: Vec<String> = files.par_iter().flat_map(|f| check(f, bless)).collect();
     assert!(problems.is_empty(), "{} problem(s):\n{}", problems.len(), problems.join("\n"));
+}
+
+#[test]
+fn the_baselines_are_exactly_the_shipped_scenarios() {
+    // Every scenario has its baseline (a missing one fails the test above too, unless blessed)
+    // and every baseline its scenario: a scenario removed or renamed leaves no stale baseline.
+    let scenarios: Vec<PathBuf> = shipped_scenarios().iter().map(|f| baseline_path(f)).collect();
+    let baselines = files_under(Path::new("tests/baselines"), "json");
+    let orphans: Vec<&PathBuf> = baselines.iter().filter(|b| !scenarios.contains(b)).collect();
+    let missing: Vec<&PathBuf> = scenarios.iter().filter(|s| !baselines.contains(s)).collect();
+    assert!(orphans.is_empty(), "baselines without a scenario: {orphans:?}");
+    assert!(missing.is_empty(), "scenarios without a baseline: {missing:?}");
+    assert!(!scenarios.is_empty());
 }
 
 #[test]

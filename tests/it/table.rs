@@ -63,26 +63,20 @@ fn the_trajectory_table_holds_the_settled_values_bit_for_bit() {
     // report and the table read in Python (both parsers exact), the settled row compared.
     let json = dir.join("report.json");
     std::fs::write(&json, tensegrity_testbed::report::Report { scenarios: vec![r.clone()] }.to_json()).unwrap();
-    let py = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
-    let script = format!(
-        "import json, pandas\n\
-         settled = json.load(open({json:?}))['scenarios'][0]['points'][0]['simulated']\n\
-         t = pandas.read_csv({path:?})\n\
-         row = t[t['tick'] == {tick}].iloc[0]\n\
-         print(all(float(row['sim:' + q]) == v for q, v in settled.items()))",
-        json = json.display().to_string(),
-        path = path.display().to_string()
-    );
-    match Command::new(&py).args(["-c", &script]).output() {
-        Ok(o) if o.status.success() => {
-            assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "True", "pandas read other values");
-            eprintln!("pandas read the settled row (tick {tick}) as the JSON report has it, bit for bit");
-        }
-        // Only a missing Python or pandas skips; a script that fails otherwise is a failure.
-        Ok(o) if !String::from_utf8_lossy(&o.stderr).contains("No module named") => {
-            panic!("the pandas read failed: {}", String::from_utf8_lossy(&o.stderr))
-        }
-        _ => eprintln!("skipped the pandas read: no Python with pandas (set TENSEGRITY_PYTHON)"),
+    if let Some(py) = crate::common::peer_python(&["pandas"], "table: the CSV read by pandas") {
+        let script = format!(
+            "import json, pandas\n\
+             settled = json.load(open({json:?}))['scenarios'][0]['points'][0]['simulated']\n\
+             t = pandas.read_csv({path:?})\n\
+             row = t[t['tick'] == {tick}].iloc[0]\n\
+             print(all(float(row['sim:' + q]) == v for q, v in settled.items()))",
+            json = json.display().to_string(),
+            path = path.display().to_string()
+        );
+        let o = Command::new(&py).args(["-c", &script]).output().expect("the peer Python runs");
+        assert!(o.status.success(), "the pandas read failed: {}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "True", "pandas read other values");
+        eprintln!("pandas read the settled row (tick {tick}) as the JSON report has it, bit for bit");
     }
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -147,29 +141,20 @@ fn the_trajectory_table_as_arrow_holds_the_csv_values() {
     let settled = &r2.points[0].simulated;
     let json = dir.join("report.json");
     std::fs::write(&json, tensegrity_testbed::report::Report { scenarios: vec![r2.clone()] }.to_json()).unwrap();
-    let py = std::env::var("TENSEGRITY_PYTHON").unwrap_or_else(|_| "python3".into());
-    let script = format!(
-        "import json, pandas\n\
-         settled = json.load(open({json:?}))['scenarios'][0]['points'][0]['simulated']\n\
-         t = pandas.read_feather({path:?})\n\
-         rows = [r for _, r in t.iterrows() if all(float(r['sim:' + q]) == v for q, v in settled.items())]\n\
-         print(len(rows) > 0)",
-        json = json.display().to_string(),
-        path = arrow.display().to_string()
-    );
-    match Command::new(&py).args(["-c", &script]).output() {
-        Ok(o) if o.status.success() => {
-            assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "True", "pandas read other values: {settled:?}");
-            eprintln!("pandas read the Arrow table's settled row as the JSON report has it, bit for bit");
-        }
-        // Only a missing Python, pandas or pyarrow skips; any other failure fails.
-        Ok(o)
-            if !String::from_utf8_lossy(&o.stderr).contains("No module named")
-                && !String::from_utf8_lossy(&o.stderr).contains("pyarrow") =>
-        {
-            panic!("the pandas read failed: {}", String::from_utf8_lossy(&o.stderr))
-        }
-        _ => eprintln!("skipped the pandas read: no Python with pandas and pyarrow (set TENSEGRITY_PYTHON)"),
+    if let Some(py) = crate::common::peer_python(&["pandas", "pyarrow"], "table: the Arrow file read by pandas") {
+        let script = format!(
+            "import json, pandas\n\
+             settled = json.load(open({json:?}))['scenarios'][0]['points'][0]['simulated']\n\
+             t = pandas.read_feather({path:?})\n\
+             rows = [r for _, r in t.iterrows() if all(float(r['sim:' + q]) == v for q, v in settled.items())]\n\
+             print(len(rows) > 0)",
+            json = json.display().to_string(),
+            path = arrow.display().to_string()
+        );
+        let o = Command::new(&py).args(["-c", &script]).output().expect("the peer Python runs");
+        assert!(o.status.success(), "the pandas read failed: {}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "True", "pandas read other values: {settled:?}");
+        eprintln!("pandas read the Arrow table's settled row as the JSON report has it, bit for bit");
     }
     std::fs::remove_dir_all(&dir).ok();
 }
