@@ -286,8 +286,15 @@ fn manriquez2019_fk_prints_the_cable_ends_of_eq8_9() {
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let values = &v["solutions"][0]["values"];
-    for k in ["x_M1", "y_M1", "z_M1", "x_M2", "y_M2", "z_M2", "L1", "L2"] {
-        assert!(values[k].is_number(), "{k} in {values}");
+    let value = |k: &str| values[k].as_f64().unwrap_or_else(|| panic!("{k} in {values}"));
+    // The base points B1 = (bx, b, -b) and B2 = (bx, -b, b) of the paper's parameters.
+    use tensegrity_testbed::mechanisms::manriquez2019::analytic::{cable_base_points, Params};
+    let bases = cable_base_points(&Params::PAPER);
+    for (i, base) in bases.iter().enumerate() {
+        let end = ["x", "y", "z"].map(|c| value(&format!("{c}_M{}", i + 1)));
+        let distance = ((end[0] - base.x).powi(2) + (end[1] - base.y).powi(2) + (end[2] - base.z).powi(2)).sqrt();
+        let length = value(&format!("L{}", i + 1));
+        assert!((length - distance).abs() <= 1e-12, "cable {}: L = {length} m, |B P_M| = {distance} m", i + 1);
     }
 }
 

@@ -209,6 +209,9 @@ fn a_free_body_spins_torque_free_within_the_measured_error() {
     }
     let p = super::common::fitted_order(&steps, &errors);
     eprintln!("torque-free spin: orientation errors {errors:?} rad at dt {steps:?}, order {p:.3}; drifts (L, energy) {drifts:?}; |L| {sizes:?}");
+    // A regression pin, not a property: rapier integrates the gyroscopic term explicitly (first
+    // order, rescaled to |L|), which the measured order 1.43 and the 0.038 rad at 1 ms reflect;
+    // no closed form gives them. Issue 45 asks for the free body's rotation without this drift.
     assert!((p - 1.43).abs() <= 0.1, "order {p}: {errors:?}");
     assert!(errors[2] <= 0.04, "{errors:?}");
     // |L| is kept (rapier rescales the explicit gyroscopic update to the momentum's size); its

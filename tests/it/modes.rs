@@ -78,15 +78,24 @@ fn modes_of(path: &str, text: Option<&str>) -> StructureModes {
     state.sim.modes().unwrap()
 }
 
-/// Three rigid-body modes (the turns about C), and the vertical mode at omega^2 = 6 k / m within
-/// 1e-9 relative (the other two couple the horizontal translations with turns about C).
+/// Three rigid-body modes (the turns about C) and three more, each within 1e-9 relative: the
+/// vertical translation at omega^2 = K / m (K = 6 k: C moves alone), and the horizontal
+/// translations coupled with the turns about the centre of mass G, d = 0.05 m above C. Along x
+/// with the turn about y, C moves by x - d theta_y: V = K (x - d theta)^2 / 2 and
+/// T = (m x'^2 + I_y theta'^2) / 2 leave one turn about C free and omega^2 = K (1 / m + d^2 / I_y);
+/// along y with the turn about x, the same with I_x. With I = (0.1, 0.2, 0.3) kg m^2 about G:
+/// 96, 99 and 102 rad^2/s^2.
 #[test]
 fn a_body_on_six_springs_vibrates_at_the_closed_form_frequency() {
     let m = modes_of("six.toml", Some(BODY_ON_SIX_SPRINGS));
     assert_eq!(m.rigid, 3, "{:?}", m.modes.iter().map(|x| x.omega()).collect::<Vec<_>>());
-    let want = 6.0 * 40.0 / 2.5;
-    let close = m.modes.iter().filter(|x| ((x.omega_squared - want) / want).abs() < 1e-9).count();
-    assert!(close >= 1, "{:?}", m.modes.iter().map(|x| x.omega_squared).collect::<Vec<_>>());
+    let (k, mass, d, inertia) = (6.0 * 40.0, 2.5, 0.05, [0.1, 0.2]);
+    let want = [k / mass, k * (1.0 / mass + d * d / inertia[1]), k * (1.0 / mass + d * d / inertia[0])];
+    let got: Vec<f64> = m.modes.iter().filter(|x| !x.rigid).map(|x| x.omega_squared).collect();
+    assert_eq!(got.len(), 3, "{got:?}");
+    for (g, w) in got.iter().zip(want) {
+        assert!(((g - w) / w).abs() <= 1e-9, "{got:?} vs {want:?}");
+    }
 }
 
 /// The prism's lowest frequencies are MuJoCo's (from the notes, mujoco 4.0 at dt = 1e-4):

@@ -72,9 +72,28 @@ fn a_prism_whose_struts_pass_through_each_other_fails_on_interference() {
     }
 }
 
-/// The shipped 3-strut prism (drawn at 130 degrees, settling at 150) keeps every member clear:
-/// its smallest clearance, over every tick, is 0.321 m between two struts (on the static
-/// relaxation's path, issue 21; 0.159 m on the path of body damping alone).
+/// The least distance between the segments p0-p1 and q0-q1 [m] (closest points clamped to the
+/// segments; sampled finely enough for a 1e-9 m bound on these struts).
+fn segment_distance(p0: common::P3, p1: common::P3, q0: common::P3, q1: common::P3) -> f64 {
+    const SAMPLES: usize = 2000;
+    let at = |a: common::P3, b: common::P3, t: f64| [0, 1, 2].map(|k| a[k] + t * (b[k] - a[k]));
+    let mut best = f64::INFINITY;
+    for i in 0..=SAMPLES {
+        let p = at(p0, p1, i as f64 / SAMPLES as f64);
+        // The closest point of the second segment to p, exactly (a projection clamped to it).
+        let d = common::sub(q1, q0);
+        let t = (common::dot(common::sub(p, q0), d) / common::dot(d, d)).clamp(0.0, 1.0);
+        best = best.min(common::norm(common::sub(p, at(q0, q1, t))));
+    }
+    best
+}
+
+/// The shipped 3-strut prism (drawn at 130 degrees, settling at 150) keeps every member clear.
+/// Its smallest clearance over every tick is at most the struts' clearance at the settled state,
+/// computed here from the settled nodes (segment distance less two radii of 0.02 m), and more
+/// than zero; the value itself, 0.3209 m between two struts on the static relaxation's path
+/// (0.159 m on the path of body damping alone), is a regression pin of that path: no closed
+/// form gives the least clearance along a settle.
 #[test]
 fn the_shipped_prism_passes_with_its_members_clear() {
     let r = common::run_file("scenarios/custom/prism3.toml");
@@ -83,7 +102,17 @@ fn the_shipped_prism_passes_with_its_members_clear() {
     assert!(i.violations.is_empty());
     assert_eq!(i.members_checked, 12, "3 struts and 9 cables");
     let c = i.min_clearance_m.expect("pairs within the margin");
-    assert!((c - 0.3209).abs() <= 1e-3, "min clearance {c} m");
+    let strut = |k: usize| (common::node(&r, &format!("B{k}")), common::node(&r, &format!("T{k}")));
+    let settled = [(1, 2), (2, 3), (3, 1)]
+        .iter()
+        .map(|&(a, b)| {
+            let ((p0, p1), (q0, q1)) = (strut(a), strut(b));
+            segment_distance(p0, p1, q0, q1) - 2.0 * 0.02
+        })
+        .fold(f64::INFINITY, f64::min);
+    eprintln!("prism3: least clearance over the run {c} m, at the settled state {settled} m");
+    assert!(c > 0.0 && c <= settled + 1e-9, "min clearance {c} m, settled {settled} m");
+    assert!((c - 0.3209).abs() <= 1e-3, "regression pin of the relaxation's path: {c} m");
 }
 
 /// A slack cable drawn straight through the held strut (on a fixed frame of its own) is

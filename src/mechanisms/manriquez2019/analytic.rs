@@ -1162,7 +1162,9 @@ mod tests {
     #[allow(clippy::approx_constant)]
     fn paper_grid_has_121_by_121_points_not_14761() {
         let g = paper_grid();
-        assert_eq!(g.len(), 14641);
+        // Table 2's range -0.5236..0.5204 rad at its step 0.0087 rad: 121 values per angle.
+        assert_eq!(g.len(), 121 * 121);
+        assert_relative_eq!((0.5204 - -0.5236) / 120.0, 0.0087, epsilon = 1e-12);
         assert_ne!(g.len(), PAPER_N_CONFIGURATIONS);
         assert_eq!(PAPER_N_CONFIGURATIONS, 29 * 509);
         assert_relative_eq!(g[0].0, -0.5236, epsilon = 1e-15);
