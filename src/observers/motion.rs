@@ -232,6 +232,10 @@ pub struct MotionObserver {
     frequencies: Vec<FrequencyPrediction>,
     /// Per frequency: the motion's times and the joint's coordinate there.
     samples: Vec<(Vec<f64>, Vec<f64>)>,
+    /// Per frequency, in a motion judged extrapolated: the coordinate in the state one level
+    /// rougher at each tick (Richardson's value from h and h/2), for the frequency's estimate of
+    /// the simulation's own error.
+    rougher: Vec<Vec<f64>>,
     /// The parameters, inputs and analytic quantities of the motion (for the predictions).
     at: Option<(Values, Values, Values)>,
     /// The structure's own modes at the motion's start that frequencies are fitted to.
@@ -245,6 +249,7 @@ impl MotionObserver {
         MotionObserver {
             frequencies: m.frequencies.clone(),
             samples: vec![(Vec::new(), Vec::new()); m.frequencies.len()],
+            rougher: vec![Vec::new(); m.frequencies.len()],
             at: None,
             modes: Vec::new(),
             extrapolated: false,
@@ -271,25 +276,43 @@ impl MotionObserver {
         formula.or_else(|| self.modal(f)).unwrap_or(f64::NAN)
     }
 
+    /// The frequency of the samples `(t, q)` by `f`'s measure [rad/s] (NaN where it finds none).
+    fn measured(f: &FrequencyPrediction, t: &[f64], q: &[f64]) -> f64 {
+        match f.measure {
+            FrequencyMeasure::Cosine => fit_cosine(t, q).map_or(f64::NAN, |x| x.omega_rad_per_s),
+            FrequencyMeasure::Period => period_frequency(t, q).unwrap_or(f64::NAN),
+        }
+    }
+
+    /// In a motion judged extrapolated: the estimate of the simulation's own error in the
+    /// measured frequency, relative: the same measure on the state one level rougher differs by
+    /// 2^4 - 1 times the finer one's error (`snapshot::RICHARDSON_ESTIMATE_DIVISOR`).
+    fn estimate(&self, f: &FrequencyPrediction, t: &[f64], rougher: &[f64], measured: f64) -> Option<f64> {
+        if !self.extrapolated || rougher.len() != t.len() {
+            return None;
+        }
+        let rough = Self::measured(f, t, rougher);
+        Some((measured - rough).abs() / measured.abs() / crate::snapshot::RICHARDSON_ESTIMATE_DIVISOR)
+    }
+
     fn report(
         &self,
         f: &FrequencyPrediction,
         (t, q): &(Vec<f64>, Vec<f64>),
-        dt_s: f64,
-        solved: &Values,
+        rougher: &[f64],
+        (dt_s, solved): (f64, &Values),
     ) -> FrequencyReport {
         let predicted = self.predicted(f, solved);
         // With a formula and a mode, the modal analysis is a third value judged against it.
         let modal = self.modal(f).filter(|_| f.formula.is_some());
         let modal_error = modal.map(|w| (w - predicted).abs() / predicted.abs());
         let fit = fit_cosine(t, q);
-        let (measured, method) = match (f.measure, self.extrapolated) {
-            (FrequencyMeasure::Cosine, false) => (fit.map_or(f64::NAN, |x| x.omega_rad_per_s), METHOD),
-            (FrequencyMeasure::Cosine, true) => (fit.map_or(f64::NAN, |x| x.omega_rad_per_s), METHOD_EXTRAPOLATED),
-            (FrequencyMeasure::Period, false) => (period_frequency(t, q).unwrap_or(f64::NAN), PERIOD_METHOD),
-            (FrequencyMeasure::Period, true) => {
-                (period_frequency(t, q).unwrap_or(f64::NAN), PERIOD_METHOD_EXTRAPOLATED)
-            }
+        let measured = Self::measured(f, t, q);
+        let method = match (f.measure, self.extrapolated) {
+            (FrequencyMeasure::Cosine, false) => METHOD,
+            (FrequencyMeasure::Cosine, true) => METHOD_EXTRAPOLATED,
+            (FrequencyMeasure::Period, false) => PERIOD_METHOD,
+            (FrequencyMeasure::Period, true) => PERIOD_METHOD_EXTRAPOLATED,
         };
         let corrected = if self.extrapolated { measured } else { corrected_for_symplectic_euler(measured, dt_s) };
         let error = (corrected - predicted).abs() / predicted.abs();
@@ -304,6 +327,7 @@ impl MotionObserver {
             uncorrected_error: (measured - predicted).abs() / predicted.abs(),
             modal_rad_per_s: modal,
             modal_error,
+            simulation_error: self.estimate(f, t, rougher, measured),
             tolerance: f.tolerance,
             passed: error <= f.tolerance && modal_error.is_none_or(|e| e <= f.tolerance),
             fit_offset: fit.map_or(f64::NAN, |x| x.offset),
@@ -322,16 +346,22 @@ impl Observer for MotionObserver {
         if self.at.is_none() {
             self.at = Some((t.params.clone(), t.inputs.clone(), t.prediction.expected.clone()));
         }
-        for (f, (ts, qs)) in self.frequencies.iter().zip(&mut self.samples) {
-            let q = match f.signal {
-                FrequencySignal::Joint(ref c) => t.snapshot.joint_coordinate(t.structure, c.index),
-                FrequencySignal::Mode(i) => {
-                    self.modes.iter().find(|m| m.index == i).map(|m| m.projector.coordinate(t.snapshot))
-                }
+        for (k, f) in self.frequencies.iter().enumerate() {
+            let q = |snap: &crate::snapshot::Snapshot| {
+                let q = match f.signal {
+                    FrequencySignal::Joint(ref c) => snap.joint_coordinate(t.structure, c.index),
+                    FrequencySignal::Mode(i) => {
+                        self.modes.iter().find(|m| m.index == i).map(|m| m.projector.coordinate(snap))
+                    }
+                };
+                q.unwrap_or(f64::NAN)
             };
-            let q = q.unwrap_or(f64::NAN);
+            let (ts, qs) = &mut self.samples[k];
             ts.push(time_s);
-            qs.push(q);
+            qs.push(q(t.snapshot));
+            if let Some((rough, _)) = t.rougher {
+                self.rougher[k].push(q(rough));
+            }
         }
     }
 
@@ -344,8 +374,17 @@ impl Observer for MotionObserver {
         let dt_s = m.dt_s;
         // The energy model's solved equilibrium at the motion's start point, if the file has one.
         let solved = report.points.last().and_then(|p| p.energy.as_ref()).map(|e| e.solved.clone()).unwrap_or_default();
-        m.frequencies =
-            self.frequencies.iter().zip(&self.samples).map(|(f, s)| self.report(f, s, dt_s, &solved)).collect();
+        m.frequencies = (0..self.frequencies.len())
+            .map(|k| self.report(&self.frequencies[k], &self.samples[k], &self.rougher[k], (dt_s, &solved)))
+            .collect();
+        for f in m.frequencies.iter().filter(|f| f.simulation_error.is_some_and(|e| f.tolerance < e)) {
+            report.warnings.push(format!(
+                "frequency:{}: tolerance {:.1e} below what this run resolves (its simulation error estimate {:.1e}): a finer time step resolves it",
+                f.name,
+                f.tolerance,
+                f.simulation_error.unwrap_or(f64::NAN)
+            ));
+        }
         if let Some(p) = report.points.last_mut() {
             p.frequencies = m.frequencies.clone();
             p.within_tolerance &= p.frequencies.iter().all(|f| f.passed);

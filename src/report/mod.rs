@@ -252,6 +252,11 @@ pub struct FrequencyReport {
     /// |modal - predicted| / predicted, where there is a modal value beside a formula.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub modal_error: Option<f64>,
+    /// In a motion judged extrapolated over the time step: the estimate of the simulation's own
+    /// error in the measured frequency, relative (the same measure on the state one level
+    /// rougher, their difference over 2^4 - 1).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulation_error: Option<f64>,
     /// The measured angular frequency of the simulated samples, w_d [rad/s].
     pub measured_rad_per_s: f64,
     /// Corrected for symplectic Euler's dispersion: w = (2 / dt) sin(w_d dt / 2) [rad/s].
@@ -277,6 +282,10 @@ fn frequency_line(f: &FrequencyReport) -> String {
     let modal = match (f.modal_rad_per_s, f.modal_error) {
         (Some(w), Some(e)) => format!(", modal {w:.9} (error {e:.3e})"),
         _ => String::new(),
+    };
+    let modal = match f.simulation_error {
+        Some(e) => format!("{modal}, simulation error {e:.1e}"),
+        None => modal,
     };
     format!(
         "frequency {} ({}): predicted {:.9} rad/s, measured {:.9}, corrected {:.9}: error {:.3e} (uncorrected {:.3e}){modal}, tolerance {:.1e}  {}",
