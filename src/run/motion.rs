@@ -119,7 +119,7 @@ pub(super) fn run_motion(
 /// stated start (`sim/levels.rs`), second order at the tick times; extrapolated over the step,
 /// fourth (`levels.rs`), by default where every free body moves in joint coordinates.
 fn start_integration(runner: &mut Runner, m: &Motion, report: &mut ScenarioReport) -> Result<(), RunError> {
-    let extrapolate = m.extrapolate.unwrap_or(!runner.sim.has_plain_free_bodies());
+    let extrapolate = m.extrapolate.unwrap_or(true);
     if let Some(r) = report.motion.as_mut() {
         r.integration = integration_text(extrapolate).into();
     }

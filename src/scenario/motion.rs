@@ -21,9 +21,9 @@
 //! undamped = false        # true: every joint's damping released for the motion (a settle to
 //!                         # the start keeps it: damped to equilibrium, then free vibration)
 //! extrapolate = true      # judge the motion extrapolated over the time step (h, h/2, h/4:
-//!                         # fourth order, with its own error estimate); false: rapier's steps.
-//!                         # Default: true where every free body moves in joint coordinates
-//!                         # (a plain free body's rotation is integrated at first order)
+//!                         # fourth order, with its own error estimate); false: rapier's steps
+//!                         # (second order; a plain free body's rotation by the implicit
+//!                         # midpoint rule, sim/rotation.rs). Default: true
 //! inputs = { x = "A*sin(w*t)" }  # optional: inputs as functions of the parameters and the
 //!                         # motion's time t, followed at their real speed (as [actuation]
 //!                         # waypoints are): each actuated joint driven through the solver

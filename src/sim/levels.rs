@@ -41,7 +41,8 @@ impl Clone for Data {
 }
 
 /// Every velocity the step integrates: each multibody's generalized velocities and each plain
-/// free body's linear and angular velocity (world frame).
+/// free body's linear velocity and angular momentum (world frame: what a step's kick changes by
+/// the torques' impulse, whatever the body's turn, `rotation.rs`).
 struct Velocities {
     multibodies: Vec<(MultibodyIndex, DVector<f64>)>,
     bodies: Vec<(usize, Vector, Vector)>,
@@ -67,7 +68,7 @@ impl Data {
                     }
                 }
                 Some(_) => {}
-                None => bodies.push((b, self.bodies[h].linvel(), self.bodies[h].angvel())),
+                None => bodies.push((b, self.bodies[h].linvel(), self.angular_momentum(m, b))),
             }
         }
         Velocities { multibodies, bodies }
@@ -80,10 +81,9 @@ impl Data {
                 mb.generalized_velocity_mut().copy_from(u);
             }
         }
-        for &(b, lin, ang) in &v.bodies {
-            let rb = &mut self.bodies[m.handles[b]];
-            rb.set_linvel(lin, true);
-            rb.set_angvel(ang, true);
+        for &(b, lin, momentum) in &v.bodies {
+            self.bodies[m.handles[b]].set_linvel(lin, true);
+            self.set_angular_momentum(m, b, momentum);
         }
     }
 }

@@ -33,6 +33,7 @@ mod path;
 mod projection;
 mod relaxation;
 mod restart;
+mod rotation;
 mod tree;
 
 pub use build::LOOPED_MULTIBODY_MAX_LINKS;
@@ -128,6 +129,7 @@ pub struct Simulation {
     drive: drive::Drive,
     projection: projection::Projection,
     closure_rests: closure_rest::ClosureRests,
+    rotation: rotation::FreeRotation,
 }
 
 impl Simulation {
@@ -158,6 +160,7 @@ impl Simulation {
             drive: drive::Drive::default(),
             projection: projection::Projection::default(),
             closure_rests: closure_rest::ClosureRests::default(),
+            rotation: rotation::FreeRotation::default(),
         };
         let commands = sim.data.commands.clone();
         sim.set_commands(&commands);
@@ -192,6 +195,9 @@ impl Simulation {
         self.path.physical = true;
         self.relaxation.on = false;
         self.data.restore_scheduled_damping(&self.model);
+        // Plain free bodies turn by the implicit midpoint rule from now on (`rotation.rs`).
+        self.rotation.on = true;
+        self.data.end_gyroscopic_forces(&self.model);
     }
 
     /// Releases every joint's and body's damping (sets it to zero) from now on: a free
@@ -268,7 +274,9 @@ impl Simulation {
             accelerated |= d.schedule_damping(m);
         }
         self.path.note_step(accelerated);
+        let turned = if self.rotation.on { d.free_rotations(m) } else { Vec::new() };
         d.step_rapier(m);
+        d.turn_free_bodies(m, &turned);
         self.closure_rests.project_internal_closures(m, d);
         self.projection.project_groups(m, d);
         d.tick += 1;
@@ -393,6 +401,7 @@ impl Simulation {
             drive: self.drive.clone(),
             projection: projection::Projection::default(),
             closure_rests: closure_rest::ClosureRests::default(),
+            rotation: self.rotation,
         }
     }
 
