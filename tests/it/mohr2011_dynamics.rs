@@ -208,6 +208,12 @@ fn free_vibration_meets_the_constrained_modal_frequency_at_every_workspace_point
         assert!(p.settled, "point {} did not settle", p.index);
         let f = p.frequencies.first().unwrap_or_else(|| panic!("point {}: no frequency measured", p.index));
         let relative = (f.corrected_rad_per_s - f.predicted_rad_per_s).abs() / f.predicted_rad_per_s;
-        assert!(relative <= 1e-6 && f.passed, "point {}: {} vs modal {}", p.index, f.corrected_rad_per_s, f.predicted_rad_per_s);
+        assert!(
+            relative <= 1e-6 && f.passed,
+            "point {}: {} vs modal {}",
+            p.index,
+            f.corrected_rad_per_s,
+            f.predicted_rad_per_s
+        );
     }
 }
