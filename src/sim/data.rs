@@ -409,9 +409,12 @@ impl Data {
         }
     }
 
-    /// Sets every joint's and body's damping to zero.
+    /// Sets every joint's and body's damping to zero, the hidden first links of split universal
+    /// joints included (`build.rs` gives them the joint's damping: left on, an undamped motion
+    /// of mohr2011 lost 13 % of its energy per second and its lowest pair of modes measured
+    /// 1.3e-4 high).
     pub(super) fn release_damping(&mut self, m: &Model) {
-        for link in m.joint_links.iter().flatten() {
+        for link in m.joint_links.iter().flatten().chain(m.hidden_links.iter()) {
             build::set_link_damping(&mut self.multibody_joints, link.multibody_joint, 0.0);
         }
         for h in &m.handles {
