@@ -2,9 +2,9 @@
 //! writes its report (atomically, never truncating the previous file) and exits non-zero; a
 //! panic in one scenario of a batch fails that scenario and the batch goes on.
 
-use std::process::{Command, Stdio};
 use super::common::{runs_its_command, send_signal, wait_for, HANG_GUARD_S};
 use std::io::BufRead;
+use std::process::{Command, Stdio};
 use std::time::Duration;
 
 fn out_dir(tag: &str) -> std::path::PathBuf {
