@@ -85,30 +85,36 @@ def test_bad_input_is_a_located_exception():
 
 
 def test_ctrl_c_stops_a_run():
-    """SIGINT to a Python running a long motion (1000 s simulated, about 5 s of wall time; at 100 s
-    the run could end before the signal 0.5 s in) stops it with KeyboardInterrupt. The child
-    takes Python's own SIGINT handler: started from a shell's background job it inherits SIGINT
-    ignored, and Python then installs none."""
+    """SIGINT to a Python running a long motion (1000 s simulated) stops it with
+    KeyboardInterrupt before the motion's end. The signal is sent once the run ticks: a model
+    callable, called at every tick, says so at the motion's first tick and keeps the last motion time it
+    saw, printed after the interrupt (below 1000 s: stopped early). The child takes Python's own
+    SIGINT handler: started from a shell's background job it inherits SIGINT ignored, and Python
+    then installs none."""
     import signal
     import sys
-    import time
 
     text = BAR.read_text().replace("duration_s = 4.0", "duration_s = 1000.0")
     script = (
         "import signal, sys, tensegrity_testbed as tt\n"
         "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
-        "print('started', flush=True)\n"
+        "seen = []\n"
+        "def model(params, inputs, t):\n"
+        "    if t is not None and not seen:\n"
+        "        print('ticking', flush=True)\n"
+        "    seen[:] = [t] if t is not None else seen\n"
+        "    return {}\n"
         "try:\n"
-        f"    tt.run({text!r}, name='long.toml')\n"
+        f"    tt.run({text!r}, name='long.toml', model=model)\n"
         "except KeyboardInterrupt:\n"
-        "    print('interrupted', flush=True); sys.exit(3)\n"
+        "    print('interrupted at t =', seen[0], flush=True); sys.exit(3)\n"
     )
     child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
-    assert child.stdout.readline().strip() == "started"
-    time.sleep(0.5)
+    assert child.stdout.readline().strip() == "ticking"  # the event the signal waits for
     child.send_signal(signal.SIGINT)
     out, _ = child.communicate(timeout=60)  # a guard against a hang, not a speed target
-    assert child.returncode == 3 and "interrupted" in out
+    assert child.returncode == 3 and out.startswith("interrupted at t = "), out
+    assert float(out.split("=")[1]) < 1000.0, out  # the motion's last tick is at 1000 s
 
 
 SWEEP = ROOT / "scenarios" / "custom" / "pinned_bar_sweep.toml"

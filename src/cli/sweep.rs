@@ -57,9 +57,17 @@ pub fn sweep(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} points, {per_sec}, {eta} left")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
+    // Off a terminal the bar is hidden: a line on standard error at the first block and at
+    // each further tenth of the points instead (a job's log; what an interrupting script waits for).
+    let plain = !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let lines_said = std::sync::atomic::AtomicUsize::new(0);
     let progress = |done: usize, total: usize| {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
+        let line = done * 10 / total.max(1) + 1;
+        if plain && lines_said.fetch_max(line, std::sync::atomic::Ordering::SeqCst) < line {
+            eprintln!("{done}/{total} points");
+        }
     };
     let result = crate::sweep::sweep(&sc, jobs, shard, Some(&signals::CANCEL), &progress);
     bar.finish_and_clear();

@@ -182,3 +182,64 @@ pub fn peer_python(modules: &[&str], check: &str) -> Option<String> {
     }
     ok.then_some(py)
 }
+
+/// How long a test waits for an event or a command before it fails [s]: a guard against a hang
+/// on any machine, loaded or not, never a speed target (speeds are the benchmarks').
+pub const HANG_GUARD_S: u64 = 60;
+
+/// Polls `ready` every 10 ms until it holds; fails the test, naming `what`, when it has not
+/// after [`HANG_GUARD_S`].
+pub fn wait_for(what: &str, mut ready: impl FnMut() -> bool) {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(HANG_GUARD_S);
+    while !ready() {
+        if std::time::Instant::now() > deadline {
+            panic!("no {what} within the {HANG_GUARD_S} s hang guard");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
+
+/// Whether process `pid` has started its command: it catches SIGINT and SIGTERM (bits 2 and 15
+/// of `SigCgt` in /proc/PID/status, set by `install_handlers`) and runs the command's thread
+/// beside its main thread (/proc/PID/task), which it starts after the handlers.
+pub fn runs_its_command(pid: u32) -> bool {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+    let caught = status
+        .lines()
+        .find_map(|l| l.strip_prefix("SigCgt:"))
+        .and_then(|hex| u64::from_str_radix(hex.trim(), 16).ok())
+        .unwrap_or(0);
+    let both = (1u64 << (2 - 1)) | (1u64 << (15 - 1));
+    let threads = std::fs::read_dir(format!("/proc/{pid}/task")).map(|d| d.count()).unwrap_or(0);
+    caught & both == both && threads >= 2
+}
+
+/// Sends `signal` ("INT", "TERM") to process `pid`.
+pub fn send_signal(signal: &str, pid: u32) {
+    let sent = Command::new("kill").args([&format!("-{signal}"), &pid.to_string()]).status().expect("kill runs");
+    assert!(sent.success(), "kill -{signal} {pid}");
+}
+
+/// Like [`tensegrity`], but fails the test (killing the command) when it has not ended after
+/// [`HANG_GUARD_S`]: for commands whose promise is to give an answer rather than hang.
+pub fn tensegrity_guarded(args: &[&str]) -> (i32, String, String) {
+    let child = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    let pid = child.id();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || tx.send(child.wait_with_output()));
+    let Ok(out) = rx.recv_timeout(std::time::Duration::from_secs(HANG_GUARD_S)) else {
+        send_signal("KILL", pid);
+        panic!("{args:?} did not end within the {HANG_GUARD_S} s hang guard");
+    };
+    let out = out.expect("the command's output");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}

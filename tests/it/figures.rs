@@ -17,6 +17,15 @@ fn ji2014_fig4_is_drawn_as_png_and_svg() {
     for text in ["theta2 [rad]", "U [J] (Eq. 4)", "K [N m/rad] (Eq. 42)", "dynamics settled at theta2"] {
         assert!(svg.contains(text), "the SVG has '{text}'");
     }
+    // The curves drawn are the data: U, tau and K each at the 721 samples of theta2 in
+    // [-pi, pi] (FIG4_SAMPLES), left to right, and K = u0 - U (Eq. 42 and Eq. 4) drawn as U's
+    // mirror image: their pixel heights correlate at -1 (to 1e-3, the pixels' rounding).
+    let curves: Vec<Vec<(f64, f64)>> = polylines(&svg).into_iter().filter(|c| c.len() > 3).collect();
+    assert_eq!(curves.iter().map(Vec::len).collect::<Vec<_>>(), vec![721; 3], "U, tau and K");
+    assert!(curves.iter().all(|c| c.windows(2).all(|w| w[1].0 >= w[0].0)), "theta2 ascending");
+    let heights = |c: &Vec<(f64, f64)>| c.iter().map(|p| p.1).collect::<Vec<f64>>();
+    let r = correlation(&heights(&curves[0]), &heights(&curves[2]));
+    assert!((r + 1.0).abs() < 1e-3, "corr(U, K) = {r}");
     let unknown = Command::new(env!("CARGO_BIN_EXE_tensegrity")).args(["figure", "no-such-figure"]).output().unwrap();
     assert_eq!(unknown.status.code(), Some(2));
 }
@@ -153,4 +162,32 @@ fn furet2018_fig4_shows_the_aspects_and_where_eq13_differs() {
     assert!((number_after(&svg, "has the other sign (") - 5.8).abs() < 0.2);
     // The non-singular paths of FINDINGS.md between the two solutions of each aspect.
     assert!((number_after(&svg, "smallest |det J| ") - 0.1349).abs() < 1e-4);
+}
+
+/// The points of every `<polyline>` of `svg` with a stroke width of 2 (the data's curves), in
+/// pixels, in the SVG's order.
+fn polylines(svg: &str) -> Vec<Vec<(f64, f64)>> {
+    svg.split("<polyline")
+        .skip(1)
+        .filter(|p| p.split('>').next().is_some_and(|tag| tag.contains("stroke-width=\"2\"")))
+        .map(|p| {
+            let at = p.find("points=\"").expect("points") + 8;
+            let list = &p[at..at + p[at..].find('"').expect("closing quote")];
+            list.split_whitespace()
+                .map(|xy| {
+                    let (x, y) = xy.split_once(',').expect("x,y");
+                    (x.parse().expect("x"), y.parse().expect("y"))
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Pearson's correlation of `a` and `b`.
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let (ma, mb) = (mean(a), mean(b));
+    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+    let var = |v: &[f64], m: f64| v.iter().map(|x| (x - m).powi(2)).sum::<f64>();
+    cov / (var(a, ma) * var(b, mb)).sqrt()
 }

@@ -1,8 +1,9 @@
 //! Fuzzing the scenario parser and validator: random mutations of the corpus scenarios in
 //! `tests/fuzz_corpus/` must give `Ok` or a located error, never a panic; a scenario that
 //! parses must build a structure and a simulation without panicking. Numbers are also mutated
-//! into extremes (1e300, 1e-300, subnormals), and each case must finish within
-//! `CASE_TIME_LIMIT_S` (no hang in parsing, validation or the analytic checks it runs).
+//! into extremes (1e300, 1e-300, subnormals), and each case must give an answer (no hang in
+//! parsing, validation or the analytic checks it runs: a case still running after
+//! `common::HANG_GUARD_S` fails as a hang).
 //!
 //! The test suite runs a few hundred cases. The long run (documented in `docs/testing.md`):
 //! `PROPTEST_CASES=1000000 cargo test --release --test it fuzz_scenarios` (stop it after 10
@@ -138,18 +139,18 @@ fn apply(text: &str, m: &Mutation) -> String {
     }
 }
 
-/// Wall time one case may take [s]: validation solves the analytic model at every point (a
-/// hang at a target of 1e100 m was found this way); the slowest corpus file takes well under
-/// a second.
-const CASE_TIME_LIMIT_S: f64 = 20.0;
-
-/// Parses and validates `text` on a thread of its own; None when it takes longer than the limit.
-fn parse_with_limit(text: String) -> Option<Result<scenario::Scenario, scenario::ScenarioError>> {
+/// Parses and validates `text` on a thread of its own: its answer, or why there is none
+/// ("panicked", or "hung" when it still runs after the hang guard; validation solves the
+/// analytic model at every point, and a hang at a target of 1e100 m was found this way).
+fn parse_guarded(text: String) -> Result<Result<scenario::Scenario, scenario::ScenarioError>, &'static str> {
     let (tx, rx) = std::sync::mpsc::channel();
     std::thread::spawn(move || {
         let _ = tx.send(scenario::parse(Path::new("fuzz.toml"), &text));
     });
-    rx.recv_timeout(std::time::Duration::from_secs_f64(CASE_TIME_LIMIT_S)).ok()
+    rx.recv_timeout(std::time::Duration::from_secs(super::common::HANG_GUARD_S)).map_err(|e| match e {
+        std::sync::mpsc::RecvTimeoutError::Timeout => "hung",
+        std::sync::mpsc::RecvTimeoutError::Disconnected => "panicked",
+    })
 }
 
 proptest! {
@@ -162,8 +163,8 @@ proptest! {
         for m in &muts {
             text = apply(&text, m);
         }
-        let parsed = parse_with_limit(text.clone());
-        prop_assert!(parsed.is_some(), "check panicked or took longer than {} s on:\n{}", CASE_TIME_LIMIT_S, text);
+        let parsed = parse_guarded(text.clone());
+        prop_assert!(parsed.is_ok(), "check {} on:\n{}", parsed.as_ref().err().unwrap_or(&""), text);
         match parsed.unwrap() {
             Err(e) => {
                 // Every error is located.

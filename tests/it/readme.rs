@@ -5,6 +5,11 @@
 //! `docs/*.md` in name order, each file's commands in its order; a command shown again (the
 //! README's tutorial steps are the chapters' first lines) runs once, where it is first shown. A
 //! line with `${SLURM_ARRAY_TASK_ID}` runs once for every task of its `--shard K/N`.
+//!
+//! Each command also does what its text says (`unmet_claims`): no panic on its standard error,
+//! a `run`'s every scenario line says PASS or "as the scenario expects", and every file its
+//! `--out`, `--json`, `--figure`, `--table` or `--record` names exists and is not empty (a
+//! directory for `figure --out`, with files in it), a `.json` one parsing as JSON.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -54,7 +59,7 @@ fn scratch() -> PathBuf {
     dir
 }
 
-fn run(dir: &Path, command: &str, task: usize) -> (bool, String) {
+fn run(dir: &Path, command: &str, task: usize) -> (bool, String, String) {
     let bin = Path::new(env!("CARGO_BIN_EXE_tensegrity")).parent().expect("bin dir").to_path_buf();
     let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
     let out = Command::new("sh")
@@ -65,8 +70,69 @@ fn run(dir: &Path, command: &str, task: usize) -> (bool, String) {
         .env("SLURM_ARRAY_TASK_ID", task.to_string())
         .output()
         .expect("sh runs");
-    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-    (out.status.success(), text)
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    (out.status.success(), text(&out.stdout), text(&out.stderr))
+}
+
+/// The flags whose value is a file (or, for `figure`, a directory) the command writes.
+const OUTPUT_FLAGS: [&str; 5] = ["--out", "--json", "--figure", "--table", "--record"];
+
+/// What `command` (run as `task`, with this stdout and stderr) claims and its outputs do not show.
+fn unmet_claims(dir: &Path, command: &str, task: usize, stdout: &str, stderr: &str) -> Vec<String> {
+    let mut unmet = Vec::new();
+    if stderr.contains("panicked") {
+        unmet.push("a panic on stderr".to_string());
+    }
+    let words: Vec<&str> = command.split_whitespace().collect();
+    if words.get(1) == Some(&"run") {
+        let verdicts: Vec<&str> = stdout.lines().chain(stderr.lines()).filter(|l| l.starts_with("== ")).collect();
+        if verdicts.is_empty() {
+            unmet.push("no scenario's verdict line".to_string());
+        }
+        for v in verdicts.iter().filter(|v| !v.ends_with(": PASS") && !v.ends_with(", as the scenario expects")) {
+            unmet.push(format!("not PASS nor as expected: {v}"));
+        }
+    }
+    for pair in words.windows(2).filter(|w| OUTPUT_FLAGS.contains(&w[0])) {
+        let name = pair[1].replace("${SLURM_ARRAY_TASK_ID}", &task.to_string());
+        if name == "-" || name.contains('{') || name.contains('|') {
+            continue;
+        }
+        if let Some(problem) = output_problem(&dir.join(&name)) {
+            unmet.push(format!("{} {name}: {problem}", pair[0]));
+        }
+    }
+    unmet
+}
+
+/// Why the output at `path` does not show it was written (None when it does). A run of several
+/// scenarios writes STEM-NAME.EXT per scenario instead: each of those then.
+fn output_problem(path: &Path) -> Option<String> {
+    if !path.exists() {
+        let stem = path.file_stem().map(|s| format!("{}-", s.to_string_lossy())).unwrap_or_default();
+        let ext = path.extension().map(|e| e.to_string_lossy().into_owned());
+        let per_scenario: Vec<PathBuf> = std::fs::read_dir(path.parent()?)
+            .ok()?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with(&stem)))
+            .filter(|p| p.extension().map(|e| e.to_string_lossy().into_owned()) == ext)
+            .collect();
+        if per_scenario.is_empty() {
+            return Some("not written".into());
+        }
+        return per_scenario.iter().find_map(|p| output_problem(p).map(|e| format!("{}: {e}", p.display())));
+    }
+    let Ok(meta) = std::fs::metadata(path) else { return Some("not readable".into()) };
+    if meta.is_dir() {
+        let files = std::fs::read_dir(path).map(|d| d.count()).unwrap_or(0);
+        return (files == 0).then(|| "an empty directory".into());
+    }
+    let text = std::fs::read(path).unwrap_or_default();
+    if text.is_empty() {
+        return Some("empty".into());
+    }
+    let json = path.extension().is_some_and(|e| e == "json");
+    json.then(|| serde_json::from_slice::<serde_json::Value>(&text).err().map(|e| format!("not JSON: {e}"))).flatten()
 }
 
 /// README.md, then every `docs/*.md` in name order.
@@ -82,7 +148,7 @@ fn documents() -> Vec<PathBuf> {
 }
 
 #[test]
-fn every_command_the_readme_and_docs_show_runs_and_exits_0() {
+fn every_command_the_readme_and_docs_show_runs_exits_0_and_writes_what_it_says() {
     let mut list: Vec<(String, usize, String)> = Vec::new();
     for file in documents() {
         let text = std::fs::read_to_string(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
@@ -98,12 +164,14 @@ fn every_command_the_readme_and_docs_show_runs_and_exits_0() {
             continue;
         }
         for task in 1..=shards(command) {
-            let (ok, text) = run(&dir, command, task);
+            let (ok, stdout, stderr) = run(&dir, command, task);
+            let mut unmet = unmet_claims(&dir, command, task, &stdout, &stderr);
             if !ok {
-                failed.push(format!(
-                    "{file}:{line}: {command} (task {task})\n{}",
-                    text.lines().take(5).collect::<Vec<_>>().join("\n")
-                ));
+                let said = format!("{stdout}{stderr}");
+                unmet.insert(0, format!("exit non-zero\n{}", said.lines().take(5).collect::<Vec<_>>().join("\n")));
+            }
+            if !unmet.is_empty() {
+                failed.push(format!("{file}:{line}: {command} (task {task}): {}", unmet.join("; ")));
             }
         }
     }

@@ -1130,17 +1130,25 @@ mod tests {
         assert!((stiffness_eq49_as_printed(&P, e.x, e.y, e.theta2) - e.stiffness).abs() > 1.0);
     }
 
+    /// K' = -tau and K'' = -K by central differences, each within the bound of its error: with
+    /// K = -A cos th2 - B sin th2 (Eq. 42) every derivative of K is at most R = hypot(A, B), so
+    /// truncation is at most h^2 R / 6 (first) and h^2 R / 12 (second); each evaluation of K
+    /// rounds its terms, of size at most S = |u0| + R, by at most 4 eps S, which the difference
+    /// quotients divide by h and h^2. h = 1e-3 balances the two for the second difference.
     #[test]
     fn derivative_identities_eq43_to_45() {
         let (l3, t1) = (1.3, 0.9);
         let e = energy_coefficients_eq4(&P, l3, t1);
+        let (r, h) = (e.a.hypot(e.b), 1e-3);
+        let ulp = 4.0 * f64::EPSILON * (e.u0.abs() + r);
+        let tol_first = h * h * r / 6.0 + 2.0 * ulp / (2.0 * h);
+        let tol_second = h * h * r / 12.0 + 4.0 * ulp / (h * h);
         for t2 in [-2.0, 0.4, 1.7] {
-            let h = 1e-4;
-            let dk = (stiffness(&P, l3, t1, t2 + h) - stiffness(&P, l3, t1, t2 - h)) / (2.0 * h);
-            assert_relative_eq!(dk, -torque(&P, l3, t1, t2), epsilon = 1e-5);
-            let d2k = (stiffness(&P, l3, t1, t2 + h) - 2.0 * stiffness(&P, l3, t1, t2) + stiffness(&P, l3, t1, t2 - h))
-                / (h * h);
-            assert_relative_eq!(d2k, -stiffness(&P, l3, t1, t2), epsilon = 1e-2);
+            let k = |t: f64| stiffness(&P, l3, t1, t);
+            let dk = (k(t2 + h) - k(t2 - h)) / (2.0 * h);
+            let d2k = (k(t2 + h) - 2.0 * k(t2) + k(t2 - h)) / (h * h);
+            assert!((dk + torque(&P, l3, t1, t2)).abs() <= tol_first, "K' + tau = {:e}", dk + torque(&P, l3, t1, t2));
+            assert!((d2k + k(t2)).abs() <= tol_second, "K'' + K = {:e} (bound {tol_second:e})", d2k + k(t2));
             // j = 0 only up to the constant U0
             assert_relative_eq!(
                 potential_energy(&P, l3, t1, t2) + stiffness(&P, l3, t1, t2),
