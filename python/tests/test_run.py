@@ -15,14 +15,20 @@ QUICK = ROOT / "scenarios" / "ji2014" / "quick.toml"
 BAR = ROOT / "scenarios" / "custom" / "pinned_bar_vibration.toml"
 
 
-def cli_report(path, *flags):
-    """The CLI's JSON report of one scenario (the binary the README's first command built)."""
+def cli_json(command, path, *flags):
+    """The CLI's JSON output of `tensegrity COMMAND PATH --json -` (the binary the README's first
+    command built)."""
     target = os.environ.get("CARGO_TARGET_DIR", str(ROOT / "target"))
     out = subprocess.run(
-        [os.path.join(target, "release", "tensegrity"), "run", str(path), "--json", "-", *flags],
+        [os.path.join(target, "release", "tensegrity"), command, str(path), "--json", "-", *flags],
         capture_output=True, text=True, cwd=ROOT,
     )
-    return json.loads(out.stdout)["scenarios"][0]
+    return json.loads(out.stdout)
+
+
+def cli_report(path, *flags):
+    """The CLI's JSON report of one scenario."""
+    return cli_json("run", path, *flags)["scenarios"][0]
 
 
 def test_settled_values_are_the_clis_bit_for_bit():
@@ -559,21 +565,10 @@ def test_bad_models_on_a_structure_from_arrays_raise_not_crash():
 ROCKER = ROOT / "scenarios" / "custom" / "rocker_frequency_curve.toml"
 
 
-def cli_modes(path, *flags):
-    """The CLI's `tensegrity modes --json -` report."""
-    target = os.environ.get("CARGO_TARGET_DIR", str(ROOT / "target"))
-    out = subprocess.run(
-        [os.path.join(target, "release", "tensegrity"), "modes", str(path), "--json", "-", *flags],
-        capture_output=True, text=True, cwd=ROOT,
-    )
-    assert out.returncode == 0, out.stderr
-    return json.loads(out.stdout)
-
-
 def test_modes_from_python_are_the_clis_modes_json():
     """tt.modes is `tensegrity modes --json`: every field equal (floats bit for bit), the
     analysis's own wall time aside."""
-    py, cli = tt.modes(str(ROCKER)), cli_modes(ROCKER)
+    py, cli = tt.modes(str(ROCKER)), cli_json("modes", ROCKER)
     py.pop("wall_s"), cli.pop("wall_s")
     assert py == cli
     assert py["joint_coordinates"] == ["pin"] and len(py["modes"]) == 1

@@ -19,6 +19,13 @@ fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
 /// mohr2011's trajectory: one row per step of the run (1239), a column per node coordinate,
 /// cable tension, actuator force, input and model quantity; the row of the settled tick holds
 /// the report's settled simulated values exactly (same f64 bits).
+/// What the peer Python `py` prints running `script` (trimmed); its failure fails the test.
+fn peer_prints(py: &str, script: &str) -> String {
+    let o = Command::new(py).args(["-c", script]).output().expect("the peer Python runs");
+    assert!(o.status.success(), "the pandas read failed: {}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout).trim().to_string()
+}
+
 #[test]
 fn the_trajectory_table_holds_the_settled_values_bit_for_bit() {
     let dir = std::env::temp_dir().join(format!("table-{}", std::process::id()));
@@ -73,9 +80,7 @@ fn the_trajectory_table_holds_the_settled_values_bit_for_bit() {
             json = json.display().to_string(),
             path = path.display().to_string()
         );
-        let o = Command::new(&py).args(["-c", &script]).output().expect("the peer Python runs");
-        assert!(o.status.success(), "the pandas read failed: {}", String::from_utf8_lossy(&o.stderr));
-        assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "True", "pandas read other values");
+        assert_eq!(peer_prints(&py, &script), "True", "pandas read other values");
         eprintln!("pandas read the settled row (tick {tick}) as the JSON report has it, bit for bit");
     }
     std::fs::remove_dir_all(&dir).ok();
@@ -151,9 +156,7 @@ fn the_trajectory_table_as_arrow_holds_the_csv_values() {
             json = json.display().to_string(),
             path = arrow.display().to_string()
         );
-        let o = Command::new(&py).args(["-c", &script]).output().expect("the peer Python runs");
-        assert!(o.status.success(), "the pandas read failed: {}", String::from_utf8_lossy(&o.stderr));
-        assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "True", "pandas read other values: {settled:?}");
+        assert_eq!(peer_prints(&py, &script), "True", "pandas read other values: {settled:?}");
         eprintln!("pandas read the Arrow table's settled row as the JSON report has it, bit for bit");
     }
     std::fs::remove_dir_all(&dir).ok();
