@@ -133,12 +133,8 @@ fn sweep_points(
             )))
         }
     };
-    let indexed: Vec<(usize, Values)> = points
-        .into_iter()
-        .enumerate()
-        .map(|(i, p)| (offset + i, p))
-        .filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1))
-        .collect();
+    let indexed: Vec<(usize, Values)> =
+        points.into_iter().enumerate().map(|(i, p)| (offset + i, p)).filter(|(i, _)| in_shard(shard, *i)).collect();
     let blocks: Vec<&[(usize, Values)]> = indexed.chunks(BLOCK_POINTS).collect();
     let total = indexed.len();
     let done = std::sync::atomic::AtomicUsize::new(0);
@@ -172,6 +168,12 @@ fn sweep_points(
     Ok((rows, errors))
 }
 
+/// Whether the point of grid index `i` is in `shard` K/N (every N-th point from the K-th; every
+/// point without a shard).
+fn in_shard(shard: Option<(usize, usize)>, i: usize) -> bool {
+    shard.is_none_or(|(k, n)| i % n == k - 1)
+}
+
 /// A pool of `jobs` threads (at least one).
 fn pool(jobs: usize) -> Result<rayon::ThreadPool, SweepError> {
     rayon::ThreadPoolBuilder::new()
@@ -198,14 +200,13 @@ fn sweep_topologies(
         offsets.push(offset);
         offset += variant.actuation.all_inputs().len();
     }
-    let in_shard = |i: usize| shard.is_none_or(|(k, n)| i % n == k - 1);
-    let total = (0..grid_points).filter(|&i| in_shard(i)).count();
+    let total = (0..grid_points).filter(|&i| in_shard(shard, i)).count();
     let done = std::sync::atomic::AtomicUsize::new(0);
     let quiet = |_: usize, _: usize| {};
     let each = |(variant, &offset): (&Scenario, &usize)| {
         let swept = sweep_points(variant, (offset, grid_points), 1, shard, cancel, &quiet);
         let n = variant.actuation.all_inputs().len();
-        let part = (offset..offset + n).filter(|&i| in_shard(i)).count();
+        let part = (offset..offset + n).filter(|&i| in_shard(shard, i)).count();
         progress(done.fetch_add(part, std::sync::atomic::Ordering::SeqCst) + part, total);
         swept.map(|(rows, errors)| (rows, errors, crate::run::rebuilt(sc, variant)))
     };

@@ -276,10 +276,11 @@ impl MotionObserver {
         formula.or_else(|| self.modal(f)).unwrap_or(f64::NAN)
     }
 
-    /// The frequency of the samples `(t, q)` by `f`'s measure [rad/s] (NaN where it finds none).
-    fn measured(f: &FrequencyPrediction, t: &[f64], q: &[f64]) -> f64 {
+    /// The frequency of the samples `(t, q)` by `f`'s measure [rad/s] (NaN where it finds none);
+    /// the cosine measure takes their fit from `fit` (made once where the report needs it too).
+    fn measured(f: &FrequencyPrediction, t: &[f64], q: &[f64], fit: impl FnOnce() -> Option<CosineFit>) -> f64 {
         match f.measure {
-            FrequencyMeasure::Cosine => fit_cosine(t, q).map_or(f64::NAN, |x| x.omega_rad_per_s),
+            FrequencyMeasure::Cosine => fit().map_or(f64::NAN, |x| x.omega_rad_per_s),
             FrequencyMeasure::Period => period_frequency(t, q).unwrap_or(f64::NAN),
         }
     }
@@ -291,7 +292,7 @@ impl MotionObserver {
         if !self.extrapolated || rougher.len() != t.len() {
             return None;
         }
-        let rough = Self::measured(f, t, rougher);
+        let rough = Self::measured(f, t, rougher, || fit_cosine(t, rougher));
         Some((measured - rough).abs() / measured.abs() / crate::snapshot::RICHARDSON_ESTIMATE_DIVISOR)
     }
 
@@ -307,7 +308,7 @@ impl MotionObserver {
         let modal = self.modal(f).filter(|_| f.formula.is_some());
         let modal_error = modal.map(|w| (w - predicted).abs() / predicted.abs());
         let fit = fit_cosine(t, q);
-        let measured = Self::measured(f, t, q);
+        let measured = Self::measured(f, t, q, || fit);
         let method = match (f.measure, self.extrapolated) {
             (FrequencyMeasure::Cosine, false) => METHOD,
             (FrequencyMeasure::Cosine, true) => METHOD_EXTRAPOLATED,

@@ -147,25 +147,11 @@ fn join_motion(x: &mut MotionReport, m: MotionReport) {
     x.steps += m.steps;
     x.steps_taken += m.steps_taken;
     x.accelerated_steps += m.accelerated_steps;
-    for f in m.frequencies {
-        match x.frequencies.iter_mut().find(|y| y.name == f.name) {
-            Some(y) if worse(f.error, y.error) || !f.passed => {
-                *y = FrequencyReport { passed: y.passed && f.passed, ..f }
-            }
-            Some(_) => {}
-            None => x.frequencies.push(f),
-        }
-    }
+    let frequency = |f: &FrequencyReport| (f.name.clone(), f.error, f.passed);
+    join_worst(&mut x.frequencies, m.frequencies, frequency, |f, passed| f.passed = passed);
     if let (Some(xl), Some(ml)) = (x.lagrangian.as_mut(), m.lagrangian) {
-        for c in ml.coordinates {
-            match xl.coordinates.iter_mut().find(|y| y.name == c.name) {
-                Some(y) if worse(c.max_error, y.max_error) || !c.passed => {
-                    *y = LagrangianCoordinateReport { passed: y.passed && c.passed, ..c }
-                }
-                Some(_) => {}
-                None => xl.coordinates.push(c),
-            }
-        }
+        let coordinate = |c: &LagrangianCoordinateReport| (c.name.clone(), c.max_error, c.passed);
+        join_worst(&mut xl.coordinates, ml.coordinates, coordinate, |c, passed| c.passed = passed);
     }
     if let (Some(xe), Some(me)) = (x.extrapolation.as_mut(), m.extrapolation) {
         for (q, e) in me.largest_estimate {
@@ -173,6 +159,30 @@ fn join_motion(x: &mut MotionReport, m: MotionReport) {
             *v = v.max(e);
         }
         xe.not_smooth_from_tick = xe.not_smooth_from_tick.or(me.not_smooth_from_tick);
+    }
+}
+
+/// Each entry of `later` joined into `joined` by name (`key`: its name, error and whether it
+/// passed): a new name is added; a known one is replaced by the later part's where that is
+/// [`worse`] or failed, passing only if both passed (`set_passed`).
+fn join_worst<T>(
+    joined: &mut Vec<T>,
+    later: Vec<T>,
+    key: impl Fn(&T) -> (String, f64, bool),
+    set_passed: impl Fn(&mut T, bool),
+) {
+    for mut entry in later {
+        let (name, error, passed) = key(&entry);
+        match joined.iter_mut().find(|y| key(y).0 == name) {
+            Some(y) => {
+                let (_, old, was) = key(y);
+                if worse(error, old) || !passed {
+                    set_passed(&mut entry, was && passed);
+                    *y = entry;
+                }
+            }
+            None => joined.push(entry),
+        }
     }
 }
 

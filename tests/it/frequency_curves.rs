@@ -28,15 +28,20 @@ fn rocker_derivatives(k1: f64, phi: f64) -> (f64, f64) {
     (first, second)
 }
 
-/// omega = sqrt(V''(phi*) / I_O) with phi* found by Newton's method here, independently of the
-/// testbed.
-fn rocker_omega(k1: f64) -> f64 {
+/// The rocker's equilibrium phi* [rad] at `k1`, by Newton's method on V' here, independently
+/// of the testbed.
+fn rocker_equilibrium(k1: f64) -> f64 {
     let mut phi = 0.8;
     for _ in 0..50 {
         let (v1, v2) = rocker_derivatives(k1, phi);
         phi -= v1 / v2;
     }
-    let (v1, v2) = rocker_derivatives(k1, phi);
+    phi
+}
+
+/// omega = sqrt(V''(phi*) / I_O) at [`rocker_equilibrium`].
+fn rocker_omega(k1: f64) -> f64 {
+    let (v1, v2) = rocker_derivatives(k1, rocker_equilibrium(k1));
     assert!(v1.abs() < 1e-12 && v2 > 0.0, "a minimum at k1 = {k1}: V' = {v1}, V'' = {v2}");
     (v2 / (M * L * L / 3.0)).sqrt()
 }
@@ -90,11 +95,7 @@ fn the_rockers_frequency_curve_agrees_three_ways_at_every_point() {
 /// Lifshitz, Mechanics, Sec. 28): a^2 (V4 / (16 V2) - 5 V3^2 / (48 V2^2)), the derivatives of V
 /// at phi*, V3 and V4 by central differences of V''.
 fn amplitude_shift(k1: f64, a: f64) -> f64 {
-    let mut phi = 0.8;
-    for _ in 0..50 {
-        let (v1, v2) = rocker_derivatives(k1, phi);
-        phi -= v1 / v2;
-    }
+    let phi = rocker_equilibrium(k1);
     let h = 1e-3;
     let v2 = |p: f64| rocker_derivatives(k1, p).1;
     let (second, plus, minus) = (v2(phi), v2(phi + h), v2(phi - h));
