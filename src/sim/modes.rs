@@ -13,7 +13,7 @@ pub use super::constrained_modes::{Constraints, ModalCoordinate};
 use super::{Data, Model, Simulation};
 use crate::eigen::EigenError;
 use crate::snapshot::{BodyPose, ModalProjector};
-use crate::structure::{BodyKind, CableLaw};
+use crate::structure::{BodyKind, CableLaw, JointKind};
 use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 /// A mode whose |omega^2| is below this fraction of the largest is a rigid-body (zero) mode.
@@ -100,7 +100,12 @@ impl Data {
             return Err(ModesError::NoFreeBody);
         }
         let inextensible = s.cables.iter().any(|c| !matches!(c.law, CableLaw::Elastic { .. }));
-        if inextensible || m.joint_impulse.iter().any(Option::is_some) {
+        // A free joint of several coordinates (a universal joint: two revolute links and a
+        // hidden body, `build.rs`) is charted by its multibody's degrees of freedom there.
+        let several = |(j, joint): (usize, &crate::structure::Joint)| {
+            !m.actuated[j] && !matches!(joint.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. })
+        };
+        if inextensible || m.joint_impulse.iter().any(Option::is_some) || s.joints.iter().enumerate().any(several) {
             return self.constrained_modes(m);
         }
         if !s.joints.is_empty() {

@@ -2,7 +2,8 @@
 //!
 //! A fixed base; the moving platform, a free rigid body of the paper's mass under gravity,
 //! held by a universal joint at O (first axis z_W fixed in the base, second axis y_M fixed in
-//! the platform, Eq. 1-5), two inextensible cables of actuated length (Eq. 12-13) and two
+//! the platform, Eq. 1-5), two inextensible cables of actuated length (Eq. 12-13; elastic as a
+//! model choice) and two
 //! linear springs. Everything is placed at the start configuration (theta1, theta2).
 
 use super::analytic::{self, Params};
@@ -23,6 +24,8 @@ pub struct ModelChoices {
     pub joint_damping: f64,
     /// Strut radius for drawing and interference \[m\].
     pub strut_radius_m: f64,
+    /// Cable law: `None` inextensible (the paper's), `Some(k)` elastic with stiffness k [N/m].
+    pub cable_stiffness_n_per_m: Option<f64>,
 }
 
 /// The structure at the start pose (theta1, theta2), cables at `cable_lengths` \[m\].
@@ -54,7 +57,7 @@ pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64, cable_lengt
             name: format!("cable {}", k + 1),
             a: nb,
             b: nt,
-            law: CableLaw::Inextensible,
+            law: m.cable_stiffness_n_per_m.map_or(CableLaw::Inextensible, |k| CableLaw::Elastic { stiffness_n_per_m: k }),
             length_m: cable_lengths[k],
             radius_m: DEFAULT_TENDON_RADIUS_M,
         });

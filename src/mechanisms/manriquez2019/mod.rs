@@ -92,6 +92,13 @@ const PARAMS: &[ParamSpec] = &[
         origin: Origin::ModelChoice,
     },
     ParamSpec {
+        symbol: "k_cable",
+        unit: "N/m",
+        default: 0.0,
+        description: "cable stiffness; 0 = inextensible, the paper's assumption (Eq. 12-13). The statics (Eq. 18-27) assume it: elastic cables settle off the inputs' pose by their stretch",
+        origin: Origin::ModelChoice,
+    },
+    ParamSpec {
         symbol: "r_strut",
         unit: "m",
         default: 0.005,
@@ -217,7 +224,7 @@ impl Mechanism for Manriquez2019 {
         super::require_positive(v, &[("a2", "m"), ("l2", "m"), ("m", "kg"), ("base_half", "m"), ("k_spring", "N/m")])?;
         super::require_non_negative(
             v,
-            &[("g", "m/s^2"), ("l0_spring", "m"), ("c_joint", "N m s/rad"), ("r_strut", "m")],
+            &[("g", "m/s^2"), ("l0_spring", "m"), ("c_joint", "N m s/rad"), ("k_cable", "N/m"), ("r_strut", "m")],
         )?;
         params_of(v).validate().map_err(|e| ModelError::param("base_x", e))
     }
@@ -271,7 +278,11 @@ impl Mechanism for Manriquez2019 {
         let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
         let off = start.get("offset").copied().unwrap_or(DEFAULT_START_OFFSET_RAD);
         let m =
-            build::ModelChoices { joint_damping: param(params, "c_joint")?, strut_radius_m: param(params, "r_strut")? };
+            build::ModelChoices {
+                joint_damping: param(params, "c_joint")?,
+                strut_radius_m: param(params, "r_strut")?,
+                cable_stiffness_n_per_m: Some(param(params, "k_cable")?).filter(|k| *k > 0.0),
+            };
         Ok(build::build(&p, &m, t1 + off, t2 + off, analytic::cable_lengths(&p, t1, t2)))
     }
     /// The cables' lengths L1, L2 of Eq. 12-13 at the joint angles.
