@@ -147,6 +147,27 @@ pub fn coordinates(s: &crate::structure::Structure) -> impl Iterator<Item = (usi
     })
 }
 
+/// The columns of a state that carry an error estimate beside the mechanism's quantities in a
+/// motion judged extrapolated (`run/levels.rs`): every joint coordinate and every node's
+/// position, named as their columns.
+pub fn estimated_columns(
+    s: &crate::structure::Structure,
+    snap: &crate::snapshot::Snapshot,
+) -> crate::mechanisms::Values {
+    let joints = coordinates(s).filter_map(|(j, name)| snap.joint_coordinate(s, j).map(|q| (name, q)));
+    let nodes =
+        s.nodes.iter().zip(&snap.nodes).flat_map(|(n, p)| {
+            ["x", "y", "z"].into_iter().zip(p).map(move |(c, x)| (format!("node:{}.{c}", n.name), *x))
+        });
+    joints.chain(nodes).collect()
+}
+
+/// The names of [`estimated_columns`], in their order.
+fn estimated_names(s: &crate::structure::Structure) -> impl Iterator<Item = String> + '_ {
+    let nodes = s.nodes.iter().flat_map(|n| ["x", "y", "z"].map(|c| format!("node:{}.{c}", n.name)));
+    coordinates(s).map(|(_, name)| name).chain(nodes)
+}
+
 /// A CSV field: quoted when it holds a comma, a quote or a line break.
 fn field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
@@ -228,7 +249,7 @@ impl Table {
         cols.extend(["path_accelerated".to_string(), "motion_time_s".to_string()]);
         cols.extend(coordinates(s).map(|(_, name)| name));
         if self.estimates {
-            cols.extend(coordinates(s).map(|(_, name)| format!("estimate:{name}")));
+            cols.extend(estimated_names(s).map(|name| format!("estimate:{name}")));
         }
         cols.extend(self.model.iter().flat_map(|m| m.table_columns()));
         cols.extend(self.model.iter().flat_map(|m| m.trajectory_columns()));
@@ -249,7 +270,7 @@ impl Table {
         v.push(t.motion_time_s);
         v.extend(coordinates(t.structure).map(|(j, _)| snap.joint_coordinate(t.structure, j)));
         if self.estimates {
-            v.extend(coordinates(t.structure).map(|(_, name)| t.estimate.and_then(|e| e.get(&name)).copied()));
+            v.extend(estimated_names(t.structure).map(|name| t.estimate.and_then(|e| e.get(&name)).copied()));
         }
         v.extend(self.model.iter().flat_map(|m| m.table_values(t)));
         v

@@ -150,10 +150,7 @@ impl<'a> Runner<'a> {
         };
         let driven: Option<&dyn Fn(f64) -> Vec<f64>> = self.motion_drive.as_ref().map(|_| &commands as _);
         levels.step(end_s, dt_s, driven)?;
-        let coordinates = |s: &Snapshot| {
-            let joints = crate::observers::table::coordinates(structure);
-            joints.filter_map(|(j, name)| s.joint_coordinate(structure, j).map(|q| (name, q))).collect()
-        };
+        let coordinates = |s: &Snapshot| crate::observers::table::estimated_columns(structure, s);
         let j = levels.judge(&snap, &|s| mech.observe(params, structure, s), &coordinates);
         Ok((j.state, j.values, Some((j.estimate, j.rougher.0, j.rougher.1))))
     }

@@ -23,13 +23,9 @@ pub fn edited(path: &str, edits: &[(&str, &str)]) -> String {
     text
 }
 
-/// Runs the scenario `text` writing its per-tick table: the report, and the named columns,
-/// one vector per column (NaN where a cell is empty).
-pub fn table_columns(
-    text: &str,
-    name: &str,
-    columns: &[&str],
-) -> (tensegrity_testbed::report::ScenarioReport, Vec<Vec<f64>>) {
+/// Runs the scenario `text` writing its per-tick table: the report, the header and every
+/// column (NaN where a cell is empty).
+pub fn table(text: &str, name: &str) -> (tensegrity_testbed::report::ScenarioReport, Vec<String>, Vec<Vec<f64>>) {
     let path = std::env::temp_dir().join(format!("tensegrity-table-{}-{name}.csv", std::process::id()));
     let _ = std::fs::remove_file(&path);
     let sc = tensegrity_testbed::scenario::parse(std::path::Path::new("variant.toml"), text).expect("valid");
@@ -38,16 +34,31 @@ pub fn table_columns(
     let csv = std::fs::read_to_string(&path).expect("the table");
     let _ = std::fs::remove_file(&path);
     let mut lines = csv.lines();
-    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
-    let index: Vec<usize> =
-        columns.iter().map(|c| header.iter().position(|h| h == c).unwrap_or_else(|| panic!("column {c}"))).collect();
-    let mut out = vec![Vec::new(); columns.len()];
+    let header: Vec<String> = lines.next().expect("a header").split(',').map(str::to_string).collect();
+    let mut out = vec![Vec::new(); header.len()];
     for line in lines {
-        let cells: Vec<&str> = line.split(',').collect();
-        for (o, i) in out.iter_mut().zip(&index) {
-            o.push(cells[*i].parse::<f64>().unwrap_or(f64::NAN));
+        for (o, cell) in out.iter_mut().zip(line.split(',')) {
+            o.push(cell.parse::<f64>().unwrap_or(f64::NAN));
         }
     }
+    (report, header, out)
+}
+
+/// Runs the scenario `text` writing its per-tick table: the report, and the named columns,
+/// one vector per column (NaN where a cell is empty).
+pub fn table_columns(
+    text: &str,
+    name: &str,
+    columns: &[&str],
+) -> (tensegrity_testbed::report::ScenarioReport, Vec<Vec<f64>>) {
+    let (report, header, mut all) = table(text, name);
+    let out = columns
+        .iter()
+        .map(|c| {
+            let i = header.iter().position(|h| h == c).unwrap_or_else(|| panic!("column {c}"));
+            std::mem::take(&mut all[i])
+        })
+        .collect();
     (report, out)
 }
 

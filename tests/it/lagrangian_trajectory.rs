@@ -162,10 +162,14 @@ fn the_recording_holds_the_model_beside_the_simulation() {
     let c = &m.lagrangian.as_ref().unwrap().coordinates[0];
     let want = vec![c.simulated_omega_rad_per_s, c.model_omega_rad_per_s];
     assert_eq!(scalars["/frequencies/trajectory\\:qe"], [(0, want.clone()), (steps, want)]);
-    // The simulation's own error estimate per quantity at every tick of the motion, the
-    // table's `estimate:` column bit for bit.
-    let keys: Vec<&String> = m.extrapolation.as_ref().expect("extrapolated").largest_estimate.keys().collect();
-    let k = keys.iter().position(|key| key.as_str() == "joint:pin.angle").expect("the pin's estimate");
+    // The simulation's own error estimate per quantity, joint coordinate and node coordinate at
+    // every tick of the motion (named in order), the table's `estimate:` columns bit for bit.
+    let largest = &m.extrapolation.as_ref().expect("extrapolated").largest_estimate;
+    let nodes = header.iter().filter_map(|h| h.strip_prefix("estimate:").filter(|n| n.starts_with("node:")));
+    let mut keys: Vec<&str> = largest.keys().map(String::as_str).filter(|k| *k != "node positions").collect();
+    keys.extend(nodes);
+    keys.sort_unstable();
+    let k = keys.iter().position(|key| *key == "joint:pin.angle").expect("the pin's estimate");
     let estimate = col("estimate:joint:pin.angle");
     let series = &scalars["/simulation_error"];
     assert_eq!(series.len() as i64, steps, "one row per tick of the motion");

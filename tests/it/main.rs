@@ -37,6 +37,7 @@ mod mohr2011_dynamics;
 mod motion;
 mod motion_messages;
 mod motion_order;
+mod motion_reference;
 mod moved_node;
 mod outputs;
 mod param_sweep;

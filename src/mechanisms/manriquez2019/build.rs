@@ -57,7 +57,9 @@ pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64, cable_lengt
             name: format!("cable {}", k + 1),
             a: nb,
             b: nt,
-            law: m.cable_stiffness_n_per_m.map_or(CableLaw::Inextensible, |k| CableLaw::Elastic { stiffness_n_per_m: k }),
+            law: m
+                .cable_stiffness_n_per_m
+                .map_or(CableLaw::Inextensible, |k| CableLaw::Elastic { stiffness_n_per_m: k }),
             length_m: cable_lengths[k],
             radius_m: DEFAULT_TENDON_RADIUS_M,
         });

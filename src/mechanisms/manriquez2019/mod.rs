@@ -277,12 +277,11 @@ impl Mechanism for Manriquez2019 {
         let p = params_of(params);
         let (t1, t2) = (input(inputs, "theta1")?, input(inputs, "theta2")?);
         let off = start.get("offset").copied().unwrap_or(DEFAULT_START_OFFSET_RAD);
-        let m =
-            build::ModelChoices {
-                joint_damping: param(params, "c_joint")?,
-                strut_radius_m: param(params, "r_strut")?,
-                cable_stiffness_n_per_m: Some(param(params, "k_cable")?).filter(|k| *k > 0.0),
-            };
+        let m = build::ModelChoices {
+            joint_damping: param(params, "c_joint")?,
+            strut_radius_m: param(params, "r_strut")?,
+            cable_stiffness_n_per_m: Some(param(params, "k_cable")?).filter(|k| *k > 0.0),
+        };
         Ok(build::build(&p, &m, t1 + off, t2 + off, analytic::cable_lengths(&p, t1, t2)))
     }
     /// The cables' lengths L1, L2 of Eq. 12-13 at the joint angles.
