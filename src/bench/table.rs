@@ -223,5 +223,44 @@ pub fn scale_motion(cases: &[crate::bench::scale::motion::MotionCase]) -> String
             c.ratio_at_equal_error.map_or("-".to_string(), |r| format!("{r:.2}"))
         );
     }
+    t.push_str(&judged_motion(cases));
+    t
+}
+
+/// The judged motion (extrapolated over the step) against MuJoCo's RK4 and Euler at equal
+/// stepping time.
+fn judged_motion(cases: &[crate::bench::scale::motion::MotionCase]) -> String {
+    let dt = crate::bench::scale::motion::EQUAL_ERROR_DT_S;
+    let mut t = format!(
+        "\nJudged motion (extrapolated over the step: h, h/2, h/4, seven steps a tick) at dt = {dt} s, against MuJoCo's RK4 and Euler at the same wall time (interpolated in log-log between their runs at dt {:?} s)\n",
+        crate::bench::scale::motion::INTEGRATOR_DT_S
+    );
+    let _ = writeln!(
+        t,
+        "{:<12} {:>5} {:>10} {:>12} | {:>12} {:>12} | judged errors at dt {:?} s",
+        "family",
+        "size",
+        "wall s",
+        "judged err",
+        "mj RK4 err",
+        "mj Euler err",
+        crate::bench::scale::motion::DT_S
+    );
+    let opt = |x: Option<f64>| x.map_or("outside".to_string(), |v| format!("{v:.2e}"));
+    for c in cases {
+        let Some(j) = c.judged.iter().find(|r| r.dt_s == dt) else { continue };
+        let errors: Vec<String> = c.judged.iter().map(|r| format!("{:.2e}", r.error_m)).collect();
+        let _ = writeln!(
+            t,
+            "{:<12} {:>5} {:>10.2e} {:>12.2e} | {:>12} {:>12} | {}",
+            c.family,
+            c.size,
+            j.wall_s,
+            j.error_m,
+            opt(c.rk4_error_at_equal_time_m),
+            opt(c.euler_error_at_equal_time_m),
+            errors.join(" ")
+        );
+    }
     t
 }

@@ -27,22 +27,21 @@ pub fn bench(command: Command) -> Result<Outcome, CliError> {
     if scale {
         let caps = scale::Caps { max_wall_s: max_case_wall_s, ..scale::DEFAULT_CAPS };
         let named = families;
-        let families = selected_families(&named)?;
         if motion {
             if peer.is_none() {
                 return Err(bad_input("--motion needs --peer: its reference is MuJoCo's RK4"));
             }
-            if let Some(f) =
-                families.iter().find(|f| !scale::motion::FAMILIES.contains(f)).filter(|_| !named.is_empty())
-            {
+            if let Some(f) = named.iter().find(|f| f.as_str() == "furet") {
                 return Err(bad_input(format!(
-                    "--motion covers the free-body families ({}); '{f}' has constraints MuJoCo holds softly, another model",
+                    "--motion covers the families whose equations MuJoCo shares ({}); '{f}' has loops MuJoCo closes softly, another model",
                     scale::motion::FAMILIES.join(", ")
                 )));
             }
+            let families = selected_families(&named, &scale::motion::FAMILIES)?;
             let command = bench::peer_command(given_peer, bench::SCALE_PEER_SCRIPT);
             return scale_motion(json, max_struts, &families, &command);
         }
+        let families = selected_families(&named, &scale::FAMILIES)?;
         return match peer {
             Some(_) => {
                 let command = bench::peer_command(given_peer, bench::SCALE_PEER_SCRIPT);
@@ -62,11 +61,12 @@ pub fn bench(command: Command) -> Result<Outcome, CliError> {
 }
 
 /// The scale families that `--family` selects (all when none is named).
-fn selected_families(only: &[String]) -> Result<Vec<&'static str>, CliError> {
-    if let Some(bad) = only.iter().find(|o| !scale::FAMILIES.contains(&o.as_str())) {
-        return Err(bad_input(format!("no scale family '{bad}' (families: {})", scale::FAMILIES.join(", "))));
+/// The families of `all` that `--family` names (all when none is named).
+fn selected_families(only: &[String], all: &[&'static str]) -> Result<Vec<&'static str>, CliError> {
+    if let Some(bad) = only.iter().find(|o| !all.contains(&o.as_str())) {
+        return Err(bad_input(format!("no scale family '{bad}' (families: {})", all.join(", "))));
     }
-    Ok(scale::FAMILIES.iter().copied().filter(|f| only.is_empty() || only.iter().any(|o| o == f)).collect())
+    Ok(all.iter().copied().filter(|f| only.is_empty() || only.iter().any(|o| o == f)).collect())
 }
 
 /// The built-in case sets that `--mechanism` selects (all when none is named).

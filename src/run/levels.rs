@@ -123,3 +123,19 @@ impl Levels {
         Judged { state: judged, values, estimate, rougher }
     }
 }
+
+/// The node positions \[m\] of `sim`'s motion after `ticks` of its step, judged as a motion
+/// run judges them: the finer levels made from its present state, every level started at its
+/// half step, the three stepped together (seven steps a tick, as a run's), and the judged
+/// state T(h/2, h/4) at the end (the benchmark's measure of the judged motion's cost).
+pub fn judged_nodes_after(sim: &mut Simulation, ticks: u64) -> Result<Vec<[f64; 3]>, SimError> {
+    let mut levels = Levels::new(sim)?;
+    sim.start_at_half_step()?;
+    let dt_s = sim.model().settings.dt_s;
+    for k in 1..=ticks {
+        sim.step()?;
+        levels.step(k as f64 * dt_s, dt_s, None)?;
+    }
+    let judged = richardson(&levels.half.snapshot_with(false), &levels.quarter.snapshot_with(false), LEAPFROG_ORDER);
+    Ok(judged.nodes)
+}

@@ -24,6 +24,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Instant;
 
+pub use levels::judged_nodes_after;
 pub use point::NO_BRANCH;
 pub use settle::SettleDetector;
 pub use settled::{modes, settle_first_point, ModesRunError, SettledState};

@@ -24,7 +24,11 @@ timeconst 2 dt; the time step per family in TUNED. `--set timestep_s=...` /
 With a "motion" entry in CASES.json (`tensegrity bench --scale --motion --peer`), each case
 is moved instead, undamped, for `duration_s` at each of `dts` and once with RK4 at
 `reference_dt_s` (`motion_case`); the node sites at the end of each run go back with the wall
-time of its steps.
+time of its steps. With `integrator_dts` as well, the same motion is run with RK4 and with
+Euler at each of those steps (`rk4_runs`, `euler_runs`: the testbed compares its judged motion
+with them at equal stepping time). A case's `spin` (a body's name and its angular velocity
+[rad/s], world axes) starts that body's free joint spinning (its frame has the world's axes at
+the start, so the local angular velocity of `qvel` is the world one).
 
 Each case is timed from loading the XML (model compile) to the settled state, as the testbed
 times building its simulation and settling it; a case faster than 0.2 s is run again until
@@ -179,6 +183,29 @@ def motion_positions(model, data, sites, steps: int) -> tuple[np.ndarray, float]
     return data.site_xpos[sites].copy(), wall_s
 
 
+def spun(model, data, case: dict) -> None:
+    """Sets the angular velocity of the case's spinning body's free joint, if any."""
+    spin = case.get("spin")
+    if spin:
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, spin["body"])
+        dof = model.jnt_dofadr[model.body_jntadr[body]]
+        data.qvel[dof + 3 : dof + 6] = spin["angular_velocity"]
+
+
+def integrator_runs(load, case: dict, motion: dict, integrator) -> list:
+    """The motion at each of `integrator_dts` with `integrator`: end sites and median wall."""
+    duration, runs = motion["duration_s"], []
+    for dt in motion.get("integrator_dts", []):
+        steps = round(duration / dt)
+        walls = []
+        while not walls or sum(walls) < MIN_CASE_WALL_S:
+            model, data, sites = load(dt, integrator)
+            pos, wall_s = motion_positions(model, data, sites, steps)
+            walls.append(wall_s)
+        runs.append({"dt_s": dt, "steps": steps, "wall_s": statistics.median(walls), "positions": pos.tolist()})
+    return runs
+
+
 def motion_case(case: dict, motion: dict) -> dict:
     """The motion protocol (`src/bench/scale/motion.rs`): the undamped export moved for
     `duration_s` at each of `dts` (the export's integrator, implicitfast) and once with RK4
@@ -191,7 +218,9 @@ def motion_case(case: dict, motion: dict) -> dict:
         if integrator is not None:
             model.opt.integrator = integrator
         sites = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, n) for n in case["nodes"]]
-        return model, mujoco.MjData(model), sites
+        data = mujoco.MjData(model)
+        spun(model, data, case)
+        return model, data, sites
 
     duration = motion["duration_s"]
     runs = []
@@ -207,7 +236,16 @@ def motion_case(case: dict, motion: dict) -> dict:
     ref_dt = motion["reference_dt_s"]
     model, data, sites = load(ref_dt, mujoco.mjtIntegrator.mjINT_RK4)
     reference, _ = motion_positions(model, data, sites, round(duration / ref_dt))
-    return {"family": case["family"], "size": case["size"], "reference": reference.tolist(), "runs": runs}
+    rk4 = integrator_runs(load, case, motion, mujoco.mjtIntegrator.mjINT_RK4)
+    euler = integrator_runs(load, case, motion, mujoco.mjtIntegrator.mjINT_EULER)
+    return {
+        "family": case["family"],
+        "size": case["size"],
+        "reference": reference.tolist(),
+        "runs": runs,
+        "rk4_runs": rk4,
+        "euler_runs": euler,
+    }
 
 
 def parse_override(text: str) -> tuple[str, float]:

@@ -66,6 +66,7 @@ pub fn case(n: usize) -> Case {
         commands: vec![analytic::base_joint_angle_a(&p, THETA_RAD); n],
         target: vec![(ends[n - 1], [x, y, 0.0])],
         measure: Measure::Absolute,
+        spin: None,
     }
 }
 

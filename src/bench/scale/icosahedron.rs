@@ -117,5 +117,6 @@ pub fn case() -> Case {
         commands: Vec::new(),
         target: design.iter().enumerate().map(|(i, (_, p))| (i, *p)).collect(),
         measure: Measure::Aligned,
+        spin: None,
     }
 }

@@ -19,6 +19,7 @@
 
 pub mod furet;
 pub mod icosahedron;
+pub mod judged;
 pub mod motion;
 pub mod peer;
 pub mod prism;
@@ -108,6 +109,8 @@ pub struct Case {
     /// The closed form: node index and its position \[m\].
     pub target: Vec<(usize, Vec3)>,
     pub measure: Measure,
+    /// A free body started spinning: its index and angular velocity [rad/s] (world frame).
+    pub spin: Option<(usize, Vec3)>,
 }
 
 /// How a case's settled nodes are compared with the closed form.

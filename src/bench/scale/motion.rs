@@ -18,15 +18,14 @@
 
 use super::{cases, Case};
 use crate::bench::{write_error, BenchError};
-use crate::settings::SimSettings;
-use crate::sim::Simulation;
 use crate::structure::Vec3;
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
 
-/// The families whose equations of motion are the same in MuJoCo (free bodies only).
-pub const FAMILIES: [&str; 4] = ["prism", "icosahedron", "tower", "spine"];
+/// The families whose equations of motion are the same in MuJoCo: free bodies, and the
+/// judged-motion structures of `judged.rs` (hinges, a spinning body).
+pub const FAMILIES: [&str; 7] = ["prism", "icosahedron", "tower", "spine", "pendulum", "rocker", "spin"];
 /// Simulated time of every run \[s\].
 pub const DURATION_S: f64 = 0.5;
 /// Time steps of both sides \[s\].
@@ -35,6 +34,9 @@ pub const DT_S: [f64; 4] = [4e-3, 2e-3, 1e-3, 5e-4];
 pub const REFERENCE_DT_S: f64 = 5e-5;
 /// The testbed's time step whose error sets the level compared \[s\].
 pub const EQUAL_ERROR_DT_S: f64 = 1e-3;
+/// MuJoCo's time steps with RK4 and with Euler \[s\], spanning the testbed's judged motion's
+/// wall time at [`EQUAL_ERROR_DT_S`] (seven steps a tick).
+pub const INTEGRATOR_DT_S: [f64; 7] = [8e-3, 4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4];
 
 /// One run of one side at one time step.
 #[derive(Clone, Debug, Serialize)]
@@ -64,6 +66,16 @@ pub struct MotionCase {
     pub peer_wall_at_equal_error_s: Option<f64>,
     /// Testbed / MuJoCo simulated seconds per wall second at that level.
     pub ratio_at_equal_error: Option<f64>,
+    /// The testbed's judged motion (extrapolated over the step, `judged.rs`) at each of [`DT_S`].
+    pub judged: Vec<MotionRun>,
+    /// MuJoCo's RK4 and Euler at each of [`INTEGRATOR_DT_S`].
+    pub peer_rk4: Vec<MotionRun>,
+    pub peer_euler: Vec<MotionRun>,
+    /// At equal stepping time: MuJoCo's RK4 and Euler errors at the wall time of the testbed's
+    /// judged run at [`EQUAL_ERROR_DT_S`] \[m\], interpolated in log-log between their runs
+    /// (None outside them).
+    pub rk4_error_at_equal_time_m: Option<f64>,
+    pub euler_error_at_equal_time_m: Option<f64>,
 }
 
 /// The testbed's run of `case` at `dt`, repeated until the runs add up to
@@ -77,18 +89,7 @@ fn testbed_run(case: &Case, dt: f64) -> Result<(Vec<Vec3>, u64, f64), BenchError
 
 /// One run of `case` at `dt`: the node positions at the end, steps and wall time of the steps.
 fn testbed_run_once(case: &Case, dt: f64) -> Result<(Vec<Vec3>, u64, f64), BenchError> {
-    let settings = SimSettings {
-        dt_s: dt,
-        body_damping_per_s: 0.0,
-        relaxation: false,
-        newton_damping: false,
-        ..case.settings.clone()
-    };
-    let mut sim = Simulation::new(&case.start, &settings)?;
-    sim.end_acceleration();
-    if !case.commands.is_empty() {
-        sim.set_commands(&case.commands);
-    }
+    let mut sim = super::judged::physical(case, dt)?;
     let steps = (DURATION_S / dt).round() as u64;
     let start = Instant::now();
     for _ in 0..steps {
@@ -128,32 +129,34 @@ fn peer_case(case: &Case, dir: &Path) -> Result<serde_json::Value, BenchError> {
     let s = &case.start;
     let path = dir.join(format!("motion-{}-{}.xml", case.family, case.size));
     super::peer::write_mjcf(case, EQUAL_ERROR_DT_S, 0.0, &path)?;
+    let spin = case.spin.map(|(b, w)| serde_json::json!({ "body": s.bodies[b].name, "angular_velocity": w }));
     Ok(serde_json::json!({
         "family": case.family, "size": case.size, "mjcf": path.display().to_string(),
-        "nodes": s.nodes.iter().map(|n| n.name.clone()).collect::<Vec<_>>(),
+        "nodes": s.nodes.iter().map(|n| n.name.clone()).collect::<Vec<_>>(), "spin": spin,
     }))
 }
 
 /// One run of the peer: time step [s], steps, wall time [s] and the nodes' final positions.
 type PeerRun = (f64, u64, f64, Vec<Vec3>);
 
-/// The peer's runs of one case and its reference positions.
-fn peer_runs(p: &serde_json::Value) -> Result<(Vec<Vec3>, Vec<PeerRun>), BenchError> {
-    let bad = || BenchError::Peer("the peer's motion case lacks 'reference' or 'runs'".into());
-    let points = |v: &serde_json::Value| -> Option<Vec<Vec3>> {
-        v.as_array()?.iter().map(|p| serde_json::from_value::<Vec3>(p.clone()).ok()).collect()
-    };
-    let reference = points(p.get("reference").ok_or_else(bad)?).ok_or_else(bad)?;
-    let runs = p.get("runs").and_then(|r| r.as_array()).ok_or_else(bad)?;
-    let runs = runs
+/// A list of points from the peer's JSON.
+fn points(v: &serde_json::Value) -> Option<Vec<Vec3>> {
+    v.as_array()?.iter().map(|p| serde_json::from_value::<Vec3>(p.clone()).ok()).collect()
+}
+
+/// The peer's runs under `key` of one case (none where the key is absent).
+fn peer_runs(p: &serde_json::Value, key: &str) -> Result<Vec<PeerRun>, BenchError> {
+    let bad = || BenchError::Peer(format!("the peer's motion case has a malformed '{key}'"));
+    let Some(runs) = p.get(key) else { return Ok(Vec::new()) };
+    runs.as_array()
+        .ok_or_else(bad)?
         .iter()
         .map(|r| {
             let num = |k: &str| r.get(k).and_then(|x| x.as_f64());
             Some((num("dt_s")?, r.get("steps")?.as_u64()?, num("wall_s")?, points(r.get("positions")?)?))
         })
         .collect::<Option<Vec<_>>>()
-        .ok_or_else(bad)?;
-    Ok((reference, runs))
+        .ok_or_else(bad)
 }
 
 fn run(dt_s: f64, steps: u64, wall_s: f64, error_m: f64) -> MotionRun {
@@ -173,16 +176,27 @@ pub fn compare(
     std::fs::create_dir_all(dir).map_err(write_error(dir))?;
     let (mut ours, mut listed) = (Vec::new(), Vec::new());
     for family in families.iter().filter(|f| FAMILIES.contains(f)) {
-        for case in cases(family, max_struts)? {
+        let family_cases = if super::judged::FAMILIES.contains(family) {
+            super::judged::cases(family)?
+        } else {
+            cases(family, max_struts)?
+        };
+        for case in family_cases {
             progress(&format!("{} {}: testbed motion ...", case.family, case.size));
             let runs = DT_S.iter().map(|&dt| testbed_run(&case, dt)).collect::<Result<Vec<_>, _>>()?;
+            let judged = DT_S
+                .iter()
+                .map(|&dt| super::judged::judged_run(&case, dt, DURATION_S))
+                .collect::<Result<Vec<_>, _>>()?;
             listed.push(peer_case(&case, dir)?);
-            ours.push((case, runs));
+            ours.push((case, runs, judged));
         }
     }
     let file = dir.join("motion_cases.json");
     let list = serde_json::json!({
-        "motion": { "duration_s": DURATION_S, "dts": DT_S, "reference_dt_s": REFERENCE_DT_S },
+        "motion": {
+            "duration_s": DURATION_S, "dts": DT_S, "reference_dt_s": REFERENCE_DT_S, "integrator_dts": INTEGRATOR_DT_S,
+        },
         "cases": listed,
     });
     crate::bench::write_whole(&file, &serde_json::to_string_pretty(&list).expect("case list serialises"))?;
@@ -191,38 +205,61 @@ pub fn compare(
     let theirs = v.get("cases").and_then(|c| c.as_array()).filter(|c| c.len() == ours.len());
     let theirs =
         theirs.ok_or_else(|| BenchError::Peer(format!("the peer did not return {} motion cases", ours.len())))?;
-    ours.into_iter().zip(theirs).map(|((case, runs), p)| compare_case(&case, runs, p)).collect()
+    ours.into_iter().zip(theirs).map(|((case, runs, judged), p)| compare_case(&case, [runs, judged], p)).collect()
 }
 
-/// One case's comparison against the peer's reference.
-fn compare_case(
-    case: &Case,
-    runs: Vec<(Vec<Vec3>, u64, f64)>,
-    p: &serde_json::Value,
-) -> Result<MotionCase, BenchError> {
-    let (reference, peer) = peer_runs(p)?;
-    let testbed: Vec<MotionRun> = DT_S
-        .iter()
-        .zip(runs)
-        .map(|(&dt, (pos, steps, wall))| run(dt, steps, wall, largest_distance(&pos, &reference)))
-        .collect();
-    let peer: Vec<MotionRun> = peer
-        .into_iter()
-        .map(|(dt, steps, wall, pos)| run(dt, steps, wall, largest_distance(&pos, &reference)))
-        .collect();
-    let ours = testbed.iter().find(|r| r.dt_s == EQUAL_ERROR_DT_S).expect("EQUAL_ERROR_DT_S is one of DT_S");
-    let (dt, wall) = peer_at_error(&peer, ours.error_m);
+/// The testbed's runs at each of [`DT_S`]: end positions, steps (or ticks), wall time.
+type TestbedRuns = Vec<(Vec<Vec3>, u64, f64)>;
+
+/// One case's comparison against the peer's reference: `[raw, judged]` the testbed's runs of
+/// rapier's steps alone and of the judged motion.
+fn compare_case(case: &Case, [raw, judged]: [TestbedRuns; 2], p: &serde_json::Value) -> Result<MotionCase, BenchError> {
+    let bad = || BenchError::Peer("the peer's motion case lacks its 'reference'".into());
+    let reference = points(p.get("reference").ok_or_else(bad)?).ok_or_else(bad)?;
+    let ours = |runs: TestbedRuns| -> Vec<MotionRun> {
+        DT_S.iter()
+            .zip(runs)
+            .map(|(&dt, (pos, steps, wall))| run(dt, steps, wall, largest_distance(&pos, &reference)))
+            .collect()
+    };
+    let theirs = |key: &str| -> Result<Vec<MotionRun>, BenchError> {
+        let runs = peer_runs(p, key)?;
+        Ok(runs
+            .into_iter()
+            .map(|(dt, steps, wall, pos)| run(dt, steps, wall, largest_distance(&pos, &reference)))
+            .collect())
+    };
+    let (testbed, judged, peer) = (ours(raw), ours(judged), theirs("runs")?);
+    let (peer_rk4, peer_euler) = (theirs("rk4_runs")?, theirs("euler_runs")?);
+    let at = |runs: &[MotionRun]| {
+        runs.iter().find(|r| r.dt_s == EQUAL_ERROR_DT_S).expect("EQUAL_ERROR_DT_S is one of DT_S").clone()
+    };
+    let (raw_at, judged_at) = (at(&testbed), at(&judged));
+    let (dt, wall) = peer_at_error(&peer, raw_at.error_m);
     Ok(MotionCase {
         family: case.family,
         size: case.size,
         struts: case.start.struts.len(),
-        equal_error_m: ours.error_m,
+        equal_error_m: raw_at.error_m,
         peer_dt_at_equal_error_s: dt,
         peer_wall_at_equal_error_s: wall,
-        ratio_at_equal_error: wall.map(|w| w / ours.wall_s),
+        ratio_at_equal_error: wall.map(|w| w / raw_at.wall_s),
+        rk4_error_at_equal_time_m: error_at_wall(&peer_rk4, judged_at.wall_s),
+        euler_error_at_equal_time_m: error_at_wall(&peer_euler, judged_at.wall_s),
         testbed,
         peer,
+        judged,
+        peer_rk4,
+        peer_euler,
     })
+}
+
+/// A peer's error at wall time `wall_s`, interpolated in log-log between its runs (those with
+/// a finite, positive error, by wall time).
+fn error_at_wall(runs: &[MotionRun], wall_s: f64) -> Option<f64> {
+    let mut by_wall: Vec<&MotionRun> = runs.iter().filter(|r| r.error_m > 0.0 && r.error_m.is_finite()).collect();
+    by_wall.sort_by(|a, b| a.wall_s.total_cmp(&b.wall_s));
+    log_log_at(&by_wall.iter().map(|r| (r.wall_s, r.error_m)).collect::<Vec<_>>(), wall_s)
 }
 
 #[cfg(test)]

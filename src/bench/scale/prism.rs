@@ -134,6 +134,7 @@ pub fn case_with(n: usize, relaxation: bool) -> Case {
         commands: Vec::new(),
         target: design.nodes.iter().enumerate().map(|(i, p)| (i, p.position)).collect(),
         measure: Measure::Twist,
+        spin: None,
         start,
     }
 }

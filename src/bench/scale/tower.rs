@@ -331,6 +331,7 @@ pub fn case(stages: usize) -> Result<Case, TowerError> {
         commands: Vec::new(),
         target: drawn.nodes.iter().enumerate().map(|(i, n)| (i, n.position)).collect(),
         measure: Measure::Aligned,
+        spin: None,
         start,
     })
 }
