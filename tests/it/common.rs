@@ -175,10 +175,19 @@ pub fn rust_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
 /// cannot run is skipped, saying so on stderr.
 pub const NO_SKIPS_VAR: &str = "TENSEGRITY_NO_SKIPS";
 
-/// Skips `check` because of `why`: a line on stderr, or a failure where [`NO_SKIPS_VAR`] is set.
+/// How many checks this run of the suite has skipped so far.
+static SKIPPED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// Skips `check` because of `why`, or fails where [`NO_SKIPS_VAR`] is set. The line goes to the
+/// process's stderr itself, past the test harness's capture (which hides what passing tests
+/// print), counted: `cargo test` shows every skip, named, as it happens.
 pub fn skip(check: &str, why: &str) {
+    use std::io::Write as _;
     assert!(std::env::var(NO_SKIPS_VAR).is_err(), "{check}: {why}, and {NO_SKIPS_VAR} forbids skipping it");
-    eprintln!("SKIPPED {check}: {why}");
+    let n = SKIPPED.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
+    // The harness names each test's thread after the test.
+    let test = std::thread::current().name().map_or(check.to_string(), str::to_string);
+    let _ = writeln!(std::io::stderr().lock(), "SKIPPED (skip {n} of this run) {test}: {why}");
 }
 
 /// The Python (`TENSEGRITY_PYTHON`, else `python3`) that imports every one of `modules`, or
