@@ -111,6 +111,15 @@ fn projected_uniform_stress(a: &DMatrix<f64>, cables: usize) -> Option<Vec<f64>>
     found.then_some(t)
 }
 
+/// The rest length \[m\] that gives a member of stiffness `stiffness_n_per_m` drawn `drawn_m`
+/// long the tension `tension_n`, drawn - tension / stiffness; None where it is not positive
+/// (the member cannot carry that tension at that length). Shared with the scenario's
+/// `[prestress]`.
+pub fn rest_length_for(tension_n: f64, stiffness_n_per_m: f64, drawn_m: f64) -> Option<f64> {
+    let rest = drawn_m - tension_n / stiffness_n_per_m;
+    (rest > 0.0).then_some(rest)
+}
+
 /// Prestresses `draft` with its self-stress scaled so that the least cable tension is
 /// `least_n` \[N\]: each elastic cable's rest length set to its drawn length less its tension
 /// over its stiffness. None when there is no such self-stress (nothing changed); an error
@@ -122,15 +131,12 @@ pub fn prestress(draft: &mut Draft, least_n: f64) -> Result<Option<Chosen>, Draf
     for (c, t) in draft.cables.iter_mut().zip(&stress) {
         let Some(k) = c.stiffness_n_per_m else { continue };
         let (tension, drawn) = (t * least_n, distance(pos(&c.a), pos(&c.b)));
-        c.length_m = drawn - tension / k;
-        if c.length_m.is_nan() || c.length_m <= 0.0 {
-            return Err(DraftError::SelfStressNoRest {
-                cable: c.name.clone(),
-                tension_n: tension,
-                stiffness_n_per_m: k,
-                drawn_m: drawn,
-            });
-        }
+        c.length_m = rest_length_for(tension, k, drawn).ok_or_else(|| DraftError::SelfStressNoRest {
+            cable: c.name.clone(),
+            tension_n: tension,
+            stiffness_n_per_m: k,
+            drawn_m: drawn,
+        })?;
     }
     let largest = stress.iter().copied().fold(0.0, f64::max) * least_n;
     let sentence = format!(

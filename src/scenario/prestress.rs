@@ -113,10 +113,10 @@ fn rest_length(
     stiffness_n_per_m: f64,
     drawn_m: f64,
 ) -> Result<f64, ScenarioError> {
-    let rest = drawn_m - tension_n / stiffness_n_per_m;
-    if rest > 0.0 {
+    if let Some(rest) = crate::import::self_stress::rest_length_for(tension_n, stiffness_n_per_m, drawn_m) {
         return Ok(rest);
     }
+    let rest = drawn_m - tension_n / stiffness_n_per_m;
     Err(ctx.err(
         at,
         format!(
