@@ -159,7 +159,9 @@ pub struct Joint {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum ActuatorTarget {
-    /// Position-controlled revolute or prismatic joint: its coordinate follows the command.
+    /// Position-controlled revolute or prismatic joint: its coordinate follows the command. A
+    /// revolute joint with a torsion spring is a servo instead ([`Structure::servo_of`]): the
+    /// command is the spring's rest angle, and the joint turns against it.
     Joint(JointId),
     /// Winch: the cable's unstretched length follows the command.
     CableLength(usize),
@@ -272,6 +274,17 @@ impl Structure {
 
     pub fn cable_id(&self, name: &str) -> Option<usize> {
         self.cables.iter().position(|m| m.name == name)
+    }
+
+    /// The actuator of joint `j` if it is a servo: a revolute joint with a torsion spring,
+    /// driven by an [`ActuatorTarget::Joint`] that sets the spring's rest angle (a position
+    /// controller of finite stiffness) rather than the joint's coordinate.
+    pub fn servo_of(&self, j: usize) -> Option<usize> {
+        let joint = &self.joints[j];
+        let revolute = matches!(joint.kind, JointKind::Revolute { .. });
+        (revolute && joint.torsion_spring.is_some())
+            .then(|| self.actuators.iter().position(|a| a.target == ActuatorTarget::Joint(j)))
+            .flatten()
     }
 
     /// The first actuator driven by input `symbol`.
@@ -450,8 +463,8 @@ impl Structure {
         Ok(())
     }
 
-    /// Actuators drive an existing revolute or prismatic joint without a torsion spring, an
-    /// existing cable, or a node of a fixed body.
+    /// Actuators drive an existing revolute or prismatic joint (a revolute one with a torsion
+    /// spring as a servo), an existing cable, or a node of a fixed body.
     fn validate_actuators(&self) -> Result<(), StructureError> {
         for a in &self.actuators {
             match a.target {
@@ -469,13 +482,7 @@ impl Structure {
                             "only revolute and prismatic joints can be actuated",
                         ));
                     }
-                    if joint.torsion_spring.is_some() {
-                        return Err(invalid(
-                            "actuator",
-                            &a.symbol,
-                            "an actuated joint cannot also carry a torsion spring",
-                        ));
-                    }
+                    // A torsion spring on an actuated joint makes it a servo (`servo_of`).
                 }
                 ActuatorTarget::CableLength(c) => {
                     if c >= self.cables.len() {

@@ -32,7 +32,9 @@
 //!   elastic cable is a `<position>` actuator on its tendon with kp = the cable's stiffness and
 //!   force range [-max, 0]: tension k (l - command) when longer, none when shorter, the cable's
 //!   law with the command as its length. A winch on an inextensible cable is its tendon's
-//!   range (set `tendon_range` to move it);
+//!   range (set `tendon_range` to move it); a servo (an actuated revolute joint with a torsion
+//!   spring: the command is its rest angle) is its joint's `stiffness` with `springref` the
+//!   exported command, no actuator element;
 //! - gravity in `<option>`; constant external loads as `<custom><numeric name="load:BODY">`
 //!   (apply them through `xfrc_applied` at the body's centre of mass); the first point's
 //!   actuator commands as the keyframe `first_point`.
@@ -95,6 +97,23 @@ const SOLIMP: &str = "0.9999 0.9999 0.001 0.5 2";
 /// measurement on mohr2011).
 const SOLVER_TOLERANCE: f64 = 1e-10;
 
+/// `s` and `o` with every servo (`Structure::servo_of`) written as its joint's spring at the
+/// exported command: MuJoCo's joint `stiffness` with `springref` the command is the same
+/// torque, -k (q - command), at this point; the servo's actuator and command are left out.
+fn servos_as_springs(s: &Structure, o: &MjcfOptions) -> (Structure, MjcfOptions) {
+    let (mut s2, mut o2) = (s.clone(), o.clone());
+    let servos: Vec<(usize, usize)> = (0..s.joints.len()).filter_map(|j| s.servo_of(j).map(|a| (a, j))).collect();
+    for &(a, j) in &servos {
+        if let (Some(t), Some(command)) = (s2.joints[j].torsion_spring.as_mut(), o.commands.get(a)) {
+            t.rest_angle_rad = *command;
+        }
+    }
+    let kept = |i: &usize| !servos.iter().any(|(a, _)| a == i);
+    s2.actuators = s.actuators.iter().enumerate().filter(|(i, _)| kept(i)).map(|(_, a)| a.clone()).collect();
+    o2.commands = o.commands.iter().enumerate().filter(|(i, _)| kept(i)).map(|(_, c)| *c).collect();
+    (s2, o2)
+}
+
 /// The body tree the export writes.
 struct Plan {
     /// For each body: the joint it hangs from in the forest.
@@ -111,6 +130,8 @@ struct Plan {
 
 /// Writes `s` as MJCF.
 pub fn to_mjcf(s: &Structure, o: &MjcfOptions) -> Mjcf {
+    let (servoed, options) = servos_as_springs(s, o);
+    let (s, o) = (&servoed, &options);
     let plan = plan(s, o.actuators);
     let size = crate::structure::structure_size(s);
     let mut w = Writer { s, o, plan: &plan, size, xml: String::new(), warnings: Vec::new() };

@@ -103,7 +103,7 @@ fn check_settings(settings: &SimSettings) -> Result<(), SimError> {
 }
 
 /// For each joint: whether an actuator drives it (position-controlled, a kinematic degree of
-/// freedom of a multibody). Two actuators on one joint are an error.
+/// freedom of a multibody; a servo's joint stays free). Two actuators on one joint are an error.
 fn actuated_joints(s: &Structure) -> Result<Vec<bool>, SimError> {
     let mut actuated = vec![false; s.joints.len()];
     for a in &s.actuators {
@@ -113,6 +113,9 @@ fn actuated_joints(s: &Structure) -> Result<Vec<bool>, SimError> {
             }
             actuated[j] = true;
         }
+    }
+    for (j, a) in actuated.iter_mut().enumerate() {
+        *a &= s.servo_of(j).is_none();
     }
     Ok(actuated)
 }

@@ -36,6 +36,8 @@ impl Drive {
         let s = &m.structure;
         for a in &s.actuators {
             let j = match a.target {
+                // A servo's joint is free already; its command moves the spring.
+                ActuatorTarget::Joint(j) if s.servo_of(j).is_some() => continue,
                 ActuatorTarget::Joint(j) => j,
                 ActuatorTarget::CableLength(_) => continue,
                 ActuatorTarget::FixedNode { .. } => {
@@ -65,10 +67,11 @@ impl Drive {
         assert_eq!(values.len(), m.structure.actuators.len(), "one command per actuator");
         d.commands.copy_from_slice(values);
         d.apply_cable_commands(m);
+        d.apply_servo_commands(m);
         let dt = m.settings.dt_s;
         for (a, command) in m.structure.actuators.iter().zip(values) {
             let ActuatorTarget::Joint(j) = a.target else { continue };
-            let Some(link) = m.joint_links[j] else { continue };
+            let Some(link) = m.joint_links[j].filter(|_| m.structure.servo_of(j).is_none()) else { continue };
             let target = command - m.structure.joints[j].initial_coordinate;
             let Some((mb, id)) = d.multibody_joints.get_mut(link.multibody_joint) else { continue };
             let Some(l) = mb.link_mut(id) else { continue };

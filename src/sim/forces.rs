@@ -124,11 +124,13 @@ impl Data {
     /// the build). Zero without a spring or off a revolute joint.
     pub(super) fn torsion_spring_torque(&self, m: &Model, j: usize) -> f64 {
         let joint = &m.structure.joints[j];
-        let (Some(t), JointKind::Revolute { axis }) = (&joint.torsion_spring, &joint.kind) else { return 0.0 };
+        let (Some((k, rest)), JointKind::Revolute { axis }) = (self.torsion_spring_now(m, j), &joint.kind) else {
+            return 0.0;
+        };
         let parent_rot = self.bodies[m.handles[joint.parent]].position().rotation;
         let child_rot = self.bodies[m.handles[joint.child]].position().rotation;
         let q = joint.initial_coordinate + relative_angle(parent_rot, child_rot, v(*axis));
-        -t.stiffness_nm_per_rad * (q - t.rest_angle_rad)
+        -k * (q - rest)
     }
 
     /// World position of a free body's centre of mass, from its current pose [m].

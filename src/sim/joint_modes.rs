@@ -83,9 +83,9 @@ impl Data {
             }
         }
         let snap = self.snapshot_with(m, false);
-        for (j, joint) in s.joints.iter().enumerate() {
-            if let (Some(t), Some(q)) = (&joint.torsion_spring, snap.joint_coordinate(s, j)) {
-                e += 0.5 * t.stiffness_nm_per_rad * (q - t.rest_angle_rad).powi(2);
+        for j in 0..s.joints.len() {
+            if let (Some((k, rest)), Some(q)) = (self.torsion_spring_now(m, j), snap.joint_coordinate(s, j)) {
+                e += 0.5 * k * (q - rest).powi(2);
             }
         }
         for b in (0..s.bodies.len()).filter(|b| m.is_free(*b)) {

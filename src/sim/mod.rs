@@ -34,6 +34,7 @@ mod projection;
 mod relaxation;
 mod restart;
 mod rotation;
+mod servo;
 mod tree;
 
 pub use build::LOOPED_MULTIBODY_MAX_LINKS;
@@ -251,6 +252,7 @@ impl Simulation {
         assert_eq!(values.len(), self.model.structure.actuators.len(), "one command per actuator");
         self.data.commands.copy_from_slice(values);
         self.data.apply_cable_commands(&self.model);
+        self.data.apply_servo_commands(&self.model);
         self.apply_joint_commands();
         self.data.move_fixed_nodes(&self.model);
     }

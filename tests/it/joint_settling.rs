@@ -91,3 +91,38 @@ fn a_heavy_pinned_strut_settles_in_tens_of_steps_on_the_dynamics_own_equilibrium
     }
     assert!(fast.points[0].residual_force_n <= 1e-9, "residual {} N", fast.points[0].residual_force_n);
 }
+
+/// An actuated revolute joint with a torsion spring is a servo: its command is the spring's
+/// rest angle and the joint turns against it. A 1 kg, 1 m bar on a servo of 50 N m/rad under
+/// gravity settles where the spring holds its weight, k (q - c) = -m g (L / 2) cos q (solved
+/// here by Newton's method), within 1e-9 rad at the commands 0 and 0.3 rad.
+#[test]
+fn a_servo_holds_its_load_by_its_spring_about_its_command() {
+    const K_NM_PER_RAD: f64 = 50.0;
+    const WEIGHT_MOMENT_NM: f64 = 1.0 * 9.81 * 0.5;
+    let text = super::common::PINNED_STRUT
+        .replace("points = [ {} ]", "points = [ { c = 0.0 }, { c = 0.3 } ]")
+        .replace("gravity = [0.0, 0.0, 0.0]", "gravity = [0.0, -9.81, 0.0]")
+        .replace("[[structure.springs]]\nname = \"k\"\na = \"Q\"\nb = \"S\"\nstiffness = 10.0\nlength = 0.5\n", "")
+        .replace(
+            "damping = 0.5\n",
+            "damping = 0.5\ntorsion_stiffness = 50.0\n[[structure.actuators]]\nsymbol = \"c\"\njoint = \"pin\"\n",
+        );
+    let sc = tensegrity_testbed::scenario::parse(std::path::Path::new("servo.toml"), &text).expect("valid");
+    let report = tensegrity_testbed::run::run(&sc, &tensegrity_testbed::run::RunOptions::default());
+    assert_eq!(report.points.len(), 2, "{}", report.verdict_line());
+    for (point, command) in report.points.iter().zip([0.0_f64, 0.3]) {
+        assert!(point.settled, "command {command}");
+        let q = point.simulated["Q.y"].atan2(point.simulated["Q.x"]);
+        let mut expected = command;
+        for _ in 0..50 {
+            let (f, df) = (
+                K_NM_PER_RAD * (expected - command) + WEIGHT_MOMENT_NM * expected.cos(),
+                K_NM_PER_RAD - WEIGHT_MOMENT_NM * expected.sin(),
+            );
+            expected -= f / df;
+        }
+        eprintln!("command {command} rad: settled at {q} rad, the balance's root {expected} rad");
+        assert!((q - expected).abs() <= 1e-9, "command {command}: {q} against {expected}");
+    }
+}

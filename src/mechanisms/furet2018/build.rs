@@ -14,7 +14,7 @@
 
 use super::analytic::{self, Params};
 use crate::structure::{
-    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut, Vec3,
+    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut, TorsionSpring, Vec3,
     DEFAULT_TENDON_RADIUS_M,
 };
 use nalgebra::Vector2;
@@ -34,6 +34,9 @@ pub struct ModelChoices {
     pub plane_offset_m: f64,
     /// Bar radius for drawing and interference \[m\].
     pub strut_radius_m: f64,
+    /// The actuators at A as servos of this stiffness [N m/rad] (`structure::Structure::servo_of`);
+    /// None: ideal position actuators.
+    pub servo_stiffness_nm_per_rad: Option<f64>,
 }
 
 fn at(v: Vector2<f64>, z: f64) -> Vec3 {
@@ -120,7 +123,11 @@ fn add_module(
         });
     }
     let actuated = s.joints.len();
-    s.joints.push(revolute(format!("X{k} A (actuated, phi{k})"), below, ac, a, x.joint_angle_a, 0.0));
+    let mut actuated_a = revolute(format!("X{k} A (actuated, phi{k})"), below, ac, a, x.joint_angle_a, 0.0);
+    actuated_a.torsion_spring = m
+        .servo_stiffness_nm_per_rad
+        .map(|k| TorsionSpring { stiffness_nm_per_rad: k, rest_angle_rad: x.joint_angle_a });
+    s.joints.push(actuated_a);
     s.joints.push(revolute(format!("X{k} C"), ac, top, c, 0.0, m.joint_damping));
     s.joints.push(revolute(format!("X{k} B"), below, bd, b, x.joint_angle_b, m.joint_damping));
     // The loop closes at D with a planar pin: the other three joints already hold the loop in

@@ -34,6 +34,7 @@ const PARAMS: &[ParamSpec] = &[
     ParamSpec { symbol: "c_joint", unit: "N m s/rad", default: 0.5, description: "viscous damping of the free joints (not in the paper: zero at rest)", origin: Origin::ModelChoice },
     ParamSpec { symbol: "dz", unit: "m", default: 0.03, description: "half the distance between the planes of the two crossed bars of an X (the paper's remark on collisions; 0 puts them in one plane)", origin: Origin::ModelChoice },
     ParamSpec { symbol: "r_strut", unit: "m", default: 0.01, description: "bar radius for drawing and interference (not in the paper)", origin: Origin::ModelChoice },
+    ParamSpec { symbol: "k_servo", unit: "N m/rad", default: 0.0, description: "stiffness of the actuators at A as servos (not in the paper): 0 = ideal position actuators, phi exactly its command (the mechanism is then rigid); > 0 = phi held by a torsion spring whose rest angle is the command, so the X modules vibrate and sag by the springs' torque over k_servo", origin: Origin::ModelChoice },
 ];
 
 const INPUTS: &[InputSpec] = &[
@@ -106,6 +107,7 @@ fn model_of(v: &Values) -> build::ModelChoices {
         joint_damping: v["c_joint"],
         plane_offset_m: v["dz"],
         strut_radius_m: v["r_strut"],
+        servo_stiffness_nm_per_rad: (v["k_servo"] > 0.0).then_some(v["k_servo"]),
     }
 }
 
@@ -146,7 +148,10 @@ impl Mechanism for Furet2018 {
     }
     fn validate_params(&self, v: &Values) -> Result<(), ModelError> {
         super::require_positive(v, &[("L", "m"), ("b", "m"), ("k_spring", "N/m"), ("m_bar", "kg")])?;
-        super::require_non_negative(v, &[("l0_spring", "m"), ("c_joint", "N m s/rad"), ("dz", "m"), ("r_strut", "m")])?;
+        super::require_non_negative(
+            v,
+            &[("l0_spring", "m"), ("c_joint", "N m s/rad"), ("dz", "m"), ("r_strut", "m"), ("k_servo", "N m/rad")],
+        )?;
         let (l, b) = (param(v, "L")?, param(v, "b")?);
         if l <= b {
             return Err(ModelError::value(
