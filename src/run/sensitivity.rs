@@ -72,6 +72,34 @@ struct Outputs<'a> {
     coordinates: EquilibriumCoordinates,
 }
 
+/// The analysis of a settled state: what its samples need, its modes (K phi = omega^2 M phi in
+/// the equilibrium's coordinates), the listed ones, and every output there.
+struct Analysis<'a> {
+    out: Outputs<'a>,
+    modes: Vec<Mode>,
+    listed: Vec<usize>,
+    base: Vec<(String, f64)>,
+}
+
+/// The analysis of `sim`, settled at `params` and `inputs` of `sc`.
+fn analyse<'a>(
+    sc: &'a Scenario,
+    sim: &mut Simulation,
+    params: &Values,
+    inputs: Values,
+) -> Result<Analysis<'a>, SensitivityRunError> {
+    let coordinates = sim.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
+    let model = sc.model.as_ref().map(|spec| ModelObserver::new(spec, sim.structure(), false, None));
+    let out = Outputs { sc, mech: sc.mechanism(), inputs, model, coordinates };
+    let k = sim.equilibrium_stiffness(&out.coordinates);
+    let mass = sim.equilibrium_mass(&out.coordinates);
+    let modes = crate::eigen::modes(&symmetric(&k), &symmetric(&mass))?;
+    let listed = listed_modes(&modes);
+    let mut base = out.sample(sim, params);
+    base.extend(listed.iter().map(|&i| (format!("mode{}.omega", i + 1), modes[i].omega())));
+    Ok(Analysis { out, modes, listed, base })
+}
+
 /// The sensitivities of `sc` at its first point, settled as `run` settles it (`check`: also
 /// by differences of settles), named by `file`.
 pub fn sensitivity(
@@ -86,22 +114,13 @@ pub fn sensitivity(
     let params = sc.params_at(&inputs);
     let mut state = settle_at(sc, &inputs, params.clone(), cancel)?;
     let wall = Instant::now();
-    let coordinates = state.sim.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
-    let model = sc.model.as_ref().map(|spec| ModelObserver::new(spec, state.sim.structure(), false, None));
-    let out = Outputs { sc, mech: sc.mechanism(), inputs, model, coordinates };
-    let k = state.sim.equilibrium_stiffness(&out.coordinates);
-    let mass = state.sim.equilibrium_mass(&out.coordinates);
-    let modes = crate::eigen::modes(&symmetric(&k), &symmetric(&mass))?;
-    let listed = listed_modes(&modes);
-    let mut base = out.sample(&state.sim, &params);
-    base.extend(listed.iter().map(|&i| (format!("mode{}.omega", i + 1), modes[i].omega())));
+    let Analysis { out, modes, listed, base } = analyse(sc, &mut state.sim, &params, inputs)?;
     let mut parameters = Vec::new();
     for (name, &value) in &params {
         if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
             return Err(RunError::Interrupted(state.sim.tick()).into());
         }
         parameters.push(out.parameter(&state.sim, &params, name, value, &modes, &listed));
-        debug_assert!(parameters.last().is_none_or(|p| p.error.is_some() || p.derivatives.len() == base.len()));
     }
     let wall_s = wall.elapsed().as_secs_f64();
     let free = out.free_outputs(&mut state.sim, &params, &modes, &base);
@@ -127,6 +146,34 @@ pub fn sensitivity(
         wall_s,
         check_wall_s: check.then(|| check_wall.elapsed().as_secs_f64()),
     })
+}
+
+/// The file's `[[sensitivities]]` at a settle point of a run (`sim` settled at `params` and
+/// `inputs`), by their names: each d(output)/d(parameter), NaN where the output is not one of
+/// the state's (a mode it has not); Err where the state has no sensitivities (the reason).
+pub(super) fn file_sensitivities(
+    sc: &Scenario,
+    sim: &mut Simulation,
+    params: &Values,
+    inputs: &Values,
+) -> Result<Values, String> {
+    let wanted = sc.model.as_ref().map_or(&[][..], |m| &m.sensitivities[..]);
+    let a = analyse(sc, sim, params, inputs.clone()).map_err(|e| e.to_string())?;
+    let mut rows: Vec<ParameterSensitivity> = Vec::new();
+    let mut out = Values::new();
+    for s in wanted {
+        if !rows.iter().any(|r| r.name == s.parameter) {
+            let value = params.get(&s.parameter).copied().unwrap_or(f64::NAN);
+            rows.push(a.out.parameter(sim, params, &s.parameter, value, &a.modes, &a.listed));
+        }
+        let row = rows.iter().find(|r| r.name == s.parameter).expect("computed above");
+        if let Some(e) = &row.error {
+            return Err(format!("d {}/d {}: {e}", s.output, s.parameter));
+        }
+        let i = a.base.iter().position(|(n, _)| n == &s.output);
+        out.insert(s.name.clone(), i.map_or(f64::NAN, |i| row.derivatives[i]));
+    }
+    Ok(out)
 }
 
 /// (K + K^T) / 2: the difference's K is symmetric up to its error and the equilibrium's.

@@ -158,3 +158,54 @@ fn the_command_writes_json_and_csv_and_refuses_loops_by_name() {
     let (code, _, err) = common::tensegrity(&["sensitivity", "scenarios/mohr2011/quick.toml"]);
     assert!(code == 2 && err.contains("the structure is held by the inextensible cable"), "{err}");
 }
+
+/// The pinned bar's file with `[[sensitivities]]` as symbols and a paper's printed
+/// sensitivities as predictions: dq*/dk1 = a k2 b / (k1^2 a^2 + k2^2 b^2) within 1e-12 and
+/// d omega/d k1 within 1e-9, at every point of the grid over k1.
+const PRINTED_SENSITIVITIES: &str = r#"
+[[sensitivities]]
+name = "dq_dk1"
+output = "pin.angle"
+parameter = "k1"
+
+[[sensitivities]]
+name = "domega_dk1"
+output = "mode1.omega"
+parameter = "k1"
+
+[[predictions]]
+quantity = "dq_dk1"
+formula = "a*k2*b/(k1^2*a^2 + k2^2*b^2)"
+class = "relative"
+tolerance = 1e-12
+
+[[predictions]]
+quantity = "domega_dk1"
+formula = "L*k1*a^2/(2*(m*L^2/3)*sqrt(L*hypot(k1*a, k2*b)/(m*L^2/3))*hypot(k1*a, k2*b))"
+class = "relative"
+tolerance = 1e-9
+"#;
+
+/// A paper's printed sensitivity is a prediction like any other: `[[sensitivities]]` names
+/// d(output)/d(parameter) at each settle point, and the run judges it.
+#[test]
+fn a_printed_sensitivity_is_judged_as_a_prediction_at_every_point() {
+    let text = std::fs::read_to_string("scenarios/custom/pinned_bar_modes.toml").unwrap() + PRINTED_SENSITIVITIES;
+    let sc = scenario::parse(Path::new("printed.toml"), &text).expect("valid");
+    let report = tensegrity_testbed::run::run(&sc, &Default::default());
+    assert!(report.passed, "{:?} {:?}", report.failures, report.warnings);
+    assert_eq!(report.points.len(), 3);
+    for p in &report.points {
+        assert!(p.errors["dq_dk1"] <= 1e-12 && p.errors["domega_dk1"] <= 1e-9, "{:?}", p.errors);
+    }
+    // A wrong formula fails.
+    let wrong = text.replace("a*k2*b/(k1^2", "1.001*a*k2*b/(k1^2");
+    let report =
+        tensegrity_testbed::run::run(&scenario::parse(Path::new("w.toml"), &wrong).unwrap(), &Default::default());
+    assert!(!report.passed);
+    // An output the state has not, a parameter the scenario has not: located.
+    let bad = text.replace("output = \"pin.angle\"", "output = \"pin.angel\"");
+    common::error_at(&bad, "\"pin.angel\"", 0, "'pin.angel' is no output of the settled state");
+    let bad = text.replace("parameter = \"k1\"\n\n[[sens", "parameter = \"k9\"\n\n[[sens");
+    common::error_at(&bad, "\"k9\"", 0, "'k9' is not a parameter of this scenario");
+}
