@@ -112,6 +112,10 @@ pub fn sensitivity(
     let sc = sc.topologies.first().unwrap_or(sc);
     let inputs = sc.actuation.first_inputs().clone();
     let params = sc.params_at(&inputs);
+    // What the analysis refuses is the structure's, known before the settle.
+    let structure = sc.mechanism().build(&params, &inputs, &sc.start).map_err(RunError::from)?;
+    let drawn = Simulation::new(&structure, &sc.sim).map_err(RunError::from)?;
+    drawn.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
     let mut state = settle_at(sc, &inputs, params.clone(), cancel)?;
     let wall = Instant::now();
     let Analysis { out, modes, listed, base } = analyse(sc, &mut state.sim, &params, inputs)?;
