@@ -191,8 +191,9 @@ def modes(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str
 
 
 def sensitivity(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml",
-                check: bool = False) -> dict:
-    """How the settled state at the first point (settled as ``run`` settles it) moves with every
+                check: bool = False, point: int = 0) -> dict:
+    """How the settled state at point ``point`` (from 0, as ``run`` numbers them; settled as
+    ``run`` settles it) moves with every
     parameter: the report of ``tensegrity sensitivity --json`` as a dict (``outputs``: each
     output's ``name``, ``value`` and ``free``; ``parameters``: one per parameter with its
     ``derivatives``, one per output, and d(coordinate)/dp in ``coordinates``; with ``check``
@@ -200,7 +201,7 @@ def sensitivity(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, nam
     ScenarioError on bad input, ValueError where the structure's sensitivities are not
     computed (the reason named), KeyboardInterrupt on Ctrl-C."""
     path, text = _source(scenario, name)
-    return json.loads(_call(_tensegrity.sensitivity_json, path, text, _sets(set), check))
+    return json.loads(_call(_tensegrity.sensitivity_json, path, text, _sets(set), check, point))
 
 
 class Structure:

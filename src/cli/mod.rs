@@ -123,8 +123,8 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         Command::Modes { scenario, json, record, set } => {
             modes::modes(&scenario, &overrides(&set)?, json.as_deref(), record.as_deref())
         }
-        Command::Sensitivity { scenario, json, csv, check, set } => {
-            sensitivity::sensitivity(&scenario, &overrides(&set)?, json.as_deref(), csv.as_deref(), check)
+        Command::Sensitivity { scenario, json, csv, point, check, set } => {
+            sensitivity::sensitivity(&scenario, &overrides(&set)?, json.as_deref(), csv.as_deref(), point, check)
         }
         bench @ Command::Bench { .. } => bench::bench(bench),
     }

@@ -1,7 +1,7 @@
 //! `tensegrity sensitivity S.toml`: how the settled state's outputs move with every parameter
 //! (`run::sensitivity`), as a table, as JSON with `--json FILE` and as CSV with `--csv FILE`
-//! (either `-`: standard output, the table then going to standard error); `--check` also
-//! measures every derivative by differences of settles.
+//! (either `-`: standard output, the table then going to standard error), at the first point
+//! or `--point N`; `--check` also measures every derivative by differences of settles.
 
 use super::{bad_input, check_outputs, failed, load_one, signals, write_atomic, CliError, Outcome};
 use crate::run::SensitivityRunError;
@@ -12,6 +12,7 @@ pub fn sensitivity(
     overrides: &[crate::scenario::Override],
     json: Option<&Path>,
     csv: Option<&Path>,
+    point: usize,
     check: bool,
 ) -> Result<Outcome, CliError> {
     let sc = load_one(scenario, overrides)?;
@@ -23,12 +24,13 @@ pub fn sensitivity(
         .filter_map(|(flag, p)| p.map(|p| (flag.to_string(), p.to_path_buf())))
         .collect();
     check_outputs(&[scenario.to_path_buf()], &outputs)?;
-    let report =
-        crate::run::sensitivity(&sc, &scenario.display().to_string(), check, Some(&signals::CANCEL)).map_err(|e| {
-            match e {
-                SensitivityRunError::Refused(_) => bad_input(format!("{}: {e}", scenario.display())),
-                _ => failed(format!("{}: {e}", scenario.display())),
-            }
+    if crate::run::sensitivity_point_of(&sc, point).is_none() {
+        return Err(bad_input(format!("--point {point}: {}", SensitivityRunError::NoPoint(point))));
+    }
+    let report = crate::run::sensitivity(&sc, &scenario.display().to_string(), point, check, Some(&signals::CANCEL))
+        .map_err(|e| match e {
+            SensitivityRunError::Refused(_) => bad_input(format!("{}: {e}", scenario.display())),
+            _ => failed(format!("{}: {e}", scenario.display())),
         })?;
     // With `--json -` or `--csv -` standard output is that file alone: the table goes to
     // standard error.

@@ -15,6 +15,9 @@ pub const CHECK_FLOOR_ELASTICITY: f64 = 1e-3;
 pub struct SensitivityReport {
     pub name: String,
     pub file: String,
+    /// The settle point analysed (from 0, as a run numbers its points) and its inputs.
+    pub point: usize,
+    pub inputs: crate::mechanisms::Values,
     /// Whether the settle criteria were met before the analysis.
     pub settled: bool,
     pub settle_steps: u64,
@@ -77,9 +80,10 @@ impl SensitivityReport {
     /// The table: a header, then per parameter one row per output.
     pub fn to_table(&self) -> String {
         let mut out = format!(
-            "== {} [{}]: {} coordinate(s) ({}), {} output(s), {} parameter(s){}\n      {:<28} {:>20} {:>20}{}\n",
+            "== {} [{}] point {}: {} coordinate(s) ({}), {} output(s), {} parameter(s){}\n      {:<28} {:>20} {:>20}{}\n",
             self.name,
             self.file,
+            self.point,
             self.coordinates.len(),
             self.coordinates.join(", "),
             self.outputs.len(),

@@ -26,7 +26,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 pub use point::NO_BRANCH;
-pub use sensitivity::{sensitivity, SensitivityRunError};
+pub use sensitivity::{point_of as sensitivity_point_of, sensitivity, SensitivityRunError};
 pub use settle::SettleDetector;
 pub use settled::{modes, settle_at, settle_first_point, ModesRunError, SettledState};
 pub use topologies::rebuilt;

@@ -52,6 +52,9 @@ pub enum SensitivityRunError {
     /// The structure's sensitivities are not computed, by name (bad input).
     #[error(transparent)]
     Refused(SensitivityError),
+    /// The scenario has no such point (bad input).
+    #[error("the scenario has no point {0} (its points are numbered from 0)")]
+    NoPoint(usize),
     /// The structure at a check's sample could not be read.
     #[error("{0}")]
     Check(String),
@@ -100,17 +103,32 @@ fn analyse<'a>(
     Ok(Analysis { out, modes, listed, base })
 }
 
-/// The sensitivities of `sc` at its first point, settled as `run` settles it (`check`: also
-/// by differences of settles), named by `file`.
+/// The scenario and inputs of point `point` (from 0, as a run numbers its points; a schedule's
+/// one point is its first waypoint): a sweep over a topology or a motion over several points
+/// is one scenario per part, their points in order. None past the last point.
+pub fn point_of(sc: &Scenario, point: usize) -> Option<(&Scenario, Values)> {
+    if sc.topologies.is_empty() {
+        let inputs = match &sc.actuation {
+            crate::scenario::Actuation::Points { points, .. } => points.get(point)?,
+            crate::scenario::Actuation::Schedule { .. } => (point == 0).then(|| sc.actuation.first_inputs())?,
+        };
+        return Some((sc, inputs.clone()));
+    }
+    let mut parts = sc.topologies.iter().flat_map(|t| t.actuation.all_inputs().into_iter().map(move |i| (t, i)));
+    parts.nth(point).map(|(t, i)| (t, i.clone()))
+}
+
+/// The sensitivities of `sc` at point `point` (from 0; see [`point_of`]), settled as `run`
+/// settles it afresh there (`check`: also by differences of settles), named by `file`;
+/// [`SensitivityRunError::NoPoint`] past the last point.
 pub fn sensitivity(
     sc: &Scenario,
     file: &str,
+    point: usize,
     check: bool,
     cancel: Option<&AtomicBool>,
 ) -> Result<SensitivityReport, SensitivityRunError> {
-    // A motion run over several points is a topology sweep of one motion each: the first's.
-    let sc = sc.topologies.first().unwrap_or(sc);
-    let inputs = sc.actuation.first_inputs().clone();
+    let (sc, inputs) = point_of(sc, point).ok_or(SensitivityRunError::NoPoint(point))?;
     let params = sc.params_at(&inputs);
     // What the analysis refuses is the structure's, known before the settle.
     let structure = sc.mechanism().build(&params, &inputs, &sc.start).map_err(RunError::from)?;
@@ -142,6 +160,8 @@ pub fn sensitivity(
     Ok(SensitivityReport {
         name: sc.name.clone(),
         file: file.to_string(),
+        point,
+        inputs: out.inputs.clone(),
         settled: state.settled,
         settle_steps: state.steps,
         coordinates: out.coordinates.names(state.sim.structure()),

@@ -12,7 +12,7 @@ use tensegrity_testbed::scenario;
 /// The report of `file` (with its check by differences of settles).
 fn report_of(file: &str) -> SensitivityReport {
     let sc = scenario::load(Path::new(file)).expect("shipped scenario");
-    tensegrity_testbed::run::sensitivity(&sc, file, true, None).expect("sensitivities")
+    tensegrity_testbed::run::sensitivity(&sc, file, 0, true, None).expect("sensitivities")
 }
 
 /// Parameter `name`'s row.
@@ -155,6 +155,18 @@ fn the_command_writes_json_and_csv_and_refuses_loops_by_name() {
     let _ = std::fs::remove_file(&csv);
     let (code, out, err) = common::tensegrity(&["sensitivity", file, "--json", "-", "--csv", "-"]);
     assert!(code == 2 && out.is_empty() && err.contains("only one of them"), "{out}{err}");
+    // Another settle point of the grid over k1: the last, k1 = 90 N/m.
+    let (code, out, err) = common::tensegrity(&["sensitivity", file, "--point", "2", "--json", "-"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let (k1, k2, a, b) = (90.0, 30.0, 0.8, 0.6);
+    let closed = a * k2 * b / (k1 * k1 * a * a + k2 * k2 * b * b);
+    let i = v["outputs"].as_array().unwrap().iter().position(|o| o["name"] == "pin.angle").unwrap();
+    let row = v["parameters"].as_array().unwrap().iter().find(|p| p["name"] == "k1").unwrap();
+    let d = row["derivatives"][i].as_f64().unwrap();
+    assert!(rel(d, closed) <= 1e-12, "at k1 = 90: {d:.15e} against {closed:.15e}");
+    let (code, _, err) = common::tensegrity(&["sensitivity", file, "--point", "3"]);
+    assert!(code == 2 && err.contains("--point 3: the scenario has no point 3"), "{err}");
     let (code, _, err) = common::tensegrity(&["sensitivity", "scenarios/mohr2011/quick.toml"]);
     assert!(code == 2 && err.contains("the structure is held by the inextensible cable"), "{err}");
 }
