@@ -457,6 +457,32 @@ fn modes_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>) 
     Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))
 }
 
+/// The sensitivities of `tensegrity sensitivity --json` (with `--check` when `check`, at
+/// `--point point`): the same report, as its JSON text, at that point settled as `run`
+/// settles it.
+/// Ctrl-C stops the settles.
+#[pyfunction]
+#[pyo3(signature = (path, text=None, set=Vec::new(), check=false, point=0))]
+fn sensitivity_json(
+    py: Python<'_>,
+    path: &str,
+    text: Option<&str>,
+    set: Vec<String>,
+    check: bool,
+    point: usize,
+) -> PyResult<String> {
+    let sc = load(path, text, &set)?;
+    let file = path.to_string();
+    let result = on_own_thread(py, move |cancel| run::sensitivity(&sc, &file, point, check, Some(cancel)))?;
+    let report = result.map_err(|e| match e {
+        run::SensitivityRunError::Refused(_) | run::SensitivityRunError::NoPoint(_) => {
+            PyValueError::new_err(format!("{path}: {e}"))
+        }
+        _ => PyException::new_err(format!("{path}: {e}")),
+    })?;
+    Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))
+}
+
 /// Scenario sections given as a JSON object (`{"motion": {...}, "energy": {...}}`) as TOML
 /// text; a value TOML cannot hold (null, a mixed array) is a ValueError naming it.
 #[pyfunction]
@@ -479,6 +505,7 @@ fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(findings, m)?)?;
     m.add_function(wrap_pyfunction!(modes_json, m)?)?;
+    m.add_function(wrap_pyfunction!(sensitivity_json, m)?)?;
     m.add_function(wrap_pyfunction!(sections_toml, m)?)?;
     m.add_class::<ArrowTable>()?;
     m.add("TestbedError", m.py().get_type::<TestbedError>())?;

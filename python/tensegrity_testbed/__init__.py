@@ -18,7 +18,8 @@ from . import _tensegrity
 
 __all__ = [
     "ScenarioError", "Prediction", "Result", "Solution", "Finding", "Structure",
-    "check", "export_mjcf", "findings", "from_matrices", "from_ntrt", "from_toml", "modes", "run", "solve", "sweep",
+    "check", "export_mjcf", "findings", "from_matrices", "from_ntrt", "from_toml", "modes", "run", "sensitivity", "solve",
+    "sweep",
 ]
 
 Scenario = Union[str, "os.PathLike[str]", "Structure"]
@@ -187,6 +188,20 @@ def modes(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str
     reason named), KeyboardInterrupt on Ctrl-C."""
     path, text = _source(scenario, name)
     return json.loads(_call(_tensegrity.modes_json, path, text, _sets(set)))
+
+
+def sensitivity(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml",
+                check: bool = False, point: int = 0) -> dict:
+    """How the settled state at point ``point`` (from 0, as ``run`` numbers them; settled as
+    ``run`` settles it) moves with every
+    parameter: the report of ``tensegrity sensitivity --json`` as a dict (``outputs``: each
+    output's ``name``, ``value`` and ``free``; ``parameters``: one per parameter with its
+    ``derivatives``, one per output, and d(coordinate)/dp in ``coordinates``; with ``check``
+    also the differences of settles in ``check`` and their ``max_check_error``). Raises
+    ScenarioError on bad input, ValueError where the structure's sensitivities are not
+    computed (the reason named), KeyboardInterrupt on Ctrl-C."""
+    path, text = _source(scenario, name)
+    return json.loads(_call(_tensegrity.sensitivity_json, path, text, _sets(set), check, point))
 
 
 class Structure:

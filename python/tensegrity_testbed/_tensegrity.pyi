@@ -11,6 +11,7 @@ __all__ = [
     "export_mjcf",
     "solve",
     "modes_json",
+    "sensitivity_json",
     "sections_toml",
     "findings",
     "ArrowTable",
@@ -92,6 +93,11 @@ def solve(mechanism: str, query: str, values: Dict[str, float]) -> List[Tuple[st
 
 def modes_json(path: str, text: Optional[str] = None, set: Sequence[str] = ...) -> str:
     """The modal analysis of ``tensegrity modes --json``, as its JSON text."""
+
+def sensitivity_json(path: str, text: Optional[str] = None, set: Sequence[str] = ..., check: bool = False,
+                     point: int = 0) -> str:
+    """The sensitivities of ``tensegrity sensitivity --json`` (``--check`` with ``check``, at
+    ``--point point``), as its JSON text."""
 
 def sections_toml(json: str) -> str:
     """Scenario sections given as a JSON object, as TOML text."""

@@ -574,6 +574,21 @@ def test_modes_from_python_are_the_clis_modes_json():
     assert py["joint_coordinates"] == ["pin"] and len(py["modes"]) == 1
 
 
+def test_sensitivity_from_python_is_the_clis_sensitivity_json():
+    """tt.sensitivity is `tensegrity sensitivity --json`: every field equal (floats bit for bit),
+    the wall times aside; the rocker's d omega/d k1 agrees with the settles' within 1e-6."""
+    py, cli = tt.sensitivity(str(ROCKER), check=True), cli_json("sensitivity", ROCKER, "--check")
+    for r in (py, cli):
+        r.pop("wall_s"), r.pop("check_wall_s")
+    assert py == cli
+    names = [o["name"] for o in py["outputs"]]
+    k1 = next(p for p in py["parameters"] if p["name"] == "k1")
+    i = names.index("mode1.omega")
+    assert abs(k1["derivatives"][i] - k1["check"][i]) <= 1e-6 * abs(k1["check"][i])
+    with pytest.raises(ValueError, match="inextensible cable"):
+        tt.sensitivity(str(ROOT / "scenarios" / "mohr2011" / "quick.toml"))
+
+
 def rocker_from_matrices(k1=10.0, k2=30.0, a=0.8, b=0.6, L=1.0, l1=0.5, l2=0.4, m=0.5):
     """The rocker of rocker_frequency_curve.toml from numpy arrays: n1 the pin at the origin, n2
     the strut's tip drawn at pi/4, n3 the anchor U = (0, a), n4 the anchor V = (b, 0); springs

@@ -70,6 +70,33 @@ pub enum Command {
         #[command(flatten)]
         set: SetArgs,
     },
+    /// How a scenario's settled state (its first point or `--point N`, settled as `run` settles it) moves
+    /// with every parameter: d/dp of the node positions, joint coordinates, member forces, the
+    /// mechanism's and the file's quantities and the lowest natural frequencies, by the
+    /// implicit function theorem (one linear solve per parameter on the tangent stiffness,
+    /// dQ/dp by rebuilding the structure at p +- h with the state held). Free bodies held by
+    /// springs and elastic cables, or joint trees; refused (exit 2): loops and inextensible
+    /// cables.
+    Sensitivity {
+        scenario: PathBuf,
+        /// Write the JSON report to this file (`-`: standard output, the table then going to
+        /// standard error).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Write one row per parameter and output to this CSV file (`-`: standard output).
+        #[arg(long, value_name = "FILE.csv")]
+        csv: Option<PathBuf>,
+        /// The settle point to analyse, from 0 as `run` numbers them (each settled afresh at
+        /// its inputs and parameters).
+        #[arg(long, default_value_t = 0, value_name = "N")]
+        point: usize,
+        /// Also measure every derivative by differences of settles (four settles per
+        /// parameter) and report the largest error.
+        #[arg(long)]
+        check: bool,
+        #[command(flatten)]
+        set: SetArgs,
+    },
     /// Validate scenario files without running them.
     Check {
         #[arg(required = true)]

@@ -16,6 +16,7 @@ mod list;
 mod merge;
 mod modes;
 mod run;
+mod sensitivity;
 mod signals;
 mod solve;
 mod sweep;
@@ -121,6 +122,9 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         Command::Export { format } => export::export(format),
         Command::Modes { scenario, json, record, set } => {
             modes::modes(&scenario, &overrides(&set)?, json.as_deref(), record.as_deref())
+        }
+        Command::Sensitivity { scenario, json, csv, point, check, set } => {
+            sensitivity::sensitivity(&scenario, &overrides(&set)?, json.as_deref(), csv.as_deref(), point, check)
         }
         bench @ Command::Bench { .. } => bench::bench(bench),
     }

@@ -126,6 +126,17 @@ pub struct ModelSpec {
     pub equations: Vec<Equation>,
     /// `[energy]`: a potential and its coordinates.
     pub energy: Option<super::energy_model::EnergySpec>,
+    /// `[[sensitivities]]`: symbols read off the settled state's sensitivities.
+    pub sensitivities: Vec<Sensitivity>,
+}
+
+/// A `[[sensitivities]]` entry: the symbol `name` (an observed value at each settle point) is
+/// d(`output`)/d(`parameter`) there.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sensitivity {
+    pub name: String,
+    pub output: String,
+    pub parameter: String,
 }
 
 impl ModelSpec {

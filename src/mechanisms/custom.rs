@@ -114,6 +114,12 @@ impl Custom {
         self
     }
 
+    /// The mechanism with its structure at these sets of parameters too.
+    pub fn with_more_variants(mut self, variants: Vec<(Values, Structure)>) -> Self {
+        self.variants.extend(variants);
+        self
+    }
+
     /// The parameters of `swept` that change nothing in the structure: at every other value of
     /// the swept ones, each value gives the same structure (a sweep that only the formulas see).
     pub fn unseen(&self, swept: &[String]) -> Vec<String> {

@@ -548,6 +548,20 @@ impl ModelObserver {
             .collect()
     }
 
+    /// The file's quantities in the state `snap` at its own time, by name, in file order
+    /// (`run::sensitivity`: outputs of a settled state).
+    pub fn quantities_at(
+        &self,
+        snap: &Snapshot,
+        inputs: &Values,
+        params: &Values,
+        observed: &Values,
+    ) -> Vec<(String, f64)> {
+        let v = self.values(snap, inputs, params, observed, snap.time_s);
+        let quantities = self.spec.symbols.iter().enumerate().filter(|(_, s)| matches!(s.source, Source::Quantity(_)));
+        quantities.map(|(i, s)| (s.name.clone(), v[i])).collect()
+    }
+
     /// The table's columns of the model: each quantity (`model:NAME`), each prediction's
     /// predicted value and error (`predicted:NAME`, `error:NAME`), each equation's residual
     /// (`equation:NAME`).

@@ -2,6 +2,7 @@
 //! (0 every check passed, 1 a check failed, 2 bad input).
 
 pub mod modes;
+pub mod sensitivity;
 pub mod verdict;
 
 use crate::mechanisms::{Finding, Values};

@@ -8,6 +8,7 @@ mod levels;
 mod motion;
 mod point;
 mod runner;
+mod sensitivity;
 mod settle;
 mod settled;
 mod topologies;
@@ -26,8 +27,9 @@ use std::time::Instant;
 
 pub use levels::judged_nodes_after;
 pub use point::NO_BRANCH;
+pub use sensitivity::{point_of as sensitivity_point_of, sensitivity, SensitivityRunError};
 pub use settle::SettleDetector;
-pub use settled::{modes, settle_first_point, ModesRunError, SettledState};
+pub use settled::{modes, settle_at, settle_first_point, ModesRunError, SettledState};
 pub use topologies::rebuilt;
 
 use stoppable::{interruptible, Halted};
@@ -281,12 +283,20 @@ fn start<'a>(
     opts: &RunOptions<'a>,
     warnings: &mut Vec<String>,
 ) -> Result<Runner<'a>, RunError> {
-    let first_inputs = match &sc.actuation {
-        Actuation::Points { points, .. } => points[0].clone(),
-        Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
-    };
-    let params = sc.params_at(&first_inputs);
-    let structure = mech.build(&params, &first_inputs, &sc.start)?;
+    let first_inputs = sc.actuation.first_inputs();
+    start_at(mech, sc, opts, warnings, first_inputs, sc.params_at(first_inputs))
+}
+
+/// [`start`] at the inputs `first_inputs` with the parameters `params`.
+fn start_at<'a>(
+    mech: Box<dyn Mechanism>,
+    sc: &'a Scenario,
+    opts: &RunOptions<'a>,
+    warnings: &mut Vec<String>,
+    first_inputs: &crate::mechanisms::Values,
+    params: crate::mechanisms::Values,
+) -> Result<Runner<'a>, RunError> {
+    let structure = mech.build(&params, first_inputs, &sc.start)?;
     let sim = Simulation::new(&structure, &sc.sim)?;
     let target = match (&opts.connect, opts.record.clone().or_else(|| sc.record.clone())) {
         (Some(url), _) => Some(RecordTarget::Live(url.clone())),
@@ -314,7 +324,7 @@ fn start<'a>(
     )?;
     let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel, params);
     // The first point's commands (a no-op where the build already placed them).
-    runner.command(&first_inputs);
+    runner.command(first_inputs);
     Ok(runner)
 }
 

@@ -171,6 +171,14 @@ pub(super) fn settle_point(
     say_settled(runner, sc, index, &s, final_energy);
     let measured = measured_point(runner, sc, (index, inputs), &s.snapshot, final_energy);
     let mut simulated = s.simulated.clone();
+    // The file's [[sensitivities]] at the settled state, before anything moves it.
+    if s.settled && sc.model.as_ref().is_some_and(|m| !m.sensitivities.is_empty()) {
+        let params = runner.params.clone();
+        match super::sensitivity::file_sensitivities(sc, &mut runner.sim, &params, inputs) {
+            Ok(values) => simulated.extend(values),
+            Err(e) => report.warnings.push(format!("point {index}: [[sensitivities]] not computed: {e}")),
+        }
+    }
     let (branch, analytic_stable, mut landed) = landed_branch(runner, sc, index, &prediction, &simulated, report);
     let stable = match sc.stability_perturbation {
         Some(d) if s.settled => Some(runner.classify(inputs, &prediction, &s.snapshot, d)?),

@@ -2,9 +2,10 @@
 //! (`tensegrity modes`): the run's own start and settle loop (the same accelerators and
 //! criteria as `run`), and the simulation handed back instead of a report.
 
-use super::{start, RunError, RunOptions};
+use super::{start_at, RunError, RunOptions};
+use crate::mechanisms::Values;
 use crate::report::modes::{ConstraintsReport, ModeReport, ModesReport};
-use crate::scenario::{Actuation, Scenario};
+use crate::scenario::Scenario;
 use crate::sim::modes::{Constraints, ModesError, StructureModes, NODES_LISTED, ZERO_MODE_RATIO};
 use crate::sim::Simulation;
 use std::sync::atomic::AtomicBool;
@@ -22,14 +23,22 @@ pub struct SettledState {
 /// Settles `sc` at its first point (a schedule: its first waypoint) as `run` does (without a
 /// recording, so with nothing to warn of).
 pub fn settle_first_point(sc: &Scenario, cancel: Option<&AtomicBool>) -> Result<SettledState, RunError> {
-    let inputs = match &sc.actuation {
-        Actuation::Points { points, .. } => points[0].clone(),
-        Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
-    };
+    let inputs = sc.actuation.first_inputs().clone();
+    settle_at(sc, &inputs, sc.params_at(&inputs), cancel)
+}
+
+/// Settles `sc` at `inputs` with every parameter at `params` (its value at the point, or
+/// another: a difference of settles over a parameter), as `run` settles a point.
+pub fn settle_at(
+    sc: &Scenario,
+    inputs: &Values,
+    params: Values,
+    cancel: Option<&AtomicBool>,
+) -> Result<SettledState, RunError> {
     let opts = RunOptions { cancel, skip_findings: true, ..RunOptions::default() };
-    let mut runner = start(sc.mechanism(), sc, &opts, &mut Vec::new())?;
-    let prediction = runner.mech.predict(&runner.params, &inputs)?;
-    let settled = runner.settle(&inputs, &prediction)?;
+    let mut runner = start_at(sc.mechanism(), sc, &opts, &mut Vec::new(), inputs, params)?;
+    let prediction = runner.mech.predict(&runner.params, inputs)?;
+    let settled = runner.settle(inputs, &prediction)?;
     Ok(SettledState { sim: runner.sim, settled: settled.settled, steps: settled.steps })
 }
 

@@ -6,10 +6,10 @@
 
 use super::error::{positive_value, Ctx, ScenarioError};
 use super::number::expr_error;
-use super::raw::{RawEquation, RawPrediction, RawQuantity, RawScenario};
+use super::raw::{RawEquation, RawPrediction, RawQuantity, RawScenario, RawSensitivity};
 use super::Actuation;
 use crate::file_model::expr::Expr;
-use crate::file_model::spec::{Equation, ErrorClass, ModelSpec, Prediction, Quantity, Source, Symbol};
+use crate::file_model::spec::{Equation, ErrorClass, ModelSpec, Prediction, Quantity, Sensitivity, Source, Symbol};
 use crate::mechanisms::{Mechanism, Values};
 use crate::structure::JointKind;
 use toml::Spanned;
@@ -35,6 +35,9 @@ pub(super) fn model(
     for q in &raw.quantities {
         quantity(ctx, &mut spec, q)?;
     }
+    for s in &raw.sensitivities {
+        sensitivity(ctx, &mut spec, s, params, raw.motion.is_some())?;
+    }
     for p in &raw.predictions {
         prediction(ctx, &mut spec, p, raw.motion.is_some())?;
     }
@@ -58,7 +61,8 @@ fn first_entry(raw: &RawScenario) -> Option<usize> {
     let p = raw.predictions.first().map(|p| p.quantity.span().start);
     let e = raw.equations.first().map(|e| e.name.span().start);
     let u = raw.energy.as_ref().map(|u| u.potential.span().start);
-    [q, p, e, u].into_iter().flatten().min()
+    let s = raw.sensitivities.first().map(|s| s.name.span().start);
+    [q, p, e, u, s].into_iter().flatten().min()
 }
 
 /// The symbols of the state: nodes, members, observed quantities, inputs, parameters and `t`
@@ -125,6 +129,55 @@ fn quantity(ctx: &Ctx, spec: &mut ModelSpec, q: &RawQuantity) -> Result<(), Scen
     spec.symbols.push(Symbol { name: name.clone(), source: Source::Quantity(spec.quantities.len()) });
     let unit = q.unit.clone().unwrap_or_else(|| "-".into());
     spec.quantities.push(Quantity { name, unit, expr, closed_form });
+    Ok(())
+}
+
+/// A `[[sensitivities]]` entry: a new symbol, read at each settle point (an observed value
+/// there), d(output)/d(parameter) with the output one of the state's (a node coordinate, a
+/// member force, a joint coordinate, an observed quantity, a `[[quantities]]` name, or the
+/// omega of mode N, `modeN.omega`) and the parameter one of the scenario's. A motion run has no
+/// settle point to compute them at: refused.
+fn sensitivity(
+    ctx: &Ctx,
+    spec: &mut ModelSpec,
+    s: &RawSensitivity,
+    params: &Values,
+    motion: bool,
+) -> Result<(), ScenarioError> {
+    if motion {
+        return Err(ctx.err(&s.name, "[[sensitivities]] are computed at settle points: a [motion] run has none"));
+    }
+    let name = new_name(ctx, spec, &s.name, "sensitivity")?;
+    let p = s.parameter.get_ref();
+    if !params.contains_key(p) {
+        let known: Vec<&str> = params.keys().map(String::as_str).collect();
+        return Err(ctx.err(
+            &s.parameter,
+            format!("'{p}' is not a parameter of this scenario (its parameters: {})", known.join(", ")),
+        ));
+    }
+    let o = s.output.get_ref();
+    let output = |x: &Symbol| {
+        &x.name == o
+            && matches!(
+                x.source,
+                Source::Node(..)
+                    | Source::MemberForce(_)
+                    | Source::JointAngle(_)
+                    | Source::JointSlide(_)
+                    | Source::Observed(_)
+                    | Source::Quantity(_)
+            )
+    };
+    let mode = o.strip_prefix("mode").and_then(|m| m.strip_suffix(".omega")).and_then(|n| n.parse::<usize>().ok());
+    if !spec.symbols.iter().any(output) && mode.is_none_or(|n| n < 1) {
+        return Err(ctx.err(
+            &s.output,
+            format!("'{o}' is no output of the settled state (a node coordinate such as P.x, a member's force, a joint's angle or slide, an observed quantity, a [[quantities]] name, or modeN.omega)"),
+        ));
+    }
+    spec.symbols.push(Symbol { name: name.clone(), source: Source::Observed(name.clone()) });
+    spec.sensitivities.push(Sensitivity { name, output: o.clone(), parameter: p.clone() });
     Ok(())
 }
 

@@ -106,9 +106,20 @@ pub(super) fn with_variants(
     params: &Values,
     sets: &[Values],
 ) -> Result<Custom, ScenarioError> {
-    let Some(st) = &raw.structure else { return Ok(custom) };
+    let variants = variants(ctx, raw, sets.iter().filter(|set| *set != params))?;
+    Ok(custom.with_variants(variants))
+}
+
+/// The file's structure resolved and read at each of `sets` (every parameter's value), as
+/// the file's own is (an error names the set); none without a `[structure]`.
+pub(super) fn variants<'a>(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    sets: impl Iterator<Item = &'a Values>,
+) -> Result<Vec<(Values, crate::structure::Structure)>, ScenarioError> {
+    let Some(st) = &raw.structure else { return Ok(Vec::new()) };
     let mut variants = Vec::new();
-    for set in sets.iter().filter(|set| *set != params) {
+    for set in sets {
         let mut st = st.clone();
         let at_set =
             |e: ScenarioError| ScenarioError { message: format!("{} (with the parameters {set:?})", e.message), ..e };
@@ -117,7 +128,7 @@ pub(super) fn with_variants(
         super::prestress::set_self_stress(ctx, raw, &mut structure, set).map_err(at_set)?;
         variants.push((set.clone(), structure));
     }
-    Ok(custom.with_variants(variants))
+    Ok(variants)
 }
 
 /// The built-in mechanism `raw.mechanism` names (a scenario without its own structure).

@@ -193,6 +193,27 @@ fn read_source(path: &Path) -> Result<String, ScenarioError> {
 /// to parse before its length was checked.
 pub const MAX_SCENARIO_BYTES: u64 = 16 << 20;
 
+impl Scenario {
+    /// This scenario with its custom structure resolved at the sets of parameters `sets` too
+    /// (each every parameter's value), read from the file's text as at any other set a sweep
+    /// asks for (plain data: nothing is built); a built-in mechanism's scenario as it is. A
+    /// sweep over a topology is refused: its structures differ by more than their values.
+    pub fn with_parameter_sets(&self, sets: &[Values]) -> Result<Scenario, ScenarioError> {
+        let Some(custom) = &self.custom else { return Ok(self.clone()) };
+        let ctx = Ctx { file: self.file.display().to_string(), source: &self.source };
+        if !self.topologies.is_empty() {
+            return Err(ctx.err_at(0, "a sweep over a topology has no structure at other parameters".into()));
+        }
+        let mut raw: RawScenario = toml::from_str(&self.source).map_err(|e| {
+            let start = e.span().map(|s| s.start).unwrap_or(0);
+            ctx.err_at(start, error::in_file_words(e.message().trim()))
+        })?;
+        expand_patterns(&ctx, &mut raw, None)?;
+        let variants = mechanism::variants(&ctx, &raw, sets.iter())?;
+        Ok(Scenario { custom: Some(custom.clone().with_more_variants(variants)), ..self.clone() })
+    }
+}
+
 /// Parses and validates scenario text (`path` names it in errors).
 pub fn parse(path: &Path, source: &str) -> Result<Scenario, ScenarioError> {
     parse_with(path, source, &[])

@@ -55,6 +55,9 @@ pub(super) struct RawScenario {
     /// Residuals that must vanish at every settled state.
     #[serde(default)]
     pub(super) equations: Vec<RawEquation>,
+    /// Derivatives of the settled state with respect to a parameter, as symbols.
+    #[serde(default)]
+    pub(super) sensitivities: Vec<RawSensitivity>,
     /// A potential energy in named coordinates: its stationary points and the one the
     /// dynamics landed on.
     #[serde(default)]
@@ -133,6 +136,19 @@ pub(super) struct RawQuantity {
     pub(super) expr: Spanned<String>,
     /// For the listing and the report (default "-").
     pub(super) unit: Option<String>,
+}
+
+/// A `[[sensitivities]]` entry: the symbol `name` is d(output)/d(parameter) at each settle
+/// point (`run::sensitivity`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSensitivity {
+    pub(super) name: Spanned<String>,
+    /// A node coordinate, member force, joint coordinate, observed quantity, `[[quantities]]`
+    /// name or `modeN.omega`.
+    pub(super) output: Spanned<String>,
+    /// A parameter of the scenario.
+    pub(super) parameter: Spanned<String>,
 }
 
 #[derive(Debug, Deserialize)]

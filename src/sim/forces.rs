@@ -514,6 +514,15 @@ struct CoordinateForce {
 }
 
 impl Data {
+    /// Every free coordinate's generalized force for the loads now, in the link tree's order:
+    /// the free joints' in joint order, then six per free root (`sensitivity.rs`).
+    pub(super) fn free_coordinate_forces(&self, m: &Model) -> Vec<f64> {
+        let held = vec![false; m.structure.cables.len()];
+        let (_, mut wrench) = self.member_loads(m, &held);
+        self.add_body_loads(m, &mut wrench);
+        self.coordinate_forces(m, &m.tree, &wrench, true).into_iter().map(|f| f.value).collect()
+    }
+
     /// Generalized force on every free coordinate of `tree` for the body loads `wrench`
     /// (force, moment about the world origin), torsion springs included when `with_springs`:
     /// each tree joint's turns (slide) in joint order, then all six coordinates of each free

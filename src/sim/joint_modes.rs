@@ -26,7 +26,7 @@ const STEP_FRACTION: f64 = 1e-4;
 
 impl Data {
     /// The joints whose coordinates are the analysis's, or why the structure is refused.
-    fn modal_joints(&self, m: &Model) -> Result<Vec<usize>, ModesError> {
+    pub(super) fn modal_joints(&self, m: &Model) -> Result<Vec<usize>, ModesError> {
         let s = &m.structure;
         // A joint that closes a loop is an impulse joint, no link of a multibody.
         for (j, joint) in s.joints.iter().enumerate() {
@@ -144,7 +144,7 @@ impl Data {
 
     /// J (6 per moving body x n): the bodies' centre-of-mass velocity and angular velocity per
     /// unit rate of each coordinate, by central differences.
-    fn body_jacobian(&mut self, m: &Model, joints: &[usize], bodies: &[usize]) -> DMatrix<f64> {
+    pub(super) fn body_jacobian(&mut self, m: &Model, joints: &[usize], bodies: &[usize]) -> DMatrix<f64> {
         let mut jac = DMatrix::zeros(6 * bodies.len(), joints.len());
         for (c, &j) in joints.iter().enumerate() {
             let h = self.modal_step(m, j);

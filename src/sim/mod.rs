@@ -34,6 +34,7 @@ mod projection;
 mod relaxation;
 mod restart;
 mod rotation;
+pub mod sensitivity;
 mod servo;
 mod tree;
 
@@ -365,6 +366,40 @@ impl Simulation {
     /// or reduced to the joints' coordinates where there are joints (`joint_modes.rs`).
     pub fn modes(&mut self) -> Result<modes::StructureModes, modes::ModesError> {
         self.data.modes(&self.model)
+    }
+
+    /// The free coordinates of the current state's sensitivities, or why it has none
+    /// (`sensitivity.rs`).
+    pub fn equilibrium_coordinates(
+        &self,
+    ) -> Result<sensitivity::EquilibriumCoordinates, sensitivity::SensitivityError> {
+        self.data.equilibrium_coordinates(&self.model)
+    }
+
+    /// The generalized forces on the coordinates `c` now [N or N m] (zero at an equilibrium).
+    pub fn generalized_forces(&self, c: &sensitivity::EquilibriumCoordinates) -> nalgebra::DVector<f64> {
+        self.data.generalized_forces(&self.model, c)
+    }
+
+    /// The tangent stiffness K = -dQ/dq in the coordinates `c` now.
+    pub fn equilibrium_stiffness(&mut self, c: &sensitivity::EquilibriumCoordinates) -> nalgebra::DMatrix<f64> {
+        self.data.equilibrium_stiffness(&self.model, c)
+    }
+
+    /// The mass matrix in the coordinates `c` now.
+    pub fn equilibrium_mass(&mut self, c: &sensitivity::EquilibriumCoordinates) -> nalgebra::DMatrix<f64> {
+        self.data.equilibrium_mass(&self.model, c)
+    }
+
+    /// Moves the coordinates `c` by `dq` (m or rad).
+    pub fn displace_coordinates(&mut self, c: &sensitivity::EquilibriumCoordinates, dq: &[f64]) {
+        self.data.displace_coordinates(&self.model, c, dq)
+    }
+
+    /// Puts this structure, the same as `from`'s built with other parameters (and commanded
+    /// before), in `from`'s configuration, coordinate by coordinate of `c`.
+    pub fn take_configuration(&mut self, from: &Simulation, c: &sensitivity::EquilibriumCoordinates) {
+        self.data.take_configuration(&self.model, &from.data, c)
     }
 
     /// Displaces the structure along mode `index` (from 0) of `analysis` (made at the current

@@ -49,6 +49,7 @@ mod relaxation;
 mod report_table;
 mod restart;
 mod scripting;
+mod sensitivity;
 mod shipped_scenarios;
 mod sim_divergence;
 mod sim_layout;

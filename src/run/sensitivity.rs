@@ -1,0 +1,448 @@
+//! A settled state's sensitivities to every parameter (`tensegrity sensitivity`), by the
+//! implicit function theorem: at the equilibrium the generalized forces Q(q, p) vanish, so
+//! dq/dp = K^-1 dQ/dp with K = -dQ/dq the tangent stiffness (`sim::sensitivity`). dQ/dp is
+//! the difference of Q over the parameter at a fixed state: the structure built again at
+//! p +- h and p +- 2 h (with its commands at the scenario's inputs), put in the settled
+//! configuration, Q read there, extrapolated (error O(h^4)); no settle. The outputs' total
+//! derivatives dy/dp = dy/dq dq/dp + dy/dp|q are the same samples moved along dq/dp: y at
+//! (q + s h dq/dp, p + s h), s = +-1, +-2. The frequencies' from the eigenvectors,
+//! d omega^2 / dp = phi^T (dK/dp - omega^2 dM/dp) phi (K and M along the same samples), and
+//! d omega / dp = (d omega^2 / dp) / (2 |omega|).
+//!
+//! With `check`, each derivative is also measured by differences of settles: the state settled
+//! afresh at p +- h and p +- 2 h, extrapolated the same way.
+
+use super::settled::{settle_at, SettledState};
+use super::RunError;
+use crate::eigen::Mode;
+use crate::mechanisms::{Mechanism, Values};
+use crate::observers::file_model::ModelObserver;
+use crate::report::sensitivity::{check_error, OutputValue, ParameterSensitivity, SensitivityReport};
+use crate::scenario::Scenario;
+use crate::sim::modes::ZERO_MODE_RATIO;
+use crate::sim::sensitivity::{derivative_from_samples, EquilibriumCoordinates, SensitivityError};
+use crate::sim::Simulation;
+use nalgebra::{DMatrix, DVector};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// A parameter's finite-difference step, a fraction of its value (error O(h^4) with the
+/// extrapolation: about 1e-12; round-off eps / h: about 1e-13).
+pub const STEP_RATIO: f64 = 1e-3;
+/// The step of a parameter whose value is 0, in its own unit.
+pub const ZERO_PARAMETER_STEP: f64 = 1e-3;
+/// The samples of every difference, in steps: -2 h, -h, h, 2 h.
+const SAMPLES: [f64; 4] = [-2.0, -1.0, 1.0, 2.0];
+/// The move along a rigid-body mode that tells which outputs it moves: its largest
+/// coordinate this fraction of the structure's size (m, or rad per m).
+const RIGID_PROBE_RATIO: f64 = 1e-5;
+/// An output moves with a rigid-body mode when that move (a central difference over +- the
+/// move) changes it by more than this fraction of its value (or of the move, for a value near
+/// 0): round-off and the move's third order change the others by about 1e-15.
+const RIGID_OUTPUT_RATIO: f64 = 1e-9;
+/// Natural frequencies reported (the lowest modes that are not rigid-body modes).
+pub const FREQUENCIES_LISTED: usize = 6;
+
+/// Why a scenario has no sensitivities.
+#[derive(Debug, thiserror::Error)]
+pub enum SensitivityRunError {
+    /// The settle stopped (divergence, interruption, a model error).
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// The structure's sensitivities are not computed, by name (bad input).
+    #[error(transparent)]
+    Refused(SensitivityError),
+    /// The scenario has no such point (bad input).
+    #[error("the scenario has no point {0} (its points are numbered from 0)")]
+    NoPoint(usize),
+    /// The structure at a check's sample could not be read.
+    #[error("{0}")]
+    Check(String),
+    /// The eigenproblem at the settled state failed.
+    #[error(transparent)]
+    Eigen(#[from] crate::eigen::EigenError),
+}
+
+/// Each sample's parameters and inputs, in the order of [`SAMPLES`].
+type Samples = Vec<(Values, Values)>;
+
+/// What an output sample needs of the scenario: its mechanism, inputs and model.
+struct Outputs<'a> {
+    sc: &'a Scenario,
+    mech: Box<dyn Mechanism>,
+    inputs: Values,
+    model: Option<ModelObserver>,
+    coordinates: EquilibriumCoordinates,
+}
+
+/// The analysis of a settled state: what its samples need, its modes (K phi = omega^2 M phi in
+/// the equilibrium's coordinates), the listed ones, and every output there.
+struct Analysis<'a> {
+    out: Outputs<'a>,
+    modes: Vec<Mode>,
+    listed: Vec<usize>,
+    base: Vec<(String, f64)>,
+}
+
+/// The analysis of `sim`, settled at `params` and `inputs` of `sc`.
+fn analyse<'a>(
+    sc: &'a Scenario,
+    sim: &mut Simulation,
+    params: &Values,
+    inputs: Values,
+) -> Result<Analysis<'a>, SensitivityRunError> {
+    let coordinates = sim.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
+    let model = sc.model.as_ref().map(|spec| ModelObserver::new(spec, sim.structure(), false, None));
+    let out = Outputs { sc, mech: sc.mechanism(), inputs, model, coordinates };
+    let k = sim.equilibrium_stiffness(&out.coordinates);
+    let mass = sim.equilibrium_mass(&out.coordinates);
+    let modes = crate::eigen::modes(&symmetric(&k), &symmetric(&mass))?;
+    let listed = listed_modes(&modes);
+    let mut base = out.sample(sim, params);
+    base.extend(listed.iter().map(|&i| (format!("mode{}.omega", i + 1), modes[i].omega())));
+    Ok(Analysis { out, modes, listed, base })
+}
+
+/// The scenario and inputs of point `point` (from 0, as a run numbers its points; a schedule's
+/// one point is its first waypoint): a sweep over a topology or a motion over several points
+/// is one scenario per part, their points in order. None past the last point.
+pub fn point_of(sc: &Scenario, point: usize) -> Option<(&Scenario, Values)> {
+    if sc.topologies.is_empty() {
+        let inputs = match &sc.actuation {
+            crate::scenario::Actuation::Points { points, .. } => points.get(point)?,
+            crate::scenario::Actuation::Schedule { .. } => (point == 0).then(|| sc.actuation.first_inputs())?,
+        };
+        return Some((sc, inputs.clone()));
+    }
+    let mut parts = sc.topologies.iter().flat_map(|t| t.actuation.all_inputs().into_iter().map(move |i| (t, i)));
+    parts.nth(point).map(|(t, i)| (t, i.clone()))
+}
+
+/// The sensitivities of `sc` at point `point` (from 0; see [`point_of`]), settled as `run`
+/// settles it afresh there (`check`: also by differences of settles), named by `file`;
+/// [`SensitivityRunError::NoPoint`] past the last point.
+pub fn sensitivity(
+    sc: &Scenario,
+    file: &str,
+    point: usize,
+    check: bool,
+    cancel: Option<&AtomicBool>,
+) -> Result<SensitivityReport, SensitivityRunError> {
+    let (sc, inputs) = point_of(sc, point).ok_or(SensitivityRunError::NoPoint(point))?;
+    let params = sc.params_at(&inputs);
+    // What the analysis refuses is the structure's, known before the settle.
+    let structure = sc.mechanism().build(&params, &inputs, &sc.start).map_err(RunError::from)?;
+    let drawn = Simulation::new(&structure, &sc.sim).map_err(RunError::from)?;
+    drawn.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
+    let mut state = settle_at(sc, &inputs, params.clone(), cancel)?;
+    let wall = Instant::now();
+    let Analysis { out, modes, listed, base } = analyse(sc, &mut state.sim, &params, inputs)?;
+    let mut parameters = Vec::new();
+    for (name, &value) in &params {
+        if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
+            return Err(RunError::Interrupted(state.sim.tick()).into());
+        }
+        parameters.push(out.parameter(&state.sim, &params, name, value, &modes, &listed));
+    }
+    let wall_s = wall.elapsed().as_secs_f64();
+    let free = out.free_outputs(&mut state.sim, &params, &modes, &base);
+    let outputs: Vec<OutputValue> = base
+        .iter()
+        .zip(free)
+        .map(|((name, value), free)| OutputValue { name: name.clone(), value: *value, free })
+        .collect();
+    let check_wall = Instant::now();
+    if check {
+        for p in parameters.iter_mut().filter(|p| p.error.is_none()) {
+            out.check(p, &params, &listed, &outputs, cancel)?;
+        }
+    }
+    Ok(SensitivityReport {
+        name: sc.name.clone(),
+        file: file.to_string(),
+        point,
+        inputs: out.inputs.clone(),
+        settled: state.settled,
+        settle_steps: state.steps,
+        coordinates: out.coordinates.names(state.sim.structure()),
+        outputs,
+        parameters,
+        wall_s,
+        check_wall_s: check.then(|| check_wall.elapsed().as_secs_f64()),
+    })
+}
+
+/// The file's `[[sensitivities]]` at a settle point of a run (`sim` settled at `params` and
+/// `inputs`), by their names: each d(output)/d(parameter), NaN where the output is not one of
+/// the state's (a mode it has not); Err where the state has no sensitivities (the reason).
+pub(super) fn file_sensitivities(
+    sc: &Scenario,
+    sim: &mut Simulation,
+    params: &Values,
+    inputs: &Values,
+) -> Result<Values, String> {
+    let wanted = sc.model.as_ref().map_or(&[][..], |m| &m.sensitivities[..]);
+    let a = analyse(sc, sim, params, inputs.clone()).map_err(|e| e.to_string())?;
+    let mut rows: Vec<ParameterSensitivity> = Vec::new();
+    let mut out = Values::new();
+    for s in wanted {
+        if !rows.iter().any(|r| r.name == s.parameter) {
+            let value = params.get(&s.parameter).copied().unwrap_or(f64::NAN);
+            rows.push(a.out.parameter(sim, params, &s.parameter, value, &a.modes, &a.listed));
+        }
+        let row = rows.iter().find(|r| r.name == s.parameter).expect("computed above");
+        if let Some(e) = &row.error {
+            return Err(format!("d {}/d {}: {e}", s.output, s.parameter));
+        }
+        let i = a.base.iter().position(|(n, _)| n == &s.output);
+        out.insert(s.name.clone(), i.map_or(f64::NAN, |i| row.derivatives[i]));
+    }
+    Ok(out)
+}
+
+/// (K + K^T) / 2: the difference's K is symmetric up to its error and the equilibrium's.
+fn symmetric(a: &DMatrix<f64>) -> DMatrix<f64> {
+    0.5 * (a + a.transpose())
+}
+
+/// The modes whose frequencies are reported: the lowest [`FREQUENCIES_LISTED`] that are not
+/// rigid-body modes (|omega^2| above [`ZERO_MODE_RATIO`] of the largest), by index.
+fn listed_modes(modes: &[Mode]) -> Vec<usize> {
+    let largest = modes.iter().fold(0.0f64, |l, m| l.max(m.omega_squared.abs()));
+    (0..modes.len())
+        .filter(|&i| modes[i].omega_squared.abs() > ZERO_MODE_RATIO * largest)
+        .take(FREQUENCIES_LISTED)
+        .collect()
+}
+
+/// K^-1 r over the modes that are not rigid: sum of phi (phi^T r) / omega^2 (phi
+/// mass-normalised, so that K^-1 = Phi Lambda^-1 Phi^T); a rigid motion is left where it is.
+fn solve(modes: &[Mode], r: &DVector<f64>) -> DVector<f64> {
+    let largest = modes.iter().fold(0.0f64, |l, m| l.max(m.omega_squared.abs()));
+    let mut x = DVector::zeros(r.len());
+    for m in modes.iter().filter(|m| m.omega_squared.abs() > ZERO_MODE_RATIO * largest) {
+        x += &m.shape * (m.shape.dot(r) / m.omega_squared);
+    }
+    x
+}
+
+/// A parameter's step: [`STEP_RATIO`] of its value, or [`ZERO_PARAMETER_STEP`] at 0.
+pub fn parameter_step(value: f64) -> f64 {
+    if value == 0.0 {
+        ZERO_PARAMETER_STEP
+    } else {
+        STEP_RATIO * value.abs()
+    }
+}
+
+impl Outputs<'_> {
+    /// Every parameter's value with `name` at `value`, its derived ones following (as
+    /// `--set NAME=VALUE` would give them), and the inputs with it where they name it.
+    fn moved(&self, params: &Values, name: &str, value: f64) -> (Values, Values) {
+        let mut point = self.inputs.clone();
+        point.insert(name.to_string(), value);
+        let mut moved = params.clone();
+        moved.extend(
+            self.sc.param_table.evaluate(
+                &point.iter().filter(|(k, _)| params.contains_key(*k)).map(|(k, v)| (k.clone(), *v)).collect(),
+            ),
+        );
+        moved.insert(name.to_string(), value);
+        let inputs = self.inputs.iter().map(|(k, v)| (k.clone(), if k == name { value } else { *v })).collect();
+        (moved, inputs)
+    }
+
+    /// The scenario with its structure at parameter `name`'s samples (`scenario`: resolved
+    /// there as at a sweep's sets of parameters), and each sample's parameters and inputs.
+    fn samples(&self, params: &Values, name: &str, value: f64, h: f64) -> Result<(Scenario, Samples), String> {
+        let moved: Vec<(Values, Values)> = SAMPLES.iter().map(|s| self.moved(params, name, value + s * h)).collect();
+        let sets: Vec<Values> = moved.iter().map(|(p, _)| p.clone()).collect();
+        let sc = self.sc.with_parameter_sets(&sets).map_err(|e| e.to_string())?;
+        Ok((sc, moved))
+    }
+
+    /// The structure of `mech` built at `params` and `inputs`, commanded there, in `at`'s
+    /// configuration.
+    fn rebuilt(
+        &self,
+        mech: &dyn Mechanism,
+        at: &Simulation,
+        params: &Values,
+        inputs: &Values,
+    ) -> Result<Simulation, String> {
+        let s = mech.build(params, inputs, &self.sc.start).map_err(|e| e.to_string())?;
+        let same = |a: &crate::structure::Structure, b: &crate::structure::Structure| {
+            (a.bodies.len(), a.nodes.len(), a.joints.len(), a.springs.len(), a.cables.len(), a.actuators.len())
+                == (b.bodies.len(), b.nodes.len(), b.joints.len(), b.springs.len(), b.cables.len(), b.actuators.len())
+        };
+        if !same(&s, at.structure()) {
+            return Err("the structure built at a step has other bodies, nodes or members".into());
+        }
+        let mut sim = Simulation::new(&s, &self.sc.sim).map_err(|e| e.to_string())?;
+        let commands = sim.structure().commands_from(&mech.commands(params, inputs));
+        sim.set_commands(&commands);
+        sim.take_configuration(at, &self.coordinates);
+        Ok(sim)
+    }
+
+    /// Every output but the frequencies in `sim`'s state at `params`, by name: the mechanism's
+    /// observed quantities (a custom structure's node coordinates and member forces), each
+    /// joint's coordinate and the file's quantities.
+    fn sample(&self, sim: &Simulation, params: &Values) -> Vec<(String, f64)> {
+        let s = sim.structure();
+        let snap = sim.snapshot_with(false);
+        let observed = self.mech.observe(params, s, &snap);
+        let mut out: Vec<(String, f64)> = observed.iter().map(|(k, v)| (k.clone(), *v)).collect();
+        for (j, joint) in s.joints.iter().enumerate() {
+            let kind = match joint.kind {
+                crate::structure::JointKind::Prismatic { .. } => "slide",
+                _ => "angle",
+            };
+            if let Some(q) = snap.joint_coordinate(s, j) {
+                out.push((format!("{}.{kind}", joint.name), q));
+            }
+        }
+        if let Some(model) = &self.model {
+            out.extend(model.quantities_at(&snap, &self.inputs, params, &observed));
+        }
+        out
+    }
+
+    /// Whether each output of `base` moves with a rigid-body mode (a free motion that no
+    /// parameter sets: a node's coordinates where the structure may turn): the settled state
+    /// moved along each such mode by [`RIGID_PROBE_RATIO`] of the structure's size at its
+    /// largest node motion, and back. The frequencies are fixed by the modes.
+    fn free_outputs(&self, sim: &mut Simulation, params: &Values, modes: &[Mode], base: &[(String, f64)]) -> Vec<bool> {
+        let mut free = vec![false; base.len()];
+        let largest = modes.iter().fold(0.0f64, |l, m| l.max(m.omega_squared.abs()));
+        for m in modes.iter().filter(|m| m.omega_squared.abs() <= ZERO_MODE_RATIO * largest) {
+            let eta = RIGID_PROBE_RATIO * sim.length_scale_m() / m.shape.amax().max(f64::MIN_POSITIVE);
+            let mut moved = Vec::new();
+            for s in [1.0, -1.0] {
+                let step: Vec<f64> = m.shape.iter().map(|v| s * eta * v).collect();
+                sim.displace_coordinates(&self.coordinates, &step);
+                moved.push(self.offsets(&self.sample(sim, params), base));
+                let back: Vec<f64> = step.iter().map(|v| -v).collect();
+                sim.displace_coordinates(&self.coordinates, &back);
+            }
+            // The central difference: the move's second order (small rotations one after the
+            // other) cancels.
+            let moved = (&moved[0] - &moved[1]) * 0.5;
+            for (f, (d, (_, y))) in free.iter_mut().zip(moved.iter().zip(base)) {
+                *f |= d.abs() > RIGID_OUTPUT_RATIO * y.abs().max(sim.length_scale_m() * RIGID_PROBE_RATIO);
+            }
+        }
+        free
+    }
+
+    /// The samples' values less the settled state's `base` (as many as the sample has), an
+    /// angle's wrapped to (-pi, pi].
+    fn offsets(&self, sample: &[(String, f64)], base: &[(String, f64)]) -> DVector<f64> {
+        DVector::from_iterator(
+            sample.len(),
+            base.iter().zip(sample).map(|((name, b), (_, v))| {
+                if self.sc.is_angle(name) {
+                    crate::mechanisms::wrap_angle(v - b)
+                } else {
+                    v - b
+                }
+            }),
+        )
+    }
+
+    /// Every output's derivative with respect to parameter `name` (at `value`) at the settled
+    /// state `at` (module docs): outputs first, then the listed modes' omega.
+    fn parameter(
+        &self,
+        at: &Simulation,
+        params: &Values,
+        name: &str,
+        value: f64,
+        modes: &[Mode],
+        listed: &[usize],
+    ) -> ParameterSensitivity {
+        let h = parameter_step(value);
+        let mut row = ParameterSensitivity {
+            name: name.to_string(),
+            value,
+            step: h,
+            coordinates: vec![],
+            derivatives: vec![],
+            check: None,
+            max_check_error: None,
+            error: None,
+        };
+        let (sc, samples) = match self.samples(params, name, value, h) {
+            Ok(s) => s,
+            Err(e) => {
+                row.error = Some(e);
+                return row;
+            }
+        };
+        let mech = sc.mechanism();
+        let mut sims = Vec::new();
+        for ((moved, inputs), s) in samples.into_iter().zip(SAMPLES) {
+            match self.rebuilt(mech.as_ref(), at, &moved, &inputs) {
+                Ok(sim) => sims.push((sim, moved)),
+                Err(e) => {
+                    row.error = Some(format!("at {name} = {}: {e}", value + s * h));
+                    return row;
+                }
+            }
+        }
+        let q: Vec<DVector<f64>> = sims.iter().map(|(sim, _)| sim.generalized_forces(&self.coordinates)).collect();
+        let dq = solve(modes, &derivative_from_samples(q[0].clone(), q[1].clone(), q[2].clone(), q[3].clone(), h));
+        let base = self.sample(at, params);
+        let mut y = Vec::new();
+        let (mut k, mut mass) = (Vec::new(), Vec::new());
+        for ((sim, moved), s) in sims.iter_mut().zip(SAMPLES) {
+            let step: Vec<f64> = dq.iter().map(|d| s * h * d).collect();
+            sim.displace_coordinates(&self.coordinates, &step);
+            y.push(self.offsets(&self.sample(sim, moved), &base));
+            k.push(sim.equilibrium_stiffness(&self.coordinates));
+            mass.push(sim.equilibrium_mass(&self.coordinates));
+        }
+        let dy = derivative_from_samples(y[0].clone(), y[1].clone(), y[2].clone(), y[3].clone(), h);
+        let dk = derivative_from_samples(k[0].clone(), k[1].clone(), k[2].clone(), k[3].clone(), h);
+        let dm = derivative_from_samples(mass[0].clone(), mass[1].clone(), mass[2].clone(), mass[3].clone(), h);
+        row.coordinates = dq.iter().copied().collect();
+        row.derivatives = dy.iter().copied().collect();
+        row.derivatives.extend(listed.iter().map(|&i| {
+            let (phi, w2) = (&modes[i].shape, modes[i].omega_squared);
+            // Nelson's d omega^2 / dp = phi^T (dK/dp - omega^2 dM/dp) phi.
+            let dw2 = phi.dot(&(&dk * phi)) - w2 * phi.dot(&(&dm * phi));
+            dw2 / (2.0 * w2.abs().sqrt())
+        }));
+        row
+    }
+
+    /// The check of `row` by differences of settles at the parameter's steps: the same
+    /// outputs, the frequencies from the modes of each settled state.
+    fn check(
+        &self,
+        row: &mut ParameterSensitivity,
+        params: &Values,
+        listed: &[usize],
+        outputs: &[OutputValue],
+        cancel: Option<&AtomicBool>,
+    ) -> Result<(), SensitivityRunError> {
+        let base: Vec<(String, f64)> = outputs.iter().map(|o| (o.name.clone(), o.value)).collect();
+        let mut y = Vec::new();
+        let (sc, samples) = self.samples(params, &row.name, row.value, row.step).map_err(SensitivityRunError::Check)?;
+        for (moved, inputs) in samples {
+            let SettledState { mut sim, .. } = settle_at(&sc, &inputs, moved.clone(), cancel)?;
+            let mut sample = self.sample(&sim, &moved);
+            let k = sim.equilibrium_stiffness(&self.coordinates);
+            let mass = sim.equilibrium_mass(&self.coordinates);
+            let modes = crate::eigen::modes(&symmetric(&k), &symmetric(&mass))?;
+            sample.extend(listed.iter().map(|&i| (format!("mode{}.omega", i + 1), modes[i].omega())));
+            y.push(self.offsets(&sample, &base));
+        }
+        let check = derivative_from_samples(y[0].clone(), y[1].clone(), y[2].clone(), y[3].clone(), row.step);
+        let errors = outputs.iter().zip(&row.derivatives).zip(check.iter()).filter(|((o, _), _)| !o.free);
+        row.max_check_error =
+            Some(errors.map(|((o, d), c)| check_error(*d, *c, o.value, row.value, row.step)).fold(0.0, f64::max));
+        row.check = Some(check.iter().copied().collect());
+        Ok(())
+    }
+}

@@ -1,0 +1,247 @@
+//! What an equilibrium's sensitivities need of the simulation (`run/sensitivity.rs` puts them
+//! together): the free coordinates q of a settled state, the generalized forces Q(q) on them
+//! (zero at an equilibrium), the tangent stiffness K = -dQ/dq and the mass matrix M in the same
+//! coordinates, a move along them, and a state carried over to the same structure built with
+//! other parameters. By the implicit function theorem on Q(q(p), p) = 0,
+//! dq/dp = K^-1 dQ/dp (one linear solve per parameter, where differences of settles need a
+//! settle per step), and for a mass-normalised mode phi,
+//! d omega^2 / dp = phi^T (dK/dp - omega^2 dM/dp) phi (the derivative of the generalized
+//! eigenvalue, Nelson 1976).
+//!
+//! The coordinates are the modal analysis's (`modes.rs`, `joint_modes.rs`): six per free body
+//! (translation of the centre of mass, small rotation about it, world frame) where there are
+//! no joints, else the free joints' coordinates of joint trees rooted on fixed bodies. Q is
+//! exact (member forces, torsion springs and constant loads projected on the coordinates,
+//! `forces.rs`), and K its central difference extrapolated over h and 2 h (Richardson, error
+//! O(h^4) and round-off eps |Q| / h: about 1e-13 of K). Structures held by loops or
+//! inextensible cables are refused, by name.
+
+use super::modes::ModesError;
+use super::{Data, Model};
+use crate::structure::{BodyKind, CableLaw};
+use nalgebra::{DMatrix, DVector};
+use rapier3d_f64::prelude::*;
+
+/// Finite-difference step of an angular coordinate [rad] (extrapolated over h and 2 h).
+const STEP_RAD: f64 = 1e-3;
+/// Finite-difference step of a linear coordinate, a fraction of the structure's size.
+const STEP_FRACTION: f64 = 1e-3;
+
+/// The free coordinates of an equilibrium.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EquilibriumCoordinates {
+    /// Six per free body (structure indices; no joints): dx, dy, dz \[m\] of the centre of
+    /// mass, then a small rotation rx, ry, rz \[rad\] about it.
+    Bodies(Vec<usize>),
+    /// The free joints' coordinates (structure indices of revolute \[rad\] and prismatic
+    /// \[m\] joints).
+    Joints(Vec<usize>),
+}
+
+impl EquilibriumCoordinates {
+    /// How many coordinates.
+    pub fn len(&self) -> usize {
+        match self {
+            EquilibriumCoordinates::Bodies(b) => 6 * b.len(),
+            EquilibriumCoordinates::Joints(j) => j.len(),
+        }
+    }
+
+    /// Whether there is none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Each coordinate's name: `BODY.x` .. `BODY.rz`, or the joint's name.
+    pub fn names(&self, s: &crate::structure::Structure) -> Vec<String> {
+        match self {
+            EquilibriumCoordinates::Bodies(b) => b
+                .iter()
+                .flat_map(|&b| ["x", "y", "z", "rx", "ry", "rz"].map(|c| format!("{}.{c}", s.bodies[b].name)))
+                .collect(),
+            EquilibriumCoordinates::Joints(j) => j.iter().map(|&j| s.joints[j].name.clone()).collect(),
+        }
+    }
+}
+
+/// Why a state has no sensitivities.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SensitivityError {
+    /// Loops or inextensible cables hold the structure.
+    #[error("the structure is held by {0}: its sensitivities are not computed (only free bodies held by springs and elastic cables, or trees of revolute and prismatic joints)")]
+    Constrained(String),
+    /// What the modal analysis refuses too.
+    #[error(transparent)]
+    Modes(#[from] ModesError),
+}
+
+/// The derivative at 0 of a function sampled at -2 h, -h, h, 2 h: the central difference
+/// extrapolated over h and 2 h, (8 (f(h) - f(-h)) - (f(2h) - f(-2h))) / (12 h), error O(h^4).
+pub fn derivative_from_samples<T>(minus2: T, minus: T, plus: T, plus2: T, h: f64) -> T
+where
+    T: std::ops::Sub<Output = T> + std::ops::Mul<f64, Output = T>,
+{
+    ((plus - minus) * 8.0 - (plus2 - minus2)) * (1.0 / (12.0 * h))
+}
+
+impl Data {
+    /// The free coordinates of the current structure, or why it has none that this analysis
+    /// takes.
+    pub(super) fn equilibrium_coordinates(&self, m: &Model) -> Result<EquilibriumCoordinates, SensitivityError> {
+        let s = &m.structure;
+        if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
+            return Err(ModesError::NoFreeBody.into());
+        }
+        if let Some(c) = s.cables.iter().find(|c| !matches!(c.law, CableLaw::Elastic { .. })) {
+            return Err(SensitivityError::Constrained(format!("the inextensible cable '{}'", c.name)));
+        }
+        if let Some(j) = (0..s.joints.len()).find(|&j| m.joint_impulse[j].is_some()) {
+            return Err(SensitivityError::Constrained(format!("the loop that joint '{}' closes", s.joints[j].name)));
+        }
+        if s.joints.is_empty() {
+            return Ok(EquilibriumCoordinates::Bodies((0..s.bodies.len()).filter(|b| m.is_free(*b)).collect()));
+        }
+        Ok(EquilibriumCoordinates::Joints(self.modal_joints(m)?))
+    }
+
+    /// The generalized forces Q on the coordinates now [N or N m]: -dV/dq, V the potential
+    /// energy of the members, torsion springs and constant loads.
+    pub(super) fn generalized_forces(&self, m: &Model, c: &EquilibriumCoordinates) -> DVector<f64> {
+        let q = self.free_coordinate_forces(m);
+        debug_assert_eq!(q.len(), c.len(), "the tree's free coordinates are the analysis's");
+        DVector::from_vec(q)
+    }
+
+    /// The finite-difference step of coordinate `i`.
+    fn coordinate_step(&self, m: &Model, c: &EquilibriumCoordinates, i: usize) -> f64 {
+        let linear = match c {
+            EquilibriumCoordinates::Bodies(_) => i % 6 < 3,
+            EquilibriumCoordinates::Joints(j) => {
+                matches!(m.structure.joints[j[i]].kind, crate::structure::JointKind::Prismatic { .. })
+            }
+        };
+        if linear {
+            STEP_FRACTION * m.length_scale_m
+        } else {
+            STEP_RAD
+        }
+    }
+
+    /// Moves coordinate `i` by `d` (m or rad), the bodies beyond a joint along.
+    pub(super) fn displace_coordinate(&mut self, m: &Model, c: &EquilibriumCoordinates, i: usize, d: f64) {
+        match c {
+            EquilibriumCoordinates::Joints(j) => self.displace_joint(m, j[i], d),
+            EquilibriumCoordinates::Bodies(b) => {
+                let h = m.handles[b[i / 6]];
+                let com = self.world_com(m, b[i / 6]);
+                let mut axis = Vector::ZERO;
+                axis[i % 3] = 1.0;
+                let pose = *self.bodies[h].position();
+                let moved = if i % 6 < 3 {
+                    Pose::from_translation(axis * d) * pose
+                } else {
+                    Pose::from_translation(com)
+                        * Pose::from_rotation(Rotation::from_axis_angle(axis, d))
+                        * Pose::from_translation(-com)
+                        * pose
+                };
+                self.bodies[h].set_position(moved, true);
+            }
+        }
+    }
+
+    /// Moves every coordinate by `dq` (m or rad), in order.
+    pub(super) fn displace_coordinates(&mut self, m: &Model, c: &EquilibriumCoordinates, dq: &[f64]) {
+        for (i, d) in dq.iter().enumerate().filter(|(_, d)| **d != 0.0) {
+            self.displace_coordinate(m, c, i, *d);
+        }
+    }
+
+    /// K = -dQ/dq now: each column a central difference extrapolated over h and 2 h, the
+    /// state restored after each move.
+    pub(super) fn equilibrium_stiffness(&mut self, m: &Model, c: &EquilibriumCoordinates) -> DMatrix<f64> {
+        let n = c.len();
+        let mut k = DMatrix::zeros(n, n);
+        for i in 0..n {
+            let h = self.coordinate_step(m, c, i);
+            let mut at = |d: f64| {
+                self.displace_coordinate(m, c, i, d);
+                let q = self.generalized_forces(m, c);
+                self.displace_coordinate(m, c, i, -d);
+                q
+            };
+            let (m2, m1, p1, p2) = (at(-2.0 * h), at(-h), at(h), at(2.0 * h));
+            k.set_column(i, &-derivative_from_samples(m2, m1, p1, p2, h));
+        }
+        k
+    }
+
+    /// The mass matrix in the coordinates: the free bodies' own, or J^T M J through the
+    /// joints (`joint_modes.rs`).
+    pub(super) fn equilibrium_mass(&mut self, m: &Model, c: &EquilibriumCoordinates) -> DMatrix<f64> {
+        match c {
+            EquilibriumCoordinates::Bodies(b) => self.mass_matrix(m, b),
+            EquilibriumCoordinates::Joints(_) => {
+                let bodies: Vec<usize> = (0..m.structure.bodies.len()).filter(|b| m.is_free(*b)).collect();
+                let jac = self.equilibrium_jacobian(m, c, &bodies);
+                jac.transpose() * self.mass_matrix(m, &bodies) * jac
+            }
+        }
+    }
+
+    /// J (6 per body of `bodies` x the coordinates): each body's centre-of-mass velocity and
+    /// angular velocity per unit rate of each coordinate, by central differences extrapolated
+    /// over h and 2 h (`joint_modes.rs` takes one step: error h^2, 1e-8 of M).
+    fn equilibrium_jacobian(&mut self, m: &Model, c: &EquilibriumCoordinates, bodies: &[usize]) -> DMatrix<f64> {
+        let start = self.body_states(m, bodies);
+        let mut jac = DMatrix::zeros(6 * bodies.len(), c.len());
+        for i in 0..c.len() {
+            let h = self.coordinate_step(m, c, i);
+            let mut at = |d: f64| {
+                self.displace_coordinate(m, c, i, d);
+                let moved = self.body_states(m, bodies);
+                self.displace_coordinate(m, c, i, -d);
+                let mut v = DVector::zeros(6 * bodies.len());
+                for (k, ((x, r), (x0, r0))) in moved.iter().zip(&start).enumerate() {
+                    v.fixed_rows_mut::<3>(6 * k).copy_from(&(x - x0));
+                    v.fixed_rows_mut::<3>(6 * k + 3).copy_from(&(r * r0.inverse()).scaled_axis());
+                }
+                v
+            };
+            let (m2, m1, p1, p2) = (at(-2.0 * h), at(-h), at(h), at(2.0 * h));
+            jac.set_column(i, &derivative_from_samples(m2, m1, p1, p2, h));
+        }
+        jac
+    }
+
+    /// Puts this structure (the same one as `from`'s, built with other parameters) in the
+    /// configuration of `from`, coordinate by coordinate: each free joint's coordinate from its
+    /// drawn configuration, each plain free body's displacement from its drawn pose. The
+    /// commands are this simulation's own (set before).
+    pub(super) fn take_configuration(&mut self, m: &Model, from: &Data, c: &EquilibriumCoordinates) {
+        match c {
+            EquilibriumCoordinates::Bodies(b) => {
+                for &b in b {
+                    let pose = *from.bodies[m.handles[b]].position();
+                    self.bodies[m.handles[b]].set_position(pose, true);
+                }
+            }
+            EquilibriumCoordinates::Joints(j) => {
+                for &j in j {
+                    if let (Some(to), Some(target)) = (self.link_coordinate(m, j), from.link_coordinate(m, j)) {
+                        self.displace_joint(m, j, target - to);
+                    }
+                }
+            }
+        }
+        self.zero_body_velocities(m);
+    }
+
+    /// Joint `j`'s coordinate in its multibody, from its drawn configuration (rad or m).
+    fn link_coordinate(&self, m: &Model, j: usize) -> Option<f64> {
+        let link = m.joint_links[j]?;
+        let (mb, id) = self.multibody_joints.get(link.multibody_joint)?;
+        let l = mb.link(id)?;
+        Some(l.joint().coords()[super::joint_free_axis(&l.joint().data)])
+    }
+}

@@ -1,0 +1,223 @@
+//! `tensegrity sensitivity`: a settled state's derivatives with respect to every parameter by
+//! the implicit function theorem (one linear solve on the tangent stiffness), against central
+//! differences of full settles (extrapolated over h and 2 h, `--check`) and against closed
+//! forms where the file or the paper has one.
+
+use crate::common;
+use std::path::Path;
+use tensegrity_testbed::mechanisms::Values;
+use tensegrity_testbed::report::sensitivity::{ParameterSensitivity, SensitivityReport};
+use tensegrity_testbed::scenario;
+
+/// The report of `file` (with its check by differences of settles).
+fn report_of(file: &str) -> SensitivityReport {
+    let sc = scenario::load(Path::new(file)).expect("shipped scenario");
+    tensegrity_testbed::run::sensitivity(&sc, file, 0, true, None).expect("sensitivities")
+}
+
+/// Parameter `name`'s row.
+fn row<'a>(r: &'a SensitivityReport, name: &str) -> &'a ParameterSensitivity {
+    r.parameters.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no parameter {name}"))
+}
+
+/// (value, derivative, check) of output `output` with respect to `param`.
+fn derivative(r: &SensitivityReport, param: &str, output: &str) -> (f64, f64, f64) {
+    let i = r.outputs.iter().position(|o| o.name == output).unwrap_or_else(|| panic!("no output {output}"));
+    let p = row(r, param);
+    (r.outputs[i].value, p.derivatives[i], p.check.as_ref().expect("checked")[i])
+}
+
+/// |a - b| / |b|.
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+/// Asserts that d(output)/d(param) agrees with the difference of settles within `tol`
+/// relative, and returns it.
+fn against_settles(r: &SensitivityReport, param: &str, output: &str, tol: f64) -> f64 {
+    let (_, d, c) = derivative(r, param, output);
+    assert!(rel(d, c) <= tol, "d {output}/d {param} = {d:.15e}, by settles {c:.15e}: {:.2e} > {tol:.0e}", rel(d, c));
+    d
+}
+
+/// The pinned bar between zero-free-length springs settles at q* = atan2(k1 a, k2 b)
+/// (pinned_bar_modes.toml, first point k1 = 10 N/m): dq*/dk1 = a k2 b / (k1^2 a^2 + k2^2 b^2),
+/// dq*/dk2 = -k1 a b / (...), dq*/da = k1 k2 b / (...), dq*/db = -k1 k2 a / (...), each
+/// within 1e-12 of the closed form and 1e-6 of the settles'. Its frequency
+/// omega^2 = L hypot(k1 a, k2 b) / I (I = m L^2 / 3) gives d omega / d k1 =
+/// L k1 a^2 / (2 I omega hypot) within 1e-9.
+#[test]
+fn the_pinned_bars_angle_moves_with_each_parameter_as_atan2_does() {
+    let r = report_of("scenarios/custom/pinned_bar_modes.toml");
+    let (k1, k2, a, b, l, m) = (10.0, 30.0, 0.8, 0.6, 1.0, 0.5);
+    let den = k1 * k1 * a * a + k2 * k2 * b * b;
+    for (p, closed) in
+        [("k1", a * k2 * b / den), ("k2", -k1 * a * b / den), ("a", k1 * k2 * b / den), ("b", -k1 * k2 * a / den)]
+    {
+        let d = against_settles(&r, p, "pin.angle", 1e-6);
+        assert!(rel(d, closed) <= 1e-12, "d q*/d {p} = {d:.15e}, closed form {closed:.15e}: {:.2e}", rel(d, closed));
+    }
+    let inertia = m * l * l / 3.0;
+    let hypot = (k1 * a).hypot(k2 * b);
+    let omega = (l * hypot / inertia).sqrt();
+    let closed = l * k1 * a * a / (2.0 * inertia * omega * hypot);
+    let d = against_settles(&r, "k1", "mode1.omega", 1e-6);
+    assert!(rel(d, closed) <= 1e-9, "d omega/d k1 = {d:.15e}, closed form {closed:.15e}: {:.2e}", rel(d, closed));
+    // The drawn angle q0 moves no node: the joint's coordinate, counted from the drawing,
+    // turns back by as much as the drawing turned.
+    for node in ["P.x", "P.y"] {
+        let (_, d, _) = derivative(&r, "q0", node);
+        assert!(d.abs() <= 1e-9, "d {node}/d q0 = {d:.3e}");
+    }
+    let (_, d, _) = derivative(&r, "q0", "pin.angle");
+    assert!((d + 1.0).abs() <= 1e-9, "d pin.angle/d q0 = {d:.15e}");
+}
+
+/// The rocker (rocker_frequency_curve.toml at its first point, k1 = 10 N/m: springs of
+/// natural lengths l1, l2, no closed form): its angle and frequency with respect to each
+/// stiffness and natural length within 1e-6 of the differences of settles.
+#[test]
+fn the_rockers_angle_and_frequency_agree_with_differences_of_settles() {
+    let r = report_of("scenarios/custom/rocker_frequency_curve.toml");
+    for p in ["k1", "k2", "l1", "l2", "a", "b", "L"] {
+        against_settles(&r, p, "pin.angle", 1e-6);
+        against_settles(&r, p, "mode1.omega", 1e-6);
+    }
+    assert!(row(&r, "k1").max_check_error.expect("checked") <= 1e-6);
+}
+
+/// The 3-prism (prism3_model.toml): its twist is pi/2 + pi/n whatever the stiffness and the
+/// rest lengths (d twist/dp within 1e-9 of 0), and its member forces move with them as the
+/// differences of settles say, within 1e-6. The node coordinates, free to turn with the
+/// structure about the fixed strut, are marked free and left out of the check.
+#[test]
+fn the_prisms_twist_stays_and_its_member_forces_agree_with_settles() {
+    let r = report_of("scenarios/custom/prism3_model.toml");
+    for p in ["k", "l_poly", "l_side", "r", "h", "twist0"] {
+        let (_, d, _) = derivative(&r, p, "twist");
+        assert!(d.abs() <= 1e-9, "d twist/d {p} = {d:.3e}");
+        assert!(row(&r, p).max_check_error.expect("checked") <= 1e-6, "{p}: {:?}", row(&r, p).max_check_error);
+    }
+    for p in ["k", "l_poly", "l_side"] {
+        for member in ["side1.force", "top12.force", "bottom23.force", "strut2.force"] {
+            against_settles(&r, p, member, 1e-6);
+        }
+    }
+    let free = |name: &str| r.outputs.iter().find(|o| o.name == name).expect("output").free;
+    assert!(free("T2.x") && !free("twist") && !free("side1.force"));
+}
+
+/// ji2014's platform pose (quick.toml's first point): theta2, x and y with respect to K1, K2
+/// and L within 1e-6 of the differences of settles, and within 1e-8 of the paper's own model
+/// (its forward kinematics) differentiated by central differences extrapolated over h and 2 h.
+#[test]
+fn ji2014s_platform_pose_agrees_with_settles_and_the_papers_model() {
+    let file = "scenarios/ji2014/quick.toml";
+    let r = report_of(file);
+    let sc = scenario::load(Path::new(file)).expect("shipped scenario");
+    let mech = sc.mechanism();
+    let inputs = sc.actuation.first_inputs().clone();
+    let params = sc.params_at(&inputs);
+    let predicted = |p: &str, v: f64, q: &str| {
+        let mut moved: Values = params.clone();
+        moved.insert(p.to_string(), v);
+        mech.predict(&moved, &inputs).expect("the paper's model").expected[q]
+    };
+    for p in ["K1", "K2", "L"] {
+        let (v, h) = (params[p], 1e-3 * params[p]);
+        for q in ["theta2", "x", "y"] {
+            let d = against_settles(&r, p, q, 1e-6);
+            let f = |s: f64| predicted(p, v + s * h, q);
+            let model = (8.0 * (f(1.0) - f(-1.0)) - (f(2.0) - f(-2.0))) / (12.0 * h);
+            assert!(rel(d, model) <= 1e-8, "d {q}/d {p} = {d:.15e}, the paper's {model:.15e}: {:.2e}", rel(d, model));
+        }
+    }
+}
+
+/// The command: its table names each parameter, `--json -` is the JSON alone (the table on
+/// standard error), `--csv` writes one row per parameter and output, both on standard output
+/// is refused, and so is a structure held by loops and inextensible cables (exit 2, named).
+#[test]
+fn the_command_writes_json_and_csv_and_refuses_loops_by_name() {
+    let file = "scenarios/custom/pinned_bar_modes.toml";
+    let (code, out, _) = common::tensegrity(&["sensitivity", file]);
+    assert!(code == 0 && out.contains("d/d k1 (= 10") && out.contains("pin.angle"), "{out}");
+    let csv = std::env::temp_dir().join(format!("sensitivity-{}.csv", std::process::id()));
+    let (code, out, err) = common::tensegrity(&["sensitivity", file, "--json", "-", "--csv", csv.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("stdout is the JSON alone");
+    assert_eq!(v["parameters"].as_array().map(Vec::len), Some(8));
+    assert!(err.contains("d/d k1"), "{err}");
+    let text = std::fs::read_to_string(&csv).expect("the CSV");
+    // A header and one row per parameter (8) and output (5 nodes x 3 coordinates, 2 spring
+    // forces, the pin's angle, mode 1's omega: 19).
+    assert_eq!(text.lines().count(), 1 + 8 * 19, "{text}");
+    let _ = std::fs::remove_file(&csv);
+    let (code, out, err) = common::tensegrity(&["sensitivity", file, "--json", "-", "--csv", "-"]);
+    assert!(code == 2 && out.is_empty() && err.contains("only one of them"), "{out}{err}");
+    // Another settle point of the grid over k1: the last, k1 = 90 N/m.
+    let (code, out, err) = common::tensegrity(&["sensitivity", file, "--point", "2", "--json", "-"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let (k1, k2, a, b) = (90.0, 30.0, 0.8, 0.6);
+    let closed = a * k2 * b / (k1 * k1 * a * a + k2 * k2 * b * b);
+    let i = v["outputs"].as_array().unwrap().iter().position(|o| o["name"] == "pin.angle").unwrap();
+    let row = v["parameters"].as_array().unwrap().iter().find(|p| p["name"] == "k1").unwrap();
+    let d = row["derivatives"][i].as_f64().unwrap();
+    assert!(rel(d, closed) <= 1e-12, "at k1 = 90: {d:.15e} against {closed:.15e}");
+    let (code, _, err) = common::tensegrity(&["sensitivity", file, "--point", "3"]);
+    assert!(code == 2 && err.contains("--point 3: the scenario has no point 3"), "{err}");
+    let (code, _, err) = common::tensegrity(&["sensitivity", "scenarios/mohr2011/quick.toml"]);
+    assert!(code == 2 && err.contains("the structure is held by the inextensible cable"), "{err}");
+}
+
+/// The pinned bar's file with `[[sensitivities]]` as symbols and a paper's printed
+/// sensitivities as predictions: dq*/dk1 = a k2 b / (k1^2 a^2 + k2^2 b^2) within 1e-12 and
+/// d omega/d k1 within 1e-9, at every point of the grid over k1.
+const PRINTED_SENSITIVITIES: &str = r#"
+[[sensitivities]]
+name = "dq_dk1"
+output = "pin.angle"
+parameter = "k1"
+
+[[sensitivities]]
+name = "domega_dk1"
+output = "mode1.omega"
+parameter = "k1"
+
+[[predictions]]
+quantity = "dq_dk1"
+formula = "a*k2*b/(k1^2*a^2 + k2^2*b^2)"
+class = "relative"
+tolerance = 1e-12
+
+[[predictions]]
+quantity = "domega_dk1"
+formula = "L*k1*a^2/(2*(m*L^2/3)*sqrt(L*hypot(k1*a, k2*b)/(m*L^2/3))*hypot(k1*a, k2*b))"
+class = "relative"
+tolerance = 1e-9
+"#;
+
+/// A paper's printed sensitivity is a prediction like any other: `[[sensitivities]]` names
+/// d(output)/d(parameter) at each settle point, and the run judges it.
+#[test]
+fn a_printed_sensitivity_is_judged_as_a_prediction_at_every_point() {
+    let text = std::fs::read_to_string("scenarios/custom/pinned_bar_modes.toml").unwrap() + PRINTED_SENSITIVITIES;
+    let sc = scenario::parse(Path::new("printed.toml"), &text).expect("valid");
+    let report = tensegrity_testbed::run::run(&sc, &Default::default());
+    assert!(report.passed, "{:?} {:?}", report.failures, report.warnings);
+    assert_eq!(report.points.len(), 3);
+    for p in &report.points {
+        assert!(p.errors["dq_dk1"] <= 1e-12 && p.errors["domega_dk1"] <= 1e-9, "{:?}", p.errors);
+    }
+    // A wrong formula fails.
+    let wrong = text.replace("a*k2*b/(k1^2", "1.001*a*k2*b/(k1^2");
+    let report =
+        tensegrity_testbed::run::run(&scenario::parse(Path::new("w.toml"), &wrong).unwrap(), &Default::default());
+    assert!(!report.passed);
+    // An output the state has not, a parameter the scenario has not: located.
+    let bad = text.replace("output = \"pin.angle\"", "output = \"pin.angel\"");
+    common::error_at(&bad, "\"pin.angel\"", 0, "'pin.angel' is no output of the settled state");
+    let bad = text.replace("parameter = \"k1\"\n\n[[sens", "parameter = \"k9\"\n\n[[sens");
+    common::error_at(&bad, "\"k9\"", 0, "'k9' is not a parameter of this scenario");
+}
