@@ -209,14 +209,15 @@ pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<S
     })?;
     let located = |e| overrides::at_flag(e, overrides, file_lines);
     overrides::apply(&ctx, &mut raw, overrides, file_lines).map_err(located)?;
-    let mut sc = match validate(&ctx, path, raw, None).map_err(located)? {
+    let spent = std::rc::Rc::default();
+    let mut sc = match validate(&ctx, path, raw, None, &spent).map_err(located)? {
         Validated::One(sc) => *sc,
         Validated::Split(topologies) => {
             let mut variants = Vec::new();
             for t in &topologies {
                 let mut raw: RawScenario = toml::from_str(source).expect("read once already");
                 overrides::apply(&ctx, &mut raw, overrides, file_lines).map_err(located)?;
-                match validate(&ctx, path, raw, Some(t)).map_err(located)? {
+                match validate(&ctx, path, raw, Some(t), &spent).map_err(located)? {
                     Validated::One(v) => variants.push(*v),
                     Validated::Split(_) => unreachable!("a topology's scenario is not split again"),
                 }
@@ -329,6 +330,7 @@ fn expand_patterns(
     ctx: &Ctx,
     raw: &mut RawScenario,
     topology: Option<&Topology>,
+    spent: &std::rc::Rc<std::cell::Cell<usize>>,
 ) -> Result<Vec<String>, ScenarioError> {
     // A parameter error is reported where the parameters are validated; templates then see none.
     let params = match topology {
@@ -340,7 +342,11 @@ fn expand_patterns(
         }
         None => number::param_values(ctx, &raw.params).unwrap_or_default(),
     };
-    let env = pattern::Env::new(&params);
+    let env = pattern::Env::new(&params, spent);
+    if topology.is_some() {
+        // Each structure of a topology sweep reads the file's text again.
+        env.spend(ctx.source.len()).map_err(|e| ctx.err(&raw.actuation, e.message))?;
+    }
     if let Some(s) = &mut raw.structure {
         repeat::expand(ctx, s.get_mut(), &env)?;
     }
@@ -435,11 +441,12 @@ fn validate(
     path: &Path,
     mut raw: RawScenario,
     topology: Option<&Topology>,
+    spent: &std::rc::Rc<std::cell::Cell<usize>>,
 ) -> Result<Validated, ScenarioError> {
     if raw.name.get_ref().trim().is_empty() {
         return Err(ctx.err(&raw.name, "name must not be empty"));
     }
-    let topology_params = expand_patterns(ctx, &mut raw, topology)?;
+    let topology_params = expand_patterns(ctx, &mut raw, topology, spent)?;
     names::names(ctx, &raw)?;
     let custom = mechanism::custom(ctx, &raw)?;
     let builtin = if custom.is_some() { None } else { Some(mechanism::builtin(ctx, &raw)?) };

@@ -291,3 +291,137 @@ fn flags() {
     }
     std::fs::remove_dir_all(&d).ok();
 }
+
+// Issue 46, the third pass: whole numbers in checked arithmetic, the work of `check` bounded,
+// standard output that cannot be written, flags twice, figure paths before any work.
+
+/// The regular n-strut prism, whose patterns are rewritten below.
+const PRISM_N: &str = "scenarios/custom/prism_n.toml";
+
+/// A range's length, a template's quotient, remainder, product or negation past the 64-bit
+/// whole numbers is refused where it is written (it had panicked with a capacity overflow or
+/// an integer overflow, or wrapped into a name).
+#[test]
+fn whole_numbers_past_64_bits() {
+    let d = dir("whole");
+    let s = std::fs::read_to_string(PRISM_N).unwrap();
+    let huge = "-9000000000000000000..9000000000000000000";
+    let repeat = s.replacen("for = { i = \"0..n\" }", &format!("for = {{ i = \"{huge}\" }}"), 1);
+    refused_at(&d, "repeat_range", &repeat, huge, 0, "at most 10000 entries");
+    let looped = s.replace(
+        "for = { i = \"1..n\" }\nname = \"strut_to_side{i}\"",
+        &format!("for = {{ i = \"{huge}\" }}\nname = \"strut_to_side{{i}}\""),
+    );
+    refused_at(&d, "looped_range", &looped, huge, 0, "at most 10000 entries");
+    let summed = s.replacen("sum(i in 0..n, B{i}.x)", &format!("sum(i in {huge}, B{{i}}.x)"), 1);
+    refused_at(&d, "sum_range", &summed, huge, 0, "at most 10000 entries");
+    let min = "(-9223372036854775807-1)";
+    for (name, template, shift) in [
+        ("quotient", format!("{min}/-1"), min.len()),
+        ("remainder", format!("{min} mod -1"), min.len() + 1),
+        ("product", format!("{min}*2"), min.len()),
+        ("negation", format!("-{min}"), 0),
+    ] {
+        let text = s.replacen("name = \"bottom{i}\"", &format!("name = \"bottom{{{template}}}\""), 1);
+        let at = format!("{{{template}}}");
+        refused_at(&d, name, &text, &at, 1 + shift, "whole number out of range");
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// What `check` expands is bounded before it is spent: 9,900 looped sums of 450 terms (they
+/// had taken 27.6 s and 7.4 GB), and a topology sweep over 1,000 prisms, are refused at the
+/// entry that passes the bound.
+#[test]
+fn expanded_work_is_bounded() {
+    let d = dir("expanded");
+    let s = std::fs::read_to_string(PRISM_N).unwrap();
+    let sums = "[[quantities]]\nfor = { j = \"0..9900\" }\nname = \"big{j}\"\nexpr = \"sum(i in 0..450, B{i mod n}.x + {j})\"\n";
+    let text = s.replacen("[[predictions]]", &format!("{sums}\n[[predictions]]"), 1);
+    let words = "the patterns expand past 2097152 bytes of names and expressions";
+    refused_at(&d, "looped_sums", &text, "\"sum(i in 0..450", 1, words);
+    let topologies = s.replace("count = 10 }", "count = 1000 }").replace("to = 12,", "to = 1002,");
+    let p = d.join("topologies.toml");
+    std::fs::write(&p, &topologies).unwrap();
+    let (code, _, err) = tensegrity(&["check", p.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("topologies.toml:") && err.contains(words), "{err}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// Runs the binary with its standard output on `/dev/full` or closed (`>&-`).
+fn with_stdout(how: &str, args: &[&str]) -> (i32, String) {
+    let bin = env!("CARGO_BIN_EXE_tensegrity");
+    let redirect = if how == "full" { ">/dev/full" } else { ">&-" };
+    let script = format!("exec \"$0\" \"$@\" {redirect}");
+    let out = Command::new("sh").arg("-c").arg(script).arg(bin).args(args).output().unwrap();
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// Standard output that cannot be written (full, closed) fails the command with exit 1 and
+/// its message, for every command that writes there; never a panic, never a silent exit 0.
+#[test]
+fn standard_output_that_cannot_be_written() {
+    let quick = "scenarios/custom/prism3.toml";
+    for how in ["full", "closed"] {
+        for args in [
+            vec!["list"],
+            vec!["check", quick],
+            vec!["run", quick, "--json", "-"],
+            vec!["sweep", SWEEP_FILE, "--jobs", "1", "--out", "-"],
+            vec!["modes", quick],
+            vec!["solve", "mohr2011", "ikp", "--set", "x=0", "--set", "y=0", "--set", "z=1"],
+        ] {
+            let (code, err) = with_stdout(how, &args);
+            assert_eq!(code, 1, "{how} {args:?}: {err}");
+            let words = if how == "full" { "writing to standard output" } else { "standard output is closed" };
+            assert!(err.contains(words) && !err.contains("panicked"), "{how} {args:?}: {err}");
+        }
+    }
+}
+
+/// `--set` of one name twice is refused with both flags named (the last had won in silence).
+#[test]
+fn a_name_set_twice() {
+    let (code, _, err) = tensegrity(&["check", SWEEP_FILE, "--set", "k2=10", "--set", "k2=20"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--set k2=10 and --set k2=20: 'k2' is set twice"), "{err}");
+    let (code, _, err) = tensegrity(&["solve", "mohr2011", "dkp", "--set", "lb=1", "--set", "lb=2"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--set lb=2: 'lb' is set twice"), "{err}");
+}
+
+/// A figure whose folder cannot be made is refused before any point is settled, as any output
+/// is; a missing folder is made, as for `--out`.
+#[test]
+fn a_figure_folder_checked_before_work() {
+    let d = dir("figure-folder");
+    let file = d.join("a-file");
+    std::fs::write(&file, "not a folder").unwrap();
+    let under_file = file.join("f.png");
+    let (code, out, err) = tensegrity(&["sweep", SWEEP_FILE, "--figure", under_file.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(&format!("{} cannot be written: {} is not a directory", under_file.display(), file.display())),
+        "{err}"
+    );
+    assert!(!out.contains("point(s)"), "nothing settled: {out}");
+    let missing = d.join("new").join("f.png");
+    let (code, _, err) = tensegrity(&["sweep", SWEEP_FILE, "--jobs", "1", "--figure", missing.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(missing.exists(), "the figure in its new folder");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// A branch whose closed form overflowed is no branch: `dkp` with lb = 1e300 had printed
+/// (0, 0, 0) as the z > 0 branch and exited 0.
+#[test]
+fn an_overflowed_branch_is_refused() {
+    let args = ["solve", "mohr2011", "dkp", "--set", "rho1=1", "--set", "rho2=1", "--set", "rho3=1"];
+    for lb in ["1e300", "1e155", "-1e300"] {
+        let set = format!("lb={lb}");
+        let (code, out, err) = tensegrity(&[&args[..], &["--set", &set]].concat());
+        assert_eq!(code, 2, "lb = {lb}: {out}{err}");
+        assert!(!out.contains("z > 0"), "lb = {lb}: no branch printed: {out}");
+    }
+}
