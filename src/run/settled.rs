@@ -57,7 +57,8 @@ pub fn modes(
 ) -> Result<(ModesReport, SettledState, StructureModes), ModesRunError> {
     let mut state = settle_first_point(sc, cancel)?;
     let wall = Instant::now();
-    let analysis = state.sim.modes().map_err(|e| match e {
+    let analysis = state.sim.modes_until(cancel).map_err(|e| match e {
+        ModesError::Eigen(crate::eigen::EigenError::Interrupted) => RunError::Interrupted(state.sim.tick()).into(),
         ModesError::Eigen(_) => ModesRunError::Eigen(e),
         _ => ModesRunError::Refused(e),
     })?;

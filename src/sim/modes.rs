@@ -15,6 +15,7 @@ use crate::eigen::EigenError;
 use crate::snapshot::{BodyPose, ModalProjector};
 use crate::structure::{BodyKind, CableLaw};
 use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
+use std::sync::atomic::AtomicBool;
 
 /// A mode whose |omega^2| is below this fraction of the largest is a rigid-body (zero) mode.
 pub const ZERO_MODE_RATIO: f64 = 1e-9;
@@ -94,21 +95,21 @@ pub enum ModesError {
 impl Data {
     /// The structure's natural modes at its current state: over six coordinates per free body,
     /// or reduced to the joints' coordinates where there are joints (`joint_modes.rs`).
-    pub(super) fn modes(&mut self, m: &Model) -> Result<StructureModes, ModesError> {
+    pub(super) fn modes(&mut self, m: &Model, cancel: Option<&AtomicBool>) -> Result<StructureModes, ModesError> {
         let s = &m.structure;
         if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
             return Err(ModesError::NoFreeBody);
         }
         let inextensible = s.cables.iter().any(|c| !matches!(c.law, CableLaw::Elastic { .. }));
         if inextensible || m.joint_impulse.iter().any(Option::is_some) {
-            return self.constrained_modes(m);
+            return self.constrained_modes(m, cancel);
         }
         if !s.joints.is_empty() {
-            return self.joint_modes(m);
+            return self.joint_modes(m, cancel);
         }
         let tangent = self.tangent_stiffness(m);
         let mass = self.mass_matrix(m, &tangent.bodies);
-        let eigen = crate::eigen::modes(&tangent.hessian, &mass)?;
+        let eigen = crate::eigen::modes_until(&tangent.hessian, &mass, cancel)?;
         let largest = eigen.iter().fold(0.0f64, |l, e| l.max(e.omega_squared.abs()));
         let modes: Vec<StructureMode> = eigen
             .into_iter()

@@ -425,3 +425,42 @@ fn an_overflowed_branch_is_refused() {
         assert!(!out.contains("z > 0"), "lb = {lb}: no branch printed: {out}");
     }
 }
+
+/// SIGINT while the Lagrangian model is integrated between two ticks (a stiff model: its
+/// kinetic energy scaled by 1e-9, about 5e5 rad/s, whose integration runs to its 10-million
+/// step limit for about a minute) stops the run at once: exit 1, the model reported as
+/// interrupted (the signal had waited for the limit).
+#[test]
+fn a_stiff_lagrangian_integration_stops_on_sigint() {
+    use crate::common::{runs_its_command, send_signal, wait_for, HANG_GUARD_S};
+    let d = dir("stiff");
+    let text = crate::common::edited(
+        "scenarios/custom/pinned_bar_large_amplitude.toml",
+        &[("kinetic = \"0.5*I_pivot*qe_dot^2\"", "kinetic = \"0.5*I_pivot*1e-9*qe_dot^2\"")],
+    );
+    let p = d.join("stiff.toml");
+    std::fs::write(&p, text).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+        .args(["run", p.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    wait_for("command's thread", || runs_its_command(pid));
+    // The motion starts within milliseconds and the model's integration then holds its tick.
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    send_signal("INT", pid);
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || tx.send(child.wait_with_output()));
+    let Ok(out) = rx.recv_timeout(std::time::Duration::from_secs(HANG_GUARD_S)) else {
+        send_signal("KILL", pid);
+        panic!("the run did not stop within the {HANG_GUARD_S} s hang guard");
+    };
+    let out = out.unwrap();
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{report}");
+    assert!(report.contains("stopped: interrupted at tick"), "{report}");
+    assert!(report.contains("the Lagrangian model cannot be integrated: interrupted"), "{report}");
+    std::fs::remove_dir_all(&d).ok();
+}
