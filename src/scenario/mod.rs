@@ -118,6 +118,14 @@ impl Scenario {
         }
     }
 
+    /// The quantities a run measures at every tick, by name: the mechanism's and the file's
+    /// `[[quantities]]` (what an external model's prediction may be compared with).
+    pub fn quantity_names(&self) -> Vec<String> {
+        let own = self.mechanism().quantities().iter().map(|q| q.symbol.to_string()).collect::<Vec<_>>();
+        let file = self.model.iter().flat_map(|m| m.quantities.iter().map(|q| q.name.clone()));
+        own.into_iter().chain(file).collect()
+    }
+
     /// Whether a compared quantity is an angle (its errors are wrapped to (-pi, pi]): one of
     /// the mechanism's angle quantities, a prediction of the file's model of class angle, or
     /// an `[energy]` coordinate of class angle.
@@ -201,6 +209,11 @@ pub fn parse(path: &Path, source: &str) -> Result<Scenario, ScenarioError> {
 /// Parses scenario text and validates it with `overrides` applied (`--set`; an error in one
 /// is reported at its flag).
 pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<Scenario, ScenarioError> {
+    // Text handed over whole (the Python package's) is bounded as a file is while it is read.
+    if source.len() as u64 > MAX_SCENARIO_BYTES {
+        let message = format!("the scenario text has {} bytes: at most {MAX_SCENARIO_BYTES}", source.len());
+        return Err(ScenarioError { file: path.display().to_string(), line: 1, col: 1, message });
+    }
     let (extended, file_lines) = overrides::extended_source(source, overrides);
     let ctx = Ctx { file: path.display().to_string(), source: &extended };
     let mut raw: RawScenario = toml::from_str(source).map_err(|e| {

@@ -464,3 +464,52 @@ fn a_stiff_lagrangian_integration_stops_on_sigint() {
     assert!(report.contains("the Lagrangian model cannot be integrated: interrupted"), "{report}");
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// Keys that mean nothing together are refused, the error naming both: a second axis on a
+/// joint that has one, an axis on a joint that has none, a rest angle of no torsion spring, a
+/// start given twice, a flag that is no flag; a triple of two numbers says so (it had been
+/// reported as [0.0, 1.0, NaN]).
+#[test]
+fn keys_that_mean_nothing_together() {
+    let d = dir("together");
+    let planar = PINNED_STRUT
+        .replace("kind = \"revolute\"", "kind = \"planar_pin\"")
+        .replace("axis = [0.0, 0.0, 1.0]", "axis = [0.0, 0.0, 1.0]\naxis2 = [1.0, 0.0, 0.0]");
+    refused_at(&d, "axis2", &planar, "axis2 = [", 8, "axis2 means nothing on a planar_pin joint");
+    let spherical = PINNED_STRUT.replace("kind = \"revolute\"", "kind = \"spherical\"");
+    refused_at(
+        &d,
+        "spherical_axis",
+        &spherical,
+        "[0.0, 0.0, 1.0]\ndamping",
+        0,
+        "axis means nothing on a spherical joint",
+    );
+    let rest = PINNED_STRUT.replace("damping = 0.5", "damping = 0.5\ntorsion_rest = 0.3");
+    refused_at(&d, "torsion_rest", &rest, "0.3", 0, "torsion_rest means nothing without torsion_stiffness");
+    let two = PINNED_STRUT.replace("axis = [0.0, 0.0, 1.0]", "axis = [0.0, 1.0]");
+    refused_at(
+        &d,
+        "two_components",
+        &two,
+        "[0.0, 1.0]",
+        0,
+        "axis must be three finite numbers [x, y, z], got 2 of them",
+    );
+    let prism = std::fs::read_to_string(PRISM_N).unwrap();
+    let turned = prism.replace("rotate = { axis = [0, 0, 1]", "rotate = { axis = [0, 1]");
+    refused_at(
+        &d,
+        "rotate_axis",
+        &turned,
+        "[0, 1]",
+        0,
+        "rotate.axis must be three finite numbers [x, y, z], got 2 of them",
+    );
+    let quick = std::fs::read_to_string("scenarios/ji2014/quick.toml").unwrap();
+    let both = format!("{quick}\n[start]\ntheta2 = 1.0\ntheta2_offset = 0.2\n");
+    refused_at(&d, "theta2_twice", &both, "theta2_offset = 0.2", 0, "[start] theta2_offset means nothing with theta2");
+    let flag = format!("{quick}\n[start]\nat_unstable_root = 2.0\n");
+    refused_at(&d, "flag", &flag, "2.0\n", 0, "at_unstable_root is a flag: 0 or 1, got 2");
+    std::fs::remove_dir_all(&d).ok();
+}
