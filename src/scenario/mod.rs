@@ -315,7 +315,10 @@ fn split(raw: &RawScenario, s: &mut Sections, topology: Option<&Topology>, used:
         Some(_) => motion_points(&s.param_table, &s.params, &s.actuation, used),
         None => topologies(&s.param_table, &s.params, &s.actuation, used),
     };
-    (parts.len() > 1).then_some(parts)
+    // One part whose topology parameters differ from the file's (a grid of one point over n)
+    // is a structure of its own too: expanded with the file's n it had been judged at another.
+    let differs = |t: &Topology| t.used.iter().any(|k| t.params.get(k) != s.params.get(k));
+    (parts.len() > 1 || parts.first().is_some_and(differs)).then_some(parts)
 }
 
 /// A motion run over several points (a grid or points of inputs or parameters): one motion
@@ -345,7 +348,8 @@ fn expand_patterns(
     topology: Option<&Topology>,
     spent: &std::rc::Rc<std::cell::Cell<usize>>,
 ) -> Result<Vec<String>, ScenarioError> {
-    // A parameter error is reported where the parameters are validated; templates then see none.
+    // A parameter's error first: templates read with no parameters would report it elsewhere
+    // (a NaN given by `--set k=nan` had been reported at a range of the structure).
     let params = match topology {
         Some(t) => {
             for (k, p) in raw.params.iter_mut().filter(|(k, _)| t.used.contains(k.get_ref())) {
@@ -353,7 +357,7 @@ fn expand_patterns(
             }
             t.params.clone()
         }
-        None => number::param_values(ctx, &raw.params).unwrap_or_default(),
+        None => number::param_values(ctx, &raw.params)?,
     };
     let env = pattern::Env::new(&params, spent);
     if topology.is_some() {

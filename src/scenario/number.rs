@@ -170,7 +170,10 @@ pub(super) fn param_table(ctx: &Ctx, raw: &ParamMap) -> Result<ParamTable, Scena
 /// parameters it names, and each finite.
 pub(super) fn param_values(ctx: &Ctx, raw: &ParamMap) -> Result<Values, ScenarioError> {
     let values = param_table(ctx, raw)?.evaluate(&Values::new());
-    for (k, p) in raw {
+    // The numbers given first, then the expressions: a NaN given (`--set r=nan`) is reported
+    // where it is given, not at a parameter computed from it.
+    let given = raw.iter().filter(|(_, p)| matches!(p.get_ref().value, Num::Value(_)));
+    for (k, p) in given.chain(raw.iter().filter(|(_, p)| matches!(p.get_ref().value, Num::Expr(_)))) {
         let x = values[k.get_ref()];
         if !x.is_finite() {
             return Err(

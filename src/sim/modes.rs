@@ -88,6 +88,9 @@ pub enum ModesError {
     JointKind(String),
     #[error("no free body: nothing moves")]
     NoFreeBody,
+    /// A motion asks for a mode (from 1) along which the structure moves without deforming.
+    #[error("mode {mode} is a rigid-body mode (omega^2 = {omega_squared:e} rad^2/s^2, one of the structure's {rigid} that move it without deforming it): there is no vibration along it to start or to fit; choose a mode from {}", rigid + 1)]
+    RigidMode { mode: usize, omega_squared: f64, rigid: usize },
     #[error(transparent)]
     Eigen(#[from] EigenError),
 }

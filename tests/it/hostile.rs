@@ -513,3 +513,90 @@ fn keys_that_mean_nothing_together() {
     refused_at(&d, "flag", &flag, "2.0\n", 0, "at_unstable_root is a flag: 0 or 1, got 2");
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// A spin faster than the simulator keeps (rapier clamps a body's turn at pi/4 rad a step, in
+/// silence) is refused at its angular velocity, whatever its size up to an overflow; one just
+/// under the bound is accepted.
+#[test]
+fn a_spin_beyond_what_the_simulator_keeps() {
+    let d = dir("spin");
+    let text = |w: &str| {
+        format!(
+            "name = \"spin\"\nmechanism = \"custom\"\n[sim]\ndt = 0.01\n[actuation]\npoints = [ {{}} ]\n[structure]\n\
+             [[structure.bodies]]\nname = \"top\"\nmass = 1.0\ninertia = [1.0, 2.0, 3.0]\n\
+             nodes = {{ XP = [1, 0, 0], XM = [-1, 0, 0], ZP = [0, 0, 1] }}\n\
+             [motion]\nduration_s = 0.1\nstart = \"drawn\"\nspin = {{ body = \"top\", angular_velocity = {w} }}\n"
+        )
+    };
+    // pi/4 / 0.01 s = 78.54 rad/s.
+    for w in ["[1e300, 0.2, 4.0]", "[1e10, 0.2, 4.0]", "[0.0, 0.0, 78.6]", "[60.0, 60.0, 0.0]"] {
+        let words = "the simulator keeps at most pi/4 rad a step, 7.853981633974483e1 rad/s at sim.dt = 0.01 s";
+        refused_at(&d, "fast", &text(w), w, 0, words);
+    }
+    let p = d.join("under.toml");
+    std::fs::write(&p, text("[0.0, 0.0, 78.5]")).unwrap();
+    let (code, _, err) = tensegrity(&["check", p.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// A run that diverges at its first step (a 1e9 N/m spring at dt = 0.1 s) leaves an earlier
+/// complete table as it was (it had been replaced by an empty file) and says so.
+#[test]
+fn a_run_without_a_tick_leaves_an_earlier_table() {
+    let d = dir("no-tick");
+    let text = PINNED_STRUT
+        .replace("stiffness = 10.0", "stiffness = 1e9")
+        .replace("[actuation]", "[sim]\ndt = 0.1\n[actuation]")
+        + "\n[motion]\nduration_s = 1.0\nstart = \"drawn\"\n";
+    let (p, table) = (d.join("diverges.toml"), d.join("table.csv"));
+    std::fs::write(&p, text).unwrap();
+    std::fs::write(&table, "tick,earlier\n0,1\n").unwrap();
+    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap(), "--table", table.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("simulation diverged at tick 1"), "{out}");
+    assert!(err.contains(&format!("no tick ran: the table {} was not written", table.display())), "{err}");
+    assert_eq!(std::fs::read_to_string(&table).unwrap(), "tick,earlier\n0,1\n");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// A motion along a rigid-body mode (the prism's modes 1-3 spin its struts about their axes)
+/// is refused by name, never judged against a frequency of about 0 rad/s.
+#[test]
+fn a_motion_along_a_rigid_body_mode_is_refused() {
+    let d = dir("rigid-mode");
+    let text = crate::common::edited(
+        "scenarios/custom/prism3_free_vibration.toml",
+        &[
+            ("mode = 4              # displaced", "mode = 1              # displaced"),
+            ("mode = 4              # fitted", "mode = 2              # fitted"),
+        ],
+    );
+    let p = d.join("rigid.toml");
+    std::fs::write(&p, text).unwrap();
+    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("mode 1 is a rigid-body mode") && out.contains("choose a mode from 4"), "{out}");
+    assert!(!out.contains("frequency lowest mode (cosine fit): predicted -"), "{out}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// `--set k=nan` of a parameter a pattern reads is reported at the flag (it had been reported
+/// at a range of the structure), and a grid of one point over a pattern's parameter builds
+/// the structure of that point (it had built the file's and judged it at the point's n).
+#[test]
+fn a_topology_parameter_at_its_flag_and_at_its_one_point() {
+    let (code, _, err) = tensegrity(&["check", PRISM_N, "--set", "r=nan"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--set r=nan:1:5: parameter 'r' must be a finite number, got NaN"), "{err}");
+    let d = dir("one-topology");
+    let text = std::fs::read_to_string(PRISM_N)
+        .unwrap()
+        .replace("from = 3, to = 12, count = 10", "from = 5, to = 5, count = 1");
+    let p = d.join("five.toml");
+    std::fs::write(&p, text).unwrap();
+    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("strut_to_side4"), "five struts built: {out}");
+    std::fs::remove_dir_all(&d).ok();
+}
