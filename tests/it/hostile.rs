@@ -341,6 +341,7 @@ fn expanded_work_is_bounded() {
     let words = "the patterns expand past 2097152 bytes of names and expressions";
     refused_at(&d, "looped_sums", &text, "\"sum(i in 0..450", 1, words);
     let topologies = s.replace("count = 10 }", "count = 1000 }").replace("to = 12,", "to = 1002,");
+    let topologies = topologies.replace("n_max = { value = 17,", "n_max = { value = 1002,");
     let p = d.join("topologies.toml");
     std::fs::write(&p, &topologies).unwrap();
     let (code, _, err) = tensegrity(&["check", p.to_str().unwrap()]);
@@ -598,5 +599,29 @@ fn a_topology_parameter_at_its_flag_and_at_its_one_point() {
     let (code, out, err) = tensegrity(&["run", p.to_str().unwrap()]);
     assert_eq!(code, 0, "{out}{err}");
     assert!(out.contains("strut_to_side4"), "five struts built: {out}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// `prism_n.toml` holds for the n it states (3 to 17) and refuses an n past them where its
+/// bound is written (it had claimed any n and settled 2.85 rad off at n = 20 and 40).
+#[test]
+fn prism_n_refuses_an_n_it_does_not_hold() {
+    let d = dir("prism-n");
+    let s = std::fs::read_to_string(PRISM_N).unwrap();
+    assert!(s.contains("n from 3 to 17") && s.contains("n_max = { value = 17,"));
+    let text = s.replace("from = 3, to = 12, count = 10", "from = 3, to = 20, count = 18");
+    refused_at(
+        &d,
+        "prism_20",
+        &text,
+        "n_checked = { value",
+        22,
+        "parameter 'n_checked' must be a finite number, got NaN",
+    );
+    let text = s.replace("from = 3, to = 12, count = 10", "from = 17, to = 17, count = 1");
+    let p = d.join("prism_17.toml");
+    std::fs::write(&p, text).unwrap();
+    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap()]);
+    assert_eq!(code, 0, "n = 17 holds: {out}{err}");
     std::fs::remove_dir_all(&d).ok();
 }
