@@ -121,7 +121,11 @@ impl Scenario {
     /// The quantities a run measures at every tick, by name: the mechanism's and the file's
     /// `[[quantities]]` (what an external model's prediction may be compared with).
     pub fn quantity_names(&self) -> Vec<String> {
-        let own = self.mechanism().quantities().iter().map(|q| q.symbol.to_string()).collect::<Vec<_>>();
+        let quantities = match &self.custom {
+            Some(c) => c.quantities(),
+            None => self.mechanism().quantities(),
+        };
+        let own = quantities.iter().map(|q| q.symbol.to_string()).collect::<Vec<_>>();
         let file = self.model.iter().flat_map(|m| m.quantities.iter().map(|q| q.name.clone()));
         own.into_iter().chain(file).collect()
     }
@@ -130,8 +134,13 @@ impl Scenario {
     /// the mechanism's angle quantities, a prediction of the file's model of class angle, or
     /// an `[energy]` coordinate of class angle.
     pub fn is_angle(&self, quantity: &str) -> bool {
-        let mechanism = self.mechanism();
-        mechanism.quantities().iter().any(|q| q.symbol == quantity && q.kind == mechanisms::QuantityKind::Angle)
+        // Borrowed, never cloned: a custom mechanism holds a structure per swept set of
+        // parameters, and a sweep's CSV asks here per cell (4000 points had taken 28.8 s).
+        let quantities = match &self.custom {
+            Some(c) => c.quantities(),
+            None => self.mechanism().quantities(),
+        };
+        quantities.iter().any(|q| q.symbol == quantity && q.kind == mechanisms::QuantityKind::Angle)
             || self.model.as_ref().is_some_and(|m| m.is_angle(quantity) || m.is_angle_coordinate(quantity))
     }
 }
