@@ -336,6 +336,11 @@ fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, Sc
         let actuated = |j: usize| s.actuators.iter().any(|a| a.target == crate::structure::ActuatorTarget::Joint(j));
         (0..s.joints.len()).filter(|j| !actuated(*j)).count() as i64
     };
+    let free = s.bodies.iter().filter(|b| b.kind == crate::structure::BodyKind::Free).count();
+    if free > crate::structure::MAX_MODAL_FREE_BODIES {
+        let most = crate::structure::MAX_MODAL_FREE_BODIES;
+        return Err(ctx.err(mode, format!("mode {}: the structure has {free} free bodies, and its modes are a dense eigenproblem solved for at most {most}", mode.get_ref())));
+    }
     let m = *mode.get_ref();
     if !(1..=count).contains(&m) {
         return Err(ctx.err(mode, format!("mode {m} does not exist: the structure has {count} (from 1)")));

@@ -88,11 +88,25 @@ pub enum ModesError {
     JointKind(String),
     #[error("no free body: nothing moves")]
     NoFreeBody,
+    /// More free bodies than the dense eigenproblem is solved for.
+    #[error("{bodies} free bodies: the modes are a dense eigenproblem, solved for at most {MAX_MODAL_FREE_BODIES} free bodies ({} coordinates; 300 had taken 20 s, 1000 more than 2 GiB)", 6 * MAX_MODAL_FREE_BODIES)]
+    TooLarge { bodies: usize },
     /// A motion asks for a mode (from 1) along which the structure moves without deforming.
     #[error("mode {mode} is a rigid-body mode (omega^2 = {omega_squared:e} rad^2/s^2, one of the structure's {rigid} that move it without deforming it): there is no vibration along it to start or to fit; choose a mode from {}", rigid + 1)]
     RigidMode { mode: usize, omega_squared: f64, rigid: usize },
     #[error(transparent)]
     Eigen(#[from] EigenError),
+}
+
+pub use crate::structure::MAX_MODAL_FREE_BODIES;
+
+/// The structure's size for its modes: an error past [`MAX_MODAL_FREE_BODIES`] free bodies.
+pub fn check_modal_size(s: &crate::structure::Structure) -> Result<(), ModesError> {
+    let bodies = s.bodies.iter().filter(|b| b.kind == BodyKind::Free).count();
+    if bodies > MAX_MODAL_FREE_BODIES {
+        return Err(ModesError::TooLarge { bodies });
+    }
+    Ok(())
 }
 
 impl Data {
@@ -103,6 +117,7 @@ impl Data {
         if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
             return Err(ModesError::NoFreeBody);
         }
+        check_modal_size(s)?;
         let inextensible = s.cables.iter().any(|c| !matches!(c.law, CableLaw::Elastic { .. }));
         if inextensible || m.joint_impulse.iter().any(Option::is_some) {
             return self.constrained_modes(m, cancel);
