@@ -423,7 +423,7 @@ fn spin(
         *o = param_number(ctx, c, params, "motion.spin.angular_velocity")?;
     }
     let (speed, most) = (crate::structure::norm(out), MAX_TURN_PER_STEP_RAD / dt_s);
-    if !(speed <= most) {
+    if speed.is_nan() || speed > most {
         return Err(ctx.err(
             &raw.angular_velocity,
             format!("angular_velocity of magnitude {speed:e} rad/s: the simulator keeps at most pi/4 rad a step, {most:e} rad/s at sim.dt = {dt_s} s (rapier would clamp the spin in silence)"),
