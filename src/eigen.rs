@@ -6,7 +6,9 @@
 //! (L^-1 K L^-T) y = lambda y, v = L^-T y (Golub & Van Loan, Matrix Computations, 4th ed.,
 //! section 8.7.2).
 
+use crate::stoppable::{interruptible, Halted};
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use std::sync::atomic::AtomicBool;
 
 /// One mode: its eigenvalue lambda = omega^2 [rad^2/s^2] and its shape, normalised so that
 /// v^T M v = 1 (mass-normalised).
@@ -33,6 +35,24 @@ pub enum EigenError {
     Shape(usize, usize, usize, usize),
     #[error("a matrix entry is not finite")]
     NotFinite,
+    /// The cancel flag was raised while the problem was solved.
+    #[error("interrupted")]
+    Interrupted,
+}
+
+/// [`modes`] on a thread of its own, waited for with `cancel` looked at every
+/// [`crate::stoppable::POLL_S`]: [`EigenError::Interrupted`] once it is raised (a dense problem of
+/// a few thousand coordinates takes tens of seconds, which a signal had waited for).
+pub fn modes_until(k: &DMatrix<f64>, m: &DMatrix<f64>, cancel: Option<&AtomicBool>) -> Result<Vec<Mode>, EigenError> {
+    if cancel.is_none() {
+        return modes(k, m);
+    }
+    let (k, m) = (k.clone(), m.clone());
+    match interruptible(cancel, move || modes(&k, &m)) {
+        Ok(result) => result,
+        Err(Halted::Interrupted) => Err(EigenError::Interrupted),
+        Err(Halted::Panicked) => panic!("the eigenproblem's thread panicked"),
+    }
 }
 
 /// The modes of K v = lambda M v, lambda ascending.
@@ -82,6 +102,17 @@ mod tests {
         // Mass-normalised: v^T M v = 1.
         let v = &modes[0].shape;
         assert!(((v.transpose() * &m * v)[0] - 1.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn a_raised_cancel_flag_stops_the_eigenproblem() {
+        let k = DMatrix::from_row_slice(2, 2, &[100.0, -50.0, -50.0, 100.0]);
+        let m = DMatrix::identity(2, 2);
+        let raised = AtomicBool::new(true);
+        assert_eq!(modes_until(&k, &m, Some(&raised)).unwrap_err(), EigenError::Interrupted);
+        let lowered = AtomicBool::new(false);
+        let solved = modes_until(&k, &m, Some(&lowered)).unwrap();
+        assert!((solved[0].omega_squared - 50.0).abs() < 1e-12);
     }
 
     #[test]

@@ -21,5 +21,6 @@ pub mod scenario;
 pub mod settings;
 pub mod sim;
 pub mod snapshot;
+pub mod stoppable;
 pub mod structure;
 pub mod sweep;

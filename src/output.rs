@@ -24,6 +24,9 @@ pub enum OutputError {
     /// The outputs `what` and `other` are on one path.
     #[error("{what} and {other} both write {}: give each its own path", path.display())]
     Shared { what: String, other: String, path: PathBuf },
+    /// The output's folder could not be made or written (`why`).
+    #[error("{} cannot be written: {} {why}", path.display(), dir.display())]
+    NoFolder { path: PathBuf, dir: PathBuf, why: &'static str },
     /// The output's directory could not be made.
     #[error("cannot create {}: {source}", dir.display())]
     CreateDir { dir: PathBuf, source: std::io::Error },
@@ -78,8 +81,27 @@ pub fn check_replaceable(path: &Path) -> Result<(), OutputError> {
     }
 }
 
-/// Refuses, before anything runs: an output equal to an input, two outputs on one path, and an
-/// output that exists but is not a regular file. `outputs` pairs each path with what it is
+/// The folder of an output can be made and written: its nearest existing ancestor is a
+/// directory this process may write in (a missing folder is made when the output is written).
+pub fn check_folder(path: &Path) -> Result<(), OutputError> {
+    let here = Path::new(".");
+    let existing =
+        path.ancestors().skip(1).map(|d| if d.as_os_str().is_empty() { here } else { d }).find(|d| d.exists());
+    let dir = existing.unwrap_or(here);
+    let refused = |why| Err(OutputError::NoFolder { path: path.to_path_buf(), dir: dir.to_path_buf(), why });
+    if !dir.is_dir() {
+        return refused("is not a directory");
+    }
+    let Ok(c) = std::ffi::CString::new(dir.as_os_str().as_encoded_bytes()) else { return refused("is not a path") };
+    // SAFETY: `c` is a NUL-terminated path that outlives the call; access only reads it.
+    if unsafe { libc::access(c.as_ptr(), libc::W_OK) } != 0 {
+        return refused("is not writable");
+    }
+    Ok(())
+}
+
+/// Refuses, before anything runs: an output equal to an input, two outputs on one path, an
+/// output that exists but is not a regular file, and one whose folder cannot be made. `outputs` pairs each path with what it is
 /// (`--json`, a recording of scenario X, ...), for the message.
 pub fn check_outputs(inputs: &[PathBuf], outputs: &[(String, PathBuf)]) -> Result<(), OutputError> {
     let ins: Vec<PathBuf> = inputs.iter().map(|p| identity(p)).collect();
@@ -94,6 +116,7 @@ pub fn check_outputs(inputs: &[PathBuf], outputs: &[(String, PathBuf)]) -> Resul
             return Err(OutputError::Shared { what, other, path: path.clone() });
         }
         check_replaceable(path)?;
+        check_folder(path)?;
         seen.push((id, what));
     }
     Ok(())

@@ -619,6 +619,11 @@ const SIZE_RUN_NODES: usize = 16;
 /// The smallest size [`structure_size`] reports [m].
 const MIN_STRUCTURE_SIZE_M: f64 = 1e-3;
 
+/// Most free bodies whose modes are computed (`sim::modes`): the dense eigenproblem of six
+/// coordinates each grows with the cube of their count (100, 200, 300 struts: 0.9, 5.2, 19.8 s;
+/// 1000 struts more than 2 GiB); at the bound about 25-45 s, stopped by a signal within a poll.
+pub const MAX_MODAL_FREE_BODIES: usize = 400;
+
 #[cfg(test)]
 mod tests {
     /// The largest distance between nodes, every pair measured (what [`super::structure_size`]

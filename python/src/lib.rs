@@ -38,6 +38,12 @@ fn scenario_error(e: ScenarioError) -> PyErr {
 /// The scenario from a path (`text` None) or from TOML text named `path`, with `NAME=VALUE`
 /// overrides.
 fn load(path: &str, text: Option<&str>, set: &[String]) -> PyResult<Scenario> {
+    if text.is_none() && path == scenario::STDIN {
+        // The interpreter's own standard input: reading it would block the caller.
+        return Err(PyValueError::new_err(
+            "'-' is the command line's standard input: give a file's path, or the TOML as text=",
+        ));
+    }
     let overrides: Vec<Override> = set
         .iter()
         .map(|s| Override::parse(s).map_err(|e| PyValueError::new_err(e.to_string())))
@@ -260,6 +266,15 @@ fn run_json(
 ) -> PyResult<(String, Option<ArrowTable>)> {
     let sc = load(path, text, &set)?;
     let predictions = self::predictions(predictions)?;
+    let known = sc.quantity_names();
+    if let Some(p) = predictions.iter().find(|p| !known.contains(&p.quantity)) {
+        return Err(PyValueError::new_err(format!(
+            "prediction '{}': the scenario measures no quantity '{}' (it measures {})",
+            p.name,
+            p.quantity,
+            known.join(", ")
+        )));
+    }
     let names = predictions.iter().map(|p| p.name.clone()).collect();
     let model = model.map(|function| Arc::new(PyModel { function, names, failure: Mutex::new(None) }));
     let external = model.clone().map(|m| External { model: m as Arc<dyn ExternalModel>, predictions });

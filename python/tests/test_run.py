@@ -630,3 +630,22 @@ def test_the_rocker_from_matrices_has_the_toml_rockers_inertia_and_frequency():
     f = r.report["motion"]["frequencies"][0]
     assert abs(f["predicted_rad_per_s"] - written) <= 1e-9 * written
     assert f["error"] <= 1e-6 and f["modal_error"] <= 1e-8
+
+
+def test_hostile_text_is_bounded_as_a_file_and_stdin_is_refused():
+    """Text past the 16 MiB a file may have is refused at its first line (30 MB had crashed the
+    interpreter); '-' would read the interpreter's own standard input and is refused."""
+    text = QUICK.read_text() + "#" * (16 << 20)
+    with pytest.raises(tt.ScenarioError) as e:
+        tt.check(text, name="huge.toml")
+    assert (e.value.file, e.value.line, e.value.col) == ("huge.toml", 1, 1)
+    assert "at most 16777216" in e.value.message
+    with pytest.raises(ValueError, match="standard input"):
+        tt.check("-")
+
+
+def test_a_prediction_of_an_unknown_quantity_raises():
+    """A prediction compared with a quantity the scenario does not measure is refused before
+    the run (it had run and reported max_error null)."""
+    with pytest.raises(ValueError, match="no quantity 'nope'"):
+        tt.run(SWEEP, model=bar_model, predictions=[tt.Prediction("q_py", "nope", "angle", 1e-9)])

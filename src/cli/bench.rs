@@ -2,7 +2,7 @@
 //! simulator, or over the scale families; the tables are `bench::table`'s.
 
 use super::args::{Command, DEFAULT_PEER};
-use super::{bad_input, write_atomic, CliError, Outcome};
+use super::{bad_input, print_out, write_atomic, CliError, Outcome};
 use crate::bench::{self, scale, table};
 use std::path::Path;
 
@@ -77,8 +77,8 @@ fn selected_case_sets(only: &[String]) -> Result<Vec<(&'static str, &'static str
     Ok(bench::CASE_SETS.iter().filter(|(m, _)| only.is_empty() || only.iter().any(|o| o == m)).copied().collect())
 }
 
-fn print_json(value: serde_json::Value) {
-    println!("{}", serde_json::to_string_pretty(&value).unwrap_or_default());
+fn print_json(value: serde_json::Value) -> Result<(), CliError> {
+    print_out(&format!("{}\n", serde_json::to_string_pretty(&value).unwrap_or_default()))
 }
 
 fn scale_families(
@@ -92,12 +92,12 @@ fn scale_families(
         eprintln!("{family}: settling up to {max_struts} struts ...");
         let r = scale::run_family(family, max_struts, caps).map_err(|e| super::failed(format!("{family}: {e}")))?;
         if !json {
-            print!("{}", table::scale_family(&r));
+            print_out(&table::scale_family(&r))?;
         }
         reports.push(r);
     }
     if json {
-        print_json(serde_json::json!({ "scale": reports }));
+        print_json(serde_json::json!({ "scale": reports }))?;
     }
     Ok(Outcome::Pass)
 }
@@ -114,10 +114,12 @@ fn scale_peer(
     let _ = std::fs::remove_dir_all(&dir);
     let (reports, rows) = out.map_err(bad_input)?;
     if json {
-        print_json(serde_json::json!({ "scale": reports, "scale_peer": rows }));
+        print_json(serde_json::json!({ "scale": reports, "scale_peer": rows }))?;
     } else {
-        reports.iter().for_each(|r| print!("{}", table::scale_family(r)));
-        print!("{}", table::scale_peer(&rows));
+        for r in &reports {
+            print_out(&table::scale_family(r))?;
+        }
+        print_out(&table::scale_peer(&rows))?;
     }
     Ok(Outcome::Pass)
 }
@@ -133,9 +135,9 @@ fn scale_motion(
     let _ = std::fs::remove_dir_all(&dir);
     let cases = out.map_err(bad_input)?;
     if json {
-        print_json(serde_json::json!({ "scale_motion": cases }));
+        print_json(serde_json::json!({ "scale_motion": cases }))?;
     } else {
-        print!("{}", table::scale_motion(&cases));
+        print_out(&table::scale_motion(&cases))?;
     }
     Ok(Outcome::Pass)
 }
@@ -148,7 +150,7 @@ fn export_case_sets(dir: &Path) -> Result<Outcome, CliError> {
         let path = dir.join(format!("{m}.json"));
         let text = serde_json::to_string_pretty(&set).expect("case set serialises");
         write_atomic(&path, &text).map_err(|e| bad_input(format!("cannot write {}: {e}", path.display())))?;
-        println!("wrote {} ({} cases)", path.display(), set.cases.len());
+        print_out(&format!("wrote {} ({} cases)\n", path.display(), set.cases.len()))?;
     }
     Ok(Outcome::Pass)
 }
@@ -166,9 +168,9 @@ fn against_peer(rounds: usize, json: bool, sets: &[(&str, &str)], command: &[Str
     }
     let _ = std::fs::remove_dir_all(&dir);
     if json {
-        print_json(serde_json::json!({ "comparisons": out }));
+        print_json(serde_json::json!({ "comparisons": out }))?;
     } else {
-        print!("{}", table::peer_comparison(&out));
+        print_out(&table::peer_comparison(&out))?;
     }
     Ok(Outcome::from_passed(out.iter().all(|c| c.testbed.all_settled)))
 }
@@ -185,9 +187,9 @@ fn case_sets(rounds: usize, json: bool, sets: &[(&str, &str)], all: bool) -> Res
         Vec::new()
     };
     if json {
-        print_json(serde_json::json!({ "results": results, "interference": interference }));
+        print_json(serde_json::json!({ "results": results, "interference": interference }))?;
     } else {
-        print!("{}", table::case_sets(&results, &interference));
+        print_out(&table::case_sets(&results, &interference))?;
     }
     Ok(Outcome::from_passed(results.iter().all(|r| r.all_settled)))
 }

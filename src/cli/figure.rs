@@ -1,6 +1,6 @@
 //! `tensegrity figure`: one of the papers' figures as PNG and SVG, or the list of them.
 
-use super::{CliError, Outcome};
+use super::{print_out, CliError, Outcome};
 use std::path::Path;
 
 pub fn figure(name: Option<&str>, out: &Path, list: bool) -> Result<Outcome, CliError> {
@@ -8,7 +8,7 @@ pub fn figure(name: Option<&str>, out: &Path, list: bool) -> Result<Outcome, Cli
         (Some(n), false) => n,
         _ => {
             for f in crate::figures::all() {
-                println!("{}: {}", f.name, f.description);
+                print_out(&format!("{}: {}\n", f.name, f.description))?;
             }
             return if list {
                 Ok(Outcome::Pass)
@@ -18,7 +18,7 @@ pub fn figure(name: Option<&str>, out: &Path, list: bool) -> Result<Outcome, Cli
         }
     };
     for f in crate::figures::draw(name, out).map_err(super::bad_input)? {
-        println!("wrote {}", f.display());
+        print_out(&format!("wrote {}\n", f.display()))?;
     }
     Ok(Outcome::Pass)
 }

@@ -1,7 +1,7 @@
 //! `tensegrity findings`: every printed equation of a paper checked against the derivation.
 
 use super::solve::{find_mechanism, parse_sets};
-use super::{CliError, Outcome};
+use super::{print_out, CliError, Outcome};
 
 pub fn findings(mechanism: &str, sets: &[String], json: bool) -> Result<Outcome, CliError> {
     let m = find_mechanism(mechanism)?;
@@ -12,16 +12,16 @@ pub fn findings(mechanism: &str, sets: &[String], json: bool) -> Result<Outcome,
             .iter()
             .map(|f| serde_json::json!({"equation": f.equation, "claim": f.claim, "measured": f.measured, "holds": f.holds}))
             .collect();
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        print_out(&format!("{}\n", serde_json::to_string_pretty(&v).unwrap_or_default()))?;
     } else {
         for f in &f {
-            println!(
-                "[{}] {}: {}\n      measured: {}",
+            print_out(&format!(
+                "[{}] {}: {}\n      measured: {}\n",
                 if f.holds { "holds" } else { "WRONG" },
                 f.equation,
                 f.claim,
                 f.measured
-            );
+            ))?;
         }
     }
     Ok(Outcome::Pass)

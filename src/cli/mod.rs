@@ -132,7 +132,17 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
 
 /// The `--set NAME=VALUE` flags of a scenario command.
 fn overrides(flags: &args::SetArgs) -> Result<Vec<Override>, CliError> {
-    flags.set.iter().map(|f| Override::parse(f).map_err(bad_input)).collect()
+    let list: Vec<Override> =
+        flags.set.iter().map(|f| Override::parse(f).map_err(bad_input)).collect::<Result<_, _>>()?;
+    for (k, o) in list.iter().enumerate() {
+        if let Some(twice) = list[k + 1..].iter().find(|t| t.name == o.name) {
+            return Err(bad_input(format!(
+                "--set {}={} and --set {}={}: '{}' is set twice (give each name once)",
+                o.name, o.value, twice.name, twice.value, o.name
+            )));
+        }
+    }
+    Ok(list)
 }
 
 /// A recording's file must end in `.rrd` (rerun's format).
@@ -185,8 +195,7 @@ fn check_outputs(inputs: &[PathBuf], outputs: &[(String, PathBuf)]) -> Result<()
 /// standard output for `-`.
 fn write_atomic(path: &Path, text: &str) -> Result<(), CliError> {
     if is_stdio(path) {
-        print!("{text}");
-        return Ok(());
+        return print_out(text);
     }
     crate::output::write_atomic(path, text.as_bytes()).map_err(failed)
 }
@@ -194,10 +203,44 @@ fn write_atomic(path: &Path, text: &str) -> Result<(), CliError> {
 /// Writes `text` to `out` (never over an input), or to stdout without `out`.
 fn write_output(out: Option<&Path>, inputs: &[PathBuf], text: &str) -> Result<Outcome, CliError> {
     let Some(o) = out.filter(|o| !is_stdio(o)) else {
-        print!("{text}");
+        print_out(text)?;
         return Ok(Outcome::Pass);
     };
     check_outputs(inputs, &[("--out".into(), o.to_path_buf())])?;
     write_atomic(o, text)?;
     Ok(Outcome::Pass)
+}
+
+/// Writes `text` to standard output, all of it: a closed or full standard output fails the
+/// command (exit 1) with its message, never a panic and never a silent exit 0. (A pipe closed
+/// by its reader ends the process as it ends any Unix filter: `signals::install_handlers`.)
+pub fn print_out(text: &str) -> Result<(), CliError> {
+    use std::io::Write;
+    if stdout_closed() {
+        return Err(failed("standard output is closed: nothing written"));
+    }
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| failed(format!("writing to standard output: {e}")))
+}
+
+/// Whether the process started with its standard output closed (`>&-`): Rust's runtime then
+/// opens /dev/null read-write in its place, which no shell redirection does (`> /dev/null`
+/// opens it write-only), so that writes would vanish.
+fn stdout_closed() -> bool {
+    // SAFETY: fcntl and fstat read the descriptor's flags and status into `st`, changing nothing.
+    unsafe {
+        let flags = libc::fcntl(libc::STDOUT_FILENO, libc::F_GETFL);
+        if flags < 0 {
+            return true;
+        }
+        let mut st: libc::stat = std::mem::zeroed();
+        let mut null: libc::stat = std::mem::zeroed();
+        let is_null = libc::fstat(libc::STDOUT_FILENO, &mut st) == 0
+            && libc::stat(c"/dev/null".as_ptr(), &mut null) == 0
+            && st.st_rdev == null.st_rdev
+            && (st.st_mode & libc::S_IFMT) == libc::S_IFCHR;
+        is_null && (flags & libc::O_ACCMODE) == libc::O_RDWR
+    }
 }

@@ -103,7 +103,7 @@ pub fn run(
     // With the JSON report on standard output the table goes to standard error.
     match o.json.as_deref().filter(|j| super::is_stdio(j)) {
         Some(_) => eprint!("{}", report.to_table()),
-        None => print!("{}", report.to_table()),
+        None => super::print_out(&report.to_table())?,
     }
     if let Some(j) = &o.json {
         write_atomic(j, &report.to_json()).map_err(|e| super::failed(format!("the JSON report: {e}")))?;

@@ -1,6 +1,6 @@
 //! `tensegrity solve`: the analytic model alone, every branch or solution of a query.
 
-use super::{bad_input, CliError, Outcome};
+use super::{bad_input, print_out, CliError, Outcome};
 use crate::mechanisms::{self, Mechanism, Solution, Values};
 
 /// Splits `--set NAME=VALUE` flags into the mechanism's parameters (with their defaults,
@@ -17,6 +17,9 @@ pub(super) fn parse_sets(
         let x: f64 = v.trim().parse().map_err(|_| bad_input(format!("--set {s}: '{v}' is not a number")))?;
         if !x.is_finite() {
             return Err(bad_input(format!("--set {s}: the value must be finite")));
+        }
+        if params.contains_key(k) || inputs.contains_key(k) {
+            return Err(bad_input(format!("--set {s}: '{k}' is set twice (give each name once)")));
         }
         if m.params().iter().any(|p| p.symbol == k) {
             params.insert(k.into(), x);
@@ -58,24 +61,26 @@ pub fn solve(mechanism: &str, query: &str, sets: &[String], json: bool) -> Resul
             "mechanism": mechanism, "query": query, "params": params, "inputs": inputs,
             "solutions": sols.iter().map(|s| serde_json::json!({"label": s.label, "values": s.values, "stable": s.stable})).collect::<Vec<_>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        print_out(&format!("{}\n", serde_json::to_string_pretty(&v).unwrap_or_default()))?;
     } else {
-        print_solutions(mechanism, query, &sols);
+        print_out(&solutions_text(mechanism, query, &sols))?;
     }
     Ok(Outcome::Pass)
 }
 
-fn print_solutions(mechanism: &str, query: &str, sols: &[Solution]) {
-    println!("{mechanism} {query}: {} result(s)", sols.len());
+fn solutions_text(mechanism: &str, query: &str, sols: &[Solution]) -> String {
+    use std::fmt::Write;
+    let mut out = format!("{mechanism} {query}: {} result(s)\n", sols.len());
     for s in sols {
         let st = match s.stable {
             Some(true) => ", stable",
             Some(false) => ", unstable",
             None => "",
         };
-        println!("  {}{st}:", s.label);
+        let _ = writeln!(out, "  {}{st}:", s.label);
         for (k, v) in &s.values {
-            println!("    {k:<12} = {v:.12}");
+            let _ = writeln!(out, "    {k:<12} = {v:.12}");
         }
     }
+    out
 }

@@ -74,8 +74,8 @@ pub fn sweep(
     let (rows, summary) = result.map_err(super::bad_input)?;
     // With the CSV or the summary on standard output, the human lines go to standard error.
     let on_stdout = [&o.csv, &o.json].into_iter().flatten().any(|p| super::is_stdio(p));
-    let say: fn(&str) = if on_stdout { |line| eprintln!("{line}") } else { |line| println!("{line}") };
-    print_summary(&summary, say);
+    let say: Say = if on_stdout { say_on_stderr } else { say_on_stdout };
+    print_summary(&summary, say)?;
     let is_angle = |q: &str| sc.is_angle(q);
     let csv_text = || crate::sweep::to_csv(&rows, &is_angle, &crate::sweep::fingerprint(&sc));
     if signals::cancelled() {
@@ -92,29 +92,32 @@ pub fn sweep(
             .filter_map(|p| p.joint.as_ref().map(|j| j.quantity()))
             .collect();
         let titled = (summary.scenario.as_str(), o.x.as_deref());
+        if let Some(dir) = f.parent().filter(|d| !d.as_os_str().is_empty()) {
+            crate::output::create_dir(dir).map_err(super::failed)?;
+        }
         crate::figures::sweep::draw(&rows, titled, &measured, &is_angle, f).map_err(super::failed)?;
     }
     if let Some(j) = &o.json {
         write_atomic(j, &serde_json::to_string_pretty(&summary).unwrap_or_default())?;
     }
     if let Some(min) = summary.min_agreement_percent {
-        say(&format!("required agreement {min:.2} %"));
+        say(&format!("required agreement {min:.2} %"))?;
     }
     if !summary.disagreements.is_empty() {
         say(&format!(
             "{} point(s) did not settle, are out of tolerance or lost their prestress",
             summary.disagreements.len()
-        ));
+        ))?;
     }
     let passed = summary.passed && !signals::cancelled();
-    say(if passed { "PASS" } else { "FAIL" });
+    say(if passed { "PASS" } else { "FAIL" })?;
     Ok(Outcome::from_passed(passed))
 }
 
 /// An interrupted sweep: the rows that ran go beside `--out`, to a file named as partial (for
 /// `merge --partial` or a later run), never over an earlier complete CSV; the summary and the
 /// figure are not written. Exit 1.
-fn interrupted(csv: Option<&Path>, rows: usize, text: &str, say: fn(&str)) -> Result<Outcome, CliError> {
+fn interrupted(csv: Option<&Path>, rows: usize, text: &str, say: Say) -> Result<Outcome, CliError> {
     match csv.filter(|p| !super::is_stdio(p)) {
         Some(p) => {
             let partial = partial_path(p);
@@ -123,9 +126,9 @@ fn interrupted(csv: Option<&Path>, rows: usize, text: &str, say: fn(&str)) -> Re
                 "interrupted: the {rows} point(s) that ran are in {} (merge --partial reads it); {} was not written",
                 partial.display(),
                 p.display()
-            ));
+            ))?;
         }
-        None => say("interrupted: no CSV written"),
+        None => say("interrupted: no CSV written")?,
     }
     Ok(Outcome::from_passed(false))
 }
@@ -138,7 +141,7 @@ pub fn partial_path(p: &Path) -> PathBuf {
 }
 
 /// The summary's lines: points, settled, within tolerance, wall time; agreement; stops.
-fn print_summary(summary: &SweepSummary, say: fn(&str)) {
+fn print_summary(summary: &SweepSummary, say: Say) -> Result<(), CliError> {
     say(&format!(
         "{}: {} point(s), {} settled, {} within tolerance, {:.2} s wall on {} job(s){}",
         summary.scenario,
@@ -148,13 +151,27 @@ fn print_summary(summary: &SweepSummary, say: fn(&str)) {
         summary.wall_s,
         summary.jobs,
         summary.shard.as_ref().map(|s| format!(", shard {s}")).unwrap_or_default()
-    ));
+    ))?;
     if let Some(w) = &summary.workspace {
-        say(&format!("workspace agreement {:.2} % ({} of {} points)", w.agreement_percent, w.agree, w.points));
+        say(&format!("workspace agreement {:.2} % ({} of {} points)", w.agreement_percent, w.agree, w.points))?;
     }
     for e in &summary.errors {
-        say(&format!("stopped: {e}"));
+        say(&format!("stopped: {e}"))?;
     }
+    Ok(())
+}
+
+/// Where the sweep's human lines go: standard output, or standard error when a CSV or the
+/// summary is there.
+type Say = fn(&str) -> Result<(), CliError>;
+
+fn say_on_stderr(line: &str) -> Result<(), CliError> {
+    eprintln!("{line}");
+    Ok(())
+}
+
+fn say_on_stdout(line: &str) -> Result<(), CliError> {
+    super::print_out(&format!("{line}\n"))
 }
 
 /// `--x`, before any point is settled: an input or a swept parameter of the scenario's points.

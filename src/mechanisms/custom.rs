@@ -22,8 +22,10 @@ pub struct Custom {
     pub expected: Values,
     /// The parameters `structure` was resolved with.
     params: Values,
-    /// The structure at the other sets of parameters a sweep over them settles at.
-    variants: Vec<(Values, Structure)>,
+    /// The structure at the other sets of parameters a sweep over them settles at (shared: a
+    /// sweep clones the mechanism per block, and 4000 copies of 4000 structures had made its
+    /// time grow with the square of its points).
+    variants: std::sync::Arc<Vec<(Values, Structure)>>,
     /// `structure`'s size [m] ([`crate::structure::structure_size`], up to quadratic in the nodes:
     /// computed once).
     size_m: f64,
@@ -104,19 +106,19 @@ impl Custom {
             },
             expected,
             params: Values::new(),
-            variants: Vec::new(),
+            variants: std::sync::Arc::default(),
         }
     }
 
     /// The mechanism with its structure at other sets of parameters (a sweep over them).
     pub fn with_variants(mut self, variants: Vec<(Values, Structure)>) -> Self {
-        self.variants = variants;
+        self.variants = std::sync::Arc::new(variants);
         self
     }
 
     /// The mechanism with its structure at these sets of parameters too.
     pub fn with_more_variants(mut self, variants: Vec<(Values, Structure)>) -> Self {
-        self.variants.extend(variants);
+        std::sync::Arc::make_mut(&mut self.variants).extend(variants);
         self
     }
 

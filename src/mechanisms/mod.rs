@@ -150,6 +150,15 @@ pub trait Mechanism: Send + Sync {
     fn start_keys(&self) -> &'static [(&'static str, &'static str)] {
         self.spec().start_keys
     }
+    /// The start keys that are flags: 0 or 1 (another number had been taken as 1).
+    fn start_flags(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// Pairs of start keys that exclude each other: with both given, the second would be
+    /// ignored (the file names the start once).
+    fn start_exclusive(&self) -> &'static [(&'static str, &'static str)] {
+        &[]
+    }
     fn alternative_inputs(&self) -> &'static [&'static [&'static str]] {
         self.spec().alternative_inputs
     }

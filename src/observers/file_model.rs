@@ -601,7 +601,7 @@ impl ModelObserver {
         if t.estimate.is_some() {
             tracker.note_extrapolated();
         }
-        tracker.push(e, v, time_s, &e.measured(v))
+        tracker.push(e, (v, &e.measured(v)), time_s, t.cancel)
     }
 
     /// This motion tick's coordinates to the comparison (as [`ModelObserver::push_trajectory`]).

@@ -29,6 +29,7 @@ use crate::file_model::spec::ErrorClass;
 use crate::mechanisms::wrap_angle;
 use crate::observers::motion::{corrected_for_symplectic_euler, fit_cosine};
 use crate::report::{LagrangianCoordinateReport, LagrangianReport};
+use std::sync::atomic::AtomicBool;
 
 /// The integrator and its error control, and its start from the samples, as the report
 /// states them.
@@ -154,9 +155,15 @@ impl Tracker {
         self.stated = Some(stated);
     }
 
-    /// One tick of the motion: its time \[s\], every symbol's value `v` there and the measured
-    /// coordinates. The rows known now.
-    pub fn push(&mut self, energy: &EnergySpec, v: &[f64], time_s: f64, measured: &[f64]) -> Vec<Row> {
+    /// One tick of the motion: every symbol's value `v` there and the measured coordinates,
+    /// its time \[s\]. The rows known now; the model's integration to them stops on `cancel`.
+    pub fn push(
+        &mut self,
+        energy: &EnergySpec,
+        (v, measured): (&[f64], &[f64]),
+        time_s: f64,
+        cancel: Option<&AtomicBool>,
+    ) -> Vec<Row> {
         if self.values.is_empty() {
             self.values = v.to_vec();
             self.values.resize(energy.values_len(), 0.0);
@@ -172,7 +179,7 @@ impl Tracker {
         if self.origin.is_none() && self.error.is_none() {
             self.begin(energy);
         }
-        self.rows(energy)
+        self.rows(energy, cancel)
     }
 
     /// Starts the model once its start is known: the stated one at the first tick, the
@@ -202,7 +209,7 @@ impl Tracker {
 
     /// The rows of the samples not handed back yet that are known now: before the first
     /// compared one, uncompared; after, the model advanced to them.
-    fn rows(&mut self, energy: &EnergySpec) -> Vec<Row> {
+    fn rows(&mut self, energy: &EnergySpec, cancel: Option<&AtomicBool>) -> Vec<Row> {
         let mut out = Vec::new();
         while self.handed < self.times.len() {
             let i = self.handed;
@@ -210,7 +217,7 @@ impl Tracker {
                 None
             } else {
                 let (Some(stepper), Some((t0, ..))) = (self.stepper.as_mut(), &self.origin) else { break };
-                match stepper.advance(energy, self.times[i] - t0, None) {
+                match stepper.advance(energy, self.times[i] - t0, cancel) {
                     Ok((q, _)) => Some(q.to_vec()),
                     Err(e) => {
                         self.error = Some(LagrangianError::NotIntegrable(e));

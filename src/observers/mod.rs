@@ -48,6 +48,9 @@ pub struct Tick<'a> {
     /// mechanism's quantities in it; what an observer measures differs between it and
     /// `snapshot` by 15 times its estimated error (`run/levels.rs`).
     pub rougher: Option<(&'a Snapshot, &'a Values)>,
+    /// The run's cancel flag, for an observer's own long work at a tick (the Lagrangian
+    /// model's integration between two ticks).
+    pub cancel: Option<&'a std::sync::atomic::AtomicBool>,
 }
 
 /// What the observers see of a settle point besides its report (which holds the inputs, the

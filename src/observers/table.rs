@@ -463,12 +463,14 @@ impl Observer for Table {
         }
     }
 
-    fn close(
-        &mut self,
-        _tick: u64,
-        _report: &ScenarioReport,
-        _warnings: &mut Vec<String>,
-    ) -> Result<(), ObserverError> {
+    fn close(&mut self, _tick: u64, _report: &ScenarioReport, warnings: &mut Vec<String>) -> Result<(), ObserverError> {
+        if let (None, Some(partial)) = (&self.keys, &self.partial) {
+            // No tick ran (a run that diverged at its first step): no table, and an earlier
+            // one at the path is left as it was, never replaced by an empty file.
+            crate::output::discard(partial);
+            warnings.push(format!("no tick ran: the table {} was not written", self.path.display()));
+            return Ok(());
+        }
         let written = match self.error.take() {
             Some(e) => Err(e),
             None => self.flush_held().and_then(|_| self.finish_file()),

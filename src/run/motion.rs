@@ -7,12 +7,13 @@ use super::levels::Levels;
 use super::runner::Runner;
 use super::settle::SettleDetector;
 use super::{point, RunError};
+use crate::eigen::EigenError;
 use crate::mechanisms::Values;
 use crate::observers::ModeAtStart;
 use crate::report::{ExtrapolationReport, MotionReport, PointReport, ScenarioReport};
 use crate::scenario::Scenario;
 use crate::settings::{Drive, FrequencySignal, Motion, MotionStart};
-use crate::sim::modes::modal_projector;
+use crate::sim::modes::{modal_projector, ModesError};
 
 /// What the report says of a motion before it runs.
 pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
@@ -166,7 +167,14 @@ fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, RunE
     if wanted.is_empty() {
         return Ok(vec![]);
     }
-    let analysis = runner.sim.modes()?;
+    let analysis = match runner.sim.modes_until(runner.cancel) {
+        Err(ModesError::Eigen(EigenError::Interrupted)) => return Err(RunError::Interrupted(runner.sim.tick())),
+        analysis => analysis?,
+    };
+    if let Some(&i) = wanted.iter().find(|&&i| analysis.modes[i].rigid) {
+        let (omega_squared, rigid) = (analysis.modes[i].omega_squared, analysis.rigid);
+        return Err(ModesError::RigidMode { mode: i + 1, omega_squared, rigid }.into());
+    }
     let modes: Vec<ModeAtStart> = wanted
         .iter()
         .map(|&index| ModeAtStart {

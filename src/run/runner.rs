@@ -26,7 +26,9 @@ pub(super) struct Runner<'a> {
     recording: bool,
     /// Notes of the observers at the current tick, handed to every observer after it.
     pub notes: Vec<Note>,
-    cancel: Option<&'a AtomicBool>,
+    /// The run's cancel flag (a signal, Ctrl-C): looked at every step, and by the long phases
+    /// between two steps (a motion's modal analysis).
+    pub cancel: Option<&'a AtomicBool>,
     /// Steps over the whole run.
     pub steps: u64,
     /// The analytic ghost nodes for the last inputs (recordings only).
@@ -174,6 +176,7 @@ impl<'a> Runner<'a> {
             ghost_nodes: None,
             estimate: None,
             rougher: None,
+            cancel: self.cancel,
         };
         let (eq, at) = (tick(equilibrium, &sim_eq), tick(&start, &sim_start));
         for o in &mut self.observers {
@@ -222,6 +225,7 @@ impl<'a> Runner<'a> {
             ghost_nodes: self.ghost.as_ref().and_then(|(_, g)| g.as_deref()),
             estimate: levels.as_ref().map(|l| &l.0),
             rougher: levels.as_ref().map(|l| (&l.1, &l.2)),
+            cancel: self.cancel,
         };
         for o in &mut self.observers {
             o.tick(&tick, &mut self.notes);

@@ -64,9 +64,14 @@ pub fn modes(
     file: &str,
     cancel: Option<&AtomicBool>,
 ) -> Result<(ModesReport, SettledState, StructureModes), ModesRunError> {
+    if let Some(c) = &sc.custom {
+        // Refused before the settle: the analysis that follows it would not be made.
+        crate::sim::modes::check_modal_size(&c.structure).map_err(ModesRunError::Refused)?;
+    }
     let mut state = settle_first_point(sc, cancel)?;
     let wall = Instant::now();
-    let analysis = state.sim.modes().map_err(|e| match e {
+    let analysis = state.sim.modes_until(cancel).map_err(|e| match e {
+        ModesError::Eigen(crate::eigen::EigenError::Interrupted) => RunError::Interrupted(state.sim.tick()).into(),
         ModesError::Eigen(_) => ModesRunError::Eigen(e),
         _ => ModesRunError::Refused(e),
     })?;

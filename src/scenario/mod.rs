@@ -118,12 +118,29 @@ impl Scenario {
         }
     }
 
+    /// The quantities a run measures at every tick, by name: the mechanism's and the file's
+    /// `[[quantities]]` (what an external model's prediction may be compared with).
+    pub fn quantity_names(&self) -> Vec<String> {
+        let quantities = match &self.custom {
+            Some(c) => c.quantities(),
+            None => self.mechanism().quantities(),
+        };
+        let own = quantities.iter().map(|q| q.symbol.to_string()).collect::<Vec<_>>();
+        let file = self.model.iter().flat_map(|m| m.quantities.iter().map(|q| q.name.clone()));
+        own.into_iter().chain(file).collect()
+    }
+
     /// Whether a compared quantity is an angle (its errors are wrapped to (-pi, pi]): one of
     /// the mechanism's angle quantities, a prediction of the file's model of class angle, or
     /// an `[energy]` coordinate of class angle.
     pub fn is_angle(&self, quantity: &str) -> bool {
-        let mechanism = self.mechanism();
-        mechanism.quantities().iter().any(|q| q.symbol == quantity && q.kind == mechanisms::QuantityKind::Angle)
+        // Borrowed, never cloned: a custom mechanism holds a structure per swept set of
+        // parameters, and a sweep's CSV asks here per cell (4000 points had taken 28.8 s).
+        let quantities = match &self.custom {
+            Some(c) => c.quantities(),
+            None => self.mechanism().quantities(),
+        };
+        quantities.iter().any(|q| q.symbol == quantity && q.kind == mechanisms::QuantityKind::Angle)
             || self.model.as_ref().is_some_and(|m| m.is_angle(quantity) || m.is_angle_coordinate(quantity))
     }
 }
@@ -208,7 +225,8 @@ impl Scenario {
             let start = e.span().map(|s| s.start).unwrap_or(0);
             ctx.err_at(start, error::in_file_words(e.message().trim()))
         })?;
-        expand_patterns(&ctx, &mut raw, None)?;
+        // The file passed the expansion's bound when it was parsed; the same text again.
+        expand_patterns(&ctx, &mut raw, None, &std::rc::Rc::default())?;
         let variants = mechanism::variants(&ctx, &raw, sets.iter())?;
         Ok(Scenario { custom: Some(custom.clone().with_more_variants(variants)), ..self.clone() })
     }
@@ -222,6 +240,11 @@ pub fn parse(path: &Path, source: &str) -> Result<Scenario, ScenarioError> {
 /// Parses scenario text and validates it with `overrides` applied (`--set`; an error in one
 /// is reported at its flag).
 pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<Scenario, ScenarioError> {
+    // Text handed over whole (the Python package's) is bounded as a file is while it is read.
+    if source.len() as u64 > MAX_SCENARIO_BYTES {
+        let message = format!("the scenario text has {} bytes: at most {MAX_SCENARIO_BYTES}", source.len());
+        return Err(ScenarioError { file: path.display().to_string(), line: 1, col: 1, message });
+    }
     let (extended, file_lines) = overrides::extended_source(source, overrides);
     let ctx = Ctx { file: path.display().to_string(), source: &extended };
     let mut raw: RawScenario = toml::from_str(source).map_err(|e| {
@@ -230,14 +253,15 @@ pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<S
     })?;
     let located = |e| overrides::at_flag(e, overrides, file_lines);
     overrides::apply(&ctx, &mut raw, overrides, file_lines).map_err(located)?;
-    let mut sc = match validate(&ctx, path, raw, None).map_err(located)? {
+    let spent = std::rc::Rc::default();
+    let mut sc = match validate(&ctx, path, raw, None, &spent).map_err(located)? {
         Validated::One(sc) => *sc,
         Validated::Split(topologies) => {
             let mut variants = Vec::new();
             for t in &topologies {
                 let mut raw: RawScenario = toml::from_str(source).expect("read once already");
                 overrides::apply(&ctx, &mut raw, overrides, file_lines).map_err(located)?;
-                match validate(&ctx, path, raw, Some(t)).map_err(located)? {
+                match validate(&ctx, path, raw, Some(t), &spent).map_err(located)? {
                     Validated::One(v) => variants.push(*v),
                     Validated::Split(_) => unreachable!("a topology's scenario is not split again"),
                 }
@@ -322,7 +346,10 @@ fn split(raw: &RawScenario, s: &mut Sections, topology: Option<&Topology>, used:
         Some(_) => motion_points(&s.param_table, &s.params, &s.actuation, used),
         None => topologies(&s.param_table, &s.params, &s.actuation, used),
     };
-    (parts.len() > 1).then_some(parts)
+    // One part whose topology parameters differ from the file's (a grid of one point over n)
+    // is a structure of its own too: expanded with the file's n it had been judged at another.
+    let differs = |t: &Topology| t.used.iter().any(|k| t.params.get(k) != s.params.get(k));
+    (parts.len() > 1 || parts.first().is_some_and(differs)).then_some(parts)
 }
 
 /// A motion run over several points (a grid or points of inputs or parameters): one motion
@@ -350,8 +377,10 @@ fn expand_patterns(
     ctx: &Ctx,
     raw: &mut RawScenario,
     topology: Option<&Topology>,
+    spent: &std::rc::Rc<std::cell::Cell<usize>>,
 ) -> Result<Vec<String>, ScenarioError> {
-    // A parameter error is reported where the parameters are validated; templates then see none.
+    // A parameter's error first: templates read with no parameters would report it elsewhere
+    // (a NaN given by `--set k=nan` had been reported at a range of the structure).
     let params = match topology {
         Some(t) => {
             for (k, p) in raw.params.iter_mut().filter(|(k, _)| t.used.contains(k.get_ref())) {
@@ -359,9 +388,13 @@ fn expand_patterns(
             }
             t.params.clone()
         }
-        None => number::param_values(ctx, &raw.params).unwrap_or_default(),
+        None => number::param_values(ctx, &raw.params)?,
     };
-    let env = pattern::Env::new(&params);
+    let env = pattern::Env::new(&params, spent);
+    if topology.is_some() {
+        // Each structure of a topology sweep reads the file's text again.
+        env.spend(ctx.source.len()).map_err(|e| ctx.err(&raw.actuation, e.message))?;
+    }
     if let Some(s) = &mut raw.structure {
         repeat::expand(ctx, s.get_mut(), &env)?;
     }
@@ -456,11 +489,12 @@ fn validate(
     path: &Path,
     mut raw: RawScenario,
     topology: Option<&Topology>,
+    spent: &std::rc::Rc<std::cell::Cell<usize>>,
 ) -> Result<Validated, ScenarioError> {
     if raw.name.get_ref().trim().is_empty() {
         return Err(ctx.err(&raw.name, "name must not be empty"));
     }
-    let topology_params = expand_patterns(ctx, &mut raw, topology)?;
+    let topology_params = expand_patterns(ctx, &mut raw, topology, spent)?;
     names::names(ctx, &raw)?;
     let custom = mechanism::custom(ctx, &raw)?;
     let builtin = if custom.is_some() { None } else { Some(mechanism::builtin(ctx, &raw)?) };

@@ -166,7 +166,7 @@ pub(super) fn motion(
         .collect::<Result<_, _>>()?;
     let undamped = section.undamped;
     let extrapolate = section.extrapolate;
-    let spin = section.spin.as_ref().map(|sp| spin(ctx, sp, first, params)).transpose()?;
+    let spin = section.spin.as_ref().map(|sp| spin(ctx, sp, (first, params), dt_s)).transpose()?;
     Ok(Some(Motion {
         duration_s,
         steps: steps as u64,
@@ -336,6 +336,11 @@ fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, Sc
         let actuated = |j: usize| s.actuators.iter().any(|a| a.target == crate::structure::ActuatorTarget::Joint(j));
         (0..s.joints.len()).filter(|j| !actuated(*j)).count() as i64
     };
+    let free = s.bodies.iter().filter(|b| b.kind == crate::structure::BodyKind::Free).count();
+    if free > crate::structure::MAX_MODAL_FREE_BODIES {
+        let most = crate::structure::MAX_MODAL_FREE_BODIES;
+        return Err(ctx.err(mode, format!("mode {}: the structure has {free} free bodies, and its modes are a dense eigenproblem solved for at most {most}", mode.get_ref())));
+    }
     let m = *mode.get_ref();
     if !(1..=count).contains(&m) {
         return Err(ctx.err(mode, format!("mode {m} does not exist: the structure has {count} (from 1)")));
@@ -379,13 +384,18 @@ fn joint_coordinate(ctx: &Ctx, name: &Spanned<String>, s: &Structure) -> Result<
     Ok(JointCoordinate { joint: name.get_ref().clone(), index, prismatic })
 }
 
+/// The largest turn of a body in one time step that rapier keeps \[rad\]: it caps every body's
+/// angular speed at this over `sim.dt` (`staged_island_solver::worker`'s `MAX_ROTATION`), in
+/// silence (spins from 1e10 to 1e154 rad/s had all peaked at one kinetic energy).
+pub const MAX_TURN_PER_STEP_RAD: f64 = std::f64::consts::FRAC_PI_4;
+
 /// `[motion] spin`: a free body that no joint holds, by name, and its angular velocity
-/// [rad/s] (world frame, three finite numbers).
+/// \[rad/s\] (world frame, three finite numbers, at most [`MAX_TURN_PER_STEP_RAD`] / `dt_s`).
 fn spin(
     ctx: &Ctx,
     sp: &Spanned<RawSpin>,
-    s: &Structure,
-    params: &Values,
+    (s, params): (&Structure, &Values),
+    dt_s: f64,
 ) -> Result<(usize, String, [f64; 3]), ScenarioError> {
     let raw = sp.get_ref();
     let name = raw.body.get_ref();
@@ -411,6 +421,13 @@ fn spin(
     let mut out = [0.0; 3];
     for (o, c) in out.iter_mut().zip(w) {
         *o = param_number(ctx, c, params, "motion.spin.angular_velocity")?;
+    }
+    let (speed, most) = (crate::structure::norm(out), MAX_TURN_PER_STEP_RAD / dt_s);
+    if speed.is_nan() || speed > most {
+        return Err(ctx.err(
+            &raw.angular_velocity,
+            format!("angular_velocity of magnitude {speed:e} rad/s: the simulator keeps at most pi/4 rad a step, {most:e} rad/s at sim.dt = {dt_s} s (rapier would clamp the spin in silence)"),
+        ));
     }
     Ok((b, name.clone(), out))
 }

@@ -170,7 +170,10 @@ pub(super) fn param_table(ctx: &Ctx, raw: &ParamMap) -> Result<ParamTable, Scena
 /// parameters it names, and each finite.
 pub(super) fn param_values(ctx: &Ctx, raw: &ParamMap) -> Result<Values, ScenarioError> {
     let values = param_table(ctx, raw)?.evaluate(&Values::new());
-    for (k, p) in raw {
+    // The numbers given first, then the expressions: a NaN given (`--set r=nan`) is reported
+    // where it is given, not at a parameter computed from it.
+    let given = raw.iter().filter(|(_, p)| matches!(p.get_ref().value, Num::Value(_)));
+    for (k, p) in given.chain(raw.iter().filter(|(_, p)| matches!(p.get_ref().value, Num::Expr(_)))) {
         let x = values[k.get_ref()];
         if !x.is_finite() {
             return Err(
@@ -202,7 +205,7 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
         Ok(())
     };
     if let Some(g) = &mut s.gravity {
-        resolve_xyz(g, "gravity", &mut resolve)?;
+        resolve_xyz(ctx, g, "gravity", &mut resolve)?;
     }
     for b in &mut s.bodies {
         resolve_body(ctx, b, &mut resolve)?;
@@ -218,7 +221,7 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
     }
     for a in &mut s.actuators {
         if let Some(d) = &mut a.direction {
-            resolve_xyz(d, "direction", &mut resolve)?;
+            resolve_xyz(ctx, d, "direction", &mut resolve)?;
             if let Some(pl) = &mut a.placement {
                 let (turn, _) = resolve_placement(ctx, pl, &mut resolve)?;
                 place(d, turn, [0.0; 3]);
@@ -235,7 +238,7 @@ type Turn = Option<([f64; 3], f64)>;
 fn resolve_placement(ctx: &Ctx, pl: &mut Placement, resolve: &mut Resolve) -> Result<(Turn, [f64; 3]), ScenarioError> {
     let mut turn = None;
     if let Some(r) = &mut pl.rotate {
-        resolve_xyz(&mut r.axis, "rotate.axis", resolve)?;
+        resolve_xyz(ctx, &mut r.axis, "rotate.axis", resolve)?;
         resolve(&mut r.angle, "rotate.angle")?;
         let axis = values(&r.axis);
         let square = axis.iter().map(|c| c * c).sum::<f64>();
@@ -246,7 +249,7 @@ fn resolve_placement(ctx: &Ctx, pl: &mut Placement, resolve: &mut Resolve) -> Re
     }
     let mut offset = [0.0; 3];
     if let Some(o) = &mut pl.offset {
-        resolve_xyz(o, "offset", resolve)?;
+        resolve_xyz(ctx, o, "offset", resolve)?;
         offset = values(o);
     }
     Ok((turn, offset))
@@ -268,8 +271,15 @@ fn place(v: &mut Xyz, turn: Turn, offset: [f64; 3]) {
 
 type Resolve<'a> = dyn FnMut(&mut Spanned<Num>, &str) -> Result<(), ScenarioError> + 'a;
 
-fn resolve_xyz(v: &mut Xyz, what: &str, resolve: &mut Resolve) -> Result<(), ScenarioError> {
-    v.get_mut().iter_mut().try_for_each(|c| resolve(c, what))
+/// Resolves a triple's three numbers; a list of another length is refused as such (it had
+/// been reported with NaN for a missing component).
+fn resolve_xyz(ctx: &Ctx, v: &mut Xyz, what: &str, resolve: &mut Resolve) -> Result<(), ScenarioError> {
+    v.get_mut().iter_mut().try_for_each(|c| resolve(c, what))?;
+    let n = v.get_ref().len();
+    if n != 3 {
+        return Err(ctx.err(v, format!("{what} must be three finite numbers [x, y, z], got {n} of them")));
+    }
+    Ok(())
 }
 
 fn resolve_body(ctx: &Ctx, b: &mut RawBody, resolve: &mut Resolve) -> Result<(), ScenarioError> {
@@ -277,10 +287,10 @@ fn resolve_body(ctx: &Ctx, b: &mut RawBody, resolve: &mut Resolve) -> Result<(),
         resolve(m, "mass")?;
     }
     if let Some(i) = &mut b.inertia {
-        resolve_xyz(i, "inertia", resolve)?;
+        resolve_xyz(ctx, i, "inertia", resolve)?;
     }
     for (name, p) in &mut b.nodes {
-        resolve_xyz(p, &format!("a coordinate of node '{}'", name.get_ref()), resolve)?;
+        resolve_xyz(ctx, p, &format!("a coordinate of node '{}'", name.get_ref()), resolve)?;
     }
     if let Some(pl) = &mut b.placement {
         let (turn, offset) = resolve_placement(ctx, pl, resolve)?;
@@ -311,7 +321,7 @@ fn resolve_joint(ctx: &Ctx, j: &mut RawJoint, resolve: &mut Resolve) -> Result<(
     };
     for (v, what) in [(&mut j.axis, "axis"), (&mut j.axis2, "axis2")] {
         if let Some(v) = v {
-            resolve_xyz(v, what, resolve)?;
+            resolve_xyz(ctx, v, what, resolve)?;
             place(v, turn, [0.0; 3]);
         }
     }

@@ -45,6 +45,18 @@ pub(super) fn params(ctx: &Ctx, m: &dyn Mechanism, raw: &ParamMap) -> Result<Val
 pub(super) fn start(ctx: &Ctx, m: &dyn Mechanism, raw: &SpannedMap) -> Result<Values, ScenarioError> {
     let known: Vec<_> = m.start_keys().iter().map(|(key, _)| *key).collect();
     known_keys(ctx, raw, &known, "start key", m.name())?;
+    let spanned = |key: &str| raw.iter().find(|(k, _)| k.get_ref() == key);
+    for (k, v) in m.start_flags().iter().filter_map(|f| spanned(f)) {
+        if ![0.0, 1.0].contains(v.get_ref()) {
+            let key = k.get_ref();
+            return Err(ctx.err(v, format!("{key} is a flag: 0 or 1, got {}", v.get_ref())));
+        }
+    }
+    for (a, b) in m.start_exclusive() {
+        if let (Some(_), Some((k, _))) = (spanned(a), spanned(b)) {
+            return Err(ctx.err(k, format!("[start] {b} means nothing with {a}: the start is given by one of them")));
+        }
+    }
     values(ctx, raw)
 }
 

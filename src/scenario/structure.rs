@@ -236,6 +236,7 @@ fn tendon_radius(ctx: &Ctx, m: &RawMember) -> Result<f64, ScenarioError> {
 /// (revolute joints) and damping >= 0.
 fn joint(ctx: &Ctx, s: &Structure, j: &RawJoint) -> Result<Joint, ScenarioError> {
     let kind = joint_kind(ctx, j)?;
+    meaningful_keys(ctx, j, &kind)?;
     let (parent, child, at) = (body(ctx, s, &j.parent)?, body(ctx, s, &j.child)?, node(ctx, s, &j.at)?);
     let torsion_spring = match &j.torsion_stiffness {
         Some(k) => Some(TorsionSpring {
@@ -270,6 +271,28 @@ fn joint(ctx: &Ctx, s: &Structure, j: &RawJoint) -> Result<Joint, ScenarioError>
         torsion_spring,
         damping,
     })
+}
+
+/// Keys of a joint that mean nothing with its other keys are refused, naming both: an axis its
+/// kind has not (`axis2` on a planar pin), a rest angle of no torsion spring.
+fn meaningful_keys(ctx: &Ctx, j: &RawJoint, kind: &JointKind) -> Result<(), ScenarioError> {
+    let k = j.kind.get_ref();
+    if let Some(a2) = j.axis2.as_ref().filter(|_| !matches!(kind, JointKind::Universal { .. })) {
+        return Err(ctx.err(
+            a2,
+            format!("axis2 means nothing on a {k} joint (kind = \"{k}\"): only a universal joint has a second axis"),
+        ));
+    }
+    if let Some(a) = j.axis.as_ref().filter(|_| matches!(kind, JointKind::Spherical | JointKind::Fixed)) {
+        return Err(ctx.err(a, format!("axis means nothing on a {k} joint (kind = \"{k}\"): it has no axis")));
+    }
+    if let (Some(rest), None) = (&j.torsion_rest, &j.torsion_stiffness) {
+        return Err(ctx.err(
+            rest,
+            "torsion_rest means nothing without torsion_stiffness: it is the rest angle of that torsion spring",
+        ));
+    }
+    Ok(())
 }
 
 /// A joint's kind, with the axes it needs.

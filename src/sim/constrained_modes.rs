@@ -40,6 +40,7 @@ use super::{Data, Model};
 use crate::structure::{BodyKind, CableLaw, JointKind};
 use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
+use std::sync::atomic::AtomicBool;
 
 /// Finite-difference step of an angular coordinate [rad]: every derivative is taken at steps
 /// h and 2 h and extrapolated (Richardson, [`richardson`]: error O(h^4), about 1e-12), so the
@@ -464,7 +465,11 @@ fn multipliers(first: &FirstDerivatives) -> DVector<f64> {
 
 impl Data {
     /// The modes of a structure held by loops and taut inextensible cables (module docs).
-    pub(super) fn constrained_modes(&mut self, m: &Model) -> Result<StructureModes, ModesError> {
+    pub(super) fn constrained_modes(
+        &mut self,
+        m: &Model,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<StructureModes, ModesError> {
         let s = &m.structure;
         let closures = self.modal_closures(m)?;
         let inextensible = (0..s.cables.len()).filter(|&c| !matches!(s.cables[c].law, CableLaw::Elastic { .. }));
@@ -498,10 +503,8 @@ impl Data {
         let eigen = if basis.ncols() == 0 {
             vec![]
         } else {
-            crate::eigen::modes(
-                &(0.5 * (&reduced_stiffness + reduced_stiffness.transpose())),
-                &(0.5 * (&reduced_mass + reduced_mass.transpose())),
-            )?
+            let symmetric = |a: &DMatrix<f64>| 0.5 * (a + a.transpose());
+            crate::eigen::modes_until(&symmetric(&reduced_stiffness), &symmetric(&reduced_mass), cancel)?
         };
         let largest = eigen.iter().fold(0.0f64, |l, e| l.max(e.omega_squared.abs()));
         let com: Vec<_> = self.body_states(m, &bodies).iter().map(|(c, _)| *c).collect();

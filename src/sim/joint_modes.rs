@@ -164,7 +164,11 @@ impl Data {
     }
 
     /// The modes of a jointed structure in its free joints' coordinates (module docs).
-    pub(super) fn joint_modes(&mut self, m: &Model) -> Result<StructureModes, ModesError> {
+    pub(super) fn joint_modes(
+        &mut self,
+        m: &Model,
+        cancel: Option<&std::sync::atomic::AtomicBool>,
+    ) -> Result<StructureModes, ModesError> {
         let joints = self.modal_joints(m)?;
         if joints.is_empty() {
             return Err(ModesError::NoFreeBody);
@@ -175,8 +179,11 @@ impl Data {
         let jac = self.body_jacobian(m, &joints, &bodies);
         let body_mass = self.mass_matrix(m, &bodies);
         let mass = jac.transpose() * &body_mass * &jac;
-        let eigen =
-            crate::eigen::modes(&(0.5 * (&stiffness + stiffness.transpose())), &(0.5 * (&mass + mass.transpose())))?;
+        let eigen = crate::eigen::modes_until(
+            &(0.5 * (&stiffness + stiffness.transpose())),
+            &(0.5 * (&mass + mass.transpose())),
+            cancel,
+        )?;
         let largest = eigen.iter().fold(0.0f64, |m, e| m.max(e.omega_squared.abs()));
         let com: Vec<_> = self.body_states(m, &bodies).iter().map(|(c, _)| *c).collect();
         let modes: Vec<StructureMode> = eigen

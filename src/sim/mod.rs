@@ -365,7 +365,16 @@ impl Simulation {
     /// The structure's natural modes at its current state: over six coordinates per free body,
     /// or reduced to the joints' coordinates where there are joints (`joint_modes.rs`).
     pub fn modes(&mut self) -> Result<modes::StructureModes, modes::ModesError> {
-        self.data.modes(&self.model)
+        self.data.modes(&self.model, None)
+    }
+
+    /// [`Simulation::modes`], the eigenproblem stopped when `cancel` is raised
+    /// (`EigenError::Interrupted`).
+    pub fn modes_until(
+        &mut self,
+        cancel: Option<&std::sync::atomic::AtomicBool>,
+    ) -> Result<modes::StructureModes, modes::ModesError> {
+        self.data.modes(&self.model, cancel)
     }
 
     /// The free coordinates of the current state's sensitivities, or why it has none

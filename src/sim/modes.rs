@@ -15,6 +15,7 @@ use crate::eigen::EigenError;
 use crate::snapshot::{BodyPose, ModalProjector};
 use crate::structure::{BodyKind, CableLaw, JointKind};
 use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
+use std::sync::atomic::AtomicBool;
 
 /// A mode whose |omega^2| is below this fraction of the largest is a rigid-body (zero) mode.
 pub const ZERO_MODE_RATIO: f64 = 1e-9;
@@ -87,18 +88,36 @@ pub enum ModesError {
     JointKind(String),
     #[error("no free body: nothing moves")]
     NoFreeBody,
+    /// More free bodies than the dense eigenproblem is solved for.
+    #[error("{bodies} free bodies: the modes are a dense eigenproblem, solved for at most {MAX_MODAL_FREE_BODIES} free bodies ({} coordinates; 300 had taken 20 s, 1000 more than 2 GiB)", 6 * MAX_MODAL_FREE_BODIES)]
+    TooLarge { bodies: usize },
+    /// A motion asks for a mode (from 1) along which the structure moves without deforming.
+    #[error("mode {mode} is a rigid-body mode (omega^2 = {omega_squared:e} rad^2/s^2, one of the structure's {rigid} that move it without deforming it): there is no vibration along it to start or to fit; choose a mode from {}", rigid + 1)]
+    RigidMode { mode: usize, omega_squared: f64, rigid: usize },
     #[error(transparent)]
     Eigen(#[from] EigenError),
+}
+
+pub use crate::structure::MAX_MODAL_FREE_BODIES;
+
+/// The structure's size for its modes: an error past [`MAX_MODAL_FREE_BODIES`] free bodies.
+pub fn check_modal_size(s: &crate::structure::Structure) -> Result<(), ModesError> {
+    let bodies = s.bodies.iter().filter(|b| b.kind == BodyKind::Free).count();
+    if bodies > MAX_MODAL_FREE_BODIES {
+        return Err(ModesError::TooLarge { bodies });
+    }
+    Ok(())
 }
 
 impl Data {
     /// The structure's natural modes at its current state: over six coordinates per free body,
     /// or reduced to the joints' coordinates where there are joints (`joint_modes.rs`).
-    pub(super) fn modes(&mut self, m: &Model) -> Result<StructureModes, ModesError> {
+    pub(super) fn modes(&mut self, m: &Model, cancel: Option<&AtomicBool>) -> Result<StructureModes, ModesError> {
         let s = &m.structure;
         if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
             return Err(ModesError::NoFreeBody);
         }
+        check_modal_size(s)?;
         let inextensible = s.cables.iter().any(|c| !matches!(c.law, CableLaw::Elastic { .. }));
         // A free joint of several coordinates (a universal joint: two revolute links and a
         // hidden body, `build.rs`) is charted by its multibody's degrees of freedom there.
@@ -106,14 +125,14 @@ impl Data {
             !m.actuated[j] && !matches!(joint.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. })
         };
         if inextensible || m.joint_impulse.iter().any(Option::is_some) || s.joints.iter().enumerate().any(several) {
-            return self.constrained_modes(m);
+            return self.constrained_modes(m, cancel);
         }
         if !s.joints.is_empty() {
-            return self.joint_modes(m);
+            return self.joint_modes(m, cancel);
         }
         let tangent = self.tangent_stiffness(m);
         let mass = self.mass_matrix(m, &tangent.bodies);
-        let eigen = crate::eigen::modes(&tangent.hessian, &mass)?;
+        let eigen = crate::eigen::modes_until(&tangent.hessian, &mass, cancel)?;
         let largest = eigen.iter().fold(0.0f64, |l, e| l.max(e.omega_squared.abs()));
         let modes: Vec<StructureMode> = eigen
             .into_iter()

@@ -291,3 +291,371 @@ fn flags() {
     }
     std::fs::remove_dir_all(&d).ok();
 }
+
+// Issue 46, the third pass: whole numbers in checked arithmetic, the work of `check` bounded,
+// standard output that cannot be written, flags twice, figure paths before any work.
+
+/// The regular n-strut prism, whose patterns are rewritten below.
+const PRISM_N: &str = "scenarios/custom/prism_n.toml";
+
+/// A range's length, a template's quotient, remainder, product or negation past the 64-bit
+/// whole numbers is refused where it is written (it had panicked with a capacity overflow or
+/// an integer overflow, or wrapped into a name).
+#[test]
+fn whole_numbers_past_64_bits() {
+    let d = dir("whole");
+    let s = std::fs::read_to_string(PRISM_N).unwrap();
+    let huge = "-9000000000000000000..9000000000000000000";
+    let repeat = s.replacen("for = { i = \"0..n\" }", &format!("for = {{ i = \"{huge}\" }}"), 1);
+    refused_at(&d, "repeat_range", &repeat, huge, 0, "at most 10000 entries");
+    let looped = s.replace(
+        "for = { i = \"1..n\" }\nname = \"strut_to_side{i}\"",
+        &format!("for = {{ i = \"{huge}\" }}\nname = \"strut_to_side{{i}}\""),
+    );
+    refused_at(&d, "looped_range", &looped, huge, 0, "at most 10000 entries");
+    let summed = s.replacen("sum(i in 0..n, B{i}.x)", &format!("sum(i in {huge}, B{{i}}.x)"), 1);
+    refused_at(&d, "sum_range", &summed, huge, 0, "at most 10000 entries");
+    let min = "(-9223372036854775807-1)";
+    for (name, template, shift) in [
+        ("quotient", format!("{min}/-1"), min.len()),
+        ("remainder", format!("{min} mod -1"), min.len() + 1),
+        ("product", format!("{min}*2"), min.len()),
+        ("negation", format!("-{min}"), 0),
+    ] {
+        let text = s.replacen("name = \"bottom{i}\"", &format!("name = \"bottom{{{template}}}\""), 1);
+        let at = format!("{{{template}}}");
+        refused_at(&d, name, &text, &at, 1 + shift, "whole number out of range");
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// What `check` expands is bounded before it is spent: 9,900 looped sums of 450 terms (they
+/// had taken 27.6 s and 7.4 GB), and a topology sweep over 1,000 prisms, are refused at the
+/// entry that passes the bound.
+#[test]
+fn expanded_work_is_bounded() {
+    let d = dir("expanded");
+    let s = std::fs::read_to_string(PRISM_N).unwrap();
+    let sums = "[[quantities]]\nfor = { j = \"0..9900\" }\nname = \"big{j}\"\nexpr = \"sum(i in 0..450, B{i mod n}.x + {j})\"\n";
+    let text = s.replacen("[[predictions]]", &format!("{sums}\n[[predictions]]"), 1);
+    let words = "the patterns expand past 2097152 bytes of names and expressions";
+    refused_at(&d, "looped_sums", &text, "\"sum(i in 0..450", 1, words);
+    let topologies = s.replace("count = 10 }", "count = 1000 }").replace("to = 12,", "to = 1002,");
+    let topologies = topologies.replace("n_max = { value = 17,", "n_max = { value = 1002,");
+    let p = d.join("topologies.toml");
+    std::fs::write(&p, &topologies).unwrap();
+    let (code, _, err) = tensegrity(&["check", p.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("topologies.toml:") && err.contains(words), "{err}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// Runs the binary with its standard output on `/dev/full` or closed (`>&-`).
+fn with_stdout(how: &str, args: &[&str]) -> (i32, String) {
+    let bin = env!("CARGO_BIN_EXE_tensegrity");
+    let redirect = if how == "full" { ">/dev/full" } else { ">&-" };
+    let script = format!("exec \"$0\" \"$@\" {redirect}");
+    let out = Command::new("sh").arg("-c").arg(script).arg(bin).args(args).output().unwrap();
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// Standard output that cannot be written (full, closed) fails the command with exit 1 and
+/// its message, for every command that writes there; never a panic, never a silent exit 0.
+#[test]
+fn standard_output_that_cannot_be_written() {
+    let quick = "scenarios/custom/prism3.toml";
+    for how in ["full", "closed"] {
+        for args in [
+            vec!["list"],
+            vec!["check", quick],
+            vec!["run", quick, "--json", "-"],
+            vec!["sweep", SWEEP_FILE, "--jobs", "1", "--out", "-"],
+            vec!["modes", quick],
+            vec!["solve", "mohr2011", "ikp", "--set", "x=0", "--set", "y=0", "--set", "z=1"],
+        ] {
+            let (code, err) = with_stdout(how, &args);
+            assert_eq!(code, 1, "{how} {args:?}: {err}");
+            let words = if how == "full" { "writing to standard output" } else { "standard output is closed" };
+            assert!(err.contains(words) && !err.contains("panicked"), "{how} {args:?}: {err}");
+        }
+    }
+}
+
+/// `--set` of one name twice is refused with both flags named (the last had won in silence).
+#[test]
+fn a_name_set_twice() {
+    let (code, _, err) = tensegrity(&["check", SWEEP_FILE, "--set", "k2=10", "--set", "k2=20"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--set k2=10 and --set k2=20: 'k2' is set twice"), "{err}");
+    let (code, _, err) = tensegrity(&["solve", "mohr2011", "dkp", "--set", "lb=1", "--set", "lb=2"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--set lb=2: 'lb' is set twice"), "{err}");
+}
+
+/// A figure whose folder cannot be made is refused before any point is settled, as any output
+/// is; a missing folder is made, as for `--out`.
+#[test]
+fn a_figure_folder_checked_before_work() {
+    let d = dir("figure-folder");
+    let file = d.join("a-file");
+    std::fs::write(&file, "not a folder").unwrap();
+    let under_file = file.join("f.png");
+    let (code, out, err) = tensegrity(&["sweep", SWEEP_FILE, "--figure", under_file.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(&format!("{} cannot be written: {} is not a directory", under_file.display(), file.display())),
+        "{err}"
+    );
+    assert!(!out.contains("point(s)"), "nothing settled: {out}");
+    let missing = d.join("new").join("f.png");
+    let (code, _, err) = tensegrity(&["sweep", SWEEP_FILE, "--jobs", "1", "--figure", missing.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(missing.exists(), "the figure in its new folder");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// A branch whose closed form overflowed is no branch: `dkp` with lb = 1e300 had printed
+/// (0, 0, 0) as the z > 0 branch and exited 0.
+#[test]
+fn an_overflowed_branch_is_refused() {
+    let args = ["solve", "mohr2011", "dkp", "--set", "rho1=1", "--set", "rho2=1", "--set", "rho3=1"];
+    for lb in ["1e300", "1e155", "-1e300"] {
+        let set = format!("lb={lb}");
+        let (code, out, err) = tensegrity(&[&args[..], &["--set", &set]].concat());
+        assert_eq!(code, 2, "lb = {lb}: {out}{err}");
+        assert!(!out.contains("z > 0"), "lb = {lb}: no branch printed: {out}");
+    }
+}
+
+/// SIGINT while the Lagrangian model is integrated between two ticks (a stiff model: its
+/// kinetic energy scaled by 1e-9, about 5e5 rad/s, whose integration runs to its 10-million
+/// step limit for about a minute) stops the run at once: exit 1, the model reported as
+/// interrupted (the signal had waited for the limit).
+#[test]
+fn a_stiff_lagrangian_integration_stops_on_sigint() {
+    use crate::common::{runs_its_command, send_signal, wait_for, HANG_GUARD_S};
+    let d = dir("stiff");
+    let text = crate::common::edited(
+        "scenarios/custom/pinned_bar_large_amplitude.toml",
+        &[("kinetic = \"0.5*I_pivot*qe_dot^2\"", "kinetic = \"0.5*I_pivot*1e-9*qe_dot^2\"")],
+    );
+    let p = d.join("stiff.toml");
+    std::fs::write(&p, text).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+        .args(["run", p.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    wait_for("command's thread", || runs_its_command(pid));
+    // The motion starts within milliseconds and the model's integration then holds its tick.
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    send_signal("INT", pid);
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || tx.send(child.wait_with_output()));
+    let Ok(out) = rx.recv_timeout(std::time::Duration::from_secs(HANG_GUARD_S)) else {
+        send_signal("KILL", pid);
+        panic!("the run did not stop within the {HANG_GUARD_S} s hang guard");
+    };
+    let out = out.unwrap();
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{report}");
+    assert!(report.contains("stopped: interrupted at tick"), "{report}");
+    assert!(report.contains("the Lagrangian model cannot be integrated: interrupted"), "{report}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// Keys that mean nothing together are refused, the error naming both: a second axis on a
+/// joint that has one, an axis on a joint that has none, a rest angle of no torsion spring, a
+/// start given twice, a flag that is no flag; a triple of two numbers says so (it had been
+/// reported as [0.0, 1.0, NaN]).
+#[test]
+fn keys_that_mean_nothing_together() {
+    let d = dir("together");
+    let planar = PINNED_STRUT
+        .replace("kind = \"revolute\"", "kind = \"planar_pin\"")
+        .replace("axis = [0.0, 0.0, 1.0]", "axis = [0.0, 0.0, 1.0]\naxis2 = [1.0, 0.0, 0.0]");
+    refused_at(&d, "axis2", &planar, "axis2 = [", 8, "axis2 means nothing on a planar_pin joint");
+    let spherical = PINNED_STRUT.replace("kind = \"revolute\"", "kind = \"spherical\"");
+    refused_at(
+        &d,
+        "spherical_axis",
+        &spherical,
+        "[0.0, 0.0, 1.0]\ndamping",
+        0,
+        "axis means nothing on a spherical joint",
+    );
+    let rest = PINNED_STRUT.replace("damping = 0.5", "damping = 0.5\ntorsion_rest = 0.3");
+    refused_at(&d, "torsion_rest", &rest, "0.3", 0, "torsion_rest means nothing without torsion_stiffness");
+    let two = PINNED_STRUT.replace("axis = [0.0, 0.0, 1.0]", "axis = [0.0, 1.0]");
+    refused_at(
+        &d,
+        "two_components",
+        &two,
+        "[0.0, 1.0]",
+        0,
+        "axis must be three finite numbers [x, y, z], got 2 of them",
+    );
+    let prism = std::fs::read_to_string(PRISM_N).unwrap();
+    let turned = prism.replace("rotate = { axis = [0, 0, 1]", "rotate = { axis = [0, 1]");
+    refused_at(
+        &d,
+        "rotate_axis",
+        &turned,
+        "[0, 1]",
+        0,
+        "rotate.axis must be three finite numbers [x, y, z], got 2 of them",
+    );
+    let quick = std::fs::read_to_string("scenarios/ji2014/quick.toml").unwrap();
+    let both = format!("{quick}\n[start]\ntheta2 = 1.0\ntheta2_offset = 0.2\n");
+    refused_at(&d, "theta2_twice", &both, "theta2_offset = 0.2", 0, "[start] theta2_offset means nothing with theta2");
+    let flag = format!("{quick}\n[start]\nat_unstable_root = 2.0\n");
+    refused_at(&d, "flag", &flag, "2.0\n", 0, "at_unstable_root is a flag: 0 or 1, got 2");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// A spin faster than the simulator keeps (rapier clamps a body's turn at pi/4 rad a step, in
+/// silence) is refused at its angular velocity, whatever its size up to an overflow; one just
+/// under the bound is accepted.
+#[test]
+fn a_spin_beyond_what_the_simulator_keeps() {
+    let d = dir("spin");
+    let text = |w: &str| {
+        format!(
+            "name = \"spin\"\nmechanism = \"custom\"\n[sim]\ndt = 0.01\n[actuation]\npoints = [ {{}} ]\n[structure]\n\
+             [[structure.bodies]]\nname = \"top\"\nmass = 1.0\ninertia = [1.0, 2.0, 3.0]\n\
+             nodes = {{ XP = [1, 0, 0], XM = [-1, 0, 0], ZP = [0, 0, 1] }}\n\
+             [motion]\nduration_s = 0.1\nstart = \"drawn\"\nspin = {{ body = \"top\", angular_velocity = {w} }}\n"
+        )
+    };
+    // pi/4 / 0.01 s = 78.54 rad/s.
+    for w in ["[1e300, 0.2, 4.0]", "[1e10, 0.2, 4.0]", "[0.0, 0.0, 78.6]", "[60.0, 60.0, 0.0]"] {
+        let words = "the simulator keeps at most pi/4 rad a step, 7.853981633974483e1 rad/s at sim.dt = 0.01 s";
+        refused_at(&d, "fast", &text(w), w, 0, words);
+    }
+    let p = d.join("under.toml");
+    std::fs::write(&p, text("[0.0, 0.0, 78.5]")).unwrap();
+    let (code, _, err) = tensegrity(&["check", p.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// A run that diverges at its first step (a 1e9 N/m spring at dt = 0.1 s) leaves an earlier
+/// complete table as it was (it had been replaced by an empty file) and says so.
+#[test]
+fn a_run_without_a_tick_leaves_an_earlier_table() {
+    let d = dir("no-tick");
+    let text = PINNED_STRUT
+        .replace("stiffness = 10.0", "stiffness = 1e9")
+        .replace("[actuation]", "[sim]\ndt = 0.1\n[actuation]")
+        + "\n[motion]\nduration_s = 1.0\nstart = \"drawn\"\n";
+    let (p, table) = (d.join("diverges.toml"), d.join("table.csv"));
+    std::fs::write(&p, text).unwrap();
+    std::fs::write(&table, "tick,earlier\n0,1\n").unwrap();
+    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap(), "--table", table.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("simulation diverged at tick 1"), "{out}");
+    assert!(err.contains(&format!("no tick ran: the table {} was not written", table.display())), "{err}");
+    assert_eq!(std::fs::read_to_string(&table).unwrap(), "tick,earlier\n0,1\n");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// A motion along a rigid-body mode (the prism's modes 1-3 spin its struts about their axes)
+/// is refused by name, never judged against a frequency of about 0 rad/s.
+#[test]
+fn a_motion_along_a_rigid_body_mode_is_refused() {
+    let d = dir("rigid-mode");
+    let text = crate::common::edited(
+        "scenarios/custom/prism3_free_vibration.toml",
+        &[
+            ("mode = 4              # displaced", "mode = 1              # displaced"),
+            ("mode = 4              # fitted", "mode = 2              # fitted"),
+        ],
+    );
+    let p = d.join("rigid.toml");
+    std::fs::write(&p, text).unwrap();
+    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("mode 1 is a rigid-body mode") && out.contains("choose a mode from 4"), "{out}");
+    assert!(!out.contains("frequency lowest mode (cosine fit): predicted -"), "{out}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// `--set k=nan` of a parameter a pattern reads is reported at the flag (it had been reported
+/// at a range of the structure), and a grid of one point over a pattern's parameter builds
+/// the structure of that point (it had built the file's and judged it at the point's n).
+#[test]
+fn a_topology_parameter_at_its_flag_and_at_its_one_point() {
+    let (code, _, err) = tensegrity(&["check", PRISM_N, "--set", "r=nan"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--set r=nan:1:5: parameter 'r' must be a finite number, got NaN"), "{err}");
+    let d = dir("one-topology");
+    let text = std::fs::read_to_string(PRISM_N)
+        .unwrap()
+        .replace("from = 3, to = 12, count = 10", "from = 5, to = 5, count = 1");
+    let p = d.join("five.toml");
+    std::fs::write(&p, text).unwrap();
+    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("strut_to_side4"), "five struts built: {out}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// `prism_n.toml` holds for the n it states (3 to 17) and refuses an n past them where its
+/// bound is written (it had claimed any n and settled 2.85 rad off at n = 20 and 40).
+#[test]
+fn prism_n_refuses_an_n_it_does_not_hold() {
+    let d = dir("prism-n");
+    let s = std::fs::read_to_string(PRISM_N).unwrap();
+    assert!(s.contains("n from 3 to 17") && s.contains("n_max = { value = 17,"));
+    let text = s.replace("from = 3, to = 12, count = 10", "from = 3, to = 20, count = 18");
+    refused_at(
+        &d,
+        "prism_20",
+        &text,
+        "n_checked = { value",
+        22,
+        "parameter 'n_checked' must be a finite number, got NaN",
+    );
+    let text = s.replace("from = 3, to = 12, count = 10", "from = 17, to = 17, count = 1");
+    let p = d.join("prism_17.toml");
+    std::fs::write(&p, text).unwrap();
+    let (code, out, err) = tensegrity(&["run", p.to_str().unwrap()]);
+    assert_eq!(code, 0, "n = 17 holds: {out}{err}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// The modes of a structure past 400 free bodies (a dense eigenproblem: 1000 struts had taken
+/// more than 2 GiB) are refused: at the motion's mode key by `check`, and by `modes` before it
+/// settles.
+#[test]
+fn modes_past_their_size_are_refused() {
+    let d = dir("modes-size");
+    let s = std::fs::read_to_string(PRISM_N).unwrap();
+    let big = s
+        .replace("grid = { n = { from = 3, to = 12, count = 10 } }", "points = [ {} ]")
+        .replace("n = { value = 3,", "n = { value = 402,")
+        .replace("n_max = { value = 17,", "n_max = { value = 402,");
+    let motion = big.replace(
+        "# The axis through",
+        "[motion]\nduration_s = 0.1\nstart = \"drawn\"\nmode = 7\namplitude = 1e-5\n\n# The axis through",
+    );
+    refused_at(
+        &d,
+        "motion_mode",
+        &motion,
+        "mode = 7",
+        7,
+        "the structure has 401 free bodies, and its modes are a dense eigenproblem solved for at most 400",
+    );
+    let p = d.join("big.toml");
+    std::fs::write(&p, &big).unwrap();
+    let (code, _, err) = tensegrity(&["modes", p.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("401 free bodies: the modes are a dense eigenproblem, solved for at most 400 free bodies"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&d).ok();
+}

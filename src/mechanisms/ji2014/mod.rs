@@ -302,6 +302,12 @@ impl Mechanism for Ji2014 {
         };
         Ok(build::build(&p, &model_of(params), l3, th1, theta2))
     }
+    fn start_flags(&self) -> &'static [&'static str] {
+        &["at_unstable_root"]
+    }
+    fn start_exclusive(&self) -> &'static [(&'static str, &'static str)] {
+        &[("theta2", "theta2_offset"), ("theta2", "at_unstable_root"), ("at_unstable_root", "theta2_offset")]
+    }
     fn starts_on_unstable_branch(&self, start: &Values) -> bool {
         start.get("at_unstable_root").is_some_and(|f| *f != 0.0)
     }

@@ -204,7 +204,7 @@ pub fn dkp_radicand_eq14(p: &Params, rho: &[f64; 3]) -> f64 {
 
 /// Eq. 12-14 (DKP), the `z >= 0` branch: centroid \[m\] from the actuated
 /// lengths `rho` \[m\]. `None` when the radicand of Eq. 14 is negative (no
-/// assembly) or a `rho` is negative / not finite. The `z < 0` mirror image
+/// assembly) or not a finite number (overflowed), or a `rho` is negative / not finite. The `z < 0` mirror image
 /// is `(x, y, -z)`.
 pub fn dkp(p: &Params, rho: &[f64; 3]) -> Option<Vector3<f64>> {
     if rho.iter().any(|r| !r.is_finite() || *r < 0.0) {
@@ -216,7 +216,8 @@ pub fn dkp(p: &Params, rho: &[f64; 3]) -> Option<Vector3<f64>> {
     let y = (2.0 * u3 - u2 - u1) / (2.0 * SQRT_3 * lb); // Eq. 13
     let rad = dkp_radicand_eq14(p, rho);
     let scale = lb * lb * (u1 + u2 + u3);
-    if rad < -DKP_RADICAND_REL_TOL * scale {
+    // An overflowed radicand (lb = 1e300) is no branch: it had printed (0, 0, 0).
+    if !rad.is_finite() || !scale.is_finite() || rad < -DKP_RADICAND_REL_TOL * scale {
         return None;
     }
     let z = rad.max(0.0).sqrt() / (SQRT_3 * lb); // Eq. 14, + branch

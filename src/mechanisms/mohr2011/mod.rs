@@ -332,7 +332,11 @@ impl Mechanism for Mohr2011 {
             "dkp" => {
                 let rho = rho_of(inputs)?;
                 let p = analytic::dkp(&pa, &rho).ok_or_else(|| {
-                    ModelError::no_solution(format!("cable lengths {rho:?} m are unreachable: Eq. 14 has no real z"))
+                    let rad = analytic::dkp_radicand_eq14(&pa, &rho);
+                    ModelError::no_solution(match rad.is_finite() {
+                        true => format!("cable lengths {rho:?} m are unreachable: Eq. 14 has no real z"),
+                        false => format!("cable lengths {rho:?} m: Eq. 14's radicand overflows ({rad}) with these values, no branch computed"),
+                    })
                 })?;
                 let st = analytic::statics(&pa, &p);
                 Ok(vec![
