@@ -123,12 +123,32 @@ pub fn fit(problem: &FitProblem, cancel: Option<&AtomicBool>) -> Result<FitRepor
     let weights = validate(problem)?;
     let sc = crate::scenario::parse_with(&problem.file, &problem.source, &problem.overrides)?;
     let initial = initial_values(problem, &sc)?;
-    let at = |p: &DVector<f64>| -> Result<Iterate, FitError> {
-        let eval = evaluate(problem, p.as_slice(), cancel)?;
-        let r = (&eval.model - measured(problem)).component_mul(&weights);
+    let cancelled = || cancel.is_some_and(|c| c.load(Ordering::SeqCst));
+    let model = &mut |p: &[f64]| evaluate(problem, p, cancel);
+    let (it, iterations, stopped) = iterate(problem, &initial, &weights, model, &cancelled)?;
+    Ok(report(problem, &sc.name, &initial, &it, &weights, iterations, stopped))
+}
+
+/// The model's outputs and Jacobian at the parameters.
+type Model<'a> = &'a mut dyn FnMut(&[f64]) -> Result<Evaluation, FitError>;
+
+/// Levenberg-Marquardt from `initial` on `model` against `problem`'s measurements weighted by
+/// `weights`: the optimum, the accepted steps and why they stopped. A step whose evaluation
+/// fails (a settle that does not come) is rejected as one that raises chi^2, unless
+/// `cancelled`.
+fn iterate(
+    problem: &FitProblem,
+    initial: &DVector<f64>,
+    weights: &DVector<f64>,
+    model: Model,
+    cancelled: &dyn Fn() -> bool,
+) -> Result<(Iterate, usize, String), FitError> {
+    let mut at = |p: &DVector<f64>| -> Result<Iterate, FitError> {
+        let eval = model(p.as_slice())?;
+        let r = (&eval.model - measured(problem)).component_mul(weights);
         Ok(Iterate { p: p.clone(), cost: r.norm_squared(), eval, r })
     };
-    let mut it = at(&initial)?;
+    let mut it = at(initial)?;
     let (mut lambda, mut iterations) = (INITIAL_DAMPING, 0);
     let stopped = loop {
         if iterations == MAX_ITERATIONS {
@@ -137,12 +157,12 @@ pub fn fit(problem: &FitProblem, cancel: Option<&AtomicBool>) -> Result<FitRepor
         if it.cost == 0.0 {
             break "chi^2 = 0".to_string();
         }
-        let j = weighted(&it.eval.jacobian, &weights);
+        let j = weighted(&it.eval.jacobian, weights);
         let step = lm_step(&j, &it.r, lambda);
-        let trial = bounded(problem, &initial, &(&it.p + &step))?;
+        let trial = bounded(problem, initial, &(&it.p + &step))?;
         let next = match at(&trial) {
             Ok(next) if next.cost < it.cost => next,
-            Err(e) if !e.is_bad_input() && !cancel.is_some_and(|c| c.load(Ordering::SeqCst)) => {
+            Err(e) if !e.is_bad_input() && !cancelled() => {
                 lambda *= DAMPING_FACTOR;
                 if lambda > MAX_DAMPING {
                     return Err(e);
@@ -168,7 +188,7 @@ pub fn fit(problem: &FitProblem, cancel: Option<&AtomicBool>) -> Result<FitRepor
             break if small_step { "the step tolerance" } else { "the chi^2 tolerance" }.to_string();
         }
     };
-    Ok(report(problem, &sc, &initial, &it, &weights, iterations, stopped))
+    Ok((it, iterations, stopped))
 }
 
 /// The data checked (finite values, positive sigmas given on every row or on none, at least
@@ -375,7 +395,7 @@ fn settled_point(
 /// The report at the optimum `it`: intervals from the covariance, residuals, combinations.
 fn report(
     problem: &FitProblem,
-    sc: &Scenario,
+    name: &str,
     initial: &DVector<f64>,
     it: &Iterate,
     weights: &DVector<f64>,
@@ -417,7 +437,7 @@ fn report(
         })
         .collect();
     FitReport {
-        name: sc.name.clone(),
+        name: name.to_string(),
         file: problem.file.display().to_string(),
         parameters,
         covariance: covariance.row_iter().map(|r| r.iter().copied().collect()).collect(),
@@ -498,4 +518,75 @@ fn edits(a: &str, b: &str) -> usize {
         }
     }
     row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The seeds of the coverage check, and the noise on each of the line's points.
+    const SEEDS: u64 = 200;
+    const POINTS: usize = 10;
+    const NOISE: f64 = 0.01;
+
+    /// A standard normal number from `state` (splitmix64, Box-Muller).
+    fn normal(state: &mut u64) -> f64 {
+        let mut uniform = || {
+            *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = *state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (u, v) = (uniform().max(f64::MIN_POSITIVE), uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+
+    /// A line y = p0 + p1 t at t = 0 .. 0.9 measured with Gaussian noise of sigma NOISE
+    /// (truth p = (2, 0.5)), fitted over 200 seeds: each 95 % interval holds the truth in
+    /// 0.95 -+ 0.033 of the 400 intervals (three binomial standard deviations, the draws
+    /// fixed by the seeds), and each fit converges in at most 6 steps (the model is linear:
+    /// each step leaves about the damping's share of the error, 1e-3 falling tenfold a step).
+    #[test]
+    fn intervals_of_a_line_hold_the_truth_in_95_percent_of_fits() {
+        let truth = [2.0, 0.5];
+        let t: Vec<f64> = (0..POINTS).map(|i| 0.1 * i as f64).collect();
+        let mut held = 0;
+        for seed in 0..SEEDS {
+            let mut state = seed;
+            let measurements = t
+                .iter()
+                .map(|&ti| Measurement {
+                    at: String::new(),
+                    point: 0,
+                    output: "y".into(),
+                    value: truth[0] + truth[1] * ti + NOISE * normal(&mut state),
+                    sigma: Some(NOISE),
+                })
+                .collect();
+            let parameters =
+                ["p0", "p1"].iter().map(|n| FitParameter { name: n.to_string(), low: None, high: None }).collect();
+            let problem = FitProblem {
+                file: PathBuf::from("line"),
+                source: String::new(),
+                overrides: Vec::new(),
+                parameters,
+                measurements,
+            };
+            let weights = validate(&problem).expect("valid");
+            let initial = DVector::from_vec(vec![1.0, 1.0]);
+            let model = &mut |p: &[f64]| {
+                Ok(Evaluation {
+                    model: DVector::from_iterator(POINTS, t.iter().map(|ti| p[0] + p[1] * ti)),
+                    jacobian: DMatrix::from_fn(POINTS, 2, |i, j| if j == 0 { 1.0 } else { t[i] }),
+                })
+            };
+            let (it, iterations, stopped) = iterate(&problem, &initial, &weights, model, &|| false).expect("a fit");
+            assert!(iterations <= 6, "seed {seed}: {iterations} steps ({stopped})");
+            let r = report(&problem, "line", &initial, &it, &weights, iterations, stopped);
+            held += r.parameters.iter().zip(truth).filter(|(p, v)| p.low <= *v && *v <= p.high).count();
+        }
+        let fraction = held as f64 / (2 * SEEDS) as f64;
+        assert!((fraction - 0.95).abs() <= 0.033, "{held} of {} intervals hold the truth", 2 * SEEDS);
+    }
 }
