@@ -97,6 +97,29 @@ pub enum Command {
         #[command(flatten)]
         set: SetArgs,
     },
+    /// Fit named parameters of a scenario to measured outputs (a CSV with the columns
+    /// point,output,value[,sigma]) by Levenberg-Marquardt, the Jacobian from the sensitivities
+    /// at each measured point settled afresh: the estimates, their covariance and 95 %
+    /// intervals, the residual of each measurement, chi^2, and the parameter combinations the
+    /// data cannot identify (their intervals infinite).
+    Fit {
+        scenario: PathBuf,
+        /// The measurements: CSV with a header naming point, output, value and optionally
+        /// sigma (the output's standard deviation, in its unit; without it the covariance is
+        /// scaled by the reduced chi^2).
+        #[arg(long, value_name = "FILE.csv")]
+        data: PathBuf,
+        /// A parameter to fit, with optional bounds (repeatable): NAME, NAME=LOW:HIGH,
+        /// NAME=LOW: or NAME=:HIGH.
+        #[arg(long = "param", value_name = "NAME[=LOW:HIGH]", required = true)]
+        params: Vec<String>,
+        /// Write the JSON report to this file (`-`: standard output, the table then going to
+        /// standard error).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        #[command(flatten)]
+        set: SetArgs,
+    },
     /// Validate scenario files without running them.
     Check {
         #[arg(required = true)]

@@ -11,6 +11,7 @@ mod check;
 mod export;
 mod figure;
 mod findings;
+mod fit;
 mod import;
 mod list;
 mod merge;
@@ -125,6 +126,9 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         }
         Command::Sensitivity { scenario, json, csv, point, check, set } => {
             sensitivity::sensitivity(&scenario, &overrides(&set)?, json.as_deref(), csv.as_deref(), point, check)
+        }
+        Command::Fit { scenario, data, params, json, set } => {
+            fit::fit(&scenario, &overrides(&set)?, &data, &params, json.as_deref())
         }
         bench @ Command::Bench { .. } => bench::bench(bench),
     }

@@ -4,6 +4,7 @@
 //! `settle.rs` the settle loop, `point.rs` one settle point (branch, stability, probe,
 //! read-out) (the pass policy is `report::verdict`).
 
+mod fit;
 mod levels;
 mod motion;
 mod point;
@@ -25,6 +26,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Instant;
 
+pub use fit::{fit, FitError, FitParameter, FitProblem, Measurement};
 pub use levels::judged_nodes_after;
 pub use point::NO_BRANCH;
 pub use sensitivity::{point_of as sensitivity_point_of, sensitivity, SensitivityRunError};

@@ -14,6 +14,7 @@ mod driven_motion;
 mod dynamic_model;
 mod export_mjcf;
 mod figures;
+mod fit;
 mod free_spin;
 mod frequency_curves;
 mod frequency_measures;

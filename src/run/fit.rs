@@ -1,0 +1,592 @@
+//! `tensegrity fit`: named parameters of a scenario fitted to measured outputs (rows: settle
+//! point, output, value, sigma) by Levenberg-Marquardt on the weighted residuals
+//! r_i = (y_i(p) - measured_i) / sigma_i. Each evaluation parses the scenario again with the
+//! parameters set as `--set NAME=VALUE` sets them (derived parameters follow), settles every
+//! measured point afresh and takes the Jacobian dy_i/dp_j from the sensitivities there
+//! (`run::sensitivity`, the implicit function theorem): no difference of settles.
+//!
+//! At the optimum, the weighted Jacobian's singular values (its columns scaled by each
+//! parameter's value, so that the ratio is free of units) tell what the data identify: below
+//! [`UNIDENTIFIABLE_RATIO`] of the largest, the right singular vector is a combination the
+//! data do not see, and the parameters in it get an infinite interval (as MuJoCo's sysid
+//! reports them). The covariance is (J^T J)^-1 over the other directions; scaled by the
+//! reduced chi^2 only when no measurement states its sigma (each then weighs 1).
+
+use super::sensitivity::{point_of, SensitivityRunError};
+use crate::report::fit::{Combination, FitReport, FitResidual, FittedParameter};
+use crate::report::sensitivity::SensitivityReport;
+use crate::scenario::{Override, Scenario, ScenarioError};
+use nalgebra::{DMatrix, DVector};
+use std::collections::btree_map::{BTreeMap, Entry};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Levenberg-Marquardt iterations (accepted steps) at most.
+pub const MAX_ITERATIONS: usize = 50;
+/// Converged when every parameter's step is below this fraction of its value.
+pub const STEP_TOLERANCE: f64 = 1e-10;
+/// Converged when a step lowers chi^2 by less than this fraction of it.
+pub const COST_TOLERANCE: f64 = 1e-14;
+/// A singular value of the weighted, value-scaled Jacobian below this fraction of the largest
+/// is a direction the data do not identify.
+pub const UNIDENTIFIABLE_RATIO: f64 = 1e-6;
+/// A parameter is named in an unidentifiable combination when its weight in the singular
+/// vector is above this.
+pub const COMBINATION_FLOOR: f64 = 0.05;
+/// The 95 % two-sided normal quantile: an interval is value -+ this many sigma.
+pub const INTERVAL_Z_95: f64 = 1.959_963_984_540_054;
+/// A parameter without bounds has run away when it moved by more than this many times its
+/// initial value (or 1 at 0).
+pub const RUNAWAY_RATIO: f64 = 1e6;
+/// The first damping lambda of (J^T J + lambda diag(J^T J)) dp = -J^T r.
+const INITIAL_DAMPING: f64 = 1e-3;
+/// The damping's factor on a rejected step (and its divisor on an accepted one).
+const DAMPING_FACTOR: f64 = 10.0;
+/// No step lowers chi^2 once the damping exceeds this.
+const MAX_DAMPING: f64 = 1e12;
+/// The floor of diag(J^T J) in the damping, a fraction of its largest entry (a parameter
+/// that moves nothing still gets a damped, finite step).
+const DIAGONAL_FLOOR: f64 = 1e-12;
+
+/// A parameter to fit, with its optional box bounds (in its own unit).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitParameter {
+    pub name: String,
+    pub low: Option<f64>,
+    pub high: Option<f64>,
+}
+
+/// A measured output at a settle point (from 0, as a run numbers them).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measurement {
+    /// Where it was read (`measured.csv:3`), for errors.
+    pub at: String,
+    pub point: usize,
+    pub output: String,
+    pub value: f64,
+    /// Its standard deviation, in the output's unit; None: unweighted.
+    pub sigma: Option<f64>,
+}
+
+/// What to fit: the scenario (its file and text, parsed again at each evaluation with its
+/// `--set` flags and the fitted parameters), the parameters and the measurements.
+#[derive(Clone, Debug)]
+pub struct FitProblem {
+    pub file: PathBuf,
+    pub source: String,
+    pub overrides: Vec<Override>,
+    pub parameters: Vec<FitParameter>,
+    pub measurements: Vec<Measurement>,
+}
+
+/// Why a fit has no result.
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    /// The scenario at some parameters does not parse (bad input).
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    /// The data or the parameters named are wrong (bad input).
+    #[error("{0}")]
+    BadInput(String),
+    /// A parameter reached its bound, or ran away (bad input: the data want it elsewhere).
+    #[error("{0}")]
+    Stopped(String),
+    /// A settle or its sensitivities failed.
+    #[error("{0}")]
+    Failed(String),
+}
+
+impl FitError {
+    /// Whether the error is the input's (exit 2) rather than the run's (exit 1).
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(self, FitError::Failed(_))
+    }
+}
+
+/// The model's outputs at the measurements and their derivatives by the fitted parameters.
+struct Evaluation {
+    model: DVector<f64>,
+    jacobian: DMatrix<f64>,
+}
+
+/// The state of the iterations: parameters, evaluation there, weighted residuals, chi^2.
+struct Iterate {
+    p: DVector<f64>,
+    eval: Evaluation,
+    r: DVector<f64>,
+    cost: f64,
+}
+
+/// Fits `problem` (see the module): the estimates, covariance, intervals, residuals and
+/// unidentifiable combinations; stopped by `cancel`.
+pub fn fit(problem: &FitProblem, cancel: Option<&AtomicBool>) -> Result<FitReport, FitError> {
+    let weights = validate(problem)?;
+    let sc = crate::scenario::parse_with(&problem.file, &problem.source, &problem.overrides)?;
+    let initial = initial_values(problem, &sc)?;
+    let cancelled = || cancel.is_some_and(|c| c.load(Ordering::SeqCst));
+    let model = &mut |p: &[f64]| evaluate(problem, p, cancel);
+    let (it, iterations, stopped) = iterate(problem, &initial, &weights, model, &cancelled)?;
+    Ok(report(problem, &sc.name, &initial, &it, &weights, iterations, stopped))
+}
+
+/// The model's outputs and Jacobian at the parameters.
+type Model<'a> = &'a mut dyn FnMut(&[f64]) -> Result<Evaluation, FitError>;
+
+/// Levenberg-Marquardt from `initial` on `model` against `problem`'s measurements weighted by
+/// `weights`: the optimum, the accepted steps and why they stopped. A step whose evaluation
+/// fails (a settle that does not come) is rejected as one that raises chi^2, unless
+/// `cancelled`.
+fn iterate(
+    problem: &FitProblem,
+    initial: &DVector<f64>,
+    weights: &DVector<f64>,
+    model: Model,
+    cancelled: &dyn Fn() -> bool,
+) -> Result<(Iterate, usize, String), FitError> {
+    let mut at = |p: &DVector<f64>| -> Result<Iterate, FitError> {
+        let eval = model(p.as_slice())?;
+        let r = (&eval.model - measured(problem)).component_mul(weights);
+        Ok(Iterate { p: p.clone(), cost: r.norm_squared(), eval, r })
+    };
+    let mut it = at(initial)?;
+    let (mut lambda, mut iterations) = (INITIAL_DAMPING, 0);
+    let stopped = loop {
+        if iterations == MAX_ITERATIONS {
+            break format!("the iteration cap, {MAX_ITERATIONS}");
+        }
+        if it.cost == 0.0 {
+            break "chi^2 = 0".to_string();
+        }
+        let j = weighted(&it.eval.jacobian, weights);
+        let step = lm_step(&j, &it.r, lambda);
+        let trial = bounded(problem, initial, &(&it.p + &step))?;
+        let next = match at(&trial) {
+            Ok(next) if next.cost < it.cost => next,
+            Err(e) if !e.is_bad_input() && !cancelled() => {
+                lambda *= DAMPING_FACTOR;
+                if lambda > MAX_DAMPING {
+                    return Err(e);
+                }
+                continue;
+            }
+            Err(e) => return Err(e),
+            Ok(_) => {
+                lambda *= DAMPING_FACTOR;
+                if lambda > MAX_DAMPING {
+                    break "no step lowers chi^2".to_string();
+                }
+                continue;
+            }
+        };
+        iterations += 1;
+        lambda /= DAMPING_FACTOR;
+        let small_step = (0..trial.len()).all(|k| (trial[k] - it.p[k]).abs() <= STEP_TOLERANCE * trial[k].abs());
+        let small_gain = it.cost - next.cost <= COST_TOLERANCE * it.cost;
+        at_bound(problem, &(&it.p + &step), &trial)?;
+        it = next;
+        if small_step || small_gain {
+            break if small_step { "the step tolerance" } else { "the chi^2 tolerance" }.to_string();
+        }
+    };
+    Ok((it, iterations, stopped))
+}
+
+/// The data checked (finite values, positive sigmas given on every row or on none, at least
+/// as many rows as parameters, each parameter once), and each row's weight 1/sigma.
+fn validate(problem: &FitProblem) -> Result<DVector<f64>, FitError> {
+    let bad = |s: String| Err(FitError::BadInput(s));
+    let (m, n) = (problem.measurements.len(), problem.parameters.len());
+    if n == 0 {
+        return bad("no parameter to fit: name one with --param NAME[=LOW:HIGH]".into());
+    }
+    for (k, f) in problem.parameters.iter().enumerate() {
+        if problem.parameters[..k].iter().any(|g| g.name == f.name) {
+            return bad(format!("--param {}: named twice", f.name));
+        }
+        if let (Some(lo), Some(hi)) = (f.low, f.high) {
+            if lo >= hi {
+                return bad(format!("--param {}={lo}:{hi}: the low bound must be below the high one", f.name));
+            }
+        }
+    }
+    let with_sigma = problem.measurements.iter().filter(|x| x.sigma.is_some()).count();
+    for x in &problem.measurements {
+        if !x.value.is_finite() {
+            return bad(format!("{}: the measured value of {} is {} (not a finite number)", x.at, x.output, x.value));
+        }
+        match x.sigma {
+            Some(s) if !(s.is_finite() && s > 0.0) => {
+                return bad(format!("{}: sigma of {} is {s}: a positive finite number", x.at, x.output));
+            }
+            None if with_sigma > 0 => {
+                return bad(format!(
+                    "{}: no sigma for {}, where other rows state one: give every row its sigma or none",
+                    x.at, x.output
+                ));
+            }
+            _ => {}
+        }
+    }
+    if m < n || (with_sigma == 0 && m == n) {
+        let why = if with_sigma == 0 {
+            " (without sigmas the noise is estimated from the residuals: more rows than parameters)"
+        } else {
+            ""
+        };
+        return bad(format!("{m} measurements for {n} fitted parameters: too few{why}"));
+    }
+    Ok(DVector::from_iterator(m, problem.measurements.iter().map(|x| 1.0 / x.sigma.unwrap_or(1.0))))
+}
+
+/// Each fitted parameter's value in the scenario, within its bounds; an unknown name refused
+/// with the parameters the scenario has.
+fn initial_values(problem: &FitProblem, sc: &Scenario) -> Result<DVector<f64>, FitError> {
+    let params = sc.params_at(sc.actuation.first_inputs());
+    let mut p = Vec::new();
+    for f in &problem.parameters {
+        if sc.actuation.first_inputs().contains_key(&f.name) {
+            return Err(FitError::BadInput(format!(
+                "--param {}: the scenario's [actuation] sets '{}' at every point: it cannot be fitted",
+                f.name, f.name
+            )));
+        }
+        let Some(&v) = params.get(&f.name) else {
+            let known: Vec<&str> = sc.params.keys().map(String::as_str).collect();
+            let close = close_names(&f.name, known.iter().copied());
+            return Err(FitError::BadInput(format!(
+                "--param {}: the scenario has no parameter '{}'{close} (its parameters: {})",
+                f.name,
+                f.name,
+                known.join(", ")
+            )));
+        };
+        p.push(v.clamp(f.low.unwrap_or(f64::NEG_INFINITY), f.high.unwrap_or(f64::INFINITY)));
+    }
+    Ok(DVector::from_vec(p))
+}
+
+/// The measured values.
+fn measured(problem: &FitProblem) -> DVector<f64> {
+    DVector::from_iterator(problem.measurements.len(), problem.measurements.iter().map(|x| x.value))
+}
+
+/// The Jacobian's rows each times its weight.
+fn weighted(j: &DMatrix<f64>, w: &DVector<f64>) -> DMatrix<f64> {
+    let mut j = j.clone();
+    for (i, mut row) in j.row_iter_mut().enumerate() {
+        row *= w[i];
+    }
+    j
+}
+
+/// The Levenberg-Marquardt step: (J^T J + lambda D) dp = -J^T r, D = diag(J^T J) with a
+/// floor, solved by the SVD (a direction the data do not see gets no step).
+fn lm_step(j: &DMatrix<f64>, r: &DVector<f64>, lambda: f64) -> DVector<f64> {
+    let mut a = j.transpose() * j;
+    let g = j.transpose() * r;
+    let largest = a.diagonal().amax().max(f64::MIN_POSITIVE);
+    for k in 0..a.ncols() {
+        a[(k, k)] += lambda * a[(k, k)].max(DIAGONAL_FLOOR * largest);
+    }
+    let n = a.ncols();
+    a.svd(true, true).solve(&(-g), 0.0).unwrap_or_else(|_| DVector::zeros(n))
+}
+
+/// `p` within each parameter's bounds; a parameter without bounds that moved by more than
+/// [`RUNAWAY_RATIO`] of its initial value is stopped and named.
+fn bounded(problem: &FitProblem, initial: &DVector<f64>, p: &DVector<f64>) -> Result<DVector<f64>, FitError> {
+    let mut out = p.clone();
+    for (k, f) in problem.parameters.iter().enumerate() {
+        out[k] = p[k].clamp(f.low.unwrap_or(f64::NEG_INFINITY), f.high.unwrap_or(f64::INFINITY));
+        let scale = if initial[k] == 0.0 { 1.0 } else { initial[k].abs() };
+        if !out[k].is_finite() || (out[k] - initial[k]).abs() > RUNAWAY_RATIO * scale {
+            return Err(FitError::Stopped(format!(
+                "{} ran away from {} to {:e}: the data do not hold it; bound it with --param {}=LOW:HIGH or fit fewer parameters",
+                f.name, initial[k], p[k], f.name
+            )));
+        }
+    }
+    Ok(out)
+}
+
+/// An accepted step that a bound cut short stops the fit, naming the parameter: the data
+/// want it beyond its bound.
+fn at_bound(problem: &FitProblem, wanted: &DVector<f64>, taken: &DVector<f64>) -> Result<(), FitError> {
+    match (0..wanted.len()).find(|&k| wanted[k] != taken[k]) {
+        None => Ok(()),
+        Some(k) => Err(FitError::Stopped(format!(
+            "{} ran into its bound {} (the step wanted {:e}): the data want it beyond --param {}={}:{}",
+            problem.parameters[k].name,
+            taken[k],
+            wanted[k],
+            problem.parameters[k].name,
+            problem.parameters[k].low.map_or(String::new(), |v| v.to_string()),
+            problem.parameters[k].high.map_or(String::new(), |v| v.to_string()),
+        ))),
+    }
+}
+
+/// The scenario parsed with the fitted parameters at `p` (as `--set NAME=VALUE`).
+fn scenario_at(problem: &FitProblem, p: &[f64]) -> Result<Scenario, FitError> {
+    let mut overrides = problem.overrides.clone();
+    overrides.extend(
+        problem.parameters.iter().zip(p).map(|(f, v)| Override { name: f.name.clone(), value: format!("{v:?}") }),
+    );
+    Ok(crate::scenario::parse_with(&problem.file, &problem.source, &overrides)?)
+}
+
+/// The model at `p`: each measured point settled afresh, its outputs and their derivatives.
+fn evaluate(problem: &FitProblem, p: &[f64], cancel: Option<&AtomicBool>) -> Result<Evaluation, FitError> {
+    let sc = scenario_at(problem, p)?;
+    let file = problem.file.display().to_string();
+    let (m, n) = (problem.measurements.len(), problem.parameters.len());
+    let mut reports: BTreeMap<usize, SensitivityReport> = BTreeMap::new();
+    let mut eval = Evaluation { model: DVector::zeros(m), jacobian: DMatrix::zeros(m, n) };
+    for (i, x) in problem.measurements.iter().enumerate() {
+        let r = match reports.entry(x.point) {
+            Entry::Occupied(e) => e.into_mut(),
+            Entry::Vacant(e) => e.insert(settled_point(&sc, &file, x, p, cancel)?),
+        };
+        let Some(k) = r.outputs.iter().position(|o| o.name == x.output) else {
+            let close = close_names(&x.output, r.outputs.iter().map(|o| o.name.as_str()));
+            return Err(FitError::BadInput(format!(
+                "{}: output '{}' names nothing at point {}{close} (see `tensegrity sensitivity --point {}`)",
+                x.at, x.output, x.point, x.point
+            )));
+        };
+        eval.model[i] = r.outputs[k].value;
+        for (j, f) in problem.parameters.iter().enumerate() {
+            let row = r.parameters.iter().find(|q| q.name == f.name);
+            let row = row.ok_or_else(|| {
+                FitError::BadInput(format!("--param {}: not a parameter at point {}", f.name, x.point))
+            })?;
+            if let Some(e) = &row.error {
+                return Err(FitError::Failed(format!("d {}/d {}: {e}", x.output, f.name)));
+            }
+            eval.jacobian[(i, j)] = row.derivatives[k];
+        }
+    }
+    Ok(eval)
+}
+
+/// The sensitivities at measurement `x`'s point of `sc` (at the fitted parameters `p`),
+/// settled afresh; a point the scenario has not, or a structure the sensitivities refuse, is
+/// bad input.
+fn settled_point(
+    sc: &Scenario,
+    file: &str,
+    x: &Measurement,
+    p: &[f64],
+    cancel: Option<&AtomicBool>,
+) -> Result<SensitivityReport, FitError> {
+    if point_of(sc, x.point).is_none() {
+        return Err(FitError::BadInput(format!("{}: the scenario has no point {} (from 0)", x.at, x.point)));
+    }
+    let r = super::sensitivity::sensitivity(sc, file, x.point, false, cancel).map_err(|e| match e {
+        SensitivityRunError::Refused(_) => FitError::BadInput(format!("{file}: {e}")),
+        _ => FitError::Failed(format!("{file} at point {}: {e}", x.point)),
+    })?;
+    if !r.settled {
+        return Err(FitError::Failed(format!("{file}: point {} did not settle at {p:?}", x.point)));
+    }
+    Ok(r)
+}
+
+/// The report at the optimum `it`: intervals from the covariance, residuals, combinations.
+fn report(
+    problem: &FitProblem,
+    name: &str,
+    initial: &DVector<f64>,
+    it: &Iterate,
+    weights: &DVector<f64>,
+    iterations: usize,
+    stopped: String,
+) -> FitReport {
+    let (m, n) = (problem.measurements.len(), problem.parameters.len());
+    let scaled = problem.measurements.iter().all(|x| x.sigma.is_none());
+    let dof = m - n;
+    let factor = if scaled { it.cost / dof as f64 } else { 1.0 };
+    let names: Vec<String> = problem.parameters.iter().map(|f| f.name.clone()).collect();
+    let (covariance, unidentifiable) =
+        covariance(&weighted(&it.eval.jacobian, weights), it.p.as_slice(), &names, factor);
+    let parameters = (0..n)
+        .map(|k| {
+            let sigma = covariance[(k, k)].sqrt();
+            let (value, half) = (it.p[k], INTERVAL_Z_95 * sigma);
+            FittedParameter {
+                name: names[k].clone(),
+                initial: initial[k],
+                value,
+                sigma,
+                low: value - half,
+                high: value + half,
+            }
+        })
+        .collect();
+    let residuals = problem
+        .measurements
+        .iter()
+        .enumerate()
+        .map(|(i, x)| FitResidual {
+            point: x.point,
+            output: x.output.clone(),
+            measured: x.value,
+            model: it.eval.model[i],
+            sigma: 1.0 / weights[i],
+            weighted: it.r[i],
+        })
+        .collect();
+    FitReport {
+        name: name.to_string(),
+        file: problem.file.display().to_string(),
+        parameters,
+        covariance: covariance.row_iter().map(|r| r.iter().copied().collect()).collect(),
+        covariance_scaled: scaled,
+        residuals,
+        chi2: it.cost,
+        degrees_of_freedom: dof,
+        iterations,
+        stopped,
+        unidentifiable,
+    }
+}
+
+/// (J^T J)^-1 times `factor` over the identifiable directions of the weighted Jacobian `j`
+/// (its columns scaled by |p| for the singular values' ratio), infinite on the rows and
+/// columns of the parameters in an unidentifiable combination; and those combinations.
+fn covariance(j: &DMatrix<f64>, p: &[f64], names: &[String], factor: f64) -> (DMatrix<f64>, Vec<Combination>) {
+    let n = p.len();
+    let scale = DVector::from_iterator(n, p.iter().map(|&v| if v == 0.0 { 1.0 } else { v.abs() }));
+    let js = j * DMatrix::from_diagonal(&scale);
+    let svd = js.svd(false, true);
+    let v_t = svd.v_t.expect("asked for V^T");
+    let largest = svd.singular_values.max();
+    let mut cov = DMatrix::zeros(n, n);
+    let mut combinations = Vec::new();
+    let mut unseen = vec![false; n];
+    for (k, &s) in svd.singular_values.iter().enumerate() {
+        let v = v_t.row(k).transpose();
+        if s > UNIDENTIFIABLE_RATIO * largest {
+            cov += &v * v.transpose() / (s * s);
+            continue;
+        }
+        let sign = if v[v.iamax()] < 0.0 { -1.0 } else { 1.0 };
+        let weights: Vec<(String, f64)> =
+            (0..n).filter(|&q| v[q].abs() > COMBINATION_FLOOR).map(|q| (names[q].clone(), sign * v[q])).collect();
+        (0..n).filter(|&q| v[q].abs() > COMBINATION_FLOOR).for_each(|q| unseen[q] = true);
+        combinations.push(Combination { weights, ratio: if largest > 0.0 { s / largest } else { 0.0 } });
+    }
+    let mut cov = DMatrix::from_diagonal(&scale) * cov * DMatrix::from_diagonal(&scale) * factor;
+    for q in (0..n).filter(|&q| unseen[q]) {
+        cov.row_mut(q).fill(f64::INFINITY);
+        cov.column_mut(q).fill(f64::INFINITY);
+    }
+    (cov, combinations)
+}
+
+/// The names of `known` within [`CLOSE_EDITS`] edits of `name` (or sharing its part before
+/// the dot), as ", close names: a, b", or "".
+fn close_names<'a>(name: &str, known: impl Iterator<Item = &'a str>) -> String {
+    let stem = name.split('.').next().unwrap_or(name);
+    let close: Vec<&str> = known
+        .filter(|k| edits(name, k) <= CLOSE_EDITS || (name.contains('.') && k.split('.').next() == Some(stem)))
+        .take(CLOSE_LISTED)
+        .collect();
+    if close.is_empty() {
+        String::new()
+    } else {
+        format!(", close names: {}", close.join(", "))
+    }
+}
+
+/// Names this many edits apart are close.
+const CLOSE_EDITS: usize = 2;
+/// Close names listed at most.
+const CLOSE_LISTED: usize = 8;
+
+/// The Levenshtein distance of `a` and `b` (characters inserted, removed or replaced).
+fn edits(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let next = (row[j + 1] + 1).min(row[j] + 1).min(diagonal + usize::from(ca != cb));
+            diagonal = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The seeds of the coverage check, and the noise on each of the line's points.
+    const SEEDS: u64 = 200;
+    const POINTS: usize = 10;
+    const NOISE: f64 = 0.01;
+
+    /// A standard normal number from `state` (splitmix64, Box-Muller).
+    fn normal(state: &mut u64) -> f64 {
+        let mut uniform = || {
+            *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = *state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (u, v) = (uniform().max(f64::MIN_POSITIVE), uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+
+    /// A line y = p0 + p1 t at t = 0 .. 0.9 measured with Gaussian noise of sigma NOISE
+    /// (truth p = (2, 0.5)), fitted over 200 seeds: each 95 % interval holds the truth in
+    /// 0.95 -+ 0.033 of the 400 intervals (three binomial standard deviations, the draws
+    /// fixed by the seeds), and each fit converges in at most 6 steps (the model is linear:
+    /// each step leaves about the damping's share of the error, 1e-3 falling tenfold a step).
+    #[test]
+    fn intervals_of_a_line_hold_the_truth_in_95_percent_of_fits() {
+        let truth = [2.0, 0.5];
+        let t: Vec<f64> = (0..POINTS).map(|i| 0.1 * i as f64).collect();
+        let mut held = 0;
+        for seed in 0..SEEDS {
+            let mut state = seed;
+            let measurements = t
+                .iter()
+                .map(|&ti| Measurement {
+                    at: String::new(),
+                    point: 0,
+                    output: "y".into(),
+                    value: truth[0] + truth[1] * ti + NOISE * normal(&mut state),
+                    sigma: Some(NOISE),
+                })
+                .collect();
+            let parameters =
+                ["p0", "p1"].iter().map(|n| FitParameter { name: n.to_string(), low: None, high: None }).collect();
+            let problem = FitProblem {
+                file: PathBuf::from("line"),
+                source: String::new(),
+                overrides: Vec::new(),
+                parameters,
+                measurements,
+            };
+            let weights = validate(&problem).expect("valid");
+            let initial = DVector::from_vec(vec![1.0, 1.0]);
+            let model = &mut |p: &[f64]| {
+                Ok(Evaluation {
+                    model: DVector::from_iterator(POINTS, t.iter().map(|ti| p[0] + p[1] * ti)),
+                    jacobian: DMatrix::from_fn(POINTS, 2, |i, j| if j == 0 { 1.0 } else { t[i] }),
+                })
+            };
+            let (it, iterations, stopped) = iterate(&problem, &initial, &weights, model, &|| false).expect("a fit");
+            assert!(iterations <= 6, "seed {seed}: {iterations} steps ({stopped})");
+            let r = report(&problem, "line", &initial, &it, &weights, iterations, stopped);
+            held += r.parameters.iter().zip(truth).filter(|(p, v)| p.low <= *v && *v <= p.high).count();
+        }
+        let fraction = held as f64 / (2 * SEEDS) as f64;
+        assert!((fraction - 0.95).abs() <= 0.033, "{held} of {} intervals hold the truth", 2 * SEEDS);
+    }
+}

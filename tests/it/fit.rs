@@ -1,0 +1,219 @@
+//! `tensegrity fit`: parameters of the pinned bar (q* = atan2(k1 a, k2 b)) fitted to synthetic
+//! measurements made from known values and a small deterministic noise, against the truth and
+//! the interval the linearised model gives; the combination the data cannot identify named;
+//! bad input refused with exit 2, naming what is wrong.
+
+use crate::common;
+use std::path::PathBuf;
+use tensegrity_testbed::report::fit::FitReport;
+use tensegrity_testbed::run::{fit, FitParameter, FitProblem, Measurement};
+
+/// The pinned bar swept over k1 (nine points, k1 = 10 .. 90 N/m), with a = 0.8 m, b = 0.6 m.
+const SWEPT_K1: &str = "scenarios/custom/pinned_bar_sweep.toml";
+const A: f64 = 0.8;
+const B: f64 = 0.6;
+/// The measurement noise's standard deviation (rad or m), the sigma every row states.
+const SIGMA: f64 = 1e-4;
+
+/// k1 at point `i` of the file's sweep \[N/m\].
+fn k1_at(i: usize) -> f64 {
+    10.0 + 10.0 * i as f64
+}
+
+/// A deterministic noise of amplitude `SIGMA` (no generator: the same numbers on every run).
+fn noise(i: usize) -> f64 {
+    SIGMA * (1.7 * i as f64 + 0.3).sin()
+}
+
+/// The pinned bar's equilibrium angle \[rad\].
+fn angle(k1: f64, k2: f64, a: f64, b: f64) -> f64 {
+    (k1 * a).atan2(k2 * b)
+}
+
+/// A problem on the scenario text `source` (named `file`) with these parameters and rows.
+fn problem(file: &str, source: String, parameters: &[&str], rows: Vec<(usize, &str, f64)>) -> FitProblem {
+    FitProblem {
+        file: PathBuf::from(file),
+        source,
+        overrides: Vec::new(),
+        parameters: parameters.iter().map(|n| FitParameter { name: n.to_string(), low: None, high: None }).collect(),
+        measurements: rows
+            .into_iter()
+            .enumerate()
+            .map(|(k, (point, output, value))| Measurement {
+                at: format!("row {k}"),
+                point,
+                output: output.to_string(),
+                value,
+                sigma: Some(SIGMA),
+            })
+            .collect(),
+    }
+}
+
+fn parameter<'a>(r: &'a FitReport, name: &str) -> &'a tensegrity_testbed::report::fit::FittedParameter {
+    r.parameters.iter().find(|p| p.name == name).expect("a fitted parameter")
+}
+
+/// k2 fitted from the angle at the sweep's nine k1 (truth 33 N/m, the file's 30 N/m the
+/// start): within its 95 % interval of the truth, its sigma within 1e-3 of the linearised
+/// model's SIGMA / sqrt(sum (dq/dk2)^2), dq/dk2 = -k1 a b / (k1^2 a^2 + k2^2 b^2), and chi^2
+/// the noise's own sum of (noise/SIGMA)^2 less the part the fit absorbs (below it).
+#[test]
+fn k2_fitted_from_the_angle_at_nine_points_holds_the_truth_in_its_interval() {
+    let truth = 33.0;
+    let rows = (0..9).map(|i| (i, "q", angle(k1_at(i), truth, A, B) + noise(i))).collect();
+    let source = std::fs::read_to_string(SWEPT_K1).expect("scenario");
+    let r = fit(&problem(SWEPT_K1, source, &["k2"], rows), None).expect("a fit");
+    let k2 = parameter(&r, "k2");
+    let slope2: f64 = (0..9)
+        .map(|i| {
+            let k1 = k1_at(i);
+            (k1 * A * B / (k1 * k1 * A * A + truth * truth * B * B)).powi(2)
+        })
+        .sum();
+    let sigma = SIGMA / slope2.sqrt();
+    assert!((k2.sigma / sigma - 1.0).abs() <= 1e-3, "sigma {:.6e}, linearised {sigma:.6e}", k2.sigma);
+    assert!(k2.low <= truth && truth <= k2.high, "k2 = {} in [{}, {}]", k2.value, k2.low, k2.high);
+    // Noise of 1e-4 rad moves k2 by at most sum |noise| / min |dq/dk2|: far below 0.05 N/m.
+    assert!((k2.value - truth).abs() <= 0.05, "k2 = {}", k2.value);
+    let noise_chi2: f64 = (0..9).map(|i| (noise(i) / SIGMA).powi(2)).sum();
+    assert!(r.chi2 <= noise_chi2 + 1e-6, "chi^2 {} above the noise's {noise_chi2}", r.chi2);
+    assert!(!r.covariance_scaled && r.unidentifiable.is_empty() && r.degrees_of_freedom == 8);
+    assert!(r.iterations <= 10, "{} iterations ({})", r.iterations, r.stopped);
+}
+
+/// The pinned bar swept over the anchor a instead (0.4 .. 1.2 m, five points), so that k1 and
+/// k2 are free to fit.
+fn swept_a() -> String {
+    common::edited(
+        SWEPT_K1,
+        &[(
+            "grid = { k1 = { from = 10.0, to = 90.0, count = 9 } }",
+            "grid = { a = { from = 0.4, to = 1.2, count = 5 } }",
+        )],
+    )
+}
+
+/// a at point `i` of [`swept_a`] \[m\].
+fn a_at(i: usize) -> f64 {
+    0.4 + 0.2 * i as f64
+}
+
+/// k1 fitted from the tip's x coordinate P.x = L cos q* (L = 1 m) at five anchors a (truth
+/// 47 N/m, start 50): within its interval and 0.05 N/m of the truth.
+#[test]
+fn k1_fitted_from_the_tips_coordinate_holds_the_truth_in_its_interval() {
+    let truth = 47.0;
+    let rows = (0..5).map(|i| (i, "P.x", angle(truth, 30.0, a_at(i), B).cos() + noise(i))).collect();
+    let r = fit(&problem("swept_a.toml", swept_a(), &["k1"], rows), None).expect("a fit");
+    let k1 = parameter(&r, "k1");
+    assert!(k1.low <= truth && truth <= k1.high, "k1 = {} in [{}, {}]", k1.value, k1.low, k1.high);
+    assert!((k1.value - truth).abs() <= 0.05 && k1.sigma > 0.0 && k1.sigma < 0.05, "k1 = {} +- {}", k1.value, k1.sigma);
+}
+
+/// k1 and k2 together from the angle atan2(k1 a, k2 b), which knows only k1/k2: one
+/// combination named, d k1/k1 + d k2/k2 (both scaled up alike: equal weights, 1/sqrt 2 each,
+/// within 1e-6), both intervals infinite, and the ratio the data have recovered within 1e-3.
+#[test]
+fn k1_and_k2_from_the_angle_alone_are_named_as_one_unidentifiable_ratio() {
+    let (k1, k2) = (47.0, 33.0);
+    let rows = (0..5).map(|i| (i, "q", angle(k1, k2, a_at(i), B) + noise(i))).collect();
+    let r = fit(&problem("swept_a.toml", swept_a(), &["k1", "k2"], rows), None).expect("a fit");
+    assert_eq!(r.unidentifiable.len(), 1, "{:?}", r.unidentifiable);
+    let c = &r.unidentifiable[0];
+    let w = |n: &str| c.weights.iter().find(|(m, _)| m == n).map(|(_, w)| *w).expect("named");
+    let half = std::f64::consts::FRAC_1_SQRT_2;
+    assert!((w("k1").abs() - half).abs() <= 1e-6 && (w("k1") - w("k2")).abs() <= 1e-6, "{:?}", c.weights);
+    assert!(c.ratio <= 1e-6);
+    for p in &r.parameters {
+        assert!(p.sigma.is_infinite() && p.low == f64::NEG_INFINITY && p.high == f64::INFINITY, "{p:?}");
+    }
+    let ratio = parameter(&r, "k1").value / parameter(&r, "k2").value;
+    assert!((ratio / (k1 / k2) - 1.0).abs() <= 1e-3, "k1/k2 = {ratio}");
+    assert!(r.to_table().contains("unidentifiable"));
+}
+
+/// A file in the temporary directory with `text`.
+fn temp_file(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tt-fit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temporary directory");
+    let path = dir.join(name);
+    std::fs::write(&path, text).expect("write");
+    path
+}
+
+/// `tensegrity fit` on the swept pinned bar with `csv` as data and these flags.
+fn fit_cli(name: &str, csv: &str, flags: &[&str]) -> (i32, String) {
+    let data = temp_file(name, csv);
+    let mut args = vec!["fit", SWEPT_K1, "--data", data.to_str().expect("utf-8")];
+    args.extend_from_slice(flags);
+    let (code, _, stderr) = common::tensegrity(&args);
+    (code, stderr)
+}
+
+/// Nine angles from k2 = 33 N/m, as a CSV.
+fn angles_csv() -> String {
+    let mut s = "point,output,value,sigma\n".to_string();
+    for i in 0..9 {
+        s += &format!("{i},q,{:.15},{SIGMA}\n", angle(k1_at(i), 33.0, A, B) + noise(i));
+    }
+    s
+}
+
+/// Each bad input is refused with exit 2 and a message naming the thing: a column, an output
+/// (with the close names), a NaN, too few rows, an unknown or swept parameter, a bound the
+/// fit runs into.
+#[test]
+fn bad_fit_input_gives_exit_2_naming_what_is_wrong() {
+    let cases: Vec<(&str, String, Vec<&str>, Vec<&str>)> = vec![
+        ("column.csv", "point,outptu,value\n0,q,1\n".into(), vec!["--param", "k2"], vec![":1:7", "'outptu'"]),
+        (
+            "output.csv",
+            "point,output,value\n0,P.w,1\n1,q,1\n".into(),
+            vec!["--param", "k2"],
+            vec![":2", "'P.w'", "P.x"],
+        ),
+        ("nan.csv", "point,output,value,sigma\n0,q,NaN,1e-4\n".into(), vec!["--param", "k2"], vec![":2:5", "NaN"]),
+        (
+            "few.csv",
+            "point,output,value,sigma\n0,q,1,1e-4\n".into(),
+            vec!["--param", "k2", "--param", "b"],
+            vec!["1 measurements for 2"],
+        ),
+        ("unknown.csv", angles_csv(), vec!["--param", "k3"], vec!["'k3'", "k1", "k2"]),
+        ("swept.csv", angles_csv(), vec!["--param", "k1"], vec!["--param k1", "[actuation]"]),
+        ("bound.csv", angles_csv(), vec!["--param", "k2=1:31"], vec!["k2 ran into its bound 31"]),
+        ("point.csv", "point,output,value\n9,q,1\n0,q,1\n".into(), vec!["--param", "k2"], vec!["no point 9"]),
+    ];
+    for (name, csv, flags, said) in cases {
+        let (code, stderr) = fit_cli(name, &csv, &flags);
+        assert_eq!(code, 2, "{name}: {stderr}");
+        for s in said {
+            assert!(stderr.contains(s), "{name}: '{s}' not in {stderr}");
+        }
+        assert!(!stderr.contains("panicked"), "{name}: {stderr}");
+    }
+}
+
+/// The command's JSON has the estimate and its interval, and exit 0.
+#[test]
+fn fit_command_writes_the_estimate_and_its_interval_as_json() {
+    let data = temp_file("good.csv", &angles_csv());
+    let (code, stdout, stderr) = common::tensegrity(&[
+        "fit",
+        SWEPT_K1,
+        "--data",
+        data.to_str().expect("utf-8"),
+        "--param",
+        "k2=1:100",
+        "--json",
+        "-",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let j: serde_json::Value = serde_json::from_str(&stdout).expect("JSON alone on stdout");
+    let p = &j["parameters"][0];
+    let (v, lo, hi) = (p["value"].as_f64().unwrap(), p["low"].as_f64().unwrap(), p["high"].as_f64().unwrap());
+    assert!(lo <= 33.0 && 33.0 <= hi && (v - 33.0).abs() <= 0.05, "{v} in [{lo}, {hi}]");
+    assert!(stderr.contains("k2"), "the table on standard error");
+}
