@@ -62,17 +62,14 @@ pub fn scenario_mjcf(
     Ok(mjcf::to_mjcf(&s, &options))
 }
 
-use crate::scenario::{Actuation, Scenario};
+use crate::scenario::Scenario;
 use crate::structure::Structure;
 
 /// The structure a scenario starts its run with, built at the first point's (or first
 /// waypoint's) inputs from the scenario's `[start]` as `run` builds it, and the actuator
 /// commands of that point (actuator order, m or rad).
 pub fn first_structure(sc: &Scenario) -> Result<(Structure, Vec<f64>), ExportError> {
-    let first_inputs = match &sc.actuation {
-        Actuation::Points { points, .. } => points[0].clone(),
-        Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
-    };
+    let first_inputs = sc.actuation.first_inputs().clone();
     let mech = sc.mechanism();
     let params = sc.params_at(&first_inputs);
     let mut s = mech.build(&params, &first_inputs, &sc.start)?;

@@ -81,14 +81,7 @@ fn from_file(family: &'static str, text: &str, edits: &[(&str, &str)]) -> Result
     }
     let path = std::path::Path::new(family);
     let sc = crate::scenario::parse(path, &text).map_err(|e| BenchError::Case(format!("{family}: {e}")))?;
-    let inputs = match &sc.actuation {
-        crate::scenario::Actuation::Points { points, .. } => points[0].clone(),
-        crate::scenario::Actuation::Schedule { waypoints } => waypoints[0].1.clone(),
-    };
-    let mut start = sc
-        .mechanism()
-        .build(&sc.params_at(&inputs), &inputs, &sc.start)
-        .map_err(|e| BenchError::Case(format!("{family}: {e}")))?;
+    let (mut start, _) = crate::export::first_structure(&sc).map_err(|e| BenchError::Case(format!("{family}: {e}")))?;
     start.joints.iter_mut().for_each(|j| j.damping = 0.0);
     Ok(Case {
         family,
