@@ -125,13 +125,9 @@ impl InterferenceSettings {
     /// Whether every excluded pair names members of `s` (else the error names the first that
     /// does not, and the members there are).
     pub fn check_member_names(&self, s: &Structure) -> Result<(), UnknownMember> {
-        let names: Vec<&str> = s
-            .struts
-            .iter()
-            .map(|t| t.name.as_str())
-            .chain(s.cables.iter().map(|c| c.name.as_str()))
-            .chain(s.springs.iter().map(|c| c.name.as_str()))
-            .collect();
+        use crate::structure::MemberKind::{Cable, Spring, Strut};
+        let names: Vec<&str> =
+            [Strut, Cable, Spring].into_iter().flat_map(|k| s.members_of(k)).map(|(_, m)| m.name.as_str()).collect();
         match self.exclude.iter().flat_map(|(a, b)| [a, b]).find(|n| !names.contains(&n.as_str())) {
             Some(name) => Err(UnknownMember { name: name.clone(), members: names.join(", ") }),
             None => Ok(()),

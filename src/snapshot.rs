@@ -38,12 +38,11 @@ pub struct Snapshot {
 }
 
 impl Snapshot {
-    /// The force of the spring or cable `name` of structure `s` \[N\] (tension positive).
+    /// The force of the spring or cable `name` of structure `s` \[N\] (tension positive);
+    /// None for a strut, which has no law of its own.
     pub fn member_force_n(&self, s: &crate::structure::Structure, name: &str) -> Option<f64> {
-        match s.spring_id(name) {
-            Some(i) => self.forces.spring_force_n.get(i).copied(),
-            None => self.forces.cable_tension_n.get(s.cable_id(name)?).copied(),
-        }
+        let i = s.member_id(name)?;
+        (s.members[i].kind() != crate::structure::MemberKind::Strut).then(|| self.forces.force_n.get(i).copied())?
     }
 
     /// A body's pose since the build (bodies are built at the identity).
@@ -107,15 +106,16 @@ impl Snapshot {
 /// Forces in every member at one instant. Tension is positive.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MemberForces {
-    /// Spring force k (l - l0) \[N\], in structure order.
-    pub spring_force_n: Vec<f64>,
-    pub spring_length_m: Vec<f64>,
-    /// Cable tension \[N\] (0 when slack).
-    pub cable_tension_n: Vec<f64>,
-    pub cable_length_m: Vec<f64>,
-    /// Unstretched (commanded) cable length \[m\].
-    pub cable_rest_length_m: Vec<f64>,
-    pub cable_slack: Vec<bool>,
+    /// Each member's force \[N\], in member order: a spring's k (l - l0), a cable's tension
+    /// (0 when slack), 0 for a strut (rigid through its body, it has no law of its own).
+    pub force_n: Vec<f64>,
+    /// Each member's length, the sum of its segments' \[m\].
+    pub length_m: Vec<f64>,
+    /// Each member's rest length now \[m\]: a spring's, a cable's unstretched (commanded)
+    /// length; NaN for a strut.
+    pub rest_length_m: Vec<f64>,
+    /// Whether each member is a slack cable.
+    pub slack: Vec<bool>,
     /// Force \[N\] or torque [N m] each actuator exerts along its joint axis (or the cable
     /// tension for a winch), in actuator order.
     pub actuator_force: Vec<f64>,
@@ -208,12 +208,10 @@ pub fn richardson(coarse: &Snapshot, fine: &Snapshot, order: i32) -> Snapshot {
         nodes: coarse.nodes.iter().zip(&fine.nodes).map(|(c, f)| p3(c, f)).collect(),
         body_poses: coarse.body_poses.iter().zip(&fine.body_poses).map(|(c, f)| pose(c, f)).collect(),
         forces: MemberForces {
-            spring_force_n: v(&cf.spring_force_n, &ff.spring_force_n),
-            spring_length_m: v(&cf.spring_length_m, &ff.spring_length_m),
-            cable_tension_n: v(&cf.cable_tension_n, &ff.cable_tension_n),
-            cable_length_m: v(&cf.cable_length_m, &ff.cable_length_m),
-            cable_rest_length_m: ff.cable_rest_length_m.clone(),
-            cable_slack: ff.cable_slack.clone(),
+            force_n: v(&cf.force_n, &ff.force_n),
+            length_m: v(&cf.length_m, &ff.length_m),
+            rest_length_m: ff.rest_length_m.clone(),
+            slack: ff.slack.clone(),
             actuator_force: v(&cf.actuator_force, &ff.actuator_force),
             residual: None,
         },

@@ -6,6 +6,7 @@
 use super::{bad_input, check_outputs, failed, load_one, signals, write_atomic, CliError, Outcome};
 use crate::run::ModesRunError;
 use crate::sim::modes::StructureModes;
+use crate::structure::MemberKind;
 use std::path::{Path, PathBuf};
 
 pub fn modes(
@@ -49,11 +50,12 @@ fn record_modes(
 ) -> Result<(), crate::observers::record::RecordError> {
     use crate::observers::modes_record::{DrawnMode, DrawnStructure};
     let s = sim.structure();
+    let segments = |kind| s.members_of(kind).flat_map(|(_, m)| m.segments()).collect();
     let drawn = DrawnStructure {
         nodes: (0..s.nodes.len()).map(|n| sim.node_position(n)).collect(),
-        struts: s.struts.iter().map(|m| (m.a, m.b)).collect(),
-        springs: s.springs.iter().map(|m| (m.a, m.b)).collect(),
-        cables: s.cables.iter().map(|m| (m.a, m.b)).collect(),
+        struts: segments(MemberKind::Strut),
+        springs: segments(MemberKind::Spring),
+        cables: segments(MemberKind::Cable),
     };
     let modes: Vec<DrawnMode> = analysis
         .modes

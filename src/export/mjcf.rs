@@ -39,7 +39,7 @@
 //!   (apply them through `xfrc_applied` at the body's centre of mass); the first point's
 //!   actuator commands as the keyframe `first_point`.
 
-use crate::structure::{ActuatorTarget, BodyKind, CableLaw, JointKind, Structure, Vec3};
+use crate::structure::{ActuatorTarget, BodyKind, CableLaw, JointKind, Law, MemberKind, Structure, Vec3};
 use std::collections::BTreeSet;
 use std::fmt::Write;
 
@@ -244,9 +244,9 @@ impl Writer<'_> {
             esc(&o.model_name),
             s.bodies.len(),
             s.nodes.len(),
-            s.struts.len(),
-            s.springs.len(),
-            s.cables.len(),
+            s.count_of(MemberKind::Strut),
+            s.count_of(MemberKind::Spring),
+            s.count_of(MemberKind::Cable),
             s.joints.len(),
             s.actuators.len()
         );
@@ -355,8 +355,8 @@ impl Writer<'_> {
     /// Capsules of the struts on body `b`, and its nodes as sites.
     fn geoms_and_sites(&mut self, b: usize, pad: &str) {
         let (s, o) = (self.s, self.plan.origin[b]);
-        for st in &s.struts {
-            let (na, nb) = (&s.nodes[st.a], &s.nodes[st.b]);
+        for (_, st) in s.members_of(MemberKind::Strut) {
+            let (na, nb) = (&s.nodes[st.ends().0], &s.nodes[st.ends().1]);
             if na.body != b {
                 continue;
             }
@@ -476,18 +476,19 @@ impl Writer<'_> {
 
     fn tendons(&mut self) {
         let s = self.s;
-        if s.springs.is_empty() && s.cables.is_empty() {
+        if s.members.iter().all(|m| m.kind() == MemberKind::Strut) {
             return;
         }
         let mut names = Unique::default();
         self.xml.push_str("<tendon>\n");
-        for sp in &s.springs {
-            let law = format!("stiffness=\"{:?}\" springlength=\"{:?}\"", sp.stiffness_n_per_m, sp.rest_length_m);
-            self.spatial(&names.get(&sp.name), &law, sp.a, sp.b);
+        for (_, sp) in s.members_of(MemberKind::Spring) {
+            let (k, rest) = (sp.stiffness_n_per_m().unwrap_or(f64::NAN), sp.rest_length_m().unwrap_or(f64::NAN));
+            let law = format!("stiffness=\"{k:?}\" springlength=\"{rest:?}\"");
+            self.spatial(&names.get(&sp.name), &law, &sp.path);
         }
-        for (c, cable) in s.cables.iter().enumerate() {
-            let l = cable.length_m;
-            let mut law = match (cable.law.clone(), self.winched(c)) {
+        for (c, cable) in s.members_of(MemberKind::Cable) {
+            let Law::Cable { law: cable_law, length_m: l } = cable.law.clone() else { continue };
+            let mut law = match (cable_law.clone(), self.winched(c)) {
                 (CableLaw::Inextensible, _) => format!("limited=\"true\" range=\"0 {l:?}\""),
                 (CableLaw::Elastic { .. }, true) => String::new(),
                 (CableLaw::Elastic { stiffness_n_per_m }, false) => {
@@ -495,23 +496,20 @@ impl Writer<'_> {
                 }
             };
             let damping = self.o.cable_damping_n_s_per_m;
-            if damping > 0.0 && !(self.winched(c) && matches!(cable.law, CableLaw::Elastic { .. })) {
+            if damping > 0.0 && !(self.winched(c) && matches!(cable_law, CableLaw::Elastic { .. })) {
                 let _ = write!(law, " damping=\"{damping:?}\"");
             }
-            self.spatial(&names.get(&cable.name), &law, cable.a, cable.b);
+            self.spatial(&names.get(&cable.name), &law, &cable.path);
         }
         self.xml.push_str("</tendon>\n");
     }
 
-    fn spatial(&mut self, name: &str, law: &str, a: usize, b: usize) {
+    /// A spatial tendon through the sites of `path`: MuJoCo's length is the sum of its
+    /// segments', a clustered cable's as the testbed counts it.
+    fn spatial(&mut self, name: &str, law: &str, path: &[usize]) {
         let s = self.s;
-        let _ = writeln!(
-            self.xml,
-            "  <spatial name=\"{}\" {law}><site site=\"{}\"/><site site=\"{}\"/></spatial>",
-            esc(name),
-            esc(&s.nodes[a].name),
-            esc(&s.nodes[b].name)
-        );
+        let sites: String = path.iter().map(|&n| format!("<site site=\"{}\"/>", esc(&s.nodes[n].name))).collect();
+        let _ = writeln!(self.xml, "  <spatial name=\"{}\" {law}>{sites}</spatial>", esc(name));
     }
 
     /// Position actuators, comments for mocap-placed and range-driven actuators, and the
@@ -559,9 +557,9 @@ impl Writer<'_> {
                     );
                 }
                 ActuatorTarget::CableLength(c) => {
-                    let cable = &s.cables[c];
+                    let cable = &s.members[c];
                     match cable.law {
-                        CableLaw::Elastic { stiffness_n_per_m } => {
+                        Law::Cable { law: CableLaw::Elastic { stiffness_n_per_m }, .. } => {
                             let _ = writeln!(
                                 rows,
                                 "  <position name=\"{name}\" tendon=\"{}\" kp=\"{stiffness_n_per_m:?}\" kv=\"{:?}\" forcelimited=\"true\" forcerange=\"{:?} 0\"/>",
@@ -571,7 +569,7 @@ impl Writer<'_> {
                             );
                             ctrl.push(command);
                         }
-                        CableLaw::Inextensible => {
+                        _ => {
                             let _ = writeln!(
                                 rows,
                                 "  <!-- {name} = {command:?}: the length of inextensible cable {} (its tendon_range upper bound) -->",

@@ -10,7 +10,7 @@ use crate::mechanisms::{
     QuantitySpec, Solution, Values,
 };
 use crate::snapshot::Snapshot;
-use crate::structure::{ActuatorTarget, Structure};
+use crate::structure::{ActuatorTarget, MemberKind, Structure};
 
 /// The mechanism built from a file's `[structure]`.
 #[derive(Clone, Debug)]
@@ -79,10 +79,10 @@ impl Custom {
             }
         }
         let size = crate::structure::structure_size(&structure);
-        let members =
-            structure.springs.iter().map(|m| &m.name).chain(structure.cables.iter().map(|m| &m.name)).chain(
-                structure.struts.iter().filter(|t| strut_reading(&structure, t, size).is_some()).map(|m| &m.name),
-            );
+        let tensioned = structure.members_of(MemberKind::Spring).chain(structure.members_of(MemberKind::Cable));
+        let read_struts =
+            structure.members_of(MemberKind::Strut).filter(|(_, t)| strut_reading(&structure, t, size).is_some());
+        let members = tensioned.chain(read_struts).map(|(_, m)| &m.name);
         for name in members {
             quantities.push(QuantitySpec {
                 symbol: leak(format!("{name}.force")),
@@ -185,35 +185,29 @@ impl Custom {
                     }
                 }
             };
-            for (i, m) in s.springs.iter().enumerate() {
-                if m.a == node {
-                    add(m.a, m.b, snap.forces.spring_force_n[i]);
-                } else if m.b == node {
-                    add(m.b, m.a, snap.forces.spring_force_n[i]);
-                }
-            }
-            for (i, m) in s.cables.iter().enumerate() {
-                if m.a == node {
-                    add(m.a, m.b, snap.forces.cable_tension_n[i]);
-                } else if m.b == node {
-                    add(m.b, m.a, snap.forces.cable_tension_n[i]);
+            for (i, m) in s.members_of(MemberKind::Spring).chain(s.members_of(MemberKind::Cable)) {
+                for (a, b) in m.segments() {
+                    if a == node {
+                        add(a, b, snap.forces.force_n[i]);
+                    } else if b == node {
+                        add(b, a, snap.forces.force_n[i]);
+                    }
                 }
             }
             f
         };
         let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        s.struts
-            .iter()
-            .enumerate()
+        s.members_of(MemberKind::Strut)
             .filter_map(|(k, st)| {
                 let reading = strut_reading(s, st, self.size_m)?;
-                let (pa, pb) = (snap.nodes[st.a], snap.nodes[st.b]);
+                let (a, b) = st.ends();
+                let (pa, pb) = (snap.nodes[a], snap.nodes[b]);
                 let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
                 let l = dot(d, d).sqrt().max(f64::MIN_POSITIVE);
                 let u = [d[0] / l, d[1] / l, d[2] / l];
                 // Strut tension t pulls a towards b: t u + fa = 0 at a, -t u + fb = 0 at b.
-                let ta = || -dot(node_force(st.a), u);
-                let tb = || dot(node_force(st.b), u);
+                let ta = || -dot(node_force(a), u);
+                let tb = || dot(node_force(b), u);
                 Some((
                     k,
                     match reading {
@@ -241,9 +235,10 @@ enum StrutReading {
 /// the axial force in a way the body's balance does not determine). `size`: the structure's
 /// ([`crate::structure::structure_size`], computed once by the caller: it can be quadratic in the
 /// nodes, and computing it per strut had made checking a 1000-rod model take 10.9 s).
-fn strut_reading(s: &Structure, st: &crate::structure::Strut, size: f64) -> Option<StrutReading> {
+fn strut_reading(s: &Structure, st: &crate::structure::Member, size: f64) -> Option<StrutReading> {
     let fixed = |n: usize| s.bodies[s.nodes[n].body].kind == crate::structure::BodyKind::Fixed;
-    if fixed(st.a) || fixed(st.b) {
+    let (a, b) = st.ends();
+    if fixed(a) || fixed(b) {
         return None;
     }
     let jointed = |n: usize| {
@@ -254,7 +249,7 @@ fn strut_reading(s: &Structure, st: &crate::structure::Strut, size: f64) -> Opti
                     <= JOINT_AT_NODE_FRACTION * size
         })
     };
-    match (jointed(st.a), jointed(st.b)) {
+    match (jointed(a), jointed(b)) {
         (false, false) => Some(StrutReading::BothEnds),
         (true, false) => Some(StrutReading::EndB),
         (false, true) => Some(StrutReading::EndA),
@@ -308,7 +303,9 @@ impl Mechanism for Custom {
         let mut s = self.structure_at(params)?.clone();
         for a in &s.actuators {
             if let (ActuatorTarget::CableLength(c), Some(l)) = (&a.target, inputs.get(&a.symbol)) {
-                s.cables[*c].length_m = *l;
+                if let crate::structure::Law::Cable { length_m, .. } = &mut s.members[*c].law {
+                    *length_m = *l;
+                }
             }
         }
         Ok(s)
@@ -332,14 +329,11 @@ impl Mechanism for Custom {
                 v.insert(format!("{}.{c}", n.name), snap.nodes[i][k]);
             }
         }
-        for (i, m) in s.springs.iter().enumerate() {
-            v.insert(format!("{}.force", m.name), snap.forces.spring_force_n[i]);
-        }
-        for (i, m) in s.cables.iter().enumerate() {
-            v.insert(format!("{}.force", m.name), snap.forces.cable_tension_n[i]);
+        for (i, m) in s.members_of(MemberKind::Spring).chain(s.members_of(MemberKind::Cable)) {
+            v.insert(format!("{}.force", m.name), snap.forces.force_n[i]);
         }
         for (k, f) in self.strut_forces(snap) {
-            v.insert(format!("{}.force", s.struts[k].name), f);
+            v.insert(format!("{}.force", s.members[k].name), f);
         }
         v
     }

@@ -14,7 +14,7 @@ use crate::report::{
     EnergyPointReport, ModelCheckReport, ModelModeReport, PointReport, ScenarioReport, StationaryReport,
 };
 use crate::snapshot::{unit, Snapshot};
-use crate::structure::{JointKind, Structure};
+use crate::structure::{JointKind, MemberKind, Structure};
 use std::cmp::Ordering;
 
 /// How a state symbol is read from a snapshot of the run's structure.
@@ -24,10 +24,9 @@ enum Bind {
     Unused,
     Time,
     Node(usize, usize),
-    SpringForce(usize),
-    SpringLength(usize),
-    CableForce(usize),
-    CableLength(usize),
+    /// A spring's or a cable's force and length (member index).
+    MemberForce(usize),
+    MemberLength(usize),
     /// Distance between a strut's end nodes.
     StrutLength(usize, usize),
     Observed(String),
@@ -65,15 +64,15 @@ fn joint_bind(s: &Structure, name: &str, angle: bool) -> Option<Bind> {
 
 impl Bind {
     fn new(source: &Source, s: &Structure) -> Bind {
-        let member = |name: &str, spring: fn(usize) -> Bind, cable: fn(usize) -> Bind| {
-            s.spring_id(name).map(spring).or_else(|| s.cable_id(name).map(cable))
-        };
+        let tension = |name: &str| s.member_id(name).filter(|&i| s.members[i].kind() != MemberKind::Strut);
         let bound = match source {
             Source::Time => Some(Bind::Time),
             Source::Node(n, axis) => s.node_id(n).map(|i| Bind::Node(i, *axis)),
-            Source::MemberForce(m) => member(m, Bind::SpringForce, Bind::CableForce),
-            Source::MemberLength(m) => member(m, Bind::SpringLength, Bind::CableLength)
-                .or_else(|| s.struts.iter().find(|t| &t.name == m).map(|t| Bind::StrutLength(t.a, t.b))),
+            Source::MemberForce(m) => tension(m).map(Bind::MemberForce),
+            Source::MemberLength(m) => tension(m).map(Bind::MemberLength).or_else(|| {
+                let (_, t) = s.members_of(MemberKind::Strut).find(|(_, t)| &t.name == m)?;
+                Some(Bind::StrutLength(t.ends().0, t.ends().1))
+            }),
             Source::Observed(q) => Some(Bind::Observed(q.clone())),
             Source::JointAngle(j) => joint_bind(s, j, true),
             Source::JointSlide(j) => joint_bind(s, j, false),
@@ -89,10 +88,8 @@ impl Bind {
             Bind::Unused => f64::NAN,
             Bind::Time => time_s,
             Bind::Node(i, axis) => snap.nodes.get(*i).map_or(f64::NAN, |p| p[*axis]),
-            Bind::SpringForce(i) => at(&snap.forces.spring_force_n, *i),
-            Bind::SpringLength(i) => at(&snap.forces.spring_length_m, *i),
-            Bind::CableForce(i) => at(&snap.forces.cable_tension_n, *i),
-            Bind::CableLength(i) => at(&snap.forces.cable_length_m, *i),
+            Bind::MemberForce(i) => at(&snap.forces.force_n, *i),
+            Bind::MemberLength(i) => at(&snap.forces.length_m, *i),
             Bind::StrutLength(a, b) => match (snap.nodes.get(*a), snap.nodes.get(*b)) {
                 (Some(pa), Some(pb)) => crate::structure::distance(*pa, *pb),
                 _ => f64::NAN,

@@ -15,7 +15,7 @@
 use super::{Note, Observer, SettlePoint, Tick};
 use crate::report::{InterferenceReport, InterferenceViolation, PairClearanceReport, PointReport, ScenarioReport};
 use crate::settings::InterferenceSettings;
-use crate::structure::{distance, NodeId, Structure, Vec3};
+use crate::structure::{distance, MemberKind, NodeId, Structure, Vec3};
 use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::math::Vector;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
@@ -40,9 +40,10 @@ pub struct PairClearance {
     pub points: [[f64; 3]; 2],
 }
 
-/// One member as the checks see it: a segment between two nodes with a radius.
+/// One straight segment of a member as the checks see it: a capsule between two nodes. A
+/// clustered cable gives one per segment of its path, each named by the cable.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Member {
+pub struct Segment {
     pub name: String,
     /// "strut", "cable" or "spring".
     pub kind: &'static str,
@@ -51,28 +52,16 @@ pub struct Member {
     pub radius_m: f64,
 }
 
-/// The members checked: every strut, then (with `tendons`) every cable and spring.
-pub fn members(s: &Structure, tendons: bool) -> Vec<Member> {
-    let mut out: Vec<Member> = s
-        .struts
-        .iter()
-        .map(|t| Member { name: t.name.clone(), kind: "strut", a: t.a, b: t.b, radius_m: t.radius_m })
-        .collect();
-    if tendons {
-        out.extend(s.cables.iter().map(|c| Member {
-            name: c.name.clone(),
-            kind: "cable",
-            a: c.a,
-            b: c.b,
-            radius_m: c.radius_m,
-        }));
-        out.extend(s.springs.iter().map(|c| Member {
-            name: c.name.clone(),
-            kind: "spring",
-            a: c.a,
-            b: c.b,
-            radius_m: c.radius_m,
-        }));
+/// The segments checked: every strut's, then (with `tendons`) every cable's and spring's.
+pub fn members(s: &Structure, tendons: bool) -> Vec<Segment> {
+    let kinds: &[MemberKind] =
+        if tendons { &[MemberKind::Strut, MemberKind::Cable, MemberKind::Spring] } else { &[MemberKind::Strut] };
+    let mut out = Vec::new();
+    for &kind in kinds {
+        for (_, m) in s.members_of(kind) {
+            let segment = |(a, b)| Segment { name: m.name.clone(), kind: kind.label(), a, b, radius_m: m.radius_m };
+            out.extend(m.segments().map(segment));
+        }
     }
     out
 }
@@ -92,7 +81,7 @@ fn point_segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f64 {
 /// The pairs (i < j) of `members` that touch by construction in the initial configuration:
 /// a shared node, coinciding endpoints (within `COINCIDENT_FRACTION` of the structure's size),
 /// or an endpoint of one on a body that carries the other, inside the other's capsule.
-pub fn attached_pairs(s: &Structure, members: &[Member]) -> HashSet<(usize, usize)> {
+pub fn attached_pairs(s: &Structure, members: &[Segment]) -> HashSet<(usize, usize)> {
     let size = crate::structure::structure_size(s);
     let pos = |n: NodeId| s.nodes[n].position;
     let body = |n: NodeId| s.nodes[n].body;
@@ -100,7 +89,7 @@ pub fn attached_pairs(s: &Structure, members: &[Member]) -> HashSet<(usize, usiz
     for i in 0..members.len() {
         for j in i + 1..members.len() {
             let (m, o) = (&members[i], &members[j]);
-            let touches = |m: &Member, o: &Member| {
+            let touches = |m: &Segment, o: &Segment| {
                 [m.a, m.b].iter().any(|&p| {
                     [o.a, o.b].iter().any(|&q| p == q || distance(pos(p), pos(q)) <= COINCIDENT_FRACTION * size)
                         || ((body(p) == body(o.a) || body(p) == body(o.b))
@@ -196,7 +185,7 @@ struct PairStats {
 /// The interference observer.
 pub struct Interference {
     settings: InterferenceSettings,
-    members: Vec<Member>,
+    members: Vec<Segment>,
     excluded: HashSet<(usize, usize)>,
     pairs_checked: usize,
     stats: BTreeMap<(usize, usize), PairStats>,

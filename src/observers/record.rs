@@ -23,6 +23,7 @@
 use super::{Note, Observer, ObserverError, Tick};
 use crate::mechanisms::wrap_angle;
 use crate::report::ScenarioReport;
+use crate::structure::MemberKind;
 use std::path::{Path, PathBuf};
 
 /// Why a recording could not be written.
@@ -332,16 +333,28 @@ fn strut_forces(s: &crate::structure::Structure, snap: &crate::snapshot::Snapsho
     let p = |n: usize| Vector3::from(snap.nodes[n]);
     // The springs' and cables' pull at every node, summed once: one pass over the members.
     let mut pull = vec![Vector3::zeros(); snap.nodes.len()];
-    let members = s.springs.iter().map(|m| (m.a, m.b)).zip(&f.spring_force_n);
-    for ((a, b), t) in members.chain(s.cables.iter().map(|m| (m.a, m.b)).zip(&f.cable_tension_n)) {
-        let d = p(b) - p(a);
-        let len = d.norm();
-        if len > 0.0 {
-            pull[a] += d * (t / len);
-            pull[b] -= d * (t / len);
+    let tensioned = s.members_of(MemberKind::Spring).chain(s.members_of(MemberKind::Cable));
+    for (i, member) in tensioned {
+        let t = f.force_n[i];
+        for (a, b) in member.segments() {
+            let d = p(b) - p(a);
+            let len = d.norm();
+            if len > 0.0 {
+                pull[a] += d * (t / len);
+                pull[b] -= d * (t / len);
+            }
         }
     }
-    s.struts.iter().map(|strut| -pull[strut.a].dot(&(p(strut.a) - p(strut.b)).normalize())).collect()
+    let axial = |(_, strut): (usize, &crate::structure::Member)| {
+        let (a, b) = strut.ends();
+        -pull[a].dot(&(p(a) - p(b)).normalize())
+    };
+    s.members_of(MemberKind::Strut).map(axial).collect()
+}
+
+/// Each segment's label among the members of `kind`: its member's name.
+fn segment_names(s: &crate::structure::Structure, kind: MemberKind) -> Vec<String> {
+    s.members_of(kind).flat_map(|(_, m)| m.segments().map(|_| m.name.clone())).collect()
 }
 
 /// Colour of a member by its force: blue in compression, red in tension, grey when slack.
@@ -481,16 +494,16 @@ impl Recorder {
         let _ = rec.log_static(
             "structure/struts",
             &rerun::LineStrips3D::update_fields()
-                .with_radii(s.struts.iter().map(|m| m.radius_m as f32).collect::<Vec<_>>())
-                .with_labels(names(s.struts.iter().map(|m| &m.name).collect())),
+                .with_radii(s.members_of(MemberKind::Strut).map(|(_, m)| m.radius_m as f32).collect::<Vec<_>>())
+                .with_labels(segment_names(s, MemberKind::Strut)),
         );
         let _ = rec.log_static(
             "structure/springs",
-            &rerun::LineStrips3D::update_fields().with_labels(names(s.springs.iter().map(|m| &m.name).collect())),
+            &rerun::LineStrips3D::update_fields().with_labels(segment_names(s, MemberKind::Spring)),
         );
         let _ = rec.log_static(
             "structure/cables",
-            &rerun::LineStrips3D::update_fields().with_labels(names(s.cables.iter().map(|m| &m.name).collect())),
+            &rerun::LineStrips3D::update_fields().with_labels(segment_names(s, MemberKind::Cable)),
         );
         let _ = rec.log_static(
             "analytic/nodes",
@@ -505,8 +518,8 @@ impl Recorder {
         };
         series("errors", error_names.to_vec());
         series("errors_log10", error_names.to_vec());
-        series("forces/springs", s.springs.iter().map(|m| m.name.clone()).collect());
-        series("forces/cables", s.cables.iter().map(|m| m.name.clone()).collect());
+        series("forces/springs", s.members_of(MemberKind::Spring).map(|(_, m)| m.name.clone()).collect());
+        series("forces/cables", s.members_of(MemberKind::Cable).map(|(_, m)| m.name.clone()).collect());
         let actuators: Vec<String> =
             s.actuators.iter().enumerate().map(|(i, a)| format!("{} #{}", a.symbol, i + 1)).collect();
         series("forces/actuators", actuators.clone());
@@ -622,23 +635,28 @@ impl Observer for Recorder {
         let c = &mut self.columns;
         let nodes = &snap.nodes;
         c.nodes.push_points(tick, time, nodes.iter().copied());
-        c.struts.push_segments(tick, time, nodes, s.struts.iter().map(|m| (m.a, m.b)));
+        let segments = |kind| s.members_of(kind).flat_map(|(_, m)| m.segments());
+        c.struts.push_segments(tick, time, nodes, segments(MemberKind::Strut));
         let f = &snap.forces;
         let struts = strut_forces(s, snap);
-        let max_f =
-            f.spring_force_n.iter().chain(&f.cable_tension_n).chain(&struts).fold(0.0f64, |m, x| m.max(x.abs()));
+        let tensions = |kind| s.members_of(kind).map(|(i, _)| f.force_n[i]);
+        let max_f = tensions(MemberKind::Spring)
+            .chain(tensions(MemberKind::Cable))
+            .chain(struts.iter().copied())
+            .fold(0.0f64, |m, x| m.max(x.abs()));
         c.struts.colors.extend(struts.iter().map(|x| force_colour(*x, max_f)));
-        if !s.springs.is_empty() {
-            c.springs.push_segments(tick, time, nodes, s.springs.iter().map(|m| (m.a, m.b)));
-            c.springs.colors.extend(f.spring_force_n.iter().map(|x| force_colour(*x, max_f)));
-        }
-        if !s.cables.is_empty() {
-            c.cables.push_segments(tick, time, nodes, s.cables.iter().map(|m| (m.a, m.b)));
-            c.cables.colors.extend(f.cable_tension_n.iter().map(|x| force_colour(*x, max_f)));
+        // Every segment of a member coloured by the member's force.
+        for (kind, column) in [(MemberKind::Spring, &mut c.springs), (MemberKind::Cable, &mut c.cables)] {
+            if s.members_of(kind).next().is_some() {
+                column.push_segments(tick, time, nodes, segments(kind));
+                let colours =
+                    s.members_of(kind).flat_map(|(i, m)| m.segments().map(move |_| force_colour(f.force_n[i], max_f)));
+                column.colors.extend(colours);
+            }
         }
         if let Some(ghost) = t.ghost_nodes {
             c.ghost_nodes.push_points(tick, time, ghost.iter().copied());
-            c.ghost_struts.push_segments(tick, time, ghost, s.struts.iter().map(|m| (m.a, m.b)));
+            c.ghost_struts.push_segments(tick, time, ghost, segments(MemberKind::Strut));
         }
         // Time series: one entity per family, one named series per member or quantity.
         if !errors.is_empty() {
@@ -646,8 +664,8 @@ impl Observer for Recorder {
             c.errors.push_values(tick, time, errors);
         }
         for (column, values) in [
-            (&mut c.spring_forces, &f.spring_force_n),
-            (&mut c.cable_forces, &f.cable_tension_n),
+            (&mut c.spring_forces, &tensions(MemberKind::Spring).collect::<Vec<_>>()),
+            (&mut c.cable_forces, &tensions(MemberKind::Cable).collect::<Vec<_>>()),
             (&mut c.actuator_forces, &f.actuator_force),
             (&mut c.inputs, &snap.actuator_values),
         ] {
@@ -766,7 +784,7 @@ pub fn blueprint(file_model: bool) -> rerun::blueprint::Blueprint {
 mod strut_force_tests {
     use super::strut_forces;
     use crate::snapshot::{MemberForces, Snapshot};
-    use crate::structure::{BodyKind, Cable, CableLaw, Structure, Strut};
+    use crate::structure::{BodyKind, CableLaw, Member, Structure};
 
     /// A strut from A (0, 0, 0) to B (1, 0, 0) with a cable of 10 N from A to C (-1, 1, 0):
     /// the cable pulls A away from B with 10 / sqrt(2) N along the strut, a compression.
@@ -777,21 +795,14 @@ mod strut_force_tests {
         let ground = s.add_body("ground", BodyKind::Fixed, None);
         let (a, b) = (s.add_node("A", bar, [0.0; 3]), s.add_node("B", bar, [1.0, 0.0, 0.0]));
         let c = s.add_node("C", ground, [-1.0, 1.0, 0.0]);
-        s.struts.push(Strut { name: "AB".into(), a, b, radius_m: 0.01 });
-        s.cables.push(Cable {
-            name: "AC".into(),
-            a,
-            b: c,
-            law: CableLaw::Inextensible,
-            length_m: 1.0,
-            radius_m: 0.001,
-        });
+        s.members.push(Member::strut("AB", a, b, 0.01));
+        s.members.push(Member::cable("AC", vec![a, c], CableLaw::Inextensible, 1.0, 0.001));
         let snap = Snapshot {
             tick: 0,
             time_s: 0.0,
             nodes: s.nodes.iter().map(|n| n.position).collect(),
             body_poses: vec![],
-            forces: MemberForces { cable_tension_n: vec![10.0], ..Default::default() },
+            forces: MemberForces { force_n: vec![0.0, 10.0], ..Default::default() },
             actuator_values: vec![],
             kinetic_energy_j: 0.0,
         };

@@ -32,10 +32,10 @@ impl SlackTracker {
 
 impl Observer for SlackTracker {
     fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>) {
-        let slack = &t.snapshot.forces.cable_slack;
+        let slack = &t.snapshot.forces.slack;
         if self.open.len() != slack.len() {
             self.open = vec![None; slack.len()];
-            self.names = t.structure.cables.iter().map(|c| c.name.clone()).collect();
+            self.names = t.structure.members.iter().map(|c| c.name.clone()).collect();
         }
         let tick = t.snapshot.tick;
         for (c, &is_slack) in slack.iter().enumerate() {

@@ -27,7 +27,7 @@
 
 use super::{Observer, ObserverError, Tick};
 use crate::report::ScenarioReport;
-use crate::structure::ActuatorTarget;
+use crate::structure::{ActuatorTarget, MemberKind};
 use arrow_array::{ArrayRef, Float64Array, RecordBatch, UInt64Array};
 use arrow_schema::{DataType, Field, Schema, SchemaRef};
 use std::fmt::Write as _;
@@ -233,13 +233,13 @@ impl Table {
         for n in &s.nodes {
             cols.extend(["x", "y", "z"].map(|c| format!("node:{}.{c}", n.name)));
         }
-        cols.extend(s.springs.iter().map(|m| format!("spring:{}.force_n", m.name)));
-        cols.extend(s.cables.iter().map(|m| format!("cable:{}.tension_n", m.name)));
+        cols.extend(s.members_of(MemberKind::Spring).map(|(_, m)| format!("spring:{}.force_n", m.name)));
+        cols.extend(s.members_of(MemberKind::Cable).map(|(_, m)| format!("cable:{}.tension_n", m.name)));
         // Several actuators may share a symbol (mohr2011's cable pairs): named by what they drive.
         cols.extend(s.actuators.iter().map(|a| {
             let target = match a.target {
                 ActuatorTarget::Joint(j) => &s.joints[j].name,
-                ActuatorTarget::CableLength(c) => &s.cables[c].name,
+                ActuatorTarget::CableLength(c) => &s.members[c].name,
                 ActuatorTarget::FixedNode { node, .. } => &s.nodes[node].name,
             };
             format!("actuator:{}@{target}.force", a.symbol)
@@ -263,7 +263,10 @@ impl Table {
         v.extend(keys.0.iter().map(|k| t.inputs.get(k).copied()));
         v.extend(snap.nodes.iter().flatten().map(|x| Some(*x)));
         let f = &snap.forces;
-        v.extend(f.spring_force_n.iter().chain(&f.cable_tension_n).chain(&f.actuator_force).map(|x| Some(*x)));
+        let s = t.structure;
+        let tensions =
+            s.members_of(MemberKind::Spring).chain(s.members_of(MemberKind::Cable)).map(|(i, _)| f.force_n[i]);
+        v.extend(tensions.chain(f.actuator_force.iter().copied()).map(Some));
         v.extend(keys.1.iter().map(|k| t.simulated.get(k).copied()));
         v.extend(keys.2.iter().map(|k| t.prediction.expected.get(k).copied()));
         v.push(Some(if t.accelerated { 1.0 } else { 0.0 }));
@@ -382,7 +385,7 @@ fn repeats_a_column(s: &crate::structure::Structure, key: &str) -> bool {
     let Some((name, what)) = key.rsplit_once('.') else { return false };
     match what {
         "x" | "y" | "z" => s.nodes.iter().any(|n| n.name == name),
-        "force" => s.springs.iter().map(|m| &m.name).chain(s.cables.iter().map(|m| &m.name)).any(|m| m == name),
+        "force" => s.members.iter().any(|m| m.kind() != MemberKind::Strut && m.name == name),
         _ => false,
     }
 }

@@ -91,9 +91,9 @@ impl Levels {
     ) -> Judged {
         let half = self.half.snapshot_with(false);
         let quarter = self.quarter.snapshot_with(false);
-        let slack = &quarter.forces.cable_slack;
-        let smooth = coarse.forces.cable_slack == *slack
-            && half.forces.cable_slack == *slack
+        let slack = &quarter.forces.slack;
+        let smooth = coarse.forces.slack == *slack
+            && half.forces.slack == *slack
             && self.last_slack.as_ref().is_none_or(|last| last == slack);
         self.last_slack = Some(slack.clone());
         if !smooth && self.rough_from_tick.is_none() {

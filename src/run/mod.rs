@@ -262,10 +262,13 @@ fn finish(runner: &mut Runner, report: &mut ScenarioReport, probe_errors: &[f64]
     };
     report.stiffness_probe =
         sc.probe.as_ref().map(|p| probe_report(runner.mech.as_ref(), p, &report.points, probe_errors));
-    report.prestress = sc
-        .prestress
-        .as_ref()
-        .map(|p| crate::report::PrestressReport::of(p, runner.sim.structure().cables.len(), &report.points));
+    report.prestress = sc.prestress.as_ref().map(|p| {
+        crate::report::PrestressReport::of(
+            p,
+            runner.sim.structure().count_of(crate::structure::MemberKind::Cable),
+            &report.points,
+        )
+    });
     conclude(report, sc);
     let tick = runner.sim.tick();
     let mut failed = None;

@@ -237,7 +237,7 @@ pub(super) fn measured_point(
 ) -> PointReport {
     let slack_cables = slack_cables(runner, snapshot);
     let prestress_fraction = prestress_fraction(runner, snapshot);
-    let cables = runner.sim.structure().cables.len();
+    let cables = runner.sim.structure().count_of(crate::structure::MemberKind::Cable);
     let prestress_lost = sc.prestress.as_ref().map(|p| p.lost(cables, slack_cables.len(), prestress_fraction));
     let residual = snapshot.forces.residual;
     PointReport {
@@ -369,13 +369,21 @@ fn energy_stability(point: &PointReport) -> Option<bool> {
 /// without a drawn tension).
 pub(super) fn prestress_fraction(runner: &Runner, snap: &Snapshot) -> Option<f64> {
     let drawn = runner.sim.structure().drawn_cable_tension_n();
-    (drawn > 0.0).then(|| snap.forces.cable_tension_n.iter().sum::<f64>() / drawn)
+    (drawn > 0.0).then(|| cable_forces(runner.sim.structure(), snap).sum::<f64>() / drawn)
+}
+
+/// Every cable's tension in `snap` \[N\], in their order.
+fn cable_forces<'a>(s: &'a crate::structure::Structure, snap: &'a Snapshot) -> impl Iterator<Item = f64> + 'a {
+    s.members_of(crate::structure::MemberKind::Cable).map(|(i, _)| snap.forces.force_n[i])
 }
 
 /// The cables slack in `snap`, by name.
 pub(super) fn slack_cables(runner: &Runner, snap: &Snapshot) -> Vec<String> {
-    let cables = &runner.sim.structure().cables;
-    cables.iter().zip(&snap.forces.cable_slack).filter(|(_, sl)| **sl).map(|(c, _)| c.name.clone()).collect()
+    let s = runner.sim.structure();
+    s.members_of(crate::structure::MemberKind::Cable)
+        .filter(|(i, _)| snap.forces.slack[*i])
+        .map(|(_, c)| c.name.clone())
+        .collect()
 }
 
 /// Euclidean distance of the simulated lengths from the analytic ones [m].

@@ -272,8 +272,8 @@ impl Outputs<'_> {
     ) -> Result<Simulation, String> {
         let s = mech.build(params, inputs, &self.sc.start).map_err(|e| e.to_string())?;
         let same = |a: &crate::structure::Structure, b: &crate::structure::Structure| {
-            (a.bodies.len(), a.nodes.len(), a.joints.len(), a.springs.len(), a.cables.len(), a.actuators.len())
-                == (b.bodies.len(), b.nodes.len(), b.joints.len(), b.springs.len(), b.cables.len(), b.actuators.len())
+            (a.bodies.len(), a.nodes.len(), a.joints.len(), a.members.len(), a.actuators.len())
+                == (b.bodies.len(), b.nodes.len(), b.joints.len(), b.members.len(), b.actuators.len())
         };
         if !same(&s, at.structure()) {
             return Err("the structure built at a step has other bodies, nodes or members".into());

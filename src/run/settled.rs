@@ -109,9 +109,9 @@ fn constraints_report(c: &Constraints, s: &crate::structure::Structure) -> Const
             .taut_cables
             .iter()
             .zip(&c.multipliers[loop_rows..])
-            .map(|(&k, t)| (s.cables[k].name.clone(), *t))
+            .map(|(&k, t)| (s.members[k].name.clone(), *t))
             .collect(),
-        slack_cables: c.slack_cables.iter().map(|&k| s.cables[k].name.clone()).collect(),
+        slack_cables: c.slack_cables.iter().map(|&k| s.members[k].name.clone()).collect(),
     }
 }
 

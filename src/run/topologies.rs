@@ -11,6 +11,7 @@ use crate::report::{
     ScenarioReport,
 };
 use crate::scenario::Scenario;
+use crate::structure::MemberKind;
 use std::path::{Path, PathBuf};
 
 /// Runs every topology of `sc` and joins the reports.
@@ -74,9 +75,9 @@ pub fn rebuilt(sc: &Scenario, variant: &Scenario) -> String {
                 ": {} bodies, {} nodes, {} struts, {} cables, {} springs, {} joints",
                 s.bodies.len(),
                 s.nodes.len(),
-                s.struts.len(),
-                s.cables.len(),
-                s.springs.len(),
+                s.count_of(MemberKind::Strut),
+                s.count_of(MemberKind::Cable),
+                s.count_of(MemberKind::Spring),
                 s.joints.len()
             )
         }

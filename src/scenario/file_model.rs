@@ -11,7 +11,7 @@ use super::Actuation;
 use crate::file_model::expr::Expr;
 use crate::file_model::spec::{Equation, ErrorClass, ModelSpec, Prediction, Quantity, Sensitivity, Source, Symbol};
 use crate::mechanisms::{Mechanism, Values};
-use crate::structure::JointKind;
+use crate::structure::{JointKind, MemberKind};
 use toml::Spanned;
 
 /// The compiled model section, or None when the file states none.
@@ -79,12 +79,12 @@ fn state_symbols(s: &crate::structure::Structure, m: &dyn Mechanism, params: &Va
             add(format!("{}.{c}", n.name), Source::Node(n.name.clone(), axis));
         }
     }
-    let members = s.springs.iter().map(|m| &m.name).chain(s.cables.iter().map(|m| &m.name));
+    let members = s.members_by_kind().filter(|(_, m)| m.kind() != MemberKind::Strut).map(|(_, m)| &m.name);
     for name in members {
         add(format!("{name}.force"), Source::MemberForce(name.clone()));
         add(format!("{name}.length"), Source::MemberLength(name.clone()));
     }
-    for st in &s.struts {
+    for (_, st) in s.members_of(MemberKind::Strut) {
         add(format!("{}.length", st.name), Source::MemberLength(st.name.clone()));
     }
     for j in &s.joints {

@@ -14,7 +14,7 @@ use super::error::{finite, Ctx, ScenarioError};
 use super::raw::{RawPrestress, RawScenario};
 use crate::mechanisms::Values;
 use crate::settings::{OnLoss, Prestress};
-use crate::structure::{distance, BodyKind, CableLaw, Structure};
+use crate::structure::{distance, BodyKind, Law, MemberKind, Structure};
 use toml::Spanned;
 
 /// The prestress judgement of a scenario: the section's, the default for a custom structure
@@ -25,10 +25,11 @@ pub(super) fn prestress(
     first: &Structure,
     custom: bool,
 ) -> Result<Option<Prestress>, ScenarioError> {
+    let has_cables = first.members_of(MemberKind::Cable).next().is_some();
     let Some(section) = raw else {
-        return Ok((custom && !first.cables.is_empty()).then_some(Prestress::DEFAULT));
+        return Ok((custom && has_cables).then_some(Prestress::DEFAULT));
     };
-    if first.cables.is_empty() {
+    if !has_cables {
         return Err(ctx.err(section, "[prestress] judges the cables' tension, and this structure has no cables"));
     }
     let p = section.get_ref();
@@ -75,31 +76,35 @@ pub(super) fn set_self_stress(
     if !(least_n.is_finite() && least_n > 0.0) {
         return Err(ctx.err(t, format!("prestress.least_tension is {least_n} N: a tension is finite and > 0")));
     }
-    let on_strut = |n: usize| s.struts.iter().any(|m| m.a == n || m.b == n);
+    if let Some((_, c)) = s.members_of(MemberKind::Cable).find(|(_, c)| c.is_clustered()) {
+        let name = &c.name;
+        return Err(ctx.err(t, format!("prestress.least_tension: cable '{name}' is clustered, and the drawn self-stress is found for straight members only")));
+    }
+    let on_strut = |n: usize| s.members_of(MemberKind::Strut).any(|(_, m)| m.path.contains(&n));
     let anchored: Vec<bool> =
         (0..s.nodes.len()).map(|n| s.bodies[s.nodes[n].body].kind == BodyKind::Fixed && !on_strut(n)).collect();
     let positions: Vec<_> = s.nodes.iter().map(|n| n.position).collect();
-    let tension: Vec<(usize, usize)> =
-        s.cables.iter().map(|c| (c.a, c.b)).chain(s.springs.iter().map(|m| (m.a, m.b))).collect();
-    let struts: Vec<(usize, usize)> = s.struts.iter().map(|m| (m.a, m.b)).collect();
+    // Cables first, then springs: the order of `self_stress_of`'s tensions.
+    let tensioned: Vec<usize> = [MemberKind::Cable, MemberKind::Spring]
+        .into_iter()
+        .flat_map(|k| s.members_of(k).map(|(i, _)| i).collect::<Vec<_>>())
+        .collect();
+    let tension: Vec<(usize, usize)> = tensioned.iter().map(|&i| s.members[i].ends()).collect();
+    let struts: Vec<(usize, usize)> = s.members_of(MemberKind::Strut).map(|(_, m)| m.ends()).collect();
     let stress = crate::import::self_stress::self_stress_of(&positions, &anchored, &tension, &struts).ok_or_else(|| {
         ctx.err(t, "prestress.least_tension: the drawn structure has no self-stress that keeps every cable and spring in tension (no load-free equilibrium of its members: check the drawing)")
     })?;
-    let (cables, springs) = stress.split_at(s.cables.len());
-    for (c, share) in s.cables.iter_mut().zip(cables) {
-        let CableLaw::Elastic { stiffness_n_per_m } = c.law else { continue };
-        c.length_m =
-            rest_length(ctx, t, &c.name, least_n * share, stiffness_n_per_m, distance(positions[c.a], positions[c.b]))?;
-    }
-    for (m, share) in s.springs.iter_mut().zip(springs) {
-        m.rest_length_m = rest_length(
-            ctx,
-            t,
-            &m.name,
-            least_n * share,
-            m.stiffness_n_per_m,
-            distance(positions[m.a], positions[m.b]),
-        )?;
+    for (&i, share) in tensioned.iter().zip(&stress) {
+        let m = &mut s.members[i];
+        let (a, b) = m.ends();
+        let Some(stiffness_n_per_m) = m.stiffness_n_per_m() else { continue };
+        let rest =
+            rest_length(ctx, t, &m.name, least_n * share, stiffness_n_per_m, distance(positions[a], positions[b]))?;
+        match &mut m.law {
+            Law::Cable { length_m, .. } => *length_m = rest,
+            Law::Spring { rest_length_m, .. } => *rest_length_m = rest,
+            Law::Strut => {}
+        }
     }
     Ok(())
 }

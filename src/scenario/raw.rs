@@ -309,6 +309,9 @@ pub(super) struct RawMember {
     pub(super) stiffness: Option<Spanned<Num>>,
     /// Springs: free length [m]; cables: unstretched length [m]. Absent: the initial distance.
     pub(super) length: Option<Spanned<Num>>,
+    /// Cables only: the inner nodes a clustered cable runs through from `a` to `b`, in order;
+    /// it slides there without friction (one tension in every segment).
+    pub(super) through: Option<Spanned<Vec<Spanned<String>>>>,
 }
 
 #[derive(Clone, Debug, Deserialize)]

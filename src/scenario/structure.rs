@@ -5,7 +5,7 @@ use super::error::{finite, positive_value, Ctx, ScenarioError};
 use super::raw::RawMemberGroup;
 use super::raw::{RawActuator, RawBody, RawJoint, RawMember, RawStructure, Xyz};
 use crate::structure::{
-    Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut,
+    Actuator, ActuatorTarget, BodyKind, CableLaw, Inertia, Joint, JointKind, Member, MemberKind, Structure,
     TorsionSpring, DEFAULT_TENDON_RADIUS_M,
 };
 use toml::Spanned;
@@ -38,9 +38,10 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
     // Names of members, joints and actuator symbols: unique, checked with every other name
     // of the file (`names.rs`).
     // Each part refers only to the parts built before it.
-    s.struts = r.struts.iter().map(|m| strut(ctx, &s, m)).collect::<Result<_, _>>()?;
-    s.springs = r.springs.iter().map(|m| spring(ctx, &s, m)).collect::<Result<_, _>>()?;
-    s.cables = r.cables.iter().map(|m| cable(ctx, &s, m)).collect::<Result<_, _>>()?;
+    let struts = r.struts.iter().map(|m| strut(ctx, &s, m)).collect::<Result<Vec<_>, _>>()?;
+    let springs = r.springs.iter().map(|m| spring(ctx, &s, m)).collect::<Result<Vec<_>, _>>()?;
+    let cables = r.cables.iter().map(|m| cable(ctx, &s, m)).collect::<Result<Vec<_>, _>>()?;
+    s.members = [struts, springs, cables].concat();
     add_member_groups(ctx, &mut s, r)?;
     s.joints = r.joints.iter().map(|j| joint(ctx, &s, j)).collect::<Result<_, _>>()?;
     s.actuators = r.actuators.iter().map(|a| actuator(ctx, &s, a)).collect::<Result<_, _>>()?;
@@ -165,8 +166,14 @@ fn body(ctx: &Ctx, s: &Structure, n: &Spanned<String>) -> Result<usize, Scenario
     s.body_id(n.get_ref()).ok_or_else(|| ctx.err(n, format!("unknown body '{}'", n.get_ref())))
 }
 
-/// A member's two nodes and the distance between them (> 0).
+/// A member's two nodes and the distance between them (> 0); `through` is a cable's alone.
 fn ends(ctx: &Ctx, s: &Structure, m: &RawMember, what: &str) -> Result<(usize, usize, f64), ScenarioError> {
+    if let Some(t) = &m.through {
+        return Err(ctx.err(
+            t,
+            format!("through: only a cable runs through inner nodes, and '{}' is a {what}", m.name.get_ref()),
+        ));
+    }
     let (a, b) = (node(ctx, s, &m.a)?, node(ctx, s, &m.b)?);
     let l = crate::structure::distance(s.nodes[a].position, s.nodes[b].position);
     if l <= 0.0 {
@@ -176,17 +183,17 @@ fn ends(ctx: &Ctx, s: &Structure, m: &RawMember, what: &str) -> Result<(usize, u
 }
 
 /// A strut, with its radius > 0 (default [`DEFAULT_STRUT_RADIUS_M`]).
-fn strut(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Strut, ScenarioError> {
+fn strut(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Member, ScenarioError> {
     let (a, b, _) = ends(ctx, s, m, "strut")?;
     let radius = match &m.radius {
         Some(v) => positive_value(ctx, v, "radius (m)")?,
         None => DEFAULT_STRUT_RADIUS_M,
     };
-    Ok(Strut { name: m.name.get_ref().clone(), a, b, radius_m: radius })
+    Ok(Member::strut(m.name.get_ref().clone(), a, b, radius))
 }
 
 /// A spring: its stiffness > 0 (required) and free length >= 0 (default: the initial distance).
-fn spring(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Spring, ScenarioError> {
+fn spring(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Member, ScenarioError> {
     let (a, b, l) = ends(ctx, s, m, "spring")?;
     let k = m.stiffness.as_ref().ok_or_else(|| ctx.err(&m.name, "a spring needs a stiffness (N/m)"))?;
     let rest = match &m.length {
@@ -199,20 +206,19 @@ fn spring(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Spring, ScenarioErr
         }
         None => l,
     };
-    Ok(Spring {
-        name: m.name.get_ref().clone(),
-        a,
-        b,
-        stiffness_n_per_m: positive_value(ctx, k, "stiffness (N/m)")?,
-        rest_length_m: rest,
-        radius_m: tendon_radius(ctx, m)?,
-    })
+    Ok(Member::spring(
+        m.name.get_ref().clone(),
+        [a, b],
+        positive_value(ctx, k, "stiffness (N/m)")?,
+        rest,
+        tendon_radius(ctx, m)?,
+    ))
 }
 
 /// A cable: elastic with a stiffness > 0, else inextensible; its length > 0 (default: the
 /// initial distance).
-fn cable(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Cable, ScenarioError> {
-    let (a, b, l) = ends(ctx, s, m, "cable")?;
+fn cable(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Member, ScenarioError> {
+    let (path, l) = cable_path(ctx, s, m)?;
     let law = match &m.stiffness {
         Some(k) => CableLaw::Elastic { stiffness_n_per_m: positive_value(ctx, k, "stiffness (N/m)")? },
         None => CableLaw::Inextensible,
@@ -221,7 +227,39 @@ fn cable(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Cable, ScenarioError
         Some(v) => positive_value(ctx, v, "length (m)")?,
         None => l,
     };
-    Ok(Cable { name: m.name.get_ref().clone(), a, b, law, length_m: length, radius_m: tendon_radius(ctx, m)? })
+    Ok(Member::cable(m.name.get_ref().clone(), path, law, length, tendon_radius(ctx, m)?))
+}
+
+/// A cable's path, `a`, the nodes it runs `through`, then `b`, and its drawn length: each
+/// segment longer than zero (no node twice in a row; a ring may end where it starts).
+fn cable_path(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<(Vec<usize>, f64), ScenarioError> {
+    let name = m.name.get_ref();
+    let inner = m.through.as_ref().map_or(&[][..], |t| &t.get_ref()[..]);
+    if let (Some(t), true) = (&m.through, inner.is_empty()) {
+        return Err(
+            ctx.err(t, format!("through: cable '{name}' names no inner node (leave the key out for a straight cable)"))
+        );
+    }
+    let spanned: Vec<&Spanned<String>> = std::iter::once(&m.a).chain(inner).chain([&m.b]).collect();
+    let path = spanned.iter().map(|n| node(ctx, s, n)).collect::<Result<Vec<_>, _>>()?;
+    let mut length = 0.0;
+    for (k, w) in path.windows(2).enumerate() {
+        let segment = crate::structure::distance(s.nodes[w[0]].position, s.nodes[w[1]].position);
+        if w[0] == w[1] {
+            return Err(ctx.err(
+                spanned[k + 1],
+                format!("cable '{name}' runs through node '{}' twice in a row", spanned[k + 1].get_ref()),
+            ));
+        }
+        if segment <= 0.0 {
+            return Err(ctx.err(&m.name, format!("cable '{name}' has a segment of zero length: its nodes coincide")));
+        }
+        length += segment;
+    }
+    if !inner.is_empty() && m.stiffness.is_none() {
+        return Err(ctx.err(&m.name, format!("cable '{name}' is clustered (through): it needs a stiffness (N/m); an inextensible clustered cable is not modelled")));
+    }
+    Ok((path, length))
 }
 
 /// A cable's or spring's radius > 0 (default [`DEFAULT_TENDON_RADIUS_M`]), for interference.
@@ -339,7 +377,9 @@ fn actuator(ctx: &Ctx, s: &Structure, a: &RawActuator) -> Result<Actuator, Scena
     let target = match (&a.joint, &a.cable, &a.node) {
         (Some(j), None, None) => ActuatorTarget::Joint(find(j, s.joints.iter().map(|x| &x.name).collect(), "joint")?),
         (None, Some(c), None) => {
-            ActuatorTarget::CableLength(find(c, s.cables.iter().map(|x| &x.name).collect(), "cable")?)
+            let cables: Vec<(usize, &String)> = s.members_of(MemberKind::Cable).map(|(i, m)| (i, &m.name)).collect();
+            let k = find(c, cables.iter().map(|x| x.1).collect(), "cable")?;
+            ActuatorTarget::CableLength(cables[k].0)
         }
         (None, None, Some(n)) => {
             let d = a.direction.as_ref().ok_or_else(|| {
@@ -367,19 +407,19 @@ fn add_member_groups(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(
     for g in &r.strut_groups {
         for m in group_members(ctx, g)? {
             let st = strut(ctx, s, &m)?;
-            s.struts.push(st);
+            s.members.push(st);
         }
     }
     for g in &r.spring_groups {
         for m in group_members(ctx, g)? {
             let sp = spring(ctx, s, &m)?;
-            s.springs.push(sp);
+            s.members.push(sp);
         }
     }
     for g in &r.cable_groups {
         for m in group_members(ctx, g)? {
             let c = cable(ctx, s, &m)?;
-            s.cables.push(c);
+            s.members.push(c);
         }
     }
     Ok(())
@@ -425,6 +465,7 @@ pub(super) fn group_members(ctx: &Ctx, g: &RawMemberGroup) -> Result<Vec<RawMemb
             radius: g.radius.clone(),
             stiffness: g.stiffness.clone(),
             length: g.length.clone(),
+            through: None,
         });
     }
     Ok(out)

@@ -1,7 +1,7 @@
 //! Structure -> rapier sets.
 
 use super::{Data, LinkRef, Model, SimError, SimSettings};
-use crate::structure::{ActuatorTarget, BodyKind, CableLaw, Joint, JointKind, Structure, Vec3};
+use crate::structure::{ActuatorTarget, BodyKind, CableLaw, Joint, JointKind, Law, MemberKind, Structure, Vec3};
 use rapier3d_f64::prelude::*;
 
 fn v(a: Vec3) -> Vector {
@@ -17,7 +17,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<(Model, Dat
     let (mut bodies, handles) = insert_bodies(s, settings);
     let joints = insert_joints(s, &mut bodies, &handles, &actuated)?;
     let Joints { mut impulse_joints, multibody_joints, joint_links, joint_impulse, hidden_links } = joints;
-    let cable_ropes = insert_ropes(s, &mut impulse_joints, &handles)?;
+    let ropes = insert_ropes(s, &mut impulse_joints, &handles)?;
     let mut model = Model {
         structure: s.clone(),
         settings: settings.clone(),
@@ -28,7 +28,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<(Model, Dat
         joint_impulse,
         internal_closures: Vec::new(),
         projected_groups: Vec::new(),
-        cable_ropes,
+        ropes,
         external_loads: external_loads(s),
         length_scale_m: crate::structure::structure_size(s),
         tree: super::tree::Tree::default(),
@@ -47,7 +47,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<(Model, Dat
         multibody_joints,
         soft_bodies: SoftBodySet::new(),
         ccd: CCDSolver::new(),
-        cable_lengths: s.cables.iter().map(|c| c.length_m).collect(),
+        rest_lengths: s.members.iter().map(|m| m.rest_length_m().unwrap_or(0.0)).collect(),
         commands: s.initial_commands(),
         probe_loads: vec![([0.0; 3], [0.0; 3]); n],
         tick: 0,
@@ -172,9 +172,10 @@ fn insert_joints(
     // Bodies held by inextensible cables stay plain rigid bodies, joined by impulse joints:
     // the configuration measured to 1e-13 on mohr2011.
     let mut roped = vec![false; s.bodies.len()];
-    for c in s.cables.iter().filter(|c| c.law == CableLaw::Inextensible) {
-        roped[s.nodes[c.a].body] = true;
-        roped[s.nodes[c.b].body] = true;
+    for c in s.members.iter().filter(|c| c.is_inextensible_cable()) {
+        for &n in &c.path {
+            roped[s.nodes[n].body] = true;
+        }
     }
     let tree = plan_tree(s, &roped, actuated)?;
     for (j, joint) in s.joints.iter().enumerate() {
@@ -244,27 +245,27 @@ fn insert_universal(
     (second, LinkRef { multibody_joint: h_first })
 }
 
-/// One rope joint per inextensible cable (None for elastic cables, which are explicit forces).
+/// One rope joint per inextensible cable, member order (None for every other member: springs
+/// and elastic cables are explicit forces). An inextensible cable is straight (validated).
 fn insert_ropes(
     s: &Structure,
     impulse_joints: &mut ImpulseJointSet,
     handles: &[RigidBodyHandle],
 ) -> Result<Vec<Option<ImpulseJointHandle>>, SimError> {
-    let mut cable_ropes = vec![None; s.cables.len()];
-    for (c, cable) in s.cables.iter().enumerate() {
-        if cable.law == CableLaw::Inextensible {
-            let (na, nb) = (&s.nodes[cable.a], &s.nodes[cable.b]);
+    let mut ropes = vec![None; s.members.len()];
+    for (c, cable) in s.members_of(MemberKind::Cable) {
+        if let Law::Cable { law: CableLaw::Inextensible, length_m } = cable.law {
+            let (a, b) = cable.ends();
+            let (na, nb) = (&s.nodes[a], &s.nodes[b]);
             if na.body == nb.body {
                 return Err(SimError::Build(format!("cable '{}' joins two nodes of the same body", cable.name)));
             }
-            let rope = RopeJointBuilder::new(cable.length_m)
-                .local_anchor1(v(na.position))
-                .local_anchor2(v(nb.position))
-                .build();
-            cable_ropes[c] = Some(impulse_joints.insert(handles[na.body], handles[nb.body], rope, true));
+            let rope =
+                RopeJointBuilder::new(length_m).local_anchor1(v(na.position)).local_anchor2(v(nb.position)).build();
+            ropes[c] = Some(impulse_joints.insert(handles[na.body], handles[nb.body], rope, true));
         }
     }
-    Ok(cable_ropes)
+    Ok(ropes)
 }
 
 fn integration_parameters(settings: &SimSettings) -> IntegrationParameters {

@@ -37,7 +37,7 @@
 
 use super::modes::{ModesError, StructureMode, StructureModes, ZERO_MODE_RATIO};
 use super::{Data, Model};
-use crate::structure::{BodyKind, CableLaw, JointKind};
+use crate::structure::{BodyKind, JointKind};
 use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
 use std::sync::atomic::AtomicBool;
@@ -256,14 +256,10 @@ impl Data {
     /// energy has a kink; None without elastic cables.
     fn kink_distance_m(&self, m: &Model) -> Option<f64> {
         let s = &m.structure;
-        (0..s.springs.len() + s.cables.len())
-            .filter_map(|i| self.elastic_member(m, i))
-            .filter(|member| member.tension_only)
-            .map(|member| {
-                let (a, b) = (self.node_position(m, member.a), self.node_position(m, member.b));
-                let l = (Vector3::from(b) - Vector3::from(a)).norm();
-                (l - member.rest_length_m).abs()
-            })
+        s.members_by_kind()
+            .filter_map(|(i, _)| Some((i, self.elastic_law(m, i)?)))
+            .filter(|(_, law)| law.tension_only)
+            .map(|(i, law)| (self.member_length_m(m, i) - law.rest_length_m).abs())
             .reduce(f64::min)
     }
 
@@ -472,7 +468,7 @@ impl Data {
     ) -> Result<StructureModes, ModesError> {
         let s = &m.structure;
         let closures = self.modal_closures(m)?;
-        let inextensible = (0..s.cables.len()).filter(|&c| !matches!(s.cables[c].law, CableLaw::Elastic { .. }));
+        let inextensible = s.members.iter().enumerate().filter(|(_, c)| c.is_inextensible_cable()).map(|(c, _)| c);
         let (taut, slack): (Vec<usize>, Vec<usize>) = inextensible.partition(|&c| self.cable_is_taut(m, c));
         let coordinates = self.modal_coordinates(m);
         if coordinates.is_empty() {

@@ -171,22 +171,27 @@ impl Data {
                 inertia.mass_kg
             };
         }
-        // Springs and elastic cables with one end carried: their force changes with the
-        // coordinate (a member with both ends carried moves rigidly and adds nothing).
-        for i in 0..s.springs.len() + s.cables.len() {
-            let Some(member) = self.elastic_member(m, i) else { continue };
-            let (a_carried, b_carried) = (carried(s.nodes[member.a].body), carried(s.nodes[member.b].body));
-            if a_carried == b_carried {
-                continue;
+        // Springs and elastic cables with one end of a segment carried: their force changes
+        // with the coordinate (a segment with both ends carried moves rigidly and adds nothing).
+        // A clustered cable's segments are taken each with the whole cable's tension and
+        // stiffness: an estimate for the schedule, which is no part of a physical path.
+        for (i, member) in s.members_by_kind() {
+            let Some(law) = self.elastic_law(m, i) else { continue };
+            let length = self.member_length_m(m, i);
+            for (a, b) in member.segments() {
+                let (a_carried, b_carried) = (carried(s.nodes[a].body), carried(s.nodes[b].body));
+                if a_carried == b_carried {
+                    continue;
+                }
+                let (x, other) = if a_carried { (a, b) } else { (b, a) };
+                let (px, po) = (Vector::from(self.node_position(m, x)), Vector::from(self.node_position(m, other)));
+                let d = po - px;
+                let l = d.length();
+                if l <= 0.0 || !law.engaged(length) {
+                    continue;
+                }
+                load.stiffness += motion.member_stiffness(px, d / l, law.tension_n(length), law.stiffness_n_per_m, l);
             }
-            let (x, other) = if a_carried { (member.a, member.b) } else { (member.b, member.a) };
-            let (px, po) = (Vector::from(self.node_position(m, x)), Vector::from(self.node_position(m, other)));
-            let d = po - px;
-            let l = d.length();
-            if l <= 0.0 || !member.engaged(l) {
-                continue;
-            }
-            load.stiffness += motion.member_stiffness(px, d / l, member.tension_n(l), member.stiffness_n_per_m, l);
         }
         if let (Some(t), true) = (&joint.torsion_spring, revolute) {
             load.force += self.torsion_spring_torque(m, j);

@@ -22,8 +22,9 @@ pub(super) struct Data {
     pub(super) multibody_joints: MultibodyJointSet,
     pub(super) soft_bodies: SoftBodySet,
     pub(super) ccd: CCDSolver,
-    /// Current unstretched cable lengths [m].
-    pub(super) cable_lengths: Vec<f64>,
+    /// Every member's current rest length, member order \[m\]: a spring's, a cable's
+    /// unstretched (commanded) length; 0 for a strut.
+    pub(super) rest_lengths: Vec<f64>,
     /// Current actuator commands, in actuator order.
     pub(super) commands: Vec<f64>,
     /// External loads [N] and [N m] applied to bodies (probes), world frame, about the body's
@@ -120,9 +121,9 @@ impl Data {
     pub(super) fn apply_cable_commands(&mut self, m: &Model) {
         for (i, a) in m.structure.actuators.iter().enumerate() {
             if let ActuatorTarget::CableLength(c) = a.target {
-                self.cable_lengths[c] = self.commands[i];
+                self.rest_lengths[c] = self.commands[i];
                 self.constraint_inputs += 1;
-                if let Some(h) = m.cable_ropes[c] {
+                if let Some(h) = m.ropes[c] {
                     if let Some(j) = self.impulse_joints.get_mut(h, true) {
                         j.data.set_limits(JointAxis::LinX, [0.0, self.commands[i]]);
                     }

@@ -4,39 +4,11 @@
 use super::least_squares::SparseRows;
 use super::tree::Tree;
 use super::{Data, MemberForces, Model, Residual};
-use crate::structure::{ActuatorTarget, CableLaw, JointKind};
+use crate::structure::{ActuatorTarget, ElasticLaw, JointKind, MemberKind};
 use rapier3d_f64::prelude::*;
 
 /// (force, moment about the world origin)
 pub(super) type Wrench = (Vector, Vector);
-
-/// A member whose force follows from its length: a spring (pushes and pulls) or an elastic
-/// cable (pulls only).
-pub(super) struct ElasticMember {
-    pub(super) a: usize,
-    pub(super) b: usize,
-    pub(super) stiffness_n_per_m: f64,
-    pub(super) rest_length_m: f64,
-    pub(super) tension_only: bool,
-}
-
-impl ElasticMember {
-    /// Whether the member carries force at length `l` [m] (a cable goes slack when not
-    /// stretched).
-    pub(super) fn engaged(&self, l: f64) -> bool {
-        !self.tension_only || l > self.rest_length_m
-    }
-
-    /// Tension at length `l` [m]: k (l - l0), at least 0 for a cable [N].
-    pub(super) fn tension_n(&self, l: f64) -> f64 {
-        let t = self.stiffness_n_per_m * (l - self.rest_length_m);
-        if self.tension_only {
-            t.max(0.0)
-        } else {
-            t
-        }
-    }
-}
 
 fn v(a: [f64; 3]) -> Vector {
     Vector::new(a[0], a[1], a[2])
@@ -51,9 +23,9 @@ impl Data {
             rb.reset_forces(false);
             rb.reset_torques(false);
         }
-        for i in 0..m.structure.springs.len() + m.structure.cables.len() {
-            if let Some(member) = self.elastic_member(m, i) {
-                self.add_member_load(m, &member);
+        for (i, _) in m.structure.members_by_kind() {
+            if let Some(law) = self.elastic_law(m, i) {
+                self.add_member_load(m, i, &law);
             }
         }
         for b in 0..n {
@@ -69,54 +41,45 @@ impl Data {
         }
     }
 
-    /// Member `i` of the springs followed by the cables, if its force follows from its length
-    /// (a spring, or an elastic cable at its current rest length).
-    pub(super) fn elastic_member(&self, m: &Model, i: usize) -> Option<ElasticMember> {
-        let s = &m.structure;
-        if let Some(sp) = s.springs.get(i) {
-            return Some(ElasticMember {
-                a: sp.a,
-                b: sp.b,
-                stiffness_n_per_m: sp.stiffness_n_per_m,
-                rest_length_m: sp.rest_length_m,
-                tension_only: false,
-            });
-        }
-        let c = i - s.springs.len();
-        match s.cables.get(c)?.law {
-            CableLaw::Elastic { stiffness_n_per_m } => Some(ElasticMember {
-                a: s.cables[c].a,
-                b: s.cables[c].b,
-                stiffness_n_per_m,
-                rest_length_m: self.cable_lengths[c],
-                tension_only: true,
-            }),
-            CableLaw::Inextensible => None,
-        }
+    /// Member `i`'s law if its force follows from its length (a spring, or an elastic cable
+    /// at its current rest length).
+    pub(super) fn elastic_law(&self, m: &Model, i: usize) -> Option<ElasticLaw> {
+        m.structure.members[i].elastic_law(self.rest_lengths[i])
     }
 
-    /// Puts the tension of member `m` on the bodies of its two nodes, each as a force at the
-    /// centre of mass plus its moment, with the centre of mass taken from the current pose:
-    /// rapier's cached world centre of mass is stale before the first step, which gave a
-    /// spurious kick of |c x F| there.
-    fn add_member_load(&mut self, m: &Model, member: &ElasticMember) {
-        let (a, b) = (member.a, member.b);
-        let (pa, pb) = (v(self.node_position(m, a)), v(self.node_position(m, b)));
-        let d = pb - pa;
-        let l = d.length();
-        let t = member.tension_n(l);
-        if l > 0.0 && t != 0.0 {
-            let f = d / l * t;
-            for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
-                let body = m.structure.nodes[node].body;
-                if m.is_free(body) {
-                    let com = self.world_com(m, body);
-                    let rb = &mut self.bodies[m.handles[body]];
-                    rb.add_force(f, false);
-                    rb.add_torque((p - com).cross(f), false);
+    /// Puts the tension of member `i` on the bodies of its path's nodes, each segment pulling
+    /// its two ends, as a force at the centre of mass plus its moment, with the centre of mass
+    /// taken from the current pose: rapier's cached world centre of mass is stale before the
+    /// first step, which gave a spurious kick of |c x F| there.
+    fn add_member_load(&mut self, m: &Model, i: usize, law: &ElasticLaw) {
+        let member = &m.structure.members[i];
+        let t = law.tension_n(self.member_length_m(m, i));
+        for (a, b) in member.segments() {
+            let (pa, pb) = (v(self.node_position(m, a)), v(self.node_position(m, b)));
+            let d = pb - pa;
+            let l = d.length();
+            if l > 0.0 && t != 0.0 {
+                let f = d / l * t;
+                for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
+                    let body = m.structure.nodes[node].body;
+                    if m.is_free(body) {
+                        let com = self.world_com(m, body);
+                        let rb = &mut self.bodies[m.handles[body]];
+                        rb.add_force(f, false);
+                        rb.add_torque((p - com).cross(f), false);
+                    }
                 }
             }
         }
+    }
+
+    /// Member `i`'s length now, the sum of its segments' \[m\].
+    pub(super) fn member_length_m(&self, m: &Model, i: usize) -> f64 {
+        let member = &m.structure.members[i];
+        let mut lengths =
+            member.segments().map(|(a, b)| (v(self.node_position(m, b)) - v(self.node_position(m, a))).length());
+        let first = lengths.next().unwrap_or(0.0);
+        lengths.fold(first, |l, s| l + s)
     }
 
     /// Torque of joint `j`'s torsion spring at the joint's current angle [N m]: -k (q - q_rest),
@@ -181,48 +144,52 @@ impl Data {
     fn member_loads(&self, m: &Model, held: &[bool]) -> (MemberForces, Vec<Wrench>) {
         let s = &m.structure;
         let mut wrench: Vec<Wrench> = vec![(Vector::ZERO, Vector::ZERO); s.bodies.len()];
-        // The member from node a to node b at its current length l pulls both ends with
+        // Member i at its current length l pulls both ends of every segment with
         // `tension_at(l)`; returns (l, tension).
-        let mut pull = |a: usize, b: usize, tension_at: &dyn Fn(f64) -> f64| -> (f64, f64) {
-            let (pa, pb) = (v(self.node_position(m, a)), v(self.node_position(m, b)));
-            let d = pb - pa;
-            let l = d.length();
+        let mut pull = |i: usize, tension_at: &dyn Fn(f64) -> f64| -> (f64, f64) {
+            let l = self.member_length_m(m, i);
             let tension = tension_at(l);
-            if l > 0.0 {
-                let f = d / l * tension;
-                for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
-                    let w = &mut wrench[s.nodes[node].body];
-                    w.0 += f;
-                    w.1 += p.cross(f);
+            for (a, b) in s.members[i].segments() {
+                let (pa, pb) = (v(self.node_position(m, a)), v(self.node_position(m, b)));
+                let d = pb - pa;
+                let segment = d.length();
+                if segment > 0.0 {
+                    let f = d / segment * tension;
+                    for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
+                        let w = &mut wrench[s.nodes[node].body];
+                        w.0 += f;
+                        w.1 += p.cross(f);
+                    }
                 }
             }
             (l, tension)
         };
-        let mut out = MemberForces::default();
-        for (i, sp) in s.springs.iter().enumerate() {
-            let member = self.elastic_member(m, i).expect("a spring is elastic");
-            let (l, force) = pull(sp.a, sp.b, &|l| member.tension_n(l));
-            out.spring_force_n.push(force);
-            out.spring_length_m.push(l);
-        }
+        let count = s.members.len();
+        let mut out = MemberForces {
+            force_n: vec![0.0; count],
+            length_m: vec![0.0; count],
+            rest_length_m: self.rest_lengths.clone(),
+            slack: vec![false; count],
+            ..MemberForces::default()
+        };
         let inv_h = m.settings.substeps as f64 / m.settings.dt_s;
-        for (c, cable) in s.cables.iter().enumerate() {
-            let (l, tension) = match self.elastic_member(m, s.springs.len() + c) {
-                Some(member) => pull(cable.a, cable.b, &|l| member.tension_n(l)),
+        for (i, member) in s.members_by_kind() {
+            let (l, force) = match (member.kind(), self.elastic_law(m, i)) {
+                (MemberKind::Strut, _) => (self.member_length_m(m, i), 0.0),
+                (_, Some(law)) => pull(i, &|l| law.tension_n(l)),
                 // Held at its length by the projection: its tension is fitted later.
-                None if held[c] => pull(cable.a, cable.b, &|_| 0.0),
-                None => {
-                    let rope = m.cable_ropes[c]
+                (_, None) if held[i] => pull(i, &|_| 0.0),
+                (_, None) => {
+                    let rope = m.ropes[i]
                         .and_then(|h| self.impulse_joints.get(h))
                         .map(|j| j.data.limits[0].impulse.abs() * inv_h)
                         .unwrap_or(0.0);
-                    pull(cable.a, cable.b, &|_| rope)
+                    pull(i, &|_| rope)
                 }
             };
-            out.cable_tension_n.push(tension);
-            out.cable_length_m.push(l);
-            out.cable_rest_length_m.push(self.cable_lengths[c]);
-            out.cable_slack.push(tension <= 0.0);
+            out.force_n[i] = force;
+            out.length_m[i] = l;
+            out.slack[i] = member.kind() == MemberKind::Cable && force <= 0.0;
         }
         (out, wrench)
     }
@@ -277,8 +244,8 @@ impl Data {
                     closure_reaction[j].1 += load.moment * lambda[k];
                 }
                 ClosureMember::Cable(c) => {
-                    out.cable_tension_n[c] = lambda[k];
-                    out.cable_slack[c] = lambda[k] <= 0.0;
+                    out.force_n[c] = lambda[k];
+                    out.slack[c] = lambda[k] <= 0.0;
                 }
             }
         }
@@ -405,9 +372,9 @@ impl Data {
     fn residual_of(&self, m: &Model, held: &[bool], wrench: &[Wrench], out: &MemberForces) -> Residual {
         let s = &m.structure;
         let mut residual = Residual::default();
-        for (c, cable) in s.cables.iter().enumerate() {
-            if matches!(cable.law, CableLaw::Inextensible) && held[c] {
-                residual.max_force_n = residual.max_force_n.max((-out.cable_tension_n[c]).max(0.0));
+        for (c, cable) in s.members_of(MemberKind::Cable) {
+            if cable.is_inextensible_cable() && held[c] {
+                residual.max_force_n = residual.max_force_n.max((-out.force_n[c]).max(0.0));
             }
         }
         for c in self.coordinate_forces(m, &m.fit_tree, wrench, true) {
@@ -444,7 +411,7 @@ impl Data {
         s.actuators
             .iter()
             .map(|a| match a.target {
-                ActuatorTarget::CableLength(c) => out.cable_tension_n[c],
+                ActuatorTarget::CableLength(c) => out.force_n[c],
                 // The force that holds the moved body against its members, along the direction.
                 ActuatorTarget::FixedNode { node, direction } => -wrench[s.nodes[node].body].0.dot(v(direction)),
                 ActuatorTarget::Joint(j) if m.joint_impulse[j].is_some() && tree.carried(j).is_none() => {
@@ -517,7 +484,7 @@ impl Data {
     /// Every free coordinate's generalized force for the loads now, in the link tree's order:
     /// the free joints' in joint order, then six per free root (`sensitivity.rs`).
     pub(super) fn free_coordinate_forces(&self, m: &Model) -> Vec<f64> {
-        let held = vec![false; m.structure.cables.len()];
+        let held = vec![false; m.structure.members.len()];
         let (_, mut wrench) = self.member_loads(m, &held);
         self.add_body_loads(m, &mut wrench);
         self.coordinate_forces(m, &m.tree, &wrench, true).into_iter().map(|f| f.value).collect()
@@ -588,13 +555,15 @@ impl Data {
     fn projected_cable_unit_loads(&self, m: &Model, held: &[bool]) -> Vec<ClosureComponent> {
         let s = &m.structure;
         let mut out = Vec::new();
-        for (c, cable) in s.cables.iter().enumerate() {
+        // Only a straight cable is inextensible (a clustered one has a stiffness).
+        for (c, cable) in s.members_of(MemberKind::Cable) {
             if !held[c] {
                 continue;
             }
-            let (pa, pb) = (v(self.node_position(m, cable.a)), v(self.node_position(m, cable.b)));
+            let (a, b) = cable.ends();
+            let (pa, pb) = (v(self.node_position(m, a)), v(self.node_position(m, b)));
             let d = (pb - pa).normalize();
-            let (ba, bb) = (s.nodes[cable.a].body, s.nodes[cable.b].body);
+            let (ba, bb) = (s.nodes[a].body, s.nodes[b].body);
             let w = [(ba, (d, pa.cross(d))), (bb, (-d, -pb.cross(d)))];
             out.push(ClosureComponent { member: ClosureMember::Cable(c), force: d, moment: Vector::ZERO, loads: w });
         }

@@ -189,8 +189,9 @@ impl Data {
             let count = if on_tree[j] { 1 } else { self.joint_row_count(m, j) };
             (Member::Joint(self.joint_frame(m, j)), [joint.parent, joint.child], count)
         });
-        let cables =
-            taut.iter().map(|&c| (Member::Cable(c), [s.nodes[s.cables[c].a].body, s.nodes[s.cables[c].b].body], 1));
+        let cables = taut.iter().map(|&c| {
+            (Member::Cable(c), [s.nodes[s.members[c].ends().0].body, s.nodes[s.members[c].ends().1].body], 1)
+        });
         let (mut entries, mut first_row, mut block) = (Vec::new(), 0, Vec::new());
         for (member, [a, b], count) in joints.chain(cables) {
             for (link, moved) in path.between(a, b) {

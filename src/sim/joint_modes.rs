@@ -75,11 +75,9 @@ impl Data {
     pub(super) fn potential_energy_about(&self, m: &Model, reference: Option<&[Vector3<f64>]>) -> f64 {
         let s = &m.structure;
         let mut e = 0.0;
-        for member in (0..s.springs.len() + s.cables.len()).filter_map(|i| self.elastic_member(m, i)) {
-            let l = (Vector3::from(self.node_position(m, member.b)) - Vector3::from(self.node_position(m, member.a)))
-                .norm();
-            if member.engaged(l) {
-                e += 0.5 * member.stiffness_n_per_m * (l - member.rest_length_m).powi(2);
+        for (i, member) in s.members_by_kind() {
+            if let Some(law) = self.elastic_law(m, i) {
+                e += law.energy_j(member.length_at(|n| self.node_position(m, n)));
             }
         }
         let snap = self.snapshot_with(m, false);

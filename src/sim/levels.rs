@@ -30,7 +30,7 @@ impl Clone for Data {
             multibody_joints: self.multibody_joints.clone(),
             soft_bodies: self.soft_bodies.clone(),
             ccd: self.ccd.clone(),
-            cable_lengths: self.cable_lengths.clone(),
+            rest_lengths: self.rest_lengths.clone(),
             commands: self.commands.clone(),
             probe_loads: self.probe_loads.clone(),
             tick: self.tick,

@@ -88,8 +88,8 @@ pub struct Model {
     /// Groups of free bodies (plain bodies and multibodies) whose joints and taut cables are
     /// closed by position projection.
     projected_groups: Vec<projection::ProjectedGroup>,
-    /// For each inextensible cable: its rope joint.
-    cable_ropes: Vec<Option<ImpulseJointHandle>>,
+    /// For each member: its rope joint if it is an inextensible cable.
+    ropes: Vec<Option<ImpulseJointHandle>>,
     /// The joint each body hangs from in the multibody forest (fixed at build).
     tree: tree::Tree,
     /// The reaction fit's tree: the multibody forest and the sparse groups' spanning trees

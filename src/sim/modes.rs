@@ -13,7 +13,7 @@ pub use super::constrained_modes::{Constraints, ModalCoordinate};
 use super::{Data, Model, Simulation};
 use crate::eigen::EigenError;
 use crate::snapshot::{BodyPose, ModalProjector};
-use crate::structure::{BodyKind, CableLaw, JointKind};
+use crate::structure::{BodyKind, JointKind};
 use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
 use std::sync::atomic::AtomicBool;
 
@@ -118,7 +118,7 @@ impl Data {
             return Err(ModesError::NoFreeBody);
         }
         check_modal_size(s)?;
-        let inextensible = s.cables.iter().any(|c| !matches!(c.law, CableLaw::Elastic { .. }));
+        let inextensible = s.members.iter().any(|c| c.is_inextensible_cable());
         // A free joint of several coordinates (a universal joint: two revolute links and a
         // hidden body, `build.rs`) is charted by its multibody's degrees of freedom there.
         let several = |(j, joint): (usize, &crate::structure::Joint)| {

@@ -373,19 +373,19 @@ impl Data {
     /// A rope cable is taut when stretched to its length (within round-off) or when rapier's
     /// rope pulled in the last step.
     pub(super) fn cable_is_taut(&self, m: &Model, c: usize) -> bool {
-        let cable = &m.structure.cables[c];
-        let l = crate::structure::distance(self.node_position(m, cable.a), self.node_position(m, cable.b));
+        let cable = &m.structure.members[c];
+        let l =
+            crate::structure::distance(self.node_position(m, cable.ends().0), self.node_position(m, cable.ends().1));
         let inv_h = m.settings.substeps as f64 / m.settings.dt_s;
-        let impulse = m.cable_ropes[c]
-            .and_then(|h| self.impulse_joints.get(h))
-            .map_or(0.0, |j| j.data.limits[0].impulse.abs() * inv_h);
-        l >= self.cable_lengths[c] - TAUT_TOLERANCE_FRACTION * m.length_scale_m || impulse > 0.0
+        let impulse =
+            m.ropes[c].and_then(|h| self.impulse_joints.get(h)).map_or(0.0, |j| j.data.limits[0].impulse.abs() * inv_h);
+        l >= self.rest_lengths[c] - TAUT_TOLERANCE_FRACTION * m.length_scale_m || impulse > 0.0
     }
 
     /// For every cable: whether it is taut and held at its length by a group's projection (its
     /// tension is then fitted from the equilibrium, not read from rapier's impulse).
     pub(super) fn cables_held_by_projection(&self, m: &Model) -> Vec<bool> {
-        let mut held = vec![false; m.structure.cables.len()];
+        let mut held = vec![false; m.structure.members.len()];
         for g in &m.projected_groups {
             for c in self.projected_taut_cables(m, g).unwrap_or_default() {
                 held[c] = true;
@@ -446,11 +446,11 @@ impl Data {
             let actuated_ok = !m.actuated[j] || matches!(joint.kind, JointKind::Revolute { .. });
             groups[g].2 &= supported && actuated_ok;
         }
-        for (c, cable) in s.cables.iter().enumerate() {
-            if m.cable_ropes[c].is_none() {
+        for (c, cable) in s.members.iter().enumerate() {
+            if m.ropes[c].is_none() {
                 continue;
             }
-            let (a, b) = (s.nodes[cable.a].body, s.nodes[cable.b].body);
+            let (a, b) = (s.nodes[cable.ends().0].body, s.nodes[cable.ends().1].body);
             let Some(m) = movable(a).or(movable(b)) else { continue };
             let root = find(&mut parent, m);
             let g = group_of(root, &mut groups);
@@ -545,9 +545,9 @@ impl Data {
                 edges.push((joint.parent, joint.child));
             }
         }
-        for (c, cable) in s.cables.iter().enumerate() {
-            if m.cable_ropes[c].is_some() {
-                edges.push((s.nodes[cable.a].body, s.nodes[cable.b].body));
+        for (c, cable) in s.members.iter().enumerate() {
+            if m.ropes[c].is_some() {
+                edges.push((s.nodes[cable.ends().0].body, s.nodes[cable.ends().1].body));
             }
         }
         // The links of one multibody move together: one group.
@@ -635,9 +635,9 @@ impl Data {
     pub(super) fn cable_rows(&self, m: &Model, taut: &[usize], out: &mut Vec<f64>) {
         let s = &m.structure;
         for &c in taut {
-            let cable = &s.cables[c];
-            let (pa, pb) = (self.node_position(m, cable.a), self.node_position(m, cable.b));
-            out.push(crate::structure::distance(pa, pb) - self.cable_lengths[c]);
+            let cable = &s.members[c];
+            let (pa, pb) = (self.node_position(m, cable.ends().0), self.node_position(m, cable.ends().1));
+            out.push(crate::structure::distance(pa, pb) - self.rest_lengths[c]);
         }
     }
 
@@ -721,11 +721,11 @@ impl Data {
         let s = &m.structure;
         let vec3 = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
         let point_rate = |b: usize, p: Vector| twist(b).map_or(Vector::ZERO, |t| t.of_point(p));
-        let cable = &s.cables[c];
-        let (pa, pb) = (vec3(self.node_position(m, cable.a)), vec3(self.node_position(m, cable.b)));
+        let cable = &s.members[c];
+        let (pa, pb) = (vec3(self.node_position(m, cable.ends().0)), vec3(self.node_position(m, cable.ends().1)));
         let d = pb - pa;
         let l = d.length();
-        let rate = point_rate(s.nodes[cable.b].body, pb) - point_rate(s.nodes[cable.a].body, pa);
+        let rate = point_rate(s.nodes[cable.ends().1].body, pb) - point_rate(s.nodes[cable.ends().0].body, pa);
         out.push(if l > 0.0 { rate.dot(d / l) } else { 0.0 });
     }
 
@@ -1148,8 +1148,9 @@ impl GroupCoordinates {
         // Each member's rows for a twist of one body: a joint's or a cable's.
         let joints =
             g.joints.iter().map(|&j| (Member::Joint(sim.joint_frame(m, j)), [s.joints[j].parent, s.joints[j].child]));
-        let cables =
-            taut.iter().map(|&c| (Member::Cable(c), [s.nodes[s.cables[c].a].body, s.nodes[s.cables[c].b].body]));
+        let cables = taut
+            .iter()
+            .map(|&c| (Member::Cable(c), [s.nodes[s.members[c].ends().0].body, s.nodes[s.members[c].ends().1].body]));
         // At most two bodies' six twists per row.
         let (mut entries, mut first_row, mut block) = (Vec::with_capacity(12 * rows), 0, Vec::new());
         for (member, bodies) in joints.chain(cables) {

@@ -53,9 +53,7 @@ impl Structure {
         }
         self.name == other.name
             && self.gravity == other.gravity
-            && self.struts == other.struts
-            && self.springs == other.springs
-            && self.cables == other.cables
+            && self.members == other.members
             && self.actuators == other.actuators
             && self.loads == other.loads
             && all(&self.bodies, &other.bodies, same_body)
@@ -71,7 +69,7 @@ impl Data {
         m.hidden_links.is_empty()
             && m.internal_closures.is_empty()
             && m.projected_groups.is_empty()
-            && m.cable_ropes.iter().all(Option::is_none)
+            && m.ropes.iter().all(Option::is_none)
             && m.joint_impulse.iter().all(Option::is_none)
             && s.joints
                 .iter()
@@ -169,19 +167,18 @@ mod tests {
         let base = s.add_body("base", crate::structure::BodyKind::Fixed, None);
         let a = s.add_node("A", base, [0.0, 0.0, 0.0]);
         let b = s.add_node("B", base, [1.0, 0.0, 0.0]);
-        s.springs.push(crate::structure::Spring {
-            name: "K".into(),
-            a,
-            b,
-            stiffness_n_per_m: 100.0,
-            rest_length_m: 0.0,
-            radius_m: crate::structure::DEFAULT_TENDON_RADIUS_M,
-        });
+        s.members.push(crate::structure::Member::spring(
+            "K",
+            [a, b],
+            100.0,
+            0.0,
+            crate::structure::DEFAULT_TENDON_RADIUS_M,
+        ));
         let mut moved = s.clone();
         moved.nodes[1].position = [0.0, 1.0, 0.0];
         assert!(s.same_but_placement(&moved));
         let mut stiffer = s.clone();
-        stiffer.springs[0].stiffness_n_per_m = 200.0;
+        stiffer.members[0].law = crate::structure::Law::Spring { stiffness_n_per_m: 200.0, rest_length_m: 0.0 };
         assert!(!s.same_but_placement(&stiffer));
     }
 }

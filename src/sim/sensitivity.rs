@@ -18,7 +18,7 @@
 
 use super::modes::ModesError;
 use super::{Data, Model};
-use crate::structure::{BodyKind, CableLaw};
+use crate::structure::BodyKind;
 use nalgebra::{DMatrix, DVector};
 use rapier3d_f64::prelude::*;
 
@@ -92,7 +92,7 @@ impl Data {
         if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
             return Err(ModesError::NoFreeBody.into());
         }
-        if let Some(c) = s.cables.iter().find(|c| !matches!(c.law, CableLaw::Elastic { .. })) {
+        if let Some(c) = s.members.iter().find(|c| c.is_inextensible_cable()) {
             return Err(SensitivityError::Constrained(format!("the inextensible cable '{}'", c.name)));
         }
         if let Some(j) = (0..s.joints.len()).find(|&j| m.joint_impulse[j].is_some()) {

@@ -41,8 +41,9 @@ fn a_prism_drawn_at_its_closed_form_twist_is_an_equilibrium() {
 fn the_expanded_octahedron_is_the_icosahedrons_equilibrium() {
     let s = icosahedron::icosahedron(0.5 * icosahedron::STRUT_LENGTH_M);
     assert_equilibrium("icosahedron", &s, &icosahedron::case());
-    for c in &s.cables {
-        let l = tensegrity_testbed::structure::distance(s.nodes[c.a].position, s.nodes[c.b].position);
+    for (_, c) in s.members_of(tensegrity_testbed::structure::MemberKind::Cable) {
+        let (a, b) = c.ends();
+        let l = tensegrity_testbed::structure::distance(s.nodes[a].position, s.nodes[b].position);
         let ratio = l / icosahedron::STRUT_LENGTH_M;
         assert!((ratio - icosahedron::cable_to_strut_ratio()).abs() <= 1e-15, "{}: {ratio}", c.name);
     }

@@ -5,6 +5,7 @@
 use std::path::Path;
 use tensegrity_testbed::scenario::{self, Scenario};
 use tensegrity_testbed::structure::CableLaw;
+use tensegrity_testbed::structure::MemberKind;
 
 /// scenarios/custom/prism3.toml's structure with its nine cables and three struts as four
 /// groups (names generated for the polygons, given for the sides).
@@ -69,14 +70,16 @@ fn groups_build_the_same_prism_as_one_table_per_member() {
     let long = scenario::load(Path::new("scenarios/custom/prism3.toml")).unwrap();
     let short = parse(PRISM_GROUPS).unwrap();
     let (l, s) = (&long.custom.unwrap().structure, &short.custom.unwrap().structure);
-    assert_eq!(s.struts, l.struts);
-    assert_eq!(s.cables.len(), 9);
-    for (a, b) in s.cables.iter().zip(&l.cables) {
-        assert_eq!((a.a, a.b, &a.law), (b.a, b.b, &b.law));
-        assert_eq!(a.length_m, b.length_m);
-        assert_eq!(a.law, CableLaw::Elastic { stiffness_n_per_m: 100.0 });
+    let of = |s: &'_ tensegrity_testbed::structure::Structure, kind| {
+        s.members_of(kind).map(|(_, m)| m.clone()).collect::<Vec<_>>()
+    };
+    assert_eq!(of(s, MemberKind::Strut), of(l, MemberKind::Strut));
+    assert_eq!(s.count_of(MemberKind::Cable), 9);
+    for (a, b) in of(s, MemberKind::Cable).iter().zip(&of(l, MemberKind::Cable)) {
+        assert_eq!((&a.path, &a.law), (&b.path, &b.law));
+        assert_eq!(a.cable_law(), Some(&CableLaw::Elastic { stiffness_n_per_m: 100.0 }));
     }
-    let names: Vec<&str> = s.cables.iter().map(|c| c.name.as_str()).collect();
+    let names: Vec<&str> = s.members_of(MemberKind::Cable).map(|(_, c)| c.name.as_str()).collect();
     assert_eq!(&names[..4], ["bottom:B1-B2", "bottom:B2-B3", "bottom:B3-B1", "top:T1-T2"]);
     assert_eq!(&names[6..], ["side1", "side2", "side3"]);
 }
@@ -90,13 +93,15 @@ fn groups_and_member_tables_mix() {
         "[[structure.cables]]\nname = \"extra\"\na = \"B1\"\nb = \"T2\"\n\n[[structure.spring_groups]]\nname = \"k\"\nstiffness = 5.0\nlength = 0.25\npairs = [[\"B2\", \"T3\"]]\n\n[[structure.strut_groups]]",
     );
     let s = parse(&text).unwrap().custom.unwrap().structure;
-    assert_eq!(s.cables[0].name, "extra");
-    assert_eq!(s.cables[0].law, CableLaw::Inextensible);
-    assert_eq!(s.cables.len(), 10);
-    assert_eq!(s.springs.len(), 1);
+    let (_, first_cable) = s.members_of(MemberKind::Cable).next().unwrap();
+    assert_eq!(first_cable.name, "extra");
+    assert_eq!(first_cable.cable_law(), Some(&CableLaw::Inextensible));
+    assert_eq!(s.count_of(MemberKind::Cable), 10);
+    assert_eq!(s.count_of(MemberKind::Spring), 1);
+    let (_, spring) = s.members_of(MemberKind::Spring).next().unwrap();
     assert_eq!(
-        (s.springs[0].name.as_str(), s.springs[0].stiffness_n_per_m, s.springs[0].rest_length_m),
-        ("k:B2-T3", 5.0, 0.25)
+        (spring.name.as_str(), spring.stiffness_n_per_m(), spring.rest_length_m()),
+        ("k:B2-T3", Some(5.0), Some(0.25))
     );
 }
 

@@ -118,10 +118,17 @@ fn the_documented_defaults_are_the_structures() {
     let i = s.bodies[1].inertia.as_ref().unwrap();
     assert!(i.com.iter().zip([0.5, 0.0, 0.0]).all(|(a, b)| (a - b).abs() <= 1e-15), "{:?}", i.com);
     assert!(i.principal_kg_m2.iter().all(|m| (m - 1.0 / 12.0).abs() <= 1e-15), "{:?}", i.principal_kg_m2);
-    assert_eq!((s.struts[0].radius_m, s.cables[0].radius_m, s.springs[0].radius_m), (0.01, 0.001, 0.001));
-    assert_eq!(s.cables[0].law, tensegrity_testbed::structure::CableLaw::Inextensible);
+    let first = |kind| s.members_of(kind).next().unwrap().1;
+    let (strut, cable, spring) = (
+        first(tensegrity_testbed::structure::MemberKind::Strut),
+        first(tensegrity_testbed::structure::MemberKind::Cable),
+        first(tensegrity_testbed::structure::MemberKind::Spring),
+    );
+    assert_eq!((strut.radius_m, cable.radius_m, spring.radius_m), (0.01, 0.001, 0.001));
+    assert_eq!(cable.cable_law(), Some(&tensegrity_testbed::structure::CableLaw::Inextensible));
     let drawn = 1.0;
-    assert!((s.cables[0].length_m - drawn).abs() <= 1e-15 && (s.springs[0].rest_length_m - drawn).abs() <= 1e-15);
+    let rest = |m: &tensegrity_testbed::structure::Member| m.rest_length_m().unwrap();
+    assert!((rest(cable) - drawn).abs() <= 1e-15 && (rest(spring) - drawn).abs() <= 1e-15);
     let j = &s.joints[0];
     assert_eq!((j.damping, j.torsion_spring.is_none(), j.initial_coordinate, s.gravity), (0.0, true, 0.0, [0.0; 3]));
     let (sim, settle) = (&sc.sim, &sc.settle);

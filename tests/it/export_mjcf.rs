@@ -86,19 +86,19 @@ fn prism3_exports_bodies_sites_capsules_and_tension_only_tendons() {
         let local: Vec<f64> = (0..3).map(|k| n.position[k] - origin[k]).collect();
         assert!(close(&numbers(attr(site, "pos")), &local, 1e-15), "{site}");
     }
-    for st in &s.struts {
+    for (_, st) in s.members_of(tensegrity_testbed::structure::MemberKind::Strut) {
         let geom = element(&xml, "geom", &st.name).unwrap();
         assert_eq!(attr(geom, "type"), "capsule");
         assert_eq!(numbers(attr(geom, "size")), [st.radius_m]);
     }
-    for c in &s.cables {
+    for (_, c) in s.members_of(tensegrity_testbed::structure::MemberKind::Cable) {
         let t = element(&xml, "spatial", &c.name).unwrap();
         assert_eq!(numbers(attr(t, "stiffness")), [100.0]);
-        assert_eq!(numbers(attr(t, "springlength")), [0.0, c.length_m]);
+        assert_eq!(numbers(attr(t, "springlength")), [0.0, c.rest_length_m().unwrap()]);
         let sites = &xml[xml.find(t).unwrap()..];
         let sites = &sites[..sites.find("</spatial>").unwrap()];
-        assert!(sites.contains(&format!("site=\"{}\"", s.nodes[c.a].name)));
-        assert!(sites.contains(&format!("site=\"{}\"", s.nodes[c.b].name)));
+        assert!(sites.contains(&format!("site=\"{}\"", s.nodes[c.ends().0].name)));
+        assert!(sites.contains(&format!("site=\"{}\"", s.nodes[c.ends().1].name)));
     }
     let option = &xml[xml.find("<option ").unwrap()..];
     assert_eq!(numbers(attr(option, "gravity")), [0.0; 3]);

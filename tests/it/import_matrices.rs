@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use tensegrity_testbed::import::matrices::{import, MatrixOptions};
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
+use tensegrity_testbed::structure::MemberKind;
 
 type P3 = [f64; 3];
 
@@ -77,10 +78,10 @@ fn a_prism_from_connectivity_matrices_settles_to_the_closed_form_twist() {
     let sc =
         scenario::parse(Path::new("prism.toml"), &imported.toml).unwrap_or_else(|e| panic!("{e}\n{}", imported.toml));
     let s = &sc.custom.as_ref().unwrap().structure;
-    assert_eq!((s.struts.len(), s.cables.len(), s.bodies.len()), (3, 9, 3));
+    assert_eq!((s.count_of(MemberKind::Strut), s.count_of(MemberKind::Cable), s.bodies.len()), (3, 9, 3));
     assert!(s.bodies[0].inertia.is_none(), "bar1 is held fixed");
-    let vertical = s.cables.iter().find(|c| c.name == "string7").unwrap();
-    assert!((vertical.length_m - (1.5 - 0.2)).abs() <= 1e-15);
+    let vertical = s.member("string7").unwrap();
+    assert!((vertical.rest_length_m().unwrap() - (1.5 - 0.2)).abs() <= 1e-15);
     let r = run(&sc, &RunOptions::default());
     assert!(r.passed, "{:?}", r.error);
     let sim = &r.points[0].simulated;
@@ -262,12 +263,12 @@ fn prisms_imported_with_defaults_are_prestressed_and_settle_at_their_twist() {
         );
         assert!(imported.toml.contains("[prestress]\nmin_fraction = 0.1\non_loss = \"fail\""), "{}", imported.toml);
         let sc = scenario::parse(Path::new("prism.toml"), &imported.toml).unwrap();
-        let cables = &sc.custom.as_ref().unwrap().structure.cables;
+        let cables = sc.custom.as_ref().unwrap().structure.count_of(MemberKind::Cable);
         let r = run(&sc, &RunOptions::default());
         assert!(r.passed, "n = {n}: {:?} {:?}", r.failures, r.prestress);
         let error = twist_error(&r, n);
         let kept = r.points[0].prestress_fraction.unwrap();
-        eprintln!("{n}-prism imported with defaults: twist within {error:.1e} rad of pi/2 + pi/{n}, {kept} of the drawn tension kept, {} cables", cables.len());
+        eprintln!("{n}-prism imported with defaults: twist within {error:.1e} rad of pi/2 + pi/{n}, {kept} of the drawn tension kept, {cables} cables");
         assert!(error <= 1e-9, "n = {n}: twist off by {error} rad");
         assert!((kept - 1.0).abs() <= 1e-6, "n = {n}: {kept}");
         std::fs::remove_dir_all(&dir).ok();

@@ -10,6 +10,7 @@ use tensegrity_testbed::import::ntrt::{import, Axes};
 use tensegrity_testbed::report::ScenarioReport;
 use tensegrity_testbed::run::{run, RunOptions};
 use tensegrity_testbed::scenario;
+use tensegrity_testbed::structure::MemberKind;
 
 const FIXTURES: &str = "tests/fixtures/ntrt";
 
@@ -42,8 +43,8 @@ fn ntrt_prism_settles_to_the_closed_form_twist() {
     let rod_length = (1.5f64 * 1.5 + 3.0).sqrt();
     let rod = s.bodies.iter().find(|b| b.inertia.is_some()).unwrap().inertia.unwrap();
     assert!((rod.mass_kg - 200.0 * std::f64::consts::PI * 0.02 * 0.02 * rod_length).abs() <= 1e-12);
-    let side = s.cables.iter().find(|c| c.name == "string b1-t1").unwrap();
-    assert!((side.length_m - (1.5 - 20.0 / 100.0)).abs() <= 1e-15);
+    let side = s.member("string b1-t1").unwrap();
+    assert!((side.rest_length_m().unwrap() - (1.5 - 20.0 / 100.0)).abs() <= 1e-15);
 
     let r = run_text("prism3.toml", &toml);
     let b: Vec<P3> = ["b1", "b2", "b3"].iter().map(|n| node(&r, n)).collect();
@@ -81,30 +82,30 @@ fn ntrt_icosahedron_from_substructures_settles_to_the_closed_form() {
     assert!(toml.contains("Skipped:\n- "), "{toml}");
     let sc = scenario::parse(Path::new("ball.toml"), &toml).unwrap();
     let s = &sc.custom.as_ref().unwrap().structure;
-    assert_eq!((s.struts.len(), s.cables.len(), s.bodies.len()), (6, 24, 6));
+    assert_eq!((s.count_of(MemberKind::Strut), s.count_of(MemberKind::Cable), s.bodies.len()), (6, 24, 6));
     let n = |name: &str| s.nodes[s.node_id(name).unwrap()].position;
     // Scaled by 2 about the centre, lifted by 3 (NTRT's y is z here).
     let p1n1 = n("ball.p1.n1");
     assert!(norm(sub(p1n1, [0.0, 1.0, 3.0 - 0.45])) <= 1e-12, "{p1n1:?}");
-    assert_eq!(s.cables.iter().filter(|c| c.name.starts_with("edge ")).count(), 8);
+    assert_eq!(s.members_of(MemberKind::Cable).filter(|(_, c)| c.name.starts_with("edge ")).count(), 8);
 
     let r = run_text("ball.toml", &toml);
     let sim = &r.points[0].simulated;
     let ratio = 6f64.sqrt() / 4.0;
     let strut = norm(sub(node(&r, "ball.p1.n1"), node(&r, "ball.p1.n2")));
     // The first strut is held (a fixed body reports no force): read the last one's.
-    let strut_force = sim[&format!("{}.force", s.struts[s.struts.len() - 1].name)];
+    let strut_force = sim[&format!("{}.force", s.members_of(MemberKind::Strut).last().unwrap().1.name)];
     let (mut length_error, mut force_error) = (0.0f64, 0.0f64);
-    for c in &s.cables {
-        let l = norm(sub(node(&r, &s.nodes[c.a].name), node(&r, &s.nodes[c.b].name)));
+    for (_, c) in s.members_of(MemberKind::Cable) {
+        let l = norm(sub(node(&r, &s.nodes[c.ends().0].name), node(&r, &s.nodes[c.ends().1].name)));
         length_error = length_error.max((l / strut - ratio).abs());
         let t = sim[&format!("{}.force", c.name)];
         force_error = force_error.max((-strut_force / t - 6f64.sqrt()).abs());
     }
     eprintln!("NTRT icosahedron: cable/strut within {length_error:.1e} of sqrt(6)/4, forces within {force_error:.1e} of sqrt 6");
     assert!(length_error <= 1e-12 && force_error <= 1e-10, "{length_error}, {force_error}");
-    for st in &s.struts {
-        let l = norm(sub(node(&r, &s.nodes[st.a].name), node(&r, &s.nodes[st.b].name)));
+    for (_, st) in s.members_of(MemberKind::Strut) {
+        let l = norm(sub(node(&r, &s.nodes[st.ends().0].name), node(&r, &s.nodes[st.ends().1].name)));
         assert!((l - 2.0).abs() <= 1e-12, "{}: {l}", st.name);
     }
 }
@@ -206,7 +207,7 @@ fn boxes_spheres_and_node_edge_bonds_are_listed_as_skipped() {
     assert!(has("node_edge bond 'p/q/node_edge'"), "{:?}", i.skipped);
     let sc = scenario::parse(Path::new("two.toml"), &i.toml).unwrap_or_else(|e| panic!("{e}\n{}", i.toml));
     let s = &sc.custom.as_ref().unwrap().structure;
-    assert_eq!((s.struts.len(), s.cables.len()), (6, 21));
+    assert_eq!((s.count_of(MemberKind::Strut), s.count_of(MemberKind::Cable)), (6, 21));
     // q is offset by one step of 2 along NTRT's y (z here).
     let (pb1, qb1) = (s.nodes[s.node_id("p.b1").unwrap()].position, s.nodes[s.node_id("q.b1").unwrap()].position);
     assert_eq!(qb1[2] - pb1[2], 2.0);
@@ -228,11 +229,14 @@ fn the_last_matching_builder_wins_as_in_ntrt() {
     let i = import(&file, Axes::ZUp).unwrap();
     let sc = scenario::parse(Path::new("sides.toml"), &i.toml).unwrap_or_else(|e| panic!("{e}\n{}", i.toml));
     let s = &sc.custom.as_ref().unwrap().structure;
-    let side = s.cables.iter().find(|c| c.name == "side string b1-t1").expect("made by 'side string'");
-    assert_eq!(side.law, tensegrity_testbed::structure::CableLaw::Elastic { stiffness_n_per_m: 200.0 });
-    assert!((side.length_m - (1.5 - 20.0 / 200.0)).abs() <= 1e-15);
-    let bottom = s.cables.iter().find(|c| c.name == "string b1-b2").unwrap();
-    assert_eq!(bottom.law, tensegrity_testbed::structure::CableLaw::Elastic { stiffness_n_per_m: 100.0 });
+    let side = s.member("side string b1-t1").expect("made by 'side string'");
+    assert_eq!(side.cable_law(), Some(&tensegrity_testbed::structure::CableLaw::Elastic { stiffness_n_per_m: 200.0 }));
+    assert!((side.rest_length_m().unwrap() - (1.5 - 20.0 / 200.0)).abs() <= 1e-15);
+    let bottom = s.member("string b1-b2").unwrap();
+    assert_eq!(
+        bottom.cable_law(),
+        Some(&tensegrity_testbed::structure::CableLaw::Elastic { stiffness_n_per_m: 100.0 })
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

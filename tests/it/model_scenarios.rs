@@ -30,8 +30,7 @@ fn parameter_expressions_place_the_nodes() {
     }
     assert!((sc.params["twist0"] - 130f64.to_radians()).abs() <= 1e-15);
     assert!((sc.params["step"] - 2.0 * std::f64::consts::PI / 3.0).abs() <= 1e-15);
-    let top23 = &s.cables[s.cable_id("top23").unwrap()];
-    assert_eq!(top23.length_m, 1.5);
+    assert_eq!(s.member("top23").unwrap().rest_length_m(), Some(1.5));
 }
 
 /// A built-in mechanism's parameters may be expressions of each other (ji2014: K2 = K1/2).

@@ -300,7 +300,7 @@ fn every_seed_scenario_has_finite_frequencies() {
             let forces = state.sim.member_forces();
             let loop_rows = c.multipliers.len() - c.taut_cables.len();
             for (&k, t) in c.taut_cables.iter().zip(&c.multipliers[loop_rows..]) {
-                let sim = forces.cable_tension_n[k];
+                let sim = forces.force_n[k];
                 assert!(
                     (t - sim).abs() <= 1e-6 * sim.abs().max(1.0),
                     "{}: cable {k} {t} N against {sim} N",

@@ -5,6 +5,7 @@
 use crate::common::tensegrity;
 use std::path::Path;
 use tensegrity_testbed::scenario::{parse, ScenarioError};
+use tensegrity_testbed::structure::MemberKind;
 
 /// The regular prism's twist pi/2 + pi/n is met within this at every n [rad].
 const TWIST_TOL_RAD: f64 = 1e-12;
@@ -59,7 +60,7 @@ fn a_repeat_places_each_copy_by_its_rotation_then_its_offset() {
         let err = got.iter().zip(want).map(|(g, w)| (g - w).abs()).fold(0.0, f64::max);
         assert!(err <= PLACEMENT_TOL_M, "{got:?} against {want:?}");
     }
-    assert_eq!(s.springs.len(), 4);
+    assert_eq!(s.count_of(MemberKind::Spring), 4);
     assert_eq!(s.bodies.len(), 5);
 }
 
@@ -68,8 +69,8 @@ fn templates_wrap_around_the_ring_and_a_name_twice_is_an_error_at_the_template()
     let wrapped = ring("3", "[[structure.repeat]]\nfor = { i = \"0..n\" }\n[[structure.repeat.cables]]\nname = \"c{i}\"\na = \"B{i}\"\nb = \"B{(i+1) mod n}\"\n");
     let sc = load(&wrapped).expect("valid");
     let s = &sc.custom.as_ref().expect("custom").structure;
-    let c2 = s.cables.iter().find(|c| c.name == "c2").expect("c2");
-    assert_eq!((s.nodes[c2.a].name.as_str(), s.nodes[c2.b].name.as_str()), ("B2", "B0"));
+    let c2 = s.member("c2").expect("c2");
+    assert_eq!((s.nodes[c2.ends().0].name.as_str(), s.nodes[c2.ends().1].name.as_str()), ("B2", "B0"));
     let twice = ring("3", "[[structure.repeat]]\nfor = { i = \"0..n\" }\n[[structure.repeat.cables]]\nname = \"c{i mod 2}\"\na = \"B{i}\"\nb = \"A{i}\"\n");
     let e = load(&twice).expect_err("c0 twice");
     assert!(e.message.contains("c0"), "{e}");

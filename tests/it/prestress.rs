@@ -33,12 +33,14 @@ fn slack_prism(extra: &str) -> String {
 fn drawn_total_tension_n(text: &str) -> f64 {
     let sc = scenario::parse(Path::new("prestress.toml"), text).unwrap();
     let s = &sc.custom.as_ref().unwrap().structure;
-    s.cables
-        .iter()
-        .map(|c| {
-            let tensegrity_testbed::structure::CableLaw::Elastic { stiffness_n_per_m } = c.law else { return 0.0 };
-            let l = tensegrity_testbed::structure::distance(s.nodes[c.a].position, s.nodes[c.b].position);
-            (stiffness_n_per_m * (l - c.length_m)).max(0.0)
+    s.members_of(tensegrity_testbed::structure::MemberKind::Cable)
+        .map(|(_, c)| {
+            let Some(&tensegrity_testbed::structure::CableLaw::Elastic { stiffness_n_per_m }) = c.cable_law() else {
+                return 0.0;
+            };
+            let (a, b) = c.ends();
+            let l = tensegrity_testbed::structure::distance(s.nodes[a].position, s.nodes[b].position);
+            (stiffness_n_per_m * (l - c.rest_length_m().unwrap())).max(0.0)
         })
         .sum()
 }

@@ -37,7 +37,7 @@ fn a_body_leaving_the_bounding_box_is_reported_as_divergence() {
 /// the explicit force law is exact at rest, so the settled position error is at round-off.
 #[test]
 fn a_free_body_on_a_zero_length_spring_settles_on_the_anchor() {
-    use tensegrity_testbed::structure::Spring;
+    use tensegrity_testbed::structure::Member;
     let mut s = Structure::default();
     let g = s.add_body("ground", BodyKind::Fixed, None);
     let b = s.add_body(
@@ -47,7 +47,7 @@ fn a_free_body_on_a_zero_length_spring_settles_on_the_anchor() {
     );
     let a = s.add_node("anchor", g, [0.0; 3]);
     let p = s.add_node("P", b, [0.3, 0.2, 0.0]);
-    s.springs.push(Spring { name: "k".into(), a, b: p, stiffness_n_per_m: 100.0, rest_length_m: 0.0, radius_m: 1e-3 });
+    s.members.push(Member::spring("k", [a, p], 100.0, 0.0, 1e-3));
     let settings = SimSettings { dt_s: 0.01, body_damping_per_s: 10.0, ..Default::default() };
     let mut sim = Simulation::new(&s, &settings).unwrap();
     for _ in 0..5000 {
@@ -65,7 +65,7 @@ fn a_free_body_on_a_zero_length_spring_settles_on_the_anchor() {
 /// check stops the run within a few ticks and says so.
 #[test]
 fn an_absurd_stiffness_is_caught_by_the_energy_check_within_a_few_ticks() {
-    use tensegrity_testbed::structure::Spring;
+    use tensegrity_testbed::structure::Member;
     let mut s = Structure::default();
     let g = s.add_body("ground", BodyKind::Fixed, None);
     let b = s.add_body(
@@ -75,14 +75,7 @@ fn an_absurd_stiffness_is_caught_by_the_energy_check_within_a_few_ticks() {
     );
     let a = s.add_node("A", g, [0.0; 3]);
     let p = s.add_node("P", b, [1.0, 0.0, 0.0]);
-    s.springs.push(Spring {
-        name: "stiff".into(),
-        a,
-        b: p,
-        stiffness_n_per_m: 1e12,
-        rest_length_m: 0.5,
-        radius_m: 1e-3,
-    });
+    s.members.push(Member::spring("stiff", [a, p], 1e12, 0.5, 1e-3));
     let mut sim = Simulation::new(&s, &SimSettings { dt_s: 0.01, ..Default::default() }).unwrap();
     let err = (0..100).find_map(|_| sim.step().err()).expect("diverges");
     match err {
@@ -101,7 +94,7 @@ fn an_absurd_stiffness_is_caught_by_the_energy_check_within_a_few_ticks() {
 /// and joints among plain bodies.
 #[test]
 fn a_joint_that_comes_apart_is_reported_with_its_gap() {
-    use tensegrity_testbed::structure::{Cable, CableLaw, ExternalLoad, Joint, JointKind};
+    use tensegrity_testbed::structure::{CableLaw, ExternalLoad, Joint, JointKind, Member};
     let mut s = Structure::default();
     let g = s.add_body("ground", BodyKind::Fixed, None);
     let arm = s.add_body(
@@ -119,7 +112,7 @@ fn a_joint_that_comes_apart_is_reported_with_its_gap() {
     let c = s.add_node("C", g, [1.0, 1.0, 0.0]);
     let p = s.add_node("P", b, [1.0, 0.0, 0.0]);
     // The cable keeps the bob a plain body, so the joint at A is an impulse (loop) joint.
-    s.cables.push(Cable { name: "c".into(), a: c, b: p, law: CableLaw::Inextensible, length_m: 2.0, radius_m: 1e-3 });
+    s.members.push(Member::cable("c", vec![c, p], CableLaw::Inextensible, 2.0, 1e-3));
     s.joints.push(Joint {
         name: "hinge".into(),
         kind: JointKind::Revolute { axis: [0.0, 0.0, 1.0] },

@@ -11,7 +11,7 @@
 
 use super::{Case, Measure};
 use crate::settings::SimSettings;
-use crate::structure::{BodyKind, Cable, CableLaw, Inertia, Structure, Strut, Vec3};
+use crate::structure::{BodyKind, CableLaw, Inertia, Member, Structure, Vec3};
 
 /// Strut length L \[m\].
 pub const STRUT_LENGTH_M: f64 = 1.0;
@@ -95,13 +95,13 @@ pub fn icosahedron(separation_m: f64) -> Structure {
         let kind = if k == 0 { BodyKind::Fixed } else { BodyKind::Free };
         let body = s.add_body(&format!("{}{}", a.0, b.0), kind, (k > 0).then_some(inertia));
         let (na, nb) = (s.add_node(a.0, body, a.1), s.add_node(b.0, body, b.1));
-        s.struts.push(Strut { name: format!("strut {}-{}", a.0, b.0), a: na, b: nb, radius_m: 0.01 });
+        s.members.push(Member::strut(format!("strut {}-{}", a.0, b.0), na, nb, 0.01));
     }
     // Nodes were added pairwise in the order of `nodes`, so node indices are those of `CABLES`.
     for (a, b) in CABLES {
         let law = CableLaw::Elastic { stiffness_n_per_m: CABLE_STIFFNESS_N_PER_M };
         let name = format!("{}-{}", ns[a].0, ns[b].0);
-        s.cables.push(Cable { name, a, b, law, length_m: CABLE_REST_LENGTH_M, radius_m: 0.001 });
+        s.members.push(Member::cable(name, vec![a, b], law, CABLE_REST_LENGTH_M, 0.001));
     }
     s
 }

@@ -32,7 +32,7 @@ use super::BenchError;
 use crate::run::SettleDetector;
 use crate::settings::{SettleCriteria, SimSettings};
 use crate::sim::Simulation;
-use crate::structure::{Structure, Vec3};
+use crate::structure::{MemberKind, Structure, Vec3};
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 use std::time::Instant;
@@ -241,9 +241,9 @@ pub fn run_case(case: &Case, caps: &Caps) -> Result<ScaleCase, BenchError> {
     Ok(ScaleCase {
         family: case.family,
         size: case.size,
-        struts: s.struts.len(),
-        cables: s.cables.len(),
-        springs: s.springs.len(),
+        struts: s.count_of(MemberKind::Strut),
+        cables: s.count_of(MemberKind::Cable),
+        springs: s.count_of(MemberKind::Spring),
         joints: s.joints.len(),
         settled: out.settled,
         steps: out.steps,

@@ -239,7 +239,7 @@ fn compare_case(case: &Case, [raw, judged]: [TestbedRuns; 2], p: &serde_json::Va
     Ok(MotionCase {
         family: case.family,
         size: case.size,
-        struts: case.start.struts.len(),
+        struts: case.start.count_of(crate::structure::MemberKind::Strut),
         equal_error_m: raw_at.error_m,
         peer_dt_at_equal_error_s: dt,
         peer_wall_at_equal_error_s: wall,

@@ -14,7 +14,7 @@
 
 use super::{run_case, Caps, Case, Measure, ScaleCase};
 use crate::settings::SimSettings;
-use crate::structure::{BodyKind, Cable, CableLaw, Inertia, Structure, Strut, Vec3};
+use crate::structure::{BodyKind, CableLaw, Inertia, Member, Structure, Vec3};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Radius of the drawn polygons [m].
@@ -64,7 +64,7 @@ pub fn prism(n: usize, twist: f64) -> Structure {
         let body = s.add_body(&format!("strut{i}"), kind, (i > 0).then_some(inertia));
         bottom.push(s.add_node(&format!("B{i}"), body, b));
         top.push(s.add_node(&format!("T{i}"), body, t));
-        s.struts.push(Strut { name: format!("strut{i}"), a: bottom[i], b: top[i], radius_m: 0.01 });
+        s.members.push(Member::strut(format!("strut{i}"), bottom[i], top[i], 0.01));
     }
     let k = CABLE_STIFFNESS_N_PER_M;
     let polygon_length = distance(polar(0.0, 0.0), polar(step, 0.0));
@@ -76,7 +76,7 @@ pub fn prism(n: usize, twist: f64) -> Structure {
     let side = side_length - side_density * side_length / k;
     let mut cable = |name: String, a: usize, b: usize, length_m: f64| {
         let law = CableLaw::Elastic { stiffness_n_per_m: k };
-        s.cables.push(Cable { name, a, b, law, length_m, radius_m: 0.001 });
+        s.members.push(Member::cable(name, vec![a, b], law, length_m, 0.001));
     };
     for i in 0..n {
         let j = (i + 1) % n;

@@ -21,7 +21,7 @@
 
 use super::{Case, Measure};
 use crate::settings::SimSettings;
-use crate::structure::{BodyKind, Cable, CableLaw, Inertia, Spring, Structure, Strut, Vec3, DEFAULT_TENDON_RADIUS_M};
+use crate::structure::{BodyKind, CableLaw, Inertia, Member, Structure, Vec3, DEFAULT_TENDON_RADIUS_M};
 
 /// Free vertebrae of the family. 249 (1000 struts) was measured too and did not settle within
 /// 20000 steps: its residual stayed at 1.2e-9 N against the 1e-9 N criterion, its error at
@@ -85,7 +85,7 @@ pub fn spine(free: usize, perturbation_m: f64) -> Structure {
         let names = ["u+", "u-", "l+", "l-"];
         let t = [1, 2, 3, 4].map(|k| s.add_node(&format!("v{i}{}", names[k - 1]), body, p[k]));
         for (k, &tip) in t.iter().enumerate() {
-            s.struts.push(Strut { name: format!("v{i} leg {}", names[k]), a: centre, b: tip, radius_m: 0.01 });
+            s.members.push(Member::strut(format!("v{i} leg {}", names[k]), centre, tip, 0.01));
         }
         tips.push(t);
     }
@@ -97,17 +97,16 @@ pub fn spine(free: usize, perturbation_m: f64) -> Structure {
             let law = CableLaw::Elastic { stiffness_n_per_m: k };
             let rest = saddle - SADDLE_TENSION_N / k;
             let (a, b) = (below[u], above[l]);
-            s.cables.push(Cable { name: format!("saddle {i}:{u}{l}"), a, b, law, length_m: rest, radius_m: 0.001 });
+            s.members.push(Member::cable(format!("saddle {i}:{u}{l}"), vec![a, b], law, rest, 0.001));
         }
         for t in 0..4 {
-            s.springs.push(Spring {
-                name: format!("vertical {i}:{t}"),
-                a: below[t],
-                b: above[t],
-                stiffness_n_per_m: k,
-                rest_length_m: PITCH_M - vertical / k,
-                radius_m: DEFAULT_TENDON_RADIUS_M,
-            });
+            s.members.push(Member::spring(
+                format!("vertical {i}:{t}"),
+                [below[t], above[t]],
+                k,
+                PITCH_M - vertical / k,
+                DEFAULT_TENDON_RADIUS_M,
+            ));
         }
     }
     s

@@ -30,7 +30,7 @@
 use super::{Case, Measure};
 use crate::settings::SimSettings;
 use crate::sim::least_squares::{SparseLeastSquares, SparseRows};
-use crate::structure::{BodyKind, Cable, CableLaw, Inertia, Spring, Structure, Strut, Vec3, DEFAULT_TENDON_RADIUS_M};
+use crate::structure::{BodyKind, CableLaw, Inertia, Member, Structure, Vec3, DEFAULT_TENDON_RADIUS_M};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Struts per stage: with 4, every stage-to-stage cable lies in a vertical plane through the
@@ -293,7 +293,7 @@ pub fn structure(d: &Design, perturbation_m: f64) -> Structure {
         );
         node_of[*a] = s.add_node(&format!("n{a}"), body, pa);
         node_of[*b] = s.add_node(&format!("n{b}"), body, pb);
-        s.struts.push(Strut { name: format!("strut{k}"), a: node_of[*a], b: node_of[*b], radius_m: 0.01 });
+        s.members.push(Member::strut(format!("strut{k}"), node_of[*a], node_of[*b], 0.01));
     }
     let k = CABLE_STIFFNESS_N_PER_M;
     for (m, ((kind, a, b), q)) in d.members.iter().zip(&d.q).enumerate() {
@@ -303,16 +303,11 @@ pub fn structure(d: &Design, perturbation_m: f64) -> Structure {
             Kind::Strut => {}
             Kind::Polygon | Kind::Side => {
                 let law = CableLaw::Elastic { stiffness_n_per_m: k };
-                s.cables.push(Cable { name, a, b, law, length_m: rest, radius_m: 0.001 });
+                s.members.push(Member::cable(name, vec![a, b], law, rest, 0.001));
             }
-            Kind::Saddle | Kind::Vertical => s.springs.push(Spring {
-                name,
-                a,
-                b,
-                stiffness_n_per_m: k,
-                rest_length_m: rest,
-                radius_m: DEFAULT_TENDON_RADIUS_M,
-            }),
+            Kind::Saddle | Kind::Vertical => {
+                s.members.push(Member::spring(name, [a, b], k, rest, DEFAULT_TENDON_RADIUS_M))
+            }
         }
     }
     s

@@ -14,7 +14,7 @@
 
 use super::analytic::{self, Params};
 use crate::structure::{
-    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut, TorsionSpring, Vec3,
+    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Member, Structure, TorsionSpring, Vec3,
     DEFAULT_TENDON_RADIUS_M,
 };
 use nalgebra::Vector2;
@@ -56,7 +56,7 @@ pub fn build_chain(name: &str, p: &Params, m: &ModelChoices, xs: &[analytic::XGe
     let mut below = base; // the body carrying this X's base bar
     let mut below_nodes =
         (s.add_node("A1", base, at(xs[0].base_left, 0.0)), s.add_node("B1", base, at(xs[0].base_right, 0.0)));
-    s.struts.push(Strut { name: "base A1B1".into(), a: below_nodes.0, b: below_nodes.1, radius_m: m.strut_radius_m });
+    s.members.push(Member::strut("base A1B1", below_nodes.0, below_nodes.1, m.strut_radius_m));
     let mut ends = Vec::with_capacity(xs.len());
     for (i, x) in xs.iter().enumerate() {
         let (top, nodes, end) = add_module(&mut s, p, m, x, i + 1, below, below_nodes);
@@ -109,18 +109,17 @@ fn add_module(
     let c = s.add_node(&format!("C{k}"), top, at(x.top_right, 0.0));
     let d = s.add_node(&format!("D{k}"), top, at(x.top_left, 0.0));
     let end = s.add_node(&format!("P{k}"), top, at(x.top_mid, 0.0));
-    s.struts.push(Strut { name: format!("X{k} crossed bar AC"), a: ac_a, b: ac_c, radius_m: r });
-    s.struts.push(Strut { name: format!("X{k} crossed bar BD"), a: bd_b, b: bd_d, radius_m: r });
-    s.struts.push(Strut { name: format!("X{k} top bar DC"), a: d, b: c, radius_m: r });
+    s.members.push(Member::strut(format!("X{k} crossed bar AC"), ac_a, ac_c, r));
+    s.members.push(Member::strut(format!("X{k} crossed bar BD"), bd_b, bd_d, r));
+    s.members.push(Member::strut(format!("X{k} top bar DC"), d, c, r));
     for (name, na, nb) in [(format!("X{k} spring AD"), a, d), (format!("X{k} spring BC"), b, c)] {
-        s.springs.push(Spring {
+        s.members.push(Member::spring(
             name,
-            a: na,
-            b: nb,
-            stiffness_n_per_m: m.spring_stiffness_n_per_m,
-            rest_length_m: m.spring_rest_length_m,
-            radius_m: DEFAULT_TENDON_RADIUS_M,
-        });
+            [na, nb],
+            m.spring_stiffness_n_per_m,
+            m.spring_rest_length_m,
+            DEFAULT_TENDON_RADIUS_M,
+        ));
     }
     let actuated = s.joints.len();
     let mut actuated_a = revolute(format!("X{k} A (actuated, phi{k})"), below, ac, a, x.joint_angle_a, 0.0);

@@ -8,7 +8,7 @@
 
 use super::analytic::{self, Params};
 use crate::structure::{
-    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Spring, Structure, Strut, DEFAULT_TENDON_RADIUS_M,
+    Actuator, ActuatorTarget, BodyKind, Inertia, Joint, JointKind, Member, Structure, DEFAULT_TENDON_RADIUS_M,
 };
 
 /// Model choices that the paper does not give (defaults in `Ji2014::params`).
@@ -62,12 +62,12 @@ pub fn build(p: &Params, m: &ModelChoices, l3: f64, theta1: f64, theta2: f64) ->
     for (name, a, b) in
         [("C1C2", c1, c2), ("C2C3", c2, c3), ("C1C3", c1, c3), ("D1D2", d1, d2), ("D2D3", d2, d3), ("D1D3", d1, d3)]
     {
-        s.struts.push(Strut { name: name.into(), a, b, radius_m: r });
+        s.members.push(Member::strut(name, a, b, r));
     }
     if l3 > 0.0 {
-        s.struts.push(Strut { name: "C1D1 (actuator L3)".into(), a: c1, b: tip, radius_m: r });
+        s.members.push(Member::strut("C1D1 (actuator L3)", c1, tip, r));
     }
-    s.springs.extend(zero_free_length_springs(p, (d2, c2), (d3, c3)));
+    s.members.extend(zero_free_length_springs(p, (d2, c2), (d3, c3)));
     s.joints.extend(joints(m, [ground, housing, rod, platform], (c1, d1), (theta1, l3, theta2)));
     s.actuators.push(Actuator { symbol: "L3".into(), target: ActuatorTarget::Joint(1) });
     s.actuators.push(Actuator { symbol: "theta1".into(), target: ActuatorTarget::Joint(0) });
@@ -75,24 +75,10 @@ pub fn build(p: &Params, m: &ModelChoices, l3: f64, theta1: f64, theta2: f64) ->
 }
 
 /// K1 (D2-C2) and K2 (D3-C3): zero-free-length springs of the paper's stiffnesses.
-fn zero_free_length_springs(p: &Params, (d2, c2): (usize, usize), (d3, c3): (usize, usize)) -> [Spring; 2] {
+fn zero_free_length_springs(p: &Params, (d2, c2): (usize, usize), (d3, c3): (usize, usize)) -> [Member; 2] {
     [
-        Spring {
-            name: "K1".into(),
-            a: d2,
-            b: c2,
-            stiffness_n_per_m: p.k1,
-            rest_length_m: 0.0,
-            radius_m: DEFAULT_TENDON_RADIUS_M,
-        },
-        Spring {
-            name: "K2".into(),
-            a: d3,
-            b: c3,
-            stiffness_n_per_m: p.k2,
-            rest_length_m: 0.0,
-            radius_m: DEFAULT_TENDON_RADIUS_M,
-        },
+        Member::spring("K1", [d2, c2], p.k1, 0.0, DEFAULT_TENDON_RADIUS_M),
+        Member::spring("K2", [d3, c3], p.k2, 0.0, DEFAULT_TENDON_RADIUS_M),
     ]
 }
 

@@ -8,7 +8,7 @@
 
 use super::analytic::{self, Params};
 use crate::structure::{
-    Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, Inertia, Joint, JointKind, Spring, Structure, Strut, Vec3,
+    Actuator, ActuatorTarget, BodyKind, CableLaw, Inertia, Joint, JointKind, Member, Structure, Vec3,
     DEFAULT_TENDON_RADIUS_M,
 };
 use nalgebra::Vector3;
@@ -47,36 +47,33 @@ pub fn build(p: &Params, m: &ModelChoices, theta1: f64, theta2: f64, cable_lengt
     let q = analytic::points(p, theta1, theta2);
     let m_node = s.add_node("M", platform, arr(q.m));
     let r = m.strut_radius_m;
-    s.struts.push(Strut { name: "rod O-M".into(), a: o_platform, b: m_node, radius_m: r });
+    s.members.push(Member::strut("rod O-M", o_platform, m_node, r));
     let _ = g;
     for (k, (b, t)) in d.cables.iter().enumerate() {
         let nb = s.add_node(&format!("B{}", k + 1), base, arr(*b));
         let nt = s.add_node(&format!("C{}", k + 1), platform, arr(*t));
-        s.struts.push(Strut { name: format!("platform M-C{}", k + 1), a: m_node, b: nt, radius_m: r });
-        s.cables.push(Cable {
-            name: format!("cable {}", k + 1),
-            a: nb,
-            b: nt,
-            law: m
-                .cable_stiffness_n_per_m
-                .map_or(CableLaw::Inextensible, |k| CableLaw::Elastic { stiffness_n_per_m: k }),
-            length_m: cable_lengths[k],
-            radius_m: DEFAULT_TENDON_RADIUS_M,
-        });
-        s.actuators.push(Actuator { symbol: format!("L{}", k + 1), target: ActuatorTarget::CableLength(k) });
+        s.members.push(Member::strut(format!("platform M-C{}", k + 1), m_node, nt, r));
+        s.members.push(Member::cable(
+            format!("cable {}", k + 1),
+            vec![nb, nt],
+            m.cable_stiffness_n_per_m.map_or(CableLaw::Inextensible, |k| CableLaw::Elastic { stiffness_n_per_m: k }),
+            cable_lengths[k],
+            DEFAULT_TENDON_RADIUS_M,
+        ));
+        let cable = s.members.len() - 1;
+        s.actuators.push(Actuator { symbol: format!("L{}", k + 1), target: ActuatorTarget::CableLength(cable) });
     }
     for (k, (b, t)) in d.springs.iter().enumerate() {
         let nb = s.add_node(&format!("B{}", k + 3), base, arr(*b));
         let nt = s.add_node(&format!("R{}", k + 1), platform, arr(*t));
-        s.struts.push(Strut { name: format!("platform M-R{}", k + 1), a: m_node, b: nt, radius_m: r });
-        s.springs.push(Spring {
-            name: format!("spring {}", k + 1),
-            a: nb,
-            b: nt,
-            stiffness_n_per_m: d.spring_k,
-            rest_length_m: d.spring_rest,
-            radius_m: DEFAULT_TENDON_RADIUS_M,
-        });
+        s.members.push(Member::strut(format!("platform M-R{}", k + 1), m_node, nt, r));
+        s.members.push(Member::spring(
+            format!("spring {}", k + 1),
+            [nb, nt],
+            d.spring_k,
+            d.spring_rest,
+            DEFAULT_TENDON_RADIUS_M,
+        ));
     }
     s.joints.push(Joint {
         name: "universal O".into(),

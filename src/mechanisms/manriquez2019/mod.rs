@@ -10,7 +10,7 @@ use super::{
     QuantityKind, QuantitySpec, QuerySpec, Solution, Values,
 };
 use crate::snapshot::Snapshot;
-use crate::structure::Structure;
+use crate::structure::{MemberKind, Structure};
 use analytic::Params;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
@@ -334,8 +334,8 @@ impl Mechanism for Manriquez2019 {
         let r = rq.to_rotation_matrix().into_inner() * analytic::rotation(start.0, start.1);
         let (th1, th2) = angles_of(&r);
         // Forces on the platform: cables (towards the base), springs, gravity; the joint reacts.
-        let tension = &snap.forces.cable_tension_n;
-        let spring = &snap.forces.spring_force_n;
+        let of = |kind| s.members_of(kind).map(|(i, _)| snap.forces.force_n[i]).collect::<Vec<_>>();
+        let (tension, spring) = (of(MemberKind::Cable), of(MemberKind::Spring));
         let (r1, r2) = (at("B3") - at("R1"), at("B4") - at("R2"));
         let mut force = Vector3::zeros();
         let mut moment = Vector3::zeros();

@@ -16,8 +16,8 @@
 
 use super::analytic::SpringChain;
 use crate::structure::{
-    Actuator, ActuatorTarget, BodyKind, Cable, CableLaw, ExternalLoad, Inertia, Joint, JointKind, Spring, Structure,
-    Strut, TorsionSpring, Vec3, DEFAULT_TENDON_RADIUS_M,
+    Actuator, ActuatorTarget, BodyKind, CableLaw, ExternalLoad, Inertia, Joint, JointKind, Member, Structure,
+    TorsionSpring, Vec3, DEFAULT_TENDON_RADIUS_M,
 };
 use nalgebra::Vector3;
 
@@ -90,25 +90,19 @@ pub fn build(g: &Geometry, m: &ModelChoices) -> Structure {
     let b_nodes: Vec<usize> = (0..3).map(|i| s.add_node(&format!("B{}", i + 1), platform, arr(b[i]))).collect();
     let r = m.strut_radius_m;
     for (i, j) in [(0, 1), (1, 2), (2, 0)] {
-        s.struts.push(Strut { name: format!("A{}A{}", i + 1, j + 1), a: a_nodes[i], b: a_nodes[j], radius_m: r });
-        s.struts.push(Strut { name: format!("B{}B{}", i + 1, j + 1), a: b_nodes[i], b: b_nodes[j], radius_m: r });
+        s.members.push(Member::strut(format!("A{}A{}", i + 1, j + 1), a_nodes[i], a_nodes[j], r));
+        s.members.push(Member::strut(format!("B{}B{}", i + 1, j + 1), b_nodes[i], b_nodes[j], r));
     }
     if let Some(k) = g.straight_stiffness_n_per_m {
         for i in 0..3 {
-            s.springs.push(Spring {
-                name: format!("leg{} spring", i + 1),
-                a: a_nodes[i],
-                b: b_nodes[i],
-                stiffness_n_per_m: k,
-                rest_length_m: g.lo,
-                radius_m: DEFAULT_TENDON_RADIUS_M,
-            });
-            s.struts.push(Strut {
-                name: format!("leg{} (straight)", i + 1),
-                a: a_nodes[i],
-                b: b_nodes[i],
-                radius_m: r,
-            });
+            s.members.push(Member::spring(
+                format!("leg{} spring", i + 1),
+                [a_nodes[i], b_nodes[i]],
+                k,
+                g.lo,
+                DEFAULT_TENDON_RADIUS_M,
+            ));
+            s.members.push(Member::strut(format!("leg{} (straight)", i + 1), a_nodes[i], b_nodes[i], r));
         }
     } else {
         add_two_link_legs(&mut s, g, m, base, platform, &a_nodes);
@@ -118,15 +112,15 @@ pub fn build(g: &Geometry, m: &ModelChoices) -> Structure {
             None => CableLaw::Inextensible,
             Some(k) => CableLaw::Elastic { stiffness_n_per_m: k },
         };
-        s.cables.push(Cable {
-            name: name.clone(),
-            a: a_nodes[*ai],
-            b: b_nodes[*bi],
+        s.members.push(Member::cable(
+            name.clone(),
+            vec![a_nodes[*ai], b_nodes[*bi]],
             law,
-            length_m: g.cable_lengths[c],
-            radius_m: DEFAULT_TENDON_RADIUS_M,
-        });
-        s.actuators.push(Actuator { symbol: symbol.clone(), target: ActuatorTarget::CableLength(c) });
+            g.cable_lengths[c],
+            DEFAULT_TENDON_RADIUS_M,
+        ));
+        let cable = s.members.len() - 1;
+        s.actuators.push(Actuator { symbol: symbol.clone(), target: ActuatorTarget::CableLength(cable) });
     }
     s
 }
@@ -163,8 +157,8 @@ fn add_two_link_legs(
         let a_lower = s.add_node(&format!("A{}_leg", i + 1), lower, arr(a[i]));
         let k_upper = s.add_node(&format!("K{}_upper", i + 1), upper, arr(k));
         let b_upper = s.add_node(&format!("B{}_leg", i + 1), upper, arr(b[i]));
-        s.struts.push(Strut { name: format!("leg{} lower link", i + 1), a: a_lower, b: k_lower, radius_m: r });
-        s.struts.push(Strut { name: format!("leg{} upper link", i + 1), a: k_upper, b: b_upper, radius_m: r });
+        s.members.push(Member::strut(format!("leg{} lower link", i + 1), a_lower, k_lower, r));
+        s.members.push(Member::strut(format!("leg{} upper link", i + 1), k_upper, b_upper, r));
         // Knee axis: the normal e2 of the leg's plane, along (K - A) x (B - K), so that a
         // positive rotation bends the knee further.
         let knee_axis = leg.e2;

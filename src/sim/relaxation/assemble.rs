@@ -3,6 +3,7 @@
 //! coupled bodies), assembled from the force laws.
 
 use super::super::{Data, Model};
+use crate::structure::MemberKind;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix3x6, Matrix6, Vector3};
 use rapier3d_f64::prelude::*;
 use std::ops::AddAssign;
@@ -105,20 +106,26 @@ impl Data {
         let s = &m.structure;
         let mut f = DVector::zeros(6 * dofs.blocks());
         let mut blocks = Vec::new();
-        for member in (0..s.springs.len() + s.cables.len()).filter_map(|i| self.elastic_member(m, i)) {
-            let (pa, pb) =
-                (Vector3::from(self.node_position(m, member.a)), Vector3::from(self.node_position(m, member.b)));
-            let d = pb - pa;
-            let l = d.norm();
-            if l <= 0.0 || !member.engaged(l) {
+        for (i, member) in s.members_by_kind() {
+            let Some(law) = self.elastic_law(m, i) else { continue };
+            let at: Vec<Vector3<f64>> = member.path.iter().map(|&n| Vector3::from(self.node_position(m, n))).collect();
+            let l = member.length_at(|n| self.node_position(m, n));
+            if l <= 0.0 || !law.engaged(l) {
                 continue;
             }
-            let (t, e) = (member.tension_n(l), d / l);
-            let km = e * e.transpose() * member.stiffness_n_per_m + (Matrix3::identity() - e * e.transpose()) * (t / l);
-            let ends = [
-                (self.node_jacobian(m, dofs, member.a, pa), pa, e * t),
-                (self.node_jacobian(m, dofs, member.b, pb), pb, -e * t),
-            ];
+            let t = law.tension_n(l);
+            // Each segment's direction and length; each path node's dl/dx: the directions of the
+            // segments leaving it less those arriving.
+            let segments: Vec<(Vector3<f64>, f64)> =
+                at.windows(2).map(|w| ((w[1] - w[0]) / (w[1] - w[0]).norm(), (w[1] - w[0]).norm())).collect();
+            let mut gradient = vec![Vector3::zeros(); at.len()];
+            for (s, (e, _)) in segments.iter().enumerate() {
+                gradient[s] += e;
+                gradient[s + 1] -= e;
+            }
+            let ends: Vec<_> = (0..at.len())
+                .map(|x| (self.node_jacobian(m, dofs, member.path[x], at[x]), at[x], gradient[x] * t))
+                .collect();
             for (x, (jx, px, fx)) in ends.iter().enumerate() {
                 let Some((i, ji)) = jx else { continue };
                 let rho = px - v3(dofs.com[*i]);
@@ -130,8 +137,8 @@ impl Data {
                 blocks.push((*i, *i, geo));
                 for (y, (jy, _, _)) in ends.iter().enumerate() {
                     let Some((k, jk)) = jy else { continue };
-                    let sign = if x == y { 1.0 } else { -1.0 };
-                    blocks.push((*i, *k, ji.transpose() * km * jk * sign));
+                    let kxy = path_stiffness(&segments, &gradient, law.stiffness_n_per_m, t, x, y);
+                    blocks.push((*i, *k, ji.transpose() * kxy * jk));
                 }
             }
         }
@@ -164,7 +171,7 @@ impl Data {
         }
         let mut anchors_of = vec![Vec::new(); n];
         let mut own_nodes = vec![Vec::new(); n];
-        let ends = s.springs.iter().map(|sp| (sp.a, sp.b)).chain(s.cables.iter().map(|c| (c.a, c.b)));
+        let ends = s.members_by_kind().filter(|(_, m)| m.kind() != MemberKind::Strut).flat_map(|(_, m)| m.segments());
         for (a, b) in ends {
             for node in [a, b] {
                 if let Some(i) = dofs.index[s.nodes[node].body] {
@@ -200,4 +207,33 @@ impl Data {
         let groups: Vec<_> = groups.into_values().map(|(blocks, anchors)| (blocks, place(anchors))).collect();
         bodies.chain(groups).collect()
     }
+}
+
+/// The block (x, y) of a path member's stiffness d2E/dx dy, x and y indices along its path:
+/// k g_x g_y^T (g the path length's gradient, the material term) plus each segment's
+/// geometric term (t / l_s)(1 - e e^T), added where x and y are the same end of it and
+/// subtracted where they are its two ends. A two-node member's K_m = k e e^T + (t / l)(1 - e e^T)
+/// and its opposite, to the bit.
+fn path_stiffness(
+    segments: &[(Vector3<f64>, f64)],
+    gradient: &[Vector3<f64>],
+    k: f64,
+    t: f64,
+    x: usize,
+    y: usize,
+) -> Matrix3<f64> {
+    let mut block = gradient[x] * gradient[y].transpose() * k;
+    for (s, (e, l)) in segments.iter().enumerate() {
+        let ends = [s, s + 1];
+        if !ends.contains(&x) || !ends.contains(&y) {
+            continue;
+        }
+        let geometric = (Matrix3::identity() - e * e.transpose()) * (t / l);
+        if x == y {
+            block += geometric;
+        } else {
+            block -= geometric;
+        }
+    }
+    block
 }

@@ -29,21 +29,10 @@ impl Data {
     ) -> (f64, f64) {
         let s = &m.structure;
         let (mut change, mut scale) = (0.0, 0.0);
-        for member in (0..s.springs.len() + s.cables.len()).filter_map(|i| self.elastic_member(m, i)) {
-            let energy = |pa: Vector3<f64>, pb: Vector3<f64>| {
-                let l = (pb - pa).norm();
-                if member.engaged(l) {
-                    0.5 * member.stiffness_n_per_m * (l - member.rest_length_m).powi(2)
-                } else {
-                    0.0
-                }
-            };
-            let now =
-                energy(Vector3::from(self.node_position(m, member.a)), Vector3::from(self.node_position(m, member.b)));
-            let then = energy(
-                self.moved_node(m, dofs, step, alpha, member.a),
-                self.moved_node(m, dofs, step, alpha, member.b),
-            );
+        for (i, member) in s.members_by_kind() {
+            let Some(law) = self.elastic_law(m, i) else { continue };
+            let now = law.energy_j(member.length_at(|n| self.node_position(m, n)));
+            let then = law.energy_j(member.length_at(|n| self.moved_node(m, dofs, step, alpha, n).into()));
             change += then - now;
             scale += now.abs() + then.abs();
         }

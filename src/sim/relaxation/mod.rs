@@ -36,7 +36,7 @@ pub(super) mod ordering;
 mod sparse;
 
 use super::{Data, Model};
-use crate::structure::{BodyKind, CableLaw, Structure};
+use crate::structure::{BodyKind, Structure};
 use nalgebra::DVector;
 
 /// Mass-weighted modes whose stiffness (as |omega^2|) is below this fraction of the stiffest
@@ -81,7 +81,7 @@ const DENSE_MAX_BODIES: usize = 8;
 /// (no joints, no inextensible cables), and at least one free body.
 pub(super) fn applies(s: &Structure) -> bool {
     s.joints.is_empty()
-        && s.cables.iter().all(|c| matches!(c.law, CableLaw::Elastic { .. }))
+        && !s.members.iter().any(|c| c.is_inextensible_cable())
         && s.bodies.iter().any(|b| b.kind == BodyKind::Free)
 }
 
@@ -218,7 +218,7 @@ mod tests {
     /// Two free bodies hung from a fixed triangle by cables stretched to 1.6 times their rest
     /// length, joined by a spring compressed to 0.8 times its free length, with gravity.
     fn hung_bodies() -> Simulation {
-        use crate::structure::{BodyKind, Cable, Inertia, Spring};
+        use crate::structure::{BodyKind, CableLaw, Inertia, Member};
         let mut s = Structure { gravity: [0.0, 0.0, -9.81], ..Default::default() };
         let ground = s.add_body("ground", BodyKind::Fixed, None);
         let fixed = [("g0", [0.0, 0.0, 2.0]), ("g1", [1.0, 0.0, 2.0]), ("g2", [0.0, 1.0, 2.0])]
@@ -235,17 +235,10 @@ mod tests {
         {
             let law = CableLaw::Elastic { stiffness_n_per_m: 150.0 };
             let length_m = length(&s, a, b) / 1.6;
-            s.cables.push(Cable { name: format!("c{a}{b}"), a, b, law, length_m, radius_m: 0.001 });
+            s.members.push(Member::cable(format!("c{a}{b}"), vec![a, b], law, length_m, 0.001));
         }
         let rest_length_m = length(&s, p, u) / 0.8;
-        s.springs.push(Spring {
-            name: "s".into(),
-            a: p,
-            b: u,
-            stiffness_n_per_m: 80.0,
-            rest_length_m,
-            radius_m: 0.001,
-        });
+        s.members.push(Member::spring("s", [p, u], 80.0, rest_length_m, 0.001));
         Simulation::new(&s, &crate::settings::SimSettings::default()).unwrap()
     }
 
@@ -305,20 +298,13 @@ mod tests {
     /// the rigid component) and the dynamics move it.
     #[test]
     fn the_sparse_step_leaves_the_rigid_motions_of_a_free_group_alone() {
-        use crate::structure::{Inertia, Spring};
+        use crate::structure::{Inertia, Member};
         let mut s = Structure { gravity: [0.0, 0.0, -9.81], ..Default::default() };
         let inertia = |com| Inertia { mass_kg: 0.5, com, principal_kg_m2: [0.02, 0.03, 0.04] };
         let one = s.add_body("one", BodyKind::Free, Some(inertia([0.0, 0.0, 0.0])));
         let two = s.add_body("two", BodyKind::Free, Some(inertia([1.0, 0.2, 0.1])));
         let (p, q) = (s.add_node("p", one, [0.1, 0.0, 0.0]), s.add_node("q", two, [0.9, 0.2, 0.3]));
-        s.springs.push(Spring {
-            name: "s".into(),
-            a: p,
-            b: q,
-            stiffness_n_per_m: 50.0,
-            rest_length_m: 0.5,
-            radius_m: 0.001,
-        });
+        s.members.push(Member::spring("s", [p, q], 50.0, 0.5, 0.001));
         let sim = Simulation::new(&s, &crate::settings::SimSettings::default()).unwrap();
         let dofs = sim.data.relaxation_dofs(&sim.model);
         let groups = sim.data.rigid_groups(&sim.model, &dofs);

@@ -7,6 +7,9 @@
 
 use std::collections::BTreeMap;
 
+mod member;
+pub use member::*;
+
 /// A 3-vector in metres (or a unit axis).
 pub type Vec3 = [f64; 3];
 
@@ -54,50 +57,6 @@ pub struct Node {
     pub body: BodyId,
     /// World position in the initial configuration \[m\].
     pub position: Vec3,
-}
-
-/// A compression member drawn between two nodes of the same body (or of two bodies joined at
-/// its ends). It carries no force law of its own: it is rigid through its body.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Strut {
-    pub name: String,
-    pub a: NodeId,
-    pub b: NodeId,
-    /// Radius of the capsule used for interference checks and drawing \[m\].
-    pub radius_m: f64,
-}
-
-/// A linear spring that pushes as well as pulls: force = stiffness (l - rest_length).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Spring {
-    pub name: String,
-    pub a: NodeId,
-    pub b: NodeId,
-    pub stiffness_n_per_m: f64,
-    /// Free length \[m\]; zero is allowed (a zero-free-length spring).
-    pub rest_length_m: f64,
-    /// Radius of the segment used for interference checks and drawing \[m\].
-    pub radius_m: f64,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub enum CableLaw {
-    /// Inextensible: never longer than `length_m`, slack (no force) when shorter.
-    Inextensible,
-    /// Elastic, tension only: force = max(0, stiffness (l - length_m)).
-    Elastic { stiffness_n_per_m: f64 },
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct Cable {
-    pub name: String,
-    pub a: NodeId,
-    pub b: NodeId,
-    pub law: CableLaw,
-    /// Unstretched length in the initial configuration \[m\] (an actuator may change it).
-    pub length_m: f64,
-    /// Radius of the segment used for interference checks and drawing \[m\].
-    pub radius_m: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -194,9 +153,8 @@ pub struct Structure {
     pub gravity: Vec3,
     pub bodies: Vec<Body>,
     pub nodes: Vec<Node>,
-    pub struts: Vec<Strut>,
-    pub springs: Vec<Spring>,
-    pub cables: Vec<Cable>,
+    /// Struts, springs and cables, one list ([`Member`]).
+    pub members: Vec<Member>,
     pub joints: Vec<Joint>,
     pub actuators: Vec<Actuator>,
     pub loads: Vec<ExternalLoad>,
@@ -261,19 +219,38 @@ impl Structure {
             .map(|a| {
                 by_symbol.get(&a.symbol).copied().unwrap_or(match a.target {
                     ActuatorTarget::Joint(j) => self.joints[j].initial_coordinate,
-                    ActuatorTarget::CableLength(c) => self.cables[c].length_m,
+                    ActuatorTarget::CableLength(c) => self.members[c].rest_length_m().unwrap_or(f64::NAN),
                     ActuatorTarget::FixedNode { .. } => 0.0,
                 })
             })
             .collect()
     }
 
-    pub fn spring_id(&self, name: &str) -> Option<usize> {
-        self.springs.iter().position(|m| m.name == name)
+    /// The member called `name`.
+    pub fn member_id(&self, name: &str) -> Option<MemberId> {
+        self.members.iter().position(|m| m.name == name)
     }
 
-    pub fn cable_id(&self, name: &str) -> Option<usize> {
-        self.cables.iter().position(|m| m.name == name)
+    /// The member called `name`.
+    pub fn member(&self, name: &str) -> Option<&Member> {
+        self.members.iter().find(|m| m.name == name)
+    }
+
+    /// Every member with its index, grouped by kind (struts, springs, cables) and in their
+    /// order within a kind: the order every sum over members takes, so that a structure's
+    /// forces add up alike however its builder interleaved the kinds.
+    pub fn members_by_kind(&self) -> impl Iterator<Item = (MemberId, &Member)> + '_ {
+        [MemberKind::Strut, MemberKind::Spring, MemberKind::Cable].into_iter().flat_map(|k| self.members_of(k))
+    }
+
+    /// How many members of one kind there are.
+    pub fn count_of(&self, kind: MemberKind) -> usize {
+        self.members_of(kind).count()
+    }
+
+    /// The members of one kind with their indices, in their order.
+    pub fn members_of(&self, kind: MemberKind) -> impl Iterator<Item = (MemberId, &Member)> + '_ {
+        self.members.iter().enumerate().filter(move |(_, m)| m.kind() == kind)
     }
 
     /// The actuator of joint `j` if it is a servo: a revolute joint with a torsion spring,
@@ -295,14 +272,10 @@ impl Structure {
     /// The cables' total tension at the drawn state \[N\]: each elastic cable's stiffness times
     /// its stretch past its rest length (an inextensible cable carries none until loaded).
     pub fn drawn_cable_tension_n(&self) -> f64 {
-        self.cables
-            .iter()
-            .map(|c| match c.law {
-                CableLaw::Elastic { stiffness_n_per_m } => {
-                    let l = distance(self.nodes[c.a].position, self.nodes[c.b].position);
-                    stiffness_n_per_m * (l - c.length_m).max(0.0)
-                }
-                CableLaw::Inextensible => 0.0,
+        self.members_of(MemberKind::Cable)
+            .filter_map(|(_, c)| {
+                let law = c.elastic_law(c.rest_length_m()?)?;
+                Some(law.tension_n(c.length_at(|n| self.nodes[n].position)))
             })
             .sum()
     }
@@ -368,32 +341,40 @@ impl Structure {
         Ok(())
     }
 
-    /// Struts, springs and cables join existing distinct nodes, with finite positive sizes and stiffnesses.
+    /// Members have unique names and join existing nodes with finite positive sizes and
+    /// stiffnesses: struts and springs two distinct nodes, cables two or more, no node twice
+    /// in a row.
     fn validate_members(&self) -> Result<(), StructureError> {
-        for s in &self.struts {
-            self.check_member("strut", &s.name, s.a, s.b)?;
-            if !(s.radius_m >= 0.0 && s.radius_m.is_finite()) {
-                return Err(invalid("strut", &s.name, "radius must be a finite number >= 0 m"));
+        let mut seen = std::collections::BTreeSet::new();
+        for m in &self.members {
+            let what = m.kind().label();
+            if !seen.insert(&m.name) {
+                return Err(invalid(what, &m.name, "another member has this name"));
             }
-        }
-        for s in &self.springs {
-            self.check_member("spring", &s.name, s.a, s.b)?;
-            if !(s.stiffness_n_per_m > 0.0 && s.stiffness_n_per_m.is_finite()) {
-                return Err(invalid("spring", &s.name, "stiffness must be a finite number > 0 N/m"));
+            self.check_path(m)?;
+            if !(m.radius_m >= 0.0 && m.radius_m.is_finite()) {
+                return Err(invalid(what, &m.name, "radius must be a finite number >= 0 m"));
             }
-            if !(s.rest_length_m >= 0.0 && s.rest_length_m.is_finite()) {
-                return Err(invalid("spring", &s.name, "rest length must be a finite number >= 0 m"));
-            }
-        }
-        for c in &self.cables {
-            self.check_member("cable", &c.name, c.a, c.b)?;
-            if !(c.length_m > 0.0 && c.length_m.is_finite()) {
-                return Err(invalid("cable", &c.name, "length must be a finite number > 0 m"));
-            }
-            if let CableLaw::Elastic { stiffness_n_per_m } = c.law {
-                if !(stiffness_n_per_m > 0.0 && stiffness_n_per_m.is_finite()) {
-                    return Err(invalid("cable", &c.name, "stiffness must be a finite number > 0 N/m"));
+            if let Some(k) = m.stiffness_n_per_m() {
+                if !(k > 0.0 && k.is_finite()) {
+                    return Err(invalid(what, &m.name, "stiffness must be a finite number > 0 N/m"));
                 }
+            }
+            match m.law {
+                Law::Spring { rest_length_m, .. } if !(rest_length_m >= 0.0 && rest_length_m.is_finite()) => {
+                    return Err(invalid(what, &m.name, "rest length must be a finite number >= 0 m"))
+                }
+                Law::Cable { length_m, .. } if !(length_m > 0.0 && length_m.is_finite()) => {
+                    return Err(invalid(what, &m.name, "length must be a finite number > 0 m"))
+                }
+                Law::Cable { law: CableLaw::Inextensible, .. } if m.is_clustered() => {
+                    return Err(invalid(
+                        what,
+                        &m.name,
+                        "a clustered cable needs a stiffness (an inextensible one through inner nodes is not modelled)",
+                    ))
+                }
+                _ => {}
             }
         }
         Ok(())
@@ -485,7 +466,7 @@ impl Structure {
                     // A torsion spring on an actuated joint makes it a servo (`servo_of`).
                 }
                 ActuatorTarget::CableLength(c) => {
-                    if c >= self.cables.len() {
+                    if self.members.get(c).is_none_or(|m| m.kind() != MemberKind::Cable) {
                         return Err(StructureError::DanglingReference {
                             what: "actuator",
                             name: a.symbol.clone(),
@@ -527,14 +508,31 @@ impl Structure {
         Ok(())
     }
 
-    fn check_member(&self, what: &'static str, name: &str, a: NodeId, b: NodeId) -> Result<(), StructureError> {
-        self.check_node(what, name, a)?;
-        self.check_node(what, name, b)?;
-        if what != "spring" && distance(self.nodes[a].position, self.nodes[b].position) < MIN_MEMBER_LENGTH_M {
-            return Err(StructureError::ZeroLength { what, name: name.into() });
+    /// A member's path: existing nodes, two of them for a strut or a spring, at least two for
+    /// a cable, no node twice in a row, and every segment of a strut or a cable longer than
+    /// [`MIN_MEMBER_LENGTH_M`].
+    fn check_path(&self, m: &Member) -> Result<(), StructureError> {
+        let what = m.kind().label();
+        for &n in &m.path {
+            self.check_node(what, &m.name, n)?;
         }
-        if a == b {
-            return Err(StructureError::ZeroLength { what, name: name.into() });
+        if m.kind() != MemberKind::Cable && m.path.len() != 2 {
+            return Err(invalid(what, &m.name, "needs exactly two nodes"));
+        }
+        if m.path.len() < 2 {
+            return Err(invalid(what, &m.name, "a cable runs through at least two nodes"));
+        }
+        for (a, b) in m.segments() {
+            if a == b && m.is_clustered() {
+                return Err(invalid(what, &m.name, "repeats a node in a row"));
+            }
+            if a == b {
+                return Err(StructureError::ZeroLength { what, name: m.name.clone() });
+            }
+            let short = distance(self.nodes[a].position, self.nodes[b].position) < MIN_MEMBER_LENGTH_M;
+            if m.kind() != MemberKind::Spring && short {
+                return Err(StructureError::ZeroLength { what, name: m.name.clone() });
+            }
         }
         Ok(())
     }
@@ -686,28 +684,14 @@ mod tests {
     #[test]
     fn a_valid_structure_passes_validation() {
         let mut s = two_bodies();
-        s.springs.push(Spring {
-            name: "k".into(),
-            a: 0,
-            b: 1,
-            stiffness_n_per_m: 10.0,
-            rest_length_m: 0.0,
-            radius_m: DEFAULT_TENDON_RADIUS_M,
-        });
+        s.members.push(Member::spring("k", [0, 1], 10.0, 0.0, DEFAULT_TENDON_RADIUS_M));
         assert_eq!(s.validate(), Ok(()));
     }
 
     #[test]
     fn a_member_naming_an_unknown_node_is_rejected() {
         let mut s = two_bodies();
-        s.cables.push(Cable {
-            name: "c".into(),
-            a: 0,
-            b: 7,
-            law: CableLaw::Inextensible,
-            length_m: 1.0,
-            radius_m: DEFAULT_TENDON_RADIUS_M,
-        });
+        s.members.push(Member::cable("c", vec![0, 7], CableLaw::Inextensible, 1.0, DEFAULT_TENDON_RADIUS_M));
         assert!(matches!(s.validate(), Err(StructureError::DanglingReference { index: 7, .. })));
     }
 
@@ -715,7 +699,7 @@ mod tests {
     fn a_zero_length_strut_is_rejected() {
         let mut s = two_bodies();
         s.add_node("A2", 0, [0.0; 3]);
-        s.struts.push(Strut { name: "s".into(), a: 0, b: 2, radius_m: 0.01 });
+        s.members.push(Member::strut("s", 0, 2, 0.01));
         assert_eq!(s.validate(), Err(StructureError::ZeroLength { what: "strut", name: "s".into() }));
     }
 
@@ -729,14 +713,7 @@ mod tests {
     #[test]
     fn a_negative_spring_stiffness_is_rejected() {
         let mut s = two_bodies();
-        s.springs.push(Spring {
-            name: "k".into(),
-            a: 0,
-            b: 1,
-            stiffness_n_per_m: -1.0,
-            rest_length_m: 0.0,
-            radius_m: DEFAULT_TENDON_RADIUS_M,
-        });
+        s.members.push(Member::spring("k", [0, 1], -1.0, 0.0, DEFAULT_TENDON_RADIUS_M));
         assert!(matches!(s.validate(), Err(StructureError::Invalid { what: "spring", .. })));
     }
 }
