@@ -7,6 +7,7 @@ mod bench;
 mod bench_scale;
 mod ci_checks;
 mod cli;
+mod clustered_cables;
 mod common;
 mod compact_members;
 mod custom_structure;

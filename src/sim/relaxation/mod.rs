@@ -218,6 +218,10 @@ mod tests {
     /// Two free bodies hung from a fixed triangle by cables stretched to 1.6 times their rest
     /// length, joined by a spring compressed to 0.8 times its free length, with gravity.
     fn hung_bodies() -> Simulation {
+        Simulation::new(&hung_structure(), &crate::settings::SimSettings::default()).unwrap()
+    }
+
+    fn hung_structure() -> Structure {
         use crate::structure::{BodyKind, CableLaw, Inertia, Member};
         let mut s = Structure { gravity: [0.0, 0.0, -9.81], ..Default::default() };
         let ground = s.add_body("ground", BodyKind::Fixed, None);
@@ -239,7 +243,7 @@ mod tests {
         }
         let rest_length_m = length(&s, p, u) / 0.8;
         s.members.push(Member::spring("s", [p, u], 80.0, rest_length_m, 0.001));
-        Simulation::new(&s, &crate::settings::SimSettings::default()).unwrap()
+        s
     }
 
     /// Away from equilibrium (tension, compression and gravity), f is minus the gradient of
@@ -247,7 +251,26 @@ mod tests {
     /// entry (step 1e-4 m or rad).
     #[test]
     fn force_and_hessian_are_the_derivatives_of_the_energy() {
-        let sim = hung_bodies();
+        assert_derivatives_of_the_energy(&hung_bodies());
+    }
+
+    /// The same with a clustered cable added, from the triangle's g0 through q (body one) and
+    /// r (body two) to g2, stretched to 1.3 times its rest length: its material term couples
+    /// all four nodes (k g g^T), its geometric term each segment's two.
+    #[test]
+    fn a_clustered_cables_force_and_hessian_are_the_derivatives_of_its_energy() {
+        use crate::structure::{CableLaw, Member};
+        let mut s = hung_structure();
+        let id = |name: &str| s.node_id(name).unwrap();
+        let path = vec![id("g0"), id("q"), id("r"), id("g2")];
+        let drawn = Member::cable("clustered", path.clone(), CableLaw::Inextensible, 1.0, 0.001)
+            .length_at(|n| s.nodes[n].position);
+        let law = CableLaw::Elastic { stiffness_n_per_m: 120.0 };
+        s.members.push(Member::cable("clustered", path, law, drawn / 1.3, 0.001));
+        assert_derivatives_of_the_energy(&Simulation::new(&s, &crate::settings::SimSettings::default()).unwrap());
+    }
+
+    fn assert_derivatives_of_the_energy(sim: &Simulation) {
         let dofs = sim.data.relaxation_dofs(&sim.model);
         let system = sim.data.relaxation_system(&sim.model, &dofs);
         let (h, f) = (system.dense(), system.force);

@@ -1,0 +1,122 @@
+//! Clustered cables: one cable through several nodes, one rest length and one stiffness for
+//! its whole length, sliding without friction at its inner nodes (`through`), so every segment
+//! carries one tension. The ring on a cable settles on the closed form by the plain dynamics as
+//! by the relaxation; interference checks every segment; bad input is located.
+
+use crate::common::{self, edited, error_at, node, norm, sub};
+use std::path::Path;
+use tensegrity_testbed::run::{run, RunOptions};
+use tensegrity_testbed::scenario;
+use tensegrity_testbed::structure::MemberKind;
+
+const RING: &str = "scenarios/custom/ring_on_clustered_cable.toml";
+
+/// The ring settled by the plain dynamics (no relaxation, body damping 5 /s) lands where the
+/// relaxation puts it: the ring within 1e-9 m and the tension within 1e-9 relative at every
+/// height, and the file's closed forms pass (theta = theta_s, T = m g / (2 cos theta_s)).
+#[test]
+fn the_ring_settles_on_the_closed_form_by_the_plain_dynamics_too() {
+    let fast = common::run_file(RING);
+    let text = edited(
+        RING,
+        &[("[settle]\n", "[sim]\nrelaxation = false\nbody_damping = 5.0\n\n[settle]\nmax_time = 200.0\n")],
+    );
+    let plain = run(&scenario::parse(Path::new("ring.toml"), &text).unwrap(), &RunOptions::default());
+    assert!(fast.passed && plain.passed, "{:?} {:?} {:?}", fast.error, plain.error, plain.failures);
+    assert!(
+        plain.settle.steps > 10 * fast.settle.steps,
+        "plain {} steps, relaxed {}",
+        plain.settle.steps,
+        fast.settle.steps
+    );
+    for (f, p) in fast.points.iter().zip(&plain.points) {
+        let (rf, rp) = (f.simulated["hang.force"], p.simulated["hang.force"]);
+        assert!(((rf - rp) / rf).abs() <= 1e-9, "tension {rf} N relaxed, {rp} N plain");
+        let d = ["R.x", "R.y", "R.z"].map(|k| f.simulated[k] - p.simulated[k]);
+        assert!(norm(d) <= 1e-9, "ring {d:?} m apart");
+    }
+}
+
+/// The ring's cable is one member whose path runs A, R, B; its one tension is the whole
+/// cable's law, k (|AR| + |RB| - L0) with the settled nodes' distances, within 1e-12 relative.
+#[test]
+fn a_clustered_cable_is_one_member_with_one_tension() {
+    let sc = scenario::load(Path::new(RING)).unwrap();
+    let s = &sc.custom.as_ref().unwrap().structure;
+    assert_eq!(s.count_of(MemberKind::Cable), 1);
+    let hang = s.member("hang").unwrap();
+    let names: Vec<&str> = hang.path.iter().map(|&n| s.nodes[n].name.as_str()).collect();
+    assert_eq!(names, ["A", "R", "B"]);
+    let r = common::run_file(RING);
+    let (a, ring, b) = (node(&r, "A"), node(&r, "R"), node(&r, "B"));
+    let length = norm(sub(ring, a)) + norm(sub(b, ring));
+    let (k, rest) = (sc.params["k"], sc.params["L0"]);
+    let tension = r.points[0].simulated["hang.force"];
+    assert!((tension - k * (length - rest)).abs() <= 1e-12 * tension, "{tension} N against {}", k * (length - rest));
+}
+
+/// A clustered cable that runs through a strut is an interference: a fixed bar along y and a
+/// cable from A over the bar's middle (its first segment crosses the bar's axis) to P and on
+/// to B fails with a violation naming the cable and the strut.
+#[test]
+fn interference_checks_every_segment_of_a_clustered_cable() {
+    let text = r#"name = "a clustered cable through a bar"
+mechanism = "custom"
+[interference]
+tendons = true
+[actuation]
+points = [ {} ]
+[structure]
+[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { Y0 = [0, -1, 0], Y1 = [0, 1, 0], A = [-1, 0, 0.5], P = [1, 0, -0.5], B = [1, 0, 1] }
+[[structure.bodies]]
+name = "bob"
+mass = 1.0
+nodes = { Q = [2, 0, 0], Q2 = [2, 0.1, 0] }
+[[structure.struts]]
+name = "bar"
+a = "Y0"
+b = "Y1"
+[[structure.cables]]
+name = "rope"
+a = "A"
+through = ["P", "B"]
+b = "Q"
+stiffness = 100.0
+"#;
+    let r = run(&scenario::parse(Path::new("through.toml"), text).unwrap(), &RunOptions::default());
+    assert!(!r.passed, "a cable through a bar must fail");
+    let i = r.interference.as_ref().expect("an interference report");
+    assert!(!i.passed && !i.violations.is_empty(), "{i:?}");
+    assert!(i.min_clearance_m.is_some_and(|c| c < 0.0), "{i:?}");
+    let pair = i.closest_pair.clone().expect("the closest pair");
+    assert!(pair.contains(&"rope".to_string()) && pair.contains(&"bar".to_string()), "{pair:?}");
+}
+
+/// Bad clustered cables are located at the key that is wrong: a strut or a spring with
+/// `through`, an empty `through`, a node twice in a row, an unknown inner node, and a clustered
+/// cable without a stiffness (an inextensible one is not modelled).
+#[test]
+fn bad_clustered_cables_are_located() {
+    let text = std::fs::read_to_string(RING).unwrap();
+    let cable = "[[structure.cables]]\nname = \"hang\"\na = \"A\"\nthrough = [\"R\"]\nb = \"B\"\nstiffness = \"k\"\n";
+    assert!(text.contains(cable));
+    let with = |replacement: &str| text.replacen(cable, replacement, 1);
+    let strut = with(
+        "[[structure.struts]]\nname = \"bar\"\na = \"A\"\nthrough = [\"R\"]\nb = \"B\"\n[[structure.cables]]\nname = \"hang\"\na = \"A\"\nb = \"B\"\nstiffness = \"k\"\n",
+    );
+    error_at(&strut, "through = [\"R\"]\nb = \"B\"\n[[structure.cables]]", 10, "only a cable runs through inner nodes");
+    let empty = with("[[structure.cables]]\nname = \"hang\"\na = \"A\"\nthrough = []\nb = \"B\"\nstiffness = \"k\"\n");
+    error_at(&empty, "through = []", 10, "names no inner node");
+    let twice = with(
+        "[[structure.cables]]\nname = \"hang\"\na = \"A\"\nthrough = [\"R\", \"R\"]\nb = \"B\"\nstiffness = \"k\"\n",
+    );
+    error_at(&twice, "\"R\", \"R\"]", 5, "runs through node 'R' twice in a row");
+    let unknown =
+        with("[[structure.cables]]\nname = \"hang\"\na = \"A\"\nthrough = [\"X\"]\nb = \"B\"\nstiffness = \"k\"\n");
+    error_at(&unknown, "\"X\"", 0, "unknown node 'X'");
+    let rigid = with("[[structure.cables]]\nname = \"hang\"\na = \"A\"\nthrough = [\"R\"]\nb = \"B\"\n");
+    error_at(&rigid, "\"hang\"", 0, "needs a stiffness");
+}
