@@ -114,8 +114,15 @@ pub struct MemberForces {
     /// Each member's rest length now \[m\]: a spring's, a cable's unstretched (commanded)
     /// length; NaN for a strut.
     pub rest_length_m: Vec<f64>,
-    /// Whether each member is a slack cable.
+    /// Whether each member is a slack cable (every segment slack).
     pub slack: Vec<bool>,
+    /// Each clustered cable's tension in each of its segments, in path order \[N\]: one value
+    /// without friction, each its own with it (`force_n` is then its last segment's, at the
+    /// end b where a winch reels); empty for a straight member.
+    pub segment_force_n: Vec<Vec<f64>>,
+    /// Each cable with friction's inner nodes: whether each is at its friction bound (slips
+    /// if pulled further); empty for every other member.
+    pub at_friction_bound: Vec<Vec<bool>>,
     /// Force \[N\] or torque [N m] each actuator exerts along its joint axis (or the cable
     /// tension for a winch), in actuator order.
     pub actuator_force: Vec<f64>,
@@ -212,6 +219,8 @@ pub fn richardson(coarse: &Snapshot, fine: &Snapshot, order: i32) -> Snapshot {
             length_m: v(&cf.length_m, &ff.length_m),
             rest_length_m: ff.rest_length_m.clone(),
             slack: ff.slack.clone(),
+            segment_force_n: cf.segment_force_n.iter().zip(&ff.segment_force_n).map(|(c, f)| v(c, f)).collect(),
+            at_friction_bound: ff.at_friction_bound.clone(),
             actuator_force: v(&cf.actuator_force, &ff.actuator_force),
             residual: None,
         },

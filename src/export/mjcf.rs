@@ -499,6 +499,14 @@ impl Writer<'_> {
             if damping > 0.0 && !(self.winched(c) && matches!(cable_law, CableLaw::Elastic { .. })) {
                 let _ = write!(law, " damping=\"{damping:?}\"");
             }
+            if cable.has_friction() {
+                let _ = writeln!(
+                    self.xml,
+                    "  <!-- cable {} has friction {:?} at its inner nodes: MuJoCo's tendon has no capstan, it slides freely here -->",
+                    esc(&cable.name),
+                    cable.friction
+                );
+            }
             self.spatial(&names.get(&cable.name), &law, &cable.path);
         }
         self.xml.push_str("</tendon>\n");

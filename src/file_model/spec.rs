@@ -18,8 +18,14 @@ pub enum Source {
     Node(String, usize),
     /// Force of a spring or cable, tension positive \[N\].
     MemberForce(String),
-    /// Length of a spring, cable or strut (distance between its end nodes) \[m\].
+    /// Length of a spring, cable or strut (distance between its end nodes; a clustered
+    /// cable's, the sum of its segments') \[m\].
     MemberLength(String),
+    /// Tension of a clustered cable's segment (from 0, in path order) \[N\].
+    SegmentForce(String, usize),
+    /// Whether a cable with friction slips at its inner node (from 0, in path order): 1 at its
+    /// friction bound, 0 held.
+    Slip(String, usize),
     /// Angle of a revolute joint \[rad\]: its initial coordinate plus the child's rotation
     /// relative to the parent about the axis since the build.
     JointAngle(String),

@@ -27,6 +27,9 @@ enum Bind {
     /// A spring's or a cable's force and length (member index).
     MemberForce(usize),
     MemberLength(usize),
+    /// A clustered cable's segment tension and an inner node's slip (member, index).
+    SegmentForce(usize, usize),
+    Slip(usize, usize),
     /// Distance between a strut's end nodes.
     StrutLength(usize, usize),
     Observed(String),
@@ -69,6 +72,8 @@ impl Bind {
             Source::Time => Some(Bind::Time),
             Source::Node(n, axis) => s.node_id(n).map(|i| Bind::Node(i, *axis)),
             Source::MemberForce(m) => tension(m).map(Bind::MemberForce),
+            Source::SegmentForce(m, k) => s.member_id(m).map(|i| Bind::SegmentForce(i, *k)),
+            Source::Slip(m, k) => s.member_id(m).map(|i| Bind::Slip(i, *k)),
             Source::MemberLength(m) => tension(m).map(Bind::MemberLength).or_else(|| {
                 let (_, t) = s.members_of(MemberKind::Strut).find(|(_, t)| &t.name == m)?;
                 Some(Bind::StrutLength(t.ends().0, t.ends().1))
@@ -90,6 +95,11 @@ impl Bind {
             Bind::Node(i, axis) => snap.nodes.get(*i).map_or(f64::NAN, |p| p[*axis]),
             Bind::MemberForce(i) => at(&snap.forces.force_n, *i),
             Bind::MemberLength(i) => at(&snap.forces.length_m, *i),
+            Bind::SegmentForce(i, k) => snap.forces.segment_force_n.get(*i).map_or(f64::NAN, |t| at(t, *k)),
+            Bind::Slip(i, k) => match snap.forces.at_friction_bound.get(*i).and_then(|b| b.get(*k)) {
+                Some(&slipping) => f64::from(u8::from(slipping)),
+                None => f64::NAN,
+            },
             Bind::StrutLength(a, b) => match (snap.nodes.get(*a), snap.nodes.get(*b)) {
                 (Some(pa), Some(pb)) => crate::structure::distance(*pa, *pb),
                 _ => f64::NAN,

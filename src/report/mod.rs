@@ -503,6 +503,9 @@ pub struct PointReport {
     /// The stability the scenario expects here (`[stability] expect`), if it says.
     pub expected_stable: Option<bool>,
     pub slack_cables: Vec<String>,
+    /// The nodes where a cable with friction is at its bound and slips ("CABLE at NODE").
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub slipping: Vec<String>,
     /// Cables the analytic statics says are slack (mechanisms with cables only).
     pub expected_slack: Option<Vec<String>>,
     /// Whether the simulated slack set equals the analytic one.
@@ -1186,6 +1189,9 @@ impl ScenarioReport {
                         format!(", NOT SETTLED: kinetic energy {:.3e} J left", p.final_kinetic_energy_j)
                     }
                 ));
+            }
+            if !p.slipping.is_empty() {
+                out.push_str(&format!("              slipping (at the friction bound): {}\n", p.slipping.join(", ")));
             }
             if let Some(modes) = p.energy.as_ref().and_then(|e| e.modes.as_ref()) {
                 let listed: Vec<String> = modes

@@ -247,6 +247,7 @@ pub(super) fn measured_point(
         residual_torque_nm: residual.map_or(f64::NAN, |r| r.max_torque_nm),
         final_kinetic_energy_j: kinetic_energy_j,
         slack_cables,
+        slipping: slipping_nodes(runner.sim.structure(), snapshot),
         prestress_fraction,
         prestress_lost,
         ..PointReport::default()
@@ -370,6 +371,18 @@ fn energy_stability(point: &PointReport) -> Option<bool> {
 pub(super) fn prestress_fraction(runner: &Runner, snap: &Snapshot) -> Option<f64> {
     let drawn = runner.sim.structure().drawn_cable_tension_n();
     (drawn > 0.0).then(|| cable_forces(runner.sim.structure(), snap).sum::<f64>() / drawn)
+}
+
+/// The inner nodes where a cable with friction is at its bound in `snap` ("CABLE at NODE").
+fn slipping_nodes(s: &crate::structure::Structure, snap: &Snapshot) -> Vec<String> {
+    let mut out = Vec::new();
+    for (i, flags) in snap.forces.at_friction_bound.iter().enumerate() {
+        for (j, _) in flags.iter().enumerate().filter(|(_, slips)| **slips) {
+            let member = &s.members[i];
+            out.push(format!("{} at {}", member.name, s.nodes[member.path[j + 1]].name));
+        }
+    }
+    out
 }
 
 /// Every cable's tension in `snap` \[N\], in their order.

@@ -84,6 +84,14 @@ fn state_symbols(s: &crate::structure::Structure, m: &dyn Mechanism, params: &Va
         add(format!("{name}.force"), Source::MemberForce(name.clone()));
         add(format!("{name}.length"), Source::MemberLength(name.clone()));
     }
+    for (_, c) in s.members_of(MemberKind::Cable).filter(|(_, c)| c.is_clustered()) {
+        for k in 1..c.path.len() {
+            add(format!("{}.force_{k}", c.name), Source::SegmentForce(c.name.clone(), k - 1));
+        }
+        for k in 1..=c.friction.len() {
+            add(format!("{}.slip_{k}", c.name), Source::Slip(c.name.clone(), k - 1));
+        }
+    }
     for (_, st) in s.members_of(MemberKind::Strut) {
         add(format!("{}.length", st.name), Source::MemberLength(st.name.clone()));
     }

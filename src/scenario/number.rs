@@ -212,6 +212,9 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
     }
     for m in s.struts.iter_mut().chain(s.springs.iter_mut()).chain(s.cables.iter_mut()) {
         resolve_member(&mut m.radius, &mut m.stiffness, &mut m.length, &mut resolve)?;
+        for mu in m.friction.iter_mut().flat_map(|f| f.get_mut().iter_mut()) {
+            resolve(mu, "friction")?;
+        }
     }
     for g in s.strut_groups.iter_mut().chain(s.spring_groups.iter_mut()).chain(s.cable_groups.iter_mut()) {
         resolve_member(&mut g.radius, &mut g.stiffness, &mut g.length, &mut resolve)?;

@@ -312,6 +312,9 @@ pub(super) struct RawMember {
     /// Cables only: the inner nodes a clustered cable runs through from `a` to `b`, in order;
     /// it slides there without friction (one tension in every segment).
     pub(super) through: Option<Spanned<Vec<Spanned<String>>>>,
+    /// Cables only: the Coulomb friction coefficient at each node of `through` (a capstan,
+    /// `sim/capstan.rs`); absent: none.
+    pub(super) friction: Option<Spanned<Vec<Spanned<Num>>>>,
 }
 
 #[derive(Clone, Debug, Deserialize)]

@@ -174,6 +174,11 @@ fn ends(ctx: &Ctx, s: &Structure, m: &RawMember, what: &str) -> Result<(usize, u
             format!("through: only a cable runs through inner nodes, and '{}' is a {what}", m.name.get_ref()),
         ));
     }
+    if let Some(f) = &m.friction {
+        let message =
+            format!("friction: only a cable has friction at inner nodes, and '{}' is a {what}", m.name.get_ref());
+        return Err(ctx.err(f, message));
+    }
     let (a, b) = (node(ctx, s, &m.a)?, node(ctx, s, &m.b)?);
     let l = crate::structure::distance(s.nodes[a].position, s.nodes[b].position);
     if l <= 0.0 {
@@ -227,7 +232,27 @@ fn cable(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Member, ScenarioErro
         Some(v) => positive_value(ctx, v, "length (m)")?,
         None => l,
     };
-    Ok(Member::cable(m.name.get_ref().clone(), path, law, length, tendon_radius(ctx, m)?))
+    let friction = cable_friction(ctx, m, path.len() - 2)?;
+    Ok(Member::cable(m.name.get_ref().clone(), path, law, length, tendon_radius(ctx, m)?).with_friction(friction))
+}
+
+/// `friction`: one finite coefficient >= 0 per inner node of the cable (`inner` of them).
+fn cable_friction(ctx: &Ctx, m: &RawMember, inner: usize) -> Result<Vec<f64>, ScenarioError> {
+    let Some(f) = &m.friction else { return Ok(Vec::new()) };
+    let name = m.name.get_ref();
+    if f.get_ref().len() != inner {
+        let message = format!("friction: cable '{name}' runs through {inner} inner node(s) and friction gives {} coefficient(s): one per node of `through`", f.get_ref().len());
+        return Err(ctx.err(f, message));
+    }
+    let mut out = Vec::new();
+    for mu in f.get_ref() {
+        let x = finite(ctx, mu, "a friction coefficient")?;
+        if x < 0.0 {
+            return Err(ctx.err(mu, format!("a friction coefficient must be >= 0, got {x}")));
+        }
+        out.push(x);
+    }
+    Ok(out)
 }
 
 /// A cable's path, `a`, the nodes it runs `through`, then `b`, and its drawn length: each
@@ -466,6 +491,7 @@ pub(super) fn group_members(ctx: &Ctx, g: &RawMemberGroup) -> Result<Vec<RawMemb
             stiffness: g.stiffness.clone(),
             length: g.length.clone(),
             through: None,
+            friction: None,
         });
     }
     Ok(out)

@@ -151,7 +151,11 @@ impl Data {
             let rb = &self.bodies[m.handles[b]];
             // From the current pose: rapier's cached centre of mass is stale before the first step.
             let com = self.world_com(m, b);
-            let gravity = g * rb.mass() * rb.gravity_scale();
+            // The structure's mass: rapier's is zero until the first step has computed the
+            // bodies' mass properties (measured: a weight on a slide kicked 8.8 mm up by the
+            // first Newton step, which a cable with friction then remembers).
+            let mass = s.bodies[b].inertia.map_or(0.0, |i| i.mass_kg);
+            let gravity = g * mass * rb.gravity_scale();
             let f = rb.user_force() + gravity;
             load.force += motion.rate(com).dot(f) + if revolute { motion.axis.dot(rb.user_torque()) } else { 0.0 };
             // Forces that do not change with the coordinate: gravity and the external loads.
@@ -178,7 +182,8 @@ impl Data {
         for (i, member) in s.members_by_kind() {
             let Some(law) = self.elastic_law(m, i) else { continue };
             let length = self.member_length_m(m, i);
-            for (a, b) in member.segments() {
+            let segment_laws = self.segment_laws(m, i);
+            for (k, (a, b)) in member.segments().enumerate() {
                 let (a_carried, b_carried) = (carried(s.nodes[a].body), carried(s.nodes[b].body));
                 if a_carried == b_carried {
                     continue;
@@ -187,6 +192,8 @@ impl Data {
                 let (px, po) = (Vector::from(self.node_position(m, x)), Vector::from(self.node_position(m, other)));
                 let d = po - px;
                 let l = d.length();
+                // A cable with friction: the segment's own law (held at its node).
+                let (law, length) = segment_laws.as_ref().map_or((law, length), |laws| (laws[k], l));
                 if l <= 0.0 || !law.engaged(length) {
                     continue;
                 }

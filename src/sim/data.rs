@@ -25,6 +25,11 @@ pub(super) struct Data {
     /// Every member's current rest length, member order \[m\]: a spring's, a cable's
     /// unstretched (commanded) length; 0 for a strut.
     pub(super) rest_lengths: Vec<f64>,
+    /// Per member, a cable with friction's share of its unstretched length in each segment
+    /// \[m\] (`capstan.rs`); empty for every other member.
+    pub(super) material: Vec<Vec<f64>>,
+    /// Per member, whether each inner node of a cable with friction is at its bound (slips).
+    pub(super) at_bound: Vec<Vec<bool>>,
     /// Current actuator commands, in actuator order.
     pub(super) commands: Vec<f64>,
     /// External loads [N] and [N m] applied to bodies (probes), world frame, about the body's
@@ -122,6 +127,7 @@ impl Data {
         for (i, a) in m.structure.actuators.iter().enumerate() {
             if let ActuatorTarget::CableLength(c) = a.target {
                 self.rest_lengths[c] = self.commands[i];
+                self.reel(c, self.commands[i]);
                 self.constraint_inputs += 1;
                 if let Some(h) = m.ropes[c] {
                     if let Some(j) = self.impulse_joints.get_mut(h, true) {

@@ -54,10 +54,13 @@ impl Data {
     fn add_member_load(&mut self, m: &Model, i: usize, law: &ElasticLaw) {
         let member = &m.structure.members[i];
         let t = law.tension_n(self.member_length_m(m, i));
-        for (a, b) in member.segments() {
+        let segment_laws = self.segment_laws(m, i);
+        for (k, (a, b)) in member.segments().enumerate() {
             let (pa, pb) = (v(self.node_position(m, a)), v(self.node_position(m, b)));
             let d = pb - pa;
             let l = d.length();
+            // A cable with friction: each segment its own tension (`capstan.rs`).
+            let t = segment_laws.as_ref().map_or(t, |laws| laws[k].tension_n(l));
             if l > 0.0 && t != 0.0 {
                 let f = d / l * t;
                 for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
@@ -145,14 +148,23 @@ impl Data {
         let s = &m.structure;
         let mut wrench: Vec<Wrench> = vec![(Vector::ZERO, Vector::ZERO); s.bodies.len()];
         // Member i at its current length l pulls both ends of every segment with
-        // `tension_at(l)`; returns (l, tension).
-        let mut pull = |i: usize, tension_at: &dyn Fn(f64) -> f64| -> (f64, f64) {
+        // `tension_at(l)` (a cable with friction, each segment with its own law); returns
+        // (l, tension, each segment's tension if it has more than one).
+        let mut pull = |i: usize, tension_at: &dyn Fn(f64) -> f64| -> (f64, f64, Vec<f64>) {
             let l = self.member_length_m(m, i);
-            let tension = tension_at(l);
-            for (a, b) in s.members[i].segments() {
+            let mut tension = tension_at(l);
+            let segment_laws = self.segment_laws(m, i);
+            let mut segments = Vec::new();
+            for (k, (a, b)) in s.members[i].segments().enumerate() {
                 let (pa, pb) = (v(self.node_position(m, a)), v(self.node_position(m, b)));
                 let d = pb - pa;
                 let segment = d.length();
+                if let Some(laws) = &segment_laws {
+                    tension = laws[k].tension_n(segment);
+                }
+                if s.members[i].is_clustered() {
+                    segments.push(tension);
+                }
                 if segment > 0.0 {
                     let f = d / segment * tension;
                     for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
@@ -162,7 +174,7 @@ impl Data {
                     }
                 }
             }
-            (l, tension)
+            (l, tension, segments)
         };
         let count = s.members.len();
         let mut out = MemberForces {
@@ -170,12 +182,14 @@ impl Data {
             length_m: vec![0.0; count],
             rest_length_m: self.rest_lengths.clone(),
             slack: vec![false; count],
+            segment_force_n: vec![Vec::new(); count],
+            at_friction_bound: self.at_bound.clone(),
             ..MemberForces::default()
         };
         let inv_h = m.settings.substeps as f64 / m.settings.dt_s;
         for (i, member) in s.members_by_kind() {
-            let (l, force) = match (member.kind(), self.elastic_law(m, i)) {
-                (MemberKind::Strut, _) => (self.member_length_m(m, i), 0.0),
+            let (l, force, segments) = match (member.kind(), self.elastic_law(m, i)) {
+                (MemberKind::Strut, _) => (self.member_length_m(m, i), 0.0, Vec::new()),
                 (_, Some(law)) => pull(i, &|l| law.tension_n(l)),
                 // Held at its length by the projection: its tension is fitted later.
                 (_, None) if held[i] => pull(i, &|_| 0.0),
@@ -189,7 +203,9 @@ impl Data {
             };
             out.force_n[i] = force;
             out.length_m[i] = l;
-            out.slack[i] = member.kind() == MemberKind::Cable && force <= 0.0;
+            let taut = force > 0.0 || segments.iter().any(|&t| t > 0.0);
+            out.slack[i] = member.kind() == MemberKind::Cable && !taut;
+            out.segment_force_n[i] = segments;
         }
         (out, wrench)
     }

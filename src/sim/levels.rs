@@ -31,6 +31,8 @@ impl Clone for Data {
             soft_bodies: self.soft_bodies.clone(),
             ccd: self.ccd.clone(),
             rest_lengths: self.rest_lengths.clone(),
+            material: self.material.clone(),
+            at_bound: self.at_bound.clone(),
             commands: self.commands.clone(),
             probe_loads: self.probe_loads.clone(),
             tick: self.tick,

@@ -16,6 +16,7 @@
 //!   (implicit, and zero at rest, so it does not move the equilibrium).
 
 mod build;
+mod capstan;
 mod closure_rest;
 mod constrained_modes;
 mod continuation;
@@ -88,6 +89,8 @@ pub struct Model {
     /// Groups of free bodies (plain bodies and multibodies) whose joints and taut cables are
     /// closed by position projection.
     projected_groups: Vec<projection::ProjectedGroup>,
+    /// Whether a cable has friction at a node (`capstan.rs`).
+    has_friction: bool,
     /// For each member: its rope joint if it is an inextensible cable.
     ropes: Vec<Option<ImpulseJointHandle>>,
     /// The joint each body hangs from in the multibody forest (fixed at build).
@@ -271,6 +274,9 @@ impl Simulation {
         if self.relaxation.on {
             self.relaxation.relax(m, d);
             accelerated = true;
+        }
+        if m.has_friction {
+            d.slide_cables(m);
         }
         d.apply_member_forces(m);
         if m.settings.newton_damping && !self.path.physical {

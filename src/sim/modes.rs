@@ -88,6 +88,8 @@ pub enum ModesError {
     JointKind(String),
     #[error("no free body: nothing moves")]
     NoFreeBody,
+    #[error("cable '{0}' has friction at a node: its force depends on the path, not on the state alone, so it has no stiffness to linearise")]
+    Friction(String),
     /// More free bodies than the dense eigenproblem is solved for.
     #[error("{bodies} free bodies: the modes are a dense eigenproblem, solved for at most {MAX_MODAL_FREE_BODIES} free bodies ({} coordinates; 300 had taken 20 s, 1000 more than 2 GiB)", 6 * MAX_MODAL_FREE_BODIES)]
     TooLarge { bodies: usize },
@@ -118,6 +120,9 @@ impl Data {
             return Err(ModesError::NoFreeBody);
         }
         check_modal_size(s)?;
+        if let Some(c) = s.members.iter().find(|c| c.has_friction()) {
+            return Err(ModesError::Friction(c.name.clone()));
+        }
         let inextensible = s.members.iter().any(|c| c.is_inextensible_cable());
         // A free joint of several coordinates (a universal joint: two revolute links and a
         // hidden body, `build.rs`) is charted by its multibody's degrees of freedom there.

@@ -92,6 +92,9 @@ impl Data {
         if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
             return Err(ModesError::NoFreeBody.into());
         }
+        if let Some(c) = s.members.iter().find(|c| c.has_friction()) {
+            return Err(ModesError::Friction(c.name.clone()).into());
+        }
         if let Some(c) = s.members.iter().find(|c| c.is_inextensible_cable()) {
             return Err(SensitivityError::Constrained(format!("the inextensible cable '{}'", c.name)));
         }

@@ -69,11 +69,16 @@ pub struct Member {
     pub law: Law,
     /// Radius of every segment's capsule, for interference checks and drawing \[m\].
     pub radius_m: f64,
+    /// A clustered cable's Coulomb friction coefficient at each inner node, in path order
+    /// (empty: it slides freely everywhere). Where one is above zero the cable is a capstan
+    /// there (`sim/capstan.rs`): the segments on either side hold tensions within
+    /// e^(mu theta) of each other, theta the angle the cable turns through at the node.
+    pub friction: Vec<f64>,
 }
 
 impl Member {
     pub fn strut(name: impl Into<String>, a: NodeId, b: NodeId, radius_m: f64) -> Member {
-        Member { name: name.into(), path: vec![a, b], law: Law::Strut, radius_m }
+        Member { name: name.into(), path: vec![a, b], law: Law::Strut, radius_m, friction: Vec::new() }
     }
 
     pub fn spring(
@@ -83,11 +88,12 @@ impl Member {
         rest_length_m: f64,
         radius_m: f64,
     ) -> Member {
-        Member { name: name.into(), path: vec![a, b], law: Law::Spring { stiffness_n_per_m, rest_length_m }, radius_m }
+        let law = Law::Spring { stiffness_n_per_m, rest_length_m };
+        Member { name: name.into(), path: vec![a, b], law, radius_m, friction: Vec::new() }
     }
 
     pub fn cable(name: impl Into<String>, path: Vec<NodeId>, law: CableLaw, length_m: f64, radius_m: f64) -> Member {
-        Member { name: name.into(), path, law: Law::Cable { law, length_m }, radius_m }
+        Member { name: name.into(), path, law: Law::Cable { law, length_m }, radius_m, friction: Vec::new() }
     }
 
     pub fn kind(&self) -> MemberKind {
@@ -106,6 +112,17 @@ impl Member {
     /// The straight segments of the path, node to node, in order.
     pub fn segments(&self) -> impl Iterator<Item = (NodeId, NodeId)> + '_ {
         self.path.windows(2).map(|w| (w[0], w[1]))
+    }
+
+    /// The same member with Coulomb friction `mu` at its inner nodes (a capstan).
+    pub fn with_friction(mut self, mu: Vec<f64>) -> Member {
+        self.friction = mu;
+        self
+    }
+
+    /// Whether friction holds the cable at any inner node.
+    pub fn has_friction(&self) -> bool {
+        self.friction.iter().any(|&mu| mu > 0.0)
     }
 
     /// Whether the path has inner nodes (a clustered cable).

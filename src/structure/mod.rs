@@ -360,6 +360,20 @@ impl Structure {
                     return Err(invalid(what, &m.name, "stiffness must be a finite number > 0 N/m"));
                 }
             }
+            if !m.friction.is_empty() && m.friction.len() + 2 != m.path.len() {
+                let message = format!(
+                    "friction takes one coefficient per inner node: {} for {}",
+                    m.friction.len(),
+                    m.path.len().saturating_sub(2)
+                );
+                return Err(invalid(what, &m.name, &message));
+            }
+            if m.friction.iter().any(|mu| !(mu.is_finite() && *mu >= 0.0)) {
+                return Err(invalid(what, &m.name, "a friction coefficient must be a finite number >= 0"));
+            }
+            if m.has_friction() && m.kind() != MemberKind::Cable {
+                return Err(invalid(what, &m.name, "only a cable has friction at its inner nodes"));
+            }
             match m.law {
                 Law::Spring { rest_length_m, .. } if !(rest_length_m >= 0.0 && rest_length_m.is_finite()) => {
                     return Err(invalid(what, &m.name, "rest length must be a finite number >= 0 m"))

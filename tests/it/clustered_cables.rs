@@ -95,6 +95,65 @@ stiffness = 100.0
     assert!(pair.contains(&"rope".to_string()) && pair.contains(&"bar".to_string()), "{pair:?}");
 }
 
+const CAPSTAN: &str = "scenarios/custom/capstan.toml";
+
+/// The capstan: a weight on a slide below the node P, the cable turning pi/2 there (mu = 0.3)
+/// and reeled in at W. Where the held tension ratio k L0 (1 / (L - L0 / 2) - 1) / (m g) is
+/// below e^(0.3 pi / 2) the node holds (not reported slipping) and the ratio is that value;
+/// past it P is reported slipping and T_out / T_in = e^(0.3 pi / 2), both within 1e-6 (the
+/// criterion; measured 3e-14). Two points hold and seven slip.
+#[test]
+fn the_capstan_holds_below_e_mu_theta_and_slips_at_it() {
+    let sc = scenario::load(Path::new(CAPSTAN)).unwrap();
+    let r = common::run_file(CAPSTAN);
+    assert!(r.passed, "{:?} {:?}", r.error, r.failures);
+    let (m, g, k, l0) = (sc.params["m"], sc.params["g"], sc.params["k"], sc.params["L0"]);
+    let bound = (0.3 * std::f64::consts::FRAC_PI_2).exp();
+    let mut held = 0;
+    for p in &r.points {
+        let held_ratio = k * l0 * (1.0 / (p.inputs["L"] - l0 / 2.0) - 1.0) / (m * g);
+        let ratio = p.simulated["ratio"];
+        if held_ratio < bound {
+            held += 1;
+            assert!(p.slipping.is_empty(), "L = {}: {:?}", p.inputs["L"], p.slipping);
+            assert!((ratio - held_ratio).abs() <= 1e-6 * held_ratio, "held at {ratio}, expected {held_ratio}");
+        } else {
+            assert_eq!(p.slipping, ["rope at P"], "L = {}", p.inputs["L"]);
+            assert!((ratio - bound).abs() <= 1e-6 * bound, "slipping at {ratio}, bound {bound}");
+        }
+    }
+    assert_eq!((held, r.points.len() - held), (2, 7));
+}
+
+/// A cable with friction has no stiffness to linearise: `modes` refuses it, naming the cable
+/// (exit 2).
+#[test]
+fn the_modes_of_a_cable_with_friction_are_refused() {
+    let (code, _, err) = common::tensegrity(&["modes", CAPSTAN]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("cable 'rope' has friction"), "{err}");
+}
+
+/// Bad friction is located: on a spring, a count that is not one per inner node, a negative
+/// coefficient.
+#[test]
+fn bad_friction_is_located() {
+    let text = std::fs::read_to_string(CAPSTAN).unwrap();
+    let with = |from: &str, to: &str| {
+        assert!(text.contains(from), "{from}");
+        text.replacen(from, to, 1)
+    };
+    let two = with("friction = [\"mu\"]", "friction = [\"mu\", 0.1]");
+    error_at(&two, "friction = [", 11, "one per node of `through`");
+    let negative = with("friction = [\"mu\"]", "friction = [-0.2]");
+    error_at(&negative, "-0.2", 0, "must be >= 0");
+    let spring = with(
+        "[[structure.actuators]]",
+        "[[structure.springs]]\nname = \"s\"\na = \"M\"\nb = \"W\"\nstiffness = 1.0\nfriction = [0.1]\n\n[[structure.actuators]]",
+    );
+    error_at(&spring, "friction = [0.1]", 11, "only a cable has friction");
+}
+
 /// Bad clustered cables are located at the key that is wrong: a strut or a spring with
 /// `through`, an empty `through`, a node twice in a row, an unknown inner node, and a clustered
 /// cable without a stiffness (an inextensible one is not modelled).

@@ -81,7 +81,7 @@ const DENSE_MAX_BODIES: usize = 8;
 /// (no joints, no inextensible cables), and at least one free body.
 pub(super) fn applies(s: &Structure) -> bool {
     s.joints.is_empty()
-        && !s.members.iter().any(|c| c.is_inextensible_cable())
+        && !s.members.iter().any(|c| c.is_inextensible_cable() || c.has_friction())
         && s.bodies.iter().any(|b| b.kind == BodyKind::Free)
 }
 
