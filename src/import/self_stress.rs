@@ -42,35 +42,40 @@ pub fn self_stress(draft: &Draft) -> Option<Vec<f64>> {
         .iter()
         .map(|(n, _)| draft.bodies.iter().any(|b| b.fixed && b.nodes.iter().any(|(m, _)| m == n)) && !on_strut(n))
         .collect();
-    let cables: Vec<(usize, usize)> =
-        draft.cables.iter().map(|c| Some((index(&c.a)?, index(&c.b)?))).collect::<Option<_>>()?;
-    let struts: Vec<(usize, usize)> =
-        draft.struts.iter().map(|s| Some((index(&s.a)?, index(&s.b)?))).collect::<Option<_>>()?;
+    let cables: Vec<Vec<usize>> =
+        draft.cables.iter().map(|c| Some(vec![index(&c.a)?, index(&c.b)?])).collect::<Option<_>>()?;
+    let struts: Vec<Vec<usize>> =
+        draft.struts.iter().map(|s| Some(vec![index(&s.a)?, index(&s.b)?])).collect::<Option<_>>()?;
     let positions: Vec<Vec3> = nodes.iter().map(|(_, p)| *p).collect();
     self_stress_of(&positions, &anchored, &cables, &struts)
 }
 
 /// A drawing's self-stress: node positions \[m\], which nodes are anchored (held, and on no
-/// strut: no row of the equilibrium matrix), the tension members and the struts by their end
-/// nodes. One tension per tension member, the least of them 1 (struts in compression), or None
-/// when no self-stress keeps every tension member in tension.
-pub fn self_stress_of(
+/// strut: no row of the equilibrium matrix), the tension members and the struts by their paths
+/// of nodes. A clustered cable's column is the sum of its segments' (one tension in every
+/// segment: the clustering of Moored and Bruhns). One tension per tension member, the least of
+/// them 1 (struts in compression), or None when no self-stress keeps every tension member in
+/// tension.
+pub fn self_stress_of<P: AsRef<[usize]>>(
     positions: &[Vec3],
     anchored: &[bool],
-    tension: &[(usize, usize)],
-    struts: &[(usize, usize)],
+    tension: &[P],
+    struts: &[P],
 ) -> Option<Vec<f64>> {
     let free: Vec<usize> = (0..positions.len()).filter(|n| !anchored[*n]).collect();
     let row = |n: usize| free.iter().position(|m| *m == n);
-    let members: Vec<(usize, usize)> = tension.iter().chain(struts).copied().collect();
+    let members: Vec<&[usize]> = tension.iter().chain(struts).map(|p| p.as_ref()).collect();
     let mut a = DMatrix::<f64>::zeros(3 * free.len(), members.len());
-    for (j, &(na, nb)) in members.iter().enumerate() {
-        let (pa, pb) = (positions[na], positions[nb]);
-        let l = distance(pa, pb);
-        for (n, sign) in [(na, 1.0), (nb, -1.0)] {
-            if let Some(r) = row(n) {
-                for k in 0..3 {
-                    a[(3 * r + k, j)] += sign * (pb[k] - pa[k]) / l;
+    for (j, path) in members.iter().enumerate() {
+        for segment in path.windows(2) {
+            let (na, nb) = (segment[0], segment[1]);
+            let (pa, pb) = (positions[na], positions[nb]);
+            let l = distance(pa, pb);
+            for (n, sign) in [(na, 1.0), (nb, -1.0)] {
+                if let Some(r) = row(n) {
+                    for k in 0..3 {
+                        a[(3 * r + k, j)] += sign * (pb[k] - pa[k]) / l;
+                    }
                 }
             }
         }

@@ -14,7 +14,7 @@ use super::error::{finite, Ctx, ScenarioError};
 use super::raw::{RawPrestress, RawScenario};
 use crate::mechanisms::Values;
 use crate::settings::{OnLoss, Prestress};
-use crate::structure::{distance, BodyKind, Law, MemberKind, Structure};
+use crate::structure::{BodyKind, Law, MemberKind, Structure};
 use toml::Spanned;
 
 /// The prestress judgement of a scenario: the section's, the default for a custom structure
@@ -76,10 +76,6 @@ pub(super) fn set_self_stress(
     if !(least_n.is_finite() && least_n > 0.0) {
         return Err(ctx.err(t, format!("prestress.least_tension is {least_n} N: a tension is finite and > 0")));
     }
-    if let Some((_, c)) = s.members_of(MemberKind::Cable).find(|(_, c)| c.is_clustered()) {
-        let name = &c.name;
-        return Err(ctx.err(t, format!("prestress.least_tension: cable '{name}' is clustered, and the drawn self-stress is found for straight members only")));
-    }
     let on_strut = |n: usize| s.members_of(MemberKind::Strut).any(|(_, m)| m.path.contains(&n));
     let anchored: Vec<bool> =
         (0..s.nodes.len()).map(|n| s.bodies[s.nodes[n].body].kind == BodyKind::Fixed && !on_strut(n)).collect();
@@ -89,17 +85,16 @@ pub(super) fn set_self_stress(
         .into_iter()
         .flat_map(|k| s.members_of(k).map(|(i, _)| i).collect::<Vec<_>>())
         .collect();
-    let tension: Vec<(usize, usize)> = tensioned.iter().map(|&i| s.members[i].ends()).collect();
-    let struts: Vec<(usize, usize)> = s.members_of(MemberKind::Strut).map(|(_, m)| m.ends()).collect();
+    let tension: Vec<&[usize]> = tensioned.iter().map(|&i| &s.members[i].path[..]).collect();
+    let struts: Vec<&[usize]> = s.members_of(MemberKind::Strut).map(|(_, m)| &m.path[..]).collect();
     let stress = crate::import::self_stress::self_stress_of(&positions, &anchored, &tension, &struts).ok_or_else(|| {
         ctx.err(t, "prestress.least_tension: the drawn structure has no self-stress that keeps every cable and spring in tension (no load-free equilibrium of its members: check the drawing)")
     })?;
     for (&i, share) in tensioned.iter().zip(&stress) {
         let m = &mut s.members[i];
-        let (a, b) = m.ends();
+        let drawn = m.length_at(|n| positions[n]);
         let Some(stiffness_n_per_m) = m.stiffness_n_per_m() else { continue };
-        let rest =
-            rest_length(ctx, t, &m.name, least_n * share, stiffness_n_per_m, distance(positions[a], positions[b]))?;
+        let rest = rest_length(ctx, t, &m.name, least_n * share, stiffness_n_per_m, drawn)?;
         match &mut m.law {
             Law::Cable { length_m, .. } => *length_m = rest,
             Law::Spring { rest_length_m, .. } => *rest_length_m = rest,

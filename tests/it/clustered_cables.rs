@@ -95,6 +95,34 @@ stiffness = 100.0
     assert!(pair.contains(&"rope".to_string()) && pair.contains(&"bar".to_string()), "{pair:?}");
 }
 
+/// `[prestress] least_tension` with a clustered ring: the drawn self-stress is found with the
+/// ring as one member (its column the sum of its three segments'), so the prism whose bottom
+/// ring is one cable gets the plain prism's self-stress: at each of the 8 least tensions the
+/// ring's one tension equals the plain bottom cables' within 1e-9 relative, and the nodes stay
+/// where the plain prism's do within 1e-9 m.
+#[test]
+fn a_clustered_ring_takes_the_drawn_self_stress() {
+    let text = std::fs::read_to_string("scenarios/custom/prism3_prestress_frequencies.toml").unwrap();
+    let statics =
+        format!("{}[expect]{}", &text[..text.find("[motion]").unwrap()], text.split("[expect]").nth(1).unwrap());
+    let start = statics.find("[[structure.cables]]\nname = \"bottom12\"").unwrap();
+    let end = statics.find("[[structure.cables]]\nname = \"top12\"").unwrap();
+    let ring = "[[structure.cables]]\nname = \"bottom\"\na = \"B1\"\nthrough = [\"B2\", \"B3\"]\nb = \"B1\"\nstiffness = \"100/3\"\n\n";
+    let clustered = format!("{}{ring}{}", &statics[..start], &statics[end..]);
+    let run_text = |t: &str| run(&scenario::parse(Path::new("ring.toml"), t).unwrap(), &RunOptions::default());
+    let (plain, ring) = (run_text(&statics), run_text(&clustered));
+    assert!(plain.passed && ring.passed, "{:?} {:?} {:?}", plain.failures, ring.error, ring.failures);
+    assert_eq!((plain.points.len(), ring.points.len()), (8, 8));
+    for (p, c) in plain.points.iter().zip(&ring.points) {
+        let (tp, tc) = (p.simulated["bottom12.force"], c.simulated["bottom.force"]);
+        assert!(((tp - tc) / tp).abs() <= 1e-9, "t0 = {}: ring {tc} N, plain {tp} N", p.inputs["t0"]);
+        for n in ["B2", "B3", "T1", "T2", "T3"] {
+            let d = ["x", "y", "z"].map(|k| p.simulated[&format!("{n}.{k}")] - c.simulated[&format!("{n}.{k}")]);
+            assert!(norm(d) <= 1e-9, "{n}: {d:?}");
+        }
+    }
+}
+
 const CAPSTAN: &str = "scenarios/custom/capstan.toml";
 
 /// The capstan: a weight on a slide below the node P, the cable turning pi/2 there (mu = 0.3)
