@@ -17,7 +17,8 @@ use crate::report::fit::{Combination, FitReport, FitResidual, FittedParameter};
 use crate::report::sensitivity::SensitivityReport;
 use crate::scenario::{Override, Scenario, ScenarioError};
 use nalgebra::{DMatrix, DVector};
-use std::collections::btree_map::{BTreeMap, Entry};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -28,6 +29,12 @@ pub const MAX_ITERATIONS: usize = 50;
 pub const STEP_TOLERANCE: f64 = 1e-10;
 /// Converged when a step lowers chi^2 by less than this fraction of it.
 pub const COST_TOLERANCE: f64 = 1e-14;
+/// Converged when a Gauss-Newton step from the iterate would lower chi^2 by less than this
+/// (times the reduced chi^2 when no row states its sigma): the optimum is then within
+/// sqrt(1e-6) = 1e-3 standard errors of the iterate along every identified direction, and the
+/// Jacobian in hand is the optimum's to that order. Checked before each step, with the
+/// Jacobian the last evaluation gave: it saves the step that would only confirm.
+pub const DECREMENT_TOLERANCE: f64 = 1e-6;
 /// A singular value of the weighted, value-scaled Jacobian below this fraction of the largest
 /// is a direction the data do not identify.
 pub const UNIDENTIFIABLE_RATIO: f64 = 1e-6;
@@ -162,6 +169,10 @@ fn iterate(
             break "chi^2 = 0".to_string();
         }
         let j = weighted(&it.eval.jacobian, weights);
+        let decrement = decrement(&j, &it.r, it.p.as_slice());
+        if decrement <= DECREMENT_TOLERANCE * noise_scale(problem, it.cost) {
+            break format!("the optimum: a Gauss-Newton step would lower chi^2 by {decrement:.1e}");
+        }
         let step = lm_step(&j, &it.r, lambda);
         let trial = bounded(problem, initial, &(&it.p + &step))?;
         let next = match at(&trial) {
@@ -193,6 +204,32 @@ fn iterate(
         }
     };
     Ok((it, iterations, stopped))
+}
+
+/// What chi^2 is measured in: 1 when the rows state their sigmas, the reduced chi^2
+/// `cost` / (rows - parameters) when none does (each row then weighs 1).
+fn noise_scale(problem: &FitProblem, cost: f64) -> f64 {
+    let (m, n) = (problem.measurements.len(), problem.parameters.len());
+    if problem.measurements.iter().all(|x| x.sigma.is_none()) {
+        cost / (m - n) as f64
+    } else {
+        1.0
+    }
+}
+
+/// How much a Gauss-Newton step from here would lower chi^2 (the Newton decrement): the
+/// squared norm of the weighted residuals `r` projected on the identified column space of the
+/// weighted Jacobian `j` (its columns scaled by |p| to tell the identified directions as
+/// [`covariance`] tells them).
+fn decrement(j: &DMatrix<f64>, r: &DVector<f64>, p: &[f64]) -> f64 {
+    let scale = DVector::from_iterator(p.len(), p.iter().map(|&v| if v == 0.0 { 1.0 } else { v.abs() }));
+    let svd = (j * DMatrix::from_diagonal(&scale)).svd(true, false);
+    let u = svd.u.expect("asked for U");
+    let largest = svd.singular_values.max();
+    (0..svd.singular_values.len())
+        .filter(|&k| svd.singular_values[k] > UNIDENTIFIABLE_RATIO * largest)
+        .map(|k| u.column(k).dot(r).powi(2))
+        .sum()
 }
 
 /// The data checked (finite values, positive sigmas given on every row or on none, at least
@@ -347,13 +384,23 @@ fn evaluate(problem: &FitProblem, p: &[f64], cancel: Option<&AtomicBool>) -> Res
     let sc = scenario_at(problem, p)?;
     let file = problem.file.display().to_string();
     let (m, n) = (problem.measurements.len(), problem.parameters.len());
-    let mut reports: BTreeMap<usize, SensitivityReport> = BTreeMap::new();
+    // Each measured point once, settled in parallel (one a core); the first failure in the
+    // data's order is the one reported.
+    let mut first: BTreeMap<usize, &Measurement> = BTreeMap::new();
+    for x in &problem.measurements {
+        first.entry(x.point).or_insert(x);
+    }
+    let settled: Vec<(usize, Result<SensitivityReport, FitError>)> =
+        first.par_iter().map(|(&point, x)| (point, settled_point(&sc, &file, x, p, cancel))).collect();
+    let mut reports: BTreeMap<usize, Result<SensitivityReport, FitError>> = settled.into_iter().collect();
+    if let Some(x) = problem.measurements.iter().find(|x| reports[&x.point].is_err()) {
+        return Err(reports.remove(&x.point).expect("a point settled").expect_err("a failure"));
+    }
+    let reports: BTreeMap<usize, SensitivityReport> =
+        reports.into_iter().map(|(k, r)| (k, r.expect("no failure"))).collect();
     let mut eval = Evaluation { model: DVector::zeros(m), jacobian: DMatrix::zeros(m, n) };
     for (i, x) in problem.measurements.iter().enumerate() {
-        let r = match reports.entry(x.point) {
-            Entry::Occupied(e) => e.into_mut(),
-            Entry::Vacant(e) => e.insert(settled_point(&sc, &file, x, p, cancel)?),
-        };
+        let r = &reports[&x.point];
         let Some(k) = r.outputs.iter().position(|o| o.name == x.output) else {
             let close = close_names(&x.output, r.outputs.iter().map(|o| o.name.as_str()));
             return Err(FitError::BadInput(format!(

@@ -15,6 +15,7 @@ mod dynamic_model;
 mod export_mjcf;
 mod figures;
 mod fit;
+mod fit_prism;
 mod free_spin;
 mod frequency_curves;
 mod frequency_measures;
