@@ -19,6 +19,7 @@ mod fit_prism;
 mod free_spin;
 mod frequency_curves;
 mod frequency_measures;
+mod frequency_slope;
 mod function_length;
 mod furet2018_dynamics;
 mod fuzz_scenarios;
