@@ -526,8 +526,10 @@ fn fit_json(
         None => tensegrity_testbed::input::read_text(Path::new(path), scenario::MAX_SCENARIO_BYTES, false)
             .map_err(|e| PyValueError::new_err(format!("{path}: the scenario file: {e}")))?,
     };
-    let overrides: Vec<Override> =
-        set.iter().map(|s| Override::parse(s).map_err(|e| PyValueError::new_err(e.to_string()))).collect::<PyResult<_>>()?;
+    let overrides: Vec<Override> = set
+        .iter()
+        .map(|s| Override::parse(s).map_err(|e| PyValueError::new_err(e.to_string())))
+        .collect::<PyResult<_>>()?;
     let parameters = params.into_iter().map(|(name, low, high)| FitParameter { name, low, high }).collect();
     let measurements = match data_path {
         Some(d) => run::read_measurements("data", &d, false).map_err(|e| PyValueError::new_err(e.to_string()))?,

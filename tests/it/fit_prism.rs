@@ -22,8 +22,7 @@ const TRUTH: [(&str, f64); 4] = [("k_poly", 150.0), ("k_side", 100.0), ("l_poly"
 const COORDINATES: [&str; 4] = ["B2", "B3", "T2", "T3"];
 const POSITION_SIGMA: f64 = 1e-4;
 /// The cable tensions measured, with this relative standard deviation.
-const CABLES: [&str; 9] =
-    ["bottom12", "bottom23", "bottom31", "top12", "top23", "top31", "side1", "side2", "side3"];
+const CABLES: [&str; 9] = ["bottom12", "bottom23", "bottom31", "top12", "top23", "top31", "side1", "side2", "side3"];
 const TENSION_SIGMA: f64 = 0.01;
 /// The seeds of the coverage experiment: SEEDS of them from SEEDS_FROM (why not from 0: at
 /// the test).
@@ -46,17 +45,19 @@ fn normal(state: &mut u64) -> f64 {
     (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
 }
 
-/// The measured outputs' names, with each one's standard deviation as a function of its true
-/// value.
-fn outputs() -> Vec<(String, Box<dyn Fn(f64) -> f64>)> {
-    let mut out: Vec<(String, Box<dyn Fn(f64) -> f64>)> = Vec::new();
+/// A measured output's standard deviation, given its true value.
+type Sigma = fn(f64) -> f64;
+
+/// The measured outputs' names, each with its standard deviation.
+fn outputs() -> Vec<(String, Sigma)> {
+    let mut out: Vec<(String, Sigma)> = Vec::new();
     for n in COORDINATES {
         for c in ["x", "y", "z"] {
-            out.push((format!("{n}.{c}"), Box::new(|_| POSITION_SIGMA)));
+            out.push((format!("{n}.{c}"), |_| POSITION_SIGMA));
         }
     }
     for c in CABLES {
-        out.push((format!("{c}.force"), Box::new(|t: f64| TENSION_SIGMA * t.abs())));
+        out.push((format!("{c}.force"), |t: f64| TENSION_SIGMA * t.abs()));
     }
     out
 }
@@ -237,7 +238,13 @@ fn prism_mass_and_gravity_are_named_as_the_pair_the_data_cannot_separate() {
     let p = |n: &str| r.parameters.iter().find(|p| p.name == n).expect("fitted");
     assert!(p("m").sigma.is_infinite() && p("g").sigma.is_infinite());
     let k = p("k_poly");
-    assert!(k.sigma.is_finite() && k.low <= 150.0 && 150.0 <= k.high, "k_poly = {} in [{}, {}]", k.value, k.low, k.high);
+    assert!(
+        k.sigma.is_finite() && k.low <= 150.0 && 150.0 <= k.high,
+        "k_poly = {} in [{}, {}]",
+        k.value,
+        k.low,
+        k.high
+    );
     let weight = p("m").value * p("g").value;
     eprintln!("prism weight: m g = {weight} (truth {}), k_poly = {} +- {}", 1.3 * 9.81, k.value, k.sigma);
     assert!((weight / (1.3 * 9.81) - 1.0).abs() <= 1e-3, "m g = {weight}");
