@@ -28,7 +28,7 @@ use std::time::Instant;
 
 pub use fit::{
     fit, measurements_from_csv, parse_parameter, read_measurements, FitError, FitParameter, FitProblem, Measurement,
-    MAX_DATA_BYTES,
+    DATA_COLUMNS, MAX_DATA_BYTES,
 };
 pub use levels::judged_nodes_after;
 pub use point::NO_BRANCH;
