@@ -156,10 +156,10 @@ fn linear_errors(a: &DMatrix<f64>, sigma: &[f64], rows: usize, seed: u64) -> Vec
 /// Why seeds 200 .. 399: the first 200 seeds (0 .. 199) draw a noise whose intervals hold the
 /// truth 732 times in 800 (91.5 %), the fits and the linearised estimator alike; measured over
 /// the 500 blocks, a block of 200 seeds spreads by 0.88 % about 94.99 %, and 5 of the 500 fall
-/// outside 93-97 %, seeds 0 .. 199 the lowest of all (the same lowest, 91.5 %, comes up with the
-/// seeds hashed first: a tail of the draws, not of the generator). The 200 fits of seeds 200 .. 399 hold it 746
-/// times (93.25 %), those of 400 .. 599 772 times (96.5 %): 2250 of 2400 (93.75 %) over the
-/// 600 seeds fitted once.
+/// outside 93-97 %, seeds 0 .. 199 the lowest of all (the same lowest, 91.5 %, comes up with
+/// the seeds hashed first: a tail of the draws, not of the generator). The 200 fits of seeds
+/// 200 .. 399 hold it 746 times (93.25 %), those of 400 .. 599 772 times (96.5 %): 2250 of
+/// 2400 (93.75 %) over the 600 seeds fitted once.
 #[test]
 fn prism_intervals_hold_the_true_parameters_in_95_percent_of_200_noisy_fits() {
     let source = std::fs::read_to_string(PRISM).expect("the prism");
