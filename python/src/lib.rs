@@ -498,6 +498,61 @@ fn sensitivity_json(
     Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))
 }
 
+/// A fitted parameter from Python: (name, low bound, high bound).
+type FitBounds = (String, Option<f64>, Option<f64>);
+/// A measured row from Python: (where it is, for errors; point; output; value; sigma).
+type MeasuredRow = (String, i64, String, f64, Option<f64>);
+
+/// The fit of `tensegrity fit --json` (`run::fit`, the CLI's own function): the scenario at
+/// `path` (or TOML `text` named `path`) with `set`, the parameters `params` within their
+/// bounds, the measurements from the CSV at `data_path` (read as `--data` reads it) or as
+/// `rows`; the same report as its JSON text. Ctrl-C stops the settles.
+#[pyfunction]
+#[pyo3(signature = (path, text=None, set=Vec::new(), params=Vec::new(), data_path=None, rows=Vec::new()))]
+fn fit_json(
+    py: Python<'_>,
+    path: &str,
+    text: Option<&str>,
+    set: Vec<String>,
+    params: Vec<FitBounds>,
+    data_path: Option<PathBuf>,
+    rows: Vec<MeasuredRow>,
+) -> PyResult<String> {
+    use tensegrity_testbed::run::{FitError, FitParameter, FitProblem, Measurement};
+    // The scenario's errors located as every other function's (ScenarioError).
+    load(path, text, &set)?;
+    let source = match text {
+        Some(t) => t.to_string(),
+        None => tensegrity_testbed::input::read_text(Path::new(path), scenario::MAX_SCENARIO_BYTES, false)
+            .map_err(|e| PyValueError::new_err(format!("{path}: the scenario file: {e}")))?,
+    };
+    let overrides: Vec<Override> = set
+        .iter()
+        .map(|s| Override::parse(s).map_err(|e| PyValueError::new_err(e.to_string())))
+        .collect::<PyResult<_>>()?;
+    let parameters = params.into_iter().map(|(name, low, high)| FitParameter { name, low, high }).collect();
+    let measurements = match data_path {
+        Some(d) => run::read_measurements("data", &d, false).map_err(|e| PyValueError::new_err(e.to_string()))?,
+        None => rows
+            .into_iter()
+            .map(|(at, point, output, value, sigma)| {
+                let point = usize::try_from(point).map_err(|_| {
+                    PyValueError::new_err(format!("{at}: point {point} is not a point number (from 0)"))
+                })?;
+                Ok(Measurement { at, point, output, value, sigma })
+            })
+            .collect::<PyResult<_>>()?,
+    };
+    let problem = FitProblem { file: PathBuf::from(path), source, overrides, parameters, measurements };
+    let result = on_own_thread(py, move |cancel| run::fit(&problem, Some(cancel)))?;
+    let report = result.map_err(|e| match e {
+        FitError::Scenario(e) => scenario_error(e),
+        e if e.is_bad_input() => PyValueError::new_err(e.to_string()),
+        e => PyException::new_err(format!("{path}: {e}")),
+    })?;
+    Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))
+}
+
 /// Scenario sections given as a JSON object (`{"motion": {...}, "energy": {...}}`) as TOML
 /// text; a value TOML cannot hold (null, a mixed array) is a ValueError naming it.
 #[pyfunction]
@@ -521,6 +576,7 @@ fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(findings, m)?)?;
     m.add_function(wrap_pyfunction!(modes_json, m)?)?;
     m.add_function(wrap_pyfunction!(sensitivity_json, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_json, m)?)?;
     m.add_function(wrap_pyfunction!(sections_toml, m)?)?;
     m.add_class::<ArrowTable>()?;
     m.add("TestbedError", m.py().get_type::<TestbedError>())?;

@@ -18,7 +18,7 @@ from . import _tensegrity
 
 __all__ = [
     "ScenarioError", "Prediction", "Result", "Solution", "Finding", "Structure",
-    "check", "export_mjcf", "findings", "from_matrices", "from_ntrt", "from_toml", "modes", "run", "sensitivity", "solve",
+    "check", "export_mjcf", "findings", "fit", "from_matrices", "from_ntrt", "from_toml", "modes", "run", "sensitivity", "solve",
     "sweep",
 ]
 
@@ -202,6 +202,94 @@ def sensitivity(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, nam
     computed (the reason named), KeyboardInterrupt on Ctrl-C."""
     path, text = _source(scenario, name)
     return json.loads(_call(_tensegrity.sensitivity_json, path, text, _sets(set), check, point))
+
+
+_FIT_COLUMNS = ("point", "output", "value", "sigma")
+
+
+def _fit_params(params) -> list:
+    """``{"k2": (1.0, 100.0), "b": None, "k1": (None, 80.0)}`` or ``["k2", "b"]`` as (name, low,
+    high) triples; ValueError naming what is wrong."""
+    if isinstance(params, str):
+        params = [params]
+    items = params.items() if isinstance(params, Mapping) else ((p, None) for p in params)
+    out = []
+    for name, bounds in items:
+        if not isinstance(name, str):
+            raise ValueError(f"params: the parameter name {name!r} is not a string")
+        if bounds is None:
+            out.append((name, None, None))
+            continue
+        try:
+            low, high = bounds
+        except (TypeError, ValueError):
+            raise ValueError(f"params[{name!r}] = {bounds!r}: give (low, high), either None, or None") from None
+        for b in (low, high):
+            if b is not None and not isinstance(b, (int, float)):
+                raise ValueError(f"params[{name!r}]: the bound {b!r} is not a number")
+        out.append((name, None if low is None else float(low), None if high is None else float(high)))
+    return out
+
+
+def _fit_rows(data) -> list:
+    """A DataFrame (or anything ``pandas.DataFrame`` takes) with the columns point, output,
+    value and optionally sigma as (where, point, output, value, sigma) rows; a missing sigma
+    (NaN or None) is no sigma, as an empty CSV cell is."""
+    import pandas as pd
+
+    frame = data if isinstance(data, pd.DataFrame) else pd.DataFrame(data)
+    unknown = [c for c in frame.columns if c not in _FIT_COLUMNS]
+    if unknown:
+        raise ValueError(f"data: the column {unknown[0]!r} names nothing: the columns are "
+                         f"{','.join(_FIT_COLUMNS)} (sigma optional)")
+    missing = [c for c in _FIT_COLUMNS[:3] if c not in frame.columns]
+    if missing:
+        raise ValueError(f"data: no column {missing[0]!r} (the columns are {','.join(_FIT_COLUMNS)}, sigma optional)")
+    rows = []
+    for index, row in zip(frame.index, frame.itertuples(index=False)):
+        at = f"data[{index}]"
+        point = row.point
+        if isinstance(point, float) and point.is_integer():
+            point = int(point)
+        if isinstance(point, bool) or not hasattr(point, "__index__"):
+            raise ValueError(f"{at}: point {point!r} is not a point number (from 0)")
+        try:
+            value = float(row.value)
+        except (TypeError, ValueError):
+            raise ValueError(f"{at}: value {row.value!r} is not a number") from None
+        sigma = getattr(row, "sigma", None)
+        if sigma is not None:
+            try:
+                sigma = float(sigma)
+            except (TypeError, ValueError):
+                raise ValueError(f"{at}: sigma {sigma!r} is not a number") from None
+            if sigma != sigma:  # NaN: no sigma, as an empty cell of the CSV
+                sigma = None
+        rows.append((at, int(point), str(row.output), value, sigma))
+    return rows
+
+
+def fit(scenario: Scenario, data, params, set: Optional[Mapping[str, Any]] = None,
+        name: str = "<string>.toml") -> dict:
+    """Parameters of a scenario fitted to measured outputs, as ``tensegrity fit`` fits them (the
+    same Rust function): the report of ``tensegrity fit --json`` as a dict (``parameters``: each
+    ``name``, ``initial``, ``value``, ``sigma`` and 95 % interval ``low``, ``high``;
+    ``covariance``, an infinite entry None; ``residuals``; ``chi2``; ``unidentifiable``: the
+    combinations the data cannot separate, as (name, weight) pairs; ``wall_s``).
+
+    ``data``: a CSV path (read as ``--data`` reads it) or a pandas DataFrame with the columns
+    point (from 0), output (as ``tensegrity sensitivity`` names them), value and optionally
+    sigma. ``params``: ``{name: (low, high)}`` (either bound None) or ``{name: None}``, or a list
+    of names. ``set``: the CLI's ``--set``. Raises ScenarioError on a bad scenario, ValueError on
+    bad data or parameters (the row or name said; a parameter the fit ran into its bound or away
+    with named), Exception when a settle fails (the point named), KeyboardInterrupt on Ctrl-C.
+    """
+    path, text = _source(scenario, name)
+    bounds = _fit_params(params)
+    if isinstance(data, (str, os.PathLike)):
+        return json.loads(_call(_tensegrity.fit_json, path, text, _sets(set), bounds, os.fspath(data), []))
+    rows = _fit_rows(data)
+    return json.loads(_call(_tensegrity.fit_json, path, text, _sets(set), bounds, None, rows))
 
 
 class Structure:

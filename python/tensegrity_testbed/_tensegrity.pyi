@@ -99,6 +99,12 @@ def sensitivity_json(path: str, text: Optional[str] = None, set: Sequence[str] =
     """The sensitivities of ``tensegrity sensitivity --json`` (``--check`` with ``check``, at
     ``--point point``), as its JSON text."""
 
+def fit_json(path: str, text: Optional[str] = None, set: Sequence[str] = ...,
+             params: Sequence[Tuple[str, Optional[float], Optional[float]]] = ..., data_path: Optional[_Path] = None,
+             rows: Sequence[Tuple[str, int, str, float, Optional[float]]] = ...) -> str:
+    """The fit of ``tensegrity fit --json`` (parameters as (name, low, high), the data from the
+    CSV at ``data_path`` or as (where, point, output, value, sigma) rows), as its JSON text."""
+
 def sections_toml(json: str) -> str:
     """Scenario sections given as a JSON object, as TOML text."""
 

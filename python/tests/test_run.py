@@ -649,3 +649,70 @@ def test_a_prediction_of_an_unknown_quantity_raises():
     the run (it had run and reported max_error null)."""
     with pytest.raises(ValueError, match="no quantity 'nope'"):
         tt.run(SWEEP, model=bar_model, predictions=[tt.Prediction("q_py", "nope", "angle", 1e-9)])
+
+
+SWEPT_BAR = ROOT / "scenarios" / "custom" / "pinned_bar_sweep.toml"
+ANGLES = ROOT / "tests" / "fixtures" / "fit" / "pinned_bar_angles.csv"
+
+
+def test_fit_from_python_is_the_clis_fit_json():
+    """tt.fit is `tensegrity fit --json`: every field equal (floats bit for bit), the wall time
+    aside, with the data as the CSV's path and as a pandas DataFrame read from it; the estimate
+    of k2 (truth 33 N/m, the file's 30 the start) holds the truth in its 95 % interval, within
+    0.01 N/m."""
+    import pandas as pd
+
+    cli = cli_json("fit", SWEPT_BAR, "--data", str(ANGLES), "--param", "k2=1:100")
+    by_path = tt.fit(str(SWEPT_BAR), ANGLES, {"k2": (1.0, 100.0)})
+    by_frame = tt.fit(str(SWEPT_BAR), pd.read_csv(ANGLES), {"k2": (1, 100)})
+    for r in (cli, by_path, by_frame):
+        assert r.pop("wall_s") > 0.0
+    assert by_path == cli and by_frame == cli
+    k2 = cli["parameters"][0]
+    assert k2["name"] == "k2" and k2["low"] <= 33.0 <= k2["high"] and abs(k2["value"] - 33.0) <= 0.01
+
+
+def test_fit_from_python_names_the_unidentifiable_pair_as_the_cli_does():
+    """k2 and b from the angle atan2(k1 a, k2 b) alone: the one combination names both, with
+    weights of magnitude 1/sqrt(2) within 1e-6, both intervals infinite (None, as in the CLI's
+    JSON), and the report the CLI's."""
+    cli = cli_json("fit", SWEPT_BAR, "--data", str(ANGLES), "--param", "k2", "--param", "b")
+    py = tt.fit(str(SWEPT_BAR), ANGLES, ["k2", "b"])
+    py.pop("wall_s"), cli.pop("wall_s")
+    assert py == cli
+    (combination,) = py["unidentifiable"]
+    assert sorted(n for n, _ in combination["weights"]) == ["b", "k2"]
+    assert all(abs(abs(w) - math.sqrt(0.5)) <= 1e-6 for _, w in combination["weights"])
+    # JSON has no infinity: the CLI's JSON and the dict both hold None there.
+    assert py["covariance"][0][0] is None and py["parameters"][0]["sigma"] is None and py["parameters"][0]["high"] is None
+
+
+def test_bad_fit_input_raises_a_clear_python_exception():
+    """An unknown parameter (its close names listed), a NaN in the data (its row named), a
+    column that names nothing, a negative point, bounds that are not a pair, mixed sigmas, and a
+    bound the fit runs into: each a ValueError saying what, none a crash."""
+    import pandas as pd
+
+    frame = pd.read_csv(ANGLES)
+    with pytest.raises(ValueError, match=r"no parameter 'k3', close names: .*k2"):
+        tt.fit(str(SWEPT_BAR), frame, ["k3"])
+    nan = frame.copy()
+    nan.loc[4, "value"] = float("nan")
+    with pytest.raises(ValueError, match=r"data\[4\]: the measured value of q is NaN \(not a finite number\)"):
+        tt.fit(str(SWEPT_BAR), nan, ["k2"])
+    with pytest.raises(ValueError, match=r"the column 'valeu' names nothing"):
+        tt.fit(str(SWEPT_BAR), frame.rename(columns={"value": "valeu"}), ["k2"])
+    negative = frame.copy()
+    negative.loc[0, "point"] = -1
+    with pytest.raises(ValueError, match=r"data\[0\]: point -1 is not a point number"):
+        tt.fit(str(SWEPT_BAR), negative, ["k2"])
+    with pytest.raises(ValueError, match=r"params\['k2'\] = 3.0: give \(low, high\)"):
+        tt.fit(str(SWEPT_BAR), frame, {"k2": 3.0})
+    mixed = frame.copy()
+    mixed.loc[2, "sigma"] = float("nan")
+    with pytest.raises(ValueError, match=r"data\[2\]: no sigma for q, where other rows state one"):
+        tt.fit(str(SWEPT_BAR), mixed, ["k2"])
+    with pytest.raises(ValueError, match=r"k2 ran into its bound 31"):
+        tt.fit(str(SWEPT_BAR), frame, {"k2": (1.0, 31.0)})
+    with pytest.raises(ValueError, match=r"has no parameter 'k3'"):
+        tt.fit(str(SWEPT_BAR), ANGLES, {"k3": None})

@@ -30,6 +30,8 @@ pub struct FitReport {
     pub stopped: String,
     /// The directions in parameter space the data do not see.
     pub unidentifiable: Vec<Combination>,
+    /// The fit's wall time \[s\] (every settle and sensitivity of every step).
+    pub wall_s: f64,
 }
 
 /// A fitted parameter.
@@ -93,8 +95,8 @@ impl FitReport {
         }
         let scaled = if self.covariance_scaled { ", covariance scaled by the reduced chi^2 (no sigmas)" } else { "" };
         s += &format!(
-            "chi^2 = {:.6e} over {} degrees of freedom{scaled}; {} iterations ({})\n",
-            self.chi2, self.degrees_of_freedom, self.iterations, self.stopped
+            "chi^2 = {:.6e} over {} degrees of freedom{scaled}; {} iterations ({}) in {:.3} s\n",
+            self.chi2, self.degrees_of_freedom, self.iterations, self.stopped, self.wall_s
         );
         s += &format!("{:>5} {:<20} {:>14} {:>14} {:>10}\n", "point", "output", "measured", "model", "weighted");
         for r in &self.residuals {

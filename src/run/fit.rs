@@ -17,9 +17,11 @@ use crate::report::fit::{Combination, FitReport, FitResidual, FittedParameter};
 use crate::report::sensitivity::SensitivityReport;
 use crate::scenario::{Override, Scenario, ScenarioError};
 use nalgebra::{DMatrix, DVector};
-use std::collections::btree_map::{BTreeMap, Entry};
-use std::path::PathBuf;
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 
 /// Levenberg-Marquardt iterations (accepted steps) at most.
 pub const MAX_ITERATIONS: usize = 50;
@@ -27,6 +29,12 @@ pub const MAX_ITERATIONS: usize = 50;
 pub const STEP_TOLERANCE: f64 = 1e-10;
 /// Converged when a step lowers chi^2 by less than this fraction of it.
 pub const COST_TOLERANCE: f64 = 1e-14;
+/// Converged when a Gauss-Newton step from the iterate would lower chi^2 by less than this
+/// (times the reduced chi^2 when no row states its sigma): the optimum is then within
+/// sqrt(1e-6) = 1e-3 standard errors of the iterate along every identified direction, and the
+/// Jacobian in hand is the optimum's to that order. Checked before each step, with the
+/// Jacobian the last evaluation gave: it saves the step that would only confirm.
+pub const DECREMENT_TOLERANCE: f64 = 1e-6;
 /// A singular value of the weighted, value-scaled Jacobian below this fraction of the largest
 /// is a direction the data do not identify.
 pub const UNIDENTIFIABLE_RATIO: f64 = 1e-6;
@@ -120,13 +128,16 @@ struct Iterate {
 /// Fits `problem` (see the module): the estimates, covariance, intervals, residuals and
 /// unidentifiable combinations; stopped by `cancel`.
 pub fn fit(problem: &FitProblem, cancel: Option<&AtomicBool>) -> Result<FitReport, FitError> {
+    let start = Instant::now();
     let weights = validate(problem)?;
     let sc = crate::scenario::parse_with(&problem.file, &problem.source, &problem.overrides)?;
     let initial = initial_values(problem, &sc)?;
     let cancelled = || cancel.is_some_and(|c| c.load(Ordering::SeqCst));
     let model = &mut |p: &[f64]| evaluate(problem, p, cancel);
     let (it, iterations, stopped) = iterate(problem, &initial, &weights, model, &cancelled)?;
-    Ok(report(problem, &sc.name, &initial, &it, &weights, iterations, stopped))
+    let mut report = report(problem, &sc.name, &initial, &it, &weights, iterations, stopped);
+    report.wall_s = start.elapsed().as_secs_f64();
+    Ok(report)
 }
 
 /// The model's outputs and Jacobian at the parameters.
@@ -158,6 +169,10 @@ fn iterate(
             break "chi^2 = 0".to_string();
         }
         let j = weighted(&it.eval.jacobian, weights);
+        let decrement = decrement(&j, &it.r, it.p.as_slice());
+        if decrement <= DECREMENT_TOLERANCE * noise_scale(problem, it.cost) {
+            break format!("the optimum: a Gauss-Newton step would lower chi^2 by {decrement:.1e}");
+        }
         let step = lm_step(&j, &it.r, lambda);
         let trial = bounded(problem, initial, &(&it.p + &step))?;
         let next = match at(&trial) {
@@ -191,6 +206,32 @@ fn iterate(
     Ok((it, iterations, stopped))
 }
 
+/// What chi^2 is measured in: 1 when the rows state their sigmas, the reduced chi^2
+/// `cost` / (rows - parameters) when none does (each row then weighs 1).
+fn noise_scale(problem: &FitProblem, cost: f64) -> f64 {
+    let (m, n) = (problem.measurements.len(), problem.parameters.len());
+    if problem.measurements.iter().all(|x| x.sigma.is_none()) {
+        cost / (m - n) as f64
+    } else {
+        1.0
+    }
+}
+
+/// How much a Gauss-Newton step from here would lower chi^2 (the Newton decrement): the
+/// squared norm of the weighted residuals `r` projected on the identified column space of the
+/// weighted Jacobian `j` (its columns scaled by |p| to tell the identified directions as
+/// [`covariance`] tells them).
+fn decrement(j: &DMatrix<f64>, r: &DVector<f64>, p: &[f64]) -> f64 {
+    let scale = DVector::from_iterator(p.len(), p.iter().map(|&v| if v == 0.0 { 1.0 } else { v.abs() }));
+    let svd = (j * DMatrix::from_diagonal(&scale)).svd(true, false);
+    let u = svd.u.expect("asked for U");
+    let largest = svd.singular_values.max();
+    (0..svd.singular_values.len())
+        .filter(|&k| svd.singular_values[k] > UNIDENTIFIABLE_RATIO * largest)
+        .map(|k| u.column(k).dot(r).powi(2))
+        .sum()
+}
+
 /// The data checked (finite values, positive sigmas given on every row or on none, at least
 /// as many rows as parameters, each parameter once), and each row's weight 1/sigma.
 fn validate(problem: &FitProblem) -> Result<DVector<f64>, FitError> {
@@ -202,6 +243,9 @@ fn validate(problem: &FitProblem) -> Result<DVector<f64>, FitError> {
     for (k, f) in problem.parameters.iter().enumerate() {
         if problem.parameters[..k].iter().any(|g| g.name == f.name) {
             return bad(format!("--param {}: named twice", f.name));
+        }
+        if let Some(v) = [f.low, f.high].into_iter().flatten().find(|v| !v.is_finite()) {
+            return bad(format!("--param {}: the bound {v} is not a finite number", f.name));
         }
         if let (Some(lo), Some(hi)) = (f.low, f.high) {
             if lo >= hi {
@@ -340,13 +384,23 @@ fn evaluate(problem: &FitProblem, p: &[f64], cancel: Option<&AtomicBool>) -> Res
     let sc = scenario_at(problem, p)?;
     let file = problem.file.display().to_string();
     let (m, n) = (problem.measurements.len(), problem.parameters.len());
-    let mut reports: BTreeMap<usize, SensitivityReport> = BTreeMap::new();
+    // Each measured point once, settled in parallel (one a core); the first failure in the
+    // data's order is the one reported.
+    let mut first: BTreeMap<usize, &Measurement> = BTreeMap::new();
+    for x in &problem.measurements {
+        first.entry(x.point).or_insert(x);
+    }
+    let settled: Vec<(usize, Result<SensitivityReport, FitError>)> =
+        first.par_iter().map(|(&point, x)| (point, settled_point(&sc, &file, x, p, cancel))).collect();
+    let mut reports: BTreeMap<usize, Result<SensitivityReport, FitError>> = settled.into_iter().collect();
+    if let Some(x) = problem.measurements.iter().find(|x| reports[&x.point].is_err()) {
+        return Err(reports.remove(&x.point).expect("a point settled").expect_err("a failure"));
+    }
+    let reports: BTreeMap<usize, SensitivityReport> =
+        reports.into_iter().map(|(k, r)| (k, r.expect("no failure"))).collect();
     let mut eval = Evaluation { model: DVector::zeros(m), jacobian: DMatrix::zeros(m, n) };
     for (i, x) in problem.measurements.iter().enumerate() {
-        let r = match reports.entry(x.point) {
-            Entry::Occupied(e) => e.into_mut(),
-            Entry::Vacant(e) => e.insert(settled_point(&sc, &file, x, p, cancel)?),
-        };
+        let r = &reports[&x.point];
         let Some(k) = r.outputs.iter().position(|o| o.name == x.output) else {
             let close = close_names(&x.output, r.outputs.iter().map(|o| o.name.as_str()));
             return Err(FitError::BadInput(format!(
@@ -448,6 +502,7 @@ fn report(
         iterations,
         stopped,
         unidentifiable,
+        wall_s: 0.0,
     }
 }
 
@@ -482,6 +537,108 @@ fn covariance(j: &DMatrix<f64>, p: &[f64], names: &[String], factor: f64) -> (DM
         cov.column_mut(q).fill(f64::INFINITY);
     }
     (cov, combinations)
+}
+
+/// Largest measurement file read \[bytes\].
+pub const MAX_DATA_BYTES: u64 = 16 << 20;
+/// The data's columns, the last one optional.
+pub const DATA_COLUMNS: [&str; 4] = ["point", "output", "value", "sigma"];
+
+/// `NAME`, `NAME=LOW:HIGH`, `NAME=LOW:` or `NAME=:HIGH` (the CLI's `--param`) as a parameter
+/// to fit.
+pub fn parse_parameter(flag: &str) -> Result<FitParameter, FitError> {
+    let (name, bounds) = flag.split_once('=').map_or((flag, None), |(n, b)| (n, Some(b)));
+    let bad = |why: &str| {
+        FitError::BadInput(format!("--param {flag}: {why} (NAME, or NAME=LOW:HIGH with either bound left out)"))
+    };
+    if name.trim().is_empty() {
+        return Err(bad("no parameter name"));
+    }
+    let Some(bounds) = bounds else {
+        return Ok(FitParameter { name: name.trim().to_string(), low: None, high: None });
+    };
+    let (lo, hi) = bounds.split_once(':').ok_or_else(|| bad("the bounds are LOW:HIGH"))?;
+    let number = |s: &str| -> Result<Option<f64>, FitError> {
+        if s.trim().is_empty() {
+            return Ok(None);
+        }
+        match s.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(Some(v)),
+            _ => Err(bad(&format!("the bound '{s}' is not a finite number"))),
+        }
+    };
+    Ok(FitParameter { name: name.trim().to_string(), low: number(lo)?, high: number(hi)? })
+}
+
+/// The measurements of the CSV file `path` (at most [`MAX_DATA_BYTES`]; `-` is standard
+/// input when `stdin` allows it), as [`measurements_from_csv`] reads them; `what` names the
+/// file in an error it cannot be read with (`--data`, `data`).
+pub fn read_measurements(what: &str, path: &Path, stdin: bool) -> Result<Vec<Measurement>, FitError> {
+    let text = crate::input::read_text(path, MAX_DATA_BYTES, stdin)
+        .map_err(|e| FitError::BadInput(format!("{what} {}: {e}", path.display())))?;
+    measurements_from_csv(&path.display().to_string(), &text)
+}
+
+/// The measurements of a CSV with a header naming [`DATA_COLUMNS`] (sigma optional, in any
+/// order), each row's errors at `file:LINE:COL`.
+pub fn measurements_from_csv(file: &str, text: &str) -> Result<Vec<Measurement>, FitError> {
+    let bad = |s: String| FitError::BadInput(s);
+    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+    let Some((_, header)) = lines.next() else {
+        return Err(bad(format!("{file}:1:1: no header: the columns are {}", DATA_COLUMNS.join(","))));
+    };
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    let mut index = [None; 4];
+    for (k, name) in names.iter().enumerate() {
+        let Some(c) = DATA_COLUMNS.iter().position(|c| c == name) else {
+            return Err(bad(format!(
+                "{file}:1:{}: the column '{name}' names nothing: the columns are {} (sigma optional)",
+                column_at(header, k),
+                DATA_COLUMNS.join(",")
+            )));
+        };
+        index[c] = Some(k);
+    }
+    if let Some(c) = (0..3).find(|&c| index[c].is_none()) {
+        return Err(bad(format!("{file}:1:1: no column '{}' in the header '{header}'", DATA_COLUMNS[c])));
+    }
+    let mut rows = Vec::new();
+    for (n, line) in lines {
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        if cells.len() != names.len() {
+            let what = format!("{} cells where the header has {}", cells.len(), names.len());
+            return Err(bad(format!("{file}:{}:1: {what}", n + 1)));
+        }
+        let at = |c: usize| {
+            (
+                cells[index[c].expect("checked")],
+                format!("{file}:{}:{}", n + 1, column_at(line, index[c].expect("checked"))),
+            )
+        };
+        let number = |c: usize| -> Result<f64, FitError> {
+            let (cell, at) = at(c);
+            cell.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| bad(format!("{at}: {} '{cell}' is not a finite number", DATA_COLUMNS[c])))
+        };
+        let (point_cell, point_at) = at(0);
+        let point = point_cell
+            .parse::<usize>()
+            .map_err(|_| bad(format!("{point_at}: point '{point_cell}' is not a point number (from 0)")))?;
+        let sigma = match index[3] {
+            Some(k) if !cells[k].is_empty() => Some(number(3)?),
+            _ => None,
+        };
+        let output = at(1).0.to_string();
+        rows.push(Measurement { at: format!("{file}:{}", n + 1), point, output, value: number(2)?, sigma });
+    }
+    Ok(rows)
+}
+
+/// The column (from 1) where cell `k` of a comma-separated `line` starts.
+fn column_at(line: &str, k: usize) -> usize {
+    line.match_indices(',').nth(k.wrapping_sub(1)).map_or(1, |(i, _)| i + 2)
 }
 
 /// The names of `known` within [`CLOSE_EDITS`] edits of `name` (or sharing its part before

@@ -26,7 +26,10 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use fit::{fit, FitError, FitParameter, FitProblem, Measurement};
+pub use fit::{
+    fit, measurements_from_csv, parse_parameter, read_measurements, FitError, FitParameter, FitProblem, Measurement,
+    DATA_COLUMNS, MAX_DATA_BYTES,
+};
 pub use levels::judged_nodes_after;
 pub use point::NO_BRANCH;
 pub use sensitivity::{point_of as sensitivity_point_of, sensitivity, SensitivityRunError};

@@ -217,3 +217,23 @@ fn fit_command_writes_the_estimate_and_its_interval_as_json() {
     assert!(lo <= 33.0 && 33.0 <= hi && (v - 33.0).abs() <= 0.05, "{v} in [{lo}, {hi}]");
     assert!(stderr.contains("k2"), "the table on standard error");
 }
+
+/// Angles the pinned bar cannot reach (q = -0.01 rad at every k1, where atan2(k1 a, k2 b) > 0
+/// for every k2 > 0) pull an unbounded k2 towards infinity, each step about doubling it: the fit
+/// stops once it is more than 1e6 times its initial 30 N/m away (above 3.0e7 N/m), exit 2,
+/// naming k2, where it went and the flag that bounds it; no panic, no settle of a runaway
+/// spring.
+#[test]
+fn a_parameter_without_bounds_that_runs_away_is_stopped_and_named() {
+    let mut csv = "point,output,value,sigma\n".to_string();
+    for i in 0..9 {
+        csv += &format!("{i},q,-0.01,{SIGMA}\n");
+    }
+    let (code, stderr) = fit_cli("runaway.csv", &csv, &["--param", "k2"]);
+    assert_eq!(code, 2, "{stderr}");
+    let said = "k2 ran away from 30 to ";
+    let at = stderr.find(said).unwrap_or_else(|| panic!("'{said}' not in {stderr}"));
+    let to: f64 = stderr[at + said.len()..].split(':').next().and_then(|v| v.trim().parse().ok()).expect("a number");
+    assert!(to > 30.0 + 1e6 * 30.0 && to.is_finite(), "stopped at {to}");
+    assert!(stderr.contains("--param k2=LOW:HIGH") && !stderr.contains("panicked"), "{stderr}");
+}
