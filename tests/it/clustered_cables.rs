@@ -153,6 +153,23 @@ fn the_capstan_holds_below_e_mu_theta_and_slips_at_it() {
     assert_eq!((held, r.points.len() - held), (2, 7));
 }
 
+/// The per-tick table carries each segment's tension and each inner node's slip: on the
+/// capstan's last row the segment beyond P holds e^(0.3 pi / 2) times the one below it within
+/// 1e-9, P slips (1), and the cable's own column is its last segment's.
+#[test]
+fn the_table_has_every_segment_and_the_slip() {
+    let text = std::fs::read_to_string(CAPSTAN).unwrap();
+    let (_, header, columns) = common::table(&text, "capstan");
+    let column = |name: &str| &columns[header.iter().position(|h| h == name).unwrap_or_else(|| panic!("{name}"))];
+    let last = |name: &str| *column(name).last().unwrap();
+    let (below, beyond) = (last("cable:rope.segment_1.tension_n"), last("cable:rope.segment_2.tension_n"));
+    let bound = (0.3 * std::f64::consts::FRAC_PI_2).exp();
+    assert!((beyond / below - bound).abs() <= 1e-9 * bound, "{beyond} / {below}");
+    assert_eq!(last("cable:rope.slip_1"), 1.0);
+    assert_eq!(last("cable:rope.tension_n"), beyond);
+    assert_eq!(column("cable:rope.slip_1")[0], 0.0, "P holds at the drawn state");
+}
+
 /// A cable with friction has no stiffness to linearise: `modes` refuses it, naming the cable
 /// (exit 2).
 #[test]
