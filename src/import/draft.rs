@@ -230,6 +230,26 @@ impl Draft {
 
     /// The scenario file: name, description, settings, one point, the structure; an error when
     /// a number of it would not be finite.
+    /// A cable's (or a spring's) table, with its drawn length as a comment.
+    fn write_cable(&self, t: &mut String, c: &DraftCable) -> Result<(), DraftError> {
+        let drawn = match self.drawn_length(c) {
+            Some(l) => format!("  # drawn {} m", num(l, &format!("cable {}", c.name))?),
+            None => String::new(),
+        };
+        let table = if c.tension_only { "cables" } else { "springs" };
+        let (name, a, b) = (quote(&c.name), quote(&c.a), quote(&c.b));
+        let _ = writeln!(t, "\n[[structure.{table}]]\nname = {name}\na = {a}\nb = {b}");
+        if !c.through.is_empty() {
+            let inner: Vec<String> = c.through.iter().map(|n| quote(n)).collect();
+            let _ = writeln!(t, "through = [{}]", inner.join(", "));
+        }
+        if let Some(k) = c.stiffness_n_per_m {
+            let _ = writeln!(t, "stiffness = {}", num(k, &format!("the stiffness of cable {}", c.name))?);
+        }
+        let _ = writeln!(t, "length = {}{drawn}", num(c.length_m, &format!("the length of cable {}", c.name))?);
+        Ok(())
+    }
+
     pub fn to_toml(&self) -> Result<String, DraftError> {
         let mut t = String::new();
         let _ = writeln!(t, "name = {}", quote(&self.name));
@@ -262,26 +282,7 @@ impl Draft {
             );
         }
         for c in &self.cables {
-            let drawn = match self.drawn_length(c) {
-                Some(l) => format!("  # drawn {} m", num(l, &format!("cable {}", c.name))?),
-                None => String::new(),
-            };
-            let table = if c.tension_only { "cables" } else { "springs" };
-            let _ = writeln!(
-                t,
-                "\n[[structure.{table}]]\nname = {}\na = {}\nb = {}",
-                quote(&c.name),
-                quote(&c.a),
-                quote(&c.b)
-            );
-            if !c.through.is_empty() {
-                let inner: Vec<String> = c.through.iter().map(|n| quote(n)).collect();
-                let _ = writeln!(t, "through = [{}]", inner.join(", "));
-            }
-            if let Some(k) = c.stiffness_n_per_m {
-                let _ = writeln!(t, "stiffness = {}", num(k, &format!("the stiffness of cable {}", c.name))?);
-            }
-            let _ = writeln!(t, "length = {}{drawn}", num(c.length_m, &format!("the length of cable {}", c.name))?);
+            self.write_cable(&mut t, c)?;
         }
         for j in &self.joints {
             let kind = if j.axis.is_some() { "revolute" } else { "spherical" };
