@@ -123,6 +123,27 @@ fn a_clustered_ring_takes_the_drawn_self_stress() {
     }
 }
 
+/// The sensitivities read a clustered cable through its one law: the ring's angle moves with
+/// the cable's rest length as the implicit equilibrium d / sin(theta) = L0 + m g / (2 k
+/// cos(theta)) says, d theta / d L0 = -1 / (d cos / sin^2 + m g sin / (2 k cos^2)), within 1e-8
+/// relative (both segments' angles; measured 2.1e-9 and 6.0e-9, the parameter derivative of the
+/// forces being a difference), and within 1e-6 of central differences of settles.
+#[test]
+fn the_rings_angle_moves_with_the_rest_length_as_the_implicit_equilibrium_says() {
+    let sc = scenario::load(Path::new(RING)).unwrap();
+    let r = tensegrity_testbed::run::sensitivity(&sc, RING, 0, true, None).expect("sensitivities");
+    let (d, m, g, k, theta) = (sc.params["d"], sc.params["m"], sc.params["g"], sc.params["k"], sc.params["theta_s"]);
+    let (s, c) = theta.sin_cos();
+    let closed = -1.0 / (d * c / (s * s) + m * g * s / (2.0 * k * c * c));
+    let p = r.parameters.iter().find(|p| p.name == "L0").expect("L0");
+    for output in ["theta_A", "theta_B"] {
+        let i = r.outputs.iter().position(|o| o.name == output).unwrap();
+        let (ift, settles) = (p.derivatives[i], p.check.as_ref().expect("checked")[i]);
+        assert!(((ift - closed) / closed).abs() <= 1e-8, "{output}: {ift} against {closed}");
+        assert!(((ift - settles) / settles).abs() <= 1e-6, "{output}: {ift} against settles {settles}");
+    }
+}
+
 const CAPSTAN: &str = "scenarios/custom/capstan.toml";
 
 /// The capstan: a weight on a slide below the node P, the cable turning pi/2 there (mu = 0.3)
