@@ -201,7 +201,7 @@ fn the_modes_of_a_cable_with_friction_are_refused() {
 }
 
 /// Bad friction is located: on a spring, a count that is not one per inner node, a negative
-/// coefficient.
+/// or non-finite coefficient.
 #[test]
 fn bad_friction_is_located() {
     let text = std::fs::read_to_string(CAPSTAN).unwrap();
@@ -213,6 +213,8 @@ fn bad_friction_is_located() {
     error_at(&two, "friction = [", 11, "one per node of `through`");
     let negative = with("friction = [\"mu\"]", "friction = [-0.2]");
     error_at(&negative, "-0.2", 0, "must be >= 0");
+    let not_a_number = with("friction = [\"mu\"]", "friction = [nan]");
+    error_at(&not_a_number, "nan]", 0, "must be a finite number");
     let spring = with(
         "[[structure.actuators]]",
         "[[structure.springs]]\nname = \"s\"\na = \"M\"\nb = \"W\"\nstiffness = 1.0\nfriction = [0.1]\n\n[[structure.actuators]]",
