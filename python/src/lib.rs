@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyCapsule;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use tensegrity_testbed::file_model::spec::ErrorClass;
 use tensegrity_testbed::mechanisms::Values;
@@ -62,9 +62,33 @@ fn check(path: &str, text: Option<&str>, set: Vec<String>) -> PyResult<String> {
     Ok(load(path, text, &set)?.name)
 }
 
+/// The Python thread running a model callable now (its `_thread.get_ident()`), 0 for none:
+/// where Ctrl-C sends its KeyboardInterrupt when a callable keeps the run from its next tick.
+static CALLABLE_THREAD: AtomicU64 = AtomicU64::new(0);
+
+/// Polls ([`tensegrity_testbed::run::stoppable::POLL_S`] each) that a run is waited for after
+/// Ctrl-C before KeyboardInterrupt is raised without it (1 s): a callable blocked in C (a
+/// sleep, a read) is then left to return on its own, and the run ends at its next tick.
+const STOP_POLLS: usize = 20;
+
+/// Raises KeyboardInterrupt in the thread of a model callable that is running, if one is: a
+/// loop in Python stops at its next bytecode, not at the run's next tick.
+fn interrupt_callable() {
+    let thread = CALLABLE_THREAD.load(Ordering::SeqCst);
+    if thread != 0 {
+        // SAFETY: called with the GIL held (from `on_own_thread`, between polls); the thread
+        // id came from `_thread.get_ident()` in that thread, and an id that has since ended
+        // is ignored by CPython (0 threads modified).
+        unsafe {
+            pyo3::ffi::PyThreadState_SetAsyncExc(thread as std::os::raw::c_long, pyo3::ffi::PyExc_KeyboardInterrupt);
+        }
+    }
+}
+
 /// Runs `work` on a thread of its own (`stoppable`) and waits for it without the GIL, looking
 /// for Ctrl-C at every poll: on one it raises the flag `work` watches (the run stops at its
-/// next tick), waits for it and raises KeyboardInterrupt.
+/// next tick) and a KeyboardInterrupt in a running model callable, waits for the run at most
+/// [`STOP_POLLS`] polls, and raises KeyboardInterrupt.
 fn on_own_thread<T: Send + 'static>(
     py: Python<'_>,
     work: impl FnOnce(&AtomicBool) -> T + Send + 'static,
@@ -84,7 +108,11 @@ fn on_own_thread<T: Send + 'static>(
         }
         if let Err(e) = py.check_signals() {
             cancel.store(true, Ordering::SeqCst);
-            py.detach(move || worker.join());
+            interrupt_callable();
+            let stopped = py.detach(|| (0..STOP_POLLS).any(|_| !matches!(worker.poll(), Ok(None))));
+            if stopped {
+                py.detach(move || worker.join());
+            }
             return Err(e);
         }
     }
@@ -132,7 +160,13 @@ impl PyModel {
         inputs: &BTreeMap<String, f64>,
         t: Option<f64>,
     ) -> PyResult<BTreeMap<String, f64>> {
-        let out: BTreeMap<String, f64> = self.function.call1(py, (params.clone(), inputs.clone(), t))?.extract(py)?;
+        // `_thread`, not `threading`: imported first from this thread, `threading` would take it
+        // for the main thread and hold the interpreter's exit for it (measured: a hang).
+        let thread: u64 = py.import("_thread")?.call_method0("get_ident")?.extract()?;
+        CALLABLE_THREAD.store(thread, Ordering::SeqCst);
+        let called = self.function.call1(py, (params.clone(), inputs.clone(), t));
+        CALLABLE_THREAD.store(0, Ordering::SeqCst);
+        let out: BTreeMap<String, f64> = called?.extract(py)?;
         for n in &self.names {
             match out.get(n) {
                 Some(v) if v.is_finite() => {}

@@ -123,6 +123,37 @@ def test_ctrl_c_stops_a_run():
     assert float(out.split("=")[1]) < 1000.0, out  # the motion's last tick is at 1000 s
 
 
+@pytest.mark.parametrize("block", ["while True:\n            pass", "time.sleep(1000)"])
+def test_ctrl_c_stops_a_run_whose_callable_blocks(block):
+    """A model callable that never returns (a loop in Python, or a sleep of 1000 s in C) keeps
+    the run from its next tick; SIGINT still raises KeyboardInterrupt in the caller: into the
+    loop at its next bytecode, and past the sleep once the run has been waited for one second
+    (the run itself stops at its next tick, when the sleep ends). The signal is sent once the
+    callable says it blocks; the 60 s guard is against a hang, not a speed target."""
+    import signal
+    import sys
+
+    text = BAR.read_text().replace("duration_s = 4.0", "duration_s = 1000.0")
+    script = (
+        "import signal, sys, time, tensegrity_testbed as tt\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+        "def model(params, inputs, t):\n"
+        "    if t is not None:\n"
+        "        print('blocking', flush=True)\n"
+        f"        {block}\n"
+        "    return {}\n"
+        "try:\n"
+        f"    tt.run({text!r}, name='long.toml', model=model)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True); sys.exit(3)\n"
+    )
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == "blocking"  # the event the signal waits for
+    child.send_signal(signal.SIGINT)
+    out, _ = child.communicate(timeout=60)
+    assert child.returncode == 3 and out.strip() == "interrupted", (child.returncode, out)
+
+
 SWEEP = ROOT / "scenarios" / "custom" / "pinned_bar_sweep.toml"
 
 
