@@ -337,9 +337,10 @@ fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, Sc
         (0..s.joints.len()).filter(|j| !actuated(*j)).count() as i64
     };
     let free = s.bodies.iter().filter(|b| b.kind == crate::structure::BodyKind::Free).count();
-    if free > crate::structure::MAX_MODAL_FREE_BODIES {
-        let most = crate::structure::MAX_MODAL_FREE_BODIES;
-        return Err(ctx.err(mode, format!("mode {}: the structure has {free} free bodies, and its modes are a dense eigenproblem solved for at most {most}", mode.get_ref())));
+    let most = crate::structure::modal_free_body_bound(s);
+    if free > most {
+        let what = if most == crate::structure::MAX_MODAL_FREE_BODIES { "a dense eigenproblem" } else { "the sparse solver's lowest" };
+        return Err(ctx.err(mode, format!("mode {}: the structure has {free} free bodies, and its modes are {what} solved for at most {most}", mode.get_ref())));
     }
     let m = *mode.get_ref();
     if !(1..=count).contains(&m) {
