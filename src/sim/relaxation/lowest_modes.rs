@@ -23,7 +23,7 @@
 use super::super::{Data, Model};
 use super::assemble::{Dofs, System};
 use super::ordering::reverse_cuthill_mckee;
-use super::sparse::{csc, rigid_motions};
+use super::sparse::{csc, rigid_motions, Motion};
 use crate::eigen::EigenError;
 use nalgebra::{DMatrix, DVector, Matrix6, SymmetricEigen, Vector3, Vector6};
 use nalgebra_sparse::factorization::{CscCholesky, CscSymbolicCholesky};
@@ -94,17 +94,17 @@ impl Data {
             factors[i].transpose() * Vector6::new(u.x, u.y, u.z, w.x, w.y, w.z)
         };
         let motions = rigid_motions(&dofs, m.length_scale_m, &weighted.position, &self.rigid_groups(m, &dofs), &weigh);
-        let mut rigid: Vec<DVector<f64>> = Vec::new();
+        let mut rigid: Vec<Motion> = Vec::new();
         let mut out = Vec::new();
         for motion in motions {
             let mut y = DVector::zeros(n);
-            for (r, x) in motion.0 {
+            for &(r, x) in &motion.0 {
                 y[r] = x;
             }
             let ay = &weighted.matrix * &y;
             if ay.norm() <= DEFLATION_RATIO * largest {
-                out.push((y.dot(&ay), y.clone()));
-                rigid.push(y);
+                out.push((y.dot(&ay), y));
+                rigid.push(motion);
             }
         }
         let want = count.min(n - rigid.len());
@@ -208,12 +208,15 @@ fn largest_magnitude(a: &CscMatrix<f64>, cancel: Option<&AtomicBool>) -> Result<
     Ok(ritz.max(diagonal))
 }
 
-/// Removes from each column of `x` its components along the orthonormal `rigid`.
-fn deflate(x: &mut DMatrix<f64>, rigid: &[DVector<f64>]) {
+/// Removes from each column of `x` its components along the orthonormal `rigid` (each by its
+/// nonzero entries: a strut's spin has six).
+fn deflate(x: &mut DMatrix<f64>, rigid: &[Motion]) {
     for mut column in x.column_iter_mut() {
         for r in rigid {
-            let along = r.dot(&column);
-            column.axpy(-along, r, 1.0);
+            let along: f64 = r.0.iter().map(|&(i, v)| v * column[i]).sum();
+            for &(i, v) in &r.0 {
+                column[i] -= along * v;
+            }
         }
     }
 }
@@ -240,7 +243,7 @@ fn shifted_factor(w: &Weighted, largest: f64) -> Result<CscCholesky<f64>, EigenE
 #[allow(clippy::type_complexity)]
 fn subspace_iteration(
     w: &Weighted,
-    rigid: &[DVector<f64>],
+    rigid: &[Motion],
     want: usize,
     largest: f64,
     cancel: Option<&AtomicBool>,
@@ -320,12 +323,12 @@ mod tests {
         };
         let largest = largest_magnitude(&weighted.matrix, None).unwrap();
         assert!((largest - 4.0).abs() <= 1e-3, "largest {largest}");
-        let rigid = vec![DVector::from_element(n, 1.0 / (n as f64).sqrt())];
+        let rigid = vec![Motion((0..n).map(|i| (i, 1.0 / (n as f64).sqrt())).collect())];
         let (pairs, _) = subspace_iteration(&weighted, &rigid, 10, largest, None).unwrap();
         for (k, (theta, x)) in pairs.iter().enumerate() {
             let exact = 2.0 - 2.0 * ((k + 1) as f64 * std::f64::consts::PI / n as f64).cos();
             assert!(((theta - exact) / exact).abs() <= 1e-12, "mode {}: {theta} against {exact}", k + 1);
-            assert!(x.dot(&rigid[0]).abs() <= 1e-12, "mode {} has a rigid component", k + 1);
+            assert!(x.sum().abs() <= 1e-12 * (n as f64).sqrt(), "mode {} has a rigid component", k + 1);
         }
         let raised = AtomicBool::new(true);
         let stopped = subspace_iteration(&weighted, &rigid, 10, largest, Some(&raised));
