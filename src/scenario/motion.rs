@@ -339,8 +339,12 @@ fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, Sc
     let free = s.bodies.iter().filter(|b| b.kind == crate::structure::BodyKind::Free).count();
     let most = crate::structure::modal_free_body_bound(s);
     if free > most {
-        let what = if most == crate::structure::MAX_MODAL_FREE_BODIES { "a dense eigenproblem" } else { "the sparse solver's lowest" };
-        return Err(ctx.err(mode, format!("mode {}: the structure has {free} free bodies, and its modes are {what} solved for at most {most}", mode.get_ref())));
+        let what = if crate::structure::modes_of_free_bodies(s) {
+            "the lowest modes of free bodies on springs and elastic cables are computed"
+        } else {
+            "its modes are a dense eigenproblem solved"
+        };
+        return Err(ctx.err(mode, format!("mode {}: the structure has {free} free bodies, and {what} for at most {most}", mode.get_ref())));
     }
     let m = *mode.get_ref();
     if !(1..=count).contains(&m) {

@@ -129,10 +129,24 @@ pub fn check_modal_size(s: &crate::structure::Structure) -> Result<(), ModesErro
     Ok(())
 }
 
+/// Which eigensolver gives the modes of free bodies on springs and elastic cables.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Solver {
+    /// Dense up to [`DENSE_MODAL_MAX_FREE_BODIES`] free bodies, sparse above.
+    BySize,
+    /// Dense at any size (every mode).
+    Dense,
+}
+
 impl Data {
     /// The structure's natural modes at its current state: over six coordinates per free body,
     /// or reduced to the joints' coordinates where there are joints (`joint_modes.rs`).
-    pub(super) fn modes(&mut self, m: &Model, cancel: Option<&AtomicBool>) -> Result<StructureModes, ModesError> {
+    pub(super) fn modes(
+        &mut self,
+        m: &Model,
+        cancel: Option<&AtomicBool>,
+        solver: Solver,
+    ) -> Result<StructureModes, ModesError> {
         let s = &m.structure;
         if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
             return Err(ModesError::NoFreeBody);
@@ -155,7 +169,8 @@ impl Data {
         }
         let (bodies, com) = self.free_blocks(m);
         let mass = self.mass_blocks(m, &bodies);
-        let (eigen, largest, lowest_of) = if bodies.len() > DENSE_MODAL_MAX_FREE_BODIES {
+        let sparse = solver == Solver::BySize && bodies.len() > DENSE_MODAL_MAX_FREE_BODIES;
+        let (eigen, largest, lowest_of) = if sparse {
             let lowest = self.lowest_modes(m, &mass, SPARSE_MODAL_COUNT, cancel)?;
             (lowest.modes, lowest.largest, Some(6 * bodies.len()))
         } else {
