@@ -344,7 +344,10 @@ fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, Sc
         } else {
             "its modes are a dense eigenproblem solved"
         };
-        return Err(ctx.err(mode, format!("mode {}: the structure has {free} free bodies, and {what} for at most {most}", mode.get_ref())));
+        return Err(ctx.err(
+            mode,
+            format!("mode {}: the structure has {free} free bodies, and {what} for at most {most}", mode.get_ref()),
+        ));
     }
     let m = *mode.get_ref();
     if !(1..=count).contains(&m) {

@@ -180,13 +180,13 @@ pub struct ElasticLaw {
 }
 
 impl ElasticLaw {
-    /// Whether the member carries force at length `l` [m] (a cable goes slack when not
+    /// Whether the member carries force at length `l` \[m\] (a cable goes slack when not
     /// stretched).
     pub fn engaged(&self, l: f64) -> bool {
         !self.tension_only || l > self.rest_length_m
     }
 
-    /// Tension at length `l` [m]: k (l - l0), at least 0 for a cable [N].
+    /// Tension at length `l` \[m\]: k (l - l0), at least 0 for a cable \[N\].
     pub fn tension_n(&self, l: f64) -> f64 {
         let t = self.stiffness_n_per_m * (l - self.rest_length_m);
         if self.tension_only {
@@ -196,7 +196,7 @@ impl ElasticLaw {
         }
     }
 
-    /// Elastic energy at length `l` [J]: k (l - l0)^2 / 2 where engaged.
+    /// Elastic energy at length `l` \[J\]: k (l - l0)^2 / 2 where engaged.
     pub fn energy_j(&self, l: f64) -> f64 {
         if self.engaged(l) {
             0.5 * self.stiffness_n_per_m * (l - self.rest_length_m).powi(2)

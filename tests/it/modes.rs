@@ -433,7 +433,8 @@ fn the_sparse_lowest_modes_of_a_large_prism_are_the_dense_ones() {
     assert_eq!((sparse.lowest_of, dense.lowest_of), (Some(6 * 149), None));
     assert_eq!((sparse.rigid, dense.rigid), (150, 150));
     assert_eq!(sparse.modes.len(), 150 + 20);
-    let lowest = |m: &StructureModes| m.modes.iter().filter(|x| !x.rigid).map(|x| x.omega()).take(20).collect::<Vec<_>>();
+    let lowest =
+        |m: &StructureModes| m.modes.iter().filter(|x| !x.rigid).map(|x| x.omega()).take(20).collect::<Vec<_>>();
     let (s, d) = (lowest(&sparse), lowest(&dense));
     for (k, (a, b)) in s.iter().zip(&d).enumerate() {
         assert!(((a - b) / b).abs() <= 1e-8, "mode {}: {a} against {b} rad/s", k + 1);

@@ -238,16 +238,18 @@ fn shifted_factor(w: &Weighted, largest: f64) -> Result<CscCholesky<f64>, EigenE
     Err(EigenError::NotFinite)
 }
 
+/// Eigenpairs (omega^2, mass-weighted vector y).
+type Pairs = Vec<(f64, DVector<f64>)>;
+
 /// The lowest `want` eigenpairs of A orthogonal to `rigid` (module docs), with the
 /// iterations taken.
-#[allow(clippy::type_complexity)]
 fn subspace_iteration(
     w: &Weighted,
     rigid: &[Motion],
     want: usize,
     largest: f64,
     cancel: Option<&AtomicBool>,
-) -> Result<(Vec<(f64, DVector<f64>)>, usize), EigenError> {
+) -> Result<(Pairs, usize), EigenError> {
     let n = w.matrix.nrows();
     let block = (want + GUARD).min(n - rigid.len());
     if want == 0 || block == 0 {

@@ -126,6 +126,9 @@ impl Motion {
     }
 }
 
+/// The mass-weighted coordinates of block i's translation u [m] and turn w [rad].
+pub(super) type Weigh<'a> = dyn Fn(usize, &Vector3<f64>, &Vector3<f64>) -> Vector6<f64> + 'a;
+
 /// The rigid motions of each group that keep its anchors in place, mass-weighted (`weigh` of
 /// each body's translation and turn: W^-1 times the motion for the step, L^T for the modes),
 /// orthonormal, in factor order. A rigid motion is a twist (t, w): body i's centre
@@ -138,7 +141,7 @@ pub(super) fn rigid_motions(
     length_m: f64,
     position: &[usize],
     groups: &[(Vec<usize>, Vec<Vector3<f64>>)],
-    weigh: &dyn Fn(usize, &Vector3<f64>, &Vector3<f64>) -> Vector6<f64>,
+    weigh: &Weigh<'_>,
 ) -> Vec<Motion> {
     let mut basis: Vec<Motion> = Vec::new();
     // For each factor block, the motions that move it.
