@@ -305,7 +305,7 @@ fn array_error(e: tensegrity_testbed::import::ImportError) -> PyErr {
 /// A scenario (TOML text) named `name` from N (3 rows), C_b and C_s as rows of numbers and one
 /// property per member (`import::matrices::from_arrays`): ValueError on what is wrong.
 #[pyfunction]
-#[pyo3(signature = (name, n, cb, cs, bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n, string_rest_length_m, tension_only, pins, quantities))]
+#[pyo3(signature = (name, n, cb, cs, bar_mass_kg, bar_radius_m, string_stiffness_n_per_m, string_tension_n, string_rest_length_m, tension_only, pins, quantities, clusters=Vec::new()))]
 // The Python function's keyword arguments, one parameter each: the arrays and one property per
 // member, as `tensegrity import matrices` takes them.
 #[allow(clippy::too_many_arguments)]
@@ -322,6 +322,7 @@ fn structure_from_arrays(
     tension_only: Vec<bool>,
     pins: Vec<(String, Option<[f64; 3]>)>,
     quantities: Vec<(String, String)>,
+    clusters: Vec<Vec<f64>>,
 ) -> PyResult<String> {
     use tensegrity_testbed::import::matrices::{from_arrays, DrawnTension, MemberProperties, StringRest};
     use tensegrity_testbed::import::DEFAULT_LEAST_TENSION_N;
@@ -347,6 +348,7 @@ fn structure_from_arrays(
         pins,
         quantities,
         prestress,
+        clusters,
     };
     Ok(from_arrays(name, &n, &cb, &cs, &p).map_err(array_error)?.toml)
 }

@@ -370,6 +370,7 @@ def from_matrices(
     *,
     string_rest_length_m=None,
     tension_only=True,
+    clusters=None,
     pins: Optional[Mapping[str, Optional[Sequence[float]]]] = None,
     quantities: Optional[Mapping[str, str]] = None,
     params: Optional[Mapping[str, Any]] = None,
@@ -391,7 +392,11 @@ def from_matrices(
     the drawing has none with every string taut), as ``tensegrity import matrices`` chooses;
     the scenario's description says which.
     ``tension_only``: True (default) for cables, False (one or per string) for linear springs
-    that push as well (zero rest length allowed). ``pins``: bar nodes joined to the ground,
+    that push as well (zero rest length allowed). ``clusters``: a clustering matrix S as CTSFEM
+    writes it (one row per clustered cable, one column per string, 1 where the string is a
+    segment of it): each row's strings become one cable ``cluster<r>`` through their nodes, one
+    tension in every segment, its stiffness theirs in series (rows must not overlap; a row's
+    strings make one path or ring). ``pins``: bar nodes joined to the ground,
     ``{"n1": (0, 0, 1)}`` a revolute joint ``pin_n1`` about that axis, ``{"n1": None}`` a
     spherical one. ``quantities``: ``{"q": "atan2(n2.y - n1.y, n2.x - n1.x)"}``, the
     scenario's ``[[quantities]]`` (expressions of the state), for predictions to compare with.
@@ -440,6 +445,7 @@ def from_matrices(
         _per_member("tension_only", tension_only, strings, "string", dtype=bool),
         pin_list,
         [(str(k), str(v)) for k, v in (quantities or {}).items()],
+        [] if clusters is None else _matrix("clusters", clusters, cols=strings).tolist(),
     )
     sections = {k: dict(v) for k, v in (("params", params), ("motion", motion), ("energy", energy)) if v is not None}
     if sections:

@@ -215,6 +215,28 @@ def test_a_prism_from_numpy_arrays_settles_to_the_closed_form_twist():
     assert max(abs(t - (np.pi / 2 + np.pi / 3)) for t in spans) <= 1e-8
 
 
+def test_a_clustering_matrix_makes_one_cable_of_the_bottom_ring():
+    """``clusters`` (CTSFEM's S): the three bottom strings one cable through n1, n2, n3 and back;
+    the prism settles at the closed-form twist (1e-8 rad) with the ring's one tension; an S whose
+    rows overlap is a ValueError naming the string and the two cables."""
+    import numpy as np
+
+    N, Cb, Cs = prism_arrays()
+    S = np.zeros((1, 9))
+    S[0, :3] = 1.0
+    text = tt.from_matrices(N, Cb, Cs, bar_radius_m=0.02, clusters=S)
+    assert 'through = ["n2", "n3"]' in text.toml
+    result = tt.run(text, name="ring.toml")
+    assert result.passed, result.failures
+    spans = strut_spans(result.report["points"][0]["simulated"], ["n1", "n2", "n3"], ["n4", "n5", "n6"],
+                        [("n1", "n5"), ("n2", "n6"), ("n3", "n4")])
+    assert max(abs(t - (np.pi / 2 + np.pi / 3)) for t in spans) <= 1e-8
+    overlapping = np.zeros((2, 9))
+    overlapping[0, :2] = overlapping[1, 1:3] = 1.0
+    with pytest.raises(ValueError, match="string2 is in clustered cables 1 and 2"):
+        tt.from_matrices(N, Cb, Cs, clusters=overlapping)
+
+
 def strut_spans(sim, bottom, top, struts):
     """The angle [rad] each strut (bottom node, top node) spans about a prism's axis, from the
     centroid of the ``bottom`` nodes to that of the ``top`` ones, in the settled values ``sim``."""

@@ -320,6 +320,11 @@ pub enum ImportFormat {
         /// Every string at --string-tension, whatever the drawn structure's self-stress.
         #[arg(long)]
         uniform_tension: bool,
+        /// A clustering matrix S as CSV (CTSFEM's): one row per clustered cable, one column
+        /// per string, 1 where the string is a segment of it; each row's strings become one
+        /// cable through their nodes (one tension, sliding at the inner nodes).
+        #[arg(long, value_name = "S.csv")]
+        clusters: Option<PathBuf>,
     },
 }
 

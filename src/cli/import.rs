@@ -26,6 +26,7 @@ pub fn import(format: ImportFormat) -> Result<Outcome, CliError> {
             string_stiffness,
             string_tension,
             uniform_tension,
+            clusters,
         } => {
             let o = MatrixOptions {
                 bar_mass_kg: bar_mass,
@@ -33,11 +34,13 @@ pub fn import(format: ImportFormat) -> Result<Outcome, CliError> {
                 string_stiffness_n_per_m: string_stiffness,
                 string_tension_n: string_tension,
                 uniform_tension,
+                clusters: clusters.clone(),
             };
             o.validate().map_err(bad_input)?;
             let imported = crate::import::matrices::import(&n, &cb, &cs, &o).map_err(bad_input)?;
             imported.chosen.iter().for_each(|c| eprintln!("chose: {c}"));
-            write_output(out.as_deref(), &[n, cb, cs], &imported.toml)
+            let inputs: Vec<std::path::PathBuf> = [n, cb, cs].into_iter().chain(clusters).collect();
+            write_output(out.as_deref(), &inputs, &imported.toml)
         }
     }
 }

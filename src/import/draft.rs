@@ -28,6 +28,8 @@ pub struct DraftStrut {
 pub struct DraftCable {
     pub name: String,
     pub a: String,
+    /// The inner nodes of a clustered cable, in order from `a` to `b` (empty: straight).
+    pub through: Vec<String>,
     pub b: String,
     /// [N/m]; None: inextensible.
     pub stiffness_n_per_m: Option<f64>,
@@ -133,18 +135,33 @@ fn xyz(v: Vec3, what: &str) -> Result<String, DraftError> {
     Ok(format!("[{}, {}, {}]", num(v[0], what)?, num(v[1], what)?, num(v[2], what)?))
 }
 
+impl DraftCable {
+    /// Its nodes in order: `a`, the inner ones, `b`.
+    pub fn path(&self) -> impl Iterator<Item = &str> {
+        std::iter::once(self.a.as_str()).chain(self.through.iter().map(String::as_str)).chain([self.b.as_str()])
+    }
+}
+
 impl Draft {
     fn position(&self, node: &str) -> Option<Vec3> {
         self.bodies.iter().flat_map(|b| &b.nodes).find(|(n, _)| n == node).map(|(_, p)| *p)
     }
 
+    /// A cable's drawn length, the sum of its segments' \[m\] (None: a node not drawn).
+    pub fn drawn_length(&self, c: &DraftCable) -> Option<f64> {
+        let path: Vec<Vec3> = c.path().map(|n| self.position(n)).collect::<Option<_>>()?;
+        let mut segments = path.windows(2).map(|w| distance(w[0], w[1]));
+        let first = segments.next()?;
+        Some(segments.fold(first, |l, s| l + s))
+    }
+
     /// Whether an elastic cable is drawn longer than its rest length (in tension when drawn).
     fn drawn_taut(&self) -> bool {
         // Springs (not tension-only) are no cables: `[prestress]` judges cables only.
-        self.cables.iter().filter(|c| c.tension_only).any(|c| {
-            let drawn = self.position(&c.a).zip(self.position(&c.b)).map(|(a, b)| distance(a, b));
-            c.stiffness_n_per_m.is_some() && drawn.is_some_and(|l| l > c.length_m)
-        })
+        self.cables
+            .iter()
+            .filter(|c| c.tension_only)
+            .any(|c| c.stiffness_n_per_m.is_some() && self.drawn_length(c).is_some_and(|l| l > c.length_m))
     }
 
     /// Size of the structure \[m\]: the largest distance between two nodes (at least 1e-3).
@@ -213,6 +230,26 @@ impl Draft {
 
     /// The scenario file: name, description, settings, one point, the structure; an error when
     /// a number of it would not be finite.
+    /// A cable's (or a spring's) table, with its drawn length as a comment.
+    fn write_cable(&self, t: &mut String, c: &DraftCable) -> Result<(), DraftError> {
+        let drawn = match self.drawn_length(c) {
+            Some(l) => format!("  # drawn {} m", num(l, &format!("cable {}", c.name))?),
+            None => String::new(),
+        };
+        let table = if c.tension_only { "cables" } else { "springs" };
+        let (name, a, b) = (quote(&c.name), quote(&c.a), quote(&c.b));
+        let _ = writeln!(t, "\n[[structure.{table}]]\nname = {name}\na = {a}\nb = {b}");
+        if !c.through.is_empty() {
+            let inner: Vec<String> = c.through.iter().map(|n| quote(n)).collect();
+            let _ = writeln!(t, "through = [{}]", inner.join(", "));
+        }
+        if let Some(k) = c.stiffness_n_per_m {
+            let _ = writeln!(t, "stiffness = {}", num(k, &format!("the stiffness of cable {}", c.name))?);
+        }
+        let _ = writeln!(t, "length = {}{drawn}", num(c.length_m, &format!("the length of cable {}", c.name))?);
+        Ok(())
+    }
+
     pub fn to_toml(&self) -> Result<String, DraftError> {
         let mut t = String::new();
         let _ = writeln!(t, "name = {}", quote(&self.name));
@@ -245,22 +282,7 @@ impl Draft {
             );
         }
         for c in &self.cables {
-            let drawn = match (self.position(&c.a), self.position(&c.b)) {
-                (Some(a), Some(b)) => format!("  # drawn {} m", num(distance(a, b), &format!("cable {}", c.name))?),
-                _ => String::new(),
-            };
-            let table = if c.tension_only { "cables" } else { "springs" };
-            let _ = writeln!(
-                t,
-                "\n[[structure.{table}]]\nname = {}\na = {}\nb = {}",
-                quote(&c.name),
-                quote(&c.a),
-                quote(&c.b)
-            );
-            if let Some(k) = c.stiffness_n_per_m {
-                let _ = writeln!(t, "stiffness = {}", num(k, &format!("the stiffness of cable {}", c.name))?);
-            }
-            let _ = writeln!(t, "length = {}{drawn}", num(c.length_m, &format!("the length of cable {}", c.name))?);
+            self.write_cable(&mut t, c)?;
         }
         for j in &self.joints {
             let kind = if j.axis.is_some() { "revolute" } else { "spherical" };

@@ -30,6 +30,8 @@ pub struct MatrixOptions {
     pub string_tension_n: f64,
     /// Every string at `string_tension_n`, whatever the self-stress.
     pub uniform_tension: bool,
+    /// A clustering matrix S as CSV ([`MemberProperties::clusters`]), if any.
+    pub clusters: Option<std::path::PathBuf>,
 }
 
 impl MatrixOptions {
@@ -40,6 +42,7 @@ impl MatrixOptions {
         string_stiffness_n_per_m: 1000.0,
         string_tension_n: super::DEFAULT_LEAST_TENSION_N,
         uniform_tension: false,
+        clusters: None,
     };
 
     /// Every option in its range, or the first that is not, named by its flag.
@@ -69,6 +72,7 @@ impl MatrixOptions {
             tension_only: vec![true; strings],
             pins: Vec::new(),
             quantities: Vec::new(),
+            clusters: Vec::new(),
             prestress: if self.uniform_tension {
                 DrawnTension::AsGiven
             } else {
@@ -106,6 +110,10 @@ pub struct MemberProperties {
     pub quantities: Vec<(String, String)>,
     /// How the strings' tensions at the drawn state are chosen.
     pub prestress: DrawnTension,
+    /// The clustering matrix S as CTSFEM writes it (empty: none): one row per clustered cable,
+    /// one column per string, 1 where the string is a segment of that cable and 0 elsewhere;
+    /// a row's strings make one path (or a ring), no string is in two rows.
+    pub clusters: Vec<Vec<f64>>,
 }
 
 /// How the strings' tensions at the drawn state are chosen.
@@ -242,8 +250,12 @@ pub fn import(n_path: &Path, cb_path: &Path, cs_path: &Path, o: &MatrixOptions) 
     let nodes = node_columns(n_path, &n)?;
     let bars = members(cb_path, &read_matrix(cb_path)?, nodes.len())?;
     let strings = members(cs_path, &read_matrix(cs_path)?, nodes.len())?;
-    let p = o.per_member(bars.len(), strings.len());
-    let (mut draft, grounded, chosen) = build([n_path, cb_path, cs_path], &nodes, &bars, &strings, &p)?;
+    let mut p = o.per_member(bars.len(), strings.len());
+    let s_path = o.clusters.as_deref().unwrap_or(Path::new("S"));
+    if let Some(s) = &o.clusters {
+        p.clusters = read_matrix(s)?.into_iter().map(|(_, row)| row).collect();
+    }
+    let (mut draft, grounded, chosen) = build([n_path, cb_path, cs_path, s_path], &nodes, &bars, &strings, &p)?;
     draft.name = format!(
         "{} (from N, C_b, C_s)",
         n_path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default()
@@ -269,7 +281,7 @@ pub fn from_arrays(
     cs: &[Vec<f64>],
     p: &MemberProperties,
 ) -> Result<Imported, ImportError> {
-    let paths = [Path::new("N"), Path::new("Cb"), Path::new("Cs")];
+    let paths = [Path::new("N"), Path::new("Cb"), Path::new("Cs"), Path::new("clusters")];
     let rows = |m: &[Vec<f64>]| -> Vec<Row> { m.iter().enumerate().map(|(i, r)| (i + 1, r.clone())).collect() };
     let n_rows = rows(n);
     if let Some((line, r)) = n_rows.iter().find(|(_, r)| r.len() != n_rows[0].1.len()) {
@@ -305,7 +317,7 @@ fn node_columns(n_path: &Path, n: &[Row]) -> Result<Vec<Vec3>, ImportError> {
 /// each pin whose ground has none), the bars, the pins, the strings and the quantities; and
 /// the number of nodes on no bar.
 fn build(
-    [_, cb_path, cs_path]: [&Path; 3],
+    [_, cb_path, cs_path, s_path]: [&Path; 4],
     nodes: &[Vec3],
     bars: &[Member],
     strings: &[Member],
@@ -341,6 +353,9 @@ fn build(
         });
     }
     add_strings(&mut draft, nodes, strings, cs_path, p)?;
+    let rows: Vec<Row> = p.clusters.iter().enumerate().map(|(i, r)| (i + 1, r.clone())).collect();
+    cluster_strings(&mut draft, &clusters_of(s_path, &rows, strings.len())?)
+        .map_err(|(line, message)| ImportError { file: s_path.display().to_string(), line, col: 1, message })?;
     let chosen = prestress(&mut draft, p).map_err(|e| ImportError::whole(cs_path, e.to_string()))?;
     draft.quantities = p.quantities.clone();
     Ok((draft, ground.len(), chosen))
@@ -450,6 +465,7 @@ fn add_strings(
             });
         }
         draft.cables.push(DraftCable {
+            through: Vec::new(),
             name,
             a: node_name(a),
             b: node_name(b),
@@ -459,6 +475,98 @@ fn add_strings(
         });
     }
     Ok(())
+}
+
+/// The clustered cables of S's rows: each row's strings (from 0), every entry 0 or 1, one
+/// column per string, no string in two rows, no row empty.
+fn clusters_of(path: &Path, rows: &[Row], strings: usize) -> Result<Vec<Vec<usize>>, ImportError> {
+    let at = |line: usize, message: String| ImportError { file: path.display().to_string(), line, col: 1, message };
+    let mut owner: Vec<Option<usize>> = vec![None; strings];
+    let mut out = Vec::new();
+    for (r, (line, row)) in rows.iter().enumerate() {
+        if row.len() != strings {
+            return Err(at(*line, format!("a row of S has one column per string: {} for {strings}", row.len())));
+        }
+        if let Some(x) = row.iter().find(|x| **x != 0.0 && **x != 1.0) {
+            return Err(at(*line, format!("S holds 0 or 1 (a string in the cable or not), got {x}")));
+        }
+        let members: Vec<usize> = (0..strings).filter(|&j| row[j] == 1.0).collect();
+        if members.is_empty() {
+            return Err(at(*line, "a row of S names no string".into()));
+        }
+        for &j in &members {
+            if let Some(other) = owner[j].replace(r) {
+                let message = format!(
+                    "string{} is in clustered cables {} and {}: rows of S must not overlap",
+                    j + 1,
+                    other + 1,
+                    r + 1
+                );
+                return Err(at(*line, message));
+            }
+        }
+        out.push(members);
+    }
+    Ok(out)
+}
+
+/// Replaces each cluster's strings by one clustered cable `cluster<r>` through their nodes
+/// in path order: its stiffness theirs in series (the same material: 1 / sum 1 / k) and its
+/// rest length the sum of theirs (the self-stress, if chosen, sets it again). An error (row
+/// from 1, message) where the strings make no single path or one is a spring.
+fn cluster_strings(draft: &mut Draft, clusters: &[Vec<usize>]) -> Result<(), (usize, String)> {
+    let mut clustered = Vec::new();
+    for (r, members) in clusters.iter().enumerate() {
+        let strings: Vec<&DraftCable> = members.iter().map(|&j| &draft.cables[j]).collect();
+        if let Some(s) = strings.iter().find(|s| !s.tension_only) {
+            return Err((r + 1, format!("{} is a spring: only tension-only strings make a clustered cable", s.name)));
+        }
+        let path = chain(&strings).ok_or_else(|| {
+            (r + 1, "the row's strings make no single path (a chain or a ring of segments)".to_string())
+        })?;
+        let compliance: f64 = strings.iter().map(|s| 1.0 / s.stiffness_n_per_m.unwrap_or(f64::INFINITY)).sum();
+        clustered.push(DraftCable {
+            name: format!("cluster{}", r + 1),
+            a: path[0].clone(),
+            through: path[1..path.len() - 1].to_vec(),
+            b: path[path.len() - 1].clone(),
+            stiffness_n_per_m: Some(1.0 / compliance),
+            length_m: strings.iter().map(|s| s.length_m).sum(),
+            tension_only: true,
+        });
+    }
+    let gone: Vec<usize> = clusters.iter().flatten().copied().collect();
+    let mut j = 0;
+    draft.cables.retain(|_| {
+        j += 1;
+        !gone.contains(&(j - 1))
+    });
+    draft.cables.extend(clustered);
+    Ok(())
+}
+
+/// The nodes of `segments` (two-node strings) in path order, None unless they make one chain
+/// (two ends) or one ring (its first node again at its end).
+fn chain(segments: &[&DraftCable]) -> Option<Vec<String>> {
+    let degree = |n: &str| segments.iter().filter(|s| s.a == n || s.b == n).count();
+    let ends: Vec<&str> =
+        segments.iter().flat_map(|s| [s.a.as_str(), s.b.as_str()]).filter(|n| degree(n) == 1).collect();
+    let start = match ends.len() {
+        0 => segments.first()?.a.clone(),
+        2 => ends[0].to_string(),
+        _ => return None,
+    };
+    let mut used = vec![false; segments.len()];
+    let mut path = vec![start];
+    while let Some(k) = (0..segments.len()).find(|&k| {
+        let last = path.last().expect("the start");
+        !used[k] && (&segments[k].a == last || &segments[k].b == last)
+    }) {
+        used[k] = true;
+        let last = path.last().expect("the start").clone();
+        path.push(if segments[k].a == last { segments[k].b.clone() } else { segments[k].a.clone() });
+    }
+    used.iter().all(|u| *u).then_some(path)
 }
 
 /// `v` as the description says it: the value when every member has it, else its range.

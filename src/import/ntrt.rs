@@ -918,6 +918,7 @@ fn add_string_cables(
             i += 1;
         }
         draft.cables.push(DraftCable {
+            through: Vec::new(),
             name,
             a: names[*a].clone(),
             b: names[*b].clone(),

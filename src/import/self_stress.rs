@@ -43,7 +43,7 @@ pub fn self_stress(draft: &Draft) -> Option<Vec<f64>> {
         .map(|(n, _)| draft.bodies.iter().any(|b| b.fixed && b.nodes.iter().any(|(m, _)| m == n)) && !on_strut(n))
         .collect();
     let cables: Vec<Vec<usize>> =
-        draft.cables.iter().map(|c| Some(vec![index(&c.a)?, index(&c.b)?])).collect::<Option<_>>()?;
+        draft.cables.iter().map(|c| c.path().map(index).collect::<Option<Vec<_>>>()).collect::<Option<_>>()?;
     let struts: Vec<Vec<usize>> =
         draft.struts.iter().map(|s| Some(vec![index(&s.a)?, index(&s.b)?])).collect::<Option<_>>()?;
     let positions: Vec<Vec3> = nodes.iter().map(|(_, p)| *p).collect();
@@ -131,11 +131,10 @@ pub fn rest_length_for(tension_n: f64, stiffness_n_per_m: f64, drawn_m: f64) -> 
 /// naming the cable when a tension leaves it no rest length.
 pub fn prestress(draft: &mut Draft, least_n: f64) -> Result<Option<Chosen>, DraftError> {
     let Some(stress) = self_stress(draft) else { return Ok(None) };
-    let positions: Vec<(String, Vec3)> = draft.bodies.iter().flat_map(|b| b.nodes.clone()).collect();
-    let pos = |n: &str| positions.iter().find(|(m, _)| m == n).map(|(_, p)| *p).unwrap_or_default();
-    for (c, t) in draft.cables.iter_mut().zip(&stress) {
+    let drawn: Vec<f64> = draft.cables.iter().map(|c| draft.drawn_length(c).unwrap_or_default()).collect();
+    for ((c, t), drawn) in draft.cables.iter_mut().zip(&stress).zip(drawn) {
         let Some(k) = c.stiffness_n_per_m else { continue };
-        let (tension, drawn) = (t * least_n, distance(pos(&c.a), pos(&c.b)));
+        let tension = t * least_n;
         c.length_m = rest_length_for(tension, k, drawn).ok_or_else(|| DraftError::SelfStressNoRest {
             cable: c.name.clone(),
             tension_n: tension,

@@ -786,6 +786,19 @@ mod strut_force_tests {
     use crate::snapshot::{MemberForces, Snapshot};
     use crate::structure::{BodyKind, CableLaw, Member, Structure};
 
+    /// The drawn state of `s` with the member forces `force_n` \[N\].
+    fn drawn(s: &Structure, force_n: Vec<f64>) -> Snapshot {
+        Snapshot {
+            tick: 0,
+            time_s: 0.0,
+            nodes: s.nodes.iter().map(|n| n.position).collect(),
+            body_poses: vec![],
+            forces: MemberForces { force_n, ..Default::default() },
+            actuator_values: vec![],
+            kinetic_energy_j: 0.0,
+        }
+    }
+
     /// A strut from A (0, 0, 0) to B (1, 0, 0) with a cable of 10 N from A to C (-1, 1, 0):
     /// the cable pulls A away from B with 10 / sqrt(2) N along the strut, a compression.
     #[test]
@@ -797,16 +810,25 @@ mod strut_force_tests {
         let c = s.add_node("C", ground, [-1.0, 1.0, 0.0]);
         s.members.push(Member::strut("AB", a, b, 0.01));
         s.members.push(Member::cable("AC", vec![a, c], CableLaw::Inextensible, 1.0, 0.001));
-        let snap = Snapshot {
-            tick: 0,
-            time_s: 0.0,
-            nodes: s.nodes.iter().map(|n| n.position).collect(),
-            body_poses: vec![],
-            forces: MemberForces { force_n: vec![0.0, 10.0], ..Default::default() },
-            actuator_values: vec![],
-            kinetic_energy_j: 0.0,
-        };
-        let f = strut_forces(&s, &snap)[0];
+        let f = strut_forces(&s, &drawn(&s, vec![0.0, 10.0]))[0];
         assert!((f + 10.0 / 2f64.sqrt()).abs() <= 1e-12, "{f}");
+    }
+
+    /// A clustered cable from C through A to D is drawn as its two segments, each labelled by
+    /// the cable, and both pull at A: with 10 N along A-C and A-D (D at (-1, -1, 0)) the strut
+    /// is compressed by 2 x 10 / sqrt(2) N.
+    #[test]
+    fn every_segment_of_a_clustered_cable_is_drawn_and_pulls() {
+        let mut s = Structure::default();
+        let bar = s.add_body("bar", BodyKind::Free, None);
+        let ground = s.add_body("ground", BodyKind::Fixed, None);
+        let (a, b) = (s.add_node("A", bar, [0.0; 3]), s.add_node("B", bar, [1.0, 0.0, 0.0]));
+        let (c, d) = (s.add_node("C", ground, [-1.0, 1.0, 0.0]), s.add_node("D", ground, [-1.0, -1.0, 0.0]));
+        s.members.push(Member::strut("AB", a, b, 0.01));
+        let law = CableLaw::Elastic { stiffness_n_per_m: 100.0 };
+        s.members.push(Member::cable("CAD", vec![c, a, d], law, 2.0, 0.001));
+        assert_eq!(super::segment_names(&s, crate::structure::MemberKind::Cable), ["CAD", "CAD"]);
+        let f = strut_forces(&s, &drawn(&s, vec![0.0, 10.0]))[0];
+        assert!((f + 2.0 * 10.0 / 2f64.sqrt()).abs() <= 1e-12, "{f}");
     }
 }

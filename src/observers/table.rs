@@ -235,6 +235,11 @@ impl Table {
         }
         cols.extend(s.members_of(MemberKind::Spring).map(|(_, m)| format!("spring:{}.force_n", m.name)));
         cols.extend(s.members_of(MemberKind::Cable).map(|(_, m)| format!("cable:{}.tension_n", m.name)));
+        // A clustered cable's segments, and where it has friction whether each inner node slips.
+        for (_, m) in s.members_of(MemberKind::Cable).filter(|(_, m)| m.is_clustered()) {
+            cols.extend((1..m.path.len()).map(|k| format!("cable:{}.segment_{k}.tension_n", m.name)));
+            cols.extend((1..=m.friction.len()).map(|k| format!("cable:{}.slip_{k}", m.name)));
+        }
         // Several actuators may share a symbol (mohr2011's cable pairs): named by what they drive.
         cols.extend(s.actuators.iter().map(|a| {
             let target = match a.target {
@@ -266,7 +271,12 @@ impl Table {
         let s = t.structure;
         let tensions =
             s.members_of(MemberKind::Spring).chain(s.members_of(MemberKind::Cable)).map(|(i, _)| f.force_n[i]);
-        v.extend(tensions.chain(f.actuator_force.iter().copied()).map(Some));
+        v.extend(tensions.map(Some));
+        for (i, _) in s.members_of(MemberKind::Cable).filter(|(_, m)| m.is_clustered()) {
+            v.extend(f.segment_force_n[i].iter().map(|x| Some(*x)));
+            v.extend(f.at_friction_bound[i].iter().map(|slips| Some(f64::from(u8::from(*slips)))));
+        }
+        v.extend(f.actuator_force.iter().map(|x| Some(*x)));
         v.extend(keys.1.iter().map(|k| t.simulated.get(k).copied()));
         v.extend(keys.2.iter().map(|k| t.prediction.expected.get(k).copied()));
         v.push(Some(if t.accelerated { 1.0 } else { 0.0 }));

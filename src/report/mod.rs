@@ -657,7 +657,8 @@ pub struct InterferenceReport {
     pub enabled: bool,
     /// Cables and springs were checked too.
     pub tendons: bool,
-    /// Members checked (struts, then cables and springs).
+    /// Member segments checked (struts, then cables and springs; a clustered cable's each
+    /// segment): the members themselves unless a cable runs through inner nodes.
     pub members_checked: usize,
     /// Smallest clearance seen over the run \[m\] (None: no pair ever came within the margin).
     #[serde(rename = "min_clearance")]
@@ -1107,7 +1108,7 @@ impl ScenarioReport {
             out.push_str("   interference: OFF (the scenario sets [interference] enabled = false)\n");
         } else if let Some(i) = &self.interference {
             out.push_str(&format!(
-                "   interference: {} member(s){}, {} pair(s) checked over {} tick(s); min clearance {}; {} violation(s) below {:.3e} m{}\n",
+                "   interference: {} member segment(s){}, {} pair(s) checked over {} tick(s); min clearance {}; {} violation(s) below {:.3e} m{}\n",
                 i.members_checked,
                 if i.tendons { " incl. cables and springs" } else { ", struts only" },
                 i.pairs_checked,

@@ -677,6 +677,21 @@ fn edits(a: &str, b: &str) -> usize {
     row[b.len()]
 }
 
+/// A standard normal number drawn from `state` (splitmix64, then Box-Muller): synthetic
+/// measurement noise that is the same for a seed on every machine (the fit's experiments and
+/// tests draw their noise with it).
+pub fn standard_normal(state: &mut u64) -> f64 {
+    let mut uniform = || {
+        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = *state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (u, v) = (uniform().max(f64::MIN_POSITIVE), uniform());
+    (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -685,19 +700,6 @@ mod tests {
     const SEEDS: u64 = 200;
     const POINTS: usize = 10;
     const NOISE: f64 = 0.01;
-
-    /// A standard normal number from `state` (splitmix64, Box-Muller).
-    fn normal(state: &mut u64) -> f64 {
-        let mut uniform = || {
-            *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = *state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let (u, v) = (uniform().max(f64::MIN_POSITIVE), uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
 
     /// A line y = p0 + p1 t at t = 0 .. 0.9 measured with Gaussian noise of sigma NOISE
     /// (truth p = (2, 0.5)), fitted over 200 seeds: each 95 % interval holds the truth in
@@ -717,7 +719,7 @@ mod tests {
                     at: String::new(),
                     point: 0,
                     output: "y".into(),
-                    value: truth[0] + truth[1] * ti + NOISE * normal(&mut state),
+                    value: truth[0] + truth[1] * ti + NOISE * standard_normal(&mut state),
                     sigma: Some(NOISE),
                 })
                 .collect();

@@ -27,8 +27,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 pub use fit::{
-    fit, measurements_from_csv, parse_parameter, read_measurements, FitError, FitParameter, FitProblem, Measurement,
-    DATA_COLUMNS, MAX_DATA_BYTES,
+    fit, measurements_from_csv, parse_parameter, read_measurements, standard_normal, FitError, FitParameter,
+    FitProblem, Measurement, DATA_COLUMNS, MAX_DATA_BYTES,
 };
 pub use levels::judged_nodes_after;
 pub use point::NO_BRANCH;

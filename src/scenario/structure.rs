@@ -270,14 +270,13 @@ fn cable_path(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<(Vec<usize>, f6
     let mut length = 0.0;
     for (k, w) in path.windows(2).enumerate() {
         let segment = crate::structure::distance(s.nodes[w[0]].position, s.nodes[w[1]].position);
-        if w[0] == w[1] {
-            return Err(ctx.err(
-                spanned[k + 1],
-                format!("cable '{name}' runs through node '{}' twice in a row", spanned[k + 1].get_ref()),
-            ));
+        if w[0] == w[1] && !inner.is_empty() {
+            let message = format!("cable '{name}' runs through node '{}' twice in a row", spanned[k + 1].get_ref());
+            return Err(ctx.err(spanned[k + 1], message));
         }
         if segment <= 0.0 {
-            return Err(ctx.err(&m.name, format!("cable '{name}' has a segment of zero length: its nodes coincide")));
+            let what = if inner.is_empty() { "zero length" } else { "a segment of zero length" };
+            return Err(ctx.err(&m.name, format!("cable '{name}' has {what}: its nodes coincide")));
         }
         length += segment;
     }

@@ -123,6 +123,27 @@ fn a_clustered_ring_takes_the_drawn_self_stress() {
     }
 }
 
+/// The sensitivities read a clustered cable through its one law: the ring's angle moves with
+/// the cable's rest length as the implicit equilibrium d / sin(theta) = L0 + m g / (2 k
+/// cos(theta)) says, d theta / d L0 = -1 / (d cos / sin^2 + m g sin / (2 k cos^2)), within 1e-8
+/// relative (both segments' angles; measured 2.1e-9 and 6.0e-9, the parameter derivative of the
+/// forces being a difference), and within 1e-6 of central differences of settles.
+#[test]
+fn the_rings_angle_moves_with_the_rest_length_as_the_implicit_equilibrium_says() {
+    let sc = scenario::load(Path::new(RING)).unwrap();
+    let r = tensegrity_testbed::run::sensitivity(&sc, RING, 0, true, None).expect("sensitivities");
+    let (d, m, g, k, theta) = (sc.params["d"], sc.params["m"], sc.params["g"], sc.params["k"], sc.params["theta_s"]);
+    let (s, c) = theta.sin_cos();
+    let closed = -1.0 / (d * c / (s * s) + m * g * s / (2.0 * k * c * c));
+    let p = r.parameters.iter().find(|p| p.name == "L0").expect("L0");
+    for output in ["theta_A", "theta_B"] {
+        let i = r.outputs.iter().position(|o| o.name == output).unwrap();
+        let (ift, settles) = (p.derivatives[i], p.check.as_ref().expect("checked")[i]);
+        assert!(((ift - closed) / closed).abs() <= 1e-8, "{output}: {ift} against {closed}");
+        assert!(((ift - settles) / settles).abs() <= 1e-6, "{output}: {ift} against settles {settles}");
+    }
+}
+
 const CAPSTAN: &str = "scenarios/custom/capstan.toml";
 
 /// The capstan: a weight on a slide below the node P, the cable turning pi/2 there (mu = 0.3)
@@ -153,6 +174,23 @@ fn the_capstan_holds_below_e_mu_theta_and_slips_at_it() {
     assert_eq!((held, r.points.len() - held), (2, 7));
 }
 
+/// The per-tick table carries each segment's tension and each inner node's slip: on the
+/// capstan's last row the segment beyond P holds e^(0.3 pi / 2) times the one below it within
+/// 1e-9, P slips (1), and the cable's own column is its last segment's.
+#[test]
+fn the_table_has_every_segment_and_the_slip() {
+    let text = std::fs::read_to_string(CAPSTAN).unwrap();
+    let (_, header, columns) = common::table(&text, "capstan");
+    let column = |name: &str| &columns[header.iter().position(|h| h == name).unwrap_or_else(|| panic!("{name}"))];
+    let last = |name: &str| *column(name).last().unwrap();
+    let (below, beyond) = (last("cable:rope.segment_1.tension_n"), last("cable:rope.segment_2.tension_n"));
+    let bound = (0.3 * std::f64::consts::FRAC_PI_2).exp();
+    assert!((beyond / below - bound).abs() <= 1e-9 * bound, "{beyond} / {below}");
+    assert_eq!(last("cable:rope.slip_1"), 1.0);
+    assert_eq!(last("cable:rope.tension_n"), beyond);
+    assert_eq!(column("cable:rope.slip_1")[0], 0.0, "P holds at the drawn state");
+}
+
 /// A cable with friction has no stiffness to linearise: `modes` refuses it, naming the cable
 /// (exit 2).
 #[test]
@@ -163,7 +201,7 @@ fn the_modes_of_a_cable_with_friction_are_refused() {
 }
 
 /// Bad friction is located: on a spring, a count that is not one per inner node, a negative
-/// coefficient.
+/// or non-finite coefficient.
 #[test]
 fn bad_friction_is_located() {
     let text = std::fs::read_to_string(CAPSTAN).unwrap();
@@ -175,6 +213,8 @@ fn bad_friction_is_located() {
     error_at(&two, "friction = [", 11, "one per node of `through`");
     let negative = with("friction = [\"mu\"]", "friction = [-0.2]");
     error_at(&negative, "-0.2", 0, "must be >= 0");
+    let not_a_number = with("friction = [\"mu\"]", "friction = [nan]");
+    error_at(&not_a_number, "nan]", 0, "must be a finite number");
     let spring = with(
         "[[structure.actuators]]",
         "[[structure.springs]]\nname = \"s\"\na = \"M\"\nb = \"W\"\nstiffness = 1.0\nfriction = [0.1]\n\n[[structure.actuators]]",

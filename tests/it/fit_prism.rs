@@ -31,20 +31,6 @@ const SEEDS_FROM: u64 = 200;
 /// The 95 % two-sided normal quantile.
 const Z_95: f64 = 1.959_963_984_540_054;
 
-/// A standard normal number from `state` (splitmix64, Box-Muller): the same draws on every
-/// machine.
-fn normal(state: &mut u64) -> f64 {
-    let mut uniform = || {
-        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let (u, v) = (uniform().max(f64::MIN_POSITIVE), uniform());
-    (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-}
-
 /// A measured output's standard deviation, given its true value.
 type Sigma = fn(f64) -> f64;
 
@@ -101,7 +87,7 @@ fn fit_noisy(
             at: format!("row {k}"),
             point: *point,
             output: output.clone(),
-            value: value + seed.map_or(0.0, |_| sigma * normal(&mut state)),
+            value: value + seed.map_or(0.0, |_| sigma * tensegrity_testbed::run::standard_normal(&mut state)),
             sigma: Some(*sigma),
         })
         .collect();
@@ -138,7 +124,7 @@ fn weighted_jacobian(file: &str, source: &str, rows: &[(usize, String, f64, f64)
 /// whether each 95 % interval holds the truth.
 fn linear_errors(a: &DMatrix<f64>, sigma: &[f64], rows: usize, seed: u64) -> Vec<f64> {
     let mut state = seed;
-    let e = DVector::from_iterator(rows, (0..rows).map(|_| normal(&mut state)));
+    let e = DVector::from_iterator(rows, (0..rows).map(|_| tensegrity_testbed::run::standard_normal(&mut state)));
     let dp = a * e;
     (0..sigma.len()).map(|k| dp[k] / sigma[k]).collect()
 }

@@ -19,6 +19,7 @@ const OPTIONS: MatrixOptions = MatrixOptions {
     string_stiffness_n_per_m: 100.0,
     string_tension_n: 20.0,
     uniform_tension: false,
+    clusters: None,
 };
 
 /// A 3-strut prism drawn untwisted: nodes 1-3 the bottom triangle (radius 1 m), 4-6 the top
@@ -110,6 +111,46 @@ fn a_prism_from_connectivity_matrices_settles_to_the_closed_form_twist() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The prism with a clustering matrix S (CTSFEM's) whose one row takes the three bottom
+/// strings: they become one cable `cluster1` through n1, n2, n3 back to n1, its stiffness the
+/// three in series (100/3 N/m). With the drawn self-stress (the ring one member) it settles at
+/// the closed-form twist within 1e-8 rad and its one tension is the plain prism's bottom
+/// strings' within 1e-9 relative. Overlapping rows and a row whose strings make no path are
+/// errors at S's row.
+#[test]
+fn a_clustering_matrix_makes_one_cable_of_the_bottom_ring() {
+    let dir = temp("clusters");
+    let [n, cb, cs] = prism_files(&dir);
+    let s_path = dir.join("S.csv");
+    std::fs::write(&s_path, "1,1,1,0,0,0,0,0,0\n").unwrap();
+    let clustered = MatrixOptions { clusters: Some(s_path.clone()), ..OPTIONS };
+    let imported = import(&n, &cb, &cs, &clustered).unwrap();
+    assert!(imported.toml.contains("through = [\"n2\", \"n3\"]"), "{}", imported.toml);
+    let sc =
+        scenario::parse(Path::new("ring.toml"), &imported.toml).unwrap_or_else(|e| panic!("{e}\n{}", imported.toml));
+    let s = &sc.custom.as_ref().unwrap().structure;
+    assert_eq!((s.count_of(MemberKind::Strut), s.count_of(MemberKind::Cable)), (3, 7));
+    let ring = s.member("cluster1").unwrap();
+    assert_eq!(ring.path.len(), 4);
+    assert!((ring.stiffness_n_per_m().unwrap() - 100.0 / 3.0).abs() <= 1e-12);
+    let plain = run(
+        &scenario::parse(Path::new("plain.toml"), &import(&n, &cb, &cs, &OPTIONS).unwrap().toml).unwrap(),
+        &RunOptions::default(),
+    );
+    let r = run(&sc, &RunOptions::default());
+    assert!(r.passed && plain.passed, "{:?} {:?}", r.error, r.failures);
+    let (t_ring, t_plain) = (r.points[0].simulated["cluster1.force"], plain.points[0].simulated["string1.force"]);
+    assert!(((t_ring - t_plain) / t_plain).abs() <= 1e-9, "ring {t_ring} N, plain bottom {t_plain} N");
+    std::fs::write(&s_path, "1,1,0,0,0,0,0,0,0\n0,1,1,0,0,0,0,0,0\n").unwrap();
+    let e = import(&n, &cb, &cs, &clustered).unwrap_err();
+    assert_eq!(e.line, 2, "{e}");
+    assert!(e.message.contains("string2 is in clustered cables 1 and 2"), "{e}");
+    std::fs::write(&s_path, "1,0,0,0,1,0,0,0,0\n").unwrap();
+    let e = import(&n, &cb, &cs, &clustered).unwrap_err();
+    assert!(e.message.contains("no single path") && e.file.ends_with("S.csv"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A node on two bars (class 2), a row without exactly one -1 and one 1, a row with too few
 /// columns and a value that is no number are errors naming the file and the row's line
 /// (comments and blank lines counted).
@@ -185,6 +226,7 @@ fn the_pinned_bar_from_arrays_settles_at_the_closed_form() {
         pins: vec![("n1".into(), Some([0.0, 0.0, 1.0]))],
         quantities: vec![("q".into(), "atan2(n2.y - n1.y, n2.x - n1.x)".into())],
         prestress: DrawnTension::AsGiven,
+        clusters: Vec::new(),
     };
     let toml = from_arrays("pinned bar", &n, &cb, &cs, &p).unwrap().toml;
     assert!(toml.contains("[[structure.springs]]") && toml.contains("kind = \"revolute\""), "{toml}");
