@@ -582,6 +582,37 @@ fn a_motion_along_a_rigid_body_mode_is_refused() {
     std::fs::remove_dir_all(&d).ok();
 }
 
+/// A motion along a mode past those the sparse solver computes (the 102-strut prism: 101 free
+/// bodies, 606 modes, of which the lowest 122 are computed: 102 rigid and 20 more) is refused
+/// by name when the motion starts; mode 123 is not among them, mode 122 is.
+#[test]
+fn a_motion_along_a_mode_the_sparse_solver_did_not_compute_is_refused() {
+    let d = dir("sparse-mode");
+    let s = std::fs::read_to_string("benches/prism_modes.toml")
+        .unwrap()
+        .replace("n = { value = 300,", "n = { value = 102,");
+    for (mode, computed) in [(123, false), (122, true)] {
+        let text = s.replace(
+            "[actuation]",
+            &format!(
+                "[motion]\nduration_s = 0.01\nstart = \"settled\"\nmode = {mode}\namplitude = 1e-6\n\n[actuation]"
+            ),
+        );
+        let p = d.join(format!("mode{mode}.toml"));
+        std::fs::write(&p, text).unwrap();
+        let (code, out, err) = tensegrity(&["run", p.to_str().unwrap()]);
+        let refused = out
+            .contains(&format!("mode {mode} was not computed: the structure's lowest 122 modes are (from 1), of 606"));
+        assert_eq!(refused, !computed, "mode {mode}: {out}{err}");
+        if computed {
+            assert!(code == 0 && out.contains("mode 122 displaced by 1e-6"), "{out}{err}");
+        } else {
+            assert_eq!(code, 1, "{out}{err}");
+        }
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
+
 /// `--set k=nan` of a parameter a pattern reads is reported at the flag (it had been reported
 /// at a range of the structure), and a grid of one point over a pattern's parameter builds
 /// the structure of that point (it had built the file's and judged it at the point's n).
