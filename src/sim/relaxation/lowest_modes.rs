@@ -96,14 +96,15 @@ impl Data {
         let motions = rigid_motions(&dofs, m.length_scale_m, &weighted.position, &self.rigid_groups(m, &dofs), &weigh);
         let mut rigid: Vec<Motion> = Vec::new();
         let mut out = Vec::new();
+        let mut product = SparseProduct::new(n);
         for motion in motions {
-            let mut y = DVector::zeros(n);
-            for &(r, x) in &motion.0 {
-                y[r] = x;
-            }
-            let ay = &weighted.matrix * &y;
-            if ay.norm() <= DEFLATION_RATIO * largest {
-                out.push((y.dot(&ay), y));
+            let (norm, quotient) = product.norm_and_quotient(&weighted.matrix, &motion);
+            if norm <= DEFLATION_RATIO * largest {
+                let mut y = DVector::zeros(n);
+                for &(r, x) in &motion.0 {
+                    y[r] = x;
+                }
+                out.push((quotient, y));
                 rigid.push(motion);
             }
         }
@@ -125,6 +126,43 @@ impl Weighted {
             x.fixed_rows_mut::<6>(6 * i).copy_from(&block);
         }
         x
+    }
+}
+
+/// A y for a sparse y (a rigid motion: a strut's spin has six entries), in a scratch vector
+/// whose touched rows are cleared after each product: the deflation test costs the columns of
+/// y's entries, not a product with a dense vector per motion (about one per body).
+struct SparseProduct {
+    scratch: Vec<f64>,
+    touched: Vec<usize>,
+}
+
+impl SparseProduct {
+    fn new(n: usize) -> Self {
+        SparseProduct { scratch: vec![0.0; n], touched: Vec::new() }
+    }
+
+    /// |A y| and y^T A y.
+    fn norm_and_quotient(&mut self, a: &CscMatrix<f64>, y: &Motion) -> (f64, f64) {
+        for &(c, x) in &y.0 {
+            let column = a.col(c);
+            for (&r, &v) in column.row_indices().iter().zip(column.values()) {
+                if self.scratch[r] == 0.0 {
+                    self.touched.push(r);
+                }
+                self.scratch[r] += v * x;
+            }
+        }
+        let quotient: f64 = y.0.iter().map(|&(r, x)| x * self.scratch[r]).sum();
+        let mut squared = 0.0;
+        self.touched.sort_unstable();
+        self.touched.dedup();
+        for &r in &self.touched {
+            squared += self.scratch[r] * self.scratch[r];
+            self.scratch[r] = 0.0;
+        }
+        self.touched.clear();
+        (squared.sqrt(), quotient)
     }
 }
 
