@@ -35,6 +35,9 @@ pub enum EigenError {
     Shape(usize, usize, usize, usize),
     #[error("a matrix entry is not finite")]
     NotFinite,
+    /// The iterative solver of large problems (`sim::modes`) did not converge.
+    #[error("the lowest modes did not converge in {0} iterations")]
+    NotConverged(usize),
     /// The cancel flag was raised while the problem was solved.
     #[error("interrupted")]
     Interrupted,

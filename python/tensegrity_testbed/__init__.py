@@ -183,7 +183,8 @@ def modes(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str
     """The structure's natural frequencies and mode shapes at its first point, settled as
     ``run`` settles it: the report of ``tensegrity modes --json`` as a dict (``modes``: one per
     mode, ascending omega^2, with ``omega_rad_per_s``, ``frequency_hz``, ``rigid`` and the
-    nodes that move most; ``coordinates``, ``joint_coordinates``, ``rigid_modes``). Raises
+    nodes that move most; ``coordinates``, ``joint_coordinates``, ``rigid_modes``; above 100
+    free bodies ``lowest_of``: the list is the lowest of that many). Raises
     ScenarioError on bad input, ValueError where the structure's modes are not computed (the
     reason named), KeyboardInterrupt on Ctrl-C."""
     path, text = _source(scenario, name)

@@ -57,7 +57,9 @@ pub enum Command {
     /// taut inextensible cables are constraints; refused (exit 2): a loop closed by a prismatic
     /// joint. The constrained modes are reduced to the constraints' tangent space, the
     /// constraint forces' geometric stiffness included; slack cables are left out, and a
-    /// structure the constraints hold rigid has no mode.
+    /// structure the constraints hold rigid has no mode. Every mode, or above 100 free bodies
+    /// on springs and elastic cables: the lowest 20 non-rigid modes and every rigid one
+    /// (sparse shift-invert), the table saying of how many.
     Modes {
         scenario: PathBuf,
         /// Write the JSON report to this file (`-`: standard output, the table then going to

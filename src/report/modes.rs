@@ -24,6 +24,11 @@ pub struct ModesReport {
     pub zero_mode_ratio: f64,
     /// Ascending omega^2.
     pub modes: Vec<ModeReport>,
+    /// Where `modes` are the lowest of the structure's modes (the sparse solver's, above
+    /// `structure::DENSE_MODAL_MAX_FREE_BODIES` free bodies): how many it has in all (its
+    /// coordinates); absent where every mode is listed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lowest_of: Option<usize>,
     /// Wall time of the analysis after the settle \[s\].
     pub wall_s: f64,
 }
@@ -81,6 +86,12 @@ impl ModesReport {
         );
         if let Some(c) = &self.constraints {
             out.push_str(&c.to_line());
+        }
+        if let Some(total) = self.lowest_of {
+            out.push_str(&format!(
+                "   the lowest {} of {total} modes (sparse shift-invert: every rigid-body mode found and the lowest non-rigid ones)\n",
+                self.modes.len()
+            ));
         }
         out.push_str(&format!(
             "   {:>4} {:>16} {:>14}  {}\n",

@@ -171,6 +171,10 @@ fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, RunE
         Err(ModesError::Eigen(EigenError::Interrupted)) => return Err(RunError::Interrupted(runner.sim.tick())),
         analysis => analysis?,
     };
+    if let Some(&i) = wanted.iter().find(|&&i| i >= analysis.modes.len()) {
+        let (computed, total) = (analysis.modes.len(), analysis.lowest_of.unwrap_or(analysis.modes.len()));
+        return Err(ModesError::NotComputed { mode: i + 1, computed, total }.into());
+    }
     if let Some(&i) = wanted.iter().find(|&&i| analysis.modes[i].rigid) {
         let (omega_squared, rigid) = (analysis.modes[i].omega_squared, analysis.rigid);
         return Err(ModesError::RigidMode { mode: i + 1, omega_squared, rigid }.into());

@@ -92,6 +92,7 @@ pub fn modes(
         rigid_modes: analysis.rigid,
         zero_mode_ratio: ZERO_MODE_RATIO,
         modes: rows(&analysis, &structure.nodes),
+        lowest_of: analysis.lowest_of,
         wall_s: wall.elapsed().as_secs_f64(),
     };
     Ok((report, state, analysis))

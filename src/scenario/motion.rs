@@ -337,9 +337,17 @@ fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, Sc
         (0..s.joints.len()).filter(|j| !actuated(*j)).count() as i64
     };
     let free = s.bodies.iter().filter(|b| b.kind == crate::structure::BodyKind::Free).count();
-    if free > crate::structure::MAX_MODAL_FREE_BODIES {
-        let most = crate::structure::MAX_MODAL_FREE_BODIES;
-        return Err(ctx.err(mode, format!("mode {}: the structure has {free} free bodies, and its modes are a dense eigenproblem solved for at most {most}", mode.get_ref())));
+    let most = crate::structure::modal_free_body_bound(s);
+    if free > most {
+        let what = if crate::structure::modes_of_free_bodies(s) {
+            "the lowest modes of free bodies on springs and elastic cables are computed"
+        } else {
+            "its modes are a dense eigenproblem solved"
+        };
+        return Err(ctx.err(
+            mode,
+            format!("mode {}: the structure has {free} free bodies, and {what} for at most {most}", mode.get_ref()),
+        ));
     }
     let m = *mode.get_ref();
     if !(1..=count).contains(&m) {

@@ -534,10 +534,11 @@ impl Data {
             bodies,
             joints: vec![],
             poses,
-            mass: body_mass,
+            mass: super::modes::diagonal_blocks(&body_mass),
             modes,
             rigid,
             constraints: Some(constraints),
+            lowest_of: None,
         })
     }
 

@@ -199,6 +199,7 @@ impl Data {
             .collect();
         let rigid = modes.iter().filter(|m| m.rigid).count();
         let poses = bodies.iter().map(|b| self.body_pose(m, *b)).collect();
-        Ok(StructureModes { bodies, joints, poses, mass: body_mass, modes, rigid, constraints: None })
+        let mass = super::modes::diagonal_blocks(&body_mass);
+        Ok(StructureModes { bodies, joints, poses, mass, modes, rigid, constraints: None, lowest_of: None })
     }
 }

@@ -371,7 +371,13 @@ impl Simulation {
     /// The structure's natural modes at its current state: over six coordinates per free body,
     /// or reduced to the joints' coordinates where there are joints (`joint_modes.rs`).
     pub fn modes(&mut self) -> Result<modes::StructureModes, modes::ModesError> {
-        self.data.modes(&self.model, None)
+        self.data.modes(&self.model, None, modes::Solver::BySize)
+    }
+
+    /// [`Simulation::modes`] by the dense eigenproblem (every mode) whatever the number of
+    /// free bodies: what the sparse solver of large structures is checked against.
+    pub fn modes_dense(&mut self) -> Result<modes::StructureModes, modes::ModesError> {
+        self.data.modes(&self.model, None, modes::Solver::Dense)
     }
 
     /// [`Simulation::modes`], the eigenproblem stopped when `cancel` is raised
@@ -380,7 +386,7 @@ impl Simulation {
         &mut self,
         cancel: Option<&std::sync::atomic::AtomicBool>,
     ) -> Result<modes::StructureModes, modes::ModesError> {
-        self.data.modes(&self.model, cancel)
+        self.data.modes(&self.model, cancel, modes::Solver::BySize)
     }
 
     /// The free coordinates of the current state's sensitivities, or why it has none

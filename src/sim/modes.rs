@@ -8,13 +8,17 @@
 //! (no inextensible cables: the relaxation's own domain); jointed ones are reduced to their
 //! joints' coordinates (`joint_modes.rs`); others are refused, by name. Modes with |omega^2| below [`ZERO_MODE_RATIO`] of the largest are rigid-body modes
 //! (a free turn or translation, a strut's spin about its axis): reported as ~0 and counted.
+//! Above [`DENSE_MODAL_MAX_FREE_BODIES`] free bodies (free bodies alone) the eigenproblem is
+//! sparse: the lowest [`SPARSE_MODAL_COUNT`] modes beyond the rigid ones, by shift-invert
+//! subspace iteration (`relaxation/lowest_modes.rs`).
 
 pub use super::constrained_modes::{Constraints, ModalCoordinate};
 use super::{Data, Model, Simulation};
 use crate::eigen::EigenError;
 use crate::snapshot::{BodyPose, ModalProjector};
 use crate::structure::{BodyKind, JointKind};
-use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
+use crate::structure::{DENSE_MODAL_MAX_FREE_BODIES, SPARSE_MODAL_COUNT};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3};
 use std::sync::atomic::AtomicBool;
 
 /// A mode whose |omega^2| is below this fraction of the largest is a rigid-body (zero) mode.
@@ -66,8 +70,8 @@ pub struct StructureModes {
     pub joints: Vec<usize>,
     /// Each free body's pose at the state analysed.
     pub poses: Vec<BodyPose>,
-    /// The mass matrix there (six coordinates per free body).
-    pub mass: DMatrix<f64>,
+    /// The mass matrix there: its 6x6 block per free body (it is block diagonal).
+    pub mass: Vec<Matrix6<f64>>,
     /// Ascending omega^2.
     pub modes: Vec<StructureMode>,
     /// How many are rigid-body modes.
@@ -75,6 +79,9 @@ pub struct StructureModes {
     /// A structure held by loops or inextensible cables: the constraints it was reduced by
     /// (`constrained_modes.rs`; each mode's `joint_shape` is then in their coordinates).
     pub constraints: Option<Constraints>,
+    /// `Some(total)` where `modes` are the lowest of the structure's `total` (the sparse
+    /// solver's); `None` where they are all of them.
+    pub lowest_of: Option<usize>,
 }
 
 /// Why a structure's modes are not computed.
@@ -93,6 +100,12 @@ pub enum ModesError {
     /// More free bodies than the dense eigenproblem is solved for.
     #[error("{bodies} free bodies: the modes are a dense eigenproblem, solved for at most {MAX_MODAL_FREE_BODIES} free bodies ({} coordinates; 300 had taken 20 s, 1000 more than 2 GiB)", 6 * MAX_MODAL_FREE_BODIES)]
     TooLarge { bodies: usize },
+    /// More free bodies (on springs and elastic cables) than the sparse solver is run for.
+    #[error("{bodies} free bodies: the lowest modes of free bodies on springs and elastic cables are computed for at most {MAX_SPARSE_MODAL_FREE_BODIES} free bodies (each rigid mode reported, about one a body, holds a shape and a motion per node: the report grows with the square of the count)")]
+    TooLargeSparse { bodies: usize },
+    /// A motion asks for a mode past those the sparse solver computed.
+    #[error("mode {mode} was not computed: the structure's lowest {computed} modes are (from 1), of {total}")]
+    NotComputed { mode: usize, computed: usize, total: usize },
     /// A motion asks for a mode (from 1) along which the structure moves without deforming.
     #[error("mode {mode} is a rigid-body mode (omega^2 = {omega_squared:e} rad^2/s^2, one of the structure's {rigid} that move it without deforming it): there is no vibration along it to start or to fit; choose a mode from {}", rigid + 1)]
     RigidMode { mode: usize, omega_squared: f64, rigid: usize },
@@ -100,21 +113,40 @@ pub enum ModesError {
     Eigen(#[from] EigenError),
 }
 
-pub use crate::structure::MAX_MODAL_FREE_BODIES;
+pub use crate::structure::{MAX_MODAL_FREE_BODIES, MAX_SPARSE_MODAL_FREE_BODIES};
 
-/// The structure's size for its modes: an error past [`MAX_MODAL_FREE_BODIES`] free bodies.
+/// The structure's size for its modes: an error past [`MAX_MODAL_FREE_BODIES`] free bodies, or
+/// [`MAX_SPARSE_MODAL_FREE_BODIES`] for free bodies on springs and elastic cables.
 pub fn check_modal_size(s: &crate::structure::Structure) -> Result<(), ModesError> {
     let bodies = s.bodies.iter().filter(|b| b.kind == BodyKind::Free).count();
-    if bodies > MAX_MODAL_FREE_BODIES {
-        return Err(ModesError::TooLarge { bodies });
+    if bodies > crate::structure::modal_free_body_bound(s) {
+        return Err(if crate::structure::modes_of_free_bodies(s) {
+            ModesError::TooLargeSparse { bodies }
+        } else {
+            ModesError::TooLarge { bodies }
+        });
     }
     Ok(())
+}
+
+/// Which eigensolver gives the modes of free bodies on springs and elastic cables.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Solver {
+    /// Dense up to [`DENSE_MODAL_MAX_FREE_BODIES`] free bodies, sparse above.
+    BySize,
+    /// Dense at any size (every mode).
+    Dense,
 }
 
 impl Data {
     /// The structure's natural modes at its current state: over six coordinates per free body,
     /// or reduced to the joints' coordinates where there are joints (`joint_modes.rs`).
-    pub(super) fn modes(&mut self, m: &Model, cancel: Option<&AtomicBool>) -> Result<StructureModes, ModesError> {
+    pub(super) fn modes(
+        &mut self,
+        m: &Model,
+        cancel: Option<&AtomicBool>,
+        solver: Solver,
+    ) -> Result<StructureModes, ModesError> {
         let s = &m.structure;
         if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
             return Err(ModesError::NoFreeBody);
@@ -135,23 +167,31 @@ impl Data {
         if !s.joints.is_empty() {
             return self.joint_modes(m, cancel);
         }
-        let tangent = self.tangent_stiffness(m);
-        let mass = self.mass_matrix(m, &tangent.bodies);
-        let eigen = crate::eigen::modes_until(&tangent.hessian, &mass, cancel)?;
-        let largest = eigen.iter().fold(0.0f64, |l, e| l.max(e.omega_squared.abs()));
+        let (bodies, com) = self.free_blocks(m);
+        let mass = self.mass_blocks(m, &bodies);
+        let sparse = solver == Solver::BySize && bodies.len() > DENSE_MODAL_MAX_FREE_BODIES;
+        let (eigen, largest, lowest_of) = if sparse {
+            let lowest = self.lowest_modes(m, &mass, SPARSE_MODAL_COUNT, cancel)?;
+            (lowest.modes, lowest.largest, Some(6 * bodies.len()))
+        } else {
+            let hessian = self.tangent_stiffness(m).hessian;
+            let eigen = crate::eigen::modes_until(&hessian, &block_diagonal(&mass), cancel)?;
+            let largest = eigen.iter().fold(0.0f64, |l, e| l.max(e.omega_squared.abs()));
+            (eigen.into_iter().map(|e| (e.omega_squared, e.shape)).collect(), largest, None)
+        };
         let modes: Vec<StructureMode> = eigen
             .into_iter()
-            .map(|e| StructureMode {
-                omega_squared: e.omega_squared,
-                rigid: e.omega_squared.abs() <= ZERO_MODE_RATIO * largest,
-                node_motion: self.node_motion(m, &tangent.bodies, &tangent.com, e.shape.as_slice()),
-                shape: e.shape.iter().copied().collect(),
+            .map(|(omega_squared, shape)| StructureMode {
+                omega_squared,
+                rigid: omega_squared.abs() <= ZERO_MODE_RATIO * largest,
+                node_motion: self.node_motion(m, &bodies, &com, shape.as_slice()),
+                shape: shape.iter().copied().collect(),
                 joint_shape: vec![],
             })
             .collect();
         let rigid = modes.iter().filter(|mode| mode.rigid).count();
-        let poses = tangent.bodies.iter().map(|b| self.body_pose(m, *b)).collect();
-        Ok(StructureModes { bodies: tangent.bodies, joints: vec![], poses, mass, modes, rigid, constraints: None })
+        let poses = bodies.iter().map(|b| self.body_pose(m, *b)).collect();
+        Ok(StructureModes { bodies, joints: vec![], poses, mass, modes, rigid, constraints: None, lowest_of })
     }
 
     /// Displaces the structure along mode `index` (from 0) of `analysis` (made at the current
@@ -184,17 +224,23 @@ impl Data {
     /// The mass matrix of the free bodies' blocks: m 1 for the translation, R diag(I) R^T for
     /// the rotation (the principal moments about the centre of mass, turned with the body).
     pub(super) fn mass_matrix(&self, m: &Model, bodies: &[usize]) -> DMatrix<f64> {
-        let mut mass = DMatrix::zeros(6 * bodies.len(), 6 * bodies.len());
-        for (i, &b) in bodies.iter().enumerate() {
+        block_diagonal(&self.mass_blocks(m, bodies))
+    }
+
+    /// The 6x6 blocks of [`Data::mass_matrix`], one per body.
+    pub(super) fn mass_blocks(&self, m: &Model, bodies: &[usize]) -> Vec<Matrix6<f64>> {
+        let block = |&b: &usize| {
             let inertia = m.structure.bodies[b].inertia.expect("free bodies have inertia");
             let q = self.body_pose(m, b).rotation_xyzw;
             let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2])).to_rotation_matrix();
             let world =
                 r.matrix() * Matrix3::from_diagonal(&Vector3::from(inertia.principal_kg_m2)) * r.matrix().transpose();
-            mass.view_mut((6 * i, 6 * i), (3, 3)).copy_from(&(Matrix3::identity() * inertia.mass_kg));
-            mass.view_mut((6 * i + 3, 6 * i + 3), (3, 3)).copy_from(&(0.5 * (world + world.transpose())));
-        }
-        mass
+            let mut mass = Matrix6::zeros();
+            mass.fixed_view_mut::<3, 3>(0, 0).copy_from(&(Matrix3::identity() * inertia.mass_kg));
+            mass.fixed_view_mut::<3, 3>(3, 3).copy_from(&(0.5 * (world + world.transpose())));
+            mass
+        };
+        bodies.iter().map(block).collect()
     }
 
     /// Each node's displacement for the coordinates `shape`: dx + dtheta x rho.
@@ -206,9 +252,13 @@ impl Data {
         shape: &[f64],
     ) -> Vec<[f64; 3]> {
         let s = &m.structure;
+        let mut block = vec![None; s.bodies.len()];
+        for (i, &b) in bodies.iter().enumerate() {
+            block[b] = block[b].or(Some(i));
+        }
         (0..s.nodes.len())
             .map(|n| {
-                let Some(i) = bodies.iter().position(|&b| b == s.nodes[n].body) else { return [0.0; 3] };
+                let Some(i) = block[s.nodes[n].body] else { return [0.0; 3] };
                 let rho = Vector3::from(self.node_position(m, n)) - com[i];
                 let dx = Vector3::from_column_slice(&shape[6 * i..6 * i + 3]);
                 let dtheta = Vector3::from_column_slice(&shape[6 * i + 3..6 * i + 6]);
@@ -224,11 +274,26 @@ impl Data {
 pub fn modal_projector(sim: &Simulation, analysis: &StructureModes, index: usize) -> ModalProjector {
     let s = sim.structure();
     let com_local = analysis.bodies.iter().map(|b| s.bodies[*b].inertia.map_or([0.0; 3], |i| i.com)).collect();
-    let weights = &analysis.mass * DVector::from_column_slice(&analysis.modes[index].shape);
-    ModalProjector {
-        bodies: analysis.bodies.clone(),
-        start: analysis.poses.clone(),
-        com_local,
-        weights: weights.iter().copied().collect(),
+    let shape = &analysis.modes[index].shape;
+    let weights = analysis
+        .mass
+        .iter()
+        .enumerate()
+        .flat_map(|(i, block)| (block * nalgebra::Vector6::from_column_slice(&shape[6 * i..6 * i + 6])).data.0[0])
+        .collect();
+    ModalProjector { bodies: analysis.bodies.clone(), start: analysis.poses.clone(), com_local, weights }
+}
+
+/// The block-diagonal matrix of `blocks`.
+pub(super) fn block_diagonal(blocks: &[Matrix6<f64>]) -> DMatrix<f64> {
+    let mut out = DMatrix::zeros(6 * blocks.len(), 6 * blocks.len());
+    for (i, b) in blocks.iter().enumerate() {
+        out.fixed_view_mut::<6, 6>(6 * i, 6 * i).copy_from(b);
     }
+    out
+}
+
+/// The 6x6 diagonal blocks of a block-diagonal `matrix` (six coordinates per body).
+pub(super) fn diagonal_blocks(matrix: &DMatrix<f64>) -> Vec<Matrix6<f64>> {
+    (0..matrix.nrows() / 6).map(|i| matrix.fixed_view::<6, 6>(6 * i, 6 * i).into_owned()).collect()
 }

@@ -631,10 +631,45 @@ const SIZE_RUN_NODES: usize = 16;
 /// The smallest size [`structure_size`] reports [m].
 const MIN_STRUCTURE_SIZE_M: f64 = 1e-3;
 
-/// Most free bodies whose modes are computed (`sim::modes`): the dense eigenproblem of six
-/// coordinates each grows with the cube of their count (100, 200, 300 struts: 0.9, 5.2, 19.8 s;
-/// 1000 struts more than 2 GiB); at the bound about 25-45 s, stopped by a signal within a poll.
+/// Most free bodies whose modes are computed (`sim::modes`) where they are a dense
+/// eigenproblem (jointed structures and those held by constraints): it grows with the cube of
+/// their count (100, 200, 300 struts: 0.9, 5.2, 19.8 s; 1000 struts more than 2 GiB); at the
+/// bound about 25-45 s, stopped by a signal within a poll.
 pub const MAX_MODAL_FREE_BODIES: usize = 400;
+
+/// Free bodies up to which the modes of a structure of free bodies held by springs and elastic
+/// cables are the dense eigenproblem (every mode); above, the sparse shift-invert solver gives
+/// the lowest [`SPARSE_MODAL_COUNT`] beyond the rigid ones. Measured on the bench prisms: at
+/// 100 free bodies the dense problem takes 0.25-0.32 s (every mode; 8.9 s at 299, growing with
+/// the cube), the sparse one at 101 free bodies 0.08 s; below, every mode is cheap enough to
+/// list, and every shipped scenario (at most a few tens of bodies) keeps the dense solver.
+pub const DENSE_MODAL_MAX_FREE_BODIES: usize = 100;
+
+/// Non-rigid modes the sparse solver computes (the lowest, with every rigid one it finds).
+pub const SPARSE_MODAL_COUNT: usize = 20;
+
+/// Most free bodies whose lowest modes the sparse solver computes: each rigid mode it reports
+/// (a strut's spin: about one per body) holds a shape and a motion per node, so the report
+/// grows with the square of the count (at the bound 410 MB and about 4 s for the whole
+/// command on the bench prism), the settle before it with the count.
+pub const MAX_SPARSE_MODAL_FREE_BODIES: usize = 2000;
+
+/// Whether the modes of `s` are those of free bodies held by springs and elastic cables (the
+/// static relaxation's domain: no joints, no inextensible cables, no friction): the sparse
+/// solver's domain above [`DENSE_MODAL_MAX_FREE_BODIES`].
+pub fn modes_of_free_bodies(s: &Structure) -> bool {
+    s.joints.is_empty() && !s.members.iter().any(|c| c.is_inextensible_cable() || c.has_friction())
+}
+
+/// The most free bodies whose modes are computed for `s`: [`MAX_SPARSE_MODAL_FREE_BODIES`] for
+/// free bodies on springs and elastic cables, [`MAX_MODAL_FREE_BODIES`] otherwise.
+pub fn modal_free_body_bound(s: &Structure) -> usize {
+    if modes_of_free_bodies(s) {
+        MAX_SPARSE_MODAL_FREE_BODIES
+    } else {
+        MAX_MODAL_FREE_BODIES
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -392,12 +392,14 @@ fn modes_help_command_table_and_chapter_say_the_same_true_thing() {
     let words = |s: &str| s.split_whitespace().collect::<Vec<_>>().join(" ");
     let (code, help, _) = tensegrity(&["modes", "--help"]);
     assert_eq!(code, 0);
+    let large = "every mode, or above 100 free bodies on springs and elastic cables: the lowest 20 non-rigid modes and every rigid one (sparse shift-invert)";
     for (what, text) in [
         ("modes --help", help),
         ("docs/command-line.md", std::fs::read_to_string("docs/command-line.md").unwrap()),
         ("docs/modes.md", std::fs::read_to_string("docs/modes.md").unwrap()),
     ] {
         assert!(words(&text).contains(scope), "{what} does not say: {scope}");
+        assert!(words(&text).to_lowercase().contains(large), "{what} does not say: {large}");
     }
     assert_eq!(tensegrity(&["modes", "scenarios/custom/pinned_bar_modes.toml"]).0, 0);
     let (code, out, err) = tensegrity(&["modes", "scenarios/furet2018/ik_solutions.toml"]);

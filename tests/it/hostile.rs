@@ -582,6 +582,37 @@ fn a_motion_along_a_rigid_body_mode_is_refused() {
     std::fs::remove_dir_all(&d).ok();
 }
 
+/// A motion along a mode past those the sparse solver computes (the 102-strut prism: 101 free
+/// bodies, 606 modes, of which the lowest 122 are computed: 102 rigid and 20 more) is refused
+/// by name when the motion starts; mode 123 is not among them, mode 122 is.
+#[test]
+fn a_motion_along_a_mode_the_sparse_solver_did_not_compute_is_refused() {
+    let d = dir("sparse-mode");
+    let s = std::fs::read_to_string("benches/prism_modes.toml")
+        .unwrap()
+        .replace("n = { value = 300,", "n = { value = 102,");
+    for (mode, computed) in [(123, false), (122, true)] {
+        let text = s.replace(
+            "[actuation]",
+            &format!(
+                "[motion]\nduration_s = 0.01\nstart = \"settled\"\nmode = {mode}\namplitude = 1e-6\n\n[actuation]"
+            ),
+        );
+        let p = d.join(format!("mode{mode}.toml"));
+        std::fs::write(&p, text).unwrap();
+        let (code, out, err) = tensegrity(&["run", p.to_str().unwrap()]);
+        let refused = out
+            .contains(&format!("mode {mode} was not computed: the structure's lowest 122 modes are (from 1), of 606"));
+        assert_eq!(refused, !computed, "mode {mode}: {out}{err}");
+        if computed {
+            assert!(code == 0 && out.contains("mode 122 displaced by 1e-6"), "{out}{err}");
+        } else {
+            assert_eq!(code, 1, "{out}{err}");
+        }
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
+
 /// `--set k=nan` of a parameter a pattern reads is reported at the flag (it had been reported
 /// at a range of the structure), and a grid of one point over a pattern's parameter builds
 /// the structure of that point (it had built the file's and judged it at the point's n).
@@ -626,20 +657,18 @@ fn prism_n_refuses_an_n_it_does_not_hold() {
     std::fs::remove_dir_all(&d).ok();
 }
 
-/// The modes of a structure past 400 free bodies (a dense eigenproblem: 1000 struts had taken
-/// more than 2 GiB) are refused: at the motion's mode key by `check`, and by `modes` before it
-/// settles.
+/// The modes of free bodies on springs and elastic cables past 2000 free bodies (the sparse
+/// solver's bound: the report of its rigid modes grows with the square of the count; jointed
+/// structures keep the dense bound of 400) are refused: at the motion's mode key by `check`,
+/// and by `modes` before it settles.
 #[test]
 fn modes_past_their_size_are_refused() {
     let d = dir("modes-size");
-    let s = std::fs::read_to_string(PRISM_N).unwrap();
-    let big = s
-        .replace("grid = { n = { from = 3, to = 12, count = 10 } }", "points = [ {} ]")
-        .replace("n = { value = 3,", "n = { value = 402,")
-        .replace("n_max = { value = 17,", "n_max = { value = 402,");
+    let s = std::fs::read_to_string("benches/prism_modes.toml").unwrap();
+    let big = s.replace("n = { value = 300,", "n = { value = 2002,");
     let motion = big.replace(
-        "# The axis through",
-        "[motion]\nduration_s = 0.1\nstart = \"drawn\"\nmode = 7\namplitude = 1e-5\n\n# The axis through",
+        "[actuation]",
+        "[motion]\nduration_s = 0.1\nstart = \"drawn\"\nmode = 7\namplitude = 1e-5\n\n[actuation]",
     );
     refused_at(
         &d,
@@ -647,14 +676,14 @@ fn modes_past_their_size_are_refused() {
         &motion,
         "mode = 7",
         7,
-        "the structure has 401 free bodies, and its modes are a dense eigenproblem solved for at most 400",
+        "the structure has 2001 free bodies, and the lowest modes of free bodies on springs and elastic cables are computed for at most 2000",
     );
     let p = d.join("big.toml");
     std::fs::write(&p, &big).unwrap();
     let (code, _, err) = tensegrity(&["modes", p.to_str().unwrap()]);
     assert_eq!(code, 2, "{err}");
     assert!(
-        err.contains("401 free bodies: the modes are a dense eigenproblem, solved for at most 400 free bodies"),
+        err.contains("2001 free bodies: the lowest modes of free bodies on springs and elastic cables are computed for at most 2000 free bodies"),
         "{err}"
     );
     std::fs::remove_dir_all(&d).ok();

@@ -32,6 +32,7 @@
 mod assemble;
 mod dense;
 mod line_search;
+mod lowest_modes;
 pub(super) mod ordering;
 mod sparse;
 
@@ -100,13 +101,11 @@ fn raised(shift: f64) -> f64 {
     }
 }
 
-/// The tangent stiffness of the free bodies at the current state (`sim::modes` reads it):
-/// for each block of six coordinates (translation of the centre of mass, then a small rotation
-/// about it, world frame) its structure body and centre of mass [m], and the dense, symmetrized
-/// Hessian of the potential energy (N/m, N, N m/rad).
+/// The tangent stiffness of the free bodies at the current state (`sim::modes` reads it): the
+/// dense, symmetrized Hessian of the potential energy (N/m, N, N m/rad) over six coordinates
+/// per free body (translation of the centre of mass, then a small rotation about it, world
+/// frame), blocks in the order of [`Data::free_blocks`].
 pub(super) struct Tangent {
-    pub(super) bodies: Vec<usize>,
-    pub(super) com: Vec<nalgebra::Vector3<f64>>,
     pub(super) hessian: nalgebra::DMatrix<f64>,
 }
 
@@ -181,12 +180,18 @@ impl Data {
     /// The Hessian the relaxation assembles, at the current state.
     pub(super) fn tangent_stiffness(&self, m: &Model) -> Tangent {
         let dofs = self.relaxation_dofs(m);
-        let hessian = self.relaxation_system(m, &dofs).dense();
+        Tangent { hessian: self.relaxation_system(m, &dofs).dense() }
+    }
+
+    /// The free bodies in the order of the relaxation's blocks: each block's structure body
+    /// and centre of mass [m].
+    pub(super) fn free_blocks(&self, m: &Model) -> (Vec<usize>, Vec<nalgebra::Vector3<f64>>) {
+        let dofs = self.relaxation_dofs(m);
         let mut bodies = vec![0; dofs.blocks()];
         for (b, i) in dofs.free() {
             bodies[i] = b;
         }
-        Tangent { bodies, com: dofs.com.iter().map(|c| assemble::v3(*c)).collect(), hessian }
+        (bodies, dofs.com.iter().map(|c| assemble::v3(*c)).collect())
     }
 
     /// Moves every free body by `step` (six coordinates per body, in the order of

@@ -15,7 +15,7 @@
 use super::assemble::{cross_matrix, v3, Dofs, System};
 use super::ordering::reverse_cuthill_mckee;
 use super::{StepSolver, SOFT_MODE_RATIO};
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, SymmetricEigen, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, SymmetricEigen, Vector3, Vector6};
 use nalgebra_sparse::factorization::{CscCholesky, CscSymbolicCholesky};
 use nalgebra_sparse::CscMatrix;
 use std::collections::BTreeMap;
@@ -65,7 +65,12 @@ impl ShiftedCholesky {
         let stiffest =
             (0..6 * n).map(|c| matrix.col(c).values().iter().map(|x| x.abs()).sum::<f64>()).fold(0.0_f64, f64::max);
         let symbolic = CscSymbolicCholesky::factor(matrix.pattern().clone());
-        let rigid = rigid_motions(dofs, length_m, &position, groups);
+        let weigh = |i: usize, u: &Vector3<f64>, w: &Vector3<f64>| {
+            let (mass, inertia) = dofs.scale[i];
+            let (u, w) = (u * mass.sqrt(), w * inertia.sqrt());
+            Vector6::new(u.x, u.y, u.z, w.x, w.y, w.z)
+        };
+        let rigid = rigid_motions(dofs, length_m, &position, groups, &weigh);
         let mut force = DVector::zeros(6 * n);
         for i in 0..n {
             for r in 0..6 {
@@ -84,7 +89,7 @@ impl ShiftedCholesky {
 
 /// The CSC matrix of `columns` (row block -> 6x6 block, per column block) and the index of
 /// each diagonal entry among its values.
-fn csc(columns: &[BTreeMap<usize, Matrix6<f64>>]) -> (CscMatrix<f64>, Vec<usize>) {
+pub(super) fn csc(columns: &[BTreeMap<usize, Matrix6<f64>>]) -> (CscMatrix<f64>, Vec<usize>) {
     let n = 6 * columns.len();
     let (mut offsets, mut rows, mut values, mut diagonal) = (vec![0], Vec::new(), Vec::new(), vec![0; n]);
     for (k, column) in columns.iter().enumerate() {
@@ -113,7 +118,7 @@ fn csc(columns: &[BTreeMap<usize, Matrix6<f64>>]) -> (CscMatrix<f64>, Vec<usize>
 const RIGID_RANK_RATIO: f64 = 1e-12;
 
 /// A motion in the mass-weighted coordinates, in factor order, by its nonzero entries.
-struct Motion(Vec<(usize, f64)>);
+pub(super) struct Motion(pub(super) Vec<(usize, f64)>);
 
 impl Motion {
     fn dot(&self, v: &DVector<f64>) -> f64 {
@@ -121,17 +126,22 @@ impl Motion {
     }
 }
 
-/// The rigid motions of each group that keep its anchors in place, mass-weighted (W^-1 times
-/// the motion), orthonormal, in factor order. A rigid motion is a twist (t, w): body i's centre
+/// The mass-weighted coordinates of block i's translation u [m] and turn w [rad].
+pub(super) type Weigh<'a> = dyn Fn(usize, &Vector3<f64>, &Vector3<f64>) -> Vector6<f64> + 'a;
+
+/// The rigid motions of each group that keep its anchors in place, mass-weighted (`weigh` of
+/// each body's translation and turn: W^-1 times the motion for the step, L^T for the modes),
+/// orthonormal, in factor order. A rigid motion is a twist (t, w): body i's centre
 /// of mass moves by t + w x (c_i - c) and turns by w; an anchor a stays where
 /// t + w x (a - c) = 0, and the free twists are the null space of those constraints. Each
 /// motion is made orthogonal to those before it that move its bodies, on its bodies' entries
 /// alone (a group's after its bodies': the supports stay the groups').
-fn rigid_motions(
+pub(super) fn rigid_motions(
     dofs: &Dofs,
     length_m: f64,
     position: &[usize],
     groups: &[(Vec<usize>, Vec<Vector3<f64>>)],
+    weigh: &Weigh<'_>,
 ) -> Vec<Motion> {
     let mut basis: Vec<Motion> = Vec::new();
     // For each factor block, the motions that move it.
@@ -152,10 +162,8 @@ fn rigid_motions(
         for (t, w) in free_twists(anchors, centre, length_m) {
             let mut motion = DVector::zeros(6 * blocks.len());
             for (k, &i) in blocks.iter().enumerate() {
-                let (mass, inertia) = dofs.scale[i];
                 let u = t + w.cross(&(v3(dofs.com[i]) - centre));
-                motion.fixed_rows_mut::<3>(6 * k).copy_from(&(u * mass.sqrt()));
-                motion.fixed_rows_mut::<3>(6 * k + 3).copy_from(&(w * inertia.sqrt()));
+                motion.fixed_rows_mut::<6>(6 * k).copy_from(&weigh(i, &u, &w));
             }
             let before = motion.norm();
             for &m in &earlier {
