@@ -22,13 +22,11 @@
 
 use super::super::{Data, Model};
 use super::assemble::{Dofs, System};
-use super::ordering::reverse_cuthill_mckee;
-use super::sparse::{csc, rigid_motions, Motion};
+use super::sparse::{csc, ordered_columns, rigid_motions, Motion};
 use crate::eigen::EigenError;
 use nalgebra::{DMatrix, DVector, Matrix6, SymmetricEigen, Vector3, Vector6};
 use nalgebra_sparse::factorization::{CscCholesky, CscSymbolicCholesky};
 use nalgebra_sparse::CscMatrix;
-use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A known rigid motion y (unit, mass-weighted) is taken out where |A y| is below this
@@ -174,23 +172,12 @@ fn weighted_stiffness(dofs: &Dofs, system: &System, mass: &[Matrix6<f64>]) -> Re
         let l = block.cholesky().ok_or(EigenError::MassNotPositiveDefinite)?.l();
         inverse_factor.push(l.try_inverse().ok_or(EigenError::MassNotPositiveDefinite)?);
     }
-    let mut neighbours = vec![Vec::new(); n];
-    for &(i, k, _) in system.blocks.iter().filter(|(i, k, _)| i != k) {
-        neighbours[i].push(k);
-    }
-    let position = reverse_cuthill_mckee(&neighbours);
-    let mut columns: Vec<BTreeMap<usize, Matrix6<f64>>> = vec![BTreeMap::new(); n];
-    for (k, column) in columns.iter_mut().enumerate() {
-        column.insert(k, Matrix6::zeros());
-    }
-    for (i, k, block) in &system.blocks {
+    let (position, columns) = ordered_columns(system, n, |i, k, block| {
         if !block.iter().all(|x| x.is_finite()) {
             return Err(EigenError::NotFinite);
         }
-        let weighted = inverse_factor[*i] * block * inverse_factor[*k].transpose() * 0.5;
-        *columns[position[*k]].entry(position[*i]).or_insert_with(Matrix6::zeros) += weighted;
-        *columns[position[*i]].entry(position[*k]).or_insert_with(Matrix6::zeros) += weighted.transpose();
-    }
+        Ok(inverse_factor[i] * block * inverse_factor[k].transpose() * 0.5)
+    })?;
     let (matrix, diagonal) = csc(&columns);
     Ok(Weighted { matrix, diagonal, position, inverse_factor })
 }
@@ -343,7 +330,7 @@ mod tests {
     #[test]
     fn the_lowest_modes_of_a_free_chain_are_the_closed_form() {
         let n = 600;
-        let mut columns: Vec<BTreeMap<usize, Matrix6<f64>>> = vec![BTreeMap::new(); n / 6];
+        let mut columns: Vec<std::collections::BTreeMap<usize, Matrix6<f64>>> = vec![Default::default(); n / 6];
         let mut entry = |r: usize, c: usize, x: f64| {
             let block = columns[c / 6].entry(r / 6).or_insert_with(Matrix6::zeros);
             block[(r % 6, c % 6)] += x;

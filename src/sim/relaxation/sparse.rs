@@ -46,21 +46,11 @@ impl ShiftedCholesky {
     pub(super) fn new(dofs: &Dofs, system: &System, groups: &[(Vec<usize>, Vec<Vector3<f64>>)], length_m: f64) -> Self {
         let n = dofs.blocks();
         let weight = dofs.weight();
-        let mut neighbours = vec![Vec::new(); n];
-        for &(i, k, _) in system.blocks.iter().filter(|(i, k, _)| i != k) {
-            neighbours[i].push(k);
-        }
-        let position = reverse_cuthill_mckee(&neighbours);
-        // Column blocks in factor order: row block -> W H W block, symmetrized.
-        let mut columns: Vec<BTreeMap<usize, Matrix6<f64>>> = vec![BTreeMap::new(); n];
-        for (k, column) in columns.iter_mut().enumerate() {
-            column.insert(k, Matrix6::zeros());
-        }
-        for (i, k, block) in &system.blocks {
-            let weighted = Matrix6::from_fn(|r, c| weight[6 * i + r] * block[(r, c)] * weight[6 * k + c]) * 0.5;
-            *columns[position[*k]].entry(position[*i]).or_insert_with(Matrix6::zeros) += weighted;
-            *columns[position[*i]].entry(position[*k]).or_insert_with(Matrix6::zeros) += weighted.transpose();
-        }
+        // W H W, symmetrized.
+        let (position, columns) = ordered_columns(system, n, |i, k, block| {
+            Ok(Matrix6::from_fn(|r, c| weight[6 * i + r] * block[(r, c)] * weight[6 * k + c]) * 0.5)
+        })
+        .unwrap_or_else(|never: std::convert::Infallible| match never {});
         let (matrix, diagonal) = csc(&columns);
         let stiffest =
             (0..6 * n).map(|c| matrix.col(c).values().iter().map(|x| x.abs()).sum::<f64>()).fold(0.0_f64, f64::max);
@@ -89,6 +79,34 @@ impl ShiftedCholesky {
 
 /// The CSC matrix of `columns` (row block -> 6x6 block, per column block) and the index of
 /// each diagonal entry among its values.
+/// One column of 6 x 6 blocks: row block -> block.
+pub(super) type ColumnBlocks = BTreeMap<usize, Matrix6<f64>>;
+
+/// The blocks of `system` weighted by `weigh(i, k, block)` (half of each: the block and its
+/// transpose are both added) in reverse Cuthill-McKee order: each block's position in that
+/// order, and the column blocks (row block -> block, the diagonal always present).
+pub(super) fn ordered_columns<E>(
+    system: &System,
+    n: usize,
+    mut weigh: impl FnMut(usize, usize, &Matrix6<f64>) -> Result<Matrix6<f64>, E>,
+) -> Result<(Vec<usize>, Vec<ColumnBlocks>), E> {
+    let mut neighbours = vec![Vec::new(); n];
+    for &(i, k, _) in system.blocks.iter().filter(|(i, k, _)| i != k) {
+        neighbours[i].push(k);
+    }
+    let position = reverse_cuthill_mckee(&neighbours);
+    let mut columns: Vec<ColumnBlocks> = vec![BTreeMap::new(); n];
+    for (k, column) in columns.iter_mut().enumerate() {
+        column.insert(k, Matrix6::zeros());
+    }
+    for (i, k, block) in &system.blocks {
+        let weighted = weigh(*i, *k, block)?;
+        *columns[position[*k]].entry(position[*i]).or_insert_with(Matrix6::zeros) += weighted;
+        *columns[position[*i]].entry(position[*k]).or_insert_with(Matrix6::zeros) += weighted.transpose();
+    }
+    Ok((position, columns))
+}
+
 pub(super) fn csc(columns: &[BTreeMap<usize, Matrix6<f64>>]) -> (CscMatrix<f64>, Vec<usize>) {
     let n = 6 * columns.len();
     let (mut offsets, mut rows, mut values, mut diagonal) = (vec![0], Vec::new(), Vec::new(), vec![0; n]);
