@@ -97,9 +97,6 @@ def test_ctrl_c_stops_a_run():
     saw, printed after the interrupt (below 1000 s: stopped early). The child takes Python's own
     SIGINT handler: started from a shell's background job it inherits SIGINT ignored, and Python
     then installs none."""
-    import signal
-    import sys
-
     text = BAR.read_text().replace("duration_s = 4.0", "duration_s = 1000.0")
     script = (
         "import signal, sys, tensegrity_testbed as tt\n"
@@ -115,11 +112,8 @@ def test_ctrl_c_stops_a_run():
         "except KeyboardInterrupt:\n"
         "    print('interrupted at t =', seen[0], flush=True); sys.exit(3)\n"
     )
-    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
-    assert child.stdout.readline().strip() == "ticking"  # the event the signal waits for
-    child.send_signal(signal.SIGINT)
-    out, _ = child.communicate(timeout=60)  # a guard against a hang, not a speed target
-    assert child.returncode == 3 and out.startswith("interrupted at t = "), out
+    code, out = interrupted(script, "ticking")
+    assert code == 3 and out.startswith("interrupted at t = "), out
     assert float(out.split("=")[1]) < 1000.0, out  # the motion's last tick is at 1000 s
 
 
@@ -130,9 +124,6 @@ def test_ctrl_c_stops_a_run_whose_callable_blocks(block):
     loop at its next bytecode, and past the sleep once the run has been waited for one second
     (the run itself stops at its next tick, when the sleep ends). The signal is sent once the
     callable says it blocks; the 60 s guard is against a hang, not a speed target."""
-    import signal
-    import sys
-
     text = BAR.read_text().replace("duration_s = 4.0", "duration_s = 1000.0")
     script = (
         "import signal, sys, time, tensegrity_testbed as tt\n"
@@ -147,11 +138,22 @@ def test_ctrl_c_stops_a_run_whose_callable_blocks(block):
         "except KeyboardInterrupt:\n"
         "    print('interrupted', flush=True); sys.exit(3)\n"
     )
+    code, out = interrupted(script, "blocking")
+    assert code == 3 and out.strip() == "interrupted", (code, out)
+
+
+def interrupted(script, event):
+    """Runs ``script`` in a child Python, sends it SIGINT once it prints the line ``event`` (the
+    event the signal waits for) and returns (its exit code, the rest of its output). The 60 s
+    wait is a guard against a hang, not a speed target."""
+    import signal
+    import sys
+
     child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
-    assert child.stdout.readline().strip() == "blocking"  # the event the signal waits for
+    assert child.stdout.readline().strip() == event
     child.send_signal(signal.SIGINT)
     out, _ = child.communicate(timeout=60)
-    assert child.returncode == 3 and out.strip() == "interrupted", (child.returncode, out)
+    return child.returncode, out
 
 
 SWEEP = ROOT / "scenarios" / "custom" / "pinned_bar_sweep.toml"
