@@ -150,9 +150,7 @@ impl Draft {
     /// A cable's drawn length, the sum of its segments' \[m\] (None: a node not drawn).
     pub fn drawn_length(&self, c: &DraftCable) -> Option<f64> {
         let path: Vec<Vec3> = c.path().map(|n| self.position(n)).collect::<Option<_>>()?;
-        let mut segments = path.windows(2).map(|w| distance(w[0], w[1]));
-        let first = segments.next()?;
-        Some(segments.fold(first, |l, s| l + s))
+        Some(crate::structure::path_length(path))
     }
 
     /// Whether an elastic cable is drawn longer than its rest length (in tension when drawn).

@@ -536,12 +536,8 @@ fn cluster_strings(draft: &mut Draft, clusters: &[Vec<usize>]) -> Result<(), (us
         });
     }
     let gone: Vec<usize> = clusters.iter().flatten().copied().collect();
-    let mut j = 0;
-    draft.cables.retain(|_| {
-        j += 1;
-        !gone.contains(&(j - 1))
-    });
-    draft.cables.extend(clustered);
+    let kept = std::mem::take(&mut draft.cables).into_iter().enumerate().filter(|(j, _)| !gone.contains(j));
+    draft.cables = kept.map(|(_, c)| c).chain(clustered).collect();
     Ok(())
 }
 

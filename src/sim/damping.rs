@@ -181,7 +181,6 @@ impl Data {
         // stiffness: an estimate for the schedule, which is no part of a physical path.
         for (i, member) in s.members_by_kind() {
             let Some(law) = self.elastic_law(m, i) else { continue };
-            let length = self.member_length_m(m, i);
             let segment_laws = self.segment_laws(m, i);
             for (k, (a, b)) in member.segments().enumerate() {
                 let (a_carried, b_carried) = (carried(s.nodes[a].body), carried(s.nodes[b].body));
@@ -192,8 +191,13 @@ impl Data {
                 let (px, po) = (Vector::from(self.node_position(m, x)), Vector::from(self.node_position(m, other)));
                 let d = po - px;
                 let l = d.length();
-                // A cable with friction: the segment's own law (held at its node).
-                let (law, length) = segment_laws.as_ref().map_or((law, length), |laws| (laws[k], l));
+                // The whole path's length (a straight member's is this segment's); a cable with
+                // friction: the segment's own law (held at its node).
+                let (law, length) = match &segment_laws {
+                    Some(laws) => (laws[k], l),
+                    None if member.is_clustered() => (law, self.member_length_m(m, i)),
+                    None => (law, l),
+                };
                 if l <= 0.0 || !law.engaged(length) {
                     continue;
                 }

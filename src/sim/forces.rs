@@ -53,14 +53,18 @@ impl Data {
     /// first step, which gave a spurious kick of |c x F| there.
     fn add_member_load(&mut self, m: &Model, i: usize, law: &ElasticLaw) {
         let member = &m.structure.members[i];
-        let t = law.tension_n(self.member_length_m(m, i));
+        // The path's length sets the tension: a straight member's is its one segment's.
+        let path_m = member.is_clustered().then(|| self.member_length_m(m, i));
         let segment_laws = self.segment_laws(m, i);
         for (k, (a, b)) in member.segments().enumerate() {
             let (pa, pb) = (v(self.node_position(m, a)), v(self.node_position(m, b)));
             let d = pb - pa;
             let l = d.length();
             // A cable with friction: each segment its own tension (`capstan.rs`).
-            let t = segment_laws.as_ref().map_or(t, |laws| laws[k].tension_n(l));
+            let t = match &segment_laws {
+                Some(laws) => laws[k].tension_n(l),
+                None => law.tension_n(path_m.unwrap_or(l)),
+            };
             if l > 0.0 && t != 0.0 {
                 let f = d / l * t;
                 for (node, f, p) in [(a, f, pa), (b, -f, pb)] {
@@ -78,11 +82,7 @@ impl Data {
 
     /// Member `i`'s length now, the sum of its segments' \[m\].
     pub(super) fn member_length_m(&self, m: &Model, i: usize) -> f64 {
-        let member = &m.structure.members[i];
-        let mut lengths =
-            member.segments().map(|(a, b)| (v(self.node_position(m, b)) - v(self.node_position(m, a))).length());
-        let first = lengths.next().unwrap_or(0.0);
-        lengths.fold(first, |l, s| l + s)
+        m.structure.members[i].length_at(|n| self.node_position(m, n))
     }
 
     /// Torque of joint `j`'s torsion spring at the joint's current angle [N m]: -k (q - q_rest),
@@ -151,17 +151,20 @@ impl Data {
         // `tension_at(l)` (a cable with friction, each segment with its own law); returns
         // (l, tension, each segment's tension if it has more than one).
         let mut pull = |i: usize, tension_at: &dyn Fn(f64) -> f64| -> (f64, f64, Vec<f64>) {
-            let l = self.member_length_m(m, i);
-            let mut tension = tension_at(l);
+            // The path's length sets the tension: a straight member's is its one segment's.
+            let path_m = s.members[i].is_clustered().then(|| self.member_length_m(m, i));
+            let (mut l, mut tension) = (0.0, 0.0);
             let segment_laws = self.segment_laws(m, i);
             let mut segments = Vec::new();
             for (k, (a, b)) in s.members[i].segments().enumerate() {
                 let (pa, pb) = (v(self.node_position(m, a)), v(self.node_position(m, b)));
                 let d = pb - pa;
                 let segment = d.length();
-                if let Some(laws) = &segment_laws {
-                    tension = laws[k].tension_n(segment);
-                }
+                l = path_m.unwrap_or(segment);
+                tension = match &segment_laws {
+                    Some(laws) => laws[k].tension_n(segment),
+                    None => tension_at(l),
+                };
                 if s.members[i].is_clustered() {
                     segments.push(tension);
                 }

@@ -9,6 +9,20 @@
 
 use super::{distance, NodeId, Vec3};
 
+/// The length of the polyline through `points` \[m\]: its segments' lengths added in order
+/// (0 for fewer than two points).
+pub fn path_length(points: impl IntoIterator<Item = Vec3>) -> f64 {
+    let mut points = points.into_iter();
+    let Some(mut last) = points.next() else { return 0.0 };
+    let mut total: Option<f64> = None;
+    for p in points {
+        let segment = distance(last, p);
+        total = Some(total.map_or(segment, |t| t + segment));
+        last = p;
+    }
+    total.unwrap_or(0.0)
+}
+
 /// Index of a member in [`super::Structure::members`].
 pub type MemberId = usize;
 
@@ -163,9 +177,7 @@ impl Member {
 
     /// The path's length with the nodes at `position` \[m\]: the sum of its segments'.
     pub fn length_at(&self, position: impl Fn(NodeId) -> Vec3) -> f64 {
-        let mut lengths = self.segments().map(|(a, b)| distance(position(a), position(b)));
-        let first = lengths.next().unwrap_or(0.0);
-        lengths.fold(first, |l, s| l + s)
+        path_length(self.path.iter().map(|&n| position(n)))
     }
 }
 
