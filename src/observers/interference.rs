@@ -28,6 +28,10 @@ const MIN_CLEARANCE_SERIES: &str = "interference/min_clearance_m";
 /// Endpoints closer than this fraction of the structure's size count as the same joint.
 const COINCIDENT_FRACTION: f64 = 1e-9;
 
+/// The most pairs the report lists (the closest); it counts the rest. A thousand struts with
+/// their tendons have 8 million pairs within a structure-sized margin, 2 GB as a list.
+pub const REPORTED_PAIRS_MAX: usize = 1000;
+
 /// One capsule: segment ends \[m\] and radius \[m\].
 pub type Capsule = ([f64; 3], [f64; 3], f64);
 
@@ -110,44 +114,86 @@ pub fn attached_pairs(s: &Structure, members: &[Segment]) -> HashSet<(usize, usi
 /// of the 3-strut prism with the hierarchy).
 const DIRECT_PAIRS_MAX_CAPSULES: usize = 48;
 
-/// Clearance of every pair of capsules closer than `margin_m`, except the excluded ones.
-pub fn clearances(capsules: &[Capsule], margin_m: f64, excluded: impl Fn(usize, usize) -> bool) -> Vec<PairClearance> {
-    if capsules.len() < 2 {
-        return Vec::new();
-    }
-    let half = 0.5 * margin_m;
-    let boxes: Vec<Aabb> = capsules
-        .iter()
-        .map(|(a, b, r)| {
-            let (a, b) = (vec3(*a), vec3(*b));
-            let pad = Vector::splat(r + half);
-            Aabb::new(a.min(b) - pad, a.max(b) + pad)
-        })
-        .collect();
+/// Clearance of every pair of capsules closer than `margin_m`, except the excluded ones, in
+/// pair order.
+pub fn clearances(
+    capsules: &[Capsule],
+    margin_m: f64,
+    excluded: impl FnMut(usize, usize) -> bool,
+) -> Vec<PairClearance> {
     let mut out = Vec::new();
-    let mut test = |i: usize, j: usize| {
-        if i < j && !excluded(i, j) {
+    visit_clearances(capsules, margin_m, excluded, |p| out.push(p));
+    out
+}
+
+/// Calls `visit` with the clearance of every pair of capsules closer than `margin_m`, in pair
+/// order (i < j, by i then j), except those `excluded` names (asked in the same order). The
+/// per-tick check folds each into its statistics as it comes, in one sequential pass: a
+/// structure whose every pair lies within the margin (a thousand members and more) costs no
+/// list of clearances and no lookup by hash.
+pub fn visit_clearances(
+    capsules: &[Capsule],
+    margin_m: f64,
+    mut excluded: impl FnMut(usize, usize) -> bool,
+    mut visit: impl FnMut(PairClearance),
+) {
+    let mut narrow = |i: usize, j: usize| {
+        if !excluded(i, j) {
             if let Some(p) = pair_clearance(capsules, i, j, margin_m) {
-                out.push(p);
+                visit(p);
             }
         }
     };
-    if capsules.len() <= DIRECT_PAIRS_MAX_CAPSULES {
-        for i in 0..capsules.len() {
-            for j in i + 1..capsules.len() {
+    let boxes = inflated_boxes(capsules, margin_m);
+    let n = capsules.len();
+    if n <= DIRECT_PAIRS_MAX_CAPSULES {
+        for i in 0..n {
+            for j in i + 1..n {
                 if boxes[i].intersects(&boxes[j]) {
-                    test(i, j);
+                    narrow(i, j);
                 }
             }
         }
-    } else {
-        let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &boxes);
-        for (i, j) in bvh.leaf_pairs(&bvh, |n1, n2| n1.intersects(n2)) {
-            test(i as usize, j as usize);
+        return;
+    }
+    let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &boxes);
+    let mut near = Vec::new();
+    for (i, bx) in boxes.iter().enumerate() {
+        near.clear();
+        near.extend(bvh.intersect_aabb(bx).map(|j| j as usize).filter(|&j| j > i));
+        near.sort_unstable();
+        for &j in &near {
+            narrow(i, j);
         }
     }
-    out.sort_by_key(|p| (p.i, p.j));
-    out
+}
+
+/// Each capsule's box, inflated by its radius and half the margin: two boxes overlap when
+/// the capsules may come within the margin (the broad phase).
+fn inflated_boxes(capsules: &[Capsule], margin_m: f64) -> Vec<Aabb> {
+    let half = 0.5 * margin_m;
+    let inflated = |(a, b, r): &Capsule| {
+        let (a, b) = (vec3(*a), vec3(*b));
+        let pad = Vector::splat(r + half);
+        Aabb::new(a.min(b) - pad, a.max(b) + pad)
+    };
+    capsules.iter().map(inflated).collect()
+}
+
+/// Keeps the smaller of `least` and `c` in `least`.
+fn lower(least: &mut Option<f64>, c: f64) {
+    *least = Some(least.map_or(c, |l| l.min(c)));
+}
+
+/// Membership in `sorted` (pairs in order) for pairs asked in increasing order: one pass.
+fn member_of(sorted: &[(usize, usize)]) -> impl FnMut(usize, usize) -> bool + '_ {
+    let mut at = 0;
+    move |i, j| {
+        while at < sorted.len() && sorted[at] < (i, j) {
+            at += 1;
+        }
+        sorted.get(at) == Some(&(i, j))
+    }
 }
 
 /// The clearance of capsules `i` and `j` (segment distance minus both radii) and the closest
@@ -169,26 +215,39 @@ fn pair_clearance(capsules: &[Capsule], i: usize, j: usize, margin_m: f64) -> Op
     })
 }
 
-#[derive(Clone, Debug)]
+/// A pair's smallest clearance over the run, where it fell and the closest points there.
+#[derive(Clone, Copy, Debug)]
 struct PairStats {
+    pair: (usize, usize),
     min_clearance_m: f64,
     tick_of_min: u64,
     points_at_min: [[f64; 3]; 2],
-    /// Open violation interval (first, last tick).
-    open: Option<(u64, u64)>,
-    /// Closed violation intervals, each with its minimum clearance and closest points.
-    violations: Vec<InterferenceViolation>,
-    /// Minimum within the open interval.
-    open_min: (f64, u64, [[f64; 3]; 2]),
 }
 
-/// The interference observer.
+/// A violation interval still open: its first and last tick so far and its smallest
+/// clearance (with the tick and the closest points there).
+#[derive(Clone, Copy, Debug)]
+struct OpenInterval {
+    first: u64,
+    last: u64,
+    min: (f64, u64, [[f64; 3]; 2]),
+}
+
+/// The interference observer. Its statistics hold one small record per pair that ever came
+/// within the margin, in pair order, so that a tick folds the clearances (which come in the
+/// same order) into them in one sequential pass.
 pub struct Interference {
     settings: InterferenceSettings,
     members: Vec<Segment>,
-    excluded: HashSet<(usize, usize)>,
+    /// The pairs not checked, in order.
+    excluded: Vec<(usize, usize)>,
     pairs_checked: usize,
-    stats: BTreeMap<(usize, usize), PairStats>,
+    /// Each pair's record, in pair order.
+    stats: Vec<PairStats>,
+    /// Violation intervals still open, by pair.
+    open: BTreeMap<(usize, usize), OpenInterval>,
+    /// Violation intervals closed.
+    closed: Vec<((usize, usize), InterferenceViolation)>,
     ticks: u64,
 }
 
@@ -204,6 +263,8 @@ impl Interference {
                 excluded.insert((i.min(j), i.max(j)));
             }
         }
+        let mut excluded: Vec<(usize, usize)> = excluded.into_iter().collect();
+        excluded.sort_unstable();
         let n = members.len();
         let pairs_checked = n * n.saturating_sub(1) / 2 - excluded.iter().filter(|(i, j)| i != j).count();
         let mut observer = Interference {
@@ -211,7 +272,9 @@ impl Interference {
             members,
             excluded,
             pairs_checked,
-            stats: BTreeMap::new(),
+            stats: Vec::new(),
+            open: BTreeMap::new(),
+            closed: Vec::new(),
             ticks: 0,
         };
         if settings.enabled {
@@ -228,12 +291,6 @@ impl Interference {
         self.members.iter().map(|t| (nodes[t.a], nodes[t.b], t.radius_m)).collect()
     }
 
-    /// The clearances at one configuration, with this observer's exclusions.
-    pub fn measure(&self, nodes: &[[f64; 3]]) -> Vec<PairClearance> {
-        let excluded = &self.excluded;
-        clearances(&self.capsules(nodes), self.settings.margin_m, |i, j| excluded.contains(&(i, j)))
-    }
-
     fn pair_names(&self, i: usize, j: usize) -> [String; 2] {
         [self.members[i].name.clone(), self.members[j].name.clone()]
     }
@@ -243,23 +300,23 @@ impl Interference {
     }
 
     pub fn report(&self) -> InterferenceReport {
-        let mut violations = Vec::new();
-        let mut closest: Option<(&(usize, usize), &PairStats)> = None;
-        for (pair, st) in &self.stats {
-            violations.extend(st.violations.iter().cloned());
-            if let Some((first, last)) = st.open {
-                violations.push(self.violation(*pair, first, last, st.open_min));
-            }
-            if closest.is_none_or(|(_, c)| st.min_clearance_m < c.min_clearance_m) {
-                closest = Some((pair, st));
-            }
-        }
+        let listed = self.listed_pairs();
+        // Each pair's violations in pair order, the closed before the open, then by first tick
+        // and names (a stable sort).
+        let mut closed: Vec<&((usize, usize), InterferenceViolation)> = self.closed.iter().collect();
+        closed.sort_by_key(|(pair, _)| *pair);
+        let mut by_pair: Vec<((usize, usize), u8, InterferenceViolation)> =
+            closed.into_iter().map(|(pair, v)| (*pair, 0, v.clone())).collect();
+        by_pair.extend(self.open.iter().map(|(&pair, iv)| (pair, 1, self.violation(pair, iv.first, iv.last, iv.min))));
+        by_pair.sort_by_key(|(pair, order, _)| (*pair, *order));
+        let mut violations: Vec<InterferenceViolation> = by_pair.into_iter().map(|(_, _, v)| v).collect();
         violations.sort_by(|a, b| (a.first_tick, &a.pair).cmp(&(b.first_tick, &b.pair)));
+        let closest = self.stats.iter().reduce(|c, st| if st.min_clearance_m < c.min_clearance_m { st } else { c });
         InterferenceReport {
-            min_clearance_m: closest.map(|(_, st)| st.min_clearance_m),
-            closest_pair: closest.map(|((i, j), _)| self.pair_names(*i, *j)),
-            closest_points: closest.map(|(_, st)| st.points_at_min),
-            tick_of_min: closest.map(|(_, st)| st.tick_of_min),
+            min_clearance_m: closest.map(|st| st.min_clearance_m),
+            closest_pair: closest.map(|st| self.pair_names(st.pair.0, st.pair.1)),
+            closest_points: closest.map(|st| st.points_at_min),
+            tick_of_min: closest.map(|st| st.tick_of_min),
             enabled: self.settings.enabled,
             tendons: self.settings.tendons,
             members_checked: self.members.len(),
@@ -270,18 +327,33 @@ impl Interference {
             informative: self.settings.informative,
             passed: self.settings.informative || violations.is_empty(),
             violations,
-            pairs: self
-                .stats
+            pairs_within_margin: (listed.len() < self.stats.len()).then_some(self.stats.len()),
+            pairs: listed
                 .iter()
-                .map(|((i, j), st)| PairClearanceReport {
-                    pair: self.pair_names(*i, *j),
-                    kinds: self.pair_kinds(*i, *j),
+                .map(|st| PairClearanceReport {
+                    pair: self.pair_names(st.pair.0, st.pair.1),
+                    kinds: self.pair_kinds(st.pair.0, st.pair.1),
                     min_clearance_m: st.min_clearance_m,
                     tick_of_min: st.tick_of_min,
                     closest_points: st.points_at_min,
                 })
                 .collect(),
         }
+    }
+
+    /// The pairs the report lists, in pair order: all that came within the margin, or past
+    /// `REPORTED_PAIRS_MAX`, that many, the closest (ties by pair order).
+    fn listed_pairs(&self) -> Vec<&PairStats> {
+        let mut listed: Vec<&PairStats> = self.stats.iter().collect();
+        if listed.len() > REPORTED_PAIRS_MAX {
+            let closer = |a: &&PairStats, b: &&PairStats| {
+                a.min_clearance_m.total_cmp(&b.min_clearance_m).then(a.pair.cmp(&b.pair))
+            };
+            listed.select_nth_unstable_by(REPORTED_PAIRS_MAX, closer);
+            listed.truncate(REPORTED_PAIRS_MAX);
+            listed.sort_unstable_by_key(|st| st.pair);
+        }
+        listed
     }
 
     fn violation(
@@ -315,7 +387,11 @@ impl Observer for Interference {
         if !self.settings.enabled {
             return;
         }
-        let c = self.measure(&p.snapshot.nodes).iter().map(|m| m.clearance_m).reduce(f64::min);
+        let mut c: Option<f64> = None;
+        let capsules = self.capsules(&p.snapshot.nodes);
+        visit_clearances(&capsules, self.settings.margin_m, member_of(&self.excluded), |m| {
+            lower(&mut c, m.clearance_m);
+        });
         point.min_clearance_m = c;
         point.interference_free = Some(c.is_none_or(|c| c >= self.settings.threshold_m));
     }
@@ -330,55 +406,151 @@ impl Interference {
     /// and the intervals below the threshold.
     fn check(&mut self, tick: u64, nodes: &[[f64; 3]], notes: &mut Vec<Note>) {
         self.ticks += 1;
-        let measured = self.measure(nodes);
-        if let Some(c) = measured.iter().map(|p| p.clearance_m).reduce(f64::min) {
-            notes.push(Note::Scalar(MIN_CLEARANCE_SERIES, c));
-        }
         let threshold = self.settings.threshold_m;
-        let mut below = std::collections::BTreeSet::new();
-        for p in &measured {
-            let st = self.stats.entry((p.i, p.j)).or_insert(PairStats {
-                min_clearance_m: f64::INFINITY,
-                tick_of_min: tick,
-                points_at_min: p.points,
-                open: None,
-                violations: Vec::new(),
-                open_min: (f64::INFINITY, tick, p.points),
-            });
+        let capsules = self.capsules(nodes);
+        let (stats, open) = (&mut self.stats, &mut self.open);
+        let mut least: Option<f64> = None;
+        let mut opened = Vec::new();
+        let mut fresh = Vec::new();
+        let mut at = 0;
+        visit_clearances(&capsules, self.settings.margin_m, member_of(&self.excluded), |p| {
+            lower(&mut least, p.clearance_m);
+            while at < stats.len() && stats[at].pair < (p.i, p.j) {
+                at += 1;
+            }
+            let st = if stats.get(at).is_some_and(|st| st.pair == (p.i, p.j)) {
+                &mut stats[at]
+            } else {
+                let pair = (p.i, p.j);
+                fresh.push(PairStats {
+                    pair,
+                    min_clearance_m: f64::INFINITY,
+                    tick_of_min: tick,
+                    points_at_min: p.points,
+                });
+                fresh.last_mut().expect("just pushed")
+            };
             if p.clearance_m < st.min_clearance_m {
                 st.min_clearance_m = p.clearance_m;
                 st.tick_of_min = tick;
                 st.points_at_min = p.points;
             }
             if p.clearance_m < threshold {
-                below.insert((p.i, p.j));
-                match &mut st.open {
-                    Some(iv) => iv.1 = tick,
-                    None => {
-                        st.open = Some((tick, tick));
-                        st.open_min = (f64::INFINITY, tick, p.points);
-                        let (a, b) = (&self.members[p.i], &self.members[p.j]);
-                        notes.push(Note::Event(format!(
-                            "interference: {} '{}' / {} '{}' clearance {:.3e} m",
-                            a.kind, a.name, b.kind, b.name, p.clearance_m
-                        )));
-                    }
-                }
-                if p.clearance_m < st.open_min.0 {
-                    st.open_min = (p.clearance_m, tick, p.points);
+                let iv = open.entry((p.i, p.j)).or_insert_with(|| {
+                    opened.push(p);
+                    OpenInterval { first: tick, last: tick, min: (f64::INFINITY, tick, p.points) }
+                });
+                iv.last = tick;
+                if p.clearance_m < iv.min.0 {
+                    iv.min = (p.clearance_m, tick, p.points);
                 }
             }
+        });
+        if self.stats.is_empty() {
+            fresh.shrink_to_fit();
+            self.stats = fresh;
+        } else if !fresh.is_empty() {
+            self.stats.extend(fresh);
+            self.stats.sort_by_key(|st| st.pair);
+        }
+        if let Some(c) = least {
+            notes.push(Note::Scalar(MIN_CLEARANCE_SERIES, c));
+        }
+        opened.sort_by_key(|p| (p.i, p.j));
+        for p in opened {
+            let (a, b) = (&self.members[p.i], &self.members[p.j]);
+            notes.push(Note::Event(format!(
+                "interference: {} '{}' / {} '{}' clearance {:.3e} m",
+                a.kind, a.name, b.kind, b.name, p.clearance_m
+            )));
         }
         // Close the intervals of pairs that are clear again.
         let to_close: Vec<(usize, usize)> =
-            self.stats.iter().filter(|(k, st)| st.open.is_some() && !below.contains(*k)).map(|(k, _)| *k).collect();
+            self.open.iter().filter(|(_, iv)| iv.last != tick).map(|(k, _)| *k).collect();
         for k in to_close {
-            let st = &self.stats[&k];
-            let (first, last) = st.open.expect("open");
-            let v = self.violation(k, first, last, st.open_min);
-            let st = self.stats.get_mut(&k).expect("present");
-            st.violations.push(v);
-            st.open = None;
+            let iv = self.open.remove(&k).expect("open");
+            self.closed.push((k, self.violation(k, iv.first, iv.last, iv.min)));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A reproducible stream of numbers in [0, 1) (a linear congruential generator).
+    fn uniform(seed: &mut u64) -> f64 {
+        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// 300 capsules (past the direct test's 48) up to 0.3 m long in a 1 m cube, radius 10 mm.
+    fn scattered_capsules() -> Vec<Capsule> {
+        let mut seed = 7;
+        let mut point = |scale: f64| [0; 3].map(|_| scale * uniform(&mut seed));
+        (0..300)
+            .map(|_| {
+                let a = point(1.0);
+                let d = point(0.3);
+                (a, [a[0] + d[0], a[1] + d[1], a[2] + d[2]], 0.01)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_bounding_volume_hierarchy_finds_every_pair_the_direct_test_finds_in_pair_order() {
+        let capsules = scattered_capsules();
+        let margin_m = 0.05;
+        let n = capsules.len();
+        let direct: Vec<PairClearance> = (0..n)
+            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+            .filter_map(|(i, j)| pair_clearance(&capsules, i, j, margin_m))
+            .collect();
+        let skipped = |i: usize, j: usize| (i + j) % 17 == 0;
+        let found = clearances(&capsules, margin_m, skipped);
+        let expected: Vec<PairClearance> = direct.into_iter().filter(|p| !skipped(p.i, p.j)).collect();
+        assert!(expected.len() > 400, "a dense enough sample: {}", expected.len());
+        assert_eq!(found, expected);
+    }
+
+    #[test]
+    fn past_its_bound_the_report_lists_the_closest_pairs_in_pair_order_and_counts_them_all() {
+        let members: Vec<Segment> =
+            (0..60).map(|k| Segment { name: format!("m{k}"), kind: "strut", a: 0, b: 0, radius_m: 0.0 }).collect();
+        let pairs: Vec<(usize, usize)> = (0..60).flat_map(|i| (i + 1..60).map(move |j| (i, j))).collect();
+        assert_eq!(pairs.len(), 1770);
+        // Clearance 1 m + k mm for the k-th pair in a scrambled order: the listed ones are those
+        // whose k is below the bound.
+        let rank = |p: usize| (p * 7919) % pairs.len();
+        let stats = pairs
+            .iter()
+            .enumerate()
+            .map(|(p, &pair)| PairStats {
+                pair,
+                min_clearance_m: 1.0 + 1e-3 * rank(p) as f64,
+                tick_of_min: 0,
+                points_at_min: [[0.0; 3]; 2],
+            })
+            .collect();
+        let observer = Interference {
+            settings: InterferenceSettings::default_on(10.0),
+            members,
+            excluded: Vec::new(),
+            pairs_checked: pairs.len(),
+            stats,
+            open: BTreeMap::new(),
+            closed: Vec::new(),
+            ticks: 1,
+        };
+        let report = observer.report();
+        assert_eq!(report.pairs.len(), REPORTED_PAIRS_MAX);
+        assert_eq!(report.pairs_within_margin, Some(1770));
+        let expected: Vec<[String; 2]> = (0..pairs.len())
+            .filter(|&p| rank(p) < REPORTED_PAIRS_MAX)
+            .map(|p| [format!("m{}", pairs[p].0), format!("m{}", pairs[p].1)])
+            .collect();
+        let listed: Vec<[String; 2]> = report.pairs.iter().map(|p| p.pair.clone()).collect();
+        assert_eq!(listed, expected);
+        assert_eq!(report.min_clearance_m, Some(1.0));
     }
 }

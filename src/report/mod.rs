@@ -675,8 +675,12 @@ pub struct InterferenceReport {
     pub informative: bool,
     pub passed: bool,
     pub violations: Vec<InterferenceViolation>,
-    /// Every pair that came within the margin: its smallest clearance over the run.
+    /// Every pair that came within the margin, in pair order: its smallest clearance over the
+    /// run. Past `REPORTED_PAIRS_MAX` pairs, only that many, the closest.
     pub pairs: Vec<PairClearanceReport>,
+    /// How many pairs came within the margin, when `pairs` lists only the closest of them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pairs_within_margin: Option<usize>,
 }
 
 /// The smallest clearance of one strut pair over the run.
