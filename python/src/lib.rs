@@ -496,11 +496,18 @@ fn findings(mechanism: &str, params: BTreeMap<String, f64>) -> PyResult<Vec<(Str
 /// The modal analysis of `tensegrity modes --json`: the same report, as its JSON text, at the
 /// scenario's first point settled as `run` settles it. Ctrl-C stops the settle.
 #[pyfunction]
-#[pyo3(signature = (path, text=None, set=Vec::new()))]
-fn modes_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>) -> PyResult<String> {
+#[pyo3(signature = (path, text=None, set=Vec::new(), count=tensegrity_testbed::structure::SPARSE_MODAL_COUNT))]
+fn modes_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>, count: usize) -> PyResult<String> {
+    let max = tensegrity_testbed::structure::MAX_SPARSE_MODAL_COUNT;
+    if !(1..=max).contains(&count) {
+        return Err(PyValueError::new_err(format!(
+            "count must be from 1 to {max} (the lowest non-rigid modes the sparse solver computes), got {count}"
+        )));
+    }
     let sc = load(path, text, &set)?;
     let file = path.to_string();
-    let result = on_own_thread(py, move |cancel| run::modes(&sc, &file, Some(cancel)).map(|(report, ..)| report))?;
+    let result =
+        on_own_thread(py, move |cancel| run::modes(&sc, &file, count, Some(cancel)).map(|(report, ..)| report))?;
     let report = result.map_err(|e| match e {
         run::ModesRunError::Refused(_) => PyValueError::new_err(format!("{path}: {e}")),
         _ => PyException::new_err(format!("{path}: {e}")),

@@ -179,16 +179,18 @@ def sweep(
     return pd.read_csv(io.StringIO(csv)), json.loads(summary)
 
 
-def modes(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml") -> dict:
+def modes(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml",
+          count: int = 20) -> dict:
     """The structure's natural frequencies and mode shapes at its first point, settled as
     ``run`` settles it: the report of ``tensegrity modes --json`` as a dict (``modes``: one per
     mode, ascending omega^2, with ``omega_rad_per_s``, ``frequency_hz``, ``rigid`` and the
     nodes that move most; ``coordinates``, ``joint_coordinates``, ``rigid_modes``; above 100
-    free bodies ``lowest_of``: the list is the lowest of that many). Raises
+    free bodies ``lowest_of``: the list is the lowest ``count`` non-rigid modes (1 to 200, as
+    ``modes --count``) and every rigid one, of that many). Raises
     ScenarioError on bad input, ValueError where the structure's modes are not computed (the
-    reason named), KeyboardInterrupt on Ctrl-C."""
+    reason named) or ``count`` is out of range, KeyboardInterrupt on Ctrl-C."""
     path, text = _source(scenario, name)
-    return json.loads(_call(_tensegrity.modes_json, path, text, _sets(set)))
+    return json.loads(_call(_tensegrity.modes_json, path, text, _sets(set), count))
 
 
 def sensitivity(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml",

@@ -629,6 +629,14 @@ def test_modes_from_python_are_the_clis_modes_json():
     assert py["joint_coordinates"] == ["pin"] and len(py["modes"]) == 1
 
 
+def test_a_modes_count_outside_its_range_raises():
+    """count is how many non-rigid modes the sparse solver computes, 1 to 200 as
+    ``modes --count``: outside, a ValueError naming the range, before any settle."""
+    for count in (0, 201):
+        with pytest.raises(ValueError, match="count must be from 1 to 200"):
+            tt.modes(str(ROCKER), count=count)
+
+
 def test_sensitivity_from_python_is_the_clis_sensitivity_json():
     """tt.sensitivity is `tensegrity sensitivity --json`: every field equal (floats bit for bit),
     the wall times aside; the rocker's d omega/d k1 agrees with the settles' within 1e-6."""

@@ -69,6 +69,11 @@ pub enum Command {
         /// Record each mode animated at its frequency to this .rrd file (rerun).
         #[arg(long, value_name = "FILE.rrd")]
         record: Option<PathBuf>,
+        /// Above 100 free bodies on springs and elastic cables: how many of the lowest
+        /// non-rigid modes the sparse solver computes (1 to 200; every mode below).
+        #[arg(long, default_value_t = crate::structure::SPARSE_MODAL_COUNT, value_name = "N",
+              value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=crate::structure::MAX_SPARSE_MODAL_COUNT as u64))]
+        count: usize,
         #[command(flatten)]
         set: SetArgs,
     },

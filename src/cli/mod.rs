@@ -121,8 +121,8 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         Command::Findings { mechanism, set, json } => findings::findings(&mechanism, &set, json),
         Command::Import { format } => import::import(format),
         Command::Export { format } => export::export(format),
-        Command::Modes { scenario, json, record, set } => {
-            modes::modes(&scenario, &overrides(&set)?, json.as_deref(), record.as_deref())
+        Command::Modes { scenario, json, record, count, set } => {
+            modes::modes(&scenario, &overrides(&set)?, json.as_deref(), record.as_deref(), count)
         }
         Command::Sensitivity { scenario, json, csv, point, check, set } => {
             sensitivity::sensitivity(&scenario, &overrides(&set)?, json.as_deref(), csv.as_deref(), point, check)

@@ -14,6 +14,7 @@ pub fn modes(
     overrides: &[crate::scenario::Override],
     json: Option<&Path>,
     record: Option<&Path>,
+    count: usize,
 ) -> Result<Outcome, CliError> {
     let sc = load_one(scenario, overrides)?;
     super::check_recording_path(record)?;
@@ -22,11 +23,13 @@ pub fn modes(
         .filter_map(|(flag, p)| p.map(|p| (flag.to_string(), p.to_path_buf())))
         .collect();
     check_outputs(&[scenario.to_path_buf()], &outputs)?;
-    let (report, state, analysis) = crate::run::modes(&sc, &scenario.display().to_string(), Some(&signals::CANCEL))
-        .map_err(|e| match e {
-            ModesRunError::Refused(_) => bad_input(format!("{}: {e}", scenario.display())),
-            _ => failed(format!("{}: {e}", scenario.display())),
-        })?;
+    let (report, state, analysis) =
+        crate::run::modes(&sc, &scenario.display().to_string(), count, Some(&signals::CANCEL)).map_err(
+            |e| match e {
+                ModesRunError::Refused(_) => bad_input(format!("{}: {e}", scenario.display())),
+                _ => failed(format!("{}: {e}", scenario.display())),
+            },
+        )?;
     // With `--json -` standard output is the JSON alone: the table goes to standard error.
     if json.is_some_and(super::is_stdio) {
         eprint!("{}", report.to_table());

@@ -506,7 +506,7 @@ mod tests {
             .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
             .filter_map(|(i, j)| pair_clearance(&capsules, i, j, margin_m))
             .collect();
-        let skipped = |i: usize, j: usize| (i + j) % 17 == 0;
+        let skipped = |i: usize, j: usize| (i + j).is_multiple_of(17);
         let found = clearances(&capsules, margin_m, skipped);
         let expected: Vec<PairClearance> = direct.into_iter().filter(|p| !skipped(p.i, p.j)).collect();
         assert!(expected.len() > 400, "a dense enough sample: {}", expected.len());

@@ -167,7 +167,9 @@ fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, RunE
     if wanted.is_empty() {
         return Ok(vec![]);
     }
-    let analysis = match runner.sim.modes_until(runner.cancel) {
+    let through = wanted.last().copied();
+    let lowest = crate::sim::modes::Lowest { through, ..Default::default() };
+    let analysis = match runner.sim.modes_until(lowest, runner.cancel) {
         Err(ModesError::Eigen(EigenError::Interrupted)) => return Err(RunError::Interrupted(runner.sim.tick())),
         analysis => analysis?,
     };

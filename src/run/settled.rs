@@ -58,10 +58,12 @@ pub enum ModesRunError {
 
 /// The modal analysis of `sc` at its first point, settled as `run` settles it: the report
 /// `tensegrity modes` prints (and `tensegrity_testbed.modes` returns), named by `file`; the
-/// settled state and the analysis with it (for a recording of the modes).
+/// settled state and the analysis with it (for a recording of the modes). Above
+/// `DENSE_MODAL_MAX_FREE_BODIES` free bodies the lowest `count` non-rigid modes.
 pub fn modes(
     sc: &Scenario,
     file: &str,
+    count: usize,
     cancel: Option<&AtomicBool>,
 ) -> Result<(ModesReport, SettledState, StructureModes), ModesRunError> {
     if let Some(c) = &sc.custom {
@@ -70,7 +72,8 @@ pub fn modes(
     }
     let mut state = settle_first_point(sc, cancel)?;
     let wall = Instant::now();
-    let analysis = state.sim.modes_until(cancel).map_err(|e| match e {
+    let lowest = crate::sim::modes::Lowest { count, through: None };
+    let analysis = state.sim.modes_until(lowest, cancel).map_err(|e| match e {
         ModesError::Eigen(crate::eigen::EigenError::Interrupted) => RunError::Interrupted(state.sim.tick()).into(),
         ModesError::Eigen(_) => ModesRunError::Eigen(e),
         _ => ModesRunError::Refused(e),

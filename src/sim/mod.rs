@@ -371,7 +371,7 @@ impl Simulation {
     /// The structure's natural modes at its current state: over six coordinates per free body,
     /// or reduced to the joints' coordinates where there are joints (`joint_modes.rs`).
     pub fn modes(&mut self) -> Result<modes::StructureModes, modes::ModesError> {
-        self.data.modes(&self.model, None, modes::Solver::BySize)
+        self.data.modes(&self.model, None, modes::Solver::BySize(modes::Lowest::default()))
     }
 
     /// [`Simulation::modes`] by the dense eigenproblem (every mode) whatever the number of
@@ -380,13 +380,14 @@ impl Simulation {
         self.data.modes(&self.model, None, modes::Solver::Dense)
     }
 
-    /// [`Simulation::modes`], the eigenproblem stopped when `cancel` is raised
-    /// (`EigenError::Interrupted`).
+    /// [`Simulation::modes`], as many as `lowest` asks of the sparse solver, the eigenproblem
+    /// stopped when `cancel` is raised (`EigenError::Interrupted`).
     pub fn modes_until(
         &mut self,
+        lowest: modes::Lowest,
         cancel: Option<&std::sync::atomic::AtomicBool>,
     ) -> Result<modes::StructureModes, modes::ModesError> {
-        self.data.modes(&self.model, cancel, modes::Solver::BySize)
+        self.data.modes(&self.model, cancel, modes::Solver::BySize(lowest))
     }
 
     /// The free coordinates of the current state's sensitivities, or why it has none

@@ -17,7 +17,7 @@ use super::{Data, Model, Simulation};
 use crate::eigen::EigenError;
 use crate::snapshot::{BodyPose, ModalProjector};
 use crate::structure::{BodyKind, JointKind};
-use crate::structure::{DENSE_MODAL_MAX_FREE_BODIES, SPARSE_MODAL_COUNT};
+use crate::structure::{DENSE_MODAL_MAX_FREE_BODIES, MAX_SPARSE_MODAL_COUNT, SPARSE_MODAL_COUNT};
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3};
 use std::sync::atomic::AtomicBool;
 
@@ -103,6 +103,9 @@ pub enum ModesError {
     /// More free bodies (on springs and elastic cables) than the sparse solver is run for.
     #[error("{bodies} free bodies: the lowest modes of free bodies on springs and elastic cables are computed for at most {MAX_SPARSE_MODAL_FREE_BODIES} free bodies (each rigid mode reported, about one a body, holds a shape and a motion per node: the report grows with the square of the count)")]
     TooLargeSparse { bodies: usize },
+    /// More non-rigid modes asked of the sparse solver than it computes.
+    #[error("the lowest {wanted} modes beyond the structure's {rigid} rigid ones were asked for (through mode {through}); the sparse solver computes at most {MAX_SPARSE_MODAL_COUNT}")]
+    TooManyWanted { wanted: usize, rigid: usize, through: usize },
     /// A motion asks for a mode past those the sparse solver computed.
     #[error("mode {mode} was not computed: the structure's lowest {computed} modes are (from 1), of {total}")]
     NotComputed { mode: usize, computed: usize, total: usize },
@@ -129,11 +132,26 @@ pub fn check_modal_size(s: &crate::structure::Structure) -> Result<(), ModesErro
     Ok(())
 }
 
+/// How many modes the sparse solver of large structures computes: the lowest `count` beyond
+/// the rigid ones, and at least through mode `through` (from 0: a motion along it). The dense
+/// eigenproblem gives every mode whatever it asks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Lowest {
+    pub count: usize,
+    pub through: Option<usize>,
+}
+
+impl Default for Lowest {
+    fn default() -> Self {
+        Lowest { count: SPARSE_MODAL_COUNT, through: None }
+    }
+}
+
 /// Which eigensolver gives the modes of free bodies on springs and elastic cables.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Solver {
-    /// Dense up to [`DENSE_MODAL_MAX_FREE_BODIES`] free bodies, sparse above.
-    BySize,
+    /// Dense up to [`DENSE_MODAL_MAX_FREE_BODIES`] free bodies, sparse above (as many as asked).
+    BySize(Lowest),
     /// Dense at any size (every mode).
     Dense,
 }
@@ -169,9 +187,12 @@ impl Data {
         }
         let (bodies, com) = self.free_blocks(m);
         let mass = self.mass_blocks(m, &bodies);
-        let sparse = solver == Solver::BySize && bodies.len() > DENSE_MODAL_MAX_FREE_BODIES;
-        let (eigen, largest, lowest_of) = if sparse {
-            let lowest = self.lowest_modes(m, &mass, SPARSE_MODAL_COUNT, cancel)?;
+        let sparse = match solver {
+            Solver::BySize(wanted) if bodies.len() > DENSE_MODAL_MAX_FREE_BODIES => Some(wanted),
+            _ => None,
+        };
+        let (eigen, largest, lowest_of) = if let Some(wanted) = sparse {
+            let lowest = self.lowest_modes(m, &mass, wanted, cancel)?;
             (lowest.modes, lowest.largest, Some(6 * bodies.len()))
         } else {
             let hessian = self.tangent_stiffness(m).hessian;

@@ -645,8 +645,14 @@ pub const MAX_MODAL_FREE_BODIES: usize = 400;
 /// list, and every shipped scenario (at most a few tens of bodies) keeps the dense solver.
 pub const DENSE_MODAL_MAX_FREE_BODIES: usize = 100;
 
-/// Non-rigid modes the sparse solver computes (the lowest, with every rigid one it finds).
+/// Non-rigid modes the sparse solver computes unless asked for more (the lowest, with every
+/// rigid one it finds): `modes --count`, or a motion along a higher mode.
 pub const SPARSE_MODAL_COUNT: usize = 20;
+
+/// Most non-rigid modes the sparse solver computes: its block of `count` + 20 vectors is
+/// orthonormalised and its Rayleigh-Ritz problem solved every iteration, work that grows with
+/// the block's square times the coordinates (measured in BENCHMARKS.md).
+pub const MAX_SPARSE_MODAL_COUNT: usize = 200;
 
 /// Most free bodies whose lowest modes the sparse solver computes: each rigid mode it reports
 /// (a strut's spin: about one per body) holds a shape and a motion per node, so the report

@@ -688,3 +688,14 @@ fn modes_past_their_size_are_refused() {
     );
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// `modes --count` outside 1 to 200 (the sparse solver's bound) is refused at its flag.
+#[test]
+fn a_modes_count_outside_its_range_is_refused_at_its_flag() {
+    for count in ["0", "201", "-3", "many"] {
+        let flag = format!("--count={count}");
+        let (code, _, err) = tensegrity(&["modes", "scenarios/custom/prism3.toml", &flag]);
+        assert_eq!(code, 2, "--count {count}: {err}");
+        assert!(err.contains("--count"), "--count {count}: {err}");
+    }
+}

@@ -8,7 +8,7 @@ use std::path::Path;
 use std::process::Command;
 use tensegrity_testbed::run::settle_first_point;
 use tensegrity_testbed::scenario;
-use tensegrity_testbed::sim::modes::StructureModes;
+use tensegrity_testbed::sim::modes::{Lowest, StructureModes};
 
 /// A free body (2.5 kg, nodes C at the origin and D 0.1 m above it: centre of mass 0.05 m
 /// above C) held at C by six zero-free-length springs (k = 40 N/m each, to anchors 1 m away on
@@ -419,7 +419,7 @@ fn the_recording_animates_every_mode() {
 /// frequencies are the dense eigenproblem's within 1e-8 relative (measured 2.7e-12 at 300
 /// struts), with the same 150 rigid-body modes (149 struts' spins about their axes and the turn
 /// about the held strut's line), each shape mass-normalised, and it says that these are the
-/// lowest of 894.
+/// lowest of 894. Asked for more (`modes --count 60`), the lowest 60 are the dense ones too.
 #[test]
 fn the_sparse_lowest_modes_of_a_large_prism_are_the_dense_ones() {
     let text = std::fs::read_to_string("benches/prism_modes.toml")
@@ -439,6 +439,12 @@ fn the_sparse_lowest_modes_of_a_large_prism_are_the_dense_ones() {
     for (k, (a, b)) in s.iter().zip(&d).enumerate() {
         assert!(((a - b) / b).abs() <= 1e-8, "mode {}: {a} against {b} rad/s", k + 1);
     }
+    let more = state.sim.modes_until(Lowest { count: 60, through: None }, None).unwrap();
+    assert_eq!((more.modes.len(), more.rigid), (150 + 60, 150));
+    let non_rigid = |m: &StructureModes| m.modes.iter().filter(|x| !x.rigid).map(|x| x.omega()).collect::<Vec<_>>();
+    for (k, (a, b)) in non_rigid(&more).iter().zip(&non_rigid(&dense)).enumerate() {
+        assert!(((a - b) / b).abs() <= 1e-8, "mode {}: {a} against {b} rad/s", k + 1);
+    }
     for mode in &sparse.modes {
         let norm: f64 = sparse
             .mass
@@ -451,4 +457,31 @@ fn the_sparse_lowest_modes_of_a_large_prism_are_the_dense_ones() {
             .sum();
         assert!((norm - 1.0).abs() <= 1e-10, "x^T M x = {norm}");
     }
+}
+
+/// A motion along a mode above the sparse solver's lowest 20 asks it for every mode through
+/// that one: on the 150-strut prism (150 rigid modes) mode 195, the 45th non-rigid, starts and
+/// runs its steps; a mode that needs more than 200 non-rigid modes (mode 351) is refused when
+/// the motion starts, naming the count asked for.
+#[test]
+fn a_motion_along_a_higher_mode_of_a_large_prism_asks_the_sparse_solver_for_it() {
+    let text = std::fs::read_to_string("benches/prism_modes.toml")
+        .unwrap()
+        .replace("n = { value = 300,", "n = { value = 150,");
+    let along = |mode: usize| {
+        let motion =
+            format!("[motion]\nduration_s = 0.05\nstart = \"drawn\"\nmode = {mode}\namplitude = 1e-6\n\n[actuation]");
+        let sc = scenario::parse(Path::new("prism150.toml"), &text.replace("[actuation]", &motion)).unwrap();
+        tensegrity_testbed::run::run(&sc, &tensegrity_testbed::run::RunOptions::default())
+    };
+    let higher = along(195);
+    assert!(higher.error.is_none(), "{:?}", higher.error);
+    let motion = higher.motion.as_ref().expect("a motion");
+    assert_eq!((motion.steps_taken, motion.steps), (10, 10));
+    let past = along(351);
+    let error = past.error.expect("refused").to_string();
+    assert!(
+        error.contains("the lowest 201 modes beyond the structure's 150 rigid ones were asked for (through mode 351); the sparse solver computes at most 200"),
+        "{error}"
+    );
 }
