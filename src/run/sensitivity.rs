@@ -75,13 +75,54 @@ struct Outputs<'a> {
     coordinates: EquilibriumCoordinates,
 }
 
-/// The analysis of a settled state: what its samples need, its modes (K phi = omega^2 M phi in
-/// the equilibrium's coordinates), the listed ones, and every output there.
+/// The analysis of a settled state: what its samples need, its linearization, the listed
+/// modes, and every output there.
 struct Analysis<'a> {
     out: Outputs<'a>,
-    modes: Vec<Mode>,
+    lin: Linearization,
     listed: Vec<usize>,
     base: Vec<(String, f64)>,
+}
+
+/// A settled state linearized in its coordinates: K, G (no rows without constraints) and the
+/// modes K phi = omega^2 M phi on null(G), each phi mass-normalised in the coordinates.
+struct Linearization {
+    stiffness: DMatrix<f64>,
+    jacobian: DMatrix<f64>,
+    modes: Vec<Mode>,
+}
+
+/// K, M and G of `sim` in `coordinates`, and the modes of the reduced problem
+/// (N^T K N) v = omega^2 (N^T M N) v, N a basis of null(G), phi = N v (all coordinates where
+/// there is no constraint).
+fn linearize(sim: &mut Simulation, coordinates: &EquilibriumCoordinates) -> Result<Linearization, SensitivityRunError> {
+    let stiffness = sim.equilibrium_stiffness(coordinates);
+    let mass = sim.equilibrium_mass(coordinates);
+    let jacobian = sim.constraint_jacobian(coordinates);
+    let modes = if jacobian.nrows() == 0 {
+        crate::eigen::modes(&symmetric(&stiffness), &symmetric(&mass))?
+    } else {
+        let (basis, _) = crate::sim::modes::null_space(&jacobian, stiffness.ncols());
+        if basis.ncols() == 0 {
+            Vec::new()
+        } else {
+            let reduce = |a: &DMatrix<f64>| symmetric(&(basis.transpose() * a * &basis));
+            let reduced = crate::eigen::modes(&reduce(&stiffness), &reduce(&mass))?;
+            reduced.into_iter().map(|m| Mode { shape: &basis * m.shape, ..m }).collect()
+        }
+    };
+    Ok(Linearization { stiffness, jacobian, modes })
+}
+
+/// The least-squares, least-norm x of a x = b (singular values of a below
+/// `NULL_SPACE_RATIO` of the largest left out); zeros where a has no rows.
+fn least_squares(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
+    if a.nrows() == 0 || a.ncols() == 0 {
+        return DVector::zeros(a.ncols());
+    }
+    let svd = a.clone().svd(true, true);
+    let tol = crate::sim::modes::NULL_SPACE_RATIO * svd.singular_values.max();
+    svd.solve(b, tol).unwrap_or_else(|_| DVector::zeros(a.ncols()))
 }
 
 /// The analysis of `sim`, settled at `params` and `inputs` of `sc`.
@@ -94,13 +135,11 @@ fn analyse<'a>(
     let coordinates = sim.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
     let model = sc.model.as_ref().map(|spec| ModelObserver::new(spec, sim.structure(), false, None));
     let out = Outputs { sc, mech: sc.mechanism(), inputs, model, coordinates };
-    let k = sim.equilibrium_stiffness(&out.coordinates);
-    let mass = sim.equilibrium_mass(&out.coordinates);
-    let modes = crate::eigen::modes(&symmetric(&k), &symmetric(&mass))?;
-    let listed = listed_modes(&modes);
+    let lin = linearize(sim, &out.coordinates)?;
+    let listed = listed_modes(&lin.modes);
     let mut base = out.sample(sim, params);
-    base.extend(listed.iter().map(|&i| (format!("mode{}.omega", i + 1), modes[i].omega())));
-    Ok(Analysis { out, modes, listed, base })
+    base.extend(listed.iter().map(|&i| (format!("mode{}.omega", i + 1), lin.modes[i].omega())));
+    Ok(Analysis { out, lin, listed, base })
 }
 
 /// The scenario and inputs of point `point` (from 0, as a run numbers its points; a schedule's
@@ -132,20 +171,20 @@ pub fn sensitivity(
     let params = sc.params_at(&inputs);
     // What the analysis refuses is the structure's, known before the settle.
     let structure = sc.mechanism().build(&params, &inputs, &sc.start).map_err(RunError::from)?;
-    let drawn = Simulation::new(&structure, &sc.sim).map_err(RunError::from)?;
+    let mut drawn = Simulation::new(&structure, &sc.sim).map_err(RunError::from)?;
     drawn.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
     let mut state = settle_at(sc, &inputs, params.clone(), cancel)?;
     let wall = Instant::now();
-    let Analysis { out, modes, listed, base } = analyse(sc, &mut state.sim, &params, inputs)?;
+    let Analysis { out, lin, listed, base } = analyse(sc, &mut state.sim, &params, inputs)?;
     let mut parameters = Vec::new();
     for (name, &value) in &params {
         if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
             return Err(RunError::Interrupted(state.sim.tick()).into());
         }
-        parameters.push(out.parameter(&state.sim, &params, name, value, &modes, &listed));
+        parameters.push(out.parameter(&state.sim, &params, name, value, &lin, &listed));
     }
     let wall_s = wall.elapsed().as_secs_f64();
-    let free = out.free_outputs(&mut state.sim, &params, &modes, &base);
+    let free = out.free_outputs(&mut state.sim, &params, &lin.modes, &base);
     let outputs: Vec<OutputValue> = base
         .iter()
         .zip(free)
@@ -188,7 +227,7 @@ pub(super) fn file_sensitivities(
     for s in wanted {
         if !rows.iter().any(|r| r.name == s.parameter) {
             let value = params.get(&s.parameter).copied().unwrap_or(f64::NAN);
-            rows.push(a.out.parameter(sim, params, &s.parameter, value, &a.modes, &a.listed));
+            rows.push(a.out.parameter(sim, params, &s.parameter, value, &a.lin, &a.listed));
         }
         let row = rows.iter().find(|r| r.name == s.parameter).expect("computed above");
         if let Some(e) = &row.error {
@@ -213,6 +252,29 @@ fn listed_modes(modes: &[Mode]) -> Vec<usize> {
         .filter(|&i| modes[i].omega_squared.abs() > ZERO_MODE_RATIO * largest)
         .take(FREQUENCIES_LISTED)
         .collect()
+}
+
+/// For each listed mode phi (omega^2) of the settled state, phi_s^T (K - omega^2 M) phi_s in
+/// `sim`'s state, phi_s = (1 - G^+ G) phi its projection on the constraints' tangent space
+/// there (phi itself without constraints): differenced over the parameter's samples, Nelson's
+/// d omega^2 / dp (module docs of sim/constrained_sensitivity.rs).
+fn modal_curvatures(
+    sim: &mut Simulation,
+    c: &EquilibriumCoordinates,
+    modes: &[Mode],
+    listed: &[usize],
+) -> DVector<f64> {
+    let k = sim.equilibrium_stiffness(c);
+    let mass = sim.equilibrium_mass(c);
+    let g = sim.constraint_jacobian(c);
+    DVector::from_iterator(
+        listed.len(),
+        listed.iter().map(|&i| {
+            let (phi, w2) = (&modes[i].shape, modes[i].omega_squared);
+            let phi = phi - least_squares(&g, &(&g * phi));
+            phi.dot(&(&k * &phi)) - w2 * phi.dot(&(&mass * &phi))
+        }),
+    )
 }
 
 /// K^-1 r over the modes that are not rigid: sum of phi (phi^T r) / omega^2 (phi
@@ -358,7 +420,7 @@ impl Outputs<'_> {
         params: &Values,
         name: &str,
         value: f64,
-        modes: &[Mode],
+        lin: &Linearization,
         listed: &[usize],
     ) -> ParameterSensitivity {
         let h = parameter_step(value);
@@ -390,29 +452,34 @@ impl Outputs<'_> {
                 }
             }
         }
-        let q: Vec<DVector<f64>> = sims.iter().map(|(sim, _)| sim.generalized_forces(&self.coordinates)).collect();
-        let dq = solve(modes, &derivative_from_samples(q[0].clone(), q[1].clone(), q[2].clone(), q[3].clone(), h));
+        let q: Vec<DVector<f64>> = sims.iter_mut().map(|(sim, _)| sim.generalized_forces(&self.coordinates)).collect();
+        let g: Vec<DVector<f64>> = sims.iter().map(|(sim, _)| sim.constraint_values(&self.coordinates)).collect();
+        let dq_dp = derivative_from_samples(q[0].clone(), q[1].clone(), q[2].clone(), q[3].clone(), h);
+        let dg_dp = derivative_from_samples(g[0].clone(), g[1].clone(), g[2].clone(), g[3].clone(), h);
+        // The move that keeps the constraints (module docs of sim/constrained_sensitivity.rs),
+        // then the equilibrium along null(G).
+        let particular = -least_squares(&lin.jacobian, &dg_dp);
+        let dq = solve(&lin.modes, &(&dq_dp - &lin.stiffness * &particular)) + &particular;
+        let lambda = self.coordinates.constraints().map_or(vec![], |c| c.multipliers.clone());
+        let dlambda = least_squares(&lin.jacobian.transpose(), &(&dq_dp - &lin.stiffness * &dq));
         let base = self.sample(at, params);
         let mut y = Vec::new();
-        let (mut k, mut mass) = (Vec::new(), Vec::new());
+        let mut curvature = Vec::new();
         for ((sim, moved), s) in sims.iter_mut().zip(SAMPLES) {
             let step: Vec<f64> = dq.iter().map(|d| s * h * d).collect();
             sim.displace_coordinates(&self.coordinates, &step);
             y.push(self.offsets(&self.sample(sim, moved), &base));
-            k.push(sim.equilibrium_stiffness(&self.coordinates));
-            mass.push(sim.equilibrium_mass(&self.coordinates));
+            let held: Vec<f64> = lambda.iter().zip(dlambda.iter()).map(|(l, d)| l + s * h * d).collect();
+            curvature.push(modal_curvatures(sim, &self.coordinates.with_multipliers(&held), &lin.modes, listed));
         }
         let dy = derivative_from_samples(y[0].clone(), y[1].clone(), y[2].clone(), y[3].clone(), h);
-        let dk = derivative_from_samples(k[0].clone(), k[1].clone(), k[2].clone(), k[3].clone(), h);
-        let dm = derivative_from_samples(mass[0].clone(), mass[1].clone(), mass[2].clone(), mass[3].clone(), h);
+        let (c0, c1, c2, c3) = (curvature[0].clone(), curvature[1].clone(), curvature[2].clone(), curvature[3].clone());
+        let dw2 = derivative_from_samples(c0, c1, c2, c3, h);
         row.coordinates = dq.iter().copied().collect();
         row.derivatives = dy.iter().copied().collect();
-        row.derivatives.extend(listed.iter().map(|&i| {
-            let (phi, w2) = (&modes[i].shape, modes[i].omega_squared);
-            // Nelson's d omega^2 / dp = phi^T (dK/dp - omega^2 dM/dp) phi.
-            let dw2 = phi.dot(&(&dk * phi)) - w2 * phi.dot(&(&dm * phi));
-            dw2 / (2.0 * w2.abs().sqrt())
-        }));
+        row.derivatives.extend(
+            listed.iter().zip(dw2.iter()).map(|(&i, dw2)| dw2 / (2.0 * lin.modes[i].omega_squared.abs().sqrt())),
+        );
         row
     }
 
@@ -432,9 +499,8 @@ impl Outputs<'_> {
         for (moved, inputs) in samples {
             let SettledState { mut sim, .. } = settle_at(&sc, &inputs, moved.clone(), cancel)?;
             let mut sample = self.sample(&sim, &moved);
-            let k = sim.equilibrium_stiffness(&self.coordinates);
-            let mass = sim.equilibrium_mass(&self.coordinates);
-            let modes = crate::eigen::modes(&symmetric(&k), &symmetric(&mass))?;
+            let coordinates = sim.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
+            let modes = linearize(&mut sim, &coordinates)?.modes;
             sample.extend(listed.iter().map(|&i| (format!("mode{}.omega", i + 1), modes[i].omega())));
             y.push(self.offsets(&sample, &base));
         }

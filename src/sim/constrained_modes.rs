@@ -50,7 +50,7 @@ const STEP_RAD: f64 = 1e-3;
 /// Finite-difference step of a linear coordinate, a fraction of the structure's size.
 const STEP_FRACTION: f64 = 1e-3;
 /// The second, coarser step of the Richardson extrapolation, as a multiple of the first.
-const COARSE_STEP_RATIO: f64 = 2.0;
+pub(super) const COARSE_STEP_RATIO: f64 = 2.0;
 /// An elastic cable's energy k (l - l0)^2 / 2 for l > l0, 0 below, has a kink at l = l0: a
 /// difference that crosses it reads the slack side's zero stiffness. The steps are cut so that
 /// the coarse step of two coordinates at once (a mixed difference) moves a node by at most this
@@ -77,7 +77,7 @@ pub enum ModalCoordinate {
 }
 
 impl ModalCoordinate {
-    fn linear(&self) -> bool {
+    pub(super) fn linear(&self) -> bool {
         match self {
             ModalCoordinate::Link { linear, .. } => *linear,
             ModalCoordinate::Body { axis, .. } => *axis < 3,
@@ -114,7 +114,7 @@ impl Constraints {
 
 /// The state the analysis moves away from and back to: each multibody's link joints and each
 /// plain body's pose.
-struct Saved {
+pub(super) struct Saved {
     multibodies: Vec<(MultibodyIndex, Vec<MultibodyJoint>)>,
     poses: Vec<(usize, Pose)>,
 }
@@ -122,7 +122,7 @@ struct Saved {
 impl Data {
     /// The analysis's coordinates: the multibodies' free degrees of freedom, then six per free
     /// body outside them.
-    fn modal_coordinates(&self, m: &Model) -> Vec<ModalCoordinate> {
+    pub(super) fn modal_coordinates(&self, m: &Model) -> Vec<ModalCoordinate> {
         let s = &m.structure;
         let free: Vec<usize> = (0..s.bodies.len()).filter(|b| m.is_free(*b)).collect();
         let mut multibodies: Vec<MultibodyIndex> = Vec::new();
@@ -160,7 +160,7 @@ impl Data {
     }
 
     /// The joints that close loops, or the first whose kind has no constraint rows.
-    fn modal_closures(&self, m: &Model) -> Result<Vec<usize>, ModesError> {
+    pub(super) fn modal_closures(&self, m: &Model) -> Result<Vec<usize>, ModesError> {
         let s = &m.structure;
         let closures: Vec<usize> = (0..s.joints.len()).filter(|&j| m.joint_impulse[j].is_some()).collect();
         let rowless = |j: &&usize| {
@@ -178,7 +178,7 @@ impl Data {
         }
     }
 
-    fn save_modal_state(&self, m: &Model, coordinates: &[ModalCoordinate]) -> Saved {
+    pub(super) fn save_modal_state(&self, m: &Model, coordinates: &[ModalCoordinate]) -> Saved {
         let mut saved = Saved { multibodies: Vec::new(), poses: Vec::new() };
         for c in coordinates {
             match *c {
@@ -197,7 +197,7 @@ impl Data {
     }
 
     /// Puts every coordinate back where [`Self::save_modal_state`] read it, to the bit.
-    fn restore_modal_state(&mut self, m: &Model, saved: &Saved) {
+    pub(super) fn restore_modal_state(&mut self, m: &Model, saved: &Saved) {
         for (index, joints) in &saved.multibodies {
             let Some(mb) = self.multibody_joints.get_multibody_mut(*index) else { continue };
             for (i, joint) in joints.iter().enumerate() {
@@ -214,7 +214,7 @@ impl Data {
     }
 
     /// Moves the coordinates: each (index into `coordinates`, displacement [rad or m]).
-    fn move_coordinates(&mut self, m: &Model, coordinates: &[ModalCoordinate], moves: &[(usize, f64)]) {
+    pub(super) fn move_coordinates(&mut self, m: &Model, coordinates: &[ModalCoordinate], moves: &[(usize, f64)]) {
         for &(k, d) in moves {
             match coordinates[k] {
                 ModalCoordinate::Link { multibody, dof, .. } => {
@@ -235,7 +235,7 @@ impl Data {
     /// The finite-difference step of each coordinate: [`STEP_RAD`] or [`STEP_FRACTION`] of
     /// the structure's size (either moves a node by at most that fraction of the size), both
     /// cut by [`Self::kink_step_ratio`].
-    fn modal_steps(&self, m: &Model, coordinates: &[ModalCoordinate]) -> Vec<f64> {
+    pub(super) fn modal_steps(&self, m: &Model, coordinates: &[ModalCoordinate]) -> Vec<f64> {
         let ratio = self.kink_step_ratio(m);
         coordinates
             .iter()
@@ -264,7 +264,7 @@ impl Data {
     }
 
     /// The constraint rows g(q) [m]: each closure's, then each taut cable's stretch.
-    fn constraint_rows(&self, m: &Model, closures: &[usize], taut: &[usize]) -> Vec<f64> {
+    pub(super) fn constraint_rows(&self, m: &Model, closures: &[usize], taut: &[usize]) -> Vec<f64> {
         let mut out = Vec::new();
         for &j in closures {
             self.joint_rows(m, j, &mut out);
@@ -275,14 +275,14 @@ impl Data {
 }
 
 /// What the first pass of differences finds: grad V [N or N m] and G.
-struct FirstDerivatives {
-    gradient: DVector<f64>,
-    jacobian: DMatrix<f64>,
+pub(super) struct FirstDerivatives {
+    pub(super) gradient: DVector<f64>,
+    pub(super) jacobian: DMatrix<f64>,
 }
 
 /// The pieces of the constrained analysis that the second pass needs.
-struct Setup<'a> {
-    coordinates: &'a [ModalCoordinate],
+pub(super) struct Setup<'a> {
+    pub(super) coordinates: &'a [ModalCoordinate],
     closures: &'a [usize],
     taut: &'a [usize],
     steps: Vec<f64>,
@@ -325,7 +325,13 @@ impl Data {
     }
 
     /// K = d2L/dq2 (lambda held) by central second differences, symmetrised.
-    fn lagrangian_hessian(&mut self, m: &Model, setup: &Setup, lambda: &DVector<f64>, ratio: f64) -> DMatrix<f64> {
+    pub(super) fn lagrangian_hessian(
+        &mut self,
+        m: &Model,
+        setup: &Setup,
+        lambda: &DVector<f64>,
+        ratio: f64,
+    ) -> DMatrix<f64> {
         let n = setup.coordinates.len();
         let h: Vec<f64> = setup.steps.iter().map(|h| ratio * h).collect();
         let l0 = self.lagrangian_moved(m, setup, lambda, &[]);
@@ -421,7 +427,7 @@ type BodyState = (Vector3<f64>, UnitQuaternion<f64>);
 
 /// Richardson's extrapolation of central differences at steps h and [`COARSE_STEP_RATIO`] h:
 /// the h^2 term of their error cancels.
-fn richardson(fine: &DMatrix<f64>, coarse: &DMatrix<f64>) -> DMatrix<f64> {
+pub(super) fn richardson(fine: &DMatrix<f64>, coarse: &DMatrix<f64>) -> DMatrix<f64> {
     let r2 = COARSE_STEP_RATIO * COARSE_STEP_RATIO;
     (fine * r2 - coarse) / (r2 - 1.0)
 }
@@ -429,7 +435,7 @@ fn richardson(fine: &DMatrix<f64>, coarse: &DMatrix<f64>) -> DMatrix<f64> {
 /// A basis of null(G) (coordinates x its dimension) and the rank of G: the right singular
 /// vectors whose singular value is at most [`NULL_SPACE_RATIO`] of the largest. G is padded
 /// with zero rows to at least square, so that the SVD gives every right singular vector.
-fn null_space(g: &DMatrix<f64>, n: usize) -> (DMatrix<f64>, usize) {
+pub(crate) fn null_space(g: &DMatrix<f64>, n: usize) -> (DMatrix<f64>, usize) {
     if g.nrows() == 0 {
         return (DMatrix::identity(n, n), 0);
     }
@@ -448,7 +454,7 @@ fn null_space(g: &DMatrix<f64>, n: usize) -> (DMatrix<f64>, usize) {
 }
 
 /// The constraint forces lambda of grad V + G^T lambda = 0 (least squares, minimum norm).
-fn multipliers(first: &FirstDerivatives) -> DVector<f64> {
+pub(super) fn multipliers(first: &FirstDerivatives) -> DVector<f64> {
     let rows = first.jacobian.nrows();
     if rows == 0 {
         return DVector::zeros(0);
@@ -475,14 +481,7 @@ impl Data {
             return Err(ModesError::NoFreeBody);
         }
         let bodies: Vec<usize> = (0..s.bodies.len()).filter(|&b| s.bodies[b].kind == BodyKind::Free).collect();
-        let setup = Setup {
-            coordinates: &coordinates,
-            closures: &closures,
-            taut: &taut,
-            steps: self.modal_steps(m, &coordinates),
-            com: (0..s.bodies.len()).map(|b| self.world_com(m, b)).map(|c| Vector3::new(c.x, c.y, c.z)).collect(),
-            saved: self.save_modal_state(m, &coordinates),
-        };
+        let setup = self.constrained_setup(m, &coordinates, &closures, &taut);
         let first = self.first_derivatives_extrapolated(m, &setup);
         let lambda = multipliers(&first);
         let stiffness = richardson(
@@ -542,8 +541,27 @@ impl Data {
         })
     }
 
+    /// What the differences of the constrained analysis need at the current state.
+    pub(super) fn constrained_setup<'a>(
+        &self,
+        m: &Model,
+        coordinates: &'a [ModalCoordinate],
+        closures: &'a [usize],
+        taut: &'a [usize],
+    ) -> Setup<'a> {
+        let s = &m.structure;
+        Setup {
+            coordinates,
+            closures,
+            taut,
+            steps: self.modal_steps(m, coordinates),
+            com: (0..s.bodies.len()).map(|b| self.world_com(m, b)).map(|c| Vector3::new(c.x, c.y, c.z)).collect(),
+            saved: self.save_modal_state(m, coordinates),
+        }
+    }
+
     /// grad V and G at steps h and 2 h, extrapolated.
-    fn first_derivatives_extrapolated(&mut self, m: &Model, setup: &Setup) -> FirstDerivatives {
+    pub(super) fn first_derivatives_extrapolated(&mut self, m: &Model, setup: &Setup) -> FirstDerivatives {
         let (fine, coarse) =
             (self.first_derivatives(m, setup, 1.0), self.first_derivatives(m, setup, COARSE_STEP_RATIO));
         let column = |v: &DVector<f64>| DMatrix::from_column_slice(v.len(), 1, v.as_slice());
@@ -555,7 +573,12 @@ impl Data {
 
     /// The mass matrix in the coordinates, J^T M_b J over the structure's free bodies and the
     /// hidden bodies, with the free bodies' J (for the modes' shapes).
-    fn coordinate_mass(&mut self, m: &Model, setup: &Setup, bodies: &[usize]) -> (DMatrix<f64>, DMatrix<f64>) {
+    pub(super) fn coordinate_mass(
+        &mut self,
+        m: &Model,
+        setup: &Setup,
+        bodies: &[usize],
+    ) -> (DMatrix<f64>, DMatrix<f64>) {
         let own = |sim: &Data| sim.body_states(m, bodies);
         let jac = richardson(
             &self.coordinate_body_jacobian(m, setup, &own, 1.0),

@@ -19,6 +19,7 @@ mod build;
 mod capstan;
 mod closure_rest;
 mod constrained_modes;
+mod constrained_sensitivity;
 mod continuation;
 mod damping;
 mod data;
@@ -393,13 +394,14 @@ impl Simulation {
     /// The free coordinates of the current state's sensitivities, or why it has none
     /// (`sensitivity.rs`).
     pub fn equilibrium_coordinates(
-        &self,
+        &mut self,
     ) -> Result<sensitivity::EquilibriumCoordinates, sensitivity::SensitivityError> {
         self.data.equilibrium_coordinates(&self.model)
     }
 
-    /// The generalized forces on the coordinates `c` now [N or N m] (zero at an equilibrium).
-    pub fn generalized_forces(&self, c: &sensitivity::EquilibriumCoordinates) -> nalgebra::DVector<f64> {
+    /// The generalized forces on the coordinates `c` now [N or N m] (zero at an equilibrium;
+    /// with constraints, -dL/dq with their forces held).
+    pub fn generalized_forces(&mut self, c: &sensitivity::EquilibriumCoordinates) -> nalgebra::DVector<f64> {
         self.data.generalized_forces(&self.model, c)
     }
 
@@ -411,6 +413,16 @@ impl Simulation {
     /// The mass matrix in the coordinates `c` now.
     pub fn equilibrium_mass(&mut self, c: &sensitivity::EquilibriumCoordinates) -> nalgebra::DMatrix<f64> {
         self.data.equilibrium_mass(&self.model, c)
+    }
+
+    /// The constraints g(q) of the coordinates `c` now [m] (none without constraints).
+    pub fn constraint_values(&self, c: &sensitivity::EquilibriumCoordinates) -> nalgebra::DVector<f64> {
+        self.data.equilibrium_constraint_values(&self.model, c)
+    }
+
+    /// G = dg/dq of the coordinates `c` now (no rows without constraints).
+    pub fn constraint_jacobian(&mut self, c: &sensitivity::EquilibriumCoordinates) -> nalgebra::DMatrix<f64> {
+        self.data.equilibrium_constraint_jacobian(&self.model, c)
     }
 
     /// Moves the coordinates `c` by `dq` (m or rad).

@@ -12,7 +12,8 @@
 //! sparse: the lowest [`SPARSE_MODAL_COUNT`] modes beyond the rigid ones, by shift-invert
 //! subspace iteration (`relaxation/lowest_modes.rs`).
 
-pub use super::constrained_modes::{Constraints, ModalCoordinate};
+pub(crate) use super::constrained_modes::null_space;
+pub use super::constrained_modes::{Constraints, ModalCoordinate, NULL_SPACE_RATIO};
 use super::{Data, Model, Simulation};
 use crate::eigen::EigenError;
 use crate::snapshot::{BodyPose, ModalProjector};

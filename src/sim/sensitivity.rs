@@ -13,12 +13,15 @@
 //! no joints, else the free joints' coordinates of joint trees rooted on fixed bodies. Q is
 //! exact (member forces, torsion springs and constant loads projected on the coordinates,
 //! `forces.rs`), and K its central difference extrapolated over h and 2 h (Richardson, error
-//! O(h^4) and round-off eps |Q| / h: about 1e-13 of K). Structures held by loops or
-//! inextensible cables are refused, by name.
+//! O(h^4) and round-off eps |Q| / h: about 1e-13 of K). A structure held by loops or taut
+//! inextensible cables has the constrained analysis's coordinates and its Lagrangian
+//! (`constrained_sensitivity.rs`): Q = -dL/dq with the constraint forces held, K = d2L/dq2, and
+//! the constraints g(q) and G = dg/dq beside them.
 
+use super::constrained_modes::Constraints;
 use super::modes::ModesError;
 use super::{Data, Model};
-use crate::structure::BodyKind;
+use crate::structure::{BodyKind, JointKind};
 use nalgebra::{DMatrix, DVector};
 use rapier3d_f64::prelude::*;
 
@@ -36,6 +39,18 @@ pub enum EquilibriumCoordinates {
     /// The free joints' coordinates (structure indices of revolute \[rad\] and prismatic
     /// \[m\] joints).
     Joints(Vec<usize>),
+    /// A structure held by loops or taut inextensible cables: the constrained analysis's
+    /// coordinates, constraints and constraint forces at the settled state.
+    Constrained(Box<ConstrainedCoordinates>),
+}
+
+/// The coordinates of a structure held by constraints, and their names.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConstrainedCoordinates {
+    pub constraints: Constraints,
+    /// A joint's name (`JOINT.axis1`, `.axis2` for a universal joint's two), or `BODY.x` ..
+    /// `BODY.rz` for a plain free body.
+    pub names: Vec<String>,
 }
 
 impl EquilibriumCoordinates {
@@ -44,6 +59,7 @@ impl EquilibriumCoordinates {
         match self {
             EquilibriumCoordinates::Bodies(b) => 6 * b.len(),
             EquilibriumCoordinates::Joints(j) => j.len(),
+            EquilibriumCoordinates::Constrained(c) => c.names.len(),
         }
     }
 
@@ -60,16 +76,31 @@ impl EquilibriumCoordinates {
                 .flat_map(|&b| ["x", "y", "z", "rx", "ry", "rz"].map(|c| format!("{}.{c}", s.bodies[b].name)))
                 .collect(),
             EquilibriumCoordinates::Joints(j) => j.iter().map(|&j| s.joints[j].name.clone()).collect(),
+            EquilibriumCoordinates::Constrained(c) => c.names.clone(),
         }
+    }
+
+    /// The constraints, for a structure held by them.
+    pub fn constraints(&self) -> Option<&Constraints> {
+        match self {
+            EquilibriumCoordinates::Constrained(c) => Some(&c.constraints),
+            _ => None,
+        }
+    }
+
+    /// The same coordinates with the constraint forces `lambda` (one per constraint row).
+    pub fn with_multipliers(&self, lambda: &[f64]) -> Self {
+        let mut out = self.clone();
+        if let EquilibriumCoordinates::Constrained(c) = &mut out {
+            c.constraints.multipliers = lambda.to_vec();
+        }
+        out
     }
 }
 
 /// Why a state has no sensitivities.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SensitivityError {
-    /// Loops or inextensible cables hold the structure.
-    #[error("the structure is held by {0}: its sensitivities are not computed (only free bodies held by springs and elastic cables, or trees of revolute and prismatic joints)")]
-    Constrained(String),
     /// What the modal analysis refuses too.
     #[error(transparent)]
     Modes(#[from] ModesError),
@@ -87,7 +118,7 @@ where
 impl Data {
     /// The free coordinates of the current structure, or why it has none that this analysis
     /// takes.
-    pub(super) fn equilibrium_coordinates(&self, m: &Model) -> Result<EquilibriumCoordinates, SensitivityError> {
+    pub(super) fn equilibrium_coordinates(&mut self, m: &Model) -> Result<EquilibriumCoordinates, SensitivityError> {
         let s = &m.structure;
         if !s.bodies.iter().any(|b| b.kind == BodyKind::Free) {
             return Err(ModesError::NoFreeBody.into());
@@ -95,11 +126,14 @@ impl Data {
         if let Some(c) = s.members.iter().find(|c| c.has_friction()) {
             return Err(ModesError::Friction(c.name.clone()).into());
         }
-        if let Some(c) = s.members.iter().find(|c| c.is_inextensible_cable()) {
-            return Err(SensitivityError::Constrained(format!("the inextensible cable '{}'", c.name)));
-        }
-        if let Some(j) = (0..s.joints.len()).find(|&j| m.joint_impulse[j].is_some()) {
-            return Err(SensitivityError::Constrained(format!("the loop that joint '{}' closes", s.joints[j].name)));
+        let several = |(j, joint): (usize, &crate::structure::Joint)| {
+            !m.actuated[j] && !matches!(joint.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. })
+        };
+        let inextensible = s.members.iter().any(|c| c.is_inextensible_cable());
+        if inextensible || m.joint_impulse.iter().any(Option::is_some) || s.joints.iter().enumerate().any(several) {
+            let constraints = self.equilibrium_constraints(m)?;
+            let names = self.modal_coordinate_names(m, &constraints.coordinates);
+            return Ok(EquilibriumCoordinates::Constrained(Box::new(ConstrainedCoordinates { constraints, names })));
         }
         if s.joints.is_empty() {
             return Ok(EquilibriumCoordinates::Bodies((0..s.bodies.len()).filter(|b| m.is_free(*b)).collect()));
@@ -109,7 +143,10 @@ impl Data {
 
     /// The generalized forces Q on the coordinates now [N or N m]: -dV/dq, V the potential
     /// energy of the members, torsion springs and constant loads.
-    pub(super) fn generalized_forces(&self, m: &Model, c: &EquilibriumCoordinates) -> DVector<f64> {
+    pub(super) fn generalized_forces(&mut self, m: &Model, c: &EquilibriumCoordinates) -> DVector<f64> {
+        if let Some(c) = c.constraints() {
+            return self.lagrangian_forces(m, c);
+        }
         let q = self.free_coordinate_forces(m);
         debug_assert_eq!(q.len(), c.len(), "the tree's free coordinates are the analysis's");
         DVector::from_vec(q)
@@ -119,9 +156,8 @@ impl Data {
     fn coordinate_step(&self, m: &Model, c: &EquilibriumCoordinates, i: usize) -> f64 {
         let linear = match c {
             EquilibriumCoordinates::Bodies(_) => i % 6 < 3,
-            EquilibriumCoordinates::Joints(j) => {
-                matches!(m.structure.joints[j[i]].kind, crate::structure::JointKind::Prismatic { .. })
-            }
+            EquilibriumCoordinates::Joints(j) => matches!(m.structure.joints[j[i]].kind, JointKind::Prismatic { .. }),
+            EquilibriumCoordinates::Constrained(c) => c.constraints.coordinates[i].linear(),
         };
         if linear {
             STEP_FRACTION * m.length_scale_m
@@ -134,6 +170,7 @@ impl Data {
     pub(super) fn displace_coordinate(&mut self, m: &Model, c: &EquilibriumCoordinates, i: usize, d: f64) {
         match c {
             EquilibriumCoordinates::Joints(j) => self.displace_joint(m, j[i], d),
+            EquilibriumCoordinates::Constrained(c) => self.move_coordinates(m, &c.constraints.coordinates, &[(i, d)]),
             EquilibriumCoordinates::Bodies(b) => {
                 let h = m.handles[b[i / 6]];
                 let com = self.world_com(m, b[i / 6]);
@@ -163,6 +200,9 @@ impl Data {
     /// K = -dQ/dq now: each column a central difference extrapolated over h and 2 h, the
     /// state restored after each move.
     pub(super) fn equilibrium_stiffness(&mut self, m: &Model, c: &EquilibriumCoordinates) -> DMatrix<f64> {
+        if let Some(c) = c.constraints() {
+            return self.lagrangian_stiffness(m, c);
+        }
         let n = c.len();
         let mut k = DMatrix::zeros(n, n);
         for i in 0..n {
@@ -184,6 +224,7 @@ impl Data {
     pub(super) fn equilibrium_mass(&mut self, m: &Model, c: &EquilibriumCoordinates) -> DMatrix<f64> {
         match c {
             EquilibriumCoordinates::Bodies(b) => self.mass_matrix(m, b),
+            EquilibriumCoordinates::Constrained(c) => self.constrained_mass(m, &c.constraints),
             EquilibriumCoordinates::Joints(_) => {
                 let bodies: Vec<usize> = (0..m.structure.bodies.len()).filter(|b| m.is_free(*b)).collect();
                 let jac = self.equilibrium_jacobian(m, c, &bodies);
@@ -223,6 +264,7 @@ impl Data {
     /// commands are this simulation's own (set before).
     pub(super) fn take_configuration(&mut self, m: &Model, from: &Data, c: &EquilibriumCoordinates) {
         match c {
+            EquilibriumCoordinates::Constrained(c) => self.take_constrained_configuration(m, from, &c.constraints),
             EquilibriumCoordinates::Bodies(b) => {
                 for &b in b {
                     let pose = *from.bodies[m.handles[b]].position();
@@ -238,6 +280,19 @@ impl Data {
             }
         }
         self.zero_body_velocities(m);
+    }
+
+    /// The constraints g(q) now (none without constraints) [m].
+    pub(super) fn equilibrium_constraint_values(&self, m: &Model, c: &EquilibriumCoordinates) -> DVector<f64> {
+        c.constraints().map_or_else(|| DVector::zeros(0), |c| self.constraint_values(m, c))
+    }
+
+    /// G = dg/dq now (no rows without constraints).
+    pub(super) fn equilibrium_constraint_jacobian(&mut self, m: &Model, c: &EquilibriumCoordinates) -> DMatrix<f64> {
+        match c.constraints() {
+            Some(k) => self.constraint_jacobian(m, k),
+            None => DMatrix::zeros(0, c.len()),
+        }
     }
 
     /// Joint `j`'s coordinate in its multibody, from its drawn configuration (rad or m).

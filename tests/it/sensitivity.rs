@@ -136,9 +136,9 @@ fn ji2014s_platform_pose_agrees_with_settles_and_the_papers_model() {
 
 /// The command: its table names each parameter, `--json -` is the JSON alone (the table on
 /// standard error), `--csv` writes one row per parameter and output, both on standard output
-/// is refused, and so is a structure held by loops and inextensible cables (exit 2, named).
+/// is refused, and so is a cable with friction (exit 2, named: its force depends on the path).
 #[test]
-fn the_command_writes_json_and_csv_and_refuses_loops_by_name() {
+fn the_command_writes_json_and_csv_and_refuses_friction_by_name() {
     let file = "scenarios/custom/pinned_bar_modes.toml";
     let (code, out, _) = common::tensegrity(&["sensitivity", file]);
     assert!(code == 0 && out.contains("d/d k1 (= 10") && out.contains("pin.angle"), "{out}");
@@ -167,8 +167,8 @@ fn the_command_writes_json_and_csv_and_refuses_loops_by_name() {
     assert!(rel(d, closed) <= 1e-12, "at k1 = 90: {d:.15e} against {closed:.15e}");
     let (code, _, err) = common::tensegrity(&["sensitivity", file, "--point", "3"]);
     assert!(code == 2 && err.contains("--point 3: the scenario has no point 3"), "{err}");
-    let (code, _, err) = common::tensegrity(&["sensitivity", "scenarios/mohr2011/quick.toml"]);
-    assert!(code == 2 && err.contains("the structure is held by the inextensible cable"), "{err}");
+    let (code, _, err) = common::tensegrity(&["sensitivity", "scenarios/custom/capstan.toml"]);
+    assert!(code == 2 && err.contains("cable 'rope' has friction at a node"), "{err}");
 }
 
 /// The pinned bar's file with `[[sensitivities]]` as symbols and a paper's printed
@@ -220,4 +220,175 @@ fn a_printed_sensitivity_is_judged_as_a_prediction_at_every_point() {
     common::error_at(&bad, "\"pin.angel\"", 0, "'pin.angel' is no output of the settled state");
     let bad = text.replace("parameter = \"k1\"\n\n[[sens", "parameter = \"k9\"\n\n[[sens");
     common::error_at(&bad, "\"k9\"", 0, "'k9' is not a parameter of this scenario");
+}
+
+/// The sensitivities of `text` (a scenario file) at its first point, with the check.
+fn report_of_text(text: &str) -> SensitivityReport {
+    let sc = scenario::parse(Path::new("held.toml"), text).expect("a valid scenario");
+    tensegrity_testbed::run::sensitivity(&sc, "held.toml", 0, true, None).expect("sensitivities")
+}
+
+/// A bar pinned at O (revolute about y), its tip A held up by an inextensible cable of
+/// length l to P at height H above O; gravity. No degree of freedom is left: the constraints
+/// alone move the state, through dg/dp.
+const CABLE_HELD_BAR: &str = r#"
+name = "a bar held up by an inextensible cable"
+mechanism = "custom"
+
+[params]
+a = { value = 1.0, unit = "m", description = "bar length" }
+H = { value = 1.0, unit = "m", description = "height of the cable's fixed end P above the pin" }
+l = { value = 1.2, unit = "m", description = "cable length" }
+m = { value = 2.0, unit = "kg" }
+g = { value = 9.81, unit = "m/s^2" }
+th = { value = "asin((a^2 + H^2 - l^2)/(2*a*H))", unit = "rad", description = "the bar's angle above the horizontal" }
+
+[settle]
+speed_tol = 1e-12
+residual_force_tol = 1e-10
+residual_torque_tol = 1e-10
+
+[actuation]
+points = [ {} ]
+
+[structure]
+gravity = [0.0, 0.0, "-g"]
+
+[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { O = [0, 0, 0], P = [0, 0, "H"] }
+
+[[structure.bodies]]
+name = "bar"
+mass = "m"
+nodes = { B = [0, 0, 0], A = ["a*cos(th)", 0, "a*sin(th)"] }
+
+[[structure.joints]]
+name = "pin"
+kind = "revolute"
+parent = "ground"
+child = "bar"
+at = "B"
+axis = [0, 1, 0]
+damping = 0.5
+
+[[structure.cables]]
+name = "stay"
+a = "A"
+b = "P"
+length = "l"
+"#;
+
+/// The cable-held bar: |A - P| = l gives sin(theta) = (a^2 + H^2 - l^2) / (2 a H), so
+/// dA.z/dl = -l / H and dA.x/dl = l tan(theta) / H; the moment about O,
+/// T a H cos(theta) / l = m g (a / 2) cos(theta), gives T = m g l / (2 H). Each derivative
+/// within 1e-9 of the closed form (parameters inside the constraint, l and H, as well as the
+/// loads m and g) and 1e-6 of the settles'.
+#[test]
+fn a_bar_held_by_an_inextensible_cable_moves_with_its_length_as_the_closed_form_does() {
+    let r = report_of_text(CABLE_HELD_BAR);
+    let (a, h, l, m, g): (f64, f64, f64, f64, f64) = (1.0, 1.0, 1.2, 2.0, 9.81);
+    let theta = ((a * a + h * h - l * l) / (2.0 * a * h)).asin();
+    let closed = [
+        ("l", "stay.force", m * g / (2.0 * h)),
+        ("H", "stay.force", -m * g * l / (2.0 * h * h)),
+        ("m", "stay.force", g * l / (2.0 * h)),
+        ("g", "stay.force", m * l / (2.0 * h)),
+        ("l", "A.z", -l / h),
+        ("l", "A.x", l * theta.tan() / h),
+    ];
+    for (p, output, expected) in closed {
+        let d = against_settles(&r, p, output, 1e-6);
+        assert!(rel(d, expected) <= 1e-9, "d {output}/d {p} = {d:.15e}, closed form {expected:.15e}");
+    }
+}
+
+/// A bar on a ball joint at O, its tip A held aside by an inextensible cable of length l to
+/// P = (d, 0, 0): A keeps to a circle about the x axis, and the bar may also spin about OA.
+const BALL_JOINT_BAR_ON_A_CABLE: &str = r#"
+name = "a bar on a ball joint held aside by an inextensible cable"
+mechanism = "custom"
+
+[params]
+a = { value = 1.0, unit = "m", description = "bar length" }
+d = { value = 1.0, unit = "m", description = "the cable's fixed end P on the x axis" }
+l = { value = 1.2, unit = "m", description = "cable length" }
+m = { value = 2.0, unit = "kg" }
+g = { value = 9.81, unit = "m/s^2" }
+ax = { value = "(a^2 + d^2 - l^2)/(2*d)", unit = "m", description = "the tip's x" }
+
+[settle]
+speed_tol = 1e-12
+residual_force_tol = 1e-10
+residual_torque_tol = 1e-10
+
+[actuation]
+points = [ {} ]
+
+[structure]
+gravity = [0.0, 0.0, "-g"]
+
+[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { O = [0, 0, 0], P = ["d", 0, 0] }
+
+[[structure.bodies]]
+name = "bar"
+mass = "m"
+nodes = { B = [0, 0, 0], A = ["ax", 0, "-sqrt(a^2 - ax^2)"] }
+
+[[structure.joints]]
+name = "ball"
+kind = "spherical"
+parent = "ground"
+child = "bar"
+at = "B"
+damping = 0.5
+
+[[structure.cables]]
+name = "stay"
+a = "A"
+b = "P"
+length = "l"
+"#;
+
+/// The swing of the ball-jointed bar on its cable, in closed form: about the x axis
+/// (the line OP) gravity's stiffness is m g r (r = |A_perp| / 2, the centre of mass's distance
+/// from the axis); the spin about OA has none, so the swing's inertia is the Schur complement
+/// M_xx - M_xs^2 / M_ss of the inertia about O (isotropic m a^2 / 12 about the centre plus
+/// m (|c|^2 1 - c c^T)) on the two axes. omega = 3.9151149408 rad/s; d omega/d g = omega / (2 g)
+/// within 1e-9; d omega/d l and d omega/d a (inside the constraint: the state and the
+/// inertia move) within 1e-6 of their central differences in closed form, and of the
+/// settles' within 1e-5 (the constrained Hessian's differences carry about 1e-7).
+#[test]
+fn a_ball_jointed_bar_on_a_cable_has_the_closed_form_sensitivities_of_its_swing() {
+    let omega = |g: f64, a: f64, l: f64| {
+        let (m, d) = (2.0, 1.0);
+        let ax = (a * a + d * d - l * l) / (2.0 * d);
+        let ar = (a * a - ax * ax).sqrt();
+        let c = nalgebra::Vector3::new(ax, 0.0, -ar) / 2.0;
+        let inertia = nalgebra::Matrix3::identity() * (m * a * a / 12.0 + m * c.dot(&c)) - c * c.transpose() * m;
+        let (x, s) = (nalgebra::Vector3::x(), nalgebra::Vector3::new(ax, 0.0, -ar) / a);
+        let (mxx, mxs, mss) = (x.dot(&(inertia * x)), x.dot(&(inertia * s)), s.dot(&(inertia * s)));
+        (m * g * ar / 2.0 / (mxx - mxs * mxs / mss)).sqrt()
+    };
+    let (g, a, l, h) = (9.81, 1.0, 1.2, 1e-5);
+    let r = report_of_text(BALL_JOINT_BAR_ON_A_CABLE);
+    let (w, _, _) = derivative(&r, "g", "mode2.omega");
+    assert!(rel(w, omega(g, a, l)) <= 1e-9, "omega = {w:.12e}, closed form {:.12e}", omega(g, a, l));
+    let closed = [
+        ("g", (omega(g + h, a, l) - omega(g - h, a, l)) / (2.0 * h), 1e-9),
+        ("l", (omega(g, a, l + h) - omega(g, a, l - h)) / (2.0 * h), 1e-6),
+        ("a", (omega(g, a + h, l) - omega(g, a - h, l)) / (2.0 * h), 1e-6),
+    ];
+    for (p, expected, tol) in closed {
+        let d = against_settles(&r, p, "mode2.omega", 1e-5);
+        assert!(
+            rel(d, expected) <= tol,
+            "d omega/d {p} = {d:.15e}, closed form {expected:.15e}: {:.2e}",
+            rel(d, expected)
+        );
+    }
 }
