@@ -639,7 +639,8 @@ def test_a_modes_count_outside_its_range_raises():
 
 def test_sensitivity_from_python_is_the_clis_sensitivity_json():
     """tt.sensitivity is `tensegrity sensitivity --json`: every field equal (floats bit for bit),
-    the wall times aside; the rocker's d omega/d k1 agrees with the settles' within 1e-6."""
+    the wall times aside; the rocker's d omega/d k1 agrees with the settles' within 1e-6; a cable
+    with friction (its force depends on the path) raises ValueError."""
     py, cli = tt.sensitivity(str(ROCKER), check=True), cli_json("sensitivity", ROCKER, "--check")
     for r in (py, cli):
         r.pop("wall_s"), r.pop("check_wall_s")
@@ -648,8 +649,8 @@ def test_sensitivity_from_python_is_the_clis_sensitivity_json():
     k1 = next(p for p in py["parameters"] if p["name"] == "k1")
     i = names.index("mode1.omega")
     assert abs(k1["derivatives"][i] - k1["check"][i]) <= 1e-6 * abs(k1["check"][i])
-    with pytest.raises(ValueError, match="inextensible cable"):
-        tt.sensitivity(str(ROOT / "scenarios" / "mohr2011" / "quick.toml"))
+    with pytest.raises(ValueError, match="cable 'rope' has friction at a node"):
+        tt.sensitivity(str(ROOT / "scenarios" / "custom" / "capstan.toml"))
 
 
 def rocker_from_matrices(k1=10.0, k2=30.0, a=0.8, b=0.6, L=1.0, l1=0.5, l2=0.4, m=0.5):
