@@ -473,17 +473,11 @@ impl Data {
         cancel: Option<&AtomicBool>,
     ) -> Result<StructureModes, ModesError> {
         let s = &m.structure;
-        let closures = self.modal_closures(m)?;
-        let inextensible = s.members.iter().enumerate().filter(|(_, c)| c.is_inextensible_cable()).map(|(c, _)| c);
-        let (taut, slack): (Vec<usize>, Vec<usize>) = inextensible.partition(|&c| self.cable_is_taut(m, c));
-        let coordinates = self.modal_coordinates(m);
-        if coordinates.is_empty() {
-            return Err(ModesError::NoFreeBody);
-        }
+        let (constraints, first) = self.constraints_here(m)?;
+        let (coordinates, closures, taut) = (&constraints.coordinates, &constraints.closures, &constraints.taut_cables);
         let bodies: Vec<usize> = (0..s.bodies.len()).filter(|&b| s.bodies[b].kind == BodyKind::Free).collect();
-        let setup = self.constrained_setup(m, &coordinates, &closures, &taut);
-        let first = self.first_derivatives_extrapolated(m, &setup);
-        let lambda = multipliers(&first);
+        let setup = self.constrained_setup(m, coordinates, closures, taut);
+        let lambda = DVector::from_column_slice(&constraints.multipliers);
         let stiffness = richardson(
             &self.lagrangian_hessian(m, &setup, &lambda, 1.0),
             &self.lagrangian_hessian(m, &setup, &lambda, COARSE_STEP_RATIO),
@@ -491,7 +485,7 @@ impl Data {
         let mass = self.coordinate_mass(m, &setup, &bodies);
         let jac = mass.1;
         let body_mass = self.mass_matrix(m, &bodies);
-        let (basis, rank) = null_space(&first.jacobian, coordinates.len());
+        let (basis, _) = null_space(&first.jacobian, coordinates.len());
         let reduced_mass = basis.transpose() * &mass.0 * &basis;
         let reduced_stiffness = basis.transpose() * &stiffness * &basis;
         // No motion left (rank G = the coordinates): no mode.
@@ -519,16 +513,6 @@ impl Data {
             .collect();
         let rigid = modes.iter().filter(|x| x.rigid).count();
         let poses = bodies.iter().map(|b| self.body_pose(m, *b)).collect();
-        let rows = first.jacobian.nrows();
-        let constraints = Constraints {
-            coordinates: coordinates.clone(),
-            closures: closures.clone(),
-            taut_cables: taut.clone(),
-            slack_cables: slack,
-            rows,
-            rank,
-            multipliers: lambda.iter().copied().collect(),
-        };
         Ok(StructureModes {
             bodies,
             joints: vec![],
@@ -539,6 +523,34 @@ impl Data {
             constraints: Some(constraints),
             lowest_of: None,
         })
+    }
+
+    /// The constraints of the current state (every joint that closes a loop, every taut
+    /// inextensible cable; a slack one left out) with their forces lambda from the
+    /// equilibrium, and the first derivatives they were found from.
+    pub(super) fn constraints_here(&mut self, m: &Model) -> Result<(Constraints, FirstDerivatives), ModesError> {
+        let s = &m.structure;
+        let closures = self.modal_closures(m)?;
+        let inextensible = s.members.iter().enumerate().filter(|(_, c)| c.is_inextensible_cable()).map(|(c, _)| c);
+        let (taut, slack): (Vec<usize>, Vec<usize>) = inextensible.partition(|&c| self.cable_is_taut(m, c));
+        let coordinates = self.modal_coordinates(m);
+        if coordinates.is_empty() {
+            return Err(ModesError::NoFreeBody);
+        }
+        let setup = self.constrained_setup(m, &coordinates, &closures, &taut);
+        let first = self.first_derivatives_extrapolated(m, &setup);
+        let lambda = multipliers(&first);
+        let rank = null_space(&first.jacobian, coordinates.len()).1;
+        let constraints = Constraints {
+            rows: first.jacobian.nrows(),
+            rank,
+            multipliers: lambda.iter().copied().collect(),
+            coordinates,
+            closures,
+            taut_cables: taut,
+            slack_cables: slack,
+        };
+        Ok((constraints, first))
     }
 
     /// What the differences of the constrained analysis need at the current state.

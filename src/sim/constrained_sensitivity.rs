@@ -17,39 +17,12 @@
 //! N(p) the projection of N onto null(G(p)) it is the derivative of
 //! phi_p^T (K - omega^2 M) phi_p, phi_p = (1 - G^+ G) phi, phi = N v.
 
-use super::constrained_modes::{multipliers, Constraints, ModalCoordinate, COARSE_STEP_RATIO};
-use super::modes::ModesError;
+use super::constrained_modes::{Constraints, ModalCoordinate, COARSE_STEP_RATIO};
 use super::{Data, LinkRef, Model};
 use nalgebra::{DMatrix, DVector};
 use rapier3d_f64::prelude::MultibodyIndex;
 
 impl Data {
-    /// The constraints of the current state, with its constraint forces lambda: every joint
-    /// that closes a loop, every taut inextensible cable (a slack one left out).
-    pub(super) fn equilibrium_constraints(&mut self, m: &Model) -> Result<Constraints, ModesError> {
-        let s = &m.structure;
-        let closures = self.modal_closures(m)?;
-        let inextensible = s.members.iter().enumerate().filter(|(_, c)| c.is_inextensible_cable()).map(|(c, _)| c);
-        let (taut, slack): (Vec<usize>, Vec<usize>) = inextensible.partition(|&c| self.cable_is_taut(m, c));
-        let coordinates = self.modal_coordinates(m);
-        if coordinates.is_empty() {
-            return Err(ModesError::NoFreeBody);
-        }
-        let setup = self.constrained_setup(m, &coordinates, &closures, &taut);
-        let first = self.first_derivatives_extrapolated(m, &setup);
-        let lambda = multipliers(&first);
-        let rank = crate::sim::constrained_modes::null_space(&first.jacobian, coordinates.len()).1;
-        Ok(Constraints {
-            rows: first.jacobian.nrows(),
-            rank,
-            multipliers: lambda.iter().copied().collect(),
-            coordinates,
-            closures,
-            taut_cables: taut,
-            slack_cables: slack,
-        })
-    }
-
     /// Q = -dL/dq = -(grad V + G^T lambda) now, lambda held at `c`'s [N or N m].
     pub(super) fn lagrangian_forces(&mut self, m: &Model, c: &Constraints) -> DVector<f64> {
         let setup = self.constrained_setup(m, &c.coordinates, &c.closures, &c.taut_cables);

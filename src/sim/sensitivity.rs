@@ -131,7 +131,7 @@ impl Data {
         };
         let inextensible = s.members.iter().any(|c| c.is_inextensible_cable());
         if inextensible || m.joint_impulse.iter().any(Option::is_some) || s.joints.iter().enumerate().any(several) {
-            let constraints = self.equilibrium_constraints(m)?;
+            let (constraints, _) = self.constraints_here(m)?;
             let names = self.modal_coordinate_names(m, &constraints.coordinates);
             return Ok(EquilibriumCoordinates::Constrained(Box::new(ConstrainedCoordinates { constraints, names })));
         }

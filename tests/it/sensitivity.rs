@@ -222,9 +222,25 @@ fn a_printed_sensitivity_is_judged_as_a_prediction_at_every_point() {
     common::error_at(&bad, "\"k9\"", 0, "'k9' is not a parameter of this scenario");
 }
 
-/// The sensitivities of `text` (a scenario file) at its first point, with the check.
+/// What the held bars below share: a tight settle at one point, under gravity g.
+const SETTLED_ONCE_UNDER_GRAVITY: &str = r#"
+[settle]
+speed_tol = 1e-12
+residual_force_tol = 1e-10
+residual_torque_tol = 1e-10
+
+[actuation]
+points = [ {} ]
+
+[structure]
+gravity = [0.0, 0.0, "-g"]
+"#;
+
+/// The sensitivities of `text` (a scenario file whose `[structure]` takes
+/// [`SETTLED_ONCE_UNDER_GRAVITY`]) at its first point, with the check.
 fn report_of_text(text: &str) -> SensitivityReport {
-    let sc = scenario::parse(Path::new("held.toml"), text).expect("a valid scenario");
+    let text = text.replace("\n[structure]\n", SETTLED_ONCE_UNDER_GRAVITY);
+    let sc = scenario::parse(Path::new("held.toml"), &text).expect("a valid scenario");
     tensegrity_testbed::run::sensitivity(&sc, "held.toml", 0, true, None).expect("sensitivities")
 }
 
@@ -243,16 +259,7 @@ m = { value = 2.0, unit = "kg" }
 g = { value = 9.81, unit = "m/s^2" }
 th = { value = "asin((a^2 + H^2 - l^2)/(2*a*H))", unit = "rad", description = "the bar's angle above the horizontal" }
 
-[settle]
-speed_tol = 1e-12
-residual_force_tol = 1e-10
-residual_torque_tol = 1e-10
-
-[actuation]
-points = [ {} ]
-
 [structure]
-gravity = [0.0, 0.0, "-g"]
 
 [[structure.bodies]]
 name = "ground"
@@ -318,16 +325,7 @@ m = { value = 2.0, unit = "kg" }
 g = { value = 9.81, unit = "m/s^2" }
 ax = { value = "(a^2 + d^2 - l^2)/(2*d)", unit = "m", description = "the tip's x" }
 
-[settle]
-speed_tol = 1e-12
-residual_force_tol = 1e-10
-residual_torque_tol = 1e-10
-
-[actuation]
-points = [ {} ]
-
 [structure]
-gravity = [0.0, 0.0, "-g"]
 
 [[structure.bodies]]
 name = "ground"
