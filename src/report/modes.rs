@@ -48,6 +48,9 @@ pub struct ConstraintsReport {
     pub taut_cables: Vec<(String, f64)>,
     /// The inextensible cables left out as slack.
     pub slack_cables: Vec<String>,
+    /// The reduced Hessian's own error as an omega^2 (its second differences at h and 2 h
+    /// apart): a mode below it, or below `zero_mode_ratio` of the largest, is rigid.
+    pub zero_floor_rad2_per_s2: f64,
 }
 
 /// One mode.
@@ -118,13 +121,14 @@ impl ConstraintsReport {
         let list = |v: &[String]| if v.is_empty() { "none".to_string() } else { v.join(", ") };
         let taut: Vec<String> = self.taut_cables.iter().map(|(n, t)| format!("{n} {t:.6} N")).collect();
         format!(
-            "   constraints: {} rows of rank {} ({} degree(s) of freedom); loops closed by {}; taut cables {}; slack cables {}\n",
+            "   constraints: {} rows of rank {} ({} degree(s) of freedom); loops closed by {}; taut cables {}; slack cables {}; rigid below {:.1e} rad^2/s^2 (the Hessian's own error)\n",
             self.rows,
             self.rank,
             self.degrees_of_freedom,
             list(&self.loop_closures),
             list(&taut),
-            list(&self.slack_cables)
+            list(&self.slack_cables),
+            self.zero_floor_rad2_per_s2
         )
     }
 }

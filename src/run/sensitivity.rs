@@ -84,34 +84,40 @@ struct Analysis<'a> {
     base: Vec<(String, f64)>,
 }
 
-/// A settled state linearized in its coordinates: K, G (no rows without constraints) and the
-/// modes K phi = omega^2 M phi on null(G), each phi mass-normalised in the coordinates.
+/// A settled state linearized in its coordinates: K, G (no rows without constraints), the
+/// modes K phi = omega^2 M phi on null(G), each phi mass-normalised in the coordinates, and
+/// which are rigid-body modes (|omega^2| below [`ZERO_MODE_RATIO`] of the largest, or with
+/// constraints below the reduced Hessian's own error, `constrained_modes::zero_floor`).
 struct Linearization {
     stiffness: DMatrix<f64>,
     jacobian: DMatrix<f64>,
     modes: Vec<Mode>,
+    rigid: Vec<bool>,
 }
 
 /// K, M and G of `sim` in `coordinates`, and the modes of the reduced problem
 /// (N^T K N) v = omega^2 (N^T M N) v, N a basis of null(G), phi = N v (all coordinates where
 /// there is no constraint).
 fn linearize(sim: &mut Simulation, coordinates: &EquilibriumCoordinates) -> Result<Linearization, SensitivityRunError> {
-    let stiffness = sim.equilibrium_stiffness(coordinates);
+    let (stiffness, error) = sim.equilibrium_stiffness_and_error(coordinates);
     let mass = sim.equilibrium_mass(coordinates);
     let jacobian = sim.constraint_jacobian(coordinates);
-    let modes = if jacobian.nrows() == 0 {
-        crate::eigen::modes(&symmetric(&stiffness), &symmetric(&mass))?
+    let (modes, floor) = if coordinates.constraints().is_none() {
+        (crate::eigen::modes(&symmetric(&stiffness), &symmetric(&mass))?, 0.0)
     } else {
         let (basis, _) = crate::sim::modes::null_space(&jacobian, stiffness.ncols());
+        let reduce = |a: &DMatrix<f64>| symmetric(&(basis.transpose() * a * &basis));
         if basis.ncols() == 0 {
-            Vec::new()
+            (Vec::new(), 0.0)
         } else {
-            let reduce = |a: &DMatrix<f64>| symmetric(&(basis.transpose() * a * &basis));
             let reduced = crate::eigen::modes(&reduce(&stiffness), &reduce(&mass))?;
-            reduced.into_iter().map(|m| Mode { shape: &basis * m.shape, ..m }).collect()
+            let floor = crate::sim::modes::zero_floor(&error, &basis, &reduce(&mass));
+            (reduced.into_iter().map(|m| Mode { shape: &basis * m.shape, ..m }).collect(), floor)
         }
     };
-    Ok(Linearization { stiffness, jacobian, modes })
+    let largest = modes.iter().fold(0.0f64, |l, m| l.max(m.omega_squared.abs()));
+    let rigid = modes.iter().map(|m| m.omega_squared.abs() <= (ZERO_MODE_RATIO * largest).max(floor)).collect();
+    Ok(Linearization { stiffness, jacobian, modes, rigid })
 }
 
 /// The least-squares, least-norm x of a x = b (singular values of a below
@@ -136,7 +142,7 @@ fn analyse<'a>(
     let model = sc.model.as_ref().map(|spec| ModelObserver::new(spec, sim.structure(), false, None));
     let out = Outputs { sc, mech: sc.mechanism(), inputs, model, coordinates };
     let lin = linearize(sim, &out.coordinates)?;
-    let listed = listed_modes(&lin.modes);
+    let listed = listed_modes(&lin.rigid);
     let mut base = out.sample(sim, params);
     base.extend(listed.iter().map(|&i| (format!("mode{}.omega", i + 1), lin.modes[i].omega())));
     Ok(Analysis { out, lin, listed, base })
@@ -184,7 +190,7 @@ pub fn sensitivity(
         parameters.push(out.parameter(&state.sim, &params, name, value, &lin, &listed));
     }
     let wall_s = wall.elapsed().as_secs_f64();
-    let free = out.free_outputs(&mut state.sim, &params, &lin.modes, &base);
+    let free = out.free_outputs(&mut state.sim, &params, &lin, &base);
     let outputs: Vec<OutputValue> = base
         .iter()
         .zip(free)
@@ -245,13 +251,9 @@ fn symmetric(a: &DMatrix<f64>) -> DMatrix<f64> {
 }
 
 /// The modes whose frequencies are reported: the lowest [`FREQUENCIES_LISTED`] that are not
-/// rigid-body modes (|omega^2| above [`ZERO_MODE_RATIO`] of the largest), by index.
-fn listed_modes(modes: &[Mode]) -> Vec<usize> {
-    let largest = modes.iter().fold(0.0f64, |l, m| l.max(m.omega_squared.abs()));
-    (0..modes.len())
-        .filter(|&i| modes[i].omega_squared.abs() > ZERO_MODE_RATIO * largest)
-        .take(FREQUENCIES_LISTED)
-        .collect()
+/// rigid-body modes ([`Linearization`]), by index.
+fn listed_modes(rigid: &[bool]) -> Vec<usize> {
+    (0..rigid.len()).filter(|&i| !rigid[i]).take(FREQUENCIES_LISTED).collect()
 }
 
 /// For each listed mode phi (omega^2) of the settled state, phi_s^T (K - omega^2 M) phi_s in
@@ -279,10 +281,9 @@ fn modal_curvatures(
 
 /// K^-1 r over the modes that are not rigid: sum of phi (phi^T r) / omega^2 (phi
 /// mass-normalised, so that K^-1 = Phi Lambda^-1 Phi^T); a rigid motion is left where it is.
-fn solve(modes: &[Mode], r: &DVector<f64>) -> DVector<f64> {
-    let largest = modes.iter().fold(0.0f64, |l, m| l.max(m.omega_squared.abs()));
+fn solve(lin: &Linearization, r: &DVector<f64>) -> DVector<f64> {
     let mut x = DVector::zeros(r.len());
-    for m in modes.iter().filter(|m| m.omega_squared.abs() > ZERO_MODE_RATIO * largest) {
+    for (m, _) in lin.modes.iter().zip(&lin.rigid).filter(|(_, rigid)| !**rigid) {
         x += &m.shape * (m.shape.dot(r) / m.omega_squared);
     }
     x
@@ -374,10 +375,15 @@ impl Outputs<'_> {
     /// parameter sets: a node's coordinates where the structure may turn): the settled state
     /// moved along each such mode by [`RIGID_PROBE_RATIO`] of the structure's size at its
     /// largest node motion, and back. The frequencies are fixed by the modes.
-    fn free_outputs(&self, sim: &mut Simulation, params: &Values, modes: &[Mode], base: &[(String, f64)]) -> Vec<bool> {
+    fn free_outputs(
+        &self,
+        sim: &mut Simulation,
+        params: &Values,
+        lin: &Linearization,
+        base: &[(String, f64)],
+    ) -> Vec<bool> {
         let mut free = vec![false; base.len()];
-        let largest = modes.iter().fold(0.0f64, |l, m| l.max(m.omega_squared.abs()));
-        for m in modes.iter().filter(|m| m.omega_squared.abs() <= ZERO_MODE_RATIO * largest) {
+        for (m, _) in lin.modes.iter().zip(&lin.rigid).filter(|(_, rigid)| **rigid) {
             let eta = RIGID_PROBE_RATIO * sim.length_scale_m() / m.shape.amax().max(f64::MIN_POSITIVE);
             let mut moved = Vec::new();
             for s in [1.0, -1.0] {
@@ -459,7 +465,7 @@ impl Outputs<'_> {
         // The move that keeps the constraints (module docs of sim/constrained_sensitivity.rs),
         // then the equilibrium along null(G).
         let particular = -least_squares(&lin.jacobian, &dg_dp);
-        let dq = solve(&lin.modes, &(&dq_dp - &lin.stiffness * &particular)) + &particular;
+        let dq = solve(lin, &(&dq_dp - &lin.stiffness * &particular)) + &particular;
         let lambda = self.coordinates.constraints().map_or(vec![], |c| c.multipliers.clone());
         let dlambda = least_squares(&lin.jacobian.transpose(), &(&dq_dp - &lin.stiffness * &dq));
         let base = self.sample(at, params);

@@ -116,6 +116,7 @@ fn constraints_report(c: &Constraints, s: &crate::structure::Structure) -> Const
             .map(|(&k, t)| (s.members[k].name.clone(), *t))
             .collect(),
         slack_cables: c.slack_cables.iter().map(|&k| s.members[k].name.clone()).collect(),
+        zero_floor_rad2_per_s2: c.zero_floor,
     }
 }
 

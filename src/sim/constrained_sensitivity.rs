@@ -17,7 +17,7 @@
 //! N(p) the projection of N onto null(G(p)) it is the derivative of
 //! phi_p^T (K - omega^2 M) phi_p, phi_p = (1 - G^+ G) phi, phi = N v.
 
-use super::constrained_modes::{Constraints, ModalCoordinate, COARSE_STEP_RATIO};
+use super::constrained_modes::{Constraints, ModalCoordinate};
 use super::{Data, LinkRef, Model};
 use nalgebra::{DMatrix, DVector};
 use rapier3d_f64::prelude::MultibodyIndex;
@@ -42,14 +42,12 @@ impl Data {
         DVector::from_vec(self.constraint_rows(m, &c.closures, &c.taut_cables))
     }
 
-    /// K = d2L/dq2 now, lambda held at `c`'s (Richardson over h and 2 h).
-    pub(super) fn lagrangian_stiffness(&mut self, m: &Model, c: &Constraints) -> DMatrix<f64> {
+    /// K = d2L/dq2 now, lambda held at `c`'s (Richardson over h and 2 h), and the size of its
+    /// error (the difference between the two steps).
+    pub(super) fn lagrangian_stiffness(&mut self, m: &Model, c: &Constraints) -> (DMatrix<f64>, DMatrix<f64>) {
         let setup = self.constrained_setup(m, &c.coordinates, &c.closures, &c.taut_cables);
         let lambda = DVector::from_column_slice(&c.multipliers);
-        super::constrained_modes::richardson(
-            &self.lagrangian_hessian(m, &setup, &lambda, 1.0),
-            &self.lagrangian_hessian(m, &setup, &lambda, COARSE_STEP_RATIO),
-        )
+        self.lagrangian_stiffness_and_error(m, &setup, &lambda)
     }
 
     /// The mass matrix in `c`'s coordinates (the hidden bodies of universal joints included).

@@ -410,6 +410,15 @@ impl Simulation {
         self.data.equilibrium_stiffness(&self.model, c)
     }
 
+    /// [`Simulation::equilibrium_stiffness`] and the size of its error (zero but where
+    /// constraints make K a second difference of the Lagrangian).
+    pub fn equilibrium_stiffness_and_error(
+        &mut self,
+        c: &sensitivity::EquilibriumCoordinates,
+    ) -> (nalgebra::DMatrix<f64>, nalgebra::DMatrix<f64>) {
+        self.data.equilibrium_stiffness_and_error(&self.model, c)
+    }
+
     /// The mass matrix in the coordinates `c` now.
     pub fn equilibrium_mass(&mut self, c: &sensitivity::EquilibriumCoordinates) -> nalgebra::DMatrix<f64> {
         self.data.equilibrium_mass(&self.model, c)

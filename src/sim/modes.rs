@@ -12,7 +12,7 @@
 //! sparse: the lowest [`SPARSE_MODAL_COUNT`] modes beyond the rigid ones, by shift-invert
 //! subspace iteration (`relaxation/lowest_modes.rs`).
 
-pub(crate) use super::constrained_modes::null_space;
+pub(crate) use super::constrained_modes::{null_space, zero_floor};
 pub use super::constrained_modes::{Constraints, ModalCoordinate, NULL_SPACE_RATIO};
 use super::{Data, Model, Simulation};
 use crate::eigen::EigenError;

@@ -200,9 +200,27 @@ impl Data {
     /// K = -dQ/dq now: each column a central difference extrapolated over h and 2 h, the
     /// state restored after each move.
     pub(super) fn equilibrium_stiffness(&mut self, m: &Model, c: &EquilibriumCoordinates) -> DMatrix<f64> {
+        self.equilibrium_stiffness_and_error(m, c).0
+    }
+
+    /// [`Self::equilibrium_stiffness`] and the size of its error: with constraints, the
+    /// difference of the second differences at h and 2 h (`constrained_modes::zero_floor`);
+    /// zero otherwise (K there is the difference of exact forces, about 1e-13 of K).
+    pub(super) fn equilibrium_stiffness_and_error(
+        &mut self,
+        m: &Model,
+        c: &EquilibriumCoordinates,
+    ) -> (DMatrix<f64>, DMatrix<f64>) {
         if let Some(c) = c.constraints() {
             return self.lagrangian_stiffness(m, c);
         }
+        let k = self.forces_stiffness(m, c);
+        let zero = DMatrix::zeros(k.nrows(), k.ncols());
+        (k, zero)
+    }
+
+    /// K = -dQ/dq of the exact generalized forces Q.
+    fn forces_stiffness(&mut self, m: &Model, c: &EquilibriumCoordinates) -> DMatrix<f64> {
         let n = c.len();
         let mut k = DMatrix::zeros(n, n);
         for i in 0..n {
