@@ -544,7 +544,7 @@ fn sensitivity_json(
 /// A fitted parameter from Python: (name, low bound, high bound).
 type FitBounds = (String, Option<f64>, Option<f64>);
 /// A measured row from Python: (where it is, for errors; point; output; value; sigma).
-type MeasuredRow = (String, i64, String, f64, Option<f64>);
+type MeasuredRow = (String, i64, String, f64, Option<f64>, Option<f64>);
 
 /// The fit of `tensegrity fit --json` (`run::fit`, the CLI's own function): the scenario at
 /// `path` (or TOML `text` named `path`) with `set`, the parameters `params` within their
@@ -578,11 +578,11 @@ fn fit_json(
         Some(d) => run::read_measurements("data", &d, false).map_err(|e| PyValueError::new_err(e.to_string()))?,
         None => rows
             .into_iter()
-            .map(|(at, point, output, value, sigma)| {
+            .map(|(at, point, output, value, sigma, time_s)| {
                 let point = usize::try_from(point).map_err(|_| {
                     PyValueError::new_err(format!("{at}: point {point} is not a point number (from 0)"))
                 })?;
-                Ok(Measurement { at, point, output, value, sigma })
+                Ok(Measurement { at, point, output, value, sigma, time_s })
             })
             .collect::<PyResult<_>>()?,
     };

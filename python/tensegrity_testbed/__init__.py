@@ -207,7 +207,7 @@ def sensitivity(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, nam
     return json.loads(_call(_tensegrity.sensitivity_json, path, text, _sets(set), check, point))
 
 
-_FIT_COLUMNS = ("point", "output", "value", "sigma")
+_FIT_COLUMNS = ("point", "output", "value", "sigma", "t_s")
 
 
 def _fit_params(params) -> list:
@@ -244,10 +244,10 @@ def _fit_rows(data) -> list:
     unknown = [c for c in frame.columns if c not in _FIT_COLUMNS]
     if unknown:
         raise ValueError(f"data: the column {unknown[0]!r} names nothing: the columns are "
-                         f"{','.join(_FIT_COLUMNS)} (sigma optional)")
+                         f"{','.join(_FIT_COLUMNS)} (sigma and t_s optional)")
     missing = [c for c in _FIT_COLUMNS[:3] if c not in frame.columns]
     if missing:
-        raise ValueError(f"data: no column {missing[0]!r} (the columns are {','.join(_FIT_COLUMNS)}, sigma optional)")
+        raise ValueError(f"data: no column {missing[0]!r} (the columns are {','.join(_FIT_COLUMNS)}, sigma and t_s optional)")
     rows = []
     for index, row in zip(frame.index, frame.itertuples(index=False)):
         at = f"data[{index}]"
@@ -268,7 +268,15 @@ def _fit_rows(data) -> list:
                 raise ValueError(f"{at}: sigma {sigma!r} is not a number") from None
             if sigma != sigma:  # NaN: no sigma, as an empty cell of the CSV
                 sigma = None
-        rows.append((at, int(point), str(row.output), value, sigma))
+        t_s = getattr(row, "t_s", None)
+        if t_s is not None:
+            try:
+                t_s = float(t_s)
+            except (TypeError, ValueError):
+                raise ValueError(f"{at}: t_s {t_s!r} is not a number") from None
+            if t_s != t_s:  # NaN: a settled state's row, as an empty cell of the CSV
+                t_s = None
+        rows.append((at, int(point), str(row.output), value, sigma, t_s))
     return rows
 
 
@@ -282,7 +290,8 @@ def fit(scenario: Scenario, data, params, set: Optional[Mapping[str, Any]] = Non
 
     ``data``: a CSV path (read as ``--data`` reads it) or a pandas DataFrame with the columns
     point (from 0), output (as ``tensegrity sensitivity`` names them), value and optionally
-    sigma. ``params``: ``{name: (low, high)}`` (either bound None) or ``{name: None}``, or a list
+    sigma and t_s (a row of the scenario's motion at that time since its start, output a
+    column of its table: ``joint:pin.angle``). ``params``: ``{name: (low, high)}`` (either bound None) or ``{name: None}``, or a list
     of names. ``set``: the CLI's ``--set``. Raises ScenarioError on a bad scenario, ValueError on
     bad data or parameters (the row or name said; a parameter the fit ran into its bound or away
     with named), Exception when a settle fails (the point named), KeyboardInterrupt on Ctrl-C.

@@ -51,6 +51,9 @@ pub struct FittedParameter {
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct FitResidual {
     pub point: usize,
+    /// A trajectory row's time since the motion's start \[s\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_s: Option<f64>,
     pub output: String,
     pub measured: f64,
     pub model: f64,
@@ -98,11 +101,16 @@ impl FitReport {
             "chi^2 = {:.6e} over {} degrees of freedom{scaled}; {} iterations ({}) in {:.3} s\n",
             self.chi2, self.degrees_of_freedom, self.iterations, self.stopped, self.wall_s
         );
-        s += &format!("{:>5} {:<20} {:>14} {:>14} {:>10}\n", "point", "output", "measured", "model", "weighted");
+        s += &format!(
+            "{:>5} {:>10} {:<20} {:>14} {:>14} {:>10}\n",
+            "point", "t [s]", "output", "measured", "model", "weighted"
+        );
         for r in &self.residuals {
+            // A trajectory row's time since the motion's start; "-" for a settled state's.
+            let t = r.time_s.map_or("-".to_string(), |t| format!("{t}"));
             s += &format!(
-                "{:>5} {:<20} {:>14.6e} {:>14.6e} {:>10.3}\n",
-                r.point, r.output, r.measured, r.model, r.weighted
+                "{:>5} {:>10} {:<20} {:>14.6e} {:>14.6e} {:>10.3}\n",
+                r.point, t, r.output, r.measured, r.model, r.weighted
             );
         }
         s

@@ -74,6 +74,9 @@ pub struct Measurement {
     pub value: f64,
     /// Its standard deviation, in the output's unit; None: unweighted.
     pub sigma: Option<f64>,
+    /// The time since the motion's start \[s\] of a trajectory row (`fit_trajectory.rs`: the
+    /// output is a column of the motion's table); None: the settled state at `point`.
+    pub time_s: Option<f64>,
 }
 
 /// What to fit: the scenario (its file and text, parsed again at each evaluation with its
@@ -371,7 +374,7 @@ fn at_bound(problem: &FitProblem, wanted: &DVector<f64>, taken: &DVector<f64>) -
 }
 
 /// The scenario parsed with the fitted parameters at `p` (as `--set NAME=VALUE`).
-fn scenario_at(problem: &FitProblem, p: &[f64]) -> Result<Scenario, FitError> {
+pub(super) fn scenario_at(problem: &FitProblem, p: &[f64]) -> Result<Scenario, FitError> {
     let mut overrides = problem.overrides.clone();
     overrides.extend(
         problem.parameters.iter().zip(p).map(|(f, v)| Override { name: f.name.clone(), value: format!("{v:?}") }),
@@ -387,19 +390,28 @@ fn evaluate(problem: &FitProblem, p: &[f64], cancel: Option<&AtomicBool>) -> Res
     // Each measured point once, settled in parallel (one a core); the first failure in the
     // data's order is the one reported.
     let mut first: BTreeMap<usize, &Measurement> = BTreeMap::new();
-    for x in &problem.measurements {
+    for x in problem.measurements.iter().filter(|x| x.time_s.is_none()) {
         first.entry(x.point).or_insert(x);
     }
     let settled: Vec<(usize, Result<SensitivityReport, FitError>)> =
         first.par_iter().map(|(&point, x)| (point, settled_point(&sc, &file, x, p, cancel))).collect();
     let mut reports: BTreeMap<usize, Result<SensitivityReport, FitError>> = settled.into_iter().collect();
-    if let Some(x) = problem.measurements.iter().find(|x| reports[&x.point].is_err()) {
+    if let Some(x) = problem.measurements.iter().find(|x| x.time_s.is_none() && reports[&x.point].is_err()) {
         return Err(reports.remove(&x.point).expect("a point settled").expect_err("a failure"));
     }
     let reports: BTreeMap<usize, SensitivityReport> =
         reports.into_iter().map(|(k, r)| (k, r.expect("no failure"))).collect();
     let mut eval = Evaluation { model: DVector::zeros(m), jacobian: DMatrix::zeros(m, n) };
-    for (i, x) in problem.measurements.iter().enumerate() {
+    let timed: Vec<usize> = (0..m).filter(|&i| problem.measurements[i].time_s.is_some()).collect();
+    if !timed.is_empty() {
+        let rows: Vec<&Measurement> = timed.iter().map(|&i| &problem.measurements[i]).collect();
+        let (model, jacobian) = super::fit_trajectory::trajectory_evaluation(problem, &rows, p, cancel)?;
+        for (k, &i) in timed.iter().enumerate() {
+            eval.model[i] = model[k];
+            eval.jacobian.set_row(i, &jacobian.row(k));
+        }
+    }
+    for (i, x) in problem.measurements.iter().enumerate().filter(|(_, x)| x.time_s.is_none()) {
         let r = &reports[&x.point];
         let Some(k) = r.outputs.iter().position(|o| o.name == x.output) else {
             let close = close_names(&x.output, r.outputs.iter().map(|o| o.name.as_str()));
@@ -483,6 +495,7 @@ fn report(
         .enumerate()
         .map(|(i, x)| FitResidual {
             point: x.point,
+            time_s: x.time_s,
             output: x.output.clone(),
             measured: x.value,
             model: it.eval.model[i],
@@ -541,8 +554,9 @@ fn covariance(j: &DMatrix<f64>, p: &[f64], names: &[String], factor: f64) -> (DM
 
 /// Largest measurement file read \[bytes\].
 pub const MAX_DATA_BYTES: u64 = 16 << 20;
-/// The data's columns, the last one optional.
-pub const DATA_COLUMNS: [&str; 4] = ["point", "output", "value", "sigma"];
+/// The data's columns, the last two optional: `t_s`, a trajectory row's time since the
+/// motion's start (`fit_trajectory.rs`).
+pub const DATA_COLUMNS: [&str; 5] = ["point", "output", "value", "sigma", "t_s"];
 
 /// `NAME`, `NAME=LOW:HIGH`, `NAME=LOW:` or `NAME=:HIGH` (the CLI's `--param`) as a parameter
 /// to fit.
@@ -588,11 +602,11 @@ pub fn measurements_from_csv(file: &str, text: &str) -> Result<Vec<Measurement>,
         return Err(bad(format!("{file}:1:1: no header: the columns are {}", DATA_COLUMNS.join(","))));
     };
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let mut index = [None; 4];
+    let mut index = [None; 5];
     for (k, name) in names.iter().enumerate() {
         let Some(c) = DATA_COLUMNS.iter().position(|c| c == name) else {
             return Err(bad(format!(
-                "{file}:1:{}: the column '{name}' names nothing: the columns are {} (sigma optional)",
+                "{file}:1:{}: the column '{name}' names nothing: the columns are {} (sigma and t_s optional)",
                 column_at(header, k),
                 DATA_COLUMNS.join(",")
             )));
@@ -630,8 +644,13 @@ pub fn measurements_from_csv(file: &str, text: &str) -> Result<Vec<Measurement>,
             Some(k) if !cells[k].is_empty() => Some(number(3)?),
             _ => None,
         };
+        let time_s = match index[4] {
+            Some(k) if !cells[k].is_empty() => Some(number(4)?),
+            _ => None,
+        };
         let output = at(1).0.to_string();
-        rows.push(Measurement { at: format!("{file}:{}", n + 1), point, output, value: number(2)?, sigma });
+        let at = format!("{file}:{}", n + 1);
+        rows.push(Measurement { at, point, output, value: number(2)?, sigma, time_s });
     }
     Ok(rows)
 }
@@ -643,7 +662,7 @@ fn column_at(line: &str, k: usize) -> usize {
 
 /// The names of `known` within [`CLOSE_EDITS`] edits of `name` (or sharing its part before
 /// the dot), as ", close names: a, b", or "".
-fn close_names<'a>(name: &str, known: impl Iterator<Item = &'a str>) -> String {
+pub(super) fn close_names<'a>(name: &str, known: impl Iterator<Item = &'a str>) -> String {
     let stem = name.split('.').next().unwrap_or(name);
     let close: Vec<&str> = known
         .filter(|k| edits(name, k) <= CLOSE_EDITS || (name.contains('.') && k.split('.').next() == Some(stem)))
@@ -721,6 +740,7 @@ mod tests {
                     output: "y".into(),
                     value: truth[0] + truth[1] * ti + NOISE * standard_normal(&mut state),
                     sigma: Some(NOISE),
+                    time_s: None,
                 })
                 .collect();
             let parameters =

@@ -5,6 +5,7 @@
 //! read-out) (the pass policy is `report::verdict`).
 
 mod fit;
+mod fit_trajectory;
 mod levels;
 mod motion;
 mod point;

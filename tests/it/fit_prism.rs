@@ -89,6 +89,7 @@ fn fit_noisy(
             output: output.clone(),
             value: value + seed.map_or(0.0, |_| sigma * tensegrity_testbed::run::standard_normal(&mut state)),
             sigma: Some(*sigma),
+            time_s: None,
         })
         .collect();
     let problem = FitProblem {
