@@ -736,6 +736,31 @@ def test_fit_from_python_is_the_clis_fit_json():
     assert k2["name"] == "k2" and k2["low"] <= 33.0 <= k2["high"] and abs(k2["value"] - 33.0) <= 0.01
 
 
+def test_a_trajectory_fits_from_python_as_from_the_cli(tmp_path):
+    """A DataFrame with t_s rows (the released bar's pin angle at twenty times, read off
+    ``tt.run(..., table=True)``) fits k2 from 25 back to the run's 30 N/m within 1e-6, and the
+    report is the CLI's on the same rows written as a CSV."""
+    import pandas as pd
+
+    released = ROOT / "scenarios" / "custom" / "pinned_bar_large_amplitude.toml"
+    ticks = tt.run(str(released), table=True).table.to_pandas()
+    ticks = ticks[ticks["motion_time_s"].notna()]
+    rows = []
+    for k in range(1, 21):
+        tick = ticks.iloc[(ticks["motion_time_s"] - 0.1 * k).abs().argmin()]
+        rows.append({"point": 0, "output": "joint:pin.angle", "value": tick["joint:pin.angle"],
+                     "sigma": 1e-4, "t_s": tick["motion_time_s"]})
+    frame = pd.DataFrame(rows)
+    py = tt.fit(str(released), frame, ["k2"], set={"k2": 25})
+    k2 = py["parameters"][0]
+    assert abs(k2["value"] - 30.0) <= 1e-6 * 30.0 and all(r["time_s"] is not None for r in py["residuals"])
+    data = tmp_path / "trajectory_rows.csv"
+    frame.to_csv(data, index=False, float_format="%.17g")
+    cli = cli_json("fit", released, "--data", str(data), "--param", "k2", "--set", "k2=25")
+    py.pop("wall_s"), cli.pop("wall_s")
+    assert py == cli
+
+
 def test_fit_from_python_names_the_unidentifiable_pair_as_the_cli_does():
     """k2 and b from the angle atan2(k1 a, k2 b) alone: the one combination names both, with
     weights of magnitude 1/sqrt(2) within 1e-6, both intervals infinite (None, as in the CLI's
