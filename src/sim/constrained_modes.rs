@@ -103,7 +103,7 @@ pub struct Constraints {
     /// The constraint forces lambda, one per row (a taut cable's tension \[N\] in the last
     /// `taut_cables.len()`).
     pub multipliers: Vec<f64>,
-    /// The reduced Hessian's own error as an omega^2 \[rad^2/s^2\] ([`zero_floor`]): a mode
+    /// The reduced Hessian's own error as an omega^2 \[rad^2/s^2\] (`zero_floor`): a mode
     /// below it is rigid (0 before the Hessian is taken).
     pub zero_floor: f64,
 }

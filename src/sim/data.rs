@@ -208,10 +208,28 @@ impl Data {
 
     /// Kinetic energy of every moving body [J].
     pub(super) fn kinetic_energy_j(&self, m: &Model) -> f64 {
-        (0..m.structure.bodies.len())
-            .filter(|b| m.is_free(*b))
-            .map(|b| self.bodies[m.handles[b]].kinetic_energy())
-            .sum()
+        (0..m.structure.bodies.len()).filter(|b| m.is_free(*b)).map(|b| self.body_kinetic_energy_j(m, b)).sum()
+    }
+
+    /// Body `b`'s kinetic energy now [J]: (m |v|^2 + w . I_w w) / 2. A multibody link's v and
+    /// w are its multibody's generalized velocity through the link's body Jacobian (both of
+    /// the step's end), not the body's own velocities, which rapier writes from the
+    /// multibody at the next step's start: read after a step, they are the step's start's, a
+    /// step behind the positions.
+    fn body_kinetic_energy_j(&self, m: &Model, b: usize) -> f64 {
+        let rb = &self.bodies[m.handles[b]];
+        let Some(link) = self.multibody_joints.rigid_body_link(m.handles[b]) else { return rb.kinetic_energy() };
+        let Some(mb) = self.multibody_joints.get_multibody(link.multibody) else { return rb.kinetic_energy() };
+        let twist = mb.body_jacobian(link.id) * mb.generalized_velocity();
+        let (v, w) = (Vector::new(twist[0], twist[1], twist[2]), Vector::new(twist[3], twist[4], twist[5]));
+        let props = rb.mass_properties().local_mprops;
+        let l = super::rotation::momentum(
+            rb.position().rotation,
+            props.principal_inertia_local_frame,
+            props.principal_inertia(),
+            w,
+        );
+        0.5 * (rb.mass() * v.length_squared() + w.dot(l))
     }
 
     /// Distance between a joint's anchor as carried by its parent and by its child [m].

@@ -424,7 +424,7 @@ impl Simulation {
         self.data.equilibrium_mass(&self.model, c)
     }
 
-    /// The constraints g(q) of the coordinates `c` now [m] (none without constraints).
+    /// The constraints g(q) of the coordinates `c` now \[m\] (none without constraints).
     pub fn constraint_values(&self, c: &sensitivity::EquilibriumCoordinates) -> nalgebra::DVector<f64> {
         self.data.equilibrium_constraint_values(&self.model, c)
     }
