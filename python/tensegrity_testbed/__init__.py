@@ -260,24 +260,22 @@ def _fit_rows(data) -> list:
             value = float(row.value)
         except (TypeError, ValueError):
             raise ValueError(f"{at}: value {row.value!r} is not a number") from None
-        sigma = getattr(row, "sigma", None)
-        if sigma is not None:
-            try:
-                sigma = float(sigma)
-            except (TypeError, ValueError):
-                raise ValueError(f"{at}: sigma {sigma!r} is not a number") from None
-            if sigma != sigma:  # NaN: no sigma, as an empty cell of the CSV
-                sigma = None
-        t_s = getattr(row, "t_s", None)
-        if t_s is not None:
-            try:
-                t_s = float(t_s)
-            except (TypeError, ValueError):
-                raise ValueError(f"{at}: t_s {t_s!r} is not a number") from None
-            if t_s != t_s:  # NaN: a settled state's row, as an empty cell of the CSV
-                t_s = None
+        sigma, t_s = _optional_number(row, "sigma", at), _optional_number(row, "t_s", at)
         rows.append((at, int(point), str(row.output), value, sigma, t_s))
     return rows
+
+
+def _optional_number(row, column: str, at: str) -> Optional[float]:
+    """A row's optional number (sigma, t_s): None where the column is absent, None or NaN (as
+    an empty cell of the CSV), else the float, ValueError naming the row if it is none."""
+    cell = getattr(row, column, None)
+    if cell is None:
+        return None
+    try:
+        number = float(cell)
+    except (TypeError, ValueError):
+        raise ValueError(f"{at}: {column} {cell!r} is not a number") from None
+    return None if number != number else number
 
 
 def fit(scenario: Scenario, data, params, set: Optional[Mapping[str, Any]] = None,
