@@ -301,16 +301,12 @@ impl Interference {
 
     pub fn report(&self) -> InterferenceReport {
         let listed = self.listed_pairs();
-        // Each pair's violations in pair order, the closed before the open, then by first tick
-        // and names (a stable sort).
-        let mut closed: Vec<&((usize, usize), InterferenceViolation)> = self.closed.iter().collect();
-        closed.sort_by_key(|(pair, _)| *pair);
-        let mut by_pair: Vec<((usize, usize), u8, InterferenceViolation)> =
-            closed.into_iter().map(|(pair, v)| (*pair, 0, v.clone())).collect();
-        by_pair.extend(self.open.iter().map(|(&pair, iv)| (pair, 1, self.violation(pair, iv.first, iv.last, iv.min))));
-        by_pair.sort_by_key(|(pair, order, _)| (*pair, *order));
-        let mut violations: Vec<InterferenceViolation> = by_pair.into_iter().map(|(_, _, v)| v).collect();
-        violations.sort_by(|a, b| (a.first_tick, &a.pair).cmp(&(b.first_tick, &b.pair)));
+        // Closed and open intervals by first tick, then names, then pair (one pair's intervals
+        // never share a first tick).
+        let mut by_pair: Vec<((usize, usize), InterferenceViolation)> = self.closed.clone();
+        by_pair.extend(self.open.iter().map(|(&pair, iv)| (pair, self.violation(pair, iv.first, iv.last, iv.min))));
+        by_pair.sort_by(|(p, a), (q, b)| (a.first_tick, &a.pair, p).cmp(&(b.first_tick, &b.pair, q)));
+        let violations: Vec<InterferenceViolation> = by_pair.into_iter().map(|(_, v)| v).collect();
         let closest = self.stats.iter().reduce(|c, st| if st.min_clearance_m < c.min_clearance_m { st } else { c });
         InterferenceReport {
             min_clearance_m: closest.map(|st| st.min_clearance_m),

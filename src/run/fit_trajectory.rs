@@ -84,6 +84,8 @@ fn values(problem: &FitProblem, t: &Batched, rows: &[&Measurement]) -> Result<DV
         out
     };
     let times = column("motion_time_s");
+    // Each output's column once, however many rows read it.
+    let mut columns: std::collections::BTreeMap<&str, Vec<f64>> = std::collections::BTreeMap::new();
     let dt_s = times.windows(2).map(|w| w[1] - w[0]).find(|d| d.is_finite() && *d > 0.0).unwrap_or(f64::INFINITY);
     let mut out = DVector::zeros(rows.len());
     for (i, x) in rows.iter().enumerate() {
@@ -96,7 +98,7 @@ fn values(problem: &FitProblem, t: &Batched, rows: &[&Measurement]) -> Result<DV
                 times.iter().copied().filter(|m| m.is_finite()).fold(0.0, f64::max)
             )));
         };
-        let values = column(&x.output);
+        let values = columns.entry(x.output.as_str()).or_insert_with(|| column(&x.output));
         if values.is_empty() {
             let names: Vec<&str> = schema.fields().iter().map(|f| f.name().as_str()).collect();
             return Err(FitError::BadInput(format!(

@@ -19,7 +19,7 @@ use crate::mechanisms::{Mechanism, Values};
 use crate::observers::file_model::ModelObserver;
 use crate::report::sensitivity::{check_error, OutputValue, ParameterSensitivity, SensitivityReport};
 use crate::scenario::Scenario;
-use crate::sim::modes::ZERO_MODE_RATIO;
+use crate::sim::modes::{least_squares, ZERO_MODE_RATIO};
 use crate::sim::sensitivity::{derivative_from_samples, EquilibriumCoordinates, SensitivityError};
 use crate::sim::Simulation;
 use nalgebra::{DMatrix, DVector};
@@ -106,29 +106,19 @@ fn linearize(sim: &mut Simulation, coordinates: &EquilibriumCoordinates) -> Resu
         (crate::eigen::modes(&symmetric(&stiffness), &symmetric(&mass))?, 0.0)
     } else {
         let (basis, _) = crate::sim::modes::null_space(&jacobian, stiffness.ncols());
-        let reduce = |a: &DMatrix<f64>| symmetric(&(basis.transpose() * a * &basis));
         if basis.ncols() == 0 {
             (Vec::new(), 0.0)
         } else {
-            let reduced = crate::eigen::modes(&reduce(&stiffness), &reduce(&mass))?;
-            let floor = crate::sim::modes::zero_floor(&error, &basis, &reduce(&mass));
+            let reduce = |a: &DMatrix<f64>| symmetric(&(basis.transpose() * a * &basis));
+            let reduced_mass = reduce(&mass);
+            let reduced = crate::eigen::modes(&reduce(&stiffness), &reduced_mass)?;
+            let floor = crate::sim::modes::zero_floor(&error, &basis, &reduced_mass);
             (reduced.into_iter().map(|m| Mode { shape: &basis * m.shape, ..m }).collect(), floor)
         }
     };
     let largest = modes.iter().fold(0.0f64, |l, m| l.max(m.omega_squared.abs()));
     let rigid = modes.iter().map(|m| m.omega_squared.abs() <= (ZERO_MODE_RATIO * largest).max(floor)).collect();
     Ok(Linearization { stiffness, jacobian, modes, rigid })
-}
-
-/// The least-squares, least-norm x of a x = b (singular values of a below
-/// `NULL_SPACE_RATIO` of the largest left out); zeros where a has no rows.
-fn least_squares(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
-    if a.nrows() == 0 || a.ncols() == 0 {
-        return DVector::zeros(a.ncols());
-    }
-    let svd = a.clone().svd(true, true);
-    let tol = crate::sim::modes::NULL_SPACE_RATIO * svd.singular_values.max();
-    svd.solve(b, tol).unwrap_or_else(|_| DVector::zeros(a.ncols()))
 }
 
 /// The analysis of `sim`, settled at `params` and `inputs` of `sc`.

@@ -477,14 +477,18 @@ pub(crate) fn zero_floor(error: &DMatrix<f64>, basis: &DMatrix<f64>, reduced_mas
 
 /// The constraint forces lambda of grad V + G^T lambda = 0 (least squares, minimum norm).
 pub(super) fn multipliers(first: &FirstDerivatives) -> DVector<f64> {
-    let rows = first.jacobian.nrows();
-    if rows == 0 {
-        return DVector::zeros(0);
+    least_squares(&first.jacobian.transpose(), &(-&first.gradient))
+}
+
+/// The least-squares, least-norm x of a x = b, singular values of a below
+/// [`NULL_SPACE_RATIO`] of the largest left out; zeros where a has no rows or columns.
+pub(crate) fn least_squares(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
+    if a.nrows() == 0 || a.ncols() == 0 {
+        return DVector::zeros(a.ncols());
     }
-    let gt = first.jacobian.transpose();
-    let svd = gt.svd(true, true);
+    let svd = a.clone().svd(true, true);
     let tol = NULL_SPACE_RATIO * svd.singular_values.max();
-    svd.solve(&(-&first.gradient), tol).unwrap_or_else(|_| DVector::zeros(rows))
+    svd.solve(b, tol).unwrap_or_else(|_| DVector::zeros(a.ncols()))
 }
 
 impl Data {

@@ -113,6 +113,24 @@ impl Model {
         self.structure.bodies[body].kind == BodyKind::Free
     }
 
+    /// Whether the structure's modes and sensitivities are those of the constrained analysis
+    /// (`constrained_modes.rs`): an inextensible cable, a joint that closes a loop, or a free
+    /// joint of several coordinates (a universal joint: two revolute links and a hidden body,
+    /// `build.rs`, charted by its multibody's degrees of freedom there).
+    pub(super) fn is_constrained(&self) -> bool {
+        let s = &self.structure;
+        let several = |(j, joint): (usize, &crate::structure::Joint)| {
+            !self.actuated[j]
+                && !matches!(
+                    joint.kind,
+                    crate::structure::JointKind::Revolute { .. } | crate::structure::JointKind::Prismatic { .. }
+                )
+        };
+        s.members.iter().any(|c| c.is_inextensible_cable())
+            || self.joint_impulse.iter().any(Option::is_some)
+            || s.joints.iter().enumerate().any(several)
+    }
+
     /// Whether every projected group is of plain bodies alone (no multibody coordinates).
     pub(super) fn projected_groups_are_plain(&self) -> bool {
         self.projected_groups.iter().all(|g| g.multibodies.is_empty())

@@ -12,12 +12,12 @@
 //! sparse: the lowest [`SPARSE_MODAL_COUNT`] modes beyond the rigid ones, by shift-invert
 //! subspace iteration (`relaxation/lowest_modes.rs`).
 
-pub(crate) use super::constrained_modes::{null_space, zero_floor};
+pub(crate) use super::constrained_modes::{least_squares, null_space, zero_floor};
 pub use super::constrained_modes::{Constraints, ModalCoordinate, NULL_SPACE_RATIO};
 use super::{Data, Model, Simulation};
 use crate::eigen::EigenError;
 use crate::snapshot::{BodyPose, ModalProjector};
-use crate::structure::{BodyKind, JointKind};
+use crate::structure::BodyKind;
 use crate::structure::{DENSE_MODAL_MAX_FREE_BODIES, MAX_SPARSE_MODAL_COUNT, SPARSE_MODAL_COUNT};
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3};
 use std::sync::atomic::AtomicBool;
@@ -174,13 +174,7 @@ impl Data {
         if let Some(c) = s.members.iter().find(|c| c.has_friction()) {
             return Err(ModesError::Friction(c.name.clone()));
         }
-        let inextensible = s.members.iter().any(|c| c.is_inextensible_cable());
-        // A free joint of several coordinates (a universal joint: two revolute links and a
-        // hidden body, `build.rs`) is charted by its multibody's degrees of freedom there.
-        let several = |(j, joint): (usize, &crate::structure::Joint)| {
-            !m.actuated[j] && !matches!(joint.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. })
-        };
-        if inextensible || m.joint_impulse.iter().any(Option::is_some) || s.joints.iter().enumerate().any(several) {
+        if m.is_constrained() {
             return self.constrained_modes(m, cancel);
         }
         if !s.joints.is_empty() {

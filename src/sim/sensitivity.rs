@@ -126,11 +126,7 @@ impl Data {
         if let Some(c) = s.members.iter().find(|c| c.has_friction()) {
             return Err(ModesError::Friction(c.name.clone()).into());
         }
-        let several = |(j, joint): (usize, &crate::structure::Joint)| {
-            !m.actuated[j] && !matches!(joint.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. })
-        };
-        let inextensible = s.members.iter().any(|c| c.is_inextensible_cable());
-        if inextensible || m.joint_impulse.iter().any(Option::is_some) || s.joints.iter().enumerate().any(several) {
+        if m.is_constrained() {
             let (constraints, _) = self.constraints_here(m)?;
             let names = self.modal_coordinate_names(m, &constraints.coordinates);
             return Ok(EquilibriumCoordinates::Constrained(Box::new(ConstrainedCoordinates { constraints, names })));
