@@ -363,7 +363,15 @@ pub struct Motion {
     /// (`run/levels.rs`). None: where every free body moves in joint coordinates (rapier
     /// integrates a plain free body's rotation at first order, which the rule does not cancel).
     pub extrapolate: Option<bool>,
+    /// The judged motion's error target, a fraction of its amplitude (the largest node
+    /// excursion): the fewest levels that meet it are chosen by running them first. None: three
+    /// levels, reported against [`DEFAULT_TARGET_ERROR`].
+    pub target_error: Option<f64>,
 }
+
+/// What a motion judged over the default three levels aims at: its error estimate at most this
+/// fraction of its amplitude (the report says whether it was met).
+pub const DEFAULT_TARGET_ERROR: f64 = 1e-9;
 
 /// Inputs as functions of the motion's time, followed physically: each actuated joint a
 /// dynamic degree of freedom held to its commanded path through the solver.

@@ -232,18 +232,21 @@ pub fn scale_motion(cases: &[crate::bench::scale::motion::MotionCase]) -> String
 fn judged_motion(cases: &[crate::bench::scale::motion::MotionCase]) -> String {
     let dt = crate::bench::scale::motion::EQUAL_ERROR_DT_S;
     let mut t = format!(
-        "\nJudged motion (extrapolated over the step: h, h/2, h/4, seven steps a tick) at dt = {dt} s, against MuJoCo's RK4 and Euler at the same wall time (interpolated in log-log between their runs at dt {:?} s)\n",
+        "\nJudged motion (extrapolated over the step: h, h/2, h/4, seven steps a tick, fourth order; '6th': h ... h/8, 15 steps a tick, sixth order) at dt = {dt} s, against MuJoCo's RK4 and Euler at the same wall time (interpolated in log-log between their runs at dt {:?} s)\n",
         crate::bench::scale::motion::INTEGRATOR_DT_S
     );
     let _ = writeln!(
         t,
-        "{:<12} {:>5} {:>10} {:>12} | {:>12} {:>12} | judged errors at dt {:?} s",
+        "{:<12} {:>5} {:>10} {:>12} | {:>12} {:>12} | {:>10} {:>12} {:>12} | judged errors at dt {:?} s",
         "family",
         "size",
         "wall s",
         "judged err",
         "mj RK4 err",
         "mj Euler err",
+        "6th wall s",
+        "6th err",
+        "mj RK4 err",
         crate::bench::scale::motion::DT_S
     );
     let opt = |x: Option<f64>| x.map_or("outside".to_string(), |v| format!("{v:.2e}"));
@@ -252,13 +255,16 @@ fn judged_motion(cases: &[crate::bench::scale::motion::MotionCase]) -> String {
         let errors: Vec<String> = c.judged.iter().map(|r| format!("{:.2e}", r.error_m)).collect();
         let _ = writeln!(
             t,
-            "{:<12} {:>5} {:>10.2e} {:>12.2e} | {:>12} {:>12} | {}",
+            "{:<12} {:>5} {:>10.2e} {:>12.2e} | {:>12} {:>12} | {:>10.2e} {:>12.2e} {:>12} | {}",
             c.family,
             c.size,
             j.wall_s,
             j.error_m,
             opt(c.rk4_error_at_equal_time_m),
             opt(c.euler_error_at_equal_time_m),
+            c.judged_sixth.wall_s,
+            c.judged_sixth.error_m,
+            opt(c.rk4_error_at_equal_time_sixth_m),
             errors.join(" ")
         );
     }

@@ -186,8 +186,18 @@ pub struct MotionReport {
 /// smooth in time (the estimates after it do not hold).
 #[derive(Clone, Debug, Default, Serialize, PartialEq)]
 pub struct ExtrapolationReport {
-    /// The time steps combined \[s\]: h, h/2, h/4.
+    /// The time steps combined \[s\]: h, h/2, h/4 (and h/8, h/16 where a target asked for more).
     pub steps_s: Vec<f64>,
+    /// The judged motion's order in the step: 2 (levels - 1).
+    pub order: i32,
+    /// The largest distance of any judged node from where it was at the motion's first tick \[m\].
+    pub amplitude_m: f64,
+    /// The error target, a fraction of the amplitude: the file's `target_error`, or
+    /// `settings::DEFAULT_TARGET_ERROR`.
+    pub target_error: f64,
+    /// Whether the largest estimate of the node positions is at most the target times the
+    /// amplitude.
+    pub target_met: bool,
     /// Each quantity's largest error estimate over the motion (its unit).
     pub largest_estimate: std::collections::BTreeMap<String, f64>,
     /// The first tick whose step saw a cable change between slack and taut (the levels disagree

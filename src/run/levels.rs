@@ -16,10 +16,16 @@
 
 use crate::mechanisms::Values;
 use crate::sim::{SimError, Simulation};
-use crate::snapshot::{richardson, Snapshot, RICHARDSON_ESTIMATE_DIVISOR};
+use crate::snapshot::{richardson, Snapshot};
 
 /// The order of the leapfrog scheme's leading error term, cancelled by one Richardson step.
 const LEAPFROG_ORDER: i32 = 2;
+
+/// The fewest levels a motion is judged over: h, h/2 and h/4, fourth order, seven steps a tick.
+pub const MIN_LEVELS: usize = 3;
+/// The most: each level more halves the finest step, adds two orders and doubles the steps
+/// (five: h ... h/16, eighth order, 31 steps a tick).
+pub const MAX_LEVELS: usize = 5;
 
 /// The prefix of a node coordinate's name among the estimated values (`observers::table`).
 const NODE_PREFIX: &str = "node:";
@@ -28,47 +34,79 @@ pub(super) const NODE_POSITIONS: &str = "node positions";
 
 /// What [`Levels::judge`] gives at a tick.
 pub(super) struct Judged {
-    /// The judged state: Richardson's value from h/2 and h/4.
+    /// The judged state: the top of Romberg's table but one (`Levels::judge`).
     pub state: Snapshot,
     /// The mechanism's quantities in it.
     pub values: Values,
     /// Each quantity's estimate of the judged state's error.
     pub estimate: Values,
-    /// Richardson's value from h and h/2, with the mechanism's quantities in it.
+    /// The same from one level coarser, with the mechanism's quantities in it.
     pub rougher: (Snapshot, Values),
 }
 
-/// The motion at h/2 and h/4 beside the runner's own at h.
+/// The motion at h/2, h/4, ... beside the runner's own at h.
 pub(super) struct Levels {
-    half: Simulation,
-    quarter: Simulation,
+    /// The finer levels, at h/2, h/4, ..., h/2^(K-1) for K levels in all.
+    finer: Vec<Simulation>,
     /// Each quantity's largest error estimate over the motion so far.
     pub largest: Values,
     /// The first tick whose step saw a cable change between slack and taut, if any.
     pub rough_from_tick: Option<u64>,
     /// Each cable's slack at the last tick, at the finest level.
     last_slack: Option<Vec<bool>>,
+    /// The largest distance of any judged node from where it was at the first tick judged \[m\].
+    pub amplitude_m: f64,
+    /// The judged node positions at the first tick judged.
+    first_nodes: Option<Vec<[f64; 3]>>,
 }
 
 /// Actuator commands at a time of the motion [s] (a driven motion's inputs).
 pub(super) type CommandsAt<'a> = &'a dyn Fn(f64) -> Vec<f64>;
 
 impl Levels {
-    /// The finer levels of `sim`, each from its present state started at its own half step.
-    /// Call before `sim` itself starts at its half step.
-    pub fn new(sim: &Simulation) -> Result<Self, SimError> {
+    /// `count` levels of `sim` (the runner's own at h; [`MIN_LEVELS`] to [`MAX_LEVELS`]), the
+    /// finer ones each from its present state started at its own half step. Call before `sim`
+    /// itself starts at its half step.
+    pub fn new(sim: &Simulation, count: usize) -> Result<Self, SimError> {
+        assert!((MIN_LEVELS..=MAX_LEVELS).contains(&count), "{count} levels");
         let dt_s = sim.model().settings.dt_s;
-        let mut half = sim.at_time_step(dt_s / 2.0);
-        half.start_at_half_step()?;
-        let mut quarter = sim.at_time_step(dt_s / 4.0);
-        quarter.start_at_half_step()?;
-        Ok(Levels { half, quarter, largest: Values::new(), rough_from_tick: None, last_slack: None })
+        let finer = (1..count)
+            .map(|i| {
+                let mut level = sim.at_time_step(dt_s / f64::from(1u32 << i));
+                level.start_at_half_step()?;
+                Ok(level)
+            })
+            .collect::<Result<Vec<_>, SimError>>()?;
+        Ok(Levels {
+            finer,
+            largest: Values::new(),
+            rough_from_tick: None,
+            last_slack: None,
+            amplitude_m: 0.0,
+            first_nodes: None,
+        })
+    }
+
+    /// How many levels, the runner's own included.
+    pub fn count(&self) -> usize {
+        self.finer.len() + 1
+    }
+
+    /// The judged motion's order in the step: 2 (K - 1) for K levels.
+    pub fn order(&self) -> i32 {
+        LEAPFROG_ORDER * self.finer.len() as i32
+    }
+
+    /// The time steps of the levels, h first \[s\].
+    pub fn steps_s(&self, dt_s: f64) -> Vec<f64> {
+        (0..self.count()).map(|i| dt_s / f64::from(1u32 << i)).collect()
     }
 
     /// Steps the finer levels over the coarse step that ends at motion time `end_s` [s] (of
     /// length `dt_s`), a driven motion's commands set at the end of each of their steps.
     pub fn step(&mut self, end_s: f64, dt_s: f64, commands_at: Option<CommandsAt>) -> Result<(), SimError> {
-        for (sim, n) in [(&mut self.half, 2u32), (&mut self.quarter, 4)] {
+        for (i, sim) in self.finer.iter_mut().enumerate() {
+            let n = 2u32 << i;
             for j in 1..=n {
                 if let Some(c) = commands_at {
                     sim.drive_commands(&c(end_s - dt_s + f64::from(j) * dt_s / f64::from(n)));
@@ -83,25 +121,29 @@ impl Levels {
     /// quantities in it (`observe` reads them off a state), the error estimate of each of them
     /// and of each value `estimated_too` reads (the joint coordinates), and the state one level
     /// rougher with its quantities.
+    ///
+    /// Romberg's table over the levels x(0) at h ... x(K-1) at h/2^(K-1): column j combines
+    /// neighbours of column j - 1 by Richardson's rule of order 2 j, T(i, j) = T(i, j-1) +
+    /// (T(i, j-1) - T(i-1, j-1)) / (4^j - 1). The judged state is T(K-1, K-2), of order 2 (K-1);
+    /// T(K-2, K-2), from one level coarser, differs from it by 4^(K-1) - 1 times its error (15
+    /// for three levels).
     pub fn judge(
         &mut self,
         coarse: &Snapshot,
         observe: &dyn Fn(&Snapshot) -> Values,
         estimated_too: &dyn Fn(&Snapshot) -> Values,
     ) -> Judged {
-        let half = self.half.snapshot_with(false);
-        let quarter = self.quarter.snapshot_with(false);
-        let slack = &quarter.forces.slack;
-        let smooth = coarse.forces.slack == *slack
-            && half.forces.slack == *slack
-            && self.last_slack.as_ref().is_none_or(|last| last == slack);
-        self.last_slack = Some(slack.clone());
-        if !smooth && self.rough_from_tick.is_none() {
-            self.rough_from_tick = Some(coarse.tick);
+        let mut column: Vec<Snapshot> =
+            std::iter::once(coarse.clone()).chain(self.finer.iter().map(|s| s.snapshot_with(false))).collect();
+        self.note_smoothness(coarse.tick, &column);
+        for j in 1..column.len() - 1 {
+            column = column.windows(2).map(|w| richardson(&w[0], &w[1], LEAPFROG_ORDER * j as i32)).collect();
         }
-        let mut judged = richardson(&half, &quarter, LEAPFROG_ORDER);
-        let rougher = richardson(coarse, &half, LEAPFROG_ORDER);
+        let (Some(mut judged), Some(rougher)) = (column.pop(), column.pop()) else {
+            unreachable!("three levels or more leave two values in the table's last column");
+        };
         (judged.tick, judged.time_s) = (coarse.tick, coarse.time_s);
+        let divisor = estimate_divisor(self.order());
         let (values, rough_values) = (observe(&judged), observe(&rougher));
         let (too, rough_too) = (estimated_too(&judged), estimated_too(&rougher));
         let estimate: Values = values
@@ -109,9 +151,10 @@ impl Levels {
             .chain(&too)
             .filter_map(|(k, v)| {
                 let r = rough_values.get(k).or_else(|| rough_too.get(k))?;
-                Some((k.clone(), (v - r).abs() / RICHARDSON_ESTIMATE_DIVISOR))
+                Some((k.clone(), (v - r).abs() / divisor))
             })
             .collect();
+        self.note_amplitude(&judged.nodes);
         let rougher = (rougher, rough_values);
         for (k, e) in &estimate {
             // Every node's position is estimated (per tick, in the table and the recording);
@@ -122,20 +165,56 @@ impl Levels {
         }
         Judged { state: judged, values, estimate, rougher }
     }
+
+    /// Notes the first tick at which the levels' cables disagree on slack, or change it since
+    /// the tick before (`levels` the states at this tick, coarsest first).
+    fn note_smoothness(&mut self, tick: u64, levels: &[Snapshot]) {
+        let slack = &levels[levels.len() - 1].forces.slack;
+        let smooth = levels.iter().all(|s| s.forces.slack == *slack)
+            && self.last_slack.as_ref().is_none_or(|last| last == slack);
+        self.last_slack = Some(slack.clone());
+        if !smooth && self.rough_from_tick.is_none() {
+            self.rough_from_tick = Some(tick);
+        }
+    }
+
+    /// Widens the amplitude to the judged `nodes` at this tick (the first tick's are where it is
+    /// measured from).
+    fn note_amplitude(&mut self, nodes: &[[f64; 3]]) {
+        let Some(first) = &self.first_nodes else {
+            self.first_nodes = Some(nodes.to_vec());
+            return;
+        };
+        for (p, p0) in nodes.iter().zip(first) {
+            let d = ((p[0] - p0[0]).powi(2) + (p[1] - p0[1]).powi(2) + (p[2] - p0[2]).powi(2)).sqrt();
+            self.amplitude_m = self.amplitude_m.max(d);
+        }
+    }
+
+    /// The largest error estimate of the judged node positions so far \[m\].
+    pub fn node_estimate_m(&self) -> f64 {
+        self.largest.get(NODE_POSITIONS).copied().unwrap_or(0.0)
+    }
+}
+
+/// The divisor of the difference between a judged value of order `order` and the one a level
+/// coarser that estimates the judged value's error: 2^order - 1.
+fn estimate_divisor(order: i32) -> f64 {
+    2f64.powi(order) - 1.0
 }
 
 /// The node positions \[m\] of `sim`'s motion after `ticks` of its step, judged as a motion
-/// run judges them: the finer levels made from its present state, every level started at its
-/// half step, the three stepped together (seven steps a tick, as a run's), and the judged
-/// state T(h/2, h/4) at the end (the benchmark's measure of the judged motion's cost).
-pub fn judged_nodes_after(sim: &mut Simulation, ticks: u64) -> Result<Vec<[f64; 3]>, SimError> {
-    let mut levels = Levels::new(sim)?;
+/// run judges them over `count` levels: the finer levels made from its present state, every
+/// level started at its half step, all stepped together (2^count - 1 steps a tick, as a run's),
+/// and the judged state at the end (the benchmark's measure of the judged motion's cost).
+pub fn judged_nodes_after(sim: &mut Simulation, ticks: u64, count: usize) -> Result<Vec<[f64; 3]>, SimError> {
+    let mut levels = Levels::new(sim, count)?;
     sim.start_at_half_step()?;
     let dt_s = sim.model().settings.dt_s;
     for k in 1..=ticks {
         sim.step()?;
         levels.step(k as f64 * dt_s, dt_s, None)?;
     }
-    let judged = richardson(&levels.half.snapshot_with(false), &levels.quarter.snapshot_with(false), LEAPFROG_ORDER);
-    Ok(judged.nodes)
+    let none = |_: &Snapshot| Values::new();
+    Ok(levels.judge(&sim.snapshot_with(false), &none, &none).state.nodes)
 }

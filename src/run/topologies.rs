@@ -160,6 +160,8 @@ fn join_motion(x: &mut MotionReport, m: MotionReport) {
             *v = v.max(e);
         }
         xe.not_smooth_from_tick = xe.not_smooth_from_tick.or(me.not_smooth_from_tick);
+        xe.amplitude_m = xe.amplitude_m.max(me.amplitude_m);
+        xe.target_met &= me.target_met;
     }
 }
 

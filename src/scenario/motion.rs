@@ -24,6 +24,11 @@
 //!                         # fourth order, with its own error estimate); false: rapier's steps
 //!                         # (second order; a plain free body's rotation by the implicit
 //!                         # midpoint rule, sim/rotation.rs). Default: true
+//! target_error = 1e-12    # optional: the judged motion's error target, a fraction of its
+//!                         # amplitude (the largest node excursion): the fewest levels (h ...
+//!                         # h/4 to h/16: order 4 to 8) whose estimate meets it, chosen by
+//!                         # running the levels first. Default: three levels, the report
+//!                         # saying whether their estimate met 1e-9 of the amplitude
 //! inputs = { x = "A*sin(w*t)" }  # optional: inputs as functions of the parameters and the
 //!                         # motion's time t, followed at their real speed (as [actuation]
 //!                         # waypoints are): each actuated joint driven through the solver
@@ -91,6 +96,9 @@ pub(super) struct RawMotion {
     /// Judge the motion extrapolated over the time step (`run/levels.rs`); by default where
     /// every free body moves in joint coordinates.
     pub(super) extrapolate: Option<bool>,
+    /// The judged motion's error target, a fraction of its amplitude: the levels of the
+    /// extrapolation are chosen to meet it (`run/motion.rs`).
+    pub(super) target_error: Option<Spanned<f64>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -166,6 +174,7 @@ pub(super) fn motion(
         .collect::<Result<_, _>>()?;
     let undamped = section.undamped;
     let extrapolate = section.extrapolate;
+    let target_error = target_error(ctx, section)?;
     let spin = section.spin.as_ref().map(|sp| spin(ctx, sp, (first, params), dt_s)).transpose()?;
     Ok(Some(Motion {
         duration_s,
@@ -178,7 +187,25 @@ pub(super) fn motion(
         drive,
         spin,
         extrapolate,
+        target_error,
     }))
+}
+
+/// `target_error`, a fraction in (0, 1) of the motion's amplitude, on an extrapolated motion.
+fn target_error(ctx: &Ctx, section: &RawMotion) -> Result<Option<f64>, ScenarioError> {
+    let Some(t) = &section.target_error else { return Ok(None) };
+    let value = *t.get_ref();
+    if !(value > 0.0 && value < 1.0) {
+        return Err(ctx.err(
+            t,
+            format!("motion.target_error is a fraction of the motion's amplitude, above 0 and below 1; got {value}"),
+        ));
+    }
+    if section.extrapolate == Some(false) {
+        return Err(ctx
+            .err(t, "motion.target_error chooses the levels of an extrapolated motion: not with extrapolate = false"));
+    }
+    Ok(Some(value))
 }
 
 /// What a motion run's inputs do: held at its single point (`points` with one point), or

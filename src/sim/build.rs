@@ -56,6 +56,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<(Model, Dat
         tick: 0,
         locked_coordinates: vec![0.0; s.joints.len()],
         constraint_inputs: 0,
+        kept_momenta: vec![None; n],
     };
     data.settle_multibody_roots(&model);
     model.tree = data.link_tree(&model);

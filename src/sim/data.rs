@@ -44,6 +44,9 @@ pub(super) struct Data {
     /// outside the step (an actuated multibody coordinate, a perturbation, a restart): the
     /// rests recorded before such a change are not returned to after it.
     pub(super) constraint_inputs: u64,
+    /// Per body, a plain free body's angular momentum as physical motion carries it
+    /// (`rotation.rs`); None until then.
+    pub(super) kept_momenta: Vec<Option<super::rotation::KeptMomentum>>,
 }
 
 /// One multibody's actuated moves per increment of a command jump: (degree of freedom,
@@ -218,9 +221,14 @@ impl Data {
     /// step behind the positions.
     fn body_kinetic_energy_j(&self, m: &Model, b: usize) -> f64 {
         let rb = &self.bodies[m.handles[b]];
-        let Some(link) = self.multibody_joints.rigid_body_link(m.handles[b]) else { return rb.kinetic_energy() };
-        let Some(mb) = self.multibody_joints.get_multibody(link.multibody) else { return rb.kinetic_energy() };
-        let twist = mb.body_jacobian(link.id) * mb.generalized_velocity();
+        let link = self.multibody_joints.rigid_body_link(m.handles[b]);
+        let linked = link.and_then(|l| Some((l.id, self.multibody_joints.get_multibody(l.multibody)?)));
+        let Some((id, mb)) = linked else {
+            // A plain body: w . L with its angular momentum at its rotation now (rapier's own
+            // kinetic energy reads a world inertia it updated before the step's turn).
+            return 0.5 * (rb.mass() * rb.linvel().length_squared() + rb.angvel().dot(self.angular_momentum(m, b)));
+        };
+        let twist = mb.body_jacobian(id) * mb.generalized_velocity();
         let (v, w) = (Vector::new(twist[0], twist[1], twist[2]), Vector::new(twist[3], twist[4], twist[5]));
         let props = rb.mass_properties().local_mprops;
         let l = super::rotation::momentum(

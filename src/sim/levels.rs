@@ -38,6 +38,7 @@ impl Clone for Data {
             tick: self.tick,
             locked_coordinates: self.locked_coordinates.clone(),
             constraint_inputs: self.constraint_inputs,
+            kept_momenta: self.kept_momenta.clone(),
         }
     }
 }

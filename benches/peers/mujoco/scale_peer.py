@@ -28,7 +28,8 @@ time of its steps. With `integrator_dts` as well, the same motion is run with RK
 Euler at each of those steps (`rk4_runs`, `euler_runs`: the testbed compares its judged motion
 with them at equal stepping time). A case's `spin` (a body's name and its angular velocity
 [rad/s], world axes) starts that body's free joint spinning (its frame has the world's axes at
-the start, so the local angular velocity of `qvel` is the world one).
+the start, so the local angular velocity of `qvel` is the world one); its reference is the
+exact torque-free motion at 30 digits (`torque_free_sites`) instead of RK4's.
 
 Each case is timed from loading the XML (model compile) to the settled state, as the testbed
 times building its simulation and settling it; a case faster than 0.2 s is run again until
@@ -46,6 +47,7 @@ import statistics
 import sys
 import time
 
+import mpmath
 import mujoco
 import numpy as np
 
@@ -64,6 +66,9 @@ TUNED = {
     "furet": {},
 }
 
+
+#: Digits of the spin's exact reference (`torque_free_sites`).
+EXACT_DIGITS = 30
 
 #: A case faster than this is run again until the runs add up to it; its wall time is the
 #: median (the testbed's MIN_CASE_WALL_S).
@@ -192,6 +197,62 @@ def spun(model, data, case: dict) -> None:
         data.qvel[dof + 3 : dof + 6] = spin["angular_velocity"]
 
 
+def quat_matrix(q) -> list:
+    """The rotation matrix (rows) of MuJoCo's quaternion (w, x, y, z), in mpmath numbers."""
+    w, x, y, z = (mpmath.mpf(float(c)) for c in q)
+    return [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ]
+
+
+def matmul(a, b) -> list:
+    return [[sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+
+
+def transpose(a) -> list:
+    return [[a[j][i] for j in range(3)] for i in range(3)]
+
+
+def torque_free_sites(model, case: dict, sites: list, duration: float) -> np.ndarray:
+    """The exact sites of the case's spinning body after `duration` [m]: the body is the case's
+    only one, free, with no force on it, so its motion is Euler's equations in its principal
+    frame, I1 w1' = (I2 - I3) w2 w3 (and cyclic), with R' = R [w]x, integrated by mpmath's Taylor
+    method at EXACT_DIGITS digits. MuJoCo's RK4 at the reference step carries a round-off of its
+    own of about 1e-14 m (measured against this), the level at which the spin is compared."""
+    mpmath.mp.dps = EXACT_DIGITS
+    body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, case["spin"]["body"])
+    inertia = [mpmath.mpf(float(i)) for i in model.body_inertia[body]]
+    to_principal = quat_matrix(model.body_iquat[body])  # principal axes in the body frame
+    start = quat_matrix(model.body_quat[body])  # body frame in the world at the start
+    w_local = [mpmath.mpf(float(c)) for c in case["spin"]["angular_velocity"]]
+    w0 = [sum(to_principal[k][i] * w_local[k] for k in range(3)) for i in range(3)]
+
+    def rates(_t, y):
+        w, r = y[:3], [y[3:6], y[6:9], y[9:12]]
+        i1, i2, i3 = inertia
+        dw = [(i2 - i3) * w[1] * w[2] / i1, (i3 - i1) * w[2] * w[0] / i2, (i1 - i2) * w[0] * w[1] / i3]
+        skew = [[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]]
+        return dw + [x for row in matmul(r, skew) for x in row]
+
+    tolerance = mpmath.mpf(10) ** (-EXACT_DIGITS)
+    y = mpmath.odefun(rates, 0, w0 + [1, 0, 0, 0, 1, 0, 0, 0, 1], tol=tolerance, degree=EXACT_DIGITS)(duration)
+    turned = [y[3:6], y[6:9], y[9:12]]
+    # The body's frame in the world: start * P * turned * P^T (P: principal axes in the body).
+    frame = matmul(matmul(matmul(start, to_principal), turned), transpose(to_principal))
+    origin = [mpmath.mpf(float(c)) for c in model.body_pos[body]]
+    ipos = [mpmath.mpf(float(c)) for c in model.body_ipos[body]]
+    com = [origin[i] + sum(start[i][k] * ipos[k] for k in range(3)) for i in range(3)]  # at rest
+    out = []
+    for site in sites:
+        if model.site_bodyid[site] != body:
+            raise ValueError("a spin case's sites must all be on its spinning body")
+        arm = [mpmath.mpf(float(c)) - o for c, o in zip(model.site_pos[site], ipos)]
+        out.append([float(com[i] + sum(frame[i][k] * arm[k] for k in range(3))) for i in range(3)])
+    return np.array(out)
+
+
 def integrator_runs(load, case: dict, motion: dict, integrator) -> list:
     """The motion at each of `integrator_dts` with `integrator`: end sites and median wall."""
     duration, runs = motion["duration_s"], []
@@ -235,7 +296,10 @@ def motion_case(case: dict, motion: dict) -> dict:
         runs.append({"dt_s": dt, "steps": steps, "wall_s": statistics.median(walls), "positions": pos.tolist()})
     ref_dt = motion["reference_dt_s"]
     model, data, sites = load(ref_dt, mujoco.mjtIntegrator.mjINT_RK4)
-    reference, _ = motion_positions(model, data, sites, round(duration / ref_dt))
+    if case.get("spin"):
+        reference = torque_free_sites(model, case, sites, duration)
+    else:
+        reference, _ = motion_positions(model, data, sites, round(duration / ref_dt))
     rk4 = integrator_runs(load, case, motion, mujoco.mjtIntegrator.mjINT_RK4)
     euler = integrator_runs(load, case, motion, mujoco.mjtIntegrator.mjINT_EULER)
     return {

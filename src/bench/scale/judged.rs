@@ -142,21 +142,22 @@ pub fn rocker_equilibrium(k1: f64) -> f64 {
     phi
 }
 
-/// The judged motion of `case` for `duration_s` at time step `dt`, repeated until the runs add
-/// up to [`super::MIN_CASE_WALL_S`]: the judged node positions at the end, the ticks and the
-/// median wall time of the steps of all three levels.
-pub fn judged_run(case: &Case, dt: f64, duration_s: f64) -> Result<(Vec<Vec3>, u64, f64), BenchError> {
-    let (positions, ticks, first) = judged_run_once(case, dt, duration_s)?;
-    let wall = super::median_wall(first, || Ok(judged_run_once(case, dt, duration_s)?.2))?;
+/// The judged motion of `case` over `levels` levels (`run::MIN_LEVELS`: fourth order) for
+/// `duration_s` at time step `dt`, repeated until the runs add up to
+/// [`super::MIN_CASE_WALL_S`]: the judged node positions at the end, the ticks and the median
+/// wall time of the steps of all the levels.
+pub fn judged_run(case: &Case, dt: f64, duration_s: f64, levels: usize) -> Result<(Vec<Vec3>, u64, f64), BenchError> {
+    let (positions, ticks, first) = judged_run_once(case, dt, duration_s, levels)?;
+    let wall = super::median_wall(first, || Ok(judged_run_once(case, dt, duration_s, levels)?.2))?;
     Ok((positions, ticks, wall))
 }
 
 /// One judged run: as [`judged_run`], its own wall time.
-fn judged_run_once(case: &Case, dt: f64, duration_s: f64) -> Result<(Vec<Vec3>, u64, f64), BenchError> {
+fn judged_run_once(case: &Case, dt: f64, duration_s: f64, levels: usize) -> Result<(Vec<Vec3>, u64, f64), BenchError> {
     let mut sim = physical(case, dt)?;
     let ticks = (duration_s / dt).round() as u64;
     let start = Instant::now();
-    let positions = crate::run::judged_nodes_after(&mut sim, ticks)?;
+    let positions = crate::run::judged_nodes_after(&mut sim, ticks, levels)?;
     Ok((positions, ticks, start.elapsed().as_secs_f64()))
 }
 

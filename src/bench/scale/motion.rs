@@ -76,7 +76,14 @@ pub struct MotionCase {
     /// (None outside them).
     pub rk4_error_at_equal_time_m: Option<f64>,
     pub euler_error_at_equal_time_m: Option<f64>,
+    /// The judged motion over four levels (h ... h/8, sixth order, 15 steps a tick) at
+    /// [`EQUAL_ERROR_DT_S`], and MuJoCo's RK4 error at its wall time \[m\].
+    pub judged_sixth: MotionRun,
+    pub rk4_error_at_equal_time_sixth_m: Option<f64>,
 }
+
+/// The levels of the bench's second judged motion: sixth order.
+const SIXTH_ORDER_LEVELS: usize = 4;
 
 /// The testbed's run of `case` at `dt`, repeated until the runs add up to
 /// [`super::MIN_CASE_WALL_S`] (as the settles are): the node positions at the end, steps and
@@ -184,10 +191,11 @@ pub fn compare(
         for case in family_cases {
             progress(&format!("{} {}: testbed motion ...", case.family, case.size));
             let runs = DT_S.iter().map(|&dt| testbed_run(&case, dt)).collect::<Result<Vec<_>, _>>()?;
-            let judged = DT_S
+            let mut judged = DT_S
                 .iter()
-                .map(|&dt| super::judged::judged_run(&case, dt, DURATION_S))
+                .map(|&dt| super::judged::judged_run(&case, dt, DURATION_S, crate::run::MIN_LEVELS))
                 .collect::<Result<Vec<_>, _>>()?;
+            judged.push(super::judged::judged_run(&case, EQUAL_ERROR_DT_S, DURATION_S, SIXTH_ORDER_LEVELS)?);
             listed.push(peer_case(&case, dir)?);
             ours.push((case, runs, judged));
         }
@@ -213,7 +221,13 @@ type TestbedRuns = Vec<(Vec<Vec3>, u64, f64)>;
 
 /// One case's comparison against the peer's reference: `[raw, judged]` the testbed's runs of
 /// rapier's steps alone and of the judged motion.
-fn compare_case(case: &Case, [raw, judged]: [TestbedRuns; 2], p: &serde_json::Value) -> Result<MotionCase, BenchError> {
+/// The judged runs are those at each of [`DT_S`], then the sixth-order one at
+/// [`EQUAL_ERROR_DT_S`].
+fn compare_case(
+    case: &Case,
+    [raw, mut judged]: [TestbedRuns; 2],
+    p: &serde_json::Value,
+) -> Result<MotionCase, BenchError> {
     let bad = || BenchError::Peer("the peer's motion case lacks its 'reference'".into());
     let reference = points(p.get("reference").ok_or_else(bad)?).ok_or_else(bad)?;
     let ours = |runs: TestbedRuns| -> Vec<MotionRun> {
@@ -229,6 +243,9 @@ fn compare_case(case: &Case, [raw, judged]: [TestbedRuns; 2], p: &serde_json::Va
             .map(|(dt, steps, wall, pos)| run(dt, steps, wall, largest_distance(&pos, &reference)))
             .collect())
     };
+    let sixth =
+        judged.pop().map(|(pos, steps, wall)| run(EQUAL_ERROR_DT_S, steps, wall, largest_distance(&pos, &reference)));
+    let sixth = sixth.ok_or_else(|| BenchError::Case("the sixth-order judged run is missing".into()))?;
     let (testbed, judged, peer) = (ours(raw), ours(judged), theirs("runs")?);
     let (peer_rk4, peer_euler) = (theirs("rk4_runs")?, theirs("euler_runs")?);
     let at = |runs: &[MotionRun]| {
@@ -246,6 +263,8 @@ fn compare_case(case: &Case, [raw, judged]: [TestbedRuns; 2], p: &serde_json::Va
         ratio_at_equal_error: wall.map(|w| w / raw_at.wall_s),
         rk4_error_at_equal_time_m: error_at_wall(&peer_rk4, judged_at.wall_s),
         euler_error_at_equal_time_m: error_at_wall(&peer_euler, judged_at.wall_s),
+        rk4_error_at_equal_time_sixth_m: error_at_wall(&peer_rk4, sixth.wall_s),
+        judged_sixth: sixth,
         testbed,
         peer,
         judged,
