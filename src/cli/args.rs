@@ -230,7 +230,7 @@ pub enum Command {
         #[arg(long, value_name = "N", default_value_t = 1000)]
         max_struts: usize,
         /// With --scale: only this family (prism, icosahedron, tower, furet, spine; with --motion
-        /// also pendulum, rocker, spin; repeatable).
+        /// also pendulum, rocker, spin, cart; repeatable).
         #[arg(long = "family", value_name = "NAME")]
         families: Vec<String>,
         /// With --scale: a case still moving after this wall time is reported as not settled
@@ -238,8 +238,8 @@ pub enum Command {
         #[arg(long, value_name = "S", default_value_t = 120.0)]
         max_case_wall_s: f64,
         /// With --scale --peer: physical motion instead of settling. The free-body families
-        /// and the pendulum, rocker and spin move undamped from their starts at several time
-        /// steps on both sides, scored against MuJoCo's RK4; steps per second, the cost at
+        /// and the pendulum, rocker, spin and driven cart move undamped from their starts at
+        /// several time steps on both sides, scored against MuJoCo's RK4; steps per second, the cost at
         /// equal error, and the judged motion (extrapolated over the step) against MuJoCo's RK4
         /// and Euler at equal stepping time.
         #[arg(long, requires = "scale")]

@@ -61,7 +61,7 @@ pub(super) struct Levels {
 }
 
 /// Actuator commands at a time of the motion [s] (a driven motion's inputs).
-pub(super) type CommandsAt<'a> = &'a dyn Fn(f64) -> Vec<f64>;
+pub type CommandsAt<'a> = &'a dyn Fn(f64) -> Vec<f64>;
 
 impl Levels {
     /// `count` levels of `sim` (the runner's own at h; [`MIN_LEVELS`] to [`MAX_LEVELS`]), the
@@ -206,14 +206,24 @@ fn estimate_divisor(order: i32) -> f64 {
 /// The node positions \[m\] of `sim`'s motion after `ticks` of its step, judged as a motion
 /// run judges them over `count` levels: the finer levels made from its present state, every
 /// level started at its half step, all stepped together (2^count - 1 steps a tick, as a run's),
-/// and the judged state at the end (the benchmark's measure of the judged motion's cost).
-pub fn judged_nodes_after(sim: &mut Simulation, ticks: u64, count: usize) -> Result<Vec<[f64; 3]>, SimError> {
+/// and the judged state at the end (the benchmark's measure of the judged motion's cost); a
+/// driven motion's commands (`commands_at` a time) set at the end of every step of each level.
+pub fn judged_nodes_after(
+    sim: &mut Simulation,
+    ticks: u64,
+    count: usize,
+    commands_at: Option<CommandsAt>,
+) -> Result<Vec<[f64; 3]>, SimError> {
     let mut levels = Levels::new(sim, count)?;
     sim.start_at_half_step()?;
     let dt_s = sim.model().settings.dt_s;
     for k in 1..=ticks {
+        let end_s = k as f64 * dt_s;
+        if let Some(c) = commands_at {
+            sim.drive_commands(&c(end_s));
+        }
         sim.step()?;
-        levels.step(k as f64 * dt_s, dt_s, None)?;
+        levels.step(end_s, dt_s, commands_at)?;
     }
     let none = |_: &Snapshot| Values::new();
     Ok(levels.judge(&sim.snapshot_with(false), &none, &none).state.nodes)

@@ -31,7 +31,7 @@ pub use fit::{
     fit, measurements_from_csv, parse_parameter, read_measurements, standard_normal, FitError, FitParameter,
     FitProblem, Measurement, DATA_COLUMNS, MAX_DATA_BYTES,
 };
-pub use levels::{judged_nodes_after, MAX_LEVELS, MIN_LEVELS};
+pub use levels::{judged_nodes_after, CommandsAt, MAX_LEVELS, MIN_LEVELS};
 pub use point::NO_BRANCH;
 pub use sensitivity::{point_of as sensitivity_point_of, sensitivity, SensitivityRunError};
 pub use settle::SettleDetector;

@@ -29,7 +29,10 @@ Euler at each of those steps (`rk4_runs`, `euler_runs`: the testbed compares its
 with them at equal stepping time). A case's `spin` (a body's name and its angular velocity
 [rad/s], world axes) starts that body's free joint spinning (its frame has the world's axes at
 the start, so the local angular velocity of `qvel` is the world one); its reference is the
-exact torque-free motion at 30 digits (`torque_free_sites`) instead of RK4's.
+exact torque-free motion at 30 digits (`torque_free_sites`) instead of RK4's. A case's `drive`
+(a slide's body, axis, stroke and rate of x(t) = A sin(w t / 2)^4) is run in the slide's frame
+(`set_drive`), its reference the exact motion of the one hinged body it carries
+(`driven_hinge_sites`).
 
 Each case is timed from loading the XML (model compile) to the settled state, as the testbed
 times building its simulation and settling it; a case faster than 0.2 s is run again until
@@ -177,15 +180,86 @@ def run_case(case: dict, overrides: dict) -> dict:
     }
 
 
-def motion_positions(model, data, sites, steps: int) -> tuple[np.ndarray, float]:
-    """Steps `steps` times from the model's initial state; the sites at the end and the wall
-    time of the steps alone."""
+def motion_positions(model, data, sites, steps: int, case: dict | None = None) -> tuple[np.ndarray, float]:
+    """Steps `steps` times from the model's initial state; the sites at the end (in the world:
+    a driven case's moved by its slide) and the wall time of the steps alone. A driven case's
+    wall is that of the same steps without the control callback: the callback is Python, called
+    at every RK4 stage, a cost that MuJoCo's own step does not have."""
     t0 = time.perf_counter()
     for _ in range(steps):
         mujoco.mj_step(model, data)
     wall_s = time.perf_counter() - t0
     mujoco.mj_kinematics(model, data)
-    return data.site_xpos[sites].copy(), wall_s
+    sites_now = data.site_xpos[sites].copy()
+    if case is not None and case.get("drive"):
+        sites_now += drive_shift(model, data, sites, case)
+        mujoco.set_mjcb_control(None)
+        data2 = mujoco.MjData(model)
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            mujoco.mj_step(model, data2)
+        wall_s = time.perf_counter() - t0
+        set_drive(model, case)
+    return sites_now, wall_s
+
+
+def drive_position(drive: dict, t: float) -> float:
+    """The driven slide's position at time `t` [m]: x(t) = A sin(w t / 2)^4."""
+    return drive["stroke_m"] * math.sin(0.5 * drive["rad_per_s"] * t) ** 4
+
+
+def drive_acceleration(drive: dict, t: float) -> float:
+    """Its acceleration [m/s^2]: x'' = (A w^2 / 2) (cos w t - cos 2 w t)."""
+    a, w = drive["stroke_m"], drive["rad_per_s"]
+    return 0.5 * a * w * w * (math.cos(w * t) - math.cos(2.0 * w * t))
+
+
+def carried_bodies(model, root: int) -> list:
+    """The bodies below `root` in the kinematic tree, `root` excluded."""
+    return [b for b in range(model.nbody) if b != root and is_below(model, b, root)]
+
+
+def is_below(model, body: int, root: int) -> bool:
+    while body != 0:
+        if body == root:
+            return True
+        body = model.body_parentid[body]
+    return False
+
+
+def set_drive(model, case: dict) -> None:
+    """A driven case's slide, in the frame it moves: the export makes the slide's body a mocap
+    body (MuJoCo holds no joint to a prescribed path inside RK4), left where it is drawn; every
+    body it carries feels the frame's fictitious force -m x''(t) along the slide, at its centre
+    of mass, set at each evaluation of the dynamics (each RK4 stage, at its time) by MuJoCo's
+    control callback. The sites are moved by x(t) along the slide afterwards (`drive_shift`).
+    The same equations as the testbed's cart on its slide; MuJoCo's RK4 is fourth order on them
+    (measured 6.2e-10, 3.9e-11, 2.4e-12 m at 4, 2, 1 ms)."""
+    drive = case.get("drive")
+    if not drive:
+        mujoco.set_mjcb_control(None)
+        return
+    root = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, drive["body"])
+    carried = carried_bodies(model, root)
+    axis = np.array(drive["axis"], dtype=float)
+
+    def fictitious(m, d):
+        a = drive_acceleration(drive, d.time)
+        for b in carried:
+            d.xfrc_applied[b, :3] = -m.body_mass[b] * a * axis
+
+    mujoco.set_mjcb_control(fictitious)
+
+
+def drive_shift(model, data, sites: list, case: dict) -> np.ndarray:
+    """What moves each of a driven case's sites from the slide's frame to the world's at the
+    data's time: x(t) along the slide for the sites on the slide's body and the bodies it
+    carries, nothing for the others (the ground's)."""
+    drive = case["drive"]
+    root = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, drive["body"])
+    shift = drive_position(drive, data.time) * np.array(drive["axis"], dtype=float)
+    moved = [is_below(model, model.site_bodyid[site], root) for site in sites]
+    return np.array([shift if m else np.zeros(3) for m in moved])
 
 
 def spun(model, data, case: dict) -> None:
@@ -253,6 +327,67 @@ def torque_free_sites(model, case: dict, sites: list, duration: float) -> np.nda
     return np.array(out)
 
 
+def rotated(axis: list, angle, v: list) -> list:
+    """v turned by `angle` about the unit `axis` (Rodrigues), in mpmath numbers."""
+    c, s_ = mpmath.cos(angle), mpmath.sin(angle)
+    dot = sum(a * b for a, b in zip(axis, v))
+    cross = [axis[1] * v[2] - axis[2] * v[1], axis[2] * v[0] - axis[0] * v[2], axis[0] * v[1] - axis[1] * v[0]]
+    return [v[i] * c + cross[i] * s_ + axis[i] * dot * (1 - c) for i in range(3)]
+
+
+def driven_hinge_sites(model, case: dict, sites: list, duration: float) -> np.ndarray | None:
+    """The exact sites of a driven case whose slide carries one body on one hinge, after
+    `duration` [m], or None for any other driven case. In the slide's frame the body turns about
+    the hinge under gravity and the fictitious force: I_n theta'' = n . (r(theta) x m (g - x''(t)
+    e)), I_n its moment about the hinge axis n, r(theta) its centre of mass from the hinge, e the
+    slide's axis; integrated by mpmath's Taylor method at EXACT_DIGITS digits from rest (the
+    drive starts with zero rate and acceleration), the sites then moved by x(t) e."""
+    mpmath.mp.dps = EXACT_DIGITS
+    drive = case["drive"]
+    root = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, drive["body"])
+    carried = carried_bodies(model, root)
+    if len(carried) != 1 or model.body_jntnum[carried[0]] != 1:
+        return None
+    body = carried[0]
+    joint = model.body_jntadr[body]
+    if model.jnt_type[joint] != mujoco.mjtJoint.mjJNT_HINGE:
+        return None
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    mp = lambda v: [mpmath.mpf(float(x)) for x in v]  # noqa: E731
+    n, pivot, com = mp(data.xaxis[joint]), mp(data.xanchor[joint]), mp(data.xipos[body])
+    r0 = [c - p for c, p in zip(com, pivot)]
+    frame = [mp(data.ximat[body][3 * i : 3 * i + 3]) for i in range(3)]
+    moments = mp(model.body_inertia[body])
+    frame_n = [sum(frame[k][i] * n[k] for k in range(3)) for i in range(3)]  # n in the inertia frame
+    mass = mpmath.mpf(float(model.body_mass[body]))
+    off_axis = [r0[i] - sum(a * b for a, b in zip(r0, n)) * n[i] for i in range(3)]
+    moment_n = sum(moments[i] * frame_n[i] ** 2 for i in range(3)) + mass * sum(x * x for x in off_axis)
+    gravity, e = mp(model.opt.gravity), mp(drive["axis"])
+    a_, w = mpmath.mpf(drive["stroke_m"]), mpmath.mpf(drive["rad_per_s"])
+
+    def rates(t, y):
+        accel = a_ * w * w / 2 * (mpmath.cos(w * t) - mpmath.cos(2 * w * t))
+        force = [mass * (gravity[i] - accel * e[i]) for i in range(3)]
+        r = rotated(n, y[0], r0)
+        torque = [r[1] * force[2] - r[2] * force[1], r[2] * force[0] - r[0] * force[2], r[0] * force[1] - r[1] * force[0]]
+        return [y[1], sum(a * b for a, b in zip(n, torque)) / moment_n]
+
+    tolerance = mpmath.mpf(10) ** (-EXACT_DIGITS)
+    theta = mpmath.odefun(rates, 0, [0, 0], tol=tolerance, degree=EXACT_DIGITS)(duration)[0]
+    shift = [a_ * mpmath.sin(w * duration / 2) ** 4 * x for x in e]
+    out = []
+    for site in sites:
+        p0 = mp(data.site_xpos[site])
+        site_body = model.site_bodyid[site]
+        if site_body == body:
+            p0 = [pv + d for pv, d in zip(pivot, rotated(n, theta, [a - b for a, b in zip(p0, pivot)]))]
+        if is_below(model, site_body, root):
+            p0 = [a + b for a, b in zip(p0, shift)]
+        out.append([float(x) for x in p0])
+    return np.array(out)
+
+
 def integrator_runs(load, case: dict, motion: dict, integrator) -> list:
     """The motion at each of `integrator_dts` with `integrator`: end sites and median wall."""
     duration, runs = motion["duration_s"], []
@@ -261,7 +396,7 @@ def integrator_runs(load, case: dict, motion: dict, integrator) -> list:
         walls = []
         while not walls or sum(walls) < MIN_CASE_WALL_S:
             model, data, sites = load(dt, integrator)
-            pos, wall_s = motion_positions(model, data, sites, steps)
+            pos, wall_s = motion_positions(model, data, sites, steps, case)
             walls.append(wall_s)
         runs.append({"dt_s": dt, "steps": steps, "wall_s": statistics.median(walls), "positions": pos.tolist()})
     return runs
@@ -273,6 +408,7 @@ def motion_case(case: dict, motion: dict) -> dict:
     at `reference_dt_s`, the reference; node sites at the end of each run."""
 
     def load(dt: float, integrator=None):
+        mujoco.set_mjcb_control(None)  # compiling evaluates the dynamics: no callback of a case before
         model = mujoco.MjModel.from_xml_path(case["mjcf"])
         model.opt.timestep = dt
         model.dof_damping[:] = 0.0
@@ -281,6 +417,7 @@ def motion_case(case: dict, motion: dict) -> dict:
         sites = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, n) for n in case["nodes"]]
         data = mujoco.MjData(model)
         spun(model, data, case)
+        set_drive(model, case)
         return model, data, sites
 
     duration = motion["duration_s"]
@@ -288,20 +425,24 @@ def motion_case(case: dict, motion: dict) -> dict:
     for dt in motion["dts"]:
         steps = round(duration / dt)
         model, data, sites = load(dt)
-        pos, wall_s = motion_positions(model, data, sites, steps)
+        pos, wall_s = motion_positions(model, data, sites, steps, case)
         walls = [wall_s]
         while sum(walls) < MIN_CASE_WALL_S:
             model, data, sites = load(dt)
-            walls.append(motion_positions(model, data, sites, steps)[1])
+            walls.append(motion_positions(model, data, sites, steps, case)[1])
         runs.append({"dt_s": dt, "steps": steps, "wall_s": statistics.median(walls), "positions": pos.tolist()})
     ref_dt = motion["reference_dt_s"]
     model, data, sites = load(ref_dt, mujoco.mjtIntegrator.mjINT_RK4)
+    exact = driven_hinge_sites(model, case, sites, duration) if case.get("drive") else None
     if case.get("spin"):
         reference = torque_free_sites(model, case, sites, duration)
+    elif exact is not None:
+        reference = exact
     else:
-        reference, _ = motion_positions(model, data, sites, round(duration / ref_dt))
+        reference, _ = motion_positions(model, data, sites, round(duration / ref_dt), case)
     rk4 = integrator_runs(load, case, motion, mujoco.mjtIntegrator.mjINT_RK4)
     euler = integrator_runs(load, case, motion, mujoco.mjtIntegrator.mjINT_EULER)
+    mujoco.set_mjcb_control(None)
     return {
         "family": case["family"],
         "size": case["size"],

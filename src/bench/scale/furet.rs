@@ -67,6 +67,7 @@ pub fn case(n: usize) -> Case {
         target: vec![(ends[n - 1], [x, y, 0.0])],
         measure: Measure::Absolute,
         spin: None,
+        drive: None,
     }
 }
 

@@ -118,5 +118,6 @@ pub fn case() -> Case {
         target: design.iter().enumerate().map(|(i, (_, p))| (i, *p)).collect(),
         measure: Measure::Aligned,
         spin: None,
+        drive: None,
     }
 }

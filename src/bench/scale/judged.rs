@@ -11,7 +11,10 @@
 //!   `rocker_frequency_curve.toml` (k1 = 40 N/m), drawn 0.3 rad from its equilibrium phi*, a
 //!   root with no closed form ([`rocker_equilibrium`]);
 //! - `spin`: a free rigid body of principal moments 1, 2, 3 kg m^2 spinning at
-//!   (0.2, 4, 0.2) rad/s, near its unstable intermediate axis, with no force on it.
+//!   (0.2, 4, 0.2) rad/s, near its unstable intermediate axis, with no force on it;
+//! - `cart`: the pendulum on a driven cart of `cart_pendulum_driven.toml`, its cart following
+//!   x(t) = A sin(w t / 2)^4 ([`SlideDrive`]) at a stroke and rate that swing the bar within
+//!   the motion (A = 0.3 m, w = 5 rad/s), from rest.
 //!
 //! The joints' damping is released, as the bodies' is: the motion is the dynamics' own.
 
@@ -23,7 +26,7 @@ use crate::structure::{BodyKind, Inertia, Structure, Vec3};
 use std::time::Instant;
 
 /// The families of this file.
-pub const FAMILIES: [&str; 3] = ["pendulum", "rocker", "spin"];
+pub const FAMILIES: [&str; 4] = ["pendulum", "rocker", "spin", "cart"];
 
 /// The pinned bar's file, drawn 0.5 rad (its `A`) past its equilibrium.
 const PENDULUM: &str = include_str!("../../../scenarios/custom/pinned_bar_large_amplitude.toml");
@@ -33,6 +36,29 @@ const ROCKER: &str = include_str!("../../../scenarios/custom/rocker_frequency_cu
 const ROCKER_AMPLITUDE_RAD: f64 = 0.3;
 /// The rocker's first spring's stiffness \[N/m\] (the file's default, inside its sweep).
 const ROCKER_K1_N_PER_M: f64 = 40.0;
+/// The driven cart's file.
+const CART: &str = include_str!("../../../scenarios/custom/cart_pendulum_driven.toml");
+/// Its drive: the stroke \[m\] and rate \[rad/s\] of x(t) = A sin(w t / 2)^4.
+const CART_STROKE_M: f64 = 0.3;
+const CART_RAD_PER_S: f64 = 5.0;
+
+/// A slide actuator following x(t) = stroke sin(w t / 2)^4 (at rest at t = 0: zero rate and
+/// acceleration), the body it carries, and the slide's axis (world).
+#[derive(Clone, Debug)]
+pub struct SlideDrive {
+    pub body: String,
+    pub axis: Vec3,
+    pub stroke_m: f64,
+    pub rad_per_s: f64,
+}
+
+impl SlideDrive {
+    /// The actuator commands (the one slide's) at motion time `t_s` \[m\].
+    pub fn commands_at(&self, t_s: f64) -> Vec<f64> {
+        vec![self.stroke_m * (0.5 * self.rad_per_s * t_s).sin().powi(4)]
+    }
+}
+
 /// The spinning body's principal moments \[kg m^2\] and mass \[kg\].
 const SPIN_MOMENTS_KG_M2: Vec3 = [1.0, 2.0, 3.0];
 const SPIN_MASS_KG: f64 = 1.0;
@@ -64,6 +90,22 @@ pub fn cases(family: &str) -> Result<Vec<Case>, BenchError> {
             from_file("rocker", ROCKER, &edits)?
         }
         "spin" => spin(),
+        "cart" => {
+            let (a, w) = (format!("A = {{ value = {CART_STROKE_M:?}"), format!("w = {{ value = {CART_RAD_PER_S:?}"));
+            let mut case =
+                from_file("cart", CART, &[("A = { value = 0.01", a.as_str()), ("w = { value = 2.5", w.as_str())])?;
+            let body = case.start.bodies.iter().position(|b| b.name == "cart");
+            let body =
+                body.ok_or_else(|| BenchError::Case("cart: the shipped file no longer has body 'cart'".into()))?;
+            let drive = SlideDrive {
+                body: case.start.bodies[body].name.clone(),
+                axis: [1.0, 0.0, 0.0],
+                stroke_m: CART_STROKE_M,
+                rad_per_s: CART_RAD_PER_S,
+            };
+            case.drive = Some(drive);
+            case
+        }
         _ => return Err(BenchError::Case(format!("no judged-motion family '{family}'"))),
     };
     Ok(vec![case])
@@ -92,6 +134,7 @@ fn from_file(family: &'static str, text: &str, edits: &[(&str, &str)]) -> Result
         target: Vec::new(),
         measure: Measure::Absolute,
         spin: None,
+        drive: None,
     })
 }
 
@@ -116,6 +159,7 @@ fn spin() -> Case {
         target: Vec::new(),
         measure: Measure::Absolute,
         spin: Some((body, SPIN_RAD_PER_S)),
+        drive: None,
     }
 }
 
@@ -157,7 +201,9 @@ fn judged_run_once(case: &Case, dt: f64, duration_s: f64, levels: usize) -> Resu
     let mut sim = physical(case, dt)?;
     let ticks = (duration_s / dt).round() as u64;
     let start = Instant::now();
-    let positions = crate::run::judged_nodes_after(&mut sim, ticks, levels)?;
+    let commands = |t: f64| case.drive.as_ref().map(|d| d.commands_at(t)).unwrap_or_default();
+    let driven: Option<&dyn Fn(f64) -> Vec<f64>> = case.drive.as_ref().map(|_| &commands as _);
+    let positions = crate::run::judged_nodes_after(&mut sim, ticks, levels, driven)?;
     Ok((positions, ticks, start.elapsed().as_secs_f64()))
 }
 
@@ -177,6 +223,9 @@ pub fn physical(case: &Case, dt: f64) -> Result<Simulation, BenchError> {
     }
     if let Some((body, w)) = case.spin {
         sim.set_body_spin(body, w)?;
+    }
+    if case.drive.is_some() {
+        sim.drive_physically()?;
     }
     Ok(sim)
 }

@@ -111,6 +111,8 @@ pub struct Case {
     pub measure: Measure,
     /// A free body started spinning: its index and angular velocity [rad/s] (world frame).
     pub spin: Option<(usize, Vec3)>,
+    /// An actuated slide followed in time (the driven cart of `judged.rs`).
+    pub drive: Option<judged::SlideDrive>,
 }
 
 /// How a case's settled nodes are compared with the closed form.

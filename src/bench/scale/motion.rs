@@ -25,7 +25,7 @@ use std::time::Instant;
 
 /// The families whose equations of motion are the same in MuJoCo: free bodies, and the
 /// judged-motion structures of `judged.rs` (hinges, a spinning body).
-pub const FAMILIES: [&str; 7] = ["prism", "icosahedron", "tower", "spine", "pendulum", "rocker", "spin"];
+pub const FAMILIES: [&str; 8] = ["prism", "icosahedron", "tower", "spine", "pendulum", "rocker", "spin", "cart"];
 /// Simulated time of every run \[s\].
 pub const DURATION_S: f64 = 0.5;
 /// Time steps of both sides \[s\].
@@ -99,7 +99,10 @@ fn testbed_run_once(case: &Case, dt: f64) -> Result<(Vec<Vec3>, u64, f64), Bench
     let mut sim = super::judged::physical(case, dt)?;
     let steps = (DURATION_S / dt).round() as u64;
     let start = Instant::now();
-    for _ in 0..steps {
+    for k in 1..=steps {
+        if let Some(d) = &case.drive {
+            sim.drive_commands(&d.commands_at(k as f64 * dt));
+        }
         sim.step()?;
     }
     Ok((sim.node_positions(), steps, start.elapsed().as_secs_f64()))
@@ -137,9 +140,12 @@ fn peer_case(case: &Case, dir: &Path) -> Result<serde_json::Value, BenchError> {
     let path = dir.join(format!("motion-{}-{}.xml", case.family, case.size));
     super::peer::write_mjcf(case, EQUAL_ERROR_DT_S, 0.0, &path)?;
     let spin = case.spin.map(|(b, w)| serde_json::json!({ "body": s.bodies[b].name, "angular_velocity": w }));
+    let drive = case.drive.as_ref().map(
+        |d| serde_json::json!({ "body": d.body, "axis": d.axis, "stroke_m": d.stroke_m, "rad_per_s": d.rad_per_s }),
+    );
     Ok(serde_json::json!({
         "family": case.family, "size": case.size, "mjcf": path.display().to_string(),
-        "nodes": s.nodes.iter().map(|n| n.name.clone()).collect::<Vec<_>>(), "spin": spin,
+        "nodes": s.nodes.iter().map(|n| n.name.clone()).collect::<Vec<_>>(), "spin": spin, "drive": drive,
     }))
 }
 

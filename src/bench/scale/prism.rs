@@ -135,6 +135,7 @@ pub fn case_with(n: usize, relaxation: bool) -> Case {
         target: design.nodes.iter().enumerate().map(|(i, p)| (i, p.position)).collect(),
         measure: Measure::Twist,
         spin: None,
+        drive: None,
         start,
     }
 }

@@ -124,5 +124,6 @@ pub fn case(free: usize) -> Case {
         target: design.nodes.iter().enumerate().map(|(i, n)| (i, n.position)).collect(),
         measure: Measure::Absolute,
         spin: None,
+        drive: None,
     }
 }

@@ -327,6 +327,7 @@ pub fn case(stages: usize) -> Result<Case, TowerError> {
         target: drawn.nodes.iter().enumerate().map(|(i, n)| (i, n.position)).collect(),
         measure: Measure::Aligned,
         spin: None,
+        drive: None,
         start,
     })
 }
