@@ -51,8 +51,8 @@ pub(super) struct FreeRotation {
 }
 
 /// A plain free body's world angular momentum as (1) carried it \[kg m^2/s\], with the angular
-/// velocity (world) \[rad/s\] it was last set to: while the body's angular velocity is still that
-/// one, L is this, not made again from the velocity.
+/// velocity (world) \[rad/s\] and the rotation it was last set to: while the body's are still
+/// those, L is this, not made again from the velocity.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct KeptMomentum {
     angvel: Vector,
@@ -184,12 +184,12 @@ impl Data {
 }
 
 impl Data {
-    /// Body `b`'s world angular momentum now: the kept one while its angular velocity is the
-    /// one kept with it.
+    /// Body `b`'s world angular momentum now: the kept one while its rotation and angular
+    /// velocity are those kept with it (nothing outside the step has set either since).
     pub(super) fn angular_momentum(&self, m: &Model, b: usize) -> Vector {
         let rb = &self.bodies[m.handles[b]];
         match self.kept_momenta[b] {
-            Some(kept) if kept.angvel == rb.angvel() => kept.momentum,
+            Some(kept) if kept.angvel == rb.angvel() && kept.rotation == rb.position().rotation => kept.momentum,
             _ => {
                 let props = rb.mass_properties().local_mprops;
                 momentum(
