@@ -60,7 +60,7 @@ pub(super) struct Levels {
     first_nodes: Option<Vec<[f64; 3]>>,
 }
 
-/// Actuator commands at a time of the motion [s] (a driven motion's inputs).
+/// Actuator commands at a time of the motion \[s\] (a driven motion's inputs).
 pub type CommandsAt<'a> = &'a dyn Fn(f64) -> Vec<f64>;
 
 impl Levels {
