@@ -206,6 +206,22 @@ pub struct ExtrapolationReport {
     pub not_smooth_from_tick: Option<u64>,
 }
 
+/// How a motion judged extrapolated was judged, and how far its node positions may be off.
+fn judged_line(x: &ExtrapolationReport) -> String {
+    let estimate = x.largest_estimate.get("node positions").copied().unwrap_or(0.0);
+    let rough = x
+        .not_smooth_from_tick
+        .map_or(String::new(), |t| format!("; not smooth from tick {t}: the estimate does not hold after it"));
+    format!(
+        "judged: extrapolated over {} levels (order {}); node positions' error estimate {estimate:.1e} m, {} the target {:.0e} of the amplitude {:.3e} m{rough}",
+        x.steps_s.len(),
+        x.order,
+        if x.target_met { "within" } else { "above" },
+        x.target_error,
+        x.amplitude_m
+    )
+}
+
 /// A motion against the file's Lagrangian model, compared tick by tick
 /// (`observers::lagrangian`).
 #[derive(Clone, Debug, Serialize, PartialEq)]
@@ -926,6 +942,9 @@ impl ScenarioReport {
         ));
         if let Some(d) = &m.driven {
             out.push_str(&format!("   actuation: {d}\n"));
+        }
+        if let Some(x) = &m.extrapolation {
+            out.push_str(&format!("   {}\n", judged_line(x)));
         }
         if self.points.len() > 1 && !m.frequencies.is_empty() {
             out.push_str("   (a motion from each point: each frequency's worst point below, every point's under it)\n");
