@@ -28,9 +28,9 @@
 //! velocity each step: the round trip L -> w -> L through the rotated inertia rounds |L| by about
 //! 1e-16 a step with a bias, which a torque-free spin turned into an angle error growing with
 //! the step count (1.2e-12 m after 0.5 s judged at dt = 1 ms, 4.9e-12 at 0.25 ms; kept, 9.6e-15
-//! and 2.0e-14: round-off without a trend). A velocity set from outside the step (a spin, a
-//! half-step start, a restart) is seen as a velocity other than the kept one, and L is made
-//! from it once.
+//! and 2.0e-14: round-off without a trend). A velocity or a pose set from outside the step (a
+//! spin, a half-step start, a restart, a projection) is seen as other than the kept one, and L
+//! is made from the velocity once (the carried rounding of (2) is dropped with a new pose).
 
 use super::{Data, Model};
 use rapier3d_f64::prelude::*;
