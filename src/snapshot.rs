@@ -183,9 +183,12 @@ impl ModalProjector {
     }
 }
 
-/// The divisor of the difference between two Richardson values, T(h/2, h/4) - T(h, h/2), that
-/// estimates the error of the finer one for a scheme whose error is even in h: 2^4 - 1.
-pub const RICHARDSON_ESTIMATE_DIVISOR: f64 = 15.0;
+/// The divisor of the difference between an extrapolated value of order `order` and the one a
+/// level coarser (T(h/2, h/4) - T(h, h/2) at order 4) that estimates the finer one's error, for a
+/// scheme whose error is even in h: 2^order - 1 (15 at order 4).
+pub fn richardson_estimate_divisor(order: i32) -> f64 {
+    2f64.powi(order) - 1.0
+}
 
 /// One Richardson step over the time step: from the same motion at step h (`coarse`) and h / 2
 /// (`fine`), a method whose error is c h^p + ... gives fine + (fine - coarse) / (2^p - 1),

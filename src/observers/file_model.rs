@@ -403,11 +403,11 @@ impl ModelObserver {
 
     /// The estimate of the simulation's own error in each prediction's simulated value (its
     /// class's error) and each equation's residual, from the judged values `v` and those of the
-    /// state one level rougher (`run/levels.rs`: they differ by 15 times the judged error).
-    fn estimates(&self, v: &[f64], rougher: &[f64]) -> Vec<f64> {
+    /// state one level rougher (`run/levels.rs`: they differ by `divisor` times the judged error).
+    fn estimates(&self, v: &[f64], rougher: &[f64], divisor: f64) -> Vec<f64> {
         let predictions = self.spec.predictions.iter().map(|p| p.class.error(rougher[p.symbol], v[p.symbol]));
         let equations = self.spec.equations.iter().map(|e| (e.residual.eval(v) - e.residual.eval(rougher)).abs());
-        predictions.chain(equations).map(|d| d / crate::snapshot::RICHARDSON_ESTIMATE_DIVISOR).collect()
+        predictions.chain(equations).map(|d| d / divisor).collect()
     }
 
     /// Each prediction's (predicted, simulated, error), then each equation's (0, residual,
@@ -702,9 +702,9 @@ impl Observer for ModelObserver {
             for (a, (_, _, e)) in self.acc.iter_mut().zip(&errors).take(predictions) {
                 a.motion_tick(*e);
             }
-            if let Some((rougher, observed)) = t.rougher {
-                let v_rougher = self.values(rougher, t.inputs, t.params, observed, time_s);
-                let estimates = self.estimates(&v, &v_rougher);
+            if let Some(rougher) = t.rougher {
+                let v_rougher = self.values(rougher.state, t.inputs, t.params, rougher.values, time_s);
+                let estimates = self.estimates(&v, &v_rougher, rougher.estimate_divisor);
                 for (a, e) in self.acc.iter_mut().zip(estimates) {
                     a.estimate(e);
                 }

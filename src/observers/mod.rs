@@ -44,13 +44,22 @@ pub struct Tick<'a> {
     /// In a motion judged extrapolated over the time step: each quantity's estimate of the
     /// simulation's own error at this tick (`run/levels.rs`).
     pub estimate: Option<&'a Values>,
-    /// There too: the state one level rougher (Richardson's value from h and h/2) with the
-    /// mechanism's quantities in it; what an observer measures differs between it and
-    /// `snapshot` by 15 times its estimated error (`run/levels.rs`).
-    pub rougher: Option<(&'a Snapshot, &'a Values)>,
+    /// There too: the state one level rougher with the mechanism's quantities in it.
+    pub rougher: Option<Rougher<'a>>,
     /// The run's cancel flag, for an observer's own long work at a tick (the Lagrangian
     /// model's integration between two ticks).
     pub cancel: Option<&'a std::sync::atomic::AtomicBool>,
+}
+
+/// In a motion judged extrapolated: the state one level rougher than the judged one
+/// (`run/levels.rs`). What an observer measures differs between it and the judged state by
+/// `estimate_divisor` times the judged value's error (15 at fourth order).
+#[derive(Clone, Copy)]
+pub struct Rougher<'a> {
+    pub state: &'a Snapshot,
+    /// The mechanism's quantities in it.
+    pub values: &'a Values,
+    pub estimate_divisor: f64,
 }
 
 /// What the observers see of a settle point besides its report (which holds the inputs, the

@@ -242,6 +242,8 @@ pub struct MotionObserver {
     modes: Vec<ModeAtStart>,
     /// The motion is judged extrapolated over the time step: no dispersion to correct.
     extrapolated: bool,
+    /// What divides a difference from the rougher state into the judged error (`Rougher`).
+    estimate_divisor: f64,
 }
 
 impl MotionObserver {
@@ -253,6 +255,7 @@ impl MotionObserver {
             at: None,
             modes: Vec::new(),
             extrapolated: false,
+            estimate_divisor: f64::NAN,
         }
     }
 
@@ -287,13 +290,13 @@ impl MotionObserver {
 
     /// In a motion judged extrapolated: the estimate of the simulation's own error in the
     /// measured frequency, relative: the same measure on the state one level rougher differs by
-    /// 2^4 - 1 times the finer one's error (`snapshot::RICHARDSON_ESTIMATE_DIVISOR`).
+    /// the levels' estimate divisor times the finer one's error (`observers::Rougher`).
     fn estimate(&self, f: &FrequencyPrediction, t: &[f64], rougher: &[f64], measured: f64) -> Option<f64> {
         if !self.extrapolated || rougher.len() != t.len() {
             return None;
         }
         let rough = Self::measured(f, t, rougher, || fit_cosine(t, rougher));
-        Some((measured - rough).abs() / measured.abs() / crate::snapshot::RICHARDSON_ESTIMATE_DIVISOR)
+        Some((measured - rough).abs() / measured.abs() / self.estimate_divisor)
     }
 
     fn report(
@@ -360,8 +363,9 @@ impl Observer for MotionObserver {
             let (ts, qs) = &mut self.samples[k];
             ts.push(time_s);
             qs.push(q(t.snapshot));
-            if let Some((rough, _)) = t.rougher {
-                self.rougher[k].push(q(rough));
+            if let Some(rough) = t.rougher {
+                self.rougher[k].push(q(rough.state));
+                self.estimate_divisor = rough.estimate_divisor;
             }
         }
     }

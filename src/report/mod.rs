@@ -206,9 +206,19 @@ pub struct ExtrapolationReport {
     pub not_smooth_from_tick: Option<u64>,
 }
 
+/// The key of the largest estimate over every node coordinate in `largest_estimate`.
+pub const NODE_POSITIONS: &str = "node positions";
+
+impl ExtrapolationReport {
+    /// The largest error estimate of the judged node positions over the motion \[m\].
+    pub fn node_estimate_m(&self) -> f64 {
+        self.largest_estimate.get(NODE_POSITIONS).copied().unwrap_or(0.0)
+    }
+}
+
 /// How a motion judged extrapolated was judged, and how far its node positions may be off.
 fn judged_line(x: &ExtrapolationReport) -> String {
-    let estimate = x.largest_estimate.get("node positions").copied().unwrap_or(0.0);
+    let estimate = x.node_estimate_m();
     let rough = x
         .not_smooth_from_tick
         .map_or(String::new(), |t| format!("; not smooth from tick {t}: the estimate does not hold after it"));
@@ -282,7 +292,7 @@ pub struct FrequencyReport {
     pub modal_error: Option<f64>,
     /// In a motion judged extrapolated over the time step: the estimate of the simulation's own
     /// error in the measured frequency, relative (the same measure on the state one level
-    /// rougher, their difference over 2^4 - 1).
+    /// rougher, their difference over the levels' estimate divisor: 2^4 - 1 at fourth order).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simulation_error: Option<f64>,
     /// The measured angular frequency of the simulated samples, w_d [rad/s].

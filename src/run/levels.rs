@@ -15,8 +15,9 @@
 //! trusted.
 
 use crate::mechanisms::Values;
+use crate::report::NODE_POSITIONS;
 use crate::sim::{SimError, Simulation};
-use crate::snapshot::{richardson, Snapshot};
+use crate::snapshot::{richardson, richardson_estimate_divisor, Snapshot};
 
 /// The order of the leapfrog scheme's leading error term, cancelled by one Richardson step.
 const LEAPFROG_ORDER: i32 = 2;
@@ -29,8 +30,6 @@ pub const MAX_LEVELS: usize = 5;
 
 /// The prefix of a node coordinate's name among the estimated values (`observers::table`).
 const NODE_PREFIX: &str = "node:";
-/// The key of the largest estimate over every node coordinate in the motion's report.
-pub(super) const NODE_POSITIONS: &str = "node positions";
 
 /// What [`Levels::judge`] gives at a tick.
 pub(super) struct Judged {
@@ -42,6 +41,8 @@ pub(super) struct Judged {
     pub estimate: Values,
     /// The same from one level coarser, with the mechanism's quantities in it.
     pub rougher: (Snapshot, Values),
+    /// What divides a difference between the two into the judged state's error.
+    pub estimate_divisor: f64,
 }
 
 /// The motion at h/2, h/4, ... beside the runner's own at h.
@@ -117,6 +118,24 @@ impl Levels {
         Ok(())
     }
 
+    /// One tick of `coarse` (the level at h, stepped here as well) and of the finer levels,
+    /// ending at motion time `end_s` \[s\], a driven motion's commands set at the end of every
+    /// step (a motion's levels run alone, with no observer: `judged_nodes_after`, the choice of
+    /// levels for a target).
+    pub fn step_with(
+        &mut self,
+        coarse: &mut Simulation,
+        end_s: f64,
+        dt_s: f64,
+        commands_at: Option<CommandsAt>,
+    ) -> Result<(), SimError> {
+        if let Some(c) = commands_at {
+            coarse.drive_commands(&c(end_s));
+        }
+        coarse.step()?;
+        self.step(end_s, dt_s, commands_at)
+    }
+
     /// The judged state at this tick (`coarse` the runner's own, at h) with the mechanism's
     /// quantities in it (`observe` reads them off a state), the error estimate of each of them
     /// and of each value `estimated_too` reads (the joint coordinates), and the state one level
@@ -133,17 +152,18 @@ impl Levels {
         observe: &dyn Fn(&Snapshot) -> Values,
         estimated_too: &dyn Fn(&Snapshot) -> Values,
     ) -> Judged {
-        let mut column: Vec<Snapshot> =
-            std::iter::once(coarse.clone()).chain(self.finer.iter().map(|s| s.snapshot_with(false))).collect();
-        self.note_smoothness(coarse.tick, &column);
-        for j in 1..column.len() - 1 {
+        let finer: Vec<Snapshot> = self.finer.iter().map(|s| s.snapshot_with(false)).collect();
+        let levels: Vec<&Snapshot> = std::iter::once(coarse).chain(&finer).collect();
+        self.note_smoothness(coarse.tick, &levels);
+        let mut column: Vec<Snapshot> = levels.windows(2).map(|w| richardson(w[0], w[1], LEAPFROG_ORDER)).collect();
+        for j in 2..levels.len() - 1 {
             column = column.windows(2).map(|w| richardson(&w[0], &w[1], LEAPFROG_ORDER * j as i32)).collect();
         }
         let (Some(mut judged), Some(rougher)) = (column.pop(), column.pop()) else {
             unreachable!("three levels or more leave two values in the table's last column");
         };
         (judged.tick, judged.time_s) = (coarse.tick, coarse.time_s);
-        let divisor = estimate_divisor(self.order());
+        let divisor = richardson_estimate_divisor(self.order());
         let (values, rough_values) = (observe(&judged), observe(&rougher));
         let (too, rough_too) = (estimated_too(&judged), estimated_too(&rougher));
         let estimate: Values = values
@@ -163,12 +183,12 @@ impl Levels {
             let largest = self.largest.entry(key.to_string()).or_insert(0.0);
             *largest = largest.max(*e);
         }
-        Judged { state: judged, values, estimate, rougher }
+        Judged { state: judged, values, estimate, rougher, estimate_divisor: divisor }
     }
 
     /// Notes the first tick at which the levels' cables disagree on slack, or change it since
     /// the tick before (`levels` the states at this tick, coarsest first).
-    fn note_smoothness(&mut self, tick: u64, levels: &[Snapshot]) {
+    fn note_smoothness(&mut self, tick: u64, levels: &[&Snapshot]) {
         let slack = &levels[levels.len() - 1].forces.slack;
         let smooth = levels.iter().all(|s| s.forces.slack == *slack)
             && self.last_slack.as_ref().is_none_or(|last| last == slack);
@@ -195,12 +215,12 @@ impl Levels {
     pub fn node_estimate_m(&self) -> f64 {
         self.largest.get(NODE_POSITIONS).copied().unwrap_or(0.0)
     }
-}
 
-/// The divisor of the difference between a judged value of order `order` and the one a level
-/// coarser that estimates the judged value's error: 2^order - 1.
-fn estimate_divisor(order: i32) -> f64 {
-    2f64.powi(order) - 1.0
+    /// Whether the judged node positions' estimate so far is at most `target` times the
+    /// amplitude.
+    pub fn meets(&self, target: f64) -> bool {
+        self.node_estimate_m() <= target * self.amplitude_m
+    }
 }
 
 /// The node positions \[m\] of `sim`'s motion after `ticks` of its step, judged as a motion
@@ -218,12 +238,7 @@ pub fn judged_nodes_after(
     sim.start_at_half_step()?;
     let dt_s = sim.model().settings.dt_s;
     for k in 1..=ticks {
-        let end_s = k as f64 * dt_s;
-        if let Some(c) = commands_at {
-            sim.drive_commands(&c(end_s));
-        }
-        sim.step()?;
-        levels.step(end_s, dt_s, commands_at)?;
+        levels.step_with(sim, k as f64 * dt_s, dt_s, commands_at)?;
     }
     let none = |_: &Snapshot| Values::new();
     Ok(levels.judge(&sim.snapshot_with(false), &none, &none).state.nodes)

@@ -3,7 +3,7 @@
 //! for good, the named coordinate displaced and given its rate, and the physical dynamics for
 //! the stated time. The observers judge it tick by tick; nothing here settles it.
 
-use super::levels::{Levels, MAX_LEVELS, MIN_LEVELS, NODE_POSITIONS};
+use super::levels::{Levels, MAX_LEVELS, MIN_LEVELS};
 use super::runner::Runner;
 use super::settle::SettleDetector;
 use super::{point, RunError};
@@ -120,9 +120,9 @@ pub(super) fn run_motion(
 
 /// The warning of a stated target that the most levels did not meet.
 fn missed_target(x: &ExtrapolationReport) -> String {
-    let estimate = x.largest_estimate.get(NODE_POSITIONS).copied().unwrap_or(0.0);
     format!(
-        "motion: the judged node positions' error estimate {estimate:.1e} m is above the target, {:.0e} of the amplitude {:.3e} m, at the most levels ({}, order {}): a smaller sim.dt meets it",
+        "motion: the judged node positions' error estimate {:.1e} m is above the target, {:.0e} of the amplitude {:.3e} m, at the most levels ({}, order {}): a smaller sim.dt meets it",
+        x.node_estimate_m(),
         x.target_error,
         x.amplitude_m,
         x.steps_s.len(),
@@ -138,7 +138,7 @@ fn extrapolation_report(l: Levels, m: &Motion, dt_s: f64) -> ExtrapolationReport
         order: l.order(),
         amplitude_m: l.amplitude_m,
         target_error,
-        target_met: l.node_estimate_m() <= target_error * l.amplitude_m,
+        target_met: l.meets(target_error),
         not_smooth_from_tick: l.rough_from_tick,
         largest_estimate: l.largest,
     }
@@ -177,11 +177,9 @@ fn start_integration(runner: &mut Runner, m: &Motion, report: &mut ScenarioRepor
 fn levels_for_target(runner: &Runner, m: &Motion, target: f64) -> Result<(usize, Vec<String>), RunError> {
     let dt_s = runner.sc.sim.dt_s;
     let structure = runner.sim.structure();
-    let commands = |t: f64| {
-        let inputs = m.drive.as_ref().map(|d| d.inputs_at(&runner.params, t)).unwrap_or_default();
-        structure.commands_from(&runner.mech.commands(&runner.params, &inputs))
-    };
-    let driven: Option<&dyn Fn(f64) -> Vec<f64>> = m.drive.as_ref().map(|_| &commands as _);
+    let (mech, params) = (runner.mech.as_ref(), &runner.params);
+    let commands = m.drive.as_ref().map(|d| move |t| super::runner::commands_at(mech, params, structure, d, t));
+    let driven = commands.as_ref().map(|c| c as &dyn Fn(f64) -> Vec<f64>);
     let none = |_: &Snapshot| Values::new();
     let nodes = |s: &Snapshot| crate::observers::table::estimated_columns(structure, s);
     let mut tried = Vec::new();
@@ -193,12 +191,7 @@ fn levels_for_target(runner: &Runner, m: &Motion, target: f64) -> Result<(usize,
             if runner.cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::SeqCst)) {
                 return Err(RunError::Interrupted(runner.sim.tick()));
             }
-            let end_s = k as f64 * dt_s;
-            if let Some(c) = driven {
-                sim.drive_commands(&c(end_s));
-            }
-            sim.step()?;
-            levels.step(end_s, dt_s, driven)?;
+            levels.step_with(&mut sim, k as f64 * dt_s, dt_s, driven)?;
             levels.judge(&sim.snapshot_with(false), &none, &nodes);
         }
         tried.push(format!(
@@ -206,7 +199,7 @@ fn levels_for_target(runner: &Runner, m: &Motion, target: f64) -> Result<(usize,
             levels.node_estimate_m(),
             levels.amplitude_m
         ));
-        if levels.node_estimate_m() <= target * levels.amplitude_m {
+        if levels.meets(target) {
             return Ok((count, tried));
         }
     }

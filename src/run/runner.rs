@@ -4,7 +4,7 @@
 use super::levels::Levels;
 use super::RunError;
 use crate::mechanisms::{Mechanism, Prediction, Values};
-use crate::observers::{Note, Observer, Tick};
+use crate::observers::{Note, Observer, Rougher, Tick};
 use crate::scenario::Scenario;
 use crate::settings::Drive;
 use crate::sim::Simulation;
@@ -46,8 +46,20 @@ pub(super) struct Runner<'a> {
 }
 
 /// The judged state and the mechanism's quantities in it; in a motion judged extrapolated also
-/// the quantities' error estimates, the state one level rougher and its quantities.
-type JudgedState = (Snapshot, Values, Option<(Values, Snapshot, Values)>);
+/// the quantities' error estimates, the state one level rougher, its quantities and the divisor
+/// that turns a difference from it into the judged error.
+type JudgedState = (Snapshot, Values, Option<(Values, Snapshot, Values, f64)>);
+
+/// The actuator commands (structure order) of `drive`'s inputs at motion time `t_s` \[s\].
+pub(super) fn commands_at(
+    mech: &dyn Mechanism,
+    params: &Values,
+    structure: &crate::structure::Structure,
+    drive: &Drive,
+    t_s: f64,
+) -> Vec<f64> {
+    structure.commands_from(&mech.commands(params, &drive.inputs_at(params, t_s)))
+}
 
 impl<'a> Runner<'a> {
     pub fn new(
@@ -146,15 +158,12 @@ impl<'a> Runner<'a> {
         let dt_s = self.sc.sim.dt_s;
         let end_s = self.motion_start_tick.map_or(0.0, |t0| snap.tick.saturating_sub(t0) as f64 * dt_s);
         let (mech, params, structure) = (&self.mech, &self.params, self.sim.structure());
-        let commands = |t: f64| {
-            let inputs = self.motion_drive.as_ref().map(|d| d.inputs_at(params, t)).unwrap_or_default();
-            structure.commands_from(&mech.commands(params, &inputs))
-        };
-        let driven: Option<&dyn Fn(f64) -> Vec<f64>> = self.motion_drive.as_ref().map(|_| &commands as _);
+        let commands = self.motion_drive.as_ref().map(|d| move |t| commands_at(mech.as_ref(), params, structure, d, t));
+        let driven = commands.as_ref().map(|c| c as &dyn Fn(f64) -> Vec<f64>);
         levels.step(end_s, dt_s, driven)?;
         let coordinates = |s: &Snapshot| crate::observers::table::estimated_columns(structure, s);
         let j = levels.judge(&snap, &|s| mech.observe(params, structure, s), &coordinates);
-        Ok((j.state, j.values, Some((j.estimate, j.rougher.0, j.rougher.1))))
+        Ok((j.state, j.values, Some((j.estimate, j.rougher.0, j.rougher.1, j.estimate_divisor))))
     }
 
     /// Shows every observer the state a motion starts from (the simulation's, before its first
@@ -224,7 +233,7 @@ impl<'a> Runner<'a> {
             simulated: &simulated,
             ghost_nodes: self.ghost.as_ref().and_then(|(_, g)| g.as_deref()),
             estimate: levels.as_ref().map(|l| &l.0),
-            rougher: levels.as_ref().map(|l| (&l.1, &l.2)),
+            rougher: levels.as_ref().map(|l| Rougher { state: &l.1, values: &l.2, estimate_divisor: l.3 }),
             cancel: self.cancel,
         };
         for o in &mut self.observers {

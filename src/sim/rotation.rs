@@ -137,14 +137,12 @@ impl Data {
             .filter(|&b| m.is_free(b) && self.multibody_joints.rigid_body_link(m.handles[b]).is_none())
             .map(|b| {
                 let rb = &self.bodies[m.handles[b]];
-                let rotation = rb.position().rotation;
-                let kept = self.kept_momenta[b].filter(|k| k.rotation == rotation);
                 FreeBodyStart {
                     body: b,
-                    rotation,
+                    rotation: rb.position().rotation,
                     angvel: rb.angvel(),
                     momentum: self.angular_momentum(m, b),
-                    carry: kept.map_or([0.0; 4], |k| k.carry),
+                    carry: self.carry(m, b),
                 }
             })
             .collect()
@@ -184,6 +182,13 @@ impl Data {
 }
 
 impl Data {
+    /// The rounding (2) carries into body `b`'s next turn: the kept one while its rotation is the
+    /// one kept with it, none after a pose set from outside the step.
+    fn carry(&self, m: &Model, b: usize) -> [f64; 4] {
+        let rotation = self.bodies[m.handles[b]].position().rotation;
+        self.kept_momenta[b].filter(|k| k.rotation == rotation).map_or([0.0; 4], |k| k.carry)
+    }
+
     /// Body `b`'s world angular momentum now: the kept one while its rotation and angular
     /// velocity are those kept with it (nothing outside the step has set either since).
     pub(super) fn angular_momentum(&self, m: &Model, b: usize) -> Vector {
@@ -207,10 +212,10 @@ impl Data {
     pub(super) fn set_angular_momentum(&mut self, m: &Model, b: usize, l: Vector) {
         let rb = &mut self.bodies[m.handles[b]];
         let props = rb.mass_properties().local_mprops;
-        let w = angvel(rb.position().rotation, props.principal_inertia_local_frame, props.principal_inertia(), l);
-        rb.set_angvel(w, true);
         let rotation = rb.position().rotation;
-        let carry = self.kept_momenta[b].filter(|k| k.rotation == rotation).map_or([0.0; 4], |k| k.carry);
+        let w = angvel(rotation, props.principal_inertia_local_frame, props.principal_inertia(), l);
+        rb.set_angvel(w, true);
+        let carry = self.carry(m, b);
         self.kept_momenta[b] = Some(KeptMomentum { angvel: w, momentum: l, rotation, carry });
     }
 }

@@ -212,3 +212,31 @@ fn a_bad_target_error_is_located() {
         super::common::error_at(&bad, &at, "target_error = ".len(), msg);
     }
 }
+
+/// A check's simulation error divides its difference from the state one level rougher by the
+/// divisor of the levels the run took (2^6 - 1 over four levels, not fourth order's 2^4 - 1): a
+/// prediction on the tip's x coordinate, the bar released at 0.5 rad and run at dt = 4 ms, where
+/// `target_error = 1e-10` takes four levels, has the levels' own estimate of that coordinate
+/// (the same difference over the same divisor) within 1e-9 of it (the prediction's verdict does
+/// not matter here).
+#[test]
+fn a_checks_simulation_error_follows_the_levels_the_run_took() {
+    let text = std::fs::read_to_string("scenarios/custom/pinned_bar_vibration.toml").expect("the shipped file");
+    let probe = "[[predictions]]\nname = \"tip x\"\nquantity = \"px\"\nformula = \"0\"\nclass = \"length\"\ntolerance = 10.0\n\n[[quantities]]\nname = \"px\"\nexpr = \"P.x\"\nunit = \"m\"\n\n[[quantities]]";
+    let edits = [
+        ("[motion]", "[motion]\ntarget_error = 1e-10"),
+        ("\ndt = 1e-3", "\ndt = 4e-3"),
+        ("A = { value = 1e-3", "A = { value = 0.5"),
+        ("[[quantities]]", probe),
+    ];
+    let text = edits.iter().fold(text, |t, (from, to)| t.replacen(from, to, 1));
+    let sc = tensegrity_testbed::scenario::parse(std::path::Path::new("pbv.toml"), &text).expect("valid");
+    let report = tensegrity_testbed::run::run(&sc, &Default::default());
+    let x = report.motion.as_ref().and_then(|m| m.extrapolation.clone()).expect("extrapolated");
+    let levels = x.largest_estimate["P.x"];
+    let check = report.model_checks.iter().find(|c| c.name == "tip x").expect("the prediction");
+    let estimate = check.simulation_error.expect("an estimate");
+    eprintln!("order {}: the levels' estimate of P.x {levels:e}, the check's {estimate:e}", x.order);
+    assert_eq!(x.order, 6, "{x:?}");
+    assert!((estimate - levels).abs() <= 1e-9 * levels, "check {estimate:e} against the levels' {levels:e}");
+}
