@@ -197,13 +197,13 @@ pub fn compare(
         for case in family_cases {
             progress(&format!("{} {}: testbed motion ...", case.family, case.size));
             let runs = DT_S.iter().map(|&dt| testbed_run(&case, dt)).collect::<Result<Vec<_>, _>>()?;
-            let mut judged = DT_S
+            let judged = DT_S
                 .iter()
                 .map(|&dt| super::judged::judged_run(&case, dt, DURATION_S, crate::run::MIN_LEVELS))
                 .collect::<Result<Vec<_>, _>>()?;
-            judged.push(super::judged::judged_run(&case, EQUAL_ERROR_DT_S, DURATION_S, SIXTH_ORDER_LEVELS)?);
+            let sixth = super::judged::judged_run(&case, EQUAL_ERROR_DT_S, DURATION_S, SIXTH_ORDER_LEVELS)?;
             listed.push(peer_case(&case, dir)?);
-            ours.push((case, runs, judged));
+            ours.push((case, runs, judged, sixth));
         }
     }
     let file = dir.join("motion_cases.json");
@@ -219,19 +219,24 @@ pub fn compare(
     let theirs = v.get("cases").and_then(|c| c.as_array()).filter(|c| c.len() == ours.len());
     let theirs =
         theirs.ok_or_else(|| BenchError::Peer(format!("the peer did not return {} motion cases", ours.len())))?;
-    ours.into_iter().zip(theirs).map(|((case, runs, judged), p)| compare_case(&case, [runs, judged], p)).collect()
+    ours.into_iter()
+        .zip(theirs)
+        .map(|((case, runs, judged, sixth), p)| compare_case(&case, [runs, judged], sixth, p))
+        .collect()
 }
 
-/// The testbed's runs at each of [`DT_S`]: end positions, steps (or ticks), wall time.
-type TestbedRuns = Vec<(Vec<Vec3>, u64, f64)>;
+/// One testbed run: end positions, steps (or ticks), wall time.
+type TestbedRun = (Vec<Vec3>, u64, f64);
+/// The testbed's runs at each of [`DT_S`].
+type TestbedRuns = Vec<TestbedRun>;
 
 /// One case's comparison against the peer's reference: `[raw, judged]` the testbed's runs of
-/// rapier's steps alone and of the judged motion.
-/// The judged runs are those at each of [`DT_S`], then the sixth-order one at
-/// [`EQUAL_ERROR_DT_S`].
+/// rapier's steps alone and of the judged motion at each of [`DT_S`], `sixth` its sixth-order
+/// judged run at [`EQUAL_ERROR_DT_S`].
 fn compare_case(
     case: &Case,
-    [raw, mut judged]: [TestbedRuns; 2],
+    [raw, judged]: [TestbedRuns; 2],
+    sixth: TestbedRun,
     p: &serde_json::Value,
 ) -> Result<MotionCase, BenchError> {
     let bad = || BenchError::Peer("the peer's motion case lacks its 'reference'".into());
@@ -249,9 +254,7 @@ fn compare_case(
             .map(|(dt, steps, wall, pos)| run(dt, steps, wall, largest_distance(&pos, &reference)))
             .collect())
     };
-    let sixth =
-        judged.pop().map(|(pos, steps, wall)| run(EQUAL_ERROR_DT_S, steps, wall, largest_distance(&pos, &reference)));
-    let sixth = sixth.ok_or_else(|| BenchError::Case("the sixth-order judged run is missing".into()))?;
+    let sixth = run(EQUAL_ERROR_DT_S, sixth.1, sixth.2, largest_distance(&sixth.0, &reference));
     let (testbed, judged, peer) = (ours(raw), ours(judged), theirs("runs")?);
     let (peer_rk4, peer_euler) = (theirs("rk4_runs")?, theirs("euler_runs")?);
     let at = |runs: &[MotionRun]| {
