@@ -23,4 +23,4 @@ pub mod sim;
 pub mod snapshot;
 pub mod stoppable;
 pub mod structure;
-pub mod sweep;
+pub mod study;

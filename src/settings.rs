@@ -360,13 +360,20 @@ pub struct Motion {
     pub spin: Option<(usize, String, [f64; 3])>,
     /// Judge the motion extrapolated over the time step: the same motion at h, h/2 and h/4,
     /// combined by Richardson's rule at fourth order, with its own error estimate
-    /// (`run/levels.rs`). None: where every free body moves in joint coordinates (rapier
-    /// integrates a plain free body's rotation at first order, which the rule does not cancel).
+    /// (`run/levels.rs`). None: extrapolated ([`Motion::extrapolated`]).
     pub extrapolate: Option<bool>,
     /// The judged motion's error target, a fraction of its amplitude (the largest node
     /// excursion): the fewest levels that meet it are chosen by running them first. None: three
     /// levels, reported against [`DEFAULT_TARGET_ERROR`].
     pub target_error: Option<f64>,
+}
+
+impl Motion {
+    /// Whether the motion is judged extrapolated over the time step (the one place that says
+    /// so: the run's levels and the table's estimate columns both ask here).
+    pub fn extrapolated(&self) -> bool {
+        self.extrapolate != Some(false)
+    }
 }
 
 /// What a motion judged over the default three levels aims at: its error estimate at most this

@@ -22,6 +22,7 @@ use tensegrity_testbed::observers::external::{External, ExternalError, ExternalM
 use tensegrity_testbed::observers::table::{MemoryTable, TableTarget};
 use tensegrity_testbed::run::stoppable::Stoppable;
 use tensegrity_testbed::run::{self, RunOptions};
+use tensegrity_testbed::study;
 use tensegrity_testbed::scenario::{self, Override, Scenario, ScenarioError};
 
 create_exception!(
@@ -132,10 +133,10 @@ fn sweep_csv(
     let sc = load(path, text, &set)?;
     let jobs = if jobs == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { jobs };
     let result = on_own_thread(py, move |cancel| {
-        let (rows, summary) = tensegrity_testbed::sweep::sweep(&sc, jobs, None, Some(cancel), &|_, _| {})?;
-        let fingerprint = tensegrity_testbed::sweep::fingerprint(&sc);
-        let csv = tensegrity_testbed::sweep::to_csv(&rows, &|q: &str| sc.is_angle(q), &fingerprint);
-        Ok::<_, tensegrity_testbed::sweep::SweepError>((
+        let (rows, summary) = tensegrity_testbed::study::sweep::sweep(&sc, jobs, None, Some(cancel), &|_, _| {})?;
+        let fingerprint = tensegrity_testbed::study::sweep::fingerprint(&sc);
+        let csv = tensegrity_testbed::study::sweep::to_csv(&rows, &|q: &str| sc.is_angle(q), &fingerprint);
+        Ok::<_, tensegrity_testbed::study::sweep::SweepError>((
             csv,
             serde_json::to_string(&summary).expect("a summary serialises"),
         ))
@@ -531,9 +532,9 @@ fn sensitivity_json(
 ) -> PyResult<String> {
     let sc = load(path, text, &set)?;
     let file = path.to_string();
-    let result = on_own_thread(py, move |cancel| run::sensitivity(&sc, &file, point, check, Some(cancel)))?;
+    let result = on_own_thread(py, move |cancel| study::sensitivity(&sc, &file, point, check, Some(cancel)))?;
     let report = result.map_err(|e| match e {
-        run::SensitivityRunError::Refused(_) | run::SensitivityRunError::NoPoint(_) => {
+        study::SensitivityRunError::Refused(_) | study::SensitivityRunError::NoPoint(_) => {
             PyValueError::new_err(format!("{path}: {e}"))
         }
         _ => PyException::new_err(format!("{path}: {e}")),
@@ -546,7 +547,7 @@ type FitBounds = (String, Option<f64>, Option<f64>);
 /// A measured row from Python: (where it is, for errors; point; output; value; sigma).
 type MeasuredRow = (String, i64, String, f64, Option<f64>, Option<f64>);
 
-/// The fit of `tensegrity fit --json` (`run::fit`, the CLI's own function): the scenario at
+/// The fit of `tensegrity fit --json` (`study::fit`, the CLI's own function): the scenario at
 /// `path` (or TOML `text` named `path`) with `set`, the parameters `params` within their
 /// bounds, the measurements from the CSV at `data_path` (read as `--data` reads it) or as
 /// `rows`; the same report as its JSON text. Ctrl-C stops the settles.
@@ -561,7 +562,7 @@ fn fit_json(
     data_path: Option<PathBuf>,
     rows: Vec<MeasuredRow>,
 ) -> PyResult<String> {
-    use tensegrity_testbed::run::{FitError, FitParameter, FitProblem, Measurement};
+    use tensegrity_testbed::study::{FitError, FitParameter, FitProblem, Measurement};
     // The scenario's errors located as every other function's (ScenarioError).
     load(path, text, &set)?;
     let source = match text {
@@ -575,7 +576,7 @@ fn fit_json(
         .collect::<PyResult<_>>()?;
     let parameters = params.into_iter().map(|(name, low, high)| FitParameter { name, low, high }).collect();
     let measurements = match data_path {
-        Some(d) => run::read_measurements("data", &d, false).map_err(|e| PyValueError::new_err(e.to_string()))?,
+        Some(d) => study::read_measurements("data", &d, false).map_err(|e| PyValueError::new_err(e.to_string()))?,
         None => rows
             .into_iter()
             .map(|(at, point, output, value, sigma, time_s)| {
@@ -587,7 +588,7 @@ fn fit_json(
             .collect::<PyResult<_>>()?,
     };
     let problem = FitProblem { file: PathBuf::from(path), source, overrides, parameters, measurements };
-    let result = on_own_thread(py, move |cancel| run::fit(&problem, Some(cancel)))?;
+    let result = on_own_thread(py, move |cancel| study::fit(&problem, Some(cancel)))?;
     let report = result.map_err(|e| match e {
         FitError::Scenario(e) => scenario_error(e),
         e if e.is_bad_input() => PyValueError::new_err(e.to_string()),

@@ -30,7 +30,8 @@ pub enum Command {
         /// table then going to standard error).
         #[arg(long)]
         json: Option<PathBuf>,
-        /// Record to this .rrd file (with several scenarios: one file each, named FILE-<scenario>.rrd).
+        /// Record to this .rrd file (with several scenarios: one file each, STEM.rrd becoming
+        /// STEM-<scenario>.rrd).
         #[arg(long)]
         record: Option<PathBuf>,
         /// Stream live to a running rerun viewer or server instead (default: rerun's own address,
@@ -40,9 +41,10 @@ pub enum Command {
         /// Record every N-th tick only (thins long runs).
         #[arg(long, default_value_t = 1, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
         record_every: u64,
-        /// Write every tick as a row of this CSV table at full f64 precision (with several
-        /// scenarios: one file each, named FILE-<scenario>.csv).
-        #[arg(long, value_name = "FILE.csv")]
+        /// Write every tick as a row of this table at full f64 precision: CSV, or Arrow IPC for a
+        /// name ending in .arrow, .feather or .ipc (with several scenarios: one file each,
+        /// STEM-<scenario>.EXT, in the format its ending says).
+        #[arg(long, value_name = "FILE.csv|FILE.arrow")]
         table: Option<PathBuf>,
         #[command(flatten)]
         set: SetArgs,
@@ -66,7 +68,7 @@ pub enum Command {
         /// standard error).
         #[arg(long)]
         json: Option<PathBuf>,
-        /// Record each mode animated at its frequency to this .rrd file (rerun).
+        /// Record each non-rigid mode animated at its frequency to this .rrd file (rerun).
         #[arg(long, value_name = "FILE.rrd")]
         record: Option<PathBuf>,
         /// Above 100 free bodies on springs and elastic cables: how many of the lowest
@@ -79,11 +81,13 @@ pub enum Command {
     },
     /// How a scenario's settled state (its first point or `--point N`, settled as `run` settles it) moves
     /// with every parameter: d/dp of the node positions, joint coordinates, member forces, the
-    /// mechanism's and the file's quantities and the lowest natural frequencies, by the
+    /// mechanism's and the file's quantities and the lowest six natural frequencies, by the
     /// implicit function theorem (one linear solve per parameter on the tangent stiffness,
-    /// dQ/dp by rebuilding the structure at p +- h with the state held). Free bodies held by
-    /// springs and elastic cables, or joint trees; refused (exit 2): loops and inextensible
-    /// cables.
+    /// dQ/dp by rebuilding the structure at p +- h and p +- 2 h with the state held). Free
+    /// bodies held by springs and elastic cables, or joint trees; joints that close loops and
+    /// taut inextensible cables are constraints, the derivatives taken in their tangent space
+    /// with the move that keeps them (slack cables left out); refused (exit 2): cables with
+    /// friction and a loop closed by a prismatic joint.
     Sensitivity {
         scenario: PathBuf,
         /// Write the JSON report to this file (`-`: standard output, the table then going to
@@ -105,15 +109,17 @@ pub enum Command {
         set: SetArgs,
     },
     /// Fit named parameters of a scenario to measured outputs (a CSV with the columns
-    /// point,output,value[,sigma]) by Levenberg-Marquardt, the Jacobian from the sensitivities
-    /// at each measured point settled afresh: the estimates, their covariance and 95 %
-    /// intervals, the residual of each measurement, chi^2, and the parameter combinations the
-    /// data cannot identify (their intervals infinite).
+    /// point,output,value[,sigma], and optionally t_s) by Levenberg-Marquardt, the Jacobian from
+    /// the sensitivities at each measured point settled afresh, or for a row with a time t_s (a
+    /// value of the scenario's motion then) from runs at each parameter's steps: the
+    /// estimates, their covariance and 95 % intervals, the residual of each measurement, chi^2,
+    /// and the parameter combinations the data cannot identify (their intervals infinite).
     Fit {
         scenario: PathBuf,
         /// The measurements: CSV with a header naming point, output, value and optionally
         /// sigma (the output's standard deviation, in its unit; without it the covariance is
-        /// scaled by the reduced chi^2).
+        /// scaled by the reduced chi^2) and t_s (seconds since the motion's start: the row's
+        /// output is then a column of the motion's per-tick table, as `run --table` names it).
         #[arg(long, value_name = "FILE.csv")]
         data: PathBuf,
         /// A parameter to fit, with optional bounds (repeatable): NAME, NAME=LOW:HIGH,
@@ -134,9 +140,10 @@ pub enum Command {
         #[command(flatten)]
         set: SetArgs,
     },
-    /// List the mechanisms, their parameters (units, defaults) and their queries; with a
-    /// scenario file, that file's mechanism (a custom file's own parameters with their values)
-    /// and the symbols its model's expressions may use.
+    /// List the mechanisms: their parameters (units, defaults), inputs, start keys, checkable
+    /// quantities and queries; with a scenario file, that file's mechanism (a custom file's own
+    /// parameters), the parameter values the file gives and the symbols its model's expressions
+    /// may use.
     List {
         scenario: Option<PathBuf>,
         #[command(flatten)]
@@ -182,6 +189,7 @@ pub enum Command {
     Merge {
         #[arg(required = true)]
         csvs: Vec<PathBuf>,
+        /// The merged CSV (`-`: standard output).
         #[arg(long)]
         out: PathBuf,
         /// Merge what is there even when points of the grid are missing (a shard left out).
@@ -216,21 +224,22 @@ pub enum Command {
         #[arg(long = "mechanism", value_name = "NAME")]
         mechanisms: Vec<String>,
         /// Also run each case set through a peer simulator, alternating rounds with the
-        /// testbed, and print the ratios. CMD gets the case-set file and `--rounds 1` appended
-        /// (default: the MuJoCo peer, `benches/peers/mujoco/peer.py` run by `$TENSEGRITY_PYTHON`, else python3).
+        /// testbed, and print the ratios. CMD gets the case-set file, `--rounds 1` and
+        /// `--min-round-wall-s S` (the testbed's shortest round) appended (default: the MuJoCo
+        /// peer, `benches/peers/mujoco/peer.py` run by `$TENSEGRITY_PYTHON`, else python3).
         #[arg(long, value_name = "CMD", num_args = 0..=1, default_missing_value = DEFAULT_PEER)]
         peer: Option<String>,
         /// Settle the scale families instead (n-strut prisms, the icosahedron, force-density
-        /// towers, furet2018 X chains) from perturbed starts: steps, wall time, memory, error
-        /// against the closed form, growth exponent. With --peer: the same structures in MuJoCo
-        /// too (default `benches/peers/mujoco/scale_peer.py`).
+        /// towers, furet2018 X chains, tensegrity spines) from perturbed starts: steps, wall
+        /// time, memory, error against the closed form, growth exponent. With --peer: the same
+        /// structures in MuJoCo too (default `benches/peers/mujoco/scale_peer.py`).
         #[arg(long)]
         scale: bool,
         /// With --scale: largest structure, in struts.
         #[arg(long, value_name = "N", default_value_t = 1000)]
         max_struts: usize,
         /// With --scale: only this family (prism, icosahedron, tower, furet, spine; with --motion
-        /// also pendulum, rocker, spin, cart; repeatable).
+        /// also pendulum, rocker, spin, cart, and not furet; repeatable).
         #[arg(long = "family", value_name = "NAME")]
         families: Vec<String>,
         /// With --scale: a case still moving after this wall time is reported as not settled
@@ -258,8 +267,10 @@ pub enum Command {
     /// Check every printed equation of a mechanism's paper against the testbed's derivation.
     Findings {
         mechanism: String,
+        /// NAME=VALUE for a parameter (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
+        /// Print JSON instead of a list.
         #[arg(long)]
         json: bool,
     },

@@ -1,11 +1,11 @@
 //! `tensegrity fit S.toml --data measured.csv --param NAME[=LOW:HIGH] ...`: the scenario's
-//! named parameters fitted to the measurements (`run::fit`, which `tt.fit` calls too), as a
+//! named parameters fitted to the measurements (`study::fit`, which `tt.fit` calls too), as a
 //! table and, with `--json FILE` (`-`: standard output, the table then going to standard
 //! error), as JSON. The data's errors are located at `FILE:LINE:COL`, the parameters' at their
 //! flag.
 
 use super::{bad_input, check_outputs, failed, signals, write_atomic, CliError, Outcome};
-use crate::run::{FitError, FitProblem};
+use crate::study::{FitError, FitProblem};
 use crate::scenario::Override;
 use std::path::Path;
 
@@ -22,12 +22,12 @@ pub fn fit(
     let source = crate::input::read_text(scenario, crate::scenario::MAX_SCENARIO_BYTES, true)
         .map_err(|e| bad_input(format!("{}: the scenario file: {e}", scenario.display())))?;
     crate::scenario::parse_with(scenario, &source, overrides).map_err(bad_input)?;
-    let parameters = params.iter().map(|p| crate::run::parse_parameter(p)).collect::<Result<Vec<_>, _>>();
-    let measurements = crate::run::read_measurements("--data", data, false);
+    let parameters = params.iter().map(|p| crate::study::parse_parameter(p)).collect::<Result<Vec<_>, _>>();
+    let measurements = crate::study::read_measurements("--data", data, false);
     let (parameters, measurements) = (parameters.map_err(cli_error)?, measurements.map_err(cli_error)?);
     let problem =
         FitProblem { file: scenario.to_path_buf(), source, overrides: overrides.to_vec(), parameters, measurements };
-    let report = crate::run::fit(&problem, Some(&signals::CANCEL)).map_err(cli_error)?;
+    let report = crate::study::fit(&problem, Some(&signals::CANCEL)).map_err(cli_error)?;
     if json.is_some_and(super::is_stdio) {
         eprint!("{}", report.to_table());
     } else {

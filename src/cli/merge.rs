@@ -14,7 +14,7 @@ pub fn merge(csvs: &[PathBuf], out: &Path, partial: bool) -> Result<Outcome, Cli
             .map_err(|e| super::bad_input(format!("{}: {e}", p.display())))?;
         texts.push((p.display().to_string(), text));
     }
-    let merged = crate::sweep::merge_csv(&texts, partial).map_err(super::bad_input)?;
+    let merged = crate::study::sweep::merge_csv(&texts, partial).map_err(super::bad_input)?;
     write_atomic(out, &merged)?;
     Ok(Outcome::Pass)
 }

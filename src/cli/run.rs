@@ -16,7 +16,8 @@ pub struct Outputs {
 }
 
 /// The file of one scenario's output: `base` itself, or with several scenarios
-/// `base-<scenario>.EXT` (the scenario's name with every character but `[A-Za-z0-9_-]` as `_`).
+/// `STEM-<scenario>.EXT` (the scenario's name with every character but `[A-Za-z0-9_-]` as `_`;
+/// EXT `base`'s own, which says the table's format, or `extension` where it has none).
 fn per_scenario(base: &Path, name: &str, several: bool, extension: &str) -> PathBuf {
     if !several {
         return base.to_path_buf();
@@ -24,6 +25,7 @@ fn per_scenario(base: &Path, name: &str, several: bool, extension: &str) -> Path
     let stem = base.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "run".into());
     let safe: String =
         name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+    let extension = base.extension().map_or(extension.to_string(), |e| e.to_string_lossy().to_string());
     base.with_file_name(format!("{stem}-{safe}.{extension}"))
 }
 

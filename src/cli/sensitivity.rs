@@ -1,10 +1,10 @@
 //! `tensegrity sensitivity S.toml`: how the settled state's outputs move with every parameter
-//! (`run::sensitivity`), as a table, as JSON with `--json FILE` and as CSV with `--csv FILE`
+//! (`study::sensitivity`), as a table, as JSON with `--json FILE` and as CSV with `--csv FILE`
 //! (either `-`: standard output, the table then going to standard error), at the first point
 //! or `--point N`; `--check` also measures every derivative by differences of settles.
 
 use super::{bad_input, check_outputs, failed, load_one, signals, write_atomic, CliError, Outcome};
-use crate::run::SensitivityRunError;
+use crate::study::SensitivityRunError;
 use std::path::{Path, PathBuf};
 
 pub fn sensitivity(
@@ -24,10 +24,10 @@ pub fn sensitivity(
         .filter_map(|(flag, p)| p.map(|p| (flag.to_string(), p.to_path_buf())))
         .collect();
     check_outputs(&[scenario.to_path_buf()], &outputs)?;
-    if crate::run::sensitivity_point_of(&sc, point).is_none() {
+    if crate::study::sensitivity_point_of(&sc, point).is_none() {
         return Err(bad_input(format!("--point {point}: {}", SensitivityRunError::NoPoint(point))));
     }
-    let report = crate::run::sensitivity(&sc, &scenario.display().to_string(), point, check, Some(&signals::CANCEL))
+    let report = crate::study::sensitivity(&sc, &scenario.display().to_string(), point, check, Some(&signals::CANCEL))
         .map_err(|e| match e {
             SensitivityRunError::Refused(_) => bad_input(format!("{}: {e}", scenario.display())),
             _ => failed(format!("{}: {e}", scenario.display())),

@@ -2,7 +2,7 @@
 
 use super::{check_outputs, load_one, signals, write_atomic, CliError, Outcome};
 use crate::scenario::Override;
-use crate::sweep::SweepSummary;
+use crate::study::sweep::SweepSummary;
 use std::path::{Path, PathBuf};
 
 /// What a sweep writes: its CSV, its JSON summary, its figure (against axis `x`).
@@ -51,7 +51,7 @@ pub fn sweep(
     let jobs = capped_jobs(jobs);
     // From here on every block stops at its next tick on a signal and the outputs are written.
     signals::stops_itself_from_now();
-    let shard = shard.map(crate::sweep::parse_shard).transpose().map_err(super::bad_input)?;
+    let shard = shard.map(crate::study::sweep::parse_shard).transpose().map_err(super::bad_input)?;
     let bar = indicatif::ProgressBar::new(0);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} points, {per_sec}, {eta} left")
@@ -69,7 +69,7 @@ pub fn sweep(
             eprintln!("{done}/{total} points");
         }
     };
-    let result = crate::sweep::sweep(&sc, jobs, shard, Some(&signals::CANCEL), &progress);
+    let result = crate::study::sweep::sweep(&sc, jobs, shard, Some(&signals::CANCEL), &progress);
     bar.finish_and_clear();
     let (rows, summary) = result.map_err(super::bad_input)?;
     // With the CSV or the summary on standard output, the human lines go to standard error.
@@ -77,7 +77,7 @@ pub fn sweep(
     let say: Say = if on_stdout { say_on_stderr } else { say_on_stdout };
     print_summary(&summary, say)?;
     let is_angle = |q: &str| sc.is_angle(q);
-    let csv_text = || crate::sweep::to_csv(&rows, &is_angle, &crate::sweep::fingerprint(&sc));
+    let csv_text = || crate::study::sweep::to_csv(&rows, &is_angle, &crate::study::sweep::fingerprint(&sc));
     if signals::cancelled() {
         return interrupted(o.csv.as_deref(), rows.len(), &csv_text(), say);
     }

@@ -4,7 +4,7 @@
 
 use crate::run::{run, RunOptions};
 use crate::scenario::{self, ScenarioError};
-use crate::sweep::SweepError;
+use crate::study::sweep::SweepError;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::ComposedElement;

@@ -62,7 +62,7 @@ fn data() -> Result<Data, FigureError> {
         .into_iter()
         .map(|(t1, t2)| (m_mm(&p, t1, t2), analytic::statics(&p, t1, t2).equilibrium))
         .collect();
-    let (rows, summary) = crate::sweep::sweep(&sc, 2, None, None, &|_, _| {})?;
+    let (rows, summary) = crate::study::sweep::sweep(&sc, 2, None, None, &|_, _| {})?;
     let dynamics = rows
         .iter()
         .map(|r| {

@@ -115,7 +115,7 @@ fn dynamics_grid(grid: &str) -> Result<Grid, FigureError> {
     let p = paper_params();
     let not_assembled =
         sc.skipped_points.iter().filter_map(|(v, _)| mohr::dkp(&p, &[v["rho1"], v["rho2"], v["rho3"]])).collect();
-    let (rows, _) = crate::sweep::sweep(&sc, SWEEP_JOBS, None, None, &|_, _| {})?;
+    let (rows, _) = crate::study::sweep::sweep(&sc, SWEEP_JOBS, None, None, &|_, _| {})?;
     let points = rows
         .iter()
         .map(|r| {
@@ -349,7 +349,7 @@ fn fig5_data() -> Result<Fig5, FigureError> {
     let g = GRID_HALF_WIDTH_M;
     let (across, at_z) = (range_toml(-g, g, GRID_COUNT), range_toml(FIG5_Z_M, FIG5_Z_M, 1));
     let sc = small_grid_scenario(&[("grid = {", format!("grid = {{ x = {across}, y = {across}, z = {at_z} }}"))])?;
-    let (rows, summary) = crate::sweep::sweep(&sc, SWEEP_JOBS, None, None, &|_, _| {})?;
+    let (rows, summary) = crate::study::sweep::sweep(&sc, SWEEP_JOBS, None, None, &|_, _| {})?;
     let points = rows
         .iter()
         .map(|r| {

@@ -8,7 +8,7 @@
 //! every error.
 
 use super::kit::{self, range, titled_page, FigureError, Format, Plot};
-use crate::sweep::Row;
+use crate::study::sweep::Row;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;

@@ -1,6 +1,6 @@
 //! Analytic versus simulated, tick by tick and at the settle points.
 
-use super::{Note, Observer, SettlePoint, Tick};
+use super::{Made, Note, Observer, SettlePoint, Setup, Tick};
 use crate::mechanisms::{wrap_angle, QuantityKind};
 use crate::report::{CheckReport, PointReport, ScenarioReport};
 use crate::settings::Check;
@@ -149,6 +149,11 @@ impl Compare {
             })
             .collect()
     }
+}
+
+/// Every run compares the analytic model with the simulation (`observers::KINDS`).
+pub(super) fn make(setup: &Setup, _warnings: &mut Vec<String>) -> Made {
+    Ok(Some(Box::new(Compare::new(setup.checks, setup.length_scale_m))))
 }
 
 impl Observer for Compare {

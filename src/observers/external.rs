@@ -8,7 +8,7 @@
 //! package raises it after the run).
 
 use super::file_model::{check_report, Acc, Judged, ModelObserver};
-use super::{Note, Observer, SettlePoint, Tick};
+use super::{Made, Note, Observer, SettlePoint, Setup, Tick};
 use crate::file_model::spec::ErrorClass;
 use crate::mechanisms::Values;
 use crate::report::{PointReport, ScenarioReport};
@@ -76,6 +76,15 @@ impl ExternalObserver {
         }
         out
     }
+}
+
+/// A run given a model outside the file (a Python callable) compares it as the file's
+/// predictions are (`observers::KINDS`).
+pub(super) fn make(setup: &Setup, _warnings: &mut Vec<String>) -> Made {
+    let Some(x) = setup.external.clone() else { return Ok(None) };
+    let motion = setup.motion.is_some();
+    let file = setup.model.map(|spec| ModelObserver::new(spec, setup.structure, false, setup.motion));
+    Ok(Some(Box::new(ExternalObserver::new(x, file, motion))))
 }
 
 impl Observer for ExternalObserver {

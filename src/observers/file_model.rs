@@ -5,7 +5,7 @@
 //! comparison with the Lagrangian model (`lagrangian.rs`).
 
 use super::lagrangian::{LagrangianError, Row, Tracker};
-use super::{Note, Observer, SettlePoint, Tick};
+use super::{Made, MotionStarted, Note, Observer, SettlePoint, Setup, Tick};
 use crate::file_model::dynamics::TrajectoryCheck;
 use crate::file_model::energy_model::Kind;
 use crate::file_model::spec::{ErrorClass, ModelSpec, Source};
@@ -255,6 +255,9 @@ pub struct ModelObserver {
     /// tick and simulated time [s] of every motion tick (a row of the comparison may be known
     /// ticks later).
     trajectory_series: Option<TrajectorySeries>,
+    /// In a motion judged extrapolated: what divides a difference from the rougher state into
+    /// the judged error (`Extrapolation::estimate_divisor`, told at the motion's start).
+    estimate_divisor: f64,
 }
 
 /// What the stated start takes from `[motion]`.
@@ -380,6 +383,7 @@ impl ModelObserver {
             trajectory_series: Self::tracker(spec, motion)
                 .filter(|_| recorded)
                 .map(|_| TrajectorySeries { entities: trajectory_entities(spec), ticks: Vec::new() }),
+            estimate_divisor: f64::NAN,
         }
     }
 
@@ -601,13 +605,9 @@ impl ModelObserver {
     }
 
     /// A motion tick's coordinates (every symbol's value `v`, the motion's time [s]) to the
-    /// comparison with the Lagrangian model: the rows known now (none without one). `t` says
-    /// whether the motion is judged extrapolated (its estimate).
+    /// comparison with the Lagrangian model: the rows known now (none without one).
     pub(super) fn push_trajectory(&mut self, t: &Tick, v: &[f64], time_s: f64) -> Vec<Row> {
         let (Some(tracker), Some(e)) = (self.trajectory.as_mut(), &self.spec.energy) else { return vec![] };
-        if t.estimate.is_some() {
-            tracker.note_extrapolated();
-        }
         tracker.push(e, (v, &e.measured(v)), time_s, t.cancel)
     }
 
@@ -689,6 +689,13 @@ impl ModelObserver {
     }
 }
 
+/// A run whose file states its own model compares it (`observers::KINDS`).
+pub(super) fn make(setup: &Setup, _warnings: &mut Vec<String>) -> Made {
+    let Some(spec) = setup.model else { return Ok(None) };
+    let recorded = setup.recording.is_some();
+    Ok(Some(Box::new(ModelObserver::new(spec, setup.structure, recorded, setup.motion))))
+}
+
 impl Observer for ModelObserver {
     fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>) {
         let time_s = t.motion_time_s.unwrap_or(t.snapshot.time_s);
@@ -704,7 +711,7 @@ impl Observer for ModelObserver {
             }
             if let Some(rougher) = t.rougher {
                 let v_rougher = self.values(rougher.state, t.inputs, t.params, rougher.values, time_s);
-                let estimates = self.estimates(&v, &v_rougher, rougher.estimate_divisor);
+                let estimates = self.estimates(&v, &v_rougher, self.estimate_divisor);
                 for (a, e) in self.acc.iter_mut().zip(estimates) {
                     a.estimate(e);
                 }
@@ -714,6 +721,14 @@ impl Observer for ModelObserver {
         }
         if let Some(series) = &self.series {
             notes.extend(series.iter().zip(&errors).map(|(s, (_, _, e))| Note::Scalar(s, *e)));
+        }
+    }
+
+    fn motion_start(&mut self, start: &MotionStarted) {
+        let Some(x) = start.extrapolation else { return };
+        self.estimate_divisor = x.estimate_divisor;
+        if let Some(tracker) = self.trajectory.as_mut() {
+            tracker.note_extrapolated();
         }
     }
 

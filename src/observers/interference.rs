@@ -12,7 +12,7 @@
 //! whose endpoint sits on a body of the other member inside that member's capsule (a cable
 //! attached along a strut). The scenario may list further pairs.
 
-use super::{Note, Observer, SettlePoint, Tick};
+use super::{Made, Note, Observer, SettlePoint, Setup, Tick};
 use crate::report::{InterferenceReport, InterferenceViolation, PairClearanceReport, PointReport, ScenarioReport};
 use crate::settings::InterferenceSettings;
 use crate::structure::{distance, MemberKind, NodeId, Structure, Vec3};
@@ -369,6 +369,12 @@ impl Interference {
             closest_points: min.2,
         }
     }
+}
+
+/// Every run checks its struts' and cables' clearances (`observers::KINDS`); an exclusion
+/// naming no member stops the run from starting.
+pub(super) fn make(setup: &Setup, _warnings: &mut Vec<String>) -> Made {
+    Ok(Some(Box::new(Interference::new(setup.structure, setup.interference)?)))
 }
 
 impl Observer for Interference {

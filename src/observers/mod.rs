@@ -4,8 +4,8 @@
 //! (parry distances between struts), `model` (the scenario file's own model) and `record`
 //! (rerun).
 //!
-//! Adding an observer: its own file here implementing [`Observer`], and one line in
-//! [`observers`].
+//! Adding an observer: its own file here implementing [`Observer`] with a `make` that says
+//! when a run has one, and one line in `KINDS`.
 
 pub mod compare;
 pub mod external;
@@ -53,12 +53,35 @@ pub struct Tick<'a> {
 
 /// In a motion judged extrapolated: the state one level rougher than the judged one
 /// (`run/levels.rs`). What an observer measures differs between it and the judged state by
-/// `estimate_divisor` times the judged value's error (15 at fourth order).
+/// the motion's [`Extrapolation::estimate_divisor`] times the judged value's error.
 #[derive(Clone, Copy)]
 pub struct Rougher<'a> {
     pub state: &'a Snapshot,
     /// The mechanism's quantities in it.
     pub values: &'a Values,
+}
+
+/// A motion run's motion as it starts (after its start point, its levels made and started at
+/// their half step, before its first step): what stays the same over all its ticks, told to
+/// every observer once.
+pub struct MotionStarted<'a> {
+    /// The structure's own modes at the start that its frequencies are fitted to.
+    pub modes: &'a [ModeAtStart],
+    /// The motion's time step h \[s\] (the ticks' spacing).
+    pub dt_s: f64,
+    /// How the motion is judged extrapolated over the time step; None: rapier's own steps.
+    pub extrapolation: Option<Extrapolation>,
+}
+
+/// A motion judged extrapolated over the time step (`run/levels.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Extrapolation {
+    /// The levels h, h/2, ... combined.
+    pub levels: usize,
+    /// The judged motion's order in the step.
+    pub order: i32,
+    /// What divides a difference between the judged state and the one a level rougher into
+    /// the judged state's error (15 at fourth order).
     pub estimate_divisor: f64,
 }
 
@@ -113,9 +136,9 @@ pub trait Observer {
     /// The equilibrium residual computed after `tick` (the settle loop computes it only once
     /// the motion has stopped).
     fn residual(&mut self, _tick: u64, _r: &Residual) {}
-    /// A motion run's motion starts (after its start point, before its first step), with the
-    /// structure's own modes there that its frequencies are fitted to.
-    fn motion_start(&mut self, _modes: &[ModeAtStart]) {}
+    /// A motion run's motion starts (after its start point and its start state, before its
+    /// first step): its modes, time step and extrapolation, the same at every tick after.
+    fn motion_start(&mut self, _start: &MotionStarted) {}
     /// A motion run's motion starts: the `equilibrium` it is displaced from (its start point)
     /// and the state it `start`s from at t = 0 (the displacement and rate of `[motion]` set, no
     /// step taken), each as a tick (`motion_time_s` Some(0)).
@@ -170,36 +193,30 @@ pub struct Setup<'a> {
     pub external: Option<external::External>,
 }
 
+/// What a kind of observer makes of a run's setup: its observer, or None where the run does
+/// not ask for it (bevy's `Plugin::build`).
+pub type Made = Result<Option<Box<dyn Observer>>, ObserverError>;
+
+/// Every kind of observer, in the order they see each tick: each file's `make` registers it
+/// with what it needs of the [`Setup`], and its `finish` adds its part to the report.
+/// Adding an observer is its file and a line here.
+const KINDS: [fn(&Setup, &mut Vec<String>) -> Made; 8] = [
+    compare::make,
+    slack::make,
+    interference::make,
+    file_model::make,
+    motion::make,
+    external::make,
+    table::make,
+    record::make,
+];
+
 /// Every observer of a run, in the order they see each tick; what the run goes on without (a
 /// live viewer nobody runs) goes into `warnings`.
 pub fn observers(setup: Setup, warnings: &mut Vec<String>) -> Result<Vec<Box<dyn Observer>>, ObserverError> {
-    let mut list: Vec<Box<dyn Observer>> =
-        vec![Box::new(compare::Compare::new(setup.checks, setup.length_scale_m)), Box::new(slack::SlackTracker::new())];
-    list.push(Box::new(interference::Interference::new(setup.structure, setup.interference)?));
-    if let Some(spec) = setup.model {
-        let recorded = setup.recording.is_some();
-        list.push(Box::new(file_model::ModelObserver::new(spec, setup.structure, recorded, setup.motion)));
-    }
-    if let Some(m) = setup.motion {
-        list.push(Box::new(motion::MotionObserver::new(m)));
-    }
-    if let Some(x) = setup.external {
-        let motion = setup.motion.is_some();
-        let file = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, setup.motion));
-        list.push(Box::new(external::ExternalObserver::new(x, file, motion)));
-    }
-    if let Some(target) = &setup.table {
-        let extrapolated = setup.motion.is_some_and(|m| m.extrapolate != Some(false));
-        let model = setup.model.map(|spec| file_model::ModelObserver::new(spec, setup.structure, false, setup.motion));
-        list.push(Box::new(match target {
-            table::TableTarget::File(path) => table::Table::start(path, model)?.with_estimates(extrapolated),
-            table::TableTarget::Memory(to) => table::Table::in_memory(to.clone(), model).with_estimates(extrapolated),
-        }));
-    }
-    if let Some(r) = &setup.recording {
-        if let Some(recorder) = record::Recorder::start(r, warnings)? {
-            list.push(Box::new(recorder));
-        }
+    let mut list = Vec::new();
+    for make in KINDS {
+        list.extend(make(&setup, warnings)?);
     }
     Ok(list)
 }

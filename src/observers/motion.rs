@@ -20,7 +20,7 @@
 //! system's own nonlinearity (a frequency shift growing with the amplitude squared) and any
 //! damping.
 
-use super::{ModeAtStart, Note, Observer, Tick};
+use super::{Made, ModeAtStart, MotionStarted, Note, Observer, Setup, Tick};
 use crate::mechanisms::Values;
 use crate::report::{FrequencyReport, ScenarioReport};
 use crate::settings::{FrequencyMeasure, FrequencyPrediction, FrequencySignal, Motion};
@@ -240,10 +240,12 @@ pub struct MotionObserver {
     at: Option<(Values, Values, Values)>,
     /// The structure's own modes at the motion's start that frequencies are fitted to.
     modes: Vec<ModeAtStart>,
-    /// The motion is judged extrapolated over the time step: no dispersion to correct.
-    extrapolated: bool,
-    /// What divides a difference from the rougher state into the judged error (`Rougher`).
-    estimate_divisor: f64,
+    /// The motion's time step \[s\], for the dispersion's correction.
+    dt_s: f64,
+    /// The motion is judged extrapolated over the time step (no dispersion to correct): what
+    /// divides a difference from the rougher state into the judged error
+    /// (`Extrapolation::estimate_divisor`).
+    estimate_divisor: Option<f64>,
 }
 
 impl MotionObserver {
@@ -254,8 +256,8 @@ impl MotionObserver {
             rougher: vec![Vec::new(); m.frequencies.len()],
             at: None,
             modes: Vec::new(),
-            extrapolated: false,
-            estimate_divisor: f64::NAN,
+            dt_s: f64::NAN,
+            estimate_divisor: None,
         }
     }
 
@@ -292,11 +294,9 @@ impl MotionObserver {
     /// measured frequency, relative: the same measure on the state one level rougher differs by
     /// the levels' estimate divisor times the finer one's error (`observers::Rougher`).
     fn estimate(&self, f: &FrequencyPrediction, t: &[f64], rougher: &[f64], measured: f64) -> Option<f64> {
-        if !self.extrapolated || rougher.len() != t.len() {
-            return None;
-        }
+        let divisor = self.estimate_divisor.filter(|_| rougher.len() == t.len())?;
         let rough = Self::measured(f, t, rougher, || fit_cosine(t, rougher));
-        Some((measured - rough).abs() / measured.abs() / self.estimate_divisor)
+        Some((measured - rough).abs() / measured.abs() / divisor)
     }
 
     fn report(
@@ -304,7 +304,7 @@ impl MotionObserver {
         f: &FrequencyPrediction,
         (t, q): &(Vec<f64>, Vec<f64>),
         rougher: &[f64],
-        (dt_s, solved): (f64, &Values),
+        solved: &Values,
     ) -> FrequencyReport {
         let predicted = self.predicted(f, solved);
         // With a formula and a mode, the modal analysis is a third value judged against it.
@@ -312,13 +312,14 @@ impl MotionObserver {
         let modal_error = modal.map(|w| (w - predicted).abs() / predicted.abs());
         let fit = fit_cosine(t, q);
         let measured = Self::measured(f, t, q, || fit);
-        let method = match (f.measure, self.extrapolated) {
+        let extrapolated = self.estimate_divisor.is_some();
+        let method = match (f.measure, extrapolated) {
             (FrequencyMeasure::Cosine, false) => METHOD,
             (FrequencyMeasure::Cosine, true) => METHOD_EXTRAPOLATED,
             (FrequencyMeasure::Period, false) => PERIOD_METHOD,
             (FrequencyMeasure::Period, true) => PERIOD_METHOD_EXTRAPOLATED,
         };
-        let corrected = if self.extrapolated { measured } else { corrected_for_symplectic_euler(measured, dt_s) };
+        let corrected = if extrapolated { measured } else { corrected_for_symplectic_euler(measured, self.dt_s) };
         let error = (corrected - predicted).abs() / predicted.abs();
         FrequencyReport {
             name: f.name.clone(),
@@ -343,10 +344,14 @@ impl MotionObserver {
     }
 }
 
+/// A motion run measures its frequencies (`observers::KINDS`).
+pub(super) fn make(setup: &Setup, _warnings: &mut Vec<String>) -> Made {
+    Ok(setup.motion.map(|m| Box::new(MotionObserver::new(m)) as Box<dyn Observer>))
+}
+
 impl Observer for MotionObserver {
     fn tick(&mut self, t: &Tick, _notes: &mut Vec<Note>) {
         let Some(time_s) = t.motion_time_s else { return };
-        self.extrapolated |= t.estimate.is_some();
         if self.at.is_none() {
             self.at = Some((t.params.clone(), t.inputs.clone(), t.prediction.expected.clone()));
         }
@@ -365,22 +370,22 @@ impl Observer for MotionObserver {
             qs.push(q(t.snapshot));
             if let Some(rough) = t.rougher {
                 self.rougher[k].push(q(rough.state));
-                self.estimate_divisor = rough.estimate_divisor;
             }
         }
     }
 
-    fn motion_start(&mut self, modes: &[ModeAtStart]) {
-        self.modes = modes.to_vec();
+    fn motion_start(&mut self, start: &MotionStarted) {
+        self.modes = start.modes.to_vec();
+        self.dt_s = start.dt_s;
+        self.estimate_divisor = start.extrapolation.map(|x| x.estimate_divisor);
     }
 
     fn finish(&mut self, report: &mut ScenarioReport) {
         let Some(m) = report.motion.as_mut() else { return };
-        let dt_s = m.dt_s;
         // The energy model's solved equilibrium at the motion's start point, if the file has one.
         let solved = report.points.last().and_then(|p| p.energy.as_ref()).map(|e| e.solved.clone()).unwrap_or_default();
         m.frequencies = (0..self.frequencies.len())
-            .map(|k| self.report(&self.frequencies[k], &self.samples[k], &self.rougher[k], (dt_s, &solved)))
+            .map(|k| self.report(&self.frequencies[k], &self.samples[k], &self.rougher[k], &solved))
             .collect();
         for f in m.frequencies.iter().filter(|f| f.simulation_error.is_some_and(|e| f.tolerance < e)) {
             report.warnings.push(format!(

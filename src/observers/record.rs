@@ -20,7 +20,7 @@
 //! The file is written to `<path>.partial` and renamed when the run ends, so a reader never
 //! sees a half-written recording under the final name.
 
-use super::{Note, Observer, ObserverError, Tick};
+use super::{Made, Note, Observer, ObserverError, Setup, Tick};
 use crate::mechanisms::wrap_angle;
 use crate::report::ScenarioReport;
 use crate::structure::MemberKind;
@@ -600,6 +600,13 @@ impl Recorder {
 
 /// Errors below this magnitude are drawn at its log10 in `errors_log10` (an error can be exactly 0).
 const LOG10_FLOOR: f64 = 1e-20;
+
+/// A run recorded writes its recording (`observers::KINDS`, the last: nothing is written when
+/// another observer cannot start); a live viewer nobody runs is a warning, no recording.
+pub(super) fn make(setup: &Setup, warnings: &mut Vec<String>) -> Made {
+    let Some(r) = &setup.recording else { return Ok(None) };
+    Ok(Recorder::start(r, warnings)?.map(|recorder| Box::new(recorder) as Box<dyn Observer>))
+}
 
 impl Observer for Recorder {
     fn tick(&mut self, t: &Tick, notes: &mut Vec<Note>) {

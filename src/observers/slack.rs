@@ -1,7 +1,7 @@
 //! Cable slackness, tick by tick: the intervals of ticks in which each cable carried no
 //! tension.
 
-use super::{Note, Observer, Tick};
+use super::{Made, Note, Observer, Setup, Tick};
 use crate::report::{ScenarioReport, SlackInterval};
 
 #[derive(Default)]
@@ -28,6 +28,11 @@ impl SlackTracker {
         out.sort_by(|a, b| (a.first_tick, &a.cable).cmp(&(b.first_tick, &b.cable)));
         out
     }
+}
+
+/// Every run tracks its cables' slack (`observers::KINDS`).
+pub(super) fn make(_setup: &Setup, _warnings: &mut Vec<String>) -> Made {
+    Ok(Some(Box::new(SlackTracker::new())))
 }
 
 impl Observer for SlackTracker {

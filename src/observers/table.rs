@@ -25,7 +25,7 @@
 //! the same f64 bit for bit. The file is written to a temporary file (`output::partial_path`) and renamed when the run
 //! is over.
 
-use super::{Observer, ObserverError, Tick};
+use super::{Made, Observer, ObserverError, Setup, Tick};
 use crate::report::ScenarioReport;
 use crate::structure::{ActuatorTarget, MemberKind};
 use arrow_array::{ArrayRef, Float64Array, RecordBatch, UInt64Array};
@@ -451,6 +451,18 @@ impl Table {
     }
 }
 
+/// A run asked for a per-tick table writes one (`observers::KINDS`), with the motion's own
+/// error estimates where the motion is judged extrapolated.
+pub(super) fn make(setup: &Setup, _warnings: &mut Vec<String>) -> Made {
+    let Some(target) = &setup.table else { return Ok(None) };
+    let extrapolated = setup.motion.is_some_and(|m| m.extrapolated());
+    let model = setup.model.map(|spec| ModelObserver::new(spec, setup.structure, false, setup.motion));
+    Ok(Some(Box::new(match target {
+        TableTarget::File(path) => Table::start(path, model)?.with_estimates(extrapolated),
+        TableTarget::Memory(to) => Table::in_memory(to.clone(), model).with_estimates(extrapolated),
+    })))
+}
+
 impl Observer for Table {
     fn tick(&mut self, t: &Tick, _notes: &mut Vec<super::Note>) {
         if self.error.is_some() {
@@ -467,6 +479,12 @@ impl Observer for Table {
         }
         if let Err(e) = self.row(t) {
             self.error = Some(e);
+        }
+    }
+
+    fn motion_start(&mut self, start: &super::MotionStarted) {
+        if let Some(model) = self.model.as_mut() {
+            model.motion_start(start);
         }
     }
 

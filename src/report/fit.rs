@@ -1,6 +1,6 @@
 //! The report of `tensegrity fit`: the fitted parameters with their standard errors and 95 %
 //! intervals, the covariance, the residual of each measurement, chi^2, and the combinations
-//! of parameters the data cannot identify (`run::fit`), as a table and JSON.
+//! of parameters the data cannot identify (`study::fit`), as a table and JSON.
 
 use serde::Serialize;
 

@@ -1,6 +1,6 @@
 //! The report of `tensegrity sensitivity`: how a settled state's outputs (node positions,
 //! joint coordinates, member forces, the mechanism's and the file's quantities, the natural
-//! frequencies) move with each parameter (`run::sensitivity`), as a table, JSON and CSV.
+//! frequencies) move with each parameter (`study::sensitivity`), as a table, JSON and CSV.
 
 use serde::Serialize;
 

@@ -15,9 +15,11 @@
 //! trusted.
 
 use crate::mechanisms::Values;
+use crate::observers::Extrapolation;
 use crate::report::NODE_POSITIONS;
 use crate::sim::{SimError, Simulation};
 use crate::snapshot::{richardson, richardson_estimate_divisor, Snapshot};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The order of the leapfrog scheme's leading error term, cancelled by one Richardson step.
 const LEAPFROG_ORDER: i32 = 2;
@@ -41,12 +43,12 @@ pub(super) struct Judged {
     pub estimate: Values,
     /// The same from one level coarser, with the mechanism's quantities in it.
     pub rougher: (Snapshot, Values),
-    /// What divides a difference between the two into the judged state's error.
-    pub estimate_divisor: f64,
 }
 
 /// The motion at h/2, h/4, ... beside the runner's own at h.
 pub(super) struct Levels {
+    /// The coarse level's time step h \[s\] (the runner's own), read once from its simulation.
+    dt_s: f64,
     /// The finer levels, at h/2, h/4, ..., h/2^(K-1) for K levels in all.
     finer: Vec<Simulation>,
     /// Each quantity's largest error estimate over the motion so far.
@@ -79,6 +81,7 @@ impl Levels {
             })
             .collect::<Result<Vec<_>, SimError>>()?;
         Ok(Levels {
+            dt_s,
             finer,
             largest: Values::new(),
             rough_from_tick: None,
@@ -99,13 +102,23 @@ impl Levels {
     }
 
     /// The time steps of the levels, h first \[s\].
-    pub fn steps_s(&self, dt_s: f64) -> Vec<f64> {
-        (0..self.count()).map(|i| dt_s / f64::from(1u32 << i)).collect()
+    pub fn steps_s(&self) -> Vec<f64> {
+        (0..self.count()).map(|i| self.dt_s / f64::from(1u32 << i)).collect()
     }
 
-    /// Steps the finer levels over the coarse step that ends at motion time `end_s` [s] (of
-    /// length `dt_s`), a driven motion's commands set at the end of each of their steps.
-    pub fn step(&mut self, end_s: f64, dt_s: f64, commands_at: Option<CommandsAt>) -> Result<(), SimError> {
+    /// How the motion is judged over these levels: their count, order and estimate divisor.
+    pub fn extrapolation(&self) -> Extrapolation {
+        Extrapolation {
+            levels: self.count(),
+            order: self.order(),
+            estimate_divisor: richardson_estimate_divisor(self.order()),
+        }
+    }
+
+    /// Steps the finer levels over the coarse step that ends at motion time `end_s` \[s\], a
+    /// driven motion's commands set at the end of each of their steps.
+    pub fn step(&mut self, end_s: f64, commands_at: Option<CommandsAt>) -> Result<(), SimError> {
+        let dt_s = self.dt_s;
         for (i, sim) in self.finer.iter_mut().enumerate() {
             let n = 2u32 << i;
             for j in 1..=n {
@@ -120,20 +133,13 @@ impl Levels {
 
     /// One tick of `coarse` (the level at h, stepped here as well) and of the finer levels,
     /// ending at motion time `end_s` \[s\], a driven motion's commands set at the end of every
-    /// step (a motion's levels run alone, with no observer: `judged_nodes_after`, the choice of
-    /// levels for a target).
-    pub fn step_with(
-        &mut self,
-        coarse: &mut Simulation,
-        end_s: f64,
-        dt_s: f64,
-        commands_at: Option<CommandsAt>,
-    ) -> Result<(), SimError> {
+    /// step (a motion's levels run alone, with no observer: [`run_alone`]).
+    fn step_with(&mut self, coarse: &mut Simulation, end_s: f64, commands_at: Option<CommandsAt>) -> Result<(), SimError> {
         if let Some(c) = commands_at {
             coarse.drive_commands(&c(end_s));
         }
         coarse.step()?;
-        self.step(end_s, dt_s, commands_at)
+        self.step(end_s, commands_at)
     }
 
     /// The judged state at this tick (`coarse` the runner's own, at h) with the mechanism's
@@ -163,7 +169,7 @@ impl Levels {
             unreachable!("three levels or more leave two values in the table's last column");
         };
         (judged.tick, judged.time_s) = (coarse.tick, coarse.time_s);
-        let divisor = richardson_estimate_divisor(self.order());
+        let divisor = self.extrapolation().estimate_divisor;
         let (values, rough_values) = (observe(&judged), observe(&rougher));
         let (too, rough_too) = (estimated_too(&judged), estimated_too(&rougher));
         let estimate: Values = values
@@ -183,7 +189,7 @@ impl Levels {
             let largest = self.largest.entry(key.to_string()).or_insert(0.0);
             *largest = largest.max(*e);
         }
-        Judged { state: judged, values, estimate, rougher, estimate_divisor: divisor }
+        Judged { state: judged, values, estimate, rougher }
     }
 
     /// Notes the first tick at which the levels' cables disagree on slack, or change it since
@@ -223,23 +229,44 @@ impl Levels {
     }
 }
 
+/// `sim`'s motion from its present state over `ticks` ticks of `count` levels, run alone (no
+/// observer): the finer levels made from it, every level started at its half step, all
+/// stepped together (2^count - 1 steps a tick, as a run's), a driven motion's commands
+/// (`commands_at` a time) set at the end of every step of each level. Where `estimated_too`
+/// is given, every tick is judged with it (the levels then hold the estimates and the
+/// amplitude); None when `cancel` is raised.
+pub(super) fn run_alone(
+    sim: &mut Simulation,
+    (ticks, count): (u64, usize),
+    commands_at: Option<CommandsAt>,
+    estimated_too: Option<&dyn Fn(&Snapshot) -> Values>,
+    cancel: Option<&AtomicBool>,
+) -> Result<Option<Levels>, SimError> {
+    let mut levels = Levels::new(sim, count)?;
+    sim.start_at_half_step()?;
+    let none = |_: &Snapshot| Values::new();
+    for k in 1..=ticks {
+        if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
+            return Ok(None);
+        }
+        levels.step_with(sim, k as f64 * levels.dt_s, commands_at)?;
+        if let Some(too) = estimated_too {
+            levels.judge(&sim.snapshot_with(false), &none, too);
+        }
+    }
+    Ok(Some(levels))
+}
+
 /// The node positions \[m\] of `sim`'s motion after `ticks` of its step, judged as a motion
-/// run judges them over `count` levels: the finer levels made from its present state, every
-/// level started at its half step, all stepped together (2^count - 1 steps a tick, as a run's),
-/// and the judged state at the end (the benchmark's measure of the judged motion's cost); a
-/// driven motion's commands (`commands_at` a time) set at the end of every step of each level.
+/// run judges them over `count` levels ([`run_alone`]), the judged state at the end only (the
+/// benchmark's measure of the judged motion's cost).
 pub fn judged_nodes_after(
     sim: &mut Simulation,
     ticks: u64,
     count: usize,
     commands_at: Option<CommandsAt>,
 ) -> Result<Vec<[f64; 3]>, SimError> {
-    let mut levels = Levels::new(sim, count)?;
-    sim.start_at_half_step()?;
-    let dt_s = sim.model().settings.dt_s;
-    for k in 1..=ticks {
-        levels.step_with(sim, k as f64 * dt_s, dt_s, commands_at)?;
-    }
+    let mut levels = run_alone(sim, (ticks, count), commands_at, None, None)?.expect("no cancel flag");
     let none = |_: &Snapshot| Values::new();
     Ok(levels.judge(&sim.snapshot_with(false), &none, &none).state.nodes)
 }

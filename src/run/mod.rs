@@ -2,15 +2,16 @@
 //!
 //! `runner.rs` holds the running state and the one step every phase goes through,
 //! `settle.rs` the settle loop, `point.rs` one settle point (branch, stability, probe,
-//! read-out) (the pass policy is `report::verdict`).
+//! read-out) (the pass policy is `report::verdict`), `motion.rs` a motion run, whose motion is
+//! one value (`judged.rs`) over its levels (`levels.rs`). The studies that drive many runs
+//! (fits, sensitivities, sweeps) live above, in `study/`.
 
-mod fit;
-mod fit_trajectory;
+mod judged;
 mod levels;
 mod motion;
 mod point;
 mod runner;
-mod sensitivity;
+pub(crate) mod sensitivity;
 mod settle;
 mod settled;
 mod topologies;
@@ -27,13 +28,9 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use fit::{
-    fit, measurements_from_csv, parse_parameter, read_measurements, standard_normal, FitError, FitParameter,
-    FitProblem, Measurement, DATA_COLUMNS, MAX_DATA_BYTES,
-};
 pub use levels::{judged_nodes_after, CommandsAt, MAX_LEVELS, MIN_LEVELS};
 pub use point::NO_BRANCH;
-pub use sensitivity::{point_of as sensitivity_point_of, sensitivity, SensitivityRunError};
+pub use sensitivity::SensitivityRunError;
 pub use settle::SettleDetector;
 pub use settled::{modes, settle_at, settle_first_point, ModesRunError, SettledState};
 pub use topologies::rebuilt;
@@ -174,7 +171,6 @@ pub fn run(sc: &Scenario, opts: &RunOptions) -> ScenarioReport {
         }
     };
     let mut probe_errors: Vec<f64> = Vec::new();
-    report.motion = sc.motion.as_ref().map(|m| motion::planned(m, sc.sim.dt_s));
     let ran = match &sc.motion {
         Some(m) => motion::run_motion(&mut runner, sc, m, &mut report, &mut probe_errors),
         None => run_actuation(&mut runner, sc, &mut report, &mut probe_errors),

@@ -3,13 +3,14 @@
 //! for good, the named coordinate displaced and given its rate, and the physical dynamics for
 //! the stated time. The observers judge it tick by tick; nothing here settles it.
 
-use super::levels::{Levels, MAX_LEVELS, MIN_LEVELS};
+use super::judged::{commands_at, JudgedMotion};
+use super::levels::{run_alone, Levels, MAX_LEVELS, MIN_LEVELS};
 use super::runner::Runner;
 use super::settle::SettleDetector;
 use super::{point, RunError};
 use crate::eigen::EigenError;
 use crate::mechanisms::Values;
-use crate::observers::ModeAtStart;
+use crate::observers::{ModeAtStart, MotionStarted};
 use crate::report::{ExtrapolationReport, MotionReport, PointReport, ScenarioReport};
 use crate::scenario::Scenario;
 use crate::settings::{Drive, FrequencySignal, Motion, MotionStart, DEFAULT_TARGET_ERROR};
@@ -17,7 +18,7 @@ use crate::sim::modes::{modal_projector, ModesError};
 use crate::snapshot::Snapshot;
 
 /// What the report says of a motion before it runs.
-pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
+fn planned(m: &Motion, dt_s: f64) -> MotionReport {
     MotionReport {
         start: m.start,
         duration_s: m.duration_s,
@@ -43,7 +44,18 @@ pub(super) fn planned(m: &Motion, dt_s: f64) -> MotionReport {
     }
 }
 
-/// Runs the motion of `m`: the start point, then the physical dynamics for its steps.
+/// What the run itself learns of a motion as it runs (the observers add theirs at the end).
+#[derive(Default)]
+struct Ran {
+    start_tick: u64,
+    steps_taken: u64,
+    accelerated_steps: u64,
+    integration: String,
+    extrapolation: Option<ExtrapolationReport>,
+}
+
+/// Runs the motion of `m`: the start point, then the physical dynamics for its steps; its
+/// report (`report.motion`) is assembled here, from what was planned and what ran.
 pub(super) fn run_motion(
     runner: &mut Runner,
     sc: &Scenario,
@@ -51,7 +63,36 @@ pub(super) fn run_motion(
     report: &mut ScenarioReport,
     probe_errors: &mut Vec<f64>,
 ) -> Result<(), RunError> {
-    let inputs = sc.actuation.first_inputs().clone();
+    let mut ran = Ran::default();
+    let result = start_and_step(runner, sc, m, report, probe_errors, &mut ran);
+    let extrapolation = ran.extrapolation.take();
+    // A stated target the most levels could not meet is warned of; the default aim is
+    // reported (`target_met`) without a warning: on a vibration of 1e-5 m, 1e-9 of it is
+    // below the positions' own round-off.
+    let missed = extrapolation.as_ref().filter(|x| !x.target_met && m.target_error.is_some());
+    report.warnings.extend(missed.map(missed_target));
+    report.motion = Some(MotionReport {
+        start_tick: ran.start_tick,
+        steps_taken: ran.steps_taken,
+        accelerated_steps: ran.accelerated_steps,
+        integration: ran.integration,
+        extrapolation,
+        ..planned(m, sc.sim.dt_s)
+    });
+    result
+}
+
+/// The start point, the motion started (`judged.rs`) and told to the observers, then its
+/// steps; what ran goes into `ran`.
+fn start_and_step(
+    runner: &mut Runner,
+    sc: &Scenario,
+    m: &Motion,
+    report: &mut ScenarioReport,
+    probe_errors: &mut Vec<f64>,
+    ran: &mut Ran,
+) -> Result<(), RunError> {
+    let mut inputs = sc.actuation.first_inputs().clone();
     match m.start {
         MotionStart::Settled => point::settle_point(runner, sc, 0, &inputs, report, probe_errors)?,
         MotionStart::Drawn => start_point(runner, sc, &inputs, report)?,
@@ -73,28 +114,27 @@ pub(super) fn run_motion(
     if let Some((body, _, w)) = &m.spin {
         runner.sim.set_body_spin(*body, *w)?;
     }
-    for o in runner.observers.iter_mut() {
-        o.motion_start(&modes);
-    }
     runner.show_motion_start(&equilibrium, &inputs)?;
-    let start_tick = runner.sim.tick();
-    runner.motion_start_tick = Some(start_tick);
+    ran.start_tick = runner.sim.tick();
     let accelerated_before = runner.accelerated_steps;
-    if let Some(r) = report.motion.as_mut() {
-        r.start_tick = start_tick;
-    }
     runner.emit(format_args!("motion: {} steps of physical dynamics, every settle accelerator off", m.steps));
     if m.drive.is_some() {
         runner.sim.drive_physically()?;
     }
-    start_integration(runner, m, report)?;
+    let levels = judged_levels(runner, m)?;
+    ran.integration = integration_text(levels);
+    let motion = JudgedMotion::start(&mut runner.sim, levels, m.drive.clone())?;
+    let started = MotionStarted { modes: &modes, dt_s: motion.dt_s(), extrapolation: motion.extrapolation() };
+    for o in runner.observers.iter_mut() {
+        o.motion_start(&started);
+    }
+    runner.motion = Some(motion);
     let mut prediction = runner.mech.predict(&runner.params, &inputs).map_err(RunError::Model)?;
     let mut result = Ok(());
-    let mut inputs = inputs;
     for k in 1..=m.steps {
-        if let Some(d) = &m.drive {
-            // The commands at the end of this step, t = k dt after the motion's start.
-            inputs = d.inputs_at(&runner.params, k as f64 * sc.sim.dt_s);
+        // A driven motion's commands at the end of this step, t = k dt after its start.
+        if let Some(driven) = runner.motion.as_ref().and_then(|j| j.inputs_after(&runner.params, k)) {
+            inputs = driven;
             runner.drive(&inputs);
             prediction = runner.mech.predict(&runner.params, &inputs).map_err(RunError::Model)?;
         }
@@ -102,19 +142,11 @@ pub(super) fn run_motion(
         if result.is_err() {
             break;
         }
-        if let Some(r) = report.motion.as_mut() {
-            r.steps_taken += 1;
-        }
+        ran.steps_taken += 1;
     }
-    if let Some(r) = report.motion.as_mut() {
-        r.accelerated_steps = runner.accelerated_steps - accelerated_before;
-        r.extrapolation = runner.levels.take().map(|l| extrapolation_report(l, m, sc.sim.dt_s));
-        // A stated target the most levels could not meet is warned of; the default aim is
-        // reported (`target_met`) without a warning: on a vibration of 1e-5 m, 1e-9 of it is
-        // below the positions' own round-off.
-        let missed = r.extrapolation.as_ref().filter(|x| !x.target_met && m.target_error.is_some());
-        report.warnings.extend(missed.map(missed_target));
-    }
+    ran.accelerated_steps = runner.accelerated_steps - accelerated_before;
+    let levels = runner.motion.take().and_then(JudgedMotion::into_levels);
+    ran.extrapolation = levels.map(|l| extrapolation_report(l, m));
     result
 }
 
@@ -131,10 +163,10 @@ fn missed_target(x: &ExtrapolationReport) -> String {
 }
 
 /// What the report says of a motion judged over `l`.
-fn extrapolation_report(l: Levels, m: &Motion, dt_s: f64) -> ExtrapolationReport {
+fn extrapolation_report(l: Levels, m: &Motion) -> ExtrapolationReport {
     let target_error = m.target_error.unwrap_or(DEFAULT_TARGET_ERROR);
     ExtrapolationReport {
-        steps_s: l.steps_s(dt_s),
+        steps_s: l.steps_s(),
         order: l.order(),
         amplitude_m: l.amplitude_m,
         target_error,
@@ -144,30 +176,20 @@ fn extrapolation_report(l: Levels, m: &Motion, dt_s: f64) -> ExtrapolationReport
     }
 }
 
-/// Starts the motion's integration: the steps from here are the leapfrog scheme from the
-/// stated start (`sim/levels.rs`), second order at the tick times; extrapolated over the step,
-/// fourth (`levels.rs`), by default where every free body moves in joint coordinates.
-fn start_integration(runner: &mut Runner, m: &Motion, report: &mut ScenarioReport) -> Result<(), RunError> {
-    let extrapolate = m.extrapolate.unwrap_or(true);
-    let count = match m.target_error {
-        Some(target) if extrapolate => {
-            let (count, tried) = levels_for_target(runner, m, target)?;
-            for line in tried {
-                runner.emit(line);
-            }
-            count
-        }
-        _ => MIN_LEVELS,
-    };
-    if let Some(r) = report.motion.as_mut() {
-        r.integration = integration_text(extrapolate.then_some(count));
+/// The levels a motion is judged over: the steps from its start are the leapfrog scheme from
+/// the stated start (`sim/levels.rs`), second order at the tick times; extrapolated over the
+/// step, by default, fourth order over [`MIN_LEVELS`] (`levels.rs`), or the fewest that meet a
+/// stated target. None: not extrapolated.
+fn judged_levels(runner: &mut Runner, m: &Motion) -> Result<Option<usize>, RunError> {
+    if !m.extrapolated() {
+        return Ok(None);
     }
-    if extrapolate {
-        runner.levels = Some(Levels::new(&runner.sim, count)?);
-        runner.motion_drive = m.drive.clone();
+    let Some(target) = m.target_error else { return Ok(Some(MIN_LEVELS)) };
+    let (count, tried) = levels_for_target(runner, m, target)?;
+    for line in tried {
+        runner.emit(line);
     }
-    runner.sim.start_at_half_step()?;
-    Ok(())
+    Ok(Some(count))
 }
 
 /// The fewest levels ([`MIN_LEVELS`] to [`MAX_LEVELS`]) whose judged motion meets `target` (its
@@ -175,25 +197,17 @@ fn start_integration(runner: &mut Runner, m: &Motion, report: &mut ScenarioRepor
 /// levels alone from the runner's state, no observer watching; [`MAX_LEVELS`] if none does
 /// (the report then says the target was not met); with a line on each count tried.
 fn levels_for_target(runner: &Runner, m: &Motion, target: f64) -> Result<(usize, Vec<String>), RunError> {
-    let dt_s = runner.sc.sim.dt_s;
     let structure = runner.sim.structure();
     let (mech, params) = (runner.mech.as_ref(), &runner.params);
-    let commands = m.drive.as_ref().map(|d| move |t| super::runner::commands_at(mech, params, structure, d, t));
+    let commands = m.drive.as_ref().map(|d| move |t| commands_at(mech, params, structure, d, t));
     let driven = commands.as_ref().map(|c| c as &dyn Fn(f64) -> Vec<f64>);
-    let none = |_: &Snapshot| Values::new();
     let nodes = |s: &Snapshot| crate::observers::table::estimated_columns(structure, s);
     let mut tried = Vec::new();
     for count in MIN_LEVELS..MAX_LEVELS {
-        let mut sim = runner.sim.at_time_step(dt_s);
-        let mut levels = Levels::new(&sim, count)?;
-        sim.start_at_half_step()?;
-        for k in 1..=m.steps {
-            if runner.cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::SeqCst)) {
-                return Err(RunError::Interrupted(runner.sim.tick()));
-            }
-            levels.step_with(&mut sim, k as f64 * dt_s, dt_s, driven)?;
-            levels.judge(&sim.snapshot_with(false), &none, &nodes);
-        }
+        let mut sim = runner.sim.at_time_step(runner.sim.model().settings.dt_s);
+        let Some(levels) = run_alone(&mut sim, (m.steps, count), driven, Some(&nodes), runner.cancel)? else {
+            return Err(RunError::Interrupted(runner.sim.tick()));
+        };
         tried.push(format!(
             "target_error {target:e}: {count} levels estimate {:.3e} m over an amplitude of {:.3e} m",
             levels.node_estimate_m(),
@@ -271,7 +285,7 @@ fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, RunE
         .map(|&index| ModeAtStart {
             index,
             omega_rad_per_s: analysis.modes[index].omega(),
-            projector: modal_projector(&runner.sim, &analysis, index),
+            projector: modal_projector(runner.sim.structure(), &analysis, index),
         })
         .collect();
     if let Some((index, amplitude_m)) = m.mode {

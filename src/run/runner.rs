@@ -1,12 +1,11 @@
 //! The state of one running scenario: its mechanism, its simulation and its observers, and the
 //! one step that every phase (settle, perturbation, probe, trajectory) goes through.
 
-use super::levels::Levels;
+use super::judged::JudgedMotion;
 use super::RunError;
 use crate::mechanisms::{Mechanism, Prediction, Values};
 use crate::observers::{Note, Observer, Rougher, Tick};
 use crate::scenario::Scenario;
-use crate::settings::Drive;
 use crate::sim::Simulation;
 use crate::snapshot::Snapshot;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -33,33 +32,17 @@ pub(super) struct Runner<'a> {
     pub steps: u64,
     /// The analytic ghost nodes for the last inputs (recordings only).
     ghost: Option<(Values, Option<Vec<[f64; 3]>>)>,
-    /// The tick a motion run's motion started at (its time origin), once it has.
-    pub motion_start_tick: Option<u64>,
     /// Whether the step before the last one was accelerated (the recording notes each change).
     was_accelerated: Option<bool>,
     /// Steps over the whole run that took a settle accelerator.
     pub accelerated_steps: u64,
-    /// A motion judged extrapolated over the time step: its finer levels (`levels.rs`).
-    pub levels: Option<Levels>,
-    /// A driven motion's inputs in time, which the finer levels follow too.
-    pub motion_drive: Option<Drive>,
+    /// A motion run's motion, once it has started (`judged.rs`).
+    pub motion: Option<JudgedMotion>,
 }
 
 /// The judged state and the mechanism's quantities in it; in a motion judged extrapolated also
-/// the quantities' error estimates, the state one level rougher, its quantities and the divisor
-/// that turns a difference from it into the judged error.
-type JudgedState = (Snapshot, Values, Option<(Values, Snapshot, Values, f64)>);
-
-/// The actuator commands (structure order) of `drive`'s inputs at motion time `t_s` \[s\].
-pub(super) fn commands_at(
-    mech: &dyn Mechanism,
-    params: &Values,
-    structure: &crate::structure::Structure,
-    drive: &Drive,
-    t_s: f64,
-) -> Vec<f64> {
-    structure.commands_from(&mech.commands(params, &drive.inputs_at(params, t_s)))
-}
+/// the quantities' error estimates, and the state one level rougher with its quantities.
+type JudgedState = (Snapshot, Values, Option<(Values, Snapshot, Values)>);
 
 impl<'a> Runner<'a> {
     pub fn new(
@@ -82,11 +65,9 @@ impl<'a> Runner<'a> {
             cancel,
             steps: 0,
             ghost: None,
-            motion_start_tick: None,
             was_accelerated: None,
             accelerated_steps: 0,
-            levels: None,
-            motion_drive: None,
+            motion: None,
         }
     }
 
@@ -151,19 +132,15 @@ impl<'a> Runner<'a> {
     /// the three combined (`levels.rs`).
     fn judged_state(&mut self) -> Result<JudgedState, RunError> {
         let snap = self.sim.snapshot_with(false);
-        let Some(levels) = self.levels.as_mut() else {
+        let judged = match self.motion.as_mut() {
+            Some(m) => m.judge(&snap, self.mech.as_ref(), &self.params, self.sim.structure())?,
+            None => None,
+        };
+        let Some(j) = judged else {
             let simulated = self.observe(&snap);
             return Ok((snap, simulated, None));
         };
-        let dt_s = self.sc.sim.dt_s;
-        let end_s = self.motion_start_tick.map_or(0.0, |t0| snap.tick.saturating_sub(t0) as f64 * dt_s);
-        let (mech, params, structure) = (&self.mech, &self.params, self.sim.structure());
-        let commands = self.motion_drive.as_ref().map(|d| move |t| commands_at(mech.as_ref(), params, structure, d, t));
-        let driven = commands.as_ref().map(|c| c as &dyn Fn(f64) -> Vec<f64>);
-        levels.step(end_s, dt_s, driven)?;
-        let coordinates = |s: &Snapshot| crate::observers::table::estimated_columns(structure, s);
-        let j = levels.judge(&snap, &|s| mech.observe(params, structure, s), &coordinates);
-        Ok((j.state, j.values, Some((j.estimate, j.rougher.0, j.rougher.1, j.estimate_divisor))))
+        Ok((j.state, j.values, Some((j.estimate, j.rougher.0, j.rougher.1))))
     }
 
     /// Shows every observer the state a motion starts from (the simulation's, before its first
@@ -220,8 +197,7 @@ impl<'a> Runner<'a> {
         }
         self.was_accelerated = Some(accelerated);
         self.accelerated_steps += u64::from(accelerated);
-        let dt = self.sc.sim.dt_s;
-        let motion_time_s = self.motion_start_tick.map(|t0| snap.tick.saturating_sub(t0) as f64 * dt);
+        let motion_time_s = self.motion.as_ref().map(|m| m.time_s(snap.tick));
         let tick = Tick {
             motion_time_s,
             accelerated,
@@ -233,7 +209,7 @@ impl<'a> Runner<'a> {
             simulated: &simulated,
             ghost_nodes: self.ghost.as_ref().and_then(|(_, g)| g.as_deref()),
             estimate: levels.as_ref().map(|l| &l.0),
-            rougher: levels.as_ref().map(|l| Rougher { state: &l.1, values: &l.2, estimate_divisor: l.3 }),
+            rougher: levels.as_ref().map(|l| Rougher { state: &l.1, values: &l.2 }),
             cancel: self.cancel,
         };
         for o in &mut self.observers {

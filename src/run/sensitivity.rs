@@ -1,4 +1,5 @@
-//! A settled state's sensitivities to every parameter (`tensegrity sensitivity`), by the
+//! A settled state's sensitivities to every parameter (`study::sensitivity` settles a point and
+//! calls this; a run's settle point reads a file's `[[sensitivities]]` here), by the
 //! implicit function theorem: at the equilibrium the generalized forces Q(q, p) vanish, so
 //! dq/dp = K^-1 dQ/dp with K = -dQ/dq the tangent stiffness (`sim::sensitivity`). dQ/dp is
 //! the difference of Q over the parameter at a fixed state: the structure built again at
@@ -8,23 +9,17 @@
 //! (q + s h dq/dp, p + s h), s = +-1, +-2. The frequencies' from the eigenvectors,
 //! d omega^2 / dp = phi^T (dK/dp - omega^2 dM/dp) phi (K and M along the same samples), and
 //! d omega / dp = (d omega^2 / dp) / (2 |omega|).
-//!
-//! With `check`, each derivative is also measured by differences of settles: the state settled
-//! afresh at p +- h and p +- 2 h, extrapolated the same way.
 
-use super::settled::{settle_at, SettledState};
 use super::RunError;
 use crate::eigen::Mode;
 use crate::mechanisms::{Mechanism, Values};
 use crate::observers::file_model::ModelObserver;
-use crate::report::sensitivity::{check_error, OutputValue, ParameterSensitivity, SensitivityReport};
+use crate::report::sensitivity::ParameterSensitivity;
 use crate::scenario::Scenario;
 use crate::sim::modes::{least_squares, ZERO_MODE_RATIO};
 use crate::sim::sensitivity::{derivative_from_samples, EquilibriumCoordinates, SensitivityError};
 use crate::sim::Simulation;
 use nalgebra::{DMatrix, DVector};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
 
 /// A parameter's finite-difference step, a fraction of its value (error O(h^4) with the
 /// extrapolation: about 1e-12; round-off eps / h: about 1e-13).
@@ -57,48 +52,76 @@ pub enum SensitivityRunError {
     NoPoint(usize),
     /// The structure at a check's sample could not be read.
     #[error("{0}")]
-    Check(String),
+    Check(SampleError),
     /// The eigenproblem at the settled state failed.
     #[error(transparent)]
     Eigen(#[from] crate::eigen::EigenError),
 }
 
+/// Why the structure at a step of a parameter could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum SampleError {
+    /// The scenario does not resolve at the step's parameters.
+    #[error(transparent)]
+    Scenario(#[from] crate::scenario::ScenarioError),
+    /// The mechanism could not build its structure there.
+    #[error(transparent)]
+    Model(#[from] crate::mechanisms::ModelError),
+    /// The simulator could not build it.
+    #[error(transparent)]
+    Sim(#[from] crate::sim::SimError),
+    /// It is another structure than the settled one's (the step changed its topology).
+    #[error("the structure built at a step has other bodies, nodes or members")]
+    OtherStructure,
+}
+
+/// Why a file's `[[sensitivities]]` were not computed at a settle point.
+#[derive(Debug, thiserror::Error)]
+pub enum FileSensitivityError {
+    /// The settled state has no sensitivities.
+    #[error("{0}")]
+    Analysis(#[from] SensitivityRunError),
+    /// One derivative could not be computed (`why`: the parameter's error in the report).
+    #[error("d {output}/d {parameter}: {why}")]
+    Derivative { output: String, parameter: String, why: String },
+}
+
 /// Each sample's parameters and inputs, in the order of [`SAMPLES`].
-type Samples = Vec<(Values, Values)>;
+pub(crate) type Samples = Vec<(Values, Values)>;
 
 /// What an output sample needs of the scenario: its mechanism, inputs and model.
-struct Outputs<'a> {
+pub(crate) struct Outputs<'a> {
     sc: &'a Scenario,
     mech: Box<dyn Mechanism>,
-    inputs: Values,
+    pub(crate) inputs: Values,
     model: Option<ModelObserver>,
-    coordinates: EquilibriumCoordinates,
+    pub(crate) coordinates: EquilibriumCoordinates,
 }
 
 /// The analysis of a settled state: what its samples need, its linearization, the listed
 /// modes, and every output there.
-struct Analysis<'a> {
-    out: Outputs<'a>,
-    lin: Linearization,
-    listed: Vec<usize>,
-    base: Vec<(String, f64)>,
+pub(crate) struct Analysis<'a> {
+    pub(crate) out: Outputs<'a>,
+    pub(crate) lin: Linearization,
+    pub(crate) listed: Vec<usize>,
+    pub(crate) base: Vec<(String, f64)>,
 }
 
 /// A settled state linearized in its coordinates: K, G (no rows without constraints), the
 /// modes K phi = omega^2 M phi on null(G), each phi mass-normalised in the coordinates, and
 /// which are rigid-body modes (|omega^2| below [`ZERO_MODE_RATIO`] of the largest, or with
 /// constraints below the reduced Hessian's own error, `constrained_modes::zero_floor`).
-struct Linearization {
+pub(crate) struct Linearization {
     stiffness: DMatrix<f64>,
     jacobian: DMatrix<f64>,
-    modes: Vec<Mode>,
-    rigid: Vec<bool>,
+    pub(crate) modes: Vec<Mode>,
+    pub(crate) rigid: Vec<bool>,
 }
 
 /// K, M and G of `sim` in `coordinates`, and the modes of the reduced problem
 /// (N^T K N) v = omega^2 (N^T M N) v, N a basis of null(G), phi = N v (all coordinates where
 /// there is no constraint).
-fn linearize(sim: &mut Simulation, coordinates: &EquilibriumCoordinates) -> Result<Linearization, SensitivityRunError> {
+pub(crate) fn linearize(sim: &mut Simulation, coordinates: &EquilibriumCoordinates) -> Result<Linearization, SensitivityRunError> {
     let (stiffness, error) = sim.equilibrium_stiffness_and_error(coordinates);
     let mass = sim.equilibrium_mass(coordinates);
     let jacobian = sim.constraint_jacobian(coordinates);
@@ -122,7 +145,7 @@ fn linearize(sim: &mut Simulation, coordinates: &EquilibriumCoordinates) -> Resu
 }
 
 /// The analysis of `sim`, settled at `params` and `inputs` of `sc`.
-fn analyse<'a>(
+pub(crate) fn analyse<'a>(
     sc: &'a Scenario,
     sim: &mut Simulation,
     params: &Values,
@@ -138,75 +161,6 @@ fn analyse<'a>(
     Ok(Analysis { out, lin, listed, base })
 }
 
-/// The scenario and inputs of point `point` (from 0, as a run numbers its points; a schedule's
-/// one point is its first waypoint): a sweep over a topology or a motion over several points
-/// is one scenario per part, their points in order. None past the last point.
-pub fn point_of(sc: &Scenario, point: usize) -> Option<(&Scenario, Values)> {
-    if sc.topologies.is_empty() {
-        let inputs = match &sc.actuation {
-            crate::scenario::Actuation::Points { points, .. } => points.get(point)?,
-            crate::scenario::Actuation::Schedule { .. } => (point == 0).then(|| sc.actuation.first_inputs())?,
-        };
-        return Some((sc, inputs.clone()));
-    }
-    let mut parts = sc.topologies.iter().flat_map(|t| t.actuation.all_inputs().into_iter().map(move |i| (t, i)));
-    parts.nth(point).map(|(t, i)| (t, i.clone()))
-}
-
-/// The sensitivities of `sc` at point `point` (from 0; see [`point_of`]), settled as `run`
-/// settles it afresh there (`check`: also by differences of settles), named by `file`;
-/// [`SensitivityRunError::NoPoint`] past the last point.
-pub fn sensitivity(
-    sc: &Scenario,
-    file: &str,
-    point: usize,
-    check: bool,
-    cancel: Option<&AtomicBool>,
-) -> Result<SensitivityReport, SensitivityRunError> {
-    let (sc, inputs) = point_of(sc, point).ok_or(SensitivityRunError::NoPoint(point))?;
-    let params = sc.params_at(&inputs);
-    // What the analysis refuses is the structure's, known before the settle.
-    let structure = sc.mechanism().build(&params, &inputs, &sc.start).map_err(RunError::from)?;
-    let mut drawn = Simulation::new(&structure, &sc.sim).map_err(RunError::from)?;
-    drawn.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
-    let mut state = settle_at(sc, &inputs, params.clone(), cancel)?;
-    let wall = Instant::now();
-    let Analysis { out, lin, listed, base } = analyse(sc, &mut state.sim, &params, inputs)?;
-    let mut parameters = Vec::new();
-    for (name, &value) in &params {
-        if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
-            return Err(RunError::Interrupted(state.sim.tick()).into());
-        }
-        parameters.push(out.parameter(&state.sim, &params, name, value, &lin, &listed));
-    }
-    let wall_s = wall.elapsed().as_secs_f64();
-    let free = out.free_outputs(&mut state.sim, &params, &lin, &base);
-    let outputs: Vec<OutputValue> = base
-        .iter()
-        .zip(free)
-        .map(|((name, value), free)| OutputValue { name: name.clone(), value: *value, free })
-        .collect();
-    let check_wall = Instant::now();
-    if check {
-        for p in parameters.iter_mut().filter(|p| p.error.is_none()) {
-            out.check(p, &params, &listed, &outputs, cancel)?;
-        }
-    }
-    Ok(SensitivityReport {
-        name: sc.name.clone(),
-        file: file.to_string(),
-        point,
-        inputs: out.inputs.clone(),
-        settled: state.settled,
-        settle_steps: state.steps,
-        coordinates: out.coordinates.names(state.sim.structure()),
-        outputs,
-        parameters,
-        wall_s,
-        check_wall_s: check.then(|| check_wall.elapsed().as_secs_f64()),
-    })
-}
-
 /// The file's `[[sensitivities]]` at a settle point of a run (`sim` settled at `params` and
 /// `inputs`), by their names: each d(output)/d(parameter), NaN where the output is not one of
 /// the state's (a mode it has not); Err where the state has no sensitivities (the reason).
@@ -215,9 +169,9 @@ pub(super) fn file_sensitivities(
     sim: &mut Simulation,
     params: &Values,
     inputs: &Values,
-) -> Result<Values, String> {
+) -> Result<Values, FileSensitivityError> {
     let wanted = sc.model.as_ref().map_or(&[][..], |m| &m.sensitivities[..]);
-    let a = analyse(sc, sim, params, inputs.clone()).map_err(|e| e.to_string())?;
+    let a = analyse(sc, sim, params, inputs.clone())?;
     let mut rows: Vec<ParameterSensitivity> = Vec::new();
     let mut out = Values::new();
     for s in wanted {
@@ -227,7 +181,8 @@ pub(super) fn file_sensitivities(
         }
         let row = rows.iter().find(|r| r.name == s.parameter).expect("computed above");
         if let Some(e) = &row.error {
-            return Err(format!("d {}/d {}: {e}", s.output, s.parameter));
+            let (output, parameter, why) = (s.output.clone(), s.parameter.clone(), e.clone());
+            return Err(FileSensitivityError::Derivative { output, parameter, why });
         }
         let i = a.base.iter().position(|(n, _)| n == &s.output);
         out.insert(s.name.clone(), i.map_or(f64::NAN, |i| row.derivatives[i]));
@@ -307,10 +262,10 @@ impl Outputs<'_> {
 
     /// The scenario with its structure at parameter `name`'s samples (`scenario`: resolved
     /// there as at a sweep's sets of parameters), and each sample's parameters and inputs.
-    fn samples(&self, params: &Values, name: &str, value: f64, h: f64) -> Result<(Scenario, Samples), String> {
+    pub(crate) fn samples(&self, params: &Values, name: &str, value: f64, h: f64) -> Result<(Scenario, Samples), SampleError> {
         let moved: Vec<(Values, Values)> = SAMPLES.iter().map(|s| self.moved(params, name, value + s * h)).collect();
         let sets: Vec<Values> = moved.iter().map(|(p, _)| p.clone()).collect();
-        let sc = self.sc.with_parameter_sets(&sets).map_err(|e| e.to_string())?;
+        let sc = self.sc.with_parameter_sets(&sets)?;
         Ok((sc, moved))
     }
 
@@ -322,16 +277,16 @@ impl Outputs<'_> {
         at: &Simulation,
         params: &Values,
         inputs: &Values,
-    ) -> Result<Simulation, String> {
-        let s = mech.build(params, inputs, &self.sc.start).map_err(|e| e.to_string())?;
+    ) -> Result<Simulation, SampleError> {
+        let s = mech.build(params, inputs, &self.sc.start)?;
         let same = |a: &crate::structure::Structure, b: &crate::structure::Structure| {
             (a.bodies.len(), a.nodes.len(), a.joints.len(), a.members.len(), a.actuators.len())
                 == (b.bodies.len(), b.nodes.len(), b.joints.len(), b.members.len(), b.actuators.len())
         };
         if !same(&s, at.structure()) {
-            return Err("the structure built at a step has other bodies, nodes or members".into());
+            return Err(SampleError::OtherStructure);
         }
-        let mut sim = Simulation::new(&s, &self.sc.sim).map_err(|e| e.to_string())?;
+        let mut sim = Simulation::new(&s, &self.sc.sim)?;
         let commands = sim.structure().commands_from(&mech.commands(params, inputs));
         sim.set_commands(&commands);
         sim.take_configuration(at, &self.coordinates);
@@ -341,7 +296,7 @@ impl Outputs<'_> {
     /// Every output but the frequencies in `sim`'s state at `params`, by name: the mechanism's
     /// observed quantities (a custom structure's node coordinates and member forces), each
     /// joint's coordinate and the file's quantities.
-    fn sample(&self, sim: &Simulation, params: &Values) -> Vec<(String, f64)> {
+    pub(crate) fn sample(&self, sim: &Simulation, params: &Values) -> Vec<(String, f64)> {
         let s = sim.structure();
         let snap = sim.snapshot_with(false);
         let observed = self.mech.observe(params, s, &snap);
@@ -365,7 +320,7 @@ impl Outputs<'_> {
     /// parameter sets: a node's coordinates where the structure may turn): the settled state
     /// moved along each such mode by [`RIGID_PROBE_RATIO`] of the structure's size at its
     /// largest node motion, and back. The frequencies are fixed by the modes.
-    fn free_outputs(
+    pub(crate) fn free_outputs(
         &self,
         sim: &mut Simulation,
         params: &Values,
@@ -395,7 +350,7 @@ impl Outputs<'_> {
 
     /// The samples' values less the settled state's `base` (as many as the sample has), an
     /// angle's wrapped to (-pi, pi].
-    fn offsets(&self, sample: &[(String, f64)], base: &[(String, f64)]) -> DVector<f64> {
+    pub(crate) fn offsets(&self, sample: &[(String, f64)], base: &[(String, f64)]) -> DVector<f64> {
         DVector::from_iterator(
             sample.len(),
             base.iter().zip(sample).map(|((name, b), (_, v))| {
@@ -410,7 +365,7 @@ impl Outputs<'_> {
 
     /// Every output's derivative with respect to parameter `name` (at `value`) at the settled
     /// state `at` (module docs): outputs first, then the listed modes' omega.
-    fn parameter(
+    pub(crate) fn parameter(
         &self,
         at: &Simulation,
         params: &Values,
@@ -433,7 +388,7 @@ impl Outputs<'_> {
         let (sc, samples) = match self.samples(params, name, value, h) {
             Ok(s) => s,
             Err(e) => {
-                row.error = Some(e);
+                row.error = Some(e.to_string());
                 return row;
             }
         };
@@ -479,32 +434,4 @@ impl Outputs<'_> {
         row
     }
 
-    /// The check of `row` by differences of settles at the parameter's steps: the same
-    /// outputs, the frequencies from the modes of each settled state.
-    fn check(
-        &self,
-        row: &mut ParameterSensitivity,
-        params: &Values,
-        listed: &[usize],
-        outputs: &[OutputValue],
-        cancel: Option<&AtomicBool>,
-    ) -> Result<(), SensitivityRunError> {
-        let base: Vec<(String, f64)> = outputs.iter().map(|o| (o.name.clone(), o.value)).collect();
-        let mut y = Vec::new();
-        let (sc, samples) = self.samples(params, &row.name, row.value, row.step).map_err(SensitivityRunError::Check)?;
-        for (moved, inputs) in samples {
-            let SettledState { mut sim, .. } = settle_at(&sc, &inputs, moved.clone(), cancel)?;
-            let mut sample = self.sample(&sim, &moved);
-            let coordinates = sim.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
-            let modes = linearize(&mut sim, &coordinates)?.modes;
-            sample.extend(listed.iter().map(|&i| (format!("mode{}.omega", i + 1), modes[i].omega())));
-            y.push(self.offsets(&sample, &base));
-        }
-        let check = derivative_from_samples(y[0].clone(), y[1].clone(), y[2].clone(), y[3].clone(), row.step);
-        let errors = outputs.iter().zip(&row.derivatives).zip(check.iter()).filter(|((o, _), _)| !o.free);
-        row.max_check_error =
-            Some(errors.map(|((o, d), c)| check_error(*d, *c, o.value, row.value, row.step)).fold(0.0, f64::max));
-        row.check = Some(check.iter().copied().collect());
-        Ok(())
-    }
 }

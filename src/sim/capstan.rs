@@ -18,7 +18,8 @@
 //! energy of its own (the path matters), so the relaxation, the modes and the sensitivities
 //! refuse it.
 
-use super::{Data, Model};
+use super::data::Data;
+use super::model::Model;
 use crate::structure::{ElasticLaw, Member};
 
 /// Sweeps over a cable's inner nodes per step, at most.

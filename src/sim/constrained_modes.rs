@@ -36,7 +36,8 @@
 //! platform on both cables) has no mode.
 
 use super::modes::{ModesError, StructureMode, StructureModes, ZERO_MODE_RATIO};
-use super::{Data, Model};
+use super::data::Data;
+use super::model::Model;
 use crate::structure::{BodyKind, JointKind};
 use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;

@@ -18,7 +18,8 @@
 //! phi_p^T (K - omega^2 M) phi_p, phi_p = (1 - G^+ G) phi, phi = N v.
 
 use super::constrained_modes::{Constraints, ModalCoordinate};
-use super::{Data, LinkRef, Model};
+use super::data::Data;
+use super::model::{LinkRef, Model};
 use nalgebra::{DMatrix, DVector};
 use rapier3d_f64::prelude::MultibodyIndex;
 

@@ -5,7 +5,7 @@
 //! A jump from one command to another is a path in the commands; the projection
 //! (`projection.rs`) must land on the configuration at the end of that path, on the assembly
 //! mode the structure started on. By default the path is cut into increments of at most
-//! [`super::MAX_CLOSED_LOOP_INCREMENT`], each projected from the last. Gauss-Newton started at
+//! `MAX_CLOSED_LOOP_INCREMENT` (`mod.rs`), each projected from the last. Gauss-Newton started at
 //! the configuration before the jump converges to the path's end directly when that start lies
 //! well inside its region of convergence, and the contraction of the first step measures how
 //! well: a Newton step from x0 shrinks the gap by about h0 / 2, where h0 = omega |dx0| is the
@@ -17,7 +17,8 @@
 //! start.
 
 use super::projection::{Projection, GAP_TOLERANCE_FRACTION};
-use super::{Data, Model};
+use super::data::Data;
+use super::model::Model;
 
 /// A jump is taken at once only if the first Gauss-Newton step of its projection left at most
 /// this fraction of the gap that the jump opened: a quarter, Deuflhard's bound for a

@@ -19,7 +19,8 @@
 //! at rest, so the equilibrium is the same as with any fixed damping; only the path to it
 //! changes.
 
-use super::{Data, Model};
+use super::data::Data;
+use super::model::Model;
 use crate::structure::JointKind;
 use rapier3d_f64::prelude::*;
 
@@ -237,7 +238,7 @@ impl Data {
                 }
             }
             if let Some(link) = m.joint_links[j] {
-                super::build::set_link_damping(&mut self.multibody_joints, link.multibody_joint, damping);
+                super::joint_data::set_link_damping(&mut self.multibody_joints, link.multibody_joint, damping);
             }
         }
         acted

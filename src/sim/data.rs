@@ -3,7 +3,7 @@
 //! Every concept reads it and moves it; [`Model`] says what it simulates, and its functions
 //! take the model beside it.
 
-use super::{build, Model, SimError};
+use super::model::{Model, SimError};
 use crate::settings::DEFAULT_JOINT_GAP_FRACTION;
 use crate::snapshot::{BodyPose, Snapshot};
 use crate::structure::ActuatorTarget;
@@ -370,7 +370,7 @@ impl Data {
             let Some(link) = m.joint_links[j] else { continue };
             let target = self.joint_command(m, j) - m.structure.joints[j].initial_coordinate;
             let Some((mb, link_id)) = self.multibody_joints.get(link.multibody_joint) else { continue };
-            let Some(current) = mb.link(link_id).map(|l| l.joint().coords()[super::joint_free_axis(&l.joint().data)])
+            let Some(current) = mb.link(link_id).map(|l| l.joint().coords()[super::joint_data::joint_free_axis(&l.joint().data)])
             else {
                 continue;
             };
@@ -384,7 +384,7 @@ impl Data {
     pub(super) fn lock_joint_at(&mut self, m: &Model, j: usize, q: f64) {
         let Some(h) = m.joint_impulse[j] else { return };
         if let Some(joint) = self.impulse_joints.get_mut(h, true) {
-            joint.data = build::locked_joint(&m.structure, &m.structure.joints[j], q);
+            joint.data = super::joint_data::locked_joint(&m.structure, &m.structure.joints[j], q);
             self.locked_coordinates[j] = q;
             self.constraint_inputs += 1;
         }
@@ -437,7 +437,7 @@ impl Data {
         for j in 0..m.structure.joints.len() {
             if let (Some(link), true) = (m.joint_links[j], self.scheduled(m, j)) {
                 let damping = m.structure.joints[j].damping;
-                build::set_link_damping(&mut self.multibody_joints, link.multibody_joint, damping);
+                super::joint_data::set_link_damping(&mut self.multibody_joints, link.multibody_joint, damping);
             }
         }
     }
@@ -448,7 +448,7 @@ impl Data {
     /// 1.3e-4 high).
     pub(super) fn release_damping(&mut self, m: &Model) {
         for link in m.joint_links.iter().flatten().chain(m.hidden_links.iter()) {
-            build::set_link_damping(&mut self.multibody_joints, link.multibody_joint, 0.0);
+            super::joint_data::set_link_damping(&mut self.multibody_joints, link.multibody_joint, 0.0);
         }
         for h in &m.handles {
             let body = &mut self.bodies[*h];

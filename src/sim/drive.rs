@@ -10,7 +10,8 @@
 //! closes a loop (locked off the tree, `build::locked_joint`) has no such degree of freedom and is
 //! refused.
 
-use super::{Data, Model, SimError};
+use super::data::Data;
+use super::model::{Model, SimError};
 use crate::structure::ActuatorTarget;
 use rapier3d_f64::prelude::*;
 
@@ -52,7 +53,7 @@ impl Drive {
             let link = m.joint_links[j].ok_or_else(refused)?;
             let (mb, id) = d.multibody_joints.get_mut(link.multibody_joint).ok_or_else(refused)?;
             let l = mb.link_mut(id).ok_or_else(refused)?;
-            let axis = AXES[super::joint_free_axis(&l.joint.data)];
+            let axis = AXES[super::joint_data::joint_free_axis(&l.joint.data)];
             l.joint.kinematic = false;
             l.joint.data.set_motor(axis, 0.0, 0.0, 0.0, RIGID_MOTOR_DAMPING);
         }
@@ -75,7 +76,7 @@ impl Drive {
             let target = command - m.structure.joints[j].initial_coordinate;
             let Some((mb, id)) = d.multibody_joints.get_mut(link.multibody_joint) else { continue };
             let Some(l) = mb.link_mut(id) else { continue };
-            let k = super::joint_free_axis(&l.joint.data);
+            let k = super::joint_data::joint_free_axis(&l.joint.data);
             let rate = (target - l.joint.coords()[k]) / dt;
             l.joint.data.set_motor_velocity(AXES[k], rate, RIGID_MOTOR_DAMPING);
         }

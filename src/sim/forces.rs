@@ -2,8 +2,9 @@
 //! equilibrium residual computed from them independently of the solver.
 
 use super::least_squares::SparseRows;
-use super::tree::Tree;
-use super::{Data, MemberForces, Model, Residual};
+use super::data::Data;
+use super::model::{Model, Tree};
+use crate::snapshot::{MemberForces, Residual};
 use crate::structure::{ActuatorTarget, ElasticLaw, JointKind, MemberKind};
 use rapier3d_f64::prelude::*;
 

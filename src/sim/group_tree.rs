@@ -14,24 +14,10 @@
 //! tree runs over the group's joints that hold a point (spherical, revolute, universal) from
 //! the bodies joined to fixed ones; a body it does not reach moves by its own twist.
 
-use super::{Data, Model};
+use super::data::Data;
+use super::model::{GroupTree, Link, Model};
 use crate::structure::JointKind;
 use rapier3d_f64::prelude::*;
-
-/// One body of the tree: its index in the group's bodies, its tree parent's (None: a fixed
-/// body) and the joint between them.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Link {
-    pub body: usize,
-    pub parent: Option<usize>,
-    pub joint: usize,
-}
-
-/// The spanning tree of a group's plain bodies, parents before children.
-#[derive(Clone, Debug, Default)]
-pub(super) struct GroupTree {
-    links: Vec<Link>,
-}
 
 impl GroupTree {
     /// The links, parents before children.

@@ -15,7 +15,8 @@
 //! coordinate are refused, by name.
 
 use super::modes::{ModesError, StructureMode, StructureModes, ZERO_MODE_RATIO};
-use super::{Data, Model};
+use super::data::Data;
+use super::model::Model;
 use crate::structure::{BodyKind, JointKind};
 use nalgebra::{DMatrix, DVector, Quaternion, UnitQuaternion, Vector3};
 

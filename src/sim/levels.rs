@@ -11,7 +11,8 @@
 //! Copies at h / 2, h / 4, ... (`Simulation::at_time_step`) from the same state are what a
 //! Richardson extrapolation over the step combines (`run/levels.rs`).
 
-use super::{Data, Model};
+use super::data::Data;
+use super::model::Model;
 use nalgebra::DVector;
 use rapier3d_f64::prelude::*;
 

@@ -26,10 +26,12 @@ mod data;
 mod drive;
 mod forces;
 mod group_tree;
+mod joint_data;
 mod joint_coordinates;
 mod joint_modes;
 pub(crate) mod least_squares;
 mod levels;
+mod model;
 pub mod modes;
 mod path;
 mod projection;
@@ -41,6 +43,7 @@ mod servo;
 mod tree;
 
 pub use build::LOOPED_MULTIBODY_MAX_LINKS;
+pub use model::{Model, SimError};
 
 use crate::structure::{BodyKind, Structure};
 use data::Data;
@@ -48,94 +51,6 @@ use rapier3d_f64::prelude::*;
 
 use crate::settings::SimSettings;
 use crate::snapshot::{BodyPose, MemberForces, Residual, Snapshot};
-
-#[derive(Debug, thiserror::Error, Clone, PartialEq)]
-pub enum SimError {
-    #[error("the structure cannot be simulated: {0}")]
-    Build(String),
-    #[error("simulation diverged at tick {tick} (t = {time_s:.6} s): {what}")]
-    Diverged { tick: u64, time_s: f64, what: String },
-    /// A request the built structure cannot carry out (a coordinate it does not have, a body
-    /// that is not free, an actuator that cannot be driven physically).
-    #[error("the simulator cannot do this: {0}")]
-    Refused(String),
-}
-
-/// Where a free body sits in a multibody, so its joint coordinates can be read and perturbed.
-#[derive(Clone, Copy, Debug)]
-struct LinkRef {
-    multibody_joint: MultibodyJointHandle,
-}
-
-/// What a simulation is built from and keeps for its whole life (MuJoCo's `mjModel`): the
-/// structure and settings, and how the build mapped them onto rapier (handles, multibody
-/// links, loop closures, rope joints, the link tree, constant loads). Only the build writes it.
-#[derive(Clone)]
-pub struct Model {
-    pub structure: Structure,
-    pub settings: SimSettings,
-    /// rapier handle of each structure body.
-    handles: Vec<RigidBodyHandle>,
-    /// For each joint: whether an actuator sets its coordinate (a kinematic multibody degree
-    /// of freedom).
-    actuated: Vec<bool>,
-    /// For each joint: the multibody link it made, if any.
-    joint_links: Vec<Option<LinkRef>>,
-    /// First halves of universal joints split into two multibody revolutes.
-    hidden_links: Vec<LinkRef>,
-    /// For each joint: the impulse joint it made, if any (loop closures).
-    joint_impulse: Vec<Option<ImpulseJointHandle>>,
-    /// Loop closures inside one multibody, closed by position projection after each step.
-    internal_closures: Vec<projection::InternalClosure>,
-    /// Groups of free bodies (plain bodies and multibodies) whose joints and taut cables are
-    /// closed by position projection.
-    projected_groups: Vec<projection::ProjectedGroup>,
-    /// Whether a cable has friction at a node (`capstan.rs`).
-    has_friction: bool,
-    /// For each member: its rope joint if it is an inextensible cable.
-    ropes: Vec<Option<ImpulseJointHandle>>,
-    /// The joint each body hangs from in the multibody forest (fixed at build).
-    tree: tree::Tree,
-    /// The reaction fit's tree: the multibody forest and the sparse groups' spanning trees
-    /// (`tree.rs`).
-    fit_tree: tree::Tree,
-    /// The structure's constant external forces, summed per body [N].
-    external_loads: Vec<[f64; 3]>,
-    /// Characteristic length of the structure \[m\], for speeds and tolerances.
-    pub length_scale_m: f64,
-    /// Whether the static relaxation applies to this structure (`relaxation/`).
-    relaxation_applies: bool,
-}
-
-impl Model {
-    /// Bodies that move (not fixed).
-    pub fn is_free(&self, body: usize) -> bool {
-        self.structure.bodies[body].kind == BodyKind::Free
-    }
-
-    /// Whether the structure's modes and sensitivities are those of the constrained analysis
-    /// (`constrained_modes.rs`): an inextensible cable, a joint that closes a loop, or a free
-    /// joint of several coordinates (a universal joint: two revolute links and a hidden body,
-    /// `build.rs`, charted by its multibody's degrees of freedom there).
-    pub(super) fn is_constrained(&self) -> bool {
-        let s = &self.structure;
-        let several = |(j, joint): (usize, &crate::structure::Joint)| {
-            !self.actuated[j]
-                && !matches!(
-                    joint.kind,
-                    crate::structure::JointKind::Revolute { .. } | crate::structure::JointKind::Prismatic { .. }
-                )
-        };
-        s.members.iter().any(|c| c.is_inextensible_cable())
-            || self.joint_impulse.iter().any(Option::is_some)
-            || s.joints.iter().enumerate().any(several)
-    }
-
-    /// Whether every projected group is of plain bodies alone (no multibody coordinates).
-    pub(super) fn projected_groups_are_plain(&self) -> bool {
-        self.projected_groups.iter().all(|g| g.multibodies.is_empty())
-    }
-}
 
 /// A simulation: the immutable [`Model`] the build returned beside the state that steps. The
 /// state is split by concept, and each file's functions take what they read and what they
@@ -572,9 +487,3 @@ const MAX_CLOSED_LOOP_INCREMENT: f64 = 0.01;
 /// closest approach) for 2 to 6 % of an 8-X chain's settle.
 const INCREMENT_GAP_FRACTION: f64 = 1e-6;
 
-/// Index (0..6: linear x, y, z, angular x, y, z) of the single free axis of a one-degree-of-
-/// freedom joint, where its coordinate lives in `MultibodyJoint::coords`.
-fn joint_free_axis(data: &GenericJoint) -> usize {
-    let locked = data.locked_axes.bits();
-    (0..6).find(|k| locked & (1 << k) == 0).unwrap_or(0)
-}

@@ -14,7 +14,8 @@
 
 pub(crate) use super::constrained_modes::{least_squares, null_space, zero_floor};
 pub use super::constrained_modes::{Constraints, ModalCoordinate, NULL_SPACE_RATIO};
-use super::{Data, Model, Simulation};
+use super::data::Data;
+use super::model::Model;
 use crate::eigen::EigenError;
 use crate::snapshot::{BodyPose, ModalProjector};
 use crate::structure::BodyKind;
@@ -287,8 +288,7 @@ impl Data {
 
 /// The reader of mode `index` (from 0) of `analysis`'s coordinate off a snapshot (plain data,
 /// `snapshot::ModalProjector`).
-pub fn modal_projector(sim: &Simulation, analysis: &StructureModes, index: usize) -> ModalProjector {
-    let s = sim.structure();
+pub fn modal_projector(s: &crate::structure::Structure, analysis: &StructureModes, index: usize) -> ModalProjector {
     let com_local = analysis.bodies.iter().map(|b| s.bodies[*b].inertia.map_or([0.0; 3], |i| i.com)).collect();
     let shape = &analysis.modes[index].shape;
     let weights = analysis

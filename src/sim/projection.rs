@@ -17,7 +17,8 @@
 //! closed, with no velocity and no solve, while nothing has opened a row there
 //! ([`Jacobian::rigid`]).
 
-use super::{Data, Model};
+use super::data::Data;
+use super::model::{GroupTree, InternalClosure, Model, ProjectedGroup};
 use crate::structure::JointKind;
 use rapier3d_f64::prelude::*;
 
@@ -292,13 +293,6 @@ impl JointFrame {
     }
 }
 
-/// A loop-closing joint inside one multibody: the rows of its gap that the projection zeroes.
-#[derive(Clone, Debug)]
-pub(super) struct InternalClosure {
-    pub(super) joint: usize,
-    pub(super) multibody: MultibodyIndex,
-}
-
 impl Data {
     /// The loop-closing joints whose two bodies are links of the same multibody.
     pub(super) fn find_internal_closures(&self, m: &Model) -> Vec<InternalClosure> {
@@ -336,34 +330,6 @@ impl Data {
             mb.update_rigid_bodies(&mut self.bodies, true);
         }
     }
-}
-
-/// Free bodies held by impulse joints and inextensible cables to each other or to fixed
-/// bodies: a group whose constraints the projection can close. Its coordinates are the poses
-/// of its plain bodies and the free coordinates of the multibodies whose links it touches
-/// (mohr2011's legs, each a multibody hung from the base, hold the end-effector, a plain body,
-/// by spherical impulse joints).
-///
-/// rapier holds these constraints at the velocity level too; under a steady load (gravity on
-/// manriquez2019's platform) the position offset it leaves grows like dt^2 and shrank only
-/// slowly with PGS iterations (3e-5 rad at dt = 2 ms; on mohr2011 1e-9 took 64 to 512 PGS
-/// iterations). After each step the group's coordinates are moved (Gauss-Newton, minimum norm,
-/// rotations of plain bodies scaled by the structure's size) until every joint's anchor gap and
-/// angular rows and every taut cable's stretch vanish to round-off; the velocities lose the
-/// components that would open a joint or stretch a taut cable. The tensions of the cables held
-/// this way are fitted from the equilibrium (`forces.rs`).
-#[derive(Clone, Debug, Default)]
-pub(super) struct ProjectedGroup {
-    /// Structure body indices of the group's free plain bodies.
-    pub bodies: Vec<usize>,
-    /// Multibodies whose links the group's joints or cables touch.
-    pub multibodies: Vec<MultibodyIndex>,
-    /// Impulse joints (structure indices) between the group's bodies or to fixed bodies.
-    pub joints: Vec<usize>,
-    /// Inextensible cables with a rope joint.
-    pub(super) cables: Vec<usize>,
-    /// A sparse group's spanning tree, along which its Gauss-Newton steps move it.
-    pub tree: Option<super::group_tree::GroupTree>,
 }
 
 /// A cable within this fraction of the structure's size of its length counts as taut.
@@ -480,7 +446,7 @@ impl Data {
             .map(|(_, mut g, _)| {
                 if g.multibodies.is_empty() && 6 * g.bodies.len() >= SPARSE_MIN_COORDINATES {
                     self.order_joints_by_band(m, &mut g);
-                    g.tree = Some(super::group_tree::GroupTree::of(m, &g.bodies, &g.joints));
+                    g.tree = Some(GroupTree::of(m, &g.bodies, &g.joints));
                 }
                 g
             })

@@ -7,7 +7,8 @@
 //! The restarted state is checked against the new structure (every node, centre of mass and
 //! inertia tensor); anything else, or a failed check, asks the caller to build afresh.
 
-use super::{Data, Model};
+use super::data::Data;
+use super::model::Model;
 use crate::structure::{JointKind, Structure};
 use rapier3d_f64::prelude::*;
 

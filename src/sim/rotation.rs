@@ -32,7 +32,8 @@
 //! spin, a half-step start, a restart, a projection) is seen as other than the kept one, and L
 //! is made from the velocity once (the carried rounding of (2) is dropped with a new pose).
 
-use super::{Data, Model};
+use super::data::Data;
+use super::model::Model;
 use rapier3d_f64::prelude::*;
 
 /// The norm of a turned rotation may leave 1 by this much before it is normalised: (2) keeps

@@ -20,7 +20,8 @@
 
 use super::constrained_modes::Constraints;
 use super::modes::ModesError;
-use super::{Data, Model};
+use super::data::Data;
+use super::model::Model;
 use crate::structure::{BodyKind, JointKind};
 use nalgebra::{DMatrix, DVector};
 use rapier3d_f64::prelude::*;
@@ -314,6 +315,6 @@ impl Data {
         let link = m.joint_links[j]?;
         let (mb, id) = self.multibody_joints.get(link.multibody_joint)?;
         let l = mb.link(id)?;
-        Some(l.joint().coords()[super::joint_free_axis(&l.joint().data)])
+        Some(l.joint().coords()[super::joint_data::joint_free_axis(&l.joint().data)])
     }
 }

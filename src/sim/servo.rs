@@ -6,7 +6,8 @@
 //!
 //! [`Structure::servo_of`]: crate::structure::Structure::servo_of
 
-use super::{Data, Model};
+use super::data::Data;
+use super::model::Model;
 use rapier3d_f64::prelude::*;
 
 /// The free axis of a revolute joint (rapier's `RevoluteJoint` frees `AngX`).

@@ -9,32 +9,9 @@
 //! 10-X chain cut into plain bodies, 20 free turns instead of 180 body coordinates.
 
 use super::forces::Wrench;
-use super::{Data, Model};
+use super::data::Data;
+use super::model::{Hang, Model, Tree};
 use crate::structure::Structure;
-
-/// Where a body hangs in a tree: the joint that carries it and the body on that joint's other
-/// side (the joint's parent for a multibody link; either side for a group's tree link).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Hang {
-    pub joint: usize,
-    pub parent: usize,
-}
-
-/// A forest of joints that carry bodies.
-#[derive(Clone, Debug, Default)]
-pub(super) struct Tree {
-    /// Each body's hang, if any (None: a root).
-    hang: Vec<Option<Hang>>,
-    /// Each joint's carried body, if the joint is in the tree.
-    carried: Vec<Option<usize>>,
-    /// Each body's number of joints to its root.
-    depth: Vec<usize>,
-    /// Bodies deepest first (ties: the higher index first): the order in which subtree sums
-    /// are handed to the parents.
-    order: Vec<usize>,
-    /// Whether any joint besides a multibody link's carries a body.
-    has_group_links: bool,
-}
 
 impl Tree {
     /// The tree of `hangs` (body, hang) over a structure's bodies and joints.

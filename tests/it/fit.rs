@@ -269,7 +269,7 @@ fn released_angles(sigma: f64, seed: u64) -> String {
     for k in 1..=20 {
         let t = 0.1 * k as f64;
         let tick = times.iter().position(|m| (m - t).abs() < 1e-9).expect("a tick at t");
-        let noise = if sigma > 0.0 { sigma * tensegrity_testbed::run::standard_normal(&mut state) } else { 0.0 };
+        let noise = if sigma > 0.0 { sigma * tensegrity_testbed::study::standard_normal(&mut state) } else { 0.0 };
         csv += &format!("0,joint:pin.angle,{:?},{},{:?}\n", angles[tick] + noise, sigma.max(1e-12), times[tick]);
     }
     csv
@@ -277,7 +277,7 @@ fn released_angles(sigma: f64, seed: u64) -> String {
 
 /// The fit of k2 to `csv` starting from k2 = 25 N/m (the truth 30).
 fn fit_released(csv: &str) -> FitReport {
-    let measurements = tensegrity_testbed::run::measurements_from_csv("angles.csv", csv).expect("valid data");
+    let measurements = tensegrity_testbed::study::measurements_from_csv("angles.csv", csv).expect("valid data");
     let problem = FitProblem {
         file: PathBuf::from(RELEASED),
         source: std::fs::read_to_string(RELEASED).expect("shipped"),

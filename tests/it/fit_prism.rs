@@ -87,7 +87,7 @@ fn fit_noisy(
             at: format!("row {k}"),
             point: *point,
             output: output.clone(),
-            value: value + seed.map_or(0.0, |_| sigma * tensegrity_testbed::run::standard_normal(&mut state)),
+            value: value + seed.map_or(0.0, |_| sigma * tensegrity_testbed::study::standard_normal(&mut state)),
             sigma: Some(*sigma),
             time_s: None,
         })
@@ -125,7 +125,7 @@ fn weighted_jacobian(file: &str, source: &str, rows: &[(usize, String, f64, f64)
 /// whether each 95 % interval holds the truth.
 fn linear_errors(a: &DMatrix<f64>, sigma: &[f64], rows: usize, seed: u64) -> Vec<f64> {
     let mut state = seed;
-    let e = DVector::from_iterator(rows, (0..rows).map(|_| tensegrity_testbed::run::standard_normal(&mut state)));
+    let e = DVector::from_iterator(rows, (0..rows).map(|_| tensegrity_testbed::study::standard_normal(&mut state)));
     let dp = a * e;
     (0..sigma.len()).map(|k| dp[k] / sigma[k]).collect()
 }

@@ -3,7 +3,7 @@
 //! solve, Nelson's eigenvector formula) against the differences of the swept curve itself.
 
 use std::path::Path;
-use tensegrity_testbed::run::sensitivity;
+use tensegrity_testbed::study::sensitivity;
 use tensegrity_testbed::scenario;
 
 const ROCKER: &str = "scenarios/custom/rocker_frequency_curve.toml";

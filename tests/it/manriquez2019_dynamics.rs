@@ -41,7 +41,7 @@ fn form_finding_grid_agrees_off_the_singular_diagonal() {
     let fine = "count = 121";
     assert_eq!(text.matches(fine).count(), 2);
     let sc = scenario::parse(path, &text.replace(fine, "count = 13")).expect("valid");
-    let (rows, summary) = tensegrity_testbed::sweep::sweep(&sc, 2, None, None, &|_, _| {}).unwrap();
+    let (rows, summary) = tensegrity_testbed::study::sweep::sweep(&sc, 2, None, None, &|_, _| {}).unwrap();
     assert_eq!(rows.len(), 13 * 13 - 1, "the pose nearest (0, 0) is skipped");
     for r in &rows {
         let p = &r.point;

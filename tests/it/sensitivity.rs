@@ -12,7 +12,7 @@ use tensegrity_testbed::scenario;
 /// The report of `file` (with its check by differences of settles).
 fn report_of(file: &str) -> SensitivityReport {
     let sc = scenario::load(Path::new(file)).expect("shipped scenario");
-    tensegrity_testbed::run::sensitivity(&sc, file, 0, true, None).expect("sensitivities")
+    tensegrity_testbed::study::sensitivity(&sc, file, 0, true, None).expect("sensitivities")
 }
 
 /// Parameter `name`'s row.
@@ -241,7 +241,7 @@ gravity = [0.0, 0.0, "-g"]
 fn report_of_text(text: &str) -> SensitivityReport {
     let text = text.replace("\n[structure]\n", SETTLED_ONCE_UNDER_GRAVITY);
     let sc = scenario::parse(Path::new("held.toml"), &text).expect("a valid scenario");
-    tensegrity_testbed::run::sensitivity(&sc, "held.toml", 0, true, None).expect("sensitivities")
+    tensegrity_testbed::study::sensitivity(&sc, "held.toml", 0, true, None).expect("sensitivities")
 }
 
 /// A bar pinned at O (revolute about y), its tip A held up by an inextensible cable of

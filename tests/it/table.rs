@@ -106,6 +106,31 @@ fn several_scenarios_get_one_table_each() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// With several scenarios and `--table FILE.arrow`, each scenario's table is an Arrow IPC file
+/// named `FILE-<scenario>.arrow` (it was a CSV named `.csv`): arrow's reader opens both, each
+/// with a node column and at least one row.
+#[test]
+fn several_scenarios_keep_the_arrow_format_of_the_tables_name() {
+    let dir = std::env::temp_dir().join(format!("table-cli-arrow-{}", std::process::id()));
+    let base = dir.join("t.arrow");
+    let (code, out, err) = tensegrity(&[
+        "run",
+        "scenarios/custom/prism3.toml",
+        "scenarios/custom/icosahedron6.toml",
+        "--table",
+        base.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
+    for name in ["t-3-strut_tensegrity_prism.arrow", "t-6-strut_tensegrity_icosahedron.arrow"] {
+        let file = std::fs::File::open(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let reader = arrow_ipc::reader::FileReader::try_new(file, None).expect("an Arrow IPC file");
+        assert!(reader.schema().fields().iter().any(|f| f.name().starts_with("node:")), "{name}");
+        let rows: usize = reader.map(|b| b.expect("a batch").num_rows()).sum();
+        assert!(rows > 0, "{name}: no rows");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// The same table as an Arrow IPC file (`--table FILE.arrow`): as many rows, `tick` UInt64 and
 /// every other column Float64 with the CSV's exact values (read back with arrow's own reader);
 /// pandas (with pyarrow) reads the settled row as the JSON report has it, bit for bit.

@@ -2,7 +2,8 @@
 //! f = -grad E and the Hessian H of the potential energy as 6x6 blocks (one per pair of
 //! coupled bodies), assembled from the force laws.
 
-use super::super::{Data, Model};
+use super::super::data::Data;
+use super::super::model::Model;
 use crate::structure::MemberKind;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix3x6, Matrix6, Vector3};
 use rapier3d_f64::prelude::*;

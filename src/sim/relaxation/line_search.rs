@@ -1,6 +1,7 @@
 //! The relaxation's line search: the energy after a trial step, and the limits of a step.
 
-use super::super::{Data, Model};
+use super::super::data::Data;
+use super::super::model::Model;
 use super::assemble::{v3, Dofs};
 use super::{MAX_STEP_FRACTION, MAX_STEP_ROTATION_RAD};
 use nalgebra::{DVector, Vector3};

@@ -20,7 +20,8 @@
 //! block method finds each of a pair of (nearly) equal frequencies, which a single-vector
 //! Lanczos would not.
 
-use super::super::{Data, Model};
+use super::super::data::Data;
+use super::super::model::Model;
 use super::assemble::{Dofs, System};
 use super::sparse::{csc, ordered_columns, rigid_motions, Motion};
 use crate::eigen::EigenError;

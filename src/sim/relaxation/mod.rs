@@ -36,7 +36,8 @@ mod lowest_modes;
 pub(super) mod ordering;
 mod sparse;
 
-use super::{Data, Model};
+use super::data::Data;
+use super::model::Model;
 use crate::structure::{BodyKind, Structure};
 use nalgebra::DVector;
 

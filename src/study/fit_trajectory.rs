@@ -8,8 +8,8 @@
 //! error over h, about 1e-6 of the derivative. The runs go in parallel, one a core, as
 //! MuJoCo's sysid differences its rollouts.
 
-use super::fit::{scenario_at, FitError, FitProblem, Measurement};
-use super::sensitivity::parameter_step;
+use super::problem::{close_names, scenario_at, FitError, FitProblem, Measurement};
+use crate::run::sensitivity::parameter_step;
 use crate::observers::table::{Batched, MemoryTable, TableTarget};
 use crate::sim::sensitivity::derivative_from_samples;
 use arrow_array::{Array, Float64Array};
@@ -63,8 +63,8 @@ fn run_at(problem: &FitProblem, p: &[f64], cancel: Option<&AtomicBool>) -> Resul
         )));
     }
     let kept = MemoryTable::default();
-    let opts = super::RunOptions { cancel, table: Some(TableTarget::Memory(kept.clone())), ..Default::default() };
-    let report = super::run(&sc, &opts);
+    let opts = crate::run::RunOptions { cancel, table: Some(TableTarget::Memory(kept.clone())), ..Default::default() };
+    let report = crate::run::run(&sc, &opts);
     if let Some(e) = &report.error {
         return Err(FitError::Failed(format!("{file} at {p:?}: {e}")));
     }
@@ -105,7 +105,7 @@ fn values(problem: &FitProblem, t: &Batched, rows: &[&Measurement]) -> Result<DV
                 "{}: output '{}' is no column of the motion's table{} (see `tensegrity run --table`)",
                 x.at,
                 x.output,
-                super::fit::close_names(&x.output, names.into_iter())
+                close_names(&x.output, names.into_iter())
             )));
         }
         out[i] = values[tick];
