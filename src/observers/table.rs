@@ -25,6 +25,7 @@
 //! the same f64 bit for bit. The file is written to a temporary file (`output::partial_path`) and renamed when the run
 //! is over.
 
+use super::file_model::ModelObserver;
 use super::{Made, Observer, ObserverError, Setup, Tick};
 use crate::report::ScenarioReport;
 use crate::structure::{ActuatorTarget, MemberKind};

@@ -51,11 +51,6 @@ impl JudgedMotion {
         self.dt_s
     }
 
-    /// The tick the motion started at.
-    pub fn start_tick(&self) -> u64 {
-        self.start_tick
-    }
-
     /// The time since the motion's start at `tick` \[s\].
     pub fn time_s(&self, tick: u64) -> f64 {
         tick.saturating_sub(self.start_tick) as f64 * self.dt_s

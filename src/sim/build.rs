@@ -2,7 +2,7 @@
 
 use super::data::Data;
 use super::model::{LinkRef, Model, SimError};
-use super::joint_data::{generic_joint, locked_joint, v};
+use super::joint_data::{generic_joint, locked_joint, set_link_damping, v};
 use super::model::Tree;
 use crate::settings::SimSettings;
 use crate::structure::{ActuatorTarget, BodyKind, CableLaw, Joint, JointKind, Law, MemberKind, Structure, Vec3};

@@ -45,12 +45,12 @@ mod tree;
 pub use build::LOOPED_MULTIBODY_MAX_LINKS;
 pub use model::{Model, SimError};
 
-use crate::structure::{BodyKind, Structure};
+use crate::structure::Structure;
 use data::Data;
 use rapier3d_f64::prelude::*;
 
 use crate::settings::SimSettings;
-use crate::snapshot::{BodyPose, MemberForces, Residual, Snapshot};
+use crate::snapshot::{BodyPose, MemberForces, Snapshot};
 
 /// A simulation: the immutable [`Model`] the build returned beside the state that steps. The
 /// state is split by concept, and each file's functions take what they read and what they

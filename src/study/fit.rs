@@ -12,15 +12,14 @@
 //! reports them). The covariance is (J^T J)^-1 over the other directions; scaled by the
 //! reduced chi^2 only when no measurement states its sigma (each then weighs 1).
 
-use super::problem::{scenario_at, FitError, FitParameter, FitProblem, Measurement};
+use super::problem::{close_names, scenario_at, FitError, FitProblem, Measurement};
 use super::sensitivity::{point_of, SensitivityRunError};
 use crate::report::fit::{Combination, FitReport, FitResidual, FittedParameter};
 use crate::report::sensitivity::SensitivityReport;
-use crate::scenario::{Override, Scenario, ScenarioError};
+use crate::scenario::Scenario;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -504,6 +503,8 @@ pub fn standard_normal(state: &mut u64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::study::problem::FitParameter;
+    use std::path::PathBuf;
 
     /// The seeds of the coverage check, and the noise on each of the line's points.
     const SEEDS: u64 = 200;

@@ -69,7 +69,7 @@ pub fn sensitivity(
     let check_wall = Instant::now();
     if check {
         for p in parameters.iter_mut().filter(|p| p.error.is_none()) {
-            check(&out, p, &params, &listed, &outputs, cancel)?;
+            check_by_settles(&out, p, &params, &listed, &outputs, cancel)?;
         }
     }
     Ok(SensitivityReport {
@@ -89,7 +89,7 @@ pub fn sensitivity(
 
 /// The check of `row` by differences of settles at the parameter's steps: the same
 /// outputs, the frequencies from the modes of each settled state.
-fn check(
+fn check_by_settles(
     out: &Outputs,
     row: &mut ParameterSensitivity,
     params: &Values,

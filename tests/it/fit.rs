@@ -6,7 +6,7 @@
 use crate::common;
 use std::path::PathBuf;
 use tensegrity_testbed::report::fit::FitReport;
-use tensegrity_testbed::run::{fit, FitParameter, FitProblem, Measurement};
+use tensegrity_testbed::study::{fit, FitParameter, FitProblem, Measurement};
 
 /// The pinned bar swept over k1 (nine points, k1 = 10 .. 90 N/m), with a = 0.8 m, b = 0.6 m.
 const SWEPT_K1: &str = "scenarios/custom/pinned_bar_sweep.toml";

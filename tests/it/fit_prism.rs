@@ -9,7 +9,7 @@ use nalgebra::{DMatrix, DVector};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use tensegrity_testbed::report::fit::FitReport;
-use tensegrity_testbed::run::{fit, sensitivity, FitParameter, FitProblem, Measurement};
+use tensegrity_testbed::study::{fit, sensitivity, FitParameter, FitProblem, Measurement};
 use tensegrity_testbed::scenario::{self, Override};
 
 /// The prism under ten loads: gravity (9.81 m/s^2 down, 6 m/s^2 sideways) and a rig's cable
