@@ -22,8 +22,8 @@ use tensegrity_testbed::observers::external::{External, ExternalError, ExternalM
 use tensegrity_testbed::observers::table::{MemoryTable, TableTarget};
 use tensegrity_testbed::run::stoppable::Stoppable;
 use tensegrity_testbed::run::{self, RunOptions};
-use tensegrity_testbed::study;
 use tensegrity_testbed::scenario::{self, Override, Scenario, ScenarioError};
+use tensegrity_testbed::study;
 
 create_exception!(
     _tensegrity,

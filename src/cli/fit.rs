@@ -5,8 +5,8 @@
 //! flag.
 
 use super::{bad_input, check_outputs, failed, signals, write_atomic, CliError, Outcome};
-use crate::study::{FitError, FitProblem};
 use crate::scenario::Override;
+use crate::study::{FitError, FitProblem};
 use std::path::Path;
 
 pub fn fit(

@@ -134,7 +134,12 @@ impl Levels {
     /// One tick of `coarse` (the level at h, stepped here as well) and of the finer levels,
     /// ending at motion time `end_s` \[s\], a driven motion's commands set at the end of every
     /// step (a motion's levels run alone, with no observer: [`run_alone`]).
-    fn step_with(&mut self, coarse: &mut Simulation, end_s: f64, commands_at: Option<CommandsAt>) -> Result<(), SimError> {
+    fn step_with(
+        &mut self,
+        coarse: &mut Simulation,
+        end_s: f64,
+        commands_at: Option<CommandsAt>,
+    ) -> Result<(), SimError> {
         if let Some(c) = commands_at {
             coarse.drive_commands(&c(end_s));
         }
@@ -258,7 +263,7 @@ pub(super) fn run_alone(
 }
 
 /// The node positions \[m\] of `sim`'s motion after `ticks` of its step, judged as a motion
-/// run judges them over `count` levels ([`run_alone`]), the judged state at the end only (the
+/// run judges them over `count` levels (`run_alone`), the judged state at the end only (the
 /// benchmark's measure of the judged motion's cost).
 pub fn judged_nodes_after(
     sim: &mut Simulation,

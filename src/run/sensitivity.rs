@@ -121,7 +121,10 @@ pub(crate) struct Linearization {
 /// K, M and G of `sim` in `coordinates`, and the modes of the reduced problem
 /// (N^T K N) v = omega^2 (N^T M N) v, N a basis of null(G), phi = N v (all coordinates where
 /// there is no constraint).
-pub(crate) fn linearize(sim: &mut Simulation, coordinates: &EquilibriumCoordinates) -> Result<Linearization, SensitivityRunError> {
+pub(crate) fn linearize(
+    sim: &mut Simulation,
+    coordinates: &EquilibriumCoordinates,
+) -> Result<Linearization, SensitivityRunError> {
     let (stiffness, error) = sim.equilibrium_stiffness_and_error(coordinates);
     let mass = sim.equilibrium_mass(coordinates);
     let jacobian = sim.constraint_jacobian(coordinates);
@@ -262,7 +265,13 @@ impl Outputs<'_> {
 
     /// The scenario with its structure at parameter `name`'s samples (`scenario`: resolved
     /// there as at a sweep's sets of parameters), and each sample's parameters and inputs.
-    pub(crate) fn samples(&self, params: &Values, name: &str, value: f64, h: f64) -> Result<(Scenario, Samples), SampleError> {
+    pub(crate) fn samples(
+        &self,
+        params: &Values,
+        name: &str,
+        value: f64,
+        h: f64,
+    ) -> Result<(Scenario, Samples), SampleError> {
         let moved: Vec<(Values, Values)> = SAMPLES.iter().map(|s| self.moved(params, name, value + s * h)).collect();
         let sets: Vec<Values> = moved.iter().map(|(p, _)| p.clone()).collect();
         let sc = self.sc.with_parameter_sets(&sets)?;
@@ -433,5 +442,4 @@ impl Outputs<'_> {
         );
         row
     }
-
 }

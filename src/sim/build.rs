@@ -1,9 +1,9 @@
 //! Structure -> rapier sets.
 
 use super::data::Data;
-use super::model::{LinkRef, Model, SimError};
 use super::joint_data::{generic_joint, locked_joint, set_link_damping, v};
 use super::model::Tree;
+use super::model::{LinkRef, Model, SimError};
 use crate::settings::SimSettings;
 use crate::structure::{ActuatorTarget, BodyKind, CableLaw, Joint, JointKind, Law, MemberKind, Structure, Vec3};
 use rapier3d_f64::prelude::*;

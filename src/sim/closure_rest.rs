@@ -14,10 +14,10 @@
 //! (a structure at rest, not one whose commands change every tick), and is used while that
 //! generation holds and the joints are within [`super::projection::RIGID_REST_FRACTION`] of it.
 
-use super::model::ProjectedGroup;
-use super::projection::{GAP_TOLERANCE_FRACTION, RIGID_REST_FRACTION, SVD_RELATIVE_TOLERANCE};
 use super::data::Data;
 use super::model::Model;
+use super::model::ProjectedGroup;
+use super::projection::{GAP_TOLERANCE_FRACTION, RIGID_REST_FRACTION, SVD_RELATIVE_TOLERANCE};
 use rapier3d_f64::prelude::*;
 
 /// Where a looped multibody's loops were last closed, at the generation of the constraint

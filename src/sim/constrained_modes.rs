@@ -35,9 +35,9 @@
 //! the coordinates: furet2018's X modules at their actuators' commands, manriquez2019's
 //! platform on both cables) has no mode.
 
-use super::modes::{ModesError, StructureMode, StructureModes, ZERO_MODE_RATIO};
 use super::data::Data;
 use super::model::Model;
+use super::modes::{ModesError, StructureMode, StructureModes, ZERO_MODE_RATIO};
 use crate::structure::{BodyKind, JointKind};
 use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;

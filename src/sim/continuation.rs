@@ -16,9 +16,9 @@
 //! bodies go back and the increments run, starting from the Jacobian the attempt formed at the
 //! start.
 
-use super::projection::{Projection, GAP_TOLERANCE_FRACTION};
 use super::data::Data;
 use super::model::Model;
+use super::projection::{Projection, GAP_TOLERANCE_FRACTION};
 
 /// A jump is taken at once only if the first Gauss-Newton step of its projection left at most
 /// this fraction of the gap that the jump opened: a quarter, Deuflhard's bound for a

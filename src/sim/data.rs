@@ -370,7 +370,8 @@ impl Data {
             let Some(link) = m.joint_links[j] else { continue };
             let target = self.joint_command(m, j) - m.structure.joints[j].initial_coordinate;
             let Some((mb, link_id)) = self.multibody_joints.get(link.multibody_joint) else { continue };
-            let Some(current) = mb.link(link_id).map(|l| l.joint().coords()[super::joint_data::joint_free_axis(&l.joint().data)])
+            let Some(current) =
+                mb.link(link_id).map(|l| l.joint().coords()[super::joint_data::joint_free_axis(&l.joint().data)])
             else {
                 continue;
             };

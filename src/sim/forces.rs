@@ -1,8 +1,8 @@
 //! Member forces: applying the explicit ones every step, reading all of them back, and the
 //! equilibrium residual computed from them independently of the solver.
 
-use super::least_squares::SparseRows;
 use super::data::Data;
+use super::least_squares::SparseRows;
 use super::model::{Model, Tree};
 use crate::snapshot::{MemberForces, Residual};
 use crate::structure::{ActuatorTarget, ElasticLaw, JointKind, MemberKind};

@@ -17,12 +17,12 @@
 //! exactly: every body on the tree and every tree joint closed at the start (a group at rest),
 //! with the jump's first-contraction test unchanged (`continuation.rs`).
 
+use super::data::Data;
+use super::model::{GroupTree, Model, ProjectedGroup};
 use super::projection::{
     close_rows, largest_abs, Closing, Jacobian, KeptJacobian, Member, Projected, RigidRest, Twist,
     GAP_TOLERANCE_FRACTION,
 };
-use super::data::Data;
-use super::model::{GroupTree, Model, ProjectedGroup};
 use crate::structure::JointKind;
 use rapier3d_f64::prelude::*;
 

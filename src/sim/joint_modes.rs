@@ -14,9 +14,9 @@
 //! Loops closed by joints, free bodies outside the trees and joints of more than one
 //! coordinate are refused, by name.
 
-use super::modes::{ModesError, StructureMode, StructureModes, ZERO_MODE_RATIO};
 use super::data::Data;
 use super::model::Model;
+use super::modes::{ModesError, StructureMode, StructureModes, ZERO_MODE_RATIO};
 use crate::structure::{BodyKind, JointKind};
 use nalgebra::{DMatrix, DVector, Quaternion, UnitQuaternion, Vector3};
 

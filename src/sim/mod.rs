@@ -26,8 +26,8 @@ mod data;
 mod drive;
 mod forces;
 mod group_tree;
-mod joint_data;
 mod joint_coordinates;
+mod joint_data;
 mod joint_modes;
 pub(crate) mod least_squares;
 mod levels;
@@ -486,4 +486,3 @@ const MAX_CLOSED_LOOP_INCREMENT: f64 = 0.01;
 /// round-off at every increment: loosened, the furet2018 scenarios' transients moved (ticks of
 /// closest approach) for 2 to 6 % of an 8-X chain's settle.
 const INCREMENT_GAP_FRACTION: f64 = 1e-6;
-

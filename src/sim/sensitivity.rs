@@ -19,9 +19,9 @@
 //! the constraints g(q) and G = dg/dq beside them.
 
 use super::constrained_modes::Constraints;
-use super::modes::ModesError;
 use super::data::Data;
 use super::model::Model;
+use super::modes::ModesError;
 use crate::structure::{BodyKind, JointKind};
 use nalgebra::{DMatrix, DVector};
 use rapier3d_f64::prelude::*;

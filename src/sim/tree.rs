@@ -8,8 +8,8 @@
 //! recursion, the fit is left with the loops' reactions in the tree's joint coordinates: at a
 //! 10-X chain cut into plain bodies, 20 free turns instead of 180 body coordinates.
 
-use super::forces::Wrench;
 use super::data::Data;
+use super::forces::Wrench;
 use super::model::{Hang, Model, Tree};
 use crate::structure::Structure;
 

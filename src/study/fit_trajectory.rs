@@ -9,8 +9,8 @@
 //! MuJoCo's sysid differences its rollouts.
 
 use super::problem::{close_names, scenario_at, FitError, FitProblem, Measurement};
-use crate::run::sensitivity::parameter_step;
 use crate::observers::table::{Batched, MemoryTable, TableTarget};
+use crate::run::sensitivity::parameter_step;
 use crate::sim::sensitivity::derivative_from_samples;
 use arrow_array::{Array, Float64Array};
 use nalgebra::{DMatrix, DVector};

@@ -9,8 +9,8 @@ use nalgebra::{DMatrix, DVector};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use tensegrity_testbed::report::fit::FitReport;
-use tensegrity_testbed::study::{fit, sensitivity, FitParameter, FitProblem, Measurement};
 use tensegrity_testbed::scenario::{self, Override};
+use tensegrity_testbed::study::{fit, sensitivity, FitParameter, FitProblem, Measurement};
 
 /// The prism under ten loads: gravity (9.81 m/s^2 down, 6 m/s^2 sideways) and a rig's cable
 /// (50 N/m) pulling T2 from an anchor moved along x by u = -0.45 .. 0.45 m, one case a point.

@@ -3,8 +3,8 @@
 //! solve, Nelson's eigenvector formula) against the differences of the swept curve itself.
 
 use std::path::Path;
-use tensegrity_testbed::study::sensitivity;
 use tensegrity_testbed::scenario;
+use tensegrity_testbed::study::sensitivity;
 
 const ROCKER: &str = "scenarios/custom/rocker_frequency_curve.toml";
 

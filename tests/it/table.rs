@@ -86,11 +86,11 @@ fn the_trajectory_table_holds_the_settled_values_bit_for_bit() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The command line writes one table per scenario when it runs several.
-#[test]
-fn several_scenarios_get_one_table_each() {
-    let dir = std::env::temp_dir().join(format!("table-cli-{}", std::process::id()));
-    let base = dir.join("t.csv");
+/// The folder `tensegrity run` of the prism and the icosahedron wrote `--table DIR/table` to
+/// (each scenario's table beside it), the command having passed.
+fn tables_of_two_scenarios(dir: &str, table: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("{dir}-{}", std::process::id()));
+    let base = dir.join(table);
     let (code, out, err) = tensegrity(&[
         "run",
         "scenarios/custom/prism3.toml",
@@ -99,6 +99,13 @@ fn several_scenarios_get_one_table_each() {
         base.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{out}{err}");
+    dir
+}
+
+/// The command line writes one table per scenario when it runs several.
+#[test]
+fn several_scenarios_get_one_table_each() {
+    let dir = tables_of_two_scenarios("table-cli", "t.csv");
     for name in ["t-3-strut_tensegrity_prism.csv", "t-6-strut_tensegrity_icosahedron.csv"] {
         let (header, rows) = read_csv(&dir.join(name));
         assert!(header.iter().any(|h| h.starts_with("node:")) && !rows.is_empty(), "{name}");
@@ -111,16 +118,7 @@ fn several_scenarios_get_one_table_each() {
 /// with a node column and at least one row.
 #[test]
 fn several_scenarios_keep_the_arrow_format_of_the_tables_name() {
-    let dir = std::env::temp_dir().join(format!("table-cli-arrow-{}", std::process::id()));
-    let base = dir.join("t.arrow");
-    let (code, out, err) = tensegrity(&[
-        "run",
-        "scenarios/custom/prism3.toml",
-        "scenarios/custom/icosahedron6.toml",
-        "--table",
-        base.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{out}{err}");
+    let dir = tables_of_two_scenarios("table-cli-arrow", "t.arrow");
     for name in ["t-3-strut_tensegrity_prism.arrow", "t-6-strut_tensegrity_icosahedron.arrow"] {
         let file = std::fs::File::open(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
         let reader = arrow_ipc::reader::FileReader::try_new(file, None).expect("an Arrow IPC file");
