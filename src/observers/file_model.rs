@@ -256,7 +256,7 @@ pub struct ModelObserver {
     /// ticks later).
     trajectory_series: Option<TrajectorySeries>,
     /// In a motion judged extrapolated: what divides a difference from the rougher state into
-    /// the judged error (`Extrapolation::estimate_divisor`, told at the motion's start).
+    /// the judged error (`MotionStarted::estimate_divisor`).
     estimate_divisor: f64,
 }
 
@@ -725,8 +725,8 @@ impl Observer for ModelObserver {
     }
 
     fn motion_start(&mut self, start: &MotionStarted) {
-        let Some(x) = start.extrapolation else { return };
-        self.estimate_divisor = x.estimate_divisor;
+        let Some(divisor) = start.estimate_divisor else { return };
+        self.estimate_divisor = divisor;
         if let Some(tracker) = self.trajectory.as_mut() {
             tracker.note_extrapolated();
         }

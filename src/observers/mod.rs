@@ -53,7 +53,7 @@ pub struct Tick<'a> {
 
 /// In a motion judged extrapolated: the state one level rougher than the judged one
 /// (`run/levels.rs`). What an observer measures differs between it and the judged state by
-/// the motion's [`Extrapolation::estimate_divisor`] times the judged value's error.
+/// the motion's [`MotionStarted::estimate_divisor`] times the judged value's error.
 #[derive(Clone, Copy)]
 pub struct Rougher<'a> {
     pub state: &'a Snapshot,
@@ -69,20 +69,10 @@ pub struct MotionStarted<'a> {
     pub modes: &'a [ModeAtStart],
     /// The motion's time step h \[s\] (the ticks' spacing).
     pub dt_s: f64,
-    /// How the motion is judged extrapolated over the time step; None: rapier's own steps.
-    pub extrapolation: Option<Extrapolation>,
-}
-
-/// A motion judged extrapolated over the time step (`run/levels.rs`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Extrapolation {
-    /// The levels h, h/2, ... combined.
-    pub levels: usize,
-    /// The judged motion's order in the step.
-    pub order: i32,
-    /// What divides a difference between the judged state and the one a level rougher into
-    /// the judged state's error (15 at fourth order).
-    pub estimate_divisor: f64,
+    /// In a motion judged extrapolated over the time step (`run/levels.rs`): what divides a
+    /// difference between the judged state and the one a level rougher into the judged
+    /// state's error (15 at fourth order). None: rapier's own steps, not extrapolated.
+    pub estimate_divisor: Option<f64>,
 }
 
 /// What the observers see of a settle point besides its report (which holds the inputs, the

@@ -244,7 +244,7 @@ pub struct MotionObserver {
     dt_s: f64,
     /// The motion is judged extrapolated over the time step (no dispersion to correct): what
     /// divides a difference from the rougher state into the judged error
-    /// (`Extrapolation::estimate_divisor`).
+    /// (`MotionStarted::estimate_divisor`).
     estimate_divisor: Option<f64>,
 }
 
@@ -377,7 +377,7 @@ impl Observer for MotionObserver {
     fn motion_start(&mut self, start: &MotionStarted) {
         self.modes = start.modes.to_vec();
         self.dt_s = start.dt_s;
-        self.estimate_divisor = start.extrapolation.map(|x| x.estimate_divisor);
+        self.estimate_divisor = start.estimate_divisor;
     }
 
     fn finish(&mut self, report: &mut ScenarioReport) {

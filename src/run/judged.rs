@@ -8,7 +8,6 @@
 
 use super::levels::{Judged, Levels};
 use crate::mechanisms::{Mechanism, Values};
-use crate::observers::Extrapolation;
 use crate::settings::Drive;
 use crate::sim::{SimError, Simulation};
 use crate::snapshot::Snapshot;
@@ -62,9 +61,10 @@ impl JudgedMotion {
         self.drive.as_ref().map(|d| d.inputs_at(params, k as f64 * self.dt_s))
     }
 
-    /// How the motion is judged extrapolated; None: not.
-    pub fn extrapolation(&self) -> Option<Extrapolation> {
-        self.levels.as_ref().map(Levels::extrapolation)
+    /// The estimate divisor of a motion judged extrapolated (`Levels::estimate_divisor`);
+    /// None: not extrapolated.
+    pub fn estimate_divisor(&self) -> Option<f64> {
+        self.levels.as_ref().map(Levels::estimate_divisor)
     }
 
     /// The judged state after the runner's own level has stepped to `coarse`: the finer levels

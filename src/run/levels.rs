@@ -15,7 +15,6 @@
 //! trusted.
 
 use crate::mechanisms::Values;
-use crate::observers::Extrapolation;
 use crate::report::NODE_POSITIONS;
 use crate::sim::{SimError, Simulation};
 use crate::snapshot::{richardson, richardson_estimate_divisor, Snapshot};
@@ -106,13 +105,10 @@ impl Levels {
         (0..self.count()).map(|i| self.dt_s / f64::from(1u32 << i)).collect()
     }
 
-    /// How the motion is judged over these levels: their count, order and estimate divisor.
-    pub fn extrapolation(&self) -> Extrapolation {
-        Extrapolation {
-            levels: self.count(),
-            order: self.order(),
-            estimate_divisor: richardson_estimate_divisor(self.order()),
-        }
+    /// What divides the judged state's difference from the state a level rougher into its
+    /// error: 4^(K-1) - 1 for K levels.
+    pub fn estimate_divisor(&self) -> f64 {
+        richardson_estimate_divisor(self.order())
     }
 
     /// Steps the finer levels over the coarse step that ends at motion time `end_s` \[s\], a
@@ -174,7 +170,7 @@ impl Levels {
             unreachable!("three levels or more leave two values in the table's last column");
         };
         (judged.tick, judged.time_s) = (coarse.tick, coarse.time_s);
-        let divisor = self.extrapolation().estimate_divisor;
+        let divisor = self.estimate_divisor();
         let (values, rough_values) = (observe(&judged), observe(&rougher));
         let (too, rough_too) = (estimated_too(&judged), estimated_too(&rougher));
         let estimate: Values = values

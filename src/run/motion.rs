@@ -124,7 +124,7 @@ fn start_and_step(
     let levels = judged_levels(runner, m)?;
     ran.integration = integration_text(levels);
     let motion = JudgedMotion::start(&mut runner.sim, levels, m.drive.clone())?;
-    let started = MotionStarted { modes: &modes, dt_s: motion.dt_s(), extrapolation: motion.extrapolation() };
+    let started = MotionStarted { modes: &modes, dt_s: motion.dt_s(), estimate_divisor: motion.estimate_divisor() };
     for o in runner.observers.iter_mut() {
         o.motion_start(&started);
     }
