@@ -38,11 +38,11 @@ pub struct Snapshot {
 }
 
 impl Snapshot {
-    /// The force of the spring or cable `name` of structure `s` \[N\] (tension positive);
-    /// None for a strut, which has no law of its own.
+    /// The force of the spring, cable or elastic strut `name` of structure `s` \[N\] (tension
+    /// positive); None for a rigid strut, which has no law of its own.
     pub fn member_force_n(&self, s: &crate::structure::Structure, name: &str) -> Option<f64> {
         let i = s.member_id(name)?;
-        (s.members[i].kind() != crate::structure::MemberKind::Strut).then(|| self.forces.force_n.get(i).copied())?
+        (!s.members[i].is_rigid_strut()).then(|| self.forces.force_n.get(i).copied())?
     }
 
     /// A body's pose since the build (bodies are built at the identity).

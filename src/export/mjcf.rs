@@ -355,7 +355,7 @@ impl Writer<'_> {
     /// Capsules of the struts on body `b`, and its nodes as sites.
     fn geoms_and_sites(&mut self, b: usize, pad: &str) {
         let (s, o) = (self.s, self.plan.origin[b]);
-        for (_, st) in s.members_of(MemberKind::Strut) {
+        for (_, st) in s.rigid_struts() {
             let (na, nb) = (&s.nodes[st.ends().0], &s.nodes[st.ends().1]);
             if na.body != b {
                 continue;
@@ -476,12 +476,15 @@ impl Writer<'_> {
 
     fn tendons(&mut self) {
         let s = self.s;
-        if s.members.iter().all(|m| m.kind() == MemberKind::Strut) {
+        if s.members.iter().all(|m| m.is_rigid_strut()) {
             return;
         }
         let mut names = Unique::default();
         self.xml.push_str("<tendon>\n");
-        for (_, sp) in s.members_of(MemberKind::Spring) {
+        // An elastic strut pushes and pulls between its two point masses, as a spring does: a
+        // tendon spring pushes too.
+        let elastic_struts = s.members_of(MemberKind::Strut).filter(|(_, m)| !m.is_rigid_strut());
+        for (_, sp) in elastic_struts.chain(s.members_of(MemberKind::Spring)) {
             let (k, rest) = (sp.stiffness_n_per_m().unwrap_or(f64::NAN), sp.rest_length_m().unwrap_or(f64::NAN));
             let law = format!("stiffness=\"{k:?}\" springlength=\"{rest:?}\"");
             self.spatial(&names.get(&sp.name), &law, &sp.path);

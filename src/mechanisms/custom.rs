@@ -10,7 +10,7 @@ use crate::mechanisms::{
     QuantitySpec, Solution, Values,
 };
 use crate::snapshot::Snapshot;
-use crate::structure::{ActuatorTarget, MemberKind, Structure};
+use crate::structure::{ActuatorTarget, Structure};
 
 /// The mechanism built from a file's `[structure]`.
 #[derive(Clone, Debug)]
@@ -79,9 +79,8 @@ impl Custom {
             }
         }
         let size = crate::structure::structure_size(&structure);
-        let tensioned = structure.members_of(MemberKind::Spring).chain(structure.members_of(MemberKind::Cable));
-        let read_struts =
-            structure.members_of(MemberKind::Strut).filter(|(_, t)| strut_reading(&structure, t, size).is_some());
+        let tensioned = structure.members_with_law();
+        let read_struts = structure.rigid_struts().filter(|(_, t)| strut_reading(&structure, t, size).is_some());
         let members = tensioned.chain(read_struts).map(|(_, m)| &m.name);
         for name in members {
             quantities.push(QuantitySpec {
@@ -185,7 +184,7 @@ impl Custom {
                     }
                 }
             };
-            for (i, m) in s.members_of(MemberKind::Spring).chain(s.members_of(MemberKind::Cable)) {
+            for (i, m) in s.members_with_law() {
                 for (a, b) in m.segments() {
                     if a == node {
                         add(a, b, snap.forces.force_n[i]);
@@ -197,7 +196,7 @@ impl Custom {
             f
         };
         let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        s.members_of(MemberKind::Strut)
+        s.rigid_struts()
             .filter_map(|(k, st)| {
                 let reading = strut_reading(s, st, self.size_m)?;
                 let (a, b) = st.ends();
@@ -329,7 +328,7 @@ impl Mechanism for Custom {
                 v.insert(format!("{}.{c}", n.name), snap.nodes[i][k]);
             }
         }
-        for (i, m) in s.members_of(MemberKind::Spring).chain(s.members_of(MemberKind::Cable)) {
+        for (i, m) in s.members_with_law() {
             v.insert(format!("{}.force", m.name), snap.forces.force_n[i]);
         }
         for (k, f) in self.strut_forces(snap) {

@@ -14,7 +14,7 @@ use crate::report::{
     EnergyPointReport, ModelCheckReport, ModelModeReport, PointReport, ScenarioReport, StationaryReport,
 };
 use crate::snapshot::{unit, Snapshot};
-use crate::structure::{JointKind, MemberKind, Structure};
+use crate::structure::{JointKind, Structure};
 use std::cmp::Ordering;
 
 /// How a state symbol is read from a snapshot of the run's structure.
@@ -67,7 +67,7 @@ fn joint_bind(s: &Structure, name: &str, angle: bool) -> Option<Bind> {
 
 impl Bind {
     fn new(source: &Source, s: &Structure) -> Bind {
-        let tension = |name: &str| s.member_id(name).filter(|&i| s.members[i].kind() != MemberKind::Strut);
+        let tension = |name: &str| s.member_id(name).filter(|&i| !s.members[i].is_rigid_strut());
         let bound = match source {
             Source::Time => Some(Bind::Time),
             Source::Node(n, axis) => s.node_id(n).map(|i| Bind::Node(i, *axis)),
@@ -75,7 +75,7 @@ impl Bind {
             Source::SegmentForce(m, k) => s.member_id(m).map(|i| Bind::SegmentForce(i, *k)),
             Source::Slip(m, k) => s.member_id(m).map(|i| Bind::Slip(i, *k)),
             Source::MemberLength(m) => tension(m).map(Bind::MemberLength).or_else(|| {
-                let (_, t) = s.members_of(MemberKind::Strut).find(|(_, t)| &t.name == m)?;
+                let (_, t) = s.rigid_struts().find(|(_, t)| &t.name == m)?;
                 Some(Bind::StrutLength(t.ends().0, t.ends().1))
             }),
             Source::Observed(q) => Some(Bind::Observed(q.clone())),

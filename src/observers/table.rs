@@ -234,8 +234,12 @@ impl Table {
         for n in &s.nodes {
             cols.extend(["x", "y", "z"].map(|c| format!("node:{}.{c}", n.name)));
         }
-        cols.extend(s.members_of(MemberKind::Spring).map(|(_, m)| format!("spring:{}.force_n", m.name)));
-        cols.extend(s.members_of(MemberKind::Cable).map(|(_, m)| format!("cable:{}.tension_n", m.name)));
+        // Elastic struts' axial forces (tension positive), then springs' and cables'.
+        cols.extend(s.members_with_law().map(|(_, m)| match m.kind() {
+            MemberKind::Strut => format!("strut:{}.force_n", m.name),
+            MemberKind::Spring => format!("spring:{}.force_n", m.name),
+            MemberKind::Cable => format!("cable:{}.tension_n", m.name),
+        }));
         // A clustered cable's segments, and where it has friction whether each inner node slips.
         for (_, m) in s.members_of(MemberKind::Cable).filter(|(_, m)| m.is_clustered()) {
             cols.extend((1..m.path.len()).map(|k| format!("cable:{}.segment_{k}.tension_n", m.name)));
@@ -270,8 +274,7 @@ impl Table {
         v.extend(snap.nodes.iter().flatten().map(|x| Some(*x)));
         let f = &snap.forces;
         let s = t.structure;
-        let tensions =
-            s.members_of(MemberKind::Spring).chain(s.members_of(MemberKind::Cable)).map(|(i, _)| f.force_n[i]);
+        let tensions = s.members_with_law().map(|(i, _)| f.force_n[i]);
         v.extend(tensions.map(Some));
         for (i, _) in s.members_of(MemberKind::Cable).filter(|(_, m)| m.is_clustered()) {
             v.extend(f.segment_force_n[i].iter().map(|x| Some(*x)));
@@ -396,7 +399,7 @@ fn repeats_a_column(s: &crate::structure::Structure, key: &str) -> bool {
     let Some((name, what)) = key.rsplit_once('.') else { return false };
     match what {
         "x" | "y" | "z" => s.nodes.iter().any(|n| n.name == name),
-        "force" => s.members.iter().any(|m| m.kind() != MemberKind::Strut && m.name == name),
+        "force" => s.members.iter().any(|m| !m.is_rigid_strut() && m.name == name),
         _ => false,
     }
 }

@@ -79,7 +79,7 @@ fn state_symbols(s: &crate::structure::Structure, m: &dyn Mechanism, params: &Va
             add(format!("{}.{c}", n.name), Source::Node(n.name.clone(), axis));
         }
     }
-    let members = s.members_by_kind().filter(|(_, m)| m.kind() != MemberKind::Strut).map(|(_, m)| &m.name);
+    let members = s.members_with_law().map(|(_, m)| &m.name);
     for name in members {
         add(format!("{name}.force"), Source::MemberForce(name.clone()));
         add(format!("{name}.length"), Source::MemberLength(name.clone()));
@@ -92,7 +92,7 @@ fn state_symbols(s: &crate::structure::Structure, m: &dyn Mechanism, params: &Va
             add(format!("{}.slip_{k}", c.name), Source::Slip(c.name.clone(), k - 1));
         }
     }
-    for (_, st) in s.members_of(MemberKind::Strut) {
+    for (_, st) in s.rigid_struts() {
         add(format!("{}.length", st.name), Source::MemberLength(st.name.clone()));
     }
     for j in &s.joints {

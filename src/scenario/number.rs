@@ -1,6 +1,7 @@
 //! A number or an expression of the file's parameters (`r = 0.5`, `h = "2*r"`), where a
 //! scenario takes a number: `[params]` entries and the numbers of a custom `[structure]`
-//! (node coordinates, gravity, masses, inertias, radii, stiffnesses, lengths, joint axes,
+//! (node coordinates, gravity, masses, inertias, radii, stiffnesses, lengths, a strut's EA, a
+//! heavy cable's density and segments, joint axes,
 //! torsion springs, damping, initial coordinates).
 //!
 //! Parameters are evaluated in the order their expressions need (a cycle is an error), then
@@ -214,6 +215,12 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
         resolve_member(&mut m.radius, &mut m.stiffness, &mut m.length, &mut resolve)?;
         for mu in m.friction.iter_mut().flat_map(|f| f.get_mut().iter_mut()) {
             resolve(mu, "friction")?;
+        }
+        let lumped = [(&mut m.ea, "EA"), (&mut m.youngs_modulus, "E"), (&mut m.area, "area")];
+        for (v, what) in lumped.into_iter().chain([(&mut m.density, "density"), (&mut m.segments, "segments")]) {
+            if let Some(v) = v {
+                resolve(v, what)?;
+            }
         }
     }
     for g in s.strut_groups.iter_mut().chain(s.spring_groups.iter_mut()).chain(s.cable_groups.iter_mut()) {

@@ -98,7 +98,7 @@ pub(super) fn set_self_stress(
         match &mut m.law {
             Law::Cable { length_m, .. } => *length_m = rest,
             Law::Spring { rest_length_m, .. } => *rest_length_m = rest,
-            Law::Strut => {}
+            Law::Strut | Law::ElasticStrut { .. } => {}
         }
     }
     Ok(())

@@ -315,6 +315,20 @@ pub(super) struct RawMember {
     /// Cables only: the Coulomb friction coefficient at each node of `through` (a capstan,
     /// `sim/capstan.rs`); absent: none.
     pub(super) friction: Option<Spanned<Vec<Spanned<Num>>>>,
+    /// Struts only: the axial stiffness E A [N] of an elastic strut (`structure/lumped.rs`);
+    /// absent (and no `E`): rigid.
+    #[serde(rename = "EA")]
+    pub(super) ea: Option<Spanned<Num>>,
+    /// Struts only: Young's modulus [Pa], with `area`, in place of `EA`.
+    #[serde(rename = "E")]
+    pub(super) youngs_modulus: Option<Spanned<Num>>,
+    /// Struts only: the cross-section [m^2], with `E`.
+    pub(super) area: Option<Spanned<Num>>,
+    /// Cables only: linear density [kg per unstretched m] of a heavy cable, built of
+    /// `segments` segments between beads; absent: massless.
+    pub(super) density: Option<Spanned<Num>>,
+    /// Cables only, with `density`: how many segments [1, 1000].
+    pub(super) segments: Option<Spanned<Num>>,
 }
 
 #[derive(Clone, Debug, Deserialize)]

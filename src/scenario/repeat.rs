@@ -67,7 +67,9 @@ macro_rules! instantiate_table {
     };
 }
 
-instantiate_table!(RawMember { name, a, b, radius, stiffness, length, through, friction } keep {});
+instantiate_table!(RawMember {
+    name, a, b, radius, stiffness, length, through, friction, ea, youngs_modulus, area, density, segments
+} keep {});
 instantiate_table!(RawMemberGroup { name, pairs, names, radius, stiffness, length } keep {});
 instantiate_table!(RawJoint {
     name, kind, parent, child, at, axis, axis2, torsion_stiffness, torsion_rest, damping, initial_coordinate

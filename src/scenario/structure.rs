@@ -2,6 +2,7 @@
 //! built into a [`Structure`].
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
+use super::number::Num;
 use super::raw::RawMemberGroup;
 use super::raw::{RawActuator, RawBody, RawJoint, RawMember, RawStructure, Xyz};
 use crate::structure::{
@@ -46,7 +47,105 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
     s.joints = r.joints.iter().map(|j| joint(ctx, &s, j)).collect::<Result<_, _>>()?;
     s.actuators = r.actuators.iter().map(|a| actuator(ctx, &s, a)).collect::<Result<_, _>>()?;
     s.validate().map_err(|e| structure_error_at(ctx, raw, e))?;
+    lump_members(ctx, &mut s, r)?;
     Ok(s)
+}
+
+/// Builds the elastic struts (`EA`, or `E` with `area`), then the heavy cables (`density`
+/// with `segments`), of point masses (`structure/lumped.rs`); a key that a member's kind
+/// cannot take is an error at the key.
+fn lump_members(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(), ScenarioError> {
+    for m in r.springs.iter() {
+        refuse_keys(
+            ctx,
+            m,
+            "spring",
+            &[
+                ("EA", &m.ea),
+                ("E", &m.youngs_modulus),
+                ("area", &m.area),
+                ("density", &m.density),
+                ("segments", &m.segments),
+            ],
+        )?;
+    }
+    for (i, m) in r.struts.iter().enumerate() {
+        refuse_keys(ctx, m, "strut", &[("density", &m.density), ("segments", &m.segments)])?;
+        if let Some((at, ea)) = axial_stiffness(ctx, m)? {
+            crate::structure::lumped::make_strut_elastic(s, i, ea).map_err(|e| ctx.err(at, e.to_string()))?;
+        }
+    }
+    let first_cable = r.struts.len() + r.springs.len();
+    for (j, m) in r.cables.iter().enumerate() {
+        refuse_keys(ctx, m, "cable", &[("EA", &m.ea), ("E", &m.youngs_modulus), ("area", &m.area)])?;
+        match (&m.density, &m.segments) {
+            (None, None) => {}
+            (None, Some(n)) => {
+                return Err(ctx.err(n, "segments means nothing without density: a heavy cable's mass per metre (kg/m)"))
+            }
+            (Some(d), None) => {
+                return Err(ctx.err(
+                    d,
+                    format!(
+                    "a heavy cable needs segments: how many elastic segments between beads it is built of (1 to {})",
+                    crate::structure::lumped::MAX_CABLE_SEGMENTS
+                ),
+                ))
+            }
+            (Some(d), Some(n)) => {
+                let density = positive_value(ctx, d, "density (kg/m)")?;
+                let count = segment_count(ctx, n)?;
+                crate::structure::lumped::hang_beads(s, first_cable + j, density, count)
+                    .map_err(|e| ctx.err(d, e.to_string()))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `keys` given on a member of kind `what`, which cannot take them: an error at the first.
+fn refuse_keys(
+    ctx: &Ctx,
+    m: &RawMember,
+    what: &str,
+    keys: &[(&str, &Option<Spanned<Num>>)],
+) -> Result<(), ScenarioError> {
+    let Some((key, v)) = keys.iter().find_map(|(k, v)| v.as_ref().map(|v| (k, v))) else { return Ok(()) };
+    let meaning = match *key {
+        "EA" | "E" | "area" => "a strut's axial stiffness",
+        _ => "a cable's mass",
+    };
+    Err(ctx.err(v, format!("{key}: {} '{}' is a {what}; {key} states {meaning}", what, m.name.get_ref())))
+}
+
+/// A strut's axial stiffness E A [N] from `EA`, or from `E` [Pa] and `area` [m^2], with the key
+/// it is read at; None for a rigid strut.
+fn axial_stiffness<'a>(ctx: &Ctx, m: &'a RawMember) -> Result<Option<(&'a Spanned<Num>, f64)>, ScenarioError> {
+    match (&m.ea, &m.youngs_modulus, &m.area) {
+        (None, None, None) => Ok(None),
+        (Some(ea), None, None) => Ok(Some((ea, positive_value(ctx, ea, "EA (N)")?))),
+        (Some(_), Some(e), _) => Err(ctx.err(e, "E: the strut states EA already (give EA, or E with area)")),
+        (Some(_), None, Some(a)) => Err(ctx.err(a, "area: the strut states EA already (give EA, or E with area)")),
+        (None, Some(e), Some(a)) => {
+            let ea = positive_value(ctx, e, "E (Pa)")? * positive_value(ctx, a, "area (m^2)")?;
+            if !ea.is_finite() {
+                return Err(ctx.err(e, format!("E times area is {ea} N: not finite")));
+            }
+            Ok(Some((e, ea)))
+        }
+        (None, Some(e), None) => Err(ctx.err(e, "E needs area, the strut's cross-section (m^2)")),
+        (None, None, Some(a)) => Err(ctx.err(a, "area needs E, Young's modulus (Pa), or give EA (N)")),
+    }
+}
+
+/// A heavy cable's segment count: a whole number from 1 to the bound.
+fn segment_count(ctx: &Ctx, n: &Spanned<Num>) -> Result<usize, ScenarioError> {
+    let x = finite(ctx, n, "segments")?;
+    let max = crate::structure::lumped::MAX_CABLE_SEGMENTS;
+    if x.fract() != 0.0 || !(1.0..=max as f64).contains(&x) {
+        return Err(ctx.err(n, format!("segments must be a whole number from 1 to {max}, got {x}")));
+    }
+    Ok(x as usize)
 }
 
 /// A structure error at the entry it names (a joint, a member, an actuator or a body), else at
@@ -491,6 +590,11 @@ pub(super) fn group_members(ctx: &Ctx, g: &RawMemberGroup) -> Result<Vec<RawMemb
             length: g.length.clone(),
             through: None,
             friction: None,
+            ea: None,
+            youngs_modulus: None,
+            area: None,
+            density: None,
+            segments: None,
         });
     }
     Ok(out)

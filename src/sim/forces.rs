@@ -193,7 +193,7 @@ impl Data {
         let inv_h = m.settings.substeps as f64 / m.settings.dt_s;
         for (i, member) in s.members_by_kind() {
             let (l, force, segments) = match (member.kind(), self.elastic_law(m, i)) {
-                (MemberKind::Strut, _) => (self.member_length_m(m, i), 0.0, Vec::new()),
+                (MemberKind::Strut, None) => (self.member_length_m(m, i), 0.0, Vec::new()),
                 (_, Some(law)) => pull(i, &|l| law.tension_n(l)),
                 // Held at its length by the projection: its tension is fitted later.
                 (_, None) if held[i] => pull(i, &|_| 0.0),

@@ -59,6 +59,15 @@ pub enum Law {
     /// A compression member drawn between two nodes of the same body (or of two bodies joined
     /// at its ends). It carries no force law of its own: it is rigid through its body.
     Strut,
+    /// An elastic strut (a bar): its two nodes are point masses of their own
+    /// (`structure/lumped.rs`), and it pushes and pulls along its axis with the axial stiffness
+    /// EA / L: force = stiffness (l - rest_length).
+    ElasticStrut {
+        /// EA / L \[N/m\].
+        stiffness_n_per_m: f64,
+        /// Its length unloaded \[m\].
+        rest_length_m: f64,
+    },
     /// A linear spring that pushes as well as pulls: force = stiffness (l - rest_length).
     Spring {
         stiffness_n_per_m: f64,
@@ -112,7 +121,7 @@ impl Member {
 
     pub fn kind(&self) -> MemberKind {
         match self.law {
-            Law::Strut => MemberKind::Strut,
+            Law::Strut | Law::ElasticStrut { .. } => MemberKind::Strut,
             Law::Spring { .. } => MemberKind::Spring,
             Law::Cable { .. } => MemberKind::Cable,
         }
@@ -145,19 +154,22 @@ impl Member {
     }
 
     /// The length it has no force at as drawn \[m\]: a spring's rest length, a cable's
-    /// unstretched length; None for a strut.
+    /// unstretched length, an elastic strut's unloaded length; None for a rigid strut.
     pub fn rest_length_m(&self) -> Option<f64> {
         match self.law {
             Law::Strut => None,
-            Law::Spring { rest_length_m, .. } => Some(rest_length_m),
+            Law::Spring { rest_length_m, .. } | Law::ElasticStrut { rest_length_m, .. } => Some(rest_length_m),
             Law::Cable { length_m, .. } => Some(length_m),
         }
     }
 
-    /// The stiffness of its elastic law \[N/m\]: None for a strut and an inextensible cable.
+    /// The stiffness of its elastic law \[N/m\]: None for a rigid strut and an inextensible
+    /// cable.
     pub fn stiffness_n_per_m(&self) -> Option<f64> {
         match self.law {
-            Law::Spring { stiffness_n_per_m, .. } => Some(stiffness_n_per_m),
+            Law::Spring { stiffness_n_per_m, .. } | Law::ElasticStrut { stiffness_n_per_m, .. } => {
+                Some(stiffness_n_per_m)
+            }
             Law::Cable { law: CableLaw::Elastic { stiffness_n_per_m }, .. } => Some(stiffness_n_per_m),
             Law::Strut | Law::Cable { law: CableLaw::Inextensible, .. } => None,
         }
@@ -169,6 +181,11 @@ impl Member {
             Law::Cable { law, .. } => Some(law),
             _ => None,
         }
+    }
+
+    /// A strut rigid through its body, with no force law of its own (an elastic strut has one).
+    pub fn is_rigid_strut(&self) -> bool {
+        matches!(self.law, Law::Strut)
     }
 
     pub fn is_inextensible_cable(&self) -> bool {

@@ -7,6 +7,7 @@
 
 use std::collections::BTreeMap;
 
+pub mod lumped;
 mod member;
 pub use member::*;
 
@@ -241,6 +242,17 @@ impl Structure {
     /// forces add up alike however its builder interleaved the kinds.
     pub fn members_by_kind(&self) -> impl Iterator<Item = (MemberId, &Member)> + '_ {
         [MemberKind::Strut, MemberKind::Spring, MemberKind::Cable].into_iter().flat_map(|k| self.members_of(k))
+    }
+
+    /// Every member whose force follows from its length (springs, cables, elastic struts), with
+    /// its index, in [`Self::members_by_kind`]'s order; a rigid strut has no law of its own.
+    pub fn members_with_law(&self) -> impl Iterator<Item = (MemberId, &Member)> + '_ {
+        self.members_by_kind().filter(|(_, m)| !m.is_rigid_strut())
+    }
+
+    /// The rigid struts with their indices, in their order.
+    pub fn rigid_struts(&self) -> impl Iterator<Item = (MemberId, &Member)> + '_ {
+        self.members_of(MemberKind::Strut).filter(|(_, m)| m.is_rigid_strut())
     }
 
     /// How many members of one kind there are.

@@ -24,6 +24,7 @@ mod frequency_slope;
 mod function_length;
 mod furet2018_dynamics;
 mod fuzz_scenarios;
+mod heavy_members;
 mod hostile;
 mod import_matrices;
 mod import_ntrt;

@@ -4,7 +4,6 @@
 
 use super::super::data::Data;
 use super::super::model::Model;
-use crate::structure::MemberKind;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix3x6, Matrix6, Vector3};
 use rapier3d_f64::prelude::*;
 use std::ops::AddAssign;
@@ -172,7 +171,7 @@ impl Data {
         }
         let mut anchors_of = vec![Vec::new(); n];
         let mut own_nodes = vec![Vec::new(); n];
-        let ends = s.members_by_kind().filter(|(_, m)| m.kind() != MemberKind::Strut).flat_map(|(_, m)| m.segments());
+        let ends = s.members_with_law().flat_map(|(_, m)| m.segments());
         for (a, b) in ends {
             for node in [a, b] {
                 if let Some(i) = dofs.index[s.nodes[node].body] {

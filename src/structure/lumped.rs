@@ -1,0 +1,157 @@
+//! Past the rigid strut and the massless cable: members built of point masses.
+//!
+//! - **An elastic strut** (a bar of axial stiffness EA): its body, which carries the strut's two
+//!   nodes and nothing else, becomes two point masses of half its mass each, one at each node,
+//!   and the strut a member that pushes and pulls with the stiffness EA / L
+//!   ([`Law::ElasticStrut`]): the lumped-mass bar of structural dynamics. Its axial frequency is
+//!   omega = sqrt(k (1/m_a + 1/m_b)) = 2 sqrt(EA / (m L)) with its ends free (the continuous
+//!   bar's is pi sqrt(EA / (m L))); its inertia about its middle is m L^2 / 4 (a uniform rigid
+//!   bar's m L^2 / 12), and it does not spin about its axis.
+//! - **A heavy cable** (linear density rho, n segments): n elastic segments of stiffness n k and
+//!   unstretched length L0 / n between n - 1 beads of mass rho L0 / n each, drawn evenly on the
+//!   straight line between its ends; the half segments at its ends, rho L0 / (2 n) each, rest on
+//!   the end nodes' bodies (taken by a fixed body, added to a point mass). rho is per unstretched
+//!   metre, so the cable's mass, rho L0, does not change as it stretches.
+//!
+//! Both are made of members and free bodies the simulator already has, so the settle, the
+//! modes, the motion, the sensitivities, interference, the table and the recording read them as
+//! they read any spring, cable and body. A point mass is a free body with one node at its centre
+//! of mass, so no member turns it: its turning is three zero modes.
+
+use super::{distance, BodyKind, Inertia, Law, MemberId, Structure, Vec3};
+
+/// The most segments a heavy cable may be built of.
+pub const MAX_CABLE_SEGMENTS: usize = 1000;
+
+/// Why a member cannot be built of point masses; the message names it and says what would do.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error("{0}")]
+pub struct LumpError(pub String);
+
+/// A point mass of `mass_kg` at `com`: its turning is a zero mode that no force drives, so its
+/// moments only need to be in the simulation's range: a rod's of the length it stands for,
+/// `length_m` (a bead's segment, half an elastic strut), m l^2 / 12 about every axis [kg m^2].
+fn bead_inertia(mass_kg: f64, com: Vec3, length_m: f64) -> Inertia {
+    Inertia { mass_kg, com, principal_kg_m2: [mass_kg * length_m * length_m / 12.0; 3] }
+}
+
+/// Whether body `b` is a point mass: free, with one node, at its centre of mass.
+fn is_point_mass(s: &Structure, b: usize) -> bool {
+    let mut nodes = s.nodes.iter().filter(|n| n.body == b);
+    let (Some(node), None) = (nodes.next(), nodes.next()) else { return false };
+    s.bodies[b].inertia.is_some_and(|i| i.com == node.position)
+}
+
+/// Makes strut `strut` elastic with axial stiffness `ea_n` = E A \[N\]: its body's mass halved
+/// onto two point masses at its nodes, the strut pushing and pulling with EA / L about its
+/// drawn length L.
+pub fn make_strut_elastic(s: &mut Structure, strut: MemberId, ea_n: f64) -> Result<(), LumpError> {
+    let name = s.members[strut].name.clone();
+    let (a, b) = s.members[strut].ends();
+    let body = s.nodes[a].body;
+    let whose = s.bodies[body].name.clone();
+    let refuse = |why: String| Err(LumpError(format!("elastic strut '{name}': {why}")));
+    if s.nodes[b].body != body {
+        return refuse("its two nodes lie on two bodies; an elastic strut's body carries its two nodes".into());
+    }
+    let Some(inertia) = s.bodies[body].inertia.filter(|_| s.bodies[body].kind == BodyKind::Free) else {
+        return refuse(format!(
+            "its body '{whose}' is fixed; an elastic strut's body is free (its mass is the strut's)"
+        ));
+    };
+    if s.nodes.iter().enumerate().any(|(n, node)| node.body == body && n != a && n != b) {
+        return refuse(format!(
+            "its body '{whose}' carries other nodes; an elastic strut's body carries its two nodes alone"
+        ));
+    }
+    if let Some(j) = s.joints.iter().find(|j| j.parent == body || j.child == body) {
+        return refuse(format!(
+            "joint '{}' holds its body '{whose}'; an elastic strut's ends are held by members",
+            j.name
+        ));
+    }
+    if s.loads.iter().any(|l| l.body == body) {
+        return refuse(format!("a load acts on its body '{whose}'"));
+    }
+    let half = 0.5 * inertia.mass_kg;
+    let length = distance(s.nodes[a].position, s.nodes[b].position);
+    let end_b = format!("{whose}_{}", s.nodes[b].name);
+    if s.body_id(&end_b).is_some() {
+        return refuse(format!("its end body would be named '{end_b}', a name the structure already has"));
+    }
+    s.bodies[body].inertia = Some(bead_inertia(half, s.nodes[a].position, 0.5 * length));
+    let new = s.add_body(&end_b, BodyKind::Free, Some(bead_inertia(half, s.nodes[b].position, 0.5 * length)));
+    s.nodes[b].body = new;
+    s.members[strut].law = Law::ElasticStrut { stiffness_n_per_m: ea_n / length, rest_length_m: length };
+    Ok(())
+}
+
+/// Builds cable `cable` of `segments` elastic segments between beads, its linear density
+/// `density_kg_per_m` \[kg per unstretched m\]: the segments are named `{cable}_s1` ..
+/// `{cable}_s{n}` from its node `a`, the beads (a body and a node each) `{cable}_b1` ..
+/// `{cable}_b{n-1}`.
+pub fn hang_beads(s: &mut Structure, cable: MemberId, density_kg_per_m: f64, segments: usize) -> Result<(), LumpError> {
+    let member = s.members[cable].clone();
+    let name = &member.name;
+    let refuse = |why: String| Err(LumpError(format!("heavy cable '{name}': {why}")));
+    let (Law::Cable { length_m, .. }, Some(k)) = (&member.law, member.stiffness_n_per_m()) else {
+        return refuse("it needs a stiffness (N/m): an inextensible heavy cable is not modelled".into());
+    };
+    if member.is_clustered() {
+        return refuse("it runs through inner nodes: a heavy clustered cable is not modelled".into());
+    }
+    if !(1..=MAX_CABLE_SEGMENTS).contains(&segments) {
+        return refuse(format!("segments is {segments}: from 1 to {MAX_CABLE_SEGMENTS}"));
+    }
+    if s.actuators.iter().any(|a| a.target == super::ActuatorTarget::CableLength(cable)) {
+        return refuse("a winch drives it: a heavy cable's length is not actuated".into());
+    }
+    let (a, b) = member.ends();
+    let (l0, n) = (*length_m, segments as f64);
+    let end_mass = density_kg_per_m * l0 / (2.0 * n);
+    for end in [a, b] {
+        let body = s.nodes[end].body;
+        if s.bodies[body].kind == BodyKind::Free && !is_point_mass(s, body) {
+            return refuse(format!(
+                "it ends on node '{}' of free body '{}', which is not a point mass: its end's share of the cable's mass ({end_mass:e} kg) has no place there (make that strut elastic, or hang the cable from a fixed body)",
+                s.nodes[end].name, s.bodies[body].name
+            ));
+        }
+    }
+    let names: Vec<String> = (1..segments).map(|i| format!("{name}_b{i}")).collect();
+    let members = (1..=segments).map(|k| format!("{name}_s{k}"));
+    let taken = names.iter().find(|b| s.body_id(b).is_some() || s.node_id(b).is_some()).cloned();
+    if let Some(b) = taken.or_else(|| members.clone().find(|m| s.member_id(m).is_some())) {
+        return refuse(format!("it would name a part '{b}', a name the structure already has"));
+    }
+    for end in [a, b] {
+        let body = s.nodes[end].body;
+        let free = s.bodies[body].kind == BodyKind::Free;
+        if let Some(i) = s.bodies[body].inertia.as_mut().filter(|_| free) {
+            let grown = (i.mass_kg + end_mass) / i.mass_kg;
+            i.mass_kg += end_mass;
+            i.principal_kg_m2 = i.principal_kg_m2.map(|m| m * grown);
+        }
+    }
+    let (pa, pb) = (s.nodes[a].position, s.nodes[b].position);
+    let mut path = vec![a];
+    for (i, bead) in names.iter().enumerate() {
+        let t = (i + 1) as f64 / n;
+        let at = [0, 1, 2].map(|c| pa[c] + t * (pb[c] - pa[c]));
+        let inertia = bead_inertia(density_kg_per_m * l0 / n, at, l0 / n);
+        let body = s.add_body(bead, BodyKind::Free, Some(inertia));
+        path.push(s.add_node(bead, body, at));
+    }
+    path.push(b);
+    let law = super::CableLaw::Elastic { stiffness_n_per_m: k * n };
+    for (k, w) in path.windows(2).enumerate() {
+        let segment =
+            super::Member::cable(format!("{name}_s{}", k + 1), w.to_vec(), law.clone(), l0 / n, member.radius_m);
+        if k == 0 {
+            s.members[cable] = segment;
+        } else {
+            s.members.push(segment);
+        }
+    }
+    Ok(())
+}

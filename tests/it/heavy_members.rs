@@ -1,0 +1,196 @@
+//! Past the rigid strut and the massless cable (`structure/lumped.rs`): heavy cables built of
+//! beads and elastic segments, elastic struts built of two point masses and an axial member,
+//! each against an exact result.
+
+use super::common;
+use std::path::Path;
+use tensegrity_testbed::run::{self, settle_first_point, RunOptions};
+use tensegrity_testbed::scenario;
+
+const BEADED: &str = "scenarios/custom/beaded_string.toml";
+
+/// The beaded string's numbers (the shipped file's parameters): N segments, span, L0, k, rho.
+const SEGMENTS: usize = 6;
+const SPAN_M: f64 = 1.2;
+const L0_M: f64 = 1.0;
+const K_N_PER_M: f64 = 500.0;
+const RHO_KG_PER_M: f64 = 0.3;
+
+/// omega_j = 2 sqrt(T / (m a)) sin(j pi / (2 (n + 1))) of n = N - 1 beads [rad/s].
+fn beaded_transverse(j: usize) -> f64 {
+    let (n, tension) = (SEGMENTS as f64, K_N_PER_M * (SPAN_M - L0_M));
+    let (m, a) = (RHO_KG_PER_M * L0_M / n, SPAN_M / n);
+    2.0 * (tension / (m * a)).sqrt() * (j as f64 * std::f64::consts::PI / (2.0 * n)).sin()
+}
+
+/// The same with T / a replaced by a segment's stiffness N k: the axial frequencies [rad/s].
+fn beaded_axial(j: usize) -> f64 {
+    let n = SEGMENTS as f64;
+    let m = RHO_KG_PER_M * L0_M / n;
+    2.0 * (n * K_N_PER_M / m).sqrt() * (j as f64 * std::f64::consts::PI / (2.0 * n)).sin()
+}
+
+/// The non-zero modal frequencies of a scenario's settled first point, ascending, with each
+/// one's mode number (from 1, the zero modes counted) [rad/s].
+fn modal_frequencies(path: &str, text: &str) -> Vec<(usize, f64)> {
+    let sc = scenario::parse(Path::new(path), text).expect("valid");
+    let mut state = settle_first_point(&sc, None).expect("settles");
+    assert!(state.settled, "{path} settles");
+    let modes = state.sim.modes().expect("modes");
+    modes.modes.iter().enumerate().filter(|(_, m)| !m.rigid).map(|(i, m)| (i + 1, m.omega())).collect()
+}
+
+/// n = 5 beads: the modal analysis gives each transverse frequency twice (the two planes) and
+/// each axial one once, every one within 1e-9 of the closed form (measured: 1e-15 to 3e-15),
+/// and nothing else; the beads' turning is 15 zero modes.
+#[test]
+fn the_beaded_strings_modes_are_the_closed_form_within_1e_9() {
+    let text = std::fs::read_to_string(BEADED).unwrap();
+    let got = modal_frequencies(BEADED, &text);
+    let n = SEGMENTS - 1;
+    let mut want: Vec<f64> =
+        (1..=n).flat_map(|j| [beaded_transverse(j), beaded_transverse(j), beaded_axial(j)]).collect();
+    want.sort_by(f64::total_cmp);
+    assert_eq!(got.len(), want.len(), "{got:?}");
+    assert_eq!(got[0].0, 16, "the first non-zero mode follows the beads' 15 turns");
+    for ((_, g), w) in got.iter().zip(&want) {
+        assert!(((g - w) / w).abs() <= 1e-9, "{g} vs {w}");
+    }
+}
+
+/// Each of the five transverse modes, displaced and left to vibrate: the frequency fitted to
+/// its coordinate meets the closed form within 1e-9 relative (the judged motion's own estimate
+/// below it), as the shipped file does for the first.
+#[test]
+fn the_beaded_strings_motion_gives_every_transverse_frequency_within_1e_9() {
+    let text = std::fs::read_to_string(BEADED).unwrap();
+    let modal = modal_frequencies(BEADED, &text);
+    for j in 1..=SEGMENTS - 1 {
+        let w = beaded_transverse(j);
+        let (mode, _) = *modal.iter().find(|(_, g)| ((g - w) / w).abs() <= 1e-9).expect("the mode");
+        let variant = common::edited(
+            BEADED,
+            &[
+                ("mode = 16             #", &format!("mode = {mode}             #")),
+                ("mode = 16\nformula = \"w0*sin(1*pi", &format!("mode = {mode}\nformula = \"w0*sin({j}*pi")),
+            ],
+        );
+        let sc = scenario::parse(Path::new("beaded.toml"), &variant).expect("valid");
+        let report = run::run(&sc, &RunOptions::default());
+        assert!(report.passed, "j = {j}: {}", report.verdict_line());
+        let f = &report.motion.as_ref().expect("motion").frequencies[0];
+        assert!(f.error <= 1e-9, "j = {j}: {}", f.error);
+        assert!(f.simulation_error.is_some_and(|e| e <= 1e-9), "j = {j}: {:?}", f.simulation_error);
+    }
+}
+
+const CATENARY: &str = "scenarios/custom/catenary.toml";
+
+/// The catenary's numbers (the shipped file's parameters).
+const CAT_L0_M: f64 = 10.0;
+const CAT_EA_N: f64 = 1e4;
+const CAT_RHO_KG_PER_M: f64 = 0.5;
+const CAT_G: f64 = 9.81;
+const CAT_H_N: f64 = 30.0;
+const CAT_VA_N: f64 = 30.0;
+
+/// Irvine's elastic catenary at unstretched arc length `s` from A: (x, z) [m].
+fn irvine(s: f64) -> [f64; 2] {
+    let (h, va, w, ea) = (CAT_H_N, CAT_VA_N, CAT_RHO_KG_PER_M * CAT_G, CAT_EA_N);
+    let v = va - w * s;
+    let x = h * s / ea + (h / w) * ((va / h).asinh() - (v / h).asinh());
+    let z = -(w * s / ea) * (va / w - s / 2.0)
+        - (h / w) * ((1.0 + (va / h).powi(2)).sqrt() - (1.0 + (v / h).powi(2)).sqrt());
+    [x, z]
+}
+
+/// The catenary file with `segments` segments, its predictions left out (they name beads of
+/// N = 20), so that any N runs.
+fn catenary_with(segments: usize) -> tensegrity_testbed::report::ScenarioReport {
+    let text = std::fs::read_to_string(CATENARY).unwrap();
+    let head = &text[..text.find("# Each bead against").expect("the predictions")];
+    let text = format!("{head}\n[expect]\nverdict = \"pass\"\n").replacen(
+        "N = { value = 20,",
+        &format!("N = {{ value = {segments},"),
+        1,
+    );
+    let sc = scenario::parse(Path::new("catenary.toml"), &text).expect("valid");
+    let report = run::run(&sc, &RunOptions::default());
+    assert!(report.passed && report.points[0].settled, "N = {segments}: {}", report.verdict_line());
+    report
+}
+
+/// The beads of the lumped chain of `segments` segments between A = 0 and B, solved exactly:
+/// every segment carries (H, Z_1 + (j - 1) m g) (each bead's weight m g added, the anchors
+/// taking the end halves), is straight and stretched to l0 / N (1 + T / EA); Newton on
+/// (H, Z_1) puts its end at B. Returns the bead positions (x, z) [m].
+fn discrete_chain(segments: usize, b: [f64; 2]) -> Vec<[f64; 2]> {
+    let n = segments as f64;
+    let weight = CAT_RHO_KG_PER_M * CAT_L0_M / n * CAT_G;
+    let walk = |h: f64, z1: f64| -> Vec<[f64; 2]> {
+        let mut p = [0.0, 0.0];
+        let mut out = Vec::new();
+        for j in 0..segments {
+            let (fx, fz) = (h, z1 + j as f64 * weight);
+            let t = fx.hypot(fz);
+            let l = CAT_L0_M / n * (1.0 + t / CAT_EA_N);
+            p = [p[0] + l * fx / t, p[1] + l * fz / t];
+            out.push(p);
+        }
+        out
+    };
+    let (mut h, mut z1) = (CAT_H_N, -CAT_VA_N);
+    for _ in 0..50 {
+        let end = |h: f64, z1: f64| *walk(h, z1).last().unwrap();
+        let r = end(h, z1);
+        let (f0, f1) = (r[0] - b[0], r[1] - b[1]);
+        let d = 1e-6;
+        let (eh, ez) = (end(h + d, z1), end(h, z1 + d));
+        let j = [[(eh[0] - r[0]) / d, (ez[0] - r[0]) / d], [(eh[1] - r[1]) / d, (ez[1] - r[1]) / d]];
+        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+        h -= (j[1][1] * f0 - j[0][1] * f1) / det;
+        z1 -= (-j[1][0] * f0 + j[0][0] * f1) / det;
+    }
+    let mut beads = walk(h, z1);
+    beads.pop();
+    beads
+}
+
+/// The settled beads are the lumped chain's own equilibrium, solved apart (Newton on its two
+/// end forces), within 1e-9 m: the simulation adds nothing to the discretisation's error.
+#[test]
+fn the_catenarys_beads_are_the_discrete_chains_equilibrium_within_1e_9_m() {
+    let report = common::run_file(CATENARY);
+    assert!(report.points[0].settled);
+    let b = irvine(CAT_L0_M);
+    for (i, want) in discrete_chain(20, b).iter().enumerate() {
+        let got = common::node(&report, &format!("cable_b{}", i + 1));
+        let err = (got[0] - want[0]).hypot(got[2] - want[1]);
+        assert!(err <= 1e-9 && got[1].abs() <= 1e-12, "bead {}: {got:?} vs {want:?} ({err:e} m)", i + 1);
+    }
+}
+
+/// Against Irvine's continuous catenary the lumped chain's error falls as 1/N^2: the largest
+/// bead error over N = 10, 20, 40 has a fitted order within 0.1 of 2 (measured: 2.00), and is
+/// 2.2e-3 m at the shipped N = 20.
+#[test]
+fn the_catenarys_error_against_irvine_falls_as_the_square_of_the_segment_length() {
+    let counts = [10usize, 20, 40];
+    let errors: Vec<f64> = counts
+        .iter()
+        .map(|&n| {
+            let report = catenary_with(n);
+            (1..n)
+                .map(|i| {
+                    let got = common::node(&report, &format!("cable_b{i}"));
+                    let want = irvine(i as f64 * CAT_L0_M / n as f64);
+                    (got[0] - want[0]).hypot(got[2] - want[1])
+                })
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    let lengths: Vec<f64> = counts.iter().map(|&n| CAT_L0_M / n as f64).collect();
+    let order = common::fitted_order(&lengths, &errors);
+    assert!((order - 2.0).abs() <= 0.1, "order {order}, errors {errors:?}");
+    assert!(errors[1] <= 2.5e-3, "{errors:?}");
+}
