@@ -78,6 +78,22 @@ pub(super) fn physical(
             )));
         }
     }
+    if let Some((omega, b)) = crate::structure::lumped::fastest_point_mass(s) {
+        let limit = crate::structure::lumped::STABLE_OMEGA_DT;
+        if omega * sim.dt_s >= limit {
+            let message = format!(
+                "point mass '{}' vibrates up to {omega:.4e} rad/s on its members (2 sum k / m), and omega dt = {:.3} with sim.dt = {} s: the step is unstable from {limit}; make sim.dt smaller than {:.3e} s, or the members softer",
+                s.bodies[b].name,
+                omega * sim.dt_s,
+                sim.dt_s,
+                limit / omega
+            );
+            return Err(match &raw.sim.dt {
+                Some(dt) => ctx.err(dt, message),
+                None => at_model(message),
+            });
+        }
+    }
     let half = sim.bounding_box_m;
     if let Some(n) = s.nodes.iter().find(|n| n.position.iter().any(|c| c.abs() > half)) {
         let message = format!(

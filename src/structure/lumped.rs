@@ -36,10 +36,33 @@ fn bead_inertia(mass_kg: f64, com: Vec3, length_m: f64) -> Inertia {
 }
 
 /// Whether body `b` is a point mass: free, with one node, at its centre of mass.
-fn is_point_mass(s: &Structure, b: usize) -> bool {
+pub fn is_point_mass(s: &Structure, b: usize) -> bool {
     let mut nodes = s.nodes.iter().filter(|n| n.body == b);
     let (Some(node), None) = (nodes.next(), nodes.next()) else { return false };
     s.bodies[b].inertia.is_some_and(|i| i.com == node.position)
+}
+
+/// The step's stability limit on omega dt: the symplectic Euler step of an undamped oscillator
+/// grows without bound beyond it.
+pub const STABLE_OMEGA_DT: f64 = 2.0;
+
+/// The fastest a point mass can vibrate on the members that hold it, by Gershgorin's bound on
+/// M^-1 K: omega^2 <= 2 sum k / m over its members \[rad/s\], with the point mass that gives
+/// it; None without a point mass held by an elastic member. For the beaded string and for an
+/// elastic strut's ends the bound is the discretisation's own highest frequency to within its
+/// last mode's sine (2 sqrt(k / m)).
+pub fn fastest_point_mass(s: &Structure) -> Option<(f64, usize)> {
+    let mut held = vec![0.0; s.bodies.len()];
+    for m in &s.members {
+        let Some(k) = m.stiffness_n_per_m() else { continue };
+        for n in &m.path {
+            held[s.nodes[*n].body] += k;
+        }
+    }
+    (0..s.bodies.len())
+        .filter(|&b| held[b] > 0.0 && is_point_mass(s, b))
+        .map(|b| ((2.0 * held[b] / s.bodies[b].inertia.map_or(f64::NAN, |i| i.mass_kg)).sqrt(), b))
+        .max_by(|x, y| x.0.total_cmp(&y.0))
 }
 
 /// Makes strut `strut` elastic with axial stiffness `ea_n` = E A \[N\]: its body's mass halved

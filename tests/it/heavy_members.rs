@@ -194,3 +194,154 @@ fn the_catenarys_error_against_irvine_falls_as_the_square_of_the_segment_length(
     assert!((order - 2.0).abs() <= 0.1, "order {order}, errors {errors:?}");
     assert!(errors[1] <= 2.5e-3, "{errors:?}");
 }
+
+const PRISM_ELASTIC: &str = "scenarios/custom/prism3_elastic.toml";
+
+/// A pin-jointed structure's equilibrium solved apart from the simulator: the positions of the
+/// nodes on free bodies (every one a point mass here) that zero the net force of the members'
+/// laws on each, by Levenberg-Marquardt from the drawing (the Jacobian by central differences;
+/// the damping keeps the step finite along a free turn). Returns every node's position [m].
+fn pin_jointed_equilibrium(s: &tensegrity_testbed::structure::Structure) -> Vec<[f64; 3]> {
+    use nalgebra::{DMatrix, DVector};
+    use tensegrity_testbed::structure::BodyKind;
+    let free: Vec<usize> = (0..s.nodes.len()).filter(|&n| s.bodies[s.nodes[n].body].kind == BodyKind::Free).collect();
+    let place = |x: &DVector<f64>| {
+        let mut p: Vec<[f64; 3]> = s.nodes.iter().map(|n| n.position).collect();
+        for (k, &n) in free.iter().enumerate() {
+            p[n] = [x[3 * k], x[3 * k + 1], x[3 * k + 2]];
+        }
+        p
+    };
+    let residual = |x: &DVector<f64>| {
+        let p = place(x);
+        let mut f = vec![[0.0; 3]; s.nodes.len()];
+        for m in &s.members {
+            let law = m.elastic_law(m.rest_length_m().unwrap()).expect("every member has a law");
+            let (a, b) = m.ends();
+            let d = [0, 1, 2].map(|c| p[b][c] - p[a][c]);
+            let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let t = law.tension_n(l);
+            for c in 0..3 {
+                f[a][c] += t * d[c] / l;
+                f[b][c] -= t * d[c] / l;
+            }
+        }
+        DVector::from_iterator(3 * free.len(), free.iter().flat_map(|&n| f[n]))
+    };
+    let mut x = DVector::from_iterator(3 * free.len(), free.iter().flat_map(|&n| s.nodes[n].position));
+    let mut lambda = 1e-3;
+    for _ in 0..500 {
+        let r = residual(&x);
+        if r.norm() < 1e-13 {
+            break;
+        }
+        let h = 1e-7;
+        let jac = DMatrix::from_fn(r.len(), x.len(), |i, j| {
+            let (mut xp, mut xm) = (x.clone(), x.clone());
+            xp[j] += h;
+            xm[j] -= h;
+            (residual(&xp)[i] - residual(&xm)[i]) / (2.0 * h)
+        });
+        let jtj = jac.transpose() * &jac;
+        let step = (&jtj + DMatrix::identity(x.len(), x.len()) * lambda).lu().solve(&(-jac.transpose() * &r)).unwrap();
+        let next = &x + step;
+        if residual(&next).norm() < r.norm() {
+            x = next;
+            lambda = (lambda * 0.3).max(1e-15);
+        } else {
+            lambda *= 10.0;
+        }
+    }
+    place(&x)
+}
+
+/// Every member's length [m], its nodes at `p`.
+fn member_lengths(s: &tensegrity_testbed::structure::Structure, p: &[[f64; 3]]) -> Vec<f64> {
+    s.members.iter().map(|m| m.length_at(|n| p[n])).collect()
+}
+
+/// The settled structure of a prism file: its (lowered) structure and every node's position.
+fn settled_prism(text: &str) -> (tensegrity_testbed::structure::Structure, Vec<[f64; 3]>) {
+    let sc = scenario::parse(Path::new("prism.toml"), text).expect("valid");
+    let (s, _) = tensegrity_testbed::export::first_structure(&sc).expect("a structure");
+    let report = run::run(&sc, &RunOptions::default());
+    assert!(report.passed && report.points[0].settled, "{}", report.verdict_line());
+    let p = s.nodes.iter().map(|n| common::node(&report, &n.name)).collect();
+    (s, p)
+}
+
+/// The elastic-strut prism's settled member lengths are those of its pin-jointed equilibrium
+/// solved apart, within 1e-10 m (the struts 4 % shorter than drawn under the cables' pull).
+#[test]
+fn the_elastic_prism_settles_where_the_pin_jointed_equilibrium_is_within_1e_10_m() {
+    let (mut s, settled) = settled_prism(&std::fs::read_to_string(PRISM_ELASTIC).unwrap());
+    // strut1 lies on the fixed body: its ends do not move, so it has no law to solve with.
+    s.members.retain(|m| !m.is_rigid_strut());
+    let solved = pin_jointed_equilibrium(&s);
+    for ((got, want), m) in member_lengths(&s, &settled).iter().zip(member_lengths(&s, &solved)).zip(&s.members) {
+        assert!((got - want).abs() <= 1e-10, "{}: {got} vs {want}", m.name);
+    }
+    let strut = s.member("strut2").unwrap();
+    let shortening = 1.0 - member_lengths(&s, &solved)[s.member_id("strut2").unwrap()] / strut.rest_length_m().unwrap();
+    assert!(shortening > 0.01, "the strut shortens: {shortening}");
+}
+
+/// As EA grows the elastic prism's cables take the rigid prism's lengths, with an error that
+/// falls as 1/EA: fitted order within 0.05 of -1 over EA = 1e4, 1e5, 1e6 N (measured -1.00).
+/// The step shrinks as 1 / sqrt(EA), as the struts' axial frequency grows (`physical.rs`
+/// refuses a step that cannot follow it).
+#[test]
+fn the_elastic_prism_becomes_the_rigid_one_as_ea_grows_with_an_error_in_1_over_ea() {
+    let rigid = std::fs::read_to_string("scenarios/custom/prism3.toml").unwrap();
+    let (s_rigid, p_rigid) = settled_prism(&rigid);
+    let cables = |s: &tensegrity_testbed::structure::Structure, p: &[[f64; 3]]| -> Vec<f64> {
+        s.members.iter().filter(|m| !matches!(m.kind(), tensegrity_testbed::structure::MemberKind::Strut)).map(|m| m.length_at(|n| p[n])).collect()
+    };
+    let want = cables(&s_rigid, &p_rigid);
+    let stiffness: [f64; 3] = [1e4, 1e5, 1e6];
+    let errors: Vec<f64> = stiffness
+        .iter()
+        .map(|ea| {
+            let dt = 0.005 * (1e4 / ea).sqrt();
+            let (ea_line, dt_line) = (format!("EA = {{ value = {ea:?},"), format!("dt = {dt:?}"));
+            let text = common::edited(PRISM_ELASTIC, &[("EA = { value = 2000.0,", &ea_line), ("dt = 0.005", &dt_line)]);
+            let (s, p) = settled_prism(&text);
+            cables(&s, &p).iter().zip(&want).map(|(g, w)| (g - w).abs()).fold(0.0, f64::max)
+        })
+        .collect();
+    let order = common::fitted_order(&stiffness, &errors);
+    assert!((order + 1.0).abs() <= 0.05, "order {order}, errors {errors:?}");
+}
+
+/// As the density goes to zero the heavy string under gravity becomes the massless one,
+/// straight between its anchors: its largest sag falls as rho (fitted order within 0.05 of 1
+/// over rho = 1e-2, 1e-3, 1e-4 kg/m; measured 1.00), and the first segment's tension's
+/// distance from k (span - L0) as rho^2 (the sag stretches the string at second order;
+/// measured 2.00). The step shrinks as sqrt(rho), as the beads' frequencies grow.
+#[test]
+fn a_heavy_string_becomes_the_massless_one_as_its_density_goes_to_zero_with_an_error_in_rho() {
+    let densities: [f64; 3] = [1e-2, 1e-3, 1e-4];
+    let massless_tension = K_N_PER_M * (SPAN_M - L0_M);
+    let (mut sags, mut tension_errors) = (Vec::new(), Vec::new());
+    for rho in densities {
+        let dt = 0.0005 * (rho / RHO_KG_PER_M).sqrt();
+        let (rho_line, dt_line) = (format!("rho = {{ value = {rho:?},"), format!("dt = {dt:?}"));
+        let edits = [
+            ("rho = { value = 0.3,", rho_line.as_str()),
+            ("dt = 0.0005", dt_line.as_str()),
+            ("gravity = [0, 0, 0]", "gravity = [0, 0, -9.81]"),
+        ];
+        let text = common::edited(BEADED, &edits);
+        let head = &text[..text.find("[motion]").expect("the motion")];
+        let sc = scenario::parse(Path::new("heavy.toml"), &format!("{head}[expect]\nverdict = \"pass\"\n")).expect("valid");
+        let report = run::run(&sc, &RunOptions::default());
+        assert!(report.passed && report.points[0].settled, "rho = {rho}: {}", report.verdict_line());
+        let sag = (1..SEGMENTS).map(|i| common::node(&report, &format!("string_b{i}"))[2].abs()).fold(0.0, f64::max);
+        sags.push(sag);
+        tension_errors.push((report.points[0].simulated["string_s1.force"] - massless_tension).abs());
+    }
+    let order = common::fitted_order(&densities, &sags);
+    assert!((order - 1.0).abs() <= 0.05, "order {order}, sags {sags:?}");
+    let order = common::fitted_order(&densities, &tension_errors);
+    assert!((order - 2.0).abs() <= 0.05, "order {order}, tension errors {tension_errors:?}");
+}
