@@ -345,3 +345,63 @@ fn a_heavy_string_becomes_the_massless_one_as_its_density_goes_to_zero_with_an_e
     let order = common::fitted_order(&densities, &tension_errors);
     assert!((order - 2.0).abs() <= 0.05, "order {order}, tension errors {tension_errors:?}");
 }
+
+/// d/dEA of the elastic strut's settled force and of its axial frequency meet their closed
+/// forms (F = 2 k a EA / (EA + k L): dF/dEA = 2 k^2 a L / (EA + k L)^2; omega^2 = 4 (k + EA / L) / m:
+/// d omega / dEA = 2 / (m L omega)) within 1e-8 relative, and the differences of settles within
+/// 1e-7 (measured 1.6e-11 and 1.3e-11; the settles' own error 5e-9).
+#[test]
+fn the_elastic_struts_sensitivities_to_ea_meet_the_closed_form() {
+    let file = "scenarios/custom/elastic_strut.toml";
+    let sc = scenario::load(Path::new(file)).expect("shipped");
+    let r = tensegrity_testbed::study::sensitivity(&sc, file, 0, true, None).expect("sensitivities");
+    let (k, a, l, m, ea): (f64, f64, f64, f64, f64) = (100.0, 0.2, 1.0, 1.0, 1000.0);
+    let ea_row = r.parameters.iter().find(|p| p.name == "EA").expect("EA");
+    let at = |name: &str| r.outputs.iter().position(|o| o.name == name).expect(name);
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+    let force = ea_row.derivatives[at("strut.force")];
+    let want_force = -2.0 * k * k * a * l / (ea + k * l).powi(2);
+    assert!(rel(force, want_force) <= 1e-8, "{force} vs {want_force}");
+    let omega = (4.0 * (k + ea / l) / m).sqrt();
+    let frequency = ea_row.derivatives[at("mode12.omega")];
+    assert!(rel(frequency, 2.0 / (m * l * omega)) <= 1e-8, "{frequency} vs {}", 2.0 / (m * l * omega));
+    let check = ea_row.check.as_ref().expect("checked");
+    for name in ["strut.force", "mode12.omega"] {
+        assert!(rel(ea_row.derivatives[at(name)], check[at(name)]) <= 1e-7, "{name}");
+    }
+}
+
+/// EA fitted from a measured strut force and axial frequency (the truth EA = 900 N; the file's
+/// 1000 N the start): the truth within the 95 % interval and within 1e-6 relative, the
+/// interval's half-width 1.96 sigma with sigma the linearised model's for the force's
+/// 1e-3 N: 1e-3 / (dF/dEA) over the frequency's share.
+#[test]
+fn ea_fitted_from_a_strut_force_and_an_axial_frequency_holds_the_truth() {
+    use tensegrity_testbed::study::{fit, FitParameter, FitProblem, Measurement};
+    let file = "scenarios/custom/elastic_strut.toml";
+    let (k, a, l, m, truth): (f64, f64, f64, f64, f64) = (100.0, 0.2, 1.0, 1.0, 900.0);
+    let force = -2.0 * k * a * truth / (truth + k * l);
+    let omega = (4.0 * (k + truth / l) / m).sqrt();
+    let row = |output: &str, value: f64| Measurement {
+        at: output.to_string(),
+        point: 0,
+        output: output.to_string(),
+        value,
+        sigma: Some(1e-3),
+        time_s: None,
+    };
+    let problem = FitProblem {
+        file: file.into(),
+        source: std::fs::read_to_string(file).unwrap(),
+        overrides: Vec::new(),
+        parameters: vec![FitParameter { name: "EA".into(), low: None, high: None }],
+        measurements: vec![row("strut.force", force), row("mode12.omega", omega)],
+    };
+    let r = fit(&problem, None).expect("a fit");
+    let ea = &r.parameters[0];
+    assert!(ea.low <= truth && truth <= ea.high, "EA = {} in [{}, {}]", ea.value, ea.low, ea.high);
+    assert!((ea.value / truth - 1.0).abs() <= 1e-6, "EA = {}", ea.value);
+    let (df, dw) = (2.0 * k * k * a * l / (truth + k * l).powi(2), 2.0 / (m * l * omega));
+    let sigma = 1e-3 / (df * df + dw * dw).sqrt();
+    assert!((ea.sigma / sigma - 1.0).abs() <= 1e-3, "sigma {} vs {sigma}", ea.sigma);
+}
