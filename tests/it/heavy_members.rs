@@ -405,3 +405,68 @@ fn ea_fitted_from_a_strut_force_and_an_axial_frequency_holds_the_truth() {
     let sigma = 1e-3 / (df * df + dw * dw).sqrt();
     assert!((ea.sigma / sigma - 1.0).abs() <= 1e-3, "sigma {} vs {sigma}", ea.sigma);
 }
+
+/// Bad input on the new keys: exit 2 at the key, with what would do. (`tensegrity check`
+/// exits 2 on each, as on any scenario error: `bad_input.rs`.)
+#[test]
+fn bad_elastic_strut_and_heavy_cable_keys_are_errors_at_their_key() {
+    let strut = std::fs::read_to_string("scenarios/custom/elastic_strut.toml").unwrap();
+    let with = |from: &str, to: &str| strut.replacen(from, to, 1);
+    for (value, msg) in [("0.0", "EA (N) must be > 0"), ("-5.0", "EA (N) must be > 0"), ("nan", "must be a finite number")] {
+        let text = with("EA = \"EA\"", &format!("EA = {value}"));
+        common::error_at(&text, &format!("EA = {value}"), 5, msg);
+    }
+    let text = with("EA = \"EA\"", "E = 2e11");
+    common::error_at(&text, "E = 2e11", 4, "E needs area");
+    let text = with("EA = \"EA\"", "EA = \"EA\"\nE = 2e11\narea = 1e-4");
+    common::error_at(&text, "E = 2e11", 4, "states EA already");
+    let text = with("EA = \"EA\"", "E = 2e11\narea = 1e300");
+    common::error_at(&text, "E = 2e11", 4, "not finite");
+    let text = with("EA = \"EA\"", "EA = \"EA\"\ndensity = 1.0");
+    common::error_at(&text, "density = 1.0", 10, "'strut' is a strut; density states a cable's mass");
+    let text = with("stiffness = \"k\"\nlength = 0.0", "stiffness = \"k\"\nlength = 0.0\nEA = 5.0");
+    common::error_at(&text, "EA = 5.0", 5, "'p_up' is a spring");
+    let text = with("[[structure.bodies]]\nname = \"bar\"\nmass = \"m\"", "[[structure.bodies]]\nname = \"bar\"\nfixed = true");
+    common::error_at(&text, "EA = \"EA\"", 5, "its body 'bar' is fixed");
+    let text = with("Q = [\"L\", 0, 0] }", "Q = [\"L\", 0, 0], R = [0.5, 0.1, 0] }");
+    common::error_at(&text, "EA = \"EA\"", 5, "carries other nodes");
+    let text = with("dt = 0.001", "dt = 0.05");
+    common::error_at(&text, "dt = 0.05", 5, "the step is unstable from 2");
+
+    let cable = std::fs::read_to_string(BEADED).unwrap();
+    let with = |from: &str, to: &str| cable.replacen(from, to, 1);
+    for (value, msg) in [("0", "from 1 to 1000"), ("1001", "from 1 to 1000"), ("2.5", "whole number"), ("-3", "from 1 to 1000")] {
+        let text = with("segments = \"N\"", &format!("segments = {value}"));
+        common::error_at(&text, &format!("segments = {value}"), 11, msg);
+    }
+    for (value, msg) in [("0.0", "density (kg/m) must be > 0"), ("-1.0", "must be > 0"), ("inf", "finite")] {
+        let text = with("density = \"rho\"", &format!("density = {value}"));
+        common::error_at(&text, &format!("density = {value}"), 10, msg);
+    }
+    let text = with("density = \"rho\"\n", "");
+    common::error_at(&text, "segments = \"N\"", 11, "segments means nothing without density");
+    let text = with("segments = \"N\"\n", "");
+    common::error_at(&text, "density = \"rho\"", 10, "a heavy cable needs segments");
+    let text = with("stiffness = \"k\"\n", "");
+    common::error_at(&text, "density = \"rho\"", 10, "an inextensible heavy cable is not modelled");
+    let text = with("density = \"rho\"", "density = \"rho\"\nEA = 1.0");
+    common::error_at(&text, "EA = 1.0", 5, "'string' is a cable; EA states a strut's axial stiffness");
+    let text = with("[[structure.cables]]\nname = \"string\"", "[[structure.bodies]]\nname = \"string_b1\"\nfixed = true\nnodes = { X = [0, 1, 0] }\n\n[[structure.cables]]\nname = \"string\"");
+    common::error_at(&text, "density = \"rho\"", 10, "it would name a part 'string_b1'");
+}
+
+/// A heavy cable that cannot be built is refused by name: through inner nodes, from a rigid
+/// free body (its end's mass would have no place), driven by a winch.
+#[test]
+fn a_heavy_cable_that_cannot_be_built_is_refused_by_name() {
+    let cable = std::fs::read_to_string(BEADED).unwrap();
+    let mid = cable.replacen("B = [\"span\", 0, 0] }", "B = [\"span\", 0, 0], M = [0.6, 0.3, 0] }", 1);
+    let text = mid.replacen("b = \"B\"\n", "b = \"B\"\nthrough = [\"M\"]\n", 1);
+    common::error_at(&text, "density = \"rho\"", 10, "a heavy clustered cable is not modelled");
+    let rigid = "[[structure.bodies]]\nname = \"plate\"\nmass = 1.0\nnodes = { C = [1.2, 0, 0], D = [1.2, 0.2, 0] }\n\n[[structure.cables]]";
+    let text = cable.replacen("B = [\"span\", 0, 0] }", "B0 = [\"span\", 0, 0] }", 1).replacen("[[structure.cables]]", rigid, 1).replacen("b = \"B\"", "b = \"C\"", 1);
+    common::error_at(&text, "density = \"rho\"", 10, "free body 'plate', which is not a point mass");
+    let winch = "[[structure.actuators]]\nsymbol = \"w\"\ncable = \"string\"\n\n[motion]";
+    let text = cable.replacen("[motion]", winch, 1);
+    common::error_at(&text, "density = \"rho\"", 10, "a winch drives it");
+}
