@@ -805,3 +805,34 @@ def test_bad_fit_input_raises_a_clear_python_exception():
         tt.fit(str(SWEPT_BAR), frame, {"k2": (1.0, 31.0)})
     with pytest.raises(ValueError, match=r"has no parameter 'k3'"):
         tt.fit(str(SWEPT_BAR), ANGLES, {"k3": None})
+
+
+ELASTIC_STRUT = ROOT / "scenarios" / "custom" / "elastic_strut.toml"
+BEADED = ROOT / "scenarios" / "custom" / "beaded_string.toml"
+
+
+def test_elastic_struts_and_heavy_cables_reach_python_as_the_cli():
+    """The new keys from Python as from the CLI: the elastic strut's settled force is the CLI's
+    bit for bit and F = 2 k a EA / (EA + k L) within 1e-10; EA set from Python
+    (set={"EA": 900}) moves it to the closed form's again; its d force/d EA is the CLI's; the
+    beaded string's beads and segments are named columns of the per-tick table; a bad segment
+    count raises ScenarioError at its line and column."""
+    result, cli = tt.run(str(ELASTIC_STRUT)), cli_report(ELASTIC_STRUT)
+    force = result.points.iloc[0]["strut.force"]
+    assert force == cli["points"][0]["simulated"]["strut.force"]
+    k, a, L = 100.0, 0.2, 1.0
+    for ea in (1000.0, 900.0):
+        r = result if ea == 1000.0 else tt.run(str(ELASTIC_STRUT), set={"EA": ea})
+        want = -2 * k * a * ea / (ea + k * L)
+        assert abs(r.points.iloc[0]["strut.force"] - want) <= 1e-10 * abs(want)
+    py, cli = tt.sensitivity(str(ELASTIC_STRUT)), cli_json("sensitivity", ELASTIC_STRUT)
+    ea_py = next(p for p in py["parameters"] if p["name"] == "EA")
+    ea_cli = next(p for p in cli["parameters"] if p["name"] == "EA")
+    assert ea_py["derivatives"] == ea_cli["derivatives"]
+    table = tt.run(str(BEADED), table=True).table
+    assert "node:string_b1.z" in table.column_names and "cable:string_s6.tension_n" in table.column_names
+    bad = BEADED.read_text().replace('segments = "N"', "segments = 0", 1)
+    with pytest.raises(tt.ScenarioError) as e:
+        tt.check(bad, name="beaded.toml")
+    line = bad[: bad.index("segments = 0")].count("\n") + 1
+    assert (e.value.line, e.value.col) == (line, 12) and "from 1 to 1000" in e.value.message

@@ -17,19 +17,6 @@ pub const STRUCTURE_EXTENT_M: (f64, f64) = (1e-4, 1e5);
 /// [kg m^2] scaled by the extent squared: outside it, the mass matrix's condition leaves f64.
 pub const BODY_MASS_KG: (f64, f64) = (1e-9, 1e9);
 
-/// Largest distance between two nodes of the structure [m].
-fn extent(s: &Structure) -> f64 {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for n in &s.nodes {
-        for k in 0..3 {
-            lo[k] = lo[k].min(n.position[k]);
-            hi[k] = hi[k].max(n.position[k]);
-        }
-    }
-    (0..3).map(|k| (hi[k] - lo[k]).max(0.0).powi(2)).sum::<f64>().sqrt()
-}
-
 /// The structure at the first point of the scenario: within the sizes above, every node inside
 /// `sim.bounding_box`. Errors are located at the key that sets the value: the bounding box
 /// when the file gives it, else the parameter farthest from 1 in order of magnitude (or the
@@ -58,7 +45,7 @@ pub(super) fn physical(
         };
         ScenarioError { message, ..e }
     };
-    let size = extent(s);
+    let size = crate::structure::extent_m(s);
     let (lo, hi) = STRUCTURE_EXTENT_M;
     if !(lo..=hi).contains(&size) {
         return Err(at_model(format!(

@@ -28,11 +28,12 @@ pub const MAX_CABLE_SEGMENTS: usize = 1000;
 #[error("{0}")]
 pub struct LumpError(pub String);
 
-/// A point mass of `mass_kg` at `com`: its turning is a zero mode that no force drives, so its
-/// moments only need to be in the simulation's range: a rod's of the length it stands for,
-/// `length_m` (a bead's segment, half an elastic strut), m l^2 / 12 about every axis [kg m^2].
-fn bead_inertia(mass_kg: f64, com: Vec3, length_m: f64) -> Inertia {
-    Inertia { mass_kg, com, principal_kg_m2: [mass_kg * length_m * length_m / 12.0; 3] }
+/// A point mass of `mass_kg` at `com`. No member turns it, so its turning is a zero mode and
+/// its moments only need to be in the simulation's range (`scenario/physical.rs`, scaled by the
+/// structure's extent): those of a free body of the structure's size `size_m` without stated
+/// inertia, m size^2 / 12 about every axis [kg m^2].
+fn bead_inertia(mass_kg: f64, com: Vec3, size_m: f64) -> Inertia {
+    Inertia { mass_kg, com, principal_kg_m2: [mass_kg * size_m * size_m / 12.0; 3] }
 }
 
 /// Whether body `b` is a point mass: free, with one node, at its centre of mass.
@@ -67,8 +68,9 @@ pub fn fastest_point_mass(s: &Structure) -> Option<(f64, usize)> {
 
 /// Makes strut `strut` elastic with axial stiffness `ea_n` = E A \[N\]: its body's mass halved
 /// onto two point masses at its nodes, the strut pushing and pulling with EA / L about its
-/// drawn length L.
-pub fn make_strut_elastic(s: &mut Structure, strut: MemberId, ea_n: f64) -> Result<(), LumpError> {
+/// drawn length L. `size_m`: the structure's extent ([`super::extent_m`]), for the point
+/// masses' moments.
+pub fn make_strut_elastic(s: &mut Structure, strut: MemberId, ea_n: f64, size_m: f64) -> Result<(), LumpError> {
     let name = s.members[strut].name.clone();
     let (a, b) = s.members[strut].ends();
     let body = s.nodes[a].body;
@@ -102,8 +104,8 @@ pub fn make_strut_elastic(s: &mut Structure, strut: MemberId, ea_n: f64) -> Resu
     if s.body_id(&end_b).is_some() {
         return refuse(format!("its end body would be named '{end_b}', a name the structure already has"));
     }
-    s.bodies[body].inertia = Some(bead_inertia(half, s.nodes[a].position, 0.5 * length));
-    let new = s.add_body(&end_b, BodyKind::Free, Some(bead_inertia(half, s.nodes[b].position, 0.5 * length)));
+    s.bodies[body].inertia = Some(bead_inertia(half, s.nodes[a].position, size_m));
+    let new = s.add_body(&end_b, BodyKind::Free, Some(bead_inertia(half, s.nodes[b].position, size_m)));
     s.nodes[b].body = new;
     s.members[strut].law = Law::ElasticStrut { stiffness_n_per_m: ea_n / length, rest_length_m: length };
     Ok(())
@@ -112,8 +114,14 @@ pub fn make_strut_elastic(s: &mut Structure, strut: MemberId, ea_n: f64) -> Resu
 /// Builds cable `cable` of `segments` elastic segments between beads, its linear density
 /// `density_kg_per_m` \[kg per unstretched m\]: the segments are named `{cable}_s1` ..
 /// `{cable}_s{n}` from its node `a`, the beads (a body and a node each) `{cable}_b1` ..
-/// `{cable}_b{n-1}`.
-pub fn hang_beads(s: &mut Structure, cable: MemberId, density_kg_per_m: f64, segments: usize) -> Result<(), LumpError> {
+/// `{cable}_b{n-1}`. `size_m`: as for [`make_strut_elastic`].
+pub fn hang_beads(
+    s: &mut Structure,
+    cable: MemberId,
+    density_kg_per_m: f64,
+    segments: usize,
+    size_m: f64,
+) -> Result<(), LumpError> {
     let member = s.members[cable].clone();
     let name = &member.name;
     let refuse = |why: String| Err(LumpError(format!("heavy cable '{name}': {why}")));
@@ -161,7 +169,7 @@ pub fn hang_beads(s: &mut Structure, cable: MemberId, density_kg_per_m: f64, seg
     for (i, bead) in names.iter().enumerate() {
         let t = (i + 1) as f64 / n;
         let at = [0, 1, 2].map(|c| pa[c] + t * (pb[c] - pa[c]));
-        let inertia = bead_inertia(density_kg_per_m * l0 / n, at, l0 / n);
+        let inertia = bead_inertia(density_kg_per_m * l0 / n, at, size_m);
         let body = s.add_body(bead, BodyKind::Free, Some(inertia));
         path.push(s.add_node(bead, body, at));
     }

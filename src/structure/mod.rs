@@ -572,6 +572,20 @@ fn invalid(what: &'static str, name: &str, message: &str) -> StructureError {
     StructureError::Invalid { what, name: name.into(), message: message.into() }
 }
 
+/// The diagonal of the nodes' bounding box in the drawing [m]: the structure's extent, which the
+/// simulation's ranges scale with (linear in the nodes, unlike [`structure_size`]).
+pub fn extent_m(s: &Structure) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for n in &s.nodes {
+        for k in 0..3 {
+            lo[k] = lo[k].min(n.position[k]);
+            hi[k] = hi[k].max(n.position[k]);
+        }
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).max(0.0).powi(2)).sum::<f64>().sqrt()
+}
+
 pub fn norm(v: Vec3) -> f64 {
     (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }

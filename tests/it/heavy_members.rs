@@ -295,7 +295,11 @@ fn the_elastic_prism_becomes_the_rigid_one_as_ea_grows_with_an_error_in_1_over_e
     let rigid = std::fs::read_to_string("scenarios/custom/prism3.toml").unwrap();
     let (s_rigid, p_rigid) = settled_prism(&rigid);
     let cables = |s: &tensegrity_testbed::structure::Structure, p: &[[f64; 3]]| -> Vec<f64> {
-        s.members.iter().filter(|m| !matches!(m.kind(), tensegrity_testbed::structure::MemberKind::Strut)).map(|m| m.length_at(|n| p[n])).collect()
+        s.members
+            .iter()
+            .filter(|m| !matches!(m.kind(), tensegrity_testbed::structure::MemberKind::Strut))
+            .map(|m| m.length_at(|n| p[n]))
+            .collect()
     };
     let want = cables(&s_rigid, &p_rigid);
     let stiffness: [f64; 3] = [1e4, 1e5, 1e6];
@@ -333,7 +337,8 @@ fn a_heavy_string_becomes_the_massless_one_as_its_density_goes_to_zero_with_an_e
         ];
         let text = common::edited(BEADED, &edits);
         let head = &text[..text.find("[motion]").expect("the motion")];
-        let sc = scenario::parse(Path::new("heavy.toml"), &format!("{head}[expect]\nverdict = \"pass\"\n")).expect("valid");
+        let sc =
+            scenario::parse(Path::new("heavy.toml"), &format!("{head}[expect]\nverdict = \"pass\"\n")).expect("valid");
         let report = run::run(&sc, &RunOptions::default());
         assert!(report.passed && report.points[0].settled, "rho = {rho}: {}", report.verdict_line());
         let sag = (1..SEGMENTS).map(|i| common::node(&report, &format!("string_b{i}"))[2].abs()).fold(0.0, f64::max);
@@ -412,7 +417,9 @@ fn ea_fitted_from_a_strut_force_and_an_axial_frequency_holds_the_truth() {
 fn bad_elastic_strut_and_heavy_cable_keys_are_errors_at_their_key() {
     let strut = std::fs::read_to_string("scenarios/custom/elastic_strut.toml").unwrap();
     let with = |from: &str, to: &str| strut.replacen(from, to, 1);
-    for (value, msg) in [("0.0", "EA (N) must be > 0"), ("-5.0", "EA (N) must be > 0"), ("nan", "must be a finite number")] {
+    for (value, msg) in
+        [("0.0", "EA (N) must be > 0"), ("-5.0", "EA (N) must be > 0"), ("nan", "must be a finite number")]
+    {
         let text = with("EA = \"EA\"", &format!("EA = {value}"));
         common::error_at(&text, &format!("EA = {value}"), 5, msg);
     }
@@ -426,7 +433,10 @@ fn bad_elastic_strut_and_heavy_cable_keys_are_errors_at_their_key() {
     common::error_at(&text, "density = 1.0", 10, "'strut' is a strut; density states a cable's mass");
     let text = with("stiffness = \"k\"\nlength = 0.0", "stiffness = \"k\"\nlength = 0.0\nEA = 5.0");
     common::error_at(&text, "EA = 5.0", 5, "'p_up' is a spring");
-    let text = with("[[structure.bodies]]\nname = \"bar\"\nmass = \"m\"", "[[structure.bodies]]\nname = \"bar\"\nfixed = true");
+    let text = with(
+        "[[structure.bodies]]\nname = \"bar\"\nmass = \"m\"",
+        "[[structure.bodies]]\nname = \"bar\"\nfixed = true",
+    );
     common::error_at(&text, "EA = \"EA\"", 5, "its body 'bar' is fixed");
     let text = with("Q = [\"L\", 0, 0] }", "Q = [\"L\", 0, 0], R = [0.5, 0.1, 0] }");
     common::error_at(&text, "EA = \"EA\"", 5, "carries other nodes");
@@ -435,7 +445,9 @@ fn bad_elastic_strut_and_heavy_cable_keys_are_errors_at_their_key() {
 
     let cable = std::fs::read_to_string(BEADED).unwrap();
     let with = |from: &str, to: &str| cable.replacen(from, to, 1);
-    for (value, msg) in [("0", "from 1 to 1000"), ("1001", "from 1 to 1000"), ("2.5", "whole number"), ("-3", "from 1 to 1000")] {
+    for (value, msg) in
+        [("0", "from 1 to 1000"), ("1001", "from 1 to 1000"), ("2.5", "whole number"), ("-3", "from 1 to 1000")]
+    {
         let text = with("segments = \"N\"", &format!("segments = {value}"));
         common::error_at(&text, &format!("segments = {value}"), 11, msg);
     }
@@ -464,7 +476,10 @@ fn a_heavy_cable_that_cannot_be_built_is_refused_by_name() {
     let text = mid.replacen("b = \"B\"\n", "b = \"B\"\nthrough = [\"M\"]\n", 1);
     common::error_at(&text, "density = \"rho\"", 10, "a heavy clustered cable is not modelled");
     let rigid = "[[structure.bodies]]\nname = \"plate\"\nmass = 1.0\nnodes = { C = [1.2, 0, 0], D = [1.2, 0.2, 0] }\n\n[[structure.cables]]";
-    let text = cable.replacen("B = [\"span\", 0, 0] }", "B0 = [\"span\", 0, 0] }", 1).replacen("[[structure.cables]]", rigid, 1).replacen("b = \"B\"", "b = \"C\"", 1);
+    let text = cable
+        .replacen("B = [\"span\", 0, 0] }", "B0 = [\"span\", 0, 0] }", 1)
+        .replacen("[[structure.cables]]", rigid, 1)
+        .replacen("b = \"B\"", "b = \"C\"", 1);
     common::error_at(&text, "density = \"rho\"", 10, "free body 'plate', which is not a point mass");
     let winch = "[[structure.actuators]]\nsymbol = \"w\"\ncable = \"string\"\n\n[motion]";
     let text = cable.replacen("[motion]", winch, 1);
