@@ -818,13 +818,13 @@ def test_elastic_struts_and_heavy_cables_reach_python_as_the_cli():
     beaded string's beads and segments are named columns of the per-tick table; a bad segment
     count raises ScenarioError at its line and column."""
     result, cli = tt.run(str(ELASTIC_STRUT)), cli_report(ELASTIC_STRUT)
-    force = result.points.iloc[0]["strut.force"]
+    force = result.points.iloc[0]["simulated:strut.force"]
     assert force == cli["points"][0]["simulated"]["strut.force"]
     k, a, L = 100.0, 0.2, 1.0
     for ea in (1000.0, 900.0):
         r = result if ea == 1000.0 else tt.run(str(ELASTIC_STRUT), set={"EA": ea})
         want = -2 * k * a * ea / (ea + k * L)
-        assert abs(r.points.iloc[0]["strut.force"] - want) <= 1e-10 * abs(want)
+        assert abs(r.points.iloc[0]["simulated:strut.force"] - want) <= 1e-10 * abs(want)
     py, cli = tt.sensitivity(str(ELASTIC_STRUT)), cli_json("sensitivity", ELASTIC_STRUT)
     ea_py = next(p for p in py["parameters"] if p["name"] == "EA")
     ea_cli = next(p for p in cli["parameters"] if p["name"] == "EA")
