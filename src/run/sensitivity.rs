@@ -116,6 +116,19 @@ pub(crate) struct Linearization {
     jacobian: DMatrix<f64>,
     pub(crate) modes: Vec<Mode>,
     pub(crate) rigid: Vec<bool>,
+    /// The point masses' turns among the zero modes (three each, over free bodies), which the
+    /// modal analysis leaves out (`sim/modes.rs`) and the modes' names therefore skip.
+    left_out: usize,
+}
+
+impl Linearization {
+    /// The output name of non-rigid mode `i` (from 0) of [`Self::modes`]: `mode{N}.omega`, N
+    /// numbered as `tensegrity modes` numbers it. The modes ascend in omega^2: an unstable one
+    /// comes before every zero mode, a stable one after them all, the left-out turns among them.
+    pub(crate) fn mode_name(&self, i: usize) -> String {
+        let before_turns = self.modes[i].omega_squared < 0.0;
+        format!("mode{}.omega", if before_turns { i + 1 } else { i + 1 - self.left_out })
+    }
 }
 
 /// K, M and G of `sim` in `coordinates`, and the modes of the reduced problem
@@ -144,7 +157,14 @@ pub(crate) fn linearize(
     };
     let largest = modes.iter().fold(0.0f64, |l, m| l.max(m.omega_squared.abs()));
     let rigid = modes.iter().map(|m| m.omega_squared.abs() <= (ZERO_MODE_RATIO * largest).max(floor)).collect();
-    Ok(Linearization { stiffness, jacobian, modes, rigid })
+    let s = sim.structure();
+    let left_out = match coordinates {
+        EquilibriumCoordinates::Bodies(bodies) => {
+            3 * bodies.iter().filter(|&&b| crate::structure::lumped::is_point_mass(s, b)).count()
+        }
+        _ => 0,
+    };
+    Ok(Linearization { stiffness, jacobian, modes, rigid, left_out })
 }
 
 /// The analysis of `sim`, settled at `params` and `inputs` of `sc`.
@@ -160,7 +180,7 @@ pub(crate) fn analyse<'a>(
     let lin = linearize(sim, &out.coordinates)?;
     let listed = listed_modes(&lin.rigid);
     let mut base = out.sample(sim, params);
-    base.extend(listed.iter().map(|&i| (format!("mode{}.omega", i + 1), lin.modes[i].omega())));
+    base.extend(listed.iter().map(|&i| (lin.mode_name(i), lin.modes[i].omega())));
     Ok(Analysis { out, lin, listed, base })
 }
 

@@ -87,7 +87,7 @@ pub fn modes(
         free_bodies: analysis.bodies.len(),
         coordinates: match &analysis.constraints {
             Some(c) => c.coordinates.len(),
-            None if analysis.joints.is_empty() => 6 * analysis.bodies.len(),
+            None if analysis.joints.is_empty() => 6 * analysis.bodies.len() - analysis.left_out,
             None => analysis.joints.len(),
         },
         joint_coordinates: analysis.joints.iter().map(|j| structure.joints[*j].name.clone()).collect(),

@@ -548,6 +548,7 @@ impl Data {
             rigid,
             constraints: Some(constraints),
             lowest_of: None,
+            left_out: 0,
         })
     }
 

@@ -201,6 +201,16 @@ impl Data {
         let rigid = modes.iter().filter(|m| m.rigid).count();
         let poses = bodies.iter().map(|b| self.body_pose(m, *b)).collect();
         let mass = super::modes::diagonal_blocks(&body_mass);
-        Ok(StructureModes { bodies, joints, poses, mass, modes, rigid, constraints: None, lowest_of: None })
+        Ok(StructureModes {
+            bodies,
+            joints,
+            poses,
+            mass,
+            modes,
+            rigid,
+            constraints: None,
+            lowest_of: None,
+            left_out: 0,
+        })
     }
 }

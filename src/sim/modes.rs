@@ -84,6 +84,9 @@ pub struct StructureModes {
     /// `Some(total)` where `modes` are the lowest of the structure's `total` (the sparse
     /// solver's); `None` where they are all of them.
     pub lowest_of: Option<usize>,
+    /// The free bodies' coordinates left out of the analysis: the point masses' turns, three
+    /// each ([`turning_coordinates`]; their shapes are zero there).
+    pub left_out: usize,
 }
 
 /// Why a structure's modes are not computed.
@@ -105,6 +108,10 @@ pub enum ModesError {
     /// More free bodies (on springs and elastic cables) than the sparse solver is run for.
     #[error("{bodies} free bodies: the lowest modes of free bodies on springs and elastic cables are computed for at most {MAX_SPARSE_MODAL_FREE_BODIES} free bodies (each rigid mode reported, about one a body, holds a shape and a motion per node: the report grows with the square of the count)")]
     TooLargeSparse { bodies: usize },
+    /// More point masses (elastic struts' ends, heavy cables' beads) than the sparse solver is
+    /// run for.
+    #[error("{points} point masses (elastic struts' ends, heavy cables' beads): the lowest modes are computed for at most {MAX_SPARSE_MODAL_POINT_MASSES}")]
+    TooManyPointMasses { points: usize },
     /// More non-rigid modes asked of the sparse solver than it computes.
     #[error("the lowest {wanted} modes beyond the structure's {rigid} rigid ones were asked for (through mode {through}); the sparse solver computes at most {MAX_SPARSE_MODAL_COUNT}")]
     TooManyWanted { wanted: usize, rigid: usize, through: usize },
@@ -118,12 +125,20 @@ pub enum ModesError {
     Eigen(#[from] EigenError),
 }
 
-pub use crate::structure::{MAX_MODAL_FREE_BODIES, MAX_SPARSE_MODAL_FREE_BODIES};
+pub use crate::structure::{MAX_MODAL_FREE_BODIES, MAX_SPARSE_MODAL_FREE_BODIES, MAX_SPARSE_MODAL_POINT_MASSES};
 
 /// The structure's size for its modes: an error past [`MAX_MODAL_FREE_BODIES`] free bodies, or
 /// [`MAX_SPARSE_MODAL_FREE_BODIES`] for free bodies on springs and elastic cables.
 pub fn check_modal_size(s: &crate::structure::Structure) -> Result<(), ModesError> {
-    let bodies = s.bodies.iter().filter(|b| b.kind == BodyKind::Free).count();
+    let free = |b: &usize| s.bodies[*b].kind == BodyKind::Free;
+    let points = (0..s.bodies.len()).filter(free).filter(|&b| crate::structure::lumped::is_point_mass(s, b)).count();
+    // A point mass's turns are no modes (`turning_coordinates`): it counts apart, where the
+    // sparse solver runs.
+    let bodies = (0..s.bodies.len()).filter(free).count();
+    if crate::structure::modes_of_free_bodies(s) && points > MAX_SPARSE_MODAL_POINT_MASSES {
+        return Err(ModesError::TooManyPointMasses { points });
+    }
+    let bodies = if crate::structure::modes_of_free_bodies(s) { bodies - points } else { bodies };
     if bodies > crate::structure::modal_free_body_bound(s) {
         return Err(if crate::structure::modes_of_free_bodies(s) {
             ModesError::TooLargeSparse { bodies }
@@ -187,14 +202,24 @@ impl Data {
             Solver::BySize(wanted) if bodies.len() > DENSE_MODAL_MAX_FREE_BODIES => Some(wanted),
             _ => None,
         };
+        let turning = turning_coordinates(s, &bodies);
+        let kept: Vec<usize> = (0..turning.len()).filter(|&c| !turning[c]).collect();
         let (eigen, largest, lowest_of) = if let Some(wanted) = sparse {
-            let lowest = self.lowest_modes(m, &mass, wanted, cancel)?;
-            (lowest.modes, lowest.largest, Some(6 * bodies.len()))
+            let lowest = self.lowest_modes(m, &mass, &turning, wanted, cancel)?;
+            (lowest.modes, lowest.largest, Some(kept.len()))
         } else {
             let hessian = self.tangent_stiffness(m).hessian;
-            let eigen = crate::eigen::modes_until(&hessian, &block_diagonal(&mass), cancel)?;
+            let (k, mm) = (hessian.select_rows(&kept), block_diagonal(&mass).select_rows(&kept));
+            let eigen = crate::eigen::modes_until(&k.select_columns(&kept), &mm.select_columns(&kept), cancel)?;
             let largest = eigen.iter().fold(0.0f64, |l, e| l.max(e.omega_squared.abs()));
-            (eigen.into_iter().map(|e| (e.omega_squared, e.shape)).collect(), largest, None)
+            let full = |shape: DVector<f64>| {
+                let mut x = DVector::zeros(turning.len());
+                for (j, &c) in kept.iter().enumerate() {
+                    x[c] = shape[j];
+                }
+                x
+            };
+            (eigen.into_iter().map(|e| (e.omega_squared, full(e.shape))).collect(), largest, None)
         };
         let modes: Vec<StructureMode> = eigen
             .into_iter()
@@ -208,7 +233,8 @@ impl Data {
             .collect();
         let rigid = modes.iter().filter(|mode| mode.rigid).count();
         let poses = bodies.iter().map(|b| self.body_pose(m, *b)).collect();
-        Ok(StructureModes { bodies, joints: vec![], poses, mass, modes, rigid, constraints: None, lowest_of })
+        let left_out = turning.len() - kept.len();
+        Ok(StructureModes { bodies, joints: vec![], poses, mass, modes, rigid, constraints: None, lowest_of, left_out })
     }
 
     /// Displaces the structure along mode `index` (from 0) of `analysis` (made at the current
@@ -298,6 +324,22 @@ pub fn modal_projector(s: &crate::structure::Structure, analysis: &StructureMode
         .flat_map(|(i, block)| (block * nalgebra::Vector6::from_column_slice(&shape[6 * i..6 * i + 6])).data.0[0])
         .collect();
     ModalProjector { bodies: analysis.bodies.clone(), start: analysis.poses.clone(), com_local, weights }
+}
+
+/// Which of the free bodies' coordinates (six per body of `bodies`, in order) are a point mass's
+/// turns (`structure::lumped::is_point_mass`: one node, at the centre of mass). In a structure
+/// of free bodies on elastic members nothing turns such a body: its member forces, gravity and
+/// loads all act at its centre. Its three turns are zero modes of nothing physical, so the
+/// analysis leaves them out (a beaded string of five beads has no rigid mode, not fifteen), and
+/// a structure of thousands of beads reports its modes without one rigid mode per bead.
+fn turning_coordinates(s: &crate::structure::Structure, bodies: &[usize]) -> Vec<bool> {
+    bodies
+        .iter()
+        .flat_map(|&b| {
+            let point = crate::structure::lumped::is_point_mass(s, b);
+            (0..6).map(move |r| point && r >= 3)
+        })
+        .collect()
 }
 
 /// The block-diagonal matrix of `blocks`.

@@ -16,7 +16,7 @@
 //! Both are made of members and free bodies the simulator already has, so the settle, the
 //! modes, the motion, the sensitivities, interference, the table and the recording read them as
 //! they read any spring, cable and body. A point mass is a free body with one node at its centre
-//! of mass, so no member turns it: its turning is three zero modes.
+//! of mass, so no member turns it: the modal analysis leaves its three turns out (`sim/modes.rs`).
 
 use super::{distance, BodyKind, Inertia, Law, MemberId, Structure, Vec3};
 
@@ -28,7 +28,7 @@ pub const MAX_CABLE_SEGMENTS: usize = 1000;
 #[error("{0}")]
 pub struct LumpError(pub String);
 
-/// A point mass of `mass_kg` at `com`. No member turns it, so its turning is a zero mode and
+/// A point mass of `mass_kg` at `com`. No member turns it, so its turning is no mode and
 /// its moments only need to be in the simulation's range (`scenario/physical.rs`, scaled by the
 /// structure's extent): those of a free body of the structure's size `size_m` without stated
 /// inertia, m size^2 / 12 about every axis [kg m^2].

@@ -686,6 +686,12 @@ pub const MAX_SPARSE_MODAL_COUNT: usize = 200;
 /// command on the bench prism), the settle before it with the count.
 pub const MAX_SPARSE_MODAL_FREE_BODIES: usize = 2000;
 
+/// Most point masses (`lumped::is_point_mass`: elastic struts' ends, heavy cables' beads) whose
+/// structure's lowest modes the sparse solver computes. Their turns are no modes, so the report
+/// does not grow with them; the solve does, about linearly (measured in BENCHMARKS.md: 2898
+/// point masses of a 100-strut prism, 8998 of a 300-strut one).
+pub const MAX_SPARSE_MODAL_POINT_MASSES: usize = 10_000;
+
 /// Whether the modes of `s` are those of free bodies held by springs and elastic cables (the
 /// static relaxation's domain: no joints, no inextensible cables, no friction): the sparse
 /// solver's domain above [`DENSE_MODAL_MAX_FREE_BODIES`].

@@ -104,8 +104,8 @@ fn check_by_settles(
         let SettledState { mut sim, .. } = settle_at(&sc, &inputs, moved.clone(), cancel)?;
         let mut sample = out.sample(&sim, &moved);
         let coordinates = sim.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
-        let modes = linearize(&mut sim, &coordinates)?.modes;
-        sample.extend(listed.iter().map(|&i| (format!("mode{}.omega", i + 1), modes[i].omega())));
+        let lin = linearize(&mut sim, &coordinates)?;
+        sample.extend(listed.iter().map(|&i| (lin.mode_name(i), lin.modes[i].omega())));
         y.push(out.offsets(&sample, &base));
     }
     let check = derivative_from_samples(y[0].clone(), y[1].clone(), y[2].clone(), y[3].clone(), row.step);

@@ -84,6 +84,7 @@ impl Data {
         &self,
         m: &Model,
         mass: &[Matrix6<f64>],
+        turning: &[bool],
         wanted: Lowest,
         cancel: Option<&AtomicBool>,
     ) -> Result<LowestModes, ModesError> {
@@ -97,25 +98,34 @@ impl Data {
             factors[i].transpose() * Vector6::new(u.x, u.y, u.z, w.x, w.y, w.z)
         };
         let motions = rigid_motions(&dofs, m.length_scale_m, &weighted.position, &self.rigid_groups(m, &dofs), &weigh);
+        // A point mass's turns are taken out as rigid motions and not reported (`modes.rs`).
+        let mut turns_at = vec![false; n];
+        for (i, &p) in weighted.position.iter().enumerate() {
+            for r in 0..6 {
+                turns_at[6 * p + r] = turning[6 * i + r];
+            }
+        }
         let mut rigid: Vec<Motion> = Vec::new();
         let mut out = Vec::new();
         let mut product = SparseProduct::new(n);
         for motion in motions {
             let (norm, quotient) = product.norm_and_quotient(&weighted.matrix, &motion);
             if norm <= DEFLATION_RATIO * largest {
-                let mut y = DVector::zeros(n);
-                for &(r, x) in &motion.0 {
-                    y[r] = x;
+                if !motion.0.iter().all(|&(r, _)| turns_at[r]) {
+                    let mut y = DVector::zeros(n);
+                    for &(r, x) in &motion.0 {
+                        y[r] = x;
+                    }
+                    out.push((quotient, y));
                 }
-                out.push((quotient, y));
                 rigid.push(motion);
             }
         }
-        let through = wanted.through.map_or(0, |i| (i + 1).saturating_sub(rigid.len()));
+        let through = wanted.through.map_or(0, |i| (i + 1).saturating_sub(out.len()));
         let want = wanted.count.max(through).min(n - rigid.len());
         if want > MAX_SPARSE_MODAL_COUNT {
             let through = wanted.through.map_or(want, |i| i + 1);
-            return Err(ModesError::TooManyWanted { wanted: want, rigid: rigid.len(), through });
+            return Err(ModesError::TooManyWanted { wanted: want, rigid: out.len(), through });
         }
         let (ritz, _) = subspace_iteration(&weighted, &rigid, want, largest, cancel)?;
         out.extend(ritz);
