@@ -85,7 +85,7 @@ pub struct StructureModes {
     /// solver's); `None` where they are all of them.
     pub lowest_of: Option<usize>,
     /// The free bodies' coordinates left out of the analysis: the point masses' turns, three
-    /// each ([`turning_coordinates`]; their shapes are zero there).
+    /// each (`turning_coordinates` in `sim/modes.rs`; their shapes are zero there).
     pub left_out: usize,
 }
 

@@ -572,7 +572,7 @@ fn invalid(what: &'static str, name: &str, message: &str) -> StructureError {
     StructureError::Invalid { what, name: name.into(), message: message.into() }
 }
 
-/// The diagonal of the nodes' bounding box in the drawing [m]: the structure's extent, which the
+/// The diagonal of the nodes' bounding box in the drawing \[m\]: the structure's extent, which the
 /// simulation's ranges scale with (linear in the nodes, unlike [`structure_size`]).
 pub fn extent_m(s: &Structure) -> f64 {
     let mut lo = [f64::INFINITY; 3];
