@@ -67,6 +67,10 @@ pub struct ModeReport {
     pub rigid: bool,
     /// The nodes that move most, with their motion relative to the largest.
     pub largest_moving: Vec<(String, f64)>,
+    /// The mode's shape: every node's displacement, world frame, for the mass-normalised
+    /// amplitude (v^T M v = 1) \[m per unit\], by node name; empty for a rigid-body mode.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub node_displacements_m: Vec<(String, [f64; 3])>,
 }
 
 impl ModesReport {

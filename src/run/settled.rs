@@ -137,6 +137,11 @@ fn rows(analysis: &StructureModes, nodes: &[crate::structure::Node]) -> Vec<Mode
                 .into_iter()
                 .map(|(n, d)| (nodes[n].name.clone(), d))
                 .collect(),
+            node_displacements_m: if m.rigid {
+                Vec::new()
+            } else {
+                nodes.iter().zip(&m.node_motion).map(|(n, d)| (n.name.clone(), *d)).collect()
+            },
         })
         .collect()
 }

@@ -59,10 +59,22 @@ pub(super) fn physical(
         let scale = size * size;
         let moments_ok = i.principal_kg_m2.iter().all(|j| (lo * scale..=hi * scale).contains(j));
         if !(lo..=hi).contains(&i.mass_kg) || !moments_ok {
-            return Err(at_model(format!(
+            let message = format!(
                 "body '{}' has mass {:e} kg and moments {:?} kg m^2; the simulation handles masses of {lo:e} to {hi:e} kg and moments of that times the extent squared ({scale:e} m^2)",
                 b.name, i.mass_kg, i.principal_kg_m2
-            )));
+            );
+            // At the body's mass (or inertia, or name) where the file declares it by that name;
+            // a built-in mechanism's, a repeated or a generated body at the model.
+            let declared =
+                raw.structure.as_ref().and_then(|st| st.get_ref().bodies.iter().find(|r| *r.name.get_ref() == b.name));
+            return Err(match declared {
+                Some(r) if !moments_ok && r.inertia.is_some() => ctx.err(r.inertia.as_ref().unwrap(), message),
+                Some(r) => match &r.mass {
+                    Some(mass) => ctx.err(mass, message),
+                    None => ctx.err(&r.name, message),
+                },
+                None => at_model(message),
+            });
         }
     }
     if let Some((omega, b)) = crate::structure::lumped::fastest_point_mass(s) {

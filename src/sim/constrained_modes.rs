@@ -259,12 +259,18 @@ impl Data {
     /// The least distance |l - l0| \[m\] of an elastic cable from its rest length, where its
     /// energy has a kink; None without elastic cables.
     fn kink_distance_m(&self, m: &Model) -> Option<f64> {
+        self.nearest_kink(m).map(|(_, d)| d)
+    }
+
+    /// The elastic cable nearest its kink and that distance |l - l0| \[m\]; None without
+    /// elastic cables.
+    pub(super) fn nearest_kink(&self, m: &Model) -> Option<(usize, f64)> {
         let s = &m.structure;
         s.members_by_kind()
             .filter_map(|(i, _)| Some((i, self.elastic_law(m, i)?)))
             .filter(|(_, law)| law.tension_only)
-            .map(|(i, law)| (self.member_length_m(m, i) - law.rest_length_m).abs())
-            .reduce(f64::min)
+            .map(|(i, law)| (i, (self.member_length_m(m, i) - law.rest_length_m).abs()))
+            .reduce(|a, b| if b.1 < a.1 { b } else { a })
     }
 
     /// The constraint rows g(q) [m]: each closure's, then each taut cable's stretch.

@@ -251,3 +251,19 @@ fn an_oversized_scenario_file_is_refused_before_parsing() {
     assert!(out.is_empty() && err.lines().count() == 1, "one error, nothing validated: {out}{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// F7 of issue 60: a body's mass or moments out of the simulation's range are an error at that
+/// body's `mass` (the file's own range) or `inertia` key (the range scaled by the structure's
+/// extent, found once the structure is built), not at `[structure]`.
+#[test]
+fn a_body_mass_out_of_range_is_an_error_at_its_mass() {
+    let text = std::fs::read_to_string("scenarios/custom/prism3.toml").unwrap();
+    let light = text.replacen("name = \"strut2\"\nmass = 1.0", "name = \"strut2\"\nmass = 1e-10", 1);
+    crate::common::error_at(&light, "mass = 1e-10", 7, "mass must lie in [1e-9, 1e9] kg");
+    let tiny = text.replacen(
+        "name = \"strut3\"\nmass = 1.0",
+        "name = \"strut3\"\nmass = 1.0\ninertia = [1e-12, 1e-12, 1e-12]",
+        1,
+    );
+    crate::common::error_at(&tiny, "inertia = [1e-12", 10, "body 'strut3' has mass 1e0 kg and moments");
+}

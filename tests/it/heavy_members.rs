@@ -485,3 +485,33 @@ fn a_heavy_cable_that_cannot_be_built_is_refused_by_name() {
     let text = cable.replacen("[motion]", winch, 1);
     common::error_at(&text, "density = \"rho\"", 10, "a winch drives it");
 }
+
+/// `modes --json` gives each non-rigid mode's shape: the beaded string's lowest mode moves bead
+/// i by a sin(pi i / (n + 1)) in one direction across the string (within 1e-9 of the largest),
+/// the anchors not at all, mass-normalised: sum m |d_i|^2 = 1 within 1e-12.
+#[test]
+fn the_beaded_strings_mode_shape_is_the_sine_of_the_closed_form() {
+    let (code, out, err) = common::tensegrity(&["modes", BEADED, "--json", "-"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let shape = v["modes"][0]["node_displacements_m"].as_array().expect("the shape");
+    let at = |name: &str| -> [f64; 3] {
+        let row = shape.iter().find(|r| r[0] == name).unwrap_or_else(|| panic!("{name}"));
+        [0, 1, 2].map(|k| row[1][k].as_f64().unwrap())
+    };
+    assert_eq!(at("A"), [0.0; 3]);
+    let n = SEGMENTS - 1;
+    let d: Vec<[f64; 3]> = (1..=n).map(|i| at(&format!("string_b{i}"))).collect();
+    let (u, top) = (d[2], (d[2][1].hypot(d[2][2])));
+    assert!(u[0].abs() <= 1e-12 * top, "across the string: {u:?}");
+    let m = RHO_KG_PER_M * L0_M / SEGMENTS as f64;
+    let mut norm = 0.0;
+    for (i, di) in d.iter().enumerate() {
+        let sine = ((i + 1) as f64 * std::f64::consts::PI / (n + 1) as f64).sin();
+        for k in 0..3 {
+            assert!((di[k] - sine * u[k]).abs() <= 1e-9 * top, "bead {}: {di:?} vs {sine} x {u:?}", i + 1);
+        }
+        norm += m * (di[0] * di[0] + di[1] * di[1] + di[2] * di[2]);
+    }
+    assert!((norm - 1.0).abs() <= 1e-12, "v^T M v = {norm}");
+}
