@@ -14,7 +14,7 @@ use super::error::{finite, Ctx, ScenarioError};
 use super::raw::{RawPrestress, RawScenario};
 use crate::mechanisms::Values;
 use crate::settings::{OnLoss, Prestress};
-use crate::structure::{BodyKind, Law, MemberKind, Structure};
+use crate::structure::{BodyKind, JointKind, Law, MemberKind, Structure};
 use toml::Spanned;
 
 /// The prestress judgement of a scenario: the section's, the default for a custom structure
@@ -77,8 +77,19 @@ pub(super) fn set_self_stress(
         return Err(ctx.err(t, format!("prestress.least_tension is {least_n} N: a tension is finite and > 0")));
     }
     let on_strut = |n: usize| s.members_of(MemberKind::Strut).any(|(_, m)| m.path.contains(&n));
+    // A node is held where it lies on a fixed body (and on no strut, whose force the balance
+    // there reads), or where a joint pins it to a fixed body: the joint's reaction holds it
+    // (F4 of issue 60: a strut pinned at its foot had counted as free there, and the drawing
+    // had seemed to have no self-stress).
+    let fixed = |b: usize| s.bodies[b].kind == BodyKind::Fixed;
+    let at_anchor = |j: &crate::structure::Joint, n: usize| {
+        j.anchor == n || (j.child == s.nodes[n].body && s.nodes[j.anchor].position == s.nodes[n].position)
+    };
+    let pinned = |n: usize| {
+        s.joints.iter().any(|j| fixed(j.parent) && at_anchor(j, n) && !matches!(j.kind, JointKind::Prismatic { .. }))
+    };
     let anchored: Vec<bool> =
-        (0..s.nodes.len()).map(|n| s.bodies[s.nodes[n].body].kind == BodyKind::Fixed && !on_strut(n)).collect();
+        (0..s.nodes.len()).map(|n| (fixed(s.nodes[n].body) && !on_strut(n)) || pinned(n)).collect();
     let positions: Vec<_> = s.nodes.iter().map(|n| n.position).collect();
     // Cables first, then springs: the order of `self_stress_of`'s tensions.
     let tensioned: Vec<usize> = [MemberKind::Cable, MemberKind::Spring]

@@ -146,3 +146,74 @@ fn a_sweep_fails_on_a_point_that_lost_its_prestress() {
     assert!((kept - 0.8747).abs() <= 1e-4 && cell(&text, "prestress_lost") == "false", "{text}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// F4 of issue 60: a mast pinned at its foot by a ball joint to the ground and guyed by three
+/// cables to the ground has a drawn self-stress (each guy t0, the mast 3 t0 / sqrt(2) in
+/// compression), which `least_tension` had refused ("check the drawing"): the foot's node was
+/// counted free because it lies on no fixed body. The joint holds it now: every guy settles at
+/// t0 = 10 N and the mast at -21.2132 N, within 1e-9 relative.
+#[test]
+fn least_tension_holds_a_node_pinned_to_the_ground_by_a_joint() {
+    let text = r#"name = "guyed mast"
+mechanism = "custom"
+[params]
+t0 = { value = 10.0, unit = "N" }
+[sim]
+dt = 0.002
+body_damping = 5.0
+[settle]
+speed_tol = 1e-10
+residual_force_tol = 1e-8
+residual_torque_tol = 1e-8
+[prestress]
+least_tension = "t0"
+[actuation]
+points = [ {} ]
+[structure]
+[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { G1 = [1, 0, 0], G2 = [-0.5, 0.866025403784439, 0], G3 = [-0.5, -0.866025403784439, 0] }
+[[structure.bodies]]
+name = "mast"
+mass = 1.0
+nodes = { B = [0, 0, 0], T = [0, 0, 1] }
+[[structure.joints]]
+name = "foot"
+kind = "spherical"
+parent = "ground"
+child = "mast"
+at = "B"
+damping = 0.1
+[[structure.struts]]
+name = "mast"
+a = "B"
+b = "T"
+[[structure.cables]]
+name = "guy1"
+a = "T"
+b = "G1"
+stiffness = 1000.0
+[[structure.cables]]
+name = "guy2"
+a = "T"
+b = "G2"
+stiffness = 1000.0
+[[structure.cables]]
+name = "guy3"
+a = "T"
+b = "G3"
+stiffness = 1000.0
+[expect]
+verdict = "pass"
+"#;
+    let sc = tensegrity_testbed::scenario::parse(std::path::Path::new("mast.toml"), text).expect("a self-stress");
+    let report = tensegrity_testbed::run::run(&sc, &tensegrity_testbed::run::RunOptions::default());
+    assert!(report.passed, "{}", report.verdict_line());
+    let at = |k: &str| report.points[0].simulated[k];
+    for guy in ["guy1.force", "guy2.force", "guy3.force"] {
+        assert!((at(guy) / 10.0 - 1.0).abs() <= 1e-9, "{guy} = {}", at(guy));
+    }
+    let mast = -30.0 / 2f64.sqrt();
+    assert!((at("mast.force") / mast - 1.0).abs() <= 1e-9, "mast {} against {mast}", at("mast.force"));
+}
