@@ -53,6 +53,31 @@ pub(super) fn physical(
             m.name()
         )));
     }
+    masses(ctx, raw, s, size, &at_model)?;
+    point_mass_step(ctx, raw, s, sim, &at_model)?;
+    let half = sim.bounding_box_m;
+    if let Some(n) = s.nodes.iter().find(|n| n.position.iter().any(|c| c.abs() > half)) {
+        let message = format!(
+            "node '{}' at {:?} m lies outside sim.bounding_box = {half} m (the box every node must stay in): enlarge the box",
+            n.name, n.position
+        );
+        return Err(match &raw.sim.bounding_box {
+            Some(b) => ctx.err(b, message),
+            None => at_model(message),
+        });
+    }
+    Ok(())
+}
+
+/// Every free body's mass and moments in the simulation's range, scaled by the extent
+/// `size_m`; an error at the body's `mass` or `inertia` key where the file declares it by name.
+fn masses(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    s: &Structure,
+    size: f64,
+    at_model: &dyn Fn(String) -> ScenarioError,
+) -> Result<(), ScenarioError> {
     for b in s.bodies.iter().filter(|b| b.kind == BodyKind::Free) {
         let Some(i) = &b.inertia else { continue };
         let (lo, hi) = BODY_MASS_KG;
@@ -77,6 +102,18 @@ pub(super) fn physical(
             });
         }
     }
+    Ok(())
+}
+
+/// The step `sim.dt` against the fastest point mass (`structure::lumped`): an error at
+/// `sim.dt` past the step's stability limit.
+fn point_mass_step(
+    ctx: &Ctx,
+    raw: &RawScenario,
+    s: &Structure,
+    sim: &SimSettings,
+    at_model: &dyn Fn(String) -> ScenarioError,
+) -> Result<(), ScenarioError> {
     if let Some((omega, b)) = crate::structure::lumped::fastest_point_mass(s) {
         let limit = crate::structure::lumped::STABLE_OMEGA_DT;
         if omega * sim.dt_s >= limit {
@@ -92,17 +129,6 @@ pub(super) fn physical(
                 None => at_model(message),
             });
         }
-    }
-    let half = sim.bounding_box_m;
-    if let Some(n) = s.nodes.iter().find(|n| n.position.iter().any(|c| c.abs() > half)) {
-        let message = format!(
-            "node '{}' at {:?} m lies outside sim.bounding_box = {half} m (the box every node must stay in): enlarge the box",
-            n.name, n.position
-        );
-        return Err(match &raw.sim.bounding_box {
-            Some(b) => ctx.err(b, message),
-            None => at_model(message),
-        });
     }
     Ok(())
 }
