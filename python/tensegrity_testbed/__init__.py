@@ -183,8 +183,9 @@ def modes(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str
           count: int = 20) -> dict:
     """The structure's natural frequencies and mode shapes at its first point, settled as
     ``run`` settles it: the report of ``tensegrity modes --json`` as a dict (``modes``: one per
-    mode, ascending omega^2, with ``omega_rad_per_s``, ``frequency_hz``, ``rigid`` and the
-    nodes that move most; ``coordinates``, ``joint_coordinates``, ``rigid_modes``; above 100
+    mode, ascending omega^2, with ``omega_rad_per_s``, ``frequency_hz``, ``rigid``, the
+    nodes that move most and, for a non-rigid mode, ``node_displacements_m``: its shape, every
+    node's ``[name, [dx, dy, dz]]`` for the mass-normalised amplitude; ``coordinates``, ``joint_coordinates``, ``rigid_modes``; above 100
     free bodies ``lowest_of``: the list is the lowest ``count`` non-rigid modes (1 to 200, as
     ``modes --count``) and every rigid one, of that many). Raises
     ScenarioError on bad input, ValueError where the structure's modes are not computed (the

@@ -836,3 +836,17 @@ def test_elastic_struts_and_heavy_cables_reach_python_as_the_cli():
         tt.check(bad, name="beaded.toml")
     line = bad[: bad.index("segments = 0")].count("\n") + 1
     assert (e.value.line, e.value.col) == (line, 12) and "from 1 to 1000" in e.value.message
+
+
+def test_a_modes_shape_reaches_python():
+    """tt.modes gives each non-rigid mode's shape as the CLI does: the beaded string's lowest
+    mode moves bead i by sin(pi i / 6) of the middle bead's displacement (within 1e-9) and its
+    anchors not at all."""
+    r = tt.modes(str(BEADED))
+    shape = dict((name, d) for name, d in r["modes"][0]["node_displacements_m"])
+    assert shape["A"] == [0.0, 0.0, 0.0] and shape["B"] == [0.0, 0.0, 0.0]
+    middle = shape["string_b3"]
+    top = math.hypot(*middle)
+    for i in range(1, 6):
+        sine = math.sin(math.pi * i / 6)
+        assert all(abs(d - sine * m) <= 1e-9 * top for d, m in zip(shape[f"string_b{i}"], middle))
