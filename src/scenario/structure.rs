@@ -55,7 +55,7 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
 /// with `segments`), of point masses (`structure/lumped.rs`); a key that a member's kind
 /// cannot take is an error at the key.
 fn lump_members(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(), ScenarioError> {
-    let size = crate::structure::extent_m(s);
+    let mut lumping = crate::structure::lumped::Lumping::new(s);
     for m in r.springs.iter() {
         refuse_keys(
             ctx,
@@ -73,7 +73,8 @@ fn lump_members(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(), Sc
     for (i, m) in r.struts.iter().enumerate() {
         refuse_keys(ctx, m, "strut", &[("density", &m.density), ("segments", &m.segments)])?;
         if let Some((at, ea)) = axial_stiffness(ctx, m)? {
-            crate::structure::lumped::make_strut_elastic(s, i, ea, size).map_err(|e| ctx.err(at, e.to_string()))?;
+            crate::structure::lumped::make_strut_elastic(s, i, ea, &mut lumping)
+                .map_err(|e| ctx.err(at, e.to_string()))?;
         }
     }
     let first_cable = r.struts.len() + r.springs.len();
@@ -96,7 +97,7 @@ fn lump_members(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(), Sc
             (Some(d), Some(n)) => {
                 let density = positive_value(ctx, d, "density (kg/m)")?;
                 let count = segment_count(ctx, n)?;
-                crate::structure::lumped::hang_beads(s, first_cable + j, density, count, size)
+                crate::structure::lumped::hang_beads(s, first_cable + j, density, count, &mut lumping)
                     .map_err(|e| ctx.err(d, e.to_string()))?;
             }
         }

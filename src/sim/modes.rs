@@ -135,7 +135,8 @@ pub use crate::structure::{MAX_MODAL_FREE_BODIES, MAX_SPARSE_MODAL_FREE_BODIES, 
 /// [`MAX_SPARSE_MODAL_FREE_BODIES`] for free bodies on springs and elastic cables.
 pub fn check_modal_size(s: &crate::structure::Structure) -> Result<(), ModesError> {
     let free = |b: &usize| s.bodies[*b].kind == BodyKind::Free;
-    let points = (0..s.bodies.len()).filter(free).filter(|&b| crate::structure::lumped::is_point_mass(s, b)).count();
+    let point = crate::structure::lumped::point_masses(s);
+    let points = (0..s.bodies.len()).filter(free).filter(|&b| point[b]).count();
     // A point mass's turns are no modes (`turning_coordinates`): it counts apart, where the
     // sparse solver runs.
     let bodies = (0..s.bodies.len()).filter(free).count();
@@ -337,13 +338,8 @@ pub fn modal_projector(s: &crate::structure::Structure, analysis: &StructureMode
 /// analysis leaves them out (a beaded string of five beads has no rigid mode, not fifteen), and
 /// a structure of thousands of beads reports its modes without one rigid mode per bead.
 fn turning_coordinates(s: &crate::structure::Structure, bodies: &[usize]) -> Vec<bool> {
-    bodies
-        .iter()
-        .flat_map(|&b| {
-            let point = crate::structure::lumped::is_point_mass(s, b);
-            (0..6).map(move |r| point && r >= 3)
-        })
-        .collect()
+    let point = crate::structure::lumped::point_masses(s);
+    bodies.iter().flat_map(|&b| (0..6).map(|r| point[b] && r >= 3).collect::<Vec<_>>()).collect()
 }
 
 /// The block-diagonal matrix of `blocks`.
