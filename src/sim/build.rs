@@ -1,7 +1,7 @@
 //! Structure -> rapier sets.
 
 use super::data::Data;
-use super::joint_data::{generic_joint, locked_joint, set_link_damping, v};
+use super::joint_data::{generic_joint, link_damping, locked_joint, set_link_damping, v};
 use super::model::Tree;
 use super::model::{LinkRef, Model, SimError};
 use crate::settings::SimSettings;
@@ -15,7 +15,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<(Model, Dat
     let n = s.bodies.len();
     let actuated = actuated_joints(s)?;
     let (mut bodies, handles) = insert_bodies(s, settings);
-    let joints = insert_joints(s, &mut bodies, &handles, &actuated)?;
+    let joints = insert_joints(s, &mut bodies, &handles, &actuated, settings_body_damping(settings))?;
     let Joints { mut impulse_joints, multibody_joints, joint_links, joint_impulse, hidden_links } = joints;
     let ropes = insert_ropes(s, &mut impulse_joints, &handles)?;
     let mut model = Model {
@@ -157,6 +157,7 @@ fn insert_joints(
     bodies: &mut RigidBodySet,
     handles: &[RigidBodyHandle],
     actuated: &[bool],
+    body_damping_per_s: f64,
 ) -> Result<Joints, SimError> {
     let mut out = Joints {
         impulse_joints: ImpulseJointSet::new(),
@@ -203,7 +204,7 @@ fn insert_joints(
             _ if actuated[j] => mb.insert_kinematic(h1, h2, generic_joint(s, joint), true).expect("checked: no loop"),
             _ => mb.insert(h1, h2, generic_joint(s, joint), true).expect("checked: no loop"),
         };
-        set_link_damping(mb, link, joint.damping);
+        set_link_damping(mb, link, link_damping(s, j, body_damping_per_s));
         out.joint_links[j] = Some(LinkRef { multibody_joint: link });
     }
     Ok(out)

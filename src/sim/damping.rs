@@ -224,7 +224,7 @@ impl Data {
             }
             let Some((mb_index, dof)) = self.dof_of(m, j) else { continue };
             let load = self.joint_load(m, j);
-            let mut damping = m.structure.joints[j].damping;
+            let mut damping = super::joint_data::link_damping(&m.structure, j, m.settings.body_damping_per_s);
             if load.stiffness > 0.0 && load.inertia > 0.0 {
                 acted = true;
                 damping = newton_damping(dt, load.stiffness, load.inertia);

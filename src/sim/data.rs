@@ -437,7 +437,7 @@ impl Data {
     pub(super) fn restore_scheduled_damping(&mut self, m: &Model) {
         for j in 0..m.structure.joints.len() {
             if let (Some(link), true) = (m.joint_links[j], self.scheduled(m, j)) {
-                let damping = m.structure.joints[j].damping;
+                let damping = super::joint_data::link_damping(&m.structure, j, m.settings.body_damping_per_s);
                 super::joint_data::set_link_damping(&mut self.multibody_joints, link.multibody_joint, damping);
             }
         }

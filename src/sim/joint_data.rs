@@ -109,3 +109,24 @@ pub(super) fn generic_joint(s: &Structure, joint: &Joint) -> GenericJoint {
 fn glam_mat3(x: Vector, y: Vector, z: Vector) -> rapier3d_f64::glamx::DMat3 {
     rapier3d_f64::glamx::DMat3::from_cols(x, y, z)
 }
+
+/// The damping of joint `j`'s multibody link [N m s/rad, or N s/m]: the joint's own, except
+/// for an undamped ball joint that hangs a body from a fixed one, which takes the bodies'
+/// damping rate `body_damping_per_s` [1/s] times the child's largest moment of inertia about
+/// the anchor. rapier damps a multibody link through its degrees of freedom only, never through
+/// the body's own damping, so a strut hanging on an undamped ball joint had swung for ever under
+/// `body_damping` (F6 of issue 60). Other links keep the joint's damping (every shipped
+/// mechanism states it; applying the rate to all of them moved four seed baselines).
+pub(super) fn link_damping(s: &Structure, j: usize, body_damping_per_s: f64) -> f64 {
+    let joint = &s.joints[j];
+    let hanging = matches!(joint.kind, JointKind::Spherical)
+        && joint.damping == 0.0
+        && s.bodies[joint.parent].kind == crate::structure::BodyKind::Fixed;
+    let Some(i) = s.bodies[joint.child].inertia.filter(|_| hanging && body_damping_per_s > 0.0) else {
+        return joint.damping;
+    };
+    let d = nalgebra::Vector3::from(i.com) - nalgebra::Vector3::from(s.nodes[joint.anchor].position);
+    let about_anchor = nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::from(i.principal_kg_m2))
+        + i.mass_kg * (nalgebra::Matrix3::identity() * d.norm_squared() - d * d.transpose());
+    body_damping_per_s * about_anchor.diagonal().max()
+}
