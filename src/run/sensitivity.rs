@@ -160,8 +160,7 @@ pub(crate) fn linearize(
     let s = sim.structure();
     let left_out = match coordinates {
         EquilibriumCoordinates::Bodies(bodies) => {
-            let point = crate::structure::lumped::point_masses(s);
-            3 * bodies.iter().filter(|&&b| point[b]).count()
+            crate::sim::modes::turning_coordinates(s, bodies).into_iter().filter(|&t| t).count()
         }
         _ => 0,
     };

@@ -357,13 +357,23 @@ fn displaced_mode(
 /// A mode of the structure's own modal analysis (from 1 in the file, from 0 here): at most six
 /// per free body, or one per free (not actuated) joint of a jointed structure.
 fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, ScenarioError> {
+    // Point masses' turns are no modes, and their bodies count apart (`structure::modal_bodies`).
+    let (bodies, points) = crate::structure::modal_bodies(s);
     let count = if s.joints.is_empty() {
-        6 * s.bodies.iter().filter(|b| b.kind == crate::structure::BodyKind::Free).count() as i64
+        (6 * bodies - 3 * points) as i64
     } else {
         let actuated = |j: usize| s.actuators.iter().any(|a| a.target == crate::structure::ActuatorTarget::Joint(j));
         (0..s.joints.len()).filter(|j| !actuated(*j)).count() as i64
     };
-    let free = s.bodies.iter().filter(|b| b.kind == crate::structure::BodyKind::Free).count();
+    let most_points = crate::structure::MAX_SPARSE_MODAL_POINT_MASSES;
+    if points > most_points {
+        let message = format!(
+            "mode {}: the structure has {points} point masses, and its modes are computed for at most {most_points}",
+            mode.get_ref()
+        );
+        return Err(ctx.err(mode, message));
+    }
+    let free = bodies - points;
     let most = crate::structure::modal_free_body_bound(s);
     if free > most {
         let what = if crate::structure::modes_of_free_bodies(s) {

@@ -134,16 +134,11 @@ pub use crate::structure::{MAX_MODAL_FREE_BODIES, MAX_SPARSE_MODAL_FREE_BODIES, 
 /// The structure's size for its modes: an error past [`MAX_MODAL_FREE_BODIES`] free bodies, or
 /// [`MAX_SPARSE_MODAL_FREE_BODIES`] for free bodies on springs and elastic cables.
 pub fn check_modal_size(s: &crate::structure::Structure) -> Result<(), ModesError> {
-    let free = |b: &usize| s.bodies[*b].kind == BodyKind::Free;
-    let point = crate::structure::lumped::point_masses(s);
-    let points = (0..s.bodies.len()).filter(free).filter(|&b| point[b]).count();
-    // A point mass's turns are no modes (`turning_coordinates`): it counts apart, where the
-    // sparse solver runs.
-    let bodies = (0..s.bodies.len()).filter(free).count();
-    if crate::structure::modes_of_free_bodies(s) && points > MAX_SPARSE_MODAL_POINT_MASSES {
+    let (free, points) = crate::structure::modal_bodies(s);
+    if points > MAX_SPARSE_MODAL_POINT_MASSES {
         return Err(ModesError::TooManyPointMasses { points });
     }
-    let bodies = if crate::structure::modes_of_free_bodies(s) { bodies - points } else { bodies };
+    let bodies = free - points;
     if bodies > crate::structure::modal_free_body_bound(s) {
         return Err(if crate::structure::modes_of_free_bodies(s) {
             ModesError::TooLargeSparse { bodies }
@@ -337,9 +332,9 @@ pub fn modal_projector(s: &crate::structure::Structure, analysis: &StructureMode
 /// loads all act at its centre. Its three turns are zero modes of nothing physical, so the
 /// analysis leaves them out (a beaded string of five beads has no rigid mode, not fifteen), and
 /// a structure of thousands of beads reports its modes without one rigid mode per bead.
-fn turning_coordinates(s: &crate::structure::Structure, bodies: &[usize]) -> Vec<bool> {
+pub(crate) fn turning_coordinates(s: &crate::structure::Structure, bodies: &[usize]) -> Vec<bool> {
     let point = crate::structure::lumped::point_masses(s);
-    bodies.iter().flat_map(|&b| (0..6).map(|r| point[b] && r >= 3).collect::<Vec<_>>()).collect()
+    bodies.iter().flat_map(|&b| [false, false, false, point[b], point[b], point[b]]).collect()
 }
 
 /// The block-diagonal matrix of `blocks`.

@@ -699,6 +699,16 @@ pub fn modes_of_free_bodies(s: &Structure) -> bool {
     s.joints.is_empty() && !s.members.iter().any(|c| c.is_inextensible_cable() || c.has_friction())
 }
 
+/// What bounds and numbers the modes of `s`: its free bodies, and the point masses among them
+/// whose turns the analysis of free bodies on springs and elastic cables leaves out
+/// (`sim/modes.rs`; none elsewhere). The modes number six per free body less three per such
+/// point mass, and the point masses count apart from [`modal_free_body_bound`].
+pub fn modal_bodies(s: &Structure) -> (usize, usize) {
+    let free = s.bodies.iter().filter(|b| b.kind == BodyKind::Free).count();
+    let points = if modes_of_free_bodies(s) { lumped::point_masses(s).into_iter().filter(|&p| p).count() } else { 0 };
+    (free, points)
+}
+
 /// The most free bodies whose modes are computed for `s`: [`MAX_SPARSE_MODAL_FREE_BODIES`] for
 /// free bodies on springs and elastic cables, [`MAX_MODAL_FREE_BODIES`] otherwise.
 pub fn modal_free_body_bound(s: &Structure) -> usize {

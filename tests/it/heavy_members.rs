@@ -457,6 +457,9 @@ fn bad_elastic_strut_and_heavy_cable_keys_are_errors_at_their_key() {
     }
     let text = with("density = \"rho\"\n", "");
     common::error_at(&text, "segments = \"N\"", 11, "segments means nothing without density");
+    // Five beads have 15 modes: their turns are none (`structure::modal_bodies`).
+    let text = with("mode = 1              #", "mode = 16             #");
+    common::error_at(&text, "mode = 16", 7, "mode 16 does not exist: the structure has 15");
     let text = with("segments = \"N\"\n", "");
     common::error_at(&text, "density = \"rho\"", 10, "a heavy cable needs segments");
     let text = with("stiffness = \"k\"\n", "");
