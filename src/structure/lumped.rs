@@ -71,19 +71,19 @@ pub fn point_masses(s: &Structure) -> Vec<bool> {
         count[node.body] += 1;
         only[node.body] = Some(n);
     }
-    (0..s.bodies.len())
-        .map(|b| {
-            let at_com = |n: usize| s.bodies[b].inertia.is_some_and(|i| i.com == s.nodes[n].position);
-            s.bodies[b].kind == BodyKind::Free && count[b] == 1 && only[b].is_some_and(at_com)
-        })
-        .collect()
+    (0..s.bodies.len()).map(|b| count[b] == 1 && only[b].is_some_and(|n| at_centre(s, b, n))).collect()
 }
 
 /// Whether body `b` is a point mass: free, with one node, at its centre of mass.
 pub fn is_point_mass(s: &Structure, b: usize) -> bool {
-    let mut nodes = s.nodes.iter().filter(|n| n.body == b);
-    let (Some(node), None) = (nodes.next(), nodes.next()) else { return false };
-    s.bodies[b].inertia.is_some_and(|i| i.com == node.position)
+    let mut nodes = (0..s.nodes.len()).filter(|&n| s.nodes[n].body == b);
+    matches!((nodes.next(), nodes.next()), (Some(n), None) if at_centre(s, b, n))
+}
+
+/// Whether node `n` is at the centre of mass of the free body `b`.
+fn at_centre(s: &Structure, b: usize, n: usize) -> bool {
+    let free = s.bodies[b].kind == BodyKind::Free;
+    free && s.bodies[b].inertia.is_some_and(|i| i.com == s.nodes[n].position)
 }
 
 /// The step's stability limit on omega dt: the symplectic Euler step of an undamped oscillator
@@ -199,8 +199,8 @@ pub fn hang_beads(
         }
     }
     let names: Vec<String> = (1..segments).map(|i| format!("{name}_b{i}")).collect();
-    let members = (1..=segments).map(|k| format!("{name}_s{k}"));
-    if let Some(b) = names.iter().cloned().chain(members).find(|b| !lumping.claim(b)) {
+    let members: Vec<String> = (1..=segments).map(|k| format!("{name}_s{k}")).collect();
+    if let Some(b) = names.iter().chain(&members).find(|b| !lumping.claim(b)) {
         return refuse(format!("it would name a part '{b}', a name the structure already has"));
     }
     let size_m = lumping.size_m;
@@ -224,9 +224,8 @@ pub fn hang_beads(
     }
     path.push(b);
     let law = super::CableLaw::Elastic { stiffness_n_per_m: k * n };
-    for (k, w) in path.windows(2).enumerate() {
-        let segment =
-            super::Member::cable(format!("{name}_s{}", k + 1), w.to_vec(), law.clone(), l0 / n, member.radius_m);
+    for (k, (w, segment_name)) in path.windows(2).zip(members).enumerate() {
+        let segment = super::Member::cable(segment_name, w.to_vec(), law.clone(), l0 / n, member.radius_m);
         if k == 0 {
             s.members[cable] = segment;
         } else {
