@@ -35,6 +35,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<(Model, Dat
         tree: Tree::default(),
         fit_tree: Tree::default(),
         relaxation_applies: super::relaxation::applies(s),
+        point_masses: crate::structure::lumped::point_masses(s),
     };
     let mut data = Data {
         pipeline: PhysicsPipeline::new(),

@@ -67,6 +67,8 @@ pub struct Model {
     pub length_scale_m: f64,
     /// Whether the static relaxation applies to this structure (`relaxation/`).
     pub(super) relaxation_applies: bool,
+    /// Which bodies are point masses (`structure::lumped::point_masses`).
+    pub(super) point_masses: Vec<bool>,
 }
 
 impl Model {

@@ -6,6 +6,7 @@ use super::assemble::{v3, Dofs};
 use super::{MAX_STEP_FRACTION, MAX_STEP_ROTATION_RAD};
 use nalgebra::{DVector, Vector3};
 use rapier3d_f64::prelude::*;
+use std::ops::AddAssign;
 
 impl Data {
     /// Node position after moving every free body by `alpha` times `step` [m].
@@ -44,6 +45,39 @@ impl Data {
             scale += work.abs() + force.norm() * m.length_scale_m;
         }
         (change, scale)
+    }
+
+    /// The largest generalized force component (N, N m) after moving by `alpha` times `step`:
+    /// the merit of a step whose energy change is below the energy's round-off.
+    pub(super) fn relaxation_force_after(&self, m: &Model, dofs: &Dofs, step: &DVector<f64>, alpha: f64) -> f64 {
+        let s = &m.structure;
+        let mut f = DVector::zeros(6 * dofs.blocks());
+        let mut push = |node: usize, p: Vector3<f64>, force: Vector3<f64>| {
+            let Some(i) = dofs.index[s.nodes[node].body] else { return };
+            let com = v3(dofs.com[i]) + step.fixed_rows::<3>(6 * i) * alpha;
+            f.fixed_rows_mut::<3>(6 * i).add_assign(&force);
+            f.fixed_rows_mut::<3>(6 * i + 3).add_assign(&((p - com).cross(&force)));
+        };
+        for (i, member) in s.members_by_kind() {
+            let Some(law) = self.elastic_law(m, i) else { continue };
+            let at: Vec<Vector3<f64>> = member.path.iter().map(|&n| self.moved_node(m, dofs, step, alpha, n)).collect();
+            let l = member.length_at(|n| self.moved_node(m, dofs, step, alpha, n).into());
+            if l <= 0.0 || !law.engaged(l) {
+                continue;
+            }
+            let t = law.tension_n(l);
+            for (w, pair) in at.windows(2).enumerate() {
+                let pull = (pair[1] - pair[0]).normalize() * t;
+                push(member.path[w], pair[0], pull);
+                push(member.path[w + 1], pair[1], -pull);
+            }
+        }
+        for (b, i) in dofs.free() {
+            let (force, torque) = self.constant_load(m, b);
+            f.fixed_rows_mut::<3>(6 * i).add_assign(&force);
+            f.fixed_rows_mut::<3>(6 * i + 3).add_assign(&torque);
+        }
+        f.amax()
     }
 
     /// The largest fraction (at most 1) of `step` that keeps every body within the step limits.

@@ -62,11 +62,20 @@ const MIN_SHIFT_RATIO: f64 = 1e-8;
 const ENERGY_ROUND_OFF: f64 = 1e-12;
 /// A step in the energy's round-off (its predicted decrease below [`ENERGY_ROUND_OFF`] of the
 /// energy's scale) is taken only while the largest generalized force component has fallen
-/// below this fraction of its value at the last step (Newton's quadratic regime): once it
-/// stalls, the force is the round-off of its own evaluation, and a step would move the soft
-/// modes by that noise over their stiffness at every tick, so the structure would never be
-/// seen at rest (a 1000-strut prism: 1e-14 m per step, above the 1e-12 m/s speed test).
+/// below this fraction of its value at the last step (Newton's quadratic regime), or, once it
+/// stalls, where the step itself lowers the force to this fraction and the force stands above
+/// its own round-off ([`FORCE_ROUND_OFF`]). A force in its round-off is noise: a step would
+/// move the soft modes by that noise over their stiffness at every tick, so the structure
+/// would never be seen at rest (a 1000-strut prism: 1e-14 m per step, above the 1e-12 m/s
+/// speed test). A force above it is not, though the energy cannot see it: the energy's
+/// round-off is that of a sum over every member, and on a 150-strut prism with heavy cables
+/// (13,000 members) a force of 6e-6 N along a stiff mode lowers the energy by 1.6e-12 J, what
+/// the sum of 1.6 J resolves.
 const STALL_RATIO: f64 = 0.5;
+/// Relative round-off of the generalized force, as a fraction of the largest member tension or
+/// constant load: a sum of a few terms of that size, each to 1e-16, leaves 1e-14 of it; 1e-12
+/// leaves room for the thousands of terms of a heavy cable's beads.
+const FORCE_ROUND_OFF: f64 = 1e-12;
 /// Largest translation of a body in one step, as a fraction of the structure's size.
 const MAX_STEP_FRACTION: f64 = 0.25;
 /// Largest rotation of a body in one step [rad].
@@ -139,9 +148,9 @@ impl Relaxation {
         let dofs = d.relaxation_dofs(m);
         let system = d.relaxation_system(m, &dofs);
         let f = &system.force;
-        let mut solver = d.relaxation_solver(m, &dofs, &system);
         let last_force = std::mem::replace(&mut self.last_force, f.amax());
         let stalled = f.amax() > STALL_RATIO * last_force;
+        let mut solver = d.relaxation_solver(m, &dofs, &system);
         let mut shift = self.shift;
         for trial in 1..=MAX_TRIALS {
             let Some(step) = solver.step(shift) else {
@@ -162,7 +171,7 @@ impl Relaxation {
             }
             let (change, scale) = d.relaxation_energy_change(m, &dofs, &step, alpha);
             let round_off = alpha * predicted <= ENERGY_ROUND_OFF * scale;
-            if round_off && stalled {
+            if round_off && stalled && !self.halves(m, d, &dofs, &system, &step, alpha) {
                 break;
             }
             if change <= -ARMIJO * alpha * predicted || round_off {
@@ -174,6 +183,23 @@ impl Relaxation {
             }
             shift = raised(shift);
         }
+    }
+
+    /// Whether a step in the energy's round-off, taken after the force stalled, is taken all
+    /// the same: the force stands above its own round-off ([`FORCE_ROUND_OFF`] of the largest
+    /// tension or load) and the step lowers it to [`STALL_RATIO`] of itself.
+    fn halves(
+        &self,
+        m: &Model,
+        d: &Data,
+        dofs: &assemble::Dofs,
+        system: &assemble::System,
+        step: &DVector<f64>,
+        alpha: f64,
+    ) -> bool {
+        let now = system.force.amax();
+        now > FORCE_ROUND_OFF * system.force_scale_n
+            && d.relaxation_force_after(m, dofs, step, alpha) <= STALL_RATIO * now
     }
 }
 
