@@ -324,8 +324,9 @@ pub(super) struct RawMember {
     pub(super) youngs_modulus: Option<Spanned<Num>>,
     /// Struts only: the cross-section [m^2], with `E`.
     pub(super) area: Option<Spanned<Num>>,
-    /// Cables only: linear density [kg per unstretched m] of a heavy cable, built of
-    /// `segments` segments between beads; absent: massless.
+    /// A cable's linear density [kg per unstretched m], a heavy cable built of `segments`
+    /// segments between beads (absent: massless); a strut's [kg/m], its body's mass
+    /// density x length (in place of the body's `mass`).
     pub(super) density: Option<Spanned<Num>>,
     /// Cables only, with `density`: how many segments [1, 1000].
     pub(super) segments: Option<Spanned<Num>>,

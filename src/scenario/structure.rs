@@ -34,7 +34,7 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
             return Err(ctx.err(&b.name, format!("duplicate body name '{}'", b.name.get_ref())));
         }
         body_names.push(b.name.get_ref().clone());
-        add_body(ctx, &mut s, b)?;
+        add_body(ctx, &mut s, b, &r.struts)?;
     }
     // Names of members, joints and actuator symbols: unique, checked with every other name
     // of the file (`names.rs`).
@@ -71,7 +71,10 @@ fn lump_members(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(), Sc
         )?;
     }
     for (i, m) in r.struts.iter().enumerate() {
-        refuse_keys(ctx, m, "strut", &[("density", &m.density), ("segments", &m.segments)])?;
+        refuse_keys(ctx, m, "strut", &[("segments", &m.segments)])?;
+        if let Some(d) = &m.density {
+            strut_density_builds(ctx, s, m, d)?;
+        }
         if let Some((at, ea)) = axial_stiffness(ctx, m)? {
             crate::structure::lumped::make_strut_elastic(s, i, ea, &mut lumping)
                 .map_err(|e| ctx.err(at, e.to_string()))?;
@@ -105,6 +108,30 @@ fn lump_members(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(), Sc
     Ok(())
 }
 
+/// A strut's `density` gives its body its mass ([`body_mass`]): the body must be free and
+/// carry the strut's two nodes alone; otherwise an error at the key.
+fn strut_density_builds(ctx: &Ctx, s: &Structure, m: &RawMember, d: &Spanned<Num>) -> Result<(), ScenarioError> {
+    let (a, b) = (node(ctx, s, &m.a)?, node(ctx, s, &m.b)?);
+    let body = s.nodes[a].body;
+    let nodes = s.nodes.iter().filter(|n| n.body == body).count();
+    let why = if s.nodes[b].body != body {
+        "its nodes are on two bodies"
+    } else if s.bodies[body].kind == BodyKind::Fixed {
+        "its body is fixed"
+    } else if nodes != 2 {
+        "its body carries other nodes (state the body's mass)"
+    } else {
+        return Ok(());
+    };
+    Err(ctx.err(
+        d,
+        format!(
+            "strut '{}': density gives the strut's own body the mass density x length, and {why}",
+            m.name.get_ref()
+        ),
+    ))
+}
+
 /// `keys` given on a member of kind `what`, which cannot take them: an error at the first.
 fn refuse_keys(
     ctx: &Ctx,
@@ -115,7 +142,8 @@ fn refuse_keys(
     let Some((key, v)) = keys.iter().find_map(|(k, v)| v.as_ref().map(|v| (k, v))) else { return Ok(()) };
     let meaning = match *key {
         "EA" | "E" | "area" => "a strut's axial stiffness",
-        _ => "a cable's mass",
+        "density" => "a strut's or a heavy cable's mass",
+        _ => "a heavy cable's count of segments",
     };
     Err(ctx.err(v, format!("{key}: {} '{}' is a {what}; {key} states {meaning}", what, m.name.get_ref())))
 }
@@ -195,7 +223,7 @@ const MAX_COORDINATE_M: f64 = 1e6;
 
 /// Adds a body (at least one node, a mass if free) and its nodes (names unique in the
 /// structure) to `s`.
-fn add_body(ctx: &Ctx, s: &mut Structure, b: &RawBody) -> Result<(), ScenarioError> {
+fn add_body(ctx: &Ctx, s: &mut Structure, b: &RawBody, struts: &[RawMember]) -> Result<(), ScenarioError> {
     if b.nodes.is_empty() {
         return Err(ctx.err(
             &b.name,
@@ -211,7 +239,7 @@ fn add_body(ctx: &Ctx, s: &mut Structure, b: &RawBody) -> Result<(), ScenarioErr
         None
     } else {
         let points: Vec<[f64; 3]> = pts.iter().map(|(_, p)| *p).collect();
-        Some(inertia(ctx, b, &points)?)
+        Some(inertia(ctx, b, &points, struts)?)
     };
     let id = s.add_body(b.name.get_ref(), if fixed { BodyKind::Fixed } else { BodyKind::Free }, inertia);
     for (n, p) in pts {
@@ -223,13 +251,57 @@ fn add_body(ctx: &Ctx, s: &mut Structure, b: &RawBody) -> Result<(), ScenarioErr
     Ok(())
 }
 
-/// The inertia of a free body with nodes at `pts`: its mass > 0 kg, the centre of mass at the
-/// nodes' mean, the principal moments as given (each > 0) or isotropic from the body's size.
-fn inertia(ctx: &Ctx, b: &RawBody, pts: &[[f64; 3]]) -> Result<Inertia, ScenarioError> {
-    let m = b.mass.as_ref().ok_or_else(|| {
-        ctx.err(&b.name, format!("free body '{}' needs a mass > 0 kg (mass = ...), or fixed = true", b.name.get_ref()))
-    })?;
-    let mass = finite(ctx, m, "mass")?;
+/// The strut of `struts` that states a `density` and whose two nodes are on body `b`.
+fn strut_with_density<'a>(b: &RawBody, struts: &'a [RawMember]) -> Option<(&'a RawMember, &'a Spanned<Num>)> {
+    let holds = |n: &Spanned<String>| b.nodes.keys().any(|k| k.get_ref() == n.get_ref());
+    let m = struts.iter().find(|m| m.density.is_some() && holds(&m.a) && holds(&m.b))?;
+    Some((m, m.density.as_ref()?))
+}
+
+/// The mass of free body `b` with nodes at `pts` \[kg\]: its `mass`, or a strut's `density`
+/// times its drawn length where the body is that strut's alone; and where the number stands.
+fn body_mass<'a>(
+    ctx: &Ctx,
+    b: &'a RawBody,
+    pts: &[[f64; 3]],
+    struts: &'a [RawMember],
+) -> Result<(f64, &'a Spanned<Num>), ScenarioError> {
+    match (&b.mass, strut_with_density(b, struts)) {
+        (_, Some((strut, d))) if b.nodes.len() != 2 => Err(ctx.err(
+            d,
+            format!(
+                "strut '{}': density gives the strut's own body the mass density x length, and its body carries other nodes (state the body's mass)",
+                strut.name.get_ref()
+            ),
+        )),
+        (Some(m), None) => Ok((finite(ctx, m, "mass")?, m)),
+        (None, Some((_, d))) => {
+            let rho = positive_value(ctx, d, "a strut's density (kg per m)")?;
+            Ok((rho * crate::structure::distance(pts[0], pts[1]), d))
+        }
+        (Some(_), Some((strut, d))) => Err(ctx.err(
+            d,
+            format!(
+                "strut '{}' states its density, which gives its body '{}' the mass density x length, and the body states its mass: state one",
+                strut.name.get_ref(),
+                b.name.get_ref()
+            ),
+        )),
+        (None, None) => Err(ctx.err(
+            &b.name,
+            format!(
+                "free body '{}' needs a mass > 0 kg (mass = ..., or its strut's density = ... kg/m), or fixed = true",
+                b.name.get_ref()
+            ),
+        )),
+    }
+}
+
+/// The inertia of a free body with nodes at `pts`: its mass > 0 kg ([`body_mass`]), the
+/// centre of mass at the nodes' mean, the principal moments as given (each > 0) or isotropic
+/// from the body's size (a strut's body: m L^2 / 12, a thin bar's about its middle).
+fn inertia(ctx: &Ctx, b: &RawBody, pts: &[[f64; 3]], struts: &[RawMember]) -> Result<Inertia, ScenarioError> {
+    let (mass, m) = body_mass(ctx, b, pts, struts)?;
     let (lo, hi) = super::physical::BODY_MASS_KG;
     if !(lo..=hi).contains(&mass) {
         return Err(

@@ -8,10 +8,12 @@
 //!   bar's is pi sqrt(EA / (m L))); its inertia about its middle is m L^2 / 4 (a uniform rigid
 //!   bar's m L^2 / 12), and it does not spin about its axis.
 //! - **A heavy cable** (linear density rho, n segments): n elastic segments of stiffness n k and
-//!   unstretched length L0 / n between n - 1 beads of mass rho L0 / n each, drawn evenly on the
-//!   straight line between its ends; the half segments at its ends, rho L0 / (2 n) each, rest on
-//!   the end nodes' bodies (taken by a fixed body, added to a point mass). rho is per unstretched
-//!   metre, so the cable's mass, rho L0, does not change as it stretches.
+//!   unstretched length L0 / n between n - 1 beads of mass rho L0 / n each, drawn at equal
+//!   steps of arc length along its drawn path; the half segments at its ends, rho L0 / (2 n)
+//!   each, rest on the end nodes' bodies (taken by a fixed body, added to a point mass). rho is
+//!   per unstretched metre, so the cable's mass, rho L0, does not change as it stretches. A
+//!   clustered cable's segment that spans an inner node is itself clustered through it, with
+//!   that node's friction: the cable slides there within the segment.
 //!
 //! Both are made of members and free bodies the simulator already has, so the settle, the
 //! modes, the motion, the sensitivities, interference, the table and the recording read them as
@@ -163,7 +165,9 @@ pub fn make_strut_elastic(
 /// Builds cable `cable` of `segments` elastic segments between beads, its linear density
 /// `density_kg_per_m` \[kg per unstretched m\]: the segments are named `{cable}_s1` ..
 /// `{cable}_s{n}` from its node `a`, the beads (a body and a node each) `{cable}_b1` ..
-/// `{cable}_b{n-1}`.
+/// `{cable}_b{n-1}`, drawn at equal steps of arc length along the drawn path. A clustered
+/// cable's segment that spans an inner node runs through it (a clustered segment, with that
+/// node's friction): the cable slides there within a segment's length.
 pub fn hang_beads(
     s: &mut Structure,
     cable: MemberId,
@@ -177,18 +181,15 @@ pub fn hang_beads(
     let (Law::Cable { length_m, .. }, Some(k)) = (&member.law, member.stiffness_n_per_m()) else {
         return refuse("it needs a stiffness (N/m): an inextensible heavy cable is not modelled".into());
     };
-    if member.is_clustered() {
-        return refuse("it runs through inner nodes: a heavy clustered cable is not modelled".into());
-    }
     if !(1..=MAX_CABLE_SEGMENTS).contains(&segments) {
         return refuse(format!("segments is {segments}: from 1 to {MAX_CABLE_SEGMENTS}"));
     }
     if s.actuators.iter().any(|a| a.target == super::ActuatorTarget::CableLength(cable)) {
         return refuse("a winch drives it: a heavy cable's length is not actuated".into());
     }
-    let (a, b) = member.ends();
     let (l0, n) = (*length_m, segments as f64);
     let end_mass = density_kg_per_m * l0 / (2.0 * n);
+    let (a, b) = member.ends();
     for end in [a, b] {
         let body = s.nodes[end].body;
         if s.bodies[body].kind == BodyKind::Free && !is_point_mass(s, body) {
@@ -198,6 +199,13 @@ pub fn hang_beads(
             ));
         }
     }
+    let drawn: Vec<Vec3> = member.path.iter().map(|&p| s.nodes[p].position).collect();
+    let places = bead_places(&drawn, segments).map_err(|inner| {
+        LumpError(format!(
+            "heavy cable '{name}': with {segments} segments a bead would sit on its inner node '{}' (within {BEAD_NODE_CLEARANCE} of a segment): choose a count that puts none there",
+            s.nodes[member.path[inner]].name
+        ))
+    })?;
     let names: Vec<String> = (1..segments).map(|i| format!("{name}_b{i}")).collect();
     let members: Vec<String> = (1..=segments).map(|k| format!("{name}_s{k}")).collect();
     if let Some(b) = names.iter().chain(&members).find(|b| !lumping.claim(b)) {
@@ -213,24 +221,61 @@ pub fn hang_beads(
             i.principal_kg_m2 = i.principal_kg_m2.map(|m| m * grown);
         }
     }
-    let (pa, pb) = (s.nodes[a].position, s.nodes[b].position);
-    let mut path = vec![a];
-    for (i, bead) in names.iter().enumerate() {
-        let t = (i + 1) as f64 / n;
-        let at = [0, 1, 2].map(|c| pa[c] + t * (pb[c] - pa[c]));
-        let inertia = bead_inertia(density_kg_per_m * l0 / n, at, size_m);
-        let body = s.add_body(bead, BodyKind::Free, Some(inertia));
-        path.push(s.add_node(bead, body, at));
+    let mut beads = vec![a];
+    for (bead, (at, _)) in names.iter().zip(&places) {
+        let body = s.add_body(bead, BodyKind::Free, Some(bead_inertia(density_kg_per_m * l0 / n, *at, size_m)));
+        beads.push(s.add_node(bead, body, *at));
     }
-    path.push(b);
+    beads.push(b);
     let law = super::CableLaw::Elastic { stiffness_n_per_m: k * n };
-    for (k, (w, segment_name)) in path.windows(2).zip(members).enumerate() {
-        let segment = super::Member::cable(segment_name, w.to_vec(), law.clone(), l0 / n, member.radius_m);
-        if k == 0 {
+    // The leg (path segment) of each bead, the ends' first and last: the inner nodes between
+    // bead j and bead j + 1 are those that start the legs after bead j's, up to bead j + 1's.
+    let legs: Vec<usize> =
+        std::iter::once(0).chain(places.iter().map(|(_, leg)| *leg)).chain([drawn.len() - 2]).collect();
+    for (j, segment_name) in members.into_iter().enumerate() {
+        let inner = legs[j] + 1..=legs[j + 1];
+        let path: Vec<usize> =
+            std::iter::once(beads[j]).chain(inner.clone().map(|v| member.path[v])).chain([beads[j + 1]]).collect();
+        let mut segment = super::Member::cable(segment_name, path, law.clone(), l0 / n, member.radius_m);
+        if !member.friction.is_empty() {
+            segment.friction = inner.map(|v| member.friction[v - 1]).collect();
+        }
+        if j == 0 {
             s.members[cable] = segment;
         } else {
             s.members.push(segment);
         }
     }
     Ok(())
+}
+
+/// How close (as a fraction of a segment's drawn length) a bead may come to a clustered
+/// cable's inner node: closer, the segment through that node would have a leg of almost no
+/// length, whose direction its first slide would turn over.
+pub const BEAD_NODE_CLEARANCE: f64 = 1e-3;
+
+/// The places of the `segments - 1` beads on the drawn path `points`, at equal steps of arc
+/// length, each with the leg (index of the path's segment) it lies on; `Err(v)` where one
+/// falls within [`BEAD_NODE_CLEARANCE`] of a segment from inner node `v`.
+fn bead_places(points: &[Vec3], segments: usize) -> Result<Vec<(Vec3, usize)>, usize> {
+    let mut arc = vec![0.0];
+    for w in points.windows(2) {
+        arc.push(arc[arc.len() - 1] + distance(w[0], w[1]));
+    }
+    // Arc length as a fraction of the whole: a straight cable's beads are at j / n exactly.
+    let total = arc[arc.len() - 1];
+    let arc: Vec<f64> = arc.iter().map(|x| x / total).collect();
+    let n = segments as f64;
+    let mut places = Vec::new();
+    for j in 1..segments {
+        let t = j as f64 / n;
+        if let Some(v) = (1..points.len() - 1).find(|&v| (arc[v] - t).abs() < BEAD_NODE_CLEARANCE / n) {
+            return Err(v);
+        }
+        let leg = (0..points.len() - 1).rev().find(|&i| arc[i] <= t).unwrap_or(0);
+        let f = (t - arc[leg]) / (arc[leg + 1] - arc[leg]);
+        let (p, q) = (points[leg], points[leg + 1]);
+        places.push(([0, 1, 2].map(|c| p[c] + f * (q[c] - p[c])), leg));
+    }
+    Ok(places)
 }
