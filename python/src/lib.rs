@@ -516,6 +516,22 @@ fn modes_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>, 
     Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))
 }
 
+/// The equilibrium matrix's analysis of `tensegrity equilibrium --json`: the same report, as
+/// its JSON text, at the scenario's first point settled as `run` settles it. Ctrl-C stops the
+/// settle.
+#[pyfunction]
+#[pyo3(signature = (path, text=None, set=Vec::new()))]
+fn equilibrium_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>) -> PyResult<String> {
+    let sc = load(path, text, &set)?;
+    let file = path.to_string();
+    let result = on_own_thread(py, move |cancel| run::equilibrium(&sc, &file, Some(cancel)).map(|(report, _)| report))?;
+    let report = result.map_err(|e| match e {
+        run::EquilibriumRunError::Refused(_) => PyValueError::new_err(format!("{path}: {e}")),
+        run::EquilibriumRunError::Run(_) => PyException::new_err(format!("{path}: {e}")),
+    })?;
+    Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))
+}
+
 /// The sensitivities of `tensegrity sensitivity --json` (with `--check` when `check`, at
 /// `--point point`): the same report, as its JSON text, at that point settled as `run`
 /// settles it.
@@ -619,6 +635,7 @@ fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(findings, m)?)?;
     m.add_function(wrap_pyfunction!(modes_json, m)?)?;
+    m.add_function(wrap_pyfunction!(equilibrium_json, m)?)?;
     m.add_function(wrap_pyfunction!(sensitivity_json, m)?)?;
     m.add_function(wrap_pyfunction!(fit_json, m)?)?;
     m.add_function(wrap_pyfunction!(sections_toml, m)?)?;

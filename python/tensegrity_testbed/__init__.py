@@ -18,7 +18,7 @@ from . import _tensegrity
 
 __all__ = [
     "ScenarioError", "Prediction", "Result", "Solution", "Finding", "Structure",
-    "check", "export_mjcf", "findings", "fit", "from_matrices", "from_ntrt", "from_toml", "modes", "run", "sensitivity", "solve",
+    "check", "equilibrium", "export_mjcf", "findings", "fit", "from_matrices", "from_ntrt", "from_toml", "modes", "run", "sensitivity", "solve",
     "sweep",
 ]
 
@@ -177,6 +177,18 @@ def sweep(
     path, text = _source(scenario, name)
     csv, summary = _call(_tensegrity.sweep_csv, path, text, _sets(set), jobs)
     return pd.read_csv(io.StringIO(csv)), json.loads(summary)
+
+
+def equilibrium(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml") -> dict:
+    """The equilibrium matrix of a pin-jointed structure at its first point, settled as ``run``
+    settles it, and its SVD: the report of ``tensegrity equilibrium --json`` as a dict
+    (``rows`` = 3 j, ``columns`` = b, ``rank``, ``self_stress_states`` = s,
+    ``mechanisms`` = m, ``singular_values``, ``self_stress``: per state ``[member, tension]``
+    pairs, largest 1; ``mechanism_shapes``: per mechanism ``[node, [dx, dy, dz]]``). Raises
+    ScenarioError on bad input, ValueError where the structure is not pin-jointed or too large
+    (the reason named), KeyboardInterrupt on Ctrl-C."""
+    path, text = _source(scenario, name)
+    return json.loads(_call(_tensegrity.equilibrium_json, path, text, _sets(set)))
 
 
 def modes(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml",

@@ -629,6 +629,19 @@ def test_modes_from_python_are_the_clis_modes_json():
     assert py["joint_coordinates"] == ["pin"] and len(py["modes"]) == 1
 
 
+def test_equilibrium_from_python_is_the_clis_equilibrium_json():
+    """tt.equilibrium is `tensegrity equilibrium --json`: every field equal (floats bit for bit),
+    the wall time aside; Kenner's prism has s = 1 and m = 2; a jointed structure raises
+    ValueError naming the joint."""
+    prism = ROOT / "scenarios" / "custom" / "prism3.toml"
+    py, cli = tt.equilibrium(str(prism)), cli_json("equilibrium", prism)
+    py.pop("wall_s"), cli.pop("wall_s")
+    assert py == cli
+    assert (py["self_stress_states"], py["mechanisms"]) == (1, 2)
+    with pytest.raises(ValueError, match="joint 'theta1' holds a body"):
+        tt.equilibrium(str(ROOT / "scenarios" / "ji2014" / "grid.toml"))
+
+
 def test_a_modes_count_outside_its_range_raises():
     """count is how many non-rigid modes the sparse solver computes, 1 to 200 as
     ``modes --count``: outside, a ValueError naming the range, before any settle."""

@@ -53,6 +53,19 @@ pub enum Command {
         #[arg(long)]
         fail_on_declared: bool,
     },
+    /// The equilibrium matrix A of a pin-jointed structure (point masses and strut bodies, no
+    /// joints) at its settled state (its first point, settled as `run` settles it), and its
+    /// SVD: rank r, s = b - r self-stress states (each member's tension), m = 3 j - r
+    /// mechanisms (the nodes each moves most), Maxwell-Calladine's 3 j - b = m - s.
+    Equilibrium {
+        scenario: PathBuf,
+        /// Write the JSON report to this file (`-`: standard output, the table then going to
+        /// standard error).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        #[command(flatten)]
+        set: SetArgs,
+    },
     /// Natural frequencies and mode shapes of a scenario's structure at its settled state (its
     /// first point, settled as `run` settles it): free bodies held by springs and elastic
     /// cables, or the revolute and prismatic joints of joint trees; joints that close loops and

@@ -8,6 +8,7 @@
 mod args;
 mod bench;
 mod check;
+mod equilibrium;
 mod export;
 mod figure;
 mod findings;
@@ -121,6 +122,9 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         Command::Findings { mechanism, set, json } => findings::findings(&mechanism, &set, json),
         Command::Import { format } => import::import(format),
         Command::Export { format } => export::export(format),
+        Command::Equilibrium { scenario, json, set } => {
+            equilibrium::equilibrium(&scenario, &overrides(&set)?, json.as_deref())
+        }
         Command::Modes { scenario, json, record, count, set } => {
             modes::modes(&scenario, &overrides(&set)?, json.as_deref(), record.as_deref(), count)
         }

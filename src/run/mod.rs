@@ -31,7 +31,9 @@ use std::time::Instant;
 pub use levels::{judged_nodes_after, CommandsAt, MAX_LEVELS, MIN_LEVELS};
 pub use point::NO_BRANCH;
 pub use settle::SettleDetector;
-pub use settled::{modes, settle_at, settle_first_point, ModesRunError, SettledState};
+pub use settled::{
+    equilibrium, modes, settle_at, settle_first_point, EquilibriumRunError, ModesRunError, SettledState,
+};
 pub use topologies::rebuilt;
 
 use stoppable::{interruptible, Halted};

@@ -145,3 +145,78 @@ fn rows(analysis: &StructureModes, nodes: &[crate::structure::Node]) -> Vec<Mode
         })
         .collect()
 }
+
+/// Why `tensegrity equilibrium` gives no matrix.
+#[derive(Debug, thiserror::Error)]
+pub enum EquilibriumRunError {
+    /// The settle to the first point stopped.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// The structure is not pin-jointed, or too large (bad input).
+    #[error(transparent)]
+    Refused(#[from] crate::structure::equilibrium::EquilibriumError),
+}
+
+/// The equilibrium matrix of `sc`'s structure at its first point, settled as `run` settles it,
+/// and its subspaces (`structure::equilibrium`).
+pub fn equilibrium(
+    sc: &Scenario,
+    file: &str,
+    cancel: Option<&AtomicBool>,
+) -> Result<(crate::report::equilibrium::EquilibriumReport, SettledState), EquilibriumRunError> {
+    if let Some(c) = &sc.custom {
+        // Refused before the settle, as the analysis would be.
+        let drawn: Vec<_> = c.structure.nodes.iter().map(|n| n.position).collect();
+        crate::structure::equilibrium::equilibrium_matrix(&c.structure, &drawn)?;
+    }
+    let state = settle_first_point(sc, cancel)?;
+    let wall = Instant::now();
+    let s = state.sim.structure();
+    let positions: Vec<_> = (0..s.nodes.len()).map(|n| state.sim.node_position(n)).collect();
+    let e = crate::structure::equilibrium::equilibrium_matrix(s, &positions)?;
+    let report = crate::report::equilibrium::EquilibriumReport {
+        name: sc.name.clone(),
+        file: file.to_string(),
+        settled: state.settled,
+        settle_steps: state.steps,
+        rows: e.a.nrows(),
+        columns: e.a.ncols(),
+        rank: e.rank,
+        self_stress_states: e.self_stress.len(),
+        mechanisms: e.mechanisms.len(),
+        rank_tolerance: crate::structure::equilibrium::RANK_TOLERANCE,
+        singular_values: e.singular_values.clone(),
+        self_stress: e.self_stress.iter().map(|t| self_stress_row(s, &e.members, t)).collect(),
+        mechanism_shapes: e
+            .mechanisms
+            .iter()
+            .map(|d| {
+                e.nodes
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &n)| (s.nodes[n].name.clone(), [d[3 * k], d[3 * k + 1], d[3 * k + 2]]))
+                    .collect()
+            })
+            .collect(),
+        wall_s: wall.elapsed().as_secs_f64(),
+    };
+    Ok((report, state))
+}
+
+/// A self-stress state per member, scaled so that its largest magnitude is 1 and its cables'
+/// tensions sum to a positive number (a tensegrity's cables pull).
+fn self_stress_row(
+    s: &crate::structure::Structure,
+    members: &[usize],
+    t: &nalgebra::DVector<f64>,
+) -> Vec<(String, f64)> {
+    let cables: f64 = members
+        .iter()
+        .zip(t.iter())
+        .filter(|(k, _)| s.members[**k].kind() == crate::structure::MemberKind::Cable)
+        .map(|(_, x)| x)
+        .sum();
+    let sign = if cables < 0.0 { -1.0 } else { 1.0 };
+    let scale = sign / t.amax();
+    members.iter().zip(t.iter()).map(|(&k, x)| (s.members[k].name.clone(), x * scale)).collect()
+}

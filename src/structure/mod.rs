@@ -7,6 +7,7 @@
 
 use std::collections::BTreeMap;
 
+pub mod equilibrium;
 pub mod lumped;
 mod member;
 pub use member::*;

@@ -13,6 +13,7 @@ mod compact_members;
 mod custom_structure;
 mod driven_motion;
 mod dynamic_model;
+mod equilibrium_matrix;
 mod export_mjcf;
 mod figures;
 mod fit;

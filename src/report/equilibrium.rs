@@ -1,0 +1,79 @@
+//! The report of `tensegrity equilibrium`: the equilibrium matrix of a pin-jointed structure at
+//! its settled state and its four subspaces (`structure::equilibrium`), as a table and as JSON.
+
+use serde::Serialize;
+use std::fmt::Write;
+
+/// Nodes listed per mechanism: the ones that move most.
+pub const MECHANISM_NODES_LISTED: usize = 5;
+
+/// The equilibrium matrix's counts and subspaces.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct EquilibriumReport {
+    pub name: String,
+    pub file: String,
+    /// Whether the settle criteria were met before the analysis.
+    pub settled: bool,
+    pub settle_steps: u64,
+    /// Rows: three per free node (3 j).
+    pub rows: usize,
+    /// Columns: one per member with a free node (b).
+    pub columns: usize,
+    pub rank: usize,
+    /// s = b - r.
+    pub self_stress_states: usize,
+    /// m = 3 j - r (a free structure's rigid motions among them).
+    pub mechanisms: usize,
+    pub rank_tolerance: f64,
+    /// Largest first.
+    pub singular_values: Vec<f64>,
+    /// Each state's tension per member (largest magnitude 1, the cables' sum positive).
+    pub self_stress: Vec<Vec<(String, f64)>>,
+    /// Each mechanism's unit node displacements (x, y, z per free node, by name).
+    pub mechanism_shapes: Vec<Vec<(String, [f64; 3])>>,
+    pub wall_s: f64,
+}
+
+impl EquilibriumReport {
+    /// The table: counts, Maxwell's rule, each self-stress state and each mechanism's most
+    /// moving nodes (its localisation).
+    pub fn to_table(&self) -> String {
+        let mut out = String::new();
+        let _ = writeln!(out, "== {} [{}]: equilibrium matrix at the settled state", self.name, self.file);
+        let _ = writeln!(out, "   settled: {} ({} steps)", self.settled, self.settle_steps);
+        let _ = writeln!(
+            out,
+            "   A: {} rows (3 j, j = {} free nodes) by {} columns (b members); rank r = {} (singular values below {:e} of the largest are zero)",
+            self.rows,
+            self.rows / 3,
+            self.columns,
+            self.rank,
+            self.rank_tolerance
+        );
+        let _ = writeln!(
+            out,
+            "   s = b - r = {} self-stress state(s), m = 3 j - r = {} mechanism(s); Maxwell-Calladine 3 j - b = {} = m - s",
+            self.self_stress_states,
+            self.mechanisms,
+            self.rows as i64 - self.columns as i64
+        );
+        for (k, state) in self.self_stress.iter().enumerate() {
+            let _ = writeln!(out, "   self-stress {}:", k + 1);
+            for (member, t) in state {
+                let _ = writeln!(out, "     {member:<20} {t:+.9}");
+            }
+        }
+        for (k, shape) in self.mechanism_shapes.iter().enumerate() {
+            let mut moving: Vec<&(String, [f64; 3])> = shape.iter().collect();
+            moving.sort_by(|a, b| norm(b.1).total_cmp(&norm(a.1)));
+            let listed: Vec<String> =
+                moving.iter().take(MECHANISM_NODES_LISTED).map(|(n, d)| format!("{n} {:.3}", norm(*d))).collect();
+            let _ = writeln!(out, "   mechanism {}: moves most {}", k + 1, listed.join(", "));
+        }
+        out
+    }
+}
+
+fn norm(d: [f64; 3]) -> f64 {
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+}

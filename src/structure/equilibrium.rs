@@ -1,0 +1,145 @@
+//! The equilibrium matrix of a pin-jointed structure and its four subspaces (Pellegrino and
+//! Calladine, "Matrix analysis of statically and kinematically indeterminate frameworks",
+//! Int. J. Solids Struct. 22(4), 1986).
+//!
+//! With the free nodes' coordinates stacked (3 j rows) and one column per member (b), the
+//! equilibrium of the nodes under member tensions t and external loads f is A t = f: member
+//! k's column holds, at each node of its path, the gradient of its length there (for a
+//! two-node member between i and j, e_ij at i and -e_ij at j, e_ij the unit vector from i
+//! to j), so that a tension pulls its nodes together. A's transpose is the compatibility
+//! matrix: B = A^T maps node displacements d to member elongations e = A^T d. With r the
+//! rank of A:
+//! - s = b - r states of self-stress (A t = 0): tensions the structure holds without load;
+//! - m = 3 j - r mechanisms (A^T d = 0): motions that stretch no member to first order, the
+//!   rigid motions of a free structure among them;
+//! - and Maxwell's rule as Calladine extended it, 3 j - b = m - s.
+//!
+//! The structure is pin-jointed where every free body is a point mass (a bead, an elastic
+//! strut's end) or a strut's body (two nodes with the strut between them) and no joint holds
+//! it: each node then has three coordinates, and every member, struts included, is a bar. A
+//! node on a fixed body is a support in all three directions; a member between two supports
+//! has no column. Others are refused with the body that is not pin-jointed.
+
+use super::{BodyKind, MemberId, NodeId, Structure, Vec3};
+use nalgebra::{DMatrix, DVector};
+
+/// Singular values below this fraction of the largest count as zero (the rank's tolerance):
+/// far above the SVD's round-off (1e-16 of the largest), far below a genuine stiffness ratio
+/// of a structure drawn to 1e-4 of its size.
+pub const RANK_TOLERANCE: f64 = 1e-10;
+
+/// The most entries (3 j times b) the dense SVDs are given: 2.2e6 (a 300-strut prism, 1794 by
+/// 1199: 6.5 s for both SVDs on one core; an SVD cannot be interrupted, so it is bounded).
+pub const MAX_EQUILIBRIUM_ENTRIES: usize = 2_200_000;
+
+/// The equilibrium matrix at a set of node positions and the subspaces of its SVD.
+#[derive(Clone, Debug)]
+pub struct EquilibriumMatrix {
+    /// The free nodes, in the order of the rows (three each: x, y, z).
+    pub nodes: Vec<NodeId>,
+    /// The members, in the order of the columns.
+    pub members: Vec<MemberId>,
+    /// A (3 j by b).
+    pub a: DMatrix<f64>,
+    /// The singular values, largest first.
+    pub singular_values: Vec<f64>,
+    /// The rank r.
+    pub rank: usize,
+    /// The self-stress states (b each, orthonormal), s of them.
+    pub self_stress: Vec<DVector<f64>>,
+    /// The mechanisms (3 j each: node displacements, orthonormal), m of them.
+    pub mechanisms: Vec<DVector<f64>>,
+}
+
+/// Why a structure has no equilibrium matrix here.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error("{0}")]
+pub struct EquilibriumError(pub String);
+
+/// The equilibrium matrix of `s` with its nodes at `positions` \[m\], and its SVD.
+pub fn equilibrium_matrix(s: &Structure, positions: &[Vec3]) -> Result<EquilibriumMatrix, EquilibriumError> {
+    check_pin_jointed(s)?;
+    let free = |n: NodeId| s.bodies[s.nodes[n].body].kind == BodyKind::Free;
+    let nodes: Vec<NodeId> =
+        (0..s.nodes.len()).filter(|&n| free(n) && s.members.iter().any(|m| m.path.contains(&n))).collect();
+    let mut row = vec![None; s.nodes.len()];
+    for (k, &n) in nodes.iter().enumerate() {
+        row[n] = Some(k);
+    }
+    let members: Vec<MemberId> = (0..s.members.len()).filter(|&k| s.members[k].path.iter().any(|&n| free(n))).collect();
+    let (rows, columns) = (3 * nodes.len(), members.len());
+    if rows * columns > MAX_EQUILIBRIUM_ENTRIES {
+        return Err(EquilibriumError(format!(
+            "its equilibrium matrix would be {rows} by {columns}, more than the {MAX_EQUILIBRIUM_ENTRIES} entries a dense SVD is given here"
+        )));
+    }
+    let mut a = DMatrix::zeros(rows, columns);
+    for (c, &k) in members.iter().enumerate() {
+        for w in s.members[k].path.windows(2) {
+            let (p, q) = (positions[w[0]], positions[w[1]]);
+            let l = super::distance(p, q);
+            if l <= 0.0 {
+                return Err(EquilibriumError(format!("member '{}' has a segment of no length", s.members[k].name)));
+            }
+            for (node, sign) in [(w[0], 1.0), (w[1], -1.0)] {
+                if let Some(r) = row[node] {
+                    for x in 0..3 {
+                        a[(3 * r + x, c)] += sign * (q[x] - p[x]) / l;
+                    }
+                }
+            }
+        }
+    }
+    let (singular_values, self_stress) = null_space(&a);
+    let rank = columns - self_stress.len();
+    let (_, mechanisms) = null_space(&a.transpose());
+    Ok(EquilibriumMatrix { nodes, members, a, singular_values, rank, self_stress, mechanisms })
+}
+
+/// Every free body a point mass or a strut's two-node body, and no joint.
+fn check_pin_jointed(s: &Structure) -> Result<(), EquilibriumError> {
+    if let Some(j) = s.joints.first() {
+        return Err(EquilibriumError(format!(
+            "joint '{}' holds a body: the equilibrium matrix is that of a pin-jointed structure (free nodes and bars)",
+            j.name
+        )));
+    }
+    let points = super::lumped::point_masses(s);
+    for (b, body) in s.bodies.iter().enumerate().filter(|(_, b)| b.kind == BodyKind::Free) {
+        let own: Vec<NodeId> = (0..s.nodes.len()).filter(|&n| s.nodes[n].body == b).collect();
+        let strut = own.len() == 2
+            && s.members.iter().any(|m| m.is_rigid_strut() && m.path.contains(&own[0]) && m.path.contains(&own[1]));
+        if !points[b] && !strut {
+            return Err(EquilibriumError(format!(
+                "body '{}' carries {} node(s) and is neither a point mass nor a strut's body: the equilibrium matrix is that of a pin-jointed structure (free nodes and bars)",
+                body.name,
+                own.len()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The singular values of `m` (largest first) and an orthonormal basis of its null space:
+/// the right singular vectors whose singular value is below [`RANK_TOLERANCE`] of the
+/// largest, and those a wide matrix has beyond its rows (zero rows are added so that the SVD
+/// gives every right singular vector).
+fn null_space(m: &DMatrix<f64>) -> (Vec<f64>, Vec<DVector<f64>>) {
+    let (rows, columns) = m.shape();
+    if columns == 0 {
+        return (Vec::new(), Vec::new());
+    }
+    let tall = if rows < columns { m.clone().resize_vertically(columns, 0.0) } else { m.clone() };
+    let svd = tall.svd(false, true);
+    let v_t = svd.v_t.expect("asked for");
+    let mut order: Vec<usize> = (0..columns).collect();
+    order.sort_by(|&i, &k| svd.singular_values[k].total_cmp(&svd.singular_values[i]));
+    let largest = svd.singular_values.max();
+    let values: Vec<f64> = order.iter().map(|&i| svd.singular_values[i]).take(rows.min(columns)).collect();
+    let null = order
+        .iter()
+        .filter(|&&i| svd.singular_values[i] <= RANK_TOLERANCE * largest)
+        .map(|&i| v_t.row(i).transpose())
+        .collect();
+    (values, null)
+}

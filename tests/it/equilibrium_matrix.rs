@@ -1,0 +1,118 @@
+//! The equilibrium matrix and its four subspaces (`structure/equilibrium.rs`,
+//! `tensegrity equilibrium`), each against a closed form.
+
+use super::common;
+use std::path::Path;
+use tensegrity_testbed::run;
+use tensegrity_testbed::scenario;
+use tensegrity_testbed::structure::equilibrium::equilibrium_matrix;
+
+/// The report of `tensegrity equilibrium --json -` on `file`.
+fn report(file: &str) -> serde_json::Value {
+    let (code, out, err) = common::tensegrity(&["equilibrium", file, "--json", "-"]);
+    assert_eq!(code, 0, "{err}");
+    serde_json::from_str(&out).unwrap()
+}
+
+/// Kenner's 3-strut prism, one strut held (`prism3.toml`): 4 free nodes, 11 members with a free
+/// node, so 3 j - b = 1; it has one self-stress state (s = 1) and two mechanisms (m = 2: the
+/// prism's infinitesimal twist and its turn about the held strut's line). The state is the
+/// settled member forces (the file's baseline, side : polygon : strut = 29.34 : 19.19 : -46.22
+/// N) to within 1e-9 of the largest, and the turn about the held strut lies in the mechanisms'
+/// span to within 1e-9.
+#[test]
+fn the_kenner_prisms_self_stress_is_its_settled_forces_and_its_mechanisms_hold_the_turn() {
+    let v = report("scenarios/custom/prism3.toml");
+    assert_eq!((v["rows"].as_u64(), v["columns"].as_u64(), v["rank"].as_u64()), (Some(12), Some(11), Some(10)));
+    assert_eq!((v["self_stress_states"].as_u64(), v["mechanisms"].as_u64()), (Some(1), Some(2)));
+    let settled = common::run_file("scenarios/custom/prism3.toml");
+    let forces = &settled.points[0].simulated;
+    let state = v["self_stress"][0].as_array().unwrap();
+    let strut = forces["strut2.force"].abs();
+    for pair in state {
+        let (name, t) = (pair[0].as_str().unwrap(), pair[1].as_f64().unwrap());
+        let force = forces[&format!("{name}.force")] / strut;
+        assert!((t - force).abs() <= 1e-9, "{name}: {t} against {force}");
+    }
+    // The turn about the held strut's line B1-T1: d = w x (p - B1) at each free node.
+    let sc =
+        scenario::parse(Path::new("prism3.toml"), &std::fs::read_to_string("scenarios/custom/prism3.toml").unwrap())
+            .unwrap();
+    let state = run::settle_first_point(&sc, None).unwrap();
+    let s = state.sim.structure();
+    let p: Vec<[f64; 3]> = (0..s.nodes.len()).map(|n| state.sim.node_position(n)).collect();
+    let e = equilibrium_matrix(s, &p).unwrap();
+    let at = |name: &str| nalgebra::Vector3::from(p[s.node_id(name).unwrap()]);
+    let w = (at("T1") - at("B1")).normalize();
+    let mut turn = nalgebra::DVector::zeros(3 * e.nodes.len());
+    for (k, &n) in e.nodes.iter().enumerate() {
+        turn.fixed_rows_mut::<3>(3 * k).copy_from(&w.cross(&(nalgebra::Vector3::from(p[n]) - at("B1"))));
+    }
+    let turn = turn.normalize();
+    let along: f64 = e.mechanisms.iter().map(|m| m.dot(&turn).powi(2)).sum();
+    assert!((along - 1.0).abs() <= 1e-9, "the turn's share in the mechanisms' span: {along}");
+}
+
+/// A straight rope, a bead between two anchors (the prestressed rope of the structural texts):
+/// 3 j = 3 rows, b = 2 members, rank 1, so s = 1 (equal tensions, (1, 1)) and m = 2 (the two
+/// motions across the rope, to first order stretching neither segment).
+#[test]
+fn a_straight_rope_has_one_self_stress_and_two_mechanisms() {
+    let text = r#"name = "a bead on a straight rope"
+mechanism = "custom"
+
+[actuation]
+points = [ {} ]
+
+[structure]
+gravity = [0, 0, 0]
+
+[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { A = [0, 0, 0], B = [2, 0, 0] }
+
+[[structure.bodies]]
+name = "bead"
+mass = 0.1
+nodes = { P = [1, 0, 0] }
+
+[[structure.cables]]
+name = "left"
+a = "A"
+b = "P"
+stiffness = 100.0
+length = 0.9
+
+[[structure.cables]]
+name = "right"
+a = "P"
+b = "B"
+stiffness = 100.0
+length = 0.9
+"#;
+    let file = std::env::temp_dir().join(format!("tensegrity-equilibrium-rope-{}.toml", std::process::id()));
+    std::fs::write(&file, text).unwrap();
+    let v = report(file.to_str().unwrap());
+    std::fs::remove_file(&file).unwrap();
+    assert_eq!(
+        (v["rank"].as_u64(), v["self_stress_states"].as_u64(), v["mechanisms"].as_u64()),
+        (Some(1), Some(1), Some(2))
+    );
+    for pair in v["self_stress"][0].as_array().unwrap() {
+        assert!((pair[1].as_f64().unwrap() - 1.0).abs() <= 1e-12, "{pair}");
+    }
+    for shape in v["mechanism_shapes"].as_array().unwrap() {
+        let d = &shape[0][1];
+        assert!(d[0].as_f64().unwrap().abs() <= 1e-12, "a mechanism moves along the rope: {d}");
+    }
+}
+
+/// A structure that is not pin-jointed (a body on a joint, a body of three nodes) is refused
+/// with exit 2 and the part that is not.
+#[test]
+fn a_structure_that_is_not_pin_jointed_is_refused_by_name() {
+    let (code, _, err) = common::tensegrity(&["equilibrium", "scenarios/ji2014/grid.toml"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("joint 'theta1' holds a body"), "{err}");
+}
