@@ -602,7 +602,7 @@ impl Writer<'_> {
 
     fn custom(&mut self) {
         let s = self.s;
-        if s.loads.is_empty() {
+        if s.loads.is_empty() && s.node_loads.is_empty() {
             return;
         }
         self.xml.push_str(
@@ -613,6 +613,21 @@ impl Writer<'_> {
                 self.xml,
                 "  <numeric name=\"load:{}:{i}\" data=\"{}\"/>",
                 esc(&s.bodies[l.body].name),
+                nums(&l.force_n)
+            );
+        }
+        if !s.node_loads.is_empty() {
+            self.xml.push_str(
+                "  <!-- point loads [N] at nodes (the node's site): apply through mj_applyFT at the site's position every step -->\n",
+            );
+        }
+        for (i, l) in s.node_loads.iter().enumerate() {
+            let node = &s.nodes[l.node];
+            let _ = writeln!(
+                self.xml,
+                "  <numeric name=\"node_load:{}:{}:{i}\" data=\"{}\"/>",
+                esc(&s.bodies[node.body].name),
+                esc(&node.name),
                 nums(&l.force_n)
             );
         }

@@ -31,6 +31,9 @@ pub struct EquilibriumReport {
     pub self_stress: Vec<Vec<(String, f64)>>,
     /// Each mechanism's unit node displacements (x, y, z per free node, by name).
     pub mechanism_shapes: Vec<Vec<(String, [f64; 3])>>,
+    /// The force each support (a node on a fixed body that a member reaches) exerts on the
+    /// structure at the settled state \[N\], by node.
+    pub reactions_n: Vec<(String, [f64; 3])>,
     pub wall_s: f64,
 }
 
@@ -61,6 +64,12 @@ impl EquilibriumReport {
             let _ = writeln!(out, "   self-stress {}:", k + 1);
             for (member, t) in state {
                 let _ = writeln!(out, "     {member:<20} {t:+.9}");
+            }
+        }
+        if !self.reactions_n.is_empty() {
+            let _ = writeln!(out, "   reactions at the supports [N]:");
+            for (node, r) in &self.reactions_n {
+                let _ = writeln!(out, "     {node:<20} {:+.9e} {:+.9e} {:+.9e}", r[0], r[1], r[2]);
             }
         }
         for (k, shape) in self.mechanism_shapes.iter().enumerate() {

@@ -187,6 +187,7 @@ pub fn equilibrium(
         rank_tolerance: crate::structure::equilibrium::RANK_TOLERANCE,
         singular_values: e.singular_values.clone(),
         self_stress: e.self_stress.iter().map(|t| self_stress_row(s, &e.members, t)).collect(),
+        reactions_n: reactions(s, &positions, &state.sim.member_forces()),
         mechanism_shapes: e
             .mechanisms
             .iter()
@@ -201,6 +202,34 @@ pub fn equilibrium(
         wall_s: wall.elapsed().as_secs_f64(),
     };
     Ok((report, state))
+}
+
+/// The reaction at each support (a node on a fixed body that members reach) \[N\]: the force
+/// the support exerts on the structure, minus the pull of every segment that ends there
+/// (tension t along the unit vector from the support to the segment's other node).
+fn reactions(
+    s: &crate::structure::Structure,
+    positions: &[[f64; 3]],
+    forces: &crate::snapshot::MemberForces,
+) -> Vec<(String, [f64; 3])> {
+    use crate::structure::BodyKind;
+    let mut at: std::collections::BTreeMap<usize, nalgebra::Vector3<f64>> = Default::default();
+    for (k, member) in s.members.iter().enumerate() {
+        for (seg, (a, b)) in member.segments().enumerate() {
+            let t = forces.segment_force_n[k].get(seg).copied().unwrap_or(forces.force_n[k]);
+            for (support, other) in [(a, b), (b, a)] {
+                if s.bodies[s.nodes[support].body].kind != BodyKind::Fixed
+                    || s.bodies[s.nodes[other].body].kind == BodyKind::Fixed
+                {
+                    continue;
+                }
+                let e = (nalgebra::Vector3::from(positions[other]) - nalgebra::Vector3::from(positions[support]))
+                    .normalize();
+                *at.entry(support).or_insert_with(nalgebra::Vector3::zeros) -= e * t;
+            }
+        }
+    }
+    at.into_iter().map(|(n, r)| (s.nodes[n].name.clone(), [r.x, r.y, r.z])).collect()
 }
 
 /// A self-stress state per member, scaled so that its largest magnitude is 1 and its cables'

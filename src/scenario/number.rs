@@ -208,6 +208,9 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
     if let Some(g) = &mut s.gravity {
         resolve_xyz(ctx, g, "gravity", &mut resolve)?;
     }
+    for l in &mut s.loads {
+        resolve_xyz(ctx, &mut l.force, "a load's force", &mut resolve)?;
+    }
     for b in &mut s.bodies {
         resolve_body(ctx, b, &mut resolve)?;
     }

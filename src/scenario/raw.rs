@@ -240,6 +240,9 @@ macro_rules! with_parts {
 with_parts!(RawStructure {
     /// Gravity [m/s^2] (default none).
     gravity: Option<Xyz>,
+    /// Point loads at nodes (`[[structure.loads]]`).
+    #[serde(default)]
+    loads: Vec<RawLoad>,
     /// Sub-structures generated over an index range (`repeat.rs`), appended to the lists.
     #[serde(default)]
     repeat: Vec<RawRepeat>,
@@ -259,6 +262,15 @@ with_parts!(
         offset: Option<Xyz>,
     }
 );
+
+/// `[[structure.loads]]`: a constant force [N] at a node, world frame; its components may be
+/// expressions of the parameters (a grid over them sweeps the load).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawLoad {
+    pub(super) node: Spanned<String>,
+    pub(super) force: Xyz,
+}
 
 /// A rotation about `axis` (through the origin) by `angle` [rad].
 #[derive(Clone, Debug, Deserialize)]

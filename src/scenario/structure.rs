@@ -46,6 +46,7 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
     add_member_groups(ctx, &mut s, r)?;
     s.joints = r.joints.iter().map(|j| joint(ctx, &s, j)).collect::<Result<_, _>>()?;
     s.actuators = r.actuators.iter().map(|a| actuator(ctx, &s, a)).collect::<Result<_, _>>()?;
+    s.node_loads = r.loads.iter().map(|l| node_load(ctx, &s, l)).collect::<Result<_, _>>()?;
     s.validate().map_err(|e| structure_error_at(ctx, raw, e))?;
     lump_members(ctx, &mut s, r)?;
     Ok(s)
@@ -325,6 +326,24 @@ fn inertia(ctx: &Ctx, b: &RawBody, pts: &[[f64; 3]], struts: &[RawMember]) -> Re
         None => [mass * size * size / 12.0; 3],
     };
     Ok(Inertia { mass_kg: mass, com, principal_kg_m2: principal })
+}
+
+/// A point load: a finite force at a node of a free body (on a fixed body the support would
+/// take it whole, so it is refused there).
+fn node_load(ctx: &Ctx, s: &Structure, l: &super::raw::RawLoad) -> Result<crate::structure::NodeLoad, ScenarioError> {
+    let n = node(ctx, s, &l.node)?;
+    let body = &s.bodies[s.nodes[n].body];
+    if body.kind == BodyKind::Fixed {
+        return Err(ctx.err(
+            &l.node,
+            format!(
+                "node '{}' is on fixed body '{}': its support would take the load whole",
+                l.node.get_ref(),
+                body.name
+            ),
+        ));
+    }
+    Ok(crate::structure::NodeLoad { node: n, force_n: xyz(ctx, &l.force, "a load's force")? })
 }
 
 /// The id of a declared node.

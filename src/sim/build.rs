@@ -31,6 +31,12 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<(Model, Dat
         ropes,
         has_friction: s.members.iter().any(|m| m.has_friction()),
         external_loads: external_loads(s),
+        node_loads: s
+            .node_loads
+            .iter()
+            .filter(|l| s.bodies[s.nodes[l.node].body].kind == crate::structure::BodyKind::Free)
+            .map(|l| (l.node, nalgebra::Vector3::from(l.force_n)))
+            .collect(),
         length_scale_m: crate::structure::structure_size(s),
         tree: Tree::default(),
         fit_tree: Tree::default(),

@@ -176,6 +176,11 @@ impl Data {
                 inertia.mass_kg
             };
         }
+        // Point loads on carried nodes: constant forces at points that move with the coordinate.
+        for &(node, force) in m.node_loads.iter().filter(|(n, _)| carried(s.nodes[*n].body)) {
+            let at = Vector::from(self.node_position(m, node));
+            load.stiffness += motion.constant_force_stiffness(at, Vector::new(force.x, force.y, force.z));
+        }
         // Springs and elastic cables with one end of a segment carried: their force changes
         // with the coordinate (a segment with both ends carried moves rigidly and adds nothing).
         // A clustered cable's segments are taken each with the whole cable's tension and

@@ -40,6 +40,14 @@ impl Data {
                 rb.add_torque(v(t), false);
             }
         }
+        for &(node, force) in &m.node_loads {
+            let b = m.structure.nodes[node].body;
+            let arm = v(self.node_position(m, node)) - self.world_com(m, b);
+            let f = Vector::new(force.x, force.y, force.z);
+            let rb = &mut self.bodies[m.handles[b]];
+            rb.add_force(f, false);
+            rb.add_torque(arm.cross(f), false);
+        }
     }
 
     /// Member `i`'s law if its force follows from its length (a spring, or an elastic cable
@@ -234,6 +242,12 @@ impl Data {
                 wrench[b].0 += v(pf);
                 wrench[b].1 += com.cross(v(pf)) + v(pt);
             }
+        }
+        for &(node, force) in &m.node_loads {
+            let b = m.structure.nodes[node].body;
+            let f = Vector::new(force.x, force.y, force.z);
+            wrench[b].0 += f;
+            wrench[b].1 += v(self.node_position(m, node)).cross(f);
         }
     }
 

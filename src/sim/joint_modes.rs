@@ -120,6 +120,11 @@ impl Data {
             let r = reference.map_or_else(Vector3::zeros, |r| r[b]);
             e -= f.x * (com.x - r.x) + f.y * (com.y - r.y) + f.z * (com.z - r.z);
         }
+        for &(node, f) in &m.node_loads {
+            let p = Vector3::from(self.node_position(m, node));
+            let r = reference.map_or_else(Vector3::zeros, |r| r[s.nodes[node].body]);
+            e -= f.dot(&(p - r));
+        }
         e
     }
 

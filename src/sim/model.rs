@@ -63,6 +63,8 @@ pub struct Model {
     pub(super) fit_tree: Tree,
     /// The structure's constant external forces, summed per body [N].
     pub(super) external_loads: Vec<[f64; 3]>,
+    /// The point loads on free bodies' nodes: node, force [N] (`Structure::node_loads`).
+    pub(super) node_loads: Vec<(usize, nalgebra::Vector3<f64>)>,
     /// Characteristic length of the structure \[m\], for speeds and tolerances.
     pub length_scale_m: f64,
     /// Whether the static relaxation applies to this structure (`relaxation/`).

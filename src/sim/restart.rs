@@ -57,6 +57,7 @@ impl Structure {
             && self.members == other.members
             && self.actuators == other.actuators
             && self.loads == other.loads
+            && self.node_loads == other.node_loads
             && all(&self.bodies, &other.bodies, same_body)
             && all(&self.nodes, &other.nodes, same_node)
             && all(&self.joints, &other.joints, same_joint)

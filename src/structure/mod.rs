@@ -147,6 +147,14 @@ pub struct ExternalLoad {
     pub force_n: Vec3,
 }
 
+/// A constant external force at a node (a point load) \[N\], world frame: it moves with the
+/// node, so on a rigid body off its centre of mass it turns the body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NodeLoad {
+    pub node: NodeId,
+    pub force_n: Vec3,
+}
+
 /// A whole mechanism, ready to be simulated.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Structure {
@@ -160,6 +168,8 @@ pub struct Structure {
     pub joints: Vec<Joint>,
     pub actuators: Vec<Actuator>,
     pub loads: Vec<ExternalLoad>,
+    /// Point loads at nodes.
+    pub node_loads: Vec<NodeLoad>,
 }
 
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -514,6 +524,12 @@ impl Structure {
     fn validate_loads(&self) -> Result<(), StructureError> {
         for (i, load) in self.loads.iter().enumerate() {
             self.check_body("load", &format!("#{i}"), load.body)?;
+            if load.force_n.iter().any(|f| !f.is_finite()) {
+                return Err(invalid("load", &format!("#{i}"), "force must be finite"));
+            }
+        }
+        for (i, load) in self.node_loads.iter().enumerate() {
+            self.check_node("load", &format!("#{i}"), load.node)?;
             if load.force_n.iter().any(|f| !f.is_finite()) {
                 return Err(invalid("load", &format!("#{i}"), "force must be finite"));
             }

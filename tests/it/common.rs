@@ -72,6 +72,14 @@ pub fn fitted_order(steps: &[f64], errors: &[f64]) -> f64 {
 }
 
 /// Loads and runs a scenario file through the library, with the default options.
+/// The head of a one-point custom scenario named `name`, settled to 1e-12 m/s and 1e-10 N
+/// (N m), without gravity: a test's structure follows it, from `[[structure.bodies]]` on.
+pub fn one_point_head(name: &str) -> String {
+    format!(
+        "name = \"{name}\"\nmechanism = \"custom\"\n\n[settle]\nspeed_tol = 1e-12\nresidual_force_tol = 1e-10\nresidual_torque_tol = 1e-10\n\n[actuation]\npoints = [ {{}} ]\n\n[structure]\ngravity = [0, 0, 0]\n\n"
+    )
+}
+
 pub fn run_file(path: &str) -> tensegrity_testbed::report::ScenarioReport {
     let sc = tensegrity_testbed::scenario::load(std::path::Path::new(path)).expect("scenario is valid");
     tensegrity_testbed::run::run(&sc, &tensegrity_testbed::run::RunOptions::default())

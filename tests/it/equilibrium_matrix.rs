@@ -58,16 +58,7 @@ fn the_kenner_prisms_self_stress_is_its_settled_forces_and_its_mechanisms_hold_t
 /// motions across the rope, to first order stretching neither segment).
 #[test]
 fn a_straight_rope_has_one_self_stress_and_two_mechanisms() {
-    let text = r#"name = "a bead on a straight rope"
-mechanism = "custom"
-
-[actuation]
-points = [ {} ]
-
-[structure]
-gravity = [0, 0, 0]
-
-[[structure.bodies]]
+    let structure = r#"[[structure.bodies]]
 name = "ground"
 fixed = true
 nodes = { A = [0, 0, 0], B = [2, 0, 0] }
@@ -91,6 +82,7 @@ b = "B"
 stiffness = 100.0
 length = 0.9
 "#;
+    let text = common::one_point_head("a bead on a straight rope") + structure;
     let file = std::env::temp_dir().join(format!("tensegrity-equilibrium-rope-{}.toml", std::process::id()));
     std::fs::write(&file, text).unwrap();
     let v = report(file.to_str().unwrap());
@@ -115,4 +107,28 @@ fn a_structure_that_is_not_pin_jointed_is_refused_by_name() {
     let (code, _, err) = common::tensegrity(&["equilibrium", "scenarios/ji2014/grid.toml"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("joint 'theta1' holds a body"), "{err}");
+}
+
+/// The reactions at the supports: Kenner's prism is held by one strut's two nodes, so the
+/// supports take what that strut would carry. By the prism's symmetry it is what each free
+/// strut carries: the reactions at B1 and T1 are equal and opposite, along the held strut's
+/// line, of the free struts' force (46.22 N) within 1e-9 relative.
+#[test]
+fn the_kenner_prisms_supports_take_a_struts_force_along_its_line() {
+    let v = report("scenarios/custom/prism3.toml");
+    let settled = common::run_file("scenarios/custom/prism3.toml");
+    let strut = settled.points[0].simulated["strut2.force"].abs();
+    let r: Vec<nalgebra::Vector3<f64>> = v["reactions_n"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|pair| nalgebra::Vector3::from_iterator(pair[1].as_array().unwrap().iter().map(|x| x.as_f64().unwrap())))
+        .collect();
+    let names: Vec<&str> = v["reactions_n"].as_array().unwrap().iter().map(|p| p[0].as_str().unwrap()).collect();
+    assert_eq!(names, ["B1", "T1"]);
+    assert!((r[0] + r[1]).norm() <= 1e-9 * strut, "{} {}", r[0], r[1]);
+    assert!((r[0].norm() - strut).abs() <= 1e-9 * strut, "{} against {strut}", r[0].norm());
+    let (b1, t1) = (common::node(&settled, "B1"), common::node(&settled, "T1"));
+    let axis = nalgebra::Vector3::new(t1[0] - b1[0], t1[1] - b1[1], t1[2] - b1[2]).normalize();
+    assert!(r[0].cross(&axis).norm() <= 1e-9 * strut, "off the strut's line: {}", r[0]);
 }

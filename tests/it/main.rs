@@ -48,6 +48,7 @@ mod moved_node;
 mod outputs;
 mod param_sweep;
 mod patterns;
+mod point_loads;
 mod prestress;
 mod readme;
 mod recording;

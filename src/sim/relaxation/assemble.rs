@@ -143,19 +143,21 @@ impl Data {
                 .collect();
             for (x, (jx, px, fx)) in ends.iter().enumerate() {
                 let Some((i, ji)) = jx else { continue };
-                let rho = px - v3(dofs.com[*i]);
                 f.fixed_rows_mut::<6>(6 * i).add_assign(&(ji.transpose() * fx));
-                let mut geo = Matrix6::zeros();
-                geo.fixed_view_mut::<3, 3>(3, 3).copy_from(
-                    &(Matrix3::identity() * fx.dot(&rho) - (fx * rho.transpose() + rho * fx.transpose()) * 0.5),
-                );
-                blocks.push((*i, *i, geo));
+                blocks.push((*i, *i, turning_stiffness(fx, &(px - v3(dofs.com[*i])))));
                 for (y, (jy, _, _)) in ends.iter().enumerate() {
                     let Some((k, jk)) = jy else { continue };
                     let kxy = path_stiffness(&segments, &gradient, law.stiffness_n_per_m, t, x, y);
                     blocks.push((*i, *k, ji.transpose() * kxy * jk));
                 }
             }
+        }
+        for &(node, force) in &m.node_loads {
+            let p = Vector3::from(self.node_position(m, node));
+            let Some((i, ji)) = self.node_jacobian(m, dofs, node, p) else { continue };
+            force_scale_n = force_scale_n.max(force.norm());
+            f.fixed_rows_mut::<6>(6 * i).add_assign(&(ji.transpose() * force));
+            blocks.push((i, i, turning_stiffness(&force, &(p - v3(dofs.com[i])))));
         }
         for (b, i) in dofs.free() {
             let (force, torque) = self.constant_load(m, b);
@@ -223,6 +225,16 @@ impl Data {
         let groups: Vec<_> = groups.into_values().map(|(blocks, anchors)| (blocks, place(anchors))).collect();
         bodies.chain(groups).collect()
     }
+}
+
+/// The geometric stiffness of a body's small rotation under a force `fx` at the arm `rho` from
+/// its centre of mass (a member's pull at a node, a point load): the 6x6 block with
+/// (F . rho) 1 - sym(F rho^T) in its rotation part.
+fn turning_stiffness(fx: &Vector3<f64>, rho: &Vector3<f64>) -> Matrix6<f64> {
+    let mut geo = Matrix6::zeros();
+    geo.fixed_view_mut::<3, 3>(3, 3)
+        .copy_from(&(Matrix3::identity() * fx.dot(rho) - (fx * rho.transpose() + rho * fx.transpose()) * 0.5));
+    geo
 }
 
 /// The block (x, y) of a path member's stiffness d2E/dx dy, x and y indices along its path:

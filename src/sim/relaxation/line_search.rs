@@ -38,6 +38,12 @@ impl Data {
             change += then - now;
             scale += now.abs() + then.abs();
         }
+        for &(node, force) in &m.node_loads {
+            let work =
+                force.dot(&(self.moved_node(m, dofs, step, alpha, node) - Vector3::from(self.node_position(m, node))));
+            change -= work;
+            scale += work.abs() + force.norm() * m.length_scale_m;
+        }
         for (b, i) in dofs.free() {
             let (force, torque) = self.constant_load(m, b);
             let work = (force.dot(&step.fixed_rows::<3>(6 * i)) + torque.dot(&step.fixed_rows::<3>(6 * i + 3))) * alpha;
@@ -71,6 +77,9 @@ impl Data {
                 push(member.path[w], pair[0], pull);
                 push(member.path[w + 1], pair[1], -pull);
             }
+        }
+        for &(node, force) in &m.node_loads {
+            push(node, self.moved_node(m, dofs, step, alpha, node), force);
         }
         for (b, i) in dofs.free() {
             let (force, torque) = self.constant_load(m, b);

@@ -302,6 +302,19 @@ mod tests {
         assert_derivatives_of_the_energy(&Simulation::new(&s, &crate::settings::SimSettings::default()).unwrap());
     }
 
+    /// The same with point loads: one at node q of body one, off its centre of mass (its
+    /// work turns the body: the rotations' geometric term), one at node r of body two.
+    #[test]
+    fn a_point_loads_force_and_hessian_are_the_derivatives_of_its_work() {
+        use crate::structure::NodeLoad;
+        let mut s = hung_structure();
+        let id = |name: &str| s.node_id(name).unwrap();
+        let (q, r) = (id("q"), id("r"));
+        s.node_loads.push(NodeLoad { node: q, force_n: [3.0, -1.5, 2.0] });
+        s.node_loads.push(NodeLoad { node: r, force_n: [-0.5, 4.0, -2.5] });
+        assert_derivatives_of_the_energy(&Simulation::new(&s, &crate::settings::SimSettings::default()).unwrap());
+    }
+
     fn assert_derivatives_of_the_energy(sim: &Simulation) {
         let dofs = sim.data.relaxation_dofs(&sim.model);
         let system = sim.data.relaxation_system(&sim.model, &dofs);
