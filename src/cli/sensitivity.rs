@@ -37,7 +37,7 @@ pub fn sensitivity(
     if json.is_some_and(super::is_stdio) || csv.is_some_and(super::is_stdio) {
         eprint!("{}", report.to_table());
     } else {
-        print!("{}", report.to_table());
+        super::print_out(&report.to_table())?;
     }
     if let Some(j) = json {
         write_atomic(j, &serde_json::to_string_pretty(&report).expect("report serialises"))?;

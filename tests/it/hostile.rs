@@ -371,6 +371,8 @@ fn standard_output_that_cannot_be_written() {
             vec!["run", quick, "--json", "-"],
             vec!["sweep", SWEEP_FILE, "--jobs", "1", "--out", "-"],
             vec!["modes", quick],
+            vec!["equilibrium", quick],
+            vec!["sensitivity", "scenarios/custom/pinned_bar_modes.toml"],
             vec!["solve", "mohr2011", "ikp", "--set", "x=0", "--set", "y=0", "--set", "z=1"],
         ] {
             let (code, err) = with_stdout(how, &args);
