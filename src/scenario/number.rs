@@ -211,6 +211,9 @@ pub(super) fn resolve_structure(ctx: &Ctx, s: &mut RawStructure, params: &Values
     for l in &mut s.loads {
         resolve_xyz(ctx, &mut l.force, "a load's force", &mut resolve)?;
     }
+    for n in &mut s.masses {
+        resolve(&mut n.mass, "a node's mass")?;
+    }
     for b in &mut s.bodies {
         resolve_body(ctx, b, &mut resolve)?;
     }

@@ -243,6 +243,9 @@ with_parts!(RawStructure {
     /// Point loads at nodes (`[[structure.loads]]`).
     #[serde(default)]
     loads: Vec<RawLoad>,
+    /// Masses added at nodes that are point masses (`[[structure.masses]]`).
+    #[serde(default)]
+    masses: Vec<RawNodeMass>,
     /// Sub-structures generated over an index range (`repeat.rs`), appended to the lists.
     #[serde(default)]
     repeat: Vec<RawRepeat>,
@@ -270,6 +273,15 @@ with_parts!(
 pub(super) struct RawLoad {
     pub(super) node: Spanned<String>,
     pub(super) force: Xyz,
+}
+
+/// `[[structure.masses]]`: a mass [kg] added at a node whose body is a point mass (a one-node
+/// free body, an elastic strut's end, a heavy cable's end on a point mass).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawNodeMass {
+    pub(super) node: Spanned<String>,
+    pub(super) mass: Spanned<Num>,
 }
 
 /// A rotation about `axis` (through the origin) by `angle` [rad].

@@ -49,6 +49,9 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
     s.node_loads = r.loads.iter().map(|l| node_load(ctx, &s, l)).collect::<Result<_, _>>()?;
     s.validate().map_err(|e| structure_error_at(ctx, raw, e))?;
     lump_members(ctx, &mut s, r)?;
+    for n in &r.masses {
+        add_node_mass(ctx, &mut s, n)?;
+    }
     Ok(s)
 }
 
@@ -344,6 +347,30 @@ fn node_load(ctx: &Ctx, s: &Structure, l: &super::raw::RawLoad) -> Result<crate:
         ));
     }
     Ok(crate::structure::NodeLoad { node: n, force_n: xyz(ctx, &l.force, "a load's force")? })
+}
+
+/// Adds a node's mass to its body, which must be a point mass (its moments grow with it, as
+/// a heavy cable's end does); on a rigid body the mass would move its centre and tilt its
+/// principal axes, so it is refused there.
+fn add_node_mass(ctx: &Ctx, s: &mut Structure, n: &super::raw::RawNodeMass) -> Result<(), ScenarioError> {
+    let node = node(ctx, s, &n.node)?;
+    let mass = positive_value(ctx, &n.mass, "a node's mass (kg)")?;
+    let body = s.nodes[node].body;
+    if !crate::structure::lumped::is_point_mass(s, body) {
+        return Err(ctx.err(
+            &n.node,
+            format!(
+                "node '{}' is on body '{}', which is not a point mass (a one-node free body, an elastic strut's end): add the mass to that body's mass",
+                n.node.get_ref(),
+                s.bodies[body].name
+            ),
+        ));
+    }
+    let inertia = s.bodies[body].inertia.as_mut().expect("a point mass is free");
+    let grown = (inertia.mass_kg + mass) / inertia.mass_kg;
+    inertia.mass_kg += mass;
+    inertia.principal_kg_m2 = inertia.principal_kg_m2.map(|m| m * grown);
+    Ok(())
 }
 
 /// The id of a declared node.

@@ -128,3 +128,24 @@ fn the_ropes_anchors_take_half_the_load_each_and_its_horizontal_tension() {
         assert!((r[0] - sign * h).abs() <= 1e-9 * p && r[1].abs() <= 1e-9 * p, "{pair}: x against {}", sign * h);
     }
 }
+
+/// A node's mass (`[[structure.masses]]`) adds to its point mass: the bead of 0.2 kg on the
+/// rope (tension T = 8 N, half-span a = 1 m), with 0.3 kg added at its node, vibrates across
+/// at sqrt(2 T / (a M)) with M = 0.5 kg and along at sqrt(2 k / M), within 1e-9 relative; on a
+/// rigid body's node, or with a mass that is not positive, it is an error at its key.
+#[test]
+fn a_nodes_mass_adds_to_its_point_mass() {
+    let unloaded = rope(0.0).replace("[[structure.loads]]\nnode = \"P\"\nforce = [0, 0, -0]\n", "");
+    let text = format!("{unloaded}\n[[structure.masses]]\nnode = \"P\"\nmass = 0.3\n");
+    let sc = scenario::parse(Path::new("rope.toml"), &text).expect("valid");
+    let (report, ..) = run::modes(&sc, "rope.toml", 20, None).expect("modes");
+    let omegas: Vec<f64> = report.modes.iter().map(|m| m.omega_rad_per_s).collect();
+    let (across, along) = ((2.0 * 8.0 / 0.5_f64).sqrt(), (2.0 * 40.0 / 0.5_f64).sqrt());
+    for (got, want) in omegas.iter().zip([across, across, along]) {
+        assert!(((got - want) / want).abs() <= 1e-9, "{omegas:?} against {across}, {across}, {along}");
+    }
+    let rigid = text.replacen("nodes = { P = [0, 0, 0] }", "nodes = { P = [0, 0, 0], Q = [0, 0.1, 0] }", 1);
+    common::error_at(&rigid, "node = \"P\"\nmass", 7, "which is not a point mass");
+    let negative = text.replacen("mass = 0.3", "mass = -0.3", 1);
+    common::error_at(&negative, "mass = -0.3", 7, "must be > 0");
+}
