@@ -233,22 +233,24 @@ pub fn print_out(text: &str) -> Result<(), CliError> {
         .map_err(|e| failed(format!("writing to standard output: {e}")))
 }
 
-/// Whether the process started with its standard output closed (`>&-`): Rust's runtime then
-/// opens /dev/null read-write in its place, which no shell redirection does (`> /dev/null`
-/// opens it write-only), so that writes would vanish.
+/// Whether the process started with its standard output closed (`>&-`), as
+/// [`record_stdout_at_start`] saw it before Rust's runtime put /dev/null in its place: writes
+/// would then vanish. A /dev/null the caller opened (`> /dev/null`, Python's
+/// `subprocess.DEVNULL`, read-write like the runtime's) is a place the caller chose.
 fn stdout_closed() -> bool {
-    // SAFETY: fcntl and fstat read the descriptor's flags and status into `st`, changing nothing.
-    unsafe {
-        let flags = libc::fcntl(libc::STDOUT_FILENO, libc::F_GETFL);
-        if flags < 0 {
-            return true;
-        }
-        let mut st: libc::stat = std::mem::zeroed();
-        let mut null: libc::stat = std::mem::zeroed();
-        let is_null = libc::fstat(libc::STDOUT_FILENO, &mut st) == 0
-            && libc::stat(c"/dev/null".as_ptr(), &mut null) == 0
-            && st.st_rdev == null.st_rdev
-            && (st.st_mode & libc::S_IFMT) == libc::S_IFCHR;
-        is_null && (flags & libc::O_ACCMODE) == libc::O_RDWR
-    }
+    STDOUT_CLOSED_AT_START.load(std::sync::atomic::Ordering::Relaxed)
 }
+
+static STDOUT_CLOSED_AT_START: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Runs before `main` (an ELF constructor, before Rust's runtime opens /dev/null on a closed
+/// standard descriptor): records whether standard output is closed.
+extern "C" fn record_stdout_at_start() {
+    // SAFETY: fcntl reads the descriptor's flags, changing nothing.
+    let closed = unsafe { libc::fcntl(libc::STDOUT_FILENO, libc::F_GETFD) } < 0;
+    STDOUT_CLOSED_AT_START.store(closed, std::sync::atomic::Ordering::Relaxed);
+}
+
+#[used]
+#[link_section = ".init_array"]
+static RECORD_STDOUT_AT_START: extern "C" fn() = record_stdout_at_start;

@@ -383,6 +383,20 @@ fn standard_output_that_cannot_be_written() {
     }
 }
 
+/// A /dev/null the caller opened read-write for standard output (Python's
+/// `subprocess.DEVNULL`) is a place the caller chose: a passing run exits 0 (it had exited 1,
+/// taken for a closed standard output, which Rust's runtime also fills with /dev/null).
+#[test]
+fn a_passing_run_into_a_read_write_dev_null_exits_0() {
+    let null = std::fs::OpenOptions::new().read(true).write(true).open("/dev/null").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_tensegrity"))
+        .args(["run", "scenarios/custom/prism3.toml"])
+        .stdout(null)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
 /// `--set` of one name twice is refused with both flags named (the last had won in silence).
 #[test]
 fn a_name_set_twice() {
