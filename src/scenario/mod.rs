@@ -48,6 +48,9 @@ pub use overrides::{Override, OverrideError};
 pub struct Scenario {
     pub file: PathBuf,
     pub source: String,
+    /// The `--set` flags it was parsed with: a study that builds the structure again at other
+    /// parameters (`with_parameter_sets`) applies them as the parse did.
+    pub overrides: Vec<Override>,
     pub name: String,
     pub description: String,
     pub mechanism: String,
@@ -217,7 +220,9 @@ impl Scenario {
     /// sweep over a topology is refused: its structures differ by more than their values.
     pub fn with_parameter_sets(&self, sets: &[Values]) -> Result<Scenario, ScenarioError> {
         let Some(custom) = &self.custom else { return Ok(self.clone()) };
-        let ctx = Ctx { file: self.file.display().to_string(), source: &self.source };
+        // The file's text with its `--set` flags, read as `parse_with` read it.
+        let (extended, file_lines) = overrides::extended_source(&self.source, &self.overrides);
+        let ctx = Ctx { file: self.file.display().to_string(), source: &extended };
         if !self.topologies.is_empty() {
             return Err(ctx.err_at(0, "a sweep over a topology has no structure at other parameters".into()));
         }
@@ -225,6 +230,8 @@ impl Scenario {
             let start = e.span().map(|s| s.start).unwrap_or(0);
             ctx.err_at(start, error::in_file_words(e.message().trim()))
         })?;
+        overrides::apply(&ctx, &mut raw, &self.overrides, file_lines)
+            .map_err(|e| overrides::at_flag(e, &self.overrides, file_lines))?;
         // The file passed the expansion's bound when it was parsed; the same text again.
         expand_patterns(&ctx, &mut raw, None, &std::rc::Rc::default())?;
         let variants = mechanism::variants(&ctx, &raw, sets.iter())?;
@@ -270,6 +277,7 @@ pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<S
         }
     };
     sc.source = source.to_string();
+    sc.overrides = overrides.to_vec();
     Ok(sc)
 }
 
@@ -527,6 +535,7 @@ fn validate(
     Ok(Validated::One(Box::new(Scenario {
         file: path.to_path_buf(),
         source: ctx.source.to_string(),
+        overrides: Vec::new(),
         name: raw.name.into_inner(),
         description: raw.description,
         mechanism: m.name().into(),

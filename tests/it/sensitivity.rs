@@ -446,3 +446,24 @@ fn a_ball_jointed_pendulums_spin_is_rigid_and_its_swing_meets_the_closed_form() 
     let d = against_settles(&r, "g", "mode2.omega", 1e-6);
     assert!(rel(d, omega / (2.0 * g)) <= 1e-9, "d omega/d g = {d:.15e}, closed form {:.15e}", omega / (2.0 * g));
 }
+
+/// A study builds the structure again at each stepped parameter as the parse built it, `--set`
+/// flags and patterns included: on the patterned prism of `benches/prism_modes.toml` with
+/// `--set n=6 --set k=120` every parameter has its derivatives (each step had been rebuilt at
+/// the file's own n = 300 and refused as another structure), and with every stiffness and
+/// tension proportional to k the frequencies go as sqrt(k): d omega / d k = omega / (2 k)
+/// within 1e-6 for the lowest mode.
+#[test]
+fn a_studys_steps_honour_the_set_flags_and_the_patterns() {
+    let overrides: Vec<scenario::Override> =
+        ["n=6", "k=120"].iter().map(|f| scenario::Override::parse(f).unwrap()).collect();
+    let file = "benches/prism_modes.toml";
+    let sc = scenario::load_with(Path::new(file), &overrides).expect("valid");
+    let r = tensegrity_testbed::study::sensitivity(&sc, file, 0, false, None).expect("sensitivities");
+    for p in &r.parameters {
+        assert!(p.error.is_none(), "d/d {}: {:?}", p.name, p.error);
+    }
+    let i = r.outputs.iter().position(|o| o.name.ends_with(".omega")).expect("a mode's frequency");
+    let (omega, d) = (r.outputs[i].value, row(&r, "k").derivatives[i]);
+    assert!(rel(d, omega / 240.0) <= 1e-6, "{}: {d} against {}", r.outputs[i].name, omega / 240.0);
+}
