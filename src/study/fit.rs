@@ -120,6 +120,11 @@ fn iterate(
         }
         let step = lm_step(&j, &it.r, lambda);
         let trial = bounded(problem, initial, &(&it.p + &step))?;
+        // A parameter already at its bound that the step wants past it: the data want it
+        // beyond (without this, the rejected steps would stop the fit there in silence).
+        let pinned: DVector<f64> =
+            DVector::from_fn(trial.len(), |k, _| if trial[k] == it.p[k] { (&it.p + &step)[k] } else { trial[k] });
+        at_bound(problem, &pinned, &trial)?;
         let next = match at(&trial) {
             Ok(next) if next.cost < it.cost => next,
             Err(e) if !e.is_bad_input() && !cancelled() => {

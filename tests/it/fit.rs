@@ -185,6 +185,9 @@ fn bad_fit_input_gives_exit_2_naming_what_is_wrong() {
         ("unknown.csv", angles_csv(), vec!["--param", "k3"], vec!["'k3'", "k1", "k2"]),
         ("swept.csv", angles_csv(), vec!["--param", "k1"], vec!["--param k1", "[actuation]"]),
         ("bound.csv", angles_csv(), vec!["--param", "k2=1:31"], vec!["k2 ran into its bound 31"]),
+        // Started at its bound (the file's 30 below it) with the data wanting 33 below it: every
+        // step is cut to nothing there, which had stopped the fit at 40 with exit 0.
+        ("start.csv", angles_csv(), vec!["--param", "k2=40:100"], vec!["k2 ran into its bound 40"]),
         ("point.csv", "point,output,value\n9,q,1\n0,q,1\n".into(), vec!["--param", "k2"], vec!["no point 9"]),
     ];
     for (name, csv, flags, said) in cases {
