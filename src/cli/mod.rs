@@ -245,12 +245,15 @@ static STDOUT_CLOSED_AT_START: std::sync::atomic::AtomicBool = std::sync::atomic
 
 /// Runs before `main` (an ELF constructor, before Rust's runtime opens /dev/null on a closed
 /// standard descriptor): records whether standard output is closed.
+#[cfg_attr(not(target_os = "linux"), allow(dead_code))]
 extern "C" fn record_stdout_at_start() {
     // SAFETY: fcntl reads the descriptor's flags, changing nothing.
     let closed = unsafe { libc::fcntl(libc::STDOUT_FILENO, libc::F_GETFD) } < 0;
     STDOUT_CLOSED_AT_START.store(closed, std::sync::atomic::Ordering::Relaxed);
 }
 
+/// (ELF only: elsewhere standard output is never taken for closed.)
+#[cfg(target_os = "linux")]
 #[used]
 #[link_section = ".init_array"]
 static RECORD_STDOUT_AT_START: extern "C" fn() = record_stdout_at_start;
