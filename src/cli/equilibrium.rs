@@ -2,7 +2,7 @@
 //! settled state and its SVD (`structure::equilibrium`), as a table and as JSON with
 //! `--json FILE` (`-`: standard output, the table then going to standard error).
 
-use super::{bad_input, check_outputs, failed, load_one, signals, write_atomic, CliError, Outcome};
+use super::{bad_input, check_outputs, failed, load_one, signals, CliError, Outcome};
 use crate::run::EquilibriumRunError;
 use std::path::{Path, PathBuf};
 
@@ -19,13 +19,6 @@ pub fn equilibrium(
             EquilibriumRunError::Refused(_) => bad_input(format!("{}: {e}", scenario.display())),
             EquilibriumRunError::Run(_) => failed(format!("{}: {e}", scenario.display())),
         })?;
-    if json.is_some_and(super::is_stdio) {
-        eprint!("{}", report.to_table());
-    } else {
-        super::print_out(&report.to_table())?;
-    }
-    if let Some(j) = json {
-        write_atomic(j, &serde_json::to_string_pretty(&report).expect("report serialises"))?;
-    }
+    super::print_report(&report.to_table(), json.is_some_and(super::is_stdio), json, &report)?;
     Ok(Outcome::from_passed(state.settled))
 }

@@ -4,7 +4,7 @@
 //! error), as JSON. The data's errors are located at `FILE:LINE:COL`, the parameters' at their
 //! flag.
 
-use super::{bad_input, check_outputs, failed, signals, write_atomic, CliError, Outcome};
+use super::{bad_input, check_outputs, failed, signals, CliError, Outcome};
 use crate::scenario::Override;
 use crate::study::{FitError, FitProblem};
 use std::path::Path;
@@ -28,14 +28,7 @@ pub fn fit(
     let problem =
         FitProblem { file: scenario.to_path_buf(), source, overrides: overrides.to_vec(), parameters, measurements };
     let report = crate::study::fit(&problem, Some(&signals::CANCEL)).map_err(cli_error)?;
-    if json.is_some_and(super::is_stdio) {
-        eprint!("{}", report.to_table());
-    } else {
-        super::print_out(&report.to_table())?;
-    }
-    if let Some(j) = json {
-        write_atomic(j, &serde_json::to_string_pretty(&report).expect("report serialises"))?;
-    }
+    super::print_report(&report.to_table(), json.is_some_and(super::is_stdio), json, &report)?;
     Ok(Outcome::from_passed(true))
 }
 

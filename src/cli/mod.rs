@@ -222,6 +222,25 @@ fn write_output(out: Option<&Path>, inputs: &[PathBuf], text: &str) -> Result<Ou
 /// Writes `text` to standard output, all of it: a closed or full standard output fails the
 /// command (exit 1) with its message, never a panic and never a silent exit 0. (A pipe closed
 /// by its reader ends the process as it ends any Unix filter: `signals::install_handlers`.)
+/// A report's table and, with `--json FILE`, the report itself: the table on standard output,
+/// or on standard error where `table_to_stderr` (a `-` output holds standard output).
+pub fn print_report(
+    table: &str,
+    table_to_stderr: bool,
+    json: Option<&Path>,
+    report: &impl serde::Serialize,
+) -> Result<(), CliError> {
+    if table_to_stderr {
+        eprint!("{table}");
+    } else {
+        print_out(table)?;
+    }
+    if let Some(j) = json {
+        write_atomic(j, &serde_json::to_string_pretty(report).expect("report serialises"))?;
+    }
+    Ok(())
+}
+
 pub fn print_out(text: &str) -> Result<(), CliError> {
     use std::io::Write;
     if stdout_closed() {

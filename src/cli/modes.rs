@@ -3,7 +3,7 @@
 //! as JSON with `--json FILE` (`-`: standard output, the table then going to standard error),
 //! and animated in a rerun recording with `--record FILE.rrd`.
 
-use super::{bad_input, check_outputs, failed, load_one, signals, write_atomic, CliError, Outcome};
+use super::{bad_input, check_outputs, failed, load_one, signals, CliError, Outcome};
 use crate::run::ModesRunError;
 use crate::sim::modes::StructureModes;
 use crate::structure::MemberKind;
@@ -31,14 +31,7 @@ pub fn modes(
             },
         )?;
     // With `--json -` standard output is the JSON alone: the table goes to standard error.
-    if json.is_some_and(super::is_stdio) {
-        eprint!("{}", report.to_table());
-    } else {
-        super::print_out(&report.to_table())?;
-    }
-    if let Some(j) = json {
-        write_atomic(j, &serde_json::to_string_pretty(&report).expect("report serialises"))?;
-    }
+    super::print_report(&report.to_table(), json.is_some_and(super::is_stdio), json, &report)?;
     if let Some(r) = record {
         record_modes(r, &state.sim, &analysis).map_err(failed)?;
     }

@@ -34,14 +34,8 @@ pub fn sensitivity(
         })?;
     // With `--json -` or `--csv -` standard output is that file alone: the table goes to
     // standard error.
-    if json.is_some_and(super::is_stdio) || csv.is_some_and(super::is_stdio) {
-        eprint!("{}", report.to_table());
-    } else {
-        super::print_out(&report.to_table())?;
-    }
-    if let Some(j) = json {
-        write_atomic(j, &serde_json::to_string_pretty(&report).expect("report serialises"))?;
-    }
+    let to_stderr = json.is_some_and(super::is_stdio) || csv.is_some_and(super::is_stdio);
+    super::print_report(&report.to_table(), to_stderr, json, &report)?;
     if let Some(c) = csv {
         write_atomic(c, &report.to_csv())?;
     }

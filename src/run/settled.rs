@@ -166,8 +166,7 @@ pub fn equilibrium(
 ) -> Result<(crate::report::equilibrium::EquilibriumReport, SettledState), EquilibriumRunError> {
     if let Some(c) = &sc.custom {
         // Refused before the settle, as the analysis would be.
-        let drawn: Vec<_> = c.structure.nodes.iter().map(|n| n.position).collect();
-        crate::structure::equilibrium::equilibrium_matrix(&c.structure, &drawn)?;
+        crate::structure::equilibrium::check(&c.structure)?;
     }
     let state = settle_first_point(sc, cancel)?;
     let wall = Instant::now();

@@ -56,16 +56,19 @@ pub struct EquilibriumMatrix {
 #[error("{0}")]
 pub struct EquilibriumError(pub String);
 
-/// The equilibrium matrix of `s` with its nodes at `positions` \[m\], and its SVD.
-pub fn equilibrium_matrix(s: &Structure, positions: &[Vec3]) -> Result<EquilibriumMatrix, EquilibriumError> {
+/// Whether `s` has an equilibrium matrix here: pin-jointed, and within
+/// [`MAX_EQUILIBRIUM_ENTRIES`] (the check before a settle, without the matrix).
+pub fn check(s: &Structure) -> Result<(), EquilibriumError> {
+    layout(s).map(|_| ())
+}
+
+/// The rows' free nodes and the columns' members of `s`'s equilibrium matrix, once `s` is
+/// pin-jointed and the matrix within [`MAX_EQUILIBRIUM_ENTRIES`].
+fn layout(s: &Structure) -> Result<(Vec<NodeId>, Vec<MemberId>), EquilibriumError> {
     check_pin_jointed(s)?;
     let free = |n: NodeId| s.bodies[s.nodes[n].body].kind == BodyKind::Free;
     let nodes: Vec<NodeId> =
         (0..s.nodes.len()).filter(|&n| free(n) && s.members.iter().any(|m| m.path.contains(&n))).collect();
-    let mut row = vec![None; s.nodes.len()];
-    for (k, &n) in nodes.iter().enumerate() {
-        row[n] = Some(k);
-    }
     let members: Vec<MemberId> = (0..s.members.len()).filter(|&k| s.members[k].path.iter().any(|&n| free(n))).collect();
     let (rows, columns) = (3 * nodes.len(), members.len());
     if rows * columns > MAX_EQUILIBRIUM_ENTRIES {
@@ -73,6 +76,17 @@ pub fn equilibrium_matrix(s: &Structure, positions: &[Vec3]) -> Result<Equilibri
             "its equilibrium matrix would be {rows} by {columns}, more than the {MAX_EQUILIBRIUM_ENTRIES} entries a dense SVD is given here"
         )));
     }
+    Ok((nodes, members))
+}
+
+/// The equilibrium matrix of `s` with its nodes at `positions` \[m\], and its SVD.
+pub fn equilibrium_matrix(s: &Structure, positions: &[Vec3]) -> Result<EquilibriumMatrix, EquilibriumError> {
+    let (nodes, members) = layout(s)?;
+    let mut row = vec![None; s.nodes.len()];
+    for (k, &n) in nodes.iter().enumerate() {
+        row[n] = Some(k);
+    }
+    let (rows, columns) = (3 * nodes.len(), members.len());
     let mut a = DMatrix::zeros(rows, columns);
     for (c, &k) in members.iter().enumerate() {
         for w in s.members[k].path.windows(2) {
