@@ -315,6 +315,21 @@ impl Writer<'_> {
         }
         let Some(j) = plan.tree_joint[b] else {
             let mass = s.bodies[b].inertia.map_or(0.0, |i| i.mass_kg);
+            let held = s.held_translations()[b];
+            if held.contains(&true) {
+                // A support in some directions (on a point mass, which nothing turns): a slide
+                // joint along each free axis.
+                for (x, axis) in ["x", "y", "z"].iter().enumerate().filter(|(x, _)| !held[*x]) {
+                    let direction = ["1 0 0", "0 1 0", "0 0 1"][x];
+                    let _ = writeln!(
+                        self.xml,
+                        "{pad}  <joint name=\"{}:slide_{axis}\" type=\"slide\" axis=\"{direction}\" damping=\"{:?}\"/>",
+                        esc(&s.bodies[b].name),
+                        self.o.body_damping_per_s * mass
+                    );
+                }
+                return;
+            }
             let _ = writeln!(
                 self.xml,
                 "{pad}  <joint name=\"{}:free\" type=\"free\" damping=\"{:?}\"/>",

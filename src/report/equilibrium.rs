@@ -15,14 +15,18 @@ pub struct EquilibriumReport {
     /// Whether the settle criteria were met before the analysis.
     pub settled: bool,
     pub settle_steps: u64,
-    /// Rows: three per free node (3 j).
+    /// Rows: three per free node, less the coordinates that supports hold (3 j - h).
     pub rows: usize,
+    /// The free nodes that members reach (j).
+    pub free_nodes: usize,
+    /// The free nodes' coordinates that supports in some directions hold (h).
+    pub held_coordinates: usize,
     /// Columns: one per member with a free node (b).
     pub columns: usize,
     pub rank: usize,
     /// s = b - r.
     pub self_stress_states: usize,
-    /// m = 3 j - r (a free structure's rigid motions among them).
+    /// m = 3 j - h - r (a free structure's rigid motions among them).
     pub mechanisms: usize,
     pub rank_tolerance: f64,
     /// Largest first.
@@ -44,18 +48,20 @@ impl EquilibriumReport {
         let mut out = String::new();
         let _ = writeln!(out, "== {} [{}]: equilibrium matrix at the settled state", self.name, self.file);
         let _ = writeln!(out, "   settled: {} ({} steps)", self.settled, self.settle_steps);
+        let held = if self.held_coordinates > 0 { " - h" } else { "" };
         let _ = writeln!(
             out,
-            "   A: {} rows (3 j, j = {} free nodes) by {} columns (b members); rank r = {} (singular values below {:e} of the largest are zero)",
+            "   A: {} rows (3 j{held}, j = {} free nodes, h = {} coordinates held by supports) by {} columns (b members); rank r = {} (singular values below {:e} of the largest are zero)",
             self.rows,
-            self.rows / 3,
+            self.free_nodes,
+            self.held_coordinates,
             self.columns,
             self.rank,
             self.rank_tolerance
         );
         let _ = writeln!(
             out,
-            "   s = b - r = {} self-stress state(s), m = 3 j - r = {} mechanism(s); Maxwell-Calladine 3 j - b = {} = m - s",
+            "   s = b - r = {} self-stress state(s), m = 3 j{held} - r = {} mechanism(s); Maxwell-Calladine 3 j{held} - b = {} = m - s",
             self.self_stress_states,
             self.mechanisms,
             self.rows as i64 - self.columns as i64

@@ -179,6 +179,8 @@ pub fn equilibrium(
         settled: state.settled,
         settle_steps: state.steps,
         rows: e.a.nrows(),
+        free_nodes: e.nodes.len(),
+        held_coordinates: 3 * e.nodes.len() - e.a.nrows(),
         columns: e.a.ncols(),
         rank: e.rank,
         self_stress_states: e.self_stress.len(),
@@ -190,41 +192,51 @@ pub fn equilibrium(
         mechanism_shapes: e
             .mechanisms
             .iter()
-            .map(|d| {
-                e.nodes
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &n)| (s.nodes[n].name.clone(), [d[3 * k], d[3 * k + 1], d[3 * k + 2]]))
-                    .collect()
-            })
+            .map(|d| e.node_displacements(d).into_iter().map(|(n, x)| (s.nodes[n].name.clone(), x)).collect())
             .collect(),
         wall_s: wall.elapsed().as_secs_f64(),
     };
     Ok((report, state))
 }
 
-/// The reaction at each support (a node on a fixed body that members reach) \[N\]: the force
-/// the support exerts on the structure, minus the pull of every segment that ends there
-/// (tension t along the unit vector from the support to the segment's other node).
+/// The reaction at each support \[N\], the force it exerts on the structure: at a node on a
+/// fixed body that members reach, minus the pull of every segment that ends there (tension t
+/// along the unit vector from the support to the segment's other node); at a support in some
+/// directions (a point mass), minus the pulls, the point loads and the weight there, along the
+/// held directions (the others are zero: nothing holds them).
 fn reactions(
     s: &crate::structure::Structure,
     positions: &[[f64; 3]],
     forces: &crate::snapshot::MemberForces,
 ) -> Vec<(String, [f64; 3])> {
     use crate::structure::BodyKind;
-    let mut at: std::collections::BTreeMap<usize, nalgebra::Vector3<f64>> = Default::default();
+    use nalgebra::Vector3;
+    let held = s.held_translations();
+    let fixed = |n: usize| s.bodies[s.nodes[n].body].kind == BodyKind::Fixed;
+    let supported = |n: usize| s.supports.iter().any(|x| x.node == n);
+    let mut at: std::collections::BTreeMap<usize, Vector3<f64>> = Default::default();
     for (k, member) in s.members.iter().enumerate() {
         for (seg, (a, b)) in member.segments().enumerate() {
             let t = forces.segment_force_n[k].get(seg).copied().unwrap_or(forces.force_n[k]);
             for (support, other) in [(a, b), (b, a)] {
-                if s.bodies[s.nodes[support].body].kind != BodyKind::Fixed
-                    || s.bodies[s.nodes[other].body].kind == BodyKind::Fixed
-                {
+                if !(fixed(support) && !fixed(other) || supported(support)) {
                     continue;
                 }
-                let e = (nalgebra::Vector3::from(positions[other]) - nalgebra::Vector3::from(positions[support]))
-                    .normalize();
-                *at.entry(support).or_insert_with(nalgebra::Vector3::zeros) -= e * t;
+                let e = (Vector3::from(positions[other]) - Vector3::from(positions[support])).normalize();
+                *at.entry(support).or_insert_with(Vector3::zeros) -= e * t;
+            }
+        }
+    }
+    for support in &s.supports {
+        let r = at.entry(support.node).or_insert_with(Vector3::zeros);
+        let body = s.nodes[support.node].body;
+        *r -= Vector3::from(s.gravity) * s.bodies[body].inertia.map_or(0.0, |i| i.mass_kg);
+        for load in s.node_loads.iter().filter(|l| l.node == support.node) {
+            *r -= Vector3::from(load.force_n);
+        }
+        for (x, h) in held[body].iter().enumerate() {
+            if !h {
+                r[x] = 0.0;
             }
         }
     }

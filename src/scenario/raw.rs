@@ -246,6 +246,9 @@ with_parts!(RawStructure {
     /// Masses added at nodes that are point masses (`[[structure.masses]]`).
     #[serde(default)]
     masses: Vec<RawNodeMass>,
+    /// Supports in some directions at point masses (`[[structure.supports]]`).
+    #[serde(default)]
+    supports: Vec<RawSupport>,
     /// Sub-structures generated over an index range (`repeat.rs`), appended to the lists.
     #[serde(default)]
     repeat: Vec<RawRepeat>,
@@ -282,6 +285,15 @@ pub(super) struct RawLoad {
 pub(super) struct RawNodeMass {
     pub(super) node: Spanned<String>,
     pub(super) mass: Spanned<Num>,
+}
+
+/// `[[structure.supports]]`: a node of a point mass held in some world directions, `fixed`
+/// a list of "x", "y" and "z" (a roller on the floor: `fixed = ["z"]`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSupport {
+    pub(super) node: Spanned<String>,
+    pub(super) fixed: Spanned<Vec<String>>,
 }
 
 /// A rotation about `axis` (through the origin) by `angle` [rad].

@@ -52,6 +52,10 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
     for n in &r.masses {
         add_node_mass(ctx, &mut s, n)?;
     }
+    for support in &r.supports {
+        let support = node_support(ctx, &s, support)?;
+        s.supports.push(support);
+    }
     Ok(s)
 }
 
@@ -76,12 +80,26 @@ fn lump_members(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(), Sc
     }
     for (i, m) in r.struts.iter().enumerate() {
         refuse_keys(ctx, m, "strut", &[("segments", &m.segments)])?;
+        if let Some(k) = &m.stiffness {
+            return Err(ctx.err(k, "a strut's stiffness is EA / L: give EA (N), or E (Pa) with area (m^2)"));
+        }
         if let Some(d) = &m.density {
             strut_density_builds(ctx, s, m, d)?;
         }
-        if let Some((at, ea)) = axial_stiffness(ctx, m)? {
-            crate::structure::lumped::make_strut_elastic(s, i, ea, &mut lumping)
-                .map_err(|e| ctx.err(at, e.to_string()))?;
+        let rest = match &m.length {
+            Some(l) => Some((l, positive_value(ctx, l, "length (m)")?)),
+            None => None,
+        };
+        match (axial_stiffness(ctx, m)?, rest) {
+            (Some((at, ea)), rest) => {
+                crate::structure::lumped::make_strut_elastic(s, i, ea, rest.map(|r| r.1), &mut lumping)
+                    .map_err(|e| ctx.err(at, e.to_string()))?
+            }
+            (None, Some((at, _))) => return Err(ctx.err(
+                at,
+                "a rigid strut keeps its drawn length: length is an elastic strut's rest length (give EA, or E with area, to prestress the bar)",
+            )),
+            (None, None) => {}
         }
     }
     let first_cable = r.struts.len() + r.springs.len();
@@ -371,6 +389,45 @@ fn add_node_mass(ctx: &Ctx, s: &mut Structure, n: &super::raw::RawNodeMass) -> R
     inertia.mass_kg += mass;
     inertia.principal_kg_m2 = inertia.principal_kg_m2.map(|m| m * grown);
     Ok(())
+}
+
+/// A support in some directions: at a node of a point mass (a rigid body's node would need
+/// its turns held too), each of x, y and z named at most once, one support per node.
+fn node_support(
+    ctx: &Ctx,
+    s: &Structure,
+    r: &super::raw::RawSupport,
+) -> Result<crate::structure::NodeSupport, ScenarioError> {
+    let node = node(ctx, s, &r.node)?;
+    let body = s.nodes[node].body;
+    if !crate::structure::lumped::is_point_mass(s, body) {
+        let why = if s.bodies[body].kind == BodyKind::Fixed {
+            "is fixed: it is held in every direction already"
+        } else {
+            "is not a point mass (a one-node free body, an elastic strut's end): a support in some directions holds a node's translations, and a rigid body's node would turn about it"
+        };
+        return Err(
+            ctx.err(&r.node, format!("node '{}' is on body '{}', which {why}", r.node.get_ref(), s.bodies[body].name))
+        );
+    }
+    if s.supports.iter().any(|o| o.node == node) {
+        return Err(ctx.err(&r.node, format!("node '{}' has a support already", r.node.get_ref())));
+    }
+    let mut held = [false; 3];
+    for axis in r.fixed.get_ref() {
+        let Some(i) = ["x", "y", "z"].iter().position(|a| a == axis) else {
+            return Err(ctx.err(&r.fixed, format!("'{axis}' is not a direction: fixed lists \"x\", \"y\" and \"z\"")));
+        };
+        if std::mem::replace(&mut held[i], true) {
+            return Err(ctx.err(&r.fixed, format!("'{axis}' is listed twice")));
+        }
+    }
+    if !held.contains(&true) {
+        return Err(
+            ctx.err(&r.fixed, "fixed lists no direction: name at least one of \"x\", \"y\" and \"z\"".to_string())
+        );
+    }
+    Ok(crate::structure::NodeSupport { node, held })
 }
 
 /// The id of a declared node.

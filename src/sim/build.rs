@@ -42,6 +42,7 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<(Model, Dat
         fit_tree: Tree::default(),
         relaxation_applies: super::relaxation::applies(s),
         point_masses: crate::structure::lumped::point_masses(s),
+        held_translations: s.held_translations(),
     };
     let mut data = Data {
         pipeline: PhysicsPipeline::new(),
@@ -69,8 +70,25 @@ pub(super) fn build(s: &Structure, settings: &SimSettings) -> Result<(Model, Dat
     model.tree = data.link_tree(&model);
     model.internal_closures = data.find_internal_closures(&model);
     model.projected_groups = data.find_projected_groups(&model);
+    check_supports(&model)?;
     model.fit_tree = data.fit_tree(&model);
     Ok((model, data))
+}
+
+/// A support in some directions holds a body that rapier steps alone: not a multibody link and
+/// not in a projected group, whose projection moves its coordinates freely.
+fn check_supports(m: &Model) -> Result<(), SimError> {
+    let s = &m.structure;
+    for support in &s.supports {
+        let b = s.nodes[support.node].body;
+        if m.tree.hang[b].is_some() || m.projected_groups.iter().any(|g| g.bodies.contains(&b)) {
+            return Err(SimError::Build(format!(
+                "the support at node '{}' holds a body that a joint or an inextensible cable holds too; a support in some directions takes a point mass held by elastic members",
+                s.nodes[support.node].name
+            )));
+        }
+    }
+    Ok(())
 }
 
 impl Data {
@@ -129,7 +147,7 @@ fn actuated_joints(s: &Structure) -> Result<Vec<bool>, SimError> {
 fn insert_bodies(s: &Structure, settings: &SimSettings) -> (RigidBodySet, Vec<RigidBodyHandle>) {
     let mut bodies = RigidBodySet::new();
     let mut handles = Vec::with_capacity(s.bodies.len());
-    for b in &s.bodies {
+    for (b, held) in s.bodies.iter().zip(s.held_translations()) {
         let builder = if b.kind == BodyKind::Fixed {
             RigidBodyBuilder::fixed()
         } else {
@@ -143,6 +161,7 @@ fn insert_bodies(s: &Structure, settings: &SimSettings) -> (RigidBodySet, Vec<Ri
                 ))
                 .linear_damping(settings_body_damping(settings))
                 .angular_damping(settings_body_damping(settings))
+                .enabled_translations(!held[0], !held[1], !held[2])
         };
         handles.push(bodies.insert(builder.build()));
     }

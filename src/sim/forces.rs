@@ -411,7 +411,13 @@ impl Data {
                 residual.max_force_n = residual.max_force_n.max((-out.force_n[c]).max(0.0));
             }
         }
-        for c in self.coordinate_forces(m, &m.fit_tree, wrench, true) {
+        let held = self.held_rows(m, &m.fit_tree);
+        for (_, c) in self
+            .coordinate_forces(m, &m.fit_tree, wrench, true)
+            .into_iter()
+            .enumerate()
+            .filter(|(r, _)| !held.contains(r))
+        {
             if c.is_torque {
                 residual.max_torque_nm = residual.max_torque_nm.max(c.value.abs());
             } else {
@@ -419,6 +425,14 @@ impl Data {
             }
         }
         residual
+    }
+
+    /// The rows of [`Self::coordinate_forces`] that supports hold (a free root's translations
+    /// along held axes): the support takes their force, as its reaction.
+    fn held_rows(&self, m: &Model, tree: &Tree) -> Vec<usize> {
+        let (_, root_row) = self.coordinate_rows(m, tree);
+        let rows = root_row.iter().zip(&m.held_translations).filter_map(|(row, held)| row.map(|r| (r, held)));
+        rows.flat_map(|(r, held)| (0..3).filter(|x| held[*x]).map(move |x| r + x)).collect()
     }
 
     /// Each actuator's force along its joint axis (or its cable's tension): minus the load of

@@ -71,6 +71,9 @@ pub struct Model {
     pub(super) relaxation_applies: bool,
     /// Which bodies are point masses (`structure::lumped::point_masses`).
     pub(super) point_masses: Vec<bool>,
+    /// Which world translations of each body its supports hold (`Structure::held_translations`;
+    /// rapier locks them, the relaxation and the modes leave them out).
+    pub(super) held_translations: Vec<[bool; 3]>,
 }
 
 impl Model {

@@ -125,6 +125,10 @@ pub enum ModesError {
     /// A motion asks for a mode (from 1) along which the structure moves without deforming.
     #[error("mode {mode} is a rigid-body mode (omega^2 = {omega_squared:e} rad^2/s^2, one of the structure's {rigid} that move it without deforming it): there is no vibration along it to start or to fit; choose a mode from {}", rigid + 1)]
     RigidMode { mode: usize, omega_squared: f64, rigid: usize },
+    /// A support in some directions: the equilibrium's sensitivities over free bodies' poses
+    /// do not take its held coordinates out yet.
+    #[error("node '{0}' has a support in some directions: sensitivities and fits of a structure with such supports are not computed yet (its modes are: tensegrity modes)")]
+    Supported(String),
     #[error(transparent)]
     Eigen(#[from] EigenError),
 }
@@ -203,10 +207,11 @@ impl Data {
             _ => None,
         };
         let turning = turning_coordinates(s, &bodies);
-        let kept: Vec<usize> = (0..turning.len()).filter(|&c| !turning[c]).collect();
+        let held = held_coordinates(m, &bodies);
+        let kept: Vec<usize> = (0..turning.len()).filter(|&c| !turning[c] && !held[c]).collect();
         let (eigen, largest, lowest_of) = if let Some(wanted) = sparse {
             let lowest = self.lowest_modes(m, &mass, &turning, wanted, cancel)?;
-            (lowest.modes, lowest.largest, Some(kept.len()))
+            (without_held(lowest.modes, &held, &mass), lowest.largest, Some(kept.len()))
         } else {
             let hessian = self.tangent_stiffness(m).hessian;
             let (k, mm) = (hessian.select_rows(&kept), block_diagonal(&mass).select_rows(&kept));
@@ -335,6 +340,33 @@ pub fn modal_projector(s: &crate::structure::Structure, analysis: &StructureMode
 pub(crate) fn turning_coordinates(s: &crate::structure::Structure, bodies: &[usize]) -> Vec<bool> {
     let point = crate::structure::lumped::point_masses(s);
     bodies.iter().flat_map(|&b| [false, false, false, point[b], point[b], point[b]]).collect()
+}
+
+/// Which of the free bodies' coordinates (six per body of `bodies`, in order) a support holds
+/// (`Structure::supports`): the modes leave them out.
+fn held_coordinates(m: &Model, bodies: &[usize]) -> Vec<bool> {
+    bodies.iter().flat_map(|&b| m.held_translations[b].into_iter().chain([false; 3])).collect()
+}
+
+/// The sparse solver's modes less those of the held coordinates: the relaxation's Hessian
+/// gives each held coordinate a stiffness of its own, alone on the diagonal at the top of the
+/// spectrum (`relaxation/assemble.rs`), so a mode that moves mostly there (by mass) is that
+/// stand-in, not the structure's.
+fn without_held(modes: Vec<(f64, DVector<f64>)>, held: &[bool], mass: &[Matrix6<f64>]) -> Vec<(f64, DVector<f64>)> {
+    if !held.contains(&true) {
+        return modes;
+    }
+    let share = |x: &DVector<f64>| {
+        let (mut part, mut whole) = (0.0, 0.0);
+        for (i, block) in mass.iter().enumerate() {
+            let all = x.fixed_rows::<6>(6 * i).into_owned();
+            let only = nalgebra::Vector6::from_fn(|r, _| if held[6 * i + r] { all[r] } else { 0.0 });
+            part += only.dot(&(block * only));
+            whole += all.dot(&(block * all));
+        }
+        part / whole.max(f64::MIN_POSITIVE)
+    };
+    modes.into_iter().filter(|(_, x)| share(x) <= 0.5).collect()
 }
 
 /// The block-diagonal matrix of `blocks`.

@@ -58,6 +58,7 @@ impl Structure {
             && self.actuators == other.actuators
             && self.loads == other.loads
             && self.node_loads == other.node_loads
+            && self.supports == other.supports
             && all(&self.bodies, &other.bodies, same_body)
             && all(&self.nodes, &other.nodes, same_node)
             && all(&self.joints, &other.joints, same_joint)

@@ -132,6 +132,9 @@ impl Data {
             let names = self.modal_coordinate_names(m, &constraints.coordinates);
             return Ok(EquilibriumCoordinates::Constrained(Box::new(ConstrainedCoordinates { constraints, names })));
         }
+        if let Some(support) = s.supports.first() {
+            return Err(ModesError::Supported(s.nodes[support.node].name.clone()).into());
+        }
         if s.joints.is_empty() {
             return Ok(EquilibriumCoordinates::Bodies((0..s.bodies.len()).filter(|b| m.is_free(*b)).collect()));
         }

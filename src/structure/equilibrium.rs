@@ -18,7 +18,8 @@
 //! strut's end) or a strut's body (two nodes with the strut between them) and no joint holds
 //! it: each node then has three coordinates, and every member, struts included, is a bar. A
 //! node on a fixed body is a support in all three directions; a member between two supports
-//! has no column. Others are refused with the body that is not pin-jointed.
+//! has no column. A support in some directions (`Structure::supports`) takes its held
+//! coordinates out of the rows. Others are refused with the body that is not pin-jointed.
 
 use super::{BodyKind, MemberId, NodeId, Structure, Vec3};
 use nalgebra::{DMatrix, DVector};
@@ -35,11 +36,14 @@ pub const MAX_EQUILIBRIUM_ENTRIES: usize = 2_200_000;
 /// The equilibrium matrix at a set of node positions and the subspaces of its SVD.
 #[derive(Clone, Debug)]
 pub struct EquilibriumMatrix {
-    /// The free nodes, in the order of the rows (three each: x, y, z).
+    /// The free nodes.
     pub nodes: Vec<NodeId>,
+    /// Each row's node and direction (0, 1, 2: x, y, z): the free nodes' coordinates that no
+    /// support holds, node by node.
+    pub rows: Vec<(NodeId, usize)>,
     /// The members, in the order of the columns.
     pub members: Vec<MemberId>,
-    /// A (3 j by b).
+    /// A (rows by b: 3 j less the held coordinates).
     pub a: DMatrix<f64>,
     /// The singular values, largest first.
     pub singular_values: Vec<f64>,
@@ -62,32 +66,41 @@ pub fn check(s: &Structure) -> Result<(), EquilibriumError> {
     layout(s).map(|_| ())
 }
 
-/// The rows' free nodes and the columns' members of `s`'s equilibrium matrix, once `s` is
-/// pin-jointed and the matrix within [`MAX_EQUILIBRIUM_ENTRIES`].
-fn layout(s: &Structure) -> Result<(Vec<NodeId>, Vec<MemberId>), EquilibriumError> {
+/// The free nodes, the rows (node, direction) and the columns' members of `s`'s equilibrium
+/// matrix, once `s` is pin-jointed and the matrix within [`MAX_EQUILIBRIUM_ENTRIES`].
+type Layout = (Vec<NodeId>, Vec<(NodeId, usize)>, Vec<MemberId>);
+
+fn layout(s: &Structure) -> Result<Layout, EquilibriumError> {
     check_pin_jointed(s)?;
     let free = |n: NodeId| s.bodies[s.nodes[n].body].kind == BodyKind::Free;
     let nodes: Vec<NodeId> =
         (0..s.nodes.len()).filter(|&n| free(n) && s.members.iter().any(|m| m.path.contains(&n))).collect();
+    let held = s.held_translations();
+    let row_list: Vec<(NodeId, usize)> = nodes
+        .iter()
+        .flat_map(|&n| {
+            let held = held[s.nodes[n].body];
+            (0..3).filter(move |&x| !held[x]).map(move |x| (n, x))
+        })
+        .collect();
     let members: Vec<MemberId> = (0..s.members.len()).filter(|&k| s.members[k].path.iter().any(|&n| free(n))).collect();
-    let (rows, columns) = (3 * nodes.len(), members.len());
+    let (rows, columns) = (row_list.len(), members.len());
     if rows * columns > MAX_EQUILIBRIUM_ENTRIES {
         return Err(EquilibriumError(format!(
             "its equilibrium matrix would be {rows} by {columns}, more than the {MAX_EQUILIBRIUM_ENTRIES} entries a dense SVD is given here"
         )));
     }
-    Ok((nodes, members))
+    Ok((nodes, row_list, members))
 }
 
 /// The equilibrium matrix of `s` with its nodes at `positions` \[m\], and its SVD.
 pub fn equilibrium_matrix(s: &Structure, positions: &[Vec3]) -> Result<EquilibriumMatrix, EquilibriumError> {
-    let (nodes, members) = layout(s)?;
-    let mut row = vec![None; s.nodes.len()];
-    for (k, &n) in nodes.iter().enumerate() {
-        row[n] = Some(k);
+    let (nodes, rows, members) = layout(s)?;
+    let mut row = vec![[None; 3]; s.nodes.len()];
+    for (k, &(n, x)) in rows.iter().enumerate() {
+        row[n][x] = Some(k);
     }
-    let (rows, columns) = (3 * nodes.len(), members.len());
-    let mut a = DMatrix::zeros(rows, columns);
+    let mut a = DMatrix::zeros(rows.len(), members.len());
     for (c, &k) in members.iter().enumerate() {
         for w in s.members[k].path.windows(2) {
             let (p, q) = (positions[w[0]], positions[w[1]]);
@@ -96,18 +109,34 @@ pub fn equilibrium_matrix(s: &Structure, positions: &[Vec3]) -> Result<Equilibri
                 return Err(EquilibriumError(format!("member '{}' has a segment of no length", s.members[k].name)));
             }
             for (node, sign) in [(w[0], 1.0), (w[1], -1.0)] {
-                if let Some(r) = row[node] {
-                    for x in 0..3 {
-                        a[(3 * r + x, c)] += sign * (q[x] - p[x]) / l;
+                for x in 0..3 {
+                    if let Some(r) = row[node][x] {
+                        a[(r, c)] += sign * (q[x] - p[x]) / l;
                     }
                 }
             }
         }
     }
     let (singular_values, self_stress) = null_space(&a);
-    let rank = columns - self_stress.len();
+    let rank = members.len() - self_stress.len();
     let (_, mechanisms) = null_space(&a.transpose());
-    Ok(EquilibriumMatrix { nodes, members, a, singular_values, rank, self_stress, mechanisms })
+    Ok(EquilibriumMatrix { nodes, rows, members, a, singular_values, rank, self_stress, mechanisms })
+}
+
+impl EquilibriumMatrix {
+    /// The displacement of each free node in the row vector `d` (a mechanism) \[m\], zero
+    /// along its held directions, in the order of [`Self::nodes`].
+    pub fn node_displacements(&self, d: &DVector<f64>) -> Vec<(NodeId, Vec3)> {
+        let mut at: Vec<(NodeId, Vec3)> = self.nodes.iter().map(|&n| (n, [0.0; 3])).collect();
+        let mut k = 0;
+        for (r, &(n, x)) in self.rows.iter().enumerate() {
+            while at[k].0 != n {
+                k += 1;
+            }
+            at[k].1[x] = d[r];
+        }
+        at
+    }
 }
 
 /// Every free body a point mass or a strut's two-node body, and no joint.

@@ -96,7 +96,8 @@ pub const STABLE_OMEGA_DT: f64 = 2.0;
 /// M^-1 K: omega^2 <= 2 sum k / m over its members \[rad/s\], with the point mass that gives
 /// it; None without a point mass held by an elastic member. For the beaded string and for an
 /// elastic strut's ends the bound is the discretisation's own highest frequency to within its
-/// last mode's sine (2 sqrt(k / m)).
+/// last mode's sine (2 sqrt(k / m)). A point mass that supports hold in every direction does
+/// not move and is left out.
 pub fn fastest_point_mass(s: &Structure) -> Option<(f64, usize)> {
     let mut held = vec![0.0; s.bodies.len()];
     for m in &s.members {
@@ -106,19 +107,21 @@ pub fn fastest_point_mass(s: &Structure) -> Option<(f64, usize)> {
         }
     }
     let points = point_masses(s);
+    let supported = s.held_translations();
     (0..s.bodies.len())
-        .filter(|&b| held[b] > 0.0 && points[b])
+        .filter(|&b| held[b] > 0.0 && points[b] && supported[b] != [true; 3])
         .map(|b| ((2.0 * held[b] / s.bodies[b].inertia.map_or(f64::NAN, |i| i.mass_kg)).sqrt(), b))
         .max_by(|x, y| x.0.total_cmp(&y.0))
 }
 
 /// Makes strut `strut` elastic with axial stiffness `ea_n` = E A \[N\]: its body's mass halved
-/// onto two point masses at its nodes, the strut pushing and pulling with EA / L about its
-/// drawn length L.
+/// onto two point masses at its nodes, the strut pushing and pulling with EA / L0 about its
+/// rest length L0, `rest_length_m` where given (a prestressed bar), else its drawn length.
 pub fn make_strut_elastic(
     s: &mut Structure,
     strut: MemberId,
     ea_n: f64,
+    rest_length_m: Option<f64>,
     lumping: &mut Lumping,
 ) -> Result<(), LumpError> {
     let name = s.members[strut].name.clone();
@@ -158,7 +161,8 @@ pub fn make_strut_elastic(
     s.bodies[body].inertia = Some(bead_inertia(half, s.nodes[a].position, size_m));
     let new = s.add_body(&end_b, BodyKind::Free, Some(bead_inertia(half, s.nodes[b].position, size_m)));
     s.nodes[b].body = new;
-    s.members[strut].law = Law::ElasticStrut { stiffness_n_per_m: ea_n / length, rest_length_m: length };
+    let rest = rest_length_m.unwrap_or(length);
+    s.members[strut].law = Law::ElasticStrut { stiffness_n_per_m: ea_n / rest, rest_length_m: rest };
     Ok(())
 }
 

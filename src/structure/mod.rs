@@ -155,6 +155,16 @@ pub struct NodeLoad {
     pub force_n: Vec3,
 }
 
+/// A support that holds a node in some world directions only (a roller, a slot), on a point
+/// mass (`lumped::is_point_mass`): its body cannot translate along the held axes, and the
+/// support's reaction is the force it takes there.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NodeSupport {
+    pub node: NodeId,
+    /// Whether x, y and z (world) are held.
+    pub held: [bool; 3],
+}
+
 /// A whole mechanism, ready to be simulated.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Structure {
@@ -170,6 +180,8 @@ pub struct Structure {
     pub loads: Vec<ExternalLoad>,
     /// Point loads at nodes.
     pub node_loads: Vec<NodeLoad>,
+    /// Supports in some directions, at point masses.
+    pub supports: Vec<NodeSupport>,
 }
 
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -325,7 +337,38 @@ impl Structure {
         self.validate_joints()?;
         self.validate_actuators()?;
         self.validate_loads()?;
+        self.validate_supports()?;
         Ok(())
+    }
+
+    /// Each support holds at least one direction of a point mass, one support per node.
+    fn validate_supports(&self) -> Result<(), StructureError> {
+        for (i, support) in self.supports.iter().enumerate() {
+            let name = self.nodes.get(support.node).map_or(format!("#{i}"), |n| n.name.clone());
+            self.check_node("support", &name, support.node)?;
+            if !support.held.contains(&true) {
+                return Err(invalid("support", &name, "holds no direction"));
+            }
+            if !lumped::is_point_mass(self, self.nodes[support.node].body) {
+                return Err(invalid("support", &name, "the node's body is not a point mass"));
+            }
+            if self.supports[..i].iter().any(|o| o.node == support.node) {
+                return Err(invalid("support", &name, "the node has another support"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Which world translations (x, y, z) of each body its supports hold.
+    pub fn held_translations(&self) -> Vec<[bool; 3]> {
+        let mut held = vec![[false; 3]; self.bodies.len()];
+        for support in &self.supports {
+            let body = &mut held[self.nodes[support.node].body];
+            for (h, s) in body.iter_mut().zip(support.held) {
+                *h |= s;
+            }
+        }
+        held
     }
 
     /// Body names are unique; a free body has a finite mass and inertia > 0.

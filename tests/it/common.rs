@@ -205,7 +205,7 @@ pub fn peer_python(modules: &[&str], check: &str) -> Option<String> {
     let import = format!("import {}", modules.join(", "));
     let ok = Command::new(&py).args(["-c", &import]).output().is_ok_and(|o| o.status.success());
     if !ok {
-        let why = format!("no Python with `{import}` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt pandas pyarrow)");
+        let why = format!("no Python with `{import}` (set TENSEGRITY_PYTHON, or pip install -r benches/peers/mujoco/requirements.txt -r benches/peers/musclepy/requirements.txt pandas pyarrow)");
         skip(check, &why);
     }
     ok.then_some(py)

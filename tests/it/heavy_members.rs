@@ -684,3 +684,41 @@ fn a_struts_density_gives_its_body_its_mass() {
     let fixed = dense.replacen("name = \"bar\"\n", "name = \"bar\"\nfixed = true\n", 1);
     common::error_at(&fixed, "density = 2.5", 10, "its body is fixed");
 }
+
+/// A bar of EA = 25e6 N drawn 1 m long with `length = 1.001` m, both ends held by supports:
+/// a prestressed bar pushing with EA (L - L0) / L0 = -24975.02 N (relative 1e-12), where
+/// `length` had been ignored and the bar settled at 0 N. On a rigid strut `length`, and on any
+/// strut `stiffness`, is an error at the key.
+#[test]
+fn an_elastic_struts_length_is_its_rest_length() {
+    let text = common::one_point_head("a prestressed bar")
+        + r#"[[structure.bodies]]
+name = "bar"
+mass = 2.0
+nodes = { A = [0, 0, 0], B = [1, 0, 0] }
+
+[[structure.struts]]
+name = "bar"
+a = "A"
+b = "B"
+EA = 25e6
+length = 1.001
+
+[[structure.supports]]
+node = "A"
+fixed = ["x", "y", "z"]
+
+[[structure.supports]]
+node = "B"
+fixed = ["x", "y", "z"]
+"#;
+    let sc = scenario::parse(Path::new("bar.toml"), &text).expect("valid");
+    let report = run::run(&sc, &RunOptions::default());
+    let force = report.points[0].simulated["bar.force"];
+    let want = 25e6 * (1.0 - 1.001) / 1.001;
+    assert!((force - want).abs() <= 1e-12 * want.abs(), "{force} against {want}");
+    let rigid = text.replacen("EA = 25e6\n", "", 1);
+    common::error_at(&rigid, "1.001", 0, "a rigid strut keeps its drawn length");
+    let stiff = text.replacen("EA = 25e6\n", "stiffness = 3.0\n", 1);
+    common::error_at(&stiff, "3.0", 0, "a strut's stiffness is EA / L");
+}

@@ -23,6 +23,9 @@ pub(super) struct Dofs {
     pub(super) com: Vec<Vector>,
     /// Mass [kg] and mean principal moment of inertia [kg m^2] of each free body.
     pub(super) scale: Vec<(f64, f64)>,
+    /// Which coordinates (six per block) a support holds (`Structure::supports`): they take
+    /// no force and no step.
+    pub(super) held: Vec<bool>,
 }
 
 impl Dofs {
@@ -37,6 +40,46 @@ impl Dofs {
             let (mass, inertia) = self.scale[r / 6];
             1.0 / if r % 6 < 3 { mass } else { inertia }.sqrt()
         })
+    }
+
+    /// Zeroes the held coordinates' entries of `f` (the supports take those forces).
+    pub(super) fn hold(&self, f: &mut DVector<f64>) {
+        for (r, _) in self.held.iter().enumerate().filter(|(_, h)| **h) {
+            f[r] = 0.0;
+        }
+    }
+
+    /// Takes the held coordinates out of the Hessian's blocks: their rows and columns zeroed,
+    /// and each given a stiffness alone on the diagonal, at the largest mass-weighted diagonal
+    /// entry of the rest (inside the spectrum, so no shift or floor moves; with no force on it,
+    /// its step is zero).
+    fn hold_blocks(&self, blocks: &mut Vec<(usize, usize, Matrix6<f64>)>) {
+        let mut diagonal = DVector::<f64>::zeros(self.held.len());
+        for (i, k, block) in blocks.iter() {
+            if i == k {
+                for r in 0..6 {
+                    diagonal[6 * i + r] += block[(r, r)];
+                }
+            }
+        }
+        let weight = self.weight();
+        let top = diagonal.iter().zip(weight.iter()).fold(0.0_f64, |t, (d, w)| t.max(d * w * w));
+        let top = if top > 0.0 { top } else { 1.0 };
+        for (i, k, block) in blocks.iter_mut() {
+            for r in 0..6 {
+                if self.held[6 * *i + r] {
+                    block.row_mut(r).fill(0.0);
+                }
+                if self.held[6 * *k + r] {
+                    block.column_mut(r).fill(0.0);
+                }
+            }
+        }
+        for (c, _) in self.held.iter().enumerate().filter(|(_, h)| **h) {
+            let mut block = Matrix6::zeros();
+            block[(c % 6, c % 6)] = top / (weight[c] * weight[c]);
+            blocks.push((c / 6, c / 6, block));
+        }
     }
 
     /// Pairs of (structure body, block) of the free bodies.
@@ -76,7 +119,7 @@ impl Data {
     /// not depend on the masses, only the path does.
     pub(super) fn relaxation_dofs(&self, m: &Model) -> Dofs {
         let s = &m.structure;
-        let mut dofs = Dofs { index: vec![None; s.bodies.len()], com: Vec::new(), scale: Vec::new() };
+        let mut dofs = Dofs { index: vec![None; s.bodies.len()], com: Vec::new(), scale: Vec::new(), held: Vec::new() };
         let free: Vec<usize> = (0..s.bodies.len()).filter(|b| m.is_free(*b)).collect();
         let inertia = |b: usize| s.bodies[b].inertia.expect("free bodies have inertia");
         let heaviest = free.iter().map(|&b| inertia(b).mass_kg).fold(0.0, f64::max);
@@ -87,6 +130,7 @@ impl Data {
             let p = inertia.principal_kg_m2;
             let mass_kg = if m.point_masses[b] { heaviest } else { inertia.mass_kg };
             dofs.scale.push((mass_kg, ((p[0] + p[1] + p[2]) / 3.0).max(f64::MIN_POSITIVE)));
+            dofs.held.extend(m.held_translations[b].iter().chain(&[false; 3]));
         }
         dofs
     }
@@ -165,6 +209,10 @@ impl Data {
             f.fixed_rows_mut::<3>(6 * i).add_assign(&force);
             f.fixed_rows_mut::<3>(6 * i + 3).add_assign(&torque);
         }
+        if dofs.held.contains(&true) {
+            dofs.hold(&mut f);
+            dofs.hold_blocks(&mut blocks);
+        }
         System { force: f, force_scale_n, blocks }
     }
 
@@ -204,6 +252,13 @@ impl Data {
                 (Some(i), None) => anchors_of[i].push(b),
                 (None, Some(k)) => anchors_of[k].push(a),
                 (None, None) => {}
+            }
+        }
+        // A support holds its node in place (in some directions: the group's rigid motions
+        // that keep it are fewer, which only leaves more to the shift).
+        for support in &s.supports {
+            if let Some(i) = dofs.index[s.nodes[support.node].body] {
+                anchors_of[i].push(support.node);
             }
         }
         let mut groups: std::collections::BTreeMap<usize, (Vec<usize>, Vec<usize>)> = Default::default();

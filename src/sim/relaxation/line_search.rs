@@ -86,6 +86,7 @@ impl Data {
             f.fixed_rows_mut::<3>(6 * i).add_assign(&force);
             f.fixed_rows_mut::<3>(6 * i + 3).add_assign(&torque);
         }
+        dofs.hold(&mut f);
         f.amax()
     }
 

@@ -1,0 +1,58 @@
+//! MusclePy, the structural peer (`benches/peers/musclepy/`), side by side with the testbed on
+//! the structures of MusclePy's own test suite: `compare.py` runs both and an exact answer of
+//! its own (closed forms, Newton's method on the same file, the eigenproblem), and every row is
+//! held here to what it claims.
+
+use super::common;
+
+/// Every compared quantity of every case, as `compare.py --json` writes it.
+fn rows() -> Option<Vec<serde_json::Value>> {
+    let py = common::peer_python(&["musclepy", "numpy"], "the MusclePy peer")?;
+    let out = std::env::temp_dir().join(format!("tensegrity-musclepy-{}.json", std::process::id()));
+    let status = std::process::Command::new(py)
+        .args(["benches/peers/musclepy/compare.py", "--tensegrity", env!("CARGO_BIN_EXE_tensegrity"), "--json"])
+        .arg(&out)
+        .stdout(std::process::Stdio::null())
+        .status()
+        .expect("compare.py runs");
+    assert!(status.success(), "compare.py: {status}");
+    let rows: Vec<serde_json::Value> = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let _ = std::fs::remove_file(&out);
+    Some(rows)
+}
+
+fn number(row: &serde_json::Value, key: &str) -> Option<f64> {
+    row[key].as_f64()
+}
+
+/// The 18 cases run on both tools. Wherever an exact answer is computed (88 rows: forces,
+/// displacements, reactions, frequencies), the testbed is within 1e-9 of it (relative, measured
+/// 2.5e-12), and it is never farther from MusclePy than MusclePy is from the exact answer (to
+/// 1e-9): each difference between the two tools is MusclePy's own (its stopping tolerance, its
+/// linear method, its load steps without equilibrium iterations, its geometric stiffness). The
+/// SVD cases' counts and subspaces, which have no exact column, agree within 1e-12.
+#[test]
+fn the_testbed_agrees_with_musclepy_where_musclepy_agrees_with_the_exact_answer() {
+    let Some(rows) = rows() else { return };
+    let cases: std::collections::BTreeSet<&str> = rows.iter().map(|r| r["case"].as_str().unwrap()).collect();
+    assert_eq!(cases.len(), 18, "{cases:?}");
+    let mut exact_rows = 0;
+    for row in &rows {
+        let (case, quantity) = (row["case"].as_str().unwrap(), row["quantity"].as_str().unwrap());
+        let (Some(mp_tb), Some(tb_ex), Some(mp_ex)) =
+            (number(row, "d_mp_tb"), number(row, "d_tb_ex"), number(row, "d_mp_ex"))
+        else {
+            continue;
+        };
+        exact_rows += 1;
+        assert!(tb_ex <= 1e-9, "{case} {quantity}: the testbed is {tb_ex:e} from the exact answer");
+        assert!(mp_tb <= mp_ex + 1e-9, "{case} {quantity}: {mp_tb:e} from MusclePy, which is {mp_ex:e} from exact");
+    }
+    assert!(exact_rows >= 88, "{exact_rows} rows with an exact answer");
+    for row in rows.iter().filter(|r| {
+        ["svd_2cables", "svd_3cables", "snelson2x_selfstress", "svd_simplex"].contains(&r["case"].as_str().unwrap())
+    }) {
+        let d = number(row, "d_mp_tb").unwrap_or_else(|| panic!("{row}: no comparison"));
+        assert!(d <= 1e-12, "{}: {d:e}", row["quantity"]);
+    }
+}
