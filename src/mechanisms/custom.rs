@@ -110,6 +110,14 @@ impl Custom {
     }
 
     /// The mechanism with its structure at other sets of parameters (a sweep over them).
+    /// The same structure, at every set of parameters, without its point loads (the reference
+    /// of a linear analysis).
+    pub fn without_point_loads(&self) -> Custom {
+        let unloaded = |s: &Structure| Structure { node_loads: Vec::new(), ..s.clone() };
+        let variants = self.variants.iter().map(|(p, s)| (p.clone(), unloaded(s))).collect();
+        Custom { structure: unloaded(&self.structure), variants: std::sync::Arc::new(variants), ..self.clone() }
+    }
+
     pub fn with_variants(mut self, variants: Vec<(Values, Structure)>) -> Self {
         self.variants = std::sync::Arc::new(variants);
         self

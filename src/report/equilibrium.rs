@@ -38,7 +38,70 @@ pub struct EquilibriumReport {
     /// The force each support (a node on a fixed body that a member reaches) exerts on the
     /// structure at the settled state \[N\], by node.
     pub reactions_n: Vec<(String, [f64; 3])>,
+    /// The linear analysis beside the exact settle, where the file states point loads.
+    pub linear: Option<LinearReport>,
+    /// Why a file with point loads has no linear analysis (a rigid member, a mechanism).
+    pub linear_refused: Option<String>,
     pub wall_s: f64,
+}
+
+/// The linear (small-displacement) analysis about the structure settled without its point
+/// loads (`structure::linear`), beside the exact settle under them.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct LinearReport {
+    /// Whether the reference (the structure without its point loads) met the settle criteria.
+    pub reference_settled: bool,
+    pub reference_settle_steps: u64,
+    /// Per free node: its name, the exact displacement (the settle under the loads less the
+    /// reference) and the linear one \[m\].
+    pub displacements_m: Vec<(String, [f64; 3], [f64; 3])>,
+    /// Per member with a free node: its name, the exact force and the linear one \[N\].
+    pub forces_n: Vec<(String, f64, f64)>,
+}
+
+impl LinearReport {
+    /// The largest node displacement of the exact settle, and the largest distance between
+    /// the exact and the linear displacement of a node \[m\].
+    pub fn largest_displacements_m(&self) -> (f64, f64) {
+        self.displacements_m.iter().fold((0.0_f64, 0.0_f64), |(d, e), (_, exact, linear)| {
+            (d.max(norm(*exact)), e.max(norm([0, 1, 2].map(|x| exact[x] - linear[x]))))
+        })
+    }
+
+    /// The largest member force of the exact settle, and the largest difference between the
+    /// exact and the linear force \[N\].
+    pub fn largest_forces_n(&self) -> (f64, f64) {
+        self.forces_n
+            .iter()
+            .fold((0.0_f64, 0.0_f64), |(f, e), (_, exact, linear)| (f.max(exact.abs()), e.max((exact - linear).abs())))
+    }
+
+    /// The table's lines: the largest differences, then each node and member.
+    fn write(&self, out: &mut String) {
+        let (d, dd) = self.largest_displacements_m();
+        let (f, df) = self.largest_forces_n();
+        let _ = writeln!(
+            out,
+            "   linear analysis about the structure without its point loads (settled: {}, {} steps), beside the exact settle under them:",
+            self.reference_settled, self.reference_settle_steps
+        );
+        let _ = writeln!(
+            out,
+            "     largest displacement {d:.6e} m, linear off by {dd:.3e} m ({:.3e} of it); largest force {f:.6e} N, linear off by {df:.3e} N ({:.3e} of it)",
+            dd / d.max(f64::MIN_POSITIVE),
+            df / f.max(f64::MIN_POSITIVE)
+        );
+        for (node, exact, linear) in &self.displacements_m {
+            let _ = writeln!(
+                out,
+                "     {node:<20} exact {:+.9e} {:+.9e} {:+.9e}  linear {:+.9e} {:+.9e} {:+.9e}",
+                exact[0], exact[1], exact[2], linear[0], linear[1], linear[2]
+            );
+        }
+        for (member, exact, linear) in &self.forces_n {
+            let _ = writeln!(out, "     {member:<20} exact {exact:+.9e} N  linear {linear:+.9e} N");
+        }
+    }
 }
 
 impl EquilibriumReport {
@@ -77,6 +140,12 @@ impl EquilibriumReport {
             for (node, r) in &self.reactions_n {
                 let _ = writeln!(out, "     {node:<20} {:+.9e} {:+.9e} {:+.9e}", r[0], r[1], r[2]);
             }
+        }
+        if let Some(linear) = &self.linear {
+            linear.write(&mut out);
+        }
+        if let Some(why) = &self.linear_refused {
+            let _ = writeln!(out, "   no linear analysis: {why}");
         }
         for (k, shape) in self.mechanism_shapes.iter().enumerate() {
             let mut moving: Vec<&(String, [f64; 3])> = shape.iter().collect();

@@ -6,6 +6,7 @@
 //! one value (`judged.rs`) over its levels (`levels.rs`). The studies that drive many runs
 //! (fits, sensitivities, sweeps) live above, in `study/`.
 
+mod equilibrium;
 mod judged;
 mod levels;
 mod motion;
@@ -28,12 +29,11 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Instant;
 
+pub use equilibrium::{equilibrium, EquilibriumRunError};
 pub use levels::{judged_nodes_after, CommandsAt, MAX_LEVELS, MIN_LEVELS};
 pub use point::NO_BRANCH;
 pub use settle::SettleDetector;
-pub use settled::{
-    equilibrium, modes, settle_at, settle_first_point, EquilibriumRunError, ModesRunError, SettledState,
-};
+pub use settled::{modes, settle_at, settle_first_point, ModesRunError, SettledState};
 pub use topologies::rebuilt;
 
 use stoppable::{interruptible, Halted};

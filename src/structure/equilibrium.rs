@@ -68,7 +68,7 @@ pub fn check(s: &Structure) -> Result<(), EquilibriumError> {
 
 /// The free nodes, the rows (node, direction) and the columns' members of `s`'s equilibrium
 /// matrix, once `s` is pin-jointed and the matrix within [`MAX_EQUILIBRIUM_ENTRIES`].
-type Layout = (Vec<NodeId>, Vec<(NodeId, usize)>, Vec<MemberId>);
+pub(super) type Layout = (Vec<NodeId>, Vec<(NodeId, usize)>, Vec<MemberId>);
 
 fn layout(s: &Structure) -> Result<Layout, EquilibriumError> {
     check_pin_jointed(s)?;
@@ -95,6 +95,15 @@ fn layout(s: &Structure) -> Result<Layout, EquilibriumError> {
 
 /// The equilibrium matrix of `s` with its nodes at `positions` \[m\], and its SVD.
 pub fn equilibrium_matrix(s: &Structure, positions: &[Vec3]) -> Result<EquilibriumMatrix, EquilibriumError> {
+    let ((nodes, rows, members), a) = matrix(s, positions)?;
+    let (singular_values, self_stress) = null_space(&a);
+    let rank = members.len() - self_stress.len();
+    let (_, mechanisms) = null_space(&a.transpose());
+    Ok(EquilibriumMatrix { nodes, rows, members, a, singular_values, rank, self_stress, mechanisms })
+}
+
+/// The layout of `s`'s equilibrium matrix and the matrix A with its nodes at `positions` \[m\].
+pub(super) fn matrix(s: &Structure, positions: &[Vec3]) -> Result<(Layout, DMatrix<f64>), EquilibriumError> {
     let (nodes, rows, members) = layout(s)?;
     let mut row = vec![[None; 3]; s.nodes.len()];
     for (k, &(n, x)) in rows.iter().enumerate() {
@@ -117,10 +126,7 @@ pub fn equilibrium_matrix(s: &Structure, positions: &[Vec3]) -> Result<Equilibri
             }
         }
     }
-    let (singular_values, self_stress) = null_space(&a);
-    let rank = members.len() - self_stress.len();
-    let (_, mechanisms) = null_space(&a.transpose());
-    Ok(EquilibriumMatrix { nodes, rows, members, a, singular_values, rank, self_stress, mechanisms })
+    Ok(((nodes, rows, members), a))
 }
 
 impl EquilibriumMatrix {

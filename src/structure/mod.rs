@@ -8,6 +8,7 @@
 use std::collections::BTreeMap;
 
 pub mod equilibrium;
+pub mod linear;
 pub mod lumped;
 mod member;
 pub use member::*;

@@ -12,6 +12,17 @@ pub fn tensegrity(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// The report of `tensegrity CMD FILE --json -` on the scenario `text` (written to a temporary
+/// file named after `name`).
+pub fn json_of(cmd: &str, text: &str, name: &str) -> serde_json::Value {
+    let path = std::env::temp_dir().join(format!("tensegrity-json-{}-{name}.toml", std::process::id()));
+    std::fs::write(&path, text).unwrap();
+    let (code, out, err) = tensegrity(&[cmd, path.to_str().unwrap(), "--json", "-"]);
+    let _ = std::fs::remove_file(&path);
+    assert_eq!(code, 0, "{err}");
+    serde_json::from_str(&out).unwrap()
+}
+
 /// The text of the scenario file at `path` with each (from, to) replaced once (each `from`
 /// must be there).
 pub fn edited(path: &str, edits: &[(&str, &str)]) -> String {

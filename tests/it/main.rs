@@ -35,6 +35,7 @@ mod ji2014_dynamics;
 mod joint_probe;
 mod joint_settling;
 mod lagrangian_trajectory;
+mod linear_analysis;
 mod manriquez2019_dynamics;
 mod model_expressions;
 mod model_scenarios;

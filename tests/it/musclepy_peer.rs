@@ -30,7 +30,8 @@ fn number(row: &serde_json::Value, key: &str) -> Option<f64> {
 /// 2.5e-12), and it is never farther from MusclePy than MusclePy is from the exact answer (to
 /// 1e-9): each difference between the two tools is MusclePy's own (its stopping tolerance, its
 /// linear method, its load steps without equilibrium iterations, its geometric stiffness). The
-/// SVD cases' counts and subspaces, which have no exact column, agree within 1e-12.
+/// SVD cases' counts and subspaces, which have no exact column, agree within 1e-12, and so does
+/// the testbed's linear analysis with MusclePy's linear method on the two-bar truss.
 #[test]
 fn the_testbed_agrees_with_musclepy_where_musclepy_agrees_with_the_exact_answer() {
     let Some(rows) = rows() else { return };
@@ -49,6 +50,15 @@ fn the_testbed_agrees_with_musclepy_where_musclepy_agrees_with_the_exact_answer(
         assert!(mp_tb <= mp_ex + 1e-9, "{case} {quantity}: {mp_tb:e} from MusclePy, which is {mp_ex:e} from exact");
     }
     assert!(exact_rows >= 88, "{exact_rows} rows with an exact answer");
+    // The testbed's linear analysis is MusclePy's linear method (truss2, unstressed at its
+    // reference: the same K).
+    let linear: Vec<&serde_json::Value> =
+        rows.iter().filter(|r| r["quantity"].as_str().unwrap().starts_with("testbed linear analysis:")).collect();
+    assert_eq!(linear.len(), 4, "the testbed's linear analysis of truss2");
+    for row in linear {
+        let d = number(row, "d_mp_tb").unwrap();
+        assert!(d <= 1e-12, "{}: {d:e}", row["quantity"]);
+    }
     for row in rows.iter().filter(|r| {
         ["svd_2cables", "svd_3cables", "snelson2x_selfstress", "svd_simplex"].contains(&r["case"].as_str().unwrap())
     }) {

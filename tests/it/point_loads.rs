@@ -11,7 +11,7 @@ const PENDULUM: &str = "scenarios/custom/pendulum_tip_load.toml";
 /// A bead between two anchors 2 a apart on two springs (stiffness k, rest length l0 each),
 /// pulled across by a point load P: 2 k (l - l0) d / l = P with l = sqrt(a^2 + d^2). The
 /// deflection d [m], solved by Newton.
-fn rope_deflection(a: f64, k: f64, l0: f64, p: f64) -> f64 {
+pub(super) fn rope_deflection(a: f64, k: f64, l0: f64, p: f64) -> f64 {
     let mut d: f64 = 0.1;
     for _ in 0..100 {
         let l = a.hypot(d);
@@ -22,7 +22,7 @@ fn rope_deflection(a: f64, k: f64, l0: f64, p: f64) -> f64 {
     d
 }
 
-fn rope(p: f64) -> String {
+pub(super) fn rope(p: f64) -> String {
     let structure = format!(
         r#"[[structure.bodies]]
 name = "ground"

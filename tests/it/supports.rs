@@ -9,16 +9,6 @@ use tensegrity_testbed::scenario;
 
 const TRUSS: &str = "scenarios/custom/truss_on_a_roller.toml";
 
-/// The report of `tensegrity CMD --json -` on the scenario `text`.
-fn json_of(cmd: &str, text: &str, name: &str) -> serde_json::Value {
-    let path = std::env::temp_dir().join(format!("tensegrity-supports-{}-{name}.toml", std::process::id()));
-    std::fs::write(&path, text).unwrap();
-    let (code, out, err) = common::tensegrity(&[cmd, path.to_str().unwrap(), "--json", "-"]);
-    let _ = std::fs::remove_file(&path);
-    assert_eq!(code, 0, "{err}");
-    serde_json::from_str(&out).unwrap()
-}
-
 fn truss() -> String {
     std::fs::read_to_string(TRUSS).unwrap()
 }
@@ -29,7 +19,7 @@ fn truss() -> String {
 /// kinematically determinate (s = m = 0).
 #[test]
 fn a_roller_truss_reactions_are_half_the_load_each_and_none_along_the_rail() {
-    let v = json_of("equilibrium", &truss(), "reactions");
+    let v = common::json_of("equilibrium", &truss(), "reactions");
     let counts = ["rows", "free_nodes", "held_coordinates", "columns", "rank", "self_stress_states", "mechanisms"];
     let got: Vec<u64> = counts.iter().map(|k| v[k].as_u64().unwrap()).collect();
     assert_eq!(got, [3, 2, 3, 3, 3, 0, 0], "{counts:?}");
@@ -58,7 +48,7 @@ fn member_stiffness(k: f64, t: f64, l: f64, e: Vector2<f64>) -> Matrix2<f64> {
 /// compression P L / (2 h)), within 1e-9 relative.
 #[test]
 fn the_roller_truss_modes_are_those_of_its_three_free_coordinates() {
-    let v = json_of("modes", &truss(), "modes");
+    let v = common::json_of("modes", &truss(), "modes");
     let (a, h, p, k_tie, k_bar, m) = (1.0_f64, 0.75_f64, 200.0, 1e4, 2e4, 10.0);
     let l = a.hypot(h);
     let (tie, bar) = (p * a / (2.0 * h), -p * l / (2.0 * h));
@@ -94,14 +84,14 @@ fn the_roller_truss_modes_are_those_of_its_three_free_coordinates() {
 #[test]
 fn a_direction_that_no_member_stretches_is_a_mechanism_stiffened_by_the_prestress_alone() {
     let text = common::edited(TRUSS, &[("fixed = [\"y\", \"z\"]", "fixed = [\"z\"]")]);
-    let v = json_of("equilibrium", &text, "mechanism");
+    let v = common::json_of("equilibrium", &text, "mechanism");
     assert_eq!((v["rows"].as_u64(), v["rank"].as_u64(), v["mechanisms"].as_u64()), (Some(4), Some(3), Some(1)));
     for (node, d) in v["mechanism_shapes"][0].as_array().unwrap().iter().map(|x| (x[0].as_str().unwrap(), &x[1])) {
         let d: Vec<f64> = (0..3).map(|k| d[k].as_f64().unwrap().abs()).collect();
         let want = if node == "B" { [0.0, 1.0, 0.0] } else { [0.0; 3] };
         assert!(d.iter().zip(want).all(|(d, w)| (d - w).abs() <= 1e-12), "{node}: {d:?}");
     }
-    let modes = json_of("modes", &text, "mechanism-modes");
+    let modes = common::json_of("modes", &text, "mechanism-modes");
     let (a, h, p, m) = (1.0_f64, 0.75_f64, 200.0, 10.0);
     let (tie, bar) = (p * a / (2.0 * h), p * a.hypot(h) / (2.0 * h));
     let want = (tie / (2.0 * a) - bar / a.hypot(h)) / m;
@@ -161,8 +151,10 @@ fn a_chain_held_in_its_plane_settles_and_vibrates_as_the_free_chain_does_in_it()
         assert!(p[1] == 0.0, "P{i} left the plane: {p:?}");
         assert!((0..3).all(|k| (p[k] - q[k]).abs() <= 1e-9), "P{i}: {p:?} against {q:?}");
     }
-    let (held, free) =
-        (json_of("modes", &chain(n, true), "chain-held"), json_of("modes", &chain(n, false), "chain-free"));
+    let (held, free) = (
+        common::json_of("modes", &chain(n, true), "chain-held"),
+        common::json_of("modes", &chain(n, false), "chain-free"),
+    );
     let omega2 = |v: &serde_json::Value| -> Vec<f64> {
         v["modes"].as_array().unwrap().iter().map(|m| m["omega_squared"].as_f64().unwrap()).collect()
     };

@@ -293,6 +293,33 @@ def static_rows(case, mp, run, eq, s, exact_x, notes, nodes, force_note="", reac
                     note=notes.get(f"R{n}.{ax}", ""))
 
 
+def linear_rows(case, mp, eq, s, nodes, note):
+    """MusclePy's linear method beside the testbed's linear analysis (`tensegrity equilibrium`'s
+    `linear`, about the structure settled without its point loads): the same method, so the
+    same answer where their stiffness matrices agree."""
+    lin = (eq or {}).get("linear")
+    if lin is None:
+        ROWS.append(dict(case=case, quantity="testbed linear analysis", musclepy="", testbed="",
+                         exact=None, d_mp_tb=None, d_mp_ex=None, d_tb_ex=None,
+                         note=f"none: {(eq or {}).get('linear_refused')}"))
+        return
+    forces = {name: linear for name, _, linear in lin["forces_n"]}
+    fmax = max(abs(t) for t in mp["forces_n"])
+    for i, tm in enumerate(mp["forces_n"]):
+        row(case, f"testbed linear analysis: e{i} force [N]", float(tm), float(forces[f"e{i}"]), None,
+            floor=fmax, note=note if i == 0 else "as e0")
+    moved = {name: np.array(linear) for name, _, linear in lin["displacements_m"]}
+    x0 = s["x"]
+    dmax = max(max(float(np.abs(np.array(mp["positions_m"][n]) - x0[s["idx"][n]]).max()) for n in nodes), 1e-12)
+    for n in nodes:
+        i = s["idx"][n]
+        for k, ax in enumerate("xyz"):
+            if s["held"][i][k]:
+                continue
+            row(case, f"testbed linear analysis: {n}.{ax} displacement [m]", float(mp["positions_m"][n][k] - x0[i][k]),
+                float(moved[n][k]), None, floor=dmax)
+
+
 # --------------------------------------------------------------------------------------------
 # The cases
 # --------------------------------------------------------------------------------------------
@@ -378,6 +405,7 @@ def compare_case(binary, case, mp):
                              exact=None, d_mp_tb=None, d_mp_ex=None, d_tb_ex=None,
                              note=f"N = -P / sqrt 2 = {-P / math.sqrt(2):.6g} N, w = P L0 / (2 EA sin^2 45) = "
                                   f"{dl:.6g} m: small displacements, equilibrium in the drawn geometry"))
+            linear_rows(case, lin, eq, s, ["N1"], "unstressed at the reference: both K = A diag(EA / L0) A^T")
             static_rows(case, lin, run, eq, s, ex, {}, ["N1"], label="linear: ",
                         force_note="MusclePy's linear method: equilibrium in the drawn geometry; exact: in the "
                                    "deformed one (the bars steepen less as N1 drops, so they push harder)")
