@@ -51,6 +51,51 @@ fn newton_velocity(dt: f64, force: f64, stiffness: f64, inertia: f64, max_step: 
     }
 }
 
+/// Steps over which the schedule must lower the largest generalized force of the joints it
+/// drives by [`STALL_PROGRESS`], or stop ([`Schedule`]); Newton's steps lower it by orders of
+/// magnitude in tens of steps (the shipped files' scheduled points take 6 to 62).
+const STALL_WINDOW_STEPS: u32 = 200;
+/// The fraction of its value at a window's start below which the force must have fallen by the
+/// window's end.
+const STALL_PROGRESS: f64 = 0.1;
+/// A force below this fraction of the first one the schedule saw at the point is round-off: no
+/// stall is read there.
+const STALL_FLOOR_RATIO: f64 = 1e-6;
+
+/// Whether the schedule still drives the joints at this point (the actuators' commands: a new
+/// point starts afresh). Each joint's Newton step holds the others (a Jacobi iteration on the
+/// joints' coordinates): where the joints are coupled more strongly than each is held (a chain
+/// of sliders under a spring across their axes) it does not converge, and the settle would
+/// never end or blow up (a bead on three sliders: 6000 steps, 11 J of kinetic energy left,
+/// where the physical dynamics settle in 5.6 s). So when the largest generalized force has not
+/// fallen to [`STALL_PROGRESS`] of itself over [`STALL_WINDOW_STEPS`] steps the schedule stops,
+/// the joints' damping back to the structure's: the physical dynamics finish the settle.
+#[derive(Clone, Default)]
+pub(super) struct Schedule {
+    /// Set once the schedule has stalled: it drives nothing from then on.
+    pub(super) stalled: bool,
+    first_force: Option<f64>,
+    window_start: f64,
+    steps: u32,
+}
+
+impl Schedule {
+    /// Notes the largest generalized force of a step the schedule drove; whether it has
+    /// stalled now.
+    pub(super) fn stalls(&mut self, force: f64) -> bool {
+        let first = *self.first_force.get_or_insert(force);
+        if self.steps == 0 {
+            self.window_start = force;
+        }
+        self.steps += 1;
+        if self.steps == STALL_WINDOW_STEPS {
+            self.steps = 0;
+            self.stalled = force > STALL_PROGRESS * self.window_start && force > STALL_FLOOR_RATIO * first;
+        }
+        self.stalled
+    }
+}
+
 /// One joint's load for the coming step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct JointLoad {
@@ -219,10 +264,11 @@ impl Data {
 
     /// Sets every scheduled joint's velocity and damping for the coming step (after the loads
     /// are applied). Whether it set any (a joint with k > 0: its velocity quenched or set, its
-    /// damping not the structure's; the step is then no part of a physical path).
-    pub(super) fn schedule_damping(&mut self, m: &Model) -> bool {
+    /// damping not the structure's; the step is then no part of a physical path), with the
+    /// largest generalized force among those joints [N m or N].
+    pub(super) fn schedule_damping(&mut self, m: &Model) -> Option<f64> {
         let dt = m.settings.dt_s;
-        let mut acted = false;
+        let mut acted: Option<f64> = None;
         for j in 0..m.structure.joints.len() {
             if !self.scheduled(m, j) {
                 continue;
@@ -231,7 +277,7 @@ impl Data {
             let load = self.joint_load(m, j);
             let mut damping = super::joint_data::link_damping(&m.structure, j, m.settings.body_damping_per_s);
             if load.stiffness > 0.0 && load.inertia > 0.0 {
-                acted = true;
+                acted = Some(acted.unwrap_or(0.0).max(load.force.abs()));
                 damping = newton_damping(dt, load.stiffness, load.inertia);
                 let max_step = match m.structure.joints[j].kind {
                     JointKind::Revolute { .. } => MAX_NEWTON_TURN_RAD,

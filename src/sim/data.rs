@@ -161,7 +161,11 @@ impl Data {
         }
     }
 
-    pub(super) fn check_divergence(&self, m: &Model) -> Result<(), SimError> {
+    /// Where the Newton schedule drove the step (`scheduled`), its velocities are an
+    /// accelerator's, not motion: a heavy body's start velocity toward its Newton point (a
+    /// 1000 kg block 0.1 m from it at dt = 1 ms: 100 m/s, 5e6 J) is no blow-up, so the
+    /// kinetic energy is not held to the limit then; positions still are.
+    pub(super) fn check_divergence(&self, m: &Model, scheduled: bool) -> Result<(), SimError> {
         let limit = m.settings.bounding_box_m;
         // Not finite, then energy, then outside the box: a blow-up is named for what it is.
         let mut outside = None;
@@ -175,7 +179,7 @@ impl Data {
             }
         }
         let energy = self.kinetic_energy_j(m);
-        if !energy.is_finite() || energy > m.settings.max_kinetic_energy_j {
+        if !energy.is_finite() || (energy > m.settings.max_kinetic_energy_j && !scheduled) {
             return Err(self.diverged(
                 m,
                 format!(

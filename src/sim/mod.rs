@@ -69,6 +69,7 @@ pub struct Simulation {
     projection: projection::Projection,
     closure_rests: closure_rest::ClosureRests,
     rotation: rotation::FreeRotation,
+    schedule: damping::Schedule,
 }
 
 impl Simulation {
@@ -100,6 +101,7 @@ impl Simulation {
             projection: projection::Projection::default(),
             closure_rests: closure_rest::ClosureRests::default(),
             rotation: rotation::FreeRotation::default(),
+            schedule: damping::Schedule::default(),
         };
         let commands = sim.data.commands.clone();
         sim.set_commands(&commands);
@@ -193,6 +195,7 @@ impl Simulation {
         self.data.apply_servo_commands(&self.model);
         self.apply_joint_commands();
         self.data.move_fixed_nodes(&self.model);
+        self.schedule = damping::Schedule::default();
     }
 
     /// Applies a constant external wrench (world frame, about the centre of mass) to a body
@@ -213,8 +216,14 @@ impl Simulation {
             d.slide_cables(m);
         }
         d.apply_member_forces(m);
-        if m.settings.newton_damping && !self.path.physical {
-            accelerated |= d.schedule_damping(m);
+        let mut scheduled = false;
+        if m.settings.newton_damping && !self.path.physical && !self.schedule.stalled {
+            if let Some(force) = d.schedule_damping(m) {
+                (accelerated, scheduled) = (true, true);
+                if self.schedule.stalls(force) {
+                    d.restore_scheduled_damping(m);
+                }
+            }
         }
         self.path.note_step(accelerated);
         let turned = if self.rotation.on { d.free_rotations(m) } else { Vec::new() };
@@ -223,7 +232,7 @@ impl Simulation {
         self.closure_rests.project_internal_closures(m, d);
         self.projection.project_groups(m, d);
         d.tick += 1;
-        d.check_divergence(m)
+        d.check_divergence(m, scheduled)
     }
 
     /// The state now, with the equilibrium residual.
@@ -415,6 +424,7 @@ impl Simulation {
             projection: projection::Projection::default(),
             closure_rests: closure_rest::ClosureRests::default(),
             rotation: self.rotation,
+            schedule: self.schedule.clone(),
         }
     }
 
