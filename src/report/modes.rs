@@ -65,6 +65,10 @@ pub struct ModeReport {
     /// omega / (2 pi) \[Hz\].
     pub frequency_hz: f64,
     pub rigid: bool,
+    /// A mechanism stiffened by the prestress: not rigid, and less than half of its stiffness
+    /// omega^2 is the members' stretching (the rest is the tensions' geometric stiffness and the
+    /// loads'); judged for structures of free bodies on members (no joints).
+    pub mechanism: bool,
     /// The nodes that move most, with their motion relative to the largest.
     pub largest_moving: Vec<(String, f64)>,
     /// The mode's shape: every node's displacement, world frame, for the mass-normalised
@@ -112,7 +116,13 @@ impl ModesReport {
                 m.omega_rad_per_s,
                 m.frequency_hz,
                 nodes.join(", "),
-                if m.rigid { "  (rigid)" } else { "" }
+                if m.rigid {
+                    "  (rigid)"
+                } else if m.mechanism {
+                    "  (mechanism: stiffened by the prestress)"
+                } else {
+                    ""
+                }
             ));
         }
         out

@@ -94,7 +94,7 @@ pub fn modes(
         constraints: analysis.constraints.as_ref().map(|c| constraints_report(c, structure)),
         rigid_modes: analysis.rigid,
         zero_mode_ratio: ZERO_MODE_RATIO,
-        modes: rows(&analysis, &structure.nodes),
+        modes: rows(&analysis, &structure.nodes, &mechanisms(&state.sim, &analysis)),
         lowest_of: analysis.lowest_of,
         wall_s: wall.elapsed().as_secs_f64(),
     };
@@ -120,8 +120,42 @@ fn constraints_report(c: &Constraints, s: &crate::structure::Structure) -> Const
     }
 }
 
+/// Below this share of a mode's stiffness omega^2 in the members' stretching, the mode is a
+/// mechanism stiffened by the prestress: a mode that stretches members has nearly all of it
+/// there, an infinitesimal mechanism about the tension over the stiffness (its strain).
+const MECHANISM_STRETCH_SHARE: f64 = 0.5;
+
+/// Which modes are mechanisms stiffened by the prestress (`ModeReport::mechanism`): their
+/// stretching energy sum k e^2 over the elastic members that pull or push (e the first-order
+/// elongation of the mass-normalised shape) below [`MECHANISM_STRETCH_SHARE`] of omega^2. Only
+/// for free bodies on members: where joints carry the bodies, torsion springs store energy that
+/// no member's stretch shows.
+fn mechanisms(sim: &Simulation, analysis: &StructureModes) -> Vec<bool> {
+    let s = sim.structure();
+    if !s.joints.is_empty() || analysis.constraints.is_some() {
+        return vec![false; analysis.modes.len()];
+    }
+    let forces = sim.member_forces();
+    let at: Vec<nalgebra::Vector3<f64>> = (0..s.nodes.len()).map(|n| sim.node_position(n).into()).collect();
+    let stretch = |mode: &crate::sim::modes::StructureMode| -> f64 {
+        let d = |n: usize| nalgebra::Vector3::from(mode.node_motion[n]);
+        s.members
+            .iter()
+            .enumerate()
+            .filter_map(|(k, member)| {
+                let stiffness = member.stiffness_n_per_m()?;
+                let pulling = member.kind() != crate::structure::MemberKind::Cable || forces.force_n[k] > 0.0;
+                let e: f64 = member.segments().map(|(p, q)| (at[q] - at[p]).normalize().dot(&(d(q) - d(p)))).sum();
+                pulling.then_some(stiffness * e * e)
+            })
+            .sum()
+    };
+    let share = |mode: &crate::sim::modes::StructureMode| stretch(mode) / mode.omega_squared.abs();
+    analysis.modes.iter().map(|mode| !mode.rigid && share(mode) < MECHANISM_STRETCH_SHARE).collect()
+}
+
 /// One report row per mode.
-fn rows(analysis: &StructureModes, nodes: &[crate::structure::Node]) -> Vec<ModeReport> {
+fn rows(analysis: &StructureModes, nodes: &[crate::structure::Node], mechanism: &[bool]) -> Vec<ModeReport> {
     analysis
         .modes
         .iter()
@@ -132,6 +166,7 @@ fn rows(analysis: &StructureModes, nodes: &[crate::structure::Node]) -> Vec<Mode
             omega_rad_per_s: m.omega(),
             frequency_hz: m.omega() / std::f64::consts::TAU,
             rigid: m.rigid,
+            mechanism: mechanism[i],
             largest_moving: m
                 .largest_moving(NODES_LISTED)
                 .into_iter()

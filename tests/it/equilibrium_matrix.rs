@@ -132,3 +132,24 @@ fn the_kenner_prisms_supports_take_a_struts_force_along_its_line() {
     let axis = nalgebra::Vector3::new(t1[0] - b1[0], t1[1] - b1[1], t1[2] - b1[2]).normalize();
     assert!(r[0].cross(&axis).norm() <= 1e-9 * strut, "off the strut's line: {}", r[0]);
 }
+
+/// `tensegrity modes` flags each mode that is a mechanism stiffened by the prestress (less than
+/// half of its omega^2 in the members' stretching). On the n-strut prism with one strut held
+/// the equilibrium matrix has m mechanisms, one of them the rigid turn about the held strut's
+/// line (a zero mode): the modes flag exactly m - 1 others, for n = 3, 4 and 6 (m = 2, 4, 8),
+/// and no mode that stretches its members.
+#[test]
+fn the_modes_flag_as_many_prestress_stiffened_mechanisms_as_the_equilibrium_matrix_has() {
+    for (n, m) in [(3, 2), (4, 4), (6, 8)] {
+        let set = format!("n={n}");
+        let run = |cmd: &str| {
+            let (code, out, err) = common::tensegrity(&[cmd, "benches/prism_modes.toml", "--set", &set, "--json", "-"]);
+            assert_eq!(code, 0, "{err}");
+            serde_json::from_str::<serde_json::Value>(&out).unwrap()
+        };
+        let (modes, matrix) = (run("modes"), run("equilibrium"));
+        assert_eq!(matrix["mechanisms"].as_u64(), Some(m), "n = {n}");
+        let flagged = modes["modes"].as_array().unwrap().iter().filter(|x| x["mechanism"] == true).count();
+        assert_eq!(flagged as u64, m - 1, "n = {n}");
+    }
+}
