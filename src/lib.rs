@@ -14,6 +14,7 @@ pub mod import;
 pub mod input;
 pub mod mechanisms;
 pub mod observers;
+pub(crate) mod ordering;
 pub mod output;
 pub mod report;
 pub mod run;

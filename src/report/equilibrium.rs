@@ -29,8 +29,11 @@ pub struct EquilibriumReport {
     /// m = 3 j - h - r (a free structure's rigid motions among them).
     pub mechanisms: usize,
     pub rank_tolerance: f64,
-    /// Largest first.
+    /// Largest first: all of them (the dense SVD), or, above its bound, the largest and the
+    /// smallest nonzero (the sparse null spaces).
     pub singular_values: Vec<f64>,
+    /// Whether `singular_values` are all of them.
+    pub all_singular_values: bool,
     /// Each state's tension per member (largest magnitude 1, the cables' sum positive).
     pub self_stress: Vec<Vec<(String, f64)>>,
     /// Each mechanism's unit node displacements (x, y, z per free node, by name).
@@ -146,6 +149,22 @@ impl EquilibriumReport {
         }
         if let Some(why) = &self.linear_refused {
             let _ = writeln!(out, "   no linear analysis: {why}");
+        }
+        if !self.all_singular_values {
+            let _ = writeln!(
+                out,
+                "   sparse analysis (above the dense SVD's bound): singular values largest {:.6e}{}",
+                self.singular_values.first().copied().unwrap_or(0.0),
+                self.singular_values.get(1).map_or(String::new(), |x| format!(", smallest nonzero {x:.6e}"))
+            );
+        }
+        if self.mechanism_shapes.len() < self.mechanisms {
+            let _ = writeln!(
+                out,
+                "   the {} mechanisms' shapes are not computed (the sparse analysis computes null spaces of at most {})",
+                self.mechanisms,
+                crate::structure::sparse_null::MAX_NULL
+            );
         }
         for (k, shape) in self.mechanism_shapes.iter().enumerate() {
             let mut moving: Vec<&(String, [f64; 3])> = shape.iter().collect();

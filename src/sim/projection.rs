@@ -483,7 +483,7 @@ impl Data {
                 n
             })
             .collect();
-        let position = super::relaxation::ordering::reverse_cuthill_mckee(&neighbours);
+        let position = crate::ordering::reverse_cuthill_mckee(&neighbours);
         let mut ordered = g.joints.clone();
         for (k, &j) in g.joints.iter().enumerate() {
             ordered[position[k]] = j;

@@ -21,7 +21,7 @@
 //! has no column. A support in some directions (`Structure::supports`) takes its held
 //! coordinates out of the rows. Others are refused with the body that is not pin-jointed.
 
-use super::{BodyKind, MemberId, NodeId, Structure, Vec3};
+use super::{sparse_null, BodyKind, MemberId, NodeId, Structure, Vec3};
 use nalgebra::{DMatrix, DVector};
 
 /// Singular values below this fraction of the largest count as zero (the rank's tolerance):
@@ -31,7 +31,11 @@ pub const RANK_TOLERANCE: f64 = 1e-10;
 
 /// The most entries (3 j times b) the dense SVDs are given: 2.2e6 (a 300-strut prism, 1794 by
 /// 1199: 6.5 s for both SVDs on one core; an SVD cannot be interrupted, so it is bounded).
+/// Larger matrices go to the sparse null spaces (`sparse_null.rs`).
 pub const MAX_EQUILIBRIUM_ENTRIES: usize = 2_200_000;
+
+/// The most rows plus columns of the sparse analysis (a 1000-strut prism has 10,993).
+pub const MAX_SPARSE_EQUILIBRIUM_SIZE: usize = 60_000;
 
 /// The equilibrium matrix at a set of node positions and the subspaces of its SVD.
 #[derive(Clone, Debug)]
@@ -43,15 +47,22 @@ pub struct EquilibriumMatrix {
     pub rows: Vec<(NodeId, usize)>,
     /// The members, in the order of the columns.
     pub members: Vec<MemberId>,
-    /// A (rows by b: 3 j less the held coordinates).
-    pub a: DMatrix<f64>,
-    /// The singular values, largest first.
+    /// A's rows (3 j less the held coordinates) and columns (b).
+    pub shape: (usize, usize),
+    /// The singular values, largest first: every one from the dense SVD; from the sparse
+    /// analysis (above [`MAX_EQUILIBRIUM_ENTRIES`]) the largest and the smallest nonzero.
     pub singular_values: Vec<f64>,
+    /// Whether `singular_values` are all of them (the dense SVD).
+    pub all_singular_values: bool,
     /// The rank r.
     pub rank: usize,
     /// The self-stress states (b each, orthonormal), s of them.
     pub self_stress: Vec<DVector<f64>>,
-    /// The mechanisms (3 j each: node displacements, orthonormal), m of them.
+    /// m, the number of mechanisms.
+    pub mechanism_count: usize,
+    /// The mechanisms (one entry per row: node displacements, orthonormal): all m of them, but
+    /// from the sparse analysis none where m is above [`sparse_null::MAX_BLOCK`] less its
+    /// guard (a 1000-strut prism has 1996: only their count is given).
     pub mechanisms: Vec<DVector<f64>>,
 }
 
@@ -85,9 +96,9 @@ fn layout(s: &Structure) -> Result<Layout, EquilibriumError> {
         .collect();
     let members: Vec<MemberId> = (0..s.members.len()).filter(|&k| s.members[k].path.iter().any(|&n| free(n))).collect();
     let (rows, columns) = (row_list.len(), members.len());
-    if rows * columns > MAX_EQUILIBRIUM_ENTRIES {
+    if rows + columns > MAX_SPARSE_EQUILIBRIUM_SIZE {
         return Err(EquilibriumError(format!(
-            "its equilibrium matrix would be {rows} by {columns}, more than the {MAX_EQUILIBRIUM_ENTRIES} entries a dense SVD is given here"
+            "its equilibrium matrix would be {rows} by {columns}, more than the {MAX_SPARSE_EQUILIBRIUM_SIZE} rows and columns the sparse analysis is given here"
         )));
     }
     Ok((nodes, row_list, members))
@@ -95,16 +106,106 @@ fn layout(s: &Structure) -> Result<Layout, EquilibriumError> {
 
 /// The equilibrium matrix of `s` with its nodes at `positions` \[m\], and its SVD.
 pub fn equilibrium_matrix(s: &Structure, positions: &[Vec3]) -> Result<EquilibriumMatrix, EquilibriumError> {
-    let ((nodes, rows, members), a) = matrix(s, positions)?;
-    let (singular_values, self_stress) = null_space(&a);
-    let rank = members.len() - self_stress.len();
-    let (_, mechanisms) = null_space(&a.transpose());
-    Ok(EquilibriumMatrix { nodes, rows, members, a, singular_values, rank, self_stress, mechanisms })
+    let (rows, columns) = (layout(s)?.1.len(), layout(s)?.2.len());
+    analysis(s, positions, rows * columns <= MAX_EQUILIBRIUM_ENTRIES)
 }
 
-/// The layout of `s`'s equilibrium matrix and the matrix A with its nodes at `positions` \[m\].
+/// [`equilibrium_matrix`] by the dense SVD (`dense`) or by the sparse null spaces
+/// (`sparse_null.rs`), whatever the size (the two are checked against each other).
+pub fn analysis(s: &Structure, positions: &[Vec3], dense: bool) -> Result<EquilibriumMatrix, EquilibriumError> {
+    let (nodes, rows, members) = layout(s)?;
+    let shape = (rows.len(), members.len());
+    let (singular_values, self_stress, mechanisms) = if dense {
+        let (_, a) = matrix(s, positions)?;
+        let (singular_values, self_stress) = null_space(&a);
+        (singular_values, self_stress, null_space(&a.transpose()).1)
+    } else {
+        let a = sparse_matrix(s, positions, &rows, &members)?;
+        let stress = sparse_null::null_space(&a, &coupled(&a.transpose()))?;
+        let m = shape.0 - (shape.1 - stress.basis.len());
+        let motions = if m <= sparse_null::MAX_NULL {
+            sparse_null::null_space(&a.transpose(), &coupled(&a))?.basis
+        } else {
+            Vec::new()
+        };
+        let values = [Some(stress.largest), stress.smallest_nonzero].into_iter().flatten().collect();
+        (values, stress.basis, motions)
+    };
+    let rank = members.len() - self_stress.len();
+    let (all_singular_values, mechanism_count) = (dense, shape.0 - rank);
+    Ok(EquilibriumMatrix {
+        nodes,
+        rows,
+        members,
+        shape,
+        singular_values,
+        all_singular_values,
+        rank,
+        self_stress,
+        mechanism_count,
+        mechanisms,
+    })
+}
+
+/// A as a sparse matrix (the same entries as [`matrix`]'s).
+fn sparse_matrix(
+    s: &Structure,
+    positions: &[Vec3],
+    rows: &[(NodeId, usize)],
+    members: &[MemberId],
+) -> Result<nalgebra_sparse::CscMatrix<f64>, EquilibriumError> {
+    let mut row = vec![[None; 3]; s.nodes.len()];
+    for (k, &(n, x)) in rows.iter().enumerate() {
+        row[n][x] = Some(k);
+    }
+    let mut coo = nalgebra_sparse::CooMatrix::new(rows.len(), members.len());
+    for (c, &k) in members.iter().enumerate() {
+        for w in s.members[k].path.windows(2) {
+            let (p, q) = (positions[w[0]], positions[w[1]]);
+            let l = super::distance(p, q);
+            if l <= 0.0 {
+                return Err(EquilibriumError(format!("member '{}' has a segment of no length", s.members[k].name)));
+            }
+            for (node, sign) in [(w[0], 1.0), (w[1], -1.0)] {
+                for x in 0..3 {
+                    if let Some(r) = row[node][x] {
+                        coo.push(r, c, sign * (q[x] - p[x]) / l);
+                    }
+                }
+            }
+        }
+    }
+    Ok(nalgebra_sparse::CscMatrix::from(&coo))
+}
+
+/// The columns of `a` that share a row, per column (the graph its Gram matrix couples). `at`
+/// is A's transpose, whose columns are A's rows.
+fn coupled(at: &nalgebra_sparse::CscMatrix<f64>) -> Vec<Vec<usize>> {
+    let mut neighbours = vec![Vec::new(); at.nrows()];
+    for column in at.col_iter() {
+        let members = column.row_indices();
+        for &i in members {
+            neighbours[i].extend(members.iter().copied().filter(|&k| k != i));
+        }
+    }
+    for list in &mut neighbours {
+        list.sort_unstable();
+        list.dedup();
+    }
+    neighbours
+}
+
+/// The layout of `s`'s equilibrium matrix and the matrix A with its nodes at `positions` \[m\],
+/// dense: refused above [`MAX_EQUILIBRIUM_ENTRIES`] (the linear analysis too is dense).
 pub(super) fn matrix(s: &Structure, positions: &[Vec3]) -> Result<(Layout, DMatrix<f64>), EquilibriumError> {
     let (nodes, rows, members) = layout(s)?;
+    if rows.len() * members.len() > MAX_EQUILIBRIUM_ENTRIES {
+        return Err(EquilibriumError(format!(
+            "its equilibrium matrix, {} by {}, is above the {MAX_EQUILIBRIUM_ENTRIES} entries a dense analysis is given here",
+            rows.len(),
+            members.len()
+        )));
+    }
     let mut row = vec![[None; 3]; s.nodes.len()];
     for (k, &(n, x)) in rows.iter().enumerate() {
         row[n][x] = Some(k);

@@ -11,6 +11,7 @@ pub mod equilibrium;
 pub mod linear;
 pub mod lumped;
 mod member;
+pub mod sparse_null;
 pub use member::*;
 
 /// A 3-vector in metres (or a unit axis).

@@ -33,7 +33,6 @@ mod assemble;
 mod dense;
 mod line_search;
 mod lowest_modes;
-pub(super) mod ordering;
 mod sparse;
 
 use super::data::Data;

@@ -13,8 +13,8 @@
 //! step leaves them out as soft modes).
 
 use super::assemble::{cross_matrix, v3, Dofs, System};
-use super::ordering::reverse_cuthill_mckee;
 use super::{StepSolver, SOFT_MODE_RATIO};
+use crate::ordering::reverse_cuthill_mckee;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, SymmetricEigen, Vector3, Vector6};
 use nalgebra_sparse::factorization::{CscCholesky, CscSymbolicCholesky};
 use nalgebra_sparse::CscMatrix;

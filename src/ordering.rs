@@ -1,7 +1,9 @@
-//! The order in which the sparse step eliminates the free bodies: reverse Cuthill-McKee on the
-//! graph of bodies coupled by members, which keeps the Cholesky factor's fill within the
-//! bandwidth of that order (a chain of bodies, such as a prism's struts, keeps a band of one
-//! block). nalgebra-sparse's Cholesky eliminates in the order it is given.
+//! The order in which a sparse Cholesky factorization eliminates its unknowns: reverse
+//! Cuthill-McKee on the graph of the unknowns (or blocks of them) that the matrix couples, which
+//! keeps the factor's fill within the bandwidth of that order (a chain of bodies, such as a
+//! prism's struts, keeps a band of one block). nalgebra-sparse's Cholesky eliminates in the
+//! order it is given. The relaxation's sparse step and the projection order free bodies by it,
+//! the large equilibrium matrix's null spaces their rows and columns (`structure/sparse_null.rs`).
 
 /// The body (block) farthest from `start` by breadth-first search among the unvisited blocks:
 /// a start at one end of the graph gives a narrow band.
@@ -24,7 +26,7 @@ fn farthest(neighbours: &[Vec<usize>], start: usize, visited: &[bool]) -> usize 
 
 /// The factor position of each of the blocks coupled as `neighbours` (reverse Cuthill-McKee:
 /// breadth first from a peripheral block, neighbours by increasing degree, then reversed).
-pub(in crate::sim) fn reverse_cuthill_mckee(neighbours: &[Vec<usize>]) -> Vec<usize> {
+pub(crate) fn reverse_cuthill_mckee(neighbours: &[Vec<usize>]) -> Vec<usize> {
     let n = neighbours.len();
     let degree = |i: usize| neighbours[i].len();
     let mut visited = vec![false; n];
