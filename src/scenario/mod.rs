@@ -87,6 +87,10 @@ pub struct Scenario {
     pub topologies: Vec<Scenario>,
     /// The parameters the patterns' ranges and templates read (`pattern.rs`).
     pub topology_params: Vec<String>,
+    /// One structure of a split scenario (a topology's, or a motion's point): the parameters
+    /// its patterns were expanded with, which a study's steps expand them with again (None:
+    /// the file's own).
+    topology: Option<Topology>,
     /// Swept parameters that change nothing in a custom structure (only formulas see them).
     pub unseen_params: Vec<String>,
     /// `[prestress]`, or the default of a custom structure with cables: when the structure has
@@ -232,8 +236,9 @@ impl Scenario {
         })?;
         overrides::apply(&ctx, &mut raw, &self.overrides, file_lines)
             .map_err(|e| overrides::at_flag(e, &self.overrides, file_lines))?;
-        // The file passed the expansion's bound when it was parsed; the same text again.
-        expand_patterns(&ctx, &mut raw, None, &std::rc::Rc::default())?;
+        // The file passed the expansion's bound when it was parsed; the same text again, with
+        // the counts of this scenario's own topology (a split scenario's part: its point's).
+        expand_patterns(&ctx, &mut raw, self.topology.as_ref(), &std::rc::Rc::default())?;
         let variants = mechanism::variants(&ctx, &raw, sets.iter())?;
         Ok(Scenario { custom: Some(custom.clone().with_more_variants(variants)), ..self.clone() })
     }
@@ -269,7 +274,14 @@ pub fn parse_with(path: &Path, source: &str, overrides: &[Override]) -> Result<S
                 let mut raw: RawScenario = toml::from_str(source).expect("read once already");
                 overrides::apply(&ctx, &mut raw, overrides, file_lines).map_err(located)?;
                 match validate(&ctx, path, raw, Some(t), &spent).map_err(located)? {
-                    Validated::One(v) => variants.push(*v),
+                    // Each part keeps the text, the flags and its topology, so that a study
+                    // builds its structure again as the parse built it.
+                    Validated::One(v) => variants.push(Scenario {
+                        source: source.to_string(),
+                        overrides: overrides.to_vec(),
+                        topology: Some(t.clone()),
+                        ..*v
+                    }),
                     Validated::Split(_) => unreachable!("a topology's scenario is not split again"),
                 }
             }
@@ -559,6 +571,7 @@ fn validate(
         motion,
         topologies: Vec::new(),
         topology_params,
+        topology: None,
         unseen_params,
         prestress,
     })))

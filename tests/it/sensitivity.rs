@@ -467,3 +467,27 @@ fn a_studys_steps_honour_the_set_flags_and_the_patterns() {
     let (omega, d) = (r.outputs[i].value, row(&r, "k").derivatives[i]);
     assert!(rel(d, omega / 240.0) <= 1e-6, "{}: {d} against {}", r.outputs[i].name, omega / 240.0);
 }
+
+/// A study at `--point N` of a sweep over a topology builds the steps at the point's own
+/// counts, as `run` builds that point: at point 2 of `scenarios/custom/prism_n.toml` (n = 5)
+/// every parameter but n has its derivatives (each step had been rebuilt at the file's n = 3
+/// and refused as another structure), the twist pi/2 + pi/5 does not move with the cables'
+/// stiffness (|d twist1 / d k| below 1e-9 rad per N/m), and with every cable force
+/// proportional to k the frequencies go as sqrt(k): d omega / d k = omega / (2 k) within 1e-6.
+#[test]
+fn a_study_at_a_point_of_a_topology_sweep_builds_its_steps_at_that_points_counts() {
+    let file = "scenarios/custom/prism_n.toml";
+    let sc = scenario::load(Path::new(file)).expect("shipped scenario");
+    let r = tensegrity_testbed::study::sensitivity(&sc, file, 2, false, None).expect("sensitivities");
+    assert_eq!(r.inputs.get("n"), Some(&5.0), "point 2 is n = 5");
+    for p in r.parameters.iter().filter(|p| p.name != "n") {
+        assert!(p.error.is_none(), "d/d {}: {:?}", p.name, p.error);
+    }
+    let twist = r.outputs.iter().position(|o| o.name == "twist1").expect("twist1");
+    let expected = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI / 5.0;
+    assert!((r.outputs[twist].value - expected).abs() <= 1e-9, "twist1 = {}", r.outputs[twist].value);
+    assert!(row(&r, "k").derivatives[twist].abs() <= 1e-9, "d twist1/d k = {}", row(&r, "k").derivatives[twist]);
+    let i = r.outputs.iter().position(|o| o.name.ends_with(".omega")).expect("a mode's frequency");
+    let (omega, d) = (r.outputs[i].value, row(&r, "k").derivatives[i]);
+    assert!(rel(d, omega / 200.0) <= 1e-6, "{}: {d} against {}", r.outputs[i].name, omega / 200.0);
+}
