@@ -102,7 +102,9 @@ fn iterate(
     let mut at = |p: &DVector<f64>| -> Result<Iterate, FitError> {
         let eval = model(p.as_slice())?;
         let r = (&eval.model - measured(problem)).component_mul(weights);
-        Ok(Iterate { p: p.clone(), cost: r.norm_squared(), eval, r })
+        let it = Iterate { p: p.clone(), cost: r.norm_squared(), eval, r };
+        representable(problem, weights, &it)?;
+        Ok(it)
     };
     let mut it = at(initial)?;
     let (mut lambda, mut iterations) = (INITIAL_DAMPING, 0);
@@ -154,6 +156,37 @@ fn iterate(
         }
     };
     Ok((it, iterations, stopped))
+}
+
+/// The weighted residuals, chi^2 and the weighted Jacobian's J^T J at `it` within what a float
+/// holds; past it (a sigma of 1e-300 overflows chi^2 to infinity, after which no step is taken
+/// and the interval came out of zero width around the start value) the fit stops as bad input,
+/// naming the row that weighs most: its sigma, and the figures that overflowed.
+fn representable(problem: &FitProblem, weights: &DVector<f64>, it: &Iterate) -> Result<(), FitError> {
+    let j = weighted(&it.eval.jacobian, weights);
+    let normal = j.transpose() * &j;
+    if it.cost.is_finite() && normal.iter().all(|v| v.is_finite()) {
+        return Ok(());
+    }
+    // Each row's weight in chi^2 and in J^T J (infinite where it overflowed, NaN taken so).
+    let weight = |i: usize| {
+        let w = it.r[i].powi(2) + j.row(i).norm_squared();
+        if w.is_nan() {
+            f64::INFINITY
+        } else {
+            w
+        }
+    };
+    let i = (0..it.r.len()).max_by(|&a, &b| weight(a).total_cmp(&weight(b))).expect("validated: rows");
+    let x = &problem.measurements[i];
+    Err(FitError::BadInput(format!(
+        "{}: sigma {:e} of {} weighs the fit past what a float holds (its weighted residual (model - measured)/sigma is {:e}, chi^2 {:e}): the estimate and its interval would mean nothing; state sigma in the output's unit, no smaller than the model resolves (every sigma scaled by one factor moves no estimate)",
+        x.at,
+        1.0 / weights[i],
+        x.output,
+        it.r[i],
+        it.cost
+    )))
 }
 
 /// What chi^2 is measured in: 1 when the rows state their sigmas, the reduced chi^2

@@ -164,7 +164,7 @@ fn angles_csv() -> String {
 
 /// Each bad input is refused with exit 2 and a message naming the thing: a column, an output
 /// (with the close names), a NaN, too few rows, an unknown or swept parameter, a bound the
-/// fit runs into.
+/// fit runs into, sigmas so small that chi^2 overflows.
 #[test]
 fn bad_fit_input_gives_exit_2_naming_what_is_wrong() {
     let cases: Vec<(&str, String, Vec<&str>, Vec<&str>)> = vec![
@@ -189,6 +189,13 @@ fn bad_fit_input_gives_exit_2_naming_what_is_wrong() {
         // step is cut to nothing there, which had stopped the fit at 40 with exit 0.
         ("start.csv", angles_csv(), vec!["--param", "k2=40:100"], vec!["k2 ran into its bound 40"]),
         ("point.csv", "point,output,value\n9,q,1\n0,q,1\n".into(), vec!["--param", "k2"], vec!["no point 9"]),
+        // Sigmas of 1e-300 overflow chi^2 (had exited 0 at the start value with sigma 0).
+        (
+            "tiny.csv",
+            angles_csv().replace(&format!(",{SIGMA}\n"), ",1e-300\n"),
+            vec!["--param", "k2"],
+            vec![".csv:", "sigma 1e-300 of q weighs the fit past what a float holds", "chi^2 inf"],
+        ),
     ];
     for (name, csv, flags, said) in cases {
         let (code, stderr) = fit_cli(name, &csv, &flags);
