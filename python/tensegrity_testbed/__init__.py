@@ -254,6 +254,11 @@ def _fit_rows(data) -> list:
     import pandas as pd
 
     frame = data if isinstance(data, pd.DataFrame) else pd.DataFrame(data)
+    columns = list(frame.columns)
+    twice = [c for k, c in enumerate(columns) if c in columns[:k]]
+    if twice:
+        # As the CSV reader refuses it: the rows had been read from the first of the two.
+        raise ValueError(f"data: the column {twice[0]!r} is named twice: which of the two to read is not said")
     unknown = [c for c in frame.columns if c not in _FIT_COLUMNS]
     if unknown:
         raise ValueError(f"data: the column {unknown[0]!r} names nothing: the columns are "

@@ -820,6 +820,23 @@ def test_bad_fit_input_raises_a_clear_python_exception():
         tt.fit(str(SWEPT_BAR), ANGLES, {"k3": None})
 
 
+def test_a_column_named_twice_raises_as_the_cli_refuses_it(tmp_path):
+    """Data naming ``value`` twice are refused, as a DataFrame and as a CSV's path, each with a
+    ValueError naming the column (the DataFrame's rows had been read from the first of the two
+    columns, the CLI's from the last)."""
+    import pandas as pd
+
+    frame = pd.read_csv(ANGLES)
+    twice = pd.concat([frame, frame[["value"]] + 1.0], axis=1)
+    assert list(twice.columns).count("value") == 2
+    with pytest.raises(ValueError, match=r"data: the column 'value' is named twice"):
+        tt.fit(str(SWEPT_BAR), twice, ["k2"])
+    csv = tmp_path / "twice.csv"
+    csv.write_text("point,output,value,value\n0,q,1,2\n1,q,1,2\n")
+    with pytest.raises(ValueError, match=r"twice.csv:1:20: the column 'value' is named twice \(also at column 14\)"):
+        tt.fit(str(SWEPT_BAR), csv, ["k2"])
+
+
 ELASTIC_STRUT = ROOT / "scenarios" / "custom" / "elastic_strut.toml"
 BEADED = ROOT / "scenarios" / "custom" / "beaded_string.toml"
 

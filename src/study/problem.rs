@@ -115,7 +115,7 @@ pub fn read_measurements(what: &str, path: &Path, stdin: bool) -> Result<Vec<Mea
 }
 
 /// The measurements of a CSV with a header naming [`DATA_COLUMNS`] (sigma optional, in any
-/// order), each row's errors at `file:LINE:COL`.
+/// order, each once), each row's errors at `file:LINE:COL`.
 pub fn measurements_from_csv(file: &str, text: &str) -> Result<Vec<Measurement>, FitError> {
     let bad = |s: String| FitError::BadInput(s);
     let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
@@ -132,6 +132,13 @@ pub fn measurements_from_csv(file: &str, text: &str) -> Result<Vec<Measurement>,
                 DATA_COLUMNS.join(",")
             )));
         };
+        if let Some(first) = index[c] {
+            return Err(bad(format!(
+                "{file}:1:{}: the column '{name}' is named twice (also at column {}): which of the two to read is not said",
+                column_at(header, k),
+                column_at(header, first)
+            )));
+        }
         index[c] = Some(k);
     }
     if let Some(c) = (0..3).find(|&c| index[c].is_none()) {

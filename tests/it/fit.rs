@@ -164,7 +164,7 @@ fn angles_csv() -> String {
 
 /// Each bad input is refused with exit 2 and a message naming the thing: a column, an output
 /// (with the close names), a NaN, too few rows, an unknown or swept parameter, a bound the
-/// fit runs into, sigmas so small that chi^2 overflows.
+/// fit runs into, a column named twice, sigmas so small that chi^2 overflows.
 #[test]
 fn bad_fit_input_gives_exit_2_naming_what_is_wrong() {
     let cases: Vec<(&str, String, Vec<&str>, Vec<&str>)> = vec![
@@ -189,6 +189,13 @@ fn bad_fit_input_gives_exit_2_naming_what_is_wrong() {
         // step is cut to nothing there, which had stopped the fit at 40 with exit 0.
         ("start.csv", angles_csv(), vec!["--param", "k2=40:100"], vec!["k2 ran into its bound 40"]),
         ("point.csv", "point,output,value\n9,q,1\n0,q,1\n".into(), vec!["--param", "k2"], vec!["no point 9"]),
+        // Two columns named value: the CLI had read the last, Python the first.
+        (
+            "twice.csv",
+            "point,output,value,value\n0,q,1,2\n1,q,1,2\n".into(),
+            vec!["--param", "k2"],
+            vec![":1:20: the column 'value' is named twice (also at column 14)"],
+        ),
         // Sigmas of 1e-300 overflow chi^2 (had exited 0 at the start value with sigma 0).
         (
             "tiny.csv",
