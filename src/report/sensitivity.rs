@@ -62,6 +62,10 @@ pub struct ParameterSensitivity {
     pub max_check_error: Option<f64>,
     /// Why this parameter has no derivatives (its structure could not be built at a step).
     pub error: Option<String>,
+    /// Why this parameter is a switch here, not differentiated (no derivatives, no error): a
+    /// pattern's count, or a value where the model changes (a member's law, a joint's kind,
+    /// the structure's counts) between it and its steps.
+    pub switch: Option<String>,
 }
 
 /// A derivative below this (in the output's unit per the parameter's) is zero to the check:
@@ -98,6 +102,10 @@ impl SensitivityReport {
             out.push_str(&format!("   d/d {} (= {}, step {:.3e})", p.name, p.value, p.step));
             if let Some(e) = &p.error {
                 out.push_str(&format!(": {e}\n"));
+                continue;
+            }
+            if let Some(why) = &p.switch {
+                out.push_str(&format!(": switch, not differentiated ({why})\n"));
                 continue;
             }
             match p.max_check_error {

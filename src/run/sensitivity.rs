@@ -70,9 +70,10 @@ pub enum SampleError {
     /// The simulator could not build it.
     #[error(transparent)]
     Sim(#[from] crate::sim::SimError),
-    /// It is another structure than the settled one's (the step changed its topology).
-    #[error("the structure built at a step has other bodies, nodes or members")]
-    OtherStructure,
+    /// The step switches the model: the structure built there is another than the settled
+    /// one's (other bodies, nodes or members, or a member's law or a joint's kind changed).
+    #[error("{0}")]
+    Switch(String),
 }
 
 /// Why a file's `[[sensitivities]]` were not computed at a settle point.
@@ -203,7 +204,7 @@ pub(super) fn file_sensitivities(
             rows.push(a.out.parameter(sim, params, &s.parameter, value, &a.lin, &a.listed));
         }
         let row = rows.iter().find(|r| r.name == s.parameter).expect("computed above");
-        if let Some(e) = &row.error {
+        if let Some(e) = row.error.as_ref().or(row.switch.as_ref()) {
             let (output, parameter, why) = (s.output.clone(), s.parameter.clone(), e.clone());
             return Err(FileSensitivityError::Derivative { output, parameter, why });
         }
@@ -211,6 +212,48 @@ pub(super) fn file_sensitivities(
         out.insert(s.name.clone(), i.map_or(f64::NAN, |i| row.derivatives[i]));
     }
     Ok(out)
+}
+
+/// How the structure `step` built at a parameter's step is another model than the `settled`
+/// one (None: the same, its numbers aside): other counts of bodies, nodes, joints, members or
+/// actuators, a member's law (mohr2011's k_cable at its default 0: inextensible cables, elastic
+/// ones at any step above), a joint's kind or torsion spring (furet2018's k_servo at 0: ideal
+/// actuators, servos above) or an actuator's target. Such a parameter switches the model there
+/// and has no derivative.
+fn switched(settled: &crate::structure::Structure, step: &crate::structure::Structure) -> Option<String> {
+    use crate::structure::{CableLaw, Law};
+    let counts = |a: &crate::structure::Structure| {
+        (a.bodies.len(), a.nodes.len(), a.joints.len(), a.members.len(), a.actuators.len())
+    };
+    if counts(settled) != counts(step) {
+        return Some("the structure built at the step has other bodies, nodes or members".into());
+    }
+    let law = |m: &crate::structure::Member| match &m.law {
+        Law::Strut => "a rigid strut",
+        Law::ElasticStrut { .. } => "an elastic strut",
+        Law::Spring { .. } => "a spring",
+        Law::Cable { law: CableLaw::Inextensible, .. } => "an inextensible cable",
+        Law::Cable { law: CableLaw::Elastic { .. }, .. } => "an elastic cable",
+    };
+    if let Some((a, b)) = settled.members.iter().zip(&step.members).find(|(a, b)| law(a) != law(b)) {
+        return Some(format!("member '{}' is {} at the value and {} at the step", a.name, law(a), law(b)));
+    }
+    let joint = |j: &crate::structure::Joint| (std::mem::discriminant(&j.kind), j.torsion_spring.is_some());
+    if let Some((a, b)) = settled.joints.iter().zip(&step.joints).find(|(a, b)| joint(a) != joint(b)) {
+        let spring = |s: bool| if s { "with a torsion spring" } else { "without one" };
+        return Some(match joint(a).0 == joint(b).0 {
+            true => format!(
+                "joint '{}' is {} at the value and {} at the step",
+                a.name,
+                spring(joint(a).1),
+                spring(joint(b).1)
+            ),
+            false => format!("joint '{}' is of another kind at the step", a.name),
+        });
+    }
+    let target = |a: &crate::structure::Actuator| std::mem::discriminant(&a.target);
+    let changed = settled.actuators.iter().zip(&step.actuators).find(|(a, b)| target(a) != target(b));
+    changed.map(|(a, _)| format!("actuator '{}' drives another target at the step", a.symbol))
 }
 
 /// (K + K^T) / 2: the difference's K is symmetric up to its error and the equilibrium's.
@@ -308,12 +351,8 @@ impl Outputs<'_> {
         inputs: &Values,
     ) -> Result<Simulation, SampleError> {
         let s = mech.build(params, inputs, &self.sc.start)?;
-        let same = |a: &crate::structure::Structure, b: &crate::structure::Structure| {
-            (a.bodies.len(), a.nodes.len(), a.joints.len(), a.members.len(), a.actuators.len())
-                == (b.bodies.len(), b.nodes.len(), b.joints.len(), b.members.len(), b.actuators.len())
-        };
-        if !same(&s, at.structure()) {
-            return Err(SampleError::OtherStructure);
+        if let Some(why) = switched(at.structure(), &s) {
+            return Err(SampleError::Switch(why));
         }
         let mut sim = Simulation::new(&s, &self.sc.sim)?;
         let commands = sim.structure().commands_from(&mech.commands(params, inputs));
@@ -413,7 +452,13 @@ impl Outputs<'_> {
             check: None,
             max_check_error: None,
             error: None,
+            switch: None,
         };
+        if self.sc.topology_params.iter().any(|t| t == name) {
+            row.switch =
+                Some(format!("a pattern reads {name}: it sets the structure's counts, which have no derivative"));
+            return row;
+        }
         let (sc, samples) = match self.samples(params, name, value, h) {
             Ok(s) => s,
             Err(e) => {
@@ -426,6 +471,11 @@ impl Outputs<'_> {
         for ((moved, inputs), s) in samples.into_iter().zip(SAMPLES) {
             match self.rebuilt(mech.as_ref(), at, &moved, &inputs) {
                 Ok(sim) => sims.push((sim, moved)),
+                Err(SampleError::Switch(why)) => {
+                    row.switch =
+                        Some(format!("the model switches between {name} = {value} and {}: {why}", value + s * h));
+                    return row;
+                }
                 Err(e) => {
                     row.error = Some(format!("at {name} = {}: {e}", value + s * h));
                     return row;

@@ -400,6 +400,12 @@ fn evaluate(problem: &FitProblem, p: &[f64], cancel: Option<&AtomicBool>) -> Res
             if let Some(e) = &row.error {
                 return Err(FitError::Failed(format!("d {}/d {}: {e}", x.output, f.name)));
             }
+            if let Some(why) = &row.switch {
+                return Err(FitError::BadInput(format!(
+                    "--param {}: a switch at point {} ({why}): the fit needs its derivative; start it off the switch with --set {}=VALUE",
+                    f.name, x.point, f.name
+                )));
+            }
             eval.jacobian[(i, j)] = row.derivatives[k];
         }
     }

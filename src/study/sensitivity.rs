@@ -68,7 +68,7 @@ pub fn sensitivity(
         .collect();
     let check_wall = Instant::now();
     if check {
-        for p in parameters.iter_mut().filter(|p| p.error.is_none()) {
+        for p in parameters.iter_mut().filter(|p| p.error.is_none() && p.switch.is_none()) {
             check_by_settles(&out, p, &params, &listed, &outputs, cancel)?;
         }
     }

@@ -491,3 +491,38 @@ fn a_study_at_a_point_of_a_topology_sweep_builds_its_steps_at_that_points_counts
     let (omega, d) = (r.outputs[i].value, row(&r, "k").derivatives[i]);
     assert!(rel(d, omega / 200.0) <= 1e-6, "{}: {d} against {}", r.outputs[i].name, omega / 200.0);
 }
+
+/// A parameter that switches the model is named as a switch and not differentiated: mohr2011's
+/// k_cable at its default 0 means inextensible cables (`(k_cable > 0).then_some(..)` in its
+/// build), so its step h = 1e-3 N/m builds elastic ones and d/d k_cable had been printed as a
+/// number (-1889.7). It now has no derivatives and no error, its row says why, the table says
+/// "switch", the command exits 0 and every other parameter but the flag `straight` keeps its
+/// derivatives. With
+/// `--set k_cable=2000` (elastic at the value and at every step) it is differentiated.
+#[test]
+fn a_parameter_that_switches_the_model_is_named_and_not_differentiated() {
+    let file = "scenarios/mohr2011/quick.toml";
+    let sc = scenario::load(Path::new(file)).expect("shipped scenario");
+    let r = tensegrity_testbed::study::sensitivity(&sc, file, 0, false, None).expect("sensitivities");
+    let k = row(&r, "k_cable");
+    let why = k.switch.as_deref().expect("k_cable named as a switch");
+    assert!(why.contains("an inextensible cable at the value and an elastic cable at the step"), "{why}");
+    assert!(k.derivatives.is_empty() && k.error.is_none(), "{k:?}");
+    // `straight` (0: the paper's two-link springs, any other value one straight strut) too:
+    // its steps build other bodies (it had been an error, failing the command).
+    let straight = row(&r, "straight").switch.as_deref().expect("straight named as a switch");
+    assert!(straight.contains("the structure built at the step has other bodies"), "{straight}");
+    for p in r.parameters.iter().filter(|p| p.name != "k_cable" && p.name != "straight") {
+        assert!(p.error.is_none() && p.switch.is_none(), "d/d {}: {:?} {:?}", p.name, p.error, p.switch);
+        assert_eq!(p.derivatives.len(), r.outputs.len(), "d/d {}", p.name);
+    }
+    assert!(r.to_table().contains("d/d k_cable (= 0, step 1.000e-3): switch, not differentiated"), "{}", r.to_table());
+    let (code, _, err) = common::tensegrity(&["sensitivity", file]);
+    assert_eq!(code, 0, "{err}");
+    let elastic = [scenario::Override::parse("k_cable=2000").unwrap()];
+    let sc = scenario::load_with(Path::new(file), &elastic).expect("valid");
+    let r = tensegrity_testbed::study::sensitivity(&sc, file, 0, false, None).expect("sensitivities");
+    let k = row(&r, "k_cable");
+    assert!(k.switch.is_none() && k.error.is_none(), "{k:?}");
+    assert!(k.derivatives.iter().all(|d| d.is_finite()) && k.derivatives.len() == r.outputs.len());
+}
