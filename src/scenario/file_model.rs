@@ -165,6 +165,14 @@ fn sensitivity(
         ));
     }
     let o = s.output.get_ref();
+    // A sensitivity is read at the settle point beside the state, not off it: no derivative
+    // of it by a parameter is computed (it had passed here and come out NaN at run time).
+    if spec.sensitivities.iter().any(|x| &x.name == o) {
+        return Err(ctx.err(
+            &s.output,
+            format!("'{o}' is another [[sensitivities]] entry, not an output of the settled state: a sensitivity of a sensitivity is not computed (its output must be a node coordinate, a member's force, a joint's angle or slide, an observed quantity, a [[quantities]] name, or modeN.omega)"),
+        ));
+    }
     let output = |x: &Symbol| {
         &x.name == o
             && matches!(

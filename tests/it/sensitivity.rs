@@ -492,6 +492,25 @@ fn a_study_at_a_point_of_a_topology_sweep_builds_its_steps_at_that_points_counts
     assert!(rel(d, omega / 200.0) <= 1e-6, "{}: {d} against {}", r.outputs[i].name, omega / 200.0);
 }
 
+/// A `[[sensitivities]]` entry whose output is another entry is refused where the parse reads
+/// it, at the output's string (it had passed `check` and come out NaN at every settle point),
+/// and `tensegrity check` exits 2 with that `file:LINE:COL`.
+#[test]
+fn a_sensitivity_of_a_sensitivity_is_refused_at_its_output() {
+    let text = std::fs::read_to_string("scenarios/custom/pinned_bar_modes.toml").unwrap()
+        + PRINTED_SENSITIVITIES
+        + "\n[[sensitivities]]\nname = \"d2q\"\noutput = \"dq_dk1\"\nparameter = \"k2\"\n";
+    let said = "'dq_dk1' is another [[sensitivities]] entry, not an output of the settled state";
+    common::error_at(&text, "output = \"dq_dk1\"", "output = ".len(), said);
+    let path = std::env::temp_dir().join(format!("tt-sens-of-sens-{}.toml", std::process::id()));
+    std::fs::write(&path, &text).unwrap();
+    let (code, _, err) = common::tensegrity(&["check", path.to_str().unwrap()]);
+    let offset = text.find("output = \"dq_dk1\"").unwrap() + "output = ".len();
+    let line = text[..offset].matches('\n').count() + 1;
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains(&format!(".toml:{line}:10: {said}")), "{err}");
+}
+
 /// A parameter that switches the model is named as a switch and not differentiated: mohr2011's
 /// k_cable at its default 0 means inextensible cables (`(k_cable > 0).then_some(..)` in its
 /// build), so its step h = 1e-3 N/m builds elastic ones and d/d k_cable had been printed as a
