@@ -19,11 +19,16 @@ pub fn fit(
     let outputs: Vec<(String, std::path::PathBuf)> =
         json.map(|j| ("--json".to_string(), j.to_path_buf())).into_iter().collect();
     check_outputs(&[scenario.to_path_buf(), data.to_path_buf()], &outputs)?;
+    // `--data -` reads standard input, as every other input does; the scenario cannot be
+    // read there too.
+    if super::is_stdio(scenario) && super::is_stdio(data) {
+        return Err(bad_input("the scenario - and --data -: only one of them can read standard input"));
+    }
     let source = crate::input::read_text(scenario, crate::scenario::MAX_SCENARIO_BYTES, true)
         .map_err(|e| bad_input(format!("{}: the scenario file: {e}", scenario.display())))?;
     crate::scenario::parse_with(scenario, &source, overrides).map_err(bad_input)?;
     let parameters = params.iter().map(|p| crate::study::parse_parameter(p)).collect::<Result<Vec<_>, _>>();
-    let measurements = crate::study::read_measurements("--data", data, false);
+    let measurements = crate::study::read_measurements("--data", data, true);
     let (parameters, measurements) = (parameters.map_err(cli_error)?, measurements.map_err(cli_error)?);
     let problem =
         FitProblem { file: scenario.to_path_buf(), source, overrides: overrides.to_vec(), parameters, measurements };

@@ -115,9 +115,12 @@ pub fn read_measurements(what: &str, path: &Path, stdin: bool) -> Result<Vec<Mea
 }
 
 /// The measurements of a CSV with a header naming [`DATA_COLUMNS`] (sigma optional, in any
-/// order, each once), each row's errors at `file:LINE:COL`.
+/// order, each once; a UTF-8 byte-order mark before it is skipped), each row's errors at
+/// `file:LINE:COL`.
 pub fn measurements_from_csv(file: &str, text: &str) -> Result<Vec<Measurement>, FitError> {
     let bad = |s: String| FitError::BadInput(s);
+    // A byte-order mark (a spreadsheet's UTF-8 export) is no part of the first column's name.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
     let Some((_, header)) = lines.next() else {
         return Err(bad(format!("{file}:1:1: no header: the columns are {}", DATA_COLUMNS.join(","))));
