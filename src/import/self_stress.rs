@@ -38,9 +38,9 @@ pub fn self_stress(draft: &Draft) -> Option<Vec<f64>> {
         draft.bodies.iter().flat_map(|b| b.nodes.iter().map(|(n, p)| (n.as_str(), *p))).collect();
     let index = |n: &str| nodes.iter().position(|(m, _)| *m == n);
     let on_strut = |n: &str| draft.struts.iter().any(|s| s.a == n || s.b == n);
-    let anchored: Vec<bool> = nodes
+    let anchored: Vec<[bool; 3]> = nodes
         .iter()
-        .map(|(n, _)| draft.bodies.iter().any(|b| b.fixed && b.nodes.iter().any(|(m, _)| m == n)) && !on_strut(n))
+        .map(|(n, _)| [draft.bodies.iter().any(|b| b.fixed && b.nodes.iter().any(|(m, _)| m == n)) && !on_strut(n); 3])
         .collect();
     let cables: Vec<Vec<usize>> =
         draft.cables.iter().map(|c| c.path().map(index).collect::<Option<Vec<_>>>()).collect::<Option<_>>()?;
@@ -50,31 +50,38 @@ pub fn self_stress(draft: &Draft) -> Option<Vec<f64>> {
     self_stress_of(&positions, &anchored, &cables, &struts)
 }
 
-/// A drawing's self-stress: node positions \[m\], which nodes are anchored (held, and on no
-/// strut: no row of the equilibrium matrix), the tension members and the struts by their paths
+/// A drawing's self-stress: node positions \[m\], which of each node's coordinates are
+/// anchored (held, and on no strut: no row of the equilibrium matrix), the tension members and the struts by their paths
 /// of nodes. A clustered cable's column is the sum of its segments' (one tension in every
 /// segment: the clustering of Moored and Bruhns). One tension per tension member, the least of
 /// them 1 (struts in compression), or None when no self-stress keeps every tension member in
 /// tension.
 pub fn self_stress_of<P: AsRef<[usize]>>(
     positions: &[Vec3],
-    anchored: &[bool],
+    anchored: &[[bool; 3]],
     tension: &[P],
     struts: &[P],
 ) -> Option<Vec<f64>> {
-    let free: Vec<usize> = (0..positions.len()).filter(|n| !anchored[*n]).collect();
-    let row = |n: usize| free.iter().position(|m| *m == n);
+    // One row per coordinate that no support holds (a roller holds some of a node's three).
+    let mut row = vec![[None; 3]; positions.len()];
+    let mut rows = 0;
+    for (n, held) in anchored.iter().enumerate() {
+        for k in (0..3).filter(|&k| !held[k]) {
+            row[n][k] = Some(rows);
+            rows += 1;
+        }
+    }
     let members: Vec<&[usize]> = tension.iter().chain(struts).map(|p| p.as_ref()).collect();
-    let mut a = DMatrix::<f64>::zeros(3 * free.len(), members.len());
+    let mut a = DMatrix::<f64>::zeros(rows, members.len());
     for (j, path) in members.iter().enumerate() {
         for segment in path.windows(2) {
             let (na, nb) = (segment[0], segment[1]);
             let (pa, pb) = (positions[na], positions[nb]);
             let l = distance(pa, pb);
             for (n, sign) in [(na, 1.0), (nb, -1.0)] {
-                if let Some(r) = row(n) {
-                    for k in 0..3 {
-                        a[(3 * r + k, j)] += sign * (pb[k] - pa[k]) / l;
+                for k in 0..3 {
+                    if let Some(r) = row[n][k] {
+                        a[(r, j)] += sign * (pb[k] - pa[k]) / l;
                     }
                 }
             }

@@ -77,7 +77,8 @@ fn with_linear(
 ) -> Result<EquilibriumReport, EquilibriumRunError> {
     let s = loaded.sim.structure();
     let Some(custom) = sc.custom.as_ref().filter(|_| !s.node_loads.is_empty()) else { return Ok(report) };
-    let reference_sc = Scenario { custom: Some(custom.without_point_loads()), ..sc.clone() };
+    let mut reference_sc = sc.clone();
+    reference_sc.custom = Some(custom.without_point_loads());
     let reference = settle_first_point(&reference_sc, cancel)?;
     let at = |state: &SettledState| (0..s.nodes.len()).map(|n| state.sim.node_position(n)).collect::<Vec<_>>();
     let (before, after) = (at(&reference), at(loaded));

@@ -88,8 +88,15 @@ pub(super) fn set_self_stress(
     let pinned = |n: usize| {
         s.joints.iter().any(|j| fixed(j.parent) && at_anchor(j, n) && !matches!(j.kind, JointKind::Prismatic { .. }))
     };
-    let anchored: Vec<bool> =
-        (0..s.nodes.len()).map(|n| (fixed(s.nodes[n].body) && !on_strut(n)) || pinned(n)).collect();
+    // A support in some directions holds those of its node's coordinates.
+    let held = s.held_translations();
+    let anchored: Vec<[bool; 3]> = (0..s.nodes.len())
+        .map(|n| {
+            let whole = (fixed(s.nodes[n].body) && !on_strut(n)) || pinned(n);
+            let by_support = s.supports.iter().any(|x| x.node == n);
+            [0, 1, 2].map(|k| whole || (by_support && held[s.nodes[n].body][k]))
+        })
+        .collect();
     let positions: Vec<_> = s.nodes.iter().map(|n| n.position).collect();
     // Cables first, then springs: the order of `self_stress_of`'s tensions.
     let tensioned: Vec<usize> = [MemberKind::Cable, MemberKind::Spring]

@@ -217,3 +217,47 @@ verdict = "pass"
     let mast = -30.0 / 2f64.sqrt();
     assert!((at("mast.force") / mast - 1.0).abs() <= 1e-9, "mast {} against {mast}", at("mast.force"));
 }
+
+/// A bead on a roller (held in y and z, `[[structure.supports]]`) between a cable to A along
+/// -x and one to D up at 45 degrees: along x its balance asks t2 = sqrt 2 t1, and the roller
+/// takes the vertical pull. `least_tension` reads the support's held directions as anchored
+/// (issue 62 item 8: a structure on supports had been refused, "check the drawing"): the cables
+/// carry 10 N and 10 sqrt 2 N within 1e-9 and the bead stays where it is drawn within 1e-12 m.
+#[test]
+fn least_tension_admits_the_reactions_of_a_support_in_some_directions() {
+    let text = common::one_point_head("a bead on a roller, prestressed")
+        + r#"[prestress]
+least_tension = 10.0
+
+[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { A = [-1, 0, 0], D = [1, 0, 1] }
+
+[[structure.bodies]]
+name = "bead"
+mass = 0.5
+nodes = { B = [0, 0, 0] }
+
+[[structure.supports]]
+node = "B"
+fixed = ["y", "z"]
+
+[[structure.cables]]
+name = "c1"
+a = "A"
+b = "B"
+stiffness = 500.0
+
+[[structure.cables]]
+name = "c2"
+a = "B"
+b = "D"
+stiffness = 500.0
+"#;
+    let sc = scenario::parse(Path::new("roller.toml"), &text).expect("a self-stress with the roller");
+    let report = run(&sc, &RunOptions::default());
+    let sim = &report.points[0].simulated;
+    assert!((sim["c1.force"] - 10.0).abs() <= 1e-9 && (sim["c2.force"] - 10.0 * 2f64.sqrt()).abs() <= 1e-9, "{sim:?}");
+    assert!(common::node(&report, "B").iter().all(|x| x.abs() <= 1e-12), "{:?}", common::node(&report, "B"));
+}
