@@ -68,9 +68,10 @@ pub enum Command {
     },
     /// Natural frequencies and mode shapes of a scenario's structure at its settled state (its
     /// first point, settled as `run` settles it): free bodies held by springs and elastic
-    /// cables, or the revolute and prismatic joints of joint trees; joints that close loops and
-    /// taut inextensible cables are constraints; refused (exit 2): a loop closed by a prismatic
-    /// joint. The constrained modes are reduced to the constraints' tangent space, the
+    /// cables (and by supports in some directions), or the revolute and prismatic joints of
+    /// joint trees; joints that close loops, ball and universal joints, and taut inextensible
+    /// cables are constraints; refused (exit 2): a loop closed by a prismatic joint. A mode that
+    /// only the prestress stiffens is marked a mechanism. The constrained modes are reduced to the constraints' tangent space, the
     /// constraint forces' geometric stiffness included; slack cables are left out, and a
     /// structure the constraints hold rigid has no mode. Every mode, or above 100 free bodies
     /// on springs and elastic cables: the lowest 20 non-rigid modes and every rigid one

@@ -65,18 +65,7 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
 fn lump_members(ctx: &Ctx, s: &mut Structure, r: &RawStructure) -> Result<(), ScenarioError> {
     let mut lumping = crate::structure::lumped::Lumping::new(s);
     for m in r.springs.iter() {
-        refuse_keys(
-            ctx,
-            m,
-            "spring",
-            &[
-                ("EA", &m.ea),
-                ("E", &m.youngs_modulus),
-                ("area", &m.area),
-                ("density", &m.density),
-                ("segments", &m.segments),
-            ],
-        )?;
+        refuse_keys(ctx, m, "spring", &[("density", &m.density), ("segments", &m.segments)])?;
     }
     for (i, m) in r.struts.iter().enumerate() {
         refuse_keys(ctx, m, "strut", &[("segments", &m.segments)])?;
@@ -176,8 +165,8 @@ fn axial_stiffness<'a>(ctx: &Ctx, m: &'a RawMember) -> Result<Option<(&'a Spanne
     match (&m.ea, &m.youngs_modulus, &m.area) {
         (None, None, None) => Ok(None),
         (Some(ea), None, None) => Ok(Some((ea, positive_value(ctx, ea, "EA (N)")?))),
-        (Some(_), Some(e), _) => Err(ctx.err(e, "E: the strut states EA already (give EA, or E with area)")),
-        (Some(_), None, Some(a)) => Err(ctx.err(a, "area: the strut states EA already (give EA, or E with area)")),
+        (Some(_), Some(e), _) => Err(ctx.err(e, "E: the member states EA already (give EA, or E with area)")),
+        (Some(_), None, Some(a)) => Err(ctx.err(a, "area: the member states EA already (give EA, or E with area)")),
         (None, Some(e), Some(a)) => {
             let ea = positive_value(ctx, e, "E (Pa)")? * positive_value(ctx, a, "area (m^2)")?;
             if !ea.is_finite() {
@@ -473,11 +462,29 @@ fn strut(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Member, ScenarioErro
     Ok(Member::strut(m.name.get_ref().clone(), a, b, radius))
 }
 
-/// A spring: its stiffness > 0 (required) and free length >= 0 (default: the initial distance).
+/// A spring: its stiffness > 0, or a bar's axial stiffness `EA` (or `E` with `area`) over its
+/// free length (one of the two required), and free length >= 0 (default: the initial
+/// distance).
 fn spring(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Member, ScenarioError> {
     let (a, b, l) = ends(ctx, s, m, "spring")?;
-    let k = m.stiffness.as_ref().ok_or_else(|| ctx.err(&m.name, "a spring needs a stiffness (N/m)"))?;
-    let rest = match &m.length {
+    let rest = spring_rest_length(ctx, m, l)?;
+    let stiffness = match (&m.stiffness, axial_stiffness(ctx, m)?) {
+        (Some(k), None) => positive_value(ctx, k, "stiffness (N/m)")?,
+        (None, Some((_, ea))) if rest > 0.0 => ea / rest,
+        (None, Some((at, _))) => return Err(ctx.err(at, "EA / L0 needs a free length L0 > 0")),
+        (Some(_), Some((at, _))) => {
+            return Err(
+                ctx.err(at, "the spring states its stiffness already (give stiffness, or EA for a bar's EA / L0)")
+            )
+        }
+        (None, None) => return Err(ctx.err(&m.name, "a spring needs a stiffness (N/m), or a bar's EA (N) for EA / L0")),
+    };
+    Ok(Member::spring(m.name.get_ref().clone(), [a, b], stiffness, rest, tendon_radius(ctx, m)?))
+}
+
+/// A spring's free length: `length` (>= 0), or the drawn distance `drawn_m`.
+fn spring_rest_length(ctx: &Ctx, m: &RawMember, drawn_m: f64) -> Result<f64, ScenarioError> {
+    Ok(match &m.length {
         Some(v) => {
             let x = finite(ctx, v, "length (m)")?;
             if x < 0.0 {
@@ -485,15 +492,8 @@ fn spring(ctx: &Ctx, s: &Structure, m: &RawMember) -> Result<Member, ScenarioErr
             }
             x
         }
-        None => l,
-    };
-    Ok(Member::spring(
-        m.name.get_ref().clone(),
-        [a, b],
-        positive_value(ctx, k, "stiffness (N/m)")?,
-        rest,
-        tendon_radius(ctx, m)?,
-    ))
+        None => drawn_m,
+    })
 }
 
 /// A cable: elastic with a stiffness > 0, else inextensible; its length > 0 (default: the

@@ -388,7 +388,7 @@ fn json_to_stdout_is_json_alone_for_every_command() {
 /// and mohr2011 at their commands: held rigid, no degree of freedom left).
 #[test]
 fn modes_help_command_table_and_chapter_say_the_same_true_thing() {
-    let scope = "free bodies held by springs and elastic cables, or the revolute and prismatic joints of joint trees; joints that close loops and taut inextensible cables are constraints; refused (exit 2): a loop closed by a prismatic joint";
+    let scope = "free bodies held by springs and elastic cables (and by supports in some directions), or the revolute and prismatic joints of joint trees; joints that close loops, ball and universal joints, and taut inextensible cables are constraints; refused (exit 2): a loop closed by a prismatic joint";
     let words = |s: &str| s.split_whitespace().collect::<Vec<_>>().join(" ");
     let (code, help, _) = tensegrity(&["modes", "--help"]);
     assert_eq!(code, 0);

@@ -432,7 +432,7 @@ fn bad_elastic_strut_and_heavy_cable_keys_are_errors_at_their_key() {
     let text = with("EA = \"EA\"", "EA = \"EA\"\nsegments = 3");
     common::error_at(&text, "segments = 3", 11, "'strut' is a strut; segments states a heavy cable's count");
     let text = with("stiffness = \"k\"\nlength = 0.0", "stiffness = \"k\"\nlength = 0.0\nEA = 5.0");
-    common::error_at(&text, "EA = 5.0", 5, "'p_up' is a spring");
+    common::error_at(&text, "EA = 5.0", 5, "the spring states its stiffness already");
     let text = with(
         "[[structure.bodies]]\nname = \"bar\"\nmass = \"m\"",
         "[[structure.bodies]]\nname = \"bar\"\nfixed = true",

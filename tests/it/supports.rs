@@ -222,3 +222,18 @@ fn the_sparse_modes_of_a_held_chain_are_its_dense_modes() {
         );
     }
 }
+
+/// A truss bar is a spring stated by its EA: `EA = "k_tie*tie0"` in place of the tie's
+/// stiffness gives EA / L0 = k_tie, and the truss stands where it does with the stiffness, the
+/// roller within 1e-12 m.
+#[test]
+fn a_spring_stated_by_its_ea_is_a_bar_of_stiffness_ea_over_its_free_length() {
+    let text = common::edited(TRUSS, &[("stiffness = \"k_tie\"", "EA = \"k_tie*tie0\"")]);
+    let run = |text: &str| {
+        let sc = scenario::parse(Path::new("truss.toml"), text).expect("valid");
+        tensegrity_testbed::run::run(&sc, &tensegrity_testbed::run::RunOptions::default())
+    };
+    let (by_ea, by_k) = (run(&text), run(&truss()));
+    let (b, c) = (common::node(&by_ea, "B"), common::node(&by_k, "B"));
+    assert!((b[0] - c[0]).abs() <= 1e-12 && (b[0] - 2.0).abs() <= 1e-9, "{b:?} against {c:?}");
+}
