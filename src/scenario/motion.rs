@@ -363,7 +363,13 @@ fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, Sc
         (6 * bodies - 3 * points) as i64
     } else {
         let actuated = |j: usize| s.actuators.iter().any(|a| a.target == crate::structure::ActuatorTarget::Joint(j));
-        (0..s.joints.len()).filter(|j| !actuated(*j)).count() as i64
+        // Free bodies beside the joint trees add their own six coordinates (a point mass three).
+        let point = crate::structure::lumped::point_masses(s);
+        let loose = (0..s.bodies.len()).filter(|&b| {
+            s.bodies[b].kind == crate::structure::BodyKind::Free && !s.joints.iter().any(|j| j.child == b)
+        });
+        let loose: usize = loose.map(|b| if point[b] { 3 } else { 6 }).sum();
+        ((0..s.joints.len()).filter(|j| !actuated(*j)).count() + loose) as i64
     };
     let most_points = crate::structure::MAX_SPARSE_MODAL_POINT_MASSES;
     if points > most_points {

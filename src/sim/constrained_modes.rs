@@ -125,7 +125,7 @@ pub(super) struct Saved {
 
 impl Data {
     /// The analysis's coordinates: the multibodies' free degrees of freedom, then six per free
-    /// body outside them.
+    /// body outside them (three per point mass).
     pub(super) fn modal_coordinates(&self, m: &Model) -> Vec<ModalCoordinate> {
         let s = &m.structure;
         let free: Vec<usize> = (0..s.bodies.len()).filter(|b| m.is_free(*b)).collect();
@@ -143,7 +143,11 @@ impl Data {
             }
         }
         for &b in free.iter().filter(|&&b| self.multibody_of(m, b).is_none()) {
-            out.extend((0..6).map(|axis| ModalCoordinate::Body { body: b, axis }));
+            // A point mass's turns move nothing (`modes.rs`, `turning_coordinates`): its three
+            // translations alone (their tiny inertia had set the reduced Hessian's error floor,
+            // as an omega^2, above every mode of a bead beside a joint tree).
+            let axes = if m.point_masses[b] { 3 } else { 6 };
+            out.extend((0..axes).map(|axis| ModalCoordinate::Body { body: b, axis }));
         }
         out
     }

@@ -94,7 +94,7 @@ pub struct StructureModes {
 pub enum ModesError {
     #[error("joint '{0}' closes a loop with a kind of joint that has no constraint rows (spherical, revolute, universal and planar pins have)")]
     Loop(String),
-    #[error("free body '{0}' hangs on no joint: a structure of free bodies and joints together is not analysed")]
+    #[error("free body '{0}' hangs on no joint: the sensitivities of free bodies beside joint trees are not computed (their modes are: tensegrity modes)")]
     Unjointed(String),
     #[error("joint '{0}' has more than one coordinate: modes are reduced to revolute and prismatic joints")]
     JointKind(String),
@@ -194,7 +194,11 @@ impl Data {
         if let Some(c) = s.members.iter().find(|c| c.has_friction()) {
             return Err(ModesError::Friction(c.name.clone()));
         }
-        if m.is_constrained() {
+        // Free bodies beside joint trees (beads on the members of a jointed structure): the
+        // constrained analysis's coordinates, the trees' joints and six per such body, with no
+        // constraint (F5 of issue 60: they had been refused).
+        let loose = |b: usize| m.is_free(b) && !s.joints.iter().any(|j| j.child == b);
+        if m.is_constrained() || (!s.joints.is_empty() && (0..s.bodies.len()).any(loose)) {
             return self.constrained_modes(m, cancel);
         }
         if !s.joints.is_empty() {

@@ -576,3 +576,83 @@ fn a_joint_modes_difference_stays_on_the_taut_side_of_a_rope() {
     let err = state.sim.modes().expect_err("too near its slack point");
     assert!(err.to_string().contains("cable 'rope' is") && err.to_string().contains("slack length"), "{err}");
 }
+
+/// A bar pinned at A (a revolute joint about z) whose tip Q holds a bead P on a spring, the
+/// bead held by two more springs to the ground: a joint tree with a free body beside it (F5 of
+/// issue 60, refused before as "hangs on no joint"). Its four coordinates (the pin's angle and
+/// the bead's three translations; a point mass's turns move nothing) give four modes, the
+/// eigenvalues of M^-1 K with K assembled by hand at the settled state (each spring's
+/// k e e^T + (t / l)(1 - e e^T), the tip moving by z x rho per radian, plus the tip force's
+/// F . rho_xy for the turn's curvature) and M = diag(m L^2 / 3, m_P, m_P, m_P): within 1e-7
+/// relative (the analysis's second differences).
+#[test]
+fn a_joint_tree_with_a_free_bead_beside_it_has_the_modes_of_its_four_coordinates() {
+    let text = common::one_point_head("a pinned bar holding a bead")
+        .replace("[settle]", "[sim]\nbody_damping = 2.0\n\n[settle]")
+        + r#"[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { O = [0, 0, 0], S = [1, 1, 0], G = [2, -1, 0] }
+
+[[structure.bodies]]
+name = "bar"
+mass = 1.0
+nodes = { A = [0, 0, 0], Q = [1, 0, 0] }
+
+[[structure.bodies]]
+name = "bead"
+mass = 0.2
+nodes = { P = [2, 0, 0] }
+
+[[structure.joints]]
+name = "pin"
+kind = "revolute"
+parent = "ground"
+child = "bar"
+at = "A"
+axis = [0, 0, 1]
+damping = 0.5
+"# + &[
+        ("up", "Q", "S", 50.0, 0.5),
+        ("link", "Q", "P", 80.0, 0.8),
+        ("down", "P", "G", 60.0, 0.7),
+        ("side", "P", "S", 40.0, 1.0),
+    ]
+    .iter()
+    .map(|(n, a, b, k, l)| {
+        format!("[[structure.springs]]\nname = \"{n}\"\na = \"{a}\"\nb = \"{b}\"\nstiffness = {k}\nlength = {l}\n\n")
+    })
+    .collect::<String>();
+    let sc = scenario::parse(Path::new("mixed.toml"), &text).expect("valid");
+    let mut state = settle_first_point(&sc, None).expect("settles");
+    assert!(state.settled);
+    let at = |n: &str| nalgebra::Vector3::from(state.sim.node_position(state.sim.structure().node_id(n).unwrap()));
+    let (q, p, s, g) = (at("Q"), at("P"), at("S"), at("G"));
+    let spring = |a: nalgebra::Vector3<f64>, b: nalgebra::Vector3<f64>, k: f64, l0: f64| {
+        let (d, eye) = (b - a, nalgebra::Matrix3::identity());
+        let (l, e) = (d.norm(), d.normalize());
+        let t = k * (l - l0);
+        (e * e.transpose() * k + (eye - e * e.transpose()) * (t / l), e * t)
+    };
+    let rho = q - at("A");
+    let r = nalgebra::Vector3::z().cross(&rho);
+    let mut k = nalgebra::Matrix4::<f64>::zeros();
+    let (up, up_pull) = spring(q, s, 50.0, 0.5);
+    let (link, link_pull) = spring(q, p, 80.0, 0.8);
+    let (down, _) = spring(p, g, 60.0, 0.7);
+    let (side, _) = spring(p, s, 40.0, 1.0);
+    let tip_force = up_pull + link_pull;
+    k[(0, 0)] = (r.transpose() * (up + link) * r)[0] + tip_force.dot(&nalgebra::Vector3::new(rho.x, rho.y, 0.0));
+    k.fixed_view_mut::<3, 3>(1, 1).copy_from(&(link + down + side));
+    let coupling = -(link * r);
+    k.fixed_view_mut::<3, 1>(1, 0).copy_from(&coupling);
+    k.fixed_view_mut::<1, 3>(0, 1).copy_from(&coupling.transpose());
+    let mass = nalgebra::Matrix4::from_diagonal(&nalgebra::Vector4::new(1.0 / 12.0 + 0.25, 0.2, 0.2, 0.2));
+    let mut want: Vec<f64> = (mass.try_inverse().unwrap() * k).eigenvalues().unwrap().iter().copied().collect();
+    want.sort_by(f64::total_cmp);
+    let analysis = state.sim.modes().expect("the modes of a joint tree with a bead beside it");
+    assert_eq!(analysis.modes.len(), 4);
+    for (mode, w) in analysis.modes.iter().zip(want) {
+        assert!((mode.omega_squared - w).abs() <= 1e-7 * w, "omega^2 {} against {w}", mode.omega_squared);
+    }
+}
