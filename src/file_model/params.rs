@@ -65,6 +65,21 @@ impl ParamTable {
         self.names.iter().any(|n| n == name)
     }
 
+    /// The parameters that nothing reaches: neither `read` (what reads a parameter by name
+    /// outside the table) nor the expression of a reached parameter (derived ones are walked
+    /// back to what they derive from, in reverse evaluation order).
+    pub fn unreached(&self, read: impl Fn(&str) -> bool) -> Vec<String> {
+        let mut reached: Vec<bool> = self.names.iter().map(|n| read(n)).collect();
+        for &i in self.order.iter().rev() {
+            if let (true, Definition::Expr(e)) = (reached[i], &self.definitions[i]) {
+                for &u in e.uses() {
+                    reached[u] = true;
+                }
+            }
+        }
+        self.names.iter().zip(reached).filter(|(_, r)| !r).map(|(n, _)| n.clone()).collect()
+    }
+
     /// Every parameter's value, those named in `set` taking the given value instead of their
     /// definition (the others that depend on them follow).
     pub fn evaluate(&self, set: &Values) -> Values {
@@ -99,6 +114,13 @@ mod tests {
         let v = t.evaluate(&set);
         assert!((v["ratio"] - 4.0).abs() < 1e-15);
         assert_eq!(v["k2"], 20.0);
+    }
+
+    #[test]
+    fn what_a_read_parameter_derives_from_is_reached() {
+        let t = table();
+        assert_eq!(t.unreached(|n| n == "ratio"), Vec::<String>::new());
+        assert_eq!(t.unreached(|n| n == "k2"), vec!["ratio".to_string(), "k1".to_string()]);
     }
 
     #[test]

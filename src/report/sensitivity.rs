@@ -66,6 +66,9 @@ pub struct ParameterSensitivity {
     /// pattern's count, or a value where the model changes (a member's law, a joint's kind,
     /// the structure's counts) between it and its steps.
     pub switch: Option<String>,
+    /// Nothing in the file reads this parameter (`Scenario::unread_params`): it gets no steps
+    /// and every derivative is 0, which is what its steps would give.
+    pub unused: bool,
 }
 
 /// A derivative below this (in the output's unit per the parameter's) is zero to the check:
@@ -106,6 +109,10 @@ impl SensitivityReport {
             }
             if let Some(why) = &p.switch {
                 out.push_str(&format!(": switch, not differentiated ({why})\n"));
+                continue;
+            }
+            if p.unused {
+                out.push_str(": unused, not differentiated (nothing in the file reads it: every derivative 0)\n");
                 continue;
             }
             match p.max_check_error {

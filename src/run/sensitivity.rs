@@ -123,6 +123,11 @@ pub(crate) struct Linearization {
 }
 
 impl Linearization {
+    /// The number of coordinates (each parameter's dq/dp has as many).
+    pub(crate) fn size(&self) -> usize {
+        self.stiffness.ncols()
+    }
+
     /// The output name of non-rigid mode `i` (from 0) of [`Self::modes`]: `mode{N}.omega`, N
     /// numbered as `tensegrity modes` numbers it. The modes ascend in omega^2: an unstable one
     /// comes before every zero mode, a stable one after them all, the left-out turns among them.
@@ -300,6 +305,34 @@ fn solve(lin: &Linearization, r: &DVector<f64>) -> DVector<f64> {
     x
 }
 
+/// Parameter `name`'s row at `value` before anything is computed: its step, no derivatives.
+fn row_of(name: &str, value: f64) -> ParameterSensitivity {
+    ParameterSensitivity {
+        name: name.to_string(),
+        value,
+        step: parameter_step(value),
+        coordinates: vec![],
+        derivatives: vec![],
+        check: None,
+        max_check_error: None,
+        error: None,
+        switch: None,
+        unused: false,
+    }
+}
+
+/// The row of a parameter that nothing in the file reads (`Scenario::unread_params`): no
+/// steps are built, and each of the `coordinates` and `outputs` derivatives is 0, which is
+/// what the steps would give (every structure the settled one).
+pub(crate) fn unused_row(name: &str, value: f64, coordinates: usize, outputs: usize) -> ParameterSensitivity {
+    ParameterSensitivity {
+        coordinates: vec![0.0; coordinates],
+        derivatives: vec![0.0; outputs],
+        unused: true,
+        ..row_of(name, value)
+    }
+}
+
 /// A parameter's step: [`STEP_RATIO`] of its value, or [`ZERO_PARAMETER_STEP`] at 0.
 pub fn parameter_step(value: f64) -> f64 {
     if value == 0.0 {
@@ -443,17 +476,7 @@ impl Outputs<'_> {
         listed: &[usize],
     ) -> ParameterSensitivity {
         let h = parameter_step(value);
-        let mut row = ParameterSensitivity {
-            name: name.to_string(),
-            value,
-            step: h,
-            coordinates: vec![],
-            derivatives: vec![],
-            check: None,
-            max_check_error: None,
-            error: None,
-            switch: None,
-        };
+        let mut row = row_of(name, value);
         if self.sc.topology_params.iter().any(|t| t == name) {
             row.switch =
                 Some(format!("a pattern reads {name}: it sets the structure's counts, which have no derivative"));

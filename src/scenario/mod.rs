@@ -117,6 +117,16 @@ impl Scenario {
         params::params_at(&self.param_table, &self.params, point)
     }
 
+    /// The parameters that nothing reads ([`params::unread`]): a change to one changes no
+    /// structure, model, check, motion or input, so a study gives it no steps. None for a
+    /// built-in mechanism, which reads its parameters itself.
+    pub fn unread_params(&self) -> Vec<String> {
+        match &self.custom {
+            Some(_) => params::unread(&self.source, &self.overrides, &self.param_table),
+            None => Vec::new(),
+        }
+    }
+
     /// The scenario's mechanism: a built-in one, or the file's own structure.
     pub fn mechanism(&self) -> Box<dyn Mechanism> {
         match &self.custom {

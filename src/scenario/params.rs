@@ -74,3 +74,37 @@ pub(crate) fn params_at(table: &ParamTable, base: &Values, point: &Values) -> Va
     out.extend(set);
     out
 }
+
+/// The parameters of a custom file's `[params]` (`table`) that nothing reads: no word of the
+/// file outside `[params]` (a key or a string anywhere else: the structure's expressions and
+/// patterns, the model, the checks, the motion, the inputs, `[[sensitivities]]`) and no word
+/// of a `--set` flag's value names one, and no parameter that is read derives from it. A word is a
+/// run of letters, digits and `_`: a parameter named in a description counts as read, which
+/// errs on the side of differentiating it. One pass over the text, however many parameters.
+pub(super) fn unread(source: &str, overrides: &[super::overrides::Override], table: &ParamTable) -> Vec<String> {
+    let Ok(file) = source.parse::<toml::Table>() else { return Vec::new() };
+    let mut words = std::collections::HashSet::new();
+    let mut add = |text: &str| {
+        words.extend(text.split(|c: char| !(c.is_alphanumeric() || c == '_')).map(str::to_string));
+    };
+    fn walk(v: &toml::Value, add: &mut dyn FnMut(&str)) {
+        match v {
+            toml::Value::String(s) => add(s),
+            toml::Value::Array(a) => a.iter().for_each(|v| walk(v, add)),
+            toml::Value::Table(t) => t.iter().for_each(|(k, v)| {
+                add(k);
+                walk(v, add)
+            }),
+            _ => {}
+        }
+    }
+    for (k, v) in file.iter().filter(|(k, _)| *k != "params") {
+        add(k);
+        walk(v, &mut add);
+    }
+    // A flag on a parameter is its definition in the table; one on `[sim]` or `[settle]` a value.
+    for o in overrides.iter().filter(|o| !table.has(&o.name)) {
+        add(&o.value);
+    }
+    table.unreached(|name| words.contains(name))
+}
