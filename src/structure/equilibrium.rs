@@ -154,11 +154,24 @@ fn sparse_matrix(
     rows: &[(NodeId, usize)],
     members: &[MemberId],
 ) -> Result<nalgebra_sparse::CscMatrix<f64>, EquilibriumError> {
+    let mut coo = nalgebra_sparse::CooMatrix::new(rows.len(), members.len());
+    entries(s, positions, rows, members, |r, c, x| coo.push(r, c, x))?;
+    Ok(nalgebra_sparse::CscMatrix::from(&coo))
+}
+
+/// Each entry of A (row, column, value; repeated pairs add up): member k's column holds, at
+/// each node of its path, minus the gradient of its length there.
+fn entries(
+    s: &Structure,
+    positions: &[Vec3],
+    rows: &[(NodeId, usize)],
+    members: &[MemberId],
+    mut entry: impl FnMut(usize, usize, f64),
+) -> Result<(), EquilibriumError> {
     let mut row = vec![[None; 3]; s.nodes.len()];
     for (k, &(n, x)) in rows.iter().enumerate() {
         row[n][x] = Some(k);
     }
-    let mut coo = nalgebra_sparse::CooMatrix::new(rows.len(), members.len());
     for (c, &k) in members.iter().enumerate() {
         for w in s.members[k].path.windows(2) {
             let (p, q) = (positions[w[0]], positions[w[1]]);
@@ -169,13 +182,13 @@ fn sparse_matrix(
             for (node, sign) in [(w[0], 1.0), (w[1], -1.0)] {
                 for x in 0..3 {
                     if let Some(r) = row[node][x] {
-                        coo.push(r, c, sign * (q[x] - p[x]) / l);
+                        entry(r, c, sign * (q[x] - p[x]) / l);
                     }
                 }
             }
         }
     }
-    Ok(nalgebra_sparse::CscMatrix::from(&coo))
+    Ok(())
 }
 
 /// The columns of `a` that share a row, per column (the graph its Gram matrix couples). `at`
@@ -206,27 +219,8 @@ pub(super) fn matrix(s: &Structure, positions: &[Vec3]) -> Result<(Layout, DMatr
             members.len()
         )));
     }
-    let mut row = vec![[None; 3]; s.nodes.len()];
-    for (k, &(n, x)) in rows.iter().enumerate() {
-        row[n][x] = Some(k);
-    }
     let mut a = DMatrix::zeros(rows.len(), members.len());
-    for (c, &k) in members.iter().enumerate() {
-        for w in s.members[k].path.windows(2) {
-            let (p, q) = (positions[w[0]], positions[w[1]]);
-            let l = super::distance(p, q);
-            if l <= 0.0 {
-                return Err(EquilibriumError(format!("member '{}' has a segment of no length", s.members[k].name)));
-            }
-            for (node, sign) in [(w[0], 1.0), (w[1], -1.0)] {
-                for x in 0..3 {
-                    if let Some(r) = row[node][x] {
-                        a[(r, c)] += sign * (q[x] - p[x]) / l;
-                    }
-                }
-            }
-        }
-    }
+    entries(s, positions, &rows, &members, |r, c, x| a[(r, c)] += x)?;
     Ok(((nodes, rows, members), a))
 }
 
