@@ -355,7 +355,8 @@ fn displaced_mode(
 }
 
 /// A mode of the structure's own modal analysis (from 1 in the file, from 0 here): at most six
-/// per free body, or one per free (not actuated) joint of a jointed structure.
+/// per free body, or one per coordinate of a free (not actuated) joint of a jointed structure
+/// (a ball joint's three, a universal joint's two: issue 62 item 1 had counted one per joint).
 fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, ScenarioError> {
     // Point masses' turns are no modes, and their bodies count apart (`structure::modal_bodies`).
     let (bodies, points) = crate::structure::modal_bodies(s);
@@ -369,7 +370,9 @@ fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, Sc
             s.bodies[b].kind == crate::structure::BodyKind::Free && !s.joints.iter().any(|j| j.child == b)
         });
         let loose: usize = loose.map(|b| if point[b] { 3 } else { 6 }).sum();
-        ((0..s.joints.len()).filter(|j| !actuated(*j)).count() + loose) as i64
+        let joints: usize =
+            (0..s.joints.len()).filter(|j| !actuated(*j)).map(|j| s.joints[j].kind.coordinate_count()).sum();
+        (joints + loose) as i64
     };
     let most_points = crate::structure::MAX_SPARSE_MODAL_POINT_MASSES;
     if points > most_points {

@@ -392,7 +392,7 @@ impl Data {
         };
         let joint_row = (0..s.joints.len())
             .map(|j| match tree.carried(j).filter(|_| !m.actuated[j]) {
-                Some(_) => at(coordinate_count(&s.joints[j].kind)),
+                Some(_) => at(s.joints[j].kind.coordinate_count()),
                 None => None,
             })
             .collect();
@@ -677,17 +677,6 @@ impl Data {
             }
         }
         out
-    }
-}
-
-/// The number of coordinates a tree joint of this kind leaves free (as
-/// `Simulation::joint_coordinate_forces` lists them).
-fn coordinate_count(kind: &JointKind) -> usize {
-    match kind {
-        JointKind::Revolute { .. } | JointKind::Prismatic { .. } => 1,
-        JointKind::Universal { .. } => 2,
-        JointKind::Spherical => 3,
-        JointKind::Fixed | JointKind::PlanarPin { .. } => 0,
     }
 }
 

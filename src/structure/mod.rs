@@ -84,6 +84,17 @@ pub enum JointKind {
 }
 
 impl JointKind {
+    /// The coordinates the joint leaves its child (a joint that closes a loop takes as many
+    /// constraint rows away instead).
+    pub fn coordinate_count(&self) -> usize {
+        match self {
+            JointKind::Revolute { .. } | JointKind::Prismatic { .. } => 1,
+            JointKind::Universal { .. } => 2,
+            JointKind::Spherical => 3,
+            JointKind::Fixed | JointKind::PlanarPin { .. } => 0,
+        }
+    }
+
     pub fn label(&self) -> &'static str {
         match self {
             JointKind::Revolute { .. } => "revolute",

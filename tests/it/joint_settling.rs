@@ -180,7 +180,8 @@ verdict = "pass"
 /// stiff spring along the slides' diagonal and two soft ones: each joint's Newton step with the
 /// others held is a Jacobi iteration that the diagonal coupling makes diverge (F2 of issue 60:
 /// 6000 accelerated steps and 11 J of kinetic energy left). The schedule now stops once it has
-/// not lowered the joints' largest force over 50 steps, and the joints' damping finishes the
+/// not lowered the joints' largest force to 0.1 of itself over 200 steps, and the joints'
+/// damping finishes the
 /// settle: it settles where the physical dynamics alone do, within 1e-9 m.
 fn slider_chain(newton_damping: bool) -> String {
     let head =

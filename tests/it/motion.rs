@@ -452,3 +452,78 @@ fn a_jointed_structure_vibrates_along_its_reduced_mode() {
     assert!((f.fit_amplitude - eta).abs() <= 1e-3 * eta, "{f:?}");
     assert!(f.passed && (f.predicted_rad_per_s - omega()).abs() <= 1e-7 * omega(), "{f:?}");
 }
+
+/// A strut on a ball joint has three coordinates, so three modes (its spin about its own axis
+/// a rigid one): `[motion] mode = 3` starts a motion along the third, where the count had been
+/// one per joint ("mode 3 does not exist: the structure has 1", issue 62 item 1); mode 4 is
+/// refused at its line, the structure having 3.
+#[test]
+fn a_ball_jointed_strut_moves_along_any_of_its_three_modes() {
+    let text = r#"name = "a strut on a ball joint held by three springs"
+mechanism = "custom"
+
+[settle]
+speed_tol = 1e-12
+residual_force_tol = 1e-10
+residual_torque_tol = 1e-10
+
+[actuation]
+points = [ {} ]
+
+[structure]
+gravity = [0, 0, 0]
+
+[[structure.bodies]]
+name = "ground"
+fixed = true
+nodes = { O = [0, 0, 0], S1 = [1, 0, 1], S2 = [-0.5, 0.9, 1], S3 = [-0.5, -0.9, 1] }
+
+[[structure.bodies]]
+name = "bar"
+mass = 1.0
+nodes = { B = [0, 0, 0], T = [0.1, 0.05, 1] }
+
+[[structure.joints]]
+name = "ball"
+kind = "spherical"
+parent = "ground"
+child = "bar"
+at = "B"
+damping = 0.5
+
+[[structure.struts]]
+name = "bar"
+a = "B"
+b = "T"
+
+[[structure.springs]]
+name = "s1"
+a = "T"
+b = "S1"
+stiffness = 50.0
+length = 0.5
+
+[[structure.springs]]
+name = "s2"
+a = "T"
+b = "S2"
+stiffness = 60.0
+length = 0.5
+
+[[structure.springs]]
+name = "s3"
+a = "T"
+b = "S3"
+stiffness = 70.0
+length = 0.5
+
+[motion]
+duration_s = 0.5
+start = "settled"
+mode = 3
+amplitude = 1e-4
+"#;
+    let report = run_text(text, &RunOptions::default());
+    assert!(report.passed, "{}", report.verdict_line());
+    error_at(&text.replacen("mode = 3", "mode = 4", 1), "mode = 4", 7, "mode 4 does not exist: the structure has 3");
+}
