@@ -329,7 +329,10 @@ impl Structure {
     }
 
     pub fn node_id(&self, name: &str) -> Option<NodeId> {
-        self.nodes.iter().position(|n| n.name == name)
+        let found = self.nodes.iter().position(|n| n.name == name);
+        #[cfg(test)]
+        NODE_NAMES_COMPARED.with(|c| c.set(c.get() + found.map_or(self.nodes.len(), |k| k + 1)));
+        found
     }
 
     pub fn body_id(&self, name: &str) -> Option<BodyId> {
@@ -790,6 +793,13 @@ pub fn modal_free_body_bound(s: &Structure) -> usize {
     } else {
         MAX_MODAL_FREE_BODIES
     }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// The node names [`Structure::node_id`] has compared on this thread: the tests' count of
+    /// the work of looking nodes up by name (each lookup scans the nodes).
+    pub(crate) static NODE_NAMES_COMPARED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
 }
 
 #[cfg(test)]
