@@ -591,6 +591,9 @@ fn fit_json(
         .map(|s| Override::parse(s).map_err(|e| PyValueError::new_err(e.to_string())))
         .collect::<PyResult<_>>()?;
     let parameters = params.into_iter().map(|(name, low, high)| FitParameter { name, low, high }).collect();
+    if rows.len() > study::MAX_DATA_ROWS {
+        return Err(PyValueError::new_err(format!("data: {}", study::too_many_rows())));
+    }
     let measurements = match data_path {
         Some(d) => study::read_measurements("data", &d, false).map_err(|e| PyValueError::new_err(e.to_string()))?,
         None => rows
@@ -625,6 +628,7 @@ fn sections_toml(json: &str) -> PyResult<String> {
 
 #[pymodule]
 fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("MAX_DATA_ROWS", study::MAX_DATA_ROWS)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(run_json, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_csv, m)?)?;

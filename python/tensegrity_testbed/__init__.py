@@ -254,6 +254,10 @@ def _fit_rows(data) -> list:
     import pandas as pd
 
     frame = data if isinstance(data, pd.DataFrame) else pd.DataFrame(data)
+    if len(frame) > _tensegrity.MAX_DATA_ROWS:
+        # Bounded as a data file is, before a row is copied.
+        raise ValueError(f"data: {len(frame)} rows: more than {_tensegrity.MAX_DATA_ROWS} measurement rows: "
+                         f"at most {_tensegrity.MAX_DATA_ROWS} (fit fewer, or average repeated rows)")
     columns = list(frame.columns)
     twice = [c for k, c in enumerate(columns) if c in columns[:k]]
     if twice:

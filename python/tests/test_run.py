@@ -820,6 +820,24 @@ def test_bad_fit_input_raises_a_clear_python_exception():
         tt.fit(str(SWEPT_BAR), ANGLES, {"k3": None})
 
 
+def test_a_million_rows_raise_a_value_error_as_the_clis_data_bound(tmp_path):
+    """A 1,000,000-row DataFrame is refused with a ValueError naming the bound, before its rows
+    are copied (it aborted the interpreter on an allocation failure); a CSV of one row past the
+    bound is refused as the CLI's --data refuses it, at its line."""
+    import numpy as np
+    import pandas as pd
+
+    bound = tt._tensegrity.MAX_DATA_ROWS
+    n = 1_000_000
+    frame = pd.DataFrame({"point": np.zeros(n, dtype=np.int64), "output": ["q"] * n, "value": np.zeros(n)})
+    with pytest.raises(ValueError, match=rf"data: 1000000 rows: more than {bound} measurement rows"):
+        tt.fit(str(SWEPT_BAR), frame, ["k2"])
+    csv = tmp_path / "many.csv"
+    csv.write_text("point,output,value\n" + "0,q,0.1\n" * (bound + 1))
+    with pytest.raises(ValueError, match=rf"many.csv:{bound + 2}:1: more than {bound} measurement rows"):
+        tt.fit(str(SWEPT_BAR), csv, ["k2"])
+
+
 def test_a_column_named_twice_raises_as_the_cli_refuses_it(tmp_path):
     """Data naming ``value`` twice are refused, as a DataFrame and as a CSV's path, each with a
     ValueError naming the column (the DataFrame's rows had been read from the first of the two

@@ -18,7 +18,7 @@ pub mod sweep;
 
 pub use fit::{fit, standard_normal};
 pub use problem::{
-    measurements_from_csv, parse_parameter, read_measurements, FitError, FitParameter, FitProblem, Measurement,
-    DATA_COLUMNS, MAX_DATA_BYTES,
+    measurements_from_csv, parse_parameter, read_measurements, too_many_rows, FitError, FitParameter, FitProblem,
+    Measurement, DATA_COLUMNS, MAX_DATA_BYTES, MAX_DATA_ROWS,
 };
 pub use sensitivity::{point_of as sensitivity_point_of, sensitivity, SensitivityRunError};

@@ -75,9 +75,17 @@ pub(crate) fn scenario_at(problem: &FitProblem, p: &[f64]) -> Result<Scenario, F
 
 /// Largest measurement file read \[bytes\].
 pub const MAX_DATA_BYTES: u64 = 16 << 20;
+/// Most measurement rows a fit takes, from a file or from Python (`tt.fit`'s DataFrame is
+/// bounded as the file is: refused before its rows are copied).
+pub const MAX_DATA_ROWS: usize = 100_000;
 /// The data's columns, the last two optional: `t_s`, a trajectory row's time since the
 /// motion's start (`fit_trajectory.rs`).
 pub const DATA_COLUMNS: [&str; 5] = ["point", "output", "value", "sigma", "t_s"];
+
+/// The error past [`MAX_DATA_ROWS`], the file's and Python's alike.
+pub fn too_many_rows() -> String {
+    format!("more than {MAX_DATA_ROWS} measurement rows: at most {MAX_DATA_ROWS} (fit fewer, or average repeated rows)")
+}
 
 /// `NAME`, `NAME=LOW:HIGH`, `NAME=LOW:` or `NAME=:HIGH` (the CLI's `--param`) as a parameter
 /// to fit.
@@ -149,6 +157,9 @@ pub fn measurements_from_csv(file: &str, text: &str) -> Result<Vec<Measurement>,
     }
     let mut rows = Vec::new();
     for (n, line) in lines {
+        if rows.len() == MAX_DATA_ROWS {
+            return Err(bad(format!("{file}:{}:1: {}", n + 1, too_many_rows())));
+        }
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
         if cells.len() != names.len() {
             let what = format!("{} cells where the header has {}", cells.len(), names.len());

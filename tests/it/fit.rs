@@ -392,3 +392,16 @@ fn bad_trajectory_rows_give_exit_2_naming_what_is_wrong() {
         }
     }
 }
+
+/// Data of one row past `MAX_DATA_ROWS` are refused at that row's line, naming the bound (the
+/// bound `tt.fit` applies to a DataFrame too); data at the bound are read.
+#[test]
+fn data_past_the_row_bound_are_refused_at_the_row() {
+    use tensegrity_testbed::study::{measurements_from_csv, MAX_DATA_ROWS};
+    let at_bound = format!("point,output,value\n{}", "0,q,0.1\n".repeat(MAX_DATA_ROWS));
+    assert_eq!(measurements_from_csv("d.csv", &at_bound).expect("at the bound").len(), MAX_DATA_ROWS);
+    let past = format!("{at_bound}0,q,0.1\n");
+    let e = measurements_from_csv("d.csv", &past).expect_err("past the bound").to_string();
+    let line = MAX_DATA_ROWS + 2;
+    assert!(e.starts_with(&format!("d.csv:{line}:1: more than {MAX_DATA_ROWS} measurement rows")), "{e}");
+}
