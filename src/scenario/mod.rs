@@ -117,7 +117,7 @@ impl Scenario {
         params::params_at(&self.param_table, &self.params, point)
     }
 
-    /// The parameters that nothing reads ([`params::unread`]): a change to one changes no
+    /// The parameters that nothing reads (`params::unread`): a change to one changes no
     /// structure, model, check, motion or input, so a study gives it no steps. None for a
     /// built-in mechanism, which reads its parameters itself.
     pub fn unread_params(&self) -> Vec<String> {

@@ -4,7 +4,7 @@
 //! The null space of a sparse A (m by n) is that of its Gram matrix G = A^T A (n by n, as
 //! sparse as the members' sharing of nodes). Its eigenvectors of least eigenvalue are found by
 //! shift-invert subspace iteration: the sparse Cholesky factor of G + sigma 1 (unknowns in
-//! reverse Cuthill-McKee order, `crate::ordering`), sigma = [`SHIFT_RATIO`] of the largest
+//! reverse Cuthill-McKee order, `crate::ordering`), sigma = `SHIFT_RATIO` of the largest
 //! eigenvalue, applied to a block of vectors, orthonormalised and rotated by Rayleigh-Ritz, until
 //! the lowest of them converge. Each vector's singular value is read as |A x| (not from G,
 //! whose eigenvalues square it and lose the small ones to round-off: |A x| of a null vector is
@@ -18,14 +18,14 @@ use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use nalgebra_sparse::factorization::CscCholesky;
 use nalgebra_sparse::{CooMatrix, CscMatrix};
 
-/// The shift of the factorization, a fraction of G's largest eigenvalue: far above the
-/// factor's round-off (G + sigma 1 is factored at a condition of 1e10), far below every
-/// nonzero eigenvalue that [`super::equilibrium::RANK_TOLERANCE`] leaves nonzero... squared:
-/// singular values between 1e-10 and 1e-5 of the largest converge slower, not wrongly.
+/// The shift of the factorization, a fraction of G's largest eigenvalue: G + sigma 1 is then
+/// factored at a condition of 1e10, well within double precision; eigenvalues of G below the
+/// shift (singular values of A below 1e-5 of the largest) converge more slowly, not wrongly,
+/// since each is judged by |A x|.
 const SHIFT_RATIO: f64 = 1e-10;
 /// The first block of vectors; it doubles while the converged ones are all null.
 const FIRST_BLOCK: usize = 16;
-/// The largest block (a null space larger than this less [`GUARD`] is refused).
+/// The largest block (a null space larger than this less `GUARD` is refused).
 pub const MAX_BLOCK: usize = 512;
 /// Vectors of the block beyond those whose convergence is required (they speed it).
 const GUARD: usize = 4;

@@ -459,21 +459,8 @@ fn a_jointed_structure_vibrates_along_its_reduced_mode() {
 /// refused at its line, the structure having 3.
 #[test]
 fn a_ball_jointed_strut_moves_along_any_of_its_three_modes() {
-    let text = r#"name = "a strut on a ball joint held by three springs"
-mechanism = "custom"
-
-[settle]
-speed_tol = 1e-12
-residual_force_tol = 1e-10
-residual_torque_tol = 1e-10
-
-[actuation]
-points = [ {} ]
-
-[structure]
-gravity = [0, 0, 0]
-
-[[structure.bodies]]
+    let text = &(super::common::one_point_head("a strut on a ball joint held by three springs")
+        + r#"[[structure.bodies]]
 name = "ground"
 fixed = true
 nodes = { O = [0, 0, 0], S1 = [1, 0, 1], S2 = [-0.5, 0.9, 1], S3 = [-0.5, -0.9, 1] }
@@ -522,7 +509,7 @@ duration_s = 0.5
 start = "settled"
 mode = 3
 amplitude = 1e-4
-"#;
+"#);
     let report = run_text(text, &RunOptions::default());
     assert!(report.passed, "{}", report.verdict_line());
     error_at(&text.replacen("mode = 3", "mode = 4", 1), "mode = 4", 7, "mode 4 does not exist: the structure has 3");
