@@ -126,6 +126,9 @@ struct Plan {
     origin: Vec<Vec3>,
     /// For each joint: driven by an actuator.
     actuated: Vec<bool>,
+    /// For each body: the world translations its supports hold (`Structure::supports`; slide
+    /// joints along the others).
+    supported: Vec<[bool; 3]>,
 }
 
 /// Writes `s` as MJCF.
@@ -204,7 +207,7 @@ fn plan(s: &Structure, mode: ActuatorMode) -> Plan {
             _ => [0.0; 3],
         })
         .collect();
-    Plan { tree_joint, mocap, held, origin, actuated }
+    Plan { tree_joint, mocap, held, origin, actuated, supported: s.held_translations() }
 }
 
 /// Escapes text for an XML attribute or comment.
@@ -315,7 +318,7 @@ impl Writer<'_> {
         }
         let Some(j) = plan.tree_joint[b] else {
             let mass = s.bodies[b].inertia.map_or(0.0, |i| i.mass_kg);
-            let held = s.held_translations()[b];
+            let held = plan.supported[b];
             if held.contains(&true) {
                 // A support in some directions (on a point mass, which nothing turns): a slide
                 // joint along each free axis.

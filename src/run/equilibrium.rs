@@ -35,7 +35,7 @@ pub fn equilibrium(
     let state = settle_first_point(sc, cancel)?;
     let wall = Instant::now();
     let s = state.sim.structure();
-    let positions: Vec<_> = (0..s.nodes.len()).map(|n| state.sim.node_position(n)).collect();
+    let positions = state.sim.node_positions();
     let e = crate::structure::equilibrium::equilibrium_matrix(s, &positions)?;
     let report = EquilibriumReport {
         name: sc.name.clone(),
@@ -80,8 +80,7 @@ fn with_linear(
     let mut reference_sc = sc.clone();
     reference_sc.custom = Some(custom.without_point_loads());
     let reference = settle_first_point(&reference_sc, cancel)?;
-    let at = |state: &SettledState| (0..s.nodes.len()).map(|n| state.sim.node_position(n)).collect::<Vec<_>>();
-    let (before, after) = (at(&reference), at(loaded));
+    let (before, after) = (reference.sim.node_positions(), loaded.sim.node_positions());
     let (t0, t) = (reference.sim.member_forces(), loaded.sim.member_forces());
     let tension = |m: usize| t0.force_n[m];
     match crate::structure::linear::linear_analysis(s, &before, &tension, &s.node_loads) {
@@ -117,7 +116,7 @@ fn reactions(
     use nalgebra::Vector3;
     let held = s.held_translations();
     let fixed = |n: usize| s.bodies[s.nodes[n].body].kind == BodyKind::Fixed;
-    let supported = |n: usize| s.supports.iter().any(|x| x.node == n);
+    let supported = |n: usize| held[s.nodes[n].body].contains(&true);
     let mut at: std::collections::BTreeMap<usize, Vector3<f64>> = Default::default();
     for (k, member) in s.members.iter().enumerate() {
         for (seg, (a, b)) in member.segments().enumerate() {

@@ -366,10 +366,7 @@ fn mode_index(ctx: &Ctx, mode: &Spanned<i64>, s: &Structure) -> Result<usize, Sc
         let actuated = |j: usize| s.actuators.iter().any(|a| a.target == crate::structure::ActuatorTarget::Joint(j));
         // Free bodies beside the joint trees add their own six coordinates (a point mass three).
         let point = crate::structure::lumped::point_masses(s);
-        let loose = (0..s.bodies.len()).filter(|&b| {
-            s.bodies[b].kind == crate::structure::BodyKind::Free && !s.joints.iter().any(|j| j.child == b)
-        });
-        let loose: usize = loose.map(|b| if point[b] { 3 } else { 6 }).sum();
+        let loose: usize = s.unjointed_free_bodies().into_iter().map(|b| if point[b] { 3 } else { 6 }).sum();
         let joints: usize =
             (0..s.joints.len()).filter(|j| !actuated(*j)).map(|j| s.joints[j].kind.coordinate_count()).sum();
         (joints + loose) as i64

@@ -93,8 +93,7 @@ pub(super) fn set_self_stress(
     let anchored: Vec<[bool; 3]> = (0..s.nodes.len())
         .map(|n| {
             let whole = (fixed(s.nodes[n].body) && !on_strut(n)) || pinned(n);
-            let by_support = s.supports.iter().any(|x| x.node == n);
-            [0, 1, 2].map(|k| whole || (by_support && held[s.nodes[n].body][k]))
+            [0, 1, 2].map(|k| whole || held[s.nodes[n].body][k])
         })
         .collect();
     let positions: Vec<_> = s.nodes.iter().map(|n| n.position).collect();

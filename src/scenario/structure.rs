@@ -53,8 +53,9 @@ pub(super) fn structure_from_file(ctx: &Ctx, raw: &Spanned<RawStructure>) -> Res
     for n in &r.masses {
         add_node_mass(ctx, &mut s, n)?;
     }
+    let (points, mut supported) = (crate::structure::lumped::point_masses(&s), vec![false; s.nodes.len()]);
     for support in &r.supports {
-        let support = node_support(ctx, &s, support)?;
+        let support = node_support(ctx, &s, support, &points, &mut supported)?;
         s.supports.push(support);
     }
     Ok(s)
@@ -390,15 +391,18 @@ fn add_node_mass(ctx: &Ctx, s: &mut Structure, n: &super::raw::RawNodeMass) -> R
 }
 
 /// A support in some directions: at a node of a point mass (a rigid body's node would need
-/// its turns held too), each of x, y and z named at most once, one support per node.
+/// its turns held too), each of x, y and z named at most once, one support per node
+/// (`points`: which bodies are point masses; `supported`: the nodes that have one so far).
 fn node_support(
     ctx: &Ctx,
     s: &Structure,
     r: &super::raw::RawSupport,
+    points: &[bool],
+    supported: &mut [bool],
 ) -> Result<crate::structure::NodeSupport, ScenarioError> {
     let node = node(ctx, s, &r.node)?;
     let body = s.nodes[node].body;
-    if !crate::structure::lumped::is_point_mass(s, body) {
+    if !points[body] {
         let why = if s.bodies[body].kind == BodyKind::Fixed {
             "is fixed: it is held in every direction already"
         } else {
@@ -408,7 +412,7 @@ fn node_support(
             ctx.err(&r.node, format!("node '{}' is on body '{}', which {why}", r.node.get_ref(), s.bodies[body].name))
         );
     }
-    if s.supports.iter().any(|o| o.node == node) {
+    if std::mem::replace(&mut supported[node], true) {
         return Err(ctx.err(&r.node, format!("node '{}' has a support already", r.node.get_ref())));
     }
     let mut held = [false; 3];

@@ -411,13 +411,9 @@ impl Data {
                 residual.max_force_n = residual.max_force_n.max((-out.force_n[c]).max(0.0));
             }
         }
-        let held = self.held_rows(m, &m.fit_tree);
-        for (_, c) in self
-            .coordinate_forces(m, &m.fit_tree, wrench, true)
-            .into_iter()
-            .enumerate()
-            .filter(|(r, _)| !held.contains(r))
-        {
+        let forces = self.coordinate_forces(m, &m.fit_tree, wrench, true);
+        let held = self.held_rows(m, &m.fit_tree, forces.len());
+        for (_, c) in forces.into_iter().enumerate().filter(|(r, _)| !held[*r]) {
             if c.is_torque {
                 residual.max_torque_nm = residual.max_torque_nm.max(c.value.abs());
             } else {
@@ -427,12 +423,16 @@ impl Data {
         residual
     }
 
-    /// The rows of [`Self::coordinate_forces`] that supports hold (a free root's translations
-    /// along held axes): the support takes their force, as its reaction.
-    fn held_rows(&self, m: &Model, tree: &Tree) -> Vec<usize> {
+    /// Whether each row of [`Self::coordinate_forces`] is held by a support (a free root's
+    /// translation along a held axis): the support takes its force, as its reaction.
+    fn held_rows(&self, m: &Model, tree: &Tree, rows: usize) -> Vec<bool> {
         let (_, root_row) = self.coordinate_rows(m, tree);
-        let rows = root_row.iter().zip(&m.held_translations).filter_map(|(row, held)| row.map(|r| (r, held)));
-        rows.flat_map(|(r, held)| (0..3).filter(|x| held[*x]).map(move |x| r + x)).collect()
+        let mut held = vec![false; rows];
+        for (row, axes) in root_row.iter().zip(&m.held_translations) {
+            let Some(r) = *row else { continue };
+            (0..3).filter(|&x| axes[x]).for_each(|x| held[r + x] = true);
+        }
+        held
     }
 
     /// Each actuator's force along its joint axis (or its cable's tension): minus the load of

@@ -17,7 +17,7 @@
 use super::data::Data;
 use super::model::Model;
 use super::modes::{ModesError, StructureMode, StructureModes, ZERO_MODE_RATIO};
-use crate::structure::{BodyKind, JointKind};
+use crate::structure::JointKind;
 use nalgebra::{DMatrix, DVector, Quaternion, UnitQuaternion, Vector3};
 
 /// Finite-difference step of a revolute coordinate [rad].
@@ -45,9 +45,8 @@ impl Data {
                 return Err(ModesError::Loop(joint.name.clone()));
             }
         }
-        let jointed = |b: usize| s.joints.iter().any(|j| j.child == b);
-        if let Some(b) = s.bodies.iter().enumerate().find(|(b, body)| body.kind == BodyKind::Free && !jointed(*b)) {
-            return Err(ModesError::Unjointed(b.1.name.clone()));
+        if let Some(&b) = s.unjointed_free_bodies().first() {
+            return Err(ModesError::Unjointed(s.bodies[b].name.clone()));
         }
         let free: Vec<usize> = (0..s.joints.len()).filter(|j| !m.actuated[*j]).collect();
         if let Some(&j) = free

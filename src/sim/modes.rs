@@ -197,8 +197,7 @@ impl Data {
         // Free bodies beside joint trees (beads on the members of a jointed structure): the
         // constrained analysis's coordinates, the trees' joints and six per such body, with no
         // constraint (F5 of issue 60: they had been refused).
-        let loose = |b: usize| m.is_free(b) && !s.joints.iter().any(|j| j.child == b);
-        if m.is_constrained() || (!s.joints.is_empty() && (0..s.bodies.len()).any(loose)) {
+        if m.is_constrained() || (!s.joints.is_empty() && !s.unjointed_free_bodies().is_empty()) {
             return self.constrained_modes(m, cancel);
         }
         if !s.joints.is_empty() {

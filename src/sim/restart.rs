@@ -78,7 +78,7 @@ impl Data {
                 .iter()
                 .zip(&m.joint_links)
                 .all(|(j, l)| l.is_some() && matches!(j.kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. }))
-            && (0..s.bodies.len()).all(|b| !m.is_free(b) || s.joints.iter().any(|j| j.child == b))
+            && s.unjointed_free_bodies().is_empty()
     }
 
     /// Turns every free joint, parents first, so that a node of its child lands where `s`

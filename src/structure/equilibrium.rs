@@ -84,8 +84,11 @@ pub(super) type Layout = (Vec<NodeId>, Vec<(NodeId, usize)>, Vec<MemberId>);
 fn layout(s: &Structure) -> Result<Layout, EquilibriumError> {
     check_pin_jointed(s)?;
     let free = |n: NodeId| s.bodies[s.nodes[n].body].kind == BodyKind::Free;
-    let nodes: Vec<NodeId> =
-        (0..s.nodes.len()).filter(|&n| free(n) && s.members.iter().any(|m| m.path.contains(&n))).collect();
+    let mut reached = vec![false; s.nodes.len()];
+    for m in &s.members {
+        m.path.iter().for_each(|&n| reached[n] = true);
+    }
+    let nodes: Vec<NodeId> = (0..s.nodes.len()).filter(|&n| free(n) && reached[n]).collect();
     let held = s.held_translations();
     let row_list: Vec<(NodeId, usize)> = nodes
         .iter()
@@ -106,17 +109,27 @@ fn layout(s: &Structure) -> Result<Layout, EquilibriumError> {
 
 /// The equilibrium matrix of `s` with its nodes at `positions` \[m\], and its SVD.
 pub fn equilibrium_matrix(s: &Structure, positions: &[Vec3]) -> Result<EquilibriumMatrix, EquilibriumError> {
-    let (rows, columns) = (layout(s)?.1.len(), layout(s)?.2.len());
-    analysis(s, positions, rows * columns <= MAX_EQUILIBRIUM_ENTRIES)
+    let layout = layout(s)?;
+    let dense = layout.1.len() * layout.2.len() <= MAX_EQUILIBRIUM_ENTRIES;
+    analysis_of(s, positions, layout, dense)
 }
 
 /// [`equilibrium_matrix`] by the dense SVD (`dense`) or by the sparse null spaces
 /// (`sparse_null.rs`), whatever the size (the two are checked against each other).
 pub fn analysis(s: &Structure, positions: &[Vec3], dense: bool) -> Result<EquilibriumMatrix, EquilibriumError> {
-    let (nodes, rows, members) = layout(s)?;
+    analysis_of(s, positions, layout(s)?, dense)
+}
+
+/// [`analysis`] of the `layout` of `s`.
+fn analysis_of(
+    s: &Structure,
+    positions: &[Vec3],
+    (nodes, rows, members): Layout,
+    dense: bool,
+) -> Result<EquilibriumMatrix, EquilibriumError> {
     let shape = (rows.len(), members.len());
     let (singular_values, self_stress, mechanisms) = if dense {
-        let (_, a) = matrix(s, positions)?;
+        let a = dense_matrix(s, positions, &rows, &members)?;
         let (singular_values, self_stress) = null_space(&a);
         (singular_values, self_stress, null_space(&a.transpose()).1)
     } else {
@@ -168,10 +181,7 @@ fn entries(
     members: &[MemberId],
     mut entry: impl FnMut(usize, usize, f64),
 ) -> Result<(), EquilibriumError> {
-    let mut row = vec![[None; 3]; s.nodes.len()];
-    for (k, &(n, x)) in rows.iter().enumerate() {
-        row[n][x] = Some(k);
-    }
+    let row = row_index(s, rows);
     for (c, &k) in members.iter().enumerate() {
         for w in s.members[k].path.windows(2) {
             let (p, q) = (positions[w[0]], positions[w[1]]);
@@ -212,6 +222,17 @@ fn coupled(at: &nalgebra_sparse::CscMatrix<f64>) -> Vec<Vec<usize>> {
 /// dense: refused above [`MAX_EQUILIBRIUM_ENTRIES`] (the linear analysis too is dense).
 pub(super) fn matrix(s: &Structure, positions: &[Vec3]) -> Result<(Layout, DMatrix<f64>), EquilibriumError> {
     let (nodes, rows, members) = layout(s)?;
+    let a = dense_matrix(s, positions, &rows, &members)?;
+    Ok(((nodes, rows, members), a))
+}
+
+/// A as a dense matrix, refused above [`MAX_EQUILIBRIUM_ENTRIES`].
+fn dense_matrix(
+    s: &Structure,
+    positions: &[Vec3],
+    rows: &[(NodeId, usize)],
+    members: &[MemberId],
+) -> Result<DMatrix<f64>, EquilibriumError> {
     if rows.len() * members.len() > MAX_EQUILIBRIUM_ENTRIES {
         return Err(EquilibriumError(format!(
             "its equilibrium matrix, {} by {}, is above the {MAX_EQUILIBRIUM_ENTRIES} entries a dense analysis is given here",
@@ -220,23 +241,42 @@ pub(super) fn matrix(s: &Structure, positions: &[Vec3]) -> Result<(Layout, DMatr
         )));
     }
     let mut a = DMatrix::zeros(rows.len(), members.len());
-    entries(s, positions, &rows, &members, |r, c, x| a[(r, c)] += x)?;
-    Ok(((nodes, rows, members), a))
+    entries(s, positions, rows, members, |r, c, x| a[(r, c)] += x)?;
+    Ok(a)
+}
+
+/// Each node's row per direction (None: not a row: a fixed node's, or held by a support).
+pub(super) fn row_index(s: &Structure, rows: &[(NodeId, usize)]) -> Vec<[Option<usize>; 3]> {
+    let mut row = vec![[None; 3]; s.nodes.len()];
+    for (k, &(n, x)) in rows.iter().enumerate() {
+        row[n][x] = Some(k);
+    }
+    row
+}
+
+/// The displacement of each of the free `nodes` in the row vector `d` \[m\], zero along
+/// their held directions (rows are listed node by node, in the order of `nodes`).
+pub(super) fn displacements_by_node(
+    nodes: &[NodeId],
+    rows: &[(NodeId, usize)],
+    d: &DVector<f64>,
+) -> Vec<(NodeId, Vec3)> {
+    let mut at: Vec<(NodeId, Vec3)> = nodes.iter().map(|&n| (n, [0.0; 3])).collect();
+    let mut k = 0;
+    for (r, &(n, x)) in rows.iter().enumerate() {
+        while at[k].0 != n {
+            k += 1;
+        }
+        at[k].1[x] = d[r];
+    }
+    at
 }
 
 impl EquilibriumMatrix {
     /// The displacement of each free node in the row vector `d` (a mechanism) \[m\], zero
     /// along its held directions, in the order of [`Self::nodes`].
     pub fn node_displacements(&self, d: &DVector<f64>) -> Vec<(NodeId, Vec3)> {
-        let mut at: Vec<(NodeId, Vec3)> = self.nodes.iter().map(|&n| (n, [0.0; 3])).collect();
-        let mut k = 0;
-        for (r, &(n, x)) in self.rows.iter().enumerate() {
-            while at[k].0 != n {
-                k += 1;
-            }
-            at[k].1[x] = d[r];
-        }
-        at
+        displacements_by_node(&self.nodes, &self.rows, d)
     }
 }
 

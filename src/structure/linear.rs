@@ -11,7 +11,7 @@
 //! order are -A^T d, A's columns being minus the members' length gradients. The answer is exact to first order in the loads; the exact one (the settle under
 //! the loads) differs at second order, by the change of geometry the linear method ignores.
 
-use super::equilibrium::{matrix, EquilibriumError};
+use super::equilibrium::{displacements_by_node, matrix, row_index, EquilibriumError};
 use super::{MemberId, NodeId, NodeLoad, Structure, Vec3};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
@@ -40,10 +40,7 @@ pub fn linear_analysis(
 ) -> Result<LinearAnalysis, EquilibriumError> {
     let ((nodes, rows, members), a) = matrix(s, positions)?;
     let stiffness = axial_stiffnesses(s, positions, &members)?;
-    let mut row = vec![[None; 3]; s.nodes.len()];
-    for (r, &(n, x)) in rows.iter().enumerate() {
-        row[n][x] = Some(r);
-    }
+    let row = row_index(s, &rows);
     let mut k = &a * DMatrix::from_diagonal(&DVector::from_vec(stiffness.clone())) * a.transpose();
     for &m in &members {
         add_geometric(&mut k, &row, s, positions, m, tension(m));
@@ -61,12 +58,7 @@ pub fn linear_analysis(
     // member's other end), so the elongations are -A^T d.
     let elongation = -(a.transpose() * &d);
     let forces_n = members.iter().enumerate().map(|(c, &m)| (m, tension(m) + stiffness[c] * elongation[c])).collect();
-    let mut displacements_m: Vec<(NodeId, Vec3)> = nodes.iter().map(|&n| (n, [0.0; 3])).collect();
-    for (r, &(n, x)) in rows.iter().enumerate() {
-        let at = nodes.iter().position(|&m| m == n).expect("a row's node is a free node");
-        displacements_m[at].1[x] = d[r];
-    }
-    Ok(LinearAnalysis { displacements_m, forces_n })
+    Ok(LinearAnalysis { displacements_m: displacements_by_node(&nodes, &rows, &d), forces_n })
 }
 
 /// Each member's axial stiffness EA / L0 \[N/m\] at the reference (zero for a cable slack

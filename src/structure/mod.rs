@@ -359,20 +359,35 @@ impl Structure {
 
     /// Each support holds at least one direction of a point mass, one support per node.
     fn validate_supports(&self) -> Result<(), StructureError> {
+        if self.supports.is_empty() {
+            return Ok(());
+        }
+        let points = lumped::point_masses(self);
+        let mut supported = vec![false; self.nodes.len()];
         for (i, support) in self.supports.iter().enumerate() {
             let name = self.nodes.get(support.node).map_or(format!("#{i}"), |n| n.name.clone());
             self.check_node("support", &name, support.node)?;
             if !support.held.contains(&true) {
                 return Err(invalid("support", &name, "holds no direction"));
             }
-            if !lumped::is_point_mass(self, self.nodes[support.node].body) {
+            if !points[self.nodes[support.node].body] {
                 return Err(invalid("support", &name, "the node's body is not a point mass"));
             }
-            if self.supports[..i].iter().any(|o| o.node == support.node) {
+            if std::mem::replace(&mut supported[support.node], true) {
                 return Err(invalid("support", &name, "the node has another support"));
             }
         }
         Ok(())
+    }
+
+    /// The free bodies that no joint carries (beside the joint trees, or every free body of a
+    /// structure without joints).
+    pub fn unjointed_free_bodies(&self) -> Vec<BodyId> {
+        let mut carried = vec![false; self.bodies.len()];
+        for j in &self.joints {
+            carried[j.child] = true;
+        }
+        (0..self.bodies.len()).filter(|&b| self.bodies[b].kind == BodyKind::Free && !carried[b]).collect()
     }
 
     /// Which world translations (x, y, z) of each body its supports hold.
