@@ -122,6 +122,27 @@ pub enum Command {
         #[command(flatten)]
         set: SetArgs,
     },
+    /// What each idealization costs the file's model: its checks run under the ideal structure,
+    /// under each `[[fidelity]]` relaxation alone (elastic struts, elastic or heavy cables, each
+    /// with its data) and under all of them together; for every checked value at every point,
+    /// every file model check and every measured frequency, the deviation from the model at each
+    /// level, each relaxation's share of the change, and the interaction (what is left over).
+    Attribute {
+        scenario: PathBuf,
+        /// Write the JSON report to this file (`-`: standard output, the table then going to
+        /// standard error).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Write one row per compared value (a grid's shares per point) to this CSV file (`-`:
+        /// standard output).
+        #[arg(long, value_name = "FILE.csv")]
+        csv: Option<PathBuf>,
+        /// Draw one bar per compared value, split by relaxation (FILE.svg or FILE.png).
+        #[arg(long, value_name = "FILE.svg")]
+        figure: Option<PathBuf>,
+        #[command(flatten)]
+        set: SetArgs,
+    },
     /// Fit named parameters of a scenario to measured outputs (a CSV with the columns
     /// point,output,value[,sigma], and optionally t_s) by Levenberg-Marquardt, the Jacobian from
     /// the sensitivities at each measured point settled afresh, or for a row with a time t_s (a

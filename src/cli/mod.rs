@@ -6,6 +6,7 @@
 //! `Result<Outcome, CliError>`), and one line in `dispatch`.
 
 mod args;
+mod attribute;
 mod bench;
 mod check;
 mod equilibrium;
@@ -130,6 +131,9 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         }
         Command::Sensitivity { scenario, json, csv, point, check, set } => {
             sensitivity::sensitivity(&scenario, &overrides(&set)?, json.as_deref(), csv.as_deref(), point, check)
+        }
+        Command::Attribute { scenario, json, csv, figure, set } => {
+            attribute::attribute(&scenario, &overrides(&set)?, json.as_deref(), csv.as_deref(), figure.as_deref())
         }
         Command::Fit { scenario, data, params, json, set } => {
             fit::fit(&scenario, &overrides(&set)?, &data, &params, json.as_deref())

@@ -15,9 +15,10 @@ mod ji2014;
 mod kit;
 mod manriquez2019;
 mod mohr2011;
+pub mod attribution;
 pub mod sweep;
 
-use kit::Format;
+pub use kit::Format;
 pub use kit::{Canvas, FigureError, Plot};
 use std::path::{Path, PathBuf};
 

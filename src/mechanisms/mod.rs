@@ -11,6 +11,7 @@ pub mod furet2018;
 pub mod ji2014;
 pub mod manriquez2019;
 pub mod mohr2011;
+pub mod relaxed;
 
 pub use angle::wrap_angle;
 pub use error::{ModelError, ParamError, UnknownName};

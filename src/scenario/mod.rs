@@ -14,6 +14,7 @@ mod checks;
 mod energy;
 mod error;
 mod expect;
+mod fidelity;
 mod file_model;
 mod for_each;
 mod interference;
@@ -96,6 +97,11 @@ pub struct Scenario {
     /// `[prestress]`, or the default of a custom structure with cables: when the structure has
     /// lost its self-stress and what that does (None: not judged).
     pub prestress: Option<crate::settings::Prestress>,
+    /// `[[fidelity]]`: the idealizations the file can relax, with their data.
+    pub fidelity: Vec<crate::structure::fidelity::Relaxation>,
+    /// Which of them a run applies (indices into `fidelity`; empty: the ideal structure, as
+    /// every run but `tensegrity attribute`'s).
+    pub relaxed: Vec<usize>,
 }
 
 impl Scenario {
@@ -129,10 +135,24 @@ impl Scenario {
 
     /// The scenario's mechanism: a built-in one, or the file's own structure.
     pub fn mechanism(&self) -> Box<dyn Mechanism> {
-        match &self.custom {
+        let ideal: Box<dyn Mechanism> = match &self.custom {
             Some(c) => Box::new(c.clone()),
             None => mechanisms::find(&self.mechanism).expect("validated mechanism"),
+        };
+        if self.relaxed.is_empty() {
+            return ideal;
         }
+        let set = self.relaxed.iter().map(|&i| self.fidelity[i].clone()).collect();
+        fidelity::relaxed(ideal, set)
+    }
+
+    /// The scenario with the relaxations `set` (indices into `fidelity`) applied to every
+    /// structure its runs build, its topologies' too.
+    pub fn relaxed_by(&self, set: &[usize]) -> Scenario {
+        let mut sc = self.clone();
+        sc.relaxed = set.to_vec();
+        sc.topologies = self.topologies.iter().map(|t| t.relaxed_by(set)).collect();
+        sc
     }
 
     /// The quantities a run measures at every tick, by name: the mechanism's and the file's
@@ -549,6 +569,13 @@ fn validate(
     closed_forms(ctx, &raw, probe.as_ref(), model, &s.param_table, &s.params, &s.actuation)?;
     let solved = judged.model.as_ref().and_then(|m| m.energy.as_ref()).map(|e| e.solved_names()).unwrap_or_default();
     let motion = motion::motion(ctx, &raw, s.sim.dt_s, (m, &first), (&first_params, &solved), &s.actuation)?;
+    let first_point = fidelity::FirstPoint {
+        structure: &first,
+        commands: m.commands(&first_params, s.actuation.first_inputs()),
+        dt_s: s.sim.dt_s,
+        winches_move: fidelity::FirstPoint::winches_move(&s.actuation, motion.is_some()),
+    };
+    let fidelity = fidelity::fidelity(ctx, &raw, &first_point)?;
     let has_probe = probe.as_ref().is_some_and(|p| p.tolerance.is_some());
     let parts =
         expect::Parts { checks, model, probe: has_probe, motion: motion.as_ref(), prestress: prestress.is_some() };
@@ -584,6 +611,8 @@ fn validate(
         topology: None,
         unseen_params,
         prestress,
+        fidelity,
+        relaxed: Vec::new(),
     })))
 }
 

@@ -40,6 +40,9 @@ pub(super) struct RawScenario {
     /// When the structure counts as having lost its self-stress, and what that does.
     #[serde(default)]
     pub(super) prestress: Option<Spanned<RawPrestress>>,
+    /// `[[fidelity]]`: the idealizations `tensegrity attribute` relaxes (`fidelity.rs`).
+    #[serde(default)]
+    pub(super) fidelity: Vec<Spanned<super::fidelity::RawRelaxation>>,
     /// `mechanism = "custom"`: the structure itself.
     #[serde(default)]
     pub(super) structure: Option<Spanned<RawStructure>>,

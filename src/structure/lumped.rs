@@ -179,6 +179,30 @@ pub fn hang_beads(
     segments: usize,
     lumping: &mut Lumping,
 ) -> Result<(), LumpError> {
+    hang_beads_with(s, cable, (density_kg_per_m, segments), EndShare::PointMassesOnly, lumping)
+}
+
+/// Where a heavy cable's end share of its mass (rho L0 / (2 n)) goes when the end is a node of
+/// a rigid free body, which a point added off its centre of mass would give products of
+/// inertia that its principal moments cannot hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EndShare {
+    /// Refused, naming the body (a file's own heavy cable: make that strut elastic).
+    PointMassesOnly,
+    /// Onto the bead next to that end, L0 / n along the cable (a relaxation of a paper's
+    /// massless cable, `structure/fidelity.rs`): the cable's mass is kept, its moment about
+    /// the end moved by rho L0^2 / (2 n^2), which vanishes with the beads' own discretisation.
+    NextBead,
+}
+
+/// [`hang_beads`] with (`density_kg_per_m`, `segments`) and the end share's place `share`.
+pub fn hang_beads_with(
+    s: &mut Structure,
+    cable: MemberId,
+    (density_kg_per_m, segments): (f64, usize),
+    share: EndShare,
+    lumping: &mut Lumping,
+) -> Result<(), LumpError> {
     let member = s.members[cable].clone();
     let name = &member.name;
     let refuse = |why: String| Err(LumpError(format!("heavy cable '{name}': {why}")));
@@ -194,9 +218,17 @@ pub fn hang_beads(
     let (l0, n) = (*length_m, segments as f64);
     let end_mass = density_kg_per_m * l0 / (2.0 * n);
     let (a, b) = member.ends();
-    for end in [a, b] {
+    let rigid_end = |s: &Structure, end: usize| {
         let body = s.nodes[end].body;
-        if s.bodies[body].kind == BodyKind::Free && !is_point_mass(s, body) {
+        s.bodies[body].kind == BodyKind::Free && !is_point_mass(s, body)
+    };
+    let onto_bead = [a, b].map(|end| share == EndShare::NextBead && rigid_end(s, end));
+    if onto_bead.contains(&true) && segments < 2 {
+        return refuse(format!("it ends on a rigid body and has {segments} segment: its end's share of the mass goes onto the next bead, so it needs 2 segments or more"));
+    }
+    for (end, moved) in [a, b].into_iter().zip(onto_bead) {
+        let body = s.nodes[end].body;
+        if rigid_end(s, end) && !moved {
             return refuse(format!(
                 "it ends on node '{}' of free body '{}', which is not a point mass: its end's share of the cable's mass ({end_mass:e} kg) has no place there (make that strut elastic, or hang the cable from a fixed body)",
                 s.nodes[end].name, s.bodies[body].name
@@ -216,9 +248,9 @@ pub fn hang_beads(
         return refuse(format!("it would name a part '{b}', a name the structure already has"));
     }
     let size_m = lumping.size_m;
-    for end in [a, b] {
+    for (end, moved) in [a, b].into_iter().zip(onto_bead) {
         let body = s.nodes[end].body;
-        let free = s.bodies[body].kind == BodyKind::Free;
+        let free = s.bodies[body].kind == BodyKind::Free && !moved;
         if let Some(i) = s.bodies[body].inertia.as_mut().filter(|_| free) {
             let grown = (i.mass_kg + end_mass) / i.mass_kg;
             i.mass_kg += end_mass;
@@ -226,8 +258,10 @@ pub fn hang_beads(
         }
     }
     let mut beads = vec![a];
-    for (bead, (at, _)) in names.iter().zip(&places) {
-        let body = s.add_body(bead, BodyKind::Free, Some(bead_inertia(density_kg_per_m * l0 / n, *at, size_m)));
+    for (j, (bead, (at, _))) in names.iter().zip(&places).enumerate() {
+        let shares = [onto_bead[0] && j == 0, onto_bead[1] && j + 2 == segments].iter().filter(|&&m| m).count();
+        let mass = density_kg_per_m * l0 / n + shares as f64 * end_mass;
+        let body = s.add_body(bead, BodyKind::Free, Some(bead_inertia(mass, *at, size_m)));
         beads.push(s.add_node(bead, body, *at));
     }
     beads.push(b);

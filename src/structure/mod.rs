@@ -8,6 +8,7 @@
 use std::collections::BTreeMap;
 
 pub mod equilibrium;
+pub mod fidelity;
 pub mod linear;
 pub mod lumped;
 mod member;

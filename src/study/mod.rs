@@ -10,6 +10,7 @@
 //!   (Levenberg-Marquardt with intervals), and the outputs of a motion's trajectory
 //!   (`tensegrity fit`).
 
+pub mod attribution;
 mod fit;
 mod fit_trajectory;
 mod problem;

@@ -1,0 +1,209 @@
+//! A paper's idealizations relaxed: the structure a model assumes (rigid struts, inextensible
+//! and massless cables) rewritten into the one a prototype would be, with the physical data the
+//! file states (`[[fidelity]]`, `scenario/fidelity.rs`). Each rewrite goes through the members
+//! and point masses the simulator already has (`lumped.rs`), so a relaxed structure settles,
+//! moves and is observed as any other. What each relaxation costs a paper's model is measured
+//! by `study/attribution.rs`.
+
+use super::lumped::{self, EndShare, Lumping};
+use super::{ActuatorTarget, CableLaw, Law, Member, MemberId, Structure};
+
+/// An idealization a paper's model makes, which a relaxation undoes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Assumption {
+    /// Cables that never stretch: relaxed to elastic cables of axial stiffness EA / L0.
+    InextensibleCables,
+    /// Struts that never deform: relaxed to elastic bars (`lumped::make_strut_elastic`).
+    RigidStruts,
+    /// Cables without mass: relaxed to beads on elastic segments (`lumped::hang_beads`).
+    MasslessCables,
+}
+
+impl Assumption {
+    /// Every assumption by the words a file names it with, in the order relaxations are
+    /// applied together (a cable is made elastic before it is hung with beads).
+    pub const ALL: [(Assumption, &'static str); 3] = [
+        (Assumption::InextensibleCables, "inextensible cables"),
+        (Assumption::RigidStruts, "rigid struts"),
+        (Assumption::MasslessCables, "massless cables"),
+    ];
+
+    /// The words a file and a report use.
+    pub fn label(self) -> &'static str {
+        Self::ALL.iter().find(|(a, _)| *a == self).map_or("", |(_, l)| l)
+    }
+
+    /// The assumption a file names, if any.
+    pub fn from_label(label: &str) -> Option<Assumption> {
+        Self::ALL.iter().find(|(_, l)| *l == label).map(|(a, _)| *a)
+    }
+
+    /// Whether the assumption holds for `m` in the ideal structure (what it may relax).
+    fn holds_for(self, m: &Member) -> bool {
+        match self {
+            Assumption::InextensibleCables => matches!(m.law, Law::Cable { law: CableLaw::Inextensible, .. }),
+            Assumption::RigidStruts => m.law == Law::Strut,
+            Assumption::MasslessCables => matches!(m.law, Law::Cable { .. }),
+        }
+    }
+}
+
+/// One idealization relaxed, with its physical data.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Relaxation {
+    /// The name a report gives its share.
+    pub name: String,
+    pub assumption: Assumption,
+    /// The members it relaxes by name (empty: every member the assumption holds for).
+    pub members: Vec<String>,
+    /// The axial stiffness E A \[N\] (elastic struts and elastic cables).
+    pub ea_n: Option<f64>,
+    /// The linear density \[kg/m\]: a heavy cable's (per unstretched metre), an elastic strut's
+    /// (its mass rho L in place of its body's).
+    pub density_kg_per_m: Option<f64>,
+    /// A heavy cable's segment count.
+    pub segments: usize,
+}
+
+/// `r` with the relaxations it is measured on top of: a heavy cable's "inextensible cables"
+/// relaxation where the ideal cable is inextensible (a heavy cable is elastic segments).
+pub fn with_base<'a>(list: &'a [Relaxation], r: &'a Relaxation) -> Vec<&'a Relaxation> {
+    let mut set = vec![r];
+    if r.assumption == Assumption::MasslessCables {
+        set.extend(list.iter().filter(|o| o.assumption == Assumption::InextensibleCables));
+    }
+    set
+}
+
+/// Why a structure cannot take a relaxation; the message names the member and says why.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error("{0}")]
+pub struct FidelityError(pub String);
+
+/// The members of `s` that `r` relaxes: those it names (each must be one the assumption holds
+/// for) or every member the assumption holds for (at least one).
+pub fn members_of(s: &Structure, r: &Relaxation) -> Result<Vec<MemberId>, FidelityError> {
+    let what = r.assumption.label();
+    if r.members.is_empty() {
+        let all: Vec<MemberId> = (0..s.members.len()).filter(|&i| r.assumption.holds_for(&s.members[i])).collect();
+        if all.is_empty() {
+            return Err(FidelityError(format!("'{}': the structure has no {what} to relax", r.name)));
+        }
+        return Ok(all);
+    }
+    r.members
+        .iter()
+        .map(|name| {
+            let i = s.member_id(name).ok_or_else(|| {
+                FidelityError(format!("'{}': the structure has no member '{name}'", r.name))
+            })?;
+            if !r.assumption.holds_for(&s.members[i]) {
+                let kind = s.members[i].kind().label();
+                return Err(FidelityError(format!("'{}': member '{name}' is a {kind} that is not one of the {what}", r.name)));
+            }
+            Ok(i)
+        })
+        .collect()
+}
+
+/// `s` with `relaxations` applied together, in [`Assumption::ALL`]'s order; `commands` are the
+/// actuators' commands at the point built (by symbol), which place a winch-driven cable at its
+/// length before it is hung with beads (its winch then no longer drives it: a run that moves
+/// the winch afterwards is refused where the file is read).
+pub fn relax(
+    s: &mut Structure,
+    relaxations: &[&Relaxation],
+    commands: &crate::mechanisms::Values,
+) -> Result<(), FidelityError> {
+    let mut order = relaxations.to_vec();
+    order.sort_by_key(|r| r.assumption);
+    let targets = order.iter().map(|r| members_of(s, r)).collect::<Result<Vec<_>, _>>()?;
+    let mut lumping = Lumping::new(s);
+    for (r, members) in order.iter().zip(targets) {
+        let lump = |e: lumped::LumpError| FidelityError(format!("'{}': {e}", r.name));
+        for i in members {
+            match r.assumption {
+                Assumption::InextensibleCables => make_cable_elastic(s, i, need(r, r.ea_n, "EA")?),
+                Assumption::RigidStruts => {
+                    if let Some(rho) = r.density_kg_per_m {
+                        set_strut_mass(s, i, rho);
+                    }
+                    lumped::make_strut_elastic(s, i, need(r, r.ea_n, "EA")?, None, &mut lumping).map_err(lump)?
+                }
+                Assumption::MasslessCables => {
+                    if let Law::Cable { law: CableLaw::Inextensible, .. } = s.members[i].law {
+                        let name = &s.members[i].name;
+                        return Err(FidelityError(format!(
+                            "'{}': cable '{name}' is inextensible, and a heavy cable is built of elastic segments: relax \"inextensible cables\" for it too (the heavy cable's share is then measured with it elastic)",
+                            r.name
+                        )));
+                    }
+                    release_winch(s, i, commands);
+                    let rho = need(r, r.density_kg_per_m, "density")?;
+                    lumped::hang_beads_with(s, i, (rho, r.segments), EndShare::NextBead, &mut lumping).map_err(lump)?
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A relaxation's datum `value` called `key`, or the error that names it.
+fn need(r: &Relaxation, value: Option<f64>, key: &str) -> Result<f64, FidelityError> {
+    value.ok_or_else(|| FidelityError(format!("'{}': relaxing {} needs {key}", r.name, r.assumption.label())))
+}
+
+/// Cable `i` elastic with the axial stiffness `ea_n` over its unstretched length: EA / L0 \[N/m\].
+fn make_cable_elastic(s: &mut Structure, i: MemberId, ea_n: f64) {
+    if let Law::Cable { law, length_m } = &mut s.members[i].law {
+        *law = CableLaw::Elastic { stiffness_n_per_m: ea_n / *length_m };
+    }
+}
+
+/// Strut `i`'s body given the mass rho L of the strut as drawn.
+fn set_strut_mass(s: &mut Structure, i: MemberId, rho_kg_per_m: f64) {
+    let (a, b) = s.members[i].ends();
+    let length = super::distance(s.nodes[a].position, s.nodes[b].position);
+    if let Some(inertia) = s.bodies[s.nodes[a].body].inertia.as_mut() {
+        let grown = rho_kg_per_m * length / inertia.mass_kg;
+        inertia.mass_kg *= grown;
+        inertia.principal_kg_m2 = inertia.principal_kg_m2.map(|m| m * grown);
+    }
+}
+
+/// Cable `i`'s winch, if one drives it, set to its command and removed: the cable is built at
+/// the commanded unstretched length and keeps it.
+fn release_winch(s: &mut Structure, i: MemberId, commands: &crate::mechanisms::Values) {
+    let Some(w) = s.actuators.iter().position(|a| a.target == ActuatorTarget::CableLength(i)) else { return };
+    if let (Some(&length), Law::Cable { length_m, .. }) = (commands.get(&s.actuators[w].symbol), &mut s.members[i].law)
+    {
+        *length_m = length;
+    }
+    s.actuators.remove(w);
+}
+
+/// Whether relaxing `r` in `s` takes a cable off its winch (a heavy cable's length is built, not
+/// driven): a run whose points move the winch without rebuilding is then refused.
+pub fn releases_winch(s: &Structure, r: &Relaxation) -> bool {
+    r.assumption == Assumption::MasslessCables
+        && members_of(s, r).is_ok_and(|ms| {
+            ms.iter().any(|&i| s.actuators.iter().any(|a| a.target == ActuatorTarget::CableLength(i)))
+        })
+}
+
+/// The forces of a relaxed structure's snapshot as the ideal structure's members carry them: a
+/// cable hung with beads keeps its first segment at its own index, and is read at its last
+/// segment, at the node its path ends on (`{name}_s{n}`), where a paper's model meets it.
+pub fn ideal_forces(s: &Structure, force_n: &[f64]) -> Vec<f64> {
+    let mut forces = force_n.to_vec();
+    for (i, m) in s.members.iter().enumerate() {
+        let Some(cable) = m.name.strip_suffix("_s1") else { continue };
+        let last = (2..=lumped::MAX_CABLE_SEGMENTS)
+            .map_while(|k| s.member_id(&format!("{cable}_s{k}")))
+            .last();
+        if let Some(last) = last {
+            forces[i] = force_n[last];
+        }
+    }
+    forces
+}

@@ -1,0 +1,315 @@
+//! What each idealization costs a paper's model (`tensegrity attribute`): the file's checks run
+//! under the ideal structure, under each `[[fidelity]]` relaxation alone, and under all of them
+//! together. For every compared value (a check at a point, a file model's check, a measured
+//! frequency) the deviation of the simulation from the model at each level, each relaxation's
+//! share of the change and what is left over, the interaction:
+//!
+//! d_all - d_ideal = sum_r (d_r - d_base(r)) + interaction,
+//!
+//! d_r the deviation with r applied (on top of its base: a heavy cable's "inextensible cables"
+//! relaxation, `structure::fidelity::with_base`), d_base(r) the deviation with its base alone
+//! (the ideal's where it has none). The shares add up by construction; the interaction is
+//! where the relaxations do not add.
+
+use crate::report::ScenarioReport;
+use crate::run::{run, RunOptions};
+use crate::scenario::Scenario;
+use crate::structure::fidelity::{self, Relaxation};
+use serde::Serialize;
+use std::sync::atomic::AtomicBool;
+
+/// One level of fidelity run: which relaxations it applies and how its run went.
+#[derive(Clone, Debug, Serialize)]
+pub struct Level {
+    /// "ideal", a relaxation's name, or "all".
+    pub name: String,
+    /// The relaxations applied, by name.
+    pub relaxed: Vec<String>,
+    /// Whether the run passed its own checks (the ideal's tolerances: a relaxed run is
+    /// expected to fail them by what the relaxations cost).
+    pub passed: bool,
+    /// Why the run stopped, if it did.
+    pub error: Option<String>,
+    pub wall_s: f64,
+}
+
+/// A relaxation as the report states it.
+#[derive(Clone, Debug, Serialize)]
+pub struct RelaxationReport {
+    pub name: String,
+    pub assumption: String,
+    pub members: Vec<String>,
+    pub ea_n: Option<f64>,
+    pub density_kg_per_m: Option<f64>,
+    pub segments: usize,
+    /// The relaxations its share is measured on top of (by name).
+    pub on_top_of: Vec<String>,
+}
+
+/// One compared value across the levels.
+#[derive(Clone, Debug, Serialize)]
+pub struct Item {
+    /// "check" (a quantity at a settle point), "frequency" (a motion's measured frequency) or
+    /// the file model's check kind ("prediction", "equation", "energy", "frequency model").
+    pub kind: String,
+    pub name: String,
+    /// The settle point (None: the run's largest error, or a motion's frequency).
+    pub point: Option<usize>,
+    /// The model's value (NaN where the report gives an error only).
+    pub model: f64,
+    /// The deviation from the model at each level, in [`AttributionReport::levels`]' order:
+    /// simulated - model (signed; an angle wrapped), or the largest error where only that is
+    /// reported.
+    pub deviation: Vec<f64>,
+    /// Each relaxation's share of d_all - d_ideal, in [`AttributionReport::relaxations`]' order.
+    pub shares: Vec<f64>,
+    /// d_all - d_ideal - sum of the shares.
+    pub interaction: f64,
+}
+
+/// `tensegrity attribute`'s report.
+#[derive(Clone, Debug, Serialize)]
+pub struct AttributionReport {
+    pub scenario: String,
+    pub file: String,
+    pub relaxations: Vec<RelaxationReport>,
+    pub levels: Vec<Level>,
+    pub items: Vec<Item>,
+}
+
+/// Why attribution cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum AttributionError {
+    #[error("the scenario has no [[fidelity]] relaxation: list the idealizations to relax, each with its data")]
+    NoRelaxation,
+    #[error("stopped by a signal")]
+    Cancelled,
+}
+
+/// The sets of relaxations each level applies (indices into `sc.fidelity`): the ideal, each
+/// relaxation with its base, and all of them (left out where it repeats the one before).
+pub fn level_sets(sc: &Scenario) -> Vec<(String, Vec<usize>)> {
+    let list = &sc.fidelity;
+    let index = |r: &Relaxation| list.iter().position(|o| std::ptr::eq(o, r)).expect("in the list");
+    let mut sets = vec![("ideal".to_string(), Vec::new())];
+    for r in list {
+        let mut set: Vec<usize> = fidelity::with_base(list, r).into_iter().map(index).collect();
+        set.sort_unstable();
+        sets.push((r.name.clone(), set));
+    }
+    // Each share's base (its set less itself), where no level above applies it alone.
+    for i in 0..list.len() {
+        let base: Vec<usize> = sets[i + 1].1.iter().copied().filter(|&j| j != i).collect();
+        if !base.is_empty() && !sets.iter().any(|(_, s)| *s == base) {
+            sets.push((format!("base of {}", list[i].name), base));
+        }
+    }
+    let all: Vec<usize> = (0..list.len()).collect();
+    if !sets.iter().any(|(_, s)| *s == all) {
+        sets.push(("all".to_string(), all));
+    }
+    sets
+}
+
+/// Runs `sc` at every level and attributes each compared value's change.
+pub fn attribute(sc: &Scenario, cancel: Option<&AtomicBool>) -> Result<AttributionReport, AttributionError> {
+    if sc.fidelity.is_empty() {
+        return Err(AttributionError::NoRelaxation);
+    }
+    let sets = level_sets(sc);
+    let mut reports = Vec::new();
+    let mut levels = Vec::new();
+    for (name, set) in &sets {
+        let wall = std::time::Instant::now();
+        let report = run(&sc.relaxed_by(set), &RunOptions { cancel, skip_findings: true, ..RunOptions::default() });
+        if cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+            return Err(AttributionError::Cancelled);
+        }
+        let relaxed = set.iter().map(|&i| sc.fidelity[i].name.clone()).collect();
+        let error = report.error.as_ref().map(|e| e.to_string());
+        levels.push(Level { name: name.clone(), relaxed, passed: report.passed, error, wall_s: wall.elapsed().as_secs_f64() });
+        reports.push(report);
+    }
+    let items = compared(sc, &reports[0])
+        .into_iter()
+        .map(|(key, model)| item(sc, &sets, &reports, key, model))
+        .collect();
+    Ok(AttributionReport {
+        scenario: sc.name.clone(),
+        file: sc.file.display().to_string(),
+        relaxations: relaxation_reports(sc, &sets),
+        levels,
+        items,
+    })
+}
+
+/// What a compared value is, to find it in every level's report.
+#[derive(Clone, Debug, PartialEq)]
+enum Key {
+    /// A check's quantity at a settle point.
+    Check { quantity: String, point: usize },
+    /// A file model's check (its largest error over the run).
+    ModelCheck { kind: String, name: String },
+    /// A motion's measured frequency against its prediction.
+    Frequency { name: String },
+}
+
+/// Every compared value of the ideal run, with the model's value.
+fn compared(sc: &Scenario, ideal: &ScenarioReport) -> Vec<(Key, f64)> {
+    let mut out = Vec::new();
+    for p in &ideal.points {
+        for c in &sc.checks {
+            let model = p.analytic.get(&c.quantity).copied().unwrap_or(f64::NAN);
+            out.push((Key::Check { quantity: c.quantity.clone(), point: p.index }, model));
+        }
+    }
+    for m in &ideal.model_checks {
+        out.push((Key::ModelCheck { kind: m.kind.clone(), name: m.name.clone() }, f64::NAN));
+    }
+    for f in ideal.motion.iter().flat_map(|m| &m.frequencies) {
+        out.push((Key::Frequency { name: f.name.clone() }, f.predicted_rad_per_s));
+    }
+    out
+}
+
+/// The deviation of `key` in `report` from the model's `model` (NaN where the run has none).
+fn deviation(sc: &Scenario, report: &ScenarioReport, key: &Key, model: f64) -> f64 {
+    match key {
+        Key::Check { quantity, point } => {
+            let p = report.points.iter().find(|p| p.index == *point);
+            let simulated = p.filter(|p| p.settled).and_then(|p| p.simulated.get(quantity)).copied();
+            let d = simulated.map_or(f64::NAN, |s| s - model);
+            if sc.is_angle(quantity) {
+                crate::mechanisms::wrap_angle(d)
+            } else {
+                d
+            }
+        }
+        Key::ModelCheck { kind, name } => report
+            .model_checks
+            .iter()
+            .find(|m| m.kind == *kind && m.name == *name)
+            .map_or(f64::NAN, |m| m.max_error),
+        Key::Frequency { name } => report
+            .motion
+            .iter()
+            .flat_map(|m| &m.frequencies)
+            .find(|f| f.name == *name)
+            .map_or(f64::NAN, |f| f.corrected_rad_per_s - model),
+    }
+}
+
+/// One compared value across the levels: its deviations, shares and interaction.
+fn item(sc: &Scenario, sets: &[(String, Vec<usize>)], reports: &[ScenarioReport], key: Key, model: f64) -> Item {
+    let deviation: Vec<f64> = reports.iter().map(|r| deviation(sc, r, &key, model)).collect();
+    let at = |set: &[usize]| sets.iter().position(|(_, s)| s == set).map_or(f64::NAN, |l| deviation[l]);
+    let shares: Vec<f64> = (0..sc.fidelity.len())
+        .map(|i| {
+            let with = &sets[i + 1].1;
+            let base: Vec<usize> = with.iter().copied().filter(|&j| j != i).collect();
+            at(with) - at(&base)
+        })
+        .collect();
+    let all: Vec<usize> = (0..sc.fidelity.len()).collect();
+    let interaction = at(&all) - deviation[0] - shares.iter().sum::<f64>();
+    let (kind, name, point) = match key {
+        Key::Check { quantity, point } => ("check".to_string(), quantity, Some(point)),
+        Key::ModelCheck { kind, name } => (kind, name, None),
+        Key::Frequency { name } => ("frequency".to_string(), name, None),
+    };
+    Item { kind, name, point, model, deviation, shares, interaction }
+}
+
+/// The report's statement of each relaxation, with the relaxations it is measured on top of.
+fn relaxation_reports(sc: &Scenario, sets: &[(String, Vec<usize>)]) -> Vec<RelaxationReport> {
+    sc.fidelity
+        .iter()
+        .enumerate()
+        .map(|(i, r)| RelaxationReport {
+            name: r.name.clone(),
+            assumption: r.assumption.label().to_string(),
+            members: r.members.clone(),
+            ea_n: r.ea_n,
+            density_kg_per_m: r.density_kg_per_m,
+            segments: r.segments,
+            on_top_of: sets[i + 1].1.iter().filter(|&&j| j != i).map(|&j| sc.fidelity[j].name.clone()).collect(),
+        })
+        .collect()
+}
+
+impl AttributionReport {
+    /// The level that applies every relaxation.
+    pub fn all_level(&self) -> usize {
+        let all = self.relaxations.len();
+        self.levels.iter().position(|l| l.relaxed.len() == all).unwrap_or(self.levels.len() - 1)
+    }
+
+    /// The table: per compared value, the model, the ideal and the relaxed deviation, each
+    /// relaxation's share and the interaction.
+    pub fn to_table(&self) -> String {
+        let mut out = format!("{} ({})\n", self.scenario, self.file);
+        for r in &self.relaxations {
+            let on_top = if r.on_top_of.is_empty() { String::new() } else { format!(", on top of {}", r.on_top_of.join(", ")) };
+            out += &format!("relaxation '{}': {}{on_top}\n", r.name, r.assumption);
+        }
+        for l in &self.levels {
+            let error = l.error.as_ref().map_or(String::new(), |e| format!(": {e}"));
+            out += &format!("level {:<24} {:.3} s{error}\n", l.name, l.wall_s);
+        }
+        let mut header = format!("{:<12} {:<16} {:>5} {:>14} {:>12} {:>12}", "kind", "name", "point", "model", "ideal", "all");
+        for r in &self.relaxations {
+            header += &format!(" {:>14}", clip(&r.name, 14));
+        }
+        out += &format!("{header} {:>12}\n", "interaction");
+        for it in &self.items {
+            let point = it.point.map_or("-".to_string(), |p| p.to_string());
+            let mut row = format!(
+                "{:<12} {:<16} {point:>5} {:>14.6e} {:>12.4e} {:>12.4e}",
+                it.kind,
+                clip(&it.name, 16),
+                it.model,
+                it.deviation[0],
+                it.deviation[self.all_level()]
+            );
+            for s in &it.shares {
+                row += &format!(" {s:>14.4e}");
+            }
+            out += &format!("{row} {:>12.4e}\n", it.interaction);
+        }
+        out + "deviation = simulated - model at each level; the shares and the interaction add up to all - ideal\n"
+    }
+
+    /// One row per compared value (a grid's shares per point).
+    pub fn to_csv(&self) -> String {
+        let mut header = "kind,name,point,model".to_string();
+        for l in &self.levels {
+            header += &format!(",deviation:{}", csv_field(&l.name));
+        }
+        for r in &self.relaxations {
+            header += &format!(",share:{}", csv_field(&r.name));
+        }
+        let mut out = header + ",interaction\n";
+        for it in &self.items {
+            let point = it.point.map_or(String::new(), |p| p.to_string());
+            out += &format!("{},{},{point},{:e}", it.kind, csv_field(&it.name), it.model);
+            for v in it.deviation.iter().chain(&it.shares) {
+                out += &format!(",{v:e}");
+            }
+            out += &format!(",{:e}\n", it.interaction);
+        }
+        out
+    }
+}
+
+fn clip(s: &str, n: usize) -> String {
+    s.chars().take(n).collect()
+}
+
+/// A CSV field quoted where it holds a comma or a quote.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
