@@ -81,15 +81,13 @@ pub fn with_base<'a>(list: &'a [Relaxation], r: &'a Relaxation) -> Vec<&'a Relax
 pub struct FidelityError(pub String);
 
 /// The members of `s` that `r` relaxes: those it names (each must be one the assumption holds
-/// for) or every member the assumption holds for (at least one).
+/// for) or every member the assumption holds for (none where it holds for none: a parameter
+/// such as a built-in mechanism's elastic cable stiffness may have relaxed it already, and the
+/// report then lists no member for it).
 pub fn members_of(s: &Structure, r: &Relaxation) -> Result<Vec<MemberId>, FidelityError> {
     let what = r.assumption.label();
     if r.members.is_empty() {
-        let all: Vec<MemberId> = (0..s.members.len()).filter(|&i| r.assumption.holds_for(&s.members[i])).collect();
-        if all.is_empty() {
-            return Err(FidelityError(format!("'{}': the structure has no {what} to relax", r.name)));
-        }
-        return Ok(all);
+        return Ok((0..s.members.len()).filter(|&i| r.assumption.holds_for(&s.members[i])).collect());
     }
     r.members
         .iter()
@@ -140,7 +138,7 @@ pub fn relax(
                     }
                     release_winch(s, i, commands);
                     let rho = need(r, r.density_kg_per_m, "density")?;
-                    lumped::hang_beads_with(s, i, (rho, r.segments), EndShare::NextBead, &mut lumping).map_err(lump)?
+                    lumped::hang_beads_with(s, i, (rho, r.segments), EndShare::NodeLoad, &mut lumping).map_err(lump)?
                 }
             }
         }

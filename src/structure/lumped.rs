@@ -189,10 +189,10 @@ pub fn hang_beads(
 pub enum EndShare {
     /// Refused, naming the body (a file's own heavy cable: make that strut elastic).
     PointMassesOnly,
-    /// Onto the bead next to that end, L0 / n along the cable (a relaxation of a paper's
-    /// massless cable, `structure/fidelity.rs`): the cable's mass is kept, its moment about
-    /// the end moved by rho L0^2 / (2 n^2), which vanishes with the beads' own discretisation.
-    NextBead,
+    /// Its weight as a point load at that node (a relaxation of a paper's massless cable,
+    /// `structure/fidelity.rs`): the statics are those of the share resting there; its inertia,
+    /// rho L0 / (2 n), is left out of the motion.
+    NodeLoad,
 }
 
 /// [`hang_beads`] with (`density_kg_per_m`, `segments`) and the end share's place `share`.
@@ -222,11 +222,8 @@ pub fn hang_beads_with(
         let body = s.nodes[end].body;
         s.bodies[body].kind == BodyKind::Free && !is_point_mass(s, body)
     };
-    let onto_bead = [a, b].map(|end| share == EndShare::NextBead && rigid_end(s, end));
-    if onto_bead.contains(&true) && segments < 2 {
-        return refuse(format!("it ends on a rigid body and has {segments} segment: its end's share of the mass goes onto the next bead, so it needs 2 segments or more"));
-    }
-    for (end, moved) in [a, b].into_iter().zip(onto_bead) {
+    let loaded = [a, b].map(|end| share == EndShare::NodeLoad && rigid_end(s, end));
+    for (end, moved) in [a, b].into_iter().zip(loaded) {
         let body = s.nodes[end].body;
         if rigid_end(s, end) && !moved {
             return refuse(format!(
@@ -248,9 +245,13 @@ pub fn hang_beads_with(
         return refuse(format!("it would name a part '{b}', a name the structure already has"));
     }
     let size_m = lumping.size_m;
-    for (end, moved) in [a, b].into_iter().zip(onto_bead) {
+    for (end, load) in [a, b].into_iter().zip(loaded) {
+        if load {
+            s.node_loads.push(super::NodeLoad { node: end, force_n: s.gravity.map(|g| g * end_mass) });
+            continue;
+        }
         let body = s.nodes[end].body;
-        let free = s.bodies[body].kind == BodyKind::Free && !moved;
+        let free = s.bodies[body].kind == BodyKind::Free;
         if let Some(i) = s.bodies[body].inertia.as_mut().filter(|_| free) {
             let grown = (i.mass_kg + end_mass) / i.mass_kg;
             i.mass_kg += end_mass;
@@ -258,10 +259,8 @@ pub fn hang_beads_with(
         }
     }
     let mut beads = vec![a];
-    for (j, (bead, (at, _))) in names.iter().zip(&places).enumerate() {
-        let shares = [onto_bead[0] && j == 0, onto_bead[1] && j + 2 == segments].iter().filter(|&&m| m).count();
-        let mass = density_kg_per_m * l0 / n + shares as f64 * end_mass;
-        let body = s.add_body(bead, BodyKind::Free, Some(bead_inertia(mass, *at, size_m)));
+    for (bead, (at, _)) in names.iter().zip(&places) {
+        let body = s.add_body(bead, BodyKind::Free, Some(bead_inertia(density_kg_per_m * l0 / n, *at, size_m)));
         beads.push(s.add_node(bead, body, *at));
     }
     beads.push(b);

@@ -44,6 +44,9 @@ pub struct RelaxationReport {
     pub segments: usize,
     /// The relaxations its share is measured on top of (by name).
     pub on_top_of: Vec<String>,
+    /// The members it relaxes in the first point's structure (none: the assumption holds for
+    /// no member there, and its share is zero).
+    pub relaxes: Vec<String>,
 }
 
 /// One compared value across the levels.
@@ -222,6 +225,8 @@ fn item(sc: &Scenario, sets: &[(String, Vec<usize>)], reports: &[ScenarioReport]
 
 /// The report's statement of each relaxation, with the relaxations it is measured on top of.
 fn relaxation_reports(sc: &Scenario, sets: &[(String, Vec<usize>)]) -> Vec<RelaxationReport> {
+    let inputs = sc.actuation.first_inputs();
+    let first = sc.mechanism().build(&sc.params_at(inputs), inputs, &sc.start).ok();
     sc.fidelity
         .iter()
         .enumerate()
@@ -233,6 +238,9 @@ fn relaxation_reports(sc: &Scenario, sets: &[(String, Vec<usize>)]) -> Vec<Relax
             density_kg_per_m: r.density_kg_per_m,
             segments: r.segments,
             on_top_of: sets[i + 1].1.iter().filter(|&&j| j != i).map(|&j| sc.fidelity[j].name.clone()).collect(),
+            relaxes: first.as_ref().map_or(Vec::new(), |s| {
+                fidelity::members_of(s, r).unwrap_or_default().iter().map(|&m| s.members[m].name.clone()).collect()
+            }),
         })
         .collect()
 }
@@ -250,7 +258,8 @@ impl AttributionReport {
         let mut out = format!("{} ({})\n", self.scenario, self.file);
         for r in &self.relaxations {
             let on_top = if r.on_top_of.is_empty() { String::new() } else { format!(", on top of {}", r.on_top_of.join(", ")) };
-            out += &format!("relaxation '{}': {}{on_top}\n", r.name, r.assumption);
+            let members = if r.relaxes.is_empty() { "no member".to_string() } else { r.relaxes.join(", ") };
+            out += &format!("relaxation '{}': {} ({members}){on_top}\n", r.name, r.assumption);
         }
         for l in &self.levels {
             let error = l.error.as_ref().map_or(String::new(), |e| format!(": {e}"));

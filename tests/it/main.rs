@@ -2,6 +2,7 @@
 //! per file): each file beside this one is a module, `common.rs` their shared helpers.
 
 mod architecture;
+mod attribution;
 mod bad_input;
 mod bench;
 mod bench_scale;
