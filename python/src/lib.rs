@@ -558,6 +558,21 @@ fn sensitivity_json(
     Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))
 }
 
+/// The attribution of `tensegrity attribute --json` (`study::attribution`, the CLI's own
+/// function): the file's checks under the ideal structure, each `[[fidelity]]` relaxation alone
+/// and all of them together, as its JSON text. Ctrl-C stops the runs.
+#[pyfunction]
+#[pyo3(signature = (path, text=None, set=Vec::new()))]
+fn attribute_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>) -> PyResult<String> {
+    let sc = load(path, text, &set)?;
+    let result = on_own_thread(py, move |cancel| study::attribution::attribute(&sc, Some(cancel)))?;
+    let report = result.map_err(|e| match e {
+        study::attribution::AttributionError::NoRelaxation => PyValueError::new_err(format!("{path}: {e}")),
+        study::attribution::AttributionError::Cancelled => PyException::new_err(format!("{path}: {e}")),
+    })?;
+    Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))
+}
+
 /// A fitted parameter from Python: (name, low bound, high bound).
 type FitBounds = (String, Option<f64>, Option<f64>);
 /// A measured row from Python: (where it is, for errors; point; output; value; sigma).
@@ -641,6 +656,7 @@ fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(modes_json, m)?)?;
     m.add_function(wrap_pyfunction!(equilibrium_json, m)?)?;
     m.add_function(wrap_pyfunction!(sensitivity_json, m)?)?;
+    m.add_function(wrap_pyfunction!(attribute_json, m)?)?;
     m.add_function(wrap_pyfunction!(fit_json, m)?)?;
     m.add_function(wrap_pyfunction!(sections_toml, m)?)?;
     m.add_class::<ArrowTable>()?;

@@ -18,7 +18,7 @@ from . import _tensegrity
 
 __all__ = [
     "ScenarioError", "Prediction", "Result", "Solution", "Finding", "Structure",
-    "check", "equilibrium", "export_mjcf", "findings", "fit", "from_matrices", "from_ntrt", "from_toml", "modes", "run", "sensitivity", "solve",
+    "attribute", "check", "equilibrium", "export_mjcf", "findings", "fit", "from_matrices", "from_ntrt", "from_toml", "modes", "run", "sensitivity", "solve",
     "sweep",
 ]
 
@@ -218,6 +218,21 @@ def sensitivity(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, nam
     computed (the reason named), KeyboardInterrupt on Ctrl-C."""
     path, text = _source(scenario, name)
     return json.loads(_call(_tensegrity.sensitivity_json, path, text, _sets(set), check, point))
+
+
+def attribute(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml") -> dict:
+    """What each idealization costs the file's model: the report of ``tensegrity attribute
+    --json`` as a dict. The checks run under the ideal structure, under each ``[[fidelity]]``
+    relaxation alone (on top of its base, ``on_top_of``) and under all of them together:
+    ``relaxations`` (each ``name``, ``assumption``, data, ``relaxes``: its members), ``levels``
+    (each ``name``, ``relaxed``, ``passed``, ``error``, ``wall_s``) and ``items``, one per compared
+    value (``kind``, ``name``, ``point``, ``model``, ``deviation`` at each level: simulated -
+    model, ``shares`` per relaxation, ``interaction``: the shares and it add up to the last
+    level's deviation less the ideal's). Raises ScenarioError on bad input (a relaxation the
+    structure cannot take among it), ValueError for a file without relaxations,
+    KeyboardInterrupt on Ctrl-C."""
+    path, text = _source(scenario, name)
+    return json.loads(_call(_tensegrity.attribute_json, path, text, _sets(set)))
 
 
 _FIT_COLUMNS = ("point", "output", "value", "sigma", "t_s")

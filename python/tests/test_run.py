@@ -898,3 +898,23 @@ def test_a_modes_shape_reaches_python():
     for i in range(1, 6):
         sine = math.sin(math.pi * i / 6)
         assert all(abs(d - sine * m) <= 1e-9 * top for d, m in zip(shape[f"string_b{i}"], middle))
+
+
+def test_attribute_from_python_is_the_clis_attribute_json():
+    """tt.attribute is `tensegrity attribute --json`: every field equal (floats bit for bit), the
+    wall times aside; on the hanging bar the elastic cable's share is -M g l / EA_c = -1.962e-2 m
+    within 1e-9 m; a file without relaxations raises ValueError, a relaxation of a member that
+    does not exist ScenarioError at its table."""
+    hanging = ROOT / "tests" / "fixtures" / "attribution" / "hanging_bar.toml"
+    py, cli = tt.attribute(str(hanging)), cli_json("attribute", hanging)
+    for r in (py, cli):
+        for level in r["levels"]:
+            level.pop("wall_s")
+    assert py == cli
+    assert abs(py["items"][0]["shares"][1] + 2.0 * 9.81 * 1.0 / 1e3) <= 1e-9
+    text = hanging.read_text()
+    with pytest.raises(ValueError, match="no \\[\\[fidelity\\]\\] relaxation"):
+        tt.attribute(text[: text.index("[[fidelity]]")], name="bare.toml")
+    with pytest.raises(tt.ScenarioError, match="no member 'rod'") as e:
+        tt.attribute(text.replace('relax = "rigid struts"', 'relax = "rigid struts"\nmembers = ["rod"]'), name="rod.toml")
+    assert e.value.line == text[: text.index('relax = "rigid struts"')].count("\n")
