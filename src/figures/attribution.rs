@@ -83,7 +83,8 @@ impl Plot for Bars {
             for (k, v) in parts {
                 let base = if *v >= 0.0 { &mut up } else { &mut down };
                 let x = i as f64;
-                let rect = Rectangle::new([(x - 0.35, *base), (x + 0.35, *base + v)], colour(*k, self.names.len()).filled());
+                let rect =
+                    Rectangle::new([(x - 0.35, *base), (x + 0.35, *base + v)], colour(*k, self.names.len()).filled());
                 chart.draw_series(std::iter::once(rect))?;
                 *base += v;
             }

@@ -10,12 +10,12 @@
 //! writer of both the PNG and the SVG file (`kit.rs`, with the axes, legends and colour maps
 //! every figure shares). `sweep.rs` draws `tensegrity sweep --figure` with the same kit.
 
+pub mod attribution;
 mod furet2018;
 mod ji2014;
 mod kit;
 mod manriquez2019;
 mod mohr2011;
-pub mod attribution;
 pub mod sweep;
 
 pub use kit::Format;

@@ -3,9 +3,7 @@
 //! each structure it builds is rewritten with the relaxations, and each snapshot is read as the
 //! ideal structure's members carry it (a heavy cable at the node its path ends on).
 
-use super::{
-    Finding, Mechanism, MechanismSpec, ModelError, Prediction, Solution, StiffnessProbe, Values,
-};
+use super::{Finding, Mechanism, MechanismSpec, ModelError, Prediction, Solution, StiffnessProbe, Values};
 use crate::snapshot::Snapshot;
 use crate::structure::fidelity::{self, Relaxation};
 use crate::structure::Structure;
@@ -66,16 +64,12 @@ impl Mechanism for Relaxed {
     /// The inner mechanism's reading of the snapshot with the ideal members' forces
     /// ([`fidelity::ideal_forces`]), and each heavy cable's `NAME.force` under its ideal name.
     fn observe(&self, params: &Values, s: &Structure, snap: &Snapshot) -> Values {
-        let forces = fidelity::ideal_forces(s, &snap.forces.force_n);
         let mut view = snap.clone();
-        view.forces.force_n.clone_from(&forces);
-        let mut values = self.inner.observe(params, s, &view);
-        for (i, m) in s.members.iter().enumerate() {
-            if let Some(cable) = m.name.strip_suffix("_s1") {
-                values.entry(format!("{cable}.force")).or_insert(forces[i]);
-            }
+        view.forces.force_n = fidelity::ideal_forces(s, &snap.forces.force_n);
+        match fidelity::ideal_names(s) {
+            Some(named) => self.inner.observe(params, &named, &view),
+            None => self.inner.observe(params, s, &view),
         }
-        values
     }
     fn length_scale(&self, params: &Values) -> f64 {
         self.inner.length_scale(params)

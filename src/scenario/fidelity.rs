@@ -13,6 +13,9 @@
 //! EA = 1.6e5                      # N; or E (Pa) with area (m^2)
 //! source = "steel wire rope, 1 mm: E = 200 GPa (assumed, catalogue)"
 //! ```
+//!
+//! `relax = "no gravity"` with `gravity = [0, -9.81, 0]` gives the structure the gravity a
+//! prototype feels (a planar mechanism built upright).
 
 use super::error::{Ctx, ScenarioError};
 use super::raw::RawScenario;
@@ -37,6 +40,7 @@ pub(super) struct RawRelaxation {
     area: Option<Spanned<f64>>,
     density: Option<Spanned<f64>>,
     segments: Option<Spanned<i64>>,
+    gravity: Option<Spanned<[f64; 3]>>,
     /// Where the data come from (the paper's prototype, a catalogue): for the reader.
     #[allow(dead_code)]
     source: Option<String>,
@@ -54,13 +58,15 @@ pub(super) struct FirstPoint<'a> {
 }
 
 impl FirstPoint<'_> {
-    /// Whether the winches move after the build in `actuation` (or in a motion).
-    pub fn winches_move(actuation: &Actuation, motion: bool) -> bool {
-        motion
-            || match actuation {
+    /// The first point's `structure` built at `commands` in the scenario's sections `s` (with a
+    /// `motion` or not).
+    pub fn new<'a>(structure: &'a Structure, commands: Values, s: &super::Sections, motion: bool) -> FirstPoint<'a> {
+        let winches_move = motion
+            || match &s.actuation {
                 Actuation::Points { points, continuation } => *continuation && points.len() > 1,
                 Actuation::Schedule { .. } => true,
-            }
+            };
+        FirstPoint { structure, commands, dt_s: s.sim.dt_s, winches_move }
     }
 }
 
@@ -137,6 +143,7 @@ fn relaxation(ctx: &Ctx, r: &Spanned<RawRelaxation>) -> Result<Relaxation, Scena
         Assumption::InextensibleCables => &[("EA (N), or E (Pa) with area (m^2)", ea.is_some())],
         Assumption::RigidStruts => &[("EA (N), or E (Pa) with area (m^2)", ea.is_some())],
         Assumption::MasslessCables => &[("density (kg/m)", density.is_some()), ("segments", raw.segments.is_some())],
+        Assumption::NoGravity => &[("gravity = [x, y, z] (m/s^2)", raw.gravity.is_some())],
     };
     if let Some((what, _)) = needs.iter().find(|(_, given)| !given) {
         return Err(ctx.err(r, format!("relaxing {} needs {what}", assumption.label())));
@@ -146,7 +153,15 @@ fn relaxation(ctx: &Ctx, r: &Spanned<RawRelaxation>) -> Result<Relaxation, Scena
         return Err(ctx.err(raw.name.as_ref().unwrap(), "name must not be empty"));
     }
     let members = raw.members.as_ref().map(|m| m.get_ref().clone()).unwrap_or_default();
-    Ok(Relaxation { name, assumption, members, ea_n: ea, density_kg_per_m: density, segments })
+    let gravity = raw.gravity.as_ref().map(|g| *g.get_ref());
+    if let Some(g) = raw.gravity.as_ref().filter(|g| g.get_ref().iter().any(|x| !x.is_finite())) {
+        return Err(ctx.err(g, "gravity must be three finite numbers (m/s^2)"));
+    }
+    if let (Assumption::NoGravity, Some(m)) = (assumption, &raw.members) {
+        return Err(ctx.err(m, "gravity acts on every body: \"no gravity\" takes no members"));
+    }
+    let gravity_m_per_s2 = gravity.filter(|_| assumption == Assumption::NoGravity);
+    Ok(Relaxation { name, assumption, members, ea_n: ea, density_kg_per_m: density, segments, gravity_m_per_s2 })
 }
 
 /// A heavy cable's segment count, 1 to [`lumped::MAX_CABLE_SEGMENTS`] (1 where not given).

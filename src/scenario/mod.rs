@@ -569,13 +569,8 @@ fn validate(
     closed_forms(ctx, &raw, probe.as_ref(), model, &s.param_table, &s.params, &s.actuation)?;
     let solved = judged.model.as_ref().and_then(|m| m.energy.as_ref()).map(|e| e.solved_names()).unwrap_or_default();
     let motion = motion::motion(ctx, &raw, s.sim.dt_s, (m, &first), (&first_params, &solved), &s.actuation)?;
-    let first_point = fidelity::FirstPoint {
-        structure: &first,
-        commands: m.commands(&first_params, s.actuation.first_inputs()),
-        dt_s: s.sim.dt_s,
-        winches_move: fidelity::FirstPoint::winches_move(&s.actuation, motion.is_some()),
-    };
-    let fidelity = fidelity::fidelity(ctx, &raw, &first_point)?;
+    let commands = m.commands(&first_params, s.actuation.first_inputs());
+    let fidelity = fidelity::fidelity(ctx, &raw, &fidelity::FirstPoint::new(&first, commands, &s, motion.is_some()))?;
     let has_probe = probe.as_ref().is_some_and(|p| p.tolerance.is_some());
     let parts =
         expect::Parts { checks, model, probe: has_probe, motion: motion.as_ref(), prestress: prestress.is_some() };

@@ -8,9 +8,16 @@
 use super::lumped::{self, EndShare, Lumping};
 use super::{ActuatorTarget, CableLaw, Law, Member, MemberId, Structure};
 
+/// Actuator commands by symbol (m or rad), as a mechanism gives them.
+pub type Commands = std::collections::BTreeMap<String, f64>;
+
 /// An idealization a paper's model makes, which a relaxation undoes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Assumption {
+    /// No gravity (a planar mechanism taken to lie in a horizontal plane): relaxed to the
+    /// gravity a prototype feels, on every body's mass (first, so that a heavy cable's end
+    /// loads weigh with it).
+    NoGravity,
     /// Cables that never stretch: relaxed to elastic cables of axial stiffness EA / L0.
     InextensibleCables,
     /// Struts that never deform: relaxed to elastic bars (`lumped::make_strut_elastic`).
@@ -22,7 +29,8 @@ pub enum Assumption {
 impl Assumption {
     /// Every assumption by the words a file names it with, in the order relaxations are
     /// applied together (a cable is made elastic before it is hung with beads).
-    pub const ALL: [(Assumption, &'static str); 3] = [
+    pub const ALL: [(Assumption, &'static str); 4] = [
+        (Assumption::NoGravity, "no gravity"),
         (Assumption::InextensibleCables, "inextensible cables"),
         (Assumption::RigidStruts, "rigid struts"),
         (Assumption::MasslessCables, "massless cables"),
@@ -44,6 +52,7 @@ impl Assumption {
             Assumption::InextensibleCables => matches!(m.law, Law::Cable { law: CableLaw::Inextensible, .. }),
             Assumption::RigidStruts => m.law == Law::Strut,
             Assumption::MasslessCables => matches!(m.law, Law::Cable { .. }),
+            Assumption::NoGravity => false,
         }
     }
 }
@@ -63,14 +72,17 @@ pub struct Relaxation {
     pub density_kg_per_m: Option<f64>,
     /// A heavy cable's segment count.
     pub segments: usize,
+    /// The gravity a prototype feels, world frame \[m/s^2\] ("no gravity" relaxed).
+    pub gravity_m_per_s2: Option<[f64; 3]>,
 }
 
 /// `r` with the relaxations it is measured on top of: a heavy cable's "inextensible cables"
-/// relaxation where the ideal cable is inextensible (a heavy cable is elastic segments).
+/// (a heavy cable is elastic segments) and "no gravity" (its mass weighs only under gravity).
 pub fn with_base<'a>(list: &'a [Relaxation], r: &'a Relaxation) -> Vec<&'a Relaxation> {
     let mut set = vec![r];
     if r.assumption == Assumption::MasslessCables {
-        set.extend(list.iter().filter(|o| o.assumption == Assumption::InextensibleCables));
+        let base = [Assumption::NoGravity, Assumption::InextensibleCables];
+        set.extend(list.iter().filter(|o| base.contains(&o.assumption)));
     }
     set
 }
@@ -92,12 +104,15 @@ pub fn members_of(s: &Structure, r: &Relaxation) -> Result<Vec<MemberId>, Fideli
     r.members
         .iter()
         .map(|name| {
-            let i = s.member_id(name).ok_or_else(|| {
-                FidelityError(format!("'{}': the structure has no member '{name}'", r.name))
-            })?;
+            let i = s
+                .member_id(name)
+                .ok_or_else(|| FidelityError(format!("'{}': the structure has no member '{name}'", r.name)))?;
             if !r.assumption.holds_for(&s.members[i]) {
                 let kind = s.members[i].kind().label();
-                return Err(FidelityError(format!("'{}': member '{name}' is a {kind} that is not one of the {what}", r.name)));
+                return Err(FidelityError(format!(
+                    "'{}': member '{name}' is a {kind} that is not one of the {what}",
+                    r.name
+                )));
             }
             Ok(i)
         })
@@ -108,16 +123,15 @@ pub fn members_of(s: &Structure, r: &Relaxation) -> Result<Vec<MemberId>, Fideli
 /// actuators' commands at the point built (by symbol), which place a winch-driven cable at its
 /// length before it is hung with beads (its winch then no longer drives it: a run that moves
 /// the winch afterwards is refused where the file is read).
-pub fn relax(
-    s: &mut Structure,
-    relaxations: &[&Relaxation],
-    commands: &crate::mechanisms::Values,
-) -> Result<(), FidelityError> {
+pub fn relax(s: &mut Structure, relaxations: &[&Relaxation], commands: &Commands) -> Result<(), FidelityError> {
     let mut order = relaxations.to_vec();
     order.sort_by_key(|r| r.assumption);
     let targets = order.iter().map(|r| members_of(s, r)).collect::<Result<Vec<_>, _>>()?;
     let mut lumping = Lumping::new(s);
     for (r, members) in order.iter().zip(targets) {
+        if let (Assumption::NoGravity, Some(g)) = (r.assumption, r.gravity_m_per_s2) {
+            s.gravity = g;
+        }
         let lump = |e: lumped::LumpError| FidelityError(format!("'{}': {e}", r.name));
         for i in members {
             match r.assumption {
@@ -140,6 +154,7 @@ pub fn relax(
                     let rho = need(r, r.density_kg_per_m, "density")?;
                     lumped::hang_beads_with(s, i, (rho, r.segments), EndShare::NodeLoad, &mut lumping).map_err(lump)?
                 }
+                Assumption::NoGravity => {}
             }
         }
     }
@@ -171,7 +186,7 @@ fn set_strut_mass(s: &mut Structure, i: MemberId, rho_kg_per_m: f64) {
 
 /// Cable `i`'s winch, if one drives it, set to its command and removed: the cable is built at
 /// the commanded unstretched length and keeps it.
-fn release_winch(s: &mut Structure, i: MemberId, commands: &crate::mechanisms::Values) {
+fn release_winch(s: &mut Structure, i: MemberId, commands: &Commands) {
     let Some(w) = s.actuators.iter().position(|a| a.target == ActuatorTarget::CableLength(i)) else { return };
     if let (Some(&length), Law::Cable { length_m, .. }) = (commands.get(&s.actuators[w].symbol), &mut s.members[i].law)
     {
@@ -184,9 +199,23 @@ fn release_winch(s: &mut Structure, i: MemberId, commands: &crate::mechanisms::V
 /// driven): a run whose points move the winch without rebuilding is then refused.
 pub fn releases_winch(s: &Structure, r: &Relaxation) -> bool {
     r.assumption == Assumption::MasslessCables
-        && members_of(s, r).is_ok_and(|ms| {
-            ms.iter().any(|&i| s.actuators.iter().any(|a| a.target == ActuatorTarget::CableLength(i)))
-        })
+        && members_of(s, r)
+            .is_ok_and(|ms| ms.iter().any(|&i| s.actuators.iter().any(|a| a.target == ActuatorTarget::CableLength(i))))
+}
+
+/// The relaxed structure `s` with each heavy cable's first segment (`{name}_s1`, at the
+/// cable's own index) named as the ideal cable was, so that a mechanism finds it by its name;
+/// None where no cable was hung with beads.
+pub fn ideal_names(s: &Structure) -> Option<Structure> {
+    let first = |m: &Member| matches!(m.law, Law::Cable { .. }) && m.name.ends_with("_s1");
+    if !s.members.iter().any(first) {
+        return None;
+    }
+    let mut named = s.clone();
+    for m in named.members.iter_mut().filter(|m| first(m)) {
+        m.name.truncate(m.name.len() - "_s1".len());
+    }
+    Some(named)
 }
 
 /// The forces of a relaxed structure's snapshot as the ideal structure's members carry them: a
@@ -196,9 +225,7 @@ pub fn ideal_forces(s: &Structure, force_n: &[f64]) -> Vec<f64> {
     let mut forces = force_n.to_vec();
     for (i, m) in s.members.iter().enumerate() {
         let Some(cable) = m.name.strip_suffix("_s1") else { continue };
-        let last = (2..=lumped::MAX_CABLE_SEGMENTS)
-            .map_while(|k| s.member_id(&format!("{cable}_s{k}")))
-            .last();
+        let last = (2..=lumped::MAX_CABLE_SEGMENTS).map_while(|k| s.member_id(&format!("{cable}_s{k}"))).last();
         if let Some(last) = last {
             forces[i] = force_n[last];
         }

@@ -246,17 +246,7 @@ pub fn hang_beads_with(
     }
     let size_m = lumping.size_m;
     for (end, load) in [a, b].into_iter().zip(loaded) {
-        if load {
-            s.node_loads.push(super::NodeLoad { node: end, force_n: s.gravity.map(|g| g * end_mass) });
-            continue;
-        }
-        let body = s.nodes[end].body;
-        let free = s.bodies[body].kind == BodyKind::Free;
-        if let Some(i) = s.bodies[body].inertia.as_mut().filter(|_| free) {
-            let grown = (i.mass_kg + end_mass) / i.mass_kg;
-            i.mass_kg += end_mass;
-            i.principal_kg_m2 = i.principal_kg_m2.map(|m| m * grown);
-        }
+        rest_end_share(s, end, end_mass, load);
     }
     let mut beads = vec![a];
     for (bead, (at, _)) in names.iter().zip(&places) {
@@ -284,6 +274,22 @@ pub fn hang_beads_with(
         }
     }
     Ok(())
+}
+
+/// A heavy cable's end share `end_mass` \[kg\] at node `end`: added to a point mass, taken by a
+/// fixed body, or (`load`: a rigid body's node) a point load of its weight there.
+fn rest_end_share(s: &mut Structure, end: usize, end_mass: f64, load: bool) {
+    if load {
+        s.node_loads.push(super::NodeLoad { node: end, force_n: s.gravity.map(|g| g * end_mass) });
+        return;
+    }
+    let body = s.nodes[end].body;
+    let free = s.bodies[body].kind == BodyKind::Free;
+    if let Some(i) = s.bodies[body].inertia.as_mut().filter(|_| free) {
+        let grown = (i.mass_kg + end_mass) / i.mass_kg;
+        i.mass_kg += end_mass;
+        i.principal_kg_m2 = i.principal_kg_m2.map(|m| m * grown);
+    }
 }
 
 /// How close (as a fraction of a segment's drawn length) a bead may come to a clustered

@@ -42,6 +42,7 @@ pub struct RelaxationReport {
     pub ea_n: Option<f64>,
     pub density_kg_per_m: Option<f64>,
     pub segments: usize,
+    pub gravity_m_per_s2: Option<[f64; 3]>,
     /// The relaxations its share is measured on top of (by name).
     pub on_top_of: Vec<String>,
     /// The members it relaxes in the first point's structure (none: the assumption holds for
@@ -58,6 +59,8 @@ pub struct Item {
     pub name: String,
     /// The settle point (None: the run's largest error, or a motion's frequency).
     pub point: Option<usize>,
+    /// The point's inputs (and swept parameters), where it is a point's.
+    pub inputs: crate::mechanisms::Values,
     /// The model's value (NaN where the report gives an error only).
     pub model: f64,
     /// The deviation from the model at each level, in [`AttributionReport::levels`]' order:
@@ -130,13 +133,17 @@ pub fn attribute(sc: &Scenario, cancel: Option<&AtomicBool>) -> Result<Attributi
         }
         let relaxed = set.iter().map(|&i| sc.fidelity[i].name.clone()).collect();
         let error = report.error.as_ref().map(|e| e.to_string());
-        levels.push(Level { name: name.clone(), relaxed, passed: report.passed, error, wall_s: wall.elapsed().as_secs_f64() });
+        levels.push(Level {
+            name: name.clone(),
+            relaxed,
+            passed: report.passed,
+            error,
+            wall_s: wall.elapsed().as_secs_f64(),
+        });
         reports.push(report);
     }
-    let items = compared(sc, &reports[0])
-        .into_iter()
-        .map(|(key, model)| item(sc, &sets, &reports, key, model))
-        .collect();
+    let items =
+        compared(sc, &reports[0]).into_iter().map(|(key, model)| item(sc, &sets, &reports, key, model)).collect();
     Ok(AttributionReport {
         scenario: sc.name.clone(),
         file: sc.file.display().to_string(),
@@ -188,11 +195,9 @@ fn deviation(sc: &Scenario, report: &ScenarioReport, key: &Key, model: f64) -> f
                 d
             }
         }
-        Key::ModelCheck { kind, name } => report
-            .model_checks
-            .iter()
-            .find(|m| m.kind == *kind && m.name == *name)
-            .map_or(f64::NAN, |m| m.max_error),
+        Key::ModelCheck { kind, name } => {
+            report.model_checks.iter().find(|m| m.kind == *kind && m.name == *name).map_or(f64::NAN, |m| m.max_error)
+        }
         Key::Frequency { name } => report
             .motion
             .iter()
@@ -220,7 +225,9 @@ fn item(sc: &Scenario, sets: &[(String, Vec<usize>)], reports: &[ScenarioReport]
         Key::ModelCheck { kind, name } => (kind, name, None),
         Key::Frequency { name } => ("frequency".to_string(), name, None),
     };
-    Item { kind, name, point, model, deviation, shares, interaction }
+    let at_point = point.and_then(|p| reports[0].points.iter().find(|q| q.index == p));
+    let inputs = at_point.map(|p| p.inputs.clone()).unwrap_or_default();
+    Item { kind, name, point, inputs, model, deviation, shares, interaction }
 }
 
 /// The report's statement of each relaxation, with the relaxations it is measured on top of.
@@ -237,6 +244,7 @@ fn relaxation_reports(sc: &Scenario, sets: &[(String, Vec<usize>)]) -> Vec<Relax
             ea_n: r.ea_n,
             density_kg_per_m: r.density_kg_per_m,
             segments: r.segments,
+            gravity_m_per_s2: r.gravity_m_per_s2,
             on_top_of: sets[i + 1].1.iter().filter(|&&j| j != i).map(|&j| sc.fidelity[j].name.clone()).collect(),
             relaxes: first.as_ref().map_or(Vec::new(), |s| {
                 fidelity::members_of(s, r).unwrap_or_default().iter().map(|&m| s.members[m].name.clone()).collect()
@@ -257,15 +265,21 @@ impl AttributionReport {
     pub fn to_table(&self) -> String {
         let mut out = format!("{} ({})\n", self.scenario, self.file);
         for r in &self.relaxations {
-            let on_top = if r.on_top_of.is_empty() { String::new() } else { format!(", on top of {}", r.on_top_of.join(", ")) };
-            let members = if r.relaxes.is_empty() { "no member".to_string() } else { r.relaxes.join(", ") };
+            let on_top =
+                if r.on_top_of.is_empty() { String::new() } else { format!(", on top of {}", r.on_top_of.join(", ")) };
+            let members = match (r.gravity_m_per_s2, r.relaxes.is_empty()) {
+                (Some(g), _) => format!("every body, g = {g:?} m/s^2"),
+                (None, true) => "no member".to_string(),
+                (None, false) => r.relaxes.join(", "),
+            };
             out += &format!("relaxation '{}': {} ({members}){on_top}\n", r.name, r.assumption);
         }
         for l in &self.levels {
             let error = l.error.as_ref().map_or(String::new(), |e| format!(": {e}"));
             out += &format!("level {:<24} {:.3} s{error}\n", l.name, l.wall_s);
         }
-        let mut header = format!("{:<12} {:<16} {:>5} {:>14} {:>12} {:>12}", "kind", "name", "point", "model", "ideal", "all");
+        let mut header =
+            format!("{:<12} {:<16} {:>5} {:>14} {:>12} {:>12}", "kind", "name", "point", "model", "ideal", "all");
         for r in &self.relaxations {
             header += &format!(" {:>14}", clip(&r.name, 14));
         }
@@ -288,9 +302,14 @@ impl AttributionReport {
         out + "deviation = simulated - model at each level; the shares and the interaction add up to all - ideal\n"
     }
 
-    /// One row per compared value (a grid's shares per point).
+    /// One row per compared value (a grid's shares per point, with the point's inputs).
     pub fn to_csv(&self) -> String {
-        let mut header = "kind,name,point,model".to_string();
+        let inputs: std::collections::BTreeSet<&String> = self.items.iter().flat_map(|it| it.inputs.keys()).collect();
+        let mut header = "kind,name,point".to_string();
+        for k in &inputs {
+            header += &format!(",{}", csv_field(k));
+        }
+        header += ",model";
         for l in &self.levels {
             header += &format!(",deviation:{}", csv_field(&l.name));
         }
@@ -300,7 +319,11 @@ impl AttributionReport {
         let mut out = header + ",interaction\n";
         for it in &self.items {
             let point = it.point.map_or(String::new(), |p| p.to_string());
-            out += &format!("{},{},{point},{:e}", it.kind, csv_field(&it.name), it.model);
+            out += &format!("{},{},{point}", it.kind, csv_field(&it.name));
+            for k in &inputs {
+                out += &it.inputs.get(*k).map_or(",".to_string(), |v| format!(",{v:e}"));
+            }
+            out += &format!(",{:e}", it.model);
             for v in it.deviation.iter().chain(&it.shares) {
                 out += &format!(",{v:e}");
             }

@@ -67,10 +67,22 @@ fn attribution_writes_its_csv_and_its_figure() {
 fn bad_relaxations_are_refused_at_their_table() {
     let text = std::fs::read_to_string(HANGING).unwrap();
     let cases = [
-        ("relax = \"rigid struts\"\nEA = 1e4", "relax = \"rigid struts\"\nEA = 1e4\nmembers = [\"rod\"]", "no member 'rod'"),
-        ("relax = \"rigid struts\"\nEA = 1e4", "relax = \"rigid struts\"\nEA = 1e4\nmembers = [\"cable\"]", "is a cable that is not one of the rigid struts"),
+        (
+            "relax = \"rigid struts\"\nEA = 1e4",
+            "relax = \"rigid struts\"\nEA = 1e4\nmembers = [\"rod\"]",
+            "no member 'rod'",
+        ),
+        (
+            "relax = \"rigid struts\"\nEA = 1e4",
+            "relax = \"rigid struts\"\nEA = 1e4\nmembers = [\"cable\"]",
+            "is a cable that is not one of the rigid struts",
+        ),
         ("relax = \"inextensible cables\"\nEA = 1e3", "relax = \"inextensible cables\"", "needs EA"),
-        ("relax = \"rigid struts\"\nEA = 1e4", "relax = \"rigid bodies\"\nEA = 1e4", "unknown assumption 'rigid bodies'"),
+        (
+            "relax = \"rigid struts\"\nEA = 1e4",
+            "relax = \"rigid bodies\"\nEA = 1e4",
+            "unknown assumption 'rigid bodies'",
+        ),
         ("relax = \"rigid struts\"\nEA = 1e4", "relax = \"rigid struts\"\nE = 2e11", "E and area go together"),
         ("density = 0.1\nsegments = 4", "density = 0.1\nsegments = 0", "segments must be 1 to 1000"),
     ];
