@@ -44,7 +44,7 @@ pub fn write(report: &AttributionReport, outputs: &[(PathBuf, Format)]) -> Resul
             (format!("{}{at}", it.name), parts)
         })
         .collect();
-    let mut names: Vec<String> = report.relaxations.iter().map(|r| r.name.clone()).collect();
+    let mut names: Vec<String> = report.relaxations.iter().map(|r| r.relaxation.name.clone()).collect();
     names.push("interaction".into());
     let figure = Bars { title: format!("What each relaxation costs the model: {}", report.scenario), names, bars };
     kit::write(outputs, SIZE, |canvas| canvas.draw(&figure))

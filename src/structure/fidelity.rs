@@ -57,8 +57,15 @@ impl Assumption {
     }
 }
 
+/// An assumption is written as its words (`"inextensible cables"`).
+impl serde::Serialize for Assumption {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.label())
+    }
+}
+
 /// One idealization relaxed, with its physical data.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Relaxation {
     /// The name a report gives its share.
     pub name: String,

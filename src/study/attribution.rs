@@ -30,19 +30,17 @@ pub struct Level {
     pub passed: bool,
     /// Why the run stopped, if it did.
     pub error: Option<String>,
+    /// The settle points that did not settle (their values are NaN at this level).
+    pub unsettled: Vec<usize>,
     pub wall_s: f64,
 }
 
-/// A relaxation as the report states it.
+/// A relaxation as the report states it: the file's, with what it is measured on top of and
+/// what it relaxes.
 #[derive(Clone, Debug, Serialize)]
 pub struct RelaxationReport {
-    pub name: String,
-    pub assumption: String,
-    pub members: Vec<String>,
-    pub ea_n: Option<f64>,
-    pub density_kg_per_m: Option<f64>,
-    pub segments: usize,
-    pub gravity_m_per_s2: Option<[f64; 3]>,
+    #[serde(flatten)]
+    pub relaxation: Relaxation,
     /// The relaxations its share is measured on top of (by name).
     pub on_top_of: Vec<String>,
     /// The members it relaxes in the first point's structure (none: the assumption holds for
@@ -138,6 +136,7 @@ pub fn attribute(sc: &Scenario, cancel: Option<&AtomicBool>) -> Result<Attributi
             relaxed,
             passed: report.passed,
             error,
+            unsettled: report.points.iter().filter(|p| !p.settled).map(|p| p.index).collect(),
             wall_s: wall.elapsed().as_secs_f64(),
         });
         reports.push(report);
@@ -238,13 +237,7 @@ fn relaxation_reports(sc: &Scenario, sets: &[(String, Vec<usize>)]) -> Vec<Relax
         .iter()
         .enumerate()
         .map(|(i, r)| RelaxationReport {
-            name: r.name.clone(),
-            assumption: r.assumption.label().to_string(),
-            members: r.members.clone(),
-            ea_n: r.ea_n,
-            density_kg_per_m: r.density_kg_per_m,
-            segments: r.segments,
-            gravity_m_per_s2: r.gravity_m_per_s2,
+            relaxation: r.clone(),
             on_top_of: sets[i + 1].1.iter().filter(|&&j| j != i).map(|&j| sc.fidelity[j].name.clone()).collect(),
             relaxes: first.as_ref().map_or(Vec::new(), |s| {
                 fidelity::members_of(s, r).unwrap_or_default().iter().map(|&m| s.members[m].name.clone()).collect()
@@ -264,24 +257,28 @@ impl AttributionReport {
     /// relaxation's share and the interaction.
     pub fn to_table(&self) -> String {
         let mut out = format!("{} ({})\n", self.scenario, self.file);
-        for r in &self.relaxations {
+        for report in &self.relaxations {
+            let (r, on_top_of) = (&report.relaxation, &report.on_top_of);
             let on_top =
-                if r.on_top_of.is_empty() { String::new() } else { format!(", on top of {}", r.on_top_of.join(", ")) };
-            let members = match (r.gravity_m_per_s2, r.relaxes.is_empty()) {
+                if on_top_of.is_empty() { String::new() } else { format!(", on top of {}", on_top_of.join(", ")) };
+            let members = match (r.gravity_m_per_s2, report.relaxes.is_empty()) {
                 (Some(g), _) => format!("every body, g = {g:?} m/s^2"),
                 (None, true) => "no member".to_string(),
-                (None, false) => r.relaxes.join(", "),
+                (None, false) => report.relaxes.join(", "),
             };
-            out += &format!("relaxation '{}': {} ({members}){on_top}\n", r.name, r.assumption);
+            out += &format!("relaxation '{}': {} ({members}){on_top}\n", r.name, r.assumption.label());
         }
         for l in &self.levels {
-            let error = l.error.as_ref().map_or(String::new(), |e| format!(": {e}"));
+            let mut error = l.error.as_ref().map_or(String::new(), |e| format!(": {e}"));
+            if !l.unsettled.is_empty() {
+                error += &format!(" (points {:?} did not settle)", l.unsettled);
+            }
             out += &format!("level {:<24} {:.3} s{error}\n", l.name, l.wall_s);
         }
         let mut header =
             format!("{:<12} {:<16} {:>5} {:>14} {:>12} {:>12}", "kind", "name", "point", "model", "ideal", "all");
         for r in &self.relaxations {
-            header += &format!(" {:>14}", clip(&r.name, 14));
+            header += &format!(" {:>14}", clip(&r.relaxation.name, 14));
         }
         out += &format!("{header} {:>12}\n", "interaction");
         for it in &self.items {
@@ -314,7 +311,7 @@ impl AttributionReport {
             header += &format!(",deviation:{}", csv_field(&l.name));
         }
         for r in &self.relaxations {
-            header += &format!(",share:{}", csv_field(&r.name));
+            header += &format!(",share:{}", csv_field(&r.relaxation.name));
         }
         let mut out = header + ",interaction\n";
         for it in &self.items {
