@@ -28,6 +28,9 @@ pub struct Level {
     /// Whether the run passed its own checks (the ideal's tolerances: a relaxed run is
     /// expected to fail them by what the relaxations cost).
     pub passed: bool,
+    /// Whether the run did what the file's `[expect]` says (the ideal level's verdict; a
+    /// relaxed level is not expected to).
+    pub as_expected: Option<bool>,
     /// Why the run stopped, if it did.
     pub error: Option<String>,
     /// The settle points that did not settle (their values are NaN at this level).
@@ -135,6 +138,7 @@ pub fn attribute(sc: &Scenario, cancel: Option<&AtomicBool>) -> Result<Attributi
             name: name.clone(),
             relaxed,
             passed: report.passed,
+            as_expected: report.as_expected,
             error,
             unsettled: report.points.iter().filter(|p| !p.settled).map(|p| p.index).collect(),
             wall_s: wall.elapsed().as_secs_f64(),

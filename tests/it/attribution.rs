@@ -116,7 +116,7 @@ fn a_relaxation_the_structure_cannot_take_is_refused_naming_why() {
     assert_eq!(err.line, line, "{err}");
 }
 
-/// Every seed's attribution file runs: its ideal level passes its own checks, and at every
+/// Every seed's attribution file runs: its ideal level gives the file's verdict, and at every
 /// compared value the shares and the interaction add up to the whole change within 1e-12 of
 /// the model's value (where the levels settled).
 #[test]
@@ -130,7 +130,7 @@ fn every_seed_attributes_and_its_shares_add_up() {
         let (code, out, err) = common::tensegrity(&["attribute", file, "--json", "-"]);
         assert_eq!(code, 0, "{file}: {err}");
         let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-        assert_eq!(v["levels"][0]["passed"], true, "{file}: the ideal level");
+        assert_eq!(v["levels"][0]["as_expected"], true, "{file}: the ideal level's verdict");
         let levels = v["levels"].as_array().unwrap();
         let every = v["relaxations"].as_array().unwrap().len();
         let all_level = levels.iter().position(|l| l["relaxed"].as_array().unwrap().len() == every).unwrap();
