@@ -917,4 +917,4 @@ def test_attribute_from_python_is_the_clis_attribute_json():
         tt.attribute(text[: text.index("[[fidelity]]")], name="bare.toml")
     with pytest.raises(tt.ScenarioError, match="no member 'rod'") as e:
         tt.attribute(text.replace('relax = "rigid struts"', 'relax = "rigid struts"\nmembers = ["rod"]'), name="rod.toml")
-    assert e.value.line == text[: text.index('relax = "rigid struts"')].count("\n")
+    assert e.value.line == text[: text.index('[[fidelity]]\nname = "elastic bar"')].count("\n") + 1
