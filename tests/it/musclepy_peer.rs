@@ -66,3 +66,40 @@ fn the_testbed_agrees_with_musclepy_where_musclepy_agrees_with_the_exact_answer(
         assert!(d <= 1e-12, "{}: {d:e}", row["quantity"]);
     }
 }
+
+/// The lowest frequency of MusclePy's dynamic simplex with its bars' axial stiffness scaled by
+/// `scale` and its cables' mass `mc` \[kg\] (`tensegrity modes`, the bars' step cut to suit).
+fn simplex_f1_hz(scale: f64, mc: f64) -> f64 {
+    let es = format!("Es={}", 7.039e10 * scale);
+    let mc = format!("mc={mc}");
+    let file = "benches/peers/musclepy/cases/simplex_dynamic.toml";
+    let args = ["modes", file, "--set", &es, "--set", &mc, "--set", "sim.dt=1e-7", "--set", "settle.max_time=0.9"];
+    let (code, out, err) = common::tensegrity(&[&args[..], &["--json", "-"]].concat());
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out[out.find('{').unwrap()..]).unwrap();
+    v["modes"][0]["frequency_hz"].as_f64().unwrap()
+}
+
+/// What the simplex's idealizations cost its lowest frequency (the peer's README). With its
+/// cables' mass (0.502 kg) and its bars' EA the testbed gives MusclePy's lumped 2.16647 Hz; the
+/// rigid-bar limit, by Richardson's rule over EA x 10 and x 100 (f linear in 1/EA near it), is
+/// 2.32804 Hz with the cables' mass and 2.52044 Hz without (the README's values from x 100 and
+/// x 1000, 2.32810 and 2.52050, within 1e-4). So against the rigid, massless ideal (2.5205 Hz)
+/// the bars' EA costs -0.1750 Hz, the cables' mass -0.1924 Hz, and together they cost 0.0134 Hz
+/// less than the two added.
+#[test]
+fn the_simplexs_frequency_splits_into_the_bars_ea_and_the_cables_mass() {
+    let rigid = |mc: f64| {
+        let (f10, f100) = (simplex_f1_hz(10.0, mc), simplex_f1_hz(100.0, mc));
+        f100 + (f100 - f10) / 9.0
+    };
+    let (elastic_heavy, elastic_light) = (simplex_f1_hz(1.0, 0.502), simplex_f1_hz(1.0, 0.0));
+    let (rigid_heavy, rigid_light) = (rigid(0.502), rigid(0.0));
+    assert!((elastic_heavy - 2.16647).abs() < 1e-5, "{elastic_heavy}");
+    assert!((rigid_heavy - 2.32810).abs() < 1e-4, "{rigid_heavy}");
+    assert!((rigid_light - 2.52050).abs() < 1e-4, "{rigid_light}");
+    let (ea, mass) = (elastic_light - rigid_light, rigid_heavy - rigid_light);
+    let interaction = elastic_heavy - rigid_light - ea - mass;
+    assert!((ea + 0.1750).abs() < 2e-4 && (mass + 0.1924).abs() < 2e-4, "{ea} {mass}");
+    assert!((interaction - 0.0134).abs() < 2e-4, "{interaction}");
+}
