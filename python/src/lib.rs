@@ -567,7 +567,9 @@ fn attribute_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<Strin
     let sc = load(path, text, &set)?;
     let result = on_own_thread(py, move |cancel| study::attribution::attribute(&sc, Some(cancel)))?;
     let report = result.map_err(|e| match e {
-        study::attribution::AttributionError::NoRelaxation => PyValueError::new_err(format!("{path}: {e}")),
+        study::attribution::AttributionError::NoRelaxation | study::attribution::AttributionError::Level { .. } => {
+            PyValueError::new_err(format!("{path}: {e}"))
+        }
         study::attribution::AttributionError::Cancelled => PyException::new_err(format!("{path}: {e}")),
     })?;
     Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))

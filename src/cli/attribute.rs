@@ -29,7 +29,9 @@ pub fn attribute(
     check_outputs(&[scenario.to_path_buf()], &outputs)?;
     let sc = load_one(scenario, overrides)?;
     let report = crate::study::attribution::attribute(&sc, Some(&signals::CANCEL)).map_err(|e| match e {
-        AttributionError::NoRelaxation => bad_input(format!("{}: {e}", scenario.display())),
+        AttributionError::NoRelaxation | AttributionError::Level { .. } => {
+            bad_input(format!("{}: {e}", scenario.display()))
+        }
         AttributionError::Cancelled => failed(format!("{}: {e}", scenario.display())),
     })?;
     let to_stderr = json.is_some_and(super::is_stdio) || csv.is_some_and(super::is_stdio);

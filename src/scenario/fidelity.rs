@@ -41,6 +41,7 @@ pub(super) struct RawRelaxation {
     density: Option<Spanned<f64>>,
     segments: Option<Spanned<i64>>,
     gravity: Option<Spanned<[f64; 3]>>,
+    set: Option<Spanned<std::collections::BTreeMap<String, f64>>>,
     /// Where the data come from (the paper's prototype, a catalogue): for the reader.
     #[allow(dead_code)]
     source: Option<String>,
@@ -52,6 +53,8 @@ pub(super) struct FirstPoint<'a> {
     pub structure: &'a Structure,
     pub commands: Values,
     pub dt_s: f64,
+    /// Every parameter's value (what a "parameter values" relaxation may set).
+    pub params: Values,
     /// The points are carried by continuation or followed in time (or a motion runs), so a
     /// winch moves a cable after its build.
     pub winches_move: bool,
@@ -66,7 +69,7 @@ impl FirstPoint<'_> {
                 Actuation::Points { points, continuation } => *continuation && points.len() > 1,
                 Actuation::Schedule { .. } => true,
             };
-        FirstPoint { structure, commands, dt_s: s.sim.dt_s, winches_move }
+        FirstPoint { structure, commands, dt_s: s.sim.dt_s, params: s.params.clone(), winches_move }
     }
 }
 
@@ -78,12 +81,17 @@ pub(super) fn fidelity(ctx: &Ctx, raw: &RawScenario, first: &FirstPoint) -> Resu
         if let Some(same) = list.iter().find(|o| o.name == relaxation.name) {
             return Err(ctx.err(r, format!("a relaxation named '{}' is listed twice: name each one", same.name)));
         }
-        if list.iter().any(|o| o.assumption == relaxation.assumption && o.members == relaxation.members) {
+        let structural = relaxation.assumption != Assumption::ParameterValues;
+        if structural && list.iter().any(|o| o.assumption == relaxation.assumption && o.members == relaxation.members) {
             return Err(ctx.err(&r.get_ref().relax, "this assumption is relaxed twice for the same members"));
         }
         list.push(relaxation);
     }
     for (r, raw_r) in list.iter().zip(&raw.fidelity) {
+        if let Some(name) = r.params.keys().find(|k| !first.params.contains_key(*k)) {
+            let at = raw_r.get_ref().set.as_ref().expect("a parameter relaxation has its set");
+            return Err(ctx.err(at, format!("'{}': set: '{name}' is not a parameter of this scenario", r.name)));
+        }
         if first.winches_move && fidelity::releases_winch(first.structure, r) {
             return Err(ctx.err(raw_r, format!("'{}': a heavy cable is built at its winch's length and the winch no longer moves it, but this run moves the winch after the build (continuation, waypoints or a motion): set continuation = false, or relax another cable", r.name)));
         }
@@ -144,6 +152,7 @@ fn relaxation(ctx: &Ctx, r: &Spanned<RawRelaxation>) -> Result<Relaxation, Scena
         Assumption::RigidStruts => &[("EA (N), or E (Pa) with area (m^2)", ea.is_some())],
         Assumption::MasslessCables => &[("density (kg/m)", density.is_some()), ("segments", raw.segments.is_some())],
         Assumption::NoGravity => &[("gravity = [x, y, z] (m/s^2)", raw.gravity.is_some())],
+        Assumption::ParameterValues => &[("set = { NAME = VALUE, ... }", raw.set.is_some())],
     };
     if let Some((what, _)) = needs.iter().find(|(_, given)| !given) {
         return Err(ctx.err(r, format!("relaxing {} needs {what}", assumption.label())));
@@ -157,11 +166,25 @@ fn relaxation(ctx: &Ctx, r: &Spanned<RawRelaxation>) -> Result<Relaxation, Scena
     if let Some(g) = raw.gravity.as_ref().filter(|g| g.get_ref().iter().any(|x| !x.is_finite())) {
         return Err(ctx.err(g, "gravity must be three finite numbers (m/s^2)"));
     }
-    if let (Assumption::NoGravity, Some(m)) = (assumption, &raw.members) {
-        return Err(ctx.err(m, "gravity acts on every body: \"no gravity\" takes no members"));
+    if let (Assumption::NoGravity | Assumption::ParameterValues, Some(m)) = (assumption, &raw.members) {
+        return Err(ctx.err(m, format!("\"{}\" acts on the whole structure: it takes no members", assumption.label())));
     }
+    let params = raw.set.as_ref().filter(|_| assumption == Assumption::ParameterValues);
+    if let Some((name, x)) = params.and_then(|p| p.get_ref().iter().find(|(_, x)| !x.is_finite())) {
+        return Err(ctx.err(params.unwrap(), format!("set: {name} = {x}: a parameter's value is a finite number")));
+    }
+    let params = params.map(|p| p.get_ref().clone()).unwrap_or_default();
     let gravity_m_per_s2 = gravity.filter(|_| assumption == Assumption::NoGravity);
-    Ok(Relaxation { name, assumption, members, ea_n: ea, density_kg_per_m: density, segments, gravity_m_per_s2 })
+    Ok(Relaxation {
+        name,
+        assumption,
+        members,
+        ea_n: ea,
+        density_kg_per_m: density,
+        segments,
+        gravity_m_per_s2,
+        params,
+    })
 }
 
 /// A heavy cable's segment count, 1 to [`lumped::MAX_CABLE_SEGMENTS`] (1 where not given).

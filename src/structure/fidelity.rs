@@ -24,16 +24,21 @@ pub enum Assumption {
     RigidStruts,
     /// Cables without mass: relaxed to beads on elastic segments (`lumped::hang_beads`).
     MasslessCables,
+    /// A model choice at its ideal value (an actuator's infinite stiffness, a joint without
+    /// damping): relaxed to the values the file states for its parameters, the scenario read
+    /// again with them as `--set` would set them.
+    ParameterValues,
 }
 
 impl Assumption {
     /// Every assumption by the words a file names it with, in the order relaxations are
     /// applied together (a cable is made elastic before it is hung with beads).
-    pub const ALL: [(Assumption, &'static str); 4] = [
+    pub const ALL: [(Assumption, &'static str); 5] = [
         (Assumption::NoGravity, "no gravity"),
         (Assumption::InextensibleCables, "inextensible cables"),
         (Assumption::RigidStruts, "rigid struts"),
         (Assumption::MasslessCables, "massless cables"),
+        (Assumption::ParameterValues, "parameter values"),
     ];
 
     /// The words a file and a report use.
@@ -52,7 +57,7 @@ impl Assumption {
             Assumption::InextensibleCables => matches!(m.law, Law::Cable { law: CableLaw::Inextensible, .. }),
             Assumption::RigidStruts => m.law == Law::Strut,
             Assumption::MasslessCables => matches!(m.law, Law::Cable { .. }),
-            Assumption::NoGravity => false,
+            Assumption::NoGravity | Assumption::ParameterValues => false,
         }
     }
 }
@@ -81,6 +86,8 @@ pub struct Relaxation {
     pub segments: usize,
     /// The gravity a prototype feels, world frame \[m/s^2\] ("no gravity" relaxed).
     pub gravity_m_per_s2: Option<[f64; 3]>,
+    /// The parameters' values ("parameter values" relaxed), by name.
+    pub params: std::collections::BTreeMap<String, f64>,
 }
 
 /// `r` with the relaxations it is measured on top of: a heavy cable's "inextensible cables"
@@ -161,7 +168,7 @@ pub fn relax(s: &mut Structure, relaxations: &[&Relaxation], commands: &Commands
                     let rho = need(r, r.density_kg_per_m, "density")?;
                     lumped::hang_beads_with(s, i, (rho, r.segments), EndShare::NodeLoad, &mut lumping).map_err(lump)?
                 }
-                Assumption::NoGravity => {}
+                Assumption::NoGravity | Assumption::ParameterValues => {}
             }
         }
     }

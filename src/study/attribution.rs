@@ -89,6 +89,9 @@ pub struct AttributionReport {
 pub enum AttributionError {
     #[error("the scenario has no [[fidelity]] relaxation: list the idealizations to relax, each with its data")]
     NoRelaxation,
+    /// The scenario read again with a level's parameter values is refused.
+    #[error("level '{level}': {error}")]
+    Level { level: String, error: crate::scenario::ScenarioError },
     #[error("stopped by a signal")]
     Cancelled,
 }
@@ -128,7 +131,8 @@ pub fn attribute(sc: &Scenario, cancel: Option<&AtomicBool>) -> Result<Attributi
     let mut levels = Vec::new();
     for (name, set) in &sets {
         let wall = std::time::Instant::now();
-        let report = run(&sc.relaxed_by(set), &RunOptions { cancel, skip_findings: true, ..RunOptions::default() });
+        let level = level_scenario(sc, set).map_err(|error| AttributionError::Level { level: name.clone(), error })?;
+        let report = run(&level, &RunOptions { cancel, skip_findings: true, ..RunOptions::default() });
         if cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
             return Err(AttributionError::Cancelled);
         }
@@ -154,6 +158,24 @@ pub fn attribute(sc: &Scenario, cancel: Option<&AtomicBool>) -> Result<Attributi
         levels,
         items,
     })
+}
+
+/// `sc` at the level that applies `set`: read again with its parameter values (as `--set`
+/// sets them, after the file's own flags) where it has any, then with its structural
+/// relaxations.
+fn level_scenario(sc: &Scenario, set: &[usize]) -> Result<Scenario, crate::scenario::ScenarioError> {
+    let params: Vec<(String, f64)> =
+        set.iter().flat_map(|&i| sc.fidelity[i].params.iter().map(|(k, v)| (k.clone(), *v))).collect();
+    if params.is_empty() {
+        return Ok(sc.relaxed_by(set));
+    }
+    let mut overrides = sc.overrides.clone();
+    overrides.extend(
+        params
+            .iter()
+            .map(|(name, value)| crate::scenario::Override { name: name.clone(), value: format!("{value:e}") }),
+    );
+    Ok(crate::scenario::parse_with(&sc.file, &sc.source, &overrides)?.relaxed_by(set))
 }
 
 /// What a compared value is, to find it in every level's report.

@@ -40,6 +40,24 @@ fn each_relaxation_of_a_hanging_bar_costs_its_closed_form_and_the_shares_add_up(
     assert_eq!(v["relaxations"][2]["on_top_of"][0], "elastic cable");
 }
 
+/// A relaxation stated as parameter values (the bar 3 kg, not 2): alone, on the rigid bar and
+/// the inextensible cable, it moves nothing (exactly 0); with the elastic members it adds
+/// the extra kilogram's stretch, -g (l / EA_c + L / (2 EA_s)) = -1.005525e-2 m, all of it in
+/// the interaction, within 1e-9 m.
+#[test]
+fn a_relaxation_by_parameter_values_shows_in_the_interaction() {
+    let text = std::fs::read_to_string(HANGING).unwrap()
+        + "\n[[fidelity]]\nname = \"heavier bar\"\nrelax = \"parameter values\"\nset = { M = 3.0 }\n";
+    let v = common::json_of("attribute", &text, "heavier");
+    let (shares, interaction, _) = only_item(&v);
+    assert_eq!(shares[3], 0.0, "{shares:?}");
+    let want = -G * (1.0 / 1e3 + 0.5 / (2.0 * 1e4));
+    assert!((interaction - want).abs() <= 1e-9, "{interaction} against {want}");
+    let bad = text.replace("set = { M = 3.0 }", "set = { mass = 3.0 }");
+    let err = tensegrity_testbed::scenario::parse(std::path::Path::new("variant.toml"), &bad).expect_err("mass");
+    assert!(err.message.contains("'mass' is not a parameter"), "{err}");
+}
+
 /// The CSV holds one row per compared value with every level's deviation, every share and the
 /// interaction; the figure is an SVG with a bar per value.
 #[test]
