@@ -364,8 +364,9 @@ fn evaluate(problem: &FitProblem, p: &[f64], cancel: Option<&AtomicBool>) -> Res
     for x in problem.measurements.iter().filter(|x| x.time_s.is_none()) {
         first.entry(x.point).or_insert(x);
     }
+    let fitted: Vec<String> = problem.parameters.iter().map(|f| f.name.clone()).collect();
     let settled: Vec<(usize, Result<SensitivityReport, FitError>)> =
-        first.par_iter().map(|(&point, x)| (point, settled_point(&sc, &file, x, p, cancel))).collect();
+        first.par_iter().map(|(&point, x)| (point, settled_point(&sc, (&file, &fitted), x, p, cancel))).collect();
     let mut reports: BTreeMap<usize, Result<SensitivityReport, FitError>> = settled.into_iter().collect();
     if let Some(x) = problem.measurements.iter().find(|x| x.time_s.is_none() && reports[&x.point].is_err()) {
         return Err(reports.remove(&x.point).expect("a point settled").expect_err("a failure"));
@@ -412,12 +413,12 @@ fn evaluate(problem: &FitProblem, p: &[f64], cancel: Option<&AtomicBool>) -> Res
     Ok(eval)
 }
 
-/// The sensitivities at measurement `x`'s point of `sc` (at the fitted parameters `p`),
-/// settled afresh; a point the scenario has not, or a structure the sensitivities refuse, is
+/// The sensitivities to the `fitted` parameters at measurement `x`'s point of `sc` (at their
+/// values `p`), settled afresh; a point the scenario has not, or a structure the sensitivities refuse, is
 /// bad input.
 fn settled_point(
     sc: &Scenario,
-    file: &str,
+    (file, fitted): (&str, &[String]),
     x: &Measurement,
     p: &[f64],
     cancel: Option<&AtomicBool>,
@@ -425,10 +426,11 @@ fn settled_point(
     if point_of(sc, x.point).is_none() {
         return Err(FitError::BadInput(format!("{}: the scenario has no point {} (from 0)", x.at, x.point)));
     }
-    let r = super::sensitivity::sensitivity(sc, file, x.point, false, cancel).map_err(|e| match e {
-        SensitivityRunError::Refused(_) => FitError::BadInput(format!("{file}: {e}")),
-        _ => FitError::Failed(format!("{file} at point {}: {e}", x.point)),
-    })?;
+    let r =
+        super::sensitivity::sensitivity_to(sc, file, (x.point, Some(fitted)), false, cancel).map_err(|e| match e {
+            SensitivityRunError::Refused(_) => FitError::BadInput(format!("{file}: {e}")),
+            _ => FitError::Failed(format!("{file} at point {}: {e}", x.point)),
+        })?;
     if !r.settled {
         return Err(FitError::Failed(format!("{file}: point {} did not settle at {p:?}", x.point)));
     }

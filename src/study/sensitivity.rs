@@ -43,6 +43,18 @@ pub fn sensitivity(
     check: bool,
     cancel: Option<&AtomicBool>,
 ) -> Result<SensitivityReport, SensitivityRunError> {
+    sensitivity_to(sc, file, (point, None), check, cancel)
+}
+
+/// [`sensitivity`] at (`point`, `only`): with `only`, the rows of those parameters alone (a
+/// fit's fitted ones: a file's other parameters and helpers cost no steps).
+pub fn sensitivity_to(
+    sc: &Scenario,
+    file: &str,
+    (point, only): (usize, Option<&[String]>),
+    check: bool,
+    cancel: Option<&AtomicBool>,
+) -> Result<SensitivityReport, SensitivityRunError> {
     let (sc, inputs) = point_of(sc, point).ok_or(SensitivityRunError::NoPoint(point))?;
     let params = sc.params_at(&inputs);
     // What the analysis refuses is the structure's, known before the settle.
@@ -56,7 +68,8 @@ pub fn sensitivity(
     // Only what something reads gets steps: a file's thousands of unread parameters cost
     // nothing (3,000 had taken 142 s, each resolving the file's structure four times).
     let unread: std::collections::HashSet<String> = sc.unread_params().into_iter().collect();
-    for (name, &value) in &params {
+    let asked = |name: &String| only.is_none_or(|o| o.contains(name));
+    for (name, &value) in params.iter().filter(|(name, _)| asked(name)) {
         if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
             return Err(RunError::Interrupted(state.sim.tick()).into());
         }

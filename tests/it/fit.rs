@@ -405,3 +405,20 @@ fn data_past_the_row_bound_are_refused_at_the_row() {
     let line = MAX_DATA_ROWS + 2;
     assert!(e.starts_with(&format!("d.csv:{line}:1: more than {MAX_DATA_ROWS} measurement rows")), "{e}");
 }
+
+/// A fit asks for the fitted parameters' sensitivities alone (issue 63: it had computed every
+/// parameter's, helpers included): the prism's sensitivities to k_side alone are one row, the
+/// same to the bit as k_side's row among all four.
+#[test]
+fn a_fit_computes_the_fitted_parameters_sensitivities_alone() {
+    use tensegrity_testbed::study::sensitivity::{sensitivity, sensitivity_to};
+    let file = "tests/fixtures/fit/prism3_loads.toml";
+    let sc = tensegrity_testbed::scenario::load(std::path::Path::new(file)).unwrap();
+    let all = sensitivity(&sc, file, 0, false, None).unwrap();
+    let only = sensitivity_to(&sc, file, (0, Some(&["k_side".to_string()])), false, None).unwrap();
+    assert_eq!(all.parameters.len(), 4);
+    assert_eq!(only.parameters.len(), 1);
+    let row = all.parameters.iter().find(|p| p.name == "k_side").unwrap();
+    let bits = |d: &[f64]| d.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+    assert_eq!(bits(&only.parameters[0].derivatives), bits(&row.derivatives));
+}
