@@ -237,3 +237,17 @@ fn an_interrupted_findings_phase_is_reported() {
     assert!(err.contains("interrupted while checking the paper's equations"), "{err}");
     assert!(!r.passed);
 }
+
+/// Attribution (mohr2011's levels with elastic cables, about 11 s) stops on SIGINT within the
+/// hang guard, exit 1, "interrupted", and writes neither its CSV nor a temporary file.
+#[test]
+fn sigint_stops_an_attribution_and_leaves_no_file() {
+    let dir = out_dir("attribute");
+    let csv = dir.join("shares.csv");
+    let args = ["attribute", "scenarios/mohr2011/cable_attribution.toml", "--csv", csv.to_str().unwrap()];
+    let (code, out, err) = signal_once_running(&args, "INT");
+    assert_eq!(code, Some(1), "{out}{err}");
+    assert!(err.contains("interrupted") || err.contains("stopped by a signal"), "{err}");
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+    assert!(left.is_empty(), "{left:?}");
+}
