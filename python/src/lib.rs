@@ -537,7 +537,7 @@ fn equilibrium_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<Str
 /// settles it.
 /// Ctrl-C stops the settles.
 #[pyfunction]
-#[pyo3(signature = (path, text=None, set=Vec::new(), check=false, point=0))]
+#[pyo3(signature = (path, text=None, set=Vec::new(), check=false, point=0, params=Vec::new()))]
 fn sensitivity_json(
     py: Python<'_>,
     path: &str,
@@ -545,10 +545,17 @@ fn sensitivity_json(
     set: Vec<String>,
     check: bool,
     point: usize,
+    params: Vec<String>,
 ) -> PyResult<String> {
     let sc = load(path, text, &set)?;
+    if let Some(name) = params.iter().find(|p| !sc.params.contains_key(*p)) {
+        return Err(PyValueError::new_err(format!("params: '{name}' is not a parameter of the scenario")));
+    }
     let file = path.to_string();
-    let result = on_own_thread(py, move |cancel| study::sensitivity(&sc, &file, point, check, Some(cancel)))?;
+    let result = on_own_thread(py, move |cancel| {
+        let only = (!params.is_empty()).then_some(params.as_slice());
+        study::sensitivity::sensitivity_to(&sc, &file, (point, only), check, Some(cancel))
+    })?;
     let report = result.map_err(|e| match e {
         study::SensitivityRunError::Refused(_) | study::SensitivityRunError::NoPoint(_) => {
             PyValueError::new_err(format!("{path}: {e}"))

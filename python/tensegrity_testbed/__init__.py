@@ -207,17 +207,19 @@ def modes(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str
 
 
 def sensitivity(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml",
-                check: bool = False, point: int = 0) -> dict:
+                check: bool = False, point: int = 0, params: Optional[list] = None) -> dict:
     """How the settled state at point ``point`` (from 0, as ``run`` numbers them; settled as
     ``run`` settles it) moves with every
     parameter: the report of ``tensegrity sensitivity --json`` as a dict (``outputs``: each
     output's ``name``, ``value`` and ``free``; ``parameters``: one per parameter with its
     ``derivatives``, one per output, and d(coordinate)/dp in ``coordinates``; with ``check``
-    also the differences of settles in ``check`` and their ``max_check_error``). Raises
+    also the differences of settles in ``check`` and their ``max_check_error``). The derived
+    parameters (expressions of others) are listed in ``derived``, not differentiated, unless
+    ``params`` names the parameters to differentiate by (the CLI's ``--param``). Raises
     ScenarioError on bad input, ValueError where the structure's sensitivities are not
     computed (the reason named), KeyboardInterrupt on Ctrl-C."""
     path, text = _source(scenario, name)
-    return json.loads(_call(_tensegrity.sensitivity_json, path, text, _sets(set), check, point))
+    return json.loads(_call(_tensegrity.sensitivity_json, path, text, _sets(set), check, point, list(params or [])))
 
 
 def attribute(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml") -> dict:

@@ -918,3 +918,16 @@ def test_attribute_from_python_is_the_clis_attribute_json():
     with pytest.raises(tt.ScenarioError, match="no member 'rod'") as e:
         tt.attribute(text.replace('relax = "rigid struts"', 'relax = "rigid struts"\nmembers = ["rod"]'), name="rod.toml")
     assert e.value.line == text[: text.index('[[fidelity]]\nname = "elastic bar"')].count("\n") + 1
+
+
+def test_sensitivity_lists_derived_parameters_apart_and_takes_params():
+    """tt.sensitivity lists the derived parameters apart (``derived``) and, with ``params``,
+    differentiates the named ones alone, as ``--param`` does; an unknown name raises ValueError."""
+    strut = ROOT / "scenarios" / "custom" / "elastic_strut.toml"
+    full = tt.sensitivity(str(strut))
+    assert full["derived"] == ["F", "delta"]
+    asked = tt.sensitivity(str(strut), params=["delta", "k"])
+    assert [p["name"] for p in asked["parameters"]] == ["delta", "k"]
+    assert asked == {**cli_json("sensitivity", strut, "--param", "delta", "--param", "k"), "wall_s": asked["wall_s"]}
+    with pytest.raises(ValueError, match="'nope' is not a parameter"):
+        tt.sensitivity(str(strut), params=["nope"])

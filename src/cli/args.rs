@@ -119,6 +119,10 @@ pub enum Command {
         /// parameter) and report the largest error.
         #[arg(long)]
         check: bool,
+        /// The parameter to differentiate by (repeatable; default: every parameter but the
+        /// derived ones, which the report lists apart).
+        #[arg(long = "param", value_name = "NAME")]
+        params: Vec<String>,
         #[command(flatten)]
         set: SetArgs,
     },

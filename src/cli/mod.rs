@@ -129,8 +129,9 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         Command::Modes { scenario, json, record, count, set } => {
             modes::modes(&scenario, &overrides(&set)?, json.as_deref(), record.as_deref(), count)
         }
-        Command::Sensitivity { scenario, json, csv, point, check, set } => {
-            sensitivity::sensitivity(&scenario, &overrides(&set)?, json.as_deref(), csv.as_deref(), point, check)
+        Command::Sensitivity { scenario, json, csv, point, check, params, set } => {
+            let outputs = (json.as_deref(), csv.as_deref());
+            sensitivity::sensitivity(&scenario, &overrides(&set)?, outputs, (point, &params), check)
         }
         Command::Attribute { scenario, json, csv, figure, set } => {
             attribute::attribute(&scenario, &overrides(&set)?, json.as_deref(), csv.as_deref(), figure.as_deref())

@@ -10,12 +10,15 @@ use std::path::{Path, PathBuf};
 pub fn sensitivity(
     scenario: &Path,
     overrides: &[crate::scenario::Override],
-    json: Option<&Path>,
-    csv: Option<&Path>,
-    point: usize,
+    (json, csv): (Option<&Path>, Option<&Path>),
+    (point, params): (usize, &[String]),
     check: bool,
 ) -> Result<Outcome, CliError> {
     let sc = load_one(scenario, overrides)?;
+    if let Some(name) = params.iter().find(|p| !sc.params.contains_key(*p)) {
+        let known: Vec<&str> = sc.params.keys().map(String::as_str).collect();
+        return Err(bad_input(format!("--param {name}: not a parameter of the scenario ({})", known.join(", "))));
+    }
     if json.is_some_and(super::is_stdio) && csv.is_some_and(super::is_stdio) {
         return Err(bad_input("--json - and --csv -: only one of them can write to standard output"));
     }
@@ -27,7 +30,9 @@ pub fn sensitivity(
     if crate::study::sensitivity_point_of(&sc, point).is_none() {
         return Err(bad_input(format!("--point {point}: {}", SensitivityRunError::NoPoint(point))));
     }
-    let report = crate::study::sensitivity(&sc, &scenario.display().to_string(), point, check, Some(&signals::CANCEL))
+    let only = (!params.is_empty()).then_some(params);
+    let file = scenario.display().to_string();
+    let report = crate::study::sensitivity::sensitivity_to(&sc, &file, (point, only), check, Some(&signals::CANCEL))
         .map_err(|e| match e {
             SensitivityRunError::Refused(_) => bad_input(format!("{}: {e}", scenario.display())),
             _ => failed(format!("{}: {e}", scenario.display())),

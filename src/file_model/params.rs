@@ -65,6 +65,13 @@ impl ParamTable {
         self.names.iter().any(|n| n == name)
     }
 
+    /// Whether `name` is a derived parameter: an expression of others, which follows them (an
+    /// expression of numbers alone, `pi/10`, is not).
+    pub fn is_derived(&self, name: &str) -> bool {
+        let at = self.names.iter().position(|n| n == name);
+        at.is_some_and(|i| matches!(&self.definitions[i], Definition::Expr(e) if !e.uses().is_empty()))
+    }
+
     /// The parameters that nothing reaches: neither `read` (what reads a parameter by name
     /// outside the table) nor the expression of a reached parameter (derived ones are walked
     /// back to what they derive from, in reverse evaluation order).

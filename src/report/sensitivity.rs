@@ -25,8 +25,12 @@ pub struct SensitivityReport {
     pub coordinates: Vec<String>,
     /// Every output at the settled state, in the order of each parameter's derivatives.
     pub outputs: Vec<OutputValue>,
-    /// One per parameter, in name order.
+    /// One per parameter, in name order: the file's own (or those asked for by name).
     pub parameters: Vec<ParameterSensitivity>,
+    /// The derived parameters (expressions of others, which follow them) left out of
+    /// `parameters`: each moves with the parameters it is defined from. Asked for by name,
+    /// one is differentiated as an input of its own.
+    pub derived: Vec<String>,
     /// Wall time of the sensitivities after the settle \[s\].
     pub wall_s: f64,
     /// Wall time of the check by differences of settles (`--check`) \[s\].
@@ -101,6 +105,12 @@ impl SensitivityReport {
             "d/dp",
             if self.check_wall_s.is_some() { format!(" {:>20}", "settles' d/dp") } else { String::new() }
         );
+        if !self.derived.is_empty() {
+            out.push_str(&format!(
+                "   derived, not differentiated (each follows the parameters it is defined from; --param NAME asks for one): {}\n",
+                self.derived.join(", ")
+            ));
+        }
         for p in &self.parameters {
             out.push_str(&format!("   d/d {} (= {}, step {:.3e})", p.name, p.value, p.step));
             if let Some(e) = &p.error {

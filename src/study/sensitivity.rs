@@ -47,7 +47,8 @@ pub fn sensitivity(
 }
 
 /// [`sensitivity`] at (`point`, `only`): with `only`, the rows of those parameters alone (a
-/// fit's fitted ones: a file's other parameters and helpers cost no steps).
+/// fit's fitted ones: a file's other parameters and helpers cost no steps); without, every
+/// parameter but the derived ones, which the report lists apart.
 pub fn sensitivity_to(
     sc: &Scenario,
     file: &str,
@@ -68,7 +69,8 @@ pub fn sensitivity_to(
     // Only what something reads gets steps: a file's thousands of unread parameters cost
     // nothing (3,000 had taken 142 s, each resolving the file's structure four times).
     let unread: std::collections::HashSet<String> = sc.unread_params().into_iter().collect();
-    let asked = |name: &String| only.is_none_or(|o| o.contains(name));
+    let derived = |name: &String| sc.param_table.is_derived(name);
+    let asked = |name: &String| only.map_or(!derived(name), |o| o.contains(name));
     for (name, &value) in params.iter().filter(|(name, _)| asked(name)) {
         if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
             return Err(RunError::Interrupted(state.sim.tick()).into());
@@ -101,6 +103,7 @@ pub fn sensitivity_to(
         coordinates: out.coordinates.names(state.sim.structure()),
         outputs,
         parameters,
+        derived: if only.is_none() { params.keys().filter(|n| derived(n)).cloned().collect() } else { Vec::new() },
         wall_s,
         check_wall_s: check.then(|| check_wall.elapsed().as_secs_f64()),
     })

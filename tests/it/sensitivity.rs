@@ -146,12 +146,14 @@ fn the_command_writes_json_and_csv_and_refuses_friction_by_name() {
     let (code, out, err) = common::tensegrity(&["sensitivity", file, "--json", "-", "--csv", csv.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).expect("stdout is the JSON alone");
-    assert_eq!(v["parameters"].as_array().map(Vec::len), Some(8));
+    // Eight parameters, of which I = m L^2 / 3 is derived and listed apart.
+    assert_eq!(v["parameters"].as_array().map(Vec::len), Some(7));
+    assert_eq!(v["derived"], serde_json::json!(["I"]));
     assert!(err.contains("d/d k1"), "{err}");
     let text = std::fs::read_to_string(&csv).expect("the CSV");
-    // A header and one row per parameter (8) and output (5 nodes x 3 coordinates, 2 spring
+    // A header and one row per parameter (7) and output (5 nodes x 3 coordinates, 2 spring
     // forces, the pin's angle, mode 1's omega: 19).
-    assert_eq!(text.lines().count(), 1 + 8 * 19, "{text}");
+    assert_eq!(text.lines().count(), 1 + 7 * 19, "{text}");
     let _ = std::fs::remove_file(&csv);
     let (code, out, err) = common::tensegrity(&["sensitivity", file, "--json", "-", "--csv", "-"]);
     assert!(code == 2 && out.is_empty() && err.contains("only one of them"), "{out}{err}");
@@ -564,9 +566,11 @@ fn a_parameter_that_nothing_reads_is_named_unused_and_not_differentiated() {
         tensegrity_testbed::study::sensitivity(&sc, file, 0, false, None).expect("sensitivities")
     };
     let (plain, hostile) = (report(&plain), report(&hostile));
-    assert_eq!(hostile.parameters.len(), plain.parameters.len() + 41);
+    // The 40 unread numbers get rows; from_u = u0 + u1 is derived, listed apart beside I and w.
+    assert_eq!(hostile.parameters.len(), plain.parameters.len() + 40);
+    assert_eq!(hostile.derived, ["I", "from_u", "w"]);
     for p in &hostile.parameters {
-        let unused = p.name.starts_with('u') || p.name == "from_u";
+        let unused = p.name.starts_with('u');
         assert_eq!(p.unused, unused, "d/d {}", p.name);
         if unused {
             assert!(p.derivatives.iter().all(|d| *d == 0.0) && p.derivatives.len() == hostile.outputs.len());
@@ -578,4 +582,31 @@ fn a_parameter_that_nothing_reads_is_named_unused_and_not_differentiated() {
     assert!(!row(&hostile, "v").derivatives.iter().all(|d| *d == 0.0), "v is read through w");
     let table = hostile.to_table();
     assert!(table.contains("d/d u7 (= 8, step 8.000e-3): unused, not differentiated"), "{table}");
+}
+
+/// The derived parameters (expressions of others) are listed apart, not differentiated
+/// (issue 62 item 5: `--check` had found errors up to 2.6e2 on them); `--param` asks for named
+/// ones alone, a derived one as an input of its own, and an unknown name is exit 2. The elastic
+/// strut's file: EA, L, a, b, k, m differentiated, delta and F listed apart; with
+/// `--param delta --param k` those two rows alone, and k's the same to the bit as in the full run.
+#[test]
+fn derived_parameters_are_listed_apart_and_asked_for_by_name() {
+    let file = "scenarios/custom/elastic_strut.toml";
+    let json = |extra: &[&str]| -> serde_json::Value {
+        let (code, out, err) = super::common::tensegrity(&[&["sensitivity", file, "--json", "-"], extra].concat());
+        assert_eq!(code, 0, "{err}");
+        serde_json::from_str(&out).unwrap()
+    };
+    let names = |v: &serde_json::Value| -> Vec<String> {
+        v["parameters"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap().to_string()).collect()
+    };
+    let all = json(&[]);
+    assert_eq!(names(&all), ["EA", "L", "a", "b", "k", "m"]);
+    assert_eq!(all["derived"], serde_json::json!(["F", "delta"]));
+    let asked = json(&["--param", "delta", "--param", "k"]);
+    assert_eq!(names(&asked), ["delta", "k"]);
+    assert_eq!(asked["parameters"][1]["derivatives"], all["parameters"][4]["derivatives"]);
+    let (code, _, err) = super::common::tensegrity(&["sensitivity", file, "--param", "nope"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--param nope: not a parameter"), "{err}");
 }
