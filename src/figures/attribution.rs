@@ -1,6 +1,7 @@
 //! `tensegrity attribute --figure`: one bar per compared value, split by relaxation, each share
-//! as a percentage of the model's value (values without one, a file model's largest error, are
-//! left out: the table and the CSV hold them), the interaction in grey.
+//! as a percentage of the model's value (values without one, a file model's largest error, and
+//! values at a point some level did not settle are left out: the table and the CSV hold them),
+//! the interaction in grey.
 
 use super::kit::{self, FigureError, Format, Plot};
 use crate::study::attribution::AttributionReport;
@@ -36,6 +37,7 @@ pub fn write(report: &AttributionReport, outputs: &[(PathBuf, Format)]) -> Resul
         .items
         .iter()
         .filter(|it| it.model.is_finite() && it.model != 0.0)
+        .filter(|it| it.interaction.is_finite() && it.shares.iter().all(|s| s.is_finite()))
         .map(|it| {
             let percent = 100.0 / it.model.abs();
             let mut parts: Vec<(usize, f64)> = it.shares.iter().map(|s| s * percent).enumerate().collect();
