@@ -514,8 +514,9 @@ impl ModelObserver {
         Some(Ok(ModesAt { reports, errors }))
     }
 
-    /// Judges the frequency predictions at a settle point (and puts the modes in its report).
-    fn frequency_point(&mut self, v: &[f64], point: &mut PointReport, notes: &mut Vec<Note>) {
+    /// Judges the frequency predictions at a settle point, or at a motion's start (`judged`),
+    /// and puts the modes in its report.
+    fn frequency_point(&mut self, v: &[f64], point: &mut PointReport, judged: bool, notes: &mut Vec<Note>) {
         let Some(report) = point.energy.as_mut() else { return };
         let Some(result) = self.model_modes(v, report) else { return };
         let errors = match result {
@@ -530,8 +531,8 @@ impl ModelObserver {
         };
         let predictions = self.spec.energy.iter().flat_map(|e| e.dynamics.iter()).flat_map(|d| &d.frequencies);
         for ((a, e), f) in self.frequencies.iter_mut().zip(&errors).zip(predictions) {
-            a.point(*e, point.settled);
-            if point.settled && e.partial_cmp(&f.tolerance).is_none_or(Ordering::is_gt) {
+            a.point(*e, judged);
+            if judged && e.partial_cmp(&f.tolerance).is_none_or(Ordering::is_gt) {
                 notes.push(Note::Event(format!(
                     "point {}: frequency {} failed: relative error {e:.3e} > tolerance {:.1e}",
                     point.index, f.name, f.tolerance
@@ -776,18 +777,24 @@ impl Observer for ModelObserver {
             point.analytic.entry(name.clone()).or_insert(*predicted);
             point.errors.insert(name.clone(), *e);
         }
+        // A motion's start point is judged where the motion starts: released from the drawn
+        // state it has not settled, and the energy model (its distance to the stationary point,
+        // its own frequencies there) is judged at that state all the same (issue 62 item 6:
+        // both had been infinite, with no reason).
+        let judged = point.settled || self.motion;
         if let Some((report, error)) = self.energy_point(&v) {
-            self.energy.point(error, point.settled);
+            self.energy.point(error, judged);
             let tol = self.spec.energy.as_ref().map_or(0.0, |e| e.tolerance);
-            if point.settled && error.partial_cmp(&tol).is_none_or(Ordering::is_gt) {
+            if judged && error.partial_cmp(&tol).is_none_or(Ordering::is_gt) {
+                let at = if point.settled { "settled" } else { "the motion's start (released, not settled) is" };
                 notes.push(Note::Event(format!(
-                    "point {}: energy: settled {:.3e} from a minimum (tolerance {tol:.1e})",
+                    "point {}: energy: {at} {:.3e} from a minimum (tolerance {tol:.1e})",
                     point.index, error
                 )));
                 point.within_tolerance = false;
             }
             point.energy = Some(report);
-            self.frequency_point(&v, point, notes);
+            self.frequency_point(&v, point, judged, notes);
         }
     }
 

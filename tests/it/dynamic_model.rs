@@ -171,3 +171,30 @@ fn bad_kinetic_energies_are_located() {
         "'nu' is not among this scenario's [[energy.frequencies]] and [[motion.frequencies]] (omega)",
     );
 }
+
+/// A motion released from a displaced drawing (no settle first: issue 62 item 6) judges the
+/// energy model at its start: the model's frequency against its formula (2.2e-16, within 1e-9)
+/// and the start's distance from the model's minimum, the drawing's displacement A = 1e-3 rad
+/// (within 1e-12), which fails the tolerance of an equilibrium with that number, not an
+/// infinite one.
+#[test]
+fn a_released_displaced_start_judges_the_energy_model_where_it_starts() {
+    let text = super::common::edited(
+        "scenarios/custom/pinned_bar_vibration.toml",
+        &[
+            ("coordinate = \"pin\"\ndisplacement = \"A\"\n", ""),
+            ("P = [\"L*cos(q_star)\", \"L*sin(q_star)\", 0]", "P = [\"L*cos(q_star + A)\", \"L*sin(q_star + A)\", 0]"),
+            ("[energy]\n", "[energy]\nkinetic = \"0.5*I_pivot*qe_dot^2\"\n"),
+            ("[expect]", "[[energy.frequencies]]\nname = \"w_model\"\nformula = \"sqrt(K/I_pivot)\"\nmode = 1\ntolerance = 1e-6\n\n[expect]"),
+            ("verdict = \"pass\"", "verdict = \"fail\"\nfailing = [\"energy\"]"),
+        ],
+    );
+    let v = super::common::json_of("run", &text, "released");
+    let checks = v["scenarios"][0]["model_checks"].as_array().unwrap();
+    let of = |name: &str| checks.iter().find(|c| c["name"] == name).unwrap();
+    assert_eq!(of("w_model")["passed"], true);
+    assert!(of("w_model")["max_error"].as_f64().unwrap() <= 1e-9, "{}", of("w_model"));
+    let energy = of("energy");
+    assert_eq!(energy["passed"], false);
+    assert!((energy["max_error"].as_f64().unwrap() - 1e-3).abs() <= 1e-12, "{energy}");
+}
