@@ -68,6 +68,8 @@ pub struct TrajectoryCheck {
     /// On the rms error over them, if given.
     pub rms_tolerance: Option<f64>,
     pub start: TrajectoryStart,
+    /// How the simulated and the model's frequencies are measured from their trajectories.
+    pub measure: crate::settings::FrequencyMeasure,
 }
 
 /// Where the Lagrangian model of `[energy.trajectory]` starts (`start = "..."`).

@@ -390,7 +390,7 @@ impl ModelObserver {
     /// The comparison with the Lagrangian model, in a motion run with `[energy.trajectory]`.
     fn tracker(spec: &ModelSpec, motion: Option<&crate::settings::Motion>) -> Option<Tracker> {
         let (energy, check, m) = (spec.energy.as_ref()?, trajectory_check(spec)?, motion?);
-        Some(Tracker::new(energy, check.start, m.duration_s))
+        Some(Tracker::new(energy, (check.start, check.measure), m.duration_s))
     }
 
     /// Every symbol's value in this state, at the model's time `time_s`.

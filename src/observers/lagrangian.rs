@@ -27,8 +27,9 @@ use crate::file_model::energy_model::EnergySpec;
 use crate::file_model::integrate::Tolerance;
 use crate::file_model::spec::ErrorClass;
 use crate::mechanisms::wrap_angle;
-use crate::observers::motion::{corrected_for_symplectic_euler, fit_cosine};
+use crate::observers::motion::{corrected_for_symplectic_euler, fit_cosine, period_frequency};
 use crate::report::{LagrangianCoordinateReport, LagrangianReport};
+use crate::settings::FrequencyMeasure;
 use std::sync::atomic::AtomicBool;
 
 /// The integrator and its error control, and its start from the samples, as the report
@@ -90,6 +91,8 @@ pub struct Row {
 #[derive(Clone, Debug)]
 pub struct Tracker {
     start: TrajectoryStart,
+    /// How each trajectory's frequency is measured.
+    measure: FrequencyMeasure,
     classes: Vec<ErrorClass>,
     /// How far the motion reaches beyond its start [s] (the integrator's first step is no longer).
     span_s: f64,
@@ -115,11 +118,13 @@ pub struct Tracker {
 }
 
 impl Tracker {
-    /// The comparison of the model of `energy` from `start`, over a motion of `span_s` \[s\].
-    pub fn new(energy: &EnergySpec, start: TrajectoryStart, span_s: f64) -> Self {
+    /// The comparison of the model of `energy` from `start`, over a motion of `span_s` \[s\],
+    /// each trajectory's frequency by `measure`.
+    pub fn new(energy: &EnergySpec, (start, measure): (TrajectoryStart, FrequencyMeasure), span_s: f64) -> Self {
         let n = energy.coordinates.len();
         Tracker {
             start,
+            measure,
             classes: energy.coordinates.iter().map(|c| c.class).collect(),
             span_s,
             values: Vec::new(),
@@ -275,7 +280,8 @@ impl Tracker {
             .map(|(i, c)| {
                 let simulated = &self.series[i][self.first_compared..];
                 let dispersion_dt = (!self.extrapolated).then_some(dt);
-                coordinate_report(&c.name, c.class, compared, simulated, &self.model[i], dispersion_dt, tolerances)
+                let series = (compared, simulated, self.model[i].as_slice());
+                coordinate_report(&c.name, c.class, series, (self.measure, dispersion_dt), tolerances)
             })
             .collect();
         LagrangianReport {
@@ -286,6 +292,7 @@ impl Tracker {
             start_rates: v0.clone(),
             integrator_steps: stepper.stats().accepted,
             error: None,
+            measure: (self.measure == FrequencyMeasure::Period).then(|| self.measure.label().to_string()),
             coordinates,
         }
     }
@@ -305,18 +312,19 @@ fn method(start: TrajectoryStart) -> &'static str {
 fn coordinate_report(
     name: &str,
     class: ErrorClass,
-    times: &[f64],
-    simulated: &[f64],
-    model: &[f64],
-    dispersion_dt_s: Option<f64>,
+    (times, simulated, model): (&[f64], &[f64], &[f64]),
+    (measure, dispersion_dt_s): (FrequencyMeasure, Option<f64>),
     (tolerance, rms_tolerance): (f64, Option<f64>),
 ) -> LagrangianCoordinateReport {
     let errors: Vec<f64> = simulated.iter().zip(model).map(|(s, m)| class.error(*m, *s)).collect();
     let max_error = errors.iter().copied().fold(0.0, f64::max);
     let max_error = if errors.iter().any(|e| e.is_nan()) { f64::INFINITY } else { max_error };
     let rms_error = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
-    let model_omega = fit_cosine(times, model).map_or(f64::NAN, |f| f.omega_rad_per_s);
-    let measured = fit_cosine(times, simulated).map_or(f64::NAN, |f| f.omega_rad_per_s);
+    let omega = |q: &[f64]| match measure {
+        FrequencyMeasure::Cosine => fit_cosine(times, q).map(|f| f.omega_rad_per_s),
+        FrequencyMeasure::Period => period_frequency(times, q),
+    };
+    let (model_omega, measured) = (omega(model).unwrap_or(f64::NAN), omega(simulated).unwrap_or(f64::NAN));
     LagrangianCoordinateReport {
         name: name.into(),
         class: class.name().into(),
@@ -362,6 +370,7 @@ pub fn not_compared(
         start_rates: vec![],
         integrator_steps: 0,
         error: Some(crate::report::ReportedError::new(why)),
+        measure: None,
         coordinates,
     }
 }

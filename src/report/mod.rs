@@ -251,6 +251,10 @@ pub struct LagrangianReport {
     /// Why the model could not be compared (every coordinate then fails, its error infinite).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<ReportedError>,
+    /// "period" where the trajectories' frequencies are measured by their periods
+    /// (`[energy.trajectory] measure`); absent: by the cosine fit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub measure: Option<String>,
     pub coordinates: Vec<LagrangianCoordinateReport>,
 }
 

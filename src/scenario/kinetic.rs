@@ -81,7 +81,8 @@ fn trajectory(ctx: &Ctx, raw: &RawTrajectory) -> Result<TrajectoryCheck, Scenari
             ctx.err(s, format!("unknown energy.trajectory.start '{}' (expected one of: {expected})", s.get_ref()))
         })?,
     };
-    Ok(TrajectoryCheck { tolerance, rms_tolerance, start })
+    let measure = super::motion::measure(ctx, raw.measure.as_ref())?;
+    Ok(TrajectoryCheck { tolerance, rms_tolerance, start, measure })
 }
 
 /// An error at the first place `name` appears as a whole symbol in the expression `text` (not

@@ -560,7 +560,7 @@ fn frequency(
 }
 
 /// `measure = "cosine"` (the default without it) or `"period"`.
-fn measure(ctx: &Ctx, m: Option<&Spanned<String>>) -> Result<FrequencyMeasure, ScenarioError> {
+pub(super) fn measure(ctx: &Ctx, m: Option<&Spanned<String>>) -> Result<FrequencyMeasure, ScenarioError> {
     let Some(m) = m else { return Ok(FrequencyMeasure::default()) };
     match m.get_ref().as_str() {
         "cosine" => Ok(FrequencyMeasure::Cosine),

@@ -101,6 +101,9 @@ pub(super) struct RawTrajectory {
     /// Where the model starts: "samples" (the default) or "stated".
     #[serde(default)]
     pub(super) start: Option<Spanned<String>>,
+    /// How each trajectory's frequency is measured: "cosine" (the default) or "period".
+    #[serde(default)]
+    pub(super) measure: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]

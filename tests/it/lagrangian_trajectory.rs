@@ -267,3 +267,33 @@ fn an_unknown_start_is_located() {
     let err = scenario::parse(Path::new("variant.toml"), &text).expect_err("refused").to_string();
     assert!(err.contains("unknown energy.trajectory.start 'paper' (expected one of: samples, stated)"), "{err}");
 }
+
+/// `[energy.trajectory] measure = "period"` (issue 62 item 7: the trajectories' frequencies had
+/// been cosine fits only): at half a radian the model's and the simulation's frequencies by
+/// their periods meet the pendulum's exact omega_A within 1e-9 (measured 4.1e-10 and 1.0e-11),
+/// where the cosine fit's are 2.0e-7 off (its bias over this record); an unknown measure is an
+/// error at its key.
+#[test]
+fn the_trajectorys_frequencies_by_their_periods_meet_the_exact_pendulum() {
+    let file = "scenarios/custom/pinned_bar_large_amplitude.toml";
+    let omegas = |measure: &str| {
+        let text = super::common::edited(
+            file,
+            &[("rms_tolerance = 2e-4", &format!("rms_tolerance = 2e-4\nmeasure = \"{measure}\""))],
+        );
+        let v = super::common::json_of("run", &text, &format!("period-{measure}"));
+        let s = &v["scenarios"][0];
+        let exact = s["motion"]["frequencies"][1]["predicted_rad_per_s"].as_f64().unwrap();
+        let c = &s["motion"]["lagrangian"]["coordinates"][0];
+        let rel = |key: &str| (c[key].as_f64().unwrap() - exact).abs() / exact;
+        (rel("model_omega_rad_per_s"), rel("simulated_omega_rad_per_s"), s["motion"]["lagrangian"]["measure"].clone())
+    };
+    let (model, simulated, named) = omegas("period");
+    assert!(model <= 1e-9 && simulated <= 1e-9, "{model} {simulated}");
+    assert_eq!(named, "period");
+    let (model, simulated, named) = omegas("cosine");
+    assert!(model >= 1e-7 && simulated >= 1e-7, "{model} {simulated}");
+    assert!(named.is_null(), "{named}");
+    let bad = super::common::edited(file, &[("rms_tolerance = 2e-4", "rms_tolerance = 2e-4\nmeasure = \"fft\"")]);
+    super::common::error_at(&bad, "\"fft\"", 0, "measure must be \"cosine\"");
+}
