@@ -268,28 +268,9 @@ impl FrequencySignal {
     }
 }
 
-/// How a motion's frequency is measured from the sampled coordinate (`[[motion.frequencies]]
-/// measure`); either is then corrected for symplectic Euler's dispersion.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum FrequencyMeasure {
-    /// A least-squares fit of c + A cos(w t + p) over every tick: exact for a linear
-    /// oscillator, biased at large amplitude (the harmonics of a nonlinear motion pull the fit).
-    #[default]
-    Cosine,
-    /// The mean period between interpolated zero crossings of the rate over every full period
-    /// of the record: unbiased at any amplitude.
-    Period,
-}
-
-impl FrequencyMeasure {
-    /// As the file and the report name it.
-    pub fn label(self) -> &'static str {
-        match self {
-            FrequencyMeasure::Cosine => "cosine",
-            FrequencyMeasure::Period => "period",
-        }
-    }
-}
+/// How a motion's frequency is measured (`[[motion.frequencies]] measure`, `[energy.trajectory]
+/// measure`): defined beside the file's dynamic model, which reads it too.
+pub use crate::file_model::dynamics::FrequencyMeasure;
 
 /// A natural frequency predicted (in closed form, or by the structure's own modal analysis)
 /// and measured from the motion.

@@ -69,7 +69,30 @@ pub struct TrajectoryCheck {
     pub rms_tolerance: Option<f64>,
     pub start: TrajectoryStart,
     /// How the simulated and the model's frequencies are measured from their trajectories.
-    pub measure: crate::settings::FrequencyMeasure,
+    pub measure: FrequencyMeasure,
+}
+
+/// How a motion's frequency is measured from the sampled coordinate (`[[motion.frequencies]]
+/// measure`); either is then corrected for symplectic Euler's dispersion.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FrequencyMeasure {
+    /// A least-squares fit of c + A cos(w t + p) over every tick: exact for a linear
+    /// oscillator, biased at large amplitude (the harmonics of a nonlinear motion pull the fit).
+    #[default]
+    Cosine,
+    /// The mean period between interpolated zero crossings of the rate over every full period
+    /// of the record: unbiased at any amplitude.
+    Period,
+}
+
+impl FrequencyMeasure {
+    /// As the file and the report name it.
+    pub fn label(self) -> &'static str {
+        match self {
+            FrequencyMeasure::Cosine => "cosine",
+            FrequencyMeasure::Period => "period",
+        }
+    }
 }
 
 /// Where the Lagrangian model of `[energy.trajectory]` starts (`start = "..."`).
