@@ -191,3 +191,22 @@ fn manriquez2019_table5_the_relaxations_do_not_explain_the_joint_force() {
         assert!((heavy - 0.0334).abs() < 2e-4, "{it}");
     }
 }
+
+/// The rest of the refusals at a relaxation's table: a step too long for the point masses a
+/// relaxation makes, a heavy cable on a winch that the run moves after its build (continuation),
+/// and "no gravity" without its gravity.
+#[test]
+fn a_relaxation_the_run_cannot_step_or_drive_is_refused_at_its_table() {
+    let hanging = std::fs::read_to_string(HANGING).unwrap();
+    let parse = |text: &str| tensegrity_testbed::scenario::parse(std::path::Path::new("variant.toml"), text);
+    let err = parse(&hanging.replacen("dt = 0.001", "dt = 0.05", 1)).expect_err("step");
+    assert!(err.message.contains("the step sim.dt = 0.05 s is unstable"), "{err}");
+    let mohr = std::fs::read_to_string("scenarios/mohr2011/cable_attribution.toml").unwrap();
+    let driven = mohr.replacen("[actuation]\ncontinuation = false", "[actuation]\ncontinuation = true", 1);
+    assert_ne!(driven, mohr);
+    let err = parse(&driven).expect_err("winch");
+    assert!(err.message.contains("the winch no longer moves it"), "{err}");
+    let gravity = hanging + "\n[[fidelity]]\nname = \"upright\"\nrelax = \"no gravity\"\n";
+    let err = parse(&gravity).expect_err("gravity");
+    assert!(err.message.contains("relaxing no gravity needs gravity"), "{err}");
+}
