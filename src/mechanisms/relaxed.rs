@@ -5,17 +5,20 @@
 
 use super::{Finding, Mechanism, MechanismSpec, ModelError, Prediction, Solution, StiffnessProbe, Values};
 use crate::snapshot::Snapshot;
-use crate::structure::fidelity::{self, Relaxation};
+use crate::structure::fidelity::{self, IdealView, Relaxation};
 use crate::structure::Structure;
 
 pub struct Relaxed {
     inner: Box<dyn Mechanism>,
     set: Vec<Relaxation>,
+    /// The ideal view of the structure built last, which every tick's snapshot is read with
+    /// (found again for a structure it does not fit).
+    view: std::sync::Mutex<Option<IdealView>>,
 }
 
 impl Relaxed {
     pub fn new(inner: Box<dyn Mechanism>, set: Vec<Relaxation>) -> Relaxed {
-        Relaxed { inner, set }
+        Relaxed { inner, set, view: std::sync::Mutex::new(None) }
     }
 }
 
@@ -50,6 +53,7 @@ impl Mechanism for Relaxed {
         let set: Vec<&Relaxation> = self.set.iter().collect();
         fidelity::relax(&mut s, &set, &self.inner.commands(params, inputs))
             .map_err(|e| ModelError::no_solution(e.to_string()))?;
+        *self.view.lock().unwrap_or_else(|p| p.into_inner()) = Some(IdealView::of(&s));
         Ok(s)
     }
     fn commands(&self, params: &Values, inputs: &Values) -> Values {
@@ -61,14 +65,22 @@ impl Mechanism for Relaxed {
     fn predict(&self, params: &Values, inputs: &Values) -> Result<Prediction, ModelError> {
         self.inner.predict(params, inputs)
     }
-    /// The inner mechanism's reading of the snapshot with the ideal members' forces
-    /// ([`fidelity::ideal_forces`]), and each heavy cable's `NAME.force` under its ideal name.
+    /// The inner mechanism's reading of the snapshot as the ideal structure's ([`IdealView`]):
+    /// each heavy cable under its ideal name, with the force at its last segment.
     fn observe(&self, params: &Values, s: &Structure, snap: &Snapshot) -> Values {
-        let mut view = snap.clone();
-        view.forces.force_n = fidelity::ideal_forces(s, &snap.forces.force_n);
-        match fidelity::ideal_names(s) {
-            Some(named) => self.inner.observe(params, &named, &view),
-            None => self.inner.observe(params, s, &view),
+        let mut view = self.view.lock().unwrap_or_else(|p| p.into_inner());
+        let view = match view.as_ref() {
+            Some(v) if v.fits(s) => v,
+            _ => view.insert(IdealView::of(s)),
+        };
+        let structure = view.structure(s);
+        match view.forces(&snap.forces.force_n) {
+            Some(force_n) => {
+                let mut ideal = snap.clone();
+                ideal.forces.force_n = force_n;
+                self.inner.observe(params, structure, &ideal)
+            }
+            None => self.inner.observe(params, structure, snap),
         }
     }
     fn length_scale(&self, params: &Values) -> f64 {

@@ -87,7 +87,7 @@ pub(super) fn fidelity(ctx: &Ctx, raw: &RawScenario, first: &FirstPoint) -> Resu
         }
         list.push(relaxation);
     }
-    for (r, raw_r) in list.iter().zip(&raw.fidelity) {
+    for (i, (r, raw_r)) in list.iter().zip(&raw.fidelity).enumerate() {
         if let Some(name) = r.params.keys().find(|k| !first.params.contains_key(*k)) {
             let at = raw_r.get_ref().set.as_ref().expect("a parameter relaxation has its set");
             return Err(ctx.err(at, format!("'{}': set: '{name}' is not a parameter of this scenario", r.name)));
@@ -95,7 +95,8 @@ pub(super) fn fidelity(ctx: &Ctx, raw: &RawScenario, first: &FirstPoint) -> Resu
         if first.winches_move && fidelity::releases_winch(first.structure, r) {
             return Err(ctx.err(raw_r, format!("'{}': a heavy cable is built at its winch's length and the winch no longer moves it, but this run moves the winch after the build (continuation, waypoints or a motion): set continuation = false, or relax another cable", r.name)));
         }
-        applies(ctx, raw_r, first, &fidelity::with_base(&list, r))?;
+        let set: Vec<&Relaxation> = fidelity::with_base(&list, i).into_iter().map(|j| &list[j]).collect();
+        applies(ctx, raw_r, first, &set)?;
     }
     if list.len() > 1 {
         applies(ctx, &raw.fidelity[0], first, &list.iter().collect::<Vec<_>>())?;

@@ -90,15 +90,13 @@ pub struct Relaxation {
     pub params: std::collections::BTreeMap<String, f64>,
 }
 
-/// `r` with the relaxations it is measured on top of: a heavy cable's "inextensible cables"
-/// (a heavy cable is elastic segments) and "no gravity" (its mass weighs only under gravity).
-pub fn with_base<'a>(list: &'a [Relaxation], r: &'a Relaxation) -> Vec<&'a Relaxation> {
-    let mut set = vec![r];
-    if r.assumption == Assumption::MasslessCables {
-        let base = [Assumption::NoGravity, Assumption::InextensibleCables];
-        set.extend(list.iter().filter(|o| base.contains(&o.assumption)));
-    }
-    set
+/// Relaxation `r` of `list` with the relaxations it is measured on top of, as indices into
+/// `list` in order: a heavy cable's "inextensible cables" (a heavy cable is elastic segments)
+/// and "no gravity" (its mass weighs only under gravity).
+pub fn with_base(list: &[Relaxation], r: usize) -> Vec<usize> {
+    let base = [Assumption::NoGravity, Assumption::InextensibleCables];
+    let under = |o: &Relaxation| list[r].assumption == Assumption::MasslessCables && base.contains(&o.assumption);
+    (0..list.len()).filter(|&i| i == r || under(&list[i])).collect()
 }
 
 /// Why a structure cannot take a relaxation; the message names the member and says why.
@@ -217,32 +215,64 @@ pub fn releases_winch(s: &Structure, r: &Relaxation) -> bool {
             .is_ok_and(|ms| ms.iter().any(|&i| s.actuators.iter().any(|a| a.target == ActuatorTarget::CableLength(i))))
 }
 
-/// The relaxed structure `s` with each heavy cable's first segment (`{name}_s1`, at the
-/// cable's own index) named as the ideal cable was, so that a mechanism finds it by its name;
-/// None where no cable was hung with beads.
-pub fn ideal_names(s: &Structure) -> Option<Structure> {
-    let first = |m: &Member| matches!(m.law, Law::Cable { .. }) && m.name.ends_with("_s1");
-    if !s.members.iter().any(first) {
-        return None;
-    }
-    let mut named = s.clone();
-    for m in named.members.iter_mut().filter(|m| first(m)) {
-        m.name.truncate(m.name.len() - "_s1".len());
-    }
-    Some(named)
+/// How a relaxed structure is read as the ideal one, found once per structure (a snapshot is
+/// read with it at every tick): each heavy cable keeps its first segment at its own index
+/// (`{name}_s1`) and is read at its last segment (`{name}_s{n}`), at the node its path ends
+/// on, where a paper's model meets it; and, where any cable was hung with beads, the structure
+/// with those first segments named as the ideal cables were, so that a mechanism finds them by
+/// their names.
+#[derive(Clone, Debug)]
+pub struct IdealView {
+    members: usize,
+    /// (first segment, last segment) of each cable hung with two or more beads' segments.
+    heavy: Vec<(MemberId, MemberId)>,
+    named: Option<Structure>,
 }
 
-/// The forces of a relaxed structure's snapshot as the ideal structure's members carry them: a
-/// cable hung with beads keeps its first segment at its own index, and is read at its last
-/// segment, at the node its path ends on (`{name}_s{n}`), where a paper's model meets it.
-pub fn ideal_forces(s: &Structure, force_n: &[f64]) -> Vec<f64> {
-    let mut forces = force_n.to_vec();
-    for (i, m) in s.members.iter().enumerate() {
-        let Some(cable) = m.name.strip_suffix("_s1") else { continue };
-        let last = (2..=lumped::MAX_CABLE_SEGMENTS).map_while(|k| s.member_id(&format!("{cable}_s{k}"))).last();
-        if let Some(last) = last {
-            forces[i] = force_n[last];
-        }
+impl IdealView {
+    /// The view of the relaxed structure `s`, in one pass over its members' names.
+    pub fn of(s: &Structure) -> IdealView {
+        let index: std::collections::HashMap<&str, MemberId> =
+            s.members.iter().enumerate().map(|(i, m)| (m.name.as_str(), i)).collect();
+        let first = |m: &Member| matches!(m.law, Law::Cable { .. }) && m.name.ends_with("_s1");
+        let heavy = (0..s.members.len())
+            .filter(|&i| first(&s.members[i]))
+            .filter_map(|i| {
+                let cable = &s.members[i].name[..s.members[i].name.len() - "_s1".len()];
+                let last =
+                    (2..=lumped::MAX_CABLE_SEGMENTS).map_while(|k| index.get(format!("{cable}_s{k}").as_str())).last();
+                last.map(|&l| (i, l))
+            })
+            .collect();
+        let named = s.members.iter().any(first).then(|| {
+            let mut named = s.clone();
+            for m in named.members.iter_mut().filter(|m| first(m)) {
+                m.name.truncate(m.name.len() - "_s1".len());
+            }
+            named
+        });
+        IdealView { members: s.members.len(), heavy, named }
     }
-    forces
+
+    /// Whether this is the view of `s` (a structure of the same members).
+    pub fn fits(&self, s: &Structure) -> bool {
+        self.members == s.members.len()
+    }
+
+    /// The members' forces `force_n` as the ideal members carry them; None where no cable
+    /// was hung with beads (they are the ideal's as they are).
+    pub fn forces(&self, force_n: &[f64]) -> Option<Vec<f64>> {
+        (!self.heavy.is_empty()).then(|| {
+            let mut forces = force_n.to_vec();
+            for &(first, last) in &self.heavy {
+                forces[first] = force_n[last];
+            }
+            forces
+        })
+    }
+
+    /// The structure a mechanism reads: `s` with its heavy cables named as the ideal's.
+    pub fn structure<'a>(&'a self, s: &'a Structure) -> &'a Structure {
+        self.named.as_ref().unwrap_or(s)
+    }
 }

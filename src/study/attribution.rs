@@ -100,13 +100,8 @@ pub enum AttributionError {
 /// relaxation with its base, and all of them (left out where it repeats the one before).
 pub fn level_sets(sc: &Scenario) -> Vec<(String, Vec<usize>)> {
     let list = &sc.fidelity;
-    let index = |r: &Relaxation| list.iter().position(|o| std::ptr::eq(o, r)).expect("in the list");
     let mut sets = vec![("ideal".to_string(), Vec::new())];
-    for r in list {
-        let mut set: Vec<usize> = fidelity::with_base(list, r).into_iter().map(index).collect();
-        set.sort_unstable();
-        sets.push((r.name.clone(), set));
-    }
+    sets.extend((0..list.len()).map(|i| (list[i].name.clone(), fidelity::with_base(list, i))));
     // Each share's base (its set less itself), where no level above applies it alone.
     for i in 0..list.len() {
         let base: Vec<usize> = sets[i + 1].1.iter().copied().filter(|&j| j != i).collect();
