@@ -237,8 +237,10 @@ fn insert_joints(
 }
 
 /// rapier's 2-DoF multibody joints are `todo!()`: a universal joint becomes two revolute links
-/// through a hidden body that sits at the anchor. Returns the second link (the joint's own)
-/// and the first (hidden) one.
+/// through a hidden body that sits at the anchor. The hidden body has no mass: the child turns
+/// with it about the first axis, so the multibody's mass matrix stays the child's (positive
+/// definite wherever the child's is) and the joint's dynamics are exactly the child's. Returns
+/// the second link (the joint's own) and the first (hidden) one.
 fn insert_universal(
     s: &Structure,
     joint: &Joint,
@@ -249,18 +251,7 @@ fn insert_universal(
     h2: RigidBodyHandle,
 ) -> (MultibodyJointHandle, LinkRef) {
     let anchor = v(s.nodes[joint.anchor].position);
-    let child = s.bodies[joint.child].inertia.expect("validated: free bodies have inertia");
-    let hidden = bodies.insert(
-        RigidBodyBuilder::dynamic()
-            .can_sleep(false)
-            .gravity_scale(0.0)
-            .additional_mass_properties(MassProperties::new(
-                anchor,
-                child.mass_kg * HIDDEN_LINK_MASS_FRACTION,
-                v(child.principal_kg_m2) * HIDDEN_LINK_MASS_FRACTION,
-            ))
-            .build(),
-    );
+    let hidden = bodies.insert(RigidBodyBuilder::dynamic().can_sleep(false).gravity_scale(0.0).build());
     let revolute =
         |axis: Vec3| RevoluteJointBuilder::new(v(axis).normalize()).local_anchor1(anchor).local_anchor2(anchor).build();
     let h_first = multibody_joints.insert(h1, hidden, revolute(axes[0]), true).expect("checked: no loop");
@@ -314,10 +305,6 @@ fn external_loads(s: &Structure) -> Vec<[f64; 3]> {
     }
     l
 }
-
-/// Mass of the hidden body of a split universal joint, as a fraction of the child's: small, so
-/// the dynamics are the child's; it sits at the anchor, so it adds no moment at rest.
-const HIDDEN_LINK_MASS_FRACTION: f64 = 1e-3;
 
 /// Chooses which joints are multibody links (the rest become impulse joints). A joint is a
 /// link when its child is free, not held by an inextensible cable, has no link yet, and its

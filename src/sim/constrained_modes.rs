@@ -21,9 +21,8 @@
 //!   constraint forces: a cable's T d2l/dq2, a loop reaction times the closure's curvature),
 //!   by central second differences;
 //! - M = sum over bodies J_b^T diag(m 1, R I R^T) J_b, J_b each body's centre-of-mass and
-//!   rotation Jacobian by central differences; the bodies include the hidden bodies that
-//!   split a universal joint into two revolute links (`build.rs`: 1e-3 of the child's mass
-//!   and moments, at the anchor), which rapier moves as the structure's own;
+//!   rotation Jacobian by central differences; the hidden bodies that split a universal
+//!   joint into two revolute links have no mass (`build.rs`), so M is the structure's own;
 //! - N, a basis of null(G) (the right singular vectors of G whose singular value is below
 //!   [`NULL_SPACE_RATIO`] of the largest), and the reduced problem
 //!   (N^T K N) v = omega^2 (N^T M N) v. Each mode's coordinates are N v.
@@ -39,7 +38,7 @@ use super::data::Data;
 use super::model::Model;
 use super::modes::{ModesError, StructureMode, StructureModes, ZERO_MODE_RATIO};
 use crate::structure::{BodyKind, JointKind};
-use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{DMatrix, DVector, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
 use std::sync::atomic::AtomicBool;
 
@@ -396,44 +395,6 @@ impl Data {
         }
         jac
     }
-
-    /// The rapier bodies of the universal joints' hidden first links.
-    fn hidden_bodies(&self, m: &Model) -> Vec<RigidBodyHandle> {
-        m.hidden_links
-            .iter()
-            .filter_map(|l| self.multibody_joints.get(l.multibody_joint))
-            .filter_map(|(mb, id)| mb.link(id).map(|link| link.rigid_body_handle()))
-            .collect()
-    }
-
-    /// Each rapier body's centre of mass and rotation now.
-    fn handle_states(&self, handles: &[RigidBodyHandle]) -> Vec<BodyState> {
-        handles
-            .iter()
-            .map(|&h| {
-                let rb = &self.bodies[h];
-                let (c, q) = (rb.center_of_mass(), rb.position().rotation);
-                (Vector3::new(c.x, c.y, c.z), UnitQuaternion::from_quaternion(Quaternion::new(q.w, q.x, q.y, q.z)))
-            })
-            .collect()
-    }
-
-    /// The mass matrix of rapier bodies (six coordinates each): m 1 and R I R^T, from rapier's
-    /// own mass properties.
-    fn handle_mass_matrix(&self, handles: &[RigidBodyHandle]) -> DMatrix<f64> {
-        let mut mass = DMatrix::zeros(6 * handles.len(), 6 * handles.len());
-        for (i, &h) in handles.iter().enumerate() {
-            let rb = &self.bodies[h];
-            let props = &rb.mass_properties().local_mprops;
-            let local = Matrix3::from_column_slice(&props.reconstruct_inertia_matrix().to_cols_array());
-            let q = rb.position().rotation;
-            let r = UnitQuaternion::from_quaternion(Quaternion::new(q.w, q.x, q.y, q.z)).to_rotation_matrix();
-            let world = r.matrix() * local * r.matrix().transpose();
-            mass.view_mut((6 * i, 6 * i), (3, 3)).copy_from(&(Matrix3::identity() * props.mass()));
-            mass.view_mut((6 * i + 3, 6 * i + 3), (3, 3)).copy_from(&(0.5 * (world + world.transpose())));
-        }
-        mass
-    }
 }
 
 /// A body's centre of mass [m] and rotation.
@@ -635,8 +596,8 @@ impl Data {
         }
     }
 
-    /// The mass matrix in the coordinates, J^T M_b J over the structure's free bodies and the
-    /// hidden bodies, with the free bodies' J (for the modes' shapes).
+    /// The mass matrix in the coordinates, J^T M_b J over the structure's free bodies (the
+    /// hidden bodies of universal joints have no mass), with their J (for the modes' shapes).
     pub(super) fn coordinate_mass(
         &mut self,
         m: &Model,
@@ -648,16 +609,7 @@ impl Data {
             &self.coordinate_body_jacobian(m, setup, &own, 1.0),
             &self.coordinate_body_jacobian(m, setup, &own, COARSE_STEP_RATIO),
         );
-        let mut mass = jac.transpose() * self.mass_matrix(m, bodies) * &jac;
-        let hidden = self.hidden_bodies(m);
-        if !hidden.is_empty() {
-            let states = |sim: &Data| sim.handle_states(&hidden);
-            let jh = richardson(
-                &self.coordinate_body_jacobian(m, setup, &states, 1.0),
-                &self.coordinate_body_jacobian(m, setup, &states, COARSE_STEP_RATIO),
-            );
-            mass += jh.transpose() * self.handle_mass_matrix(&hidden) * &jh;
-        }
+        let mass = jac.transpose() * self.mass_matrix(m, bodies) * &jac;
         (mass, jac)
     }
 

@@ -51,7 +51,7 @@ impl Data {
         self.lagrangian_stiffness_and_error(m, &setup, &lambda)
     }
 
-    /// The mass matrix in `c`'s coordinates (the hidden bodies of universal joints included).
+    /// The mass matrix in `c`'s coordinates.
     pub(super) fn constrained_mass(&mut self, m: &Model, c: &Constraints) -> DMatrix<f64> {
         let setup = self.constrained_setup(m, &c.coordinates, &c.closures, &c.taut_cables);
         let bodies: Vec<usize> = (0..m.structure.bodies.len()).filter(|&b| m.is_free(b)).collect();
