@@ -133,6 +133,10 @@ pub trait Observer {
     /// and the state it `start`s from at t = 0 (the displacement and rate of `[motion]` set, no
     /// step taken), each as a tick (`motion_time_s` Some(0)).
     fn motion_start_state(&mut self, _equilibrium: &Tick, _start: &Tick) {}
+    /// A motion run's motion again, run alone from the same start at half its amplitude
+    /// (`run/amplitude.rs`), after the motion itself: its judged `state` at motion time `time_s`
+    /// \[s\] of `structure`, for the amplitude's own shift of the measured frequencies.
+    fn half_amplitude_tick(&mut self, _time_s: f64, _state: &Snapshot, _structure: &Structure) {}
     /// A settle point: fill in what this observer measures there (`point` has the rest).
     fn settle_point(&mut self, _p: &SettlePoint, _point: &mut PointReport, _notes: &mut Vec<Note>) {}
     /// The run is over: put what was gathered into the report.

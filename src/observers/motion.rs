@@ -24,6 +24,8 @@ use super::{Made, ModeAtStart, MotionStarted, Note, Observer, Setup, Tick};
 use crate::mechanisms::Values;
 use crate::report::{FrequencyReport, ScenarioReport};
 use crate::settings::{FrequencyMeasure, FrequencyPrediction, FrequencySignal, Motion};
+use crate::snapshot::Snapshot;
+use crate::structure::Structure;
 
 /// How a frequency is measured with `measure = "cosine"`, as the report states it.
 pub const METHOD: &str = "least-squares fit of c + A cos(w t + p) over every tick of the motion, \
@@ -42,6 +44,21 @@ pub const PERIOD_METHOD: &str = "period: mean period 2 pi / w_d between interpol
 /// (`run/levels.rs`): its dispersion is gone with its h^2 term, so nothing is corrected.
 pub const METHOD_EXTRAPOLATED: &str = "least-squares fit of c + A cos(w t + p) over every tick of \
     the motion extrapolated over the time step (fourth order: no dispersion to correct)";
+
+/// omega(A) - omega(0) over omega(A) - omega(A/2) where the amplitude's shift is c A^2.
+const AMPLITUDE_SHIFT_FACTOR: f64 = 4.0 / 3.0;
+
+/// A measured frequency's error bar, relative, and its parts.
+struct ErrorBar {
+    /// The measure's own error over the record.
+    measure: Option<f64>,
+    /// The frequency at half the amplitude \[rad/s\] and the amplitude's shift (signed).
+    shift: Option<(f64, f64)>,
+    /// The parts' sum; None where nothing was measured.
+    total: Option<f64>,
+    /// What it leaves out.
+    leaves_out: Vec<String>,
+}
 
 /// Fewest samples a fit is made from.
 const MIN_FIT_SAMPLES: usize = 16;
@@ -236,6 +253,9 @@ pub struct MotionObserver {
     /// rougher at each tick (Richardson's value from h and h/2), for the frequency's estimate of
     /// the simulation's own error.
     rougher: Vec<Vec<f64>>,
+    /// Per frequency: the times and coordinates of the motion again at half its amplitude
+    /// (`run/amplitude.rs`); empty where it was not run.
+    half: Vec<(Vec<f64>, Vec<f64>)>,
     /// The parameters, inputs and analytic quantities of the motion (for the predictions).
     at: Option<(Values, Values, Values)>,
     /// The structure's own modes at the motion's start that frequencies are fitted to.
@@ -254,11 +274,22 @@ impl MotionObserver {
             frequencies: m.frequencies.clone(),
             samples: vec![(Vec::new(), Vec::new()); m.frequencies.len()],
             rougher: vec![Vec::new(); m.frequencies.len()],
+            half: vec![(Vec::new(), Vec::new()); m.frequencies.len()],
             at: None,
             modes: Vec::new(),
             dt_s: f64::NAN,
             estimate_divisor: None,
         }
+    }
+
+    /// Frequency `k`'s coordinate in `snap`: its joint's, or its mode's modal coordinate; NaN
+    /// where there is none.
+    fn signal(&self, k: usize, snap: &Snapshot, structure: &Structure) -> f64 {
+        let q = match self.frequencies[k].signal {
+            FrequencySignal::Joint(ref c) => snap.joint_coordinate(structure, c.index),
+            FrequencySignal::Mode(i) => self.mode(i).map(|m| m.projector.coordinate(snap)),
+        };
+        q.unwrap_or(f64::NAN)
     }
 
     fn mode(&self, index: usize) -> Option<&ModeAtStart> {
@@ -299,13 +330,67 @@ impl MotionObserver {
         Some((measured - rough).abs() / measured.abs() / divisor)
     }
 
-    fn report(
-        &self,
-        f: &FrequencyPrediction,
-        (t, q): &(Vec<f64>, Vec<f64>),
-        rougher: &[f64],
-        solved: &Values,
-    ) -> FrequencyReport {
+    /// The measure's own error over the record, relative: the largest difference between the
+    /// same measure on either half of the record and on the whole (an error falling as 1/T to
+    /// 1/T^2 with the record's length T gives 1 to 3 times the whole's); None where a half
+    /// holds nothing to measure.
+    fn measure_error(f: &FrequencyPrediction, t: &[f64], q: &[f64], measured: f64) -> Option<f64> {
+        let mid = t.len() / 2;
+        let mut spread = 0.0f64;
+        for (th, qh) in [(&t[..mid], &q[..mid]), (&t[mid..], &q[mid..])] {
+            let w = Self::measured(f, th, qh, || fit_cosine(th, qh));
+            if !w.is_finite() {
+                return None;
+            }
+            spread = spread.max((w - measured).abs());
+        }
+        Some(spread / measured.abs())
+    }
+
+    /// The frequency at half the amplitude (corrected as `corrected` is) and the amplitude's own
+    /// shift of `corrected`, relative and signed: with omega(A) = omega(0) + c A^2,
+    /// 4/3 (omega(A) - omega(A/2)) / omega(A); None where the motion did not run again.
+    fn amplitude_shift(&self, f: &FrequencyPrediction, k: usize, corrected: f64) -> Option<(f64, f64)> {
+        let (t, q) = &self.half[k];
+        if t.is_empty() {
+            return None;
+        }
+        let measured = Self::measured(f, t, q, || fit_cosine(t, q));
+        let half = if self.estimate_divisor.is_some() {
+            measured
+        } else {
+            corrected_for_symplectic_euler(measured, self.dt_s)
+        };
+        half.is_finite().then(|| (half, AMPLITUDE_SHIFT_FACTOR * (corrected - half) / corrected.abs()))
+    }
+
+    /// The measured frequency's error bar: the simulation's error, the measure's and the
+    /// amplitude's shift, and what it leaves out.
+    fn error_bar(&self, f: &FrequencyPrediction, k: usize, simulation: Option<f64>, corrected: f64) -> ErrorBar {
+        let (t, q) = &self.samples[k];
+        let measure = corrected.is_finite().then(|| Self::measure_error(f, t, q, corrected)).flatten();
+        let shift = self.amplitude_shift(f, k, corrected);
+        let mut leaves_out = Vec::new();
+        if simulation.is_none() {
+            leaves_out.push("the simulation's own error (a motion not extrapolated over the time step)".to_string());
+        }
+        if measure.is_none() {
+            leaves_out.push("the measure's own error (a half of the record has nothing to measure)".to_string());
+        }
+        if shift.is_none() {
+            leaves_out.push(
+                "the amplitude's shift (a motion without an amplitude of its own, or nothing measured at half of it)"
+                    .to_string(),
+            );
+        }
+        let parts = [simulation, measure, shift.map(|s| s.1.abs())];
+        let total = corrected.is_finite().then(|| parts.iter().flatten().sum());
+        ErrorBar { measure, shift, total, leaves_out }
+    }
+
+    fn report(&self, f: &FrequencyPrediction, k: usize, solved: &Values) -> FrequencyReport {
+        let (t, q) = &self.samples[k];
+        let rougher = &self.rougher[k];
         let predicted = self.predicted(f, solved);
         // With a formula and a mode, the modal analysis is a third value judged against it.
         let modal = self.modal(f).filter(|_| f.formula.is_some());
@@ -321,6 +406,8 @@ impl MotionObserver {
         };
         let corrected = if extrapolated { measured } else { corrected_for_symplectic_euler(measured, self.dt_s) };
         let error = (corrected - predicted).abs() / predicted.abs();
+        let simulation_error = self.estimate(f, t, rougher, measured);
+        let bar = self.error_bar(f, k, simulation_error, corrected);
         FrequencyReport {
             name: f.name.clone(),
             coordinate: f.signal.label(),
@@ -332,7 +419,12 @@ impl MotionObserver {
             uncorrected_error: (measured - predicted).abs() / predicted.abs(),
             modal_rad_per_s: modal,
             modal_error,
-            simulation_error: self.estimate(f, t, rougher, measured),
+            simulation_error,
+            measure_error: bar.measure,
+            half_amplitude_rad_per_s: bar.shift.map(|s| s.0),
+            amplitude_shift: bar.shift.map(|s| s.1),
+            error_bar: bar.total,
+            error_bar_leaves_out: bar.leaves_out,
             tolerance: f.tolerance,
             passed: error <= f.tolerance && modal_error.is_none_or(|e| e <= f.tolerance),
             fit_offset: fit.map_or(f64::NAN, |x| x.offset),
@@ -341,6 +433,36 @@ impl MotionObserver {
             samples: t.len(),
             method: method.into(),
         }
+    }
+}
+
+/// The warning of a frequency whose tolerance is below its error bar, naming the largest part
+/// and what resolves it.
+fn unresolved(f: &FrequencyReport) -> Option<String> {
+    let bar = f.error_bar.filter(|&e| f.tolerance < e)?;
+    let parts = [
+        (f.simulation_error, "simulation error estimate", "a finer time step"),
+        (f.measure_error, "measure's own error", measure_remedy(&f.measure)),
+        (f.amplitude_shift.map(f64::abs), "amplitude's shift", "a smaller amplitude"),
+    ];
+    let (largest, what, remedy) =
+        parts
+            .iter()
+            .filter_map(|&(e, w, r)| Some((e?, w, r)))
+            .fold((0.0, "", ""), |a, b| if b.0 > a.0 { b } else { a });
+    Some(format!(
+        "frequency:{}: tolerance {:.1e} below what this run resolves (its error bar {bar:.1e}, mostly the {what} {largest:.1e}): {remedy} resolves it",
+        f.name, f.tolerance
+    ))
+}
+
+/// What resolves a measure's own error: a cosine fit's bias (harmonics over a record that is
+/// no whole number of periods) goes with the period measure; the period measure's with a
+/// longer record.
+fn measure_remedy(measure: &str) -> &'static str {
+    match measure {
+        "cosine" => "measure = \"period\" (or a longer record, duration_s)",
+        _ => "a longer record (duration_s)",
     }
 }
 
@@ -355,22 +477,22 @@ impl Observer for MotionObserver {
         if self.at.is_none() {
             self.at = Some((t.params.clone(), t.inputs.clone(), t.prediction.expected.clone()));
         }
-        for (k, f) in self.frequencies.iter().enumerate() {
-            let q = |snap: &crate::snapshot::Snapshot| {
-                let q = match f.signal {
-                    FrequencySignal::Joint(ref c) => snap.joint_coordinate(t.structure, c.index),
-                    FrequencySignal::Mode(i) => {
-                        self.modes.iter().find(|m| m.index == i).map(|m| m.projector.coordinate(snap))
-                    }
-                };
-                q.unwrap_or(f64::NAN)
-            };
+        for k in 0..self.frequencies.len() {
+            let q = self.signal(k, t.snapshot, t.structure);
+            let rough = t.rougher.map(|r| self.signal(k, r.state, t.structure));
             let (ts, qs) = &mut self.samples[k];
             ts.push(time_s);
-            qs.push(q(t.snapshot));
-            if let Some(rough) = t.rougher {
-                self.rougher[k].push(q(rough.state));
-            }
+            qs.push(q);
+            self.rougher[k].extend(rough);
+        }
+    }
+
+    fn half_amplitude_tick(&mut self, time_s: f64, state: &Snapshot, structure: &Structure) {
+        for k in 0..self.frequencies.len() {
+            let q = self.signal(k, state, structure);
+            let (ts, qs) = &mut self.half[k];
+            ts.push(time_s);
+            qs.push(q);
         }
     }
 
@@ -384,17 +506,17 @@ impl Observer for MotionObserver {
         let Some(m) = report.motion.as_mut() else { return };
         // The energy model's solved equilibrium at the motion's start point, if the file has one.
         let solved = report.points.last().and_then(|p| p.energy.as_ref()).map(|e| e.solved.clone()).unwrap_or_default();
-        m.frequencies = (0..self.frequencies.len())
-            .map(|k| self.report(&self.frequencies[k], &self.samples[k], &self.rougher[k], &solved))
-            .collect();
-        for f in m.frequencies.iter().filter(|f| f.simulation_error.is_some_and(|e| f.tolerance < e)) {
-            report.warnings.push(format!(
-                "frequency:{}: tolerance {:.1e} below what this run resolves (its simulation error estimate {:.1e}): a finer time step resolves it",
+        m.frequencies = (0..self.frequencies.len()).map(|k| self.report(&self.frequencies[k], k, &solved)).collect();
+        report.warnings.extend(m.frequencies.iter().filter_map(unresolved));
+        report.warnings.extend(m.frequencies.iter().filter(|f| !f.measured_rad_per_s.is_finite()).map(|f| {
+            format!(
+                "frequency:{}: nothing measured: the cosine fit needs three crossings of the signal's mean, the period measure a full period between turning points, and the record holds {:.2} predicted periods ({} samples over {:.3} s): a longer duration_s measures it",
                 f.name,
-                f.tolerance,
-                f.simulation_error.unwrap_or(f64::NAN)
-            ));
-        }
+                m.duration_s * f.predicted_rad_per_s / std::f64::consts::TAU,
+                f.samples,
+                m.duration_s
+            )
+        }));
         if let Some(p) = report.points.last_mut() {
             p.frequencies = m.frequencies.clone();
             p.within_tolerance &= p.frequencies.iter().all(|f| f.passed);

@@ -300,6 +300,25 @@ pub struct FrequencyReport {
     /// rougher, their difference over the levels' estimate divisor: 2^4 - 1 at fourth order).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simulation_error: Option<f64>,
+    /// The measure's own error over the record, relative: the largest difference between the
+    /// measure on either half of the record and on the whole.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub measure_error: Option<f64>,
+    /// The frequency of the same motion at half the amplitude, run alone after it, corrected
+    /// as `corrected_rad_per_s` is \[rad/s\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub half_amplitude_rad_per_s: Option<f64>,
+    /// The amplitude's own shift of the corrected frequency from its zero-amplitude limit,
+    /// relative and signed: 4/3 (corrected - half amplitude) / corrected (a shift c A^2).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub amplitude_shift: Option<f64>,
+    /// The corrected frequency's error bar against a small-amplitude (linear) prediction,
+    /// relative: simulation_error + measure_error + |amplitude_shift|, those that were made.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_bar: Option<f64>,
+    /// What the error bar leaves out, and why.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub error_bar_leaves_out: Vec<String>,
     /// The measured angular frequency of the simulated samples, w_d [rad/s].
     pub measured_rad_per_s: f64,
     /// Corrected for symplectic Euler's dispersion: w = (2 / dt) sin(w_d dt / 2) [rad/s].
@@ -330,6 +349,10 @@ fn frequency_line(f: &FrequencyReport) -> String {
         Some(e) => format!("{modal}, simulation error {e:.1e}"),
         None => modal,
     };
+    let modal = match f.error_bar {
+        Some(e) => format!("{modal}, error bar {e:.1e}{}", error_bar_parts(f)),
+        None => modal,
+    };
     format!(
         "frequency {} ({}): predicted {:.9} rad/s, measured {:.9}, corrected {:.9}: error {:.3e} (uncorrected {:.3e}){modal}, tolerance {:.1e}  {}",
         f.name,
@@ -342,6 +365,25 @@ fn frequency_line(f: &FrequencyReport) -> String {
         f.tolerance,
         if f.passed { "pass" } else { "FAIL" }
     )
+}
+
+/// The error bar's parts beyond the simulation's error, and what it leaves out.
+fn error_bar_parts(f: &FrequencyReport) -> String {
+    let mut parts = Vec::new();
+    if let Some(e) = f.measure_error {
+        parts.push(format!("measure {e:.1e}"));
+    }
+    if let Some(e) = f.amplitude_shift {
+        parts.push(format!("amplitude shift {e:+.1e}"));
+    }
+    if !f.error_bar_leaves_out.is_empty() {
+        parts.push(format!("leaves out {}", f.error_bar_leaves_out.join(", ")));
+    }
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", parts.join("; "))
+    }
 }
 
 /// The note under a table of checks in a motion run, whose transient cells are "-".

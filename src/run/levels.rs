@@ -258,6 +258,39 @@ pub(super) fn run_alone(
     Ok(Some(levels))
 }
 
+/// `sim`'s undriven motion from its present state over `ticks` ticks, run alone (no observer)
+/// as a motion run steps it: over `count` levels judged extrapolated (`run_alone`), or
+/// rapier's own steps from a half step (None); each tick's judged state handed to `each` with
+/// its motion time \[s\]. False when `cancel` is raised.
+pub(super) fn each_judged_state(
+    sim: &mut Simulation,
+    (ticks, count): (u64, Option<usize>),
+    cancel: Option<&AtomicBool>,
+    each: &mut dyn FnMut(f64, &Snapshot),
+) -> Result<bool, SimError> {
+    let dt_s = sim.model().settings.dt_s;
+    let mut levels = count.map(|c| Levels::new(sim, c)).transpose()?;
+    sim.start_at_half_step()?;
+    let none = |_: &Snapshot| Values::new();
+    for k in 1..=ticks {
+        if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
+            return Ok(false);
+        }
+        let t_s = k as f64 * dt_s;
+        match levels.as_mut() {
+            Some(levels) => {
+                levels.step_with(sim, t_s, None)?;
+                each(t_s, &levels.judge(&sim.snapshot_with(false), &none, &none).state);
+            }
+            None => {
+                sim.step()?;
+                each(t_s, &sim.snapshot_with(false));
+            }
+        }
+    }
+    Ok(true)
+}
+
 /// The node positions \[m\] of `sim`'s motion after `ticks` of its step, judged as a motion
 /// run judges them over `count` levels (`run_alone`), the judged state at the end only (the
 /// benchmark's measure of the judged motion's cost).

@@ -6,6 +6,7 @@
 //! one value (`judged.rs`) over its levels (`levels.rs`). The studies that drive many runs
 //! (fits, sensitivities, sweeps) live above, in `study/`.
 
+mod amplitude;
 mod equilibrium;
 mod judged;
 mod levels;

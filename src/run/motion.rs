@@ -3,6 +3,7 @@
 //! for good, the named coordinate displaced and given its rate, and the physical dynamics for
 //! the stated time. The observers judge it tick by tick; nothing here settles it.
 
+use super::amplitude::HalfAmplitude;
 use super::judged::{commands_at, JudgedMotion};
 use super::levels::{run_alone, Levels, MAX_LEVELS, MIN_LEVELS};
 use super::runner::Runner;
@@ -106,10 +107,15 @@ fn start_and_step(
     if m.undamped {
         runner.sim.release_damping();
     }
+    // The same motion at half the amplitude, run after this one (`amplitude.rs`).
+    let mut half = HalfAmplitude::wanted(&runner.sim, m);
     // The modes at the start state itself, before the coordinate's displacement moves it.
-    let modes = start_modes(runner, m)?;
+    let modes = start_modes(runner, m, half.as_mut())?;
     if let Some((c, displacement, rate)) = &m.coordinate {
         runner.sim.set_joint_motion(c.index, *displacement, *rate)?;
+        if let Some(h) = half.as_mut() {
+            h.set_joint_motion(c.index, *displacement, *rate)?;
+        }
     }
     if let Some((body, _, w)) = &m.spin {
         runner.sim.set_body_spin(*body, *w)?;
@@ -145,9 +151,15 @@ fn start_and_step(
         ran.steps_taken += 1;
     }
     ran.accelerated_steps = runner.accelerated_steps - accelerated_before;
-    let levels = runner.motion.take().and_then(JudgedMotion::into_levels);
-    ran.extrapolation = levels.map(|l| extrapolation_report(l, m));
-    result
+    let judged = runner.motion.take().and_then(JudgedMotion::into_levels);
+    ran.extrapolation = judged.map(|l| extrapolation_report(l, m));
+    match (result, half) {
+        (Ok(()), Some(half)) => {
+            runner.emit(format_args!("the motion again at half its amplitude, alone: {} steps", ran.steps_taken));
+            half.run(runner, ran.steps_taken, levels)
+        }
+        (result, _) => result,
+    }
 }
 
 /// The warning of a stated target that the most levels did not meet.
@@ -255,7 +267,11 @@ fn driven_text(d: &Drive) -> String {
 
 /// The structure's own modes at the start that the motion needs (its displacement along one,
 /// the frequencies fitted to them), analysed before the displacement, which follows.
-fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, RunError> {
+fn start_modes(
+    runner: &mut Runner,
+    m: &Motion,
+    half: Option<&mut HalfAmplitude>,
+) -> Result<Vec<ModeAtStart>, RunError> {
     let fitted = m.frequencies.iter().filter_map(|f| match f.signal {
         FrequencySignal::Mode(i) => Some(i),
         FrequencySignal::Joint(_) => None,
@@ -290,6 +306,9 @@ fn start_modes(runner: &mut Runner, m: &Motion) -> Result<Vec<ModeAtStart>, RunE
         .collect();
     if let Some((index, amplitude_m)) = m.mode {
         let eta = runner.sim.displace_along_mode(&analysis, index, amplitude_m);
+        if let Some(h) = half {
+            h.displace_along_mode(&analysis, index, amplitude_m);
+        }
         runner.emit(format_args!(
             "start displaced along mode {} (omega {:.9} rad/s): largest node displacement {amplitude_m:e} m, modal coordinate {eta:.6e}",
             index + 1,

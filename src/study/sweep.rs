@@ -520,7 +520,7 @@ impl FrequencyColumns {
     fn header(&self) -> Vec<String> {
         let mut h = Vec::new();
         for (name, modal) in self.names.iter().zip(&self.modal) {
-            for part in ["predicted", "measured", "corrected", "error"] {
+            for part in ["predicted", "measured", "corrected", "error", "error_bar", "amplitude_shift"] {
                 h.push(format!("frequency_{name}_{part}"));
             }
             if *modal {
@@ -541,6 +541,8 @@ impl FrequencyColumns {
             c.push(opt(f.map(|f| f.measured_rad_per_s)));
             c.push(opt(f.map(|f| f.corrected_rad_per_s)));
             c.push(opt(f.map(|f| f.error)));
+            c.push(opt(f.and_then(|f| f.error_bar)));
+            c.push(opt(f.and_then(|f| f.amplitude_shift)));
             if *modal {
                 c.push(opt(f.and_then(|f| f.modal_rad_per_s)));
                 c.push(opt(f.and_then(|f| f.modal_error)));
