@@ -11,9 +11,13 @@
 //! the settled state, with V the potential energy (`joint_modes.rs`: elastic members, torsion
 //! springs, constant loads):
 //! - G = dg/dq and grad V by central differences at steps h and 2 h (h = [`STEP_RAD`] rad or
-//!   [`STEP_FRACTION`] of the structure's size, cut where an elastic cable is within a few
-//!   steps of its rest length: [`KINK_STEP_FRACTION`]), extrapolated: (4 D(h) - D(2h)) / 3,
-//!   error O(h^4) (every derivative below is taken so);
+//!   [`STEP_FRACTION`] of the structure's size), extrapolated: (4 D(h) - D(2h)) / 3, error
+//!   O(h^4) (every derivative below is taken so). V keeps each elastic member on the branch of
+//!   its law it is on at the state (a taut cable's k (l - l0)^2 / 2 on both sides of its rest
+//!   length, a slack one's 0): the one-sided stiffness the small vibration feels, with no
+//!   difference crossing a kink (they had: cut steps near the kink, and a cable stretched less
+//!   than the least step read its slack side: a base-pinned prism at t0 = 0.2 N, k = 1e4 N/m,
+//!   had omega^2 = -104.6 where it is +1.956);
 //! - the constraint forces lambda from the equilibrium grad V + G^T lambda = 0 (least
 //!   squares; a taut cable's lambda is its tension [N], a loop's its joint reaction);
 //! - K = d2L/dq2, the Hessian of the Lagrangian L = V + lambda . g with lambda held (the
@@ -51,16 +55,6 @@ const STEP_RAD: f64 = 1e-3;
 const STEP_FRACTION: f64 = 1e-3;
 /// The second, coarser step of the Richardson extrapolation, as a multiple of the first.
 pub(super) const COARSE_STEP_RATIO: f64 = 2.0;
-/// An elastic cable's energy k (l - l0)^2 / 2 for l > l0, 0 below, has a kink at l = l0: a
-/// difference that crosses it reads the slack side's zero stiffness. The steps are cut so that
-/// the coarse step of two coordinates at once (a mixed difference) moves a node by at most this
-/// fraction of the distance of every elastic cable from its kink (measured on mohr2011 with
-/// cables of 2000 N/m stretched 1.6e-3 m: at the default step of 6e-3 m its pair of modes
-/// split into 21.349 and 21.568 rad/s; cut, both 21.360286, as the free vibration measures).
-const KINK_STEP_FRACTION: f64 = 0.5;
-/// The steps are cut to no less than this fraction of their default: round-off grows as
-/// h^-2 in a second difference (1e-8 relative at 1e-2 on mohr2011).
-const MIN_STEP_RATIO: f64 = 1e-2;
 /// Singular values of G below this fraction of the largest span its null space: G by central
 /// differences carries an error of about h^2 = 1e-8 of its entries, far below this, and the
 /// constraints of the shipped structures have singular values above 1e-3 of the largest.
@@ -240,40 +234,9 @@ impl Data {
     }
 
     /// The finite-difference step of each coordinate: [`STEP_RAD`] or [`STEP_FRACTION`] of
-    /// the structure's size (either moves a node by at most that fraction of the size), both
-    /// cut by [`Self::kink_step_ratio`].
+    /// the structure's size (either moves a node by at most that fraction of the size).
     pub(super) fn modal_steps(&self, m: &Model, coordinates: &[ModalCoordinate]) -> Vec<f64> {
-        let ratio = self.kink_step_ratio(m);
-        coordinates
-            .iter()
-            .map(|c| ratio * if c.linear() { STEP_FRACTION * m.length_scale_m } else { STEP_RAD })
-            .collect()
-    }
-
-    /// The factor (at most 1, at least [`MIN_STEP_RATIO`]) that keeps the differences on one
-    /// side of every elastic cable's kink ([`KINK_STEP_FRACTION`]).
-    fn kink_step_ratio(&self, m: &Model) -> f64 {
-        let Some(distance_m) = self.kink_distance_m(m) else { return 1.0 };
-        // The coarse step moves a node by up to COARSE_STEP_RATIO h, twice in a mixed difference.
-        let largest_move_m = 2.0 * COARSE_STEP_RATIO * STEP_FRACTION * m.length_scale_m;
-        (KINK_STEP_FRACTION * distance_m / largest_move_m).clamp(MIN_STEP_RATIO, 1.0)
-    }
-
-    /// The least distance |l - l0| \[m\] of an elastic cable from its rest length, where its
-    /// energy has a kink; None without elastic cables.
-    fn kink_distance_m(&self, m: &Model) -> Option<f64> {
-        self.nearest_kink(m).map(|(_, d)| d)
-    }
-
-    /// The elastic cable nearest its kink and that distance |l - l0| \[m\]; None without
-    /// elastic cables.
-    pub(super) fn nearest_kink(&self, m: &Model) -> Option<(usize, f64)> {
-        let s = &m.structure;
-        s.members_by_kind()
-            .filter_map(|(i, _)| Some((i, self.elastic_law(m, i)?)))
-            .filter(|(_, law)| law.tension_only)
-            .map(|(i, law)| (i, (self.member_length_m(m, i) - law.rest_length_m).abs()))
-            .reduce(|a, b| if b.1 < a.1 { b } else { a })
+        coordinates.iter().map(|c| if c.linear() { STEP_FRACTION * m.length_scale_m } else { STEP_RAD }).collect()
     }
 
     /// The constraint rows g(q) [m]: each closure's, then each taut cable's stretch.
@@ -302,13 +265,15 @@ pub(super) struct Setup<'a> {
     /// Each body's centre of mass at the state analysed (the loads' reference).
     com: Vec<Vector3<f64>>,
     saved: Saved,
+    /// Each member's branch at the state analysed (`Data::engaged_members`).
+    engaged: Vec<bool>,
 }
 
 impl Data {
     /// L = V + lambda . g with the coordinates moved by `moves`, the state restored after.
     fn lagrangian_moved(&mut self, m: &Model, setup: &Setup, lambda: &DVector<f64>, moves: &[(usize, f64)]) -> f64 {
         self.move_coordinates(m, setup.coordinates, moves);
-        let v = self.potential_energy_about(m, Some(&setup.com));
+        let v = self.potential_energy_about(m, Some(&setup.com), &setup.engaged);
         let g = self.constraint_rows(m, setup.closures, setup.taut);
         self.restore_modal_state(m, &setup.saved);
         v + g.iter().zip(lambda.iter()).map(|(a, b)| a * b).sum::<f64>()
@@ -323,7 +288,7 @@ impl Data {
             let h = ratio * setup.steps[k];
             let at = |sim: &mut Data, d: f64| {
                 sim.move_coordinates(m, setup.coordinates, &[(k, d)]);
-                let v = sim.potential_energy_about(m, Some(&setup.com));
+                let v = sim.potential_energy_about(m, Some(&setup.com), &setup.engaged);
                 let g = sim.constraint_rows(m, setup.closures, setup.taut);
                 sim.restore_modal_state(m, &setup.saved);
                 (v, g)
@@ -582,6 +547,7 @@ impl Data {
             steps: self.modal_steps(m, coordinates),
             com: (0..s.bodies.len()).map(|b| self.world_com(m, b)).map(|c| Vector3::new(c.x, c.y, c.z)).collect(),
             saved: self.save_modal_state(m, coordinates),
+            engaged: self.engaged_members(m),
         }
     }
 

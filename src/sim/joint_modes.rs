@@ -24,17 +24,6 @@ use nalgebra::{DMatrix, DVector, Quaternion, UnitQuaternion, Vector3};
 const STEP_RAD: f64 = 1e-4;
 /// Finite-difference step of a prismatic coordinate, a fraction of the structure's length.
 const STEP_FRACTION: f64 = 1e-4;
-/// An elastic cable's energy k (l - l0)^2 / 2 for l > l0, 0 below, has a kink at l = l0: a
-/// difference that crosses it reads the slack side's zero stiffness (a rope stretched 0.05 mm
-/// by a 0.05 kg slider on it, 447.2 rad/s, had come out 417.2 at the default step of 0.1 mm).
-/// The steps are cut so that a mixed difference (two coordinates at once, each moving a node
-/// by at most [`STEP_FRACTION`] of the size: a turn of [`STEP_RAD`] too) moves a node by at
-/// most this fraction of every elastic cable's distance from its kink.
-const KINK_STEP_FRACTION: f64 = 0.5;
-/// The steps are cut to no less than this fraction of their default (round-off grows as h^-2
-/// in a second difference); a cable nearer its kink than that is refused, with its name.
-const MIN_STEP_RATIO: f64 = 1e-2;
-
 impl Data {
     /// The joints whose coordinates are the analysis's, or why the structure is refused.
     pub(super) fn modal_joints(&self, m: &Model) -> Result<Vec<usize>, ModesError> {
@@ -58,29 +47,12 @@ impl Data {
         Ok(free)
     }
 
-    /// The finite-difference step of joint `j`'s coordinate, cut by `ratio`
-    /// ([`Data::joint_kink_step_ratio`]).
-    fn modal_step(&self, m: &Model, j: usize, ratio: f64) -> f64 {
-        ratio
-            * match m.structure.joints[j].kind {
-                JointKind::Prismatic { .. } => STEP_FRACTION * m.length_scale_m,
-                _ => STEP_RAD,
-            }
-    }
-
-    /// The factor (at most 1) that keeps every difference on one side of every elastic cable's
-    /// kink ([`KINK_STEP_FRACTION`]), or the refusal where it would fall below
-    /// [`MIN_STEP_RATIO`].
-    fn joint_kink_step_ratio(&self, m: &Model) -> Result<f64, ModesError> {
-        let Some((cable, distance_m)) = self.nearest_kink(m) else { return Ok(1.0) };
-        let largest_move_m = 2.0 * STEP_FRACTION * m.length_scale_m;
-        let ratio = KINK_STEP_FRACTION * distance_m / largest_move_m;
-        if ratio < MIN_STEP_RATIO {
-            let name = m.structure.members[cable].name.clone();
-            let step_m = MIN_STEP_RATIO * largest_move_m;
-            return Err(ModesError::NearKink { cable: name, distance_m, step_m });
+    /// The finite-difference step of joint `j`'s coordinate.
+    fn modal_step(&self, m: &Model, j: usize) -> f64 {
+        match m.structure.joints[j].kind {
+            JointKind::Prismatic { .. } => STEP_FRACTION * m.length_scale_m,
+            _ => STEP_RAD,
         }
-        Ok(ratio.min(1.0))
     }
 
     /// Moves joint `j`'s coordinate by `d` (rad or m), the bodies beyond it along.
@@ -90,21 +62,36 @@ impl Data {
         let _ = self.move_joint(m, j, d, None);
     }
 
-    /// The potential energy now [J]: elastic members (engaged), torsion springs, and the work
-    /// of the constant loads (gravity, external loads) on the centres of mass.
-    fn potential_energy_j(&self, m: &Model) -> f64 {
-        self.potential_energy_about(m, None)
+    /// Whether each member (structure order) is engaged now: an elastic member taut, or a
+    /// two-sided spring; false for every other. The branches a modal analysis's energy keeps.
+    pub(super) fn engaged_members(&self, m: &Model) -> Vec<bool> {
+        let s = &m.structure;
+        let mut engaged = vec![false; s.members.len()];
+        for (i, member) in s.members_by_kind() {
+            if let Some(law) = self.elastic_law(m, i) {
+                engaged[i] = law.engaged(member.length_at(|n| self.node_position(m, n)));
+            }
+        }
+        engaged
     }
 
-    /// [`Self::potential_energy_j`] with the loads' work taken from each body's centre of mass
-    /// at `reference` (indexed by body; None: the world origin), which keeps the large constant
-    /// -f . x_ref out of the sum and its round-off out of second differences.
-    pub(super) fn potential_energy_about(&self, m: &Model, reference: Option<&[Vector3<f64>]>) -> f64 {
+    /// The potential energy now [J]: elastic members (each on its branch `engaged`, so that a
+    /// difference that would cross a cable's kink reads the cable's stiffness where it is),
+    /// torsion springs, and the work of the constant loads (gravity, external loads) on the
+    /// centres of mass, taken from each body's centre of mass at `reference` (indexed by body;
+    /// None: the world origin), which keeps the large constant -f . x_ref out of the sum and its
+    /// round-off out of second differences.
+    pub(super) fn potential_energy_about(
+        &self,
+        m: &Model,
+        reference: Option<&[Vector3<f64>]>,
+        engaged: &[bool],
+    ) -> f64 {
         let s = &m.structure;
         let mut e = 0.0;
         for (i, member) in s.members_by_kind() {
             if let Some(law) = self.elastic_law(m, i) {
-                e += law.energy_j(member.length_at(|n| self.node_position(m, n)));
+                e += law.energy_on_branch_j(member.length_at(|n| self.node_position(m, n)), engaged[i]);
             }
         }
         let snap = self.snapshot_with(m, false);
@@ -127,10 +114,11 @@ impl Data {
         e
     }
 
-    /// V with the coordinates `joints` moved by `d`, the state restored after.
-    fn energy_moved(&mut self, m: &Model, moves: &[(usize, f64)]) -> f64 {
+    /// V (on the branches `engaged`) with the coordinates `joints` moved by `d`, the state
+    /// restored after.
+    fn energy_moved(&mut self, m: &Model, engaged: &[bool], moves: &[(usize, f64)]) -> f64 {
         moves.iter().for_each(|&(j, d)| self.displace_joint(m, j, d));
-        let e = self.potential_energy_j(m);
+        let e = self.potential_energy_about(m, None, engaged);
         moves.iter().rev().for_each(|&(j, d)| self.displace_joint(m, j, -d));
         e
     }
@@ -138,19 +126,19 @@ impl Data {
     /// K = d2V/dq2 by central second differences.
     fn joint_stiffness(&mut self, m: &Model, joints: &[usize]) -> Result<DMatrix<f64>, ModesError> {
         let n = joints.len();
-        let ratio = self.joint_kink_step_ratio(m)?;
-        let h: Vec<f64> = joints.iter().map(|&j| self.modal_step(m, j, ratio)).collect();
-        let e0 = self.potential_energy_j(m);
+        let h: Vec<f64> = joints.iter().map(|&j| self.modal_step(m, j)).collect();
+        let engaged = self.engaged_members(m);
+        let e0 = self.potential_energy_about(m, None, &engaged);
         let mut k = DMatrix::zeros(n, n);
         for a in 0..n {
             let (ja, ha) = (joints[a], h[a]);
-            k[(a, a)] = (self.energy_moved(m, &[(ja, ha)]) - 2.0 * e0 + self.energy_moved(m, &[(ja, -ha)])) / (ha * ha);
+            k[(a, a)] = (self.energy_moved(m, &engaged, &[(ja, ha)]) - 2.0 * e0 + self.energy_moved(m, &engaged, &[(ja, -ha)])) / (ha * ha);
             for b in 0..a {
                 let (jb, hb) = (joints[b], h[b]);
-                let pp = self.energy_moved(m, &[(ja, ha), (jb, hb)]);
-                let pm = self.energy_moved(m, &[(ja, ha), (jb, -hb)]);
-                let mp = self.energy_moved(m, &[(ja, -ha), (jb, hb)]);
-                let mm = self.energy_moved(m, &[(ja, -ha), (jb, -hb)]);
+                let pp = self.energy_moved(m, &engaged, &[(ja, ha), (jb, hb)]);
+                let pm = self.energy_moved(m, &engaged, &[(ja, ha), (jb, -hb)]);
+                let mp = self.energy_moved(m, &engaged, &[(ja, -ha), (jb, hb)]);
+                let mm = self.energy_moved(m, &engaged, &[(ja, -ha), (jb, -hb)]);
                 k[(a, b)] = (pp - pm - mp + mm) / (4.0 * ha * hb);
                 k[(b, a)] = k[(a, b)];
             }
@@ -178,7 +166,7 @@ impl Data {
     pub(super) fn body_jacobian(&mut self, m: &Model, joints: &[usize], bodies: &[usize]) -> DMatrix<f64> {
         let mut jac = DMatrix::zeros(6 * bodies.len(), joints.len());
         for (c, &j) in joints.iter().enumerate() {
-            let h = self.modal_step(m, j, 1.0);
+            let h = self.modal_step(m, j);
             self.displace_joint(m, j, h);
             let plus = self.body_states(m, bodies);
             self.displace_joint(m, j, -2.0 * h);

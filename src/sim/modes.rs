@@ -108,10 +108,6 @@ pub enum ModesError {
     /// More free bodies (on springs and elastic cables) than the sparse solver is run for.
     #[error("{bodies} free bodies: the lowest modes of free bodies on springs and elastic cables are computed for at most {MAX_SPARSE_MODAL_FREE_BODIES} free bodies (each rigid mode reported, about one a body, holds a shape and a motion per node: the report grows with the square of the count)")]
     TooLargeSparse { bodies: usize },
-    /// An elastic cable so near its slack length that a finite difference of the joint modes
-    /// would cross it.
-    #[error("cable '{cable}' is {distance_m:e} m from its slack length: the joint modes' finite differences (at their least, {step_m:e} m) would cross it and read its slack side (a silent wrong stiffness); stretch it more, or analyse the structure without joints")]
-    NearKink { cable: String, distance_m: f64, step_m: f64 },
     /// More point masses (elastic struts' ends, heavy cables' beads) than the sparse solver is
     /// run for.
     #[error("{points} point masses (elastic struts' ends, heavy cables' beads): the lowest modes are computed for at most {MAX_SPARSE_MODAL_POINT_MASSES}")]

@@ -225,6 +225,18 @@ impl ElasticLaw {
         }
     }
 
+    /// Elastic energy \[J\] at length `l` \[m\] on the branch of its law where it is `engaged`
+    /// (a cable taut: k (l - l0)^2 / 2 on either side of l0; slack: 0): the energy's smooth
+    /// part about a state where the member was so. A modal analysis's differences read it, so
+    /// that none crosses a cable's kink at its rest length.
+    pub fn energy_on_branch_j(&self, l: f64, engaged: bool) -> f64 {
+        if engaged {
+            0.5 * self.stiffness_n_per_m * (l - self.rest_length_m).powi(2)
+        } else {
+            0.0
+        }
+    }
+
     /// Elastic energy at length `l` \[J\]: k (l - l0)^2 / 2 where engaged.
     pub fn energy_j(&self, l: f64) -> f64 {
         if self.engaged(l) {
