@@ -212,7 +212,8 @@ def sensitivity(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, nam
     ``run`` settles it) moves with every
     parameter: the report of ``tensegrity sensitivity --json`` as a dict (``outputs``: each
     output's ``name``, ``value`` and ``free``; ``parameters``: one per parameter with its
-    ``derivatives``, one per output, and d(coordinate)/dp in ``coordinates``; with ``check``
+    ``derivatives``, one per output, each one's error estimate in ``estimates``, and
+    d(coordinate)/dp in ``coordinates``; with ``check``
     also the differences of settles in ``check`` and their ``max_check_error``). The derived
     parameters (expressions of others) are listed in ``derived``, not differentiated, unless
     ``params`` names the parameters to differentiate by (the CLI's ``--param``). Raises

@@ -1,14 +1,18 @@
 //! Expressions of a scenario file's model (`"2*r*sin(pi/n)"`): compiled once against a known
-//! list of symbols, evaluated with a slice of numbers in that list's order, differentiated
-//! symbolically. The rest of the testbed sees only [`Expr`] and [`ExprError`]; the engine
-//! underneath is the `exmex` crate (see the README's Stack section for why).
+//! list of symbols, evaluated with a slice of numbers in that list's order, differentiated to
+//! the second order by forward differentiation (`dual.rs`). The rest of the testbed sees only
+//! [`Expr`] and [`ExprError`]. The `exmex` crate checks the text; the expression's own tree
+//! evaluates it (exmex 0.21 evaluated `sin(x^2 + y^2 + 1)` wrongly, and its symbolic
+//! derivatives grew past any bound: README, Stack).
 //!
 //! Grammar: numbers (`1`, `2.5`, `1e-3`), symbols (`r`, `B1.x`, `side1.force`; any other name
 //! between braces, `{spring AD.force}`), `+ - * / ^` with the usual precedence, parentheses,
 //! the functions [`FUNCTIONS`] and the constants `pi` and `e`. Every error carries the byte
 //! offset in the expression where it lies and, for an unknown name, the names that exist.
 
+use super::dual::{self, Node};
 use exmex::prelude::*;
+use std::sync::Arc;
 
 /// The functions an expression may call, with their number of arguments.
 pub const FUNCTIONS: &[(&str, usize)] = &[
@@ -63,12 +67,6 @@ pub const MAX_EXPRESSION_BYTES: usize = 10_000;
 /// the stack).
 pub const MAX_EXPRESSION_DEPTH: usize = 64;
 
-/// Largest expression differentiated symbolically [bytes of the engine's text]: the engine's
-/// derivative costs time and memory that grow with the square of its input and more (a sum of
-/// 400 terms took 8 s and 3 GB, one of 800 overflowed the stack), and each order multiplies
-/// the size, so a larger one is refused before the work.
-pub const MAX_DIFFERENTIATED_BYTES: usize = 1_000;
-
 /// Why an expression does not compile or differentiate, at byte `offset` of its text.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("at byte {offset}: {message}")]
@@ -81,14 +79,23 @@ fn err(offset: usize, message: impl Into<String>) -> ExprError {
     ExprError { offset, message: message.into() }
 }
 
-/// A compiled expression of a list of symbols.
+/// A compiled expression of a list of symbols, or its first or second derivative.
 #[derive(Clone, Debug)]
 pub struct Expr {
     text: String,
-    flat: FlatEx<f64>,
-    /// For each of the engine's variables (in its order), the index in the symbol list.
+    /// The compiled expression's tree (`dual.rs`), evaluated directly.
+    tree: Arc<Node>,
+    /// The symbols (indices in the list) the tree reads, ascending.
     order: Vec<usize>,
+    /// The engine's text of the expression compiled, before any derivative.
+    source: Arc<str>,
+    /// The symbols it has been differentiated by, in order (at most [`MAX_DERIVATIVE_ORDER`]).
+    wrt: Vec<usize>,
 }
+
+/// Highest order of a derivative: forward differentiation with hyper-dual numbers gives the
+/// first and second (the energy models' gradients, Hessians, momenta and mass matrices).
+const MAX_DERIVATIVE_ORDER: usize = 2;
 
 impl Expr {
     /// Compiles `text` against `symbols` (the names it may use, in the order of the values
@@ -108,9 +115,23 @@ impl Expr {
             return Err(err(0, "empty expression"));
         }
         let engine_text = Translator::new(text, symbols, &tokens).translate()?;
-        let flat =
-            FlatEx::<f64>::parse(&engine_text).map_err(|e| err(0, format!("not a valid expression ({})", e.msg())))?;
-        Ok(Expr { text: text.to_string(), order: order_of(&flat), flat })
+        // The engine checks the text; the tree evaluates it (exmex 0.21 evaluates a function of
+        // two powers and a number, `sin(x^2 + y^2 + 1)`, wrongly: 1.0014 at (0.37, -0.21)).
+        FlatEx::<f64>::parse(&engine_text).map_err(|e| err(0, format!("not a valid expression ({})", e.msg())))?;
+        let tree = dual::parse(&engine_text).map_err(|e| err(0, format!("not a valid expression ({})", e.0)))?;
+        Ok(Expr {
+            text: text.to_string(),
+            order: tree.symbols(),
+            tree: Arc::new(tree),
+            source: engine_text.into(),
+            wrt: vec![],
+        })
+    }
+
+    /// The engine's text of the expression compiled (before any derivative).
+    #[cfg(test)]
+    pub(crate) fn source(&self) -> &str {
+        &self.source
     }
 
     /// The expression as written.
@@ -126,53 +147,41 @@ impl Expr {
     /// The value with `values[i]` for symbol `i` of the list it was compiled against (NaN when
     /// a value is missing).
     pub fn eval(&self, values: &[f64]) -> f64 {
-        const ON_STACK: usize = 16;
-        let n = self.order.len();
-        let get = |i: usize| values.get(self.order[i]).copied().unwrap_or(f64::NAN);
-        let result = if n <= ON_STACK {
-            let mut buf = [0.0; ON_STACK];
-            (0..n).for_each(|i| buf[i] = get(i));
-            self.flat.eval(&buf[..n])
-        } else {
-            self.flat.eval(&(0..n).map(get).collect::<Vec<_>>())
-        };
-        result.unwrap_or(f64::NAN)
+        match self.wrt[..] {
+            [] => self.tree.value(values),
+            [i] => self.tree.eval(values, Some(i), None).a,
+            [i, j] => self.tree.eval(values, Some(i), Some(j)).ab,
+            _ => f64::NAN,
+        }
     }
 
-    /// The symbolic partial derivative with respect to symbol `symbol` of the list (zero when
-    /// the expression does not use it). atan2, abs, min and max have no derivative here.
+    /// The partial derivative with respect to symbol `symbol` of the list (zero when the
+    /// expression does not use it), exact to round-off: the compiled expression's tree
+    /// differentiated forward (`dual.rs`), to the second order.
     pub fn derivative(&self, symbol: usize) -> Result<Expr, ExprError> {
-        let size = self.size();
-        if size > MAX_DIFFERENTIATED_BYTES {
-            return Err(err(
-                0,
-                format!(
-                    "{} has {size} bytes, too large to differentiate symbolically (at most {MAX_DIFFERENTIATED_BYTES}): \
-                     write it with fewer terms or nested functions",
-                    self.shown()
-                ),
-            ));
-        }
-        let flat = match self.order.iter().position(|&s| s == symbol) {
-            Some(var) => self
-                .flat
-                .clone()
-                .partial(var)
-                .map_err(|e| err(0, format!("no symbolic derivative of {} ({})", self.shown(), e.msg())))?,
-            None => FlatEx::<f64>::parse("0").map_err(|e| err(0, e.msg().to_string()))?,
-        };
         let text = if self.text.starts_with(DERIVATIVE_OF) {
             format!("{}'", self.text)
         } else {
             format!("{DERIVATIVE_OF}{}", self.text)
         };
-        Ok(Expr { text, order: order_of(&flat), flat })
+        if !self.order.contains(&symbol) {
+            let zero = Arc::new(Node::Number(0.0));
+            return Ok(Expr { text, tree: zero, order: vec![], source: "0".into(), wrt: vec![] });
+        }
+        if self.wrt.len() >= MAX_DERIVATIVE_ORDER {
+            return Err(err(0, format!("{}: derivatives of the third order and above are not taken", self.shown())));
+        }
+        let mut wrt = self.wrt.clone();
+        wrt.push(symbol);
+        Ok(Expr { text, tree: self.tree.clone(), order: self.order.clone(), source: self.source.clone(), wrt })
     }
 
-    /// The size of the expression as the engine holds it [bytes of its text]: what its
-    /// evaluation and its derivative cost grow with.
+    /// What evaluating the expression costs, in bytes of its text: the compiled text's length,
+    /// times 1 + the derivative's order (a hyper-dual pass carries that many more numbers;
+    /// measured: 10,000 Newton starts of an 11-sine potential's gradient and Hessian, 6 million
+    /// unweighted, took 0.58 s a settle point).
     pub fn size(&self) -> usize {
-        self.flat.unparse().len()
+        self.source.len() * (1 + self.wrt.len())
     }
 
     /// The expression for a message: its text, or its start when long.
@@ -188,11 +197,6 @@ impl Expr {
 
 /// How a derivative's text starts (`the derivative of V`, a second one `the derivative of V'`).
 const DERIVATIVE_OF: &str = "the derivative of ";
-
-/// The symbol index of each of the engine's variables (`v00003` -> 3).
-fn order_of(flat: &FlatEx<f64>) -> Vec<usize> {
-    flat.var_names().iter().map(|v| v[1..].parse().unwrap_or(usize::MAX)).collect()
-}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Kind {

@@ -6,6 +6,7 @@
 //! (`integrate.rs`); the file's parameters, evaluated again at
 //! each point of a sweep over them (`params.rs`).
 
+mod dual;
 pub mod dynamics;
 pub mod energy_model;
 pub mod expr;

@@ -59,6 +59,10 @@ pub struct ParameterSensitivity {
     pub coordinates: Vec<f64>,
     /// d(output)/d(parameter), one per output of the report (empty with `error`).
     pub derivatives: Vec<f64>,
+    /// Each derivative's error estimate (the five-point stencil against the three-point one
+    /// over the same samples: an upper bound where truncation rules), one per output.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub estimates: Vec<f64>,
     /// The same by differences of settles (`--check`), one per output.
     pub check: Option<Vec<f64>>,
     /// The largest error of `derivatives` against `check`, relative (see
@@ -91,7 +95,7 @@ impl SensitivityReport {
     /// The table: a header, then per parameter one row per output.
     pub fn to_table(&self) -> String {
         let mut out = format!(
-            "== {} [{}] point {}: {} coordinate(s) ({}), {} output(s), {} parameter(s){}\n      {:<28} {:>20} {:>20}{}\n",
+            "== {} [{}] point {}: {} coordinate(s) ({}), {} output(s), {} parameter(s){}\n      {:<28} {:>20} {:>20} {:>10}{}\n",
             self.name,
             self.file,
             self.point,
@@ -103,6 +107,7 @@ impl SensitivityReport {
             "output",
             "value",
             "d/dp",
+            "estimate",
             if self.check_wall_s.is_some() { format!(" {:>20}", "settles' d/dp") } else { String::new() }
         );
         if !self.derived.is_empty() {
@@ -138,7 +143,11 @@ impl SensitivityReport {
                 }
                 let check = c.map_or(String::new(), |c| format!(" {c:>20.12e}"));
                 let free = if o.free { "  (free)" } else { "" };
-                out.push_str(&format!("      {:<28} {:>20.12e} {:>20.12e}{check}{free}\n", o.name, o.value, d));
+                let estimate = p.estimates.get(i).map_or(String::new(), |e| format!(" +- {e:.1e}"));
+                out.push_str(&format!(
+                    "      {:<28} {:>20.12e} {:>20.12e}{estimate}{check}{free}\n",
+                    o.name, o.value, d
+                ));
             }
             if zero > 0 {
                 out.push_str(&format!("      ({zero} output(s) with a zero derivative not listed)\n"));
@@ -149,7 +158,8 @@ impl SensitivityReport {
 
     /// The CSV: one row per parameter and output.
     pub fn to_csv(&self) -> String {
-        let mut out = String::from("parameter,parameter_value,output,output_value,free,derivative,check,check_error\n");
+        let mut out =
+            String::from("parameter,parameter_value,output,output_value,free,derivative,estimate,check,check_error\n");
         for p in &self.parameters {
             for (i, (o, d)) in self.outputs.iter().zip(&p.derivatives).enumerate() {
                 let (c, e) = match &p.check {
@@ -158,8 +168,9 @@ impl SensitivityReport {
                     }
                     None => (String::new(), String::new()),
                 };
+                let estimate = p.estimates.get(i).map_or(String::new(), |x| format!("{x:e}"));
                 out.push_str(&format!(
-                    "{},{:e},{},{:e},{},{:e},{c},{e}\n",
+                    "{},{:e},{},{:e},{},{:e},{estimate},{c},{e}\n",
                     p.name, p.value, o.name, o.value, o.free, d
                 ));
             }

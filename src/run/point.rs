@@ -157,6 +157,28 @@ fn branch_of(
 pub const NO_BRANCH: &str = "none of the analytic branches";
 
 /// Settles the point `index` at `inputs` and adds its report.
+/// The warnings of the file's predictions of a sensitivity whose tolerance is below that
+/// sensitivity's error estimate at point `index` (relative to its value for a relative check).
+fn unresolved_sensitivities(sc: &Scenario, index: usize, values: &Values, estimates: &Values) -> Vec<String> {
+    let Some(model) = sc.model.as_ref() else { return vec![] };
+    let mut out = Vec::new();
+    for p in &model.predictions {
+        let name = &model.symbols[p.symbol].name;
+        let (Some(&v), Some(&e)) = (values.get(name), estimates.get(name)) else { continue };
+        let resolved = match p.class {
+            crate::file_model::spec::ErrorClass::Relative => e / v.abs(),
+            _ => e,
+        };
+        if p.tolerance < resolved {
+            out.push(format!(
+                "prediction:{}: tolerance {:.1e} below what the sensitivity {name} resolves at point {index} (its estimate {resolved:.1e}): a tolerance above it, or a parameter step the analysis resolves better",
+                p.name, p.tolerance
+            ));
+        }
+    }
+    out
+}
+
 pub(super) fn settle_point(
     runner: &mut Runner,
     sc: &Scenario,
@@ -175,7 +197,10 @@ pub(super) fn settle_point(
     if s.settled && sc.model.as_ref().is_some_and(|m| !m.sensitivities.is_empty()) {
         let params = runner.params.clone();
         match super::sensitivity::file_sensitivities(sc, &mut runner.sim, &params, inputs) {
-            Ok(values) => simulated.extend(values),
+            Ok((values, estimates)) => {
+                report.warnings.extend(unresolved_sensitivities(sc, index, &values, &estimates));
+                simulated.extend(values);
+            }
             Err(e) => report.warnings.push(format!("point {index}: [[sensitivities]] not computed: {e}")),
         }
     }

@@ -17,7 +17,9 @@ use crate::observers::file_model::ModelObserver;
 use crate::report::sensitivity::ParameterSensitivity;
 use crate::scenario::Scenario;
 use crate::sim::modes::{least_squares, ZERO_MODE_RATIO};
-use crate::sim::sensitivity::{derivative_from_samples, EquilibriumCoordinates, SensitivityError};
+use crate::sim::sensitivity::{
+    derivative_estimate_from_samples, derivative_from_samples, EquilibriumCoordinates, SensitivityError,
+};
 use crate::sim::Simulation;
 use nalgebra::{DMatrix, DVector};
 
@@ -192,17 +194,18 @@ pub(crate) fn analyse<'a>(
 
 /// The file's `[[sensitivities]]` at a settle point of a run (`sim` settled at `params` and
 /// `inputs`), by their names: each d(output)/d(parameter), NaN where the output is not one of
-/// the state's (a mode it has not); Err where the state has no sensitivities (the reason).
+/// the state's (a mode it has not), and beside them each one's error estimate; Err where the
+/// state has no sensitivities (the reason).
 pub(super) fn file_sensitivities(
     sc: &Scenario,
     sim: &mut Simulation,
     params: &Values,
     inputs: &Values,
-) -> Result<Values, FileSensitivityError> {
+) -> Result<(Values, Values), FileSensitivityError> {
     let wanted = sc.model.as_ref().map_or(&[][..], |m| &m.sensitivities[..]);
     let a = analyse(sc, sim, params, inputs.clone())?;
     let mut rows: Vec<ParameterSensitivity> = Vec::new();
-    let mut out = Values::new();
+    let (mut out, mut estimates) = (Values::new(), Values::new());
     for s in wanted {
         if !rows.iter().any(|r| r.name == s.parameter) {
             let value = params.get(&s.parameter).copied().unwrap_or(f64::NAN);
@@ -215,8 +218,9 @@ pub(super) fn file_sensitivities(
         }
         let i = a.base.iter().position(|(n, _)| n == &s.output);
         out.insert(s.name.clone(), i.map_or(f64::NAN, |i| row.derivatives[i]));
+        estimates.insert(s.name.clone(), i.and_then(|i| row.estimates.get(i).copied()).unwrap_or(f64::NAN));
     }
-    Ok(out)
+    Ok((out, estimates))
 }
 
 /// How the structure `step` built at a parameter's step is another model than the `settled`
@@ -313,6 +317,7 @@ fn row_of(name: &str, value: f64) -> ParameterSensitivity {
         step: parameter_step(value),
         coordinates: vec![],
         derivatives: vec![],
+        estimates: vec![],
         check: None,
         max_check_error: None,
         error: None,
@@ -328,6 +333,7 @@ pub(crate) fn unused_row(name: &str, value: f64, coordinates: usize, outputs: us
     ParameterSensitivity {
         coordinates: vec![0.0; coordinates],
         derivatives: vec![0.0; outputs],
+        estimates: vec![0.0; outputs],
         unused: true,
         ..row_of(name, value)
     }
@@ -528,11 +534,16 @@ impl Outputs<'_> {
         let dy = derivative_from_samples(y[0].clone(), y[1].clone(), y[2].clone(), y[3].clone(), h);
         let (c0, c1, c2, c3) = (curvature[0].clone(), curvature[1].clone(), curvature[2].clone(), curvature[3].clone());
         let dw2 = derivative_from_samples(c0, c1, c2, c3, h);
+        let omega = |i: usize| 2.0 * lin.modes[i].omega_squared.abs().sqrt();
         row.coordinates = dq.iter().copied().collect();
         row.derivatives = dy.iter().copied().collect();
-        row.derivatives.extend(
-            listed.iter().zip(dw2.iter()).map(|(&i, dw2)| dw2 / (2.0 * lin.modes[i].omega_squared.abs().sqrt())),
-        );
+        row.derivatives.extend(listed.iter().zip(dw2.iter()).map(|(&i, dw2)| dw2 / omega(i)));
+        // Both sample sets are 0 at the settled state itself (offsets from it; the curvature of
+        // its own eigenpairs), which the estimate's noise part reads.
+        row.estimates = derivative_estimate_from_samples(&y[0], &y[1], &y[2], &y[3], h).iter().copied().collect();
+        let dw2_estimate =
+            derivative_estimate_from_samples(&curvature[0], &curvature[1], &curvature[2], &curvature[3], h);
+        row.estimates.extend(listed.iter().zip(dw2_estimate.iter()).map(|(&i, e)| e / omega(i)));
         row
     }
 }

@@ -132,7 +132,9 @@ impl Data {
         let mut k = DMatrix::zeros(n, n);
         for a in 0..n {
             let (ja, ha) = (joints[a], h[a]);
-            k[(a, a)] = (self.energy_moved(m, &engaged, &[(ja, ha)]) - 2.0 * e0 + self.energy_moved(m, &engaged, &[(ja, -ha)])) / (ha * ha);
+            k[(a, a)] = (self.energy_moved(m, &engaged, &[(ja, ha)]) - 2.0 * e0
+                + self.energy_moved(m, &engaged, &[(ja, -ha)]))
+                / (ha * ha);
             for b in 0..a {
                 let (jb, hb) = (joints[b], h[b]);
                 let pp = self.energy_moved(m, &engaged, &[(ja, ha), (jb, hb)]);
