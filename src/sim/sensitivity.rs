@@ -120,7 +120,7 @@ where
 /// are 0 at the point itself (offsets from it): its truncation, the difference from the central
 /// difference at h over the same samples ((plus - minus) / (2 h), whose O(h^2) error bounds the
 /// five-point stencil's O(h^4) from above), and its samples' own noise sigma (a finite
-/// difference's round-off inside each sample) through the stencil, [`NOISE_SIGMAS`] of it.
+/// difference's round-off inside each sample) through the stencil, `NOISE_SIGMAS` of it.
 /// sigma is read from the fourth difference of the five values -2 h ... 2 h, which a smooth
 /// function makes h^4 times its fourth derivative (negligible at these steps) and independent
 /// noise sigma sqrt(1 + 16 + 16 + 1); the stencil turns it into sigma sqrt(130) / (12 h).
