@@ -352,7 +352,8 @@ impl MotionObserver {
     /// 4/3 (omega(A) - omega(A/2)) / omega(A); None where the motion did not run again.
     fn amplitude_shift(&self, f: &FrequencyPrediction, k: usize, corrected: f64) -> Option<(f64, f64)> {
         let (t, q) = &self.half[k];
-        if t.is_empty() {
+        // Not run, or stopped before its end (a divergence): no shift.
+        if t.is_empty() || t.len() != self.samples[k].0.len() {
             return None;
         }
         let measured = Self::measured(f, t, q, || fit_cosine(t, q));
