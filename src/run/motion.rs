@@ -154,21 +154,31 @@ fn start_and_step(
     let judged = runner.motion.take().and_then(JudgedMotion::into_levels);
     ran.extrapolation = judged.map(|l| extrapolation_report(l, m));
     match (result, half) {
-        (Ok(()), Some(half)) => {
-            runner.emit(format_args!("the motion again at half its amplitude, alone: {} steps", ran.steps_taken));
-            match half.run(runner, ran.steps_taken, levels) {
-                Err(RunError::Interrupted(tick)) => Err(RunError::Interrupted(tick)),
-                // The motion itself ran: its frequencies stand, their error bars say what is missing.
-                Err(e) => {
-                    report.warnings.push(format!(
-                        "motion: the same motion at half its amplitude stopped ({e}): the frequencies' error bars leave out the amplitude's shift"
-                    ));
-                    Ok(())
-                }
-                Ok(()) => Ok(()),
-            }
-        }
+        (Ok(()), Some(half)) => run_half_amplitude(runner, half, (ran.steps_taken, levels), report),
         (result, _) => result,
+    }
+}
+
+/// The motion again at half its amplitude, over its `steps` judged over `levels`
+/// (`amplitude.rs`). Its stop (a divergence) leaves the run standing, with a warning; an
+/// interruption stops the run.
+fn run_half_amplitude(
+    runner: &mut Runner,
+    half: HalfAmplitude,
+    (steps, levels): (u64, Option<usize>),
+    report: &mut ScenarioReport,
+) -> Result<(), RunError> {
+    runner.emit(format_args!("the motion again at half its amplitude, alone: {steps} steps"));
+    match half.run(runner, steps, levels) {
+        Err(RunError::Interrupted(tick)) => Err(RunError::Interrupted(tick)),
+        // The motion itself ran: its frequencies stand, their error bars say what is missing.
+        Err(e) => {
+            report.warnings.push(format!(
+                "motion: the same motion at half its amplitude stopped ({e}): the frequencies' error bars leave out the amplitude's shift"
+            ));
+            Ok(())
+        }
+        Ok(()) => Ok(()),
     }
 }
 
