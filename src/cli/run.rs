@@ -93,6 +93,7 @@ pub fn run(
             skip_findings: false,
             table: o.table_path(sc, several).map(Into::into),
             external: None,
+            bare: false,
         };
         // A panic inside one scenario fails that scenario, with its message; the batch goes on.
         let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_scenario(sc, &opts)))

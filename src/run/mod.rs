@@ -58,6 +58,10 @@ pub struct RunOptions<'a> {
     /// A model outside the file (the Python package's callables), compared as the file's
     /// predictions are (`observers::external`).
     pub external: Option<crate::observers::external::External>,
+    /// The settle alone, watched by no observer: a study that reads the settled state (modes,
+    /// sensitivities, fits) has no use for the checks, the interference (every pair of members,
+    /// every tick: most of a 1000-strut prism's settle) or a recording.
+    pub bare: bool,
 }
 
 /// Why a run stopped early, or failed after its end: the report's `error`, each kind kept as
@@ -208,16 +212,31 @@ fn start_at<'a>(
 ) -> Result<Runner<'a>, RunError> {
     let structure = mech.build(&params, first_inputs, &sc.start)?;
     let sim = Simulation::new(&structure, &sc.sim)?;
+    let observers = if opts.bare { vec![] } else { observed(&sim, sc, opts, mech.length_scale(&params), warnings)? };
+    let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel, params);
+    // The first point's commands (a no-op where the build already placed them).
+    runner.command(first_inputs);
+    Ok(runner)
+}
+
+/// The observers of a run of `sc` on `sim` (`observers::KINDS`).
+fn observed(
+    sim: &Simulation,
+    sc: &Scenario,
+    opts: &RunOptions,
+    length_scale_m: f64,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Box<dyn crate::observers::Observer>>, RunError> {
     let target = match (&opts.connect, opts.record.clone().or_else(|| sc.record.clone())) {
         (Some(url), _) => Some(RecordTarget::Live(url.clone())),
         (None, Some(path)) => Some(RecordTarget::File(path)),
         (None, None) => None,
     };
-    let observers = observers::observers(
+    Ok(observers::observers(
         Setup {
             structure: sim.structure(),
             checks: &sc.checks,
-            length_scale_m: mech.length_scale(&params),
+            length_scale_m,
             interference: &sc.interference,
             model: sc.model.as_ref(),
             recording: target.map(|target| Recording {
@@ -231,11 +250,7 @@ fn start_at<'a>(
             external: opts.external.clone(),
         },
         warnings,
-    )?;
-    let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel, params);
-    // The first point's commands (a no-op where the build already placed them).
-    runner.command(first_inputs);
-    Ok(runner)
+    )?)
 }
 
 /// The report's summaries and verdict once the run is over; then the observers write what

@@ -35,7 +35,7 @@ pub fn settle_at(
     params: Values,
     cancel: Option<&AtomicBool>,
 ) -> Result<SettledState, RunError> {
-    let opts = RunOptions { cancel, skip_findings: true, ..RunOptions::default() };
+    let opts = RunOptions { cancel, skip_findings: true, bare: true, ..RunOptions::default() };
     let mut runner = start_at(sc.mechanism(), sc, &opts, &mut Vec::new(), inputs, params)?;
     let prediction = runner.mech.predict(&runner.params, inputs)?;
     let settled = runner.settle(inputs, &prediction)?;

@@ -33,6 +33,7 @@ pub(super) fn run_topologies(sc: &Scenario, opts: &RunOptions) -> ScenarioReport
                 other => other.clone(),
             }),
             external: opts.external.clone(),
+            bare: opts.bare,
         };
         let mut r = run(variant, &options);
         let note = rebuilt(sc, variant);
