@@ -288,6 +288,9 @@ pub struct FrequencyPrediction {
     pub symbols: Vec<String>,
     /// Relative.
     pub tolerance: f64,
+    /// The prediction holds at the motion's amplitude: the amplitude's shift is no part of its
+    /// error bar.
+    pub at_amplitude: bool,
 }
 
 impl PartialEq for FrequencyPrediction {
@@ -296,6 +299,7 @@ impl PartialEq for FrequencyPrediction {
             && self.measure == other.measure
             && self.formula.as_ref().map(|f| f.text()) == other.formula.as_ref().map(|f| f.text())
             && self.tolerance == other.tolerance
+            && self.at_amplitude == other.at_amplitude
     }
 }
 

@@ -351,6 +351,9 @@ impl MotionObserver {
     /// shift of `corrected`, relative and signed: with omega(A) = omega(0) + c A^2,
     /// 4/3 (omega(A) - omega(A/2)) / omega(A); None where the motion did not run again.
     fn amplitude_shift(&self, f: &FrequencyPrediction, k: usize, corrected: f64) -> Option<(f64, f64)> {
+        if f.at_amplitude {
+            return None;
+        }
         let (t, q) = &self.half[k];
         // Not run, or stopped before its end (a divergence): no shift.
         if t.is_empty() || t.len() != self.samples[k].0.len() {
@@ -378,9 +381,9 @@ impl MotionObserver {
         if measure.is_none() {
             leaves_out.push("the measure's own error (a half of the record has nothing to measure)".to_string());
         }
-        if shift.is_none() {
+        if shift.is_none() && !f.at_amplitude {
             leaves_out.push(
-                "the amplitude's shift (a motion without an amplitude of its own, or nothing measured at half of it)"
+                "the amplitude's shift (a driven or spun motion, one released from a drawing that is no equilibrium, or nothing measured at half the amplitude)"
                     .to_string(),
             );
         }

@@ -4,12 +4,13 @@
 //! c A^2 to leading order); a linear prediction (a mode's, a paper's small-oscillation
 //! formula) is its limit at A -> 0. So that a measured frequency's error bar holds that shift,
 //! the motion runs a second time, alone and after the motion itself, from the same start state
-//! (settled, damping released, the modes analysed) at half the amplitude: the mode's amplitude,
+//! (settled, or drawn at an equilibrium; damping released, the modes analysed) at half the
+//! amplitude: the mode's amplitude,
 //! or the coordinate's displacement and rate, halved. The observers see each of its judged
 //! states (`Observer::half_amplitude_tick`); with omega(A) = omega(0) + c A^2, the shift at A is
 //! 4/3 (omega(A) - omega(A/2)) (`observers/motion.rs`). It costs a second motion; a motion
-//! whose amplitude is not its own (driven, spun, released from its drawing) or that measures
-//! no frequency has none.
+//! whose amplitude is not its own (driven, spun, released from a drawing that is no
+//! equilibrium) or that measures no frequency has none.
 
 use super::levels::each_judged_state;
 use super::runner::Runner;
@@ -25,9 +26,12 @@ pub(super) struct HalfAmplitude {
 
 impl HalfAmplitude {
     /// A copy of `sim` at the motion's start (before its displacement), where `m` measures
-    /// frequencies of a free vibration whose amplitude it states.
-    pub fn wanted(sim: &Simulation, m: &Motion) -> Option<Self> {
-        let free = m.drive.is_none() && m.spin.is_none() && m.start == MotionStart::Settled;
+    /// frequencies of a free vibration whose amplitude it states about an equilibrium: a
+    /// settled start, or a drawn one `at_equilibrium` (at rest, its residual within the settle's
+    /// tolerances).
+    pub fn wanted(sim: &Simulation, m: &Motion, at_equilibrium: bool) -> Option<Self> {
+        let from_rest = m.start == MotionStart::Settled || at_equilibrium;
+        let free = m.drive.is_none() && m.spin.is_none() && from_rest;
         let stated = m.mode.is_some() || m.coordinate.is_some();
         (free && stated && !m.frequencies.is_empty())
             .then(|| HalfAmplitude { sim: sim.at_time_step(sim.model().settings.dt_s) })

@@ -108,7 +108,8 @@ fn start_and_step(
         runner.sim.release_damping();
     }
     // The same motion at half the amplitude, run after this one (`amplitude.rs`).
-    let mut half = HalfAmplitude::wanted(&runner.sim, m);
+    let at_equilibrium = report.points.last().is_some_and(|p| p.settled);
+    let mut half = HalfAmplitude::wanted(&runner.sim, m, at_equilibrium);
     // The modes at the start state itself, before the coordinate's displacement moves it.
     let modes = start_modes(runner, m, half.as_mut())?;
     if let Some((c, displacement, rate)) = &m.coordinate {

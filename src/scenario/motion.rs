@@ -48,6 +48,9 @@
 //!                         # for a linear oscillator, biased by the harmonics at large
 //!                         # amplitude: 1e-6 relative at 0.3 rad), or the mean period between
 //!                         # interpolated zero crossings of the rate (unbiased at any amplitude)
+//! at_amplitude = false    # true: the formula holds at the motion's amplitude (an exact
+//!                         # large-amplitude period), so the amplitude's own shift is no part
+//!                         # of its error bar; by default a small-oscillation prediction
 //! ```
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
@@ -124,6 +127,9 @@ pub(super) struct RawFrequency {
     pub(super) tolerance: Spanned<f64>,
     /// "cosine" (the default) or "period": how the frequency is measured from the motion.
     pub(super) measure: Option<Spanned<String>>,
+    /// The formula holds at the motion's amplitude (not only as it vanishes): the amplitude's
+    /// own shift is no error of it. Default false (a small-oscillation prediction).
+    pub(super) at_amplitude: Option<bool>,
 }
 
 /// The validated `[motion]` section, or None without one. `first` is the structure at the first
@@ -539,7 +545,8 @@ fn frequency(
         if let FrequencySignal::Joint(_) = signal {
             return Err(ctx.err(&f.name, format!("frequency '{name}' of a joint needs a formula [rad/s]")));
         }
-        return Ok(FrequencyPrediction { name, signal, measure, formula: None, symbols, tolerance });
+        let at_amplitude = false;
+        return Ok(FrequencyPrediction { name, signal, measure, formula: None, symbols, tolerance, at_amplitude });
     };
     let names: Vec<&str> = symbols.iter().map(String::as_str).collect();
     let what = format!(
@@ -547,7 +554,8 @@ fn frequency(
     );
     let formula = Expr::compile(text.get_ref(), &names).map_err(|e| expr_error(ctx, text.span().start, &e, &what))?;
     let reads_solved = formula.uses().iter().any(|&i| i >= known);
-    let p = FrequencyPrediction { name, signal, measure, formula: Some(formula), symbols, tolerance };
+    let at_amplitude = f.at_amplitude.unwrap_or(false);
+    let p = FrequencyPrediction { name, signal, measure, formula: Some(formula), symbols, tolerance, at_amplitude };
     let Ok(prediction) = mech.predict(params, inputs) else { return Ok(p) };
     if reads_solved {
         return Ok(p); // judged once the energy model is solved at the motion's start
