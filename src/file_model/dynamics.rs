@@ -1,5 +1,5 @@
 //! The file's dynamic model: a kinetic energy T(q, q') in the `[energy]` coordinates q and
-//! their rates q' (`NAME_dot`) beside the potential V(q). From its symbolic derivatives:
+//! their rates q' (`NAME_dot`) beside the potential V(q). From its derivatives (forward, exact to round-off):
 //! - the mass matrix M(q) = d2T/dq'2 (T must be a quadratic form in the rates, so M does not
 //!   depend on them);
 //! - the linearised natural frequencies and mode shapes at a stationary point q*: the

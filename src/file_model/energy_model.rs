@@ -1,6 +1,6 @@
 //! An energy model stated in a scenario file (`[energy]`): a potential-energy expression in
-//! named coordinates. Its stationary points are found by Newton's method on the symbolic
-//! gradient and Hessian (no finite differences), from the settled state and from a scan, and
+//! named coordinates. Its stationary points are found by Newton's method on its
+//! gradient and Hessian (forward derivatives, no finite differences), from the settled state and from a scan, and
 //! each is classified by the Hessian's eigenvalues (nalgebra `SymmetricEigen`).
 
 use super::expr::Expr;

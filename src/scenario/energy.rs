@@ -1,5 +1,5 @@
-//! `[energy]`: a potential in named coordinates, compiled with its symbolic gradient and
-//! Hessian into an [`EnergySpec`]; each coordinate with how it is read off the settled state;
+//! `[energy]`: a potential in named coordinates, compiled with its gradient and
+//! Hessian (forward derivatives) into an [`EnergySpec`]; each coordinate with how it is read off the settled state;
 //! its kinetic energy and frequency predictions in `kinetic.rs`.
 
 use super::error::{finite, positive_value, Ctx, ScenarioError};
@@ -15,7 +15,7 @@ use toml::Spanned;
 /// counts across coordinates: two scans of 10,000 had taken 3.4 GB).
 const MAX_SCAN: i64 = 10_000;
 
-/// Largest number of coordinates of a potential: its Hessian has their square of symbolic
+/// Largest number of coordinates of a potential: its Hessian has their square of
 /// derivatives, each evaluated at every Newton step of every start.
 const MAX_COORDINATES: usize = 20;
 

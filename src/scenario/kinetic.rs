@@ -1,5 +1,5 @@
 //! `[energy] kinetic` and `[[energy.frequencies]]`: the file's dynamic model, compiled with the
-//! symbolic mass matrix d2T/dq'2, dT/dq and d2T/dq'dq into a [`Dynamics`]. Errors, located:
+//! mass matrix d2T/dq'2, dT/dq and d2T/dq'dq (forward derivatives, exact to round-off) into a [`Dynamics`]. Errors, located:
 //! a symbol of the simulated state in T, a coordinate whose rate T lacks, a mass matrix that
 //! depends on the rates (T not quadratic in them) or, where it is constant, is not positive
 //! definite (both probed with the parameters' values); frequencies without a kinetic energy, a mode out of range.
