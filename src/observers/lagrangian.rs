@@ -27,7 +27,7 @@ use crate::file_model::energy_model::EnergySpec;
 use crate::file_model::integrate::Tolerance;
 use crate::file_model::spec::ErrorClass;
 use crate::mechanisms::wrap_angle;
-use crate::observers::motion::{corrected_for_symplectic_euler, fit_cosine, period_frequency};
+use crate::observers::motion::{corrected_for_symplectic_euler, frequency_by};
 use crate::report::{LagrangianCoordinateReport, LagrangianReport};
 use crate::settings::FrequencyMeasure;
 use std::sync::atomic::AtomicBool;
@@ -56,13 +56,13 @@ fn start(series: &[Vec<f64>], times: &[f64]) -> (f64, Vec<f64>, Vec<f64>) {
     (0.5 * (times[0] + times[1]), q, v)
 }
 
-/// Why a motion was not compared with the Lagrangian model.
 /// Most integrator steps (accepted and rejected) of the Lagrangian model a compared tick of
 /// the motion, on average: the shipped models take about one; a model whose kinetic energy is
 /// scaled by 1e-9 (about 5e5 rad/s against a 1 ms step) had taken some 50,000 a tick, running
 /// for a minute to the integrator's limit of ten million.
 pub const MAX_MODEL_STEPS_PER_TICK: usize = 10_000;
 
+/// Why a motion was not compared with the Lagrangian model.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LagrangianError {
     /// Too few ticks of motion to read the start from.
@@ -341,10 +341,7 @@ fn coordinate_report(
     let max_error = errors.iter().copied().fold(0.0, f64::max);
     let max_error = if errors.iter().any(|e| e.is_nan()) { f64::INFINITY } else { max_error };
     let rms_error = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
-    let omega = |q: &[f64]| match measure {
-        FrequencyMeasure::Cosine => fit_cosine(times, q).map(|f| f.omega_rad_per_s),
-        FrequencyMeasure::Period => period_frequency(times, q),
-    };
+    let omega = |q: &[f64]| frequency_by(measure, times, q);
     let (model_omega, measured) = (omega(model).unwrap_or(f64::NAN), omega(simulated).unwrap_or(f64::NAN));
     LagrangianCoordinateReport {
         name: name.into(),

@@ -234,6 +234,15 @@ pub fn fit_cosine(t: &[f64], q: &[f64]) -> Option<CosineFit> {
     })
 }
 
+/// The frequency of the samples (t, q) by `measure` [rad/s]: the cosine fit's, or the mean
+/// period's; None where it finds none.
+pub fn frequency_by(measure: FrequencyMeasure, t: &[f64], q: &[f64]) -> Option<f64> {
+    match measure {
+        FrequencyMeasure::Cosine => fit_cosine(t, q).map(|f| f.omega_rad_per_s),
+        FrequencyMeasure::Period => period_frequency(t, q),
+    }
+}
+
 /// The frequency of a linear oscillator whose symplectic Euler samples at step `dt_s` turn at
 /// `measured` rad/s: (2 / dt) sin(w_d dt / 2). NaN beyond the step's stability (w_d dt > pi).
 pub fn corrected_for_symplectic_euler(measured_rad_per_s: f64, dt_s: f64) -> f64 {
@@ -326,7 +335,7 @@ impl MotionObserver {
     /// the levels' estimate divisor times the finer one's error (`observers::Rougher`).
     fn estimate(&self, f: &FrequencyPrediction, t: &[f64], rougher: &[f64], measured: f64) -> Option<f64> {
         let divisor = self.estimate_divisor.filter(|_| rougher.len() == t.len())?;
-        let rough = Self::measured(f, t, rougher, || fit_cosine(t, rougher));
+        let rough = frequency_by(f.measure, t, rougher).unwrap_or(f64::NAN);
         Some((measured - rough).abs() / measured.abs() / divisor)
     }
 
@@ -338,7 +347,7 @@ impl MotionObserver {
         let mid = t.len() / 2;
         let mut spread = 0.0f64;
         for (th, qh) in [(&t[..mid], &q[..mid]), (&t[mid..], &q[mid..])] {
-            let w = Self::measured(f, th, qh, || fit_cosine(th, qh));
+            let w = frequency_by(f.measure, th, qh).unwrap_or(f64::NAN);
             if !w.is_finite() {
                 return None;
             }
@@ -359,7 +368,7 @@ impl MotionObserver {
         if t.is_empty() || t.len() != self.samples[k].0.len() {
             return None;
         }
-        let measured = Self::measured(f, t, q, || fit_cosine(t, q));
+        let measured = frequency_by(f.measure, t, q).unwrap_or(f64::NAN);
         let half = if self.estimate_divisor.is_some() {
             measured
         } else {

@@ -50,11 +50,11 @@ impl HalfAmplitude {
     /// Runs the copy over `ticks` ticks judged as the motion was (`levels`), each judged state
     /// handed to the runner's observers.
     pub fn run(mut self, runner: &mut Runner, ticks: u64, levels: Option<usize>) -> Result<(), RunError> {
-        let structure = self.sim.structure().clone();
-        let observers = &mut runner.observers;
+        // The copy's structure is the runner's own (the same build).
+        let (structure, observers) = (runner.sim.structure(), &mut runner.observers);
         let mut each = |t_s: f64, state: &crate::snapshot::Snapshot| {
             for o in observers.iter_mut() {
-                o.half_amplitude_tick(t_s, state, &structure);
+                o.half_amplitude_tick(t_s, state, structure);
             }
         };
         let tick = runner.sim.tick();

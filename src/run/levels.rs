@@ -65,6 +65,9 @@ pub(super) struct Levels {
 /// Actuator commands at a time of the motion \[s\] (a driven motion's inputs).
 pub type CommandsAt<'a> = &'a dyn Fn(f64) -> Vec<f64>;
 
+/// What takes each judged state of a motion run alone, with its motion time \[s\].
+pub type EachJudged<'a> = &'a mut dyn FnMut(f64, &Snapshot);
+
 impl Levels {
     /// `count` levels of `sim` (the runner's own at h; [`MIN_LEVELS`] to [`MAX_LEVELS`]), the
     /// finer ones each from its present state started at its own half step. Call before `sim`
@@ -235,13 +238,15 @@ impl Levels {
 /// stepped together (2^count - 1 steps a tick, as a run's), a driven motion's commands
 /// (`commands_at` a time) set at the end of every step of each level. Where `estimated_too`
 /// is given, every tick is judged with it (the levels then hold the estimates and the
-/// amplitude); None when `cancel` is raised.
+/// amplitude); where `each` is, every tick is judged and its judged state handed to it with its
+/// motion time \[s\]. None when `cancel` is raised.
 pub(super) fn run_alone(
     sim: &mut Simulation,
     (ticks, count): (u64, usize),
     commands_at: Option<CommandsAt>,
     estimated_too: Option<&dyn Fn(&Snapshot) -> Values>,
     cancel: Option<&AtomicBool>,
+    mut each: Option<EachJudged>,
 ) -> Result<Option<Levels>, SimError> {
     let mut levels = Levels::new(sim, count)?;
     sim.start_at_half_step()?;
@@ -250,9 +255,13 @@ pub(super) fn run_alone(
         if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
             return Ok(None);
         }
-        levels.step_with(sim, k as f64 * levels.dt_s, commands_at)?;
-        if let Some(too) = estimated_too {
-            levels.judge(&sim.snapshot_with(false), &none, too);
+        let t_s = k as f64 * levels.dt_s;
+        levels.step_with(sim, t_s, commands_at)?;
+        if estimated_too.is_some() || each.is_some() {
+            let judged = levels.judge(&sim.snapshot_with(false), &none, estimated_too.unwrap_or(&none));
+            if let Some(each) = each.as_mut() {
+                each(t_s, &judged.state);
+            }
         }
     }
     Ok(Some(levels))
@@ -266,27 +275,19 @@ pub(super) fn each_judged_state(
     sim: &mut Simulation,
     (ticks, count): (u64, Option<usize>),
     cancel: Option<&AtomicBool>,
-    each: &mut dyn FnMut(f64, &Snapshot),
+    each: EachJudged,
 ) -> Result<bool, SimError> {
+    if let Some(count) = count {
+        return Ok(run_alone(sim, (ticks, count), None, None, cancel, Some(each))?.is_some());
+    }
     let dt_s = sim.model().settings.dt_s;
-    let mut levels = count.map(|c| Levels::new(sim, c)).transpose()?;
     sim.start_at_half_step()?;
-    let none = |_: &Snapshot| Values::new();
     for k in 1..=ticks {
         if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
             return Ok(false);
         }
-        let t_s = k as f64 * dt_s;
-        match levels.as_mut() {
-            Some(levels) => {
-                levels.step_with(sim, t_s, None)?;
-                each(t_s, &levels.judge(&sim.snapshot_with(false), &none, &none).state);
-            }
-            None => {
-                sim.step()?;
-                each(t_s, &sim.snapshot_with(false));
-            }
-        }
+        sim.step()?;
+        each(k as f64 * dt_s, &sim.snapshot_with(false));
     }
     Ok(true)
 }
@@ -300,7 +301,7 @@ pub fn judged_nodes_after(
     count: usize,
     commands_at: Option<CommandsAt>,
 ) -> Result<Vec<[f64; 3]>, SimError> {
-    let mut levels = run_alone(sim, (ticks, count), commands_at, None, None)?.expect("no cancel flag");
+    let mut levels = run_alone(sim, (ticks, count), commands_at, None, None, None)?.expect("no cancel flag");
     let none = |_: &Snapshot| Values::new();
     Ok(levels.judge(&sim.snapshot_with(false), &none, &none).state.nodes)
 }

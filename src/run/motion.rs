@@ -238,7 +238,7 @@ fn levels_for_target(runner: &Runner, m: &Motion, target: f64) -> Result<(usize,
     let mut tried = Vec::new();
     for count in MIN_LEVELS..MAX_LEVELS {
         let mut sim = runner.sim.at_time_step(runner.sim.model().settings.dt_s);
-        let Some(levels) = run_alone(&mut sim, (m.steps, count), driven, Some(&nodes), runner.cancel)? else {
+        let Some(levels) = run_alone(&mut sim, (m.steps, count), driven, Some(&nodes), runner.cancel, None)? else {
             return Err(RunError::Interrupted(runner.sim.tick()));
         };
         tried.push(format!(

@@ -156,7 +156,6 @@ fn branch_of(
 /// The label of a settled state that lies on none of the analytic branches.
 pub const NO_BRANCH: &str = "none of the analytic branches";
 
-/// Settles the point `index` at `inputs` and adds its report.
 /// The warnings of the file's predictions of a sensitivity whose tolerance is below that
 /// sensitivity's error estimate at point `index` (relative to its value for a relative check).
 fn unresolved_sensitivities(sc: &Scenario, index: usize, values: &Values, estimates: &Values) -> Vec<String> {
@@ -179,6 +178,7 @@ fn unresolved_sensitivities(sc: &Scenario, index: usize, values: &Values, estima
     out
 }
 
+/// Settles the point `index` at `inputs` and adds its report.
 pub(super) fn settle_point(
     runner: &mut Runner,
     sc: &Scenario,

@@ -18,7 +18,7 @@ use crate::report::sensitivity::ParameterSensitivity;
 use crate::scenario::Scenario;
 use crate::sim::modes::{least_squares, ZERO_MODE_RATIO};
 use crate::sim::sensitivity::{
-    derivative_estimate_from_samples, derivative_from_samples, EquilibriumCoordinates, SensitivityError,
+    derivative_and_estimate, derivative_from_samples, EquilibriumCoordinates, SensitivityError,
 };
 use crate::sim::Simulation;
 use nalgebra::{DMatrix, DVector};
@@ -531,18 +531,16 @@ impl Outputs<'_> {
             let held: Vec<f64> = lambda.iter().zip(dlambda.iter()).map(|(l, d)| l + s * h * d).collect();
             curvature.push(modal_curvatures(sim, &self.coordinates.with_multipliers(&held), &lin.modes, listed));
         }
-        let dy = derivative_from_samples(y[0].clone(), y[1].clone(), y[2].clone(), y[3].clone(), h);
-        let (c0, c1, c2, c3) = (curvature[0].clone(), curvature[1].clone(), curvature[2].clone(), curvature[3].clone());
-        let dw2 = derivative_from_samples(c0, c1, c2, c3, h);
+        // Both sample sets are 0 at the settled state itself (offsets from it; the curvature of
+        // its own eigenpairs), which the estimate's noise part reads.
+        let (dy, dy_estimate) = derivative_and_estimate(&y[0], &y[1], &y[2], &y[3], h);
+        let c = &curvature;
+        let (dw2, dw2_estimate) = derivative_and_estimate(&c[0], &c[1], &c[2], &c[3], h);
         let omega = |i: usize| 2.0 * lin.modes[i].omega_squared.abs().sqrt();
         row.coordinates = dq.iter().copied().collect();
         row.derivatives = dy.iter().copied().collect();
         row.derivatives.extend(listed.iter().zip(dw2.iter()).map(|(&i, dw2)| dw2 / omega(i)));
-        // Both sample sets are 0 at the settled state itself (offsets from it; the curvature of
-        // its own eigenpairs), which the estimate's noise part reads.
-        row.estimates = derivative_estimate_from_samples(&y[0], &y[1], &y[2], &y[3], h).iter().copied().collect();
-        let dw2_estimate =
-            derivative_estimate_from_samples(&curvature[0], &curvature[1], &curvature[2], &curvature[3], h);
+        row.estimates = dy_estimate.iter().copied().collect();
         row.estimates.extend(listed.iter().zip(dw2_estimate.iter()).map(|(&i, e)| e / omega(i)));
         row
     }

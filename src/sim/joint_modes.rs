@@ -124,7 +124,7 @@ impl Data {
     }
 
     /// K = d2V/dq2 by central second differences.
-    fn joint_stiffness(&mut self, m: &Model, joints: &[usize]) -> Result<DMatrix<f64>, ModesError> {
+    fn joint_stiffness(&mut self, m: &Model, joints: &[usize]) -> DMatrix<f64> {
         let n = joints.len();
         let h: Vec<f64> = joints.iter().map(|&j| self.modal_step(m, j)).collect();
         let engaged = self.engaged_members(m);
@@ -145,7 +145,7 @@ impl Data {
                 k[(b, a)] = k[(a, b)];
             }
         }
-        Ok(k)
+        k
     }
 
     /// Each moving body's centre of mass and rotation (as a quaternion) now.
@@ -196,7 +196,7 @@ impl Data {
         }
         let s = &m.structure;
         let bodies: Vec<usize> = (0..s.bodies.len()).filter(|b| m.is_free(*b)).collect();
-        let stiffness = self.joint_stiffness(m, &joints)?;
+        let stiffness = self.joint_stiffness(m, &joints);
         let jac = self.body_jacobian(m, &joints, &bodies);
         let body_mass = self.mass_matrix(m, &bodies);
         let mass = jac.transpose() * &body_mass * &jac;

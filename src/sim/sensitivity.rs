@@ -116,7 +116,7 @@ where
     ((plus - minus) * 8.0 - (plus2 - minus2)) * (1.0 / (12.0 * h))
 }
 
-/// The error estimate of [`derivative_from_samples`], element by element, for samples that
+/// [`derivative_from_samples`] with its error estimate, element by element, for samples that
 /// are 0 at the point itself (offsets from it): its truncation, the difference from the central
 /// difference at h over the same samples ((plus - minus) / (2 h), whose O(h^2) error bounds the
 /// five-point stencil's O(h^4) from above), and its samples' own noise sigma (a finite
@@ -124,18 +124,19 @@ where
 /// sigma is read from the fourth difference of the five values -2 h ... 2 h, which a smooth
 /// function makes h^4 times its fourth derivative (negligible at these steps) and independent
 /// noise sigma sqrt(1 + 16 + 16 + 1); the stencil turns it into sigma sqrt(130) / (12 h).
-pub fn derivative_estimate_from_samples(
+pub fn derivative_and_estimate(
     minus2: &DVector<f64>,
     minus: &DVector<f64>,
     plus: &DVector<f64>,
     plus2: &DVector<f64>,
     h: f64,
-) -> DVector<f64> {
+) -> (DVector<f64>, DVector<f64>) {
     let five = derivative_from_samples(minus2.clone(), minus.clone(), plus.clone(), plus2.clone(), h);
     let three = (plus - minus) / (2.0 * h);
     let fourth = minus2 - minus * 4.0 - plus * 4.0 + plus2;
     let noise = fourth.abs() * (NOISE_SIGMAS * 130f64.sqrt() / (34f64.sqrt() * 12.0 * h));
-    (five - three).abs() + noise
+    let estimate = (&five - three).abs() + noise;
+    (five, estimate)
 }
 
 /// How many of the samples' noise sigmas a derivative's estimate carries.

@@ -239,11 +239,7 @@ impl ElasticLaw {
 
     /// Elastic energy at length `l` \[J\]: k (l - l0)^2 / 2 where engaged.
     pub fn energy_j(&self, l: f64) -> f64 {
-        if self.engaged(l) {
-            0.5 * self.stiffness_n_per_m * (l - self.rest_length_m).powi(2)
-        } else {
-            0.0
-        }
+        self.energy_on_branch_j(l, self.engaged(l))
     }
 }
 
