@@ -180,29 +180,29 @@ impl Custom {
     /// [N]: minus the member forces on an end node along the strut, so that it balances them.
     fn strut_forces(&self, snap: &Snapshot) -> Vec<(usize, f64)> {
         let s = &self.structure;
-        let node_force = |node: usize| -> [f64; 3] {
-            let mut f = [0.0; 3];
-            let mut add = |a: usize, b: usize, t: f64| {
-                let (pa, pb) = (snap.nodes[a], snap.nodes[b]);
-                let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
-                let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                if l > 0.0 {
-                    for k in 0..3 {
-                        f[k] += t * d[k] / l;
-                    }
-                }
-            };
-            for (i, m) in s.members_with_law() {
-                for (a, b) in m.segments() {
-                    if a == node {
-                        add(a, b, snap.forces.force_n[i]);
-                    } else if b == node {
-                        add(b, a, snap.forces.force_n[i]);
-                    }
+        // The member forces on every node, summed in one pass over the members (in member
+        // and segment order, as a sum per node would take them): a pass per strut end had
+        // made the observation quadratic in the structure's size.
+        let mut node_forces = vec![[0.0; 3]; snap.nodes.len()];
+        let mut add = |a: usize, b: usize, t: f64| {
+            let (pa, pb) = (snap.nodes[a], snap.nodes[b]);
+            let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+            let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            if l > 0.0 {
+                for k in 0..3 {
+                    node_forces[a][k] += t * d[k] / l;
                 }
             }
-            f
         };
+        for (i, m) in s.members_with_law() {
+            for (a, b) in m.segments() {
+                add(a, b, snap.forces.force_n[i]);
+                if b != a {
+                    add(b, a, snap.forces.force_n[i]);
+                }
+            }
+        }
+        let node_force = |node: usize| node_forces[node];
         let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         s.rigid_struts()
             .filter_map(|(k, st)| {

@@ -20,7 +20,9 @@ use crate::sim::modes::{least_squares, ZERO_MODE_RATIO};
 use crate::sim::sensitivity::{
     derivative_and_estimate, derivative_from_samples, EquilibriumCoordinates, SensitivityError,
 };
+use crate::sim::sparse_sensitivity::SparseLinearization;
 use crate::sim::Simulation;
+use crate::structure::DENSE_MODAL_MAX_FREE_BODIES;
 use nalgebra::{DMatrix, DVector};
 
 /// A parameter's finite-difference step, a fraction of its value (error O(h^4) with the
@@ -99,6 +101,10 @@ pub(crate) struct Outputs<'a> {
     pub(crate) inputs: Values,
     model: Option<ModelObserver>,
     pub(crate) coordinates: EquilibriumCoordinates,
+    /// Whether each output name asked so far is an angle (`Scenario::is_angle` scans the
+    /// quantities: a 300-strut prism's 3,005 outputs at each of its samples had spent most of
+    /// its sensitivities' time there).
+    angles: std::cell::RefCell<std::collections::HashMap<String, bool>>,
 }
 
 /// The analysis of a settled state: what its samples need, its linearization, the listed
@@ -115,7 +121,7 @@ pub(crate) struct Analysis<'a> {
 /// which are rigid-body modes (|omega^2| below [`ZERO_MODE_RATIO`] of the largest, or with
 /// constraints below the reduced Hessian's own error, `constrained_modes::zero_floor`).
 pub(crate) struct Linearization {
-    stiffness: DMatrix<f64>,
+    stiffness: Stiffness,
     jacobian: DMatrix<f64>,
     pub(crate) modes: Vec<Mode>,
     pub(crate) rigid: Vec<bool>,
@@ -124,10 +130,21 @@ pub(crate) struct Linearization {
     left_out: usize,
 }
 
+/// K as the linearization holds it: dense, or for a structure of more than
+/// [`DENSE_MODAL_MAX_FREE_BODIES`] free bodies (where `tensegrity modes` turns sparse) its
+/// lowest modes and the sparse solve of K x = r (`sim/sparse_sensitivity.rs`).
+enum Stiffness {
+    Dense(DMatrix<f64>),
+    Sparse(Box<SparseLinearization>),
+}
+
 impl Linearization {
     /// The number of coordinates (each parameter's dq/dp has as many).
     pub(crate) fn size(&self) -> usize {
-        self.stiffness.ncols()
+        match &self.stiffness {
+            Stiffness::Dense(k) => k.ncols(),
+            Stiffness::Sparse(sparse) => sparse.size(),
+        }
     }
 
     /// The output name of non-rigid mode `i` (from 0) of [`Self::modes`]: `mode{N}.omega`, N
@@ -146,6 +163,15 @@ pub(crate) fn linearize(
     sim: &mut Simulation,
     coordinates: &EquilibriumCoordinates,
 ) -> Result<Linearization, SensitivityRunError> {
+    if let EquilibriumCoordinates::Bodies(bodies) = coordinates {
+        if bodies.len() > DENSE_MODAL_MAX_FREE_BODIES {
+            let refused = |e| SensitivityRunError::Refused(SensitivityError::Modes(e));
+            let sparse = sim.sparse_linearization(bodies, FREQUENCIES_LISTED).map_err(refused)?;
+            let (modes, rigid) = (sparse.modes.clone(), sparse.rigid.clone());
+            let stiffness = Stiffness::Sparse(Box::new(sparse));
+            return Ok(Linearization { stiffness, jacobian: DMatrix::zeros(0, 0), modes, rigid, left_out: 0 });
+        }
+    }
     let (stiffness, error) = sim.equilibrium_stiffness_and_error(coordinates);
     let mass = sim.equilibrium_mass(coordinates);
     let jacobian = sim.constraint_jacobian(coordinates);
@@ -172,7 +198,7 @@ pub(crate) fn linearize(
         }
         _ => 0,
     };
-    Ok(Linearization { stiffness, jacobian, modes, rigid, left_out })
+    Ok(Linearization { stiffness: Stiffness::Dense(stiffness), jacobian, modes, rigid, left_out })
 }
 
 /// The analysis of `sim`, settled at `params` and `inputs` of `sc`.
@@ -184,7 +210,7 @@ pub(crate) fn analyse<'a>(
 ) -> Result<Analysis<'a>, SensitivityRunError> {
     let coordinates = sim.equilibrium_coordinates().map_err(SensitivityRunError::Refused)?;
     let model = sc.model.as_ref().map(|spec| ModelObserver::new(spec, sim.structure(), false, None));
-    let out = Outputs { sc, mech: sc.mechanism(), inputs, model, coordinates };
+    let out = Outputs { sc, mech: sc.mechanism(), inputs, model, coordinates, angles: Default::default() };
     let lin = linearize(sim, &out.coordinates)?;
     let listed = listed_modes(&lin.rigid);
     let mut base = out.sample(sim, params);
@@ -283,9 +309,15 @@ fn listed_modes(rigid: &[bool]) -> Vec<usize> {
 fn modal_curvatures(
     sim: &mut Simulation,
     c: &EquilibriumCoordinates,
-    modes: &[Mode],
+    lin: &Linearization,
     listed: &[usize],
 ) -> DVector<f64> {
+    let modes = &lin.modes;
+    if let Stiffness::Sparse(_) = lin.stiffness {
+        // From the forces along phi (`sim/sparse_sensitivity.rs`): no K of every coordinate.
+        let curvature = |&i: &usize| sim.modal_curvature(c, &modes[i].shape, modes[i].omega_squared);
+        return DVector::from_vec(listed.iter().map(curvature).collect());
+    }
     let k = sim.equilibrium_stiffness(c);
     let mass = sim.equilibrium_mass(c);
     let g = sim.constraint_jacobian(c);
@@ -301,12 +333,34 @@ fn modal_curvatures(
 
 /// K^-1 r over the modes that are not rigid: sum of phi (phi^T r) / omega^2 (phi
 /// mass-normalised, so that K^-1 = Phi Lambda^-1 Phi^T); a rigid motion is left where it is.
-fn solve(lin: &Linearization, r: &DVector<f64>) -> DVector<f64> {
+fn solve(lin: &Linearization, r: &DVector<f64>) -> Result<DVector<f64>, crate::eigen::EigenError> {
+    if let Stiffness::Sparse(sparse) = &lin.stiffness {
+        return sparse.solve(r);
+    }
     let mut x = DVector::zeros(r.len());
     for (m, _) in lin.modes.iter().zip(&lin.rigid).filter(|(_, rigid)| !**rigid) {
         x += &m.shape * (m.shape.dot(r) / m.omega_squared);
     }
-    x
+    Ok(x)
+}
+
+impl Linearization {
+    /// dq/dp and the constraint forces' dlambda/dp from dQ/dp and dg/dp: the move that keeps
+    /// the constraints (module docs of sim/constrained_sensitivity.rs), then the equilibrium
+    /// along null(G).
+    fn displacement(
+        &self,
+        dq_dp: &DVector<f64>,
+        dg_dp: &DVector<f64>,
+    ) -> Result<(DVector<f64>, DVector<f64>), crate::eigen::EigenError> {
+        let Stiffness::Dense(k) = &self.stiffness else {
+            return Ok((solve(self, dq_dp)?, DVector::zeros(0)));
+        };
+        let particular = -least_squares(&self.jacobian, dg_dp);
+        let dq = solve(self, &(dq_dp - k * &particular))? + &particular;
+        let dlambda = least_squares(&self.jacobian.transpose(), &(dq_dp - k * &dq));
+        Ok((dq, dlambda))
+    }
 }
 
 /// Parameter `name`'s row at `value` before anything is computed: its step, no derivatives.
@@ -455,18 +509,30 @@ impl Outputs<'_> {
         free
     }
 
+    /// Whether output `name` is an angle, asked of the scenario once per name.
+    fn is_angle(&self, name: &str) -> bool {
+        if let Some(&angle) = self.angles.borrow().get(name) {
+            return angle;
+        }
+        let angle = self.sc.is_angle(name);
+        self.angles.borrow_mut().insert(name.to_string(), angle);
+        angle
+    }
+
     /// The samples' values less the settled state's `base` (as many as the sample has), an
     /// angle's wrapped to (-pi, pi].
     pub(crate) fn offsets(&self, sample: &[(String, f64)], base: &[(String, f64)]) -> DVector<f64> {
         DVector::from_iterator(
             sample.len(),
-            base.iter().zip(sample).map(|((name, b), (_, v))| {
-                if self.sc.is_angle(name) {
-                    crate::mechanisms::wrap_angle(v - b)
-                } else {
-                    v - b
-                }
-            }),
+            base.iter().zip(sample).map(
+                |((name, b), (_, v))| {
+                    if self.is_angle(name) {
+                        crate::mechanisms::wrap_angle(v - b)
+                    } else {
+                        v - b
+                    }
+                },
+            ),
         )
     }
 
@@ -517,10 +583,14 @@ impl Outputs<'_> {
         let dg_dp = derivative_from_samples(g[0].clone(), g[1].clone(), g[2].clone(), g[3].clone(), h);
         // The move that keeps the constraints (module docs of sim/constrained_sensitivity.rs),
         // then the equilibrium along null(G).
-        let particular = -least_squares(&lin.jacobian, &dg_dp);
-        let dq = solve(lin, &(&dq_dp - &lin.stiffness * &particular)) + &particular;
+        let (dq, dlambda) = match lin.displacement(&dq_dp, &dg_dp) {
+            Ok(d) => d,
+            Err(e) => {
+                row.error = Some(format!("the static response to {name} was not solved: {e}"));
+                return row;
+            }
+        };
         let lambda = self.coordinates.constraints().map_or(vec![], |c| c.multipliers.clone());
-        let dlambda = least_squares(&lin.jacobian.transpose(), &(&dq_dp - &lin.stiffness * &dq));
         let base = self.sample(at, params);
         let mut y = Vec::new();
         let mut curvature = Vec::new();
@@ -529,7 +599,7 @@ impl Outputs<'_> {
             sim.displace_coordinates(&self.coordinates, &step);
             y.push(self.offsets(&self.sample(sim, moved), &base));
             let held: Vec<f64> = lambda.iter().zip(dlambda.iter()).map(|(l, d)| l + s * h * d).collect();
-            curvature.push(modal_curvatures(sim, &self.coordinates.with_multipliers(&held), &lin.modes, listed));
+            curvature.push(modal_curvatures(sim, &self.coordinates.with_multipliers(&held), lin, listed));
         }
         // Both sample sets are 0 at the settled state itself (offsets from it; the curvature of
         // its own eigenpairs), which the estimate's noise part reads.

@@ -40,6 +40,7 @@ mod restart;
 mod rotation;
 pub mod sensitivity;
 mod servo;
+pub mod sparse_sensitivity;
 mod tree;
 
 pub use build::LOOPED_MULTIBODY_MAX_LINKS;
@@ -359,6 +360,29 @@ impl Simulation {
         c: &sensitivity::EquilibriumCoordinates,
     ) -> (nalgebra::DMatrix<f64>, nalgebra::DMatrix<f64>) {
         self.data.equilibrium_stiffness_and_error(&self.model, c)
+    }
+
+    /// The lowest `count` modes beyond the rigid ones of a structure of free bodies in the
+    /// free bodies' coordinates `bodies`, and the solver of K x = r over its modes that are not
+    /// rigid: the sensitivities of a structure too large for a dense K
+    /// (`sparse_sensitivity.rs`).
+    pub fn sparse_linearization(
+        &mut self,
+        bodies: &[usize],
+        count: usize,
+    ) -> Result<sparse_sensitivity::SparseLinearization, modes::ModesError> {
+        self.data.sparse_linearization(&self.model, bodies, count)
+    }
+
+    /// phi^T (K - omega^2 M) phi in free bodies' coordinates `c` now, from the forces along
+    /// phi (`sparse_sensitivity.rs`).
+    pub fn modal_curvature(
+        &mut self,
+        c: &sensitivity::EquilibriumCoordinates,
+        phi: &nalgebra::DVector<f64>,
+        omega_squared: f64,
+    ) -> f64 {
+        self.data.modal_curvature(&self.model, c, phi, omega_squared)
     }
 
     /// The mass matrix in the coordinates `c` now.

@@ -179,7 +179,7 @@ impl Data {
     }
 
     /// The finite-difference step of coordinate `i`.
-    fn coordinate_step(&self, m: &Model, c: &EquilibriumCoordinates, i: usize) -> f64 {
+    pub(super) fn coordinate_step(&self, m: &Model, c: &EquilibriumCoordinates, i: usize) -> f64 {
         let linear = match c {
             EquilibriumCoordinates::Bodies(_) => i % 6 < 3,
             EquilibriumCoordinates::Joints(j) => matches!(m.structure.joints[j[i]].kind, JointKind::Prismatic { .. }),

@@ -639,3 +639,42 @@ fn the_prism_mechanisms_slope_against_prestress_meets_the_reference_with_its_est
         assert!(estimate >= (d - exact).abs() && estimate <= 1e-5 * exact, "t0 = {t0}: estimate {estimate:e}");
     }
 }
+
+/// Above 100 free bodies, where `tensegrity modes` turns sparse, the sensitivities do too
+/// (`sim/sparse_sensitivity.rs`): on the 150-strut prism of `benches/prism_modes.toml` the six
+/// frequencies are `tensegrity modes`' own within 1e-12 (the dense K of differenced forces had
+/// put a thin strut's spin among them and the others up to 0.7 % off at 300 struts), d omega /
+/// d k = omega / (2 k) within 1e-8 (every force proportional to k), and every derivative by h
+/// and by k (nodes, forces, frequencies) meets the differences of settles (`--check`) within
+/// 1e-6.
+#[test]
+fn a_large_structures_sensitivities_are_its_modes_own_and_meet_the_settles() {
+    let overrides: Vec<scenario::Override> = ["n=150"].iter().map(|f| scenario::Override::parse(f).unwrap()).collect();
+    let file = "benches/prism_modes.toml";
+    let sc = scenario::load_with(Path::new(file), &overrides).expect("valid");
+    let only = ["h".to_string(), "k".to_string()];
+    let r = tensegrity_testbed::study::sensitivity::sensitivity_to(&sc, file, (0, Some(&only)), true, None)
+        .expect("sensitivities");
+    let (modes, _, _) = tensegrity_testbed::run::modes(&sc, file, 6, None).expect("modes");
+    let frequencies: Vec<(usize, &tensegrity_testbed::report::sensitivity::OutputValue)> =
+        r.outputs.iter().enumerate().filter(|(_, o)| o.name.ends_with(".omega")).collect();
+    assert_eq!(frequencies.len(), 6, "six frequencies");
+    for (i, o) in &frequencies {
+        let index: usize = o.name.trim_start_matches("mode").trim_end_matches(".omega").parse().unwrap();
+        let mode = &modes.modes[index - 1];
+        assert!(!mode.rigid, "{} is a deforming mode", o.name);
+        assert!(
+            rel(o.value, mode.omega_rad_per_s) <= 1e-12,
+            "{}: {} against modes' {}",
+            o.name,
+            o.value,
+            mode.omega_rad_per_s
+        );
+        let d = row(&r, "k").derivatives[*i];
+        assert!(rel(d, o.value / 200.0) <= 1e-8, "d {}/d k = {d} against {}", o.name, o.value / 200.0);
+    }
+    for p in &r.parameters {
+        let error = p.max_check_error.expect("checked");
+        assert!(error <= 1e-6, "d/d {}: largest error against the settles {error:e}", p.name);
+    }
+}

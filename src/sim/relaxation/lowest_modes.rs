@@ -68,13 +68,13 @@ pub(in crate::sim) struct LowestModes {
 }
 
 /// The mass-weighted stiffness A in factor order and what maps it back.
-struct Weighted {
-    matrix: CscMatrix<f64>,
+pub(super) struct Weighted {
+    pub(super) matrix: CscMatrix<f64>,
     diagonal: Vec<usize>,
     /// Factor position of each block.
-    position: Vec<usize>,
+    pub(super) position: Vec<usize>,
     /// L^-1 of each block's mass, in block order.
-    inverse_factor: Vec<Matrix6<f64>>,
+    pub(super) inverse_factor: Vec<Matrix6<f64>>,
 }
 
 impl Data {
@@ -137,7 +137,7 @@ impl Data {
 
 impl Weighted {
     /// x = L^-T y in block order.
-    fn shape(&self, y: &DVector<f64>) -> DVector<f64> {
+    pub(super) fn shape(&self, y: &DVector<f64>) -> DVector<f64> {
         let mut x = DVector::zeros(y.len());
         for (i, &p) in self.position.iter().enumerate() {
             let block = self.inverse_factor[i].transpose() * y.fixed_rows::<6>(6 * p);
@@ -185,7 +185,7 @@ impl SparseProduct {
 }
 
 /// A = L^-1 H L^-T in factor order, symmetrized as `System::dense` is.
-fn weighted_stiffness(dofs: &Dofs, system: &System, mass: &[Matrix6<f64>]) -> Result<Weighted, EigenError> {
+pub(super) fn weighted_stiffness(dofs: &Dofs, system: &System, mass: &[Matrix6<f64>]) -> Result<Weighted, EigenError> {
     let n = dofs.blocks();
     let mut inverse_factor = Vec::with_capacity(n);
     for block in mass {
@@ -221,7 +221,7 @@ fn start_vector(n: usize, seed: u64) -> DVector<f64> {
 
 /// The largest |omega^2|: the extreme Ritz values of [`LANCZOS_STEPS`] Lanczos steps on A
 /// (fully reorthogonalized), at least the largest |diagonal entry|.
-fn largest_magnitude(a: &CscMatrix<f64>, cancel: Option<&AtomicBool>) -> Result<f64, EigenError> {
+pub(super) fn largest_magnitude(a: &CscMatrix<f64>, cancel: Option<&AtomicBool>) -> Result<f64, EigenError> {
     let n = a.nrows();
     let steps = LANCZOS_STEPS.min(n);
     let mut basis: Vec<DVector<f64>> = vec![start_vector(n, 1).normalize()];
@@ -267,7 +267,7 @@ fn deflate(x: &mut DMatrix<f64>, rigid: &[Motion]) {
 }
 
 /// The Cholesky factor of A - sigma 1, sigma lowered until it exists.
-fn shifted_factor(w: &Weighted, largest: f64) -> Result<CscCholesky<f64>, EigenError> {
+pub(super) fn shifted_factor(w: &Weighted, largest: f64) -> Result<CscCholesky<f64>, EigenError> {
     let symbolic = CscSymbolicCholesky::factor(w.matrix.pattern().clone());
     let mut sigma = -SHIFT_RATIO * largest.max(f64::MIN_POSITIVE);
     for _ in 0..40 {

@@ -33,11 +33,13 @@ mod assemble;
 mod dense;
 mod line_search;
 mod lowest_modes;
+mod modal_solve;
 mod sparse;
 
 use super::data::Data;
 use super::model::Model;
 use crate::structure::{BodyKind, Structure};
+pub(crate) use modal_solve::ModalSolve;
 use nalgebra::DVector;
 
 /// Mass-weighted modes whose stiffness (as |omega^2|) is below this fraction of the stiffest
