@@ -380,6 +380,15 @@ fn standard_output_that_cannot_be_written() {
             vec!["equilibrium", quick],
             vec!["sensitivity", "scenarios/custom/pinned_bar_modes.toml"],
             vec!["solve", "mohr2011", "ikp", "--set", "x=0", "--set", "y=0", "--set", "z=1"],
+            vec![
+                "fit",
+                "scenarios/custom/pinned_bar_sweep.toml",
+                "--data",
+                "tests/fixtures/fit/pinned_bar_angles.csv",
+                "--param",
+                "k2=1:100",
+            ],
+            vec!["attribute", "tests/fixtures/attribution/hanging_bar.toml"],
         ] {
             let (code, err) = with_stdout(how, &args);
             assert_eq!(code, 1, "{how} {args:?}: {err}");
@@ -387,6 +396,39 @@ fn standard_output_that_cannot_be_written() {
             assert!(err.contains(words) && !err.contains("panicked"), "{how} {args:?}: {err}");
         }
     }
+}
+
+/// The class behind the test above, kept closed: no source file but the command line's own
+/// `cli/mod.rs` (`print_out`, the one checked writer) prints to standard output or takes it;
+/// code under `#[cfg(test)]` aside. `fit` and `sensitivity` had printed with `print!` and
+/// panicked on a full standard output.
+#[test]
+fn only_the_checked_writer_writes_standard_output() {
+    let mut offenders = Vec::new();
+    let mut dirs = vec![std::path::PathBuf::from("src")];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                dirs.push(path);
+                continue;
+            }
+            if path.extension().is_none_or(|e| e != "rs") || path.ends_with("src/cli/mod.rs") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            let code = text.split("#[cfg(test)]").next().unwrap_or("");
+            for (n, line) in code.lines().enumerate() {
+                let line = line.split("//").next().unwrap_or("");
+                if ["print!(", "println!(", "io::stdout()", "stdout().lock"].iter().any(|w| line.contains(w))
+                    && !line.contains("eprint")
+                {
+                    offenders.push(format!("{}:{}: {}", path.display(), n + 1, line.trim()));
+                }
+            }
+        }
+    }
+    assert!(offenders.is_empty(), "standard output outside the checked writer:\n{}", offenders.join("\n"));
 }
 
 /// A /dev/null the caller opened read-write for standard output (Python's
