@@ -2,6 +2,8 @@
 //! testbed could build for ji2014 (one body on one revolute joint, one explicit spring force),
 //! with the joint as a multibody link (what the testbed uses: exact joints) and as an impulse
 //! joint. It bounds what any settling strategy can reach per step (BENCHMARKS.md, issue 11).
+//! Each at rapier's default substeps (four) and at one, the testbed's default (`[sim]
+//! substeps`): the floor of the testbed's own physical step on a hinge (issue 64).
 
 use rapier3d_f64::prelude::*;
 
@@ -12,7 +14,7 @@ const REPEATS: usize = 5;
 const DT_S: f64 = 0.15;
 const STIFFNESS_N_PER_M: f64 = 200.0;
 
-fn us_per_step(multibody: bool) -> f64 {
+fn us_per_step(multibody: bool, substeps: usize) -> f64 {
     let mut bodies = RigidBodySet::new();
     let mut colliders = ColliderSet::new();
     let mut impulse_joints = ImpulseJointSet::new();
@@ -32,7 +34,7 @@ fn us_per_step(multibody: bool) -> f64 {
         impulse_joints.insert(ground, body, joint, true);
     }
     let mut pipeline = PhysicsPipeline::new();
-    let params = IntegrationParameters { dt: DT_S, ..Default::default() };
+    let params = IntegrationParameters { dt: DT_S, num_solver_iterations: substeps, ..Default::default() };
     let (mut islands, mut broad, mut narrow) = (IslandManager::new(), BroadPhaseBvh::new(), NarrowPhase::new());
     let (mut soft, mut ccd) = (SoftBodySet::new(), CCDSolver::new());
     let spring_anchor = Vector::new(-1.0, -1.7, 0.0);
@@ -68,8 +70,10 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() {
-    for (label, multibody) in [("multibody revolute", true), ("impulse revolute", false)] {
-        let m = median((0..REPEATS).map(|_| us_per_step(multibody)).collect());
-        println!("{label}: {m:.2} us per rapier step (median of {REPEATS} x {STEPS} steps)");
+    for substeps in [IntegrationParameters::default().num_solver_iterations, 1] {
+        for (label, multibody) in [("multibody revolute", true), ("impulse revolute", false)] {
+            let m = median((0..REPEATS).map(|_| us_per_step(multibody, substeps)).collect());
+            println!("{label}, {substeps} substep(s): {m:.2} us per rapier step (median of {REPEATS} x {STEPS} steps)");
+        }
     }
 }
