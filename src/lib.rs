@@ -5,6 +5,7 @@
 //! [`sim`]ulation -> [`observers`] -> [`report`].
 
 pub mod bench;
+pub mod certify;
 pub mod cli;
 pub mod eigen;
 pub mod export;
@@ -12,6 +13,7 @@ pub mod figures;
 pub mod file_model;
 pub mod import;
 pub mod input;
+pub mod interval;
 pub mod mechanisms;
 pub mod observers;
 pub(crate) mod ordering;

@@ -126,6 +126,26 @@ pub enum Command {
         #[command(flatten)]
         set: SetArgs,
     },
+    /// A proof, in interval arithmetic, that the settled state (its first point or `--point N`,
+    /// settled as `run` settles it) is within a box holding exactly one equilibrium
+    /// (Krawczyk's test on the equilibrium equations as built), with the largest box found,
+    /// how far the settled state is from that equilibrium, and its stability proven over the
+    /// box (the inertia of the stiffness; a lower bound on its smallest eigenvalue). Free
+    /// bodies on springs and elastic cables, gravity and constant loads; refused (exit 2):
+    /// joints, supports, inextensible and clustered cables, and a motion. Exit 0 when proven,
+    /// 1 when not (the reason printed).
+    Certify {
+        scenario: PathBuf,
+        /// Write the JSON report to this file (`-`: standard output, the table then going to
+        /// standard error).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// The settle point to certify, from 0 as `run` numbers them.
+        #[arg(long, default_value_t = 0, value_name = "N")]
+        point: usize,
+        #[command(flatten)]
+        set: SetArgs,
+    },
     /// What each idealization costs the file's model: its checks run under the ideal structure,
     /// under each `[[fidelity]]` relaxation alone (elastic struts, elastic or heavy cables, each
     /// with its data) and under all of them together; for every checked value at every point,

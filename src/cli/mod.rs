@@ -8,6 +8,7 @@
 mod args;
 mod attribute;
 mod bench;
+mod certify;
 mod check;
 mod equilibrium;
 mod export;
@@ -132,6 +133,9 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         Command::Sensitivity { scenario, json, csv, point, check, params, set } => {
             let outputs = (json.as_deref(), csv.as_deref());
             sensitivity::sensitivity(&scenario, &overrides(&set)?, outputs, (point, &params), check)
+        }
+        Command::Certify { scenario, json, point, set } => {
+            certify::certify(&scenario, &overrides(&set)?, json.as_deref(), point)
         }
         Command::Attribute { scenario, json, csv, figure, set } => {
             attribute::attribute(&scenario, &overrides(&set)?, json.as_deref(), csv.as_deref(), figure.as_deref())

@@ -1,6 +1,7 @@
 //! Reports: a readable table on stdout, one JSON document for machines, and the exit code
 //! (0 every check passed, 1 a check failed, 2 bad input).
 
+pub mod certificate;
 pub mod equilibrium;
 pub mod fit;
 pub mod modes;

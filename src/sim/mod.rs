@@ -17,6 +17,7 @@
 
 mod build;
 mod capstan;
+mod certificate;
 mod closure_rest;
 mod constrained_modes;
 mod constrained_sensitivity;
@@ -44,6 +45,7 @@ pub mod sparse_sensitivity;
 mod tree;
 
 pub use build::LOOPED_MULTIBODY_MAX_LINKS;
+pub use certificate::CertifyError;
 pub use model::{Model, SimError};
 
 use crate::structure::Structure;
@@ -383,6 +385,12 @@ impl Simulation {
         omega_squared: f64,
     ) -> f64 {
         self.data.modal_curvature(&self.model, c, phi, omega_squared)
+    }
+
+    /// The current state as equilibrium equations for a proof (`sim/certificate.rs`), or why
+    /// the structure has none.
+    pub fn equilibrium_problem(&self) -> Result<crate::certify::Problem, CertifyError> {
+        self.data.equilibrium_problem(&self.model)
     }
 
     /// The mass matrix in the coordinates `c` now.

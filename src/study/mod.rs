@@ -11,6 +11,7 @@
 //!   (`tensegrity fit`).
 
 pub mod attribution;
+pub mod certify;
 mod fit;
 mod fit_trajectory;
 mod problem;

@@ -6,6 +6,7 @@ mod attribution;
 mod bad_input;
 mod bench;
 mod bench_scale;
+mod certify;
 mod ci_checks;
 mod cli;
 mod clustered_cables;

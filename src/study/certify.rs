@@ -1,0 +1,61 @@
+//! `tensegrity certify`: a scenario's point settled afresh as `run` settles it, and a proof
+//! of its equilibrium there (`crate::certify`, the equations from `sim/certificate.rs`).
+
+use crate::report::certificate::CertificateReport;
+use crate::run::{settle_at, RunError};
+use crate::scenario::Scenario;
+use crate::sim::{CertifyError, Simulation};
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+/// Why a point has no certificate report.
+#[derive(Debug, thiserror::Error)]
+pub enum CertifyRunError {
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// The structure is outside the proof's domain (bad input).
+    #[error(transparent)]
+    Refused(CertifyError),
+    /// A motion has no equilibrium to prove (bad input).
+    #[error("the scenario is a motion ([motion]): a motion has no settled equilibrium to certify; certify its settle points in a scenario without [motion]")]
+    Motion,
+    #[error("the scenario has no point {0} (its points are numbered from 0)")]
+    NoPoint(usize),
+}
+
+/// The certificate of `sc` at point `point` (from 0, as `run` numbers them), named by `file`.
+pub fn certify(
+    sc: &Scenario,
+    file: &str,
+    point: usize,
+    cancel: Option<&AtomicBool>,
+) -> Result<CertificateReport, CertifyRunError> {
+    if sc.motion.is_some() {
+        return Err(CertifyRunError::Motion);
+    }
+    let (sc, inputs) = super::sensitivity::point_of(sc, point).ok_or(CertifyRunError::NoPoint(point))?;
+    let params = sc.params_at(&inputs);
+    // Refused before the settle: the structure's kind is known from its drawing.
+    let structure = sc.mechanism().build(&params, &inputs, &sc.start).map_err(RunError::from)?;
+    Simulation::new(&structure, &sc.sim)
+        .map_err(RunError::from)?
+        .equilibrium_problem()
+        .map_err(CertifyRunError::Refused)?;
+    let settle_wall = Instant::now();
+    let state = settle_at(sc, &inputs, params, cancel)?;
+    let settle_wall_s = settle_wall.elapsed().as_secs_f64();
+    let wall = Instant::now();
+    let problem = state.sim.equilibrium_problem().map_err(CertifyRunError::Refused)?;
+    let certificate = crate::certify::certify(&problem);
+    Ok(CertificateReport {
+        name: sc.name.clone(),
+        file: file.to_string(),
+        point,
+        inputs,
+        settled: state.settled,
+        settle_steps: state.steps,
+        settle_wall_s,
+        certify_wall_s: wall.elapsed().as_secs_f64(),
+        certificate,
+    })
+}
