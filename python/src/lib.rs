@@ -565,6 +565,21 @@ fn sensitivity_json(
     Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))
 }
 
+/// The certificate of `tensegrity certify --json` (at `--point point`): the same report, as
+/// its JSON text, at that point settled as `run` settles it. Ctrl-C stops the settle.
+#[pyfunction]
+#[pyo3(signature = (path, text=None, set=Vec::new(), point=0))]
+fn certify_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>, point: usize) -> PyResult<String> {
+    let sc = load(path, text, &set)?;
+    let file = path.to_string();
+    let result = on_own_thread(py, move |cancel| study::certify::certify(&sc, &file, point, Some(cancel)))?;
+    let report = result.map_err(|e| match e {
+        study::certify::CertifyRunError::Run(_) => PyException::new_err(format!("{path}: {e}")),
+        _ => PyValueError::new_err(format!("{path}: {e}")),
+    })?;
+    Ok(serde_json::to_string_pretty(&report).expect("a report serialises"))
+}
+
 /// The attribution of `tensegrity attribute --json` (`study::attribution`, the CLI's own
 /// function): the file's checks under the ideal structure, each `[[fidelity]]` relaxation alone
 /// and all of them together, as its JSON text. Ctrl-C stops the runs.
@@ -666,6 +681,7 @@ fn _tensegrity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(equilibrium_json, m)?)?;
     m.add_function(wrap_pyfunction!(sensitivity_json, m)?)?;
     m.add_function(wrap_pyfunction!(attribute_json, m)?)?;
+    m.add_function(wrap_pyfunction!(certify_json, m)?)?;
     m.add_function(wrap_pyfunction!(fit_json, m)?)?;
     m.add_function(wrap_pyfunction!(sections_toml, m)?)?;
     m.add_class::<ArrowTable>()?;

@@ -18,7 +18,7 @@ from . import _tensegrity
 
 __all__ = [
     "ScenarioError", "Prediction", "Result", "Solution", "Finding", "Structure",
-    "attribute", "check", "equilibrium", "export_mjcf", "findings", "fit", "from_matrices", "from_ntrt", "from_toml", "modes", "run", "sensitivity", "solve",
+    "attribute", "certify", "check", "equilibrium", "export_mjcf", "findings", "fit", "from_matrices", "from_ntrt", "from_toml", "modes", "run", "sensitivity", "solve",
     "sweep",
 ]
 
@@ -221,6 +221,22 @@ def sensitivity(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, nam
     computed (the reason named), KeyboardInterrupt on Ctrl-C."""
     path, text = _source(scenario, name)
     return json.loads(_call(_tensegrity.sensitivity_json, path, text, _sets(set), check, point, list(params or [])))
+
+
+def certify(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml",
+            point: int = 0) -> dict:
+    """A proof, in interval arithmetic, of the settled equilibrium at point ``point`` (from 0,
+    settled as ``run`` settles it): the report of ``tensegrity certify --json`` as a dict
+    (``certificate``: ``residual``, ``boxes``, and ``proof`` with the largest box that holds
+    exactly one equilibrium, ``radius_m``, ``node_radius_m``, the equilibrium's enclosure
+    ``enclosure_radius_m``, the settled state's distance from it ``settled_offset_m``, a free
+    turn's ``held_coordinate``, and ``stability`` (``kind``: ``stable`` with
+    ``smallest_eigenvalue_at_least_n_per_m``, ``unstable`` with ``index``, or ``unproven`` with
+    ``why``); or no ``proof`` and the ``reason``). Raises ScenarioError on bad input, ValueError
+    for a structure outside the proof's domain (joints, supports, inextensible or clustered
+    cables) or a motion, KeyboardInterrupt on Ctrl-C."""
+    path, text = _source(scenario, name)
+    return json.loads(_call(_tensegrity.certify_json, path, text, _sets(set), point))
 
 
 def attribute(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml") -> dict:

@@ -666,6 +666,22 @@ def test_sensitivity_from_python_is_the_clis_sensitivity_json():
         tt.sensitivity(str(ROOT / "scenarios" / "custom" / "capstan.toml"))
 
 
+def test_certify_from_python_is_the_clis_certify_json():
+    """tt.certify is `tensegrity certify --json`: every field equal (floats bit for bit), the wall
+    times aside; the prism is proven unique up to its free turn and stable, its settled state
+    within 1e-11 m of the equilibrium; a jointed structure raises ValueError naming its joint."""
+    prism = ROOT / "scenarios" / "custom" / "prism3.toml"
+    py, cli = tt.certify(str(prism)), cli_json("certify", prism)
+    for r in (py, cli):
+        r.pop("settle_wall_s"), r.pop("certify_wall_s")
+    assert py == cli
+    proof = py["certificate"]["proof"]
+    assert proof["settled_offset_m"] <= 1e-11 and proof["held_coordinate"]
+    assert proof["stability"]["kind"] == "stable"
+    with pytest.raises(ValueError, match="joint 'pin'"):
+        tt.certify(str(ROOT / "scenarios" / "custom" / "pendulum_tip_load.toml"))
+
+
 def rocker_from_matrices(k1=10.0, k2=30.0, a=0.8, b=0.6, L=1.0, l1=0.5, l2=0.4, m=0.5):
     """The rocker of rocker_frequency_curve.toml from numpy arrays: n1 the pin at the origin, n2
     the strut's tip drawn at pi/4, n3 the anchor U = (0, a), n4 the anchor V = (b, 0); springs
