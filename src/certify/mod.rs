@@ -157,6 +157,32 @@ pub struct Proof {
     pub stability: Stability,
 }
 
+impl Certificate {
+    /// No proof, for `reason` (a structure outside the proof's domain).
+    pub fn refused(reason: String) -> Certificate {
+        Certificate { coordinates: 0, residual: f64::NAN, proof: None, reason: Some(reason), boxes: 0 }
+    }
+
+    /// One line: what is proven, or why nothing is.
+    pub fn summary(&self) -> String {
+        let Some(p) = &self.proof else {
+            return format!("certificate: not proven: {}", self.reason.as_deref().unwrap_or("no box passed"));
+        };
+        let stability = match &p.stability {
+            Stability::Stable { smallest_eigenvalue_at_least_n_per_m: s } => {
+                format!("stable (smallest eigenvalue >= {s:.3e} N/m)")
+            }
+            Stability::Unstable { index } => format!("unstable (index {index})"),
+            Stability::Unproven { why } => format!("stability not proven: {why}"),
+        };
+        let turn = p.held_coordinate.as_ref().map(|c| format!(" up to the free turn ({c} held)")).unwrap_or_default();
+        format!(
+            "certificate: one equilibrium within {:.3e} m{turn}, the settled state within {:.1e} m of it; {stability}",
+            p.radius_m, p.settled_offset_m
+        )
+    }
+}
+
 /// The certificate of a settled state: a proof, or why there is none.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Certificate {

@@ -52,6 +52,11 @@ pub enum Command {
         /// `[expect]` (the exit code before: the physics' verdict instead of the declared one).
         #[arg(long)]
         fail_on_declared: bool,
+        /// At each settle point, a proof of the equilibrium there (as `tensegrity certify`):
+        /// the point report's `certificate` and a line under the point. Refused (exit 2) for a
+        /// motion and a structure outside the proof's domain.
+        #[arg(long)]
+        certify: bool,
     },
     /// The equilibrium matrix A of a pin-jointed structure (point masses and strut bodies, no
     /// joints) at its settled state (its first point, settled as `run` settles it), and its

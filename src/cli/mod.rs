@@ -108,8 +108,8 @@ fn exit_code(result: Result<Outcome, CliError>) -> u8 {
 /// Runs the command.
 fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
     match cli.command {
-        Command::Run { scenarios, json, record, connect, record_every, table, set, fail_on_declared } => {
-            let outputs = run::Outputs { json, record, connect, record_every, table };
+        Command::Run { scenarios, json, record, connect, record_every, table, set, fail_on_declared, certify } => {
+            let outputs = run::Outputs { json, record, connect, record_every, table, certify };
             run::run(&scenarios, &overrides(&set)?, &outputs, fail_on_declared)
         }
         Command::Check { scenarios, set } => check::check(&scenarios, &overrides(&set)?),

@@ -13,6 +13,8 @@ pub struct Outputs {
     pub connect: Option<String>,
     pub record_every: u64,
     pub table: Option<PathBuf>,
+    /// `--certify`: a proof of the equilibrium at each settle point.
+    pub certify: bool,
 }
 
 /// The file of one scenario's output: `base` itself, or with several scenarios
@@ -76,6 +78,12 @@ pub fn run(
         )));
     }
     check_outputs(paths, &o.files(&scenarios))?;
+    if o.certify {
+        for (sc, path) in scenarios.iter().zip(paths) {
+            crate::study::certify::certifiable(sc, 0)
+                .map_err(|e| super::bad_input(format!("--certify: {}: {e}", path.display())))?;
+        }
+    }
     // From here on each run stops at its next tick on a signal and the reports are written.
     signals::stops_itself_from_now();
     let several = scenarios.len() > 1;
@@ -94,6 +102,7 @@ pub fn run(
             table: o.table_path(sc, several).map(Into::into),
             external: None,
             bare: false,
+            certify: o.certify,
         };
         // A panic inside one scenario fails that scenario, with its message; the batch goes on.
         let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_scenario(sc, &opts)))

@@ -622,6 +622,9 @@ pub struct PointReport {
     /// over several points has one motion per point; empty without `[[motion.frequencies]]`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub frequencies: Vec<FrequencyReport>,
+    /// With `run --certify`: the proof of the equilibrium here, or why there is none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub certificate: Option<crate::certify::Certificate>,
     /// Each judged quantity's error here as its verdict measures it (a check's normalised
     /// error, a prediction's in its class, the probe's relative): what the table's point lines
     /// show (the JSON has them per check, prediction and probe).
@@ -1284,6 +1287,9 @@ impl ScenarioReport {
             }
             if !p.slipping.is_empty() {
                 out.push_str(&format!("              slipping (at the friction bound): {}\n", p.slipping.join(", ")));
+            }
+            if let Some(c) = &p.certificate {
+                out.push_str(&format!("              {}\n", c.summary()));
             }
             if let Some(modes) = p.energy.as_ref().and_then(|e| e.modes.as_ref()) {
                 let listed: Vec<String> = modes

@@ -62,6 +62,9 @@ pub struct RunOptions<'a> {
     /// sensitivities, fits) has no use for the checks, the interference (every pair of members,
     /// every tick: most of a 1000-strut prism's settle) or a recording.
     pub bare: bool,
+    /// At each settle point, a proof of the equilibrium there (`crate::certify`): the point
+    /// report's `certificate`.
+    pub certify: bool,
 }
 
 /// Why a run stopped early, or failed after its end: the report's `error`, each kind kept as
@@ -214,6 +217,7 @@ fn start_at<'a>(
     let sim = Simulation::new(&structure, &sc.sim)?;
     let observers = if opts.bare { vec![] } else { observed(&sim, sc, opts, mech.length_scale(&params), warnings)? };
     let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel, params);
+    runner.certify = opts.certify;
     // The first point's commands (a no-op where the build already placed them).
     runner.command(first_inputs);
     Ok(runner)

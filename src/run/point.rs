@@ -204,6 +204,8 @@ pub(super) fn settle_point(
             Err(e) => report.warnings.push(format!("point {index}: [[sensitivities]] not computed: {e}")),
         }
     }
+    // The proof of the equilibrium, also before anything moves the state.
+    let certificate = (runner.certify && s.settled).then(|| certificate_here(runner));
     let (branch, analytic_stable, mut landed) = landed_branch(runner, sc, index, &prediction, &simulated, report);
     let stable = match sc.stability_perturbation {
         Some(d) if s.settled => Some(runner.classify(inputs, &prediction, &s.snapshot, d)?),
@@ -238,6 +240,7 @@ pub(super) fn settle_point(
             .map(|(source, values)| crate::report::PaperValues { source, values }),
         analytic: landed,
         simulated,
+        certificate,
         // The observers fill in the tolerances, the clearance, the interference and the energy.
         ..measured
     };
@@ -248,6 +251,14 @@ pub(super) fn settle_point(
     runner.hand_out_notes();
     report.points.push(point);
     Ok(())
+}
+
+/// The certificate of the settled state (`crate::certify`), or the reason there is none.
+fn certificate_here(runner: &Runner) -> crate::certify::Certificate {
+    match runner.sim.equilibrium_problem() {
+        Ok(problem) => crate::certify::certify(&problem),
+        Err(e) => crate::certify::Certificate::refused(e.to_string()),
+    }
 }
 
 /// The report of the point `(index, inputs)` with what every point reads off its state the

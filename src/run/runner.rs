@@ -38,6 +38,8 @@ pub(super) struct Runner<'a> {
     pub accelerated_steps: u64,
     /// A motion run's motion, once it has started (`judged.rs`).
     pub motion: Option<JudgedMotion>,
+    /// Whether each settle point's equilibrium is certified (`RunOptions::certify`).
+    pub certify: bool,
 }
 
 /// The judged state and the mechanism's quantities in it; in a motion judged extrapolated also
@@ -68,6 +70,7 @@ impl<'a> Runner<'a> {
             was_accelerated: None,
             accelerated_steps: 0,
             motion: None,
+            certify: false,
         }
     }
 

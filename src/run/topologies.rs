@@ -34,6 +34,7 @@ pub(super) fn run_topologies(sc: &Scenario, opts: &RunOptions) -> ScenarioReport
             }),
             external: opts.external.clone(),
             bare: opts.bare,
+            certify: opts.certify,
         };
         let mut r = run(variant, &options);
         let note = rebuilt(sc, variant);

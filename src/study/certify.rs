@@ -23,6 +23,19 @@ pub enum CertifyRunError {
     NoPoint(usize),
 }
 
+/// Whether point `point` of `sc` can be certified, known before any settle from the structure as
+/// drawn there: not in a motion, and a structure in the proof's domain.
+pub fn certifiable(sc: &Scenario, point: usize) -> Result<(), CertifyRunError> {
+    if sc.motion.is_some() {
+        return Err(CertifyRunError::Motion);
+    }
+    let (sc, inputs) = super::sensitivity::point_of(sc, point).ok_or(CertifyRunError::NoPoint(point))?;
+    let params = sc.params_at(&inputs);
+    let structure = sc.mechanism().build(&params, &inputs, &sc.start).map_err(RunError::from)?;
+    let sim = Simulation::new(&structure, &sc.sim).map_err(RunError::from)?;
+    sim.equilibrium_problem().map(|_| ()).map_err(CertifyRunError::Refused)
+}
+
 /// The certificate of `sc` at point `point` (from 0, as `run` numbers them), named by `file`.
 pub fn certify(
     sc: &Scenario,
@@ -30,17 +43,9 @@ pub fn certify(
     point: usize,
     cancel: Option<&AtomicBool>,
 ) -> Result<CertificateReport, CertifyRunError> {
-    if sc.motion.is_some() {
-        return Err(CertifyRunError::Motion);
-    }
+    certifiable(sc, point)?;
     let (sc, inputs) = super::sensitivity::point_of(sc, point).ok_or(CertifyRunError::NoPoint(point))?;
     let params = sc.params_at(&inputs);
-    // Refused before the settle: the structure's kind is known from its drawing.
-    let structure = sc.mechanism().build(&params, &inputs, &sc.start).map_err(RunError::from)?;
-    Simulation::new(&structure, &sc.sim)
-        .map_err(RunError::from)?
-        .equilibrium_problem()
-        .map_err(CertifyRunError::Refused)?;
     let settle_wall = Instant::now();
     let state = settle_at(sc, &inputs, params, cancel)?;
     let settle_wall_s = settle_wall.elapsed().as_secs_f64();
