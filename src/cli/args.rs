@@ -235,6 +235,11 @@ pub enum Command {
         /// The figure's axis: an input or a swept parameter (default: the one with most values).
         #[arg(long)]
         x: Option<String>,
+        /// At each point, a proof of the equilibrium there (as `tensegrity certify`): the CSV's
+        /// `certified_*` columns. Refused (exit 2) for a motion and a structure outside the
+        /// proof's domain.
+        #[arg(long)]
+        certify: bool,
         #[command(flatten)]
         set: SetArgs,
     },

@@ -114,8 +114,8 @@ fn dispatch(cli: Cli) -> Result<Outcome, CliError> {
         }
         Command::Check { scenarios, set } => check::check(&scenarios, &overrides(&set)?),
         Command::List { scenario, set } => list::list(scenario.as_deref(), &overrides(&set)?),
-        Command::Sweep { scenario, out, json, jobs, shard, figure, x, set } => {
-            let outputs = sweep::Outputs { csv: out, json, figure, x };
+        Command::Sweep { scenario, out, json, jobs, shard, figure, x, certify, set } => {
+            let outputs = sweep::Outputs { csv: out, json, figure, x, certify };
             sweep::sweep(&scenario, &overrides(&set)?, &outputs, jobs, shard.as_deref())
         }
         Command::Merge { csvs, out, partial } => merge::merge(&csvs, &out, partial),

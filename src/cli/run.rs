@@ -78,8 +78,8 @@ pub fn run(
         )));
     }
     check_outputs(paths, &o.files(&scenarios))?;
-    if o.certify {
-        for (sc, path) in scenarios.iter().zip(paths) {
+    for (sc, path) in scenarios.iter().zip(paths).filter(|(sc, _)| o.certify || sc.certify) {
+        {
             crate::study::certify::certifiable(sc, 0)
                 .map_err(|e| super::bad_input(format!("--certify: {}: {e}", path.display())))?;
         }

@@ -11,10 +11,28 @@ pub struct Outputs {
     pub json: Option<PathBuf>,
     pub figure: Option<PathBuf>,
     pub x: Option<String>,
+    /// `--certify`: a proof of the equilibrium at each point.
+    pub certify: bool,
 }
 
 /// Refuses outputs that mean nothing or would destroy data, before any work: a figure that is no
 /// .png or .svg, an output over the scenario, and the CSV and the JSON both on standard output
+/// The scenario, every point certified with `--certify`; refused (exit 2) where its points
+/// cannot be (a motion, a structure outside the proof's domain), with the flag or the file's
+/// `[certify]`.
+fn certified_or_not(
+    sc: crate::scenario::Scenario,
+    path: &Path,
+    flag: bool,
+) -> Result<crate::scenario::Scenario, CliError> {
+    let sc = if flag { sc.certified() } else { sc };
+    if sc.certify {
+        crate::study::certify::certifiable(&sc, 0)
+            .map_err(|e| super::bad_input(format!("--certify: {}: {e}", path.display())))?;
+    }
+    Ok(sc)
+}
+
 /// (mixed, neither could be read).
 fn check_sweep_outputs(path: &Path, o: &Outputs) -> Result<(), CliError> {
     if let Some(f) =
@@ -45,7 +63,7 @@ pub fn sweep(
     jobs: usize,
     shard: Option<&str>,
 ) -> Result<Outcome, CliError> {
-    let sc = load_one(path, overrides)?;
+    let sc = certified_or_not(load_one(path, overrides)?, path, o.certify)?;
     check_sweep_outputs(path, o)?;
     check_axis(&sc, o.x.as_deref())?;
     let jobs = capped_jobs(jobs);

@@ -710,6 +710,19 @@ impl Observer for Recorder {
         }
     }
 
+    /// A certified settle point's proof as an event (`run --certify`, `[certify]`), and its
+    /// box's radius and the settled state's distance from the equilibrium as series.
+    fn settle_point(&mut self, p: &super::SettlePoint, point: &mut crate::report::PointReport, _notes: &mut Vec<Note>) {
+        let Some(c) = &point.certificate else { return };
+        let tick = p.snapshot.tick;
+        self.note(tick, &Note::Event(format!("point {}: {}", point.index, c.summary())));
+        if let Some(proof) = &c.proof {
+            let time_s = if tick == self.last_tick { self.last_time_s } else { 0.0 };
+            self.scalars_at(tick, time_s, "certificate/radius_m", &[proof.radius_m]);
+            self.scalars_at(tick, time_s, "certificate/settled_offset_m", &[proof.settled_offset_m]);
+        }
+    }
+
     /// Buffers the equilibrium residual of `tick`, computed after the tick was recorded.
     fn residual(&mut self, tick: u64, r: &crate::snapshot::Residual) {
         if !tick.is_multiple_of(self.every) {

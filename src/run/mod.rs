@@ -217,7 +217,7 @@ fn start_at<'a>(
     let sim = Simulation::new(&structure, &sc.sim)?;
     let observers = if opts.bare { vec![] } else { observed(&sim, sc, opts, mech.length_scale(&params), warnings)? };
     let mut runner = Runner::new(mech, sc, sim, observers, opts.cancel, params);
-    runner.certify = opts.certify;
+    runner.certify = opts.certify || sc.certify;
     // The first point's commands (a no-op where the build already placed them).
     runner.command(first_inputs);
     Ok(runner)

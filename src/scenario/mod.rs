@@ -102,9 +102,18 @@ pub struct Scenario {
     /// Which of them a run applies (indices into `fidelity`; empty: the ideal structure, as
     /// every run but `tensegrity attribute`'s).
     pub relaxed: Vec<usize>,
+    /// `[certify]` (or `--certify`): a proof of the equilibrium at every settle point.
+    pub certify: bool,
 }
 
 impl Scenario {
+    /// The scenario with every settle point certified (`--certify`), its topologies' parts too.
+    pub fn certified(mut self) -> Scenario {
+        self.certify = true;
+        self.topologies = self.topologies.into_iter().map(Scenario::certified).collect();
+        self
+    }
+
     /// The stability the scenario states for settle point `index` (None: it does not say,
     /// or leaves it to the energy model, which decides at the settled state).
     pub fn expected_stable(&self, index: usize) -> Option<bool> {
@@ -576,6 +585,7 @@ fn validate(
         expect::Parts { checks, model, probe: has_probe, motion: motion.as_ref(), prestress: prestress.is_some() };
     let expect = raw.expect.as_ref().map(|e| expect::expectation(ctx, e, &parts)).transpose()?;
     let unseen_params = custom.as_ref().map(|c| c.unseen(&swept(&s))).unwrap_or_default();
+    let certify = certify_section(ctx, &raw)?;
     Ok(Validated::One(Box::new(Scenario {
         file: path.to_path_buf(),
         source: ctx.source.to_string(),
@@ -608,7 +618,18 @@ fn validate(
         prestress,
         fidelity,
         relaxed: Vec::new(),
+        certify,
     })))
+}
+
+/// `[certify]`: whether the settle points are certified; refused in a motion, which has no
+/// settled equilibrium.
+fn certify_section(ctx: &Ctx, raw: &RawScenario) -> Result<bool, ScenarioError> {
+    let Some(section) = &raw.certify else { return Ok(false) };
+    if section.get_ref().enabled && raw.motion.is_some() {
+        return Err(ctx.err(section, "[certify] in a motion: a motion has no settled equilibrium to certify; certify its settle points in a scenario without [motion]"));
+    }
+    Ok(section.get_ref().enabled)
 }
 
 /// The parameters, settings, start and actuation of a scenario of the mechanism `m`.

@@ -68,6 +68,22 @@ pub(super) struct RawScenario {
     /// A motion run: the physical dynamics for a stated time (`motion.rs`).
     #[serde(default)]
     pub(super) motion: Option<Spanned<super::motion::RawMotion>>,
+    /// `[certify]`: a proof of the equilibrium at every settle point (`crate::certify`).
+    #[serde(default)]
+    pub(super) certify: Option<Spanned<RawCertify>>,
+}
+
+/// `[certify]`: whether every settle point's equilibrium is certified (`enabled`, default true).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawCertify {
+    #[serde(default = "certify_by_default")]
+    pub(super) enabled: bool,
+}
+
+/// A `[certify]` section certifies unless it says `enabled = false`.
+fn certify_by_default() -> bool {
+    true
 }
 
 #[derive(Debug, Deserialize)]

@@ -367,22 +367,11 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool, sweep: &str) -> Str
     }
     header.extend(energy.header());
     header.extend(frequencies.header());
-    header.extend(
-        [
-            "settled",
-            "steps",
-            "within_tolerance",
-            "stable",
-            "branch",
-            "slack_cables",
-            "expected_slack",
-            "prestress_fraction",
-            "prestress_lost",
-            "min_clearance_m",
-            "sweep",
-        ]
-        .map(String::from),
-    );
+    let certified = rows.iter().any(|r| r.point.certificate.is_some());
+    if certified {
+        header.extend(CERTIFICATE_COLUMNS.map(String::from));
+    }
+    header.extend(POINT_COLUMNS.map(String::from));
     let mut out = header.join(",");
     out.push('\n');
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
@@ -399,21 +388,76 @@ pub fn to_csv(rows: &[Row], is_angle: &dyn Fn(&str) -> bool, sweep: &str) -> Str
         }
         cells.extend(energy.cells(p));
         cells.extend(frequencies.cells(p));
-        cells.push(p.settled.to_string());
-        cells.push(p.steps.to_string());
-        cells.push(p.within_tolerance.to_string());
-        cells.push(p.stable.map(|b| b.to_string()).unwrap_or_default());
-        cells.push(format!("\"{}\"", p.branch.replace('"', "'")));
-        cells.push(p.slack_cables.join(";"));
-        cells.push(p.expected_slack.as_ref().map(|e| e.join(";")).unwrap_or_default());
-        cells.push(opt(p.prestress_fraction));
-        cells.push(p.prestress_lost.map(|b| b.to_string()).unwrap_or_default());
-        cells.push(opt(p.min_clearance_m));
-        cells.push(sweep.to_string());
+        if certified {
+            cells.extend(certificate_cells(p));
+        }
+        cells.extend(point_cells(p, sweep));
         out.push_str(&cells.join(","));
         out.push('\n');
     }
     out
+}
+
+/// The last columns of every row: the point's settle and judgement, and the sweep's
+/// fingerprint.
+const POINT_COLUMNS: [&str; 11] = [
+    "settled",
+    "steps",
+    "within_tolerance",
+    "stable",
+    "branch",
+    "slack_cables",
+    "expected_slack",
+    "prestress_fraction",
+    "prestress_lost",
+    "min_clearance_m",
+    "sweep",
+];
+
+/// A point's cells under [`POINT_COLUMNS`].
+fn point_cells(p: &PointReport, sweep: &str) -> Vec<String> {
+    let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+    vec![
+        p.settled.to_string(),
+        p.steps.to_string(),
+        p.within_tolerance.to_string(),
+        p.stable.map(|b| b.to_string()).unwrap_or_default(),
+        format!("\"{}\"", p.branch.replace('"', "'")),
+        p.slack_cables.join(";"),
+        p.expected_slack.as_ref().map(|e| e.join(";")).unwrap_or_default(),
+        opt(p.prestress_fraction),
+        p.prestress_lost.map(|b| b.to_string()).unwrap_or_default(),
+        opt(p.min_clearance_m),
+        sweep.to_string(),
+    ]
+}
+
+/// The columns of a certified sweep (`[certify]`, `--certify`): the largest box proven to
+/// hold exactly one equilibrium (scaled radius, m), the settled state's distance from that
+/// equilibrium (m), the stability proven there (`stable`, `unstable`, `unproven`, or
+/// `not proven` without a proof), the lower bound on the smallest eigenvalue (N/m) or the
+/// unstable index.
+const CERTIFICATE_COLUMNS: [&str; 5] = [
+    "certified_radius_m",
+    "certified_offset_m",
+    "certified_stability",
+    "certified_smallest_eigenvalue_n_per_m",
+    "certified_index",
+];
+
+/// A point's cells under [`CERTIFICATE_COLUMNS`].
+fn certificate_cells(p: &PointReport) -> Vec<String> {
+    use crate::certify::Stability;
+    let Some(proof) = p.certificate.as_ref().and_then(|c| c.proof.as_ref()) else {
+        let said = if p.certificate.is_some() { "not proven" } else { "" };
+        return vec![String::new(), String::new(), said.to_string(), String::new(), String::new()];
+    };
+    let (kind, bound, index) = match &proof.stability {
+        Stability::Stable { smallest_eigenvalue_at_least_n_per_m: s } => ("stable", num(*s), String::new()),
+        Stability::Unstable { index } => ("unstable", String::new(), index.to_string()),
+        Stability::Unproven { .. } => ("unproven", String::new(), String::new()),
+    };
+    vec![num(proof.radius_m), num(proof.settled_offset_m), kind.to_string(), bound, index]
 }
 
 /// The columns of the `[energy]` model's stationary points: the one landed on

@@ -210,3 +210,43 @@ fn run_certify_puts_a_certificate_at_every_settle_point() {
     let (code, _, err) = crate::common::tensegrity(&["run", "scenarios/custom/pendulum_tip_load.toml", "--certify"]);
     assert!(code == 2 && err.contains("--certify") && err.contains("joint 'pin'"), "{err}");
 }
+
+/// A file's `[certify]` section certifies its run's settle points as `--certify` does, and
+/// `sweep --certify` writes each point's proof in the CSV (`certified_radius_m`,
+/// `certified_offset_m`, `certified_stability`, `certified_smallest_eigenvalue_n_per_m`,
+/// `certified_index`): every point of prism_n stable, its bound above 0.1 N/m. `[certify]` in a
+/// motion is refused at its line (exit 2).
+#[test]
+fn a_certify_section_and_sweep_certify_prove_every_point() {
+    let dir = std::env::temp_dir().join(format!("certify-section-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let with_section = |file: &str| {
+        let path = dir.join(Path::new(file).file_name().unwrap());
+        std::fs::write(&path, std::fs::read_to_string(file).unwrap() + "\n[certify]\n").unwrap();
+        path.display().to_string()
+    };
+    let prism = with_section("scenarios/custom/prism3.toml");
+    let (code, out, err) = crate::common::tensegrity(&["run", &prism, "--json", "-"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["scenarios"][0]["points"][0]["certificate"]["proof"]["stability"]["kind"], "stable");
+    let (code, csv, err) =
+        crate::common::tensegrity(&["sweep", "scenarios/custom/prism_n.toml", "--certify", "--out", "-"]);
+    assert_eq!(code, 0, "{err}");
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name}"));
+    let (kind, bound) = (column("certified_stability"), column("certified_smallest_eigenvalue_n_per_m"));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 10);
+    for r in &rows {
+        assert_eq!(r[kind], "stable");
+        assert!(r[bound].parse::<f64>().unwrap() > 0.1, "{}", r[bound]);
+    }
+    let motion = with_section("scenarios/custom/pinned_prism_mechanism.toml");
+    let (code, _, err) = crate::common::tensegrity(&["check", &motion]);
+    assert!(code == 2 && err.contains("[certify] in a motion"), "{err}");
+    let line = std::fs::read_to_string(&motion).unwrap().lines().count();
+    assert!(err.contains(&format!(":{line}:1:")), "located at the section's line {line}: {err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

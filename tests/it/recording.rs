@@ -143,3 +143,31 @@ fn a_failed_check_is_an_event_of_the_recording() {
     assert!(events.contains("> tolerance 1.0e-30"), "{events}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A certified settle point (`[certify]`) is an event of the recording, with what is proven:
+/// the prism's equilibrium unique in a box, up to its free turn.
+#[test]
+fn a_certificate_is_an_event_of_the_recording() {
+    let dir = std::env::temp_dir().join(format!("tensegrity-rec-certify-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rrd = dir.join("certified.rrd");
+    let path = Path::new("scenarios/custom/prism3.toml");
+    let text = format!("{}\n[certify]\n", std::fs::read_to_string(path).unwrap());
+    let sc = scenario::parse(path, &text).expect("valid");
+    let r = run(&sc, &RunOptions { record: Some(rrd.clone()), ..RunOptions::default() });
+    assert!(r.passed);
+    let file = std::io::BufReader::new(std::fs::File::open(&rrd).unwrap());
+    let mut events = String::new();
+    for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
+        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.unwrap() {
+            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).unwrap();
+            if chunk.entity_path().to_string() == "/events" {
+                events.push_str(&format!("{chunk}"));
+            }
+        }
+    }
+    assert!(events.contains("point 0: certificate: one equilibrium within"), "{events}");
+    // The chunk's printout cuts long cells short: what follows the free turn is not shown.
+    assert!(events.contains("up to the free turn (strut2.z held)"), "{events}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
