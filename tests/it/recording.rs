@@ -116,6 +116,21 @@ fn connect_without_a_viewer_goes_on() {
     assert_eq!(steps(&out), steps(&alone), "{out}");
 }
 
+/// The printout of a recording's `/events` chunks.
+fn events_of(rrd: &Path) -> String {
+    let file = std::io::BufReader::new(std::fs::File::open(rrd).unwrap());
+    let mut events = String::new();
+    for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
+        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.unwrap() {
+            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).unwrap();
+            if chunk.entity_path().to_string() == "/events" {
+                events.push_str(&format!("{chunk}"));
+            }
+        }
+    }
+    events
+}
+
 /// A check that fails at a settle point is an event of the recording, with the quantity, its
 /// error and the tolerance (a tolerance of 1e-30 on theta2 fails at every point).
 #[test]
@@ -129,16 +144,7 @@ fn a_failed_check_is_an_event_of_the_recording() {
     let sc = scenario::parse(path, &text).expect("valid");
     let r = run(&sc, &RunOptions { record: Some(rrd.clone()), ..RunOptions::default() });
     assert!(!r.passed);
-    let file = std::io::BufReader::new(std::fs::File::open(&rrd).unwrap());
-    let mut events = String::new();
-    for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
-        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.unwrap() {
-            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).unwrap();
-            if chunk.entity_path().to_string() == "/events" {
-                events.push_str(&format!("{chunk}"));
-            }
-        }
-    }
+    let events = events_of(&rrd);
     assert!(events.contains("point 0: check theta2 failed: error"), "{events}");
     assert!(events.contains("> tolerance 1.0e-30"), "{events}");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -156,16 +162,7 @@ fn a_certificate_is_an_event_of_the_recording() {
     let sc = scenario::parse(path, &text).expect("valid");
     let r = run(&sc, &RunOptions { record: Some(rrd.clone()), ..RunOptions::default() });
     assert!(r.passed);
-    let file = std::io::BufReader::new(std::fs::File::open(&rrd).unwrap());
-    let mut events = String::new();
-    for msg in re_log_encoding::Decoder::<re_log_types::LogMsg>::decode_lazy(file) {
-        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.unwrap() {
-            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).unwrap();
-            if chunk.entity_path().to_string() == "/events" {
-                events.push_str(&format!("{chunk}"));
-            }
-        }
-    }
+    let events = events_of(&rrd);
     assert!(events.contains("point 0: certificate: one equilibrium within"), "{events}");
     // The chunk's printout cuts long cells short: what follows the free turn is not shown.
     assert!(events.contains("up to the free turn (strut2.z held)"), "{events}");
