@@ -98,14 +98,7 @@ fn search(s: &System, certificate: &mut Certificate, eigen: &DVector<f64>, held:
             }
         }
     }
-    // The stiffness over the enclosure itself (it holds the equilibrium; tighter than the
-    // box it came from, which the elimination of an ill-conditioned stiffness needs).
-    let mut tight: Vec<Interval> = s.center.iter().map(|&c| Interval::point(c)).collect();
-    for (i, &c) in s.free.iter().enumerate() {
-        tight[c] = k[i];
-    }
-    let j = reduced(&gradient_and_hessian(s.problem, &tight).1, &s.free);
-    let mut proof = proof(s, passed, &k, &j, eigen);
+    let mut proof = proof(s, passed, &k, eigen);
     proof.held_coordinate = held;
     certificate.proof = Some(proof);
 }
@@ -199,9 +192,17 @@ fn test(s: &System, rho: f64) -> Option<(Vec<Interval>, IntervalMatrix)> {
     Some((k, j))
 }
 
-/// The proof: the largest box's sizes (scaled radius `rho`), the enclosure K and the stability
-/// over J from the smallest box that passed (it holds the same equilibrium).
-fn proof(s: &System, rho: f64, k: &[Interval], j: &IntervalMatrix, eigen: &DVector<f64>) -> Proof {
+/// The proof: the largest box's sizes (scaled radius `rho`), the enclosure K from the smallest
+/// box that passed (it holds the same equilibrium), the nodes over K and the stability over J(K)
+/// (tighter than the box K came from, which the elimination of an ill-conditioned stiffness
+/// needs).
+fn proof(s: &System, rho: f64, k: &[Interval], eigen: &DVector<f64>) -> Proof {
+    let mut tight: Vec<Interval> = s.center.iter().map(|&c| Interval::point(c)).collect();
+    for (i, &c) in s.free.iter().enumerate() {
+        tight[c] = k[i];
+    }
+    let j = reduced(&gradient_and_hessian(s.problem, &tight).1, &s.free);
+    let node_enclosures = s.problem.node_names.iter().cloned().zip(node_positions(s.problem, &tight)).collect();
     let x = boxed(s, rho);
     let node_radius_m = node_positions(s.problem, &x).iter().flatten().fold(0.0_f64, |m, c| m.max(c.rad()));
     let enclosure_radius_m = k.iter().zip(&s.scales).fold(0.0_f64, |m, (c, sc)| m.max(c.rad() * sc));
@@ -213,7 +214,9 @@ fn proof(s: &System, rho: f64, k: &[Interval], j: &IntervalMatrix, eigen: &DVect
         enclosure_radius_m,
         settled_offset_m,
         held_coordinate: None,
-        stability: stability(j, &s.scales, eigen),
+        stability: stability(&j, &s.scales, eigen),
+        node_enclosures,
+        model: None,
     }
 }
 

@@ -155,6 +155,48 @@ pub struct Proof {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub held_coordinate: Option<String>,
     pub stability: Stability,
+    /// Each node's position over the equilibrium's enclosure, by name \[m\] (what the file's
+    /// model is judged against: [`Proof::judge_model`]).
+    #[serde(skip)]
+    pub node_enclosures: Vec<(String, [crate::interval::Interval; 3])>,
+    /// The file's model's node positions against the enclosure, where it predicts any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<ModelInside>,
+}
+
+/// Where the file's model puts the nodes, against the proven equilibrium's enclosure.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ModelInside {
+    /// Node coordinates predicted inside the enclosure: the model's point is the proven
+    /// equilibrium there, to the enclosure's width.
+    pub inside: usize,
+    /// Those predicted outside it, by quantity (`NODE.x`): the model is not the equilibrium
+    /// there.
+    pub outside: Vec<String>,
+    /// The largest distance of a prediction outside the enclosure from it \[m\] (0: none).
+    pub largest_outside_m: f64,
+}
+
+impl Proof {
+    /// Judges the model's `predicted` values that are node coordinates (`NODE.x`, `.y`, `.z`)
+    /// against the equilibrium's enclosure ([`Proof::model`]).
+    pub fn judge_model(&mut self, predicted: &std::collections::BTreeMap<String, f64>) {
+        let mut judged = ModelInside { inside: 0, outside: Vec::new(), largest_outside_m: 0.0 };
+        for (name, &value) in predicted {
+            let Some((node, axis)) = name.rsplit_once('.') else { continue };
+            let Some(k) = ["x", "y", "z"].iter().position(|a| *a == axis) else { continue };
+            let Some((_, p)) = self.node_enclosures.iter().find(|(n, _)| n == node) else { continue };
+            if p[k].contains(value) {
+                judged.inside += 1;
+            } else {
+                judged.outside.push(name.clone());
+                judged.largest_outside_m = judged.largest_outside_m.max((p[k].lo - value).max(value - p[k].hi));
+            }
+        }
+        if judged.inside + judged.outside.len() > 0 {
+            self.model = Some(judged);
+        }
+    }
 }
 
 impl Certificate {
@@ -176,8 +218,20 @@ impl Certificate {
             Stability::Unproven { why } => format!("stability not proven: {why}"),
         };
         let turn = p.held_coordinate.as_ref().map(|c| format!(" up to the free turn ({c} held)")).unwrap_or_default();
+        let model = match &p.model {
+            Some(m) if m.outside.is_empty() => {
+                format!("; the model's {} node coordinate(s) inside its enclosure: proven", m.inside)
+            }
+            Some(m) => format!(
+                "; the model's node coordinates: {} inside its enclosure, {} outside (largest {:.1e} m): not the proven equilibrium",
+                m.inside,
+                m.outside.len(),
+                m.largest_outside_m
+            ),
+            None => String::new(),
+        };
         format!(
-            "certificate: one equilibrium within {:.3e} m{turn}, the settled state within {:.1e} m of it; {stability}",
+            "certificate: one equilibrium within {:.3e} m{turn}, the settled state within {:.1e} m of it; {stability}{model}",
             p.radius_m, p.settled_offset_m
         )
     }

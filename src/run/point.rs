@@ -245,6 +245,10 @@ pub(super) fn settle_point(
         ..measured
     };
     observe_point(runner, &s.snapshot, outside, &mut point);
+    // The file's model fills its predictions in above.
+    if let Some(proof) = point.certificate.as_mut().and_then(|c| c.proof.as_mut()) {
+        proof.judge_model(&point.analytic);
+    }
     if sc.expected_stability == crate::scenario::ExpectedStability::FromEnergy {
         point.expected_stable = energy_stability(&point);
     }

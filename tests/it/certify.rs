@@ -250,3 +250,30 @@ fn a_certify_section_and_sweep_certify_prove_every_point() {
     assert!(err.contains(&format!(":{line}:1:")), "located at the section's line {line}: {err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The file's model judged against the proven equilibrium: the buckled bead's y* (from
+/// [`buckled_y`], to about 1e-15 m) lies inside the equilibrium's enclosure, which a run with
+/// `[certify]` reports as proven; the same model moved by 1e-6 m lies outside it, reported with
+/// its distance (1e-6 m less the enclosure's width, within 1e-9 m).
+#[test]
+fn a_model_inside_the_enclosure_is_proven_and_one_moved_1e_6_is_not() {
+    let eps = 1e-4;
+    let h = buckled_y(eps);
+    for (offset, inside) in [(0.0, true), (1e-6, false)] {
+        let text = format!(
+            "{}\n[[predictions]]\nquantity = \"B.y\"\nformula = \"{:e}\"\nclass = \"length\"\ntolerance = 1e-5\n\n[certify]\n",
+            buckled_bead(eps, &format!("{:e}", 1.01 * h)),
+            h + offset
+        );
+        let sc = scenario::parse(Path::new("bead.toml"), &text).expect("valid");
+        let r = tensegrity_testbed::run::run(&sc, &tensegrity_testbed::run::RunOptions::default());
+        let proof = r.points[0].certificate.as_ref().and_then(|c| c.proof.as_ref()).expect("proven");
+        let model = proof.model.as_ref().expect("the model's node coordinate judged");
+        if inside {
+            assert_eq!((model.inside, model.outside.len()), (1, 0), "{model:?}");
+        } else {
+            assert_eq!(model.outside, vec!["B.y".to_string()]);
+            assert!((model.largest_outside_m - 1e-6).abs() <= 1e-9, "{}", model.largest_outside_m);
+        }
+    }
+}
