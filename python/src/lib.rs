@@ -568,11 +568,19 @@ fn sensitivity_json(
 /// The certificate of `tensegrity certify --json` (at `--point point`): the same report, as
 /// its JSON text, at that point settled as `run` settles it. Ctrl-C stops the settle.
 #[pyfunction]
-#[pyo3(signature = (path, text=None, set=Vec::new(), point=0))]
-fn certify_json(py: Python<'_>, path: &str, text: Option<&str>, set: Vec<String>, point: usize) -> PyResult<String> {
+#[pyo3(signature = (path, text=None, set=Vec::new(), point=0, stiffness=false))]
+fn certify_json(
+    py: Python<'_>,
+    path: &str,
+    text: Option<&str>,
+    set: Vec<String>,
+    point: usize,
+    stiffness: bool,
+) -> PyResult<String> {
     let sc = load(path, text, &set)?;
     let file = path.to_string();
-    let result = on_own_thread(py, move |cancel| study::certify::certify(&sc, &file, point, Some(cancel)))?;
+    let result =
+        on_own_thread(py, move |cancel| study::certify::certify_with(&sc, &file, (point, stiffness), Some(cancel)))?;
     let report = result.map_err(|e| match e {
         study::certify::CertifyRunError::Run(_) => PyException::new_err(format!("{path}: {e}")),
         _ => PyValueError::new_err(format!("{path}: {e}")),

@@ -224,7 +224,7 @@ def sensitivity(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, nam
 
 
 def certify(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml",
-            point: int = 0) -> dict:
+            point: int = 0, stiffness: bool = False) -> dict:
     """A proof, in interval arithmetic, of the settled equilibrium at point ``point`` (from 0,
     settled as ``run`` settles it): the report of ``tensegrity certify --json`` as a dict
     (``certificate``: ``residual``, ``boxes``, and ``proof`` with the largest box that holds
@@ -234,9 +234,12 @@ def certify(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: s
     ``smallest_eigenvalue_at_least_n_per_m``, ``unstable`` with ``index``, or ``unproven`` with
     ``why``); or no ``proof`` and the ``reason``). Raises ScenarioError on bad input, ValueError
     for a structure outside the proof's domain (joints, supports, inextensible or clustered
-    cables) or a motion, KeyboardInterrupt on Ctrl-C."""
+    cables) or a motion, KeyboardInterrupt on Ctrl-C. With ``stiffness``, also ``stiffness``:
+    the stiffness at the settled state over the proof's unknowns (``coordinates``, ``matrix``,
+    N/m, rotations as arcs at the structure's size), for an independent check of the
+    stability."""
     path, text = _source(scenario, name)
-    return json.loads(_call(_tensegrity.certify_json, path, text, _sets(set), point))
+    return json.loads(_call(_tensegrity.certify_json, path, text, _sets(set), point, stiffness))
 
 
 def attribute(scenario: Scenario, set: Optional[Mapping[str, Any]] = None, name: str = "<string>.toml") -> dict:

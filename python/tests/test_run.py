@@ -682,6 +682,27 @@ def test_certify_from_python_is_the_clis_certify_json():
         tt.certify(str(ROOT / "scenarios" / "custom" / "pendulum_tip_load.toml"))
 
 
+def test_the_proven_stability_agrees_with_crlins_verified_bound():
+    """The oracle: the stiffness at each settled state, exported (`stiffness=True`), is proven
+    positive definite by crlin (verified linear algebra, independent of the testbed), and the
+    certificate's lower bound on its smallest eigenvalue lies below crlin's verified upper
+    bound on it (the certificate's holds over the equilibrium's enclosure, crlin's at the
+    settled state: 1e-9 relative apart at most); on the prism, the icosahedron and the
+    catenary."""
+    import crlin
+    import numpy as np
+
+    for file in ["prism3.toml", "icosahedron6.toml", "catenary.toml"]:
+        r = tt.certify(str(ROOT / "scenarios" / "custom" / file), stiffness=True)
+        a = np.array(r["stiffness"]["matrix"])
+        assert a.shape == (len(r["stiffness"]["coordinates"]),) * 2
+        lam = crlin.spd(a)
+        assert lam > 0, file
+        lo, hi = crlin.eig_sym(a)
+        ours = r["certificate"]["proof"]["stability"]["smallest_eigenvalue_at_least_n_per_m"]
+        assert 0 < ours <= hi[0] * (1 + 1e-9), (file, ours, lo[0], hi[0])
+
+
 def rocker_from_matrices(k1=10.0, k2=30.0, a=0.8, b=0.6, L=1.0, l1=0.5, l2=0.4, m=0.5):
     """The rocker of rocker_frequency_curve.toml from numpy arrays: n1 the pin at the origin, n2
     the strut's tip drawn at pi/4, n3 the anchor U = (0, a), n4 the anchor V = (b, 0); springs

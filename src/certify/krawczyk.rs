@@ -269,3 +269,20 @@ pub fn excludes_equilibrium(problem: &Problem, radius_m: f64) -> bool {
     let (f, _) = gradient_and_hessian(problem, &x);
     f.iter().any(|c| !c.contains(0.0))
 }
+
+/// The stiffness at the settled state (q = 0) over the unknowns (the gauge's coordinate left
+/// out), coordinates scaled to m as the stability's bound is (rotations as arcs at the
+/// structure's size), symmetrized float midpoints \[N/m\]: what an independent verified
+/// eigenvalue bound can check the certificate's stability against. Each unknown's name beside.
+pub fn reduced_stiffness(problem: &Problem) -> (Vec<String>, Vec<Vec<f64>>) {
+    let n = problem.size();
+    let gauge = problem.gauge();
+    let free: Vec<usize> = (0..n).filter(|&i| Some(i) != gauge).collect();
+    let (scales, names) = (problem.scales(), problem.coordinate_names());
+    let (_, j) = gradient_and_hessian(problem, &vec![Interval::ZERO; n]);
+    let matrix = free
+        .iter()
+        .map(|&r| free.iter().map(|&c| 0.5 * (j.at(r, c).mid() + j.at(c, r).mid()) / (scales[r] * scales[c])).collect())
+        .collect();
+    (free.iter().map(|&i| names[i].clone()).collect(), matrix)
+}

@@ -23,7 +23,7 @@ pub mod inertia;
 pub mod jet;
 mod krawczyk;
 
-pub use krawczyk::{certify, excludes_equilibrium};
+pub use krawczyk::{certify, excludes_equilibrium, reduced_stiffness};
 
 /// A free body's block of coordinates: dx, dy, dz of its centre of mass \[m\], then one
 /// rotation \[rad\] per kept direction.

@@ -19,6 +19,18 @@ pub struct CertificateReport {
     pub settle_wall_s: f64,
     pub certify_wall_s: f64,
     pub certificate: Certificate,
+    /// Asked for (`tt.certify(..., stiffness=True)`): the stiffness at the settled state over
+    /// the unknowns, scaled to N/m ([`crate::certify::reduced_stiffness`]), for an independent
+    /// check of the stability.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<StiffnessExport>,
+}
+
+/// A stiffness matrix by its coordinates' names \[N/m\].
+#[derive(Clone, Debug, Serialize)]
+pub struct StiffnessExport {
+    pub coordinates: Vec<String>,
+    pub matrix: Vec<Vec<f64>>,
 }
 
 impl CertificateReport {

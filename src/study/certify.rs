@@ -43,6 +43,17 @@ pub fn certify(
     point: usize,
     cancel: Option<&AtomicBool>,
 ) -> Result<CertificateReport, CertifyRunError> {
+    certify_with(sc, file, (point, false), cancel)
+}
+
+/// [`certify`], with the stiffness at the settled state when `stiffness`
+/// ([`CertificateReport::stiffness`]).
+pub fn certify_with(
+    sc: &Scenario,
+    file: &str,
+    (point, stiffness): (usize, bool),
+    cancel: Option<&AtomicBool>,
+) -> Result<CertificateReport, CertifyRunError> {
     certifiable(sc, point)?;
     let (sc, inputs) = super::sensitivity::point_of(sc, point).ok_or(CertifyRunError::NoPoint(point))?;
     let params = sc.params_at(&inputs);
@@ -52,6 +63,10 @@ pub fn certify(
     let wall = Instant::now();
     let problem = state.sim.equilibrium_problem().map_err(CertifyRunError::Refused)?;
     let certificate = crate::certify::certify(&problem);
+    let stiffness = stiffness.then(|| {
+        let (coordinates, matrix) = crate::certify::reduced_stiffness(&problem);
+        crate::report::certificate::StiffnessExport { coordinates, matrix }
+    });
     Ok(CertificateReport {
         name: sc.name.clone(),
         file: file.to_string(),
@@ -62,5 +77,6 @@ pub fn certify(
         settle_wall_s,
         certify_wall_s: wall.elapsed().as_secs_f64(),
         certificate,
+        stiffness,
     })
 }
