@@ -48,7 +48,8 @@ struct NodeJets {
     p: [Jet; 3],
 }
 
-/// The position jets of `node` over `x`; None for a fixed node (its derivatives are zero).
+/// The position jets of `node` over `x`; for a fixed node, Err with its position (it has no
+/// derivatives).
 fn node_jets(problem: &Problem, node: &Node, x: &[Interval]) -> Result<NodeJets, [Interval; 3]> {
     let (block, arm) = match node {
         Node::Fixed(p) => return Err(p.map(Interval::point)),
