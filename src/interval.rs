@@ -198,13 +198,6 @@ impl Mul<f64> for Interval {
     }
 }
 
-impl Add<f64> for Interval {
-    type Output = Interval;
-    fn add(self, x: f64) -> Interval {
-        self + Interval::point(x)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -36,8 +36,7 @@ struct System<'a> {
 pub fn certify(problem: &Problem) -> Certificate {
     let n = problem.size();
     let (f0, _) = gradient_and_hessian(problem, &vec![Interval::ZERO; n]);
-    let gauge = problem.gauge();
-    let free: Vec<usize> = (0..n).filter(|&i| Some(i) != gauge).collect();
+    let free = problem.unknowns();
     let residual = free.iter().fold(0.0_f64, |m, &i| m.max(f0[i].mag()));
     let mut certificate = Certificate { coordinates: n, residual, proof: None, reason: None, boxes: 0 };
     if free.is_empty() {
@@ -57,7 +56,7 @@ pub fn certify(problem: &Problem) -> Certificate {
     let m = free.len();
     let yf: Vec<Interval> = (0..m).map(|i| (0..m).fold(Interval::ZERO, |s, k| s + fc[free[k]] * y[(i, k)])).collect();
     let system = System { problem, free, scales, center, y, yf };
-    search(&system, &mut certificate, &eigen, gauge.map(|g| problem.coordinate_names()[g].clone()));
+    search(&system, &mut certificate, &eigen, problem.gauge().map(|g| problem.coordinate_names()[g].clone()));
     certificate
 }
 
@@ -134,8 +133,8 @@ fn centre(problem: &Problem, free: &[usize], scales: &[f64]) -> Result<Centre, S
         (DVector::from_iterator(m, free.iter().map(|&i| f[i].mid())), jm)
     };
     let mut x = DVector::zeros(n);
-    let (_, j0) = float_at(&x);
-    let scaled = DMatrix::from_fn(m, m, |r, c| j0[(r, c)] / (scales[r] * scales[c]));
+    let mut here = float_at(&x);
+    let scaled = DMatrix::from_fn(m, m, |r, c| here.1[(r, c)] / (scales[r] * scales[c]));
     let eigen = SymmetricEigen::new(scaled).eigenvalues;
     let largest = eigen.amax();
     let smallest = eigen.iter().fold(f64::INFINITY, |a, l| a.min(l.abs()));
@@ -145,14 +144,14 @@ fn centre(problem: &Problem, free: &[usize], scales: &[f64]) -> Result<Centre, S
         ));
     }
     for _ in 0..NEWTON_STEPS {
-        let (f, j) = float_at(&x);
+        let (f, j) = here;
         let Some(dx) = j.lu().solve(&(-f)) else { return Err("the stiffness at the Newton centre is singular".into()) };
         for (k, &i) in free.iter().enumerate() {
             x[i] += dx[k];
         }
+        here = float_at(&x);
     }
-    let (_, j) = float_at(&x);
-    let y = j.try_inverse().ok_or("the stiffness at the Newton centre is singular")?;
+    let y = here.1.try_inverse().ok_or("the stiffness at the Newton centre is singular")?;
     Ok((x, y, eigen))
 }
 
@@ -275,11 +274,9 @@ pub fn excludes_equilibrium(problem: &Problem, radius_m: f64) -> bool {
 /// structure's size), symmetrized float midpoints \[N/m\]: what an independent verified
 /// eigenvalue bound can check the certificate's stability against. Each unknown's name beside.
 pub fn reduced_stiffness(problem: &Problem) -> (Vec<String>, Vec<Vec<f64>>) {
-    let n = problem.size();
-    let gauge = problem.gauge();
-    let free: Vec<usize> = (0..n).filter(|&i| Some(i) != gauge).collect();
+    let free = problem.unknowns();
     let (scales, names) = (problem.scales(), problem.coordinate_names());
-    let (_, j) = gradient_and_hessian(problem, &vec![Interval::ZERO; n]);
+    let (_, j) = gradient_and_hessian(problem, &vec![Interval::ZERO; problem.size()]);
     let matrix = free
         .iter()
         .map(|&r| free.iter().map(|&c| 0.5 * (j.at(r, c).mid() + j.at(c, r).mid()) / (scales[r] * scales[c])).collect())

@@ -39,6 +39,12 @@ pub struct Block {
 }
 
 impl Problem {
+    /// The proof's unknowns: every coordinate but the gauge's ([`Problem::gauge`]).
+    pub fn unknowns(&self) -> Vec<usize> {
+        let gauge = self.gauge();
+        (0..self.size()).filter(|&i| Some(i) != gauge).collect()
+    }
+
     /// The coordinate held by the gauge of [`Problem::turn_axis`]: the translation that the
     /// turn moves most (its rate along the turn, u x (c - a), largest in magnitude).
     pub fn gauge(&self) -> Option<usize> {

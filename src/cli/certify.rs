@@ -25,3 +25,10 @@ pub fn certify(
     super::print_report(&report.to_table(), json.is_some_and(super::is_stdio), json, &report)?;
     Ok(Outcome::from_passed(report.settled && report.proven()))
 }
+
+/// Refuses (exit 2, naming `--certify` and the file) a scenario whose settle points cannot be
+/// certified (`study::certify::certifiable`: a motion, a structure outside the proof's domain),
+/// before anything runs: `run` and `sweep` with `--certify` or a file's `[certify]`.
+pub(super) fn refuse_uncertifiable(sc: &crate::scenario::Scenario, path: &Path) -> Result<(), CliError> {
+    crate::study::certify::certifiable(sc, 0).map_err(|e| bad_input(format!("--certify: {}: {e}", path.display())))
+}

@@ -79,10 +79,7 @@ pub fn run(
     }
     check_outputs(paths, &o.files(&scenarios))?;
     for (sc, path) in scenarios.iter().zip(paths).filter(|(sc, _)| o.certify || sc.certify) {
-        {
-            crate::study::certify::certifiable(sc, 0)
-                .map_err(|e| super::bad_input(format!("--certify: {}: {e}", path.display())))?;
-        }
+        super::certify::refuse_uncertifiable(sc, path)?;
     }
     // From here on each run stops at its next tick on a signal and the reports are written.
     signals::stops_itself_from_now();

@@ -15,11 +15,8 @@ pub struct Outputs {
     pub certify: bool,
 }
 
-/// Refuses outputs that mean nothing or would destroy data, before any work: a figure that is no
-/// .png or .svg, an output over the scenario, and the CSV and the JSON both on standard output
 /// The scenario, every point certified with `--certify`; refused (exit 2) where its points
-/// cannot be (a motion, a structure outside the proof's domain), with the flag or the file's
-/// `[certify]`.
+/// cannot be (`certify::refuse_uncertifiable`), with the flag or the file's `[certify]`.
 fn certified_or_not(
     sc: crate::scenario::Scenario,
     path: &Path,
@@ -27,12 +24,13 @@ fn certified_or_not(
 ) -> Result<crate::scenario::Scenario, CliError> {
     let sc = if flag { sc.certified() } else { sc };
     if sc.certify {
-        crate::study::certify::certifiable(&sc, 0)
-            .map_err(|e| super::bad_input(format!("--certify: {}: {e}", path.display())))?;
+        super::certify::refuse_uncertifiable(&sc, path)?;
     }
     Ok(sc)
 }
 
+/// Refuses outputs that mean nothing or would destroy data, before any work: a figure that is no
+/// .png or .svg, an output over the scenario, and the CSV and the JSON both on standard output
 /// (mixed, neither could be read).
 fn check_sweep_outputs(path: &Path, o: &Outputs) -> Result<(), CliError> {
     if let Some(f) =

@@ -441,6 +441,15 @@ impl Recorder {
         Ok(Some(Recorder::new(rec, Target::Live { url }, every)))
     }
 
+    /// The simulated time of `tick` \[s\]: the last tick seen's, or the start's.
+    fn time_of(&self, tick: u64) -> f64 {
+        if tick == self.last_tick {
+            self.last_time_s
+        } else {
+            0.0
+        }
+    }
+
     /// Stores a text document (static: it belongs to the whole run).
     pub fn document(&mut self, entity: &str, text: &str) {
         let _ = self.rec.log_static(entity, &rerun::TextDocument::new(text));
@@ -699,7 +708,7 @@ impl Observer for Recorder {
     fn note(&mut self, tick: u64, note: &Note) {
         match note {
             Note::Event(text) => {
-                let time_s = if tick == self.last_tick { self.last_time_s } else { 0.0 };
+                let time_s = self.time_of(tick);
                 self.columns.events.push_text(tick, time_s, text);
             }
             Note::Scalar(entity, value) => self.scalar(tick, entity, *value),
@@ -717,7 +726,7 @@ impl Observer for Recorder {
         let tick = p.snapshot.tick;
         self.note(tick, &Note::Event(format!("point {}: {}", point.index, c.summary())));
         if let Some(proof) = &c.proof {
-            let time_s = if tick == self.last_tick { self.last_time_s } else { 0.0 };
+            let time_s = self.time_of(tick);
             self.scalars_at(tick, time_s, "certificate/radius_m", &[proof.radius_m]);
             self.scalars_at(tick, time_s, "certificate/settled_offset_m", &[proof.settled_offset_m]);
         }

@@ -166,8 +166,7 @@ pub(crate) fn linearize(
     if let EquilibriumCoordinates::Bodies(bodies) = coordinates {
         if bodies.len() > DENSE_MODAL_MAX_FREE_BODIES {
             let refused = |e| SensitivityRunError::Refused(SensitivityError::Modes(e));
-            let sparse = sim.sparse_linearization(bodies, FREQUENCIES_LISTED).map_err(refused)?;
-            let (modes, rigid) = (sparse.modes.clone(), sparse.rigid.clone());
+            let (modes, rigid, sparse) = sim.sparse_linearization(bodies, FREQUENCIES_LISTED).map_err(refused)?;
             let stiffness = Stiffness::Sparse(Box::new(sparse));
             return Ok(Linearization { stiffness, jacobian: DMatrix::zeros(0, 0), modes, rigid, left_out: 0 });
         }

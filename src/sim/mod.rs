@@ -372,7 +372,7 @@ impl Simulation {
         &mut self,
         bodies: &[usize],
         count: usize,
-    ) -> Result<sparse_sensitivity::SparseLinearization, modes::ModesError> {
+    ) -> Result<sparse_sensitivity::SparseModes, modes::ModesError> {
         self.data.sparse_linearization(&self.model, bodies, count)
     }
 

@@ -18,11 +18,12 @@ use super::sensitivity::{derivative_from_samples, EquilibriumCoordinates};
 use crate::eigen::Mode;
 use nalgebra::{DVector, Matrix6};
 
-/// The linearization of a large structure of free bodies: its lowest modes (in the
-/// coordinates' order, mass-normalised) with which are rigid, and K^+ r.
+/// The lowest modes of a large structure of free bodies (in the coordinates' order,
+/// mass-normalised), which of them are rigid, and K^+ r (`SparseLinearization`).
+pub type SparseModes = (Vec<Mode>, Vec<bool>, SparseLinearization);
+
+/// K^+ r of a large structure of free bodies, in its coordinates' order.
 pub struct SparseLinearization {
-    pub modes: Vec<Mode>,
-    pub rigid: Vec<bool>,
     solve: ModalSolve,
     /// For each block of the modal analysis, the coordinates' block (the bodies' order).
     order: Vec<usize>,
@@ -66,7 +67,7 @@ impl Data {
         m: &Model,
         bodies: &[usize],
         count: usize,
-    ) -> Result<SparseLinearization, ModesError> {
+    ) -> Result<SparseModes, ModesError> {
         let analysis = self.modes(m, None, Solver::BySize(Lowest { count, through: None }))?;
         let order: Vec<usize> = analysis
             .bodies
@@ -82,7 +83,7 @@ impl Data {
         let modes =
             known.iter().map(|(w2, x, _)| Mode { omega_squared: *w2, shape: to_coordinates(&order, x) }).collect();
         let rigid = known.iter().map(|(_, _, rigid)| *rigid).collect();
-        Ok(SparseLinearization { modes, rigid, solve, order })
+        Ok((modes, rigid, SparseLinearization { solve, order }))
     }
 
     /// phi^T (K - omega^2 M) phi in free bodies' coordinates `c` now: phi^T K phi =

@@ -93,7 +93,7 @@ impl Data {
         let weighted = weighted_stiffness(&dofs, &system, mass)?;
         let n = weighted.matrix.nrows();
         let largest = largest_magnitude(&weighted.matrix, cancel)?;
-        let factors: Vec<Matrix6<f64>> = weighted.inverse_factor.iter().map(|l| l.try_inverse().unwrap()).collect();
+        let factors = weighted.factors();
         let weigh = |i: usize, u: &Vector3<f64>, w: &Vector3<f64>| {
             factors[i].transpose() * Vector6::new(u.x, u.y, u.z, w.x, w.y, w.z)
         };
@@ -136,6 +136,11 @@ impl Data {
 }
 
 impl Weighted {
+    /// L of each block's mass, in block order (the inverse of `inverse_factor`).
+    pub(super) fn factors(&self) -> Vec<Matrix6<f64>> {
+        self.inverse_factor.iter().map(|l| l.try_inverse().expect("a Cholesky factor's inverse")).collect()
+    }
+
     /// x = L^-T y in block order.
     pub(super) fn shape(&self, y: &DVector<f64>) -> DVector<f64> {
         let mut x = DVector::zeros(y.len());

@@ -54,8 +54,7 @@ impl Data {
         let weighted = weighted_stiffness(&dofs, &system, mass)?;
         let largest = largest_magnitude(&weighted.matrix, None)?;
         let factor = shifted_factor(&weighted, largest)?;
-        let mass_factor: Vec<Matrix6<f64>> =
-            weighted.inverse_factor.iter().map(|l| l.try_inverse().expect("a Cholesky factor's inverse")).collect();
+        let mass_factor = weighted.factors();
         let mut solve = ModalSolve { weighted, factor, mass_factor, known: Vec::new() };
         solve.known = known.iter().map(|(w2, x, rigid)| (*w2, x.clone(), solve.weigh_shape(x), *rigid)).collect();
         Ok(solve)
